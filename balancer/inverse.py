@@ -1,0 +1,402 @@
+"""Inverse dynamics of the four-bar with a prescribed crank motion, by two independent routes.
+
+Given the crank's motion (θ1, θ̇1, θ̈1), find what the linkage does to its frame: the ground
+reactions R̄A0 and R̄A3 (forces of the mechanism **on** the ground), the driving torque of a motor
+on the ground that imposes the crank's motion, the shaking force ``R̄A0 + R̄A3`` and the shaking
+moment about A0 (everything the mechanism exerts on the ground, the motor's reaction torque and
+the counter-rotors' gear reactions included).
+
+Routes:
+
+``"newton-euler"``
+    Free-body equations of each link, solved in closed form (rocker and coupler moment equations
+    for the coupler–rocker pin force, then force balances down the chain).
+``"mass-matrix"``
+    Meijaard & van der Wijk's constant equivalent mass matrices (Eq. 45–54): nodal inertia and
+    load forces ``G = F − M·r̈`` at A0…A3, then virtual displacements that respect the link
+    lengths — a rotation of the crank for the driving torque (Eq. 47, 50), a translation of the
+    whole for the shaking force (Eq. 59), a displacement of A3 for R̄A3 (Eq. 52), a rotation of
+    the whole about A0 for the shaking moment (Sect. 5.2).
+
+Counter-rotors: a counter-rotor of inertia J on link k's ground pivot, geared through a train
+whose housing is the ground, acts on the link as extra inertia (``(Ik + J)·αk``) and puts a
+reaction moment ``2·J·αk`` on the ground; its angular momentum is ``−J·ωk``.
+
+Everything is vectorised over the states of a :class:`~balancer.kinematics.Motion`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .errors import AssemblyError
+from .kinematics import Motion, assembly_range, cross, motion_of
+from .massmodels import (
+    equivalent_inertia_forces,
+    equivalent_joint_forces,
+    inertial_parameters,
+)
+from .model import FourBar, Link
+
+Route = Literal["newton-euler", "mass-matrix"]
+ROUTES: tuple[Route, ...] = ("newton-euler", "mass-matrix")
+
+
+@dataclass(frozen=True)
+class Reactions:
+    """What the linkage exerts on its frame at each state.
+
+    Attributes
+    ----------
+    RA0, RA3
+        Forces of the mechanism on the ground at A0 and A3, complex ``x + i·y``, N.
+    driving_torque
+        Torque of the motor on the crank, N·m (its reaction on the ground is the opposite).
+    shaking_moment
+        Moment about A0 of everything the mechanism exerts on the ground, N·m.
+    """
+
+    RA0: NDArray[np.complex128]
+    RA3: NDArray[np.complex128]
+    driving_torque: NDArray[np.float64]
+    shaking_moment: NDArray[np.float64]
+
+    @property
+    def shaking_force(self) -> NDArray[np.complex128]:
+        """``R̄A0 + R̄A3``, N."""
+        return self.RA0 + self.RA3
+
+
+def dynamic_link(link: Link) -> Link:
+    """The link as the equations of motion see it: counter-rotor inertia added to ``I``."""
+    if link.counter_rotor == 0.0:
+        return link
+    return Link(
+        mass=link.mass,
+        inertia=link.inertia + link.counter_rotor,
+        e=link.e,
+        f=link.f,
+        force=link.force,
+        moment=link.moment,
+    )
+
+
+def link_com_kinematics(
+    linkage: FourBar, mo: Motion
+) -> tuple[tuple[NDArray[np.complex128], ...], tuple[NDArray[np.complex128], ...]]:
+    """Positions and accelerations of the three links' centres of mass, m and m/s².
+
+    ``r̄k = r̄p + s̄k·l̄k/lk`` and ``r̈k = r̈p + (i·αk − ωk²)·s̄k·l̄k/lk``.
+    """
+    l1, l2, l3, _ = linkage.lengths
+    zeta = [link.com / length for link, length in zip(linkage.links, (l1, l2, l3), strict=True)]
+    acc_a1, acc_a2 = mo.joint_accelerations
+    joint_pos = (0.0, mo.pos.A1, mo.pos.A2)
+    joint_acc = (0.0, acc_a1, acc_a2)
+    pos = tuple(joint_pos[k] + zeta[k] * mo.vectors[k] for k in range(3))
+    acc = tuple(joint_acc[k] + zeta[k] * mo.vector_acceleration(k) for k in range(3))
+    return pos, acc
+
+
+def _applied_forces(linkage: FourBar, gravity: complex, loads: bool) -> list[complex]:
+    """Constant applied force on each link at its centre of mass (load plus weight), N."""
+    return [
+        (link.force_complex if loads else 0j) + link.mass * gravity for link in linkage.links
+    ]
+
+
+def _counter_rotor_moment(linkage: FourBar, mo: Motion) -> NDArray[np.float64] | float:
+    """Reaction moment of the counter-rotors' gear trains on the ground, ``2·Σ Jk·αk``, N·m."""
+    total: NDArray[np.float64] | float = 0.0
+    for k, link in enumerate(linkage.links):
+        if link.counter_rotor:
+            total = total + 2.0 * link.counter_rotor * mo.alpha[k]
+    return total
+
+
+def newton_euler(
+    linkage: FourBar,
+    mo: Motion,
+    *,
+    gravity: tuple[float, float] = (0.0, 0.0),
+    loads: bool = True,
+) -> Reactions:
+    """Reactions, driving torque and shaking moment from the links' free-body equations.
+
+    Pin forces: ``P̄0`` ground on crank at A0, ``P̄1`` crank on coupler at A1, ``P̄2`` coupler on
+    rocker at A2, ``P̄3`` ground on rocker at A3. The coupler's moment equation about A1 and the
+    rocker's about A3 give ``P̄2 = (c2·l̄3 + c3·l̄2)/(l̄2 × l̄3)``; the force balances then give
+    ``P̄3``, ``P̄1``, ``P̄0``, and the crank's moment equation about A0 the driving torque.
+
+    Parameters
+    ----------
+    linkage
+        The four-bar.
+    mo
+        Its motion (the crank's acceleration is imposed by the motor).
+    gravity
+        Gravitational acceleration ``(gx, gy)``, m/s².
+    loads
+        Include the links' applied forces and moments.
+    """
+    dyn = [dynamic_link(link) for link in linkage.links]
+    g = complex(*gravity)
+    f1, f2, f3 = _applied_forces(linkage, g, loads)
+    mom1, mom2, mom3 = (link.moment if loads else 0.0 for link in linkage.links)
+    mass = [link.mass for link in linkage.links]
+    (r1, r2, r3), (a1, a2, a3) = link_com_kinematics(linkage, mo)
+    v1, v2, v3 = mo.vectors
+    al1, al2, al3 = mo.alpha
+    a3_pos = complex(linkage.lengths[3], 0.0)
+    # Net force each link needs beyond its applied force: m·a − F.
+    need1 = mass[0] * a1 - f1
+    need2 = mass[1] * a2 - f2
+    need3 = mass[2] * a3 - f3
+    c2 = -cross(r2 - mo.pos.A1, need2) + mom2 - dyn[1].inertia * al2
+    c3 = dyn[2].inertia * al3 + cross(r3 - a3_pos, need3) - mom3
+    p2 = (c2 * v3 + c3 * v2) / cross(v2, v3)
+    p3 = need3 - p2
+    p1 = need2 + p2
+    p0 = need1 + p1
+    tau = dyn[0].inertia * al1 + cross(r1, need1) + cross(v1, p1) - mom1
+    ra0 = -p0
+    ra3 = -p3
+    moment = cross(a3_pos, ra3) - tau + _counter_rotor_moment(linkage, mo)
+    return Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
+
+
+def mass_matrix(
+    linkage: FourBar,
+    mo: Motion,
+    *,
+    gravity: tuple[float, float] = (0.0, 0.0),
+    loads: bool = True,
+) -> Reactions:
+    """Reactions, driving torque and shaking moment from the equivalent mass matrices (Eq. 45–54).
+
+    The nodal forces ``G_n = F_n − (M·r̈)_n`` at the joints A0…A3 (Eq. 45–46, 48–49, 53–54)
+    are combined by virtual displacements that keep the link lengths: rotating the crank
+    (``δr̄A1 = i·l̄1``, ``δr̄A2 = −i·l̄3·Θ3``; Eq. 47, 50) gives the driving torque; translating
+    everything gives the shaking force (Eq. 59); moving A3 with A0 and A1 held gives
+    ``R̄A3 = G_A3 + l̄3·(l̄2 × G_A2)/(l̄2 × l̄3)`` (Eq. 52 with the lengths kept); rotating
+    everything about A0 gives the shaking moment ``Σ r̄n × G_n`` (Sect. 5.2).
+
+    Parameters are as for :func:`newton_euler`.
+    """
+    g = complex(*gravity)
+    forces = _applied_forces(linkage, g, loads)
+    l1, l2, l3, l4 = linkage.lengths
+    lengths = (l1, l2, l3)
+    v1, v2, v3 = mo.vectors
+    acc_a1, acc_a2 = mo.joint_accelerations
+    node_acc = (0.0, acc_a1, acc_a2, 0.0)
+    vectors = (v1, v2, v3)
+    nodes: list = [0j, 0j, 0j, 0j]
+    for k, link in enumerate(linkage.links):
+        p, q = k, k + 1
+        loaded = Link(
+            mass=link.mass,
+            inertia=link.inertia,
+            e=link.e,
+            f=link.f,
+            force=(forces[k].real, forces[k].imag),
+            moment=link.moment if loads else 0.0,
+        )
+        fp, fq = equivalent_joint_forces(loaded, lengths[k], vectors[k])
+        ip, iq = equivalent_inertia_forces(
+            inertial_parameters(dynamic_link(link)), lengths[k], node_acc[p], node_acc[q]
+        )
+        nodes[p] = nodes[p] + fp - ip
+        nodes[q] = nodes[q] + fq - iq
+    g0, g1, g2, g3 = nodes
+    big3 = mo.transfer[1]
+    # Crank rotation δθ1 = 1: δA1 = i·l̄1, δA2 = −i·l̄3·Θ3;  ⟨i·x, G⟩ = x × G.
+    tau = -(cross(v1, g1) - big3 * cross(v3, g2))
+    shaking = g0 + g1 + g2 + g3
+    ra3 = g3 + v3 * cross(v2, g2) / cross(v2, v3)
+    ra0 = shaking - ra3
+    a2_pos = mo.pos.A2
+    moment = cross(v1, g1) + cross(a2_pos, g2) + cross(complex(l4, 0.0), g3)
+    moment = moment + _counter_rotor_moment(linkage, mo)
+    return Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
+
+
+_ROUTE_FUNCTIONS = {"newton-euler": newton_euler, "mass-matrix": mass_matrix}
+
+
+def inverse_dynamics(
+    linkage: FourBar,
+    mo: Motion,
+    *,
+    route: Route = "newton-euler",
+    gravity: tuple[float, float] = (0.0, 0.0),
+    loads: bool = True,
+) -> Reactions:
+    """Reactions of the four-bar for a prescribed motion by the chosen ``route``."""
+    try:
+        fn = _ROUTE_FUNCTIONS[route]
+    except KeyError:
+        raise ValueError(f"unknown route {route!r}; choose from {ROUTES}") from None
+    return fn(linkage, mo, gravity=gravity, loads=loads)
+
+
+def angular_momentum(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
+    """Angular momentum of the moving parts about A0, counter-rotors included, kg·m²/s.
+
+    ``H = Σ (Ik·ωk + mk·r̄k × ṙk) − Σ Jk·ωk``; the shaking moment without loads equals ``−dH/dt``.
+    """
+    l1, l2, l3, _ = linkage.lengths
+    vel_a1, vel_a2 = mo.joint_velocities
+    joint_pos = (0.0, mo.pos.A1, mo.pos.A2)
+    joint_vel = (0.0, vel_a1, vel_a2)
+    total = 0.0
+    for k, (link, length) in enumerate(zip(linkage.links, (l1, l2, l3), strict=True)):
+        zeta = link.com / length
+        r = joint_pos[k] + zeta * mo.vectors[k]
+        v = joint_vel[k] + zeta * mo.vector_rate(k)
+        total = total + (link.inertia - link.counter_rotor) * mo.omega[k] + link.mass * cross(r, v)
+    return total
+
+
+def kinetic_energy(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
+    """Kinetic energy of the moving parts, counter-rotors included, J."""
+    l1, l2, l3, _ = linkage.lengths
+    vel_a1, vel_a2 = mo.joint_velocities
+    joint_vel = (0.0, vel_a1, vel_a2)
+    total = 0.0
+    for k, (link, length) in enumerate(zip(linkage.links, (l1, l2, l3), strict=True)):
+        v = joint_vel[k] + link.com / length * mo.vector_rate(k)
+        total = total + 0.5 * (
+            link.mass * np.abs(v) ** 2 + (link.inertia + link.counter_rotor) * mo.omega[k] ** 2
+        )
+    return total
+
+
+@dataclass(frozen=True)
+class Figure:
+    """RMS and maximum magnitude of a quantity over the samples of a cycle (same unit)."""
+
+    rms: float
+    max: float
+
+    @classmethod
+    def of(cls, values: NDArray) -> Figure:
+        """Figures of an array of real or complex values (complex: vector magnitudes)."""
+        mag2 = np.abs(values) ** 2
+        return cls(rms=float(np.sqrt(np.mean(mag2))), max=float(np.sqrt(np.max(mag2))))
+
+    def as_dict(self) -> dict[str, float]:
+        """``{"rms": …, "max": …}``."""
+        return {"rms": self.rms, "max": self.max}
+
+
+@dataclass(frozen=True)
+class CycleSummary:
+    """The figures of a cycle analysis (see :class:`CycleAnalysis`)."""
+
+    shaking_force: Figure
+    shaking_moment: Figure
+    driving_torque: Figure
+    RA0: Figure
+    RA3: Figure
+
+    def as_dict(self) -> dict[str, dict[str, float]]:
+        """Plain dictionary with the fixed JSON names."""
+        return {
+            "shaking_force": self.shaking_force.as_dict(),
+            "shaking_moment": self.shaking_moment.as_dict(),
+            "driving_torque": self.driving_torque.as_dict(),
+        }
+
+
+@dataclass(frozen=True)
+class CycleAnalysis:
+    """One crank revolution at constant speed: what the linkage does to its frame.
+
+    Attributes
+    ----------
+    linkage
+        The analysed four-bar.
+    speed
+        Crank speed, rad/s.
+    motion
+        Kinematics at the sampled crank angles ``θ1 = 2π·j/N``.
+    reactions
+        Ground reactions, driving torque and shaking moment at those angles.
+    route
+        The inverse-dynamics route used.
+    """
+
+    linkage: FourBar
+    speed: float
+    motion: Motion
+    reactions: Reactions
+    route: str
+    summary: CycleSummary = field(init=False)
+
+    def __post_init__(self) -> None:
+        r = self.reactions
+        object.__setattr__(
+            self,
+            "summary",
+            CycleSummary(
+                shaking_force=Figure.of(r.shaking_force),
+                shaking_moment=Figure.of(r.shaking_moment),
+                driving_torque=Figure.of(r.driving_torque),
+                RA0=Figure.of(r.RA0),
+                RA3=Figure.of(r.RA3),
+            ),
+        )
+
+    @property
+    def theta1(self) -> NDArray[np.float64]:
+        """Sampled crank angles, rad."""
+        return self.motion.pos.theta1
+
+    @property
+    def time(self) -> NDArray[np.float64]:
+        """Time at each sample from θ1 = 0, s."""
+        return self.theta1 / self.speed
+
+
+def sample_angles(samples: int) -> NDArray[np.float64]:
+    """``samples`` equally spaced crank angles over one revolution from 0, rad."""
+    return np.arange(samples) * (2 * np.pi / samples)
+
+
+def cycle_analysis(
+    linkage: FourBar,
+    speed: float,
+    samples: int = 360,
+    *,
+    route: Route = "newton-euler",
+    loads: bool = True,
+    theta1: NDArray[np.float64] | None = None,
+) -> CycleAnalysis:
+    """Analyse one crank revolution at constant ``speed`` (rad/s) over ``samples`` angles.
+
+    Gravity is not part of a cycle analysis (it belongs to ``[simulation]``); loads are, unless
+    ``loads`` is false.
+
+    Raises
+    ------
+    AssemblyError
+        If the crank cannot turn a full revolution.
+    """
+    rng = assembly_range(linkage.lengths)
+    if not rng.full:
+        raise AssemblyError(
+            "a cycle analysis needs a crank that turns a full revolution, but this linkage "
+            f"assembles only for θ1 in {rng.describe()}",
+            key="mechanism.lengths",
+        )
+    angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
+    mo = motion_of(linkage, angles, speed, 0.0)
+    reactions = inverse_dynamics(linkage, mo, route=route, loads=loads)
+    return CycleAnalysis(
+        linkage=linkage, speed=speed, motion=mo, reactions=reactions, route=route
+    )

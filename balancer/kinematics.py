@@ -1,0 +1,486 @@
+"""Kinematics of the 4R four-bar, vectorised over arrays of crank angles.
+
+Implements Meijaard & van der Wijk (2020), Sect. 2: dependent angles for either assembly
+(Eq. 2–4), first-order transfer functions and angular velocities (Eq. 5–7), angular
+accelerations (Eq. 8–10) and the θ2-free form of the coupler's rate and acceleration (Eq. 11),
+which serves as a cross-check. Also the Grashof classification and the crank angles at which the
+linkage can be assembled.
+
+Vectors in the plane are complex numbers, as in the paper: ``l̄k = lk·exp(iθk)``. Two helpers
+give the scalar and the cross product of such vectors: ``inner(x, y) = Re(x*·y)`` (the paper's
+``⟨x̄, ȳ⟩``) and ``cross(x, y) = Im(x*·y)``, the z-component of ``x × y``; note
+``⟨x̄, iȳ⟩ = −cross(x, y)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import StrEnum
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import AssemblyError
+from .model import FourBar
+
+#: Relative tolerance within which a position at a triangle-inequality bound counts as reached
+#: (rounding) rather than outside the assembly range.
+BOUND_TOLERANCE = 1e-12
+#: |sin(θ3 − θ2)| below which a position is flagged as (near) a dead or change point.
+SINGULAR_TOLERANCE = 1e-6
+
+Lengths = tuple[float, float, float, float]
+
+
+def inner(x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
+    """Scalar product ``⟨x̄, ȳ⟩ = Re(x*·y)`` of plane vectors given as complex numbers."""
+    x = np.asarray(x)
+    y = np.asarray(y)
+    return x.real * y.real + x.imag * y.imag
+
+
+def cross(x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
+    """Z-component of ``x × y`` for plane vectors given as complex numbers (``Im(x*·y)``)."""
+    x = np.asarray(x)
+    y = np.asarray(y)
+    return x.real * y.imag - x.imag * y.real
+
+
+class LinkageClass(StrEnum):
+    """Grashof classification of a four-bar (which links can turn fully)."""
+
+    CRANK_ROCKER = "crank-rocker"
+    """Grashof, crank shortest: the crank turns fully, the rocker oscillates."""
+    DOUBLE_CRANK = "double-crank"
+    """Grashof, frame shortest: crank and rocker both turn fully (drag link)."""
+    ROCKER_CRANK = "rocker-crank"
+    """Grashof, rocker shortest: the rocker turns fully, the crank only oscillates."""
+    DOUBLE_ROCKER = "double-rocker"
+    """Grashof, coupler shortest: the coupler turns fully, crank and rocker oscillate."""
+    TRIPLE_ROCKER = "triple-rocker"
+    """Non-Grashof: no link turns fully relative to the frame."""
+    CHANGE_POINT = "change-point"
+    """s + l = p + q: all joints become collinear and the assembly can switch (parallelogram,
+    deltoid)."""
+
+
+def classify(lengths: Lengths, rtol: float = BOUND_TOLERANCE) -> LinkageClass:
+    """Grashof classification of a four-bar with lengths ``(l1, l2, l3, l4)``.
+
+    Grashof's condition ``s + l ≤ p + q`` (shortest plus longest at most the sum of the other
+    two); equality within ``rtol`` of the perimeter is a change-point linkage.
+    """
+    ordered = sorted(lengths)
+    s, p, q, long_ = ordered
+    slack = (p + q) - (s + long_)
+    if abs(slack) <= rtol * sum(lengths):
+        return LinkageClass.CHANGE_POINT
+    if slack < 0:
+        return LinkageClass.TRIPLE_ROCKER
+    shortest = int(np.argmin(lengths))
+    return (
+        LinkageClass.CRANK_ROCKER,
+        LinkageClass.DOUBLE_ROCKER,
+        LinkageClass.ROCKER_CRANK,
+        LinkageClass.DOUBLE_CRANK,
+    )[shortest]
+
+
+@dataclass(frozen=True)
+class AssemblyRange:
+    """The crank angles at which the linkage can be assembled.
+
+    Attributes
+    ----------
+    intervals
+        Closed intervals ``(start, end)`` of θ1 in rad, ``start < end``, within
+        ``[-π, 2π]``; empty if the linkage cannot be assembled at all.
+    full
+        Whether the crank can turn a full revolution.
+    """
+
+    intervals: tuple[tuple[float, float], ...]
+    full: bool
+
+    @property
+    def empty(self) -> bool:
+        """Whether no crank angle assembles."""
+        return not self.intervals
+
+    def contains(self, theta1: ArrayLike, atol: float = 1e-12) -> NDArray[np.bool_]:
+        """Whether each crank angle (rad) lies in the range."""
+        t = np.asarray(theta1, dtype=float)
+        if self.full:
+            return np.ones(t.shape, dtype=bool)
+        inside = np.zeros(t.shape, dtype=bool)
+        for a, b in self.intervals:
+            # Bring the angle into [a, a + 2π).
+            w = a + np.mod(t - a, 2 * math.pi)
+            inside |= (w <= b + atol) | (w >= a + 2 * math.pi - atol)
+        return inside
+
+    def describe(self) -> str:
+        """Human-readable form, in degrees."""
+        if self.full:
+            return "full revolution"
+        if self.empty:
+            return "none"
+        return ", ".join(f"[{math.degrees(a):.4g}°, {math.degrees(b):.4g}°]" for a, b in self.intervals)
+
+
+def cosine_bounds(lengths: Lengths) -> tuple[float, float]:
+    """Bounds ``(c_lo, c_hi)`` on cos θ1 for assembly (from Eq. 2 and the triangle inequalities).
+
+    ``|l2 − l3| ≤ l23 ≤ l2 + l3`` with ``l23² = l1² + l4² − 2·l1·l4·cos θ1`` gives
+    ``c_lo ≤ cos θ1 ≤ c_hi``.
+    """
+    l1, l2, l3, l4 = lengths
+    base = l1 * l1 + l4 * l4
+    c_lo = (base - (l2 + l3) ** 2) / (2 * l1 * l4)
+    c_hi = (base - (l2 - l3) ** 2) / (2 * l1 * l4)
+    return c_lo, c_hi
+
+
+def assembly_range(lengths: Lengths, rtol: float = BOUND_TOLERANCE) -> AssemblyRange:
+    """Crank angles at which a four-bar with lengths ``(l1, l2, l3, l4)`` assembles."""
+    c_lo, c_hi = cosine_bounds(lengths)
+    tol = rtol * 4  # the bounds are O(1) numbers; allow a few roundings
+    if c_lo > 1 + tol or c_hi < -1 - tol or c_lo > c_hi:
+        return AssemblyRange(intervals=(), full=False)
+    lo_free = c_lo <= -1 + tol  # no upper bound on l23 binds
+    hi_free = c_hi >= 1 - tol  # no lower bound on l23 binds
+    if lo_free and hi_free:
+        return AssemblyRange(intervals=((-math.pi, math.pi),), full=True)
+    a_lo = math.acos(min(1.0, max(-1.0, c_lo)))  # cos θ1 ≥ c_lo  ⇔  |θ1| ≤ a_lo
+    a_hi = math.acos(min(1.0, max(-1.0, c_hi)))  # cos θ1 ≤ c_hi  ⇔  |θ1| ≥ a_hi
+    if hi_free:
+        return AssemblyRange(intervals=((-a_lo, a_lo),), full=False)
+    if lo_free:
+        return AssemblyRange(intervals=((a_hi, 2 * math.pi - a_hi),), full=False)
+    return AssemblyRange(intervals=((-a_lo, -a_hi), (a_hi, a_lo)), full=False)
+
+
+def crank_turns_fully(lengths: Lengths) -> bool:
+    """Whether the crank can turn a full revolution."""
+    return assembly_range(lengths).full
+
+
+def _sign(branch: str) -> float:
+    if branch == "+":
+        return 1.0
+    if branch == "-":
+        return -1.0
+    raise ValueError(f"branch must be '+' or '-', got {branch!r}")
+
+
+@dataclass(frozen=True)
+class Position:
+    """Configuration of a four-bar at an array of crank angles (Eq. 2–4).
+
+    Attributes
+    ----------
+    lengths
+        ``(l1, l2, l3, l4)``, m.
+    theta1
+        Crank angles, rad, shape ``(N,)``.
+    l1, l2, l3
+        Link vectors ``l̄k = lk·exp(iθk)`` as complex arrays, m.
+    singular
+        Flag for positions at or near a dead or change point (|sin(θ3 − θ2)| <
+        :data:`SINGULAR_TOLERANCE`), where the dependent rates are ill-determined.
+    """
+
+    lengths: Lengths
+    theta1: NDArray[np.float64]
+    l1: NDArray[np.complex128]
+    l2: NDArray[np.complex128]
+    l3: NDArray[np.complex128]
+    singular: NDArray[np.bool_]
+
+    @property
+    def A1(self) -> NDArray[np.complex128]:
+        """Position of joint A1 (crank–coupler), m."""
+        return self.l1
+
+    @cached_property
+    def A2(self) -> NDArray[np.complex128]:
+        """Position of joint A2 (coupler–rocker), m."""
+        return self.l1 + self.l2
+
+    @property
+    def A3(self) -> complex:
+        """Position of the ground pivot A3, m."""
+        return complex(self.lengths[3], 0.0)
+
+    @cached_property
+    def theta2(self) -> NDArray[np.float64]:
+        """Coupler angle θ2, rad in (−π, π]."""
+        return np.angle(self.l2)
+
+    @cached_property
+    def theta3(self) -> NDArray[np.float64]:
+        """Rocker angle θ3 (direction A2→A3), rad in (−π, π]."""
+        return np.angle(self.l3)
+
+    @cached_property
+    def sin_transmission(self) -> NDArray[np.float64]:
+        """``sin(θ3 − θ2)``: zero at dead and change points."""
+        return cross(self.l2, self.l3) / (self.lengths[1] * self.lengths[2])
+
+    @cached_property
+    def branch_sign(self) -> NDArray[np.float64]:
+        """+1 where A2 is to the left of the directed line A1→A3, −1 to its right, 0 on it."""
+        l23 = self.l2 + self.l3
+        return np.sign(cross(l23, self.l2))
+
+
+def _as_1d(x: ArrayLike) -> NDArray[np.float64]:
+    a = np.asarray(x, dtype=float)
+    return a.reshape(-1) if a.ndim else a.reshape(1)
+
+
+def position(
+    lengths: Lengths,
+    theta1: ArrayLike,
+    branch: str | ArrayLike = "+",
+    *,
+    check: bool = True,
+) -> Position:
+    """Dependent link vectors at crank angles ``theta1`` (Eq. 2–4).
+
+    Parameters
+    ----------
+    lengths
+        ``(l1, l2, l3, l4)``, m.
+    theta1
+        Crank angle(s), rad.
+    branch
+        ``"+"`` or ``"-"`` (see :class:`balancer.model.FourBar`), or an array of ±1 per angle.
+    check
+        Raise :class:`AssemblyError` for an angle outside the assembly range; otherwise such
+        positions come back as NaN and flagged singular.
+
+    Returns
+    -------
+    Position
+        The configuration; positions within :data:`BOUND_TOLERANCE` of a triangle-inequality
+        bound are put on it exactly and flagged.
+    """
+    l1, l2, l3, l4 = lengths
+    t = _as_1d(theta1)
+    sign = _sign(branch) if isinstance(branch, str) else np.asarray(branch, dtype=float)
+    u1 = np.exp(1j * t)
+    v1 = l1 * u1
+    v23 = l4 - v1  # l̄23 = −l̄1 − l̄4, from A1 to A3
+    l23 = np.abs(v23)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d23 = (l23 * l23 + l2 * l2 - l3 * l3) / (2 * l23)  # Eq. 3
+        h_sq = l2 * l2 - d23 * d23
+        tol = BOUND_TOLERANCE * 4 * max(l2, l3) ** 2
+        bad = (h_sq < -tol) | (l23 <= BOUND_TOLERANCE * max(l1, l4)) | ~np.isfinite(h_sq)
+        if check and bad.any():
+            k = int(np.argmax(bad))
+            rng = assembly_range(lengths)
+            raise AssemblyError(
+                f"the linkage cannot be assembled at crank angle θ1 = {t[k]:.6g} rad "
+                f"({math.degrees(t[k]):.6g}°); it assembles for θ1 in {rng.describe()}",
+                key="theta1",
+                value=float(t[k]),
+            )
+        h23 = sign * np.sqrt(np.maximum(h_sq, 0.0))
+        v2 = (d23 + 1j * h23) * (v23 / l23)  # Eq. 4
+    v3 = v23 - v2
+    v2 = np.where(bad, np.nan, v2)
+    v3 = np.where(bad, np.nan, v3)
+    s_mu = cross(v2, v3) / (l2 * l3)
+    singular = bad | (np.abs(s_mu) < SINGULAR_TOLERANCE)
+    return Position(lengths=lengths, theta1=t, l1=v1, l2=v2, l3=v3, singular=singular)
+
+
+def position_of(linkage: FourBar, theta1: ArrayLike, *, check: bool = True) -> Position:
+    """:func:`position` for a :class:`~balancer.model.FourBar` on its own branch."""
+    return position(linkage.lengths, theta1, linkage.branch, check=check)
+
+
+def transfer_functions(pos: Position) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """First-order kinematic transfer functions ``Θ2 = dθ2/dθ1``, ``Θ3 = dθ3/dθ1`` (Eq. 7).
+
+    ``Θ2 = −⟨l̄3, il̄1⟩/⟨l̄3, il̄2⟩``, ``Θ3 = −⟨l̄2, il̄1⟩/⟨l̄2, il̄3⟩``; infinite at dead points.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        big2 = -cross(pos.l3, pos.l1) / cross(pos.l3, pos.l2)
+        big3 = -cross(pos.l2, pos.l1) / cross(pos.l2, pos.l3)
+    return big2, big3
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Positions, angular velocities and accelerations of a four-bar at arrays of states.
+
+    Attributes
+    ----------
+    pos
+        The configuration.
+    omega
+        Angular velocities ``(ω1, ω2, ω3)``, rad/s, each shape ``(N,)``.
+    alpha
+        Angular accelerations ``(α1, α2, α3)``, rad/s², each shape ``(N,)``.
+    transfer
+        ``(Θ2, Θ3)`` of Eq. 7.
+    """
+
+    pos: Position
+    omega: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+    alpha: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+    transfer: tuple[NDArray[np.float64], NDArray[np.float64]]
+
+    @property
+    def lengths(self) -> Lengths:
+        """``(l1, l2, l3, l4)``, m."""
+        return self.pos.lengths
+
+    @property
+    def size(self) -> int:
+        """Number of states."""
+        return self.pos.theta1.size
+
+    @property
+    def vectors(self) -> tuple[NDArray[np.complex128], ...]:
+        """Link vectors ``(l̄1, l̄2, l̄3)``, m."""
+        return (self.pos.l1, self.pos.l2, self.pos.l3)
+
+    @cached_property
+    def theta(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """Link angles ``(θ1, θ2, θ3)``, rad (θ2, θ3 in (−π, π])."""
+        return (self.pos.theta1, self.pos.theta2, self.pos.theta3)
+
+    def vector_rate(self, k: int) -> NDArray[np.complex128]:
+        """Time derivative ``i·ωk·l̄k`` of link vector ``k`` (0-based), m/s."""
+        return 1j * self.omega[k] * self.vectors[k]
+
+    def vector_acceleration(self, k: int) -> NDArray[np.complex128]:
+        """Second derivative ``(i·αk − ωk²)·l̄k`` of link vector ``k`` (0-based), m/s²."""
+        return (1j * self.alpha[k] - self.omega[k] ** 2) * self.vectors[k]
+
+    @cached_property
+    def joint_velocities(self) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+        """Velocities of A1 and A2, m/s."""
+        v1 = self.vector_rate(0)
+        return v1, v1 + self.vector_rate(1)
+
+    @cached_property
+    def joint_accelerations(self) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+        """Accelerations of A1 and A2, m/s²."""
+        a1 = self.vector_acceleration(0)
+        return a1, a1 + self.vector_acceleration(1)
+
+    def joint_positions(self) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+        """Positions of A1 and A2, m."""
+        return self.pos.A1, self.pos.A2
+
+
+def dependent_accelerations(
+    pos: Position,
+    transfer: tuple[NDArray[np.float64], NDArray[np.float64]],
+    omega: tuple[ArrayLike, ArrayLike, ArrayLike],
+    alpha1: ArrayLike,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Angular accelerations of coupler and rocker (Eq. 9–10).
+
+    ``θ̈2 = Θ2·θ̈1 + (⟨l̄3,l̄1⟩θ̇1² + ⟨l̄3,l̄2⟩θ̇2² + l3²θ̇3²)/⟨l̄3, il̄2⟩`` and
+    ``θ̈3 = Θ3·θ̈1 + (⟨l̄2,l̄1⟩θ̇1² + l2²θ̇2² + ⟨l̄2,l̄3⟩θ̇3²)/⟨l̄2, il̄3⟩``.
+    """
+    _, l2, l3, _ = pos.lengths
+    w1, w2, w3 = (np.asarray(w) for w in omega)
+    v1, v2, v3 = pos.l1, pos.l2, pos.l3
+    big2, big3 = transfer
+    w1s, w2s, w3s = w1 * w1, w2 * w2, w3 * w3
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a2 = big2 * alpha1 + (inner(v3, v1) * w1s + inner(v3, v2) * w2s + l3 * l3 * w3s) / (
+            -cross(v3, v2)
+        )
+        a3 = big3 * alpha1 + (inner(v2, v1) * w1s + l2 * l2 * w2s + inner(v2, v3) * w3s) / (
+            -cross(v2, v3)
+        )
+    return a2, a3
+
+
+def motion(
+    lengths: Lengths,
+    theta1: ArrayLike,
+    omega1: ArrayLike = 0.0,
+    alpha1: ArrayLike = 0.0,
+    branch: str | ArrayLike = "+",
+    *,
+    check: bool = True,
+) -> Motion:
+    """Full kinematics at crank states ``(θ1, θ̇1, θ̈1)`` (Eq. 2–10).
+
+    Parameters
+    ----------
+    lengths
+        ``(l1, l2, l3, l4)``, m.
+    theta1, omega1, alpha1
+        Crank angle (rad), angular velocity (rad/s) and acceleration (rad/s²); broadcast
+        together.
+    branch
+        Assembly, see :func:`position`.
+    check
+        See :func:`position`.
+    """
+    t, w1, a1 = np.broadcast_arrays(_as_1d(theta1), _as_1d(omega1), _as_1d(alpha1))
+    pos = position(lengths, t, branch, check=check)
+    big = transfer_functions(pos)
+    w2 = big[0] * w1  # Eq. 6
+    w3 = big[1] * w1
+    a2, a3 = dependent_accelerations(pos, big, (w1, w2, w3), a1)
+    return Motion(
+        pos=pos,
+        omega=(np.array(w1, dtype=float), w2, w3),
+        alpha=(np.array(a1, dtype=float), a2, a3),
+        transfer=big,
+    )
+
+
+def motion_of(
+    linkage: FourBar,
+    theta1: ArrayLike,
+    omega1: ArrayLike = 0.0,
+    alpha1: ArrayLike = 0.0,
+    *,
+    check: bool = True,
+) -> Motion:
+    """:func:`motion` for a :class:`~balancer.model.FourBar` on its own branch."""
+    return motion(linkage.lengths, theta1, omega1, alpha1, linkage.branch, check=check)
+
+
+def coupler_rates_eq11(
+    lengths: Lengths,
+    theta1: ArrayLike,
+    theta3: ArrayLike,
+    omega1: ArrayLike,
+    omega3: ArrayLike,
+    alpha1: ArrayLike,
+    alpha3: ArrayLike,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Coupler angular velocity and acceleration from θ1, θ3 and their rates only (Eq. 11).
+
+    A second route to ``θ̇2`` and ``θ̈2`` that does not use θ2, for cross-checking Eq. 6 and 9.
+    """
+    l1, l2, l3, l4 = lengths
+    t1, t3, w1, w3, a1, a3 = (np.asarray(x, dtype=float) for x in (
+        theta1, theta3, omega1, omega3, alpha1, alpha3))
+    c13 = np.cos(t1 - t3)
+    s13 = np.sin(t1 - t3)
+    k1 = l1 * (l1 + l3 * c13 - l4 * np.cos(t1))
+    k3 = l3 * (l3 + l1 * c13 - l4 * np.cos(t3))
+    w2 = (k1 * w1 + k3 * w3) / (l2 * l2)
+    a2 = (
+        k1 * a1
+        - l1 * (l3 * s13 - l4 * np.sin(t1)) * w1 * w1
+        + k3 * a3
+        + l3 * (l1 * s13 + l4 * np.sin(t3)) * w3 * w3
+    ) / (l2 * l2)
+    return w2, a2

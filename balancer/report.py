@@ -1,0 +1,205 @@
+"""Presentation of results: readable tables, JSON documents and CSV files.
+
+Computation lives elsewhere; this module only turns result objects into text. The JSON field
+names that other tools rely on are fixed in DESIGN.md.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from .conditions import force_balance_error, force_balance_residuals, is_force_balanced
+from .inverse import CycleAnalysis, Figure
+from .kinematics import classify
+
+UNITS = {"shaking_force": "N", "shaking_moment": "N·m", "driving_torque": "N·m"}
+
+
+def _fmt(x: float, width: int = 12) -> str:
+    if x == 0:
+        return f"{0:>{width}.4g}"
+    if abs(x) >= 1e5 or abs(x) < 1e-3:
+        return f"{x:>{width}.4e}"
+    return f"{x:>{width}.6g}"
+
+
+def table(rows: Sequence[Sequence[str]], header: Sequence[str]) -> str:
+    """A plain text table: first column left-aligned, the others right-aligned."""
+    widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
+    lines = []
+    for r in [header, *rows]:
+        cells = [
+            str(c).ljust(w) if i == 0 else str(c).rjust(w)
+            for i, (c, w) in enumerate(zip(r, widths, strict=True))
+        ]
+        lines.append("  ".join(cells).rstrip())
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def reaction_extremes(values: np.ndarray) -> dict[str, float]:
+    """Magnitude maximum and component extremes of a complex force history, N."""
+    return {
+        "max": float(np.max(np.abs(values))),
+        "x_min": float(np.min(values.real)),
+        "x_max": float(np.max(values.real)),
+        "y_min": float(np.min(values.imag)),
+        "y_max": float(np.max(values.imag)),
+    }
+
+
+def figures_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
+    """The three fixed figures ``shaking_force``, ``shaking_moment``, ``driving_torque``."""
+    return analysis.summary.as_dict()
+
+
+def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str, Any]:
+    """The ``analyze --json`` document."""
+    linkage = analysis.linkage
+    c14, c34 = force_balance_residuals(linkage)
+    doc: dict[str, Any] = {}
+    if spec is not None:
+        doc["spec"] = spec
+    doc.update(
+        {
+            "mechanism": linkage.type,
+            "class": str(classify(linkage.lengths)),
+            "branch": linkage.branch,
+            "speed": analysis.speed,
+            "samples": int(analysis.motion.size),
+            "route": analysis.route,
+            "gravity": "not included",
+            **figures_dict(analysis),
+            "force_balanced": is_force_balanced(linkage),
+            "force_balance_residual": {
+                "c14": [c14.real, c14.imag],
+                "c34": [c34.real, c34.imag],
+                "relative": force_balance_error(linkage),
+            },
+            "reactions": {
+                "A0": reaction_extremes(analysis.reactions.RA0),
+                "A3": reaction_extremes(analysis.reactions.RA3),
+            },
+            "units": {
+                "force": "N",
+                "moment": "N·m",
+                "speed": "rad/s",
+                "force_balance_residual": "kg (relative: dimensionless)",
+            },
+        }
+    )
+    return doc
+
+
+def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
+    """The readable ``analyze`` report."""
+    linkage = analysis.linkage
+    s = analysis.summary
+    rpm = analysis.speed * 60 / (2 * math.pi)
+    head = f"balancer analyze — {spec}" if spec else "balancer analyze"
+    lines = [
+        head,
+        f"{linkage.type} ({classify(linkage.lengths)}), branch {linkage.branch}; "
+        f"crank at {analysis.speed:g} rad/s ({rpm:.4g} rpm), {analysis.motion.size} crank angles "
+        f"over one revolution; route {analysis.route}; loads included, gravity not",
+        "",
+        table(
+            [
+                [name.replace("_", " "), _fmt(fig.rms), _fmt(fig.max), UNITS[name]]
+                for name, fig in (
+                    ("shaking_force", s.shaking_force),
+                    ("shaking_moment", s.shaking_moment),
+                    ("driving_torque", s.driving_torque),
+                )
+            ],
+            ["quantity", "RMS", "max", "unit"],
+        ),
+        "",
+    ]
+    rows = []
+    for name, values in (("A0", analysis.reactions.RA0), ("A3", analysis.reactions.RA3)):
+        ex = reaction_extremes(values)
+        rows.append(
+            [f"R{name}", *(_fmt(ex[k]) for k in ("max", "x_min", "x_max", "y_min", "y_max"))]
+        )
+    lines.append(
+        table(rows, ["reaction (N)", "|R| max", "Rx min", "Rx max", "Ry min", "Ry max"])
+    )
+    lines.append("")
+    err = force_balance_error(linkage)
+    if is_force_balanced(linkage):
+        lines.append(f"force-balanced: yes (Eq. 57 residual {err:.2e} of the total mass)")
+    else:
+        lines.append(
+            f"force-balanced: no (Eq. 57 residual {err:.3g} of the total mass; "
+            "the total centre of mass moves)"
+        )
+    return "\n".join(lines)
+
+
+def figure_dict(fig: Figure) -> dict[str, float]:
+    """``{"rms": …, "max": …}``."""
+    return fig.as_dict()
+
+
+def dumps_json(doc: dict[str, Any]) -> str:
+    """JSON text with a trailing newline; NaN and infinity are not allowed."""
+    return json.dumps(doc, indent=2, allow_nan=False) + "\n"
+
+
+ANALYSIS_COLUMNS = (
+    "t",
+    "theta1",
+    "theta2",
+    "theta3",
+    "omega1",
+    "omega2",
+    "omega3",
+    "alpha1",
+    "alpha2",
+    "alpha3",
+    "RA0x",
+    "RA0y",
+    "RA3x",
+    "RA3y",
+    "shaking_force_x",
+    "shaking_force_y",
+    "shaking_moment",
+    "driving_torque",
+)
+
+
+def analysis_csv(analysis: CycleAnalysis) -> str:
+    """Per-angle values of a cycle analysis as CSV text (SI units, full precision)."""
+    mo, r = analysis.motion, analysis.reactions
+    cols = [
+        analysis.time,
+        *mo.theta,
+        *mo.omega,
+        *mo.alpha,
+        r.RA0.real,
+        r.RA0.imag,
+        r.RA3.real,
+        r.RA3.imag,
+        r.shaking_force.real,
+        r.shaking_force.imag,
+        r.shaking_moment,
+        r.driving_torque,
+    ]
+    return csv_text(ANALYSIS_COLUMNS, cols)
+
+
+def csv_text(columns: Sequence[str], values: Sequence[np.ndarray]) -> str:
+    """CSV with a header row; numbers written so that they read back exactly."""
+    data = np.column_stack([np.broadcast_to(np.asarray(v, dtype=float), np.shape(values[0]))
+                            for v in values])
+    buf = io.StringIO()
+    buf.write(",".join(columns) + "\n")
+    np.savetxt(buf, data, delimiter=",", fmt="%.17g")
+    return buf.getvalue()

@@ -1,0 +1,510 @@
+"""Design specs in TOML: load and validate them into model objects, and write them back.
+
+The key names are fixed (see the project's DESIGN.md)::
+
+    title = "optional free text"
+
+    [mechanism]
+    type = "four-bar"
+    branch = "+"                      # or "-"
+    [mechanism.lengths]
+    crank = 1.0                       # m
+    coupler = 3.0
+    rocker = 2.0
+    frame = 3.2
+
+    [links.crank]                     # also [links.coupler], [links.rocker]
+    mass = 2.1                        # kg
+    inertia = 1.1                     # kg·m² about the centre of mass
+    com = { s = 0.6, sigma = 0.3 }    # or { e = .., f = .. }, m and rad
+    force = [1.1, 1.2]                # N, at the centre of mass (optional)
+    moment = 0.37                     # N·m (optional)
+    counter_rotor = 0.0               # kg·m², crank and rocker only (optional)
+
+    [operation]
+    speed = 10.0                      # rad/s
+    samples = 360
+
+    [simulation]
+    duration = 5.0                    # s
+    theta1 = 1.0                      # rad
+    omega1 = 0.0                      # rad/s
+    gravity = [0.0, -9.81]            # m/s² (optional)
+    drive = "free"                    # or "constant-speed"
+
+Every error names the file, the key and the value; unknown keys are errors (a typo such as
+``mas`` must not be silently ignored).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import os
+import tempfile
+import tomllib
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from .errors import AssemblyError, SpecError
+from .kinematics import assembly_range
+from .model import DRIVES, METHODS, Design, FourBar, Link, Operation, SimulationSettings
+
+MECHANISM_TYPES = ("four-bar",)
+
+
+class _Table:
+    """A TOML table being read: typed access by key, with the dotted path for messages, and a
+    check that every key was used."""
+
+    def __init__(self, data: dict[str, Any], path: str) -> None:
+        self.data = data
+        self.path = path
+        self.used: set[str] = set()
+
+    def key(self, name: str) -> str:
+        return f"{self.path}.{name}" if self.path else name
+
+    def has(self, name: str) -> bool:
+        return name in self.data
+
+    def raw(self, name: str) -> Any:
+        self.used.add(name)
+        return self.data[name]
+
+    def _missing(self, name: str) -> SpecError:
+        return SpecError("missing required key", key=self.key(name))
+
+    def table(self, name: str, *, required: bool = True) -> _Table | None:
+        if name not in self.data:
+            if required:
+                raise self._missing(name)
+            return None
+        value = self.raw(name)
+        if not isinstance(value, dict):
+            raise SpecError("must be a table", key=self.key(name), value=value)
+        return _Table(value, self.key(name))
+
+    def number(
+        self,
+        name: str,
+        *,
+        default: float | None = None,
+        check: Callable[[float], bool] | None = None,
+        requirement: str = "",
+    ) -> float:
+        if name not in self.data:
+            if default is None:
+                raise self._missing(name)
+            return default
+        value = self.raw(name)
+        return _as_number(value, self.key(name), check, requirement)
+
+    def positive(self, name: str, *, default: float | None = None) -> float:
+        return self.number(name, default=default, check=lambda x: x > 0, requirement="positive")
+
+    def nonnegative(self, name: str, *, default: float | None = None) -> float:
+        return self.number(
+            name, default=default, check=lambda x: x >= 0, requirement="zero or positive"
+        )
+
+    def integer(self, name: str, *, default: int, minimum: int) -> int:
+        if name not in self.data:
+            return default
+        value = self.raw(name)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise SpecError("must be an integer", key=self.key(name), value=value)
+        if value < minimum:
+            raise SpecError(f"must be at least {minimum}", key=self.key(name), value=value)
+        return value
+
+    def string(self, name: str, *, choices: tuple[str, ...], default: str | None = None) -> str:
+        if name not in self.data:
+            if default is None:
+                raise self._missing(name)
+            return default
+        value = self.raw(name)
+        if not isinstance(value, str):
+            raise SpecError("must be a string", key=self.key(name), value=value)
+        if value not in choices:
+            options = ", ".join(f'"{c}"' for c in choices)
+            raise SpecError(f"must be one of {options}", key=self.key(name), value=value)
+        return value
+
+    def text(self, name: str, *, default: str) -> str:
+        if name not in self.data:
+            return default
+        value = self.raw(name)
+        if not isinstance(value, str):
+            raise SpecError("must be a string", key=self.key(name), value=value)
+        return value
+
+    def vector2(self, name: str, *, default: tuple[float, float]) -> tuple[float, float]:
+        if name not in self.data:
+            return default
+        value = self.raw(name)
+        if not isinstance(value, list) or len(value) != 2:
+            raise SpecError("must be a list of two numbers [x, y]", key=self.key(name), value=value)
+        x = _as_number(value[0], self.key(name) + "[0]", None, "")
+        y = _as_number(value[1], self.key(name) + "[1]", None, "")
+        return (x, y)
+
+    def finish(self) -> None:
+        """Raise on the first key that was not used (unknown, or a typo)."""
+        for name in self.data:
+            if name not in self.used:
+                known = self._known_names()
+                close = difflib.get_close_matches(name, known, n=1)
+                hint = f"; did you mean '{close[0]}'?" if close else ""
+                raise SpecError(f"unknown key '{name}'{hint}", key=self.key(name))
+
+    def _known_names(self) -> list[str]:
+        return sorted(_KNOWN_KEYS.get(_generic(self.path), ()))
+
+
+def _generic(path: str) -> str:
+    """Map a concrete table path to the pattern used for key suggestions."""
+    parts = path.split(".")
+    if len(parts) >= 2 and parts[0] in ("links", "original"):
+        parts[1] = "*"
+    return ".".join(parts)
+
+
+_KNOWN_KEYS: dict[str, tuple[str, ...]] = {
+    "": ("title", "mechanism", "links", "operation", "simulation", "balance", "original"),
+    "mechanism": ("type", "branch", "lengths"),
+    "mechanism.lengths": FourBar.length_names,
+    "links": FourBar.link_names,
+    "original": FourBar.link_names,
+    "links.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor"),
+    "original.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor"),
+    "links.*.com": ("s", "sigma", "e", "f"),
+    "original.*.com": ("s", "sigma", "e", "f"),
+    "operation": ("speed", "samples"),
+    "simulation": (
+        "duration",
+        "theta1",
+        "omega1",
+        "gravity",
+        "drive",
+        "method",
+        "rtol",
+        "atol",
+        "outputs",
+    ),
+}
+
+
+def _as_number(
+    value: Any, key: str, check: Callable[[float], bool] | None, requirement: str
+) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise SpecError("must be a number", key=key, value=value)
+    x = float(value)
+    if not math.isfinite(x):
+        raise SpecError("must be a finite number", key=key, value=value)
+    if check is not None and not check(x):
+        raise SpecError(f"must be {requirement}", key=key, value=value)
+    return x
+
+
+# ----------------------------------------------------------------------------------------------
+# Reading
+
+
+def _read_link(table: _Table, name: str, lengths: tuple[float, ...]) -> Link:
+    mass = table.positive("mass")
+    inertia = table.positive("inertia")
+    com = table.table("com")
+    assert com is not None
+    polar = com.has("s") or com.has("sigma")
+    cartesian = com.has("e") or com.has("f")
+    if polar and cartesian:
+        raise SpecError(
+            "give the centre of mass either as {s, sigma} or as {e, f}, not both",
+            key=com.path,
+        )
+    if polar:
+        s = com.nonnegative("s")
+        sigma = com.number("sigma")
+        e, f = s * math.cos(sigma), s * math.sin(sigma)
+    elif cartesian:
+        e = com.number("e")
+        f = com.number("f")
+    else:
+        raise SpecError("missing required key: give {s, sigma} or {e, f}", key=com.path)
+    com.finish()
+    force = table.vector2("force", default=(0.0, 0.0))
+    moment = table.number("moment", default=0.0)
+    counter_rotor = table.nonnegative("counter_rotor", default=0.0)
+    if counter_rotor and name not in FourBar.grounded_links:
+        raise SpecError(
+            "a counter-rotor sits on a ground pivot: only the crank and the rocker can have one",
+            key=table.key("counter_rotor"),
+            value=counter_rotor,
+        )
+    table.finish()
+    return Link(
+        mass=mass,
+        inertia=inertia,
+        e=e,
+        f=f,
+        force=force,
+        moment=moment,
+        counter_rotor=counter_rotor,
+    )
+
+
+def _read_links(table: _Table, lengths: tuple[float, ...]) -> dict[str, Link]:
+    links = {}
+    for name in FourBar.link_names:
+        sub = table.table(name)
+        assert sub is not None
+        links[name] = _read_link(sub, name, lengths)
+    table.finish()
+    return links
+
+
+def _read_mechanism(root: _Table) -> FourBar:
+    mech = root.table("mechanism")
+    assert mech is not None
+    mech.string("type", choices=MECHANISM_TYPES)
+    branch = mech.string("branch", choices=("+", "-"), default="+")
+    lengths_table = mech.table("lengths")
+    assert lengths_table is not None
+    lengths = tuple(lengths_table.positive(n) for n in FourBar.length_names)
+    lengths_table.finish()
+    mech.finish()
+    if assembly_range(lengths).empty:
+        l1, l2, l3, l4 = lengths
+        raise AssemblyError(
+            "the linkage cannot be assembled at any crank angle: the coupler and rocker "
+            f"(|l2 − l3| = {abs(l2 - l3):.6g} m to l2 + l3 = {l2 + l3:.6g} m) cannot bridge "
+            f"A1 to A3 (|l4 − l1| = {abs(l4 - l1):.6g} m to l1 + l4 = {l1 + l4:.6g} m)",
+            key="mechanism.lengths",
+            value=dict(zip(FourBar.length_names, lengths, strict=True)),
+        )
+    links_table = root.table("links")
+    assert links_table is not None
+    links = _read_links(links_table, lengths)
+    return FourBar(lengths=lengths, branch=branch, **links)  # type: ignore[arg-type]
+
+
+def _read_operation(root: _Table) -> Operation | None:
+    table = root.table("operation", required=False)
+    if table is None:
+        return None
+    speed = table.number(
+        "speed", check=lambda x: x != 0, requirement="non-zero (the crank must turn)"
+    )
+    samples = table.integer("samples", default=360, minimum=8)
+    table.finish()
+    return Operation(speed=speed, samples=samples)
+
+
+def _read_simulation(root: _Table) -> SimulationSettings:
+    table = root.table("simulation", required=False)
+    defaults = SimulationSettings()
+    if table is None:
+        return defaults
+    settings = SimulationSettings(
+        duration=table.positive("duration", default=defaults.duration),
+        theta1=table.number("theta1", default=defaults.theta1),
+        omega1=table.number("omega1", default=defaults.omega1),
+        gravity=table.vector2("gravity", default=defaults.gravity),
+        drive=table.string("drive", choices=DRIVES, default=defaults.drive),  # type: ignore[arg-type]
+        method=table.string("method", choices=METHODS, default=defaults.method),
+        rtol=table.number(
+            "rtol",
+            default=defaults.rtol,
+            check=lambda x: 1e-14 <= x < 1,
+            requirement="between 1e-14 and 1",
+        ),
+        atol=table.positive("atol", default=defaults.atol),
+        outputs=table.integer("outputs", default=defaults.outputs, minimum=2),
+    )
+    table.finish()
+    return settings
+
+
+def _read_original(root: _Table, mechanism: FourBar) -> FourBar | None:
+    table = root.table("original", required=False)
+    if table is None:
+        return None
+    links = _read_links(table, mechanism.lengths)
+    return mechanism.with_links(links)
+
+
+def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
+    """Validate a parsed TOML document and build the :class:`~balancer.model.Design`.
+
+    Raises
+    ------
+    SpecError
+        With the key and value at fault and ``source`` as the file name.
+    """
+    try:
+        root = _Table(data, "")
+        title = root.text("title", default="")
+        mechanism = _read_mechanism(root)
+        operation = _read_operation(root)
+        simulation = _read_simulation(root)
+        balance = None
+        if root.has("balance"):
+            from .problem import read_balance  # the redesign problem's own reader
+
+            balance = read_balance(root.table("balance"), mechanism)
+        original = _read_original(root, mechanism)
+        root.finish()
+    except SpecError as exc:
+        if source is not None and exc.source is None:
+            raise exc.with_source(source) from None
+        raise
+    return Design(
+        mechanism=mechanism,
+        operation=operation,
+        simulation=simulation,
+        balance=balance,
+        original=original,
+        title=title,
+    )
+
+
+def load_design(path: str | os.PathLike[str]) -> Design:
+    """Read and validate a design spec from a TOML file.
+
+    Raises
+    ------
+    SpecError
+        If the file cannot be read, is not valid TOML, or fails validation.
+    """
+    p = Path(path)
+    try:
+        raw = p.read_bytes()
+    except FileNotFoundError:
+        raise SpecError("no such file", source=str(p)) from None
+    except OSError as exc:
+        raise SpecError(f"cannot read the file ({exc.strerror})", source=str(p)) from None
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise SpecError("not a UTF-8 text file", source=str(p)) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(f"not valid TOML: {exc}", source=str(p)) from None
+    return design_from_dict(data, source=str(p))
+
+
+def loads_design(text: str, source: str = "<string>") -> Design:
+    """Read and validate a design spec from TOML text."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(f"not valid TOML: {exc}", source=source) from None
+    return design_from_dict(data, source=source)
+
+
+# ----------------------------------------------------------------------------------------------
+# Writing
+#
+# A small emitter for this fixed schema rather than a general TOML writer: it writes floats
+# with ``repr`` (shortest text that reads back to the same number, so a model round-trips
+# exactly) and adds unit comments a designer can read.
+
+
+def _num(x: float) -> str:
+    if isinstance(x, bool):
+        raise TypeError("a bool is not a number")
+    if isinstance(x, int):
+        return str(x)
+    text = repr(float(x))
+    return text
+
+
+def _string(text: str) -> str:
+    escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
+    return f'"{escaped}"'
+
+
+def _link_lines(link: Link) -> list[str]:
+    lines = [
+        f"mass = {_num(link.mass)}  # kg",
+        f"inertia = {_num(link.inertia)}  # kg·m² about the centre of mass",
+        f"com = {{ e = {_num(link.e)}, f = {_num(link.f)} }}  "
+        f"# m (s = {link.s:.6g} m, sigma = {link.sigma:.6g} rad)",
+    ]
+    if link.force != (0.0, 0.0):
+        lines.append(f"force = [{_num(link.force[0])}, {_num(link.force[1])}]  # N")
+    if link.moment != 0.0:
+        lines.append(f"moment = {_num(link.moment)}  # N·m")
+    if link.counter_rotor != 0.0:
+        lines.append(f"counter_rotor = {_num(link.counter_rotor)}  # kg·m²")
+    return lines
+
+
+def dumps_design(design: Design) -> str:
+    """The design as TOML text that :func:`loads_design` reads back to an equal design."""
+    mech = design.mechanism
+    out: list[str] = []
+    if design.title:
+        out += [f"title = {_string(design.title)}", ""]
+    out += ["[mechanism]", f'type = "{mech.type}"', f'branch = "{mech.branch}"', ""]
+    out.append("[mechanism.lengths]  # m")
+    for name, length in zip(mech.length_names, mech.lengths, strict=True):
+        out.append(f"{name} = {_num(length)}")
+    for name in mech.link_names:
+        out += ["", f"[links.{name}]", *_link_lines(mech.link(name))]
+    if design.operation is not None:
+        op = design.operation
+        out += [
+            "",
+            "[operation]",
+            f"speed = {_num(op.speed)}  # rad/s",
+            f"samples = {_num(op.samples)}",
+        ]
+    sim = design.simulation
+    out += [
+        "",
+        "[simulation]",
+        f"duration = {_num(sim.duration)}  # s",
+        f"theta1 = {_num(sim.theta1)}  # rad",
+        f"omega1 = {_num(sim.omega1)}  # rad/s",
+        f"gravity = [{_num(sim.gravity[0])}, {_num(sim.gravity[1])}]  # m/s²",
+        f'drive = "{sim.drive}"',
+        f'method = "{sim.method}"',
+        f"rtol = {_num(sim.rtol)}",
+        f"atol = {_num(sim.atol)}",
+        f"outputs = {_num(sim.outputs)}",
+    ]
+    if design.balance is not None:
+        from .problem import balance_lines
+
+        out += ["", *balance_lines(design.balance)]
+    if design.original is not None:
+        out += ["", "# The unbalanced design this one was derived from (same geometry)."]
+        for name in mech.link_names:
+            out += ["", f"[original.{name}]", *_link_lines(design.original.link(name))]
+    return "\n".join(out) + "\n"
+
+
+def write_atomic(path: str | os.PathLike[str], text: str | bytes) -> None:
+    """Write a file whole or not at all (temporary file in the same folder, then rename)."""
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    mode = "wb" if isinstance(text, bytes) else "w"
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", dir=folder)
+    try:
+        with os.fdopen(fd, mode, **({} if mode == "wb" else {"encoding": "utf-8"})) as fh:
+            fh.write(text)
+        os.replace(tmp, target)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def save_design(design: Design, path: str | os.PathLike[str]) -> None:
+    """Write the design to a TOML file, whole or not at all."""
+    write_atomic(path, dumps_design(design))
