@@ -28,6 +28,7 @@ Everything is vectorised over the states of a :class:`~balancer.kinematics.Motio
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
@@ -147,17 +148,20 @@ def newton_euler(
     g = complex(*gravity)
     f1, f2, f3 = _applied_forces(linkage, g, loads)
     mom1, mom2, mom3 = (link.moment if loads else 0.0 for link in linkage.links)
-    mass = [link.mass for link in linkage.links]
-    (r1, r2, r3), (a1, a2, a3) = link_com_kinematics(linkage, mo)
+    l1, l2, l3, _ = linkage.lengths
+    z1, z2, z3 = (link.com / length for link, length in zip(linkage.links, (l1, l2, l3), strict=True))
     v1, v2, v3 = mo.vectors
     al1, al2, al3 = mo.alpha
-    a3_pos = complex(linkage.lengths[3], 0.0)
+    acc1, acc2, acc3 = (mo.vector_acceleration(k) for k in range(3))
+    # Centres of mass relative to A0, A1 and A3, and their accelerations (A3 = A2 + l̄3 is fixed).
+    r1, r2_a1, r3_a3 = z1 * v1, z2 * v2, (z3 - 1) * v3
+    a1, a2, a3 = z1 * acc1, acc1 + z2 * acc2, (z3 - 1) * acc3
     # Net force each link needs beyond its applied force: m·a − F.
-    need1 = mass[0] * a1 - f1
-    need2 = mass[1] * a2 - f2
-    need3 = mass[2] * a3 - f3
-    c2 = -cross(r2 - mo.pos.A1, need2) + mom2 - dyn[1].inertia * al2
-    c3 = dyn[2].inertia * al3 + cross(r3 - a3_pos, need3) - mom3
+    need1 = dyn[0].mass * a1 - f1
+    need2 = dyn[1].mass * a2 - f2
+    need3 = dyn[2].mass * a3 - f3
+    c2 = -cross(r2_a1, need2) + mom2 - dyn[1].inertia * al2
+    c3 = dyn[2].inertia * al3 + cross(r3_a3, need3) - mom3
     p2 = (c2 * v3 + c3 * v2) / cross(v2, v3)
     p3 = need3 - p2
     p1 = need2 + p2
@@ -165,7 +169,7 @@ def newton_euler(
     tau = dyn[0].inertia * al1 + cross(r1, need1) + cross(v1, p1) - mom1
     ra0 = -p0
     ra3 = -p3
-    moment = cross(a3_pos, ra3) - tau + _counter_rotor_moment(linkage, mo)
+    moment = linkage.lengths[3] * ra3.imag - tau + _counter_rotor_moment(linkage, mo)
     return Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
 
 
@@ -286,7 +290,10 @@ class Figure:
     @classmethod
     def of(cls, values: NDArray) -> Figure:
         """Figures of an array of real or complex values (complex: vector magnitudes)."""
-        mag2 = np.abs(values) ** 2
+        if np.iscomplexobj(values):
+            mag2 = values.real * values.real + values.imag * values.imag
+        else:
+            mag2 = values * values
         return cls(rms=float(np.sqrt(np.mean(mag2))), max=float(np.sqrt(np.max(mag2))))
 
     def as_dict(self) -> dict[str, float]:
@@ -323,8 +330,8 @@ class CycleAnalysis:
         The analysed four-bar.
     speed
         Crank speed, rad/s.
-    motion
-        Kinematics at the sampled crank angles ``θ1 = 2π·j/N``.
+    theta1
+        The sampled crank angles ``θ1 = 2π·j/N``, rad.
     reactions
         Ground reactions, driving torque and shaking moment at those angles.
     route
@@ -333,7 +340,7 @@ class CycleAnalysis:
 
     linkage: FourBar
     speed: float
-    motion: Motion
+    theta1: NDArray[np.float64]
     reactions: Reactions
     route: str
     summary: CycleSummary = field(init=False)
@@ -352,10 +359,15 @@ class CycleAnalysis:
             ),
         )
 
+    @cached_property
+    def motion(self) -> Motion:
+        """Kinematics at the sampled angles (computed when first asked for)."""
+        return motion_of(self.linkage, self.theta1, self.speed, 0.0)
+
     @property
-    def theta1(self) -> NDArray[np.float64]:
-        """Sampled crank angles, rad."""
-        return self.motion.pos.theta1
+    def samples(self) -> int:
+        """Number of sampled crank angles."""
+        return self.theta1.size
 
     @property
     def time(self) -> NDArray[np.float64]:
@@ -395,8 +407,22 @@ def cycle_analysis(
             key="mechanism.lengths",
         )
     angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
-    mo = motion_of(linkage, angles, speed, 0.0)
-    reactions = inverse_dynamics(linkage, mo, route=route, loads=loads)
+    n = angles.size
+    # Evaluate in chunks that fit the CPU cache, writing into preallocated arrays: faster, and a
+    # fraction of the memory of whole-array temporaries. The kinematics are not kept (the
+    # result recomputes them when asked), so a long cycle costs little memory.
+    ra0, ra3 = np.empty(n, complex), np.empty(n, complex)
+    tau, moment = np.empty(n), np.empty(n)
+    for start in range(0, n, CHUNK):
+        sl = slice(start, start + CHUNK)
+        mo = motion_of(linkage, angles[sl], speed, 0.0)
+        r = inverse_dynamics(linkage, mo, route=route, loads=loads)
+        ra0[sl], ra3[sl], tau[sl], moment[sl] = r.RA0, r.RA3, r.driving_torque, r.shaking_moment
+    reactions = Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
     return CycleAnalysis(
-        linkage=linkage, speed=speed, motion=mo, reactions=reactions, route=route
+        linkage=linkage, speed=speed, theta1=angles, reactions=reactions, route=route
     )
+
+
+#: Number of crank angles evaluated at once by :func:`cycle_analysis`.
+CHUNK = 16384

@@ -292,8 +292,9 @@ def position(
         h23 = sign * np.sqrt(np.maximum(h_sq, 0.0))
         v2 = (d23 + 1j * h23) * (v23 / l23)  # Eq. 4
     v3 = v23 - v2
-    v2 = np.where(bad, np.nan, v2)
-    v3 = np.where(bad, np.nan, v3)
+    if bad.any():
+        v2[bad] = np.nan
+        v3[bad] = np.nan
     s_mu = cross(v2, v3) / (l2 * l3)
     singular = bad | (np.abs(s_mu) < SINGULAR_TOLERANCE)
     return Position(lengths=lengths, theta1=t, l1=v1, l2=v2, l3=v3, singular=singular)

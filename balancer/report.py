@@ -72,7 +72,7 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
             "class": str(classify(linkage.lengths)),
             "branch": linkage.branch,
             "speed": analysis.speed,
-            "samples": int(analysis.motion.size),
+            "samples": int(analysis.samples),
             "route": analysis.route,
             "gravity": "not included",
             **figures_dict(analysis),
@@ -106,7 +106,7 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
     lines = [
         head,
         f"{linkage.type} ({classify(linkage.lengths)}), branch {linkage.branch}; "
-        f"crank at {analysis.speed:g} rad/s ({rpm:.4g} rpm), {analysis.motion.size} crank angles "
+        f"crank at {analysis.speed:g} rad/s ({rpm:.4g} rpm), {analysis.samples} crank angles "
         f"over one revolution; route {analysis.route}; loads included, gravity not",
         "",
         table(

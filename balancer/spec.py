@@ -62,6 +62,12 @@ class _Table:
         self.data = data
         self.path = path
         self.used: set[str] = set()
+        known = _KNOWN_KEYS.get(_generic(path))
+        if known is not None:
+            # Report a typo before the missing key it causes ("mas" before "mass is missing").
+            for name in data:
+                if name not in known:
+                    self._unknown(name)
 
     def key(self, name: str) -> str:
         return f"{self.path}.{name}" if self.path else name
@@ -154,13 +160,13 @@ class _Table:
         """Raise on the first key that was not used (unknown, or a typo)."""
         for name in self.data:
             if name not in self.used:
-                known = self._known_names()
-                close = difflib.get_close_matches(name, known, n=1)
-                hint = f"; did you mean '{close[0]}'?" if close else ""
-                raise SpecError(f"unknown key '{name}'{hint}", key=self.key(name))
+                self._unknown(name)
 
-    def _known_names(self) -> list[str]:
-        return sorted(_KNOWN_KEYS.get(_generic(self.path), ()))
+    def _unknown(self, name: str) -> None:
+        known = sorted(_KNOWN_KEYS.get(_generic(self.path), ()))
+        close = difflib.get_close_matches(name, known, n=1)
+        hint = f"; did you mean '{close[0]}'?" if close else ""
+        raise SpecError(f"unknown key '{name}'{hint}", key=self.key(name))
 
 
 def _generic(path: str) -> str:

@@ -1,0 +1,5 @@
+"""``python -m balancer``: the same as the ``balancer`` command."""
+
+from .cli import entry_point
+
+entry_point()

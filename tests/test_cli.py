@@ -1,0 +1,101 @@
+"""The command line: analyze's table, JSON and CSV, exit codes, and the installed script."""
+
+from __future__ import annotations
+
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balancer.cli import main
+from balancer.report import ANALYSIS_COLUMNS
+
+EXAMPLE = str(Path(__file__).resolve().parent.parent / "examples" / "meijaard2020.toml")
+
+
+def test_analyze_table(capsys):
+    assert main(["analyze", EXAMPLE]) == 0
+    out = capsys.readouterr().out
+    for words in ("shaking force", "shaking moment", "driving torque", "RA0", "RA3",
+                  "force-balanced: no", "crank-rocker"):
+        assert words in out
+
+
+def test_analyze_json_has_the_fixed_fields(capsys):
+    assert main(["analyze", EXAMPLE, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    for name in ("shaking_force", "shaking_moment", "driving_torque"):
+        assert set(doc[name]) >= {"rms", "max"}
+        assert doc[name]["max"] >= doc[name]["rms"] > 0
+    assert doc["force_balanced"] is False
+    assert set(doc["reactions"]) == {"A0", "A3"}
+
+
+def test_analyze_routes_agree_through_the_cli(capsys):
+    docs = []
+    for route in ("newton-euler", "mass-matrix"):
+        assert main(["analyze", EXAMPLE, "--json", "--route", route]) == 0
+        docs.append(json.loads(capsys.readouterr().out))
+    for name in ("shaking_force", "shaking_moment", "driving_torque"):
+        for k in ("rms", "max"):
+            assert docs[0][name][k] == pytest.approx(docs[1][name][k], rel=1e-12)
+
+
+def test_analyze_csv(tmp_path, capsys):
+    path = tmp_path / "cycle.csv"
+    assert main(["analyze", EXAMPLE, "--csv", str(path)]) == 0
+    capsys.readouterr()
+    with path.open() as fh:
+        rows = list(csv.reader(fh))
+    assert tuple(rows[0]) == ANALYSIS_COLUMNS
+    data = np.array(rows[1:], dtype=float)
+    assert data.shape == (360, len(ANALYSIS_COLUMNS))
+    col = {name: data[:, i] for i, name in enumerate(ANALYSIS_COLUMNS)}
+    assert np.allclose(col["shaking_force_x"], col["RA0x"] + col["RA3x"], rtol=0, atol=1e-9)
+    assert np.allclose(col["omega1"], 10.0) and np.allclose(col["alpha1"], 0.0)
+
+
+def test_csv_into_a_missing_folder_is_bad_input_and_writes_nothing(tmp_path, capsys):
+    path = tmp_path / "no" / "cycle.csv"
+    assert main(["analyze", EXAMPLE, "--csv", str(path)]) == 2
+    assert "--csv" in capsys.readouterr().err
+    assert not path.parent.exists()
+
+
+def test_bad_arguments_exit_2_with_one_line(capsys):
+    assert main(["analyze"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "SPEC" in err
+    assert main(["frobnicate", EXAMPLE]) == 2
+    assert main(["analyze", EXAMPLE, "--route", "guess"]) == 2
+
+
+def test_analyze_without_operating_speed_is_bad_input(tmp_path, capsys):
+    text = Path(EXAMPLE).read_text()
+    start = text.index("[operation]")
+    end = text.index("[simulation]")
+    path = tmp_path / "noop.toml"
+    path.write_text(text[:start] + text[end:])
+    assert main(["analyze", str(path)]) == 2
+    assert "operation.speed" in capsys.readouterr().err
+
+
+def test_analyze_of_a_crank_that_cannot_turn_is_bad_input(tmp_path, capsys):
+    text = Path(EXAMPLE).read_text().replace("crank = 1.0", "crank = 2.9")
+    path = tmp_path / "rocking.toml"
+    path.write_text(text)
+    assert main(["analyze", str(path)]) == 2
+    assert "full revolution" in capsys.readouterr().err
+
+
+def test_installed_console_script_runs():
+    exe = Path(sys.executable).parent / "balancer"
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "balancer"]
+    done = subprocess.run([*cmd, "analyze", EXAMPLE, "--json"], capture_output=True, text=True,
+                          check=False)
+    assert done.returncode == 0, done.stderr
+    assert "shaking_moment" in json.loads(done.stdout)

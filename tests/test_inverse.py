@@ -1,0 +1,220 @@
+"""Inverse dynamics: the two routes against each other and against momentum and energy."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import CLASS_EXAMPLES, paper_linkage, random_angles, random_linkage, random_link
+from helpers import derivative, rel_err
+
+from balancer import inverse
+from balancer import kinematics as kin
+from balancer import massmodels as mm
+from balancer.conditions import berkof_counter_rotors, force_balanced_by_crank_and_rocker
+from balancer.errors import AssemblyError
+from balancer.model import FourBar
+
+
+def _states(seed, n_linkages=40, per=25, margin=0.05, speed=4.0, **kw):
+    """Random linkages with states (θ1, ω1, α1) and a gravity vector.
+
+    ``margin`` is the least |sin(θ3 − θ2)| kept; finite-difference tests use a wider one so
+    that the higher derivatives, which set their truncation error, stay moderate.
+    """
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(n_linkages):
+        linkage = random_linkage(rng, **kw)
+        t = random_angles(rng, linkage, per)
+        keep = np.abs(kin.position_of(linkage, t).sin_transmission) > margin
+        t = t[keep]
+        out.append((linkage, t, rng.uniform(-speed, speed, t.size),
+                    rng.uniform(-2 * speed, 2 * speed, t.size), tuple(rng.uniform(-10, 10, 2))))
+    return out
+
+
+def _fd_states(seed):
+    return _states(seed, n_linkages=15, per=4, margin=0.3, speed=2.0)
+
+
+def _scale(r: inverse.Reactions) -> dict[str, float]:
+    return {
+        "force": max(np.max(np.abs(r.RA0)), np.max(np.abs(r.RA3)), 1.0),
+        "moment": max(np.max(np.abs(r.shaking_moment)), np.max(np.abs(r.driving_torque)), 1.0),
+    }
+
+
+@pytest.mark.parametrize(("linkage", "t", "w", "a", "g"), _states(20))
+def test_newton_euler_and_mass_matrix_routes_agree(linkage, t, w, a, g):
+    mo = kin.motion_of(linkage, t, w, a)
+    ne = inverse.newton_euler(linkage, mo, gravity=g)
+    mx = inverse.mass_matrix(linkage, mo, gravity=g)
+    s = _scale(ne)
+    assert rel_err(ne.RA0, mx.RA0, scale=s["force"]) < 1e-9
+    assert rel_err(ne.RA3, mx.RA3, scale=s["force"]) < 1e-9
+    assert rel_err(ne.driving_torque, mx.driving_torque, scale=s["moment"]) < 1e-9
+    assert rel_err(ne.shaking_moment, mx.shaking_moment, scale=s["moment"]) < 1e-9
+
+
+@pytest.mark.parametrize("name", list(CLASS_EXAMPLES))
+@pytest.mark.parametrize("branch", ["+", "-"])
+def test_routes_agree_for_every_grashof_class(name, branch):
+    rng = np.random.default_rng(hash((name, branch)) % 2**32)
+    lengths = CLASS_EXAMPLES[name]
+    linkage = FourBar(
+        lengths=lengths,
+        branch=branch,
+        crank=random_link(rng, lengths[0], loads=True, rotor=True),
+        coupler=random_link(rng, lengths[1], loads=True, rotor=False),
+        rocker=random_link(rng, lengths[2], loads=True, rotor=True),
+    )
+    t = random_angles(rng, linkage, 200)
+    t = t[np.abs(kin.position_of(linkage, t).sin_transmission) > 0.05]
+    mo = kin.motion_of(linkage, t, rng.uniform(-3, 3, t.size), rng.uniform(-3, 3, t.size))
+    ne = inverse.newton_euler(linkage, mo, gravity=(0.0, -9.81))
+    mx = inverse.mass_matrix(linkage, mo, gravity=(0.0, -9.81))
+    s = _scale(ne)
+    for x, y, key in ((ne.RA0, mx.RA0, "force"), (ne.RA3, mx.RA3, "force"),
+                      (ne.driving_torque, mx.driving_torque, "moment"),
+                      (ne.shaking_moment, mx.shaking_moment, "moment")):
+        assert rel_err(x, y, scale=s[key]) < 1e-9
+
+
+def _trajectory(linkage, t0, w0, a0):
+    """Motion along θ1(t) = t0 + w0·t + a0·t²/2 as a function of t."""
+    return lambda t: kin.motion_of(linkage, t0 + w0 * t + 0.5 * a0 * t * t, w0 + a0 * t, a0)
+
+
+def _linear_momentum(linkage, mo):
+    vel_a1, vel_a2 = mo.joint_velocities
+    joint_vel = (0.0, vel_a1, vel_a2)
+    return sum(
+        c.mass * (joint_vel[k] + c.com / linkage.lengths[k] * mo.vector_rate(k))
+        for k, c in enumerate(linkage.links)
+    )
+
+
+@pytest.mark.parametrize(("linkage", "t", "w", "a", "g"), _fd_states(21))
+def test_shaking_force_is_loads_minus_rate_of_linear_momentum(linkage, t, w, a, g):
+    for t0, w0, a0 in zip(t, w, a, strict=True):
+        traj = _trajectory(linkage, t0, w0, a0)
+        r = inverse.newton_euler(linkage, traj(0.0), gravity=g)
+        dp = derivative(lambda s: _linear_momentum(linkage, traj(s)))
+        loads = sum(c.force_complex + c.mass * complex(*g) for c in linkage.links)
+        expected = loads - dp
+        assert rel_err(r.shaking_force, expected, scale=max(1.0, abs(expected[0]))) < 1e-9
+
+
+@pytest.mark.parametrize(("linkage", "t", "w", "a", "g"), _fd_states(24))
+def test_total_mass_times_centre_of_mass_acceleration(linkage, t, w, a, g):
+    """Linear momentum is m_tot times the velocity of the total centre of mass (Eq. 16/32)."""
+    for t0, w0, a0 in zip(t, w, a, strict=True):
+        traj = _trajectory(linkage, t0, w0, a0)
+        v_com = derivative(lambda s: mm.total_com_frame(linkage, traj(s).pos))
+        p = _linear_momentum(linkage, traj(0.0))
+        assert rel_err(p, linkage.total_mass * v_com, scale=max(1.0, abs(p[0]))) < 1e-9
+
+
+@pytest.mark.parametrize(("linkage", "t", "w", "a", "g"), _fd_states(22))
+def test_shaking_moment_is_load_moment_minus_rate_of_angular_momentum(linkage, t, w, a, g):
+    grav = complex(*g)
+    for t0, w0, a0 in zip(t, w, a, strict=True):
+        traj = _trajectory(linkage, t0, w0, a0)
+        mo = traj(0.0)
+        r = inverse.newton_euler(linkage, mo, gravity=g)
+        dh = derivative(lambda s: inverse.angular_momentum(linkage, traj(s)))
+        coms = mm.link_centres_of_mass(linkage, mo.pos)
+        load_moment = sum(
+            kin.cross(rk, c.force_complex + c.mass * grav) + c.moment
+            for rk, c in zip(coms, linkage.links, strict=True)
+        )
+        expected = load_moment - dh
+        scale = max(1.0, abs(r.shaking_moment[0]), abs(dh[0]))
+        assert rel_err(r.shaking_moment, expected, scale=scale) < 1e-9
+
+
+@pytest.mark.parametrize(("linkage", "t", "w", "a", "g"), _fd_states(23))
+def test_driving_torque_power_balances_kinetic_energy(linkage, t, w, a, g):
+    grav = complex(*g)
+    for t0, w0, a0 in zip(t, w, a, strict=True):
+        if abs(w0) < 0.2:
+            continue
+        traj = _trajectory(linkage, t0, w0, a0)
+        mo = traj(0.0)
+        r = inverse.newton_euler(linkage, mo, gravity=g)
+        dT = derivative(lambda s: inverse.kinetic_energy(linkage, traj(s)))
+        # Power of the loads and of gravity at the centres of mass.
+        vel_a1, vel_a2 = mo.joint_velocities
+        joint_vel = (0.0, vel_a1, vel_a2)
+        power = 0.0
+        for k, c in enumerate(linkage.links):
+            v = joint_vel[k] + c.com / linkage.lengths[k] * mo.vector_rate(k)
+            power = power + kin.inner(v, c.force_complex + c.mass * grav) + c.moment * mo.omega[k]
+        expected = dT - power
+        scale = max(1.0, abs(r.driving_torque[0] * w0), abs(dT[0]))
+        assert rel_err(r.driving_torque * w0, expected, scale=scale) < 1e-9
+
+
+def test_force_balanced_paper_example_has_no_shaking_force():
+    linkage = force_balanced_by_crank_and_rocker(paper_linkage(loads=False))
+    mo = kin.motion_of(linkage, np.linspace(0, 2 * np.pi, 100), 1.7, 0.9)
+    for route in inverse.ROUTES:
+        r = inverse.inverse_dynamics(linkage, mo, route=route)
+        assert np.max(np.abs(r.shaking_force)) < 1e-12 * np.max(np.abs(r.RA0))
+        assert np.max(np.abs(r.RA0)) > 1.0  # the individual reactions are far from zero
+
+
+def test_berkof_complete_balance_has_no_shaking_moment_at_any_motion():
+    from dataclasses import replace
+
+    base = paper_linkage(loads=False)
+    l2 = base.lengths[1]
+    c2 = base.coupler
+    coupler = replace(c2, e=1.2, f=0.0, inertia=c2.mass * 1.2 * (l2 - 1.2))
+    linkage = force_balanced_by_crank_and_rocker(base.with_link("coupler", coupler))
+    j1, j3 = berkof_counter_rotors(linkage)
+    linkage = linkage.with_links({
+        "crank": replace(linkage.crank, counter_rotor=j1),
+        "rocker": replace(linkage.rocker, counter_rotor=j3),
+    })
+    rng = np.random.default_rng(5)
+    t = rng.uniform(-np.pi, np.pi, 300)
+    mo = kin.motion_of(linkage, t, rng.uniform(-5, 5, 300), rng.uniform(-20, 20, 300))
+    for route in inverse.ROUTES:
+        r = inverse.inverse_dynamics(linkage, mo, route=route)
+        scale = np.max(np.abs(r.driving_torque))
+        assert np.max(np.abs(r.shaking_force)) < 1e-12 * np.max(np.abs(r.RA0))
+        assert np.max(np.abs(r.shaking_moment)) < 1e-12 * scale
+
+
+def test_cycle_analysis_samples_and_figures(paper):
+    ca = inverse.cycle_analysis(paper, 10.0, 360)
+    assert ca.samples == 360 and ca.motion.size == 360
+    assert np.allclose(np.diff(ca.theta1), 2 * np.pi / 360)
+    sf = np.abs(ca.reactions.shaking_force)
+    assert ca.summary.shaking_force.max == pytest.approx(sf.max(), rel=1e-15)
+    assert ca.summary.shaking_force.rms == pytest.approx(np.sqrt(np.mean(sf**2)), rel=1e-15)
+    other = inverse.cycle_analysis(paper, 10.0, 360, route="mass-matrix")
+    for name in ("shaking_force", "shaking_moment", "driving_torque"):
+        a, b = getattr(ca.summary, name), getattr(other.summary, name)
+        assert a.rms == pytest.approx(b.rms, rel=1e-12)
+        assert a.max == pytest.approx(b.max, rel=1e-12)
+
+
+def test_cycle_analysis_refuses_a_crank_that_cannot_turn():
+    rng = np.random.default_rng(0)
+    lengths = CLASS_EXAMPLES["rocker-crank"]
+    linkage = FourBar(lengths=lengths, crank=random_link(rng, 2, loads=False, rotor=False),
+                      coupler=random_link(rng, 3, loads=False, rotor=False),
+                      rocker=random_link(rng, 1, loads=False, rotor=False))
+    with pytest.raises(AssemblyError, match="full revolution"):
+        inverse.cycle_analysis(linkage, 10.0)
+
+
+def test_speed_scaling_without_loads(paper):
+    """Without loads every inertial quantity scales with the square of the speed."""
+    free = paper.without_loads()
+    a = inverse.cycle_analysis(free, 3.0, 90)
+    b = inverse.cycle_analysis(free, 6.0, 90)
+    assert rel_err(b.reactions.RA0, 4 * a.reactions.RA0) < 1e-13
+    assert rel_err(b.reactions.shaking_moment, 4 * a.reactions.shaking_moment) < 1e-13

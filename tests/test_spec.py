@@ -1,0 +1,171 @@
+"""Design specs: reading, validation errors (one class each), and exact round trips."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import random_linkage
+
+from balancer import spec
+from balancer.cli import main
+from balancer.errors import AssemblyError, SpecError
+from balancer.model import Design, Operation, SimulationSettings
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+BASE = """
+[mechanism]
+type = "four-bar"
+branch = "+"
+[mechanism.lengths]
+crank = 1.0
+coupler = 3.0
+rocker = 2.0
+frame = 3.2
+[links.crank]
+mass = 2.1
+inertia = 1.1
+com = { s = 0.6, sigma = 0.3 }
+[links.coupler]
+mass = 3.0
+inertia = 3.1
+com = { e = 1.2, f = 0.5 }
+[links.rocker]
+mass = 2.2
+inertia = 2.1
+com = { s = 1.66, sigma = -0.4 }
+[operation]
+speed = 10.0
+"""
+
+
+def test_the_example_loads_with_the_papers_values():
+    design = spec.load_design(EXAMPLES / "meijaard2020.toml")
+    m = design.mechanism
+    assert m.lengths == (1.0, 3.0, 2.0, 3.2)
+    assert m.crank.s == pytest.approx(0.6, abs=1e-15)
+    assert m.crank.sigma == pytest.approx(0.3, abs=1e-15)
+    assert m.rocker.sigma == pytest.approx(-0.4, abs=1e-15)
+    assert m.coupler.force == (1.3, -1.4)
+    assert design.simulation.theta1 == 1.0 and design.simulation.duration == 5.0
+
+
+def test_round_trip_is_exact_for_the_example():
+    design = spec.load_design(EXAMPLES / "meijaard2020.toml")
+    text = spec.dumps_design(design)
+    again = spec.loads_design(text)
+    assert again == design
+    assert spec.dumps_design(again) == text
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_round_trip_is_exact_for_random_designs(seed):
+    rng = np.random.default_rng(seed)
+    design = Design(
+        mechanism=random_linkage(rng),
+        operation=Operation(speed=float(rng.uniform(-20, 20)), samples=int(rng.integers(8, 999))),
+        simulation=SimulationSettings(
+            duration=float(rng.uniform(0.1, 9)),
+            theta1=float(rng.normal()),
+            omega1=float(rng.normal()),
+            gravity=(float(rng.normal()), -9.81),
+            drive=str(rng.choice(["free", "constant-speed"])),
+            method=str(rng.choice(["opened-loop", "lie-group"])),
+            rtol=1e-9,
+            atol=1e-11,
+            outputs=int(rng.integers(2, 2000)),
+        ),
+        title=f"random design {seed} with \"quotes\" and a backslash \\",
+    )
+    assert spec.loads_design(spec.dumps_design(design)) == design
+
+
+def _load(text: str) -> Design:
+    return spec.loads_design(text, source="test.toml")
+
+
+BAD = {
+    "missing key": (BASE.replace("mass = 2.1\n", ""), "links.crank.mass", "missing"),
+    "wrong type": (BASE.replace("mass = 3.0", 'mass = "heavy"'), "links.coupler.mass", "number"),
+    "bool is no number": (BASE.replace("mass = 3.0", "mass = true"), "links.coupler.mass", "number"),
+    "non-positive length": (BASE.replace("rocker = 2.0", "rocker = -2.0"),
+                            "mechanism.lengths.rocker", "positive"),
+    "zero length": (BASE.replace("crank = 1.0", "crank = 0"), "mechanism.lengths.crank", "positive"),
+    "non-positive mass": (BASE.replace("mass = 2.2", "mass = 0.0"), "links.rocker.mass",
+                          "positive"),
+    "non-positive inertia": (BASE.replace("inertia = 3.1", "inertia = -1"),
+                             "links.coupler.inertia", "positive"),
+    "unknown key (typo)": (BASE.replace("mass = 2.1", "mas = 2.1"), "links.crank",
+                           "did you mean 'mass'"),
+    "unknown table": (BASE + "\n[simulaton]\nduration = 1\n", "simulaton", "did you mean"),
+    "unknown link": (BASE + "\n[links.slider]\nmass = 1\n", "links.slider", "unknown key"),
+    "bad branch": (BASE.replace('branch = "+"', 'branch = "left"'), "mechanism.branch",
+                   "must be one of"),
+    "bad type": (BASE.replace('type = "four-bar"', 'type = "five-bar"'), "mechanism.type",
+                 "must be one of"),
+    "cannot assemble": (BASE.replace("frame = 3.2", "frame = 9.0"), "mechanism.lengths",
+                        "cannot be assembled at any crank angle"),
+    "counter-rotor on the coupler": (
+        BASE.replace("com = { e = 1.2, f = 0.5 }", "com = { e = 1.2, f = 0.5 }\ncounter_rotor = 1"),
+        "links.coupler.counter_rotor", "ground pivot"),
+    "mixed centre of mass": (BASE.replace("com = { e = 1.2, f = 0.5 }", "com = { e = 1.2, s = 1 }"),
+                             "links.coupler.com", "either"),
+    "zero speed": (BASE.replace("speed = 10.0", "speed = 0"), "operation.speed", "non-zero"),
+    "not finite": (BASE.replace("speed = 10.0", "speed = inf"), "operation.speed", "finite"),
+    "bad force": (BASE.replace("mass = 2.2", "mass = 2.2\nforce = [1.0]"), "links.rocker.force",
+                  "two numbers"),
+    "bad drive": (BASE + '\n[simulation]\ndrive = "motor"\n', "simulation.drive", "one of"),
+    "bad samples": (BASE.replace("speed = 10.0", "speed = 10.0\nsamples = 2.5"),
+                    "operation.samples", "integer"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_bad_specs_raise_spec_error_naming_the_key(case):
+    text, key, words = BAD[case]
+    with pytest.raises(SpecError) as info:
+        _load(text)
+    message = str(info.value)
+    assert key in message and words in message and "test.toml" in message
+    assert "\n" not in message
+    assert info.value.exit_code == 2
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_bad_specs_exit_2_with_one_line(case, tmp_path, capsys):
+    text, key, _ = BAD[case]
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    assert main(["analyze", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and key in err and str(path) in err
+    assert "Traceback" not in err
+
+
+def test_cannot_assemble_is_an_assembly_error():
+    with pytest.raises(AssemblyError):
+        _load(BAD["cannot assemble"][0])
+
+
+def test_value_is_named_in_the_message():
+    with pytest.raises(SpecError, match=r"got -2\.0"):
+        _load(BAD["non-positive length"][0])
+
+
+def test_missing_file_and_invalid_toml(tmp_path, capsys):
+    assert main(["analyze", str(tmp_path / "nope.toml")]) == 2
+    assert "no such file" in capsys.readouterr().err
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[mechanism\n")
+    assert main(["analyze", str(bad)]) == 2
+    assert "not valid TOML" in capsys.readouterr().err
+
+
+def test_save_design_is_atomic(tmp_path):
+    design = spec.load_design(EXAMPLES / "meijaard2020.toml")
+    target = tmp_path / "out.toml"
+    spec.save_design(design, target)
+    assert spec.load_design(target) == design
+    assert [p.name for p in tmp_path.iterdir()] == ["out.toml"]
