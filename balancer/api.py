@@ -26,7 +26,8 @@ def analyze(design: Design, *, route: Route = "newton-euler") -> CycleAnalysis:
     """
     if design.operation is None:
         raise SpecError(
-            "missing required key: a cycle analysis needs the operating speed", key="operation.speed"
+            "missing required key: a cycle analysis needs the operating speed",
+            key="operation.speed",
         )
     return cycle_analysis(
         design.mechanism, design.operation.speed, design.operation.samples, route=route

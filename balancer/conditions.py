@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from .model import FourBar, Link
+from .model import FourBar
 
 #: Relative residual of Eq. 57 below which a design counts as force-balanced.
 FORCE_BALANCE_TOLERANCE = 1e-9

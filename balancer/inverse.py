@@ -149,7 +149,9 @@ def newton_euler(
     f1, f2, f3 = _applied_forces(linkage, g, loads)
     mom1, mom2, mom3 = (link.moment if loads else 0.0 for link in linkage.links)
     l1, l2, l3, _ = linkage.lengths
-    z1, z2, z3 = (link.com / length for link, length in zip(linkage.links, (l1, l2, l3), strict=True))
+    z1, z2, z3 = (
+        link.com / length for link, length in zip(linkage.links, (l1, l2, l3), strict=True)
+    )
     v1, v2, v3 = mo.vectors
     al1, al2, al3 = mo.alpha
     acc1, acc2, acc3 = (mo.vector_acceleration(k) for k in range(3))

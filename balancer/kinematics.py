@@ -127,7 +127,9 @@ class AssemblyRange:
             return "full revolution"
         if self.empty:
             return "none"
-        return ", ".join(f"[{math.degrees(a):.4g}°, {math.degrees(b):.4g}°]" for a, b in self.intervals)
+        return ", ".join(
+            f"[{math.degrees(a):.4g}°, {math.degrees(b):.4g}°]" for a, b in self.intervals
+        )
 
 
 def cosine_bounds(lengths: Lengths) -> tuple[float, float]:

@@ -27,8 +27,7 @@ from .model import FourBar, Link
 
 
 def inertial_parameters(link: Link) -> tuple[float, float, float, float]:
-    """Inertial parameters ``(m, m·e, m·f, J)`` of a link, with ``J = I + m·s²`` (about its
-    first joint)."""
+    """Inertial parameters ``(m, m·e, m·f, J)``; ``J = I + m·s²`` is about the first joint."""
     m = link.mass
     return (m, m * link.e, m * link.f, link.inertia_about_joint())
 
@@ -95,9 +94,11 @@ def opened_loop_vectors(linkage: FourBar, pos: Position) -> OpenedLoopVectors:
 
 @dataclass(frozen=True)
 class FrameVectors:
-    """Principal vectors of the system about the frame (Eq. 30) and the derived vectors
-    ``ā'12``, ``ā'32`` (Eq. 31), m; complex arrays over the positions (``a41``, ``a43`` are
-    constant)."""
+    """Principal vectors of the system about the frame (Eq. 30) and derived vectors (Eq. 31), m.
+
+    Complex arrays over the positions; ``a41`` and ``a43`` are constant, ``a12p``, ``a32p`` are
+    ``ā'12``, ``ā'32``.
+    """
 
     a14: NDArray[np.complex128]
     a41: complex
@@ -123,7 +124,7 @@ def frame_coefficients(linkage: FourBar) -> tuple[complex, complex]:
 
 def frame_vectors(linkage: FourBar, pos: Position) -> FrameVectors:
     """Principal vectors about the frame at the given positions (Eq. 30–31)."""
-    (l1, l2, _, l4), (c1, c2, c3) = linkage.lengths, linkage.links
+    (_, l2, _, l4), (c1, c2, c3) = linkage.lengths, linkage.links
     mt = linkage.total_mass
     k14, k34 = frame_coefficients(linkage)
     v4 = -l4  # l̄4 = l4·exp(iπ)
@@ -155,15 +156,19 @@ def total_com_direct(linkage: FourBar, pos: Position) -> NDArray[np.complex128]:
 
 
 def total_com_opened(linkage: FourBar, pos: Position) -> NDArray[np.complex128]:
-    """Total centre of mass from the opened-loop principal vectors, ``r̄S = −(ā'14 + ā21 + ā32)``
-    (Eq. 16 with A0 at the origin), m."""
+    """Total centre of mass from the opened-loop principal vectors (Eq. 16), m.
+
+    ``r̄S = −(ā'14 + ā21 + ā32)`` with A0 at the origin.
+    """
     pv = opened_loop_vectors(linkage, pos)
     return -(pv.a14p + pv.a21 + pv.a32)
 
 
 def total_com_frame(linkage: FourBar, pos: Position) -> NDArray[np.complex128]:
-    """Total centre of mass from the principal vectors about the frame,
-    ``r̄S = −ā14 − ā41 − ā34`` (Eq. 32), m."""
+    """Total centre of mass from the principal vectors about the frame (Eq. 32), m.
+
+    ``r̄S = −ā14 − ā41 − ā34``.
+    """
     pv = frame_vectors(linkage, pos)
     return -pv.a14 - pv.a41 - pv.a34
 

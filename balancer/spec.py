@@ -55,8 +55,10 @@ MECHANISM_TYPES = ("four-bar",)
 
 
 class _Table:
-    """A TOML table being read: typed access by key, with the dotted path for messages, and a
-    check that every key was used."""
+    """A TOML table being read.
+
+    Typed access by key, with the dotted path for messages, and a check that every key was used.
+    """
 
     def __init__(self, data: dict[str, Any], path: str) -> None:
         self.data = data

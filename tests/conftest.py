@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from balancer.kinematics import assembly_range, classify
+from balancer.kinematics import assembly_range
 from balancer.model import FourBar, Link
 
 #: Meijaard & van der Wijk (2020), Eq. 56.

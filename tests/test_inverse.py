@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import CLASS_EXAMPLES, paper_linkage, random_angles, random_linkage, random_link
+from conftest import CLASS_EXAMPLES, paper_linkage, random_angles, random_link, random_linkage
 from helpers import derivative, rel_err
 
 from balancer import inverse
@@ -99,7 +99,7 @@ def test_shaking_force_is_loads_minus_rate_of_linear_momentum(linkage, t, w, a, 
     for t0, w0, a0 in zip(t, w, a, strict=True):
         traj = _trajectory(linkage, t0, w0, a0)
         r = inverse.newton_euler(linkage, traj(0.0), gravity=g)
-        dp = derivative(lambda s: _linear_momentum(linkage, traj(s)))
+        dp = derivative(lambda s, traj=traj: _linear_momentum(linkage, traj(s)))
         loads = sum(c.force_complex + c.mass * complex(*g) for c in linkage.links)
         expected = loads - dp
         assert rel_err(r.shaking_force, expected, scale=max(1.0, abs(expected[0]))) < 1e-9
@@ -110,7 +110,7 @@ def test_total_mass_times_centre_of_mass_acceleration(linkage, t, w, a, g):
     """Linear momentum is m_tot times the velocity of the total centre of mass (Eq. 16/32)."""
     for t0, w0, a0 in zip(t, w, a, strict=True):
         traj = _trajectory(linkage, t0, w0, a0)
-        v_com = derivative(lambda s: mm.total_com_frame(linkage, traj(s).pos))
+        v_com = derivative(lambda s, traj=traj: mm.total_com_frame(linkage, traj(s).pos))
         p = _linear_momentum(linkage, traj(0.0))
         assert rel_err(p, linkage.total_mass * v_com, scale=max(1.0, abs(p[0]))) < 1e-9
 
@@ -122,7 +122,7 @@ def test_shaking_moment_is_load_moment_minus_rate_of_angular_momentum(linkage, t
         traj = _trajectory(linkage, t0, w0, a0)
         mo = traj(0.0)
         r = inverse.newton_euler(linkage, mo, gravity=g)
-        dh = derivative(lambda s: inverse.angular_momentum(linkage, traj(s)))
+        dh = derivative(lambda s, traj=traj: inverse.angular_momentum(linkage, traj(s)))
         coms = mm.link_centres_of_mass(linkage, mo.pos)
         load_moment = sum(
             kin.cross(rk, c.force_complex + c.mass * grav) + c.moment
@@ -142,7 +142,7 @@ def test_driving_torque_power_balances_kinetic_energy(linkage, t, w, a, g):
         traj = _trajectory(linkage, t0, w0, a0)
         mo = traj(0.0)
         r = inverse.newton_euler(linkage, mo, gravity=g)
-        dT = derivative(lambda s: inverse.kinetic_energy(linkage, traj(s)))
+        dT = derivative(lambda s, traj=traj: inverse.kinetic_energy(linkage, traj(s)))
         # Power of the loads and of gravity at the centres of mass.
         vel_a1, vel_a2 = mo.joint_velocities
         joint_vel = (0.0, vel_a1, vel_a2)
