@@ -35,7 +35,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .errors import AssemblyError
-from .kinematics import Motion, assembly_range, cross, motion_of
+from .kinematics import (
+    Motion,
+    assembly_range,
+    change_point_angles,
+    cycle_branch_signs,
+    cross,
+    motion,
+    motion_of,
+)
 from .massmodels import (
     equivalent_inertia_forces,
     equivalent_joint_forces,
@@ -59,17 +67,19 @@ class Reactions:
         Torque of the motor on the crank, N·m (its reaction on the ground is the opposite).
     shaking_moment
         Moment about A0 of everything the mechanism exerts on the ground, N·m.
+    shaking_force
+        ``R̄A0 + R̄A3``, N (computed from them when not given).
     """
 
     RA0: NDArray[np.complex128]
     RA3: NDArray[np.complex128]
     driving_torque: NDArray[np.float64]
     shaking_moment: NDArray[np.float64]
+    shaking_force: NDArray[np.complex128] = None  # type: ignore[assignment]
 
-    @property
-    def shaking_force(self) -> NDArray[np.complex128]:
-        """``R̄A0 + R̄A3``, N."""
-        return self.RA0 + self.RA3
+    def __post_init__(self) -> None:
+        if self.shaking_force is None:
+            object.__setattr__(self, "shaking_force", self.RA0 + self.RA3)
 
 
 def dynamic_link(link: Link) -> Link:
@@ -228,7 +238,9 @@ def mass_matrix(
     a2_pos = mo.pos.A2
     moment = cross(v1, g1) + cross(a2_pos, g2) + cross(complex(l4, 0.0), g3)
     moment = moment + _counter_rotor_moment(linkage, mo)
-    return Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
+    return Reactions(
+        RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment, shaking_force=shaking
+    )
 
 
 _ROUTE_FUNCTIONS = {"newton-euler": newton_euler, "mass-matrix": mass_matrix}
@@ -296,6 +308,8 @@ class Figure:
             mag2 = values.real * values.real + values.imag * values.imag
         else:
             mag2 = values * values
+        if np.isnan(mag2).any():  # unbounded values at change points are left out
+            mag2 = mag2[~np.isnan(mag2)]
         return cls(rms=float(np.sqrt(np.mean(mag2))), max=float(np.sqrt(np.max(mag2))))
 
     def as_dict(self) -> dict[str, float]:
@@ -338,6 +352,8 @@ class CycleAnalysis:
         Ground reactions, driving torque and shaking moment at those angles.
     route
         The inverse-dynamics route used.
+    singular
+        Samples at a change point, where the individual reactions are unbounded (NaN).
     """
 
     linkage: FourBar
@@ -345,6 +361,7 @@ class CycleAnalysis:
     theta1: NDArray[np.float64]
     reactions: Reactions
     route: str
+    singular: NDArray[np.bool_] | None = None
     summary: CycleSummary = field(init=False)
 
     def __post_init__(self) -> None:
@@ -364,7 +381,8 @@ class CycleAnalysis:
     @cached_property
     def motion(self) -> Motion:
         """Kinematics at the sampled angles (computed when first asked for)."""
-        return motion_of(self.linkage, self.theta1, self.speed, 0.0)
+        signs = cycle_branch_signs(self.linkage.lengths, self.linkage.branch, self.theta1)
+        return motion(self.linkage.lengths, self.theta1, self.speed, 0.0, signs, check=True)
 
     @property
     def samples(self) -> int:
@@ -394,7 +412,10 @@ def cycle_analysis(
     """Analyse one crank revolution at constant ``speed`` (rad/s) over ``samples`` angles.
 
     Gravity is not part of a cycle analysis (it belongs to ``[simulation]``); loads are, unless
-    ``loads`` is false.
+    ``loads`` is false. A change-point linkage (parallelogram, deltoid) follows its smooth
+    motion through the positions where all joints are collinear; there the shaking force and
+    moment and the driving torque are the limits of that motion, and the individual reactions,
+    which grow without bound, are NaN and flagged in :attr:`CycleAnalysis.singular`.
 
     Raises
     ------
@@ -410,19 +431,58 @@ def cycle_analysis(
         )
     angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
     n = angles.size
+    signs = cycle_branch_signs(linkage.lengths, linkage.branch, angles)
+
+    def evaluate(theta, sign) -> Reactions:
+        mo = motion(linkage.lengths, theta, speed, 0.0, sign)
+        return inverse_dynamics(linkage, mo, route=route, loads=loads)
+
     # Evaluate in chunks that fit the CPU cache, writing into preallocated arrays: faster, and a
     # fraction of the memory of whole-array temporaries. The kinematics are not kept (the
     # result recomputes them when asked), so a long cycle costs little memory.
-    ra0, ra3 = np.empty(n, complex), np.empty(n, complex)
-    tau, moment = np.empty(n), np.empty(n)
+    out = {
+        "RA0": np.empty(n, complex),
+        "RA3": np.empty(n, complex),
+        "shaking_force": np.empty(n, complex),
+        "driving_torque": np.empty(n),
+        "shaking_moment": np.empty(n),
+    }
     for start in range(0, n, CHUNK):
         sl = slice(start, start + CHUNK)
-        mo = motion_of(linkage, angles[sl], speed, 0.0)
-        r = inverse_dynamics(linkage, mo, route=route, loads=loads)
-        ra0[sl], ra3[sl], tau[sl], moment[sl] = r.RA0, r.RA3, r.driving_torque, r.shaking_moment
-    reactions = Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
+        r = evaluate(angles[sl], signs if isinstance(signs, str) else signs[sl])
+        for name, array in out.items():
+            array[sl] = getattr(r, name)
+    singular = np.zeros(n, bool)
+    # Samples exactly at a change point (all joints collinear, the transfer functions 0/0):
+    # limits of the smooth motion by extrapolation with error O(δ⁴), symmetric at θ1 = π, which
+    # the motion passes through, one-sided at θ1 = 0, where the revolution starts.
+    delta = 1e-4
+    for theta_star in change_point_angles(linkage.lengths):
+        hit = np.abs(np.angle(np.exp(1j * (angles - theta_star)))) < 1e-9
+        if not hit.any():
+            continue
+        if theta_star == 0.0:
+            steps, weights = (1, 2, 3, 4), (4.0, -6.0, 4.0, -1.0)
+        else:
+            steps, weights = (-2, -1, 1, 2), (-1 / 6, 2 / 3, 2 / 3, -1 / 6)
+        parts = []
+        for k in steps:
+            sign = cycle_branch_signs(linkage.lengths, linkage.branch, theta_star + k * delta)
+            parts.append(evaluate(angles[hit] + k * delta, sign))
+        for name in ("shaking_force", "driving_torque", "shaking_moment"):
+            out[name][hit] = sum(
+                w * getattr(p, name) for w, p in zip(weights, parts, strict=True)
+            )
+        out["RA0"][hit] = np.nan
+        out["RA3"][hit] = np.nan
+        singular |= hit
     return CycleAnalysis(
-        linkage=linkage, speed=speed, theta1=angles, reactions=reactions, route=route
+        linkage=linkage,
+        speed=speed,
+        theta1=angles,
+        reactions=Reactions(**out),
+        route=route,
+        singular=singular,
     )
 
 

@@ -273,15 +273,28 @@ def position(
     l1, l2, l3, l4 = lengths
     t = _as_1d(theta1)
     sign = _sign(branch) if isinstance(branch, str) else np.asarray(branch, dtype=float)
-    u1 = np.exp(1j * t)
-    v1 = l1 * u1
+    c_half = np.cos(0.5 * t)
+    s_half = np.sin(0.5 * t)
+    v1 = np.empty(t.shape, complex)  # l̄1 = l1·exp(iθ1), from the half angles
+    v1.real = l1 * (c_half * c_half - s_half * s_half)
+    v1.imag = 2 * l1 * c_half * s_half
     v23 = l4 - v1  # l̄23 = −l̄1 − l̄4, from A1 to A3
     l23 = np.abs(v23)
+    # h23 of Eq. 3 in Heron's form, 4·l23²·h23² = [(l2 + l3)² − l23²]·[l23² − (l2 − l3)²], with
+    # both factors written through half-angles of θ1 so that neither suffers cancellation near
+    # a triangle-inequality bound (where l23 varies only quadratically with θ1 and Eq. 3 as
+    # written loses half the digits of h23):
+    #   (l2 + l3)² − l23² = [(l2 + l3)² − (l1 + l4)²] + 4·l1·l4·cos²(θ1/2)
+    #   l23² − (l2 − l3)² = [(l4 − l1)² − (l2 − l3)²] + 4·l1·l4·sin²(θ1/2)
+    k_far = (l2 + l3 - l1 - l4) * (l2 + l3 + l1 + l4)
+    k_near = (l4 - l1 - l2 + l3) * (l4 - l1 + l2 - l3)
+    far = k_far + 4 * l1 * l4 * c_half * c_half
+    near = k_near + 4 * l1 * l4 * s_half * s_half
     with np.errstate(divide="ignore", invalid="ignore"):
         d23 = (l23 * l23 + l2 * l2 - l3 * l3) / (2 * l23)  # Eq. 3
-        h_sq = l2 * l2 - d23 * d23
-        tol = BOUND_TOLERANCE * 4 * max(l2, l3) ** 2
-        bad = (h_sq < -tol) | (l23 <= BOUND_TOLERANCE * max(l1, l4)) | ~np.isfinite(h_sq)
+        tol = BOUND_TOLERANCE * 4 * (l1 + l2 + l3 + l4) ** 2
+        bad = (far < -tol) | (near < -tol) | (l23 <= BOUND_TOLERANCE * max(l1, l4))
+        bad |= ~np.isfinite(d23)
         if check and bad.any():
             k = int(np.argmax(bad))
             rng = assembly_range(lengths)
@@ -291,7 +304,7 @@ def position(
                 key="theta1",
                 value=float(t[k]),
             )
-        h23 = sign * np.sqrt(np.maximum(h_sq, 0.0))
+        h23 = sign * np.sqrt(np.maximum(far, 0.0) * np.maximum(near, 0.0)) / (2 * l23)
         v2 = (d23 + 1j * h23) * (v23 / l23)  # Eq. 4
     v3 = v23 - v2
     if bad.any():
@@ -487,3 +500,59 @@ def coupler_rates_eq11(
         + l3 * (l1 * s13 + l4 * np.sin(t3)) * w3 * w3
     ) / (l2 * l2)
     return w2, a2
+
+
+# ----------------------------------------------------------------------------------------------
+# Change points: where the two assemblies meet and the motion can pass from one to the other
+
+
+def change_point_angles(lengths: Lengths, rtol: float = BOUND_TOLERANCE) -> tuple[float, ...]:
+    """Crank angles in ``[0, 2π)`` at which all four joints are collinear while the crank turns.
+
+    In a change-point linkage (s + l = p + q) the two assemblies meet at θ1 = 0 and/or π and a
+    motion through such a position can continue on either; elsewhere they never meet while the
+    crank turns.
+    """
+    c_lo, c_hi = cosine_bounds(lengths)
+    tol = 4 * rtol
+    out = []
+    if abs(c_hi - 1) <= tol:
+        out.append(0.0)
+    if abs(c_lo + 1) <= tol:
+        out.append(math.pi)
+    return tuple(out)
+
+
+def smooth_continuation_flips(
+    lengths: Lengths, theta_star: float, sign: float, delta: float = 1e-5
+) -> bool:
+    """Whether the smooth motion through the change point ``theta_star`` changes branch sign.
+
+    The motion follows the analytic continuation of the path it is on: the assembly after the
+    change point whose transfer function Θ2 continues the one before it.
+    """
+    before = position(lengths, theta_star - delta, sign)
+    big_before = transfer_functions(before)[0][0]
+    after_same = transfer_functions(position(lengths, theta_star + delta, sign))[0][0]
+    after_flip = transfer_functions(position(lengths, theta_star + delta, -sign))[0][0]
+    return abs(after_flip - big_before) < abs(after_same - big_before)
+
+
+def cycle_branch_signs(
+    lengths: Lengths, branch: str, theta1: ArrayLike
+) -> NDArray[np.float64] | str:
+    """Assembly sign at each crank angle of a smooth revolution.
+
+    For most linkages this is just ``branch``. For a change-point linkage the given branch
+    holds on the arc after θ1 = 0 and the sign changes where the smooth motion passes from one
+    assembly to the other (the parallelogram stays a parallelogram through its flat positions).
+    """
+    points = change_point_angles(lengths)
+    if not points:
+        return branch
+    t = np.mod(_as_1d(theta1), 2 * math.pi)
+    sign = _sign(branch)
+    signs = np.full(t.shape, sign)
+    if math.pi in points and smooth_continuation_flips(lengths, math.pi, sign):
+        signs[t > math.pi] = -sign
+    return signs

@@ -44,7 +44,11 @@ def table(rows: Sequence[Sequence[str]], header: Sequence[str]) -> str:
 
 
 def reaction_extremes(values: np.ndarray) -> dict[str, float]:
-    """Magnitude maximum and component extremes of a complex force history, N."""
+    """Magnitude maximum and component extremes of a complex force history, N.
+
+    Unbounded values (NaN, at the change points of a change-point linkage) are left out.
+    """
+    values = values[~np.isnan(values)]
     return {
         "max": float(np.max(np.abs(values))),
         "x_min": float(np.min(values.real)),
@@ -86,6 +90,7 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
                 "A0": reaction_extremes(analysis.reactions.RA0),
                 "A3": reaction_extremes(analysis.reactions.RA3),
             },
+            "change_points": _change_points(analysis),
             "units": {
                 "force": "N",
                 "moment": "N·m",
@@ -95,6 +100,13 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
         }
     )
     return doc
+
+
+def _change_points(analysis: CycleAnalysis) -> list[float]:
+    """Sampled crank angles (rad) at which the individual reactions are unbounded."""
+    if analysis.singular is None:
+        return []
+    return [float(t) for t in analysis.theta1[analysis.singular]]
 
 
 def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
@@ -132,6 +144,15 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
         table(rows, ["reaction (N)", "|R| max", "Rx min", "Rx max", "Ry min", "Ry max"])
     )
     lines.append("")
+    points = _change_points(analysis)
+    if points:
+        where = ", ".join(f"{math.degrees(t):g}°" for t in points)
+        lines += [
+            f"change point at θ1 = {where}: all joints collinear; the individual reactions are "
+            "unbounded there and left out of their extremes (shaking force, moment and torque "
+            "are the limits of the smooth motion)",
+            "",
+        ]
     err = force_balance_error(linkage)
     if is_force_balanced(linkage):
         lines.append(f"force-balanced: yes (Eq. 57 residual {err:.2e} of the total mass)")

@@ -218,3 +218,54 @@ def test_speed_scaling_without_loads(paper):
     b = inverse.cycle_analysis(free, 6.0, 90)
     assert rel_err(b.reactions.RA0, 4 * a.reactions.RA0) < 1e-13
     assert rel_err(b.reactions.shaking_moment, 4 * a.reactions.shaking_moment) < 1e-13
+
+
+def test_parallelogram_cycle_passes_its_change_points_smoothly():
+    """A parallelogram (change-point linkage) stays a parallelogram through θ1 = 0 and π.
+
+    Independent route: its motion is known in closed form (coupler translates, θ3 = θ1 + π),
+    so the shaking force is ω²·e^{iθ1}·(m1·ζ1·l1 + m2·l1 − m3·(ζ3 − 1)·l3) and the shaking
+    moment is minus the rate of the closed-form angular momentum.
+    """
+    from balancer.model import Link
+
+    l1, l2 = 1.0, 2.0
+    crank = Link(mass=1.0, inertia=0.1, e=0.4, f=0.1)
+    coupler = Link(mass=2.0, inertia=0.5, e=1.1, f=0.2)
+    rocker = Link(mass=1.5, inertia=0.2, e=0.3, f=-0.1)
+    linkage = FourBar(lengths=(l1, l2, l1, l2), branch="+", crank=crank, coupler=coupler,
+                      rocker=rocker)
+    speed = 7.0
+    ca = inverse.cycle_analysis(linkage, speed, 72)
+    th = ca.theta1
+    # At the change points (θ1 = 0, π) the individual reactions are unbounded: flagged, NaN.
+    at_change = np.isclose(np.cos(th) ** 2, 1.0, rtol=0, atol=1e-15)
+    assert np.array_equal(ca.singular, at_change) and at_change.sum() == 2
+    assert np.all(np.isnan(ca.reactions.RA0[at_change]))
+    assert np.all(np.isfinite(ca.reactions.RA0[~at_change]))
+    for name in ("shaking_force", "shaking_moment", "driving_torque"):
+        assert np.all(np.isfinite(getattr(ca.reactions, name)))
+        assert np.isfinite(getattr(ca.summary, name).rms)
+    # Constant kinetic energy: no driving torque (to the extrapolation error at θ1 = 0).
+    assert abs(ca.reactions.driving_torque).max() < 1e-10 * abs(ca.reactions.shaking_moment).max()
+    mo = ca.motion
+    assert np.max(np.abs(np.sin(mo.theta[1]))) < 1e-12  # coupler parallel to the frame
+    z1, z3 = crank.com / l1, rocker.com / l1
+    u = np.exp(1j * th)
+    force = speed**2 * u * (crank.mass * z1 * l1 + coupler.mass * l1 - rocker.mass * (z3 - 1) * l1)
+    assert rel_err(ca.reactions.shaking_force, force) < 1e-9
+
+    def momentum(t):
+        w = speed
+        e = np.exp(1j * (th + w * t))
+        r1, v1 = z1 * l1 * e, 1j * w * z1 * l1 * e
+        r2, v2 = l1 * e + coupler.com, 1j * w * l1 * e
+        r3 = l2 + (z3 - 1) * (-l1 * e)
+        v3 = (z3 - 1) * (-1j * w * l1 * e)
+        return (crank.inertia * w + crank.mass * kin.cross(r1, v1) + coupler.mass
+                * kin.cross(r2, v2) + rocker.inertia * w + rocker.mass * kin.cross(r3, v3))
+
+    moment = -derivative(momentum)
+    assert rel_err(ca.reactions.shaking_moment, moment) < 1e-9
+    other = inverse.cycle_analysis(linkage, speed, 72, route="mass-matrix")
+    assert rel_err(other.reactions.shaking_moment, moment) < 1e-9
