@@ -39,10 +39,9 @@ from .kinematics import (
     Motion,
     assembly_range,
     change_point_angles,
-    cycle_branch_signs,
     cross,
+    cycle_branch_signs,
     motion,
-    motion_of,
 )
 from .massmodels import (
     equivalent_inertia_forces,
