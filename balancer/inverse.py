@@ -184,6 +184,33 @@ def newton_euler(
     return Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
 
 
+def _combine_nodal_forces(mo: Motion, nodes, l4: float) -> Reactions:
+    """Reactions from nodal forces ``G_n`` at A0…A3 by length-keeping virtual displacements.
+
+    The counter-rotors' gear reaction on the ground is not included.
+    """
+    g0, g1, g2, g3 = nodes
+    v1, v2, v3 = mo.vectors
+    big3 = mo.transfer[1]
+    # Crank rotation δθ1 = 1: δA1 = i·l̄1, δA2 = −i·l̄3·Θ3;  ⟨i·x, G⟩ = x × G.
+    tau = -(cross(v1, g1) - big3 * cross(v3, g2))
+    shaking = g0 + g1 + g2 + g3  # translation of everything (Eq. 59)
+    ra3 = g3 + v3 * cross(v2, g2) / cross(v2, v3)  # A3 moved, A0 and A1 held
+    ra0 = shaking - ra3
+    moment = cross(v1, g1) + cross(mo.pos.A2, g2) + l4 * g3.imag  # rotation about A0
+    return Reactions(
+        RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment, shaking_force=shaking
+    )
+
+
+def _inertial_nodal_forces(params, lengths, mo: Motion, k: int):
+    """Nodal inertia forces ``−(Me·r̈)`` of link ``k`` (0-based) at its two joints (Eq. 45)."""
+    acc_a1, acc_a2 = mo.joint_accelerations
+    node_acc = (0.0, acc_a1, acc_a2, 0.0)
+    ip, iq = equivalent_inertia_forces(params, lengths[k], node_acc[k], node_acc[k + 1])
+    return -ip, -iq
+
+
 def mass_matrix(
     linkage: FourBar,
     mo: Motion,
@@ -204,15 +231,9 @@ def mass_matrix(
     """
     g = complex(*gravity)
     forces = _applied_forces(linkage, g, loads)
-    l1, l2, l3, l4 = linkage.lengths
-    lengths = (l1, l2, l3)
-    v1, v2, v3 = mo.vectors
-    acc_a1, acc_a2 = mo.joint_accelerations
-    node_acc = (0.0, acc_a1, acc_a2, 0.0)
-    vectors = (v1, v2, v3)
+    lengths = linkage.lengths[:3]
     nodes: list = [0j, 0j, 0j, 0j]
     for k, link in enumerate(linkage.links):
-        p, q = k, k + 1
         loaded = Link(
             mass=link.mass,
             inertia=link.inertia,
@@ -221,25 +242,105 @@ def mass_matrix(
             force=(forces[k].real, forces[k].imag),
             moment=link.moment if loads else 0.0,
         )
-        fp, fq = equivalent_joint_forces(loaded, lengths[k], vectors[k])
-        ip, iq = equivalent_inertia_forces(
-            inertial_parameters(dynamic_link(link)), lengths[k], node_acc[p], node_acc[q]
+        fp, fq = equivalent_joint_forces(loaded, lengths[k], mo.vectors[k])
+        ip, iq = _inertial_nodal_forces(
+            inertial_parameters(dynamic_link(link)), lengths, mo, k
         )
-        nodes[p] = nodes[p] + fp - ip
-        nodes[q] = nodes[q] + fq - iq
-    g0, g1, g2, g3 = nodes
-    big3 = mo.transfer[1]
-    # Crank rotation δθ1 = 1: δA1 = i·l̄1, δA2 = −i·l̄3·Θ3;  ⟨i·x, G⟩ = x × G.
-    tau = -(cross(v1, g1) - big3 * cross(v3, g2))
-    shaking = g0 + g1 + g2 + g3
-    ra3 = g3 + v3 * cross(v2, g2) / cross(v2, v3)
-    ra0 = shaking - ra3
-    a2_pos = mo.pos.A2
-    moment = cross(v1, g1) + cross(a2_pos, g2) + cross(complex(l4, 0.0), g3)
-    moment = moment + _counter_rotor_moment(linkage, mo)
-    return Reactions(
-        RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment, shaking_force=shaking
-    )
+        nodes[k] = nodes[k] + fp + ip
+        nodes[k + 1] = nodes[k + 1] + fq + iq
+    r = _combine_nodal_forces(mo, nodes, linkage.lengths[3])
+    cr = _counter_rotor_moment(linkage, mo)
+    if np.any(cr):
+        r = Reactions(
+            RA0=r.RA0,
+            RA3=r.RA3,
+            driving_torque=r.driving_torque,
+            shaking_moment=r.shaking_moment + cr,
+            shaking_force=r.shaking_force,
+        )
+    return r
+
+
+#: Names of the design variables of :func:`regressors`, in order.
+PARAMETER_NAMES: tuple[str, ...] = (
+    "m1", "m1e1", "m1f1", "J1",
+    "m2", "m2e2", "m2f2", "J2",
+    "m3", "m3e3", "m3f3", "J3",
+    "Jc1", "Jc3",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Regressors:
+    """Linear maps from the inertial parameters to what the linkage does to its frame.
+
+    For a prescribed motion every reaction is linear in ``x`` (:data:`PARAMETER_NAMES`): per
+    link ``(m, m·e, m·f, J)`` with ``J = I + m·s²`` about its first joint (kg, kg·m, kg·m,
+    kg·m²), then the counter-rotor inertias of crank and rocker (kg·m²). Each attribute is an
+    ``(N, 14)`` matrix: e.g. the shaking moment at state ``j`` is ``shaking_moment[j] @ x``.
+    Applied loads are not included (a force at a centre of mass that moves is not linear in
+    ``x``); gravity is, when given.
+    """
+
+    RA0: NDArray[np.complex128]
+    RA3: NDArray[np.complex128]
+    shaking_force: NDArray[np.complex128]
+    driving_torque: NDArray[np.float64]
+    shaking_moment: NDArray[np.float64]
+
+
+def parameter_vector(linkage: FourBar) -> NDArray[np.float64]:
+    """The design vector ``x`` of :class:`Regressors` for a four-bar."""
+    values = [v for link in linkage.links for v in inertial_parameters(link)]
+    values += [linkage.crank.counter_rotor, linkage.rocker.counter_rotor]
+    return np.array(values, dtype=float)
+
+
+def regressors(
+    lengths: tuple[float, float, float, float],
+    mo: Motion,
+    *,
+    gravity: tuple[float, float] = (0.0, 0.0),
+) -> Regressors:
+    """The linear maps of :class:`Regressors` by the mass-matrix route (Eq. 45–54).
+
+    Column ``i`` is the mass-matrix route evaluated with the unit vector ``eᵢ`` as inertial
+    parameters; the route is linear in them, so the columns are exact.
+    """
+    n = mo.size
+    g = complex(*gravity)
+    cols: dict[str, list] = {name: [] for name in ("RA0", "RA3", "shaking_force",
+                                                   "driving_torque", "shaking_moment")}
+    zero = np.zeros(n, complex)
+    for k in range(3):
+        for i in range(4):
+            params = [0.0, 0.0, 0.0, 0.0]
+            params[i] = 1.0
+            nodes: list = [zero, zero, zero, zero]
+            ip, iq = _inertial_nodal_forces(tuple(params), lengths[:3], mo, k)
+            if g != 0 and i < 3:
+                # Weight m·g at the centre of mass (Eq. 46): (m − conj(m·ζ))·g at p, conj(m·ζ)·g
+                # at q, with m·ζ = (m·e + i·m·f)/l.
+                m_zeta = (params[1] + 1j * params[2]) / lengths[k]
+                ip = ip + (params[0] - np.conj(m_zeta)) * g
+                iq = iq + np.conj(m_zeta) * g
+            nodes[k] = nodes[k] + ip
+            nodes[k + 1] = nodes[k + 1] + iq
+            r = _combine_nodal_forces(mo, nodes, lengths[3])
+            for name in cols:
+                cols[name].append(np.broadcast_to(getattr(r, name), (n,)))
+    for k in (0, 2):  # counter-rotors: inertia on the link, reaction 2·J·α on the ground
+        nodes = [zero, zero, zero, zero]
+        ip, iq = _inertial_nodal_forces((0.0, 0.0, 0.0, 1.0), lengths[:3], mo, k)
+        nodes[k] = nodes[k] + ip
+        nodes[k + 1] = nodes[k + 1] + iq
+        r = _combine_nodal_forces(mo, nodes, lengths[3])
+        for name in cols:
+            value = getattr(r, name)
+            if name == "shaking_moment":
+                value = value + 2.0 * mo.alpha[k]
+            cols[name].append(np.broadcast_to(value, (n,)))
+    return Regressors(**{name: np.column_stack(c) for name, c in cols.items()})
 
 
 _ROUTE_FUNCTIONS = {"newton-euler": newton_euler, "mass-matrix": mass_matrix}
