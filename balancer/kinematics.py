@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from enum import StrEnum
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -243,6 +243,21 @@ def _as_1d(x: ArrayLike) -> NDArray[np.float64]:
     return a.reshape(-1) if a.ndim else a.reshape(1)
 
 
+@lru_cache(maxsize=256)
+def _heron_constants(lengths: Lengths) -> tuple[float, float]:
+    """``(l2 + l3)² − (l1 + l4)²`` and ``(l4 − l1)² − (l2 − l3)²`` of the Heron form of Eq. 3.
+
+    One of them is zero exactly for a change-point linkage: it is set to zero when it is within
+    the classification tolerance, so that rounding in the lengths' sums (0.25 + 0.1 − 0.1 −
+    0.25 ≠ 0 in floating point) does not spoil the positions near the change point.
+    """
+    l1, l2, l3, l4 = lengths
+    k_far = ((l2 - l1) + (l3 - l4)) * (l2 + l3 + l1 + l4)
+    k_near = ((l4 - l1) + (l3 - l2)) * ((l4 - l1) + (l2 - l3))
+    tol = 4 * BOUND_TOLERANCE * (l1 + l2 + l3 + l4) ** 2
+    return (0.0 if abs(k_far) <= tol else k_far), (0.0 if abs(k_near) <= tol else k_near)
+
+
 def position(
     lengths: Lengths,
     theta1: ArrayLike,
@@ -286,8 +301,7 @@ def position(
     # written loses half the digits of h23):
     #   (l2 + l3)² − l23² = [(l2 + l3)² − (l1 + l4)²] + 4·l1·l4·cos²(θ1/2)
     #   l23² − (l2 − l3)² = [(l4 − l1)² − (l2 − l3)²] + 4·l1·l4·sin²(θ1/2)
-    k_far = (l2 + l3 - l1 - l4) * (l2 + l3 + l1 + l4)
-    k_near = (l4 - l1 - l2 + l3) * (l4 - l1 + l2 - l3)
+    k_far, k_near = _heron_constants(lengths)
     far = k_far + 4 * l1 * l4 * c_half * c_half
     near = k_near + 4 * l1 * l4 * s_half * s_half
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -506,6 +520,7 @@ def coupler_rates_eq11(
 # Change points: where the two assemblies meet and the motion can pass from one to the other
 
 
+@lru_cache(maxsize=256)
 def change_point_angles(lengths: Lengths, rtol: float = BOUND_TOLERANCE) -> tuple[float, ...]:
     """Crank angles in ``[0, 2π)`` at which all four joints are collinear while the crank turns.
 
@@ -523,36 +538,148 @@ def change_point_angles(lengths: Lengths, rtol: float = BOUND_TOLERANCE) -> tupl
     return tuple(out)
 
 
+@lru_cache(maxsize=256)
 def smooth_continuation_flips(
     lengths: Lengths, theta_star: float, sign: float, delta: float = 1e-5
 ) -> bool:
     """Whether the smooth motion through the change point ``theta_star`` changes branch sign.
 
-    The motion follows the analytic continuation of the path it is on: the assembly after the
-    change point whose transfer function Θ2 continues the one before it.
+    The motion, arriving with increasing θ1 on the assembly ``sign``, follows the analytic
+    continuation of its path: the assembly after the change point whose transfer function Θ2
+    continues the one before it.
     """
     before = position(lengths, theta_star - delta, sign)
     big_before = transfer_functions(before)[0][0]
     after_same = transfer_functions(position(lengths, theta_star + delta, sign))[0][0]
     after_flip = transfer_functions(position(lengths, theta_star + delta, -sign))[0][0]
-    return abs(after_flip - big_before) < abs(after_same - big_before)
+    return bool(abs(after_flip - big_before) < abs(after_same - big_before))
+
+
+def branch_sign_along(
+    lengths: Lengths, sign0: float, theta0: float, theta1: ArrayLike
+) -> NDArray[np.float64] | float:
+    """Assembly sign of the smooth motion at crank angle(s) ``theta1`` (unwrapped, rad).
+
+    The motion is on assembly ``sign0`` at ``theta0`` and moves continuously in θ1; for a
+    change-point linkage the sign changes at each change point it passes where the smooth
+    continuation switches assembly (the parallelogram stays a parallelogram). Any other linkage
+    keeps ``sign0``. ``theta0`` should not itself be a change point.
+    """
+    points = change_point_angles(lengths)
+    if not points:
+        return sign0
+    t = np.asarray(theta1, dtype=float)
+    flips = 0
+    for theta_star in points:
+        flip_plus = smooth_continuation_flips(lengths, theta_star, 1.0)
+        flip_minus = smooth_continuation_flips(lengths, theta_star, -1.0)
+        if flip_plus != flip_minus:  # never seen; be explicit rather than wrong
+            raise NotImplementedError("a change point whose continuation depends on the branch")
+        if flip_plus:
+            # Number of points θ* + 2πn passed between θ0 and θ1.
+            k0 = np.floor((theta0 - theta_star) / (2 * math.pi))
+            k1 = np.floor((t - theta_star) / (2 * math.pi))
+            flips = flips + np.abs(k1 - k0)
+    signs = sign0 * np.where(np.mod(flips, 2) == 1, -1.0, 1.0)
+    return signs if np.ndim(signs) else float(signs)
 
 
 def cycle_branch_signs(
     lengths: Lengths, branch: str, theta1: ArrayLike
 ) -> NDArray[np.float64] | str:
-    """Assembly sign at each crank angle of a smooth revolution.
+    """Assembly sign at each crank angle of a smooth revolution θ1 ∈ [0, 2π).
 
     For most linkages this is just ``branch``. For a change-point linkage the given branch
-    holds on the arc after θ1 = 0 and the sign changes where the smooth motion passes from one
-    assembly to the other (the parallelogram stays a parallelogram through its flat positions).
+    holds just after θ1 = 0 and the sign changes where the smooth motion passes from one
+    assembly to the other.
     """
-    points = change_point_angles(lengths)
-    if not points:
+    if not change_point_angles(lengths):
         return branch
     t = np.mod(_as_1d(theta1), 2 * math.pi)
-    sign = _sign(branch)
-    signs = np.full(t.shape, sign)
-    if math.pi in points and smooth_continuation_flips(lengths, math.pi, sign):
-        signs[t > math.pi] = -sign
-    return signs
+    return np.asarray(branch_sign_along(lengths, _sign(branch), 1e-9, t), dtype=float) * np.ones(
+        t.shape
+    )
+
+
+def motion_from_angles(
+    lengths: Lengths,
+    theta: tuple[ArrayLike, ArrayLike, ArrayLike],
+    omega: tuple[ArrayLike, ArrayLike, ArrayLike],
+    alpha: tuple[ArrayLike, ArrayLike, ArrayLike],
+) -> Motion:
+    """A :class:`Motion` from given link angles, rates and accelerations (no loop solve).
+
+    For states that come from a simulation, which carries all three angles; the loop closure is
+    whatever the state satisfies.
+    """
+    l1, l2, l3, _ = lengths
+    th = [_as_1d(x) for x in theta]
+    n = max(x.size for x in th)
+    th = [np.broadcast_to(x, (n,)) for x in th]
+    vectors = [length * np.exp(1j * x) for length, x in zip((l1, l2, l3), th, strict=True)]
+    s_mu = cross(vectors[1], vectors[2]) / (l2 * l3)
+    pos = Position(
+        lengths=lengths,
+        theta1=np.array(th[0], dtype=float),
+        l1=vectors[0],
+        l2=vectors[1],
+        l3=vectors[2],
+        singular=np.abs(s_mu) < SINGULAR_TOLERANCE,
+    )
+    big = transfer_functions(pos)
+    om = tuple(np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in omega)
+    al = tuple(np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in alpha)
+    return Motion(pos=pos, omega=om, alpha=al, transfer=big)  # type: ignore[arg-type]
+
+
+# ----------------------------------------------------------------------------------------------
+# One state at a time: the same equations for Python scalars, for the integrators' right-hand
+# sides (numpy's per-call overhead on size-1 arrays would dominate). Tested against the
+# vectorised functions above.
+
+
+def position_scalar(lengths: Lengths, theta1: float, sign: float) -> tuple[complex, complex, complex]:
+    """Link vectors ``(l̄1, l̄2, l̄3)`` at one crank angle (Eq. 2–4, as :func:`position`).
+
+    Raises
+    ------
+    ValueError
+        If the linkage cannot be assembled at ``theta1``.
+    """
+    l1, l2, l3, l4 = lengths
+    c_half = math.cos(0.5 * theta1)
+    s_half = math.sin(0.5 * theta1)
+    v1 = complex(l1 * (c_half * c_half - s_half * s_half), 2 * l1 * c_half * s_half)
+    v23 = l4 - v1
+    l23 = abs(v23)
+    k_far, k_near = _heron_constants(lengths)
+    far = k_far + 4 * l1 * l4 * c_half * c_half
+    near = k_near + 4 * l1 * l4 * s_half * s_half
+    tol = BOUND_TOLERANCE * 4 * (l1 + l2 + l3 + l4) ** 2
+    if far < -tol or near < -tol or l23 == 0.0:
+        raise ValueError(f"the linkage cannot be assembled at θ1 = {theta1!r} rad")
+    d23 = (l23 * l23 + l2 * l2 - l3 * l3) / (2 * l23)
+    h23 = sign * math.sqrt(max(far, 0.0) * max(near, 0.0)) / (2 * l23)
+    v2 = complex(d23, h23) * (v23 / l23)
+    return v1, v2, v23 - v2
+
+
+def rates_scalar(
+    lengths: Lengths, vectors: tuple[complex, complex, complex], omega1: float
+) -> tuple[float, float, float, float, float, float]:
+    """Transfer functions and velocity terms at one state (Eq. 7, 9–10, as the vectorised ones).
+
+    Returns ``(Θ2, Θ3, θ̇2, θ̇3, b2, b3)`` with ``θ̈k = Θk·θ̈1 + bk``.
+    """
+    _, l2, l3, _ = lengths
+    v1, v2, v3 = vectors
+    c23 = v2.real * v3.imag - v2.imag * v3.real  # l̄2 × l̄3
+    big2 = (v3.real * v1.imag - v3.imag * v1.real) / c23  # −(l̄3 × l̄1)/(l̄3 × l̄2)
+    big3 = -(v2.real * v1.imag - v2.imag * v1.real) / c23
+    w2, w3 = big2 * omega1, big3 * omega1
+    w1s, w2s, w3s = omega1 * omega1, w2 * w2, w3 * w3
+    b2 = ((v3.real * v1.real + v3.imag * v1.imag) * w1s
+          + (v3.real * v2.real + v3.imag * v2.imag) * w2s + l3 * l3 * w3s) / c23
+    b3 = -((v2.real * v1.real + v2.imag * v1.imag) * w1s + l2 * l2 * w2s
+           + (v2.real * v3.real + v2.imag * v3.imag) * w3s) / c23
+    return big2, big3, w2, w3, b2, b3

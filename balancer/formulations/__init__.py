@@ -1,0 +1,200 @@
+"""Forward dynamics of the four-bar in four formulations that must agree.
+
+=================  ==================================================  =========================
+name               formulation                                         state
+=================  ==================================================  =========================
+``opened-loop``    principal vectors, loop opened at A3 (Meijaard &     θ1, θ2, θ3, θ̇1, θ̇2, θ̇3
+                   van der Wijk 2020, Eq. 22–28): five linear
+                   equations for θ̈1..3 and R̄A3, R̄A0 from Eq. 28
+``complex-masses`` complex joint masses, closed loop (Eq. 36–40),     θ1, θ̇1
+                   reduced to one equation in θ1
+``mass-matrix``    constant equivalent mass matrices, truss elements   r̄A1, r̄A2 and their rates
+                   (Eq. 41–55): Cartesian joint coordinates with
+                   length constraints, reactions from Eq. 52–54
+``lie-group``      attitude vectors on the rotation group, reduced     Π1, q_A, q_B, q_D
+                   to Hamiltonian form without multipliers (Bai, Xia
+                   & Ge 2024, Eq. 82–85)
+=================  ==================================================  =========================
+
+Each is a :class:`Formulation`: it turns a state into its time derivative and evaluates the link
+angles, rates, accelerations and the ground reactions at a state. The crank either moves freely
+under the loads and gravity, or a motor on the ground holds it at constant speed; then the last
+state component is the motor's work ``∫τ·θ̇1 dt`` and the driving torque is reported.
+The integration itself (tolerances, projection of the non-minimal states, events, outputs) is
+:mod:`balancer.simulate`.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..inverse import dynamic_link
+from ..kinematics import branch_sign_along, change_point_angles, position_scalar, rates_scalar
+from ..model import FourBar
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """What a formulation says about one state.
+
+    Attributes
+    ----------
+    theta, omega, alpha
+        Angles (rad), angular velocities (rad/s) and accelerations (rad/s²) of links 1–3.
+    RA0, RA3
+        Forces of the mechanism on the ground at A0 and A3, complex ``x + i·y``, N.
+    driving_torque
+        Torque of the motor on the crank, N·m (zero in free motion).
+    """
+
+    theta: NDArray[np.float64]
+    omega: NDArray[np.float64]
+    alpha: NDArray[np.float64]
+    RA0: complex
+    RA3: complex
+    driving_torque: float = 0.0
+
+
+class Formulation(ABC):
+    """Equations of motion of a four-bar in one formulation.
+
+    Parameters
+    ----------
+    linkage
+        The four-bar (its counter-rotors add to the inertia of crank and rocker).
+    gravity
+        Gravitational acceleration ``(gx, gy)``, m/s².
+    speed
+        ``None`` for free motion; otherwise the constant crank speed (rad/s) a motor holds.
+    """
+
+    #: Name used by ``--method``.
+    name: ClassVar[str]
+    #: Whether the state is minimal (one coordinate and its rate): no constraints can drift.
+    minimal: ClassVar[bool]
+
+    def __init__(
+        self,
+        linkage: FourBar,
+        *,
+        gravity: tuple[float, float] = (0.0, 0.0),
+        speed: float | None = None,
+    ) -> None:
+        self.linkage = linkage
+        self.gravity = complex(*gravity)
+        self.speed = speed
+        self.lengths = linkage.lengths
+        #: Links as the dynamics see them (counter-rotor inertia added).
+        self.links = tuple(dynamic_link(link) for link in linkage.links)
+        #: Applied force on each link at its centre of mass, weight included, N.
+        self.forces = tuple(link.force_complex + link.mass * self.gravity for link in linkage.links)
+        #: Applied moment on each link, N·m.
+        self.moments = tuple(link.moment for link in linkage.links)
+        self.mass = tuple(link.mass for link in linkage.links)
+        self.total_mass = sum(self.mass)
+        #: Centres of mass as fractions of the link vectors, ``ζk = s̄k/lk``.
+        self.zeta = tuple(
+            link.com / length for link, length in zip(linkage.links, self.lengths, strict=False)
+        )
+        self.theta1_start = 0.0
+        self.sign0 = 1.0 if linkage.branch == "+" else -1.0
+
+    @property
+    def driven(self) -> bool:
+        """Whether a motor holds the crank at constant speed."""
+        return self.speed is not None
+
+    def crank_angle(self, t: float) -> float:
+        """Prescribed crank angle at time ``t`` (driven motion), rad."""
+        assert self.speed is not None
+        return self.theta1_start + self.speed * t
+
+    @abstractmethod
+    def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
+        """The state with the crank at ``theta1`` (rad) turning at ``omega1`` (rad/s) at t = 0."""
+
+    @abstractmethod
+    def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Time derivative of the state."""
+
+    @abstractmethod
+    def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
+        """Angles, rates, accelerations and reactions at a state."""
+
+    @abstractmethod
+    def transmission(self, t: float, y: NDArray[np.float64]) -> float:
+        """``sin(θ3 − θ2)``: zero where coupler and rocker are aligned (a dead point of the crank
+        or a change point).
+        """
+
+    def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
+        """Crank angle at a state, rad."""
+        if self.driven:
+            return self.crank_angle(t)
+        return float(self.evaluate(t, y).theta[0])
+
+    def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Put a state back on the constraint manifold (identity for minimal formulations)."""
+        return y
+
+    def near_change_point(self, theta1: float, width: float = 0.1) -> bool:
+        """Whether the crank angle (rad) is within ``width`` of a change point of the linkage.
+
+        There all joints become collinear, the loop-closure Jacobian loses rank and the two
+        assemblies cross: a least-norm projection cannot tell them apart, so the non-minimal
+        formulations project onto the assembly of the smooth motion instead
+        (:meth:`branch_vectors`).
+        """
+        points = change_point_angles(self.lengths)
+        return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < width for p in points)
+
+    def branch_vectors(self, theta1: float, omega1: float):
+        """Link vectors and the dependent rates ``(l̄1, l̄2, l̄3), θ̇2, θ̇3`` on the assembly the
+        smooth motion is on at crank angle ``theta1`` (unwrapped, rad) (Eq. 2–7).
+        """
+        sign = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
+        vectors = position_scalar(self.lengths, theta1, float(sign))
+        _, _, w2, w3, _, _ = rates_scalar(self.lengths, vectors, omega1)
+        return vectors, w2, w3
+
+    def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
+        """Loop-closure residuals of a state: position (m) and velocity (m/s)."""
+        return 0.0, 0.0
+
+    def motor_work(self, y: NDArray[np.float64]) -> float:
+        """Work done by the motor since t = 0, J (zero in free motion)."""
+        return float(y[-1]) if self.driven else 0.0
+
+
+def formulation_class(name: str) -> type[Formulation]:
+    """The formulation called ``name`` (see :data:`balancer.model.METHODS`)."""
+    import importlib
+
+    modules = {
+        "opened-loop": ("opened_loop", "OpenedLoop"),
+        "complex-masses": ("complex_masses", "ComplexMasses"),
+        "mass-matrix": ("mass_matrix", "MassMatrix"),
+        "lie-group": ("lie_group", "LieGroup"),
+    }
+    try:
+        module, cls = modules[name]
+    except KeyError:
+        raise ValueError(f"unknown formulation {name!r}; choose from {sorted(modules)}") from None
+    return getattr(importlib.import_module(f".{module}", __name__), cls)
+
+
+def make(
+    name: str,
+    linkage: FourBar,
+    *,
+    gravity: tuple[float, float] = (0.0, 0.0),
+    speed: float | None = None,
+) -> Formulation:
+    """Instantiate the formulation called ``name``."""
+    return formulation_class(name)(linkage, gravity=gravity, speed=speed)

@@ -1,0 +1,1 @@
+"""Balancing optimisers (placeholder while building)."""

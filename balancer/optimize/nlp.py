@@ -1,0 +1,242 @@
+"""Nonlinear balancing in the designer's own parameters (CasADi + IPOPT).
+
+Decision vector (scaled; only what may change): per link, in the order crank, coupler, rocker,
+``m/m_ref`` (kg), ``e/l`` and ``f/l`` (centre of mass in the link frame, m), ``I/(m_ref·l²)``
+(inertia about the centre of mass, kg·m²); then the counter-rotor inertias of crank and rocker
+over their link's ``m_ref·l²`` (kg·m²). Fixed quantities are constants; inert ones (see
+:attr:`balancer.problem.NumericProblem.inert`) are left out and settled afterwards.
+
+The objective is the same ``J`` as the convex problem's, written through the inertial
+parameters ``π(p) = (m, m·e, m·f, I + m·(e² + f²))`` (:func:`balancer.problem.physical_to_inertial`)
+and the factor ``R`` of the mass-matrix regressors (Eq. 45–54): ``J = ‖R·π‖² + w_m·Δm``.
+Constraints: force balance (Eq. 58, bilinear equalities), the centre of mass in its disc
+``(e − c)² + f² ≤ R²``, ``I ≥ m·ρ²``, and simple bounds — an upper inertia bound is exact here,
+which is where this formulation can beat the convex relaxation.
+
+IPOPT is built once per problem (:class:`NlpSolver`) and warm-started from the convex optimum.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from ..problem import NumericProblem, inertial_to_physical, physical_to_inertial
+from .result import StageReport
+
+#: IPOPT's options, in one place: quiet, tight, warm-started.
+IPOPT_OPTIONS: dict[str, object] = {
+    "print_time": False,
+    "ipopt.print_level": 0,
+    "ipopt.sb": "yes",
+    "ipopt.tol": 1e-12,
+    "ipopt.acceptable_tol": 1e-9,
+    "ipopt.constr_viol_tol": 1e-12,
+    "ipopt.max_iter": 300,
+    "ipopt.warm_start_init_point": "yes",
+    "ipopt.warm_start_bound_push": 1e-9,
+    "ipopt.warm_start_bound_frac": 1e-9,
+    "ipopt.warm_start_slack_bound_push": 1e-9,
+    "ipopt.warm_start_slack_bound_frac": 1e-9,
+    "ipopt.warm_start_mult_bound_push": 1e-9,
+    "ipopt.mu_init": 1e-6,
+}
+
+_CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+_INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed")
+
+
+@dataclass(frozen=True, kw_only=True)
+class NlpSolution:
+    """IPOPT's answer.
+
+    Attributes
+    ----------
+    x
+        Design vector (inert entries settled).
+    objective
+        ``J(x)``, (N·m)².
+    status
+        ``"optimal"`` (IPOPT converged: a local optimum), ``"infeasible"`` or ``"failed"``.
+    feasible
+        Whether ``x`` meets every bound and force balance (checked, not taken from IPOPT).
+    stage
+        The solver run.
+    """
+
+    x: NDArray[np.float64]
+    objective: float
+    status: str
+    feasible: bool
+    stage: StageReport
+
+
+class NlpSolver:
+    """The balancing NLP of a redesign problem, built once and solved from given starts.
+
+    Parameters
+    ----------
+    data
+        The numeric problem.
+    options
+        IPOPT/CasADi options to override :data:`IPOPT_OPTIONS`.
+    """
+
+    def __init__(self, data: NumericProblem, *, options: dict | None = None) -> None:
+        self.data = data
+        self.options = {**IPOPT_OPTIONS, **(options or {})}
+        self._names: list[tuple[int, str]] = []  # (link index or entry, kind) per variable
+        lbx: list[float] = []
+        ubx: list[float] = []
+        parts = []
+        symbols = []
+        g: list = []
+        lbg: list[float] = []
+        ubg: list[float] = []
+        varying: set[int] = set()  # entries of x[:12] that can change
+
+        def variable(name: str, lo: float, hi: float, tag: tuple[int, str]):
+            s = ca.SX.sym(name)
+            symbols.append(s)
+            lbx.append(lo)
+            ubx.append(hi)
+            self._names.append(tag)
+            return s
+
+        for b in data.links:
+            k, mref, l, iref = 4 * b.index, b.mass_ref, b.length, b.inertia_ref
+            if b.mass[0] < b.mass[1]:
+                m = mref * variable(f"m{b.index}", b.mass[0] / mref, b.mass[1] / mref,
+                                    (b.index, "m"))
+                varying.update((k, k + 1, k + 2))
+            else:
+                m = b.mass[0]
+            if b.com_fixed is None:
+                c, r = b.com_centre / l, b.com_radius / l
+                e = l * variable(f"e{b.index}", c - r, c + r, (b.index, "e"))
+                f = l * variable(f"f{b.index}", -r, r, (b.index, "f"))
+                g.append((e / l - c) ** 2 + (f / l) ** 2)
+                lbg.append(-math.inf)
+                ubg.append(r * r)
+                varying.update((k + 1, k + 2))
+            else:
+                e, f = b.com_fixed.real, b.com_fixed.imag
+            if data.inert[k + 3] or b.inertia_fixed:
+                inertia = b.original.inertia if data.inert[k + 3] else b.inertia[0]
+            else:
+                inertia = iref * variable(
+                    f"I{b.index}", b.inertia[0] / iref, b.inertia[1] / iref, (b.index, "I")
+                )
+                if b.gyration > 0 and b.mass[0] < b.mass[1]:
+                    g.append((inertia - m * b.gyration**2) / iref)
+                    lbg.append(0.0)
+                    ubg.append(math.inf)
+                elif b.gyration > 0:
+                    lbx[-1] = max(lbx[-1], b.mass[0] * b.gyration**2 / iref)
+            parts += list(physical_to_inertial(m, e, f, inertia))
+        for entry, b in ((12, data.links[0]), (13, data.links[2])):
+            assert b.counter_rotor is not None
+            lo, hi = b.counter_rotor
+            scale = data.scales[entry]
+            if data.inert[entry] or lo == hi:
+                parts.append(lo)
+            else:
+                parts.append(scale * variable(f"Jc{entry}", lo / scale, hi / scale, (entry, "Jc")))
+        pi = ca.vertcat(*parts)
+        if data.force_balance is not None:
+            a, rhs = data.force_balance
+            mtot = data.original_mass
+            residual = (ca.mtimes(ca.DM(a), pi[:12]) - ca.DM(rhs)) / mtot
+            for i in range(a.shape[0]):
+                if any(a[i, j] != 0 for j in varying):
+                    g.append(residual[i])
+                    lbg.append(0.0)
+                    ubg.append(0.0)
+        scale = data.objective_scale
+        value = 0
+        if data.factor.shape[0]:
+            r = ca.mtimes(ca.DM(data.factor / scale), pi)
+            value = ca.sumsqr(r)
+        if data.weights.added_mass:
+            value = value + data.weights.added_mass / scale**2 * (
+                pi[0] + pi[4] + pi[8] - data.original_mass
+            )
+        v = ca.vertcat(*symbols)
+        self._pi = ca.Function("pi", [v], [pi])
+        self._lbx = np.array(lbx)
+        self._ubx = np.array(ubx)
+        self._lbg = np.array(lbg)
+        self._ubg = np.array(ubg)
+        self._solver = ca.nlpsol(
+            "balance", "ipopt", {"x": v, "f": value, "g": ca.vertcat(*g)}, self.options
+        )
+
+    @property
+    def size(self) -> int:
+        """Number of decision variables."""
+        return len(self._names)
+
+    def start(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The scaled decision vector for design vector ``x``, clipped into the bounds."""
+        data = self.data
+        physical = [inertial_to_physical(x[4 * i : 4 * i + 4]) for i in range(3)]
+        out = []
+        for index, kind in self._names:
+            if kind == "Jc":
+                out.append(x[index] / data.scales[index])
+                continue
+            b = data.links[index]
+            m, e, f, inertia = physical[index]
+            out.append(
+                {"m": m / b.mass_ref, "e": e / b.length, "f": f / b.length,
+                 "I": inertia / b.inertia_ref}[kind]
+            )
+        v = np.clip(np.array(out, float), self._lbx, self._ubx)
+        for i, (index, kind) in enumerate(self._names):  # pull the centre of mass into its disc
+            if kind == "e":
+                b = data.links[index]
+                c, r = b.com_centre / b.length, b.com_radius / b.length
+                d = math.hypot(v[i] - c, v[i + 1])
+                if d > r:
+                    v[i] = c + (v[i] - c) * r / d
+                    v[i + 1] *= r / d
+        return v
+
+    def design(self, v: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The design vector ``x`` of a scaled decision vector (inert entries settled)."""
+        return self.data.settle(np.array(self._pi(v)).ravel())
+
+    def solve(self, x_start: NDArray[np.float64]) -> NlpSolution:
+        """Run IPOPT from design vector ``x_start`` (normally the convex optimum)."""
+        data = self.data
+        v0 = self.start(np.asarray(x_start, float))
+        t0 = time.perf_counter()
+        sol = self._solver(
+            x0=v0, lbx=self._lbx, ubx=self._ubx, lbg=self._lbg, ubg=self._ubg
+        )
+        elapsed = time.perf_counter() - t0
+        stats = self._solver.stats()
+        word = str(stats.get("return_status", "unknown"))
+        x = self.design(np.array(sol["x"]).ravel())
+        feasible = not data.violations(x)
+        if word in _CONVERGED:
+            status = "optimal"
+        elif word in _INFEASIBLE:
+            status = "infeasible"
+        else:
+            status = "failed"
+        objective = data.objective(x)
+        stage = StageReport(
+            name="nlp",
+            converged=word in _CONVERGED,
+            solver_status=word,
+            iterations=int(stats.get("iter_count", 0)),
+            time=elapsed,
+            objective=objective,
+        )
+        return NlpSolution(x=x, objective=objective, status=status, feasible=feasible, stage=stage)

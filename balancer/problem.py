@@ -1,0 +1,858 @@
+"""The redesign problem: which links may change, within which bounds, and what to minimise.
+
+A design spec's ``[balance]`` section describes it::
+
+    [balance]
+    force_balance = true          # exact shaking-force balance (Eq. 57–58) as constraints
+    [balance.objective]           # J = w_M·mean(Msh²) + w_τ·mean(τ²) + w_F·mean(|F̄sh|²)
+    shaking_moment = 1.0          #     + w_m·(total mass − original total mass)
+    driving_torque = 0.0          # w_τ, (N·m)²/(N·m)²
+    shaking_force = 0.0           # w_F, (N·m)²/N² (useful only with force_balance = false)
+    added_mass = 0.0              # w_m, (N·m)²/kg
+    [balance.crank]               # a link listed here may change; links not listed stay fixed
+    mass = [2.1, 8.4]             # kg: a range, or one number that fixes the mass;
+                                  #     absent: fixed at the spec's value
+    com_radius = 1.0              # m: centre of mass anywhere within this distance of
+                                  #     com_about; absent: the centre of mass stays where it is
+    com_about = "A0"              # a joint of this link; default crank A0, coupler A1, rocker A3
+    min_gyration = 0.1            # m: inertia about the centre of mass I ≥ m·ρ²
+    inertia = [0.5, 2.0]          # kg·m² about the centre of mass: a range, or one number that
+                                  #     fixes it (see below)
+    counter_rotor = [0.0, 20.0]   # kg·m²: a range or one number (crank and rocker only);
+                                  #     absent: fixed at the spec's counter_rotor
+
+The inertia about the centre of mass ``I`` is free (``I ≥ m·ρ²``, ``ρ`` = ``min_gyration``,
+default 0) when the mass or the centre of mass may change or ``min_gyration`` is given; when the
+mass and the centre of mass are fixed and ``min_gyration`` is absent it stays at the spec's
+value. ``inertia`` (our addition to the schema) bounds or fixes it explicitly, for a part whose
+inertia is given although its mass or centre of mass may move; it combines with
+``min_gyration``. The objective is evaluated at ``[operation] speed`` over ``[operation]
+samples`` equally spaced crank angles ``θ1 = 2π·j/N``.
+
+**Inertial balancing only.** With the crank at constant speed every reaction, the shaking force,
+the shaking moment about A0 and the driving torque are linear in the inertial parameters
+``x = (m1, m1e1, m1f1, J1, m2, m2e2, m2f2, J2, m3, m3e3, m3f3, J3, Jc1, Jc3)``
+(:data:`balancer.inverse.PARAMETER_NAMES`; ``J = I + m·(e² + f²)`` about the link's first joint,
+``Jc`` the counter-rotor inertias). Applied loads are not (a force at a centre of mass that the
+redesign moves), so the redesign balances the **inertial** shaking; the loads stay on the links
+of the balanced design as they were.
+
+Two halves:
+
+- the spec side, :class:`BalanceProblem` (with :class:`Objective` and one :class:`LinkFreedom`
+  per listed link), read by :func:`read_balance` and written back exactly by
+  :func:`balance_lines`;
+- the numeric side, :class:`NumericProblem` from :func:`numeric_problem`: regressor matrices
+  (mass-matrix route, Eq. 45–54), per-link bounds (:class:`LinkBounds`), the force-balance
+  equations (Eq. 58), the objective, and the feasibility check that the optimisers in
+  :mod:`balancer.optimize` and the tests rely on.
+
+This module imports neither CVXPY nor CasADi.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .conditions import force_balance_matrix
+from .errors import AssemblyError, SpecError
+from .inverse import Regressors, parameter_vector, regressors, sample_angles
+from .kinematics import assembly_range, change_point_angles, cycle_branch_signs, motion
+from .model import Design, FourBar, Link
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .spec import _Table
+
+#: Joints of each moving link, first then second (Meijaard & van der Wijk 2020, Fig. 1).
+JOINTS: dict[str, tuple[str, str]] = {
+    "crank": ("A0", "A1"),
+    "coupler": ("A1", "A2"),
+    "rocker": ("A2", "A3"),
+}
+#: The joint ``com_radius`` is measured from when ``com_about`` is absent: the ground pivot of
+#: crank and rocker, the crank pin of the coupler.
+DEFAULT_ABOUT: dict[str, str] = {"crank": "A0", "coupler": "A1", "rocker": "A3"}
+
+_BALANCE_KEYS = ("force_balance", "objective", "crank", "coupler", "rocker")
+_OBJECTIVE_KEYS = ("shaking_moment", "driving_torque", "shaking_force", "added_mass")
+_LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "counter_rotor")
+
+#: Relative tolerance of :meth:`NumericProblem.violations` (bounds and Eq. 57).
+FEASIBILITY_TOLERANCE = 1e-9
+
+
+# ----------------------------------------------------------------------------------------------
+# The spec side
+
+
+@dataclass(frozen=True, kw_only=True)
+class Objective:
+    """Weights of the objective ``J`` (see the module docstring).
+
+    ``J = w_M·mean(Msh²) + w_τ·mean(τ²) + w_F·mean(|F̄sh|²) + w_m·(Σm − Σm_original)``, in
+    (N·m)², over the sampled crank angles.
+
+    Attributes
+    ----------
+    shaking_moment
+        ``w_M``, dimensionless.
+    driving_torque
+        ``w_τ``, (N·m)²/(N·m)².
+    shaking_force
+        ``w_F``, (N·m)²/N² (zero at every design when force balance is imposed).
+    added_mass
+        ``w_m``, (N·m)²/kg: penalises mass added to the linkage.
+    """
+
+    shaking_moment: float = 1.0
+    driving_torque: float = 0.0
+    shaking_force: float = 0.0
+    added_mass: float = 0.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class LinkFreedom:
+    """What may change on one link, as written in ``[balance.<link>]``.
+
+    Attributes
+    ----------
+    mass
+        ``(low, high)`` mass range, kg (equal ends fix the mass); ``None``: fixed at the spec's.
+    com_radius
+        The centre of mass may lie anywhere within this distance of ``com_about``, m;
+        ``None``: the centre of mass stays where the spec has it.
+    com_about
+        Joint of this link the radius is measured from (``None``: :data:`DEFAULT_ABOUT`).
+    min_gyration
+        Least radius of gyration about the centre of mass ``ρ`` (``I ≥ m·ρ²``), m.
+    inertia
+        ``(low, high)`` range of the inertia about the centre of mass, kg·m² (equal ends fix
+        it); ``None``: the default rule of the module docstring.
+    counter_rotor
+        ``(low, high)`` range of the counter-rotor inertia, kg·m² (crank and rocker only);
+        ``None``: fixed at the spec's ``counter_rotor``.
+    """
+
+    mass: tuple[float, float] | None = None
+    com_radius: float | None = None
+    com_about: str | None = None
+    min_gyration: float | None = None
+    inertia: tuple[float, float] | None = None
+    counter_rotor: tuple[float, float] | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class BalanceProblem:
+    """The redesign problem of a spec's ``[balance]`` section.
+
+    Attributes
+    ----------
+    force_balance
+        Impose exact shaking-force balance (Eq. 57–58) as equality constraints.
+    objective
+        Weights of the objective.
+    crank, coupler, rocker
+        What may change on each link; ``None``: the link stays as it is.
+    """
+
+    force_balance: bool = True
+    objective: Objective = field(default_factory=Objective)
+    crank: LinkFreedom | None = None
+    coupler: LinkFreedom | None = None
+    rocker: LinkFreedom | None = None
+
+    def link(self, name: str) -> LinkFreedom | None:
+        """The freedom of link ``name``, or ``None`` if it is not listed."""
+        if name not in JOINTS:
+            raise KeyError(name)
+        return getattr(self, name)
+
+
+def _check_keys(table: _Table, known: tuple[str, ...]) -> None:
+    """Reject unknown keys first, with a suggestion for a typo."""
+    for name in table.data:
+        if name not in known:
+            close = difflib.get_close_matches(name, known, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise SpecError(f"unknown key '{name}'{hint}", key=table.key(name))
+
+
+def _read_range(
+    table: _Table, name: str, *, positive: bool, unit: str
+) -> tuple[float, float] | None:
+    """A number (fixes the value) or a list ``[low, high]``; ``None`` if absent."""
+    if not table.has(name):
+        return None
+    key = table.key(name)
+    value = table.raw(name)
+    if isinstance(value, list):
+        if len(value) != 2:
+            raise SpecError(
+                f"must be a number or a range [low, high] in {unit}", key=key, value=value
+            )
+        items = value
+    else:
+        items = [value, value]
+    bounds = []
+    for item in items:
+        if isinstance(item, bool) or not isinstance(item, int | float):
+            raise SpecError(
+                f"must be a number or a range [low, high] in {unit}", key=key, value=value
+            )
+        x = float(item)
+        if not math.isfinite(x):
+            raise SpecError("must be finite", key=key, value=value)
+        if positive and x <= 0:
+            raise SpecError("bounds must be positive", key=key, value=value)
+        if x < 0:
+            raise SpecError("bounds must be zero or positive", key=key, value=value)
+        bounds.append(x)
+    lo, hi = bounds
+    if lo > hi:
+        raise SpecError("the lower bound exceeds the upper bound", key=key, value=value)
+    return (lo, hi)
+
+
+def _read_link_freedom(table: _Table) -> LinkFreedom:
+    _check_keys(table, _LINK_KEYS)
+    com_about = None
+    if table.has("com_about"):
+        com_about = table.string("com_about", choices=("A0", "A1", "A2", "A3"))
+    freedom = LinkFreedom(
+        mass=_read_range(table, "mass", positive=True, unit="kg"),
+        com_radius=table.nonnegative("com_radius") if table.has("com_radius") else None,
+        com_about=com_about,
+        min_gyration=table.nonnegative("min_gyration") if table.has("min_gyration") else None,
+        inertia=_read_range(table, "inertia", positive=False, unit="kg·m²"),
+        counter_rotor=_read_range(table, "counter_rotor", positive=False, unit="kg·m²"),
+    )
+    table.finish()
+    return freedom
+
+
+def read_balance(table: _Table, mechanism: FourBar) -> BalanceProblem:
+    """Read and validate a spec's ``[balance]`` table (called by :mod:`balancer.spec`).
+
+    Parameters
+    ----------
+    table
+        The ``[balance]`` table being read.
+    mechanism
+        The spec's linkage, for the values of what stays fixed.
+
+    Raises
+    ------
+    SpecError
+        Naming the key and value at fault (see :func:`check_problem`).
+    """
+    _check_keys(table, _BALANCE_KEYS)
+    force_balance = True
+    if table.has("force_balance"):
+        value = table.raw("force_balance")
+        if not isinstance(value, bool):
+            raise SpecError(
+                "must be true or false", key=table.key("force_balance"), value=value
+            )
+        force_balance = value
+    objective = Objective()
+    sub = table.table("objective", required=False)
+    if sub is not None:
+        _check_keys(sub, _OBJECTIVE_KEYS)
+        objective = Objective(
+            **{name: sub.nonnegative(name, default=getattr(objective, name))
+               for name in _OBJECTIVE_KEYS}
+        )
+        sub.finish()
+    links: dict[str, LinkFreedom] = {}
+    for name in JOINTS:
+        sub = table.table(name, required=False)
+        if sub is not None:
+            links[name] = _read_link_freedom(sub)
+    table.finish()
+    problem = BalanceProblem(force_balance=force_balance, objective=objective, **links)
+    check_problem(problem, mechanism)
+    return problem
+
+
+def _link_is_free(name: str, freedom: LinkFreedom, link: Link) -> bool:
+    """Whether anything about the link may vary (not just be set to another fixed value)."""
+    b = resolve_link(name, freedom, link, 1.0)
+    return (
+        b.mass[0] < b.mass[1]
+        or b.com_radius is not None
+        or b.inertia[0] < b.inertia[1]
+        or (b.counter_rotor is not None and b.counter_rotor[0] < b.counter_rotor[1])
+    )
+
+
+def check_problem(problem: BalanceProblem, mechanism: FourBar) -> None:
+    """Raise :class:`SpecError` on a contradictory or impossible redesign problem.
+
+    Checks what one key alone cannot: a joint that is not on the link, a counter-rotor on the
+    coupler, a least radius of gyration that no allowed inertia meets, a zero objective, a
+    problem in which nothing may change. (Whether force balance can be met within the bounds
+    is the optimiser's question; see :mod:`balancer.optimize`.)
+    """
+    w = problem.objective
+    weights = (w.shaking_moment, w.driving_torque, w.shaking_force, w.added_mass)
+    if any(x < 0 for x in weights):
+        raise SpecError("weights must be zero or positive", key="balance.objective")
+    if not any(weights):
+        raise SpecError(
+            "every weight is zero: there is nothing to minimise", key="balance.objective"
+        )
+    for name in JOINTS:
+        freedom = problem.link(name)
+        if freedom is None:
+            continue
+        key = f"balance.{name}"
+        if freedom.com_about is not None:
+            if freedom.com_about not in JOINTS[name]:
+                joints = " or ".join(JOINTS[name])
+                raise SpecError(
+                    f"must be a joint of the {name} ({joints})",
+                    key=f"{key}.com_about",
+                    value=freedom.com_about,
+                )
+            if freedom.com_radius is None:
+                raise SpecError(
+                    "com_about needs com_radius (without it the centre of mass is fixed)",
+                    key=f"{key}.com_about",
+                    value=freedom.com_about,
+                )
+        if freedom.counter_rotor is not None and name not in FourBar.grounded_links:
+            raise SpecError(
+                "a counter-rotor sits on a ground pivot: only the crank and the rocker can "
+                "have one",
+                key=f"{key}.counter_rotor",
+                value=list(freedom.counter_rotor),
+            )
+        length = mechanism.lengths[list(JOINTS).index(name)]
+        bounds = resolve_link(name, freedom, mechanism.link(name), length)
+        rho = bounds.gyration
+        least = bounds.mass[0] * rho * rho
+        if least > bounds.inertia[1]:
+            raise SpecError(
+                f"needs an inertia about the centre of mass of at least m·ρ² = {least:.6g} "
+                f"kg·m² at the least mass, more than the {bounds.inertia[1]:.6g} kg·m² "
+                f"allowed" + (f" by {key}.inertia" if freedom.inertia is not None else ""),
+                key=f"{key}.min_gyration",
+                value=freedom.min_gyration,
+            )
+    if not any(
+        problem.link(n) is not None and _link_is_free(n, problem.link(n), mechanism.link(n))
+        for n in JOINTS
+    ):
+        raise SpecError(
+            "nothing may change: give a link a mass range, com_radius, min_gyration, an "
+            "inertia range or a counter_rotor range",
+            key="balance",
+        )
+
+
+def _num(x: float) -> str:
+    """Shortest text that reads back to the same float (``repr``)."""
+    return repr(float(x))
+
+
+def _range_text(bounds: tuple[float, float]) -> str:
+    lo, hi = bounds
+    return _num(lo) if lo == hi else f"[{_num(lo)}, {_num(hi)}]"
+
+
+def balance_lines(problem: BalanceProblem) -> list[str]:
+    """The problem as TOML lines that :func:`read_balance` reads back to an equal problem."""
+    w = problem.objective
+    lines = [
+        "[balance]",
+        f"force_balance = {'true' if problem.force_balance else 'false'}",
+        "",
+        "[balance.objective]  # J = mean(Msh²) + w_tau·mean(tau²) + w_force·mean(|Fsh|²)"
+        " + w_mass·Δmass",
+        f"shaking_moment = {_num(w.shaking_moment)}",
+        f"driving_torque = {_num(w.driving_torque)}  # (N·m)²/(N·m)²",
+        f"shaking_force = {_num(w.shaking_force)}  # (N·m)²/N²",
+        f"added_mass = {_num(w.added_mass)}  # (N·m)²/kg",
+    ]
+    for name in JOINTS:
+        freedom = problem.link(name)
+        if freedom is None:
+            continue
+        lines += ["", f"[balance.{name}]"]
+        if freedom.mass is not None:
+            lines.append(f"mass = {_range_text(freedom.mass)}  # kg")
+        if freedom.com_radius is not None:
+            lines.append(f"com_radius = {_num(freedom.com_radius)}  # m")
+        if freedom.com_about is not None:
+            lines.append(f'com_about = "{freedom.com_about}"')
+        if freedom.min_gyration is not None:
+            lines.append(f"min_gyration = {_num(freedom.min_gyration)}  # m")
+        if freedom.inertia is not None:
+            lines.append(f"inertia = {_range_text(freedom.inertia)}  # kg·m² about the COM")
+        if freedom.counter_rotor is not None:
+            lines.append(f"counter_rotor = {_range_text(freedom.counter_rotor)}  # kg·m²")
+    return lines
+
+
+# ----------------------------------------------------------------------------------------------
+# The numeric side
+
+
+@dataclass(frozen=True, kw_only=True)
+class LinkBounds:
+    """The resolved bounds of one link (every default applied).
+
+    Attributes
+    ----------
+    name
+        ``"crank"``, ``"coupler"`` or ``"rocker"``.
+    index
+        0, 1 or 2 (the link's block of four in the design vector ``x``).
+    length
+        ``lk``, m.
+    original
+        The link as the spec has it.
+    listed
+        Whether the link appears in ``[balance]``.
+    mass
+        ``(low, high)``, kg; ``high`` already includes the cap ``I_high/ρ²`` implied by the
+        inertia bounds.
+    com_fixed
+        ``s̄ = e + i·f`` when the centre of mass cannot move, m; else ``None``.
+    com_centre
+        Position of ``com_about`` along the link from the first joint (0 or ``l``), m.
+    com_radius
+        Radius of the disc the centre of mass must stay in, m (``None``: fixed).
+    inertia
+        ``(low, high)`` inertia about the centre of mass, kg·m² (``high`` may be ``inf``).
+    gyration
+        Least radius of gyration ``ρ``, m.
+    counter_rotor
+        ``(low, high)``, kg·m², or ``None`` (the coupler has none).
+    """
+
+    name: str
+    index: int
+    length: float
+    original: Link
+    listed: bool
+    mass: tuple[float, float]
+    com_fixed: complex | None
+    com_centre: float
+    com_radius: float | None
+    inertia: tuple[float, float]
+    gyration: float
+    counter_rotor: tuple[float, float] | None
+
+    @property
+    def key(self) -> str:
+        """Spec key of the link's table, ``balance.<name>``."""
+        return f"balance.{self.name}"
+
+    @property
+    def about(self) -> str:
+        """Name of the joint at :attr:`com_centre`."""
+        first, second = JOINTS[self.name]
+        return first if self.com_centre == 0.0 else second
+
+    @property
+    def inertia_fixed(self) -> bool:
+        """Whether the inertia about the centre of mass is fixed."""
+        return self.inertia[0] == self.inertia[1]
+
+    @property
+    def mass_ref(self) -> float:
+        """Mass scale, kg."""
+        return self.original.mass
+
+    @property
+    def inertia_ref(self) -> float:
+        """Inertia scale ``m·l²``, kg·m²."""
+        return self.original.mass * self.length**2
+
+
+def resolve_link(name: str, freedom: LinkFreedom | None, link: Link, length: float) -> LinkBounds:
+    """Apply the defaults of the module docstring to one link's freedom."""
+    first, second = JOINTS[name]
+    index = list(JOINTS).index(name)
+    rotor = (link.counter_rotor, link.counter_rotor) if name in FourBar.grounded_links else None
+    if freedom is None:
+        return LinkBounds(
+            name=name, index=index, length=length, original=link, listed=False,
+            mass=(link.mass, link.mass), com_fixed=link.com, com_centre=0.0, com_radius=None,
+            inertia=(link.inertia, link.inertia), gyration=0.0, counter_rotor=rotor,
+        )  # fmt: skip
+    mass = freedom.mass if freedom.mass is not None else (link.mass, link.mass)
+    about = freedom.com_about or DEFAULT_ABOUT[name]
+    centre = 0.0 if about == first else length
+    com_fixed: complex | None = None
+    radius = freedom.com_radius
+    if radius is None:
+        com_fixed = link.com
+    elif radius == 0.0:
+        com_fixed = complex(centre, 0.0)
+        radius = None
+    rho = freedom.min_gyration or 0.0
+    if freedom.inertia is not None:
+        inertia = freedom.inertia
+    elif mass[0] < mass[1] or freedom.com_radius is not None or freedom.min_gyration is not None:
+        inertia = (0.0, math.inf)
+    else:
+        inertia = (link.inertia, link.inertia)
+    if rho > 0 and math.isfinite(inertia[1]):
+        mass = (mass[0], min(mass[1], inertia[1] / rho**2))
+    if name in FourBar.grounded_links and freedom.counter_rotor is not None:
+        rotor = freedom.counter_rotor
+    return LinkBounds(
+        name=name, index=index, length=length, original=link, listed=True, mass=mass,
+        com_fixed=com_fixed, com_centre=centre, com_radius=radius, inertia=inertia,
+        gyration=rho, counter_rotor=rotor,
+    )  # fmt: skip
+
+
+def physical_to_inertial(m, e, f, inertia):
+    """Inertial parameters ``(m, m·e, m·f, J)`` from ``m``, ``e``, ``f``, ``I``.
+
+    ``J = I + m·(e² + f²)`` is the inertia about the first joint. Works on floats, numpy arrays
+    and CasADi symbols alike (the NLP writes its objective through it).
+    """
+    return m, m * e, m * f, inertia + m * (e * e + f * f)
+
+
+def inertial_to_physical(params) -> tuple[float, float, float, float]:
+    """``(m, e, f, I)`` from inertial parameters ``(m, m·e, m·f, J)`` (inverse of the above)."""
+    m, me, mf, j = (float(p) for p in params)
+    e, f = me / m, mf / m
+    return m, e, f, j - m * (e * e + f * f)
+
+
+def _cycle_regressors(linkage: FourBar, speed: float, angles: NDArray[np.float64]) -> Regressors:
+    """Regressors over a revolution, as :func:`balancer.inverse.cycle_analysis` samples it.
+
+    A change-point linkage follows its smooth motion (branch signs from
+    :func:`~balancer.kinematics.cycle_branch_signs`); at a sample exactly at a change point the
+    rows of shaking force, shaking moment and driving torque are the limits of that motion,
+    extrapolated as ``cycle_analysis`` does (error O(δ⁴)); the rows of the individual
+    reactions, unbounded there, are NaN.
+    """
+    lengths = linkage.lengths
+    n = angles.size
+    hit = np.zeros(n, bool)
+    points = change_point_angles(lengths)
+    for theta_star in points:
+        hit |= np.abs(np.angle(np.exp(1j * (angles - theta_star)))) < 1e-9
+
+    def evaluate(theta: NDArray[np.float64]) -> Regressors:
+        signs = cycle_branch_signs(lengths, linkage.branch, theta)
+        return regressors(lengths, motion(lengths, theta, speed, 0.0, signs))
+
+    regular = evaluate(angles[~hit]) if (~hit).any() else None
+    out = {
+        "RA0": np.full((n, 14), np.nan, complex),
+        "RA3": np.full((n, 14), np.nan, complex),
+        "shaking_force": np.empty((n, 14), complex),
+        "driving_torque": np.empty((n, 14)),
+        "shaking_moment": np.empty((n, 14)),
+    }
+    if regular is not None:
+        for name, array in out.items():
+            array[~hit] = getattr(regular, name)
+    delta = 1e-4
+    for theta_star in points:
+        here = np.abs(np.angle(np.exp(1j * (angles - theta_star)))) < 1e-9
+        if not here.any():
+            continue
+        if theta_star == 0.0:
+            steps, weights = (1, 2, 3, 4), (4.0, -6.0, 4.0, -1.0)
+        else:
+            steps, weights = (-2, -1, 1, 2), (-1 / 6, 2 / 3, 2 / 3, -1 / 6)
+        parts = [evaluate(angles[here] + k * delta) for k in steps]
+        for name in ("shaking_force", "driving_torque", "shaking_moment"):
+            out[name][here] = sum(
+                w * getattr(p, name) for w, p in zip(weights, parts, strict=True)
+            )
+    return Regressors(**out)
+
+
+@dataclass(frozen=True, kw_only=True)
+class NumericProblem:
+    """The redesign problem in numbers, built once by :func:`numeric_problem`.
+
+    The objective is ``J(x) = ‖K·x‖² + w_m·(Σm − Σm_original)`` with ``K`` the weighted
+    regressor rows (shaking moment, driving torque, shaking force) divided by ``√N``;
+    :attr:`factor` ``R`` (from a QR factorisation of ``K``) has ``‖R·x‖ = ‖K·x‖`` and only 14
+    columns' worth of rows, which is what the optimisers use.
+
+    Attributes
+    ----------
+    problem
+        The spec-side problem.
+    linkage
+        The original design.
+    speed
+        Crank speed, rad/s.
+    theta1
+        Sampled crank angles, rad.
+    regressors
+        ``(N, 14)`` linear maps of :func:`balancer.inverse.regressors` at those angles.
+    links
+        Resolved bounds of crank, coupler and rocker.
+    x0
+        Design vector of the original linkage.
+    rows
+        ``K`` above, ``(rows, 14)``, N·m.
+    factor
+        ``R`` above, upper triangular, N·m.
+    force_balance
+        ``(A, b)`` of Eq. 58 on the first twelve entries of ``x`` (``A·x[:12] = b``), or
+        ``None`` when force balance is not imposed.
+    inert
+        Entries of ``x`` (inertias about the first joint, counter-rotors) that change nothing
+        the objective measures: their regressor columns vanish (the crank's at constant speed:
+        ``α1 = 0``). The optimisers leave them out; :meth:`settle` then gives them the value
+        nearest the original's that the bounds allow.
+    """
+
+    problem: BalanceProblem
+    linkage: FourBar
+    speed: float
+    theta1: NDArray[np.float64]
+    regressors: Regressors
+    links: tuple[LinkBounds, LinkBounds, LinkBounds]
+    x0: NDArray[np.float64]
+    rows: NDArray[np.float64]
+    factor: NDArray[np.float64]
+    force_balance: tuple[NDArray[np.float64], NDArray[np.float64]] | None
+    inert: tuple[bool, ...]
+
+    @property
+    def samples(self) -> int:
+        """Number of sampled crank angles ``N``."""
+        return self.theta1.size
+
+    @property
+    def weights(self) -> Objective:
+        """The objective's weights."""
+        return self.problem.objective
+
+    @cached_property
+    def original_mass(self) -> float:
+        """Total mass of the original moving links, kg."""
+        return self.linkage.total_mass
+
+    @cached_property
+    def scales(self) -> NDArray[np.float64]:
+        """Typical magnitude of each entry of ``x`` (m, m·l, m·l, m·l² per link; counter-rotors
+        like their link's ``m·l²``), for scaling the optimisers' variables.
+        """
+        out = np.empty(14)
+        for b in self.links:
+            m, l = b.mass_ref, b.length
+            out[4 * b.index : 4 * b.index + 4] = (m, m * l, m * l, m * l * l)
+        out[12] = self.links[0].inertia_ref
+        out[13] = self.links[2].inertia_ref
+        return out
+
+    def quadratic(self, x: NDArray[np.float64]) -> float:
+        """``‖K·x‖²``: the weighted mean squares, (N·m)²."""
+        r = self.rows @ x
+        return float(r @ r)
+
+    def objective(self, x: NDArray[np.float64]) -> float:
+        """``J(x)`` from the full regressor matrices, (N·m)² (see the module docstring)."""
+        w = self.weights
+        reg = self.regressors
+        total = 0.0
+        if w.shaking_moment:
+            total += w.shaking_moment * float(np.mean((reg.shaking_moment @ x) ** 2))
+        if w.driving_torque:
+            total += w.driving_torque * float(np.mean((reg.driving_torque @ x) ** 2))
+        if w.shaking_force:
+            force = reg.shaking_force @ x
+            total += w.shaking_force * float(np.mean(force.real**2 + force.imag**2))
+        if w.added_mass:
+            total += w.added_mass * (float(x[0] + x[4] + x[8]) - self.original_mass)
+        return total
+
+    @cached_property
+    def original_objective(self) -> float:
+        """``J`` of the original design, (N·m)²."""
+        return self.objective(self.x0)
+
+    @cached_property
+    def objective_scale(self) -> float:
+        """``‖K·x0‖``, or a fallback when it vanishes: the scale of ``√J``, N·m."""
+        value = math.sqrt(self.quadratic(self.x0))
+        if value > 0:
+            return value
+        fallback = float(np.linalg.norm(self.factor) * np.linalg.norm(self.x0))
+        return fallback if fallback > 0 else 1.0
+
+    def settle(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Give the :attr:`inert` entries the value nearest the original's that is allowed.
+
+        An inert inertia keeps the original inertia about the centre of mass, clipped to
+        ``[max(I_low, m·ρ²), I_high]``; an inert counter-rotor keeps its original inertia,
+        clipped to its range. Nothing the objective or a constraint measures changes.
+        """
+        x = np.array(x, dtype=float)
+        for b in self.links:
+            k = 4 * b.index
+            if not self.inert[k + 3]:
+                continue
+            m, me, mf = x[k], x[k + 1], x[k + 2]
+            lo = max(b.inertia[0], m * b.gyration**2)
+            inertia = min(max(b.original.inertia, lo), b.inertia[1])
+            x[k + 3] = inertia + (me * me + mf * mf) / m
+        for index, b in ((12, self.links[0]), (13, self.links[2])):
+            if self.inert[index] and b.counter_rotor is not None:
+                lo, hi = b.counter_rotor
+                x[index] = min(max(b.original.counter_rotor, lo), hi)
+        return x
+
+    def linkage_of(self, x: NDArray[np.float64]) -> FourBar:
+        """The four-bar with inertial parameters ``x`` (loads kept from the original links).
+
+        ``m``, ``e = m·e/m``, ``f = m·f/m``, ``I = J − m·(e² + f²)``, counter-rotors.
+        """
+        links = {}
+        for b in self.links:
+            m, e, f, inertia = inertial_to_physical(x[4 * b.index : 4 * b.index + 4])
+            rotor = 0.0
+            if b.name == "crank":
+                rotor = float(x[12])
+            elif b.name == "rocker":
+                rotor = float(x[13])
+            links[b.name] = replace(
+                b.original, mass=m, e=e, f=f, inertia=inertia, counter_rotor=rotor
+            )
+        return self.linkage.with_links(links)
+
+    def violations(
+        self, x: NDArray[np.float64], tol: float = FEASIBILITY_TOLERANCE
+    ) -> list[str]:
+        """The constraints that ``x`` breaks by more than ``tol`` (relative), as text.
+
+        Bounds are compared on the scale of the link (``m``, ``l``, ``m·l²``); force balance
+        as :func:`balancer.conditions.force_balance_error` (residual of Eq. 57 over the total
+        mass). An empty list means ``x`` is a feasible design.
+        """
+        out = []
+        for b in self.links:
+            k = 4 * b.index
+            m, me, mf, j = x[k : k + 4]
+            if not m > 0:
+                out.append(f"{b.name}: mass {m:.6g} kg is not positive")
+                continue
+            l, mref, iref = b.length, b.mass_ref, b.inertia_ref
+            if m < b.mass[0] - tol * mref or m > b.mass[1] + tol * mref:
+                out.append(f"{b.key}.mass: {m:.9g} kg outside [{b.mass[0]:.9g}, {b.mass[1]:.9g}]")
+            com = complex(me, mf) / m
+            if b.com_fixed is not None:
+                if abs(com - b.com_fixed) > tol * l:
+                    out.append(f"{b.name}: centre of mass moved by {abs(com - b.com_fixed):.3g} m")
+            elif abs(com - b.com_centre) > b.com_radius + tol * l:
+                out.append(
+                    f"{b.key}.com_radius: centre of mass {abs(com - b.com_centre):.9g} m from "
+                    f"{b.about} (at most {b.com_radius:.9g})"
+                )
+            inertia = j - (me * me + mf * mf) / m
+            lo = max(b.inertia[0], m * b.gyration**2)
+            if inertia < lo - tol * iref or inertia > b.inertia[1] + tol * iref:
+                out.append(
+                    f"{b.name}: inertia {inertia:.9g} kg·m² outside [{lo:.9g}, {b.inertia[1]:.9g}]"
+                )
+        for index, b in ((12, self.links[0]), (13, self.links[2])):
+            assert b.counter_rotor is not None
+            lo, hi = b.counter_rotor
+            scale = max(b.inertia_ref, hi)
+            if x[index] < lo - tol * scale or x[index] > hi + tol * scale:
+                out.append(
+                    f"{b.key}.counter_rotor: {x[index]:.9g} kg·m² outside [{lo:.9g}, {hi:.9g}]"
+                )
+        if self.force_balance is not None:
+            a, rhs = self.force_balance
+            residual = float(np.max(np.abs(a @ x[:12] - rhs)))
+            total = float(x[0] + x[4] + x[8])
+            if residual > tol * total:
+                out.append(f"force balance: Eq. 57 residual {residual / total:.3g} of the mass")
+        return out
+
+
+def numeric_problem(design: Design) -> NumericProblem:
+    """Build the numeric redesign problem of a design spec once.
+
+    Raises
+    ------
+    SpecError
+        If the spec has no ``[balance]`` or no ``[operation]`` section, or the problem is
+        contradictory (see :func:`check_problem`).
+    AssemblyError
+        If the crank cannot turn a full revolution.
+    """
+    problem = design.balance
+    if problem is None:
+        raise SpecError("missing: the spec has no [balance] section", key="balance")
+    if not isinstance(problem, BalanceProblem):
+        raise TypeError(f"design.balance must be a BalanceProblem, not {type(problem).__name__}")
+    if design.operation is None:
+        raise SpecError(
+            "missing required key: the balancing objective is evaluated at the operating speed",
+            key="operation.speed",
+        )
+    linkage = design.mechanism
+    check_problem(problem, linkage)
+    rng = assembly_range(linkage.lengths)
+    if not rng.full:
+        raise AssemblyError(
+            "balancing needs a crank that turns a full revolution, but this linkage assembles "
+            f"only for θ1 in {rng.describe()}",
+            key="mechanism.lengths",
+        )
+    speed = design.operation.speed
+    angles = sample_angles(design.operation.samples)
+    reg = _cycle_regressors(linkage, speed, angles)
+    n = angles.size
+    w = problem.objective
+    blocks = []
+    if w.shaking_moment:
+        blocks.append(math.sqrt(w.shaking_moment) * reg.shaking_moment)
+    if w.driving_torque:
+        blocks.append(math.sqrt(w.driving_torque) * reg.driving_torque)
+    if w.shaking_force:
+        blocks += [math.sqrt(w.shaking_force) * reg.shaking_force.real,
+                   math.sqrt(w.shaking_force) * reg.shaking_force.imag]
+    rows = np.vstack(blocks) / math.sqrt(n) if blocks else np.zeros((0, 14))
+    factor = np.linalg.qr(rows, mode="r") if blocks else np.zeros((0, 14))
+    links = tuple(
+        resolve_link(name, problem.link(name), linkage.link(name), linkage.lengths[i])
+        for i, name in enumerate(JOINTS)
+    )
+    fb = None
+    if problem.force_balance:
+        ab = force_balance_matrix(linkage.lengths)
+        fb = (ab[:, :12], ab[:, 12])
+    norms = np.linalg.norm(factor, axis=0) if blocks else np.zeros(14)
+    threshold = 1e-12 * max(float(norms.max(initial=0.0)), 1e-300)
+    candidates = {3, 7, 11, 12, 13}
+    inert = tuple(i in candidates and norms[i] <= threshold for i in range(14))
+    return NumericProblem(
+        problem=problem,
+        linkage=linkage,
+        speed=speed,
+        theta1=angles,
+        regressors=reg,
+        links=links,  # type: ignore[arg-type]
+        x0=parameter_vector(linkage),
+        rows=rows,
+        factor=factor,
+        force_balance=fb,
+        inert=inert,
+    )

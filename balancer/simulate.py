@@ -1,0 +1,378 @@
+"""Forward dynamics: integrate a formulation, project, detect events, report what happened.
+
+The integrator is SciPy's explicit Runge–Kutta method of order 8 (DOP853), stepped by hand so
+that after every accepted step the non-minimal formulations' states are projected back onto the
+loop closure and its derivative (the drift before projection is reported). Output values come
+from the step's dense output, projected in the same way, at equally spaced times.
+
+Events:
+
+- a formulation whose coordinate is the crank angle (``complex-masses``, ``lie-group``) cannot
+  pass a dead point of the crank, where coupler and rocker align: the simulation stops there
+  with a :class:`~balancer.errors.LockupError` that names the time and the crank angle (the
+  ``opened-loop`` and ``mass-matrix`` formulations pass through such points);
+- the change points of a change-point linkage (all joints collinear) are passed on the smooth
+  motion by every formulation;
+- a crank driven at constant speed that would leave the range where the linkage assembles locks
+  the linkage: the simulation stops there.
+
+Energy: the kinetic energy change must equal the work of the loads, of gravity and of the motor.
+The loads are constant forces at the centres of mass and constant moments, so their work is a
+function of the configuration, ``W = Σ F̄k·(r̄k − r̄k0) + Mk·(θk − θk0)``; the motor's work is
+integrated with the state.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.integrate import DOP853
+from scipy.optimize import brentq
+
+from .errors import AssemblyError, LockupError, SolverError, SpecError
+from .formulations import Formulation, make
+from .inverse import kinetic_energy, link_com_kinematics
+from .kinematics import assembly_range, change_point_angles, motion_from_angles
+from .model import METHODS, Design, FourBar, SimulationSettings
+
+#: |sin(θ3 − θ2)| at which a crank-angle formulation stops before a dead point.
+DEAD_POINT_THRESHOLD = 1e-3
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A simulated motion at equally spaced output times.
+
+    Attributes
+    ----------
+    method
+        Formulation used.
+    drive
+        ``"free"`` or ``"constant-speed"``.
+    t
+        Output times, s, shape ``(n,)``.
+    theta, omega, alpha
+        Link angles (rad, continuous from their initial values), angular velocities (rad/s)
+        and accelerations (rad/s²), each of shape ``(3, n)`` for links 1–3.
+    RA0, RA3
+        Forces of the mechanism on the ground at A0 and A3, complex, N.
+    driving_torque
+        Motor torque on the crank, N·m (zero in free motion).
+    kinetic_energy
+        Kinetic energy of the moving parts, counter-rotors included, J.
+    work
+        Work of the loads, gravity and the motor since t = 0, J.
+    energy_error
+        ``max|T − T0 − W|`` relative to the largest of ``|T|`` and ``|W|`` (dimensionless).
+    drift
+        Largest loop-closure residual before projection: position (m) and velocity (m/s).
+    nfev
+        Right-hand-side evaluations.
+    steps
+        Accepted integration steps.
+    seconds
+        Wall-clock time of the integration and the outputs, s.
+    rtol, atol
+        Integrator tolerances used.
+    """
+
+    method: str
+    drive: str
+    t: NDArray[np.float64]
+    theta: NDArray[np.float64]
+    omega: NDArray[np.float64]
+    alpha: NDArray[np.float64]
+    RA0: NDArray[np.complex128]
+    RA3: NDArray[np.complex128]
+    driving_torque: NDArray[np.float64]
+    kinetic_energy: NDArray[np.float64]
+    work: NDArray[np.float64]
+    energy_error: float
+    drift: tuple[float, float]
+    nfev: int
+    steps: int
+    seconds: float
+    rtol: float
+    atol: float
+    shaking_moment: NDArray[np.float64] = field(repr=False, default=None)  # type: ignore[assignment]
+
+    @property
+    def shaking_force(self) -> NDArray[np.complex128]:
+        """``R̄A0 + R̄A3``, N."""
+        return self.RA0 + self.RA3
+
+    def state(self, index: int) -> dict[str, list[float]]:
+        """Angles, rates and accelerations of links 1–3 at output ``index``."""
+        return {
+            "theta": [float(x) for x in self.theta[:, index]],
+            "omega": [float(x) for x in self.omega[:, index]],
+            "alpha": [float(x) for x in self.alpha[:, index]],
+        }
+
+
+def _unwrap(theta: NDArray[np.float64], omega: NDArray[np.float64], t: NDArray[np.float64]):
+    """Continuous angles: each step takes the 2π branch nearest to the trapezoidal prediction."""
+    out = np.array(theta, dtype=float)
+    for i in range(1, out.size):
+        predicted = out[i - 1] + 0.5 * (omega[i - 1] + omega[i]) * (t[i] - t[i - 1])
+        out[i] += 2 * math.pi * round((predicted - out[i]) / (2 * math.pi))
+    return out
+
+
+def _check_start(linkage: FourBar, theta1: float, speed: float | None) -> None:
+    rng = assembly_range(linkage.lengths)
+    if not rng.contains(theta1):
+        raise AssemblyError(
+            f"the linkage cannot be assembled at the initial crank angle; it assembles for θ1 "
+            f"in {rng.describe()}",
+            key="simulation.theta1",
+            value=theta1,
+        )
+
+
+def _lock_time(linkage: FourBar, theta1: float, speed: float, duration: float) -> float | None:
+    """First time a crank driven at ``speed`` leaves the assembly range, or None."""
+    rng = assembly_range(linkage.lengths)
+    if rng.full or speed == 0:
+        return None
+    for a, b in rng.intervals:
+        # Bring θ1 into the interval's own 2π window.
+        w = a + math.fmod(theta1 - a, 2 * math.pi) % (2 * math.pi)
+        if a - 1e-12 <= w <= b + 1e-12:
+            end = b if speed > 0 else a
+            t_lock = (end - w) / speed
+            return t_lock if t_lock <= duration else None
+    return None
+
+
+class _Stepper:
+    """One integration with projection, dense outputs and events."""
+
+    def __init__(self, f: Formulation, duration: float, rtol: float, atol: float,
+                 outputs: int, progress: Callable[[float, float], None] | None) -> None:
+        self.f = f
+        self.duration = duration
+        self.rtol = rtol
+        self.atol = atol
+        self.t_out = np.linspace(0.0, duration, outputs)
+        self.progress = progress
+        self.extra_fev = 0
+
+    def run(self, y0: NDArray[np.float64], stop_at: float | None):
+        f = self.f
+        t_end = self.duration if stop_at is None else min(stop_at, self.duration)
+        solver = DOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=self.atol)
+        states: list[NDArray[np.float64]] = []
+        times: list[float] = []
+        drift = [0.0, 0.0]
+        k = 0
+        steps = 0
+        watch = not f.minimal or f.name in ("complex-masses", "lie-group")
+        passes_dead_points = f.name in ("opened-loop", "mass-matrix")
+        change_points = change_point_angles(f.lengths)
+        # The first output is the initial state.
+        while k < self.t_out.size and self.t_out[k] <= 0.0:
+            states.append(np.array(y0))
+            times.append(float(self.t_out[k]))
+            k += 1
+        stopped: tuple[float, NDArray[np.float64]] | None = None
+        while solver.status == "running":
+            message = solver.step()
+            if solver.status == "failed":
+                raise SolverError(f"the integrator failed at t = {solver.t:.6g} s: {message}")
+            steps += 1
+            interp = solver.dense_output()
+            if not f.minimal:
+                res = f.constraint_residual(solver.t, solver.y)
+                drift = [max(drift[0], res[0]), max(drift[1], res[1])]
+                y_new = f.project(solver.t, solver.y)
+                solver.y = y_new
+                solver.f = f.rhs(solver.t, y_new)  # the next step starts from the projection
+                self.extra_fev += 1
+            if watch and not passes_dead_points:
+                event = self._dead_point(interp, solver.t_old, solver.t, change_points)
+                if event is not None:
+                    stopped = event
+                    solver.status = "finished"
+            t_hi = solver.t if stopped is None else stopped[0]
+            while k < self.t_out.size and self.t_out[k] <= t_hi + 1e-14 * max(1.0, t_hi):
+                y = interp(min(self.t_out[k], solver.t))
+                states.append(f.project(self.t_out[k], y) if not f.minimal else y)
+                times.append(float(self.t_out[k]))
+                k += 1
+            if self.progress is not None:
+                self.progress(solver.t, self.duration)
+        return times, states, drift, solver.nfev + self.extra_fev, steps, stopped
+
+    def _dead_point(self, interp, t0: float, t1: float, change_points):
+        """The time at which |sin(θ3 − θ2)| falls to the threshold within a step, or None."""
+        f = self.f
+
+        def gap(t: float) -> float:
+            y = interp(t)
+            if change_points and _near_change_point(f, t, y, change_points):
+                return 1.0  # passable: the smooth motion goes through
+            return abs(f.transmission(t, y)) - DEAD_POINT_THRESHOLD
+
+        if gap(t1) > 0:
+            return None
+        t_event = brentq(gap, t0, t1, xtol=1e-12) if gap(t0) > 0 else t0
+        return t_event, interp(t_event)
+
+
+def _near_change_point(f: Formulation, t: float, y, points) -> bool:
+    theta1 = f.theta1_of(t, y)
+    return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < 0.05 for p in points)
+
+
+def simulate(
+    linkage: FourBar,
+    settings: SimulationSettings,
+    *,
+    method: str | None = None,
+    drive: str | None = None,
+    duration: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    outputs: int | None = None,
+    progress: Callable[[float, float], None] | None = None,
+) -> Trajectory:
+    """Simulate the linkage's motion.
+
+    Parameters
+    ----------
+    linkage
+        The four-bar.
+    settings
+        The spec's ``[simulation]`` settings; the keyword arguments override them.
+    method
+        Formulation (:data:`balancer.model.METHODS`).
+    drive
+        ``"free"`` or ``"constant-speed"`` (the crank held at ``settings.omega1``).
+    duration
+        Simulated time, s.
+    rtol, atol
+        Integrator tolerances.
+    outputs
+        Number of equally spaced output times.
+    progress
+        Called as ``progress(t, duration)`` after every step.
+
+    Raises
+    ------
+    SpecError
+        For bad settings or an initial crank angle where the linkage does not assemble.
+    LockupError
+        If the motion reaches a position the formulation cannot pass (its ``partial``
+        attribute holds the trajectory up to there).
+    """
+    method = method or settings.method
+    drive = drive or settings.drive
+    duration = settings.duration if duration is None else duration
+    rtol = settings.rtol if rtol is None else rtol
+    atol = settings.atol if atol is None else atol
+    outputs = settings.outputs if outputs is None else outputs
+    if method not in METHODS:
+        raise SpecError(f"unknown formulation; choose from {', '.join(METHODS)}", key="method",
+                        value=method)
+    if not (duration > 0 and math.isfinite(duration)):
+        raise SpecError("must be a positive number of seconds", key="duration", value=duration)
+    if not (1e-14 <= rtol < 1):
+        raise SpecError("must be between 1e-14 and 1", key="rtol", value=rtol)
+    theta1, omega1 = settings.theta1, settings.omega1
+    _check_start(linkage, theta1, None)
+    speed = None
+    stop_at = None
+    if drive == "constant-speed":
+        if omega1 == 0:
+            raise SpecError("a crank driven at constant speed needs a non-zero speed",
+                            key="simulation.omega1", value=omega1)
+        speed = omega1
+        stop_at = _lock_time(linkage, theta1, speed, duration)
+    f = make(method, linkage, gravity=settings.gravity, speed=speed)
+    y0 = f.initial_state(theta1, omega1)
+    start = _time.perf_counter()
+    stepper = _Stepper(f, duration, rtol, atol, outputs, progress)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        times, states, drift, nfev, steps, stopped = stepper.run(y0, stop_at)
+    traj = _trajectory(f, times, states, drift, nfev, steps, rtol, atol,
+                       _time.perf_counter() - start)
+    if stopped is not None:
+        t_event, y_event = stopped
+        th = f.evaluate(t_event, y_event).theta[0]
+        raise _lockup(
+            f"the motion reaches a dead point of the crank (coupler and rocker aligned) at "
+            f"t = {t_event:.6g} s, θ1 = {th:.6g} rad; the {f.name} formulation uses the crank "
+            "angle as its coordinate and cannot pass it (opened-loop and mass-matrix can)",
+            t_event, th, traj)
+    if stop_at is not None:
+        th = f.crank_angle(stop_at)
+        raise _lockup(
+            f"the crank, driven at {speed:g} rad/s, reaches the end of the range where the "
+            f"linkage assembles at t = {stop_at:.6g} s, θ1 = {th:.6g} rad: the linkage locks",
+            stop_at, th, traj)
+    return traj
+
+
+def _lockup(message: str, t: float, theta1: float, partial: Trajectory) -> LockupError:
+    err = LockupError(message, time=t, theta1=theta1)
+    err.partial = partial  # type: ignore[attr-defined]
+    return err
+
+
+def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
+                seconds) -> Trajectory:
+    t = np.array(times)
+    evals = [f.evaluate(ti, yi) for ti, yi in zip(times, states, strict=True)]
+    omega = np.array([e.omega for e in evals]).T
+    alpha = np.array([e.alpha for e in evals]).T
+    theta = np.array([_unwrap(np.array([e.theta[k] for e in evals]), omega[k], t)
+                      for k in range(3)])
+    ra0 = np.array([e.RA0 for e in evals])
+    ra3 = np.array([e.RA3 for e in evals])
+    tau = np.array([e.driving_torque for e in evals])
+    motor = np.array([f.motor_work(y) for y in states])
+    # Energy: T − T0 = work of loads and gravity (a function of the configuration) + motor.
+    mo = motion_from_angles(f.lengths, tuple(theta), tuple(omega), tuple(alpha))
+    kin = kinetic_energy(f.linkage, mo)
+    (r1, r2, r3), _ = link_com_kinematics(f.linkage, mo)
+    work = motor.copy()
+    for k, r in enumerate((r1, r2, r3)):
+        work += np.real(np.conj(f.forces[k]) * (r - r[0])) + f.moments[k] * (theta[k] - theta[k][0])
+    scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), 1e-300)
+    energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
+    moment = f.lengths[3] * ra3.imag - tau
+    for k, link in enumerate(f.linkage.links):
+        if link.counter_rotor:
+            moment = moment + 2 * link.counter_rotor * alpha[k]
+    return Trajectory(
+        method=f.name,
+        drive="constant-speed" if f.driven else "free",
+        t=t,
+        theta=theta,
+        omega=omega,
+        alpha=alpha,
+        RA0=ra0,
+        RA3=ra3,
+        driving_torque=tau,
+        kinetic_energy=kin,
+        work=work,
+        energy_error=energy_error,
+        drift=(float(drift[0]), float(drift[1])),
+        nfev=int(nfev),
+        steps=int(steps),
+        seconds=float(seconds),
+        rtol=rtol,
+        atol=atol,
+        shaking_moment=moment,
+    )
+
+
+def simulate_design(design: Design, **overrides) -> Trajectory:
+    """:func:`simulate` with a design's own linkage and ``[simulation]`` settings."""
+    return simulate(design.mechanism, design.simulation, **overrides)
