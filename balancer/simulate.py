@@ -298,8 +298,11 @@ def simulate(
     y0 = f.initial_state(theta1, omega1)
     start = _time.perf_counter()
     stepper = _Stepper(f, duration, rtol, atol, outputs, progress)
+    # A driven crank that locks: integrate up to just before the dead point, where the torque
+    # it would need grows without bound.
+    end = None if stop_at is None else _before_lock(f, stop_at)
     with np.errstate(divide="ignore", invalid="ignore"):
-        times, states, drift, nfev, steps, stopped = stepper.run(y0, stop_at)
+        times, states, drift, nfev, steps, stopped = stepper.run(y0, end)
     traj = _trajectory(f, times, states, drift, nfev, steps, rtol, atol,
                        _time.perf_counter() - start)
     if stopped is not None:
@@ -317,6 +320,23 @@ def simulate(
             f"linkage assembles at t = {stop_at:.6g} s, θ1 = {th:.6g} rad: the linkage locks",
             stop_at, th, traj)
     return traj
+
+
+def _before_lock(f: Formulation, t_lock: float) -> float:
+    """The time before ``t_lock`` at which |sin(θ3 − θ2)| of the prescribed motion falls to
+    :data:`DEAD_POINT_THRESHOLD`."""
+    from .kinematics import position_scalar
+
+    sign = f.sign0
+
+    def gap(t: float) -> float:
+        _, v2, v3 = position_scalar(f.lengths, f.crank_angle(t), sign)
+        return abs(v2.real * v3.imag - v2.imag * v3.real) / (f.lengths[1] * f.lengths[2]) - (
+            DEAD_POINT_THRESHOLD)
+
+    if gap(0.0) <= 0:
+        return 0.0
+    return brentq(gap, 0.0, t_lock, xtol=1e-14)
 
 
 def _lockup(message: str, t: float, theta1: float, partial: Trajectory) -> LockupError:

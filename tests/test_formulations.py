@@ -1,0 +1,243 @@
+"""The four formulations of the equations of motion against each other and against physics."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import CLASS_EXAMPLES, paper_linkage, random_angles, random_link, random_linkage
+from helpers import rel_err
+
+from balancer import inverse
+from balancer import kinematics as kin
+from balancer.errors import LockupError
+from balancer.formulations import make
+from balancer.model import METHODS, FourBar, Link, SimulationSettings
+from balancer.simulate import simulate
+
+
+def _states(seed, n=60):
+    """Random linkages (loads, gravity, counter-rotors; both branches, every Grashof class)
+    with states away from dead points."""
+    rng = np.random.default_rng(seed)
+    out = []
+    while len(out) < n:
+        linkage = random_linkage(rng)
+        t = random_angles(rng, linkage, 1)[0]
+        if abs(kin.position_of(linkage, t).sin_transmission[0]) < 0.05:
+            continue
+        out.append((linkage, t, rng.uniform(-4, 4), tuple(rng.uniform(-10, 10, 2))))
+    return out
+
+
+@pytest.mark.parametrize(("linkage", "theta1", "omega1", "gravity"), _states(40))
+@pytest.mark.parametrize("driven", [False, True])
+def test_formulations_agree_with_each_other_and_newton_euler(linkage, theta1, omega1, gravity,
+                                                             driven):
+    speed = omega1 if driven else None
+    evals = {}
+    for name in METHODS:
+        f = make(name, linkage, gravity=gravity, speed=speed)
+        evals[name] = f.evaluate(0.0, f.initial_state(theta1, omega1))
+    ref = evals["opened-loop"]
+    # Independent route: with the accelerations found, Newton–Euler needs no motor in free
+    # motion and the same motor torque when driven; it gives the same reactions.
+    mo = kin.motion_of(linkage, theta1, omega1, ref.alpha[0])
+    ne = inverse.newton_euler(linkage, mo, gravity=gravity)
+    force = max(abs(ne.RA0[0]), abs(ne.RA3[0]), 1.0)
+    moment = max(abs(ne.shaking_moment[0]), force * max(linkage.lengths))
+    acc = max(np.max(np.abs(ref.alpha)), omega1**2, 1.0)
+    assert abs(ne.driving_torque[0] - ref.driving_torque) < 1e-9 * moment
+    assert rel_err([mo.alpha[1][0], mo.alpha[2][0]], ref.alpha[1:], scale=acc) < 1e-9
+    for name, ev in evals.items():
+        assert rel_err(ev.omega, ref.omega, scale=max(1.0, abs(omega1))) < 1e-12, name
+        assert rel_err(ev.alpha, ref.alpha, scale=acc) < 1e-9, name
+        assert abs(ev.RA0 - ne.RA0[0]) < 1e-9 * force, name
+        assert abs(ev.RA3 - ne.RA3[0]) < 1e-9 * force, name
+        assert abs(ev.driving_torque - ref.driving_torque) < 1e-9 * moment, name
+        d = np.remainder(ev.theta - ref.theta + np.pi, 2 * np.pi) - np.pi
+        assert np.max(np.abs(d)) < 1e-12, name
+
+
+@pytest.fixture(scope="module")
+def paper_runs():
+    """The paper's example (Eq. 56): free from rest at θ1 = 1 rad for 5 s, no gravity."""
+    settings = SimulationSettings(duration=5.0, theta1=1.0, omega1=0.0)
+    return {m: simulate(paper_linkage(), settings, method=m, rtol=1e-11, atol=1e-13)
+            for m in METHODS}
+
+
+def test_paper_example_final_states_agree(paper_runs):
+    ref = paper_runs["opened-loop"]
+    for name, tr in paper_runs.items():
+        for key in ("theta", "omega", "alpha"):
+            a = np.array(tr.state(-1)[key])
+            b = np.array(ref.state(-1)[key])
+            assert np.max(np.abs(a - b)) < 1e-8, (name, key)
+        for key in ("theta", "omega", "alpha"):
+            assert tr.state(0)[key] == pytest.approx(ref.state(0)[key], abs=1e-12)
+
+
+def test_paper_example_reaction_histories_agree(paper_runs):
+    ref = paper_runs["opened-loop"]
+    scale = max(np.max(np.abs(ref.RA0)), np.max(np.abs(ref.RA3)))
+    for name, tr in paper_runs.items():
+        assert np.array_equal(tr.t, ref.t)
+        assert np.max(np.abs(tr.RA0 - ref.RA0)) < 1e-8 * scale, name
+        assert np.max(np.abs(tr.RA3 - ref.RA3)) < 1e-8 * scale, name
+
+
+def test_paper_example_energy_and_drift(paper_runs):
+    for name, tr in paper_runs.items():
+        assert tr.energy_error < 1e-9, name
+        assert tr.drift[0] < 1e-10 and tr.drift[1] < 1e-10, name
+        # The loads do work: the kinetic energy really changes.
+        assert np.ptp(tr.kinetic_energy) > 0.1
+
+
+def test_paper_example_reactions_are_the_inverse_dynamics_of_the_motion(paper_runs):
+    """Along the simulated motion, Newton–Euler with the simulated accelerations gives the
+    simulated reactions and needs no motor (free motion)."""
+    tr = paper_runs["mass-matrix"]
+    linkage = paper_linkage()
+    mo = kin.motion_of(linkage, tr.theta[0], tr.omega[0], tr.alpha[0])
+    ne = inverse.newton_euler(linkage, mo)
+    scale = np.max(np.abs(tr.RA0))
+    assert np.max(np.abs(ne.RA0 - tr.RA0)) < 1e-9 * scale
+    assert np.max(np.abs(ne.driving_torque)) < 1e-9 * scale
+
+
+def _bai(lengths):
+    """Bai, Xia & Ge (2024), Sect. 7: masses and inertias; centres of mass at mid-link (the paper
+    does not give them)."""
+    masses = (0.1, 0.25, 0.18)
+    inertias = (0.001, 0.016, 0.006)
+    links = [Link(mass=m, inertia=i, e=length / 2, f=0.0)
+             for m, i, length in zip(masses, inertias, lengths, strict=False)]
+    return FourBar(lengths=lengths, crank=links[0], coupler=links[1], rocker=links[2])
+
+
+def test_bai_crank_rocker_with_gravity():
+    linkage = _bai((0.12, 0.25, 0.26, 0.3))
+    # Their initial attitudes: q_A = (1, 0), q_B = (0.3044, 0.9534), q_D = (−0.3996, 0.9167);
+    # printed to four digits (their q_B has length 1.0008), so they agree to about 1e-3.
+    pos = kin.position_of(linkage, 0.0)
+    assert abs(pos.l2[0] / 0.25 - complex(0.3044, 0.9534)) < 2e-3
+    assert abs(-pos.l3[0] / 0.26 - complex(-0.3996, 0.9167)) < 2e-3
+    settings = SimulationSettings(duration=5.0, theta1=0.0, omega1=0.0, gravity=(0.0, -9.81))
+    runs = {m: simulate(linkage, settings, method=m, rtol=1e-11, atol=1e-13) for m in METHODS}
+    ref = runs["opened-loop"]
+    for name, tr in runs.items():
+        assert tr.energy_error < 1e-9, name
+        assert np.max(np.abs(tr.theta[:, -1] - ref.theta[:, -1])) < 1e-8, name
+    # With gravity only, energy is conserved: the motion is periodic and returns to rest height.
+    assert np.max(np.abs(ref.work + (ref.kinetic_energy[0] - ref.kinetic_energy))) < 1e-9
+
+
+def test_bai_parallelogram_keeps_its_coupler_parallel():
+    linkage = _bai((0.1, 0.25, 0.1, 0.25))
+    assert str(kin.classify(linkage.lengths)) == "change-point"
+    # Their initial attitudes q0 = [0.6; 0.8; 1; 0; 0.6; 0.8], momentum 0.
+    settings = SimulationSettings(duration=5.0, theta1=math.atan2(0.8, 0.6), omega1=0.0,
+                                  gravity=(0.0, -9.81))
+    runs = {m: simulate(linkage, settings, method=m, rtol=1e-10, atol=1e-12) for m in METHODS}
+    ref = runs["complex-masses"]
+    for name, tr in runs.items():
+        assert np.max(np.abs(np.sin(tr.theta[1]))) < 1e-12, name  # coupler ∥ frame
+        rocker = np.remainder(tr.theta[2] - tr.theta[0], 2 * np.pi)  # rocker ∥ crank
+        assert np.max(np.abs(rocker - np.pi)) < 1e-12, name
+        assert tr.energy_error < 1e-8, name
+        # It swings through both change points (θ1 = 0 and −π) like a pendulum.
+        assert tr.theta[0].min() < -np.pi < 0 < tr.theta[0].max()
+        assert np.max(np.abs(tr.theta[0] - ref.theta[0])) < 1e-7, name
+
+
+def _triple_rocker():
+    rng = np.random.default_rng(3)
+    lengths = CLASS_EXAMPLES["triple-rocker"]
+    links = [random_link(rng, length, loads=False, rotor=False) for length in lengths[:3]]
+    return FourBar(lengths=lengths, crank=links[0], coupler=links[1], rocker=links[2])
+
+
+def test_non_minimal_formulations_swing_through_a_dead_point():
+    linkage = _triple_rocker()
+    rng = kin.assembly_range(linkage.lengths)
+    (lo, hi), = rng.intervals
+    settings = SimulationSettings(duration=3.0, theta1=0.0, omega1=6.0)
+    runs = {m: simulate(linkage, settings, method=m, rtol=1e-11, atol=1e-13)
+            for m in ("opened-loop", "mass-matrix")}
+    ref = runs["opened-loop"]
+    # The crank turns back at the ends of its range, where coupler and rocker align.
+    assert ref.theta[0].max() <= hi + 1e-9 and ref.theta[0].max() > hi - 1e-3
+    assert np.any(np.diff(np.sign(np.sin(ref.theta[2] - ref.theta[1]))) != 0)
+    for name, tr in runs.items():
+        assert tr.energy_error < 1e-8, name
+        assert np.max(np.abs(tr.theta[:, -1] - ref.theta[:, -1])) < 1e-7, name
+
+
+@pytest.mark.parametrize("method", ["complex-masses", "lie-group"])
+def test_crank_angle_formulations_stop_at_a_dead_point(method):
+    linkage = _triple_rocker()
+    settings = SimulationSettings(duration=3.0, theta1=0.0, omega1=6.0)
+    reference = simulate(linkage, settings, method="opened-loop", rtol=1e-11, atol=1e-13,
+                         outputs=30001)
+    # The reference passes the dead point where sin(θ3 − θ2) changes sign, the crank at the end
+    # of its range.
+    s = np.sign(np.sin(reference.theta[2] - reference.theta[1]))
+    first = reference.t[np.argmax(s != s[0])]
+    with pytest.raises(LockupError, match="dead point") as info:
+        simulate(linkage, settings, method=method, rtol=1e-11, atol=1e-13)
+    assert abs(info.value.time - first) < 2e-4
+    (_, hi), = kin.assembly_range(linkage.lengths).intervals
+    assert abs(info.value.theta1 - hi) < 1e-5
+    partial = info.value.partial
+    assert partial.t[-1] <= info.value.time + 1e-12 and partial.energy_error < 1e-8
+
+
+def test_driven_crank_that_cannot_turn_locks():
+    rng = np.random.default_rng(4)
+    lengths = CLASS_EXAMPLES["rocker-crank"]
+    links = [random_link(rng, length, loads=False, rotor=False) for length in lengths[:3]]
+    linkage = FourBar(lengths=lengths, crank=links[0], coupler=links[1], rocker=links[2])
+    _, (_, hi) = kin.assembly_range(lengths).intervals  # the interval of θ1 = 1 rad
+    settings = SimulationSettings(duration=2.0, theta1=1.0, omega1=2.0, drive="constant-speed")
+    with pytest.raises(LockupError, match="locks") as info:
+        simulate(linkage, settings, method="opened-loop")
+    assert info.value.time == pytest.approx((hi - 1.0) / 2.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_driven_motion_matches_the_cycle_analysis(method):
+    """A crank held at constant speed: the simulation's torque and reactions are the cycle
+    analysis's, and the motor's work balances the kinetic energy and the loads' work."""
+    linkage = paper_linkage()
+    speed = 4.0
+    settings = SimulationSettings(duration=2 * np.pi / speed, theta1=0.0, omega1=speed,
+                                  drive="constant-speed", outputs=73)
+    tr = simulate(linkage, settings, method=method, rtol=1e-11, atol=1e-13)
+    ca = inverse.cycle_analysis(linkage, speed, theta1=tr.theta[0])
+    scale = np.max(np.abs(ca.reactions.RA0))
+    assert np.max(np.abs(tr.RA0 - ca.reactions.RA0)) < 1e-9 * scale
+    assert np.max(np.abs(tr.RA3 - ca.reactions.RA3)) < 1e-9 * scale
+    tau_scale = np.max(np.abs(ca.reactions.driving_torque))
+    assert np.max(np.abs(tr.driving_torque - ca.reactions.driving_torque)) < 1e-9 * tau_scale
+    assert np.max(np.abs(tr.shaking_moment - ca.reactions.shaking_moment)) < 1e-9 * tau_scale
+    assert tr.energy_error < 1e-9
+    assert np.allclose(tr.omega[0], speed) and np.allclose(tr.alpha[0], 0.0, atol=1e-12)
+
+
+def test_counter_rotors_enter_every_formulation():
+    base = paper_linkage()
+    from dataclasses import replace
+
+    linkage = base.with_links({"crank": replace(base.crank, counter_rotor=0.7),
+                               "rocker": replace(base.rocker, counter_rotor=1.3)})
+    settings = SimulationSettings(duration=2.0, theta1=1.0, omega1=0.5)
+    runs = {m: simulate(linkage, settings, method=m, rtol=1e-11, atol=1e-13) for m in METHODS}
+    plain = simulate(base, settings, method="opened-loop", rtol=1e-11, atol=1e-13)
+    ref = runs["opened-loop"]
+    assert np.max(np.abs(plain.theta[:, -1] - ref.theta[:, -1])) > 1e-3  # they matter
+    for name, tr in runs.items():
+        assert np.max(np.abs(tr.theta[:, -1] - ref.theta[:, -1])) < 1e-8, name
+        assert tr.energy_error < 1e-9, name
