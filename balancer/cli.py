@@ -51,6 +51,91 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
     return 0
 
 
+class _Progress:
+    """Progress of a long simulation on a terminal.
+
+    Shown after the first second, then updated a few times a second; nothing when the stream is
+    not a terminal.
+    """
+
+    def __init__(self, stream=None, delay: float = 1.0) -> None:
+        import time
+
+        self.stream = sys.stderr if stream is None else stream
+        self.clock = time.perf_counter
+        self.start = self.clock()
+        self.delay = delay
+        self.last = 0.0
+        self.shown = False
+
+    def __call__(self, t: float, duration: float) -> None:
+        now = self.clock()
+        if now - self.start < self.delay or now - self.last < 0.25:
+            return
+        if not getattr(self.stream, "isatty", lambda: False)():
+            return
+        self.last = now
+        self.shown = True
+        self.stream.write(f"\rsimulating: {100 * t / duration:5.1f} % (t = {t:.4g} s of "
+                          f"{duration:g} s)")
+        self.stream.flush()
+
+    def done(self) -> None:
+        if self.shown:
+            self.stream.write("\r" + " " * 60 + "\r")
+            self.stream.flush()
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    from .report import dumps_json, simulation_csv, simulation_json, simulation_text
+    from .simulate import simulate_design
+    from .spec import load_design, write_atomic
+
+    out = _output_path(args.out, "--out") if args.out else None
+    design = load_design(args.spec)
+    progress = _Progress()
+    try:
+        traj = simulate_design(
+            design,
+            method=args.method,
+            drive=args.drive,
+            duration=args.duration,
+            rtol=args.rtol,
+            atol=args.atol,
+            outputs=args.outputs,
+            progress=progress,
+        )
+    finally:
+        progress.done()
+    if out is not None:
+        write_atomic(out, simulation_csv(traj, all_columns=args.all_columns))
+    if args.json:
+        sys.stdout.write(dumps_json(simulation_json(traj, spec=args.spec)))
+    else:
+        print(simulation_text(traj, spec=args.spec))
+    return 0
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not value > 0 or value != value or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a positive number: {text!r}")
+    return value
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if value < 2:
+        raise argparse.ArgumentTypeError(f"must be at least 2: {text!r}")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``balancer`` command."""
     parser = _Parser(
@@ -82,6 +167,33 @@ def build_parser() -> argparse.ArgumentParser:
         help="inverse-dynamics route (both agree to rounding; default newton-euler)",
     )
     p.set_defaults(handler=_cmd_analyze)
+
+    from .model import DRIVES, METHODS
+
+    p = sub.add_parser(
+        "simulate",
+        help="forward dynamics in one of four formulations",
+        description=(
+            "Forward dynamics of the linkage from the spec's [simulation] settings: free motion "
+            "under the loads (and gravity), or the crank held at constant speed by a motor. "
+            "Prints the initial and final angles, rates and accelerations, the shaking figures, "
+            "the energy balance and the constraint drift."
+        ),
+    )
+    p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
+    p.add_argument("--method", choices=METHODS, help="formulation (default: the spec's, or "
+                   "opened-loop)")
+    p.add_argument("--drive", choices=DRIVES, help="free motion or constant crank speed "
+                   "(default: the spec's)")
+    p.add_argument("--duration", type=_positive_float, metavar="T", help="simulated time, s")
+    p.add_argument("--rtol", type=_positive_float, metavar="R", help="relative tolerance")
+    p.add_argument("--atol", type=_positive_float, metavar="A", help="absolute tolerance")
+    p.add_argument("--outputs", type=_count, metavar="N", help="number of output times")
+    p.add_argument("--out", metavar="CSV", help="write the time histories to a CSV file")
+    p.add_argument("--all-columns", action="store_true",
+                   help="add shaking force and moment, driving torque, energy to the CSV")
+    p.add_argument("--json", action="store_true", help="print a JSON document instead")
+    p.set_defaults(handler=_cmd_simulate)
     return parser
 
 

@@ -638,7 +638,9 @@ def motion_from_angles(
 # vectorised functions above.
 
 
-def position_scalar(lengths: Lengths, theta1: float, sign: float) -> tuple[complex, complex, complex]:
+def position_scalar(
+    lengths: Lengths, theta1: float, sign: float
+) -> tuple[complex, complex, complex]:
     """Link vectors ``(l̄1, l̄2, l̄3)`` at one crank angle (Eq. 2–4, as :func:`position`).
 
     Raises

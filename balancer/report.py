@@ -224,3 +224,109 @@ def csv_text(columns: Sequence[str], values: Sequence[np.ndarray]) -> str:
     buf.write(",".join(columns) + "\n")
     np.savetxt(buf, data, delimiter=",", fmt="%.17g")
     return buf.getvalue()
+
+
+# ----------------------------------------------------------------------------------------------
+# simulate
+
+SIMULATION_COLUMNS = (
+    "t",
+    "theta1",
+    "theta2",
+    "theta3",
+    "omega1",
+    "omega2",
+    "omega3",
+    "alpha1",
+    "alpha2",
+    "alpha3",
+    "RA0x",
+    "RA0y",
+    "RA3x",
+    "RA3y",
+)
+#: Extra columns written after the fixed ones with ``--all-columns``.
+SIMULATION_EXTRA_COLUMNS = (
+    "shaking_force_x",
+    "shaking_force_y",
+    "shaking_moment",
+    "driving_torque",
+    "kinetic_energy",
+    "work",
+)
+
+
+def simulation_csv(traj, all_columns: bool = False) -> str:
+    """The time histories of a simulation as CSV text (the fixed columns, then optionally more)."""
+    cols = [traj.t, *traj.theta, *traj.omega, *traj.alpha, traj.RA0.real, traj.RA0.imag,
+            traj.RA3.real, traj.RA3.imag]
+    names = list(SIMULATION_COLUMNS)
+    if all_columns:
+        sf = traj.shaking_force
+        cols += [sf.real, sf.imag, traj.shaking_moment, traj.driving_torque, traj.kinetic_energy,
+                 traj.work]
+        names += SIMULATION_EXTRA_COLUMNS
+    return csv_text(names, cols)
+
+
+def simulation_json(traj, spec: str | None = None) -> dict[str, Any]:
+    """The ``simulate --json`` document."""
+    doc: dict[str, Any] = {}
+    if spec is not None:
+        doc["spec"] = spec
+    doc.update(
+        {
+            "method": traj.method,
+            "drive": traj.drive,
+            "duration": float(traj.t[-1]),
+            "outputs": int(traj.t.size),
+            "rtol": traj.rtol,
+            "atol": traj.atol,
+            "initial": traj.state(0),
+            "final": traj.state(-1),
+            "steps": traj.steps,
+            "nfev": traj.nfev,
+            "seconds": traj.seconds,
+            "energy_error": traj.energy_error,
+            "constraint_drift": {"position": traj.drift[0], "velocity": traj.drift[1]},
+            "shaking_force": Figure.of(traj.shaking_force).as_dict(),
+            "shaking_moment": Figure.of(traj.shaking_moment).as_dict(),
+            "driving_torque": Figure.of(traj.driving_torque).as_dict(),
+            "reactions": {"A0": reaction_extremes(traj.RA0), "A3": reaction_extremes(traj.RA3)},
+            "units": {"theta": "rad", "omega": "rad/s", "alpha": "rad/s²", "force": "N",
+                      "moment": "N·m", "constraint_drift": "m, m/s"},
+        }
+    )
+    return doc
+
+
+def simulation_text(traj, spec: str | None = None) -> str:
+    """The readable ``simulate`` report: the paper's Table 1 quantities and the checks."""
+    head = f"balancer simulate — {spec}" if spec else "balancer simulate"
+    lines = [
+        head,
+        f"{traj.drive} motion for {traj.t[-1]:g} s, formulation {traj.method}, rtol "
+        f"{traj.rtol:g}: {traj.steps} steps, {traj.nfev} right-hand sides, {traj.seconds:.3g} s",
+        "",
+    ]
+    rows = []
+    for when, index in (("initial", 0), ("final", -1)):
+        st = traj.state(index)
+        for k in range(3):
+            rows.append([f"{when} link {k + 1}", _fmt(st["theta"][k], 14), _fmt(st["omega"][k], 14),
+                         _fmt(st["alpha"][k], 14)])
+    lines.append(table(rows, ["state", "θ (rad)", "θ̇ (rad/s)", "θ̈ (rad/s²)"]))
+    lines.append("")
+    rows = [[name.replace("_", " "), _fmt(fig.rms), _fmt(fig.max), UNITS[name]] for name, fig in (
+        ("shaking_force", Figure.of(traj.shaking_force)),
+        ("shaking_moment", Figure.of(traj.shaking_moment)),
+        ("driving_torque", Figure.of(traj.driving_torque)),
+    )]
+    lines.append(table(rows, ["quantity over time", "RMS", "max", "unit"]))
+    lines.append("")
+    lines.append(
+        f"energy balance: kinetic energy change = work of loads, gravity and motor to "
+        f"{traj.energy_error:.1e} (relative); loop-closure drift before projection "
+        f"{traj.drift[0]:.1e} m, {traj.drift[1]:.1e} m/s"
+    )
+    return "\n".join(lines)

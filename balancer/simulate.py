@@ -109,19 +109,18 @@ class Trajectory:
     def state(self, index: int) -> dict[str, list[float]]:
         """Angles, rates and accelerations of links 1–3 at output ``index``."""
         return {
-            "theta": [float(x) for x in self.theta[:, index]],
-            "omega": [float(x) for x in self.omega[:, index]],
-            "alpha": [float(x) for x in self.alpha[:, index]],
+            "theta": [float(x) + 0.0 for x in self.theta[:, index]],
+            "omega": [float(x) + 0.0 for x in self.omega[:, index]],
+            "alpha": [float(x) + 0.0 for x in self.alpha[:, index]],
         }
 
 
 def _unwrap(theta: NDArray[np.float64], omega: NDArray[np.float64], t: NDArray[np.float64]):
     """Continuous angles: each step takes the 2π branch nearest to the trapezoidal prediction."""
-    out = np.array(theta, dtype=float)
-    for i in range(1, out.size):
-        predicted = out[i - 1] + 0.5 * (omega[i - 1] + omega[i]) * (t[i] - t[i - 1])
-        out[i] += 2 * math.pi * round((predicted - out[i]) / (2 * math.pi))
-    return out
+    theta = np.asarray(theta, dtype=float)
+    predicted = 0.5 * (omega[:-1] + omega[1:]) * np.diff(t)
+    turns = np.round((predicted - np.diff(theta)) / (2 * math.pi))
+    return theta + 2 * math.pi * np.concatenate([[0.0], np.cumsum(turns)])
 
 
 def _check_start(linkage: FourBar, theta1: float, speed: float | None) -> None:
@@ -307,7 +306,7 @@ def simulate(
                        _time.perf_counter() - start)
     if stopped is not None:
         t_event, y_event = stopped
-        th = f.evaluate(t_event, y_event).theta[0]
+        th = f.theta1_of(t_event, y_event)
         raise _lockup(
             f"the motion reaches a dead point of the crank (coupler and rocker aligned) at "
             f"t = {t_event:.6g} s, θ1 = {th:.6g} rad; the {f.name} formulation uses the crank "
@@ -323,8 +322,10 @@ def simulate(
 
 
 def _before_lock(f: Formulation, t_lock: float) -> float:
-    """The time before ``t_lock`` at which |sin(θ3 − θ2)| of the prescribed motion falls to
-    :data:`DEAD_POINT_THRESHOLD`."""
+    """The time before ``t_lock`` at which the prescribed motion's |sin(θ3 − θ2)| is small.
+
+    That is, where it falls to :data:`DEAD_POINT_THRESHOLD`.
+    """
     from .kinematics import position_scalar
 
     sign = f.sign0
@@ -348,14 +349,12 @@ def _lockup(message: str, t: float, theta1: float, partial: Trajectory) -> Locku
 def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
                 seconds) -> Trajectory:
     t = np.array(times)
-    evals = [f.evaluate(ti, yi) for ti, yi in zip(times, states, strict=True)]
-    omega = np.array([e.omega for e in evals]).T
-    alpha = np.array([e.alpha for e in evals]).T
-    theta = np.array([_unwrap(np.array([e.theta[k] for e in evals]), omega[k], t)
-                      for k in range(3)])
-    ra0 = np.array([e.RA0 for e in evals])
-    ra3 = np.array([e.RA3 for e in evals])
-    tau = np.array([e.driving_torque for e in evals])
+    ev = f.evaluate_batch(times, states)
+    omega, alpha = np.asarray(ev.omega, float), np.asarray(ev.alpha, float)
+    theta = np.array([_unwrap(ev.theta[k], omega[k], t) for k in range(3)])
+    ra0 = np.asarray(ev.RA0, complex)
+    ra3 = np.asarray(ev.RA3, complex)
+    tau = np.asarray(ev.driving_torque, float) * np.ones(t.size)
     motor = np.array([f.motor_work(y) for y in states])
     # Energy: T − T0 = work of loads and gravity (a function of the configuration) + motor.
     mo = motion_from_angles(f.lengths, tuple(theta), tuple(omega), tuple(alpha))

@@ -99,3 +99,86 @@ def test_installed_console_script_runs():
                           check=False)
     assert done.returncode == 0, done.stderr
     assert "shaking_moment" in json.loads(done.stdout)
+
+
+def test_simulate_json_has_the_fixed_fields(capsys):
+    assert main(["simulate", EXAMPLE, "--json", "--duration", "1"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    for when in ("initial", "final"):
+        assert set(doc[when]) == {"theta", "omega", "alpha"}
+        assert all(len(doc[when][k]) == 3 for k in ("theta", "omega", "alpha"))
+    assert doc["initial"]["theta"][0] == 1.0 and doc["initial"]["omega"] == [0.0, 0.0, 0.0]
+    assert doc["energy_error"] < 1e-8
+
+
+def test_simulate_methods_agree_through_the_cli(capsys):
+    finals = []
+    for method in ("opened-loop", "complex-masses", "mass-matrix", "lie-group"):
+        assert main(["simulate", EXAMPLE, "--json", "--method", method, "--rtol", "1e-11",
+                     "--atol", "1e-13"]) == 0
+        finals.append(json.loads(capsys.readouterr().out)["final"])
+    for other in finals[1:]:
+        for key in ("theta", "omega", "alpha"):
+            assert np.allclose(other[key], finals[0][key], rtol=0, atol=1e-8)
+
+
+def test_simulate_csv_columns(tmp_path, capsys):
+    from balancer.report import SIMULATION_COLUMNS
+
+    path = tmp_path / "run.csv"
+    assert main(["simulate", EXAMPLE, "--out", str(path), "--duration", "0.5",
+                 "--outputs", "11"]) == 0
+    assert "energy balance" in capsys.readouterr().out
+    with path.open() as fh:
+        rows = list(csv.reader(fh))
+    assert tuple(rows[0]) == SIMULATION_COLUMNS == (
+        "t", "theta1", "theta2", "theta3", "omega1", "omega2", "omega3",
+        "alpha1", "alpha2", "alpha3", "RA0x", "RA0y", "RA3x", "RA3y")
+    data = np.array(rows[1:], dtype=float)
+    assert data.shape == (11, 14)
+    assert np.allclose(data[:, 0], np.linspace(0, 0.5, 11))
+
+
+def test_simulate_lockup_exits_1_and_writes_nothing(tmp_path, capsys):
+    text = Path(EXAMPLE).read_text().replace("crank = 1.0", "crank = 2.9")
+    spec = tmp_path / "rocking.toml"
+    spec.write_text(text.replace('drive = "free"', 'drive = "constant-speed"').replace(
+        "omega1 = 0.0", "omega1 = 3.0"))
+    out = tmp_path / "run.csv"
+    assert main(["simulate", str(spec), "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "locks" in err and "t = " in err and err.count("\n") == 1
+    assert not out.exists()
+
+
+def test_simulate_bad_arguments(capsys):
+    assert main(["simulate", EXAMPLE, "--method", "euler"]) == 2
+    assert main(["simulate", EXAMPLE, "--duration", "-1"]) == 2
+    assert main(["simulate", EXAMPLE, "--rtol", "abc"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 3 and "Traceback" not in err
+
+
+def test_simulate_initial_angle_outside_the_assembly_range(tmp_path, capsys):
+    text = Path(EXAMPLE).read_text().replace("crank = 1.0", "crank = 2.9")
+    spec = tmp_path / "rocking.toml"
+    spec.write_text(text.replace("theta1 = 1.0", "theta1 = 3.0"))
+    assert main(["simulate", str(spec)]) == 2
+    assert "simulation.theta1" in capsys.readouterr().err
+
+
+def test_progress_is_shown_on_a_terminal_only():
+    import io
+
+    from balancer.cli import _Progress
+
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    tty, pipe = Tty(), io.StringIO()
+    for stream in (tty, pipe):
+        p = _Progress(stream=stream, delay=0.0)
+        p(2.5, 5.0)
+        p.done()
+    assert "50.0 %" in tty.getvalue() and pipe.getvalue() == ""

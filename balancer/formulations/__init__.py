@@ -60,6 +60,17 @@ class Evaluation:
     RA3: complex
     driving_torque: float = 0.0
 
+    def at(self, index: int) -> Evaluation:
+        """The state ``index`` of an evaluation of arrays (from ``evaluate_batch``)."""
+        return Evaluation(
+            theta=self.theta[:, index],
+            omega=self.omega[:, index],
+            alpha=self.alpha[:, index],
+            RA0=complex(self.RA0[index]),
+            RA3=complex(self.RA3[index]),
+            driving_torque=float(np.asarray(self.driving_torque)[index]),
+        )
+
 
 class Formulation(ABC):
     """Equations of motion of a four-bar in one formulation.
@@ -127,11 +138,25 @@ class Formulation(ABC):
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         """Angles, rates, accelerations and reactions at a state."""
 
+    def evaluate_batch(self, times, states) -> Evaluation:
+        """:meth:`evaluate` at many states, as an :class:`Evaluation` of arrays.
+
+        ``theta``, ``omega``, ``alpha`` have shape ``(3, n)``. Formulations override it with
+        vectorised versions of their own equations.
+        """
+        evals = [self.evaluate(t, y) for t, y in zip(times, states, strict=True)]
+        return Evaluation(
+            theta=np.array([e.theta for e in evals]).T,
+            omega=np.array([e.omega for e in evals]).T,
+            alpha=np.array([e.alpha for e in evals]).T,
+            RA0=np.array([e.RA0 for e in evals]),
+            RA3=np.array([e.RA3 for e in evals]),
+            driving_torque=np.array([e.driving_torque for e in evals]),
+        )
+
     @abstractmethod
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
-        """``sin(θ3 − θ2)``: zero where coupler and rocker are aligned (a dead point of the crank
-        or a change point).
-        """
+        """``sin(θ3 − θ2)``: zero where coupler and rocker align (dead point or change point)."""
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         """Crank angle at a state, rad."""
@@ -155,8 +180,9 @@ class Formulation(ABC):
         return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < width for p in points)
 
     def branch_vectors(self, theta1: float, omega1: float):
-        """Link vectors and the dependent rates ``(l̄1, l̄2, l̄3), θ̇2, θ̇3`` on the assembly the
-        smooth motion is on at crank angle ``theta1`` (unwrapped, rad) (Eq. 2–7).
+        """Link vectors and dependent rates ``(l̄1, l̄2, l̄3), θ̇2, θ̇3`` of the smooth motion.
+
+        On the assembly the motion is on at crank angle ``theta1`` (unwrapped, rad) (Eq. 2–7).
         """
         sign = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
         vectors = position_scalar(self.lengths, theta1, float(sign))

@@ -72,10 +72,18 @@ class ComplexMasses(Formulation):
     # -- Eq. 36–39 -----------------------------------------------------------------------------
 
     def _reduced(self, theta1: float, omega1: float):
-        """Terms of the reduced equation: ``(ΘᵀMΘ, ΘᵀQ − ΘᵀMb − ΘᵀCθ̇², kinematics)``."""
+        """Terms of the reduced equation at one state: ``(ΘᵀMΘ, ΘᵀQ − ΘᵀMb − ΘᵀCθ̇², kin)``."""
         vectors = self._vectors(theta1)
-        v1, _, v3 = vectors
-        big2, big3, w2, w3, b2, b3 = rates_scalar(self.lengths, vectors, omega1)
+        kin = (vectors, *rates_scalar(self.lengths, vectors, omega1))
+        inertia, force = self._dynamics(kin, omega1)
+        return inertia, force, kin
+
+    def _dynamics(self, kin, omega1):
+        """Eq. 36–39 reduced to θ1, for scalars or arrays of states.
+
+        ``kin = ((l̄1, l̄2, l̄3), Θ2, Θ3, θ̇2, θ̇3, b2, b3)`` with ``θ̈k = Θk·θ̈1 + bk``.
+        """
+        (v1, _, v3), big2, big3, w2, w3, b2, b3 = kin
         m2 = self.mass[1]
         m13 = -_ip(self.m2p * v1, self.m2q * v3) / m2  # Eq. 37
         c13 = _cross(self.m2p * v1, self.m2q * v3) / m2  # Eq. 38, C31 = −C13
@@ -90,7 +98,7 @@ class ComplexMasses(Formulation):
         mb = (m13 * b3, self.m22 * b2, self.m33 * b3)  # M·b with b = (0, b2, b3)
         cw = (c13 * w3 * w3, 0.0, -c13 * omega1 * omega1)  # C·θ̇²
         force = (q1 - mb[0] - cw[0]) + big2 * (q2 - mb[1] - cw[1]) + big3 * (q3 - mb[2] - cw[2])
-        return inertia, force, (vectors, big2, big3, w2, w3, b2, b3)
+        return inertia, force
 
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         self.theta1_start = float(theta1)
@@ -106,20 +114,40 @@ class ComplexMasses(Formulation):
 
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         theta1, omega1 = self._crank(t, y)
-        inertia, force, (vectors, big2, big3, w2, w3, b2, b3) = self._reduced(theta1, omega1)
+        inertia, force, kin = self._reduced(theta1, omega1)
+        return self._evaluation(theta1, omega1, inertia, force, kin)
+
+    def evaluate_batch(self, times, states) -> Evaluation:
+        """The same equations on arrays of states, with the vectorised kinematics (Eq. 2–10)."""
+        from ..kinematics import motion
+
+        cranks = [self._crank(t, y) for t, y in zip(times, states, strict=True)]
+        theta1 = np.array([c[0] for c in cranks])
+        omega1 = np.array([c[1] for c in cranks])
+        signs = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
+        mo = motion(self.lengths, theta1, omega1, 0.0, signs * np.ones_like(theta1), check=False)
+        kin = (mo.vectors, *mo.transfer, mo.omega[1], mo.omega[2], mo.alpha[1], mo.alpha[2])
+        inertia, force = self._dynamics(kin, omega1)
+        return self._evaluation(theta1, omega1, inertia, force, kin)
+
+    def _evaluation(self, theta1, omega1, inertia, force, kin) -> Evaluation:
+        vectors, big2, big3, w2, w3, b2, b3 = kin
         if self.driven:
-            alpha1, tau = 0.0, -force
+            alpha1, tau = 0.0 * force, -force
         else:
-            alpha1, tau = force / inertia, 0.0
-        alpha = np.array([alpha1, big2 * alpha1 + b2, big3 * alpha1 + b3])
-        omega = np.array([omega1, w2, w3])
+            alpha1, tau = force / inertia, 0.0 * force
+        alpha = np.array([alpha1 + 0.0 * big2, big2 * alpha1 + b2, big3 * alpha1 + b3])
+        omega = np.array([omega1 + 0.0 * w2, w2, w3])
         ra0, ra3 = self._reactions(vectors, omega, alpha)
-        theta = np.array([theta1, *np.angle(vectors[1:])])
+        theta = np.array([theta1 + 0.0 * big2, np.angle(vectors[1]), np.angle(vectors[2])])
         return Evaluation(theta=theta, omega=omega, alpha=alpha, RA0=ra0, RA3=ra3,
                           driving_torque=tau)
 
-    def _reactions(self, vectors, omega, alpha) -> tuple[complex, complex]:
-        """R̄A0, R̄A3 by virtual displacements with the complex masses (Eq. 35, 40)."""
+    def _reactions(self, vectors, omega, alpha):
+        """R̄A0, R̄A3 by virtual displacements with the complex masses (Eq. 35, 40).
+
+        For scalars or arrays of states.
+        """
         v1, v2, v3 = vectors
         m1, m2, m3 = self.mass
         z1, _, z3 = self.zeta
@@ -135,7 +163,7 @@ class ComplexMasses(Formulation):
         shaking = f1 + f2 + f3 - p1 - p2 - p3
         # A3 moved by δ with A0, A1 held: i·(l̄2·δθ2 + l̄3·δθ3) = δ.
         c23 = _cross(v2, v3)
-        ra3 = 0j
+        ra3 = 0j * v1
         for delta in (1.0, 1j):
             d2 = _ip(v3, delta) / c23
             d3 = -_ip(v2, delta) / c23
@@ -149,7 +177,7 @@ class ComplexMasses(Formulation):
                 + (mo[2] - inertias[2] * alpha[2]) * d3
             )
             ra3 += work * delta  # ⟨δ, R̄A3⟩ = virtual work of links 2 and 3
-        return complex(shaking - ra3), complex(ra3)
+        return shaking - ra3, ra3
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         return self.crank_angle(t) if self.driven else float(y[0])

@@ -70,7 +70,7 @@ class LieGroup(Formulation):
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
-        (l1, l2, l3, _), (c1, c2, c3) = self.lengths, self.links
+        (l1, _, l3, _), (c1, c2, c3) = self.lengths, self.links
         # Centre-of-mass offsets in each body frame: the rocker's frame starts at A3 along q_D.
         self.rho = (c1.com, c2.com, complex(l3 - c3.e, -c3.f))
         g1, g2, g3 = (_gamma(r) for r in self.rho)
@@ -161,7 +161,8 @@ class LieGroup(Formulation):
         pi_dot = p * w1 * w1 + q_loads  # Eq. 84
         return np.concatenate([[pi_dot], q_dot])
 
-    def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
+    def _kinematic_state(self, t: float, y: NDArray[np.float64]):
+        """Angles, rates, accelerations and motor torque at a state (Eq. 82–85)."""
         q = self._q(y, self.driven)
         sigma, p, q_loads, k, dk, _ = self.terms(q)
         w1 = self._omega1(t, y, sigma)
@@ -176,18 +177,22 @@ class LieGroup(Formulation):
         theta = np.array(
             [math.atan2(q[1], q[0]), math.atan2(q[3], q[2]), math.atan2(-q[5], -q[4])]
         )
-        # Reactions: the links' Newton–Euler equations with these accelerations.
+        return theta, omega, alpha, tau
+
+    def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
+        return self.evaluate_batch([t], [y]).at(0)
+
+    def evaluate_batch(self, times, states) -> Evaluation:
+        """Accelerations per state, then reactions from Newton–Euler in one vectorised call."""
+        parts = [self._kinematic_state(t, y) for t, y in zip(times, states, strict=True)]
+        theta = np.array([p[0] for p in parts]).T
+        omega = np.array([p[1] for p in parts]).T
+        alpha = np.array([p[2] for p in parts]).T
+        tau = np.array([p[3] for p in parts])
         mo = motion_from_angles(self.lengths, tuple(theta), tuple(omega), tuple(alpha))
-        gravity = (self.gravity.real, self.gravity.imag)
-        mo_tau = newton_euler(self.linkage, mo, gravity=gravity)
-        return Evaluation(
-            theta=theta,
-            omega=omega,
-            alpha=alpha,
-            RA0=complex(mo_tau.RA0[0]),
-            RA3=complex(mo_tau.RA3[0]),
-            driving_torque=tau,
-        )
+        ne = newton_euler(self.linkage, mo, gravity=(self.gravity.real, self.gravity.imag))
+        return Evaluation(theta=theta, omega=omega, alpha=alpha, RA0=ne.RA0, RA3=ne.RA3,
+                          driving_torque=tau)
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         return self.crank_angle(t) if self.driven else math.atan2(y[2], y[1])
@@ -218,8 +223,9 @@ class LieGroup(Formulation):
         return float(max(np.linalg.norm(self._closure(q)), norms * max(self.lengths))), 0.0
 
     def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Normalise the attitudes and solve Eq. 86 for q_B, q_D by Newton's method, as the
-        paper does for its initial state; Π1 is kept.
+        """Normalise the attitudes and solve Eq. 86 for q_B, q_D by Newton's method.
+
+        As the paper does for its initial state; Π1 is kept.
         """
         y = np.array(y, dtype=float)
         off = 0 if self.driven else 1

@@ -1,5 +1,6 @@
-"""Constant equivalent mass matrices: the four-bar as three truss elements (Meijaard & van der
-Wijk 2020, Sect. 4.2 and 5.1).
+"""Constant equivalent mass matrices: the four-bar as three truss elements.
+
+Meijaard & van der Wijk 2020, Sect. 4.2 and 5.1.
 
 Each link is a truss element between two nodes with the constant 4×4 mass matrix of Eq. 45 and
 its loads reduced to the nodes (Eq. 46). The coordinates are the Cartesian positions of the

@@ -47,7 +47,7 @@ class OpenedLoop(Formulation):
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
-        (l1, l2, l3, _), (c1, c2, c3) = self.lengths, self.links
+        (l1, l2, _, _), (c1, c2, c3) = self.lengths, self.links
         m1, m2, m3 = self.mass
         # Constant diagonal of the mass matrix (Eq. 23, second forms): inertias of the reduced
         # systems about the links' first joints.
@@ -150,8 +150,9 @@ class OpenedLoop(Formulation):
         return alpha, ra3, tau, pv, vectors
 
     def _solve_reduced(self, theta1: float, omega1: float):
-        """The single equation in θ1 with ``θ̈k = Θk·θ̈1 + bk`` (Eq. 7, 9–10), then R̄A3 from
-        Eq. 22 by least squares.
+        """The single equation in θ1 with ``θ̈k = Θk·θ̈1 + bk`` (Eq. 7, 9–10).
+
+        Then R̄A3 from Eq. 22 by least squares.
         """
         vectors, w2, w3 = self.branch_vectors(theta1, omega1)
         big2, big3, _, _, b2, b3 = rates_scalar(self.lengths, vectors, omega1)
@@ -228,9 +229,10 @@ class OpenedLoop(Formulation):
         return abs(phi), float(np.linalg.norm(g @ y[3:6]))
 
     def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Least-norm Gauss–Newton correction of the angles onto the loop closure (Eq. 26), then
-        of the rates onto its derivative (Eq. 5); with the crank driven, θ1 and θ̇1 are
-        prescribed and only θ2, θ3 and their rates are corrected.
+        """Least-norm Gauss–Newton correction onto the loop closure (Eq. 26) and its rate (Eq. 5).
+
+        With the crank driven, θ1 and θ̇1 are prescribed and only θ2, θ3 and their rates are
+        corrected; near a change point the state is put on the smooth motion's assembly.
         """
         y = np.array(y, dtype=float)
         free = slice(0, 3) if not self.driven else slice(1, 3)
