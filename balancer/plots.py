@@ -1,0 +1,157 @@
+"""Figures for a designer's report (matplotlib, Agg; never ``show()``).
+
+Each ``plot_*`` function draws on the axes it is given (or a new figure's) and returns them;
+:func:`verification_figure` assembles the report figure of ``balancer verify`` and
+:func:`save_figure` writes it as PNG and SVG, whole or not at all.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from .inverse import link_com_kinematics
+from .kinematics import motion_from_angles
+from .model import FourBar
+from .simulate import Trajectory
+
+#: Colours for A0, A3 and their sum (colour-blind safe).
+COLOURS = {"A0": "#0072B2", "A3": "#D55E00", "sum": "#000000", "before": "#999999",
+           "after": "#009E73"}
+
+
+def _axes(ax: Axes | None) -> Axes:
+    if ax is not None:
+        return ax
+    return Figure(figsize=(7, 4), layout="constrained").add_subplot()
+
+
+def plot_reactions(traj: Trajectory, ax: Axes | None = None, title: str = "") -> Axes:
+    """Components of R̄A0, R̄A3 and of their sum over time (as the paper's Fig. 8 and 9)."""
+    ax = _axes(ax)
+    t = traj.t
+    ax.plot(t, traj.RA0.real, color=COLOURS["A0"], lw=1.2, label="$R_{A0x}$")
+    ax.plot(t, traj.RA0.imag, color=COLOURS["A0"], lw=1.2, ls="--", label="$R_{A0y}$")
+    ax.plot(t, traj.RA3.real, color=COLOURS["A3"], lw=1.2, label="$R_{A3x}$")
+    ax.plot(t, traj.RA3.imag, color=COLOURS["A3"], lw=1.2, ls="--", label="$R_{A3y}$")
+    total = traj.shaking_force
+    ax.plot(t, total.real, color=COLOURS["sum"], lw=1.8, label="$R_{A0x}+R_{A3x}$")
+    ax.plot(t, total.imag, color=COLOURS["sum"], lw=1.8, ls="--", label="$R_{A0y}+R_{A3y}$")
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("force on the ground (N)")
+    ax.set_title(title or f"reactions, {traj.drive} motion")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small", ncol=3, loc="upper right")
+    return ax
+
+
+def plot_shaking_moment(
+    traj: Trajectory, original: Trajectory | None = None, ax: Axes | None = None,
+    title: str = "",
+) -> Axes:
+    """Shaking moment about A0 over time, before (the original) and after."""
+    ax = _axes(ax)
+    if original is not None:
+        ax.plot(original.t, original.shaking_moment, color=COLOURS["before"], lw=1.5,
+                label="before (original)")
+    ax.plot(traj.t, traj.shaking_moment, color=COLOURS["after"], lw=1.5,
+            label="after" if original is not None else "shaking moment")
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("shaking moment about A0 (N·m)")
+    ax.set_title(title or f"shaking moment, {traj.drive} motion")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small")
+    return ax
+
+
+def centre_of_mass_path(linkage: FourBar, traj: Trajectory) -> np.ndarray:
+    """Total centre of mass along a simulated motion, complex, m."""
+    mo = motion_from_angles(linkage.lengths, tuple(traj.theta), tuple(traj.omega),
+                            tuple(traj.alpha))
+    (r1, r2, r3), _ = link_com_kinematics(linkage, mo)
+    m1, m2, m3 = (link.mass for link in linkage.links)
+    return (m1 * r1 + m2 * r2 + m3 * r3) / linkage.total_mass
+
+
+def plot_com_path(
+    linkage: FourBar, traj: Trajectory, original: FourBar | None = None,
+    original_traj: Trajectory | None = None, ax: Axes | None = None,
+) -> Axes:
+    """Path of the total centre of mass, with the ground pivots (a point when balanced)."""
+    ax = _axes(ax)
+    if original is not None and original_traj is not None:
+        path = centre_of_mass_path(original, original_traj)
+        ax.plot(path.real, path.imag, color=COLOURS["before"], lw=1.5, label="before (original)")
+    path = centre_of_mass_path(linkage, traj)
+    label = "after" if original is not None else "total centre of mass"
+    if np.ptp(path.real) + np.ptp(path.imag) < 1e-9 * max(linkage.lengths):
+        ax.plot(path.real[:1], path.imag[:1], "o", color=COLOURS["after"],
+                label=f"{label}: stationary")
+    else:
+        ax.plot(path.real, path.imag, color=COLOURS["after"], lw=1.5, label=label)
+    ax.plot([0, linkage.lengths[3]], [0, 0], "k^", ms=8, label="ground pivots A0, A3")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title("path of the total centre of mass")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small")
+    return ax
+
+
+def verification_figure(design, verification) -> Figure:
+    """The report figure of ``balancer verify``.
+
+    Columns: the crank driven at the operating speed, free motion; rows: reactions at A0 and A3
+    and their sum, shaking moment before and after, path of the total centre of mass.
+    """
+    fig = Figure(figsize=(13, 14), layout="constrained")
+    axes = fig.subplots(3, 2)
+    title = design.title or "design"
+    fig.suptitle(f"{title}: verification by simulation ({verification.method} formulation)")
+    speed = design.operation.speed if design.operation else 0.0
+    runs = ((verification.driven, f"crank driven at {speed:g} rad/s", 0),
+            (verification.free, "free motion", 1))
+    for run, label, col in runs:
+        if run.trajectory is None:
+            axes[0, col].text(0.5, 0.5, f"{label}: no simulation\n{run.note}", ha="center",
+                              va="center", wrap=True, transform=axes[0, col].transAxes)
+            continue
+        plot_reactions(run.trajectory, ax=axes[0, col], title=f"reactions, {label}")
+        plot_shaking_moment(run.trajectory, run.original, ax=axes[1, col],
+                            title=f"shaking moment, {label}")
+        plot_com_path(design.mechanism, run.trajectory, design.original, run.original,
+                      ax=axes[2, col])
+        axes[2, col].set_title(f"path of the total centre of mass, {label}")
+    return fig
+
+
+def save_figure(fig: Figure, path: str | os.PathLike[str]) -> list[Path]:
+    """Write the figure as PNG and SVG next to each other (``path``'s stem), atomically.
+
+    Returns the files written.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig)
+    target = Path(path)
+    stem = target.with_suffix("") if target.suffix.lower() in (".png", ".svg") else target
+    written = []
+    for suffix, dpi in ((".png", 150), (".svg", None)):
+        out = stem.with_suffix(suffix)
+        fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=suffix,
+                                   dir=out.parent if str(out.parent) else ".")
+        os.close(fd)
+        try:
+            fig.savefig(tmp, dpi=dpi, format=suffix[1:])
+            os.replace(tmp, out)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        written.append(out)
+    return written
