@@ -1,4 +1,4 @@
-"""Proof by simulation: does the design shake its frame as little as claimed?
+"""Proof by simulation that a design shakes its frame as little as claimed.
 
 A balanced design is simulated with a formulation other than the one the optimiser used (the
 optimiser's objective comes from the equivalent mass matrices, Eq. 45–54; the default check uses
@@ -49,8 +49,10 @@ class RunCheck:
 
     @property
     def force_level(self) -> float | None:
-        """Largest shaking force relative to the largest individual reaction (dimensionless):
-        at integration-error level for a force-balanced design."""
+        """Largest shaking force relative to the largest individual reaction (dimensionless).
+
+        At integration-error level for a force-balanced design.
+        """
         if self.trajectory is None or self.max_shaking_force is None:
             return None
         scale = max(np.max(np.abs(self.trajectory.RA0)), np.max(np.abs(self.trajectory.RA3)))
