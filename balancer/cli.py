@@ -137,6 +137,20 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from .spec import load_design
+
+    if not args.animate:
+        raise SpecError("nothing to plot: give --animate PATH", key="--animate")
+    path = _output_path(args.animate, "--animate")
+    design = load_design(args.spec)
+    from .plots import animate
+
+    animate(design.mechanism, path, frames=args.frames, title=design.title)
+    print(f"wrote {path}")
+    return 0
+
+
 def _positive_float(text: str) -> float:
     try:
         value = float(text)
@@ -235,6 +249,18 @@ def build_parser() -> argparse.ArgumentParser:
                    help="formulation for the simulations (default opened-loop)")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
     p.set_defaults(handler=_cmd_verify)
+
+    p = sub.add_parser(
+        "plot",
+        help="pictures of the linkage (an animation of it running)",
+        description="Draw the linkage: --animate writes a GIF of one crank revolution with the "
+        "total centre of mass traced.",
+    )
+    p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
+    p.add_argument("--animate", metavar="PATH", help="write a GIF animation to PATH")
+    p.add_argument("--frames", type=_count, default=72, metavar="N",
+                   help="frames per revolution (default 72)")
+    p.set_defaults(handler=_cmd_plot)
     return parser
 
 

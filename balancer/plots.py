@@ -25,6 +25,14 @@ COLOURS = {"A0": "#0072B2", "A3": "#D55E00", "sum": "#000000", "before": "#99999
            "after": "#009E73"}
 
 
+def _publish(tmp: str, target: Path) -> None:
+    """Give a finished temporary file the usual permissions and move it into place."""
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+    os.replace(tmp, target)
+
+
 def _axes(ax: Axes | None) -> Axes:
     if ax is not None:
         return ax
@@ -149,9 +157,94 @@ def save_figure(fig: Figure, path: str | os.PathLike[str]) -> list[Path]:
         os.close(fd)
         try:
             fig.savefig(tmp, dpi=dpi, format=suffix[1:])
-            os.replace(tmp, out)
+            _publish(tmp, out)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
             raise
         written.append(out)
     return written
+
+
+def linkage_frames(linkage: FourBar, frames: int = 72):
+    """Joint positions and centres of mass over one crank revolution, for drawing.
+
+    Returns ``(joints, coms, total)``: joints ``(frames, 4)`` complex (A0, A1, A2, A3), link
+    centres of mass ``(frames, 3)`` and the total centre of mass ``(frames,)``, m.
+    """
+    from .inverse import sample_angles
+    from .kinematics import cycle_branch_signs, motion
+
+    angles = sample_angles(frames)
+    signs = cycle_branch_signs(linkage.lengths, linkage.branch, angles)
+    mo = motion(linkage.lengths, angles, 1.0, 0.0, signs, check=False)
+    a3 = np.full(frames, complex(linkage.lengths[3], 0.0))
+    joints = np.column_stack([np.zeros(frames, complex), mo.pos.A1, mo.pos.A2, a3])
+    (r1, r2, r3), _ = link_com_kinematics(linkage, mo)
+    coms = np.column_stack([r1, r2, r3])
+    m = np.array([link.mass for link in linkage.links])
+    total = coms @ m / m.sum()
+    return joints, coms, total
+
+
+def animate(linkage: FourBar, path: str | os.PathLike[str], *, frames: int = 72, fps: int = 24,
+            title: str = "") -> Path:
+    """Write a GIF of the linkage turning one revolution with its total centre of mass traced.
+
+    Frames are equally spaced crank angles (the crank at constant speed). The still parts are
+    drawn once and each frame only blits the moving artists onto them (matplotlib's animation
+    machinery would redraw the whole figure three times a frame); Pillow writes the GIF.
+    Written whole or not at all.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image
+
+    joints, coms, total = linkage_frames(linkage, frames)
+    fig = Figure(figsize=(6, 4.5), dpi=100, layout="constrained")
+    canvas = FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    everything = np.concatenate([joints.ravel(), coms.ravel(), total])
+    pad = 0.08 * max(linkage.lengths)
+    ax.set_xlim(everything.real.min() - pad, everything.real.max() + pad)
+    ax.set_ylim(everything.imag.min() - pad, everything.imag.max() + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(title or "linkage over one crank revolution")
+    ax.grid(alpha=0.3)
+    ax.plot(total.real, total.imag, color=COLOURS["before"], lw=1, ls=":",
+            label="path of the total centre of mass")
+    ax.plot([0, linkage.lengths[3]], [0, 0], "k^", ms=10, zorder=5)
+    (bars,) = ax.plot([], [], "-o", color=COLOURS["A0"], lw=3, ms=6, label="links",
+                      animated=True)
+    (link_coms,) = ax.plot([], [], "s", color=COLOURS["A3"], ms=5,
+                           label="link centres of mass", animated=True)
+    (trace,) = ax.plot([], [], color=COLOURS["after"], lw=2, animated=True)
+    (com,) = ax.plot([], [], "o", color=COLOURS["after"], ms=9, label="total centre of mass",
+                     animated=True)
+    ax.legend(fontsize="small", loc="upper right")
+    canvas.draw()
+    fig.set_layout_engine("none")
+    background = canvas.copy_from_bbox(fig.bbox)
+    images = []
+    for k in range(frames):
+        canvas.restore_region(background)
+        bars.set_data(joints[k].real, joints[k].imag)
+        link_coms.set_data(coms[k].real, coms[k].imag)
+        trace.set_data(total[: k + 1].real, total[: k + 1].imag)
+        com.set_data([total[k].real], [total[k].imag])
+        for artist in (trace, bars, link_coms, com):
+            ax.draw_artist(artist)
+        rgba = np.asarray(canvas.buffer_rgba())
+        images.append(Image.fromarray(rgba[..., :3].copy()).quantize(colors=64))
+    target = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".gif",
+                               dir=target.parent if str(target.parent) else ".")
+    os.close(fd)
+    try:
+        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
+                       duration=round(1000 / fps), loop=0)
+        _publish(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return target
