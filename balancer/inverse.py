@@ -553,22 +553,12 @@ def cycle_analysis(
         for name, array in out.items():
             array[sl] = getattr(r, name)
     singular = np.zeros(n, bool)
-    # Samples exactly at a change point (all joints collinear, the transfer functions 0/0):
-    # limits of the smooth motion by extrapolation with error O(δ⁴), symmetric at θ1 = π, which
-    # the motion passes through, one-sided at θ1 = 0, where the revolution starts.
-    delta = 1e-4
-    for theta_star in change_point_angles(linkage.lengths):
-        hit = np.abs(np.angle(np.exp(1j * (angles - theta_star)))) < 1e-9
-        if not hit.any():
-            continue
-        if theta_star == 0.0:
-            steps, weights = (1, 2, 3, 4), (4.0, -6.0, 4.0, -1.0)
-        else:
-            steps, weights = (-2, -1, 1, 2), (-1 / 6, 2 / 3, 2 / 3, -1 / 6)
-        parts = []
-        for k in steps:
-            sign = cycle_branch_signs(linkage.lengths, linkage.branch, theta_star + k * delta)
-            parts.append(evaluate(angles[hit] + k * delta, sign))
+    for hit, offsets, weights in change_point_limits(linkage.lengths, angles):
+        parts = [
+            evaluate(angles[hit] + d, cycle_branch_signs(linkage.lengths, linkage.branch,
+                                                         angles[hit] + d))
+            for d in offsets
+        ]
         for name in ("shaking_force", "driving_torque", "shaking_moment"):
             out[name][hit] = sum(
                 w * getattr(p, name) for w, p in zip(weights, parts, strict=True)
@@ -584,6 +574,35 @@ def cycle_analysis(
         route=route,
         singular=singular,
     )
+
+
+def change_point_limits(lengths, angles: NDArray[np.float64]):
+    """How to evaluate a revolution's samples that fall exactly on a change point.
+
+    There all joints are collinear and the transfer functions are 0/0; the shaking force, the
+    shaking moment and the driving torque are the limits of the smooth motion, extrapolated
+    with error O(δ⁴) (δ = 1e-4 rad): symmetrically at θ1 = π, which the motion passes through,
+    one-sidedly at θ1 = 0, where the revolution starts. (The individual reactions grow without
+    bound there.)
+
+    Returns
+    -------
+    list of (mask, offsets, weights)
+        For each change point hit by ``angles``: which samples, the crank-angle offsets (rad)
+        at which to evaluate, and the weights of those evaluations.
+    """
+    delta = 1e-4
+    out = []
+    for theta_star in change_point_angles(lengths):
+        hit = np.abs(np.angle(np.exp(1j * (angles - theta_star)))) < 1e-9
+        if not hit.any():
+            continue
+        if theta_star == 0.0:
+            steps, weights = (1, 2, 3, 4), (4.0, -6.0, 4.0, -1.0)
+        else:
+            steps, weights = (-2, -1, 1, 2), (-1 / 6, 2 / 3, 2 / 3, -1 / 6)
+        out.append((hit, tuple(k * delta for k in steps), weights))
+    return out
 
 
 #: Number of crank angles evaluated at once by :func:`cycle_analysis`.

@@ -63,8 +63,14 @@ from numpy.typing import NDArray
 
 from .conditions import force_balance_matrix
 from .errors import AssemblyError, SpecError
-from .inverse import Regressors, parameter_vector, regressors, sample_angles
-from .kinematics import assembly_range, change_point_angles, cycle_branch_signs, motion
+from .inverse import (
+    Regressors,
+    change_point_limits,
+    parameter_vector,
+    regressors,
+    sample_angles,
+)
+from .kinematics import assembly_range, cycle_branch_signs, motion
 from .model import Design, FourBar, Link
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -257,17 +263,17 @@ def read_balance(table: _Table, mechanism: FourBar) -> BalanceProblem:
     if table.has("force_balance"):
         value = table.raw("force_balance")
         if not isinstance(value, bool):
-            raise SpecError(
-                "must be true or false", key=table.key("force_balance"), value=value
-            )
+            raise SpecError("must be true or false", key=table.key("force_balance"), value=value)
         force_balance = value
     objective = Objective()
     sub = table.table("objective", required=False)
     if sub is not None:
         _check_keys(sub, _OBJECTIVE_KEYS)
         objective = Objective(
-            **{name: sub.nonnegative(name, default=getattr(objective, name))
-               for name in _OBJECTIVE_KEYS}
+            **{
+                name: sub.nonnegative(name, default=getattr(objective, name))
+                for name in _OBJECTIVE_KEYS
+            }
         )
         sub.finish()
     links: dict[str, LinkFreedom] = {}
@@ -544,16 +550,15 @@ def _cycle_regressors(linkage: FourBar, speed: float, angles: NDArray[np.float64
     """
     lengths = linkage.lengths
     n = angles.size
+    limits = change_point_limits(lengths, angles)
     hit = np.zeros(n, bool)
-    points = change_point_angles(lengths)
-    for theta_star in points:
-        hit |= np.abs(np.angle(np.exp(1j * (angles - theta_star)))) < 1e-9
+    for mask, _, _ in limits:
+        hit |= mask
 
     def evaluate(theta: NDArray[np.float64]) -> Regressors:
         signs = cycle_branch_signs(lengths, linkage.branch, theta)
         return regressors(lengths, motion(lengths, theta, speed, 0.0, signs))
 
-    regular = evaluate(angles[~hit]) if (~hit).any() else None
     out = {
         "RA0": np.full((n, 14), np.nan, complex),
         "RA3": np.full((n, 14), np.nan, complex),
@@ -561,23 +566,14 @@ def _cycle_regressors(linkage: FourBar, speed: float, angles: NDArray[np.float64
         "driving_torque": np.empty((n, 14)),
         "shaking_moment": np.empty((n, 14)),
     }
-    if regular is not None:
+    if (~hit).any():
+        regular = evaluate(angles[~hit])
         for name, array in out.items():
             array[~hit] = getattr(regular, name)
-    delta = 1e-4
-    for theta_star in points:
-        here = np.abs(np.angle(np.exp(1j * (angles - theta_star)))) < 1e-9
-        if not here.any():
-            continue
-        if theta_star == 0.0:
-            steps, weights = (1, 2, 3, 4), (4.0, -6.0, 4.0, -1.0)
-        else:
-            steps, weights = (-2, -1, 1, 2), (-1 / 6, 2 / 3, 2 / 3, -1 / 6)
-        parts = [evaluate(angles[here] + k * delta) for k in steps]
+    for mask, offsets, weights in limits:
+        parts = [evaluate(angles[mask] + d) for d in offsets]
         for name in ("shaking_force", "driving_torque", "shaking_moment"):
-            out[name][here] = sum(
-                w * getattr(p, name) for w, p in zip(weights, parts, strict=True)
-            )
+            out[name][mask] = sum(w * getattr(p, name) for w, p in zip(weights, parts, strict=True))
     return Regressors(**out)
 
 
@@ -649,8 +645,10 @@ class NumericProblem:
 
     @cached_property
     def scales(self) -> NDArray[np.float64]:
-        """Typical magnitude of each entry of ``x`` (m, m·l, m·l, m·l² per link; counter-rotors
-        like their link's ``m·l²``), for scaling the optimisers' variables.
+        """Typical magnitude of each entry of ``x``, for scaling the optimisers' variables.
+
+        ``m``, ``m·l``, ``m·l``, ``m·l²`` per link (original mass); counter-rotors like their
+        link's ``m·l²``.
         """
         out = np.empty(14)
         for b in self.links:
@@ -685,6 +683,16 @@ class NumericProblem:
     def original_objective(self) -> float:
         """``J`` of the original design, (N·m)²."""
         return self.objective(self.x0)
+
+    @cached_property
+    def objective_reference(self) -> float:
+        """A positive scale of ``J``: ``‖K·x0‖² + w_m·Σm_original``, (N·m)².
+
+        The floor of relative gaps (``J`` of the original may be zero or negative when only
+        mass is penalised).
+        """
+        value = self.quadratic(self.x0) + self.weights.added_mass * self.original_mass
+        return value if value > 0 else 1.0
 
     @cached_property
     def objective_scale(self) -> float:
@@ -735,9 +743,7 @@ class NumericProblem:
             )
         return self.linkage.with_links(links)
 
-    def violations(
-        self, x: NDArray[np.float64], tol: float = FEASIBILITY_TOLERANCE
-    ) -> list[str]:
+    def violations(self, x: NDArray[np.float64], tol: float = FEASIBILITY_TOLERANCE) -> list[str]:
         """The constraints that ``x`` breaks by more than ``tol`` (relative), as text.
 
         Bounds are compared on the scale of the link (``m``, ``l``, ``m·l²``); force balance
@@ -827,8 +833,10 @@ def numeric_problem(design: Design) -> NumericProblem:
     if w.driving_torque:
         blocks.append(math.sqrt(w.driving_torque) * reg.driving_torque)
     if w.shaking_force:
-        blocks += [math.sqrt(w.shaking_force) * reg.shaking_force.real,
-                   math.sqrt(w.shaking_force) * reg.shaking_force.imag]
+        blocks += [
+            math.sqrt(w.shaking_force) * reg.shaking_force.real,
+            math.sqrt(w.shaking_force) * reg.shaking_force.imag,
+        ]
     rows = np.vstack(blocks) / math.sqrt(n) if blocks else np.zeros((0, 14))
     factor = np.linalg.qr(rows, mode="r") if blocks else np.zeros((0, 14))
     links = tuple(

@@ -23,8 +23,9 @@ compressed to its 14-column triangular factor ``R``.
 Two stages: the SOCP gives the optimum (the lower bound); then, because the optimum is usually
 not unique (the crank's inertia and counter-rotor do nothing at constant speed, the shaking
 moment sees only the difference of the rocker's inertia and its counter-rotor, and complete
-balance leaves a whole family of couplers), a **tie-break** picks, among the designs within
-``1e-8`` (relative) of the optimum, the one nearest the original in scaled parameters.
+balance leaves a whole family of couplers), a **tie-break** picks, among the designs that give
+the same ``K·x`` (unique at the optimum, as ``J`` is strictly convex in it) and the same total
+mass, the one nearest the original in scaled parameters.
 
 An infeasible problem (force balance cannot be met within the bounds) is diagnosed by an elastic
 (phase-1) problem with a slack on each bound and raises :class:`InfeasibleError` naming the
@@ -39,6 +40,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass
 
 import cvxpy as cp
@@ -47,7 +49,7 @@ from numpy.typing import NDArray
 
 from ..errors import SolverError
 from ..problem import DEFAULT_ABOUT, JOINTS, NumericProblem
-from .result import InfeasibleError, StageReport
+from .result import InfeasibleError, StageReport, gap_floor
 
 #: Clarabel's settings for every solve here (tight: the zero optimum of complete balancing
 #: must be reached to ~1e-10 of the original shaking moment).
@@ -60,9 +62,9 @@ CLARABEL_SETTINGS: dict[str, float | int] = {
     "tol_ktratio": 1e-8,
     "max_iter": 200,
 }
-#: The tie-break keeps the objective within ``TIE_RELATIVE·optimum + TIE_ABSOLUTE·original``.
-TIE_RELATIVE = 1e-8
-TIE_ABSOLUTE = 1e-10
+#: The tie-break's design replaces the SOCP's if its objective is no worse by more than this,
+#: relative to the lower bound (or the floor of :func:`.result.gap_floor` at a zero optimum).
+TIE_ACCEPT = 1e-7
 #: A slack of the elastic problem above this (in scaled units) names a bound to widen.
 SLACK_TOLERANCE = 1e-7
 
@@ -200,39 +202,48 @@ class ConvexSolver:
         lay = self.layout
         x = lay.c + lay.T @ self._u
         constraints, self._relaxed = self._constraints(x)
+        self._fb: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._inconsistent = self._force_balance(x, constraints)
         k = data.factor.shape[0]
-        self._P = cp.Parameter((k, n), name="P") if k else None
-        self._q = cp.Parameter(k, name="q") if k else None
+        r = data.factor / self._scale
+        p_matrix, q_vector = r @ lay.T, r @ lay.c
         w_mass = data.weights.added_mass / self._scale**2
-        mass_term = (x[0] + x[4] + x[8] - data.original_mass) * w_mass if w_mass else 0.0
-        self._norm_form = w_mass == 0
+        mass = x[0] + x[4] + x[8]
+        mass_term = (mass - data.original_mass) * w_mass if w_mass else 0.0
+        self._norm_form = w_mass == 0 and k > 0
         if k:
-            residual = self._P @ self._u + self._q
+            residual = p_matrix @ self._u + q_vector
             if self._norm_form:
                 value = cp.norm(residual)
             else:
                 value = cp.sum_squares(residual) + mass_term
         else:
             value = mass_term
-        self._value = value
         self._stage1 = cp.Problem(cp.Minimize(value), constraints)
-        self._bound = cp.Parameter(name="bound")
+        # Tie-break. J is strictly convex in y = P·u, so every optimal design has the same y
+        # (and, with mass penalised, the same total mass): fix them at the SOCP's values, in an
+        # orthonormal basis of the directions they measure, and pick the design nearest the
+        # preferred one. (Bounding J by the optimum instead leaves a thin shell that Clarabel
+        # meets only "almost"; its violations, once repaired, cost more than the tie-break.)
+        rows = []
+        if k:
+            _, sv, vt = np.linalg.svd(p_matrix, full_matrices=False)
+            rows = list(vt[sv > 1e-12 * sv.max(initial=0.0)])
+        if w_mass:
+            g = lay.T[0] + lay.T[4] + lay.T[8]
+            for v in rows:
+                g = g - (v @ g) * v
+            if np.linalg.norm(g) > 1e-12 * np.linalg.norm(lay.T[0] + lay.T[4] + lay.T[8]):
+                rows.append(g / np.linalg.norm(g))
+        self._seen = np.array(rows).reshape(len(rows), n)
+        self._seen_value = cp.Parameter(len(rows), name="seen")
         self._prefer = cp.Parameter(n, name="prefer")
+        fixed = [self._seen @ self._u == self._seen_value] if rows else []
         self._stage2 = cp.Problem(
-            cp.Minimize(cp.sum_squares(self._u - self._prefer)),
-            [*constraints, value <= self._bound],
+            cp.Minimize(cp.sum_squares(self._u - self._prefer)), [*constraints, *fixed]
         )
-        self._set_objective_data()
 
     # -- building ------------------------------------------------------------------------------
-
-    def _set_objective_data(self) -> None:
-        if self._P is None:
-            return
-        r = self.data.factor / self._scale
-        self._P.value = r @ self.layout.T
-        self._q.value = r @ self.layout.c
 
     def _constraints(self, x) -> tuple[list, list[str]]:
         data, lay = self.data, self.layout
@@ -275,8 +286,10 @@ class ConvexSolver:
             if entry in free:
                 assert b.counter_rotor is not None
                 scale = data.scales[entry]
-                out += [x[entry] / scale >= b.counter_rotor[0] / scale,
-                        x[entry] / scale <= b.counter_rotor[1] / scale]
+                out += [
+                    x[entry] / scale >= b.counter_rotor[0] / scale,
+                    x[entry] / scale <= b.counter_rotor[1] / scale,
+                ]
         return out, relaxed
 
     def _force_balance(self, x, constraints: list) -> bool:
@@ -297,6 +310,7 @@ class ConvexSolver:
                 inconsistent = True
         if keep:
             constraints.append(at[keep] @ self._u == rhs[keep])
+            self._fb = (at[keep], rhs[keep], np.linalg.pinv(at[keep]))
         return inconsistent
 
     # -- solving -------------------------------------------------------------------------------
@@ -304,7 +318,7 @@ class ConvexSolver:
     def _run(self, problem: cp.Problem, name: str) -> tuple[StageReport, bool]:
         start = time.perf_counter()
         try:
-            problem.solve(solver=cp.CLARABEL, **self.settings)
+            _solve(problem, self.settings)
             status = str(problem.status)
         except cp.error.SolverError as exc:  # numerical failure inside Clarabel
             status = f"solver error: {exc}"
@@ -355,92 +369,209 @@ class ConvexSolver:
                 f"the convex balancing problem could not be solved (Clarabel: "
                 f"{report.solver_status} after {report.iterations} iterations)"
             )
-        u = np.array(self._u.value)
         value = float(self._stage1.value)
-        if self._P is not None and self._norm_form:
+        if self._norm_form:
             lower = (value * self._scale) ** 2  # the norm ‖R·x‖ was minimised
         else:
             lower = value * self._scale**2
+        u1 = np.array(self._u.value)
+        x, tight = self.repair(u1)
+        objective = data.objective(x)
         if tie_break and lay.size:
             target = data.x0 if prefer is None else np.asarray(prefer, float)
             self._prefer.value = lay.u(target)
-            self._bound.value = value + TIE_RELATIVE * abs(value) + TIE_ABSOLUTE
+            self._seen_value.value = self._seen @ u1
             report2, ok2 = self._run(self._stage2, "tie-break")
             stages.append(report2)
             if ok2:
-                u = np.array(self._u.value)
-        x = lay.x(u)
-        tight = True
-        for name in self._relaxed:
-            b = next(b for b in data.links if b.name == name)
-            k = 4 * b.index
-            inertia = x[k + 3] - (x[k + 1] ** 2 + x[k + 2] ** 2) / x[k]
-            if inertia > b.inertia[1] + 1e-9 * b.inertia_ref:
-                tight = False
-                x[k + 3] += b.inertia[1] - inertia  # move into the bound: feasible
-        x = data.settle(x)
+                x2, tight2 = self.repair(np.array(self._u.value))
+                objective2 = data.objective(x2)
+                slack = TIE_ACCEPT * max(abs(lower), gap_floor(data.objective_reference))
+                if objective2 <= objective + slack:
+                    x, tight, objective = x2, tight2, objective2
         return ConvexSolution(
             x=x,
-            objective=data.objective(x),
+            objective=objective,
             lower_bound=lower,
             relaxation_tight=tight,
             converged=True,
             stages=tuple(stages),
         )
 
+    def repair(self, u: NDArray[np.float64]) -> tuple[NDArray[np.float64], bool]:
+        """The design of solver variables ``u``, with the solver's small violations removed.
+
+        Clarabel meets the constraints to its tolerance (``1e-10``, or ~``1e-5`` when it stops
+        "almost solved"). First the least change of ``u`` restores Eq. 58 to rounding (it moves
+        the design by about Clarabel's tolerance). A design that then meets every bound to
+        :data:`balancer.problem.FEASIBILITY_TOLERANCE` is kept as it is; otherwise masses and
+        counter-rotors are clipped into their bounds and centres of mass pulled into their
+        discs, Eq. 58 restored again (alternating twice), and each inertia about the centre of
+        mass put into its bounds (inertias do not enter Eq. 58). Returns the design vector
+        (inert entries settled) and whether the convex relaxation was tight: an upper inertia
+        bound overshot by more than ``1e-6`` relative is a relaxation that was not tight, and
+        the design moved into it is feasible but possibly not optimal.
+        """
+        data, lay = self.data, self.layout
+        u = np.array(u, dtype=float)
+        index = {entry: j for j, entry in enumerate(lay.primary)}
+        if self._fb is not None:  # Eq. 58 to rounding, not to Clarabel's tolerance
+            at, rhs, pinv = self._fb
+            u -= pinv @ (at @ u - rhs)
+        # Met to the feasibility tolerance: leave the solver's design alone (a "repair" of a
+        # 1e-12 violation would cost more objective than it is worth at a zero optimum).
+        rounds = 2 if data.violations(data.settle(lay.x(u))) else 0
+        for _ in range(rounds):
+            for b in data.links:
+                k = 4 * b.index
+                if k in index:
+                    j = index[k]
+                    u[j] = np.clip(u[j], b.mass[0] / data.scales[k], b.mass[1] / data.scales[k])
+                if b.com_fixed is None:
+                    x = lay.x(u)
+                    m, d = x[k], complex(x[k + 1], x[k + 2]) - x[k] * b.com_centre
+                    if abs(d) > m * b.com_radius:
+                        d *= m * b.com_radius / abs(d)
+                        s = m * b.com_centre + d
+                        u[index[k + 1]] = s.real / data.scales[k + 1]
+                        u[index[k + 2]] = s.imag / data.scales[k + 2]
+            for entry, b in ((12, data.links[0]), (13, data.links[2])):
+                if entry in index:
+                    assert b.counter_rotor is not None
+                    lo, hi = (v / data.scales[entry] for v in b.counter_rotor)
+                    u[index[entry]] = np.clip(u[index[entry]], lo, hi)
+            if self._fb is not None:
+                at, rhs, pinv = self._fb
+                u -= pinv @ (at @ u - rhs)
+        x = lay.x(u)
+        tight = True
+        for b in data.links:
+            k = 4 * b.index
+            if data.inert[k + 3] or (k + 3) not in index:
+                continue
+            q = (x[k + 1] ** 2 + x[k + 2] ** 2) / x[k]
+            inertia = x[k + 3] - q
+            if inertia > b.inertia[1] * (1 + 1e-6) + 1e-9 * b.inertia_ref:
+                tight = False
+            low = max(b.inertia[0], x[k] * b.gyration**2)
+            if rounds and not low <= inertia <= b.inertia[1]:
+                x[k + 3] = min(max(inertia, low), b.inertia[1]) + q
+        return data.settle(x), tight
+
     # -- infeasibility -------------------------------------------------------------------------
 
-    def diagnose(self) -> InfeasibleError:
-        """The elastic (phase-1) problem: which bounds to widen so that force balance is met.
+    def _bound_constraints(self, m, s, tau, slack=None, skip=None) -> list:
+        """Eq. 58 and the bounds on masses and centres of mass (what force balance meets).
 
-        Every bound on the masses and centres of mass gets a nonnegative slack (a fixed mass or
-        centre of mass too, at ten times the weight: widening a bound is preferred to freeing
-        a fixed quantity); the weighted sum of the slacks is minimised subject to Eq. 58.
-        The nonzero slacks name the bounds; the design found gives the values that suffice
-        together.
+        In scaled variables ``m[i] = m_i/m_ref``, ``s[i] = S_i/(m_ref·l)``. ``tau`` multiplies
+        every constant (1, or a variable for the Charnes–Cooper form of a ratio); ``slack``
+        (a function of a group name) relaxes each group; ``skip`` names a group left out.
+        Groups are ``(i, kind)`` with kind ``mass-low``, ``mass-high``, ``com`` (the disc of a
+        listed radius) or ``com-fixed`` (a centre of mass that may not move).
         """
         data = self.data
-        mtot = data.original_mass
-        m = cp.Variable(3)
-        s = cp.Variable((3, 2))
-        slacks: list[tuple[cp.Variable, str, float]] = []
+
+        def relax(group):
+            return 0.0 if slack is None else slack(group)
+
         cons: list = []
-
-        def slack(kind: str, weight: float) -> cp.Variable:
-            t = cp.Variable(nonneg=True)
-            slacks.append((t, kind, weight))
-            return t
-
-        x_parts = []
+        parts = []
         for b in data.links:
             i, mref, l = b.index, b.mass_ref, b.length
-            fixed_mass = b.mass[0] == b.mass[1]
-            w = 10.0 if fixed_mass else 1.0
-            cons += [
-                m[i] >= b.mass[0] / mref - slack(f"{i}:mass-low", w),
-                m[i] <= b.mass[1] / mref + slack(f"{i}:mass-high", w),
-                m[i] >= 1e-2 * b.mass[0] / mref,
-            ]
+            if skip != (i, "mass-low"):
+                cons.append(m[i] >= b.mass[0] / mref * tau - relax((i, "mass-low")))
+            if skip != (i, "mass-high"):
+                cons.append(m[i] <= b.mass[1] / mref * tau + relax((i, "mass-high")))
+            cons.append(m[i] >= 0.1 * b.mass[0] / mref * tau)
             if b.com_fixed is None:
-                cons.append(
-                    cp.norm(s[i] - cp.hstack([b.com_centre / l * m[i], 0.0]))
-                    <= b.com_radius / l * m[i] + slack(f"{i}:com", 1.0)
-                )
+                group = (i, "com")
+                lhs = cp.norm(s[i] - cp.hstack([b.com_centre / l * m[i], 0.0]))
+                rhs = b.com_radius / l * m[i]
             else:
-                e0, f0 = b.com_fixed.real / l, b.com_fixed.imag / l
-                cons.append(
-                    cp.norm(s[i] - cp.hstack([e0 * m[i], f0 * m[i]]))
-                    <= slack(f"{i}:com-fixed", 10.0)
+                group = (i, "com-fixed")
+                lhs = cp.norm(
+                    s[i] - cp.hstack([b.com_fixed.real / l * m[i], b.com_fixed.imag / l * m[i]])
                 )
-            x_parts += [m[i] * mref, s[i, 0] * mref * l, s[i, 1] * mref * l, 0.0]
+                rhs = 0.0
+            if skip != group:
+                cons.append(lhs <= rhs + relax(group))
+            parts += [m[i] * mref, s[i, 0] * mref * l, s[i, 1] * mref * l, 0.0]
         assert data.force_balance is not None
-        a, rhs = data.force_balance
-        x12 = cp.hstack(x_parts)
-        cons.append(a @ x12 / mtot == rhs / mtot)
-        objective = cp.Minimize(sum(w * t for t, _, w in slacks))
-        problem = cp.Problem(objective, cons)
+        a, rhs_fb = data.force_balance
+        mtot = data.original_mass
+        cons.append(a @ cp.hstack(parts) / mtot == rhs_fb / mtot * tau)
+        return cons
+
+    def diagnose(self) -> InfeasibleError:
+        """Which bounds to widen so that force balance can be met, and to what.
+
+        First each bound alone (a mass bound, a centre-of-mass radius; a fixed mass or centre
+        of mass too): with every other bound kept, the value it needs is computed exactly (the
+        least radius by the Charnes–Cooper form of ``‖S − m·c‖/m``, a mass by a linear
+        objective). The bounds that suffice alone are reported, those the spec already gives
+        as ranges first, smallest relative change first. If no single bound suffices, an
+        elastic (phase-1) problem puts a nonnegative slack on every bound (ten times the
+        weight on a fixed quantity; slacks in common units: kg over the total mass, kg·m over
+        the total mass times the longest link) and minimises their weighted sum subject to
+        Eq. 58; its nonzero slacks name the bounds, and its design the values that suffice
+        together. (Only force balance can make the problem infeasible: every other condition
+        is met by some inertia, and :func:`balancer.problem.check_problem` has rejected empty
+        ranges.)
+        """
+        data = self.data
+        groups = []
+        for b in data.links:
+            groups += [(b.index, "mass-low"), (b.index, "mass-high")]
+            groups.append((b.index, "com" if b.com_fixed is None else "com-fixed"))
+        ranked = []
+        for group in groups:
+            value = self._needed(group)
+            if value is None:
+                continue
+            i, kind = group
+            b = data.links[i]
+            lo, hi = b.mass
+            if kind == "mass-high":
+                ranked.append((lo == hi, value / hi - 1, group, value))
+            elif kind == "mass-low":
+                ranked.append((lo == hi, 1 - value / lo, group, value))
+            elif kind == "com":
+                ranked.append((False, (value - b.com_radius) / b.length, group, value))
+            else:
+                ranked.append((True, value / b.length, group, value))
+        if ranked:
+            ranked.sort(key=lambda item: item[:2])
+            best = [r for r in ranked if r[0] == ranked[0][0]][:3]
+            items, parts = zip(*(self._describe(g, v) for _, _, g, v in best), strict=True)
+            message = "force balance cannot be met within the bounds: " + ", or ".join(parts)
+            return InfeasibleError(message, needed=tuple(items), jointly=False)
+        return self._elastic()
+
+    def _elastic(self) -> InfeasibleError:
+        """The phase-1 problem of :meth:`diagnose`, for when no single bound suffices."""
+        data = self.data
+        mtot = data.original_mass
+        moment_unit = mtot * max(b.length for b in data.links)
+        m = cp.Variable(3)
+        s = cp.Variable((3, 2))
+        slacks: dict[tuple[int, str], tuple[cp.Variable, float]] = {}
+
+        def slack(group: tuple[int, str]) -> cp.Variable:
+            b = data.links[group[0]]
+            if group[1].startswith("mass"):
+                fixed = b.mass[0] == b.mass[1]
+                weight = (10.0 if fixed else 1.0) * b.mass_ref / mtot
+            else:
+                weight = (10.0 if group[1] == "com-fixed" else 1.0) * b.mass_ref * b.length
+                weight /= moment_unit
+            t = cp.Variable(nonneg=True)
+            slacks[group] = (t, weight)
+            return t
+
+        cons = self._bound_constraints(m, s, 1.0, slack=slack)
+        problem = cp.Problem(cp.Minimize(sum(w * t for t, w in slacks.values())), cons)
         try:
-            problem.solve(solver=cp.CLARABEL, **self.settings)
+            _solve(problem, self.settings)
         except cp.error.SolverError as exc:
             return InfeasibleError(f"force balance cannot be met within the bounds ({exc})")
         if problem.status not in _SOLVED:
@@ -448,58 +579,108 @@ class ConvexSolver:
                 "force balance cannot be met within the bounds (the elastic problem failed: "
                 f"{problem.status})"
             )
-        needed = []
-        for t, kind, _ in slacks:
-            if t.value is None or t.value <= SLACK_TOLERANCE:
-                continue
-            i, what = kind.split(":")
-            b = data.links[int(i)]
-            mi = float(m.value[int(i)]) * b.mass_ref
-            com = complex(*(s.value[int(i)] * b.mass_ref * b.length)) / mi
-            if what == "mass-low":
-                if b.mass[0] == b.mass[1]:
-                    needed.append((f"{b.key}.mass", _down(mi), b.mass[0], "kg", "allow"))
-                else:
-                    needed.append((f"{b.key}.mass", _down(mi), b.mass[0], "kg", "low"))
-            elif what == "mass-high":
-                if b.mass[0] == b.mass[1]:
-                    needed.append((f"{b.key}.mass", _up(mi), b.mass[1], "kg", "allow"))
-                else:
-                    needed.append((f"{b.key}.mass", _up(mi), b.mass[1], "kg", "high"))
-            elif what == "com":
-                distance = abs(com - b.com_centre)
-                needed.append((f"{b.key}.com_radius", _up(distance), b.com_radius, "m", "least"))
-            else:
-                about = DEFAULT_ABOUT[b.name]
-                centre = 0.0 if about == JOINTS[b.name][0] else b.length
-                distance = abs(com - centre)
-                needed.append((f"{b.key}.com_radius", _up(distance), None, "m", about))
-        if not needed:
+        support = [g for g, (t, _) in slacks.items() if t.value > SLACK_TOLERANCE]
+        if not support:
             return InfeasibleError(
                 "the convex solver reported the balancing problem infeasible, but a design "
                 "within the bounds meets force balance: numerical trouble (try other bounds)"
             )
-        parts = []
-        for key, value, current, unit, how in needed:
-            if how == "least":
-                parts.append(f"{key} must be at least {value:.4g} {unit} (is {current!r})")
-            elif how == "high":
-                parts.append(f"{key} must allow up to {value:.4g} {unit} (is at most {current!r})")
-            elif how == "low":
-                parts.append(
-                    f"{key} must allow down to {value:.4g} {unit} (is at least {current!r})"
-                )
-            elif how == "allow":
-                parts.append(f"{key} must allow {value:.4g} {unit} (fixed at {current!r})")
-            else:
-                parts.append(
-                    f"{key} must be at least {value:.4g} {unit} about {how} (the centre of mass "
-                    "is fixed now)"
-                )
+        items, parts = [], []
+        for i, kind in support:
+            b = data.links[i]
+            mi = float(m.value[i]) * b.mass_ref
+            com = complex(*(s.value[i] * b.mass_ref * b.length)) / mi
+            value = mi if kind.startswith("mass") else abs(com - self._centre(b, kind))
+            item, text = self._describe((i, kind), value)
+            items.append(item)
+            parts.append(text)
         message = "force balance cannot be met within the bounds: " + "; ".join(parts)
-        return InfeasibleError(
-            message, needed=tuple((k, v, c, u) for k, v, c, u, _ in needed)
+        return InfeasibleError(message + " (together)", needed=tuple(items), jointly=True)
+
+    @staticmethod
+    def _centre(b, kind: str) -> float:
+        """The point a radius is measured from: ``com_about``, or the default joint."""
+        if kind == "com":
+            return b.com_centre
+        return 0.0 if DEFAULT_ABOUT[b.name] == JOINTS[b.name][0] else b.length
+
+    def _needed(self, group: tuple[int, str]) -> float | None:
+        """The exact bound group ``group`` needs with every other bound kept (or ``None``)."""
+        i, kind = group
+        b = self.data.links[i]
+        m = cp.Variable(3)
+        s = cp.Variable((3, 2))
+        if kind.startswith("com"):
+            tau = cp.Variable(nonneg=True)  # Charnes–Cooper: scale everything so that m_i = 1
+            cons = self._bound_constraints(m, s, tau, skip=group)
+            cons.append(m[i] == 1.0)
+            centre = self._centre(b, kind) / b.length
+            objective = cp.Minimize(cp.norm(s[i] - cp.hstack([centre, 0.0])))
+            scale = b.length  # ‖S/m − c‖ in metres
+        else:
+            cons = self._bound_constraints(m, s, 1.0, skip=group)
+            sign = 1.0 if kind == "mass-high" else -1.0
+            objective = cp.Minimize(sign * m[i])
+            scale = sign * b.mass_ref
+        problem = cp.Problem(objective, cons)
+        try:
+            _solve(problem, self.settings)
+        except cp.error.SolverError:
+            return None
+        if problem.status not in _SOLVED:
+            return None
+        return float(problem.value) * scale
+
+    def _describe(
+        self, group: tuple[int, str], value: float
+    ) -> tuple[tuple[str, float, float | None, str], str]:
+        """``(key, needed, current, unit)`` and the words for one bound to widen."""
+        i, kind = group
+        b = self.data.links[i]
+        key = f"{b.key}.mass"
+        fixed = b.mass[0] == b.mass[1]
+        if kind == "mass-high":
+            v = _up(value)
+            if fixed:
+                return (
+                    key,
+                    v,
+                    b.mass[1],
+                    "kg",
+                ), f"{key} must allow {v:.4g} kg (fixed at {b.mass[1]!r})"
+            return (key, v, b.mass[1], "kg"), (
+                f"{key} must allow up to {v:.4g} kg (is at most {b.mass[1]!r})"
+            )
+        if kind == "mass-low":
+            v = _down(value)
+            if fixed:
+                return (
+                    key,
+                    v,
+                    b.mass[0],
+                    "kg",
+                ), f"{key} must allow {v:.4g} kg (fixed at {b.mass[0]!r})"
+            return (key, v, b.mass[0], "kg"), (
+                f"{key} must allow down to {v:.4g} kg (is at least {b.mass[0]!r})"
+            )
+        key = f"{b.key}.com_radius"
+        v = _up(value)
+        if kind == "com":
+            return (key, v, b.com_radius, "m"), (
+                f"{key} must be at least {v:.4g} m (is {b.com_radius!r})"
+            )
+        about = DEFAULT_ABOUT[b.name]
+        return (key, v, None, "m"), (
+            f"{key} must be given, at least {v:.4g} m about {about} (the centre of mass is "
+            "fixed now)"
         )
+
+
+def _solve(problem: cp.Problem, settings: dict) -> None:
+    """Solve with Clarabel; an inaccurate solution is judged by its status, not a warning."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+        problem.solve(solver=cp.CLARABEL, **settings)
 
 
 def _up(x: float, digits: int = 4) -> float:

@@ -13,7 +13,8 @@ Constraints: force balance (Eq. 58, bilinear equalities), the centre of mass in 
 ``(e − c)² + f² ≤ R²``, ``I ≥ m·ρ²``, and simple bounds — an upper inertia bound is exact here,
 which is where this formulation can beat the convex relaxation.
 
-IPOPT is built once per problem (:class:`NlpSolver`) and warm-started from the convex optimum.
+IPOPT is built once per problem (:class:`NlpSolver`) and started from the convex optimum (a
+primal warm start).
 """
 
 from __future__ import annotations
@@ -29,7 +30,11 @@ from numpy.typing import NDArray
 from ..problem import NumericProblem, inertial_to_physical, physical_to_inertial
 from .result import StageReport
 
-#: IPOPT's options, in one place: quiet, tight, warm-started.
+#: IPOPT's options, in one place: quiet and tight. The start is the convex optimum (a primal
+#: warm start); IPOPT's own warm-start mode, which also wants multipliers that the convex
+#: problem does not give in these variables, stalled on the degenerate optimum of complete
+#: balancing (300 iterations without convergence), so the defaults for μ and the bound push
+#: are kept: 15–30 iterations, a few milliseconds, on PB1 and PB2.
 IPOPT_OPTIONS: dict[str, object] = {
     "print_time": False,
     "ipopt.print_level": 0,
@@ -38,13 +43,6 @@ IPOPT_OPTIONS: dict[str, object] = {
     "ipopt.acceptable_tol": 1e-9,
     "ipopt.constr_viol_tol": 1e-12,
     "ipopt.max_iter": 300,
-    "ipopt.warm_start_init_point": "yes",
-    "ipopt.warm_start_bound_push": 1e-9,
-    "ipopt.warm_start_bound_frac": 1e-9,
-    "ipopt.warm_start_slack_bound_push": 1e-9,
-    "ipopt.warm_start_slack_bound_frac": 1e-9,
-    "ipopt.warm_start_mult_bound_push": 1e-9,
-    "ipopt.mu_init": 1e-6,
 }
 
 _CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
@@ -111,8 +109,9 @@ class NlpSolver:
         for b in data.links:
             k, mref, l, iref = 4 * b.index, b.mass_ref, b.length, b.inertia_ref
             if b.mass[0] < b.mass[1]:
-                m = mref * variable(f"m{b.index}", b.mass[0] / mref, b.mass[1] / mref,
-                                    (b.index, "m"))
+                m = mref * variable(
+                    f"m{b.index}", b.mass[0] / mref, b.mass[1] / mref, (b.index, "m")
+                )
                 varying.update((k, k + 1, k + 2))
             else:
                 m = b.mass[0]
@@ -181,6 +180,11 @@ class NlpSolver:
         """Number of decision variables."""
         return len(self._names)
 
+    @property
+    def bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Lower and upper bounds of the scaled decision vector (``±inf`` where none)."""
+        return self._lbx.copy(), self._ubx.copy()
+
     def start(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The scaled decision vector for design vector ``x``, clipped into the bounds."""
         data = self.data
@@ -193,8 +197,12 @@ class NlpSolver:
             b = data.links[index]
             m, e, f, inertia = physical[index]
             out.append(
-                {"m": m / b.mass_ref, "e": e / b.length, "f": f / b.length,
-                 "I": inertia / b.inertia_ref}[kind]
+                {
+                    "m": m / b.mass_ref,
+                    "e": e / b.length,
+                    "f": f / b.length,
+                    "I": inertia / b.inertia_ref,
+                }[kind]
             )
         v = np.clip(np.array(out, float), self._lbx, self._ubx)
         for i, (index, kind) in enumerate(self._names):  # pull the centre of mass into its disc
@@ -216,9 +224,7 @@ class NlpSolver:
         data = self.data
         v0 = self.start(np.asarray(x_start, float))
         t0 = time.perf_counter()
-        sol = self._solver(
-            x0=v0, lbx=self._lbx, ubx=self._ubx, lbg=self._lbg, ubg=self._ubg
-        )
+        sol = self._solver(x0=v0, lbx=self._lbx, ubx=self._ubx, lbg=self._lbg, ubg=self._ubg)
         elapsed = time.perf_counter() - t0
         stats = self._solver.stats()
         word = str(stats.get("return_status", "unknown"))

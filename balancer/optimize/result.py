@@ -21,6 +21,23 @@ from ..model import Design, FourBar
 GAP_TOLERANCE = 1e-6
 
 
+def gap_floor(reference: float) -> float:
+    """The least denominator of a relative gap, ``1e-10·reference`` (N·m)².
+
+    ``reference`` is a positive scale of the objective
+    (:attr:`balancer.problem.NumericProblem.objective_reference`, the original design's mean
+    squares); ``1e-10`` is Clarabel's tolerance on the objective scaled by it. A zero
+    optimum (complete balancing) would otherwise divide by zero; with this floor a gap of at
+    most :data:`GAP_TOLERANCE` there means an RMS below ``1e-8`` of the original's.
+    """
+    return max(1e-10 * abs(reference), 1e-300)
+
+
+def gap(objective: float, lower_bound: float, reference: float) -> float:
+    """Relative gap ``(J − J_low)/max(|J_low|, floor)`` (see :func:`gap_floor`), dimensionless."""
+    return (objective - lower_bound) / max(abs(lower_bound), gap_floor(reference))
+
+
 class Status(StrEnum):
     """Outcome of a balancing."""
 
@@ -53,6 +70,9 @@ class StageReport:
         Wall-clock time of the stage, s.
     objective
         The objective ``J`` at the stage's design, (N·m)² (``nan`` if it has none).
+    gap
+        That objective's relative gap to the convex lower bound (see :func:`gap`; ``nan``
+        until the bound is known).
     """
 
     name: str
@@ -61,6 +81,7 @@ class StageReport:
     iterations: int
     time: float
     objective: float
+    gap: float = float("nan")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -96,7 +117,7 @@ class BalanceResult:
         (N·m)².
     gap
         ``(objective − lower_bound)/max(|lower_bound|, floor)``, dimensionless; the floor is
-        ``1e-12`` of the original's objective, so that a zero optimum gives a gap of 0.
+        ``1e-10`` of the original's mean squares (:func:`gap_floor`), for a zero optimum.
     relaxation_tight
         Whether the convex relaxation was exact at its optimum (always, unless a link has a
         bounded inertia about a centre of mass that may move).
@@ -150,12 +171,20 @@ class InfeasibleError(SolverError):
     Attributes
     ----------
     needed
-        The bounds that would make it feasible together: ``(key, needed value, current value,
-        unit)`` per bound, e.g. ``("balance.crank.com_radius", 1.758, 1.0, "m")``.
+        Bounds that would make it feasible: ``(key, needed value, current value or None,
+        unit)`` each, e.g. ``("balance.crank.com_radius", 0.5859, 0.3, "m")``.
+    jointly
+        ``False``: each of :attr:`needed` suffices alone (the others kept); ``True``: they
+        suffice together.
     """
 
     def __init__(
-        self, message: str, *, needed: tuple[tuple[str, float, float | None, str], ...] = ()
+        self,
+        message: str,
+        *,
+        needed: tuple[tuple[str, float, float | None, str], ...] = (),
+        jointly: bool = False,
     ) -> None:
         self.needed = needed
+        self.jointly = jointly
         super().__init__(message)

@@ -1,0 +1,394 @@
+"""The balancing optimisers: optimality, feasibility, agreement of the backends, PB1 and PB2.
+
+Checks that do not re-run the optimiser's own code: force balance by
+:func:`balancer.conditions.force_balance_error` on the rebuilt links; the objective by the
+Newton–Euler cycle analysis (the optimisers use the mass-matrix regressors); optimality by a
+random search over feasible designs built in closed form (Eq. 57 solved for the crank's and
+rocker's centres of mass); complete balance by Berkof's conditions; infeasibility diagnoses by
+solving again with the bound they ask for.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import random_linkage
+
+from balancer import spec
+from balancer.conditions import (
+    berkof_residuals,
+    force_balance_error,
+    force_balanced_by_crank_and_rocker,
+)
+from balancer.errors import SolverError, SpecError
+from balancer.inverse import cycle_analysis
+from balancer.model import Design, Operation
+from balancer.optimize import ConvexSolver, InfeasibleError, Optimizer, Status, optimize
+from balancer.problem import (
+    DEFAULT_ABOUT,
+    JOINTS,
+    BalanceProblem,
+    LinkFreedom,
+    NumericProblem,
+    Objective,
+    numeric_problem,
+    physical_to_inertial,
+)
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+
+def _load(name: str, old: str = "", new: str = "") -> Design:
+    text = (EXAMPLES / name).read_text()
+    if old:
+        assert old in text
+        text = text.replace(old, new)
+    return spec.loads_design(text)
+
+
+def _newton_euler_objective(result, data: NumericProblem) -> float:
+    """``J`` of the balanced design from its Newton–Euler cycle analysis."""
+    w, s = data.weights, result.after.summary
+    return (
+        w.shaking_moment * s.shaking_moment.rms**2
+        + w.driving_torque * s.driving_torque.rms**2
+        + w.shaking_force * s.shaking_force.rms**2
+        + w.added_mass * (result.linkage.total_mass - data.linkage.total_mass)
+    )
+
+
+# ----------------------------------------------------------------------------------------------
+# Random problems and a random search
+
+
+def _random_design(seed: int) -> Design:
+    """A random linkage and random bounds around a feasible (force-balanced) anchor design."""
+    rng = np.random.default_rng(seed)
+    linkage = random_linkage(rng, loads=False, rotors=True, full_turn=True)
+    force_balance = seed % 3 != 0
+    anchor = force_balanced_by_crank_and_rocker(linkage) if force_balance else linkage
+    links = {}
+    for index, name in enumerate(JOINTS):
+        if name == "coupler" and seed % 2:
+            continue  # the coupler stays fixed in half the problems
+        link, length = anchor.link(name), linkage.lengths[index]
+        centre = 0.0 if DEFAULT_ABOUT[name] == JOINTS[name][0] else length
+        links[name] = LinkFreedom(
+            mass=(link.mass * rng.uniform(0.5, 1.0), link.mass * rng.uniform(1.0, 3.0)),
+            com_radius=abs(link.com - centre) * rng.uniform(1.05, 1.6) + 0.05 * length,
+            min_gyration=math.sqrt(link.inertia / link.mass) * rng.uniform(0.2, 0.9),
+            counter_rotor=(0.0, rng.uniform(0.5, 5.0)) if name != "coupler" else None,
+        )
+    objective = Objective(
+        shaking_moment=rng.uniform(0.5, 2.0),
+        driving_torque=rng.uniform(0.0, 0.3) if seed % 4 == 1 else 0.0,
+        shaking_force=0.0 if force_balance else rng.uniform(0.1, 1.0),
+        added_mass=rng.uniform(0.0, 50.0) if seed % 4 == 2 else 0.0,
+    )
+    return Design(
+        mechanism=linkage,
+        operation=Operation(speed=float(rng.uniform(5.0, 15.0)), samples=72),
+        balance=BalanceProblem(force_balance=force_balance, objective=objective, **links),
+    )
+
+
+def _feasible_samples(data: NumericProblem, rng, n: int, around=None, spread: float = 1.0):
+    """Random feasible designs (rows), independent of the optimisers.
+
+    Masses, centres of mass (uniform in their discs) and inertias are drawn within the bounds;
+    with force balance, Eq. 57 is then solved for the crank's and the rocker's centre of mass,
+    ``s̄1 = −(m2/m1)·(1 − s̄2/l2)·l1`` and ``s̄3 = l3·(1 + (m2/m3)·s̄2/l2)``, and designs that
+    leave a disc are dropped. ``around`` (a design vector) with ``spread`` < 1 draws near it.
+    """
+    l1, l2, l3, _ = data.linkage.lengths
+    out = []
+    for _ in range(n):
+        m, com, inertia = [], [], []
+        for b in data.links:
+            k = 4 * b.index
+            lo, hi = b.mass
+            if around is not None:
+                m0 = around[k]
+                lo, hi = max(lo, m0 - spread * (hi - lo)), min(hi, m0 + spread * (hi - lo))
+            mass = rng.uniform(lo, hi)
+            if b.com_fixed is not None:
+                s = b.com_fixed
+            else:
+                c, r = b.com_centre, b.com_radius
+                if around is not None:
+                    c = complex(around[k + 1], around[k + 2]) / around[k]
+                    r = spread * b.com_radius
+                s = c + r * math.sqrt(rng.random()) * np.exp(2j * math.pi * rng.random())
+            low = max(b.inertia[0], mass * b.gyration**2)
+            high = min(b.inertia[1], low + b.inertia_ref)
+            inertia.append(rng.uniform(low, high))
+            m.append(mass)
+            com.append(s)
+        if data.force_balance is not None:
+            com[0] = -(m[1] / m[0]) * (1 - com[1] / l2) * l1
+            com[2] = l3 * (1 + (m[1] / m[2]) * com[1] / l2)
+        x = np.zeros(14)
+        for i in range(3):
+            x[4 * i : 4 * i + 4] = physical_to_inertial(m[i], com[i].real, com[i].imag, inertia[i])
+        for entry, b in ((12, data.links[0]), (13, data.links[2])):
+            x[entry] = rng.uniform(*b.counter_rotor)
+        if not data.violations(x):
+            out.append(x)
+    return out
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_random_problems_optimum_is_feasible_consistent_and_unbeaten(seed):
+    design = _random_design(seed)
+    data = numeric_problem(design)
+    result = Optimizer(data).run("nlp")
+    assert result.success and result.status is Status.OPTIMAL, result.message
+    # Feasible: every bound, and exact force balance by the independent residual of Eq. 57.
+    assert data.violations(result.x) == []
+    if data.force_balance is not None:
+        assert force_balance_error(result.linkage) < 1e-10
+    # The objective by the Newton–Euler route (the optimisers used the mass-matrix one).
+    expected = _newton_euler_objective(result, data)
+    scale = abs(expected) + data.weights.added_mass * result.linkage.total_mass
+    floor = 1e-12 * data.original_objective  # a zero optimum is met to rounding only
+    assert abs(result.objective - expected) <= 1e-9 * scale + floor
+    # The lower bound holds and is reached.
+    assert result.objective >= result.lower_bound - 1e-7 * abs(result.lower_bound) - floor
+    # No feasible design from a random search does better: far and near the optimum.
+    rng = np.random.default_rng(1000 + seed)
+    samples = _feasible_samples(data, rng, 1500)
+    samples += _feasible_samples(data, rng, 500, around=result.x, spread=0.02)
+    assert len(samples) > 100
+    best = min(data.objective(x) for x in samples)
+    assert best >= result.objective - 1e-7 * abs(result.objective) - floor
+    # The original design, if feasible, is no better either.
+    if not data.violations(data.x0):
+        assert data.original_objective >= result.objective - floor
+
+
+# ----------------------------------------------------------------------------------------------
+# PB1 and PB2
+
+
+@pytest.fixture(scope="module")
+def pb1():
+    design = _load("pb1.toml")
+    data = numeric_problem(design)
+    opt = Optimizer(data)
+    return design, data, opt.run("convex"), opt.run("nlp")
+
+
+@pytest.fixture(scope="module")
+def pb2():
+    design = _load("pb2.toml")
+    data = numeric_problem(design)
+    opt = Optimizer(data)
+    return design, data, opt, opt.run("convex"), opt.run("nlp")
+
+
+def test_pb1_convex_and_nlp_agree_and_meet_the_lower_bound(pb1):
+    design, data, convex, nlp = pb1
+    for r in (convex, nlp):
+        assert r.status is Status.OPTIMAL and r.relaxation_tight
+        assert data.violations(r.x) == []
+        assert force_balance_error(r.linkage) < 1e-10
+        # Clarabel's tolerance (1e-10 on the norm) and the tie-break's (2e-8 on J).
+        assert abs(r.objective - r.lower_bound) <= 1e-7 * r.lower_bound
+        assert r.objective == pytest.approx(_newton_euler_objective(r, data), rel=1e-9)
+    assert convex.objective == pytest.approx(nlp.objective, rel=1e-6)
+    # IPOPT on its own (from the original design, not the convex start) reaches it too.
+    alone = Optimizer(data).nlp.solve(data.x0)
+    assert alone.status == "optimal" and alone.feasible
+    assert alone.objective == pytest.approx(convex.lower_bound, rel=1e-7)
+    # What the objective sees is unique (it is strictly convex in K·x): the shaking moment
+    # history, although the designs are not (see PB2 and the inert crank inertia). Designs
+    # within δ·J of the optimum differ in it by at most ~√δ: 1e-5 for δ = 1e-10.
+    m_convex = convex.after.reactions.shaking_moment
+    m_alone = cycle_analysis(data.linkage_of(alone.x), data.speed, data.samples, loads=False)
+    scale = np.abs(convex.before.reactions.shaking_moment).max()
+    assert np.abs(m_alone.reactions.shaking_moment - m_convex).max() < 1e-5 * scale
+    # Partial balancing: the shaking moment drops but does not vanish.
+    ratio = convex.after.summary.shaking_moment.rms / convex.before.summary.shaking_moment.rms
+    assert 0.1 < ratio < 0.9
+
+
+def test_pb2_balances_the_shaking_moment_completely(pb2):
+    design, data, opt, convex, nlp = pb2
+    for r in (convex, nlp):
+        assert r.status is Status.OPTIMAL, r.message
+        assert data.violations(r.x) == []
+        rms0 = r.before.summary.shaking_moment.rms
+        assert r.after.summary.shaking_moment.rms < 1e-6 * rms0
+        assert r.after.summary.shaking_force.rms < 1e-6 * r.before.summary.shaking_force.rms
+        # Berkof: a coupler equivalent to point masses at its joints, and the rocker's
+        # counter-rotor equal to its reduced inertia.
+        res = berkof_residuals(r.linkage)
+        assert res.force < 1e-10
+        assert abs(res.coupler_offset) < 1e-8 and abs(res.coupler_inertia) < 1e-8
+        assert abs(res.rocker_rotor) < 1e-8
+    # IPOPT from the original design, on its own, finds a complete balance as well.
+    alone = opt.nlp.solve(data.x0)
+    assert alone.status == "optimal" and alone.feasible
+    assert math.sqrt(alone.objective / data.original_objective) < 1e-6
+    res = berkof_residuals(data.linkage_of(alone.x))
+    assert abs(res.coupler_offset) < 1e-7 and abs(res.coupler_inertia) < 1e-7
+
+
+def test_pb2_optimum_is_degenerate_but_berkof_is_determined(pb2):
+    """Many designs balance completely; all meet Berkof's coupler conditions.
+
+    The tie-break is pointed at random designs: the coupler's mass and centre of mass vary
+    between the optima found, its offset f2 and the inertia condition do not. The crank's
+    counter-rotor and inertia do nothing at constant speed and stay as in the original.
+    """
+    design, data, opt, convex, nlp = pb2
+    solver = ConvexSolver(data)
+    rng = np.random.default_rng(7)
+    masses, offsets = [], []
+    for _ in range(3):
+        prefer = data.x0 * rng.uniform(0.5, 2.0, 14)
+        sol = solver.solve(prefer=prefer)
+        assert data.violations(sol.x) == []
+        assert math.sqrt(sol.objective / data.original_objective) < 1e-6
+        linkage = data.linkage_of(sol.x)
+        res = berkof_residuals(linkage)
+        assert abs(res.coupler_offset) < 1e-7 and abs(res.coupler_inertia) < 1e-7
+        assert abs(res.rocker_rotor) < 1e-7
+        masses.append(linkage.coupler.mass)
+        offsets.append(linkage.coupler.e)
+        assert linkage.crank.counter_rotor == design.mechanism.crank.counter_rotor
+        assert linkage.crank.inertia == pytest.approx(design.mechanism.crank.inertia, rel=1e-12)
+    assert max(masses) - min(masses) > 0.1 or max(offsets) - min(offsets) > 0.05
+
+
+def test_the_default_tie_break_changes_the_original_least(pb2):
+    design, data, opt, convex, nlp = pb2
+    # The coupler keeps its mass: the nearest complete balance needs only a new mass layout.
+    assert convex.linkage.coupler.mass == pytest.approx(design.mechanism.coupler.mass, rel=1e-6)
+    untied = ConvexSolver(data).solve(tie_break=False)
+    scaled = data.scales
+
+    def distance(x):
+        return float(np.linalg.norm((x - data.x0) / scaled))
+
+    assert distance(convex.x) <= distance(untied.x) + 1e-6
+
+
+def test_the_balanced_design_is_written_and_read_back(pb1, tmp_path):
+    design, data, convex, nlp = pb1
+    balanced = nlp.balanced_design(design)
+    assert balanced.original == design.mechanism
+    path = tmp_path / "balanced.toml"
+    spec.save_design(balanced, path)
+    again = spec.load_design(path)
+    assert again == balanced
+    assert numeric_problem(again).violations(nlp.x) == []  # same bounds: still feasible
+
+
+# ----------------------------------------------------------------------------------------------
+# The relaxation and the NLP
+
+
+def test_a_fixed_inertia_that_the_relaxation_misses_is_found_by_the_nlp():
+    """Rocker inertia fixed at 2.1 kg·m² while its centre of mass may move, counter-rotor 20.
+
+    The convex envelope lets the rocker's inertia grow (lower bound = PB1's optimum); the
+    exact design must keep it, so the convex design is only feasible and IPOPT improves or
+    matches it, never below the bound, and random restarts do not beat it.
+    """
+    design = _load(
+        "pb1.toml",
+        "min_gyration = 0.2                # m: 0.1·l3\ncounter_rotor = [0.0, 20.0]",
+        "inertia = 2.1\ncounter_rotor = 40.0",
+    )
+    data = numeric_problem(design)
+    opt = Optimizer(data)
+    convex, nlp = opt.run("convex"), opt.run("nlp")
+    assert not convex.relaxation_tight and convex.status is Status.FEASIBLE
+    assert nlp.status is Status.FEASIBLE and nlp.gap > 1
+    for r in (convex, nlp):
+        assert r.success and data.violations(r.x) == []
+        assert r.linkage.rocker.inertia == pytest.approx(2.1, rel=1e-12)
+        assert r.objective >= r.lower_bound
+    assert nlp.objective < 0.9 * convex.objective
+    rng = np.random.default_rng(3)
+    solver = opt.nlp
+    lower, upper = solver.bounds
+    for _ in range(5):
+        start = solver.design(rng.uniform(lower, np.minimum(upper, lower + 5)))
+        other = solver.solve(start)
+        if other.feasible:
+            assert other.objective >= nlp.objective * (1 - 1e-9)
+
+
+# ----------------------------------------------------------------------------------------------
+# Infeasible problems and bad calls
+
+
+def _pb1_small_crank(radius: float) -> Design:
+    """PB1 with the crank's mass at most 3 kg and its centre of mass within ``radius`` of A0."""
+    return _load(
+        "pb1.toml",
+        "mass = [2.1, 8.4]                 # kg: 1x–4x\ncom_radius = 1.0",
+        f"mass = [2.1, 3.0]\ncom_radius = {radius!r}",
+    )
+
+
+def test_an_infeasible_radius_is_named_with_the_value_that_suffices():
+    design = _pb1_small_crank(0.3)
+    with pytest.raises(InfeasibleError) as info:
+        optimize(design, "convex")
+    err = info.value
+    assert isinstance(err, SolverError) and err.exit_code == 1
+    message = str(err)
+    assert "\n" not in message
+    assert message.startswith("force balance cannot be met within the bounds: ")
+    assert "balance.crank.com_radius must be at least" in message and "(is 0.3)" in message
+    key, needed, current, unit = err.needed[0]
+    assert (key, current, unit) == ("balance.crank.com_radius", 0.3, "m")
+    # The value asked for suffices (rounded up); a little less does not.
+    assert optimize(_pb1_small_crank(needed), "convex").success
+    with pytest.raises(InfeasibleError):
+        optimize(_pb1_small_crank(needed * 0.999), "convex")
+    # The other way out, a heavier crank, is offered too and suffices as well.
+    assert ", or balance.crank.mass must allow up to" in message
+    key, heavier, _, _ = err.needed[1]
+    text = (EXAMPLES / "pb1.toml").read_text()
+    text = text.replace("mass = [2.1, 8.4]", f"mass = [2.1, {heavier!r}]")
+    assert optimize(spec.loads_design(text.replace("com_radius = 1.0 ", "com_radius = 0.3 ")),
+                    "convex").success  # fmt: skip
+
+
+def test_a_fixed_centre_of_mass_that_prevents_balance_is_named():
+    design = _load("pb1.toml", "com_radius = 1.0                  # m: l1 around A0\n"
+                   'com_about = "A0"\n', "")  # fmt: skip
+    with pytest.raises(InfeasibleError) as info:
+        optimize(design, "convex")
+    key, needed, current, _ = info.value.needed[0]
+    assert key == "balance.crank.com_radius" and current is None
+    assert "must be given" in str(info.value)
+    fixed = _load("pb1.toml", "com_radius = 1.0                  # m: l1 around A0",
+                  f"com_radius = {needed}")  # fmt: skip
+    assert optimize(fixed, "convex").success
+
+
+def test_force_balance_with_nothing_that_can_meet_it_is_infeasible():
+    design = _load("pb1.toml")
+    problem = BalanceProblem(crank=LinkFreedom(counter_rotor=(0.0, 1.0)))
+    with pytest.raises(InfeasibleError, match="force balance cannot be met"):
+        optimize(replace(design, balance=problem))
+
+
+def test_bad_calls_are_spec_errors():
+    design = _load("pb1.toml")
+    with pytest.raises(SpecError, match="backend"):
+        optimize(design, "simplex")
+    with pytest.raises(SpecError, match="operation.speed") as info:
+        optimize(replace(design, operation=None))
+    assert info.value.exit_code == 2
+    with pytest.raises(SpecError, match="balance"):
+        optimize(replace(design, balance=None))

@@ -1,0 +1,325 @@
+"""The redesign problem: the [balance] section (errors, defaults, exact round trip) and its numbers.
+
+The objective the optimisers minimise is built from the mass-matrix regressors (Eq. 45–54); here
+it is checked against the Newton–Euler cycle analysis, an independent route.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import CLASS_EXAMPLES, PAPER_LENGTHS, paper_links, random_linkage
+
+from balancer import spec
+from balancer.cli import main
+from balancer.errors import AssemblyError, SpecError
+from balancer.inverse import cycle_analysis, parameter_vector
+from balancer.model import Design, FourBar, Operation
+from balancer.problem import (
+    BalanceProblem,
+    LinkFreedom,
+    Objective,
+    numeric_problem,
+    resolve_link,
+)
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+BASE = """
+[mechanism]
+type = "four-bar"
+[mechanism.lengths]
+crank = 1.0
+coupler = 3.0
+rocker = 2.0
+frame = 3.2
+[links.crank]
+mass = 2.1
+inertia = 1.1
+com = { s = 0.6, sigma = 0.3 }
+[links.coupler]
+mass = 3.0
+inertia = 3.1
+com = { s = 1.45, sigma = 0.4 }
+[links.rocker]
+mass = 2.2
+inertia = 2.1
+com = { s = 1.66, sigma = -0.4 }
+[operation]
+speed = 10.0
+samples = 72
+[balance]
+[balance.crank]
+mass = [2.1, 8.4]
+com_radius = 1.0
+min_gyration = 0.1
+counter_rotor = [0.0, 20.0]
+"""
+
+
+def _with(old: str, new: str) -> str:
+    assert old in BASE
+    return BASE.replace(old, new)
+
+
+BAD = {
+    "mass range reversed": (_with("mass = [2.1, 8.4]", "mass = [8.4, 2.1]"),
+                            "balance.crank.mass", "exceeds the upper bound"),
+    "zero mass bound": (_with("mass = [2.1, 8.4]", "mass = [0.0, 8.4]"),
+                        "balance.crank.mass", "positive"),
+    "negative fixed mass": (_with("mass = [2.1, 8.4]", "mass = -2.0"),
+                            "balance.crank.mass", "positive"),
+    "range of three": (_with("mass = [2.1, 8.4]", "mass = [1.0, 2.0, 3.0]"),
+                       "balance.crank.mass", "range [low, high]"),
+    "range of strings": (_with("mass = [2.1, 8.4]", 'mass = ["light", "heavy"]'),
+                         "balance.crank.mass", "range [low, high]"),
+    "negative radius": (_with("com_radius = 1.0", "com_radius = -1.0"),
+                        "balance.crank.com_radius", "zero or positive"),
+    "negative gyration": (_with("min_gyration = 0.1", "min_gyration = -0.1"),
+                          "balance.crank.min_gyration", "zero or positive"),
+    "negative counter-rotor": (_with("counter_rotor = [0.0, 20.0]", "counter_rotor = [-1.0, 2.0]"),
+                               "balance.crank.counter_rotor", "zero or positive"),
+    "counter-rotor on the coupler": (BASE + "[balance.coupler]\ncounter_rotor = [0.0, 1.0]\n",
+                                     "balance.coupler.counter_rotor", "ground pivot"),
+    "joint not on the link": (_with("com_radius = 1.0", 'com_radius = 1.0\ncom_about = "A3"'),
+                              "balance.crank.com_about", "joint of the crank (A0 or A1)"),
+    "no such joint": (_with("com_radius = 1.0", 'com_radius = 1.0\ncom_about = "B0"'),
+                      "balance.crank.com_about", "must be one of"),
+    "com_about without radius": (_with("com_radius = 1.0", 'com_about = "A0"'),
+                                 "balance.crank.com_about", "needs com_radius"),
+    "typo in a link key": (_with("min_gyration = 0.1", "min_gyraton = 0.1"),
+                           "balance.crank.min_gyraton", "did you mean 'min_gyration'"),
+    "typo in a link name": (BASE.replace("[balance.crank]", "[balance.crnak]"),
+                            "balance.crnak", "did you mean 'crank'"),
+    "typo in the objective": (BASE + "[balance.objective]\nshaking_moments = 1.0\n",
+                              "balance.objective.shaking_moments", "did you mean 'shaking_moment'"),
+    "negative weight": (BASE + "[balance.objective]\ndriving_torque = -1.0\n",
+                        "balance.objective.driving_torque", "zero or positive"),
+    "all weights zero": (BASE + "[balance.objective]\nshaking_moment = 0.0\n",
+                         "balance.objective", "nothing to minimise"),
+    "force_balance not a bool": (BASE.replace("[balance]\n", '[balance]\nforce_balance = "yes"\n'),
+                                 "balance.force_balance", "true or false"),
+    "nothing free": (BASE.split("[balance.crank]")[0] + "[balance.crank]\ncounter_rotor = 0.0\n",
+                     "balance", "nothing may change"),
+    "nothing listed": (BASE.split("[balance.crank]")[0], "balance", "nothing may change"),
+    "gyration beyond the inertia bound": (
+        _with("min_gyration = 0.1", "min_gyration = 0.5\ninertia = [0.1, 0.4]"),
+        "balance.crank.min_gyration", "at least m·ρ² = 0.525"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_bad_balance_sections_raise_spec_error_naming_the_key(case):
+    text, key, words = BAD[case]
+    with pytest.raises(SpecError) as info:
+        spec.loads_design(text, source="test.toml")
+    message = str(info.value)
+    assert key in message and words in message and "test.toml" in message, message
+    assert "\n" not in message
+    assert info.value.exit_code == 2
+
+
+@pytest.mark.parametrize("case", ["mass range reversed", "typo in a link key", "nothing free"])
+def test_bad_balance_sections_exit_2_with_one_line(case, tmp_path, capsys):
+    text, key, _ = BAD[case]
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    assert main(["analyze", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and key in err and "Traceback" not in err
+
+
+def test_the_value_is_named():
+    with pytest.raises(SpecError, match=r"got \[8\.4, 2\.1\]"):
+        spec.loads_design(BAD["mass range reversed"][0])
+
+
+def test_a_balance_section_is_read_with_its_defaults():
+    design = spec.loads_design(BASE)
+    problem = design.balance
+    assert isinstance(problem, BalanceProblem)
+    assert problem.force_balance is True
+    assert problem.objective == Objective(shaking_moment=1.0)
+    assert problem.crank == LinkFreedom(
+        mass=(2.1, 8.4), com_radius=1.0, min_gyration=0.1, counter_rotor=(0.0, 20.0)
+    )
+    assert problem.coupler is None and problem.rocker is None
+
+
+def test_defaults_resolve_as_documented():
+    links = paper_links(loads=False)
+    # Not listed: everything fixed at the spec's values.
+    b = resolve_link("coupler", None, links["coupler"], 3.0)
+    assert b.mass == (3.0, 3.0) and b.com_fixed == links["coupler"].com
+    assert b.inertia == (3.1, 3.1) and b.counter_rotor is None
+    # Mass free: inertia free (ρ = 0 by default); the rocker's radius is about A3 = l3.
+    b = resolve_link("rocker", LinkFreedom(mass=(1.0, 3.0), com_radius=0.5), links["rocker"], 2.0)
+    assert b.inertia == (0.0, math.inf) and b.com_centre == 2.0 and b.about == "A3"
+    assert b.counter_rotor == (0.0, 0.0)  # fixed at the spec's (none)
+    # Mass and centre of mass fixed, no min_gyration: the inertia stays.
+    b = resolve_link("crank", LinkFreedom(counter_rotor=(0.0, 1.0)), links["crank"], 1.0)
+    assert b.inertia == (1.1, 1.1) and b.mass == (2.1, 2.1)
+    # ... unless min_gyration is given.
+    b = resolve_link("crank", LinkFreedom(min_gyration=0.2), links["crank"], 1.0)
+    assert b.inertia == (0.0, math.inf) and b.gyration == 0.2
+    # A zero radius pins the centre of mass to the joint; an inertia bound caps the mass.
+    b = resolve_link(
+        "crank",
+        LinkFreedom(mass=(1.0, 9.0), com_radius=0.0, com_about="A1", min_gyration=0.5,
+                    inertia=(0.0, 1.0)),
+        links["crank"], 1.0,
+    )  # fmt: skip
+    assert b.com_fixed == 1.0 + 0j and b.com_radius is None
+    assert b.mass == (1.0, 4.0)  # I ≤ 1 and I ≥ m·0.25
+
+
+def _random_problem(rng: np.random.Generator) -> BalanceProblem:
+    def pair(lo, hi):
+        a, b = sorted(float(v) for v in rng.uniform(lo, hi, 2))
+        return (a, a) if rng.random() < 0.2 else (a, b)
+
+    def freedom(name):
+        if rng.random() < 0.3:
+            return None
+        grounded = name != "coupler"
+        joints = {"crank": "A0", "coupler": "A2", "rocker": "A2"}
+        radius = float(rng.uniform(0, 2)) if rng.random() < 0.7 else None
+        return LinkFreedom(
+            mass=pair(0.1, 9.0) if rng.random() < 0.7 else None,
+            com_radius=radius,
+            com_about=joints[name] if radius is not None and rng.random() < 0.5 else None,
+            min_gyration=float(rng.uniform(0, 0.1)) if rng.random() < 0.5 else None,
+            inertia=pair(1.0, 5.0) if rng.random() < 0.3 else None,
+            counter_rotor=pair(0.0, 3.0) if grounded and rng.random() < 0.6 else None,
+        )
+
+    links = {name: freedom(name) for name in ("crank", "coupler", "rocker")}
+    links["crank"] = links["crank"] or LinkFreedom(counter_rotor=(0.0, 1.0))
+    return BalanceProblem(
+        force_balance=bool(rng.random() < 0.5),
+        objective=Objective(
+            shaking_moment=float(rng.uniform(0, 2)),
+            driving_torque=float(rng.uniform(0, 1)),
+            shaking_force=float(rng.uniform(0, 1)),
+            added_mass=float(rng.uniform(0, 100)),
+        ),
+        **links,
+    )
+
+
+@pytest.mark.parametrize("seed", range(15))
+def test_the_balance_section_round_trips_exactly(seed):
+    rng = np.random.default_rng(seed)
+    design = Design(
+        mechanism=random_linkage(rng),
+        operation=Operation(speed=float(rng.uniform(1, 20))),
+        balance=_random_problem(rng),
+    )
+    text = spec.dumps_design(design)
+    again = spec.loads_design(text)
+    assert again == design
+    assert spec.dumps_design(again) == text
+
+
+@pytest.mark.parametrize("name", ["pb1.toml", "pb2.toml"])
+def test_the_examples_round_trip_exactly(name):
+    design = spec.load_design(EXAMPLES / name)
+    assert not design.mechanism.has_loads  # inertial balancing: the loads of Eq. 56 left out
+    assert design.mechanism.lengths == PAPER_LENGTHS
+    text = spec.dumps_design(design)
+    assert spec.loads_design(text) == design
+
+
+def test_the_problem_needs_the_operating_speed_and_a_balance_section():
+    design = spec.loads_design(BASE)
+    with pytest.raises(SpecError, match="operation.speed"):
+        numeric_problem(replace(design, operation=None))
+    with pytest.raises(SpecError, match="balance"):
+        numeric_problem(replace(design, balance=None))
+
+
+def test_a_crank_that_cannot_turn_is_bad_input():
+    design = spec.loads_design(BASE)
+    rocker_crank = replace(design.mechanism, lengths=CLASS_EXAMPLES["rocker-crank"])
+    with pytest.raises(AssemblyError):
+        numeric_problem(replace(design, mechanism=rocker_crank))
+
+
+def _objective_by_newton_euler(data, linkage: FourBar) -> float:
+    """The objective from the Newton–Euler cycle analysis (no loads), not the regressors."""
+    w = data.weights
+    s = cycle_analysis(linkage, data.speed, data.samples, route="newton-euler", loads=False)
+    summary = s.summary
+    return (
+        w.shaking_moment * summary.shaking_moment.rms**2
+        + w.driving_torque * summary.driving_torque.rms**2
+        + w.shaking_force * summary.shaking_force.rms**2
+        + w.added_mass * (linkage.total_mass - data.linkage.total_mass)
+    )
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_objective_equals_the_newton_euler_route(seed):
+    """Regressors (mass-matrix route, Eq. 45–54) against free-body equations, to 1e-9."""
+    rng = np.random.default_rng(100 + seed)
+    linkage = random_linkage(rng, loads=True, full_turn=True)  # loads must be left out
+    problem = _random_problem(rng)
+    design = Design(
+        mechanism=linkage,
+        operation=Operation(speed=float(rng.uniform(-20, 20)), samples=int(rng.integers(8, 200))),
+        balance=problem,
+    )
+    data = numeric_problem(design)
+    # The original, and a design with every parameter perturbed.
+    other = data.linkage_of(data.x0 * rng.uniform(0.8, 1.2, 14) + rng.uniform(0.0, 0.1, 14))
+    for lk in (linkage, other):
+        x = parameter_vector(lk)
+        expected = _objective_by_newton_euler(data, lk)
+        scale = abs(expected) + data.weights.added_mass * lk.total_mass
+        assert abs(data.objective(x) - expected) <= 1e-9 * scale
+        # The factor R the optimisers use gives the same quadratic part.
+        assert float(np.sum((data.factor @ x) ** 2)) == pytest.approx(data.quadratic(x), rel=1e-12)
+
+
+@pytest.mark.parametrize("branch", ["+", "-"])
+def test_the_objective_of_a_change_point_linkage_matches_the_cycle_analysis(branch):
+    """Parallelogram and anti-parallelogram: samples at the change points θ1 = 0, π."""
+    links = paper_links(loads=False)
+    linkage = FourBar(lengths=CLASS_EXAMPLES["change-point"], branch=branch, **links)
+    design = Design(
+        mechanism=linkage,
+        operation=Operation(speed=7.0, samples=36),  # samples at θ1 = 0 and π: change points
+        balance=BalanceProblem(crank=LinkFreedom(counter_rotor=(0.0, 1.0))),
+    )
+    data = numeric_problem(design)
+    assert np.isfinite(data.regressors.shaking_moment).all()
+    expected = _objective_by_newton_euler(data, linkage)
+    assert data.objective(data.x0) == pytest.approx(expected, rel=1e-8)
+
+
+def test_settling_the_inert_entries_changes_nothing_measured():
+    design = spec.load_design(EXAMPLES / "pb2.toml")
+    data = numeric_problem(design)
+    # At constant crank speed (α1 = 0) the crank's inertia and counter-rotor do nothing.
+    assert [i for i, flag in enumerate(data.inert) if flag] == [3, 12]
+    x = data.x0.copy()
+    x[3], x[12] = 50.0, 7.0
+    settled = data.settle(x)
+    assert settled[3] == pytest.approx(data.x0[3], rel=1e-15)  # original inertia, allowed
+    assert settled[12] == 0.0  # the original has no counter-rotor
+    assert data.objective(settled) == pytest.approx(data.objective(x), rel=1e-13)
+
+
+def test_violations_name_what_is_broken():
+    data = numeric_problem(spec.load_design(EXAMPLES / "pb1.toml"))
+    x = data.x0.copy()
+    broken = data.violations(x)
+    assert any("force balance" in v for v in broken)  # the paper's design is not balanced
+    x[0] = 9.0  # crank mass above 8.4
+    assert any("balance.crank.mass" in v for v in data.violations(x))
+    x[13] = 25.0
+    assert any("balance.rocker.counter_rotor" in v for v in data.violations(x))
