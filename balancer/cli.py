@@ -137,6 +137,35 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_optimize(args: argparse.Namespace) -> int:
+    from .api import analyze
+    from .errors import SolverError
+    from .optimize import optimize
+    from .report import dumps_json, optimization_json, optimization_text
+    from .spec import load_design, save_design
+    from .verify import verify
+
+    out = _output_path(args.out, "--out") if args.out else None
+    design = load_design(args.spec)
+    if design.balance is None:
+        raise SpecError("missing required table: the redesign problem ([balance])",
+                        key="balance", source=args.spec)
+    result = optimize(design, backend=args.backend)
+    if not result.success:
+        raise SolverError(f"the balancing failed: {result.message}")
+    balanced = result.balanced_design(design)
+    before, after = analyze(design), analyze(balanced)
+    verification = None if args.no_verify else verify(balanced, duration=args.verify_duration)
+    if out is not None:
+        save_design(balanced, out)
+    if args.json:
+        sys.stdout.write(dumps_json(optimization_json(result, before, after, verification,
+                                                      spec=args.spec, out=out)))
+    else:
+        print(optimization_text(result, before, after, verification, spec=args.spec, out=out))
+    return 0
+
+
 def _cmd_plot(args: argparse.Namespace) -> int:
     from .spec import load_design
 
@@ -249,6 +278,30 @@ def build_parser() -> argparse.ArgumentParser:
                    help="formulation for the simulations (default opened-loop)")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
     p.set_defaults(handler=_cmd_verify)
+
+    p = sub.add_parser(
+        "optimize",
+        help="redesign the links for exact force balance and least shaking moment",
+        description=(
+            "Solve the redesign problem of the spec's [balance] section: exact shaking-force "
+            "balance as constraints, the shaking moment (and optional weighted terms) "
+            "minimised over one revolution at the operating speed. The convex backend solves "
+            "the second-order cone program in the inertial parameters (a global optimum: the "
+            "lower bound); the nlp backend then solves the designer's physical parametrisation "
+            "with IPOPT from it and reports the gap. The result is checked by an independent "
+            "simulation and can be written as a complete spec."
+        ),
+    )
+    p.add_argument("spec", metavar="SPEC", help="design spec (TOML) with a [balance] section")
+    p.add_argument("--out", metavar="BALANCED.toml", help="write the balanced design as a spec")
+    p.add_argument("--backend", choices=("nlp", "convex"), default="nlp",
+                   help="optimiser (default nlp: convex first, then IPOPT)")
+    p.add_argument("--json", action="store_true", help="print a JSON document instead")
+    p.add_argument("--no-verify", action="store_true",
+                   help="skip the check by simulation")
+    p.add_argument("--verify-duration", type=_positive_float, metavar="T",
+                   help="simulated time of each check, s (default: the spec's)")
+    p.set_defaults(handler=_cmd_optimize)
 
     p = sub.add_parser(
         "plot",

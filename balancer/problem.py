@@ -523,6 +523,29 @@ def resolve_link(name: str, freedom: LinkFreedom | None, link: Link, length: flo
     )  # fmt: skip
 
 
+def _bounded_least_squares(a, x, entries, lower, upper, original) -> NDArray[np.float64]:
+    """Values of ``x[entries]`` within bounds minimising ``‖a·x‖²``, nearest ``original``.
+
+    A light pull towards the original (1e-6 of the problem's scale) picks one among equally
+    good choices.
+    """
+    from scipy.optimize import lsq_linear
+
+    entries = list(entries)
+    cols = a[:, entries]
+    rest = a @ x - cols @ x[entries]
+    lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+    original = np.asarray(original, float)
+    if np.all(lower == upper):
+        return original.copy()
+    scale = np.maximum(np.abs(original), 1.0)
+    weight = 1e-6 * max(float(np.linalg.norm(cols)), 1e-300)
+    lhs = np.vstack([cols * scale, weight * np.eye(len(entries))])
+    rhs = np.concatenate([-rest, weight * original / scale])
+    sol = lsq_linear(lhs, rhs, bounds=(lower / scale, upper / scale), method="bvls", tol=1e-14)
+    return np.clip(sol.x * scale, lower, upper)
+
+
 def physical_to_inertial(m, e, f, inertia):
     """Inertial parameters ``(m, m·e, m·f, J)`` from ``m``, ``e``, ``f``, ``I``.
 
@@ -703,27 +726,74 @@ class NumericProblem:
         fallback = float(np.linalg.norm(self.factor) * np.linalg.norm(self.x0))
         return fallback if fallback > 0 else 1.0
 
-    def settle(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Give the :attr:`inert` entries the value nearest the original's that is allowed.
+    @cached_property
+    def acceleration_rows(self) -> NDArray[np.float64]:
+        """Shaking moment per unit crank acceleration at rest, ``(N, 14)/√N``, N·m/(rad/s²).
 
-        An inert inertia keeps the original inertia about the centre of mass, clipped to
-        ``[max(I_low, m·ρ²), I_high]``; an inert counter-rotor keeps its original inertia,
-        clipped to its range. Nothing the objective or a constraint measures changes.
+        The rows of :func:`balancer.inverse.regressors` at ``(θ1, θ̇1 = 0, θ̈1 = 1)`` on the
+        sampled angles (change points left out). The objective, at constant speed, does not see
+        what the crank's rotary inertia does when the speed changes; this does.
+        """
+        lengths = self.linkage.lengths
+        keep = np.ones(self.theta1.size, bool)
+        for mask, _, _ in change_point_limits(lengths, self.theta1):
+            keep &= ~mask
+        theta = self.theta1[keep]
+        signs = cycle_branch_signs(lengths, self.linkage.branch, theta)
+        reg = regressors(lengths, motion(lengths, theta, 0.0, 1.0, signs))
+        return reg.shaking_moment / math.sqrt(theta.size)
+
+    def settle(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Give the :attr:`inert` entries their values.
+
+        Nothing the objective or a constraint measures depends on them, but the shaking moment
+        of a motion whose crank speed changes (start-up, speed fluctuation, free motion) does:
+        they are chosen, within their bounds, to minimise the mean square of the shaking moment
+        per unit crank acceleration (:attr:`acceleration_rows`) — by the counter-rotors alone
+        first, the inertias about the centres of mass kept, and by the inertias too only if
+        that leaves it reducible — and among equally good choices nearest the original. With
+        Berkof's conditions met this gives the crank the counter-rotor that completes the
+        balance for every motion.
         """
         x = np.array(x, dtype=float)
+        entries, lower, upper, original = [], [], [], []
         for b in self.links:
             k = 4 * b.index
             if not self.inert[k + 3]:
                 continue
             m, me, mf = x[k], x[k + 1], x[k + 2]
+            q = (me * me + mf * mf) / m
             lo = max(b.inertia[0], m * b.gyration**2)
-            inertia = min(max(b.original.inertia, lo), b.inertia[1])
-            x[k + 3] = inertia + (me * me + mf * mf) / m
+            entries.append(k + 3)
+            lower.append(lo + q)
+            upper.append(b.inertia[1] + q)
+            original.append(min(max(b.original.inertia, lo), b.inertia[1]) + q)
         for index, b in ((12, self.links[0]), (13, self.links[2])):
             if self.inert[index] and b.counter_rotor is not None:
                 lo, hi = b.counter_rotor
-                x[index] = min(max(b.original.counter_rotor, lo), hi)
-        return x
+                entries.append(index)
+                lower.append(lo)
+                upper.append(hi)
+                original.append(min(max(b.original.counter_rotor, lo), hi))
+        if not entries:
+            return x
+        x[entries] = original
+        a = self.acceleration_rows
+        lower_a, upper_a, original_a = (np.array(v, dtype=float) for v in (lower, upper,
+                                                                             original))
+        rotors = np.array([i >= 12 for i in entries])
+        best = x.copy()
+        if rotors.any():
+            idx = [e for e, r in zip(entries, rotors, strict=True) if r]
+            best[idx] = _bounded_least_squares(a, best, idx, lower_a[rotors], upper_a[rotors],
+                                               original_a[rotors])
+        full = x.copy()
+        full[entries] = _bounded_least_squares(a, x, entries, lower_a, upper_a, original_a)
+        ms_best = float(np.sum((a @ best) ** 2))
+        ms_full = float(np.sum((a @ full) ** 2))
+        if ms_full < ms_best - 1e-9 * max(ms_best, 1e-300):
+            best = full
+        return best
 
     def linkage_of(self, x: NDArray[np.float64]) -> FourBar:
         """The four-bar with inertial parameters ``x`` (loads kept from the original links).

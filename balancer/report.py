@@ -366,3 +366,105 @@ def verification_text(verification, spec: str | None = None, plots=()) -> str:
     for path in plots:
         lines.append(f"wrote {path}")
     return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------------------------
+# optimize
+
+
+def link_parameters(link) -> dict[str, float]:
+    """A link's physical parameters for a report (SI units)."""
+    return {
+        "mass": link.mass,
+        "inertia": link.inertia,
+        "e": link.e,
+        "f": link.f,
+        "s": link.s,
+        "sigma": link.sigma,
+        "counter_rotor": link.counter_rotor,
+    }
+
+
+def optimization_json(result, before, after, verification=None, spec=None, out=None) -> dict:
+    """The ``optimize --json`` document.
+
+    ``before``, ``after``, ``links``, ``status`` and ``verification`` are fixed names.
+    """
+    linkage = result.linkage
+    doc: dict[str, Any] = {}
+    if spec is not None:
+        doc["spec"] = spec
+    doc.update(
+        {
+            "backend": result.backend,
+            "status": str(result.status),
+            "success": result.success,
+            "message": result.message,
+            "before": before.summary.as_dict(),
+            "after": after.summary.as_dict(),
+            "links": {name: link_parameters(linkage.link(name)) for name in linkage.link_names},
+            "original_links": {name: link_parameters(result.original.link(name))
+                               for name in linkage.link_names},
+            "objective": result.objective,
+            "original_objective": result.original_objective,
+            "lower_bound": result.lower_bound,
+            "gap": result.gap,
+            "relaxation_tight": result.relaxation_tight,
+            "iterations": result.iterations,
+            "time": result.time,
+            "stages": [
+                {"name": s.name, "converged": s.converged, "solver_status": s.solver_status,
+                 "iterations": s.iterations, "time": s.time, "objective": s.objective}
+                for s in result.stages
+            ],
+            "force_balanced": is_force_balanced(linkage),
+            "force_balance_residual": force_balance_error(linkage),
+            "verification": None if verification is None else verification.as_dict(),
+            "out": None if out is None else str(out),
+            "units": {"objective": "(N·m)², mean square of the inertial shaking", "time": "s",
+                      "mass": "kg", "inertia": "kg·m²", "e, f, s": "m", "sigma": "rad"},
+        }
+    )
+    return doc
+
+
+def optimization_text(result, before, after, verification=None, spec=None, out=None) -> str:
+    """The readable ``optimize`` report."""
+    head = f"balancer optimize — {spec}" if spec else "balancer optimize"
+    lines = [
+        head,
+        f"backend {result.backend}: {result.message}",
+        f"{result.iterations} solver iterations in {1e3 * result.time:.1f} ms "
+        f"({', '.join(s.name for s in result.stages)}); the objective is the mean-square "
+        "inertial shaking (loads left out)",
+        "",
+    ]
+    rows = []
+    for name in ("shaking_force", "shaking_moment", "driving_torque"):
+        b, a = getattr(before.summary, name), getattr(after.summary, name)
+        ratio = a.rms / b.rms if b.rms > 0 else float("nan")
+        rows.append([name.replace("_", " "), _fmt(b.rms), _fmt(a.rms), f"{ratio:.3g}",
+                     _fmt(b.max), _fmt(a.max), UNITS[name]])
+    lines.append(table(rows, ["at the operating speed", "RMS before", "RMS after", "ratio",
+                              "max before", "max after", "unit"]))
+    lines.append("")
+    rows = []
+    for name in result.linkage.link_names:
+        old, new = result.original.link(name), result.linkage.link(name)
+        for key, unit in (("mass", "kg"), ("e", "m"), ("f", "m"), ("inertia", "kg·m²"),
+                          ("counter_rotor", "kg·m²")):
+            a, b = getattr(old, key), getattr(new, key)
+            if key == "counter_rotor" and name not in result.linkage.grounded_links:
+                continue
+            changed = "" if abs(a - b) <= 1e-12 * max(1.0, abs(a)) else "changed"
+            rows.append([f"{name} {key}", f"{a:.6g}", f"{b:.6g}", unit, changed])
+    lines.append(table(rows, ["parameter", "before", "after", "unit", ""]))
+    lines.append("")
+    err = force_balance_error(result.linkage)
+    lines.append(f"force balance (Eq. 57): residual {err:.1e} of the total mass")
+    if verification is not None:
+        lines.append("")
+        lines.append(verification_text(verification).split("\n", 1)[1].strip("\n"))
+    if out is not None:
+        lines.append(f"wrote {out}")
+    return "\n".join(lines)

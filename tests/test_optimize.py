@@ -243,7 +243,9 @@ def test_pb2_optimum_is_degenerate_but_berkof_is_determined(pb2):
 
     The tie-break is pointed at random designs: the coupler's mass and centre of mass vary
     between the optima found, its offset f2 and the inertia condition do not. The crank's
-    counter-rotor and inertia do nothing at constant speed and stay as in the original.
+    counter-rotor and inertia do nothing at constant speed; they are set for a crank whose speed
+    changes, which completes Berkof's balance (the crank keeps its inertia, the counter-rotor
+    takes Berkof's value).
     """
     design, data, opt, convex, nlp = pb2
     solver = ConvexSolver(data)
@@ -260,8 +262,8 @@ def test_pb2_optimum_is_degenerate_but_berkof_is_determined(pb2):
         assert abs(res.rocker_rotor) < 1e-7
         masses.append(linkage.coupler.mass)
         offsets.append(linkage.coupler.e)
-        assert linkage.crank.counter_rotor == design.mechanism.crank.counter_rotor
-        assert linkage.crank.inertia == pytest.approx(design.mechanism.crank.inertia, rel=1e-12)
+        assert abs(res.crank_rotor) < 1e-7
+        assert linkage.crank.inertia == pytest.approx(design.mechanism.crank.inertia, rel=1e-6)
     assert max(masses) - min(masses) > 0.1 or max(offsets) - min(offsets) > 0.05
 
 

@@ -1,0 +1,138 @@
+"""optimize and verify end to end: the balanced design is proven by an independent simulation."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balancer import spec
+from balancer.cli import main
+from balancer.conditions import berkof_residuals, force_balance_error
+from balancer.verify import verify
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+
+@pytest.fixture(scope="module")
+def pb2_balanced(tmp_path_factory):
+    out = tmp_path_factory.mktemp("pb2") / "balanced.toml"
+    assert main(["optimize", str(EXAMPLES / "pb2.toml"), "--out", str(out), "--no-verify",
+                 "--json"]) == 0
+    return out
+
+
+def test_pb2_balanced_spec_is_complete_and_balanced(pb2_balanced):
+    design = spec.load_design(pb2_balanced)
+    assert design.original is not None and design.balance is not None
+    linkage = design.mechanism
+    assert force_balance_error(linkage) < 1e-10
+    res = berkof_residuals(linkage)
+    assert max(abs(res.coupler_offset), abs(res.coupler_inertia), abs(res.crank_rotor),
+               abs(res.rocker_rotor)) < 1e-7
+
+
+def test_pb2_verifies_at_integration_error_level_driven_and_free(pb2_balanced):
+    """Issue 4: reaction sums and shaking moment at integration-error level in both motions,
+    simulated by a formulation the optimiser did not use."""
+    design = spec.load_design(pb2_balanced)
+    v = verify(design, duration=2.0)
+    assert v.method != "mass-matrix"
+    for run in (v.driven, v.free):
+        assert run.trajectory is not None and run.original is not None
+        assert run.force_ratio < 1e-9 and run.force_level < 1e-9
+        assert run.moment_ratio < 1e-9
+        # The original really shakes in this motion.
+        assert run.original_max_shaking_moment > 1.0
+        assert run.trajectory.energy_error < 1e-9
+
+
+def test_pb1_optimize_json(tmp_path, capsys):
+    out = tmp_path / "pb1_balanced.toml"
+    assert main(["optimize", str(EXAMPLES / "pb1.toml"), "--json", "--out", str(out),
+                 "--verify-duration", "1"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    for key in ("before", "after", "links", "status", "verification"):
+        assert key in doc
+    for name in ("shaking_force", "shaking_moment", "driving_torque"):
+        assert set(doc["before"][name]) == {"rms", "max"} == set(doc["after"][name])
+    assert doc["status"] == "optimal" and doc["success"] is True
+    assert set(doc["links"]) == {"crank", "coupler", "rocker"}
+    assert "counter_rotor" in doc["links"]["rocker"]
+    assert doc["after"]["shaking_force"]["max"] < 1e-9 * doc["before"]["shaking_force"]["max"]
+    assert doc["after"]["shaking_moment"]["rms"] < doc["before"]["shaking_moment"]["rms"]
+    # The RMS of the balanced design (Newton–Euler route) is the optimiser's objective (mass
+    # matrices): mean square = J.
+    assert doc["after"]["shaking_moment"]["rms"] ** 2 == pytest.approx(doc["objective"],
+                                                                       rel=1e-9)
+    assert doc["lower_bound"] == pytest.approx(doc["objective"], rel=1e-6)
+    ver = doc["verification"]
+    assert ver["max_shaking_force"] < 1e-8 * doc["before"]["shaking_force"]["max"]
+    assert ver["max_shaking_moment"] > 0
+    # The written spec analyses to the same figures.
+    assert main(["analyze", str(out), "--json"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert again["shaking_moment"]["rms"] == pytest.approx(doc["after"]["shaking_moment"]["rms"],
+                                                           rel=1e-12)
+    assert again["force_balanced"] is True
+
+
+def test_convex_and_nlp_backends_agree_through_the_cli(capsys):
+    objectives = []
+    for backend in ("convex", "nlp"):
+        assert main(["optimize", str(EXAMPLES / "pb1.toml"), "--json", "--backend", backend,
+                     "--no-verify"]) == 0
+        objectives.append(json.loads(capsys.readouterr().out)["objective"])
+    assert objectives[0] == pytest.approx(objectives[1], rel=1e-6)
+
+
+def test_optimize_without_balance_section_is_bad_input(capsys):
+    assert main(["optimize", str(EXAMPLES / "meijaard2020.toml")]) == 2
+    assert "balance" in capsys.readouterr().err
+
+
+def test_infeasible_bounds_exit_1_naming_the_bound(tmp_path, capsys):
+    text = (EXAMPLES / "pb1.toml").read_text().replace("com_radius = 1.0", "com_radius = 0.15")
+    path = tmp_path / "tight.toml"
+    path.write_text(text)
+    out = tmp_path / "never.toml"
+    assert main(["optimize", str(path), "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "balance.crank.com_radius" in err and err.count("\n") == 1
+    assert not out.exists()
+
+
+def test_verify_plots_and_json(tmp_path, capsys, pb2_balanced):
+    plot = tmp_path / "report.png"
+    assert main(["verify", str(pb2_balanced), "--plot", str(plot), "--duration", "0.5",
+                 "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert {"max_shaking_force", "max_shaking_moment", "driven", "free"} <= set(doc)
+    assert plot.exists() and plot.with_suffix(".svg").exists()
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert b"<svg" in plot.with_suffix(".svg").read_bytes()[:500]
+
+
+def test_verify_of_an_unbalanced_design_reports_its_shaking(capsys):
+    assert main(["verify", str(EXAMPLES / "meijaard2020.toml"), "--duration", "0.5"]) == 0
+    out = capsys.readouterr().out
+    assert "vanish" not in out and "driven at the operating speed" in out
+
+
+def test_animation(tmp_path, capsys):
+    gif = tmp_path / "run.gif"
+    assert main(["plot", str(EXAMPLES / "pb1.toml"), "--animate", str(gif), "--frames", "8"]) == 0
+    from PIL import Image
+
+    with Image.open(gif) as im:
+        assert im.n_frames == 8
+    assert main(["plot", str(EXAMPLES / "pb1.toml")]) == 2
+    capsys.readouterr()
+
+
+def test_balanced_design_round_trips(pb2_balanced):
+    design = spec.load_design(pb2_balanced)
+    assert spec.loads_design(spec.dumps_design(design)) == design
+    assert np.isfinite(design.mechanism.crank.counter_rotor)
