@@ -743,8 +743,11 @@ class NumericProblem:
         reg = regressors(lengths, motion(lengths, theta, 0.0, 1.0, signs))
         return reg.shaking_moment / math.sqrt(theta.size)
 
-    def settle(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+    def settle(self, x: NDArray[np.float64], *, for_motion: bool = True) -> NDArray[np.float64]:
         """Give the :attr:`inert` entries their values.
+
+        With ``for_motion`` false they just take the allowed value nearest the original's (all
+        that a check of the objective or the constraints needs); otherwise:
 
         Nothing the objective or a constraint measures depends on them, but the shaking moment
         of a motion whose crank speed changes (start-up, speed fluctuation, free motion) does:
@@ -778,6 +781,8 @@ class NumericProblem:
         if not entries:
             return x
         x[entries] = original
+        if not for_motion:
+            return x
         a = self.acceleration_rows
         lower_a, upper_a, original_a = (np.array(v, dtype=float) for v in (lower, upper,
                                                                              original))

@@ -390,6 +390,7 @@ class ConvexSolver:
                 if objective2 <= objective + slack:
                     x, tight, objective = x2, tight2, objective2
             x, objective = self.polish(x, target, objective)
+        x = data.settle(x)  # the inert entries, for a crank whose speed changes
         return ConvexSolution(
             x=x,
             objective=objective,
@@ -418,7 +419,7 @@ class ConvexSolver:
                 continue
             trial = u.copy()
             trial[j] = preferred[j]
-            xt = data.settle(lay.x(trial))
+            xt = data.settle(lay.x(trial), for_motion=False)
             if data.violations(xt):
                 continue
             jt = data.objective(xt)
@@ -448,7 +449,7 @@ class ConvexSolver:
             u -= pinv @ (at @ u - rhs)
         # Met to the feasibility tolerance: leave the solver's design alone (a "repair" of a
         # 1e-12 violation would cost more objective than it is worth at a zero optimum).
-        rounds = 2 if data.violations(data.settle(lay.x(u))) else 0
+        rounds = 2 if data.violations(data.settle(lay.x(u), for_motion=False)) else 0
         for _ in range(rounds):
             for b in data.links:
                 k = 4 * b.index
@@ -484,7 +485,7 @@ class ConvexSolver:
             low = max(b.inertia[0], x[k] * b.gyration**2)
             if rounds and not low <= inertia <= b.inertia[1]:
                 x[k + 3] = min(max(inertia, low), b.inertia[1]) + q
-        return data.settle(x), tight
+        return data.settle(x, for_motion=False), tight
 
     # -- infeasibility -------------------------------------------------------------------------
 
