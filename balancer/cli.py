@@ -274,8 +274,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", metavar="PATH", help="write the figure to PATH (.png and .svg)")
     p.add_argument("--duration", type=_positive_float, metavar="T",
                    help="simulated time of each run, s (default: the spec's)")
-    p.add_argument("--method", choices=METHODS, default="opened-loop",
-                   help="formulation for the simulations (default opened-loop)")
+    p.add_argument("--method", choices=METHODS,
+                   help="formulation for the simulations (default: one the optimiser did not "
+                   "use: opened-loop for a four-bar, complex-masses for a slider-crank)")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
     p.set_defaults(handler=_cmd_verify)
 

@@ -67,7 +67,11 @@ class Reactions:
     shaking_moment
         Moment about A0 of everything the mechanism exerts on the ground, N·m.
     shaking_force
-        ``R̄A0 + R̄A3``, N (computed from them when not given).
+        The sum of the forces on the frame, N: ``R̄A0 + R̄A3`` for a four-bar (computed from
+        them when not given).
+    guide_line
+        For a slider-crank, whose R̄A3 is the slider's normal force on its guide: the x of
+        that force's line of action, m (``None`` for a four-bar).
     """
 
     RA0: NDArray[np.complex128]
@@ -75,6 +79,7 @@ class Reactions:
     driving_torque: NDArray[np.float64]
     shaking_moment: NDArray[np.float64]
     shaking_force: NDArray[np.complex128] = None  # type: ignore[assignment]
+    guide_line: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         if self.shaking_force is None:
@@ -289,10 +294,12 @@ class Regressors:
     shaking_moment: NDArray[np.float64]
 
 
-def parameter_vector(linkage: FourBar) -> NDArray[np.float64]:
-    """The design vector ``x`` of :class:`Regressors` for a four-bar."""
+def parameter_vector(linkage) -> NDArray[np.float64]:
+    """The design vector ``x`` of :class:`Regressors` for a four-bar (or a slider-crank: rod and
+    slider in the places of coupler and rocker, no second counter-rotor)."""
     values = [v for link in linkage.links for v in inertial_parameters(link)]
-    values += [linkage.crank.counter_rotor, linkage.rocker.counter_rotor]
+    third = linkage.links[2].counter_rotor if linkage.type == "four-bar" else 0.0
+    values += [linkage.crank.counter_rotor, third]
     return np.array(values, dtype=float)
 
 
@@ -481,6 +488,10 @@ class CycleAnalysis:
     @cached_property
     def motion(self) -> Motion:
         """Kinematics at the sampled angles (computed when first asked for)."""
+        if self.linkage.type == "slider-crank":
+            from .slider_crank.kinematics import motion_of as slider_motion
+
+            return slider_motion(self.linkage, self.theta1, self.speed, 0.0)  # type: ignore[return-value]
         signs = cycle_branch_signs(self.linkage.lengths, self.linkage.branch, self.theta1)
         return motion(self.linkage.lengths, self.theta1, self.speed, 0.0, signs, check=True)
 
@@ -522,6 +533,10 @@ def cycle_analysis(
     AssemblyError
         If the crank cannot turn a full revolution.
     """
+    if linkage.type == "slider-crank":
+        from .slider_crank.dynamics import cycle_analysis as slider_cycle
+
+        return slider_cycle(linkage, speed, samples, route=route, loads=loads, theta1=theta1)
     rng = assembly_range(linkage.lengths)
     if not rng.full:
         raise AssemblyError(

@@ -23,6 +23,11 @@ Drive = Literal["free", "constant-speed"]
 
 #: Names of the formulations of the equations of motion (see :mod:`balancer.formulations`).
 METHODS: tuple[str, ...] = ("opened-loop", "complex-masses", "mass-matrix", "lie-group")
+#: The formulations of each mechanism type; the first is its default.
+METHODS_BY_TYPE: dict[str, tuple[str, ...]] = {
+    "four-bar": METHODS,
+    "slider-crank": ("mass-matrix", "complex-masses"),
+}
 #: Ways the crank can be driven in a simulation.
 DRIVES: tuple[str, ...] = ("free", "constant-speed")
 
@@ -163,6 +168,125 @@ class FourBar:
 
 
 @dataclass(frozen=True, kw_only=True)
+class GasForce:
+    """A force on the slider along its guide that depends on the crank angle (a gas force).
+
+    It acts between the slider (piston, along +x) and the frame (cylinder head, along −x), on the
+    guide line: it drives the crank but, being internal to the machine, does not shake the frame
+    except through the reaction of what holds the crank.
+
+    Attributes
+    ----------
+    angles
+        Crank angles of the table, rad, increasing within one period starting at 0.
+    values
+        Force along +x at those angles, N; linear interpolation, periodic.
+    period
+        Period in crank angle, rad (2π; 4π for a four-stroke cycle).
+    """
+
+    angles: tuple[float, ...] = (0.0,)
+    values: tuple[float, ...] = (0.0,)
+    period: float = 2 * math.pi
+
+    @classmethod
+    def constant(cls, value: float) -> GasForce:
+        """A constant force along +x, N."""
+        return cls(angles=(0.0,), values=(float(value),))
+
+    @property
+    def is_zero(self) -> bool:
+        """Whether the force vanishes everywhere."""
+        return all(v == 0.0 for v in self.values)
+
+    def at(self, theta1):
+        """The force (N) at crank angle(s) ``theta1`` (rad)."""
+        import numpy as np
+
+        if len(self.values) == 1:
+            return self.values[0] + 0.0 * np.asarray(theta1, dtype=float)
+        return np.interp(np.mod(theta1, self.period), self.angles, self.values,
+                         period=self.period)
+
+
+@dataclass(frozen=True, kw_only=True)
+class SliderCrank:
+    """A slider-crank A0 A1 A2 with the slider's pin A2 on a straight guide (Wunderlich 1964,
+    Sect. 3).
+
+    A0 at the origin; link 1 (crank) A0→A1, link 2 (connecting rod) A1→A2; the slider's pin A2
+    moves on the guide line ``y = offset`` along x. θ1, θ2 are the angles of A0→A1 and A1→A2.
+
+    Attributes
+    ----------
+    lengths
+        ``(r, L, e)``: crank and rod lengths (m, positive) and the signed offset of the guide
+        from A0 (m).
+    crank, rod
+        The rotating links (centre of mass in the link frame, as for the four-bar).
+    slider
+        The slider: its centre of mass relative to the pin is in global axes; its inertia does
+        not matter (it does not turn).
+    branch
+        ``"+"``: the slider on the +x side of the crank pin; ``"-"``: the other assembly.
+    gas_force
+        Force on the slider along the guide, from the frame (see :class:`GasForce`).
+    """
+
+    type: ClassVar[str] = "slider-crank"
+    link_names: ClassVar[tuple[str, str, str]] = ("crank", "rod", "slider")
+    length_names: ClassVar[tuple[str, ...]] = ("crank", "rod", "offset")
+    grounded_links: ClassVar[tuple[str, ...]] = ("crank",)
+
+    lengths: tuple[float, float, float]
+    crank: Link
+    rod: Link
+    slider: Link
+    branch: Branch = "+"
+    gas_force: GasForce = field(default_factory=GasForce)
+
+    @property
+    def links(self) -> tuple[Link, Link, Link]:
+        """The moving links in order (crank, rod, slider)."""
+        return (self.crank, self.rod, self.slider)
+
+    @property
+    def total_mass(self) -> float:
+        """Mass of the moving parts, kg."""
+        return self.crank.mass + self.rod.mass + self.slider.mass
+
+    @property
+    def has_loads(self) -> bool:
+        """Whether any link carries an applied force or moment, or a gas force acts."""
+        return any(link.has_loads for link in self.links) or not self.gas_force.is_zero
+
+    def link(self, name: str) -> Link:
+        """Return the link called ``name`` (``"crank"``, ``"rod"`` or ``"slider"``)."""
+        if name not in self.link_names:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def with_link(self, name: str, link: Link) -> SliderCrank:
+        """Return a copy with link ``name`` replaced."""
+        if name not in self.link_names:
+            raise KeyError(name)
+        return replace(self, **{name: link})
+
+    def with_links(self, links: dict[str, Link]) -> SliderCrank:
+        """Return a copy with several links replaced."""
+        return replace(self, **links)
+
+    def without_loads(self) -> SliderCrank:
+        """Return a copy with every applied force, moment and gas force removed."""
+        return replace(self, gas_force=GasForce(),
+                       **{n: self.link(n).without_loads() for n in self.link_names})
+
+
+#: A mechanism the package knows.
+Mechanism = FourBar | SliderCrank
+
+
+@dataclass(frozen=True, kw_only=True)
 class Operation:
     """The operating condition a cycle analysis and a balancing refer to.
 
@@ -196,7 +320,8 @@ class SimulationSettings:
         ``"free"``: the crank moves under the loads alone; ``"constant-speed"``: a motor on the
         ground holds the crank at ``omega1``.
     method
-        Formulation of the equations of motion (see :mod:`balancer.formulations`).
+        Formulation of the equations of motion (see :mod:`balancer.formulations`); ``None``:
+        the mechanism's default.
     rtol, atol
         Relative and absolute tolerances of the integrator.
     outputs
@@ -208,7 +333,7 @@ class SimulationSettings:
     omega1: float = 0.0
     gravity: tuple[float, float] = (0.0, 0.0)
     drive: Drive = "free"
-    method: str = "opened-loop"
+    method: str | None = None
     rtol: float = 1e-10
     atol: float = 1e-12
     outputs: int = 501
@@ -234,9 +359,9 @@ class Design:
         A free-text name for reports.
     """
 
-    mechanism: FourBar
+    mechanism: FourBar | SliderCrank
     operation: Operation | None = None
     simulation: SimulationSettings = field(default_factory=SimulationSettings)
     balance: object | None = None
-    original: FourBar | None = None
+    original: FourBar | SliderCrank | None = None
     title: str = ""

@@ -77,13 +77,11 @@ def plot_shaking_moment(
     return ax
 
 
-def centre_of_mass_path(linkage: FourBar, traj: Trajectory) -> np.ndarray:
+def centre_of_mass_path(linkage, traj: Trajectory) -> np.ndarray:
     """Total centre of mass along a simulated motion, complex, m."""
-    mo = motion_from_angles(linkage.lengths, tuple(traj.theta), tuple(traj.omega),
-                            tuple(traj.alpha))
-    (r1, r2, r3), _ = link_com_kinematics(linkage, mo)
-    m1, m2, m3 = (link.mass for link in linkage.links)
-    return (m1 * r1 + m2 * r2 + m3 * r3) / linkage.total_mass
+    from .mechanisms import centre_of_mass_path as path
+
+    return path(linkage, traj.theta, tuple(traj.omega), tuple(traj.alpha))
 
 
 def plot_com_path(
@@ -102,7 +100,10 @@ def plot_com_path(
                 label=f"{label}: stationary")
     else:
         ax.plot(path.real, path.imag, color=COLOURS["after"], lw=1.5, label=label)
-    ax.plot([0, linkage.lengths[3]], [0, 0], "k^", ms=8, label="ground pivots A0, A3")
+    from .mechanisms import frame_points
+
+    ground = np.array(frame_points(linkage))
+    ax.plot(ground.real, ground.imag, "k^", ms=8, label="frame (pivots, guide)")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
@@ -165,25 +166,15 @@ def save_figure(fig: Figure, path: str | os.PathLike[str]) -> list[Path]:
     return written
 
 
-def linkage_frames(linkage: FourBar, frames: int = 72):
+def linkage_frames(linkage, frames: int = 72):
     """Joint positions and centres of mass over one crank revolution, for drawing.
 
-    Returns ``(joints, coms, total)``: joints ``(frames, 4)`` complex (A0, A1, A2, A3), link
-    centres of mass ``(frames, 3)`` and the total centre of mass ``(frames,)``, m.
+    Returns ``(joints, coms, total)``: joints ``(frames, k)`` complex, link centres of mass
+    ``(frames, 3)`` and the total centre of mass ``(frames,)``, m.
     """
-    from .inverse import sample_angles
-    from .kinematics import cycle_branch_signs, motion
+    from .mechanisms import drawing_frames
 
-    angles = sample_angles(frames)
-    signs = cycle_branch_signs(linkage.lengths, linkage.branch, angles)
-    mo = motion(linkage.lengths, angles, 1.0, 0.0, signs, check=False)
-    a3 = np.full(frames, complex(linkage.lengths[3], 0.0))
-    joints = np.column_stack([np.zeros(frames, complex), mo.pos.A1, mo.pos.A2, a3])
-    (r1, r2, r3), _ = link_com_kinematics(linkage, mo)
-    coms = np.column_stack([r1, r2, r3])
-    m = np.array([link.mass for link in linkage.links])
-    total = coms @ m / m.sum()
-    return joints, coms, total
+    return drawing_frames(linkage, frames)
 
 
 def animate(linkage: FourBar, path: str | os.PathLike[str], *, frames: int = 72, fps: int = 24,
@@ -213,7 +204,12 @@ def animate(linkage: FourBar, path: str | os.PathLike[str], *, frames: int = 72,
     ax.grid(alpha=0.3)
     ax.plot(total.real, total.imag, color=COLOURS["before"], lw=1, ls=":",
             label="path of the total centre of mass")
-    ax.plot([0, linkage.lengths[3]], [0, 0], "k^", ms=10, zorder=5)
+    from .mechanisms import frame_points
+
+    ground = np.array(frame_points(linkage))
+    ax.plot(ground.real[:2], ground.imag[:2], "k^", ms=10, zorder=5)
+    if linkage.type == "slider-crank":
+        ax.plot(ground.real[1:], ground.imag[1:], "k-", lw=6, alpha=0.25, zorder=1)
     (bars,) = ax.plot([], [], "-o", color=COLOURS["A0"], lw=3, ms=6, label="links",
                       animated=True)
     (link_coms,) = ax.plot([], [], "s", color=COLOURS["A3"], ms=5,

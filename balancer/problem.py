@@ -71,23 +71,37 @@ from .inverse import (
     sample_angles,
 )
 from .kinematics import assembly_range, cycle_branch_signs, motion
-from .model import Design, FourBar, Link
+from .model import Design, FourBar, Link, Mechanism
 
 if TYPE_CHECKING:  # pragma: no cover
     from .spec import _Table
 
-#: Joints of each moving link, first then second (Meijaard & van der Wijk 2020, Fig. 1).
-JOINTS: dict[str, tuple[str, str]] = {
-    "crank": ("A0", "A1"),
-    "coupler": ("A1", "A2"),
-    "rocker": ("A2", "A3"),
+#: Joints of each moving link, first then second, per mechanism type (Meijaard & van der Wijk
+#: 2020, Fig. 1; a slider has only its pin).
+LINK_JOINTS: dict[str, dict[str, tuple[str, str]]] = {
+    "four-bar": {"crank": ("A0", "A1"), "coupler": ("A1", "A2"), "rocker": ("A2", "A3")},
+    "slider-crank": {"crank": ("A0", "A1"), "rod": ("A1", "A2"), "slider": ("A2", "A2")},
 }
 #: The joint ``com_radius`` is measured from when ``com_about`` is absent: the ground pivot of
-#: crank and rocker, the crank pin of the coupler.
-DEFAULT_ABOUT: dict[str, str] = {"crank": "A0", "coupler": "A1", "rocker": "A3"}
+#: crank and rocker, the crank pin of coupler and rod, the slider's pin.
+DEFAULT_ABOUTS: dict[str, dict[str, str]] = {
+    "four-bar": {"crank": "A0", "coupler": "A1", "rocker": "A3"},
+    "slider-crank": {"crank": "A0", "rod": "A1", "slider": "A2"},
+}
+#: The four-bar's joints and default joints (the first mechanism).
+JOINTS = LINK_JOINTS["four-bar"]
+DEFAULT_ABOUT = DEFAULT_ABOUTS["four-bar"]
+#: Entry of the design vector holding the counter-rotor of a link on a ground pivot.
+ROTOR_ENTRY: dict[str, int] = {"crank": 12, "rocker": 13}
 
-_BALANCE_KEYS = ("force_balance", "objective", "crank", "coupler", "rocker")
-_OBJECTIVE_KEYS = ("shaking_moment", "driving_torque", "shaking_force", "added_mass")
+_OBJECTIVE_KEYS = (
+    "shaking_moment",
+    "driving_torque",
+    "shaking_force",
+    "shaking_force_x",
+    "shaking_force_y",
+    "added_mass",
+)
 _LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "counter_rotor")
 
 #: Relative tolerance of :meth:`NumericProblem.violations` (bounds and Eq. 57).
@@ -113,6 +127,9 @@ class Objective:
         ``w_τ``, (N·m)²/(N·m)².
     shaking_force
         ``w_F``, (N·m)²/N² (zero at every design when force balance is imposed).
+    shaking_force_x, shaking_force_y
+        Weights of the shaking force's components along and across x (for a slider-crank:
+        along and across the guide), (N·m)²/N²; they add to ``w_F``.
     added_mass
         ``w_m``, (N·m)²/kg: penalises mass added to the linkage.
     """
@@ -120,6 +137,8 @@ class Objective:
     shaking_moment: float = 1.0
     driving_torque: float = 0.0
     shaking_force: float = 0.0
+    shaking_force_x: float = 0.0
+    shaking_force_y: float = 0.0
     added_mass: float = 0.0
 
 
@@ -164,8 +183,9 @@ class BalanceProblem:
         Impose exact shaking-force balance (Eq. 57–58) as equality constraints.
     objective
         Weights of the objective.
-    crank, coupler, rocker
-        What may change on each link; ``None``: the link stays as it is.
+    crank, coupler, rocker, rod, slider
+        What may change on each link (four-bar: crank, coupler, rocker; slider-crank: crank,
+        rod, slider); ``None``: the link stays as it is.
     """
 
     force_balance: bool = True
@@ -173,10 +193,12 @@ class BalanceProblem:
     crank: LinkFreedom | None = None
     coupler: LinkFreedom | None = None
     rocker: LinkFreedom | None = None
+    rod: LinkFreedom | None = None
+    slider: LinkFreedom | None = None
 
     def link(self, name: str) -> LinkFreedom | None:
         """The freedom of link ``name``, or ``None`` if it is not listed."""
-        if name not in JOINTS:
+        if name not in ("crank", "coupler", "rocker", "rod", "slider"):
             raise KeyError(name)
         return getattr(self, name)
 
@@ -243,7 +265,7 @@ def _read_link_freedom(table: _Table) -> LinkFreedom:
     return freedom
 
 
-def read_balance(table: _Table, mechanism: FourBar) -> BalanceProblem:
+def read_balance(table: _Table, mechanism: Mechanism) -> BalanceProblem:
     """Read and validate a spec's ``[balance]`` table (called by :mod:`balancer.spec`).
 
     Parameters
@@ -258,7 +280,8 @@ def read_balance(table: _Table, mechanism: FourBar) -> BalanceProblem:
     SpecError
         Naming the key and value at fault (see :func:`check_problem`).
     """
-    _check_keys(table, _BALANCE_KEYS)
+    names = mechanism.link_names
+    _check_keys(table, ("force_balance", "objective", *names))
     force_balance = True
     if table.has("force_balance"):
         value = table.raw("force_balance")
@@ -277,7 +300,7 @@ def read_balance(table: _Table, mechanism: FourBar) -> BalanceProblem:
         )
         sub.finish()
     links: dict[str, LinkFreedom] = {}
-    for name in JOINTS:
+    for name in names:
         sub = table.table(name, required=False)
         if sub is not None:
             links[name] = _read_link_freedom(sub)
@@ -287,9 +310,9 @@ def read_balance(table: _Table, mechanism: FourBar) -> BalanceProblem:
     return problem
 
 
-def _link_is_free(name: str, freedom: LinkFreedom, link: Link) -> bool:
+def _link_is_free(name: str, freedom: LinkFreedom, link: Link, mechanism) -> bool:
     """Whether anything about the link may vary (not just be set to another fixed value)."""
-    b = resolve_link(name, freedom, link, 1.0)
+    b = resolve_link(name, freedom, link, 1.0, mechanism)
     return (
         b.mass[0] < b.mass[1]
         or b.com_radius is not None
@@ -298,7 +321,7 @@ def _link_is_free(name: str, freedom: LinkFreedom, link: Link) -> bool:
     )
 
 
-def check_problem(problem: BalanceProblem, mechanism: FourBar) -> None:
+def check_problem(problem: BalanceProblem, mechanism: Mechanism) -> None:
     """Raise :class:`SpecError` on a contradictory or impossible redesign problem.
 
     Checks what one key alone cannot: a joint that is not on the link, a counter-rotor on the
@@ -307,21 +330,25 @@ def check_problem(problem: BalanceProblem, mechanism: FourBar) -> None:
     is the optimiser's question; see :mod:`balancer.optimize`.)
     """
     w = problem.objective
-    weights = (w.shaking_moment, w.driving_torque, w.shaking_force, w.added_mass)
+    weights = tuple(getattr(w, name) for name in _OBJECTIVE_KEYS)
     if any(x < 0 for x in weights):
         raise SpecError("weights must be zero or positive", key="balance.objective")
     if not any(weights):
         raise SpecError(
             "every weight is zero: there is nothing to minimise", key="balance.objective"
         )
-    for name in JOINTS:
+    joints_of = LINK_JOINTS[mechanism.type]
+    for name in ("crank", "coupler", "rocker", "rod", "slider"):
+        if problem.link(name) is not None and name not in mechanism.link_names:
+            raise SpecError(f"a {mechanism.type} has no {name}", key=f"balance.{name}")
+    for name in mechanism.link_names:
         freedom = problem.link(name)
         if freedom is None:
             continue
         key = f"balance.{name}"
         if freedom.com_about is not None:
-            if freedom.com_about not in JOINTS[name]:
-                joints = " or ".join(JOINTS[name])
+            if freedom.com_about not in joints_of[name]:
+                joints = " or ".join(dict.fromkeys(joints_of[name]))
                 raise SpecError(
                     f"must be a joint of the {name} ({joints})",
                     key=f"{key}.com_about",
@@ -333,15 +360,15 @@ def check_problem(problem: BalanceProblem, mechanism: FourBar) -> None:
                     key=f"{key}.com_about",
                     value=freedom.com_about,
                 )
-        if freedom.counter_rotor is not None and name not in FourBar.grounded_links:
+        if freedom.counter_rotor is not None and name not in mechanism.grounded_links:
+            where = " and the ".join(mechanism.grounded_links)
             raise SpecError(
-                "a counter-rotor sits on a ground pivot: only the crank and the rocker can "
-                "have one",
+                f"a counter-rotor sits on a ground pivot: only the {where} can have one",
                 key=f"{key}.counter_rotor",
                 value=list(freedom.counter_rotor),
             )
-        length = mechanism.lengths[list(JOINTS).index(name)]
-        bounds = resolve_link(name, freedom, mechanism.link(name), length)
+        length = link_length(mechanism, name)
+        bounds = resolve_link(name, freedom, mechanism.link(name), length, mechanism)
         rho = bounds.gyration
         least = bounds.mass[0] * rho * rho
         if least > bounds.inertia[1]:
@@ -353,8 +380,9 @@ def check_problem(problem: BalanceProblem, mechanism: FourBar) -> None:
                 value=freedom.min_gyration,
             )
     if not any(
-        problem.link(n) is not None and _link_is_free(n, problem.link(n), mechanism.link(n))
-        for n in JOINTS
+        problem.link(n) is not None
+        and _link_is_free(n, problem.link(n), mechanism.link(n), mechanism)
+        for n in mechanism.link_names
     ):
         raise SpecError(
             "nothing may change: give a link a mass range, com_radius, min_gyration, an "
@@ -385,9 +413,12 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
         f"shaking_moment = {_num(w.shaking_moment)}",
         f"driving_torque = {_num(w.driving_torque)}  # (N·m)²/(N·m)²",
         f"shaking_force = {_num(w.shaking_force)}  # (N·m)²/N²",
+        *([f"shaking_force_x = {_num(w.shaking_force_x)}  # (N·m)²/N², along x",
+           f"shaking_force_y = {_num(w.shaking_force_y)}  # (N·m)²/N², across x"]
+          if w.shaking_force_x or w.shaking_force_y else []),
         f"added_mass = {_num(w.added_mass)}  # (N·m)²/kg",
     ]
-    for name in JOINTS:
+    for name in ("crank", "coupler", "rocker", "rod", "slider"):
         freedom = problem.link(name)
         if freedom is None:
             continue
@@ -448,6 +479,8 @@ class LinkBounds:
     index: int
     length: float
     original: Link
+    joints: tuple[str, str]
+    default_about: str
     listed: bool
     mass: tuple[float, float]
     com_fixed: complex | None
@@ -465,7 +498,7 @@ class LinkBounds:
     @property
     def about(self) -> str:
         """Name of the joint at :attr:`com_centre`."""
-        first, second = JOINTS[self.name]
+        first, second = self.joints
         return first if self.com_centre == 0.0 else second
 
     @property
@@ -484,19 +517,35 @@ class LinkBounds:
         return self.original.mass * self.length**2
 
 
-def resolve_link(name: str, freedom: LinkFreedom | None, link: Link, length: float) -> LinkBounds:
+def link_length(mechanism, name: str) -> float:
+    """The length that scales link ``name``'s parameters (a slider's: the crank's), m."""
+    if mechanism.type == "slider-crank" and name == "slider":
+        return mechanism.lengths[0]
+    return mechanism.lengths[mechanism.link_names.index(name)]
+
+
+def resolve_link(
+    name: str, freedom: LinkFreedom | None, link: Link, length: float, mechanism=None
+) -> LinkBounds:
     """Apply the defaults of the module docstring to one link's freedom."""
-    first, second = JOINTS[name]
-    index = list(JOINTS).index(name)
-    rotor = (link.counter_rotor, link.counter_rotor) if name in FourBar.grounded_links else None
+    kind = "four-bar" if mechanism is None else mechanism.type
+    grounded = FourBar.grounded_links if mechanism is None else mechanism.grounded_links
+    joints = LINK_JOINTS[kind][name]
+    first, second = joints
+    index = list(LINK_JOINTS[kind]).index(name)
+    rotor = (link.counter_rotor, link.counter_rotor) if name in grounded else None
+    if rotor is None and kind == "slider-crank" and name == "slider":
+        rotor = (0.0, 0.0)  # the design vector's second counter-rotor entry: none, held at zero
+    common = {"name": name, "index": index, "length": length, "original": link,
+              "joints": joints, "default_about": DEFAULT_ABOUTS[kind][name]}
     if freedom is None:
         return LinkBounds(
-            name=name, index=index, length=length, original=link, listed=False,
+            **common, listed=False,
             mass=(link.mass, link.mass), com_fixed=link.com, com_centre=0.0, com_radius=None,
             inertia=(link.inertia, link.inertia), gyration=0.0, counter_rotor=rotor,
         )  # fmt: skip
     mass = freedom.mass if freedom.mass is not None else (link.mass, link.mass)
-    about = freedom.com_about or DEFAULT_ABOUT[name]
+    about = freedom.com_about or DEFAULT_ABOUTS[kind][name]
     centre = 0.0 if about == first else length
     com_fixed: complex | None = None
     radius = freedom.com_radius
@@ -514,10 +563,10 @@ def resolve_link(name: str, freedom: LinkFreedom | None, link: Link, length: flo
         inertia = (link.inertia, link.inertia)
     if rho > 0 and math.isfinite(inertia[1]):
         mass = (mass[0], min(mass[1], inertia[1] / rho**2))
-    if name in FourBar.grounded_links and freedom.counter_rotor is not None:
+    if name in grounded and freedom.counter_rotor is not None:
         rotor = freedom.counter_rotor
     return LinkBounds(
-        name=name, index=index, length=length, original=link, listed=True, mass=mass,
+        **common, listed=True, mass=mass,
         com_fixed=com_fixed, com_centre=centre, com_radius=radius, inertia=inertia,
         gyration=rho, counter_rotor=rotor,
     )  # fmt: skip
@@ -531,19 +580,25 @@ def _bounded_least_squares(a, x, entries, lower, upper, original) -> NDArray[np.
     """
     from scipy.optimize import lsq_linear
 
-    entries = list(entries)
-    cols = a[:, entries]
-    rest = a @ x - cols @ x[entries]
     lower, upper = np.asarray(lower, float), np.asarray(upper, float)
     original = np.asarray(original, float)
-    if np.all(lower == upper):
-        return original.copy()
+    free = lower < upper
+    out = original.copy()
+    if not free.any():
+        return out
+    x = np.array(x, dtype=float)
+    x[list(entries)] = original  # the fixed ones at their value, the free ones solved for
+    entries = [e for e, f in zip(entries, free, strict=True) if f]
+    lower, upper, original = lower[free], upper[free], original[free]
+    cols = a[:, entries]
+    rest = a @ x - cols @ x[entries]
     scale = np.maximum(np.abs(original), 1.0)
     weight = 1e-6 * max(float(np.linalg.norm(cols)), 1e-300)
     lhs = np.vstack([cols * scale, weight * np.eye(len(entries))])
     rhs = np.concatenate([-rest, weight * original / scale])
     sol = lsq_linear(lhs, rhs, bounds=(lower / scale, upper / scale), method="bvls", tol=1e-14)
-    return np.clip(sol.x * scale, lower, upper)
+    out[free] = np.clip(sol.x * scale, lower, upper)
+    return out
 
 
 def physical_to_inertial(m, e, f, inertia):
@@ -562,7 +617,7 @@ def inertial_to_physical(params) -> tuple[float, float, float, float]:
     return m, e, f, j - m * (e * e + f * f)
 
 
-def _cycle_regressors(linkage: FourBar, speed: float, angles: NDArray[np.float64]) -> Regressors:
+def _cycle_regressors(linkage, speed: float, angles: NDArray[np.float64]) -> Regressors:
     """Regressors over a revolution, as :func:`balancer.inverse.cycle_analysis` samples it.
 
     A change-point linkage follows its smooth motion (branch signs from
@@ -571,6 +626,11 @@ def _cycle_regressors(linkage: FourBar, speed: float, angles: NDArray[np.float64
     extrapolated as ``cycle_analysis`` does (error O(δ⁴)); the rows of the individual
     reactions, unbounded there, are NaN.
     """
+    if linkage.type == "slider-crank":
+        from .slider_crank.dynamics import regressors as slider_regressors
+        from .slider_crank.kinematics import motion_of as slider_motion
+
+        return slider_regressors(linkage.lengths, slider_motion(linkage, angles, speed, 0.0))
     lengths = linkage.lengths
     n = angles.size
     limits = change_point_limits(lengths, angles)
@@ -640,7 +700,7 @@ class NumericProblem:
     """
 
     problem: BalanceProblem
-    linkage: FourBar
+    linkage: Mechanism
     speed: float
     theta1: NDArray[np.float64]
     regressors: Regressors
@@ -695,9 +755,11 @@ class NumericProblem:
             total += w.shaking_moment * float(np.mean((reg.shaking_moment @ x) ** 2))
         if w.driving_torque:
             total += w.driving_torque * float(np.mean((reg.driving_torque @ x) ** 2))
-        if w.shaking_force:
+        if w.shaking_force or w.shaking_force_x or w.shaking_force_y:
             force = reg.shaking_force @ x
-            total += w.shaking_force * float(np.mean(force.real**2 + force.imag**2))
+            wx = w.shaking_force + w.shaking_force_x
+            wy = w.shaking_force + w.shaking_force_y
+            total += wx * float(np.mean(force.real**2)) + wy * float(np.mean(force.imag**2))
         if w.added_mass:
             total += w.added_mass * (float(x[0] + x[4] + x[8]) - self.original_mass)
         return total
@@ -735,6 +797,12 @@ class NumericProblem:
         what the crank's rotary inertia does when the speed changes; this does.
         """
         lengths = self.linkage.lengths
+        if self.linkage.type == "slider-crank":
+            from .slider_crank.dynamics import regressors as slider_regressors
+            from .slider_crank.kinematics import motion_of as slider_motion
+
+            reg = slider_regressors(lengths, slider_motion(self.linkage, self.theta1, 0.0, 1.0))
+            return reg.shaking_moment / math.sqrt(self.theta1.size)
         keep = np.ones(self.theta1.size, bool)
         for mask, _, _ in change_point_limits(lengths, self.theta1):
             keep &= ~mask
@@ -749,13 +817,13 @@ class NumericProblem:
         With ``for_motion`` false they just take the allowed value nearest the original's (all
         that a check of the objective or the constraints needs); otherwise:
 
-        Nothing the objective or a constraint measures depends on them, but the shaking moment
-        of a motion whose crank speed changes (start-up, speed fluctuation, free motion) does:
-        they are chosen, within their bounds, to minimise the mean square of the shaking moment
-        per unit crank acceleration (:attr:`acceleration_rows`) — by the counter-rotors alone
-        first, the inertias about the centres of mass kept, and by the inertias too only if
-        that leaves it reducible — and among equally good choices nearest the original. With
-        Berkof's conditions met this gives the crank the counter-rotor that completes the
+        Nothing the objective or a constraint measures depends on them. An inertia about a
+        centre of mass keeps the allowed value nearest the original's (a designer's crankshaft
+        or flywheel is not shrunk behind their back). A counter-rotor is chosen, within its
+        bounds, to minimise the mean square of the shaking moment per unit crank acceleration
+        (:attr:`acceleration_rows`): what a change of crank speed (start-up, fluctuation, free
+        motion) makes the frame feel; among equally good choices the one nearest the original.
+        With Berkof's conditions met this gives the crank the counter-rotor that completes the
         balance for every motion.
         """
         x = np.array(x, dtype=float)
@@ -787,20 +855,13 @@ class NumericProblem:
         lower_a, upper_a, original_a = (np.array(v, dtype=float) for v in (lower, upper,
                                                                              original))
         rotors = np.array([i >= 12 for i in entries])
-        best = x.copy()
         if rotors.any():
             idx = [e for e, r in zip(entries, rotors, strict=True) if r]
-            best[idx] = _bounded_least_squares(a, best, idx, lower_a[rotors], upper_a[rotors],
-                                               original_a[rotors])
-        full = x.copy()
-        full[entries] = _bounded_least_squares(a, x, entries, lower_a, upper_a, original_a)
-        ms_best = float(np.sum((a @ best) ** 2))
-        ms_full = float(np.sum((a @ full) ** 2))
-        if ms_full < ms_best - 1e-9 * max(ms_best, 1e-300):
-            best = full
-        return best
+            x[idx] = _bounded_least_squares(a, x, idx, lower_a[rotors], upper_a[rotors],
+                                            original_a[rotors])
+        return x
 
-    def linkage_of(self, x: NDArray[np.float64]) -> FourBar:
+    def linkage_of(self, x: NDArray[np.float64]) -> Mechanism:
         """The four-bar with inertial parameters ``x`` (loads kept from the original links).
 
         ``m``, ``e = m·e/m``, ``f = m·f/m``, ``I = J − m·(e² + f²)``, counter-rotors.
@@ -808,11 +869,9 @@ class NumericProblem:
         links = {}
         for b in self.links:
             m, e, f, inertia = inertial_to_physical(x[4 * b.index : 4 * b.index + 4])
-            rotor = 0.0
-            if b.name == "crank":
-                rotor = float(x[12])
-            elif b.name == "rocker":
-                rotor = float(x[13])
+            if abs(inertia - b.original.inertia) <= 1e-12 * b.inertia_ref:
+                inertia = b.original.inertia  # only roundoff from J − m·s²
+            rotor = float(x[ROTOR_ENTRY[b.name]]) if b.name in ROTOR_ENTRY else 0.0
             links[b.name] = replace(
                 b.original, mass=m, e=e, f=f, inertia=inertia, counter_rotor=rotor
             )
@@ -851,7 +910,10 @@ class NumericProblem:
                     f"{b.name}: inertia {inertia:.9g} kg·m² outside [{lo:.9g}, {b.inertia[1]:.9g}]"
                 )
         for index, b in ((12, self.links[0]), (13, self.links[2])):
-            assert b.counter_rotor is not None
+            if b.counter_rotor is None:
+                if abs(x[index]) > tol * b.inertia_ref:
+                    out.append(f"{b.name}: has no counter-rotor, got {x[index]:.6g} kg·m²")
+                continue
             lo, hi = b.counter_rotor
             scale = max(b.inertia_ref, hi)
             if x[index] < lo - tol * scale or x[index] > hi + tol * scale:
@@ -863,7 +925,7 @@ class NumericProblem:
             residual = float(np.max(np.abs(a @ x[:12] - rhs)))
             total = float(x[0] + x[4] + x[8])
             if residual > tol * total:
-                out.append(f"force balance: Eq. 57 residual {residual / total:.3g} of the mass")
+                out.append(f"force balance: residual {residual / total:.3g} of the mass")
         return out
 
 
@@ -890,7 +952,12 @@ def numeric_problem(design: Design) -> NumericProblem:
         )
     linkage = design.mechanism
     check_problem(problem, linkage)
-    rng = assembly_range(linkage.lengths)
+    if linkage.type == "slider-crank":
+        from .slider_crank.kinematics import assembly_range as slider_range
+
+        rng = slider_range(linkage.lengths)
+    else:
+        rng = assembly_range(linkage.lengths)
     if not rng.full:
         raise AssemblyError(
             "balancing needs a crank that turns a full revolution, but this linkage assembles "
@@ -907,20 +974,26 @@ def numeric_problem(design: Design) -> NumericProblem:
         blocks.append(math.sqrt(w.shaking_moment) * reg.shaking_moment)
     if w.driving_torque:
         blocks.append(math.sqrt(w.driving_torque) * reg.driving_torque)
-    if w.shaking_force:
-        blocks += [
-            math.sqrt(w.shaking_force) * reg.shaking_force.real,
-            math.sqrt(w.shaking_force) * reg.shaking_force.imag,
-        ]
+    wx, wy = w.shaking_force + w.shaking_force_x, w.shaking_force + w.shaking_force_y
+    if wx:
+        blocks.append(math.sqrt(wx) * reg.shaking_force.real)
+    if wy:
+        blocks.append(math.sqrt(wy) * reg.shaking_force.imag)
     rows = np.vstack(blocks) / math.sqrt(n) if blocks else np.zeros((0, 14))
     factor = np.linalg.qr(rows, mode="r") if blocks else np.zeros((0, 14))
     links = tuple(
-        resolve_link(name, problem.link(name), linkage.link(name), linkage.lengths[i])
-        for i, name in enumerate(JOINTS)
+        resolve_link(name, problem.link(name), linkage.link(name), link_length(linkage, name),
+                     linkage)
+        for name in linkage.link_names
     )
     fb = None
     if problem.force_balance:
-        ab = force_balance_matrix(linkage.lengths)
+        if linkage.type == "slider-crank":
+            from .slider_crank.conditions import force_balance_matrix as slider_balance
+
+            ab = slider_balance(linkage.lengths)  # Wunderlich's Eq. 20a–b
+        else:
+            ab = force_balance_matrix(linkage.lengths)  # Eq. 57–58
         fb = (ab[:, :12], ab[:, 12])
     norms = np.linalg.norm(factor, axis=0) if blocks else np.zeros(14)
     threshold = 1e-12 * max(float(norms.max(initial=0.0)), 1e-300)

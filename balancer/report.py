@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from .conditions import force_balance_error, force_balance_residuals, is_force_balanced
+from .conditions import force_balance_error, is_force_balanced, named_force_balance_residuals
 from .inverse import CycleAnalysis, Figure
 from .kinematics import classify
 
@@ -58,6 +58,20 @@ def reaction_extremes(values: np.ndarray) -> dict[str, float]:
     }
 
 
+def mechanism_class(linkage) -> str:
+    """Grashof class of a four-bar, or whether a slider-crank's crank turns fully."""
+    if linkage.type == "slider-crank":
+        from .slider_crank.kinematics import classify as slider_classify
+
+        return slider_classify(linkage.lengths)
+    return str(classify(linkage.lengths))
+
+
+def reaction_names(linkage) -> tuple[str, str]:
+    """What the two ground reactions are called: A0 and A3, or A0 and the guide."""
+    return ("A0", "guide") if linkage.type == "slider-crank" else ("A0", "A3")
+
+
 def figures_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
     """The three fixed figures ``shaking_force``, ``shaking_moment``, ``driving_torque``."""
     return analysis.summary.as_dict()
@@ -66,14 +80,14 @@ def figures_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
 def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str, Any]:
     """The ``analyze --json`` document."""
     linkage = analysis.linkage
-    c14, c34 = force_balance_residuals(linkage)
+    residuals = named_force_balance_residuals(linkage)
     doc: dict[str, Any] = {}
     if spec is not None:
         doc["spec"] = spec
     doc.update(
         {
             "mechanism": linkage.type,
-            "class": str(classify(linkage.lengths)),
+            "class": mechanism_class(linkage),
             "branch": linkage.branch,
             "speed": analysis.speed,
             "samples": int(analysis.samples),
@@ -82,14 +96,11 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
             **figures_dict(analysis),
             "force_balanced": is_force_balanced(linkage),
             "force_balance_residual": {
-                "c14": [c14.real, c14.imag],
-                "c34": [c34.real, c34.imag],
+                **{name: [c.real, c.imag] for name, c in residuals.items()},
                 "relative": force_balance_error(linkage),
             },
-            "reactions": {
-                "A0": reaction_extremes(analysis.reactions.RA0),
-                "A3": reaction_extremes(analysis.reactions.RA3),
-            },
+            "reactions": _reactions_dict(linkage, analysis.reactions.RA0,
+                                         analysis.reactions.RA3, analysis.reactions.guide_line),
             "change_points": _change_points(analysis),
             "units": {
                 "force": "N",
@@ -100,6 +111,18 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
         }
     )
     return doc
+
+
+def _reactions_dict(linkage, ra0, ra3, guide_line=None) -> dict[str, dict[str, float]]:
+    first, second = reaction_names(linkage)
+    out = {first: reaction_extremes(ra0), second: reaction_extremes(ra3)}
+    if guide_line is not None:
+        line = np.asarray(guide_line)
+        line = line[np.isfinite(line)]
+        if line.size:
+            out[second]["line_of_action_x_min"] = float(line.min())
+            out[second]["line_of_action_x_max"] = float(line.max())
+    return out
 
 
 def _change_points(analysis: CycleAnalysis) -> list[float]:
@@ -117,7 +140,7 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
     head = f"balancer analyze — {spec}" if spec else "balancer analyze"
     lines = [
         head,
-        f"{linkage.type} ({classify(linkage.lengths)}), branch {linkage.branch}; "
+        f"{linkage.type} ({mechanism_class(linkage)}), branch {linkage.branch}; "
         f"crank at {analysis.speed:g} rad/s ({rpm:.4g} rpm), {analysis.samples} crank angles "
         f"over one revolution; route {analysis.route}; loads included, gravity not",
         "",
@@ -135,14 +158,28 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
         "",
     ]
     rows = []
-    for name, values in (("A0", analysis.reactions.RA0), ("A3", analysis.reactions.RA3)):
+    first, second = reaction_names(linkage)
+    for name, values in ((first, analysis.reactions.RA0), (second, analysis.reactions.RA3)):
         ex = reaction_extremes(values)
+        label = "guide (slider on it)" if name == "guide" else f"R{name}"
         rows.append(
-            [f"R{name}", *(_fmt(ex[k]) for k in ("max", "x_min", "x_max", "y_min", "y_max"))]
+            [label, *(_fmt(ex[k]) for k in ("max", "x_min", "x_max", "y_min", "y_max"))]
         )
     lines.append(
         table(rows, ["reaction (N)", "|R| max", "Rx min", "Rx max", "Ry min", "Ry max"])
     )
+    line = analysis.reactions.guide_line
+    if line is not None and np.isfinite(line).any():
+        lines.append(f"the guide's normal force acts at x from {np.nanmin(line):.4g} m to "
+                     f"{np.nanmax(line):.4g} m along the guide")
+    if linkage.type == "slider-crank":
+        from .slider_crank.conditions import harmonics
+
+        h = harmonics(analysis)
+        lines += ["", table(
+            [[name, _fmt(h[name][1]), _fmt(h[name][2]), unit] for name, unit in (
+                ("shaking_force_x", "N"), ("shaking_force_y", "N"), ("shaking_moment", "N·m"))],
+            ["harmonic amplitude", "primary (1×)", "secondary (2×)", "unit"])]
     lines.append("")
     points = _change_points(analysis)
     if points:
@@ -154,11 +191,12 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
             "",
         ]
     err = force_balance_error(linkage)
+    eq = "Eq. 20a–b" if linkage.type == "slider-crank" else "Eq. 57"
     if is_force_balanced(linkage):
-        lines.append(f"force-balanced: yes (Eq. 57 residual {err:.2e} of the total mass)")
+        lines.append(f"force-balanced: yes ({eq} residual {err:.2e} of the total mass)")
     else:
         lines.append(
-            f"force-balanced: no (Eq. 57 residual {err:.3g} of the total mass; "
+            f"force-balanced: no ({eq} residual {err:.3g} of the total mass; "
             "the total centre of mass moves)"
         )
     return "\n".join(lines)
@@ -196,9 +234,36 @@ ANALYSIS_COLUMNS = (
 )
 
 
+SLIDER_ANALYSIS_COLUMNS = (
+    "t",
+    "theta1",
+    "theta2",
+    "omega1",
+    "omega2",
+    "alpha1",
+    "alpha2",
+    "x3",
+    "v3",
+    "a3",
+    "RA0x",
+    "RA0y",
+    "guide_force_y",
+    "guide_line_x",
+    "shaking_force_x",
+    "shaking_force_y",
+    "shaking_moment",
+    "driving_torque",
+)
+
+
 def analysis_csv(analysis: CycleAnalysis) -> str:
     """Per-angle values of a cycle analysis as CSV text (SI units, full precision)."""
     mo, r = analysis.motion, analysis.reactions
+    if analysis.linkage.type == "slider-crank":
+        cols = [analysis.time, mo.theta1, mo.theta2, *mo.omega, *mo.alpha, mo.x, mo.v, mo.a,
+                r.RA0.real, r.RA0.imag, r.RA3.imag, r.guide_line, r.shaking_force.real,
+                r.shaking_force.imag, r.shaking_moment, r.driving_torque]
+        return csv_text(SLIDER_ANALYSIS_COLUMNS, cols)
     cols = [
         analysis.time,
         *mo.theta,
@@ -261,6 +326,9 @@ def simulation_csv(traj, all_columns: bool = False) -> str:
     cols = [traj.t, *traj.theta, *traj.omega, *traj.alpha, traj.RA0.real, traj.RA0.imag,
             traj.RA3.real, traj.RA3.imag]
     names = list(SIMULATION_COLUMNS)
+    if traj.slider is not None:  # a slider-crank: the slider along its guide
+        cols += list(traj.slider)
+        names += ["x3", "v3", "a3"]
     if all_columns:
         sf = traj.shaking_force
         cols += [sf.real, sf.imag, traj.shaking_moment, traj.driving_torque, traj.kinetic_energy,
@@ -293,6 +361,9 @@ def simulation_json(traj, spec: str | None = None) -> dict[str, Any]:
             "shaking_moment": Figure.of(traj.shaking_moment).as_dict(),
             "driving_torque": Figure.of(traj.driving_torque).as_dict(),
             "reactions": {"A0": reaction_extremes(traj.RA0), "A3": reaction_extremes(traj.RA3)},
+            **({"slider": {"initial": [float(v) for v in traj.slider[:, 0]],
+                           "final": [float(v) for v in traj.slider[:, -1]]}}
+               if traj.slider is not None else {}),
             "units": {"theta": "rad", "omega": "rad/s", "alpha": "rad/s²", "force": "N",
                       "moment": "N·m", "constraint_drift": "m, m/s"},
         }
@@ -461,7 +532,8 @@ def optimization_text(result, before, after, verification=None, spec=None, out=N
     lines.append(table(rows, ["parameter", "before", "after", "unit", ""]))
     lines.append("")
     err = force_balance_error(result.linkage)
-    lines.append(f"force balance (Eq. 57): residual {err:.1e} of the total mass")
+    eq = "Eq. 20a–b" if result.linkage.type == "slider-crank" else "Eq. 57"
+    lines.append(f"force balance ({eq}): residual {err:.1e} of the total mass")
     if verification is not None:
         lines.append("")
         lines.append(verification_text(verification).split("\n", 1)[1].strip("\n"))

@@ -36,8 +36,6 @@ from scipy.optimize import brentq
 
 from .errors import AssemblyError, LockupError, SolverError, SpecError
 from .formulations import Formulation, make
-from .inverse import kinetic_energy, link_com_kinematics
-from .kinematics import assembly_range, change_point_angles, motion_from_angles
 from .model import METHODS, Design, FourBar, SimulationSettings
 
 #: |sin(θ3 − θ2)| at which a crank-angle formulation stops before a dead point.
@@ -71,6 +69,9 @@ class Trajectory:
         ``max|T − T0 − W|`` relative to the largest of ``|T|`` and ``|W|`` (dimensionless).
     drift
         Largest loop-closure residual before projection: position (m) and velocity (m/s).
+    slider
+        For a slider-crank: the slider's position, velocity and acceleration along the guide,
+        shape ``(3, n)`` (m, m/s, m/s²).
     nfev
         Right-hand-side evaluations.
     steps
@@ -100,10 +101,14 @@ class Trajectory:
     rtol: float
     atol: float
     shaking_moment: NDArray[np.float64] = field(repr=False, default=None)  # type: ignore[assignment]
+    shaking_force_values: NDArray[np.complex128] | None = field(repr=False, default=None)
+    slider: NDArray[np.float64] | None = field(repr=False, default=None)
 
     @property
     def shaking_force(self) -> NDArray[np.complex128]:
-        """``R̄A0 + R̄A3``, N."""
+        """Sum of the forces on the frame (``R̄A0 + R̄A3`` for a four-bar), N."""
+        if self.shaking_force_values is not None:
+            return self.shaking_force_values
         return self.RA0 + self.RA3
 
     def state(self, index: int) -> dict[str, list[float]]:
@@ -123,8 +128,8 @@ def _unwrap(theta: NDArray[np.float64], omega: NDArray[np.float64], t: NDArray[n
     return theta + 2 * math.pi * np.concatenate([[0.0], np.cumsum(turns)])
 
 
-def _check_start(linkage: FourBar, theta1: float, speed: float | None) -> None:
-    rng = assembly_range(linkage.lengths)
+def _check_start(f: Formulation, theta1: float) -> None:
+    rng = f.assembly_range()
     if not rng.contains(theta1):
         raise AssemblyError(
             f"the linkage cannot be assembled at the initial crank angle; it assembles for θ1 "
@@ -134,9 +139,9 @@ def _check_start(linkage: FourBar, theta1: float, speed: float | None) -> None:
         )
 
 
-def _lock_time(linkage: FourBar, theta1: float, speed: float, duration: float) -> float | None:
+def _lock_time(f: Formulation, theta1: float, speed: float, duration: float) -> float | None:
     """First time a crank driven at ``speed`` leaves the assembly range, or None."""
-    rng = assembly_range(linkage.lengths)
+    rng = f.assembly_range()
     if rng.full or speed == 0:
         return None
     for a, b in rng.intervals:
@@ -171,9 +176,8 @@ class _Stepper:
         drift = [0.0, 0.0]
         k = 0
         steps = 0
-        watch = not f.minimal or f.name in ("complex-masses", "lie-group")
-        passes_dead_points = f.name in ("opened-loop", "mass-matrix")
-        change_points = change_point_angles(f.lengths)
+        passes_dead_points = f.passes_dead_points
+        change_points = f.change_points()
         # The first output is the initial state.
         while k < self.t_out.size and self.t_out[k] <= 0.0:
             states.append(np.array(y0))
@@ -193,7 +197,7 @@ class _Stepper:
                 solver.y = y_new
                 solver.f = f.rhs(solver.t, y_new)  # the next step starts from the projection
                 self.extra_fev += 1
-            if watch and not passes_dead_points:
+            if not passes_dead_points:
                 event = self._dead_point(interp, solver.t_old, solver.t, change_points)
                 if event is not None:
                     stopped = event
@@ -270,30 +274,35 @@ def simulate(
         If the motion reaches a position the formulation cannot pass (its ``partial``
         attribute holds the trajectory up to there).
     """
-    method = method or settings.method
+    from .formulations import FORMULATIONS, default_method
+
+    method = method or settings.method or default_method(linkage.type)
     drive = drive or settings.drive
     duration = settings.duration if duration is None else duration
     rtol = settings.rtol if rtol is None else rtol
     atol = settings.atol if atol is None else atol
     outputs = settings.outputs if outputs is None else outputs
-    if method not in METHODS:
-        raise SpecError(f"unknown formulation; choose from {', '.join(METHODS)}", key="method",
-                        value=method)
+    if method not in FORMULATIONS[linkage.type]:
+        raise SpecError(
+            f"the {linkage.type} has no such formulation; choose from "
+            f"{', '.join(FORMULATIONS[linkage.type])}", key="method", value=method)
     if not (duration > 0 and math.isfinite(duration)):
         raise SpecError("must be a positive number of seconds", key="duration", value=duration)
     if not (1e-14 <= rtol < 1):
         raise SpecError("must be between 1e-14 and 1", key="rtol", value=rtol)
     theta1, omega1 = settings.theta1, settings.omega1
-    _check_start(linkage, theta1, None)
     speed = None
-    stop_at = None
     if drive == "constant-speed":
         if omega1 == 0:
             raise SpecError("a crank driven at constant speed needs a non-zero speed",
                             key="simulation.omega1", value=omega1)
         speed = omega1
-        stop_at = _lock_time(linkage, theta1, speed, duration)
-    f = make(method, linkage, gravity=settings.gravity, speed=speed)
+    try:
+        f = make(method, linkage, gravity=settings.gravity, speed=speed)
+    except ValueError as exc:
+        raise SpecError(str(exc), key="method", value=method) from None
+    _check_start(f, theta1)
+    stop_at = None if speed is None else _lock_time(f, theta1, speed, duration)
     y0 = f.initial_state(theta1, omega1)
     start = _time.perf_counter()
     stepper = _Stepper(f, duration, rtol, atol, outputs, progress)
@@ -326,14 +335,8 @@ def _before_lock(f: Formulation, t_lock: float) -> float:
 
     That is, where it falls to :data:`DEAD_POINT_THRESHOLD`.
     """
-    from .kinematics import position_scalar
-
-    sign = f.sign0
-
     def gap(t: float) -> float:
-        _, v2, v3 = position_scalar(f.lengths, f.crank_angle(t), sign)
-        return abs(v2.real * v3.imag - v2.imag * v3.real) / (f.lengths[1] * f.lengths[2]) - (
-            DEAD_POINT_THRESHOLD)
+        return f.transmission_of_crank(f.crank_angle(t)) - DEAD_POINT_THRESHOLD
 
     if gap(0.0) <= 0:
         return 0.0
@@ -356,19 +359,13 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
     ra3 = np.asarray(ev.RA3, complex)
     tau = np.asarray(ev.driving_torque, float) * np.ones(t.size)
     motor = np.array([f.motor_work(y) for y in states])
+    slider = None if ev.slider is None else np.asarray(ev.slider, float)
     # Energy: T − T0 = work of loads and gravity (a function of the configuration) + motor.
-    mo = motion_from_angles(f.lengths, tuple(theta), tuple(omega), tuple(alpha))
-    kin = kinetic_energy(f.linkage, mo)
-    (r1, r2, r3), _ = link_com_kinematics(f.linkage, mo)
-    work = motor.copy()
-    for k, r in enumerate((r1, r2, r3)):
-        work += np.real(np.conj(f.forces[k]) * (r - r[0])) + f.moments[k] * (theta[k] - theta[k][0])
+    kin, work = f.energy(theta, omega, alpha, slider)
+    work = work + motor
     scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), 1e-300)
     energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
-    moment = f.lengths[3] * ra3.imag - tau
-    for k, link in enumerate(f.linkage.links):
-        if link.counter_rotor:
-            moment = moment + 2 * link.counter_rotor * alpha[k]
+    shaking_force, moment = f.shaking(ev)
     return Trajectory(
         method=f.name,
         drive="constant-speed" if f.driven else "free",
@@ -388,7 +385,9 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
         seconds=float(seconds),
         rtol=rtol,
         atol=atol,
-        shaking_moment=moment,
+        shaking_moment=np.asarray(moment, float) * np.ones(t.size),
+        shaking_force_values=np.asarray(shaking_force, complex) * np.ones(t.size),
+        slider=slider,
     )
 
 

@@ -49,9 +49,20 @@ from typing import Any
 
 from .errors import AssemblyError, SpecError
 from .kinematics import assembly_range
-from .model import DRIVES, METHODS, Design, FourBar, Link, Operation, SimulationSettings
+from .model import (
+    DRIVES,
+    METHODS_BY_TYPE,
+    Design,
+    FourBar,
+    GasForce,
+    Link,
+    Operation,
+    SimulationSettings,
+    SliderCrank,
+)
 
-MECHANISM_TYPES = ("four-bar",)
+MECHANISMS = {"four-bar": FourBar, "slider-crank": SliderCrank}
+MECHANISM_TYPES = tuple(MECHANISMS)
 
 
 class _Table:
@@ -64,12 +75,17 @@ class _Table:
         self.data = data
         self.path = path
         self.used: set[str] = set()
-        known = _KNOWN_KEYS.get(_generic(path))
-        if known is not None:
-            # Report a typo before the missing key it causes ("mas" before "mass is missing").
-            for name in data:
-                if name not in known:
-                    self._unknown(name)
+        self.known: tuple[str, ...] | None = _KNOWN_KEYS.get(_generic(path))
+        if self.known is not None:
+            self.expect(self.known)
+
+    def expect(self, known: tuple[str, ...]) -> None:
+        """Declare the keys this table may hold, and report a typo now, before the missing key
+        it causes ("mas" before "mass is missing")."""
+        self.known = tuple(known)
+        for name in self.data:
+            if name not in self.known:
+                self._unknown(name)
 
     def key(self, name: str) -> str:
         return f"{self.path}.{name}" if self.path else name
@@ -165,7 +181,7 @@ class _Table:
                 self._unknown(name)
 
     def _unknown(self, name: str) -> None:
-        known = sorted(_KNOWN_KEYS.get(_generic(self.path), ()))
+        known = sorted(self.known or ())
         close = difflib.get_close_matches(name, known, n=1)
         hint = f"; did you mean '{close[0]}'?" if close else ""
         raise SpecError(f"unknown key '{name}'{hint}", key=self.key(name))
@@ -182,11 +198,8 @@ def _generic(path: str) -> str:
 _KNOWN_KEYS: dict[str, tuple[str, ...]] = {
     "": ("title", "mechanism", "links", "operation", "simulation", "balance", "original"),
     "mechanism": ("type", "branch", "lengths"),
-    "mechanism.lengths": FourBar.length_names,
-    "links": FourBar.link_names,
-    "original": FourBar.link_names,
-    "links.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor"),
-    "original.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor"),
+    "links.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor", "gas_force"),
+    "original.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor", "gas_force"),
     "links.*.com": ("s", "sigma", "e", "f"),
     "original.*.com": ("s", "sigma", "e", "f"),
     "operation": ("speed", "samples"),
@@ -221,9 +234,11 @@ def _as_number(
 # Reading
 
 
-def _read_link(table: _Table, name: str, lengths: tuple[float, ...]) -> Link:
+def _read_link(table: _Table, name: str, mechanism_class) -> Link:
+    slider = mechanism_class is SliderCrank and name == "slider"
     mass = table.positive("mass")
-    inertia = table.positive("inertia")
+    # A slider does not turn: its inertia does not matter and may be left out.
+    inertia = table.nonnegative("inertia", default=0.0) if slider else table.positive("inertia")
     com = table.table("com")
     assert com is not None
     polar = com.has("s") or com.has("sigma")
@@ -246,13 +261,15 @@ def _read_link(table: _Table, name: str, lengths: tuple[float, ...]) -> Link:
     force = table.vector2("force", default=(0.0, 0.0))
     moment = table.number("moment", default=0.0)
     counter_rotor = table.nonnegative("counter_rotor", default=0.0)
-    if counter_rotor and name not in FourBar.grounded_links:
+    if counter_rotor and name not in mechanism_class.grounded_links:
+        where = " and ".join(mechanism_class.grounded_links)
         raise SpecError(
-            "a counter-rotor sits on a ground pivot: only the crank and the rocker can have one",
+            f"a counter-rotor sits on a ground pivot: only the {where} can have one",
             key=table.key("counter_rotor"),
             value=counter_rotor,
         )
-    table.finish()
+    if table.has("gas_force") and not slider:
+        raise SpecError("only a slider carries a gas force", key=table.key("gas_force"))
     return Link(
         mass=mass,
         inertia=inertia,
@@ -264,26 +281,90 @@ def _read_link(table: _Table, name: str, lengths: tuple[float, ...]) -> Link:
     )
 
 
-def _read_links(table: _Table, lengths: tuple[float, ...]) -> dict[str, Link]:
+def _read_gas_force(table: _Table) -> GasForce:
+    """``gas_force = 1500.0`` or ``gas_force = {crank_angle = [...], force = [...], period}``."""
+    key = table.key("gas_force")
+    if not table.has("gas_force"):
+        return GasForce()
+    raw = table.raw("gas_force")
+    if not isinstance(raw, dict):
+        return GasForce.constant(_as_number(raw, key, None, ""))
+    sub = _Table(raw, key)
+    sub.expect(("crank_angle", "force", "period"))
+    period = sub.positive("period", default=2 * math.pi)
+    angles, values = (sub.raw(k) if sub.has(k) else None for k in ("crank_angle", "force"))
+    for k, v in (("crank_angle", angles), ("force", values)):
+        if not isinstance(v, list) or not v:
+            raise SpecError("must be a non-empty list of numbers", key=f"{key}.{k}", value=v)
+    angles = [_as_number(a, f"{key}.crank_angle", None, "") for a in angles]
+    values = [_as_number(v, f"{key}.force", None, "") for v in values]
+    if len(angles) != len(values):
+        raise SpecError(f"crank_angle and force must have the same length ({len(angles)} and "
+                        f"{len(values)})", key=key)
+    if any(b <= a for a, b in zip(angles, angles[1:], strict=False)) or angles[0] < 0 or (
+            angles[-1] >= period):
+        raise SpecError("crank angles must increase within one period, from 0",
+                        key=f"{key}.crank_angle", value=angles)
+    sub.finish()
+    return GasForce(angles=tuple(angles), values=tuple(values), period=period)
+
+
+def _read_links(table: _Table, mechanism_class) -> tuple[dict[str, Link], GasForce]:
+    """The links of a mechanism, and the gas force on its slider (if it has one)."""
+    table.expect(mechanism_class.link_names)
     links = {}
-    for name in FourBar.link_names:
+    gas = GasForce()
+    for name in mechanism_class.link_names:
         sub = table.table(name)
         assert sub is not None
-        links[name] = _read_link(sub, name, lengths)
+        links[name] = _read_link(sub, name, mechanism_class)
+        if mechanism_class is SliderCrank and name == "slider":
+            gas = _read_gas_force(sub)
+        sub.finish()
     table.finish()
-    return links
+    return links, gas
 
 
-def _read_mechanism(root: _Table) -> FourBar:
+def _read_mechanism(root: _Table) -> FourBar | SliderCrank:
     mech = root.table("mechanism")
     assert mech is not None
-    mech.string("type", choices=MECHANISM_TYPES)
+    kind = mech.string("type", choices=MECHANISM_TYPES)
+    cls = MECHANISMS[kind]
     branch = mech.string("branch", choices=("+", "-"), default="+")
     lengths_table = mech.table("lengths")
     assert lengths_table is not None
-    lengths = tuple(lengths_table.positive(n) for n in FourBar.length_names)
+    lengths_table.expect(cls.length_names)
+    if cls is SliderCrank:
+        lengths = (
+            lengths_table.positive("crank"),
+            lengths_table.positive("rod"),
+            lengths_table.number("offset", default=0.0),
+        )
+    else:
+        lengths = tuple(lengths_table.positive(n) for n in cls.length_names)
     lengths_table.finish()
     mech.finish()
+    _check_assembles(cls, lengths)
+    links_table = root.table("links")
+    assert links_table is not None
+    links, gas = _read_links(links_table, cls)
+    if cls is SliderCrank:
+        return SliderCrank(lengths=lengths, branch=branch, gas_force=gas, **links)  # type: ignore[arg-type]
+    return FourBar(lengths=lengths, branch=branch, **links)  # type: ignore[arg-type]
+
+
+def _check_assembles(cls, lengths) -> None:
+    if cls is SliderCrank:
+        r, big_l, e = lengths
+        if abs(e) > r + big_l:
+            raise AssemblyError(
+                f"the slider-crank cannot be assembled at any crank angle: the guide is "
+                f"{abs(e):.6g} m from A0, beyond the reach of crank and rod "
+                f"({r + big_l:.6g} m)",
+                key="mechanism.lengths.offset",
+                value=e,
+            )
+        return
     if assembly_range(lengths).empty:
         l1, l2, l3, l4 = lengths
         raise AssemblyError(
@@ -293,10 +374,6 @@ def _read_mechanism(root: _Table) -> FourBar:
             key="mechanism.lengths",
             value=dict(zip(FourBar.length_names, lengths, strict=True)),
         )
-    links_table = root.table("links")
-    assert links_table is not None
-    links = _read_links(links_table, lengths)
-    return FourBar(lengths=lengths, branch=branch, **links)  # type: ignore[arg-type]
 
 
 def _read_operation(root: _Table) -> Operation | None:
@@ -311,7 +388,7 @@ def _read_operation(root: _Table) -> Operation | None:
     return Operation(speed=speed, samples=samples)
 
 
-def _read_simulation(root: _Table) -> SimulationSettings:
+def _read_simulation(root: _Table, mechanism) -> SimulationSettings:
     table = root.table("simulation", required=False)
     defaults = SimulationSettings()
     if table is None:
@@ -322,7 +399,8 @@ def _read_simulation(root: _Table) -> SimulationSettings:
         omega1=table.number("omega1", default=defaults.omega1),
         gravity=table.vector2("gravity", default=defaults.gravity),
         drive=table.string("drive", choices=DRIVES, default=defaults.drive),  # type: ignore[arg-type]
-        method=table.string("method", choices=METHODS, default=defaults.method),
+        method=table.string("method", choices=METHODS_BY_TYPE[mechanism.type], default="")
+        or None,
         rtol=table.number(
             "rtol",
             default=defaults.rtol,
@@ -336,11 +414,11 @@ def _read_simulation(root: _Table) -> SimulationSettings:
     return settings
 
 
-def _read_original(root: _Table, mechanism: FourBar) -> FourBar | None:
+def _read_original(root: _Table, mechanism):
     table = root.table("original", required=False)
     if table is None:
         return None
-    links = _read_links(table, mechanism.lengths)
+    links, _ = _read_links(table, type(mechanism))
     return mechanism.with_links(links)
 
 
@@ -357,7 +435,7 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
         title = root.text("title", default="")
         mechanism = _read_mechanism(root)
         operation = _read_operation(root)
-        simulation = _read_simulation(root)
+        simulation = _read_simulation(root, mechanism)
         balance = None
         if root.has("balance"):
             from .problem import read_balance  # the redesign problem's own reader
@@ -434,12 +512,13 @@ def _string(text: str) -> str:
     return f'"{escaped}"'
 
 
-def _link_lines(link: Link) -> list[str]:
+def _link_lines(link: Link, frame: str = "link") -> list[str]:
     lines = [
         f"mass = {_num(link.mass)}  # kg",
         f"inertia = {_num(link.inertia)}  # kg·m² about the centre of mass",
         f"com = {{ e = {_num(link.e)}, f = {_num(link.f)} }}  "
-        f"# m (s = {link.s:.6g} m, sigma = {link.sigma:.6g} rad)",
+        + (f"# m (s = {link.s:.6g} m, sigma = {link.sigma:.6g} rad)" if frame == "link"
+           else "# m from the pin, in global axes"),
     ]
     if link.force != (0.0, 0.0):
         lines.append(f"force = [{_num(link.force[0])}, {_num(link.force[1])}]  # N")
@@ -448,6 +527,27 @@ def _link_lines(link: Link) -> list[str]:
     if link.counter_rotor != 0.0:
         lines.append(f"counter_rotor = {_num(link.counter_rotor)}  # kg·m²")
     return lines
+
+
+def _gas_lines(gas: GasForce) -> list[str]:
+    if gas.is_zero:
+        return []
+    if len(gas.values) == 1:
+        return [f"gas_force = {_num(gas.values[0])}  # N along the guide"]
+    angles = ", ".join(_num(a) for a in gas.angles)
+    values = ", ".join(_num(v) for v in gas.values)
+    return [f"gas_force = {{ crank_angle = [{angles}], force = [{values}], "
+            f"period = {_num(gas.period)} }}  # rad, N"]
+
+
+def _links_lines(mech, prefix: str) -> list[str]:
+    out = []
+    for name in mech.link_names:
+        frame = "global" if mech.type == "slider-crank" and name == "slider" else "link"
+        out += ["", f"[{prefix}.{name}]", *_link_lines(mech.link(name), frame)]
+        if prefix == "links" and frame == "global":
+            out += _gas_lines(mech.gas_force)
+    return out
 
 
 def dumps_design(design: Design) -> str:
@@ -460,8 +560,7 @@ def dumps_design(design: Design) -> str:
     out.append("[mechanism.lengths]  # m")
     for name, length in zip(mech.length_names, mech.lengths, strict=True):
         out.append(f"{name} = {_num(length)}")
-    for name in mech.link_names:
-        out += ["", f"[links.{name}]", *_link_lines(mech.link(name))]
+    out += _links_lines(mech, "links")
     if design.operation is not None:
         op = design.operation
         out += [
@@ -479,7 +578,7 @@ def dumps_design(design: Design) -> str:
         f"omega1 = {_num(sim.omega1)}  # rad/s",
         f"gravity = [{_num(sim.gravity[0])}, {_num(sim.gravity[1])}]  # m/s²",
         f'drive = "{sim.drive}"',
-        f'method = "{sim.method}"',
+        *([f'method = "{sim.method}"'] if sim.method else []),
         f"rtol = {_num(sim.rtol)}",
         f"atol = {_num(sim.atol)}",
         f"outputs = {_num(sim.outputs)}",
@@ -490,8 +589,7 @@ def dumps_design(design: Design) -> str:
         out += ["", *balance_lines(design.balance)]
     if design.original is not None:
         out += ["", "# The unbalanced design this one was derived from (same geometry)."]
-        for name in mech.link_names:
-            out += ["", f"[original.{name}]", *_link_lines(design.original.link(name))]
+        out += _links_lines(design.original, "original")
     return "\n".join(out) + "\n"
 
 

@@ -15,12 +15,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .errors import LockupError, SpecError
-from .kinematics import assembly_range
+from .mechanisms import VERIFY_METHOD, assembly_range
 from .model import Design, FourBar
 from .simulate import Trajectory, simulate
 
-#: Formulation used by default to check a design balanced with the mass-matrix objective.
-DEFAULT_METHOD = "opened-loop"
+#: Formulation used by default to check a four-bar balanced with the mass-matrix objective
+#: (a slider-crank's: see :data:`balancer.mechanisms.VERIFY_METHOD`).
+DEFAULT_METHOD = VERIFY_METHOD["four-bar"]
 
 
 @dataclass(frozen=True)
@@ -158,7 +159,7 @@ def _run(linkage: FourBar, original: FourBar | None, settings, method: str, **kw
 def verify(
     design: Design,
     *,
-    method: str = DEFAULT_METHOD,
+    method: str | None = None,
     duration: float | None = None,
     rtol: float = 1e-11,
     atol: float = 1e-13,
@@ -172,7 +173,8 @@ def verify(
         The design; its ``[operation]`` speed is needed for the driven run, its ``[original]``
         (if any) is simulated alongside.
     method
-        Formulation for the simulations (by default one the optimiser did not use).
+        Formulation for the simulations (by default one the optimiser did not use:
+        :data:`balancer.mechanisms.VERIFY_METHOD`).
     duration
         Simulated time of each run, s (default: the spec's ``[simulation] duration``).
     rtol, atol
@@ -189,13 +191,14 @@ def verify(
         raise SpecError("missing required key: the driven check runs at the operating speed",
                         key="operation.speed")
     linkage = design.mechanism
+    method = method or VERIFY_METHOD[linkage.type]
     settings = design.simulation
     if duration is not None:
         settings = replace(settings, duration=duration)
     if outputs is not None:
         settings = replace(settings, outputs=outputs)
     start = settings.theta1
-    if not assembly_range(linkage.lengths).full:
+    if not assembly_range(linkage).full:
         raise SpecError("a driven check needs a crank that turns a full revolution",
                         key="mechanism.lengths")
     driven_settings = replace(settings, drive="constant-speed", omega1=design.operation.speed,

@@ -46,11 +46,18 @@ class Evaluation:
     Attributes
     ----------
     theta, omega, alpha
-        Angles (rad), angular velocities (rad/s) and accelerations (rad/s²) of links 1–3.
+        Angles (rad), angular velocities (rad/s) and accelerations (rad/s²) of links 1–3 (a
+        slider's are zero).
     RA0, RA3
-        Forces of the mechanism on the ground at A0 and A3, complex ``x + i·y``, N.
+        Forces of the mechanism on the ground at A0 and at A3 (a slider-crank: on the guide),
+        complex ``x + i·y``, N.
     driving_torque
         Torque of the motor on the crank, N·m (zero in free motion).
+    shaking_force, shaking_moment
+        Sum of the forces on the frame (N) and their moment about A0 (N·m), when the
+        formulation computes them itself (otherwise the simulation does, from the above).
+    slider
+        Slider position, velocity and acceleration along the guide (m, m/s, m/s²), if any.
     """
 
     theta: NDArray[np.float64]
@@ -59,6 +66,9 @@ class Evaluation:
     RA0: complex
     RA3: complex
     driving_torque: float = 0.0
+    shaking_force: complex | None = None
+    shaking_moment: float | None = None
+    slider: NDArray[np.float64] | None = None
 
     def at(self, index: int) -> Evaluation:
         """The state ``index`` of an evaluation of arrays (from ``evaluate_batch``)."""
@@ -69,6 +79,11 @@ class Evaluation:
             RA0=complex(self.RA0[index]),
             RA3=complex(self.RA3[index]),
             driving_torque=float(np.asarray(self.driving_torque)[index]),
+            shaking_force=None if self.shaking_force is None else complex(
+                np.asarray(self.shaking_force)[index]),
+            shaking_moment=None if self.shaking_moment is None else float(
+                np.asarray(self.shaking_moment)[index]),
+            slider=None if self.slider is None else np.asarray(self.slider)[:, index],
         )
 
 
@@ -89,6 +104,10 @@ class Formulation(ABC):
     name: ClassVar[str]
     #: Whether the state is minimal (one coordinate and its rate): no constraints can drift.
     minimal: ClassVar[bool]
+    #: Whether the formulation passes a dead point of the crank (coupler and rocker aligned).
+    passes_dead_points: ClassVar[bool] = False
+    #: Number of links that turn (a slider does not).
+    rotating_links: ClassVar[int] = 3
 
     def __init__(
         self,
@@ -109,9 +128,11 @@ class Formulation(ABC):
         self.moments = tuple(link.moment for link in linkage.links)
         self.mass = tuple(link.mass for link in linkage.links)
         self.total_mass = sum(self.mass)
-        #: Centres of mass as fractions of the link vectors, ``ζk = s̄k/lk``.
+        #: Centres of mass as fractions of the link vectors, ``ζk = s̄k/lk`` (rotating links).
         self.zeta = tuple(
-            link.com / length for link, length in zip(linkage.links, self.lengths, strict=False)
+            link.com / length
+            for link, length in zip(linkage.links[: self.rotating_links], self.lengths,
+                                    strict=False)
         )
         self.theta1_start = 0.0
         self.sign0 = 1.0 if linkage.branch == "+" else -1.0
@@ -145,6 +166,12 @@ class Formulation(ABC):
         vectorised versions of their own equations.
         """
         evals = [self.evaluate(t, y) for t, y in zip(times, states, strict=True)]
+
+        def stack(name):
+            values = [getattr(e, name) for e in evals]
+            return None if values[0] is None else np.array(values)
+
+        slider = stack("slider")
         return Evaluation(
             theta=np.array([e.theta for e in evals]).T,
             omega=np.array([e.omega for e in evals]).T,
@@ -152,11 +179,60 @@ class Formulation(ABC):
             RA0=np.array([e.RA0 for e in evals]),
             RA3=np.array([e.RA3 for e in evals]),
             driving_torque=np.array([e.driving_torque for e in evals]),
+            shaking_force=stack("shaking_force"),
+            shaking_moment=stack("shaking_moment"),
+            slider=None if slider is None else slider.T,
         )
 
     @abstractmethod
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         """``sin(θ3 − θ2)``: zero where coupler and rocker align (dead point or change point)."""
+
+    # -- what the simulation driver needs to know of the mechanism (four-bar here) ------------
+
+    def assembly_range(self):
+        """Crank angles at which the mechanism assembles."""
+        from ..kinematics import assembly_range
+
+        return assembly_range(self.lengths)
+
+    def change_points(self) -> tuple[float, ...]:
+        """Crank angles at which the assemblies meet (passed on the smooth motion)."""
+        return change_point_angles(self.lengths)
+
+    def transmission_of_crank(self, theta1: float) -> float:
+        """|sin(θ3 − θ2)| on the motion's assembly at crank angle ``theta1``: zero at a dead
+        point."""
+        sign = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
+        _, v2, v3 = position_scalar(self.lengths, theta1, float(sign))
+        return abs(v2.real * v3.imag - v2.imag * v3.real) / (self.lengths[1] * self.lengths[2])
+
+    def energy(self, theta, omega, alpha, slider=None):
+        """Kinetic energy (J) and the work of loads and gravity since the first state (J) at
+        output states (arrays over time; angles continuous)."""
+        from ..inverse import kinetic_energy, link_com_kinematics
+        from ..kinematics import motion_from_angles
+
+        mo = motion_from_angles(self.lengths, tuple(theta), tuple(omega), tuple(alpha))
+        kin = kinetic_energy(self.linkage, mo)
+        coms, _ = link_com_kinematics(self.linkage, mo)
+        work = 0.0 * kin
+        for k, r in enumerate(coms):
+            work = work + np.real(np.conj(self.forces[k]) * (r - r[0])) + self.moments[k] * (
+                theta[k] - theta[k][0])
+        return kin, work
+
+    def shaking(self, ev: Evaluation) -> tuple:
+        """Shaking force (N) and moment about A0 (N·m) from a (batch) evaluation."""
+        if ev.shaking_force is not None and ev.shaking_moment is not None:
+            return ev.shaking_force, ev.shaking_moment
+        ra3 = np.asarray(ev.RA3, complex)
+        tau = np.asarray(ev.driving_torque, float)
+        moment = self.lengths[3] * ra3.imag - tau
+        for k, link in enumerate(self.linkage.links):
+            if link.counter_rotor:
+                moment = moment + 2 * link.counter_rotor * np.asarray(ev.alpha)[k]
+        return np.asarray(ev.RA0, complex) + ra3, moment
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         """Crank angle at a state, rad."""
@@ -198,21 +274,38 @@ class Formulation(ABC):
         return float(y[-1]) if self.driven else 0.0
 
 
-def formulation_class(name: str) -> type[Formulation]:
-    """The formulation called ``name`` (see :data:`balancer.model.METHODS`)."""
+#: Formulations per mechanism type: name → (module, class); the first is the default.
+FORMULATIONS: dict[str, dict[str, tuple[str, str]]] = {
+    "four-bar": {
+        "opened-loop": ("balancer.formulations.opened_loop", "OpenedLoop"),
+        "complex-masses": ("balancer.formulations.complex_masses", "ComplexMasses"),
+        "mass-matrix": ("balancer.formulations.mass_matrix", "MassMatrix"),
+        "lie-group": ("balancer.formulations.lie_group", "LieGroup"),
+    },
+    "slider-crank": {
+        "mass-matrix": ("balancer.slider_crank.formulations", "SliderMassMatrix"),
+        "complex-masses": ("balancer.slider_crank.formulations", "SliderComplexMasses"),
+    },
+}
+
+
+def default_method(mechanism_type: str) -> str:
+    """The formulation used when none is asked for."""
+    return next(iter(FORMULATIONS[mechanism_type]))
+
+
+def formulation_class(name: str, mechanism_type: str = "four-bar") -> type[Formulation]:
+    """The formulation called ``name`` for a mechanism type (see :data:`FORMULATIONS`)."""
     import importlib
 
-    modules = {
-        "opened-loop": ("opened_loop", "OpenedLoop"),
-        "complex-masses": ("complex_masses", "ComplexMasses"),
-        "mass-matrix": ("mass_matrix", "MassMatrix"),
-        "lie-group": ("lie_group", "LieGroup"),
-    }
+    table = FORMULATIONS[mechanism_type]
     try:
-        module, cls = modules[name]
+        module, cls = table[name]
     except KeyError:
-        raise ValueError(f"unknown formulation {name!r}; choose from {sorted(modules)}") from None
-    return getattr(importlib.import_module(f".{module}", __name__), cls)
+        raise ValueError(
+            f"the {mechanism_type} has no formulation {name!r}; choose from {', '.join(table)}"
+        ) from None
+    return getattr(importlib.import_module(module), cls)
 
 
 def make(
@@ -222,5 +315,5 @@ def make(
     gravity: tuple[float, float] = (0.0, 0.0),
     speed: float | None = None,
 ) -> Formulation:
-    """Instantiate the formulation called ``name``."""
-    return formulation_class(name)(linkage, gravity=gravity, speed=speed)
+    """Instantiate the formulation called ``name`` for the mechanism."""
+    return formulation_class(name, linkage.type)(linkage, gravity=gravity, speed=speed)

@@ -148,7 +148,7 @@ class LieGroup(Formulation):
         if self.driven:
             return np.append(q, 0.0)
         sigma = self.terms(q)[0]
-        return np.concatenate([[sigma * omega1], q])  # Eq. 82
+        return np.concatenate([[sigma * omega1], q, [theta1]])  # Eq. 82; the crank angle
 
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         q = self._q(y, self.driven)
@@ -159,7 +159,7 @@ class LieGroup(Formulation):
             tau = p * w1 * w1 - q_loads
             return np.append(q_dot, tau * w1)
         pi_dot = p * w1 * w1 + q_loads  # Eq. 84
-        return np.concatenate([[pi_dot], q_dot])
+        return np.concatenate([[pi_dot], q_dot, [w1]])
 
     def _kinematic_state(self, t: float, y: NDArray[np.float64]):
         """Angles, rates, accelerations and motor torque at a state (Eq. 82–85)."""
@@ -175,7 +175,7 @@ class LieGroup(Formulation):
         omega = np.array([w1, k[0] * w1, k[1] * w1])
         alpha = np.array([alpha1, *(k * alpha1 + dk * w1 * w1)])
         theta = np.array(
-            [math.atan2(q[1], q[0]), math.atan2(q[3], q[2]), math.atan2(-q[5], -q[4])]
+            [self._unwrapped_crank(t, y), math.atan2(q[3], q[2]), math.atan2(-q[5], -q[4])]
         )
         return theta, omega, alpha, tau
 
@@ -197,15 +197,16 @@ class LieGroup(Formulation):
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         return self.crank_angle(t) if self.driven else math.atan2(y[2], y[1])
 
-    def _unwrapped_crank(self, t: float, q: NDArray[np.float64]) -> float:
-        """The crank angle, continuous along the motion (q_A only gives it modulo 2π)."""
+    def _unwrapped_crank(self, t: float, y: NDArray[np.float64]) -> float:
+        """The crank angle, continuous along the motion.
+
+        ``q_A`` gives it only modulo 2π; free motion carries the continuous angle as an
+        auxiliary state after ``(Π1, q)`` (advanced by θ̇1, snapped to ``q_A``), bookkeeping
+        outside the formulation's own equations.
+        """
         if self.driven:
             return self.crank_angle(t)
-        angle = math.atan2(q[1], q[0])
-        last = getattr(self, "_theta1_last", self.theta1_start)
-        angle = last + math.remainder(angle - last, 2 * math.pi)
-        self._theta1_last = angle
-        return angle
+        return float(y[7]) + math.remainder(math.atan2(y[2], y[1]) - y[7], 2 * math.pi)
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         q = self._q(y, self.driven)
@@ -235,13 +236,14 @@ class LieGroup(Formulation):
             q[0:2] = math.cos(th), math.sin(th)
         else:
             q[0:2] /= np.linalg.norm(q[0:2])
-        theta1 = self._unwrapped_crank(t, q)
+        theta1 = self._unwrapped_crank(t, y)
         if self.near_change_point(theta1):
             # On the assembly of the smooth motion (Eq. 86 has two solutions that cross here).
             (_, v2, v3), _, _ = self.branch_vectors(theta1, 0.0)
             u2, u3 = v2 / abs(v2), v3 / abs(v3)
             q[2:6] = u2.real, u2.imag, -u3.real, -u3.imag
             y[off : off + 6] = q
+            y[7] = theta1
             return y
         l1, l2, l3, _ = self.lengths
         phi_b = math.atan2(q[3], q[2])
@@ -258,4 +260,6 @@ class LieGroup(Formulation):
             phi_b += dphi[0]
             phi_d += dphi[1]
         y[off : off + 6] = q
+        if not self.driven:
+            y[7] = self._unwrapped_crank(t, y)
         return y

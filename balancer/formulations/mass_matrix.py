@@ -40,6 +40,7 @@ class MassMatrix(Formulation):
 
     name = "mass-matrix"
     minimal = False
+    passes_dead_points = True
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
@@ -169,16 +170,16 @@ class MassMatrix(Formulation):
         a1, a2 = mo.pos.A1[0], mo.pos.A2[0]
         v1, v2 = mo.joint_velocities[0][0], mo.joint_velocities[1][0]
         y = [a1.real, a1.imag, a2.real, a2.imag, v1.real, v1.imag, v2.real, v2.imag]
-        if self.driven:
-            y.append(0.0)
+        y.append(0.0 if self.driven else float(theta1))  # motor work, or the crank angle
         return np.array(y, dtype=float)
 
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         acc, _, tau, _ = self.solve(t, y)
         dy = np.concatenate([y[4:8], acc])
         if self.driven:
-            dy = np.append(dy, tau * float(self.speed))  # type: ignore[arg-type]
-        return dy
+            return np.append(dy, tau * float(self.speed))  # type: ignore[arg-type]
+        a1, v_a1 = complex(y[0], y[1]), complex(y[4], y[5])
+        return np.append(dy, _cross(a1, v_a1) / abs(a1) ** 2)  # θ̇1
 
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         acc, lam, tau, vectors = self.solve(t, y)
@@ -188,6 +189,7 @@ class MassMatrix(Formulation):
         accels = (acc_a1, acc_a2 - acc_a1, -acc_a2)
         # Eq. 55: angles from the nodal coordinates; rates from l̄ × l̄̇ = ω·l².
         theta = np.array([math.atan2(v.imag, v.real) for v in vectors])
+        theta[0] = self._unwrapped_crank(t, y)
         omega = np.array([_cross(v, r) / abs(v) ** 2 for v, r in zip(vectors, rates, strict=True)])
         alpha = np.array([_cross(v, a) / abs(v) ** 2 for v, a in zip(vectors, accels, strict=True)])
         f = self._forces(vectors, tau)
@@ -202,14 +204,14 @@ class MassMatrix(Formulation):
         return self.crank_angle(t) if self.driven else math.atan2(y[1], y[0])
 
     def _unwrapped_crank(self, t: float, y: NDArray[np.float64]) -> float:
-        """The crank angle, continuous along the motion (the nodes only give it modulo 2π)."""
+        """The crank angle, continuous along the motion.
+
+        The nodes give it only modulo 2π; free motion carries the continuous angle as an
+        auxiliary state (advanced by θ̇1, snapped to the nodes), driven motion prescribes it.
+        """
         if self.driven:
             return self.crank_angle(t)
-        angle = math.atan2(y[1], y[0])
-        last = getattr(self, "_theta1_last", self.theta1_start)
-        angle = last + math.remainder(angle - last, 2 * math.pi)
-        self._theta1_last = angle
-        return angle
+        return float(y[8]) + math.remainder(math.atan2(y[1], y[0]) - y[8], 2 * math.pi)
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         a1, a2, _, _ = self._nodes(y)
@@ -269,6 +271,8 @@ class MassMatrix(Formulation):
         resid = (jac @ y[4:8])[rows]
         vf = slice(4 + free.start, 4 + free.stop)
         y[vf] -= np.linalg.lstsq(jac[rows, free], resid, rcond=None)[0]
+        if not self.driven:
+            y[8] = self._unwrapped_crank(t, y)
         return y
 
 

@@ -44,6 +44,7 @@ class OpenedLoop(Formulation):
 
     name = "opened-loop"
     minimal = False
+    passes_dead_points = True
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)

@@ -48,7 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import SolverError
-from ..problem import DEFAULT_ABOUT, JOINTS, NumericProblem
+from ..problem import NumericProblem
 from .result import InfeasibleError, StageReport, gap_floor
 
 #: Clarabel's settings for every solve here (tight: the zero optimum of complete balancing
@@ -631,7 +631,7 @@ class ConvexSolver:
         """The point a radius is measured from: ``com_about``, or the default joint."""
         if kind == "com":
             return b.com_centre
-        return 0.0 if DEFAULT_ABOUT[b.name] == JOINTS[b.name][0] else b.length
+        return 0.0 if b.default_about == b.joints[0] else b.length
 
     def _needed(self, group: tuple[int, str]) -> float | None:
         """The exact bound group ``group`` needs with every other bound kept (or ``None``)."""
@@ -698,7 +698,7 @@ class ConvexSolver:
             return (key, v, b.com_radius, "m"), (
                 f"{key} must be at least {v:.4g} m (is {b.com_radius!r})"
             )
-        about = DEFAULT_ABOUT[b.name]
+        about = b.default_about
         return (key, v, None, "m"), (
             f"{key} must be given, at least {v:.4g} m about {about} (the centre of mass is "
             "fixed now)"

@@ -1,0 +1,395 @@
+"""Forward dynamics of the slider-crank in two formulations that must agree.
+
+``complex-masses``
+    One equation in θ1. The rod's linear momentum is carried by complex masses at its joints
+    (Meijaard & van der Wijk 2020, Eq. 29): ``m2·ṙ2 = m̄2p·ṙA1 + m̄2q·ṙA2``, and with
+    ``ṙA1 = i·l̄1·θ̇1``, ``ṙA2 = X·θ̇1`` (X = dx/dθ1), ``θ̇2 = Θ2·θ̇1`` the kinetic energy is
+    ``T = Σ(θ1)·θ̇1²/2`` with::
+
+        Σ = I1 + m1·s1² + |m̄2p·i·l̄1 + m̄2q·X|²/m2 + I2·Θ2² + m3·X²
+
+    so that ``Σ·θ̈1 + Σ'·θ̇1²/2 = Q`` (Lagrange). The reactions follow from Newton–Euler with
+    the accelerations found.
+``mass-matrix``
+    Truss elements (Sect. 4.2, 5.1): nodes A1 and A2 in Cartesian coordinates, the equivalent
+    mass matrices of crank and rod (Eq. 45) and the slider's mass at A2, the constraints
+    ``|r̄A1|² = r²``, ``|r̄A2 − r̄A1|² = L²`` and ``y_A2 = e`` with multipliers; the reactions are
+    the multipliers: the guide's normal force directly, R̄A0 from node A0's equation.
+
+Both take the gas force as acting between slider and frame along the guide.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..formulations import Evaluation, Formulation
+from ..kinematics import cross
+from .dynamics import kinetic_energy, newton_euler
+from .kinematics import assembly_range, motion
+
+
+class _SliderFormulation(Formulation):
+    """What both slider-crank formulations share: the mechanism's geometry for the driver."""
+
+    rotating_links = 2
+    passes_dead_points = False
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.sign0 = 1.0 if self.linkage.branch == "+" else -1.0
+        self.offset = self.lengths[2]
+
+    def assembly_range(self):
+        return assembly_range(self.lengths)
+
+    def change_points(self) -> tuple[float, ...]:
+        return ()
+
+    def transmission_of_crank(self, theta1: float) -> float:
+        r, big_l, e = self.lengths
+        s2 = (e - r * math.sin(theta1)) / big_l
+        return math.sqrt(max(1 - s2 * s2, 0.0))
+
+    def gas(self, theta1):
+        return self.linkage.gas_force.at(theta1)
+
+    def motion_of(self, theta1, omega1=0.0, alpha1=0.0):
+        return motion(self.lengths, theta1, omega1, alpha1, self.sign0, check=False)
+
+    def energy(self, theta, omega, alpha, slider=None):
+        """Kinetic energy and the work of the loads, gravity and gas force since the start, J."""
+        mo = self.motion_of(theta[0], omega[0], alpha[0])
+        kin = kinetic_energy(self.linkage, mo)
+        r, big_l, _ = self.lengths
+        z1, z2 = self.linkage.crank.com / r, self.linkage.rod.com / big_l
+        coms = (z1 * mo.l1, mo.l1 + z2 * mo.l2, mo.A2 + self.linkage.slider.com)
+        work = 0.0 * kin
+        for k, c in enumerate(coms):
+            work = work + np.real(np.conj(self.forces[k]) * (c - c[0]))
+        for k in range(2):
+            work = work + self.moments[k] * (theta[k] - theta[k][0])
+        # The gas force along the guide: a function of the crank angle, so its work is the
+        # integral of G(θ1)·dx/dθ1 over θ1 (by quadrature between outputs, with the table's
+        # breakpoints as break points).
+        return kin, work + self.gas_work(theta[0])
+
+    def gas_work(self, theta1) -> NDArray[np.float64]:
+        """Work of the gas force from ``theta1[0]`` to each ``theta1`` (continuous angles), J."""
+        import warnings
+
+        from scipy.integrate import IntegrationWarning, quad
+
+        gas = self.linkage.gas_force
+        out = np.zeros(len(theta1))
+        if gas.is_zero:
+            return out
+
+        def power(t: float) -> float:  # G·dx/dθ1
+            return float(gas.at(t)) * float(self.motion_of(t, 1.0, 0.0).v[0])
+
+        for i in range(1, len(theta1)):
+            a, b = float(theta1[i - 1]), float(theta1[i])
+            lo, hi = min(a, b), max(a, b)
+            k0, k1 = math.floor(lo / gas.period), math.ceil(hi / gas.period)
+            breaks = [k * gas.period + t for k in range(k0, k1 + 1) for t in gas.angles
+                      if lo < k * gas.period + t < hi]
+            with warnings.catch_warnings():  # roundoff near the asked 1e-12 is no news
+                warnings.simplefilter("ignore", IntegrationWarning)
+                value = quad(power, a, b, points=breaks or None, epsabs=0.0, epsrel=1e-12,
+                             limit=200)[0] if a != b else 0.0
+            out[i] = out[i - 1] + value
+        return out
+
+    def shaking(self, ev: Evaluation) -> tuple:
+        return ev.shaking_force, ev.shaking_moment
+
+    def _evaluation(self, theta1, omega1, alpha1, driving_torque) -> Evaluation:
+        """Reactions and everything else from the crank's state and acceleration."""
+        mo = self.motion_of(theta1, omega1, alpha1)
+        ne = newton_euler(self.linkage, mo, gravity=(self.gravity.real, self.gravity.imag))
+        theta = np.array([mo.theta1, np.angle(mo.l2), 0.0 * mo.theta1])
+        return Evaluation(
+            theta=theta,
+            omega=np.array([mo.omega[0], mo.omega[1], 0.0 * mo.theta1]),
+            alpha=np.array([mo.alpha[0], mo.alpha[1], 0.0 * mo.theta1]),
+            RA0=ne.RA0,
+            RA3=ne.RA3,
+            driving_torque=driving_torque,
+            shaking_force=ne.shaking_force,
+            shaking_moment=ne.shaking_moment,
+            slider=np.array([mo.x, mo.v, mo.a]),
+        )
+
+
+class SliderComplexMasses(_SliderFormulation):
+    """One equation in θ1 with the rod's complex joint masses."""
+
+    name = "complex-masses"
+    minimal = True
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        c1, c2, c3 = self.links
+        self.m2p = c2.mass * (1 - self.zeta[1])
+        self.m2q = c2.mass * self.zeta[1]
+        self.crank_inertia = c1.inertia + c1.mass * abs(c1.com) ** 2  # about A0, rotor included
+
+    def _crank(self, t: float, y) -> tuple[float, float]:
+        if self.driven:
+            return self.crank_angle(t), float(self.speed)  # type: ignore[arg-type]
+        return float(y[0]), float(y[1])
+
+    def reduced(self, theta1: float, omega1: float, torque: float = 0.0):
+        """``(Σ, Σ'/2, Q)`` at a state: the generalised inertia, half its derivative and the
+        generalised force of loads, gravity, gas force and motor torque."""
+        c1, c2, c3 = self.links
+        m2 = c2.mass
+        at_rest = self.motion_of(theta1, 0.0, 1.0)  # velocity maps: accelerations for θ̈1 = 1
+        turning = self.motion_of(theta1, 1.0, 0.0)  # their derivatives: for θ̇1 = 1
+        v1 = at_rest.l1[0]
+        big2, big_x = at_rest.transfer[0][0], at_rest.transfer[1][0]
+        d_big2, d_big_x = turning.alpha[1][0], turning.a[0]
+        p = self.m2p * 1j * v1 + self.m2q * big_x  # rod momentum per unit θ̇1 (times m2)
+        dp = -self.m2p * v1 + self.m2q * d_big_x
+        sigma = (self.crank_inertia + abs(p) ** 2 / m2 + c2.inertia * big2 * big2
+                 + c3.mass * big_x * big_x)
+        half_dsigma = ((p.real * dp.real + p.imag * dp.imag) / m2 + c2.inertia * big2 * d_big2
+                       + c3.mass * big_x * d_big_x)
+        f1, f2, f3 = self.forces
+        z1 = self.zeta[0]
+        q = (self.moments[0] + torque + cross(z1 * v1, f1) + (p.real * f2.real + p.imag * f2.imag)
+             / m2 + self.moments[1] * big2 + (f3.real + float(self.gas(theta1))) * big_x)
+        return sigma, half_dsigma, float(q)
+
+    def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
+        self.theta1_start = float(theta1)
+        motion(self.lengths, theta1, 0.0, 0.0, self.sign0)  # raises if it does not assemble
+        return np.array([0.0]) if self.driven else np.array([theta1, omega1], dtype=float)
+
+    def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        theta1, omega1 = self._crank(t, y)
+        sigma, half_dsigma, q = self.reduced(theta1, omega1)
+        if self.driven:
+            tau = half_dsigma * omega1 * omega1 - q  # Σ·0 + Σ'ω²/2 = Q + τ
+            return np.array([tau * omega1])
+        return np.array([omega1, (q - half_dsigma * omega1 * omega1) / sigma])
+
+    def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
+        return self.evaluate_batch([t], [y]).at(0)
+
+    def evaluate_batch(self, times, states) -> Evaluation:
+        cranks = [self._crank(t, y) for t, y in zip(times, states, strict=True)]
+        alphas, torques = [], []
+        for theta1, omega1 in cranks:
+            sigma, half_dsigma, q = self.reduced(theta1, omega1)
+            if self.driven:
+                alphas.append(0.0)
+                torques.append(half_dsigma * omega1 * omega1 - q)
+            else:
+                alphas.append((q - half_dsigma * omega1 * omega1) / sigma)
+                torques.append(0.0)
+        theta1 = np.array([c[0] for c in cranks])
+        omega1 = np.array([c[1] for c in cranks])
+        return self._evaluation(theta1, omega1, np.array(alphas), np.array(torques))
+
+    def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
+        return self.crank_angle(t) if self.driven else float(y[0])
+
+    def transmission(self, t: float, y: NDArray[np.float64]) -> float:
+        return self.transmission_of_crank(self._crank(t, y)[0])
+
+
+class SliderMassMatrix(_SliderFormulation):
+    """Truss elements for crank and rod, the slider a mass at its pin, the guide a constraint."""
+
+    name = "mass-matrix"
+    minimal = False
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        c1, c2, c3 = self.links
+        r, big_l, _ = self.lengths
+        # Eq. 45 for crank (A0→A1) and rod (A1→A2) over the nodes A0, A1, A2, and the slider's
+        # mass at A2 (it does not turn): a constant 6×6 matrix.
+        m6 = np.zeros((6, 6))
+        m6[0:4, 0:4] += _element(c1, r)
+        m6[2:6, 2:6] += _element(c2, big_l)
+        m6[4, 4] += c3.mass
+        m6[5, 5] += c3.mass
+        self.m_global = m6
+        self.m_free = m6[2:6, 2:6]
+
+    # -- geometry ----------------------------------------------------------------------------
+
+    def _constraints(self, x):
+        """``Φ`` and ``∂Φ/∂x`` for x = (A1x, A1y, A2x, A2y)."""
+        r, big_l, e = self.lengths
+        a1, a2 = complex(x[0], x[1]), complex(x[2], x[3])
+        v1, v2 = a1, a2 - a1
+        phi = np.array([0.5 * (abs(v1) ** 2 - r * r), 0.5 * (abs(v2) ** 2 - big_l * big_l),
+                        x[3] - e])
+        jac = np.array([[v1.real, v1.imag, 0.0, 0.0],
+                        [-v2.real, -v2.imag, v2.real, v2.imag],
+                        [0.0, 0.0, 0.0, 1.0]])
+        return phi, jac
+
+    def _forces(self, x, tau: float, gas: float):
+        """Nodal applied forces at A0, A1, A2 (Eq. 46), the gas force and the motor torque in."""
+        from ..massmodels import equivalent_joint_forces
+        from ..model import Link
+
+        r, big_l, _ = self.lengths
+        a1, a2 = complex(x[0], x[1]), complex(x[2], x[3])
+        out = [0j, 0j, 0j]
+        for k, (vec, length, (p, q)) in enumerate(((a1, r, (0, 1)), (a2 - a1, big_l, (1, 2)))):
+            link = self.links[k]
+            loaded = Link(mass=link.mass, inertia=link.inertia, e=link.e, f=link.f,
+                          force=(self.forces[k].real, self.forces[k].imag),
+                          moment=self.moments[k] + (tau if k == 0 else 0.0))
+            fp, fq = equivalent_joint_forces(loaded, length, vec)
+            out[p] += fp
+            out[q] += fq
+        out[2] += self.forces[2] + gas
+        return out
+
+    def crank_of(self, t: float, y) -> float:
+        """The crank angle, continuous along the motion.
+
+        The nodes give it only modulo 2π; free motion carries the continuous angle as an
+        auxiliary state (advanced by θ̇1, snapped to the nodes), driven motion prescribes it.
+        """
+        if self.driven:
+            return self.crank_angle(t)
+        return float(y[8]) + math.remainder(math.atan2(y[1], y[0]) - y[8], 2 * math.pi)
+
+    def solve(self, t: float, y: NDArray[np.float64]):
+        """Accelerations, multipliers (crank, rod, guide) and the motor torque at a state."""
+        x, xd = y[0:4], y[4:8]
+        a1d, a2d = complex(xd[0], xd[1]), complex(xd[2], xd[3])
+        _, jac = self._constraints(x)
+        gamma = np.array([-abs(a1d) ** 2, -abs(a2d - a1d) ** 2, 0.0])
+        f = self._forces(x, 0.0, float(self.gas(self.crank_of(t, y))))
+        f_free = np.array([f[1].real, f[1].imag, f[2].real, f[2].imag])
+        if not self.driven:
+            a = np.zeros((7, 7))
+            a[0:4, 0:4] = self.m_free
+            a[0:4, 4:7] = jac.T
+            a[4:7, 0:4] = jac
+            z = np.linalg.solve(a, np.concatenate([f_free, gamma]))
+            return z[0:4], z[4:7], 0.0
+        omega = float(self.speed)  # type: ignore[arg-type]
+        a1 = complex(x[0], x[1])
+        acc_a1 = -omega * omega * a1
+        x1 = np.array([acc_a1.real, acc_a1.imag])
+        couple = 1j * a1 / self.lengths[0] ** 2  # τ's nodal force at A1 (Eq. 46)
+        a = np.zeros((6, 6))
+        a[0:4, 0:2] = self.m_free[:, 2:4]
+        a[0:4, 2:5] = jac.T
+        a[0:2, 5] = [-couple.real, -couple.imag]
+        a[4:6, 0:2] = jac[1:3, 2:4]
+        rhs = np.concatenate([f_free - self.m_free[:, 0:2] @ x1,
+                              gamma[1:3] - jac[1:3, 0:2] @ x1])
+        z = np.linalg.solve(a, rhs)
+        return np.concatenate([x1, z[0:2]]), z[2:5], float(z[5])
+
+    def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
+        self.theta1_start = float(theta1)
+        if self.driven:
+            omega1 = float(self.speed)  # type: ignore[arg-type]
+        mo = motion(self.lengths, theta1, omega1, 0.0, self.sign0)
+        a1, a2 = mo.A1[0], mo.A2[0]
+        v1 = mo.vector_rate(0)[0]
+        y = [a1.real, a1.imag, a2.real, a2.imag, v1.real, v1.imag, mo.v[0], 0.0]
+        y.append(0.0 if self.driven else float(theta1))  # motor work, or the crank angle
+        return np.array(y, dtype=float)
+
+    def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        acc, _, tau = self.solve(t, y)
+        dy = np.concatenate([y[4:8], acc])
+        if self.driven:
+            return np.append(dy, tau * float(self.speed))  # type: ignore[arg-type]
+        a1, v_a1 = complex(y[0], y[1]), complex(y[4], y[5])
+        return np.append(dy, cross(a1, v_a1) / abs(a1) ** 2)  # θ̇1
+
+    def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
+        acc, lam, tau = self.solve(t, y)
+        x, xd = y[0:4], y[4:8]
+        a1, a2 = complex(x[0], x[1]), complex(x[2], x[3])
+        vel1, vel2 = complex(xd[0], xd[1]), complex(xd[2], xd[3])
+        acc1, acc2 = complex(acc[0], acc[1]), complex(acc[2], acc[3])
+        v1, v2 = a1, a2 - a1
+        theta1 = self.crank_of(t, y)
+        omega = (cross(v1, vel1) / abs(v1) ** 2, cross(v2, vel2 - vel1) / abs(v2) ** 2)
+        alpha = (cross(v1, acc1) / abs(v1) ** 2, cross(v2, acc2 - acc1) / abs(v2) ** 2)
+        gas = float(self.gas(theta1))
+        f = self._forces(x, tau, gas)
+        node_acc = np.array([0.0, 0.0, acc[0], acc[1], acc[2], acc[3]])
+        inertia = self.m_global @ node_acc
+        # Node A0's equation: R̄A0 = F_A0 − (M·ẍ)_A0 + l̄1·λ1 (Eq. 52–54 with the axial force).
+        ra0 = f[0] - complex(inertia[0], inertia[1]) + v1 * lam[0]
+        n_guide = -lam[2]  # the guide's normal force on the slider
+        # The guide also resists the slider's turning: its couple balances the slider's moment.
+        c3 = self.links[2]
+        m_guide = -(self.moments[2] + cross(c3.com, self.forces[2] - c3.mass * acc2.real))
+        h = self.offset
+        moment = -a2.real * n_guide - m_guide + h * gas - tau
+        if self.linkage.crank.counter_rotor:
+            moment += 2 * self.linkage.crank.counter_rotor * alpha[0]
+        return Evaluation(
+            theta=np.array([theta1, math.atan2(v2.imag, v2.real), 0.0]),
+            omega=np.array([omega[0], omega[1], 0.0]),
+            alpha=np.array([alpha[0], alpha[1], 0.0]),
+            RA0=ra0,
+            RA3=-1j * n_guide,
+            driving_torque=tau,
+            shaking_force=ra0 - 1j * n_guide - gas,
+            shaking_moment=moment,
+            slider=np.array([a2.real, vel2.real, acc2.real]),
+        )
+
+    def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
+        return self.crank_of(t, y)
+
+    def transmission(self, t: float, y: NDArray[np.float64]) -> float:
+        v2 = complex(y[2] - y[0], y[3] - y[1])
+        return v2.real / abs(v2)
+
+    def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
+        phi, jac = self._constraints(y[0:4])
+        r, big_l, _ = self.lengths
+        pos = max(abs(phi[0]) / r, abs(phi[1]) / big_l, abs(phi[2]))
+        return float(pos), float(np.max(np.abs(jac @ y[4:8])))
+
+    def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Least-norm Newton correction onto the constraints and their derivatives."""
+        y = np.array(y, dtype=float)
+        rows, free = slice(0, 3), slice(0, 4)
+        if self.driven:
+            th = self.crank_angle(t)
+            a1 = self.lengths[0] * complex(math.cos(th), math.sin(th))
+            v1 = 1j * float(self.speed) * a1  # type: ignore[arg-type]
+            y[0:2] = a1.real, a1.imag
+            y[4:6] = v1.real, v1.imag
+            rows, free = slice(1, 3), slice(2, 4)
+        for _ in range(4):
+            phi, jac = self._constraints(y[0:4])
+            if np.max(np.abs(phi[rows])) <= 1e-16 * sum(abs(v) for v in self.lengths):
+                break
+            y[free] -= np.linalg.lstsq(jac[rows, free], phi[rows], rcond=None)[0]
+        _, jac = self._constraints(y[0:4])
+        resid = (jac @ y[4:8])[rows]
+        vf = slice(4 + free.start, 4 + free.stop)
+        y[vf] -= np.linalg.lstsq(jac[rows, free], resid, rcond=None)[0]
+        if not self.driven:
+            y[8] = self.crank_of(t, y)
+        return y
+
+
+def _element(link, length: float) -> NDArray[np.float64]:
+    from ..massmodels import equivalent_mass_matrix, inertial_parameters
+
+    return equivalent_mass_matrix(inertial_parameters(link), length)
