@@ -211,8 +211,9 @@ class GasForce:
 
 @dataclass(frozen=True, kw_only=True)
 class SliderCrank:
-    """A slider-crank A0 A1 A2 with the slider's pin A2 on a straight guide (Wunderlich 1964,
-    Sect. 3).
+    """A slider-crank A0 A1 A2 with the slider's pin A2 on a straight guide.
+
+    Wunderlich (1964), Sect. 3.
 
     A0 at the origin; link 1 (crank) A0→A1, link 2 (connecting rod) A1→A2; the slider's pin A2
     moves on the guide line ``y = offset`` along x. θ1, θ2 are the angles of A0→A1 and A1→A2.

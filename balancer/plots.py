@@ -15,8 +15,6 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from .inverse import link_com_kinematics
-from .kinematics import motion_from_angles
 from .model import FourBar
 from .simulate import Trajectory
 

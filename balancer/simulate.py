@@ -36,7 +36,7 @@ from scipy.optimize import brentq
 
 from .errors import AssemblyError, LockupError, SolverError, SpecError
 from .formulations import Formulation, make
-from .model import METHODS, Design, FourBar, SimulationSettings
+from .model import Design, FourBar, SimulationSettings
 
 #: |sin(θ3 − θ2)| at which a crank-angle formulation stops before a dead point.
 DEAD_POINT_THRESHOLD = 1e-3

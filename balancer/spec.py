@@ -80,8 +80,10 @@ class _Table:
             self.expect(self.known)
 
     def expect(self, known: tuple[str, ...]) -> None:
-        """Declare the keys this table may hold, and report a typo now, before the missing key
-        it causes ("mas" before "mass is missing")."""
+        """Declare the keys this table may hold, and report a typo now.
+
+        Before the missing key it causes ("mas" before "mass is missing").
+        """
         self.known = tuple(known)
         for name in self.data:
             if name not in self.known:

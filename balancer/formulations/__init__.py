@@ -201,15 +201,16 @@ class Formulation(ABC):
         return change_point_angles(self.lengths)
 
     def transmission_of_crank(self, theta1: float) -> float:
-        """|sin(θ3 − θ2)| on the motion's assembly at crank angle ``theta1``: zero at a dead
-        point."""
+        """|sin(θ3 − θ2)| on the motion's assembly at ``theta1``: zero at a dead point."""
         sign = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
         _, v2, v3 = position_scalar(self.lengths, theta1, float(sign))
         return abs(v2.real * v3.imag - v2.imag * v3.real) / (self.lengths[1] * self.lengths[2])
 
     def energy(self, theta, omega, alpha, slider=None):
-        """Kinetic energy (J) and the work of loads and gravity since the first state (J) at
-        output states (arrays over time; angles continuous)."""
+        """Kinetic energy and the work of loads and gravity since the first state, J.
+
+        At output states (arrays over time; angles continuous).
+        """
         from ..inverse import kinetic_energy, link_com_kinematics
         from ..kinematics import motion_from_angles
 

@@ -47,9 +47,11 @@ def is_force_balanced(mech: SliderCrank, tol: float = FORCE_BALANCE_TOLERANCE) -
 
 
 def force_balance_matrix(lengths) -> NDArray[np.float64]:
-    """Eq. 20a–b as ``[A | b]`` (4×13) in the stacked inertial parameters of crank, rod and
-    slider (the layout of :data:`balancer.inverse.PARAMETER_NAMES`, rod and slider in the
-    places of coupler and rocker)."""
+    """Eq. 20a–b as ``[A | b]`` (4×13) in the stacked inertial parameters.
+
+    Crank, rod and slider in the layout of :data:`balancer.inverse.PARAMETER_NAMES` (rod and
+    slider in the places of coupler and rocker).
+    """
     r, big_l, _ = lengths
     a = np.zeros((4, 13))
     a[0, 1], a[0, 4], a[0, 8] = 1 / r, 1.0, 1.0  # Re: m1e1/r + m2 + m3

@@ -44,8 +44,10 @@ def _loads(mech: SliderCrank, mo: SliderMotion, gravity: complex, loads: bool):
 
 
 def _finish(mech, mo, ra0, n_guide, m_guide, tau, gas, shaking, alpha1) -> Reactions:
-    """Frame loads from the crank-pivot force, the guide's normal force and couple on the
-    slider, the motor torque and the gas force."""
+    """Frame loads from the pin and guide forces, the motor torque and the gas force.
+
+    The guide's normal force and couple are those on the slider.
+    """
     h = mech.lengths[2]
     ra3 = -1j * n_guide  # the slider on its guide
     moment = -mo.x * n_guide - m_guide + h * gas - tau
@@ -107,8 +109,11 @@ def _nodal(params_crank, params_rod, m3, mo: SliderMotion, lengths):
 
 
 def _combine(mech_lengths, mo: SliderMotion, nodes, gas, slider_moment, rotor_alpha) -> tuple:
-    """Torque, shaking force, guide force, crank-pivot force and shaking moment from nodal
-    forces ``G`` at A0, A1, A2 (gas excluded) by length- and guide-keeping displacements."""
+    """Torque, shaking force, guide force, crank-pivot force and shaking moment.
+
+    From the nodal forces ``G`` at A0, A1, A2 (gas excluded) by virtual displacements that keep
+    the lengths and the guide.
+    """
     g0, g1, g2 = nodes
     v1, v2 = mo.l1, mo.l2
     big_x = mo.transfer[1]
@@ -130,8 +135,10 @@ def mass_matrix(
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
 ) -> Reactions:
-    """Frame loads from the equivalent mass matrices of crank and rod (Eq. 45–46) and the
-    slider's mass, by virtual displacements (see the module docstring)."""
+    """Frame loads from the equivalent mass matrices (Eq. 45–46) by virtual displacements.
+
+    Crank and rod as truss elements, the slider a mass at its pin (see the module docstring).
+    """
     r, big_l, _ = mech.lengths
     g = complex(*gravity)
     forces, moments, gas = _loads(mech, mo, g, loads)

@@ -144,8 +144,11 @@ class SliderComplexMasses(_SliderFormulation):
         return float(y[0]), float(y[1])
 
     def reduced(self, theta1: float, omega1: float, torque: float = 0.0):
-        """``(Σ, Σ'/2, Q)`` at a state: the generalised inertia, half its derivative and the
-        generalised force of loads, gravity, gas force and motor torque."""
+        """``(Σ, Σ'/2, Q)`` at a state.
+
+        The generalised inertia, half its derivative, and the generalised force of loads,
+        gravity, gas force and motor torque.
+        """
         c1, c2, c3 = self.links
         m2 = c2.mass
         at_rest = self.motion_of(theta1, 0.0, 1.0)  # velocity maps: accelerations for θ̈1 = 1

@@ -196,6 +196,5 @@ def motion_of(mechanism, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: Arr
 
 
 def classify(lengths: Lengths) -> str:
-    """``"rotating crank"`` when the crank turns fully (``r + |e| ≤ L``), else
-    ``"oscillating crank"``."""
+    """Whether the crank turns fully (``r + |e| ≤ L``): ``"rotating crank"`` or not."""
     return "rotating crank" if assembly_range(lengths).full else "oscillating crank"

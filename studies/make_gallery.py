@@ -1,0 +1,77 @@
+"""Regenerate ``docs/gallery/``: the studies in full mode, a few of their figures, an animation.
+
+Runs every study (``studies/*.py`` with a ``run``) in full mode into ``studies/out/<name>/``,
+copies the figures listed in :data:`CHOSEN` into ``docs/gallery/`` under stable names, and
+writes an animation of the example of Meijaard & van der Wijk (2020), Eq. 56
+(``examples/meijaard2020.toml``) with :func:`balancer.plots.animate`. The gallery is committed,
+so each file must stay small (:data:`MAX_BYTES`); the script says which one does not and exits
+with status 1.
+
+Run ``python studies/make_gallery.py`` from anywhere; ``README_SECTION.md`` beside the figures
+holds the README text that shows them.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import shutil
+import sys
+import time
+from pathlib import Path
+from types import ModuleType
+
+from balancer.plots import animate
+from balancer.spec import load_design
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+GALLERY = ROOT / "docs" / "gallery"
+STUDIES = ("meijaard2020_example", "meijaard2020_balanced", "wunderlich1964",
+           "bai2024_lie_group", "benchmarks_pb")
+#: (study, figure it writes, name in the gallery).
+CHOSEN = (
+    ("meijaard2020_balanced", "comparison.png", "balancing_four_designs.png"),
+    ("wunderlich1964", "fig1_com_path.png", "wunderlich_com_path.png"),
+    ("bai2024_lie_group", "fig7_parallelogram.png", "bai_parallelogram.png"),
+)
+ANIMATION = "meijaard2020.gif"
+FRAMES = 48
+#: Size budget per gallery file, bytes.
+MAX_BYTES = {".png": 250_000, ".gif": 600_000}
+
+
+def load_study(name: str) -> ModuleType:
+    """Import ``studies/<name>.py`` from its file."""
+    spec = importlib.util.spec_from_file_location(f"study_{name}", HERE / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def main() -> int:
+    """Run the studies, fill the gallery, report sizes; 0 if every file is within budget."""
+    GALLERY.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name in STUDIES:
+        start = time.perf_counter()
+        load_study(name).run(HERE / "out" / name)
+        print(f"{name:<24} {time.perf_counter() - start:6.1f} s")
+    for study, figure, target in CHOSEN:
+        written.append(Path(shutil.copyfile(HERE / "out" / study / figure, GALLERY / target)))
+    design = load_design(ROOT / "examples" / "meijaard2020.toml")
+    written.append(animate(design.mechanism, GALLERY / ANIMATION, frames=FRAMES,
+                           title=design.title))
+    status = 0
+    for path in written:
+        size = path.stat().st_size
+        budget = MAX_BYTES[path.suffix]
+        note = "" if size <= budget else f"  OVER the budget of {budget // 1000} kB"
+        status = status or int(size > budget)
+        print(f"{path.relative_to(ROOT)}  {size / 1000:.0f} kB{note}")
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
