@@ -16,6 +16,7 @@ from __future__ import annotations
 import cmath
 import math
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from typing import ClassVar, Literal
 
 Branch = Literal["+", "-"]
@@ -180,7 +181,9 @@ class GasForce:
     angles
         Crank angles of the table, rad, increasing within one period starting at 0.
     values
-        Force along +x at those angles, N; linear interpolation, periodic.
+        Force along +x at those angles, N, interpolated by a periodic cubic spline (a pressure
+        table samples a smooth curve; the spline is twice continuously differentiable, which
+        an integrator of the motion needs to keep its accuracy).
     period
         Period in crank angle, rad (2π; 4π for a four-stroke cycle).
     """
@@ -199,14 +202,23 @@ class GasForce:
         """Whether the force vanishes everywhere."""
         return all(v == 0.0 for v in self.values)
 
+    @cached_property
+    def _spline(self):
+        from scipy.interpolate import CubicSpline
+
+        angles = list(self.angles) + [self.angles[0] + self.period]
+        values = list(self.values) + [self.values[0]]
+        return CubicSpline(angles, values, bc_type="periodic")
+
     def at(self, theta1):
         """The force (N) at crank angle(s) ``theta1`` (rad)."""
         import numpy as np
 
+        t = np.asarray(theta1, dtype=float)
         if len(self.values) == 1:
-            return self.values[0] + 0.0 * np.asarray(theta1, dtype=float)
-        return np.interp(np.mod(theta1, self.period), self.angles, self.values,
-                         period=self.period)
+            return self.values[0] + 0.0 * t
+        start = self.angles[0]
+        return self._spline(start + np.mod(t - start, self.period))
 
 
 @dataclass(frozen=True, kw_only=True)

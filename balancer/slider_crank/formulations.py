@@ -74,7 +74,7 @@ class _SliderFormulation(Formulation):
             work = work + self.moments[k] * (theta[k] - theta[k][0])
         # The gas force along the guide: a function of the crank angle, so its work is the
         # integral of G(θ1)·dx/dθ1 over θ1 (by quadrature between outputs, with the table's
-        # breakpoints as break points).
+        # knots as break points).
         return kin, work + self.gas_work(theta[0])
 
     def gas_work(self, theta1) -> NDArray[np.float64]:

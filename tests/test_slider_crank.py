@@ -1,0 +1,375 @@
+"""The slider-crank (Wunderlich 1964, Sect. 3–4) through the pipeline, each quantity checked by a
+second route: finite differences, momentum and energy, the other inverse-dynamics route, the
+other formulation, closed forms."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from helpers import derivative, rel_err
+
+from balancer import spec
+from balancer.cli import main
+from balancer.errors import AssemblyError, SpecError
+from balancer.formulations import make
+from balancer.kinematics import cross
+from balancer.model import GasForce, Link, SimulationSettings, SliderCrank
+from balancer.simulate import simulate
+from balancer.slider_crank import conditions as sc_cond
+from balancer.slider_crank import dynamics as sd
+from balancer.slider_crank import kinematics as sk
+from balancer.slider_crank import massmodels as sm
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+GAS = GasForce(angles=(0.0, 1.0, 2.5, 4.0), values=(-300.0, -120.0, 10.0, -40.0))
+
+
+def _link(rng, length, *, loads=True):
+    return Link(mass=rng.uniform(0.3, 3.0), inertia=rng.uniform(0.01, 0.2),
+                e=rng.uniform(-0.5, 1.5) * length, f=rng.uniform(-0.3, 0.3) * length,
+                force=tuple(rng.uniform(-5, 5, 2)) if loads else (0.0, 0.0),
+                moment=rng.uniform(-1, 1) if loads else 0.0)
+
+
+def random_slider_crank(rng, *, loads=True, rotor=True, full_turn=True) -> SliderCrank:
+    while True:
+        r, big_l = rng.uniform(0.05, 0.3), rng.uniform(0.1, 0.8)
+        e = rng.uniform(-0.3, 0.3) * big_l
+        if sk.assembly_range((r, big_l, e)).full == full_turn or not full_turn:
+            if not sk.assembly_range((r, big_l, e)).empty:
+                break
+    crank = _link(rng, r, loads=loads)
+    if rotor:
+        crank = replace(crank, counter_rotor=rng.uniform(0, 0.1))
+    return SliderCrank(lengths=(r, big_l, e), crank=crank, rod=_link(rng, big_l, loads=loads),
+                       slider=_link(rng, r, loads=loads), branch=str(rng.choice(["+", "-"])),
+                       gas_force=GAS if loads else GasForce())
+
+
+def _angles(rng, mech, n):
+    rng_ = sk.assembly_range(mech.lengths)
+    (a, b), *_ = rng_.intervals
+    return rng.uniform(a + 0.05, b - 0.05, n)
+
+
+CASES = [random_slider_crank(np.random.default_rng(seed), full_turn=seed % 3 != 0)
+         for seed in range(12)]
+
+
+@pytest.mark.parametrize("mech", CASES)
+def test_kinematics_against_finite_differences(mech):
+    rng = np.random.default_rng(1)
+    for t0 in _angles(rng, mech, 3):
+        w0, a0 = rng.uniform(-3, 3), rng.uniform(-5, 5)
+
+        def at(t, t0=t0, w0=w0, a0=a0):
+            return sk.motion_of(mech, t0 + w0 * t + 0.5 * a0 * t * t, w0 + a0 * t, a0)
+
+        mo = at(0.0)
+        if mo.singular[0]:
+            continue
+        r, big_l, e = mech.lengths
+        assert abs(mo.A2[0].imag - e) < 1e-15 and abs(abs(mo.l2[0]) - big_l) < 1e-14 * big_l
+        assert abs(mo.l1[0] + mo.l2[0] - mo.A2[0]) < 1e-15  # the loop
+        side = np.sign(mo.x[0] - mo.A1[0].real)
+        assert side == (1 if mech.branch == "+" else -1)
+        scale = max(1.0, abs(mo.v[0]), abs(mo.a[0]))
+        assert rel_err(derivative(lambda t: at(t).x), mo.v, scale=scale) < 1e-9
+        assert rel_err(derivative(lambda t: at(t).v), mo.a, scale=scale) < 1e-8
+        u2 = lambda t: at(t).l2 / abs(at(t).l2)  # noqa: E731
+        w2 = np.imag(np.conj(u2(0.0)) * derivative(u2))
+        assert rel_err(w2, mo.omega[1], scale=max(1.0, abs(w0))) < 1e-9
+        assert rel_err(derivative(lambda t: at(t).omega[1]), mo.alpha[1], scale=scale) < 1e-8
+
+
+def test_assembly_range_and_dead_points():
+    lengths = (0.2, 0.3, 0.2)  # r + |e| > L: the crank cannot turn
+    rng = sk.assembly_range(lengths)
+    assert not rng.full and len(rng.intervals) == 1
+    for end in rng.intervals[0]:
+        mo = sk.motion(lengths, end)
+        assert mo.singular[0] and abs(abs(mo.l2[0].imag) - 0.3) < 1e-12  # rod square to guide
+    with pytest.raises(AssemblyError):
+        sk.motion(lengths, -math.pi / 2)  # the arc that is excluded: e − r·sin θ1 > L
+    assert sk.assembly_range((0.1, 0.3, 0.15)).full
+
+
+@pytest.mark.parametrize("mech", CASES)
+@pytest.mark.parametrize("gravity", [(0.0, 0.0), (0.4, -9.81)])
+def test_the_two_inverse_dynamics_routes_agree(mech, gravity):
+    rng = np.random.default_rng(2)
+    t = _angles(rng, mech, 40)
+    mo = sk.motion_of(mech, t, rng.uniform(-4, 4, t.size), rng.uniform(-8, 8, t.size))
+    keep = ~mo.singular
+    a = sd.newton_euler(mech, mo, gravity=gravity)
+    b = sd.mass_matrix(mech, mo, gravity=gravity)
+    force = max(np.max(np.abs(a.RA0)), np.max(np.abs(a.RA3)), 1.0)
+    moment = max(np.max(np.abs(a.shaking_moment)), np.max(np.abs(a.driving_torque)), 1.0)
+    for name, scale in (("RA0", force), ("RA3", force), ("shaking_force", force),
+                        ("driving_torque", moment), ("shaking_moment", moment)):
+        assert rel_err(getattr(a, name)[keep], getattr(b, name)[keep], scale=scale) < 1e-9
+
+
+@pytest.mark.parametrize("mech", CASES[:6])
+def test_shaking_force_moment_and_torque_against_momentum_and_energy(mech):
+    """Shaking force = loads − dP/dt; shaking moment = load moments − dH/dt (the gas force is
+    internal: it cancels); τ·θ̇1 = dT/dt − power of loads and gas."""
+    rng = np.random.default_rng(3)
+    g = (0.3, -9.81)
+    for t0 in _angles(rng, mech, 3):
+        w0, a0 = rng.uniform(0.5, 2.0), rng.uniform(-2, 2)
+
+        def at(t, t0=t0, w0=w0, a0=a0):
+            return sk.motion_of(mech, t0 + w0 * t + 0.5 * a0 * t * t, w0 + a0 * t, a0)
+
+        mo = at(0.0)
+        if abs(mo.transfer[0][0]) > 20:
+            continue
+        rea = sd.newton_euler(mech, mo, gravity=g)
+        r, big_l, _ = mech.lengths
+        c1, c2, c3 = mech.links
+        z1, z2 = c1.com / r, c2.com / big_l
+
+        def momentum(t):
+            m = at(t)
+            v = (z1 * m.vector_rate(0), m.vector_rate(0) + z2 * m.vector_rate(1), m.v + 0j)
+            return sum(link.mass * vk for link, vk in zip(mech.links, v, strict=True))
+
+        loads = [link.force_complex + link.mass * complex(*g) for link in mech.links]
+        expected = sum(loads) - derivative(momentum)
+        assert rel_err(rea.shaking_force, expected, scale=max(1.0, abs(expected[0]))) < 1e-9
+        coms = sm.link_centres_of_mass(mech, mo)
+        load_moment = sum(cross(c, f) + link.moment for c, f, link in zip(coms, loads,
+                                                                           mech.links,
+                                                                           strict=True))
+        dh = derivative(lambda t: sd.angular_momentum(mech, at(t)))
+        exp_m = load_moment - dh
+        assert rel_err(rea.shaking_moment, exp_m, scale=max(1.0, abs(exp_m[0]))) < 1e-9
+        dt = derivative(lambda t: sd.kinetic_energy(mech, at(t)))
+        vel = (z1 * mo.vector_rate(0), mo.vector_rate(0) + z2 * mo.vector_rate(1), mo.v + 0j)
+        power = sum(np.real(np.conj(f) * v) for f, v in zip(loads, vel, strict=True))
+        power = power + mech.crank.moment * mo.omega[0] + mech.rod.moment * mo.omega[1]
+        power = power + mech.gas_force.at(mo.theta1) * mo.v
+        scale = max(1.0, abs(dt[0]), abs(rea.driving_torque[0] * w0))
+        assert rel_err(rea.driving_torque * w0, dt - power, scale=scale) < 1e-9
+
+
+@pytest.mark.parametrize("mech", CASES)
+def test_wunderlich_similarity_to_rounding(mech):
+    rng = np.random.default_rng(4)
+    mo = sk.motion_of(mech, _angles(rng, mech, 60))
+    w = sm.wunderlich_slider_crank(mech)
+    com = sm.total_com_direct(mech, mo)
+    scale = sum(abs(x) for x in mech.lengths)
+    assert rel_err(w.trace(mo), com, scale=scale) < 1e-12
+    # The generating slider-crank is the original scaled and turned by α1 (Eq. 18).
+    b1, b2 = w.generating_joints(mo)
+    assert rel_err(np.abs(b1 - w.B0), abs(w.scale) * mech.lengths[0], scale=scale) < 1e-12
+    assert rel_err(np.abs(b2 - b1), abs(w.scale) * mech.lengths[1], scale=scale) < 1e-12
+
+
+def test_wunderlich_circle_and_point_cases():
+    rng = np.random.default_rng(5)
+    mech = random_slider_crank(rng, loads=False, rotor=False)
+    r, big_l, _ = mech.lengths
+    t = sk.assembly_range(mech.lengths).intervals[0]
+    mo = sk.motion_of(mech, np.linspace(t[0] + 0.01, t[1] - 0.01, 80))
+    # Eq. 20b alone: the rod's centre of mass beyond the crank pin, σ2 = −m3/m2 → a circle
+    # about B0 of radius |α1|·r (Eq. 14b).
+    c2, c3 = mech.rod, mech.slider
+    s2 = -(c3.mass / c2.mass) * big_l
+    m20b = mech.with_link("rod", replace(c2, e=s2, f=0.0))
+    w = sm.wunderlich_slider_crank(m20b)
+    assert w.is_circle and not w.is_stationary
+    radius = np.abs(sm.total_com_direct(m20b, mo) - w.B0)
+    assert np.ptp(radius) < 1e-14 and abs(radius[0] - abs(w.alpha[1]) * r) < 1e-14
+    # Eq. 20a alone: the crank's beyond A0, σ1 = −(m2 + m3)/m1 → an arc about B0 (Eq. 14a).
+    m20a = mech.with_link("crank", replace(mech.crank, e=-(c2.mass + c3.mass) / mech.crank.mass
+                                           * r, f=0.0))
+    w = sm.wunderlich_slider_crank(m20a)
+    assert w.is_circle
+    radius = np.abs(sm.total_com_direct(m20a, mo) - w.B0)
+    assert np.ptp(radius) < 1e-14
+    # Both: a point (Eq. 14c), at B0 = m3·s3.
+    both = sc_cond.force_balanced_by_counterweights(mech)
+    assert sm.wunderlich_slider_crank(both).is_stationary and sc_cond.is_force_balanced(both)
+    com = sm.total_com_direct(both, mo)
+    assert np.max(np.abs(com - c3.mass * c3.com / both.total_mass)) < 1e-15
+
+
+@pytest.mark.parametrize("method", ["complex-masses", "mass-matrix"])
+@pytest.mark.parametrize("drive", ["free", "constant-speed"])
+def test_eq20_balanced_design_has_no_simulated_shaking_force(method, drive):
+    """Issue 5: with (20a) and (20b) the simulated shaking force vanishes at integration-error
+    level, free and driven, in both formulations."""
+    rng = np.random.default_rng(6)
+    mech = sc_cond.force_balanced_by_counterweights(random_slider_crank(rng, loads=False))
+    settings = SimulationSettings(duration=1.0, theta1=0.3, omega1=8.0, drive=drive)
+    tr = simulate(mech, settings, method=method, rtol=1e-11, atol=1e-13)
+    reactions = max(np.max(np.abs(tr.RA0)), np.max(np.abs(tr.RA3)))
+    assert reactions > 1.0
+    assert np.max(np.abs(tr.shaking_force)) < 1e-9 * reactions
+    assert tr.energy_error < 1e-9
+
+
+@pytest.mark.parametrize("mech", CASES[:8])
+@pytest.mark.parametrize("driven", [False, True])
+def test_formulations_agree_at_states(mech, driven):
+    rng = np.random.default_rng(7)
+    g = (0.2, -9.81)
+    for t in _angles(rng, mech, 4):
+        w = rng.uniform(-5, 5)
+        evs = []
+        for name in ("complex-masses", "mass-matrix"):
+            f = make(name, mech, gravity=g, speed=w if driven else None)
+            evs.append(f.evaluate(0.0, f.initial_state(t, w)))
+        a, b = evs
+        mo = sk.motion_of(mech, t, w, a.alpha[0])
+        ne = sd.newton_euler(mech, mo, gravity=g)
+        force = max(abs(ne.RA0[0]), abs(ne.RA3[0]), 1.0)
+        assert abs(a.alpha[0] - b.alpha[0]) < 1e-9 * max(1.0, abs(a.alpha[0]), w * w)
+        assert abs(ne.driving_torque[0] - a.driving_torque) < 1e-9 * max(1.0, force)
+        for ev in evs:
+            assert abs(ev.RA0 - ne.RA0[0]) < 1e-9 * force
+            assert abs(ev.RA3 - ne.RA3[0]) < 1e-9 * force
+            assert abs(ev.shaking_moment - ne.shaking_moment[0]) < 1e-9 * max(1.0, force)
+
+
+def test_engine_simulations_agree_and_balance_energy():
+    design = spec.load_design(EXAMPLES / "engine.toml")
+    runs = {}
+    for method in ("complex-masses", "mass-matrix"):
+        for drive in ("free", "constant-speed"):
+            runs[method, drive] = simulate(design.mechanism, design.simulation, method=method,
+                                           drive=drive, rtol=1e-12, atol=1e-14)
+    for drive in ("free", "constant-speed"):
+        a, b = runs["complex-masses", drive], runs["mass-matrix", drive]
+        # A steep gas-force cycle at 9000 rpm (energies of hundreds of joules, three and a half
+        # revolutions): at rtol 1e-12 the two agree to 1e-9 of the angle travelled.
+        assert np.max(np.abs(a.theta[:, -1] - b.theta[:, -1])) < 1e-9 * abs(a.theta[0, -1])
+        assert np.max(np.abs(a.slider[:, -1] - b.slider[:, -1])) < 1e-7 * np.max(np.abs(a.slider))
+        assert a.energy_error < 5e-9 and b.energy_error < 5e-9
+    # Driven at constant speed, the simulation's torque is the cycle analysis's.
+    tr = runs["complex-masses", "constant-speed"]
+    ca = sd.cycle_analysis(design.mechanism, design.simulation.omega1, theta1=tr.theta[0])
+    scale = np.max(np.abs(ca.reactions.driving_torque))
+    assert np.max(np.abs(tr.driving_torque - ca.reactions.driving_torque)) < 1e-9 * scale
+
+
+def test_partial_balancing_matches_the_classic_closed_form():
+    """An in-line engine with only a crank counterweight, minimising w_x·RMS(Fx)² + w_y·RMS(Fy)²:
+    the counterweight's force is a pure first harmonic, so the optimum balances the rotating
+    masses and the fraction w_x/(w_x + w_y) of the reciprocating mass (the rod split into two
+    masses at its joints; its centre of mass on its line)."""
+    from balancer.inverse import parameter_vector
+    from balancer.optimize import optimize
+    from balancer.optimize.nlp import NlpSolver
+    from balancer.problem import numeric_problem
+
+    base = spec.load_design(EXAMPLES / "engine.toml")
+    for wx, wy in ((1.0, 1.0), (3.0, 1.0), (1.0, 4.0)):
+        text = spec.dumps_design(base).replace(
+            "shaking_force_x = 1.0", f"shaking_force_x = {wx}").replace(
+            "shaking_force_y = 1.0", f"shaking_force_y = {wy}")
+        design = spec.loads_design(text)
+        result = optimize(design, backend="convex")
+        crank = result.linkage.crank
+        expected = sc_cond.classic_counterweight(base.mechanism, wx / (wx + wy))
+        closed = replace(base.mechanism.crank, e=(expected / crank.mass).real, f=0.0)
+        data = numeric_problem(design)
+        x_closed = parameter_vector(base.mechanism.with_link("crank", closed))
+        # The objective is quadratic and flat at the optimum: it is met to the solver's
+        # tolerance, the counterweight to about its square root.
+        assert result.objective == pytest.approx(data.objective(x_closed), rel=1e-9)
+        assert abs(crank.mass * crank.com - expected) < 1e-5 * abs(expected)
+        # IPOPT on the designer's parameters converges on the counterweight itself.
+        nlp = NlpSolver(data).solve(data.x0)
+        got = complex(nlp.x[1], nlp.x[2])
+        assert abs(got - expected) < 1e-8 * abs(expected)
+    # Equal weights: the classic half of the reciprocating mass, and only the first harmonic
+    # moved (the secondary is the reciprocating mass's, which a crank counterweight cannot touch).
+    design = base
+    result = optimize(design, backend="nlp")
+    before = sc_cond.harmonics(result.before)
+    after = sc_cond.harmonics(result.after)
+    assert after["shaking_force_x"][2] == pytest.approx(before["shaking_force_x"][2], rel=1e-9)
+    assert after["shaking_force_x"][1] < before["shaking_force_x"][1]
+
+
+def test_full_force_balance_with_a_rod_counterweight():
+    """Eq. 20a–b as constraints in both backends: crank and rod counterweights."""
+    from balancer.optimize import optimize
+
+    text = (EXAMPLES / "engine.toml").read_text()
+    text = text.replace("force_balance = false", "force_balance = true").replace(
+        "[balance.crank]", "[balance.rod]\nmass = [0.07, 0.3]\ncom_radius = 0.1\n"
+        "com_about = \"A1\"\nmin_gyration = 0.02\n\n[balance.crank]").replace(
+        "mass = [0.9, 1.4]", "mass = [0.9, 3.0]").replace("com_radius = 0.03", "com_radius = 0.06")
+    design = spec.loads_design(text)
+    for backend in ("convex", "nlp"):
+        result = optimize(design, backend=backend)
+        assert result.success
+        assert sc_cond.force_balance_error(result.linkage) < 1e-10
+        assert result.after.summary.shaking_force.max < 1e-8 * result.before.summary.shaking_force.max
+        assert result.linkage.rod.e < 0  # the counterweight beyond the crank pin (Eq. 20b)
+
+
+def test_slider_crank_spec_errors_and_round_trip(tmp_path):
+    design = spec.load_design(EXAMPLES / "engine.toml")
+    assert design.mechanism.type == "slider-crank" and len(design.mechanism.gas_force.values) > 1
+    assert spec.loads_design(spec.dumps_design(design)) == design
+    text = (EXAMPLES / "engine.toml").read_text()
+    bad = {
+        "rocker under a slider-crank": (text.replace("[links.rod]", "[links.rocker]"),
+                                        "links.rocker"),
+        "offset beyond reach": (text.replace("offset = 0.0 ", "offset = 0.5 "),
+                                "mechanism.lengths.offset"),
+        "frame length": (text.replace("offset = 0.0 ", "frame = 0.1 "), "mechanism.lengths"),
+        "gas table lengths": (text.replace("force = [-3500.0, ", "force = ["),
+                              "links.slider.gas_force"),
+        "gas on the crank": (text.replace("com = { e = -0.004, f = 0.0 }",
+                                          "com = { e = -0.004, f = 0.0 }\ngas_force = 1.0"),
+                             "links.crank.gas_force"),
+        "counter-rotor on the slider": (text.replace("mass = 0.060", "mass = 0.060\n"
+                                                     "counter_rotor = 1.0"),
+                                        "links.slider.counter_rotor"),
+        "balance of a rocker": (text + "\n[balance.rocker]\nmass = [1.0, 2.0]\n",
+                                "balance.rocker"),
+    }
+    for name, (body, key) in bad.items():
+        with pytest.raises(SpecError) as info:
+            spec.loads_design(body, source="e.toml")
+        assert key in str(info.value), name
+    path = tmp_path / "bad.toml"
+    path.write_text(bad["offset beyond reach"][0])
+    assert main(["analyze", str(path)]) == 2
+
+
+def test_slider_crank_through_the_command_line(tmp_path, capsys):
+    engine = str(EXAMPLES / "engine.toml")
+    assert main(["analyze", engine, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert set(doc["reactions"]) == {"A0", "guide"} and doc["shaking_force"]["rms"] > 0
+    out = tmp_path / "run.csv"
+    assert main(["simulate", engine, "--out", str(out), "--duration", "0.005"]) == 0
+    capsys.readouterr()
+    header = out.read_text().splitlines()[0].split(",")
+    assert header[:14] == ["t", "theta1", "theta2", "theta3", "omega1", "omega2", "omega3",
+                           "alpha1", "alpha2", "alpha3", "RA0x", "RA0y", "RA3x", "RA3y"]
+    assert header[14:] == ["x3", "v3", "a3"]
+    balanced = tmp_path / "balanced.toml"
+    assert main(["optimize", engine, "--out", str(balanced), "--json",
+                 "--verify-duration", "0.005"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["status"] == "optimal" and set(doc["links"]) == {"crank", "rod", "slider"}
+    assert main(["verify", str(balanced), "--duration", "0.005", "--plot",
+                 str(tmp_path / "v.png")]) == 0
+    assert "complex-masses" in capsys.readouterr().out
+    assert main(["simulate", engine, "--method", "lie-group"]) == 2
+    assert "slider-crank" in capsys.readouterr().err
+    assert main(["plot", engine, "--animate", str(tmp_path / "e.gif"), "--frames", "6"]) == 0
