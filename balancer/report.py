@@ -102,6 +102,8 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
             "reactions": _reactions_dict(linkage, analysis.reactions.RA0,
                                          analysis.reactions.RA3, analysis.reactions.guide_line),
             "change_points": _change_points(analysis),
+            **({"harmonics": _harmonics_dict(analysis)} if linkage.type == "slider-crank"
+               else {}),
             "units": {
                 "force": "N",
                 "moment": "N·m",
@@ -123,6 +125,14 @@ def _reactions_dict(linkage, ra0, ra3, guide_line=None) -> dict[str, dict[str, f
             out[second]["line_of_action_x_min"] = float(line.min())
             out[second]["line_of_action_x_max"] = float(line.max())
     return out
+
+
+def _harmonics_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
+    """Primary and secondary harmonic amplitudes of a slider-crank's shaking (N, N·m)."""
+    from .slider_crank.conditions import harmonics
+
+    h = harmonics(analysis)
+    return {name: {"primary": float(v[1]), "secondary": float(v[2])} for name, v in h.items()}
 
 
 def _change_points(analysis: CycleAnalysis) -> list[float]:
@@ -490,6 +500,9 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
             ],
             "force_balanced": is_force_balanced(linkage),
             "force_balance_residual": force_balance_error(linkage),
+            **({"harmonics": {"before": _harmonics_dict(before),
+                              "after": _harmonics_dict(after)}}
+               if linkage.type == "slider-crank" else {}),
             "verification": None if verification is None else verification.as_dict(),
             "out": None if out is None else str(out),
             "units": {"objective": "(N·m)², mean square of the inertial shaking", "time": "s",
@@ -519,6 +532,12 @@ def optimization_text(result, before, after, verification=None, spec=None, out=N
     lines.append(table(rows, ["at the operating speed", "RMS before", "RMS after", "ratio",
                               "max before", "max after", "unit"]))
     lines.append("")
+    if result.linkage.type == "slider-crank":
+        hb, ha = _harmonics_dict(before), _harmonics_dict(after)
+        rows = [[name.replace("_", " "), _fmt(hb[name][order]), _fmt(ha[name][order]), order]
+                for name in ("shaking_force_x", "shaking_force_y", "shaking_moment")
+                for order in ("primary", "secondary")]
+        lines += [table(rows, ["harmonic amplitude", "before", "after", "order"]), ""]
     rows = []
     for name in result.linkage.link_names:
         old, new = result.original.link(name), result.linkage.link(name)

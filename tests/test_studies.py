@@ -87,6 +87,10 @@ def test_wunderlich1964(quick):
     assert r["stationary_force_balance"] < 1e-12
     assert r["neutral_equilibrium"] < 1e-9
     assert abs(r["stationary_point"].imag) < 1e-15
+    sc = r["slider_crank"]  # Fig. 3 / Theorem 3 and Eq. 20a–b
+    assert sc["similarity_error"] < 1e-12
+    assert sc["stationary_spread"] < 1e-12 and sc["stationary_at_B0"] < 1e-12
+    assert any(f.name == "fig3_slider_crank.png" for f in r["figures"])
 
 
 def test_bai2024_lie_group(quick):
