@@ -125,7 +125,10 @@ class Optimizer:
             if nlp.status == "optimal" and nlp.feasible:
                 scale = max(abs(objective), gap_floor(data.objective_reference))
                 if not feasible or nlp.objective < objective - TIE_TOLERANCE * scale:
-                    x, objective, feasible = nlp.x, nlp.objective, True
+                    xb = self.convex.balanced(nlp.x)  # Eq. 58 to rounding, not to IPOPT's tol
+                    if data.violations(xb):
+                        xb = nlp.x
+                    x, objective, feasible = xb, data.objective(xb), True
             else:
                 notes.append(f"IPOPT: {nlp.stage.solver_status}")
         elapsed = time.perf_counter() - t0

@@ -414,18 +414,59 @@ class ConvexSolver:
         u = lay.u(x)
         preferred = lay.u(target)
         floor = gap_floor(data.objective_reference)
+        pinned = np.zeros(u.size, dtype=bool)  # entries put back: Eq. 58 may not move them
         for j in range(u.size):
             if u[j] == preferred[j]:
+                pinned[j] = True
                 continue
             trial = u.copy()
             trial[j] = preferred[j]
+            trial_pinned = pinned.copy()
+            trial_pinned[j] = True
+            trial = self.restore_balance(trial, trial_pinned)
             xt = data.settle(lay.x(trial), for_motion=False)
             if data.violations(xt):
                 continue
             jt = data.objective(xt)
             if abs(jt - objective) <= 1e-12 * max(abs(objective), floor):
-                u, x, objective = trial, xt, jt
+                u, x, objective, pinned = trial, xt, jt, trial_pinned
         return x, objective
+
+    def balanced(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Design vector ``x`` (another solver's, e.g. IPOPT's) with Eq. 58 met to rounding.
+
+        The least change of the free variables does it (:meth:`restore_balance`); the entries
+        that are not free variables are kept.
+        """
+        lay = self.layout
+        x = np.array(x, dtype=float)
+        if not lay.size:
+            return x
+        u = lay.u(x)
+        return x + lay.T @ (self.restore_balance(u) - u)
+
+    def restore_balance(
+        self, u: NDArray[np.float64], pinned: NDArray[np.bool_] | None = None
+    ) -> NDArray[np.float64]:
+        """Solver variables ``u`` moved the least to meet Eq. 58 to rounding.
+
+        The move is the least in the scaled variables; the ``pinned`` entries are kept.
+        Interior-point solvers meet the force balance to their tolerance (Clarabel's 1e-10,
+        IPOPT's 1e-12 in scaled units); this puts the shaking force at rounding level. Where
+        the unpinned entries cannot restore a row, the least-squares correction is made and the
+        feasibility check that follows decides.
+        """
+        u = np.array(u, dtype=float)
+        if self._fb is None:
+            return u
+        at, rhs, pinv = self._fb
+        residual = at @ u - rhs
+        if pinned is None or not pinned.any():
+            return u - pinv @ residual
+        free = ~pinned
+        if free.any():
+            u[free] -= np.linalg.lstsq(at[:, free], residual, rcond=None)[0]
+        return u
 
     def repair(self, u: NDArray[np.float64]) -> tuple[NDArray[np.float64], bool]:
         """The design of solver variables ``u``, with the solver's small violations removed.
@@ -444,9 +485,7 @@ class ConvexSolver:
         data, lay = self.data, self.layout
         u = np.array(u, dtype=float)
         index = {entry: j for j, entry in enumerate(lay.primary)}
-        if self._fb is not None:  # Eq. 58 to rounding, not to Clarabel's tolerance
-            at, rhs, pinv = self._fb
-            u -= pinv @ (at @ u - rhs)
+        u = self.restore_balance(u)  # Eq. 58 to rounding, not to Clarabel's tolerance
         # Met to the feasibility tolerance: leave the solver's design alone (a "repair" of a
         # 1e-12 violation would cost more objective than it is worth at a zero optimum).
         rounds = 2 if data.violations(data.settle(lay.x(u), for_motion=False)) else 0
@@ -469,9 +508,7 @@ class ConvexSolver:
                     assert b.counter_rotor is not None
                     lo, hi = (v / data.scales[entry] for v in b.counter_rotor)
                     u[index[entry]] = np.clip(u[index[entry]], lo, hi)
-            if self._fb is not None:
-                at, rhs, pinv = self._fb
-                u -= pinv @ (at @ u - rhs)
+            u = self.restore_balance(u)
         x = lay.x(u)
         tight = True
         for b in data.links:
