@@ -138,30 +138,37 @@ def verification_figure(design, verification) -> Figure:
     return fig
 
 
+def _write_atomic(fig: Figure, out: Path, dpi: float | None) -> Path:
+    """Write ``fig`` to ``out`` (format from the suffix) via a temporary file, whole or not."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig)
+    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=out.suffix,
+                               dir=out.parent if str(out.parent) else ".")
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=dpi, format=out.suffix[1:])
+        _publish(tmp, out)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return out
+
+
 def save_figure(fig: Figure, path: str | os.PathLike[str]) -> list[Path]:
     """Write the figure as PNG and SVG next to each other (``path``'s stem), atomically.
 
     Returns the files written.
     """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    FigureCanvasAgg(fig)
     target = Path(path)
     stem = target.with_suffix("") if target.suffix.lower() in (".png", ".svg") else target
-    written = []
-    for suffix, dpi in ((".png", 150), (".svg", None)):
-        out = stem.with_suffix(suffix)
-        fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=suffix,
-                                   dir=out.parent if str(out.parent) else ".")
-        os.close(fd)
-        try:
-            fig.savefig(tmp, dpi=dpi, format=suffix[1:])
-            _publish(tmp, out)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-        written.append(out)
-    return written
+    return [_write_atomic(fig, stem.with_suffix(suffix), dpi)
+            for suffix, dpi in ((".png", 150), (".svg", None))]
+
+
+def save_png(fig: Figure, path: str | os.PathLike[str], dpi: float = 100) -> Path:
+    """Write the figure as one PNG at ``dpi``, atomically; returns the path written."""
+    return _write_atomic(fig, Path(path).with_suffix(".png"), dpi)
 
 
 def linkage_frames(linkage, frames: int = 72):

@@ -33,17 +33,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from balancer.formulations import make
 from balancer.kinematics import classify
 from balancer.model import METHODS, FourBar, Link, SimulationSettings
-from balancer.plots import COLOURS
+from balancer.plots import COLOURS, save_png
+from balancer.report import markdown_table
 from balancer.simulate import simulate
 
 NAME = "bai2024_lie_group"
-DPI = 100
 GRAVITY = (0.0, -9.81)
 #: Masses (kg) and moments of inertia (kg·m², about the centres of mass) of Sect. 7.
 MASSES = (0.1, 0.25, 0.18)
@@ -69,21 +68,6 @@ CASES = (
     Case("parallelogram", "parallelogram (Sect. 7.3, Fig. 7–8)", (0.1, 0.25, 0.1, 0.25),
          math.atan2(0.8, 0.6), (0.6, 0.8, 1, 0, 0.6, 0.8), "fig7_parallelogram.png"),
 )
-
-
-def save_png(fig: Figure, path: Path) -> Path:
-    """Write a figure as PNG with the Agg canvas."""
-    FigureCanvasAgg(fig)
-    fig.savefig(path, dpi=DPI)
-    return path
-
-
-def markdown_table(header: list[str], rows: list[list[str]]) -> str:
-    """A GitHub-flavoured markdown table (first column left-aligned, the others right)."""
-    lines = ["| " + " | ".join(header) + " |",
-             "|" + "|".join([":---"] + ["---:"] * (len(header) - 1)) + "|"]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
-    return "\n".join(lines)
 
 
 def linkage(lengths: tuple[float, float, float, float]) -> FourBar:

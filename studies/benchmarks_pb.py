@@ -27,34 +27,18 @@ import time
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from balancer.conditions import berkof_residuals, force_balance_error
 from balancer.optimize import BACKENDS, optimize
-from balancer.plots import COLOURS, verification_figure
+from balancer.plots import COLOURS, save_png, verification_figure
+from balancer.report import markdown_table
 from balancer.spec import load_design
 from balancer.verify import verify
 
 NAME = "benchmarks_pb"
 ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = {"PB1": ROOT / "examples" / "pb1.toml", "PB2": ROOT / "examples" / "pb2.toml"}
-DPI = 100
-
-
-def save_png(fig: Figure, path: Path, dpi: int = DPI) -> Path:
-    """Write a figure as PNG with the Agg canvas."""
-    FigureCanvasAgg(fig)
-    fig.savefig(path, dpi=dpi)
-    return path
-
-
-def markdown_table(header: list[str], rows: list[list[str]]) -> str:
-    """A GitHub-flavoured markdown table (first column left-aligned, the others right)."""
-    lines = ["| " + " | ".join(header) + " |",
-             "|" + "|".join([":---"] + ["---:"] * (len(header) - 1)) + "|"]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
-    return "\n".join(lines)
 
 
 def figure_cycle(name: str, result) -> Figure:

@@ -29,7 +29,6 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from balancer.conditions import (
@@ -40,14 +39,14 @@ from balancer.conditions import (
 from balancer.inverse import cycle_analysis
 from balancer.model import METHODS, SimulationSettings
 from balancer.optimize import optimize
-from balancer.plots import COLOURS, plot_reactions
+from balancer.plots import COLOURS, plot_reactions, save_png
+from balancer.report import markdown_table
 from balancer.simulate import simulate
 from balancer.spec import dumps_design, load_design, loads_design
 
 NAME = "meijaard2020_balanced"
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
-DPI = 100
 RTOL, ATOL = 1e-11, 1e-13
 #: Operating speed of the comparison (PB1/PB2's), rad/s, and crank angles per revolution.
 SPEED, SAMPLES = 10.0, 360
@@ -55,21 +54,6 @@ SPEED, SAMPLES = 10.0, 360
 FREE = SimulationSettings(duration=5.0, theta1=1.0, omega1=1.0)
 DESIGN_COLOURS = {"original": COLOURS["before"], "force-balanced": COLOURS["A0"],
                   "moment-minimised": COLOURS["A3"], "complete": COLOURS["after"]}
-
-
-def save_png(fig: Figure, path: Path) -> Path:
-    """Write a figure as PNG with the Agg canvas."""
-    FigureCanvasAgg(fig)
-    fig.savefig(path, dpi=DPI)
-    return path
-
-
-def markdown_table(header: list[str], rows: list[list[str]]) -> str:
-    """A GitHub-flavoured markdown table (first column left-aligned, the others right)."""
-    lines = ["| " + " | ".join(header) + " |",
-             "|" + "|".join([":---"] + ["---:"] * (len(header) - 1)) + "|"]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
-    return "\n".join(lines)
 
 
 def balanced_from(problem_spec: Path, linkage, title: str):

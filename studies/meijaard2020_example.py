@@ -27,40 +27,24 @@ import time
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from balancer.formulations import make
 from balancer.model import METHODS
-from balancer.plots import COLOURS
+from balancer.plots import COLOURS, save_png
+from balancer.report import markdown_table
 from balancer.simulate import simulate
 from balancer.spec import load_design
 
 NAME = "meijaard2020_example"
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "examples" / "meijaard2020.toml"
-DPI = 100
 #: Integrator tolerances (tight: the spread between formulations is then integration error).
 RTOL, ATOL = 1e-11, 1e-13
 #: Output times over the 5 s, as the paper's 501 values.
 OUTPUTS = 501
 LINE_STYLES = {"opened-loop": "-", "complex-masses": "--", "mass-matrix": "-.",
                "lie-group": ":"}
-
-
-def save_png(fig: Figure, path: Path) -> Path:
-    """Write a figure as PNG with the Agg canvas."""
-    FigureCanvasAgg(fig)
-    fig.savefig(path, dpi=DPI)
-    return path
-
-
-def markdown_table(header: list[str], rows: list[list[str]]) -> str:
-    """A GitHub-flavoured markdown table (first column left-aligned, the others right)."""
-    lines = ["| " + " | ".join(header) + " |",
-             "|" + "|".join([":---"] + ["---:"] * (len(header) - 1)) + "|"]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
-    return "\n".join(lines)
 
 
 def simulate_all(design, outputs: int) -> dict:

@@ -33,7 +33,6 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from balancer.conditions import force_balance_error
@@ -41,7 +40,8 @@ from balancer.inverse import sample_angles
 from balancer.kinematics import position_of
 from balancer.massmodels import link_centres_of_mass, total_com_direct, wunderlich_linkage
 from balancer.model import FourBar, Link, SimulationSettings, SliderCrank
-from balancer.plots import COLOURS
+from balancer.plots import COLOURS, save_png
+from balancer.report import markdown_table
 from balancer.simulate import simulate
 from balancer.slider_crank import conditions as sc_cond
 from balancer.slider_crank import kinematics as sk
@@ -51,27 +51,11 @@ from balancer.spec import load_design
 NAME = "wunderlich1964"
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "examples" / "meijaard2020.toml"
-DPI = 100
 #: Crank angle at which the linkages are drawn, rad.
 DRAW_AT = 1.0
 #: Theorem 2's free choice: the crank's centre of mass as a real fraction of the crank,
 #: σ1 = −1 (a counterweight at the crank's length beyond A0).
 SIGMA1 = -1.0
-
-
-def save_png(fig: Figure, path: Path) -> Path:
-    """Write a figure as PNG with the Agg canvas."""
-    FigureCanvasAgg(fig)
-    fig.savefig(path, dpi=DPI)
-    return path
-
-
-def markdown_table(header: list[str], rows: list[list[str]]) -> str:
-    """A GitHub-flavoured markdown table (first column left-aligned, the others right)."""
-    lines = ["| " + " | ".join(header) + " |",
-             "|" + "|".join([":---"] + ["---:"] * (len(header) - 1)) + "|"]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
-    return "\n".join(lines)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -300,8 +284,7 @@ def slider_crank_counterpart(out_dir: Path, quick: bool = False) -> dict:
         ax.set_ylabel("y (m)")
         ax.grid(alpha=0.3)
         ax.legend(fontsize="small", loc="lower left")
-    FigureCanvasAgg(fig)
-    fig.savefig(out_dir / "fig3_slider_crank.png", dpi=DPI)
+    save_png(fig, out_dir / "fig3_slider_crank.png")
     return {
         "similarity_error": similarity,
         "beta": complex(w.beta),

@@ -1,0 +1,49 @@
+"""Output helpers shared by the CLI and the studies: markdown tables and atomic figure files."""
+
+from __future__ import annotations
+
+import struct
+
+import pytest
+from matplotlib.figure import Figure
+
+from balancer.plots import save_figure, save_png
+from balancer.report import markdown_table
+
+
+def test_markdown_table_aligns_first_column_left_and_the_others_right():
+    text = markdown_table(["case", "rms (N)", "max (N)"], [["PB1", "1.5", "2"], ["PB2", "0", "0"]])
+    assert text == (
+        "| case | rms (N) | max (N) |\n"
+        "|:---|---:|---:|\n"
+        "| PB1 | 1.5 | 2 |\n"
+        "| PB2 | 0 | 0 |"
+    )
+
+
+def _png_size(path) -> tuple[int, int]:
+    """Width and height from the PNG's IHDR chunk (read independently of matplotlib)."""
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and data[12:16] == b"IHDR"
+    return struct.unpack(">II", data[16:24])
+
+
+def test_save_png_writes_one_png_at_the_asked_resolution_and_no_temporary_file(tmp_path):
+    fig = Figure(figsize=(4.0, 3.0))
+    fig.add_subplot().plot([0, 1], [1, 0])
+    written = save_png(fig, tmp_path / "curve.svg", dpi=50)  # the suffix is made .png
+    assert written == tmp_path / "curve.png"
+    assert _png_size(written) == (200, 150)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["curve.png"]
+
+
+def test_save_figure_writes_png_and_svg_and_leaves_nothing_on_failure(tmp_path):
+    fig = Figure(figsize=(2.0, 1.0))
+    fig.add_subplot().plot([0, 1], [0, 1])
+    written = save_figure(fig, tmp_path / "report.png")
+    assert written == [tmp_path / "report.png", tmp_path / "report.svg"]
+    assert _png_size(written[0]) == (300, 150)  # 150 dpi
+    assert written[1].read_text().lstrip().startswith("<?xml")
+    with pytest.raises(FileNotFoundError):
+        save_png(fig, tmp_path / "missing" / "x.png")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report.png", "report.svg"]
