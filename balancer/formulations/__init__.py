@@ -147,6 +147,16 @@ class Formulation(ABC):
         assert self.speed is not None
         return self.theta1_start + self.speed * t
 
+    @staticmethod
+    def continuous_crank(wrapped: float, carried: float) -> float:
+        """The crank angle continuous along a free motion, rad.
+
+        Formulations whose coordinates give the crank angle only modulo 2π (nodal positions,
+        attitudes) carry the continuous angle as an auxiliary state ``carried``, advanced by
+        θ̇1; it is snapped here to the coordinates' ``wrapped`` angle.
+        """
+        return carried + math.remainder(wrapped - carried, 2 * math.pi)
+
     @abstractmethod
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         """The state with the crank at ``theta1`` (rad) turning at ``omega1`` (rad/s) at t = 0."""

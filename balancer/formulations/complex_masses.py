@@ -25,13 +25,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..kinematics import branch_sign_along, position_scalar, rates_scalar
+from ..kinematics import branch_sign_along, cross_scalar, position_scalar, rates_scalar
 from . import Evaluation, Formulation
-
-
-def _cross(x: complex, y: complex) -> float:
-    """⟨i·x̄, ȳ⟩ = x × y."""
-    return x.real * y.imag - x.imag * y.real
 
 
 def _ip(x: complex, y: complex) -> float:
@@ -86,13 +81,13 @@ class ComplexMasses(Formulation):
         (v1, _, v3), big2, big3, w2, w3, b2, b3 = kin
         m2 = self.mass[1]
         m13 = -_ip(self.m2p * v1, self.m2q * v3) / m2  # Eq. 37
-        c13 = _cross(self.m2p * v1, self.m2q * v3) / m2  # Eq. 38, C31 = −C13
+        c13 = cross_scalar(self.m2p * v1, self.m2q * v3) / m2  # Eq. 38, C31 = −C13
         f1, f2, f3 = self.forces
         mo1, mo2, mo3 = self.moments
         z1, _, z3 = self.zeta
-        q1 = mo1 + _cross(z1 * v1, f1) + _cross(self.m2p * v1, f2) / m2  # Eq. 39
+        q1 = mo1 + cross_scalar(z1 * v1, f1) + cross_scalar(self.m2p * v1, f2) / m2  # Eq. 39
         q2 = mo2
-        q3 = mo3 - _cross(self.m2q * v3, f2) / m2 + _cross((z3 - 1) * v3, f3)
+        q3 = mo3 - cross_scalar(self.m2q * v3, f2) / m2 + cross_scalar((z3 - 1) * v3, f3)
         # Θᵀ·M·Θ with M = [[m11, 0, m13], [0, m22, 0], [m13, 0, m33]].
         inertia = self.m11 + 2 * m13 * big3 + self.m22 * big2 * big2 + self.m33 * big3 * big3
         mb = (m13 * b3, self.m22 * b2, self.m33 * b3)  # M·b with b = (0, b2, b3)
@@ -162,7 +157,7 @@ class ComplexMasses(Formulation):
         # Translation of the whole system (Eq. 40, δr̄S): the resultant force on the ground.
         shaking = f1 + f2 + f3 - p1 - p2 - p3
         # A3 moved by δ with A0, A1 held: i·(l̄2·δθ2 + l̄3·δθ3) = δ.
-        c23 = _cross(v2, v3)
+        c23 = cross_scalar(v2, v3)
         ra3 = 0j * v1
         for delta in (1.0, 1j):
             d2 = _ip(v3, delta) / c23
@@ -185,4 +180,4 @@ class ComplexMasses(Formulation):
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         theta1, _ = self._crank(t, y)
         _, v2, v3 = self._vectors(theta1)
-        return _cross(v2, v3) / (self.lengths[1] * self.lengths[2])
+        return cross_scalar(v2, v3) / (self.lengths[1] * self.lengths[2])

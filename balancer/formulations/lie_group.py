@@ -175,7 +175,7 @@ class LieGroup(Formulation):
         omega = np.array([w1, k[0] * w1, k[1] * w1])
         alpha = np.array([alpha1, *(k * alpha1 + dk * w1 * w1)])
         theta = np.array(
-            [self._unwrapped_crank(t, y), math.atan2(q[3], q[2]), math.atan2(-q[5], -q[4])]
+            [self.theta1_of(t, y), math.atan2(q[3], q[2]), math.atan2(-q[5], -q[4])]
         )
         return theta, omega, alpha, tau
 
@@ -195,18 +195,14 @@ class LieGroup(Formulation):
                           driving_torque=tau)
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
-        return self.crank_angle(t) if self.driven else math.atan2(y[2], y[1])
-
-    def _unwrapped_crank(self, t: float, y: NDArray[np.float64]) -> float:
-        """The crank angle, continuous along the motion.
+        """The crank angle, continuous along the motion (:meth:`continuous_crank`).
 
         ``q_A`` gives it only modulo 2π; free motion carries the continuous angle as an
-        auxiliary state after ``(Π1, q)`` (advanced by θ̇1, snapped to ``q_A``), bookkeeping
-        outside the formulation's own equations.
+        auxiliary state after ``(Π1, q)``, bookkeeping outside the formulation's own equations.
         """
         if self.driven:
             return self.crank_angle(t)
-        return float(y[7]) + math.remainder(math.atan2(y[2], y[1]) - y[7], 2 * math.pi)
+        return self.continuous_crank(math.atan2(y[2], y[1]), float(y[7]))
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         q = self._q(y, self.driven)
@@ -236,7 +232,7 @@ class LieGroup(Formulation):
             q[0:2] = math.cos(th), math.sin(th)
         else:
             q[0:2] /= np.linalg.norm(q[0:2])
-        theta1 = self._unwrapped_crank(t, y)
+        theta1 = self.theta1_of(t, y)
         if self.near_change_point(theta1):
             # On the assembly of the smooth motion (Eq. 86 has two solutions that cross here).
             (_, v2, v3), _, _ = self.branch_vectors(theta1, 0.0)
@@ -261,5 +257,5 @@ class LieGroup(Formulation):
             phi_d += dphi[1]
         y[off : off + 6] = q
         if not self.driven:
-            y[7] = self._unwrapped_crank(t, y)
+            y[7] = self.theta1_of(t, y)
         return y

@@ -24,18 +24,129 @@ constraints and their derivatives.
 from __future__ import annotations
 
 import math
+from abc import abstractmethod
 from types import SimpleNamespace
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..kinematics import rates_scalar
+from ..kinematics import cross_scalar, rates_scalar
 from ..massmodels import fourbar_force_vector, global_mass_matrix
 from ..model import Link
 from . import Evaluation, Formulation
 
 
-class MassMatrix(Formulation):
+class NodalTruss(Formulation):
+    """What a linkage of truss elements with moving nodes A1 (crank pin) and A2 shares.
+
+    State ``y = (x, ẋ, a)`` with ``x = (r_A1x, r_A1y, r_A2x, r_A2y)`` (m) and ``a`` the
+    continuous crank angle (free motion, rad) or the motor's work (driven, J). A subclass gives
+    the constant free-node mass matrix :attr:`m_free` (4×4, Eq. 48) and three constraints
+    :meth:`constraints` ``(Φ, Φx)``; the first is the crank's ``(|r̄A1|² − l1²)/2``.
+    """
+
+    m_free: NDArray[np.float64]
+    #: Newton on the positions stops when every |Φ| is below this, in Φ's units.
+    node_tolerance: float
+
+    @abstractmethod
+    def constraints(
+        self, x: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``Φ(x)`` (3) and ``∂Φ/∂x`` (3×4)."""
+
+    @abstractmethod
+    def solve(self, t: float, y: NDArray[np.float64]) -> tuple:
+        """``(ẍ, λ, τ, …)``: node accelerations, multipliers and the motor torque at a state."""
+
+    def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
+        """The crank angle, continuous along the motion (:meth:`continuous_crank`).
+
+        The nodes give it only modulo 2π; free motion carries the continuous angle as the
+        auxiliary state.
+        """
+        if self.driven:
+            return self.crank_angle(t)
+        return self.continuous_crank(math.atan2(y[1], y[0]), float(y[8]))
+
+    def node_state(self, a1: complex, a2: complex, v_a1: complex, v_a2: complex,
+                   theta1: float) -> NDArray[np.float64]:
+        """The state of node positions (m) and velocities (m/s) at crank angle ``theta1``."""
+        y = [a1.real, a1.imag, a2.real, a2.imag, v_a1.real, v_a1.imag, v_a2.real, v_a2.imag]
+        y.append(0.0 if self.driven else float(theta1))  # motor work, or the crank angle
+        return np.array(y, dtype=float)
+
+    def node_accelerations(
+        self,
+        jac: NDArray[np.float64],
+        gamma: NDArray[np.float64],
+        f_free: NDArray[np.float64],
+        a1: complex,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+        """``(ẍ, λ, τ)`` from ``M·ẍ + Φxᵀ·λ = F``, ``Φx·ẍ = γ`` (Eq. 48–50).
+
+        Free motion: one linear solve for ẍ and λ (τ = 0). Driven: r̈A1 is the prescribed
+        circle's ``−ω²·r̄A1``; the unknowns are r̈A2, λ and the motor torque τ, which enters
+        the crank's nodal force at A1 as ``i·τ·r̄A1/l1²`` (Eq. 46).
+        """
+        m = self.m_free
+        if not self.driven:
+            a = np.zeros((7, 7))
+            a[0:4, 0:4] = m
+            a[0:4, 4:7] = jac.T
+            a[4:7, 0:4] = jac
+            z = np.linalg.solve(a, np.concatenate([f_free, gamma]))
+            return z[0:4], z[4:7], 0.0
+        omega = float(self.speed)  # type: ignore[arg-type]
+        acc_a1 = -omega * omega * a1
+        x1 = np.array([acc_a1.real, acc_a1.imag])
+        couple = 1j * a1 / self.lengths[0] ** 2
+        a = np.zeros((6, 6))
+        a[0:4, 0:2] = m[:, 2:4]
+        a[0:4, 2:5] = jac.T
+        a[0:2, 5] = [-couple.real, -couple.imag]
+        a[4:6, 0:2] = jac[1:3, 2:4]
+        rhs = np.concatenate([f_free - m[:, 0:2] @ x1, gamma[1:3] - jac[1:3, 0:2] @ x1])
+        z = np.linalg.solve(a, rhs)
+        return np.concatenate([x1, z[0:2]]), z[2:5], float(z[5])
+
+    def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        acc, _, tau = self.solve(t, y)[:3]
+        dy = np.concatenate([y[4:8], acc])
+        if self.driven:
+            return np.append(dy, tau * float(self.speed))  # type: ignore[arg-type]
+        a1, v_a1 = complex(y[0], y[1]), complex(y[4], y[5])
+        return np.append(dy, cross_scalar(a1, v_a1) / abs(a1) ** 2)  # θ̇1
+
+    def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Least-norm Newton correction of the nodes onto the constraints, then of their rates.
+
+        Driven, the crank node is put on its prescribed place first and only A2 is corrected.
+        """
+        y = np.array(y, dtype=float)
+        rows, free = slice(0, 3), slice(0, 4)
+        if self.driven:
+            th = self.crank_angle(t)
+            a1 = self.lengths[0] * complex(math.cos(th), math.sin(th))
+            v1 = 1j * float(self.speed) * a1  # type: ignore[arg-type]
+            y[0:2] = a1.real, a1.imag
+            y[4:6] = v1.real, v1.imag
+            rows, free = slice(1, 3), slice(2, 4)
+        for _ in range(4):
+            phi, jac = self.constraints(y[0:4])
+            if np.max(np.abs(phi[rows])) <= self.node_tolerance:
+                break
+            y[free] -= np.linalg.lstsq(jac[rows, free], phi[rows], rcond=None)[0]
+        _, jac = self.constraints(y[0:4])
+        resid = (jac @ y[4:8])[rows]
+        vf = slice(4 + free.start, 4 + free.stop)
+        y[vf] -= np.linalg.lstsq(jac[rows, free], resid, rcond=None)[0]
+        if not self.driven:
+            y[8] = self.theta1_of(t, y)
+        return y
+
+
+class MassMatrix(NodalTruss):
     """Truss elements with the equivalent mass matrix, Eq. 41–55."""
 
     name = "mass-matrix"
@@ -66,6 +177,7 @@ class MassMatrix(Formulation):
             }
         )
         self.a3 = complex(self.lengths[3], 0.0)
+        self.node_tolerance = 1e-16 * sum(self.lengths) ** 2  # Φ in m²
 
     # -- geometry ----------------------------------------------------------------------------
 
@@ -102,7 +214,7 @@ class MassMatrix(Formulation):
         dependent); there the paper's own reduction is used (Eq. 47, 50–51): ``ẍ = J·θ̈1 + c``
         on the assembly of the smooth motion, ``Jᵀ(M·ẍ − F) = 0``, and λ by least squares.
         """
-        theta1 = self._unwrapped_crank(t, y)
+        theta1 = self.theta1_of(t, y)
         if self.near_change_point(theta1):
             return self._solve_reduced(t, y, theta1)
         a1, a2, v_a1, v_a2 = self._nodes(y)
@@ -111,32 +223,13 @@ class MassMatrix(Formulation):
         gamma = np.array([-abs(v_a1) ** 2, -abs(v_a2 - v_a1) ** 2, -abs(v_a2) ** 2])
         f = self._forces(vectors)
         f_free = np.array([f[1].real, f[1].imag, f[2].real, f[2].imag])
-        if not self.driven:
-            a = np.zeros((7, 7))
-            a[0:4, 0:4] = self.m_free
-            a[0:4, 4:7] = jac.T
-            a[4:7, 0:4] = jac
-            z = np.linalg.solve(a, np.concatenate([f_free, gamma]))
-            return z[0:4], z[4:7], 0.0, vectors
-        # Driven: r̈A1 of the prescribed circle; unknowns r̈A2 (2), λ1..3 and τ.
-        omega = float(self.speed)  # type: ignore[arg-type]
-        acc_a1 = -omega * omega * a1
-        x1 = np.array([acc_a1.real, acc_a1.imag])
-        # τ enters the crank's nodal force at A1 as i·τ·l̄1/l1² (Eq. 46).
-        couple = 1j * vectors[0] / self.lengths[0] ** 2
-        a = np.zeros((6, 6))
-        a[0:4, 0:2] = self.m_free[:, 2:4]
-        a[0:4, 2:5] = jac.T
-        a[0:2, 5] = [-couple.real, -couple.imag]
-        a[4:6, 0:2] = jac[1:3, 2:4]
-        rhs = np.concatenate([f_free - self.m_free[:, 0:2] @ x1, gamma[1:3] - jac[1:3, 0:2] @ x1])
-        z = np.linalg.solve(a, rhs)
-        return np.concatenate([x1, z[0:2]]), z[2:5], float(z[5]), vectors
+        acc, lam, tau = self.node_accelerations(jac, gamma, f_free, a1)
+        return acc, lam, tau, vectors
 
     def _solve_reduced(self, t: float, y: NDArray[np.float64], theta1: float):
         a1 = complex(y[0], y[1])
-        omega1 = float(self.speed) if self.driven else _cross(a1, complex(y[4], y[5])) / abs(
-            a1) ** 2
+        v_a1 = complex(y[4], y[5])
+        omega1 = float(self.speed) if self.driven else cross_scalar(a1, v_a1) / abs(a1) ** 2
         vectors, w2, w3 = self.branch_vectors(theta1, omega1)
         v1, v2, v3 = vectors
         _, big3, _, _, _, b3 = rates_scalar(self.lengths, vectors, omega1)
@@ -167,19 +260,8 @@ class MassMatrix(Formulation):
         if self.driven:
             omega1 = float(self.speed)  # type: ignore[arg-type]
         mo = motion_of(self.linkage, theta1, omega1, 0.0)
-        a1, a2 = mo.pos.A1[0], mo.pos.A2[0]
-        v1, v2 = mo.joint_velocities[0][0], mo.joint_velocities[1][0]
-        y = [a1.real, a1.imag, a2.real, a2.imag, v1.real, v1.imag, v2.real, v2.imag]
-        y.append(0.0 if self.driven else float(theta1))  # motor work, or the crank angle
-        return np.array(y, dtype=float)
-
-    def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        acc, _, tau, _ = self.solve(t, y)
-        dy = np.concatenate([y[4:8], acc])
-        if self.driven:
-            return np.append(dy, tau * float(self.speed))  # type: ignore[arg-type]
-        a1, v_a1 = complex(y[0], y[1]), complex(y[4], y[5])
-        return np.append(dy, _cross(a1, v_a1) / abs(a1) ** 2)  # θ̇1
+        return self.node_state(mo.pos.A1[0], mo.pos.A2[0], mo.joint_velocities[0][0],
+                               mo.joint_velocities[1][0], theta1)
 
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         acc, lam, tau, vectors = self.solve(t, y)
@@ -189,9 +271,11 @@ class MassMatrix(Formulation):
         accels = (acc_a1, acc_a2 - acc_a1, -acc_a2)
         # Eq. 55: angles from the nodal coordinates; rates from l̄ × l̄̇ = ω·l².
         theta = np.array([math.atan2(v.imag, v.real) for v in vectors])
-        theta[0] = self._unwrapped_crank(t, y)
-        omega = np.array([_cross(v, r) / abs(v) ** 2 for v, r in zip(vectors, rates, strict=True)])
-        alpha = np.array([_cross(v, a) / abs(v) ** 2 for v, a in zip(vectors, accels, strict=True)])
+        theta[0] = self.theta1_of(t, y)
+        omega = np.array([cross_scalar(v, r) / abs(v) ** 2
+                          for v, r in zip(vectors, rates, strict=True)])
+        alpha = np.array([cross_scalar(v, a) / abs(v) ** 2
+                          for v, a in zip(vectors, accels, strict=True)])
         f = self._forces(vectors, tau)
         node_acc = np.array([0.0, 0.0, acc[0], acc[1], acc[2], acc[3], 0.0, 0.0])
         inertia = self.m_global @ node_acc  # Eq. 52–53: rows A0 and A3 give M_r·ẍ
@@ -200,32 +284,23 @@ class MassMatrix(Formulation):
         return Evaluation(theta=theta, omega=omega, alpha=alpha, RA0=ra0, RA3=ra3,
                           driving_torque=tau)
 
-    def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
-        return self.crank_angle(t) if self.driven else math.atan2(y[1], y[0])
-
-    def _unwrapped_crank(self, t: float, y: NDArray[np.float64]) -> float:
-        """The crank angle, continuous along the motion.
-
-        The nodes give it only modulo 2π; free motion carries the continuous angle as an
-        auxiliary state (advanced by θ̇1, snapped to the nodes), driven motion prescribes it.
-        """
-        if self.driven:
-            return self.crank_angle(t)
-        return float(y[8]) + math.remainder(math.atan2(y[1], y[0]) - y[8], 2 * math.pi)
-
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         a1, a2, _, _ = self._nodes(y)
         _, v2, v3 = self._vectors(a1, a2)
-        return _cross(v2, v3) / (self.lengths[1] * self.lengths[2])
+        return cross_scalar(v2, v3) / (self.lengths[1] * self.lengths[2])
 
     # -- constraints -------------------------------------------------------------------------
 
-    def _phi(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+    def constraints(
+        self, x: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``Φk = (|r̄q − r̄p|² − lk²)/2`` for crank, coupler and rocker (m²), and ``∂Φ/∂x``."""
         a1, a2 = complex(x[0], x[1]), complex(x[2], x[3])
         l1, l2, l3, _ = self.lengths
-        return 0.5 * np.array(
+        phi = 0.5 * np.array(
             [abs(a1) ** 2 - l1 * l1, abs(a2 - a1) ** 2 - l2 * l2, abs(self.a3 - a2) ** 2 - l3 * l3]
         )
+        return phi, self._jacobian(a1, a2)
 
     def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
         a1, a2 = complex(y[0], y[1]), complex(y[2], y[3])
@@ -235,46 +310,24 @@ class MassMatrix(Formulation):
         return float(pos), float(np.max(np.abs(vel)))
 
     def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Least-norm Newton correction of the nodes onto the lengths, then of their rates."""
+        """:meth:`NodalTruss.project`, except near a change point.
+
+        There the length constraints are dependent: the nodes are put on the assembly of the
+        smooth motion from Eq. 2–4 at the crank angle, their rates from Eq. 6 with the crank's
+        rate kept.
+        """
+        theta1 = self.theta1_of(t, y)
+        if not self.near_change_point(theta1):
+            return super().project(t, y)
         y = np.array(y, dtype=float)
-        free = slice(0, 4)
-        rows = slice(0, 3)
-        theta1 = self._unwrapped_crank(t, y)
-        if self.near_change_point(theta1):
-            # On the assembly of the smooth motion: nodes from Eq. 2–4 at the crank angle, rates
-            # from Eq. 6 with the crank's rate kept.
-            a1 = complex(y[0], y[1])
-            v_a1 = complex(y[4], y[5])
-            omega1 = self.speed if self.driven else _cross(a1, v_a1) / abs(a1) ** 2
-            (v1, v2, v3), w2, w3 = self.branch_vectors(theta1, float(omega1))
-            a2 = v1 + v2
-            v_a1 = 1j * omega1 * v1
-            v_a2 = v_a1 + 1j * w2 * v2
-            y[0:8] = [v1.real, v1.imag, a2.real, a2.imag, v_a1.real, v_a1.imag,
-                      v_a2.real, v_a2.imag]
-            return y
-        if self.driven:
-            th = self.crank_angle(t)
-            a1 = self.lengths[0] * complex(math.cos(th), math.sin(th))
-            v1 = 1j * float(self.speed) * a1  # type: ignore[arg-type]
-            y[0:2] = a1.real, a1.imag
-            y[4:6] = v1.real, v1.imag
-            free, rows = slice(2, 4), slice(1, 3)
-        scale = sum(self.lengths) ** 2
-        for _ in range(4):
-            phi = self._phi(y[0:4])[rows]
-            if np.max(np.abs(phi)) <= 1e-16 * scale:
-                break
-            jac = self._jacobian(complex(y[0], y[1]), complex(y[2], y[3]))[rows, free]
-            y[free] -= np.linalg.lstsq(jac, phi, rcond=None)[0]
-        jac = self._jacobian(complex(y[0], y[1]), complex(y[2], y[3]))
-        resid = (jac @ y[4:8])[rows]
-        vf = slice(4 + free.start, 4 + free.stop)
-        y[vf] -= np.linalg.lstsq(jac[rows, free], resid, rcond=None)[0]
-        if not self.driven:
-            y[8] = self._unwrapped_crank(t, y)
+        a1 = complex(y[0], y[1])
+        v_a1 = complex(y[4], y[5])
+        omega1 = self.speed if self.driven else cross_scalar(a1, v_a1) / abs(a1) ** 2
+        (v1, v2, v3), w2, w3 = self.branch_vectors(theta1, float(omega1))
+        a2 = v1 + v2
+        v_a1 = 1j * omega1 * v1
+        v_a2 = v_a1 + 1j * w2 * v2
+        y[0:8] = [v1.real, v1.imag, a2.real, a2.imag, v_a1.real, v_a1.imag,
+                  v_a2.real, v_a2.imag]
         return y
 
-
-def _cross(x: complex, y: complex) -> float:
-    return x.real * y.imag - x.imag * y.real

@@ -25,7 +25,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from ..kinematics import rates_scalar
+from ..kinematics import cross_scalar, rates_scalar
 from . import Evaluation, Formulation
 
 
@@ -33,10 +33,6 @@ def _ip(x: complex, y: complex) -> float:
     """⟨x̄, ȳ⟩ = Re(x*·y)."""
     return x.real * y.real + x.imag * y.imag
 
-
-def _cross(x: complex, y: complex) -> float:
-    """⟨i·x̄, ȳ⟩ = x × y."""
-    return x.real * y.imag - x.imag * y.real
 
 
 class OpenedLoop(Formulation):
@@ -98,18 +94,19 @@ class OpenedLoop(Formulation):
                 [m13, m23, self.m_diag[2]],
             ]
         )
-        c12 = mt * _cross(v1, a21)
-        c13 = mt * _cross(v1, a32)
-        c23 = mt * _cross(v2, a32)
+        c12 = mt * cross_scalar(v1, a21)
+        c13 = mt * cross_scalar(v1, a32)
+        c23 = mt * cross_scalar(v2, a32)
         big_c = np.array([[0.0, c12, c13], [-c12, 0.0, c23], [-c13, -c23, 0.0]])
         f1, f2, f3 = self.forces
         mo1, mo2, mo3 = self.moments
         q = np.array(
             [
-                mo1 - _cross(a14p, f1) - (m2 + m3) / m1 * _cross(a12, f1) + _cross(v1, f2 + f3),
-                mo2 - (m1 + m2) / m2 * _cross(a21, f2) - m3 / m2 * _cross(a23, f2)
-                + _cross(v2, f3),
-                mo3 - mt / m3 * _cross(a32, f3),
+                mo1 - cross_scalar(a14p, f1) - (m2 + m3) / m1 * cross_scalar(a12, f1)
+                + cross_scalar(v1, f2 + f3),
+                mo2 - (m1 + m2) / m2 * cross_scalar(a21, f2) - m3 / m2 * cross_scalar(a23, f2)
+                + cross_scalar(v2, f3),
+                mo3 - mt / m3 * cross_scalar(a32, f3),
             ]
         )  # Eq. 25
         g = np.array([[-v.imag for v in vectors], [v.real for v in vectors]])

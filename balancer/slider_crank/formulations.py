@@ -27,7 +27,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..formulations import Evaluation, Formulation
-from ..kinematics import cross
+from ..formulations.mass_matrix import NodalTruss
+from ..kinematics import cross_scalar
 from .dynamics import kinetic_energy, newton_euler
 from .kinematics import assembly_range, motion
 
@@ -164,8 +165,9 @@ class SliderComplexMasses(_SliderFormulation):
                        + c3.mass * big_x * d_big_x)
         f1, f2, f3 = self.forces
         z1 = self.zeta[0]
-        q = (self.moments[0] + torque + cross(z1 * v1, f1) + (p.real * f2.real + p.imag * f2.imag)
-             / m2 + self.moments[1] * big2 + (f3.real + float(self.gas(theta1))) * big_x)
+        q = (self.moments[0] + torque + cross_scalar(z1 * v1, f1)
+             + (p.real * f2.real + p.imag * f2.imag) / m2 + self.moments[1] * big2
+             + (f3.real + float(self.gas(theta1))) * big_x)
         return sigma, half_dsigma, float(q)
 
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
@@ -206,7 +208,7 @@ class SliderComplexMasses(_SliderFormulation):
         return self.transmission_of_crank(self._crank(t, y)[0])
 
 
-class SliderMassMatrix(_SliderFormulation):
+class SliderMassMatrix(_SliderFormulation, NodalTruss):
     """Truss elements for crank and rod, the slider a mass at its pin, the guide a constraint."""
 
     name = "mass-matrix"
@@ -225,11 +227,15 @@ class SliderMassMatrix(_SliderFormulation):
         m6[5, 5] += c3.mass
         self.m_global = m6
         self.m_free = m6[2:6, 2:6]
+        self.node_tolerance = 1e-16 * sum(abs(v) for v in self.lengths)
 
     # -- geometry ----------------------------------------------------------------------------
 
-    def _constraints(self, x):
-        """``Φ`` and ``∂Φ/∂x`` for x = (A1x, A1y, A2x, A2y)."""
+    def constraints(self, x):
+        """``Φ`` and ``∂Φ/∂x`` for x = (A1x, A1y, A2x, A2y).
+
+        Crank and rod ``(|l̄|² − l²)/2`` (m²), the guide ``y_A2 − e`` (m).
+        """
         r, big_l, e = self.lengths
         a1, a2 = complex(x[0], x[1]), complex(x[2], x[3])
         v1, v2 = a1, a2 - a1
@@ -259,64 +265,22 @@ class SliderMassMatrix(_SliderFormulation):
         out[2] += self.forces[2] + gas
         return out
 
-    def crank_of(self, t: float, y) -> float:
-        """The crank angle, continuous along the motion.
-
-        The nodes give it only modulo 2π; free motion carries the continuous angle as an
-        auxiliary state (advanced by θ̇1, snapped to the nodes), driven motion prescribes it.
-        """
-        if self.driven:
-            return self.crank_angle(t)
-        return float(y[8]) + math.remainder(math.atan2(y[1], y[0]) - y[8], 2 * math.pi)
-
     def solve(self, t: float, y: NDArray[np.float64]):
         """Accelerations, multipliers (crank, rod, guide) and the motor torque at a state."""
         x, xd = y[0:4], y[4:8]
         a1d, a2d = complex(xd[0], xd[1]), complex(xd[2], xd[3])
-        _, jac = self._constraints(x)
+        _, jac = self.constraints(x)
         gamma = np.array([-abs(a1d) ** 2, -abs(a2d - a1d) ** 2, 0.0])
-        f = self._forces(x, 0.0, float(self.gas(self.crank_of(t, y))))
+        f = self._forces(x, 0.0, float(self.gas(self.theta1_of(t, y))))
         f_free = np.array([f[1].real, f[1].imag, f[2].real, f[2].imag])
-        if not self.driven:
-            a = np.zeros((7, 7))
-            a[0:4, 0:4] = self.m_free
-            a[0:4, 4:7] = jac.T
-            a[4:7, 0:4] = jac
-            z = np.linalg.solve(a, np.concatenate([f_free, gamma]))
-            return z[0:4], z[4:7], 0.0
-        omega = float(self.speed)  # type: ignore[arg-type]
-        a1 = complex(x[0], x[1])
-        acc_a1 = -omega * omega * a1
-        x1 = np.array([acc_a1.real, acc_a1.imag])
-        couple = 1j * a1 / self.lengths[0] ** 2  # τ's nodal force at A1 (Eq. 46)
-        a = np.zeros((6, 6))
-        a[0:4, 0:2] = self.m_free[:, 2:4]
-        a[0:4, 2:5] = jac.T
-        a[0:2, 5] = [-couple.real, -couple.imag]
-        a[4:6, 0:2] = jac[1:3, 2:4]
-        rhs = np.concatenate([f_free - self.m_free[:, 0:2] @ x1,
-                              gamma[1:3] - jac[1:3, 0:2] @ x1])
-        z = np.linalg.solve(a, rhs)
-        return np.concatenate([x1, z[0:2]]), z[2:5], float(z[5])
+        return self.node_accelerations(jac, gamma, f_free, complex(x[0], x[1]))
 
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         self.theta1_start = float(theta1)
         if self.driven:
             omega1 = float(self.speed)  # type: ignore[arg-type]
         mo = motion(self.lengths, theta1, omega1, 0.0, self.sign0)
-        a1, a2 = mo.A1[0], mo.A2[0]
-        v1 = mo.vector_rate(0)[0]
-        y = [a1.real, a1.imag, a2.real, a2.imag, v1.real, v1.imag, mo.v[0], 0.0]
-        y.append(0.0 if self.driven else float(theta1))  # motor work, or the crank angle
-        return np.array(y, dtype=float)
-
-    def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        acc, _, tau = self.solve(t, y)
-        dy = np.concatenate([y[4:8], acc])
-        if self.driven:
-            return np.append(dy, tau * float(self.speed))  # type: ignore[arg-type]
-        a1, v_a1 = complex(y[0], y[1]), complex(y[4], y[5])
-        return np.append(dy, cross(a1, v_a1) / abs(a1) ** 2)  # θ̇1
+        return self.node_state(mo.A1[0], mo.A2[0], mo.vector_rate(0)[0], complex(mo.v[0]), theta1)
 
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         acc, lam, tau = self.solve(t, y)
@@ -325,9 +289,11 @@ class SliderMassMatrix(_SliderFormulation):
         vel1, vel2 = complex(xd[0], xd[1]), complex(xd[2], xd[3])
         acc1, acc2 = complex(acc[0], acc[1]), complex(acc[2], acc[3])
         v1, v2 = a1, a2 - a1
-        theta1 = self.crank_of(t, y)
-        omega = (cross(v1, vel1) / abs(v1) ** 2, cross(v2, vel2 - vel1) / abs(v2) ** 2)
-        alpha = (cross(v1, acc1) / abs(v1) ** 2, cross(v2, acc2 - acc1) / abs(v2) ** 2)
+        theta1 = self.theta1_of(t, y)
+        omega = (cross_scalar(v1, vel1) / abs(v1) ** 2,
+                 cross_scalar(v2, vel2 - vel1) / abs(v2) ** 2)
+        alpha = (cross_scalar(v1, acc1) / abs(v1) ** 2,
+                 cross_scalar(v2, acc2 - acc1) / abs(v2) ** 2)
         gas = float(self.gas(theta1))
         f = self._forces(x, tau, gas)
         node_acc = np.array([0.0, 0.0, acc[0], acc[1], acc[2], acc[3]])
@@ -337,7 +303,7 @@ class SliderMassMatrix(_SliderFormulation):
         n_guide = -lam[2]  # the guide's normal force on the slider
         # The guide also resists the slider's turning: its couple balances the slider's moment.
         c3 = self.links[2]
-        m_guide = -(self.moments[2] + cross(c3.com, self.forces[2] - c3.mass * acc2.real))
+        m_guide = -(self.moments[2] + cross_scalar(c3.com, self.forces[2] - c3.mass * acc2.real))
         h = self.offset
         moment = -a2.real * n_guide - m_guide + h * gas - tau
         if self.linkage.crank.counter_rotor:
@@ -354,42 +320,15 @@ class SliderMassMatrix(_SliderFormulation):
             slider=np.array([a2.real, vel2.real, acc2.real]),
         )
 
-    def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
-        return self.crank_of(t, y)
-
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         v2 = complex(y[2] - y[0], y[3] - y[1])
         return v2.real / abs(v2)
 
     def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
-        phi, jac = self._constraints(y[0:4])
+        phi, jac = self.constraints(y[0:4])
         r, big_l, _ = self.lengths
         pos = max(abs(phi[0]) / r, abs(phi[1]) / big_l, abs(phi[2]))
         return float(pos), float(np.max(np.abs(jac @ y[4:8])))
-
-    def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Least-norm Newton correction onto the constraints and their derivatives."""
-        y = np.array(y, dtype=float)
-        rows, free = slice(0, 3), slice(0, 4)
-        if self.driven:
-            th = self.crank_angle(t)
-            a1 = self.lengths[0] * complex(math.cos(th), math.sin(th))
-            v1 = 1j * float(self.speed) * a1  # type: ignore[arg-type]
-            y[0:2] = a1.real, a1.imag
-            y[4:6] = v1.real, v1.imag
-            rows, free = slice(1, 3), slice(2, 4)
-        for _ in range(4):
-            phi, jac = self._constraints(y[0:4])
-            if np.max(np.abs(phi[rows])) <= 1e-16 * sum(abs(v) for v in self.lengths):
-                break
-            y[free] -= np.linalg.lstsq(jac[rows, free], phi[rows], rcond=None)[0]
-        _, jac = self._constraints(y[0:4])
-        resid = (jac @ y[4:8])[rows]
-        vf = slice(4 + free.start, 4 + free.stop)
-        y[vf] -= np.linalg.lstsq(jac[rows, free], resid, rcond=None)[0]
-        if not self.driven:
-            y[8] = self.crank_of(t, y)
-        return y
 
 
 def _element(link, length: float) -> NDArray[np.float64]:
