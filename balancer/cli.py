@@ -321,11 +321,16 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     parser = build_parser()
+    args = None
     try:
         args = parser.parse_args(argv)
         handler: Callable[[argparse.Namespace], int] = args.handler
         return handler(args)
     except BalancerError as exc:
+        spec = getattr(args, "spec", None)
+        if (isinstance(exc, SpecError) and exc.source is None and spec and exc.key
+                and not exc.key.startswith("-")):
+            exc = exc.with_source(spec)  # a spec key found wrong after loading: name the file
         print(f"balancer: error: {exc}", file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt:

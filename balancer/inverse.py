@@ -34,10 +34,8 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from .errors import AssemblyError
 from .kinematics import (
     Motion,
-    assembly_range,
     change_point_angles,
     cross,
     cycle_branch_signs,
@@ -48,6 +46,7 @@ from .massmodels import (
     equivalent_joint_forces,
     inertial_parameters,
 )
+from .mechanisms import require_full_revolution
 from .model import FourBar, Link
 
 Route = Literal["newton-euler", "mass-matrix"]
@@ -540,13 +539,7 @@ def cycle_analysis(
         from .slider_crank.dynamics import cycle_analysis as slider_cycle
 
         return slider_cycle(linkage, speed, samples, route=route, loads=loads, theta1=theta1)
-    rng = assembly_range(linkage.lengths)
-    if not rng.full:
-        raise AssemblyError(
-            "a cycle analysis needs a crank that turns a full revolution, but this linkage "
-            f"assembles only for θ1 in {rng.describe()}",
-            key="mechanism.lengths",
-        )
+    require_full_revolution(linkage, "a cycle analysis")
     angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
     n = angles.size
     signs = cycle_branch_signs(linkage.lengths, linkage.branch, angles)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from .errors import AssemblyError
 from .kinematics import AssemblyRange
 from .model import FourBar, SliderCrank
 
@@ -26,6 +27,26 @@ def assembly_range(mechanism: FourBar | SliderCrank) -> AssemblyRange:
     from .kinematics import assembly_range as fourbar_range
 
     return fourbar_range(mechanism.lengths)
+
+
+def require_full_revolution(mechanism: FourBar | SliderCrank, purpose: str) -> AssemblyRange:
+    """The assembly range, if the crank turns a full revolution.
+
+    Raises
+    ------
+    AssemblyError
+        Otherwise (exit code 2, naming ``mechanism.lengths``): ``purpose`` (e.g. "a cycle
+        analysis") needs a crank that turns.
+    """
+    rng = assembly_range(mechanism)
+    if not rng.full:
+        condition = " (crank + |offset| ≤ rod)" if mechanism.type == "slider-crank" else ""
+        raise AssemblyError(
+            f"{purpose} needs a crank that turns a full revolution{condition}, but this "
+            f"{mechanism.type} assembles only for θ1 in {rng.describe()}",
+            key="mechanism.lengths",
+        )
+    return rng
 
 
 def centre_of_mass_path(mechanism, theta, omega=None, alpha=None) -> NDArray[np.complex128]:

@@ -62,7 +62,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .conditions import force_balance_matrix
-from .errors import AssemblyError, SpecError
+from .errors import SpecError
 from .inverse import (
     Regressors,
     change_point_limits,
@@ -70,7 +70,8 @@ from .inverse import (
     regressors,
     sample_angles,
 )
-from .kinematics import assembly_range, cycle_branch_signs, motion
+from .kinematics import cycle_branch_signs, motion
+from .mechanisms import require_full_revolution
 from .model import Design, FourBar, Link, Mechanism
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -952,18 +953,7 @@ def numeric_problem(design: Design) -> NumericProblem:
         )
     linkage = design.mechanism
     check_problem(problem, linkage)
-    if linkage.type == "slider-crank":
-        from .slider_crank.kinematics import assembly_range as slider_range
-
-        rng = slider_range(linkage.lengths)
-    else:
-        rng = assembly_range(linkage.lengths)
-    if not rng.full:
-        raise AssemblyError(
-            "balancing needs a crank that turns a full revolution, but this linkage assembles "
-            f"only for θ1 in {rng.describe()}",
-            key="mechanism.lengths",
-        )
+    require_full_revolution(linkage, "balancing")
     speed = design.operation.speed
     angles = sample_angles(design.operation.samples)
     reg = _cycle_regressors(linkage, speed, angles)

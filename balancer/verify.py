@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .errors import LockupError, SpecError
-from .mechanisms import VERIFY_METHOD, assembly_range
+from .mechanisms import VERIFY_METHOD, require_full_revolution
 from .model import Design, FourBar
 from .simulate import Trajectory, simulate
 
@@ -198,9 +198,7 @@ def verify(
     if outputs is not None:
         settings = replace(settings, outputs=outputs)
     start = settings.theta1
-    if not assembly_range(linkage).full:
-        raise SpecError("a driven check needs a crank that turns a full revolution",
-                        key="mechanism.lengths")
+    require_full_revolution(linkage, "a driven check")
     driven_settings = replace(settings, drive="constant-speed", omega1=design.operation.speed,
                               theta1=start)
     free_settings = replace(settings, drive="free")

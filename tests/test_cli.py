@@ -89,7 +89,11 @@ def test_analyze_of_a_crank_that_cannot_turn_is_bad_input(tmp_path, capsys):
     path = tmp_path / "rocking.toml"
     path.write_text(text)
     assert main(["analyze", str(path)]) == 2
-    assert "full revolution" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "full revolution" in err
+    # Found after loading, the message still names the file and the key.
+    assert err.startswith(f"balancer: error: {path}: mechanism.lengths: ")
+    assert err.count("\n") == 1
 
 
 def test_installed_console_script_runs():

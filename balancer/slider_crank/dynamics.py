@@ -27,12 +27,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import AssemblyError
 from ..inverse import CycleAnalysis, Reactions, Regressors, dynamic_link, sample_angles
 from ..kinematics import cross
 from ..massmodels import equivalent_inertia_forces, equivalent_joint_forces, inertial_parameters
+from ..mechanisms import require_full_revolution
 from ..model import Link, SliderCrank
-from .kinematics import SliderMotion, assembly_range, motion_of
+from .kinematics import SliderMotion, motion_of
 
 
 def _loads(mech: SliderCrank, mo: SliderMotion, gravity: complex, loads: bool):
@@ -237,13 +237,7 @@ def cycle_analysis(
     AssemblyError
         If the crank cannot turn a full revolution (``r + |e| > L``).
     """
-    rng = assembly_range(mech.lengths)
-    if not rng.full:
-        raise AssemblyError(
-            "a cycle analysis needs a crank that turns a full revolution (crank + |offset| ≤ "
-            f"rod), but this slider-crank assembles only for θ1 in {rng.describe()}",
-            key="mechanism.lengths",
-        )
+    require_full_revolution(mech, "a cycle analysis")
     angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
     mo = motion_of(mech, angles, speed, 0.0)
     reactions = inverse_dynamics(mech, mo, route=route, loads=loads)
