@@ -239,12 +239,6 @@ class Position:
         """``sin(θ3 − θ2)``: zero at dead and change points."""
         return cross(self.l2, self.l3) / (self.lengths[1] * self.lengths[2])
 
-    @cached_property
-    def branch_sign(self) -> NDArray[np.float64]:
-        """+1 where A2 is to the left of the directed line A1→A3, −1 to its right, 0 on it."""
-        l23 = self.l2 + self.l3
-        return np.sign(cross(l23, self.l2))
-
 
 def _as_1d(x: ArrayLike) -> NDArray[np.float64]:
     a = np.asarray(x, dtype=float)

@@ -220,17 +220,13 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
     return "\n".join(lines)
 
 
-def figure_dict(fig: Figure) -> dict[str, float]:
-    """``{"rms": …, "max": …}``."""
-    return fig.as_dict()
-
-
 def dumps_json(doc: dict[str, Any]) -> str:
     """JSON text with a trailing newline; NaN and infinity are not allowed."""
     return json.dumps(doc, indent=2, allow_nan=False) + "\n"
 
 
-ANALYSIS_COLUMNS = (
+#: The columns of ``simulate``'s CSV, fixed by DESIGN.md.
+SIMULATION_COLUMNS = (
     "t",
     "theta1",
     "theta2",
@@ -245,11 +241,13 @@ ANALYSIS_COLUMNS = (
     "RA0y",
     "RA3x",
     "RA3y",
-    "shaking_force_x",
-    "shaking_force_y",
-    "shaking_moment",
-    "driving_torque",
 )
+#: What the frame feels and what drives the crank, after the state and reactions.
+SHAKING_COLUMNS = ("shaking_force_x", "shaking_force_y", "shaking_moment", "driving_torque")
+#: Extra columns written after the fixed ones with ``simulate --all-columns``.
+SIMULATION_EXTRA_COLUMNS = (*SHAKING_COLUMNS, "kinetic_energy", "work")
+#: The columns of ``analyze --csv`` for a four-bar.
+ANALYSIS_COLUMNS = (*SIMULATION_COLUMNS, *SHAKING_COLUMNS)
 
 
 SLIDER_ANALYSIS_COLUMNS = (
@@ -267,10 +265,7 @@ SLIDER_ANALYSIS_COLUMNS = (
     "RA0y",
     "guide_force_y",
     "guide_line_x",
-    "shaking_force_x",
-    "shaking_force_y",
-    "shaking_moment",
-    "driving_torque",
+    *SHAKING_COLUMNS,
 )
 
 
@@ -311,33 +306,6 @@ def csv_text(columns: Sequence[str], values: Sequence[np.ndarray]) -> str:
 
 # ----------------------------------------------------------------------------------------------
 # simulate
-
-SIMULATION_COLUMNS = (
-    "t",
-    "theta1",
-    "theta2",
-    "theta3",
-    "omega1",
-    "omega2",
-    "omega3",
-    "alpha1",
-    "alpha2",
-    "alpha3",
-    "RA0x",
-    "RA0y",
-    "RA3x",
-    "RA3y",
-)
-#: Extra columns written after the fixed ones with ``--all-columns``.
-SIMULATION_EXTRA_COLUMNS = (
-    "shaking_force_x",
-    "shaking_force_y",
-    "shaking_moment",
-    "driving_torque",
-    "kinetic_energy",
-    "work",
-)
-
 
 def simulation_csv(traj, all_columns: bool = False) -> str:
     """The time histories of a simulation as CSV text (the fixed columns, then optionally more)."""
