@@ -703,32 +703,18 @@ class ConvexSolver:
         """``(key, needed, current, unit)`` and the words for one bound to widen."""
         i, kind = group
         b = self.data.links[i]
-        key = f"{b.key}.mass"
-        fixed = b.mass[0] == b.mass[1]
-        if kind == "mass-high":
-            v = _up(value)
-            if fixed:
-                return (
-                    key,
-                    v,
-                    b.mass[1],
-                    "kg",
-                ), f"{key} must allow {v:.4g} kg (fixed at {b.mass[1]!r})"
-            return (key, v, b.mass[1], "kg"), (
-                f"{key} must allow up to {v:.4g} kg (is at most {b.mass[1]!r})"
-            )
-        if kind == "mass-low":
-            v = _down(value)
-            if fixed:
-                return (
-                    key,
-                    v,
-                    b.mass[0],
-                    "kg",
-                ), f"{key} must allow {v:.4g} kg (fixed at {b.mass[0]!r})"
-            return (key, v, b.mass[0], "kg"), (
-                f"{key} must allow down to {v:.4g} kg (is at least {b.mass[0]!r})"
-            )
+        if kind in ("mass-high", "mass-low"):
+            key = f"{b.key}.mass"
+            high = kind == "mass-high"
+            v = _up(value) if high else _down(value)
+            current = b.mass[1] if high else b.mass[0]
+            if b.mass[0] == b.mass[1]:
+                words = f"{key} must allow {v:.4g} kg (fixed at {current!r})"
+            elif high:
+                words = f"{key} must allow up to {v:.4g} kg (is at most {current!r})"
+            else:
+                words = f"{key} must allow down to {v:.4g} kg (is at least {current!r})"
+            return (key, v, current, "kg"), words
         key = f"{b.key}.com_radius"
         v = _up(value)
         if kind == "com":
