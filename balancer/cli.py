@@ -147,9 +147,6 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 
     out = _output_path(args.out, "--out") if args.out else None
     design = load_design(args.spec)
-    if design.balance is None:
-        raise SpecError("missing required table: the redesign problem ([balance])",
-                        key="balance", source=args.spec)
     result = optimize(design, backend=args.backend)
     if not result.success:
         raise SolverError(f"the balancing failed: {result.message}")

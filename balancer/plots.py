@@ -15,6 +15,8 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from . import mechanisms
+from .mechanisms import drawing_frames
 from .model import FourBar
 from .simulate import Trajectory
 
@@ -77,9 +79,8 @@ def plot_shaking_moment(
 
 def centre_of_mass_path(linkage, traj: Trajectory) -> np.ndarray:
     """Total centre of mass along a simulated motion, complex, m."""
-    from .mechanisms import centre_of_mass_path as path
-
-    return path(linkage, traj.theta, tuple(traj.omega), tuple(traj.alpha))
+    return mechanisms.centre_of_mass_path(linkage, traj.theta, tuple(traj.omega),
+                                          tuple(traj.alpha))
 
 
 def plot_com_path(
@@ -171,17 +172,6 @@ def save_png(fig: Figure, path: str | os.PathLike[str], dpi: float = 100) -> Pat
     return _write_atomic(fig, Path(path).with_suffix(".png"), dpi)
 
 
-def linkage_frames(linkage, frames: int = 72):
-    """Joint positions and centres of mass over one crank revolution, for drawing.
-
-    Returns ``(joints, coms, total)``: joints ``(frames, k)`` complex, link centres of mass
-    ``(frames, 3)`` and the total centre of mass ``(frames,)``, m.
-    """
-    from .mechanisms import drawing_frames
-
-    return drawing_frames(linkage, frames)
-
-
 def animate(linkage: FourBar, path: str | os.PathLike[str], *, frames: int = 72, fps: int = 24,
             title: str = "") -> Path:
     """Write a GIF of the linkage turning one revolution with its total centre of mass traced.
@@ -194,7 +184,7 @@ def animate(linkage: FourBar, path: str | os.PathLike[str], *, frames: int = 72,
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from PIL import Image
 
-    joints, coms, total = linkage_frames(linkage, frames)
+    joints, coms, total = drawing_frames(linkage, frames)
     fig = Figure(figsize=(6, 4.5), dpi=100, layout="constrained")
     canvas = FigureCanvasAgg(fig)
     ax = fig.add_subplot()

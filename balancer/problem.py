@@ -943,7 +943,8 @@ def numeric_problem(design: Design) -> NumericProblem:
     """
     problem = design.balance
     if problem is None:
-        raise SpecError("missing: the spec has no [balance] section", key="balance")
+        raise SpecError("missing required table: the redesign problem ([balance])",
+                        key="balance")
     if not isinstance(problem, BalanceProblem):
         raise TypeError(f"design.balance must be a BalanceProblem, not {type(problem).__name__}")
     if design.operation is None:
