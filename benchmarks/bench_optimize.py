@@ -2,7 +2,8 @@
 
 Run on its own: ``python benchmarks/bench_optimize.py [--repeats N]``. Everything runs in one
 process with the problem already built (regressors, the CVXPY problem compiled by a first solve,
-the IPOPT solver created); each time is the median (and the best) of ``N`` solves.
+the IPOPT solver created); each time is the median (and the best) of ``N`` solves, the
+differential evolution's of ``--de-repeats`` runs.
 
 Rows:
 
@@ -141,7 +142,7 @@ def _run_de(data: NumericProblem):
     return float(result.fun), int(result.nit), int(result.nfev)
 
 
-def _bench(name: str, repeats: int) -> list[tuple]:
+def _bench(name: str, repeats: int, de_repeats: int) -> list[tuple]:
     """Rows ``(problem, method, median s, best s, iterations, J, J_original)`` for one problem."""
     design = load_design(ROOT / "examples" / f"{name}.toml")
     t = time.perf_counter()
@@ -181,7 +182,7 @@ def _bench(name: str, repeats: int) -> list[tuple]:
         med, best, res = _timed(lambda b=backend: opt.run(b), max(3, repeats // 3))
         rows.append((name, f"run({backend!r}) + analyses", med, best, res.iterations,
                      res.objective, j0))  # fmt: skip
-    med, best, (fun, nit, nfev) = _timed(lambda: _run_de(data), 1)
+    med, best, (fun, nit, nfev) = _timed(lambda: _run_de(data), de_repeats)
     rows.append((name, f"DE ({nfev} evaluations)", med, best, nit, fun, j0))
     return rows
 
@@ -189,8 +190,12 @@ def _bench(name: str, repeats: int) -> list[tuple]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=15, help="solves per timing (median)")
+    parser.add_argument("--de-repeats", type=int, default=3,
+                        help="differential-evolution runs per timing (median; seeded, so each "
+                        "run is the same search)")
     args = parser.parse_args()
-    rows = _bench("pb1", args.repeats) + _bench("pb2", args.repeats)
+    rows = _bench("pb1", args.repeats, args.de_repeats) + _bench("pb2", args.repeats,
+                                                                 args.de_repeats)
     header = ("problem", "method", "median ms", "best ms", "iterations", "J (N·m)²",
               "√(J/J_orig)")  # fmt: skip
     table = [header]

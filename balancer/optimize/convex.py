@@ -220,6 +220,7 @@ class ConvexSolver:
         else:
             value = mass_term
         self._stage1 = cp.Problem(cp.Minimize(value), constraints)
+        self._stage1_data: tuple | None = None  # CVXPY's compiled form, made on the first solve
         # Tie-break. J is strictly convex in y = P·u, so every optimal design has the same y
         # (and, with mass penalised, the same total mass): fix them at the SOCP's values, in an
         # orthonormal basis of the directions they measure, and pick the design nearest the
@@ -318,7 +319,10 @@ class ConvexSolver:
     def _run(self, problem: cp.Problem, name: str) -> tuple[StageReport, bool]:
         start = time.perf_counter()
         try:
-            _solve(problem, self.settings)
+            if problem is self._stage1:
+                self._solve_stage1()
+            else:
+                _solve(problem, self.settings)
             status = str(problem.status)
         except cp.error.SolverError as exc:  # numerical failure inside Clarabel
             status = f"solver error: {exc}"
@@ -336,6 +340,22 @@ class ConvexSolver:
             objective=objective,
         )
         return report, ok
+
+    def _solve_stage1(self) -> None:
+        """Solve the SOCP from its solver data, compiled by CVXPY on the first solve only.
+
+        The SOCP has no parameters, so its canonical form (CVXPY's most expensive step,
+        about as long as Clarabel's solve) does not change between solves.
+        """
+        if self._stage1_data is None:
+            self._stage1_data = self._stage1.get_problem_data(
+                cp.CLARABEL, solver_opts=self.settings
+            )
+        data, chain, inverse = self._stage1_data
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+            solution = chain.solve_via_data(self._stage1, data, solver_opts=self.settings)
+            self._stage1.unpack_results(solution, chain, inverse)
 
     def solve(
         self, *, prefer: NDArray[np.float64] | None = None, tie_break: bool = True
