@@ -27,6 +27,8 @@ Everything is vectorised over the states of a :class:`~balancer.kinematics.Motio
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Literal
@@ -558,11 +560,21 @@ def cycle_analysis(
         "driving_torque": np.empty(n),
         "shaking_moment": np.empty(n),
     }
-    for start in range(0, n, CHUNK):
+    def fill(start: int) -> None:
         sl = slice(start, start + CHUNK)
         r = evaluate(angles[sl], signs if isinstance(signs, str) else signs[sl])
         for name, array in out.items():
             array[sl] = getattr(r, name)
+
+    starts = range(0, n, CHUNK)
+    if len(starts) > 1 and WORKERS > 1:
+        # numpy releases the GIL inside its loops: chunks on two cores, each writing its own
+        # slice of the outputs (the same numbers as one after the other).
+        with ThreadPoolExecutor(WORKERS) as pool:
+            list(pool.map(fill, starts))
+    else:
+        for start in starts:
+            fill(start)
     singular = np.zeros(n, bool)
     for hit, offsets, weights in change_point_limits(linkage.lengths, angles):
         parts = [
@@ -617,4 +629,7 @@ def change_point_limits(lengths, angles: NDArray[np.float64]):
 
 
 #: Number of crank angles evaluated at once by :func:`cycle_analysis`.
-CHUNK = 16384
+CHUNK = 32768
+#: Threads evaluating the chunks of a long cycle (numpy's loops run without the GIL; more than
+#: two gain little against the Python between them).
+WORKERS = min(2, os.cpu_count() or 1)

@@ -201,6 +201,21 @@ def test_cycle_analysis_samples_and_figures(paper):
         assert a.max == pytest.approx(b.max, rel=1e-12)
 
 
+@pytest.mark.parametrize("workers", [1, 2])
+def test_cycle_analysis_in_chunks_equals_one_evaluation_of_all_angles(paper, monkeypatch, workers):
+    """The chunked (and threaded) evaluation fills every sample, in order, with the values of
+    one whole-array evaluation: 1000 angles in chunks of 64, the last one short. (To rounding,
+    not bitwise: numpy's vectorised sin/cos may round differently at a loop's tail.)"""
+    monkeypatch.setattr(inverse, "CHUNK", 64)
+    monkeypatch.setattr(inverse, "WORKERS", workers)
+    ca = inverse.cycle_analysis(paper, 10.0, 1000)
+    mo = kin.motion(paper.lengths, ca.theta1, 10.0, 0.0, paper.branch)
+    whole = inverse.inverse_dynamics(paper, mo)
+    for name in ("RA0", "RA3", "shaking_force", "shaking_moment", "driving_torque"):
+        got, want = getattr(ca.reactions, name), getattr(whole, name)
+        assert rel_err(got, want) < 1e-14, name
+
+
 def test_cycle_analysis_refuses_a_crank_that_cannot_turn():
     rng = np.random.default_rng(0)
     lengths = CLASS_EXAMPLES["rocker-crank"]
