@@ -18,8 +18,12 @@ Events:
 
 Energy: the kinetic energy change must equal the work of the loads, of gravity and of the motor.
 The loads are constant forces at the centres of mass and constant moments, so their work is a
-function of the configuration, ``W = Σ F̄k·(r̄k − r̄k0) + Mk·(θk − θk0)``; the motor's work is
-integrated with the state.
+function of the configuration, ``W = Σ F̄k·(r̄k − r̄k0) + Mk·(θk − θk0)``; the motor's work and
+the work of a force that depends on the crank angle (a gas force) are integrated with the state:
+the driver appends one component ``W_extra`` with ``Ẇ_extra`` =
+:meth:`~balancer.formulations.Formulation.extra_power`. ``T − T0 − W`` is then a first integral
+of the integrated system, which the integrator keeps to its tolerance: the reported
+:attr:`Trajectory.energy_error` is a check of the integration, at no extra cost.
 """
 
 from __future__ import annotations
@@ -168,7 +172,9 @@ class _Stepper:
         self.extra_fev = 0
 
     def run(self, y0: NDArray[np.float64], stop_at: float | None):
-        f = self.f
+        """Integrate from ``y0``; the states returned carry the extra work as a last entry."""
+        f = _WithExtraWork(self.f)
+        y0 = np.append(y0, 0.0)
         t_end = self.duration if stop_at is None else min(stop_at, self.duration)
         solver = DOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=self.atol)
         states: list[NDArray[np.float64]] = []
@@ -214,7 +220,7 @@ class _Stepper:
 
     def _dead_point(self, interp, t0: float, t1: float, change_points):
         """The time at which |sin(θ3 − θ2)| falls to the threshold within a step, or None."""
-        f = self.f
+        f = _WithExtraWork(self.f)
 
         def gap(t: float) -> float:
             y = interp(t)
@@ -228,7 +234,41 @@ class _Stepper:
         return t_event, interp(t_event)
 
 
-def _near_change_point(f: Formulation, t: float, y, points) -> bool:
+class _WithExtraWork:
+    """A formulation whose state carries, as a last entry, the work of the extra power.
+
+    ``Ẇ_extra`` = :meth:`~balancer.formulations.Formulation.extra_power` (a force that depends
+    on the crank angle, such as a gas force): integrated with the motion, so that the energy
+    balance ``T − T0 = W_config + W_motor + W_extra`` is a first integral of the integrated
+    system. Projection and events see the formulation's own state.
+    """
+
+    def __init__(self, f: Formulation) -> None:
+        self.f = f
+        self.minimal = f.minimal
+        self.passes_dead_points = f.passes_dead_points
+
+    def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        own = y[:-1]
+        return np.append(self.f.rhs(t, own), self.f.extra_power(t, own))
+
+    def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.append(self.f.project(t, y[:-1]), y[-1])
+
+    def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
+        return self.f.constraint_residual(t, y[:-1])
+
+    def transmission(self, t: float, y: NDArray[np.float64]) -> float:
+        return self.f.transmission(t, y[:-1])
+
+    def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
+        return self.f.theta1_of(t, y[:-1])
+
+    def change_points(self) -> tuple[float, ...]:
+        return self.f.change_points()
+
+
+def _near_change_point(f, t: float, y, points) -> bool:
     theta1 = f.theta1_of(t, y)
     return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < 0.05 for p in points)
 
@@ -352,6 +392,8 @@ def _lockup(message: str, t: float, theta1: float, partial: Trajectory) -> Locku
 def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
                 seconds) -> Trajectory:
     t = np.array(times)
+    extra = np.array([y[-1] for y in states])
+    states = [y[:-1] for y in states]
     ev = f.evaluate_batch(times, states)
     omega, alpha = np.asarray(ev.omega, float), np.asarray(ev.alpha, float)
     theta = np.array([_unwrap(ev.theta[k], omega[k], t) for k in range(3)])
@@ -360,9 +402,10 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
     tau = np.asarray(ev.driving_torque, float) * np.ones(t.size)
     motor = np.array([f.motor_work(y) for y in states])
     slider = None if ev.slider is None else np.asarray(ev.slider, float)
-    # Energy: T − T0 = work of loads and gravity (a function of the configuration) + motor.
+    # Energy: T − T0 = work of loads and gravity (a function of the configuration) + motor
+    # + the extra work integrated with the motion (a gas force).
     kin, work = f.energy(theta, omega, alpha, slider)
-    work = work + motor
+    work = work + motor + extra
     scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), 1e-300)
     energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
     shaking_force, moment = f.shaking(ev)

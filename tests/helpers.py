@@ -32,3 +32,15 @@ def rel_err(a, b, scale=None) -> float:
     b = np.asarray(b)
     s = scale if scale is not None else max(np.max(np.abs(a)), np.max(np.abs(b)), 1e-300)
     return float(np.max(np.abs(a - b)) / s)
+
+
+def integration_bound(*trajectories) -> float:
+    """A bound on the relative global error of simulated trajectories, from their tolerances.
+
+    DOP853 keeps each step's local error within ``rtol`` relative to the state (``atol`` is
+    chosen far below ``rtol`` times the states' scale in these tests). Without damping the local
+    errors add up over the steps, so after ``n`` steps a relative global error of ``n·rtol``;
+    two independent trajectories differ by at most the sum of their bounds. Quantities quadratic
+    in the rates (kinetic energy) take twice it: a relative error ε in a rate changes them by 2ε.
+    """
+    return float(sum(tr.steps * tr.rtol for tr in trajectories))

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import derivative, rel_err
+from helpers import derivative, integration_bound, rel_err
 
 from balancer import spec
 from balancer.cli import main
@@ -253,7 +253,10 @@ def test_engine_simulations_agree_and_balance_energy():
         # revolutions): at rtol 1e-12 the two agree to 1e-9 of the angle travelled.
         assert np.max(np.abs(a.theta[:, -1] - b.theta[:, -1])) < 1e-9 * abs(a.theta[0, -1])
         assert np.max(np.abs(a.slider[:, -1] - b.slider[:, -1])) < 1e-7 * np.max(np.abs(a.slider))
-        assert a.energy_error < 5e-9 and b.energy_error < 5e-9
+        # T − T0 − W is a first integral of the integrated system (the gas force's work is
+        # integrated with the motion): it drifts by the integration's own error.
+        for tr in (a, b):
+            assert tr.energy_error < 2 * integration_bound(tr), (tr.method, drive)
     # Driven at constant speed, the simulation's torque is the cycle analysis's.
     tr = runs["complex-masses", "constant-speed"]
     ca = sd.cycle_analysis(design.mechanism, design.simulation.omega1, theta1=tr.theta[0])

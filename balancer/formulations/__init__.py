@@ -280,6 +280,15 @@ class Formulation(ABC):
         """Loop-closure residuals of a state: position (m) and velocity (m/s)."""
         return 0.0, 0.0
 
+    def extra_power(self, t: float, y: NDArray[np.float64]) -> float:
+        """Power of the loads whose work is not a function of the configuration, W.
+
+        Such as a force that depends on the crank angle. The driver integrates it with the
+        motion (:mod:`balancer.simulate`); constant loads and gravity need none (their work is
+        in :meth:`energy`), nor the motor (its work is a state of the driven formulations).
+        """
+        return 0.0
+
     def motor_work(self, y: NDArray[np.float64]) -> float:
         """Work done by the motor since t = 0, J (zero in free motion)."""
         return float(y[-1]) if self.driven else 0.0

@@ -62,7 +62,7 @@ class _SliderFormulation(Formulation):
         return motion(self.lengths, theta1, omega1, alpha1, self.sign0, check=False)
 
     def energy(self, theta, omega, alpha, slider=None):
-        """Kinetic energy and the work of the loads, gravity and gas force since the start, J."""
+        """Kinetic energy and the work of the loads and gravity since the start, J."""
         mo = self.motion_of(theta[0], omega[0], alpha[0])
         kin = kinetic_energy(self.linkage, mo)
         r, big_l, _ = self.lengths
@@ -73,37 +73,8 @@ class _SliderFormulation(Formulation):
             work = work + np.real(np.conj(self.forces[k]) * (c - c[0]))
         for k in range(2):
             work = work + self.moments[k] * (theta[k] - theta[k][0])
-        # The gas force along the guide: a function of the crank angle, so its work is the
-        # integral of G(θ1)·dx/dθ1 over θ1 (by quadrature between outputs, with the table's
-        # knots as break points).
-        return kin, work + self.gas_work(theta[0])
-
-    def gas_work(self, theta1) -> NDArray[np.float64]:
-        """Work of the gas force from ``theta1[0]`` to each ``theta1`` (continuous angles), J."""
-        import warnings
-
-        from scipy.integrate import IntegrationWarning, quad
-
-        gas = self.linkage.gas_force
-        out = np.zeros(len(theta1))
-        if gas.is_zero:
-            return out
-
-        def power(t: float) -> float:  # G·dx/dθ1
-            return float(gas.at(t)) * float(self.motion_of(t, 1.0, 0.0).v[0])
-
-        for i in range(1, len(theta1)):
-            a, b = float(theta1[i - 1]), float(theta1[i])
-            lo, hi = min(a, b), max(a, b)
-            k0, k1 = math.floor(lo / gas.period), math.ceil(hi / gas.period)
-            breaks = [k * gas.period + t for k in range(k0, k1 + 1) for t in gas.angles
-                      if lo < k * gas.period + t < hi]
-            with warnings.catch_warnings():  # roundoff near the asked 1e-12 is no news
-                warnings.simplefilter("ignore", IntegrationWarning)
-                value = quad(power, a, b, points=breaks or None, epsabs=0.0, epsrel=1e-12,
-                             limit=200)[0] if a != b else 0.0
-            out[i] = out[i - 1] + value
-        return out
+        # The gas force's work is integrated with the motion (extra_power).
+        return kin, work
 
     def shaking(self, ev: Evaluation) -> tuple:
         return ev.shaking_force, ev.shaking_moment
@@ -203,6 +174,13 @@ class SliderComplexMasses(_SliderFormulation):
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         return self.crank_angle(t) if self.driven else float(y[0])
+
+    def extra_power(self, t: float, y: NDArray[np.float64]) -> float:
+        """The gas force's power ``G(θ1)·X·θ̇1``, W."""
+        if self.linkage.gas_force.is_zero:
+            return 0.0
+        theta1, omega1 = self._crank(t, y)
+        return float(self.gas(theta1)) * float(self.motion_of(theta1, omega1, 0.0).v[0])
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         return self.transmission_of_crank(self._crank(t, y)[0])
@@ -319,6 +297,12 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):
             shaking_moment=moment,
             slider=np.array([a2.real, vel2.real, acc2.real]),
         )
+
+    def extra_power(self, t: float, y: NDArray[np.float64]) -> float:
+        """The gas force's power ``G(θ1)·ẋA2``, W."""
+        if self.linkage.gas_force.is_zero:
+            return 0.0
+        return float(self.gas(self.theta1_of(t, y))) * float(y[6])
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         v2 = complex(y[2] - y[0], y[3] - y[1])
