@@ -9,45 +9,56 @@ use them.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from .errors import BalancerError, SpecError
+from .errors import BalancerError, OutputError, SpecError
 
 
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose errors are one line and exit code 2."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        raise SpecError(f"{self.prog}: {message} (see '{self.prog} --help')")
+        raise SpecError(f"{message} (see '{self.prog} --help')")
 
 
-def _output_path(value: str, option: str) -> Path:
-    """An output file path whose folder exists."""
-    path = Path(value)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise SpecError("the folder to write into does not exist", key=option, value=value)
-    if path.is_dir():
-        raise SpecError("is a folder, not a file", key=option, value=value)
+def _output_path(args: argparse.Namespace, value: str | None, option: str) -> Path | None:
+    """An output path given as ``option``, checked before any work is done.
+
+    Its folder must exist and take a file; it must not be the input spec unless ``--force``.
+    """
+    if value is None:
+        return None
+    from .outputs import check_writable
+
+    path = check_writable(value, option)
+    spec = Path(args.spec)
+    same = path.exists() and spec.exists() and os.path.samefile(path, spec)
+    if (same or os.path.realpath(path) == os.path.realpath(spec)) and not args.force:
+        raise OutputError("would overwrite the input spec; give another path, or --force",
+                          key=option, value=value)
     return path
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
     from .api import analyze
+    from .outputs import write_atomic
     from .report import analysis_csv, analysis_json, analysis_text, dumps_json
-    from .spec import load_design, write_atomic
+    from .spec import load_design
 
-    csv_path = _output_path(args.csv, "--csv") if args.csv else None
+    csv_path = _output_path(args, args.csv, "--csv")
     design = load_design(args.spec)
     analysis = analyze(design, route=args.route)
-    if csv_path is not None:
-        write_atomic(csv_path, analysis_csv(analysis))
+    csv = analysis_csv(analysis) if csv_path is not None else None
     if args.json:
-        sys.stdout.write(dumps_json(analysis_json(analysis, spec=args.spec)))
+        text = dumps_json(analysis_json(analysis, spec=args.spec))
     else:
-        print(analysis_text(analysis, spec=args.spec))
+        text = analysis_text(analysis, spec=args.spec) + "\n"
+    if csv_path is not None:
+        write_atomic(csv_path, csv)
+    sys.stdout.write(text)
     return 0
 
 
@@ -87,11 +98,12 @@ class _Progress:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
+    from .outputs import write_atomic
     from .report import dumps_json, simulation_csv, simulation_json, simulation_text
     from .simulate import simulate_design
-    from .spec import load_design, write_atomic
+    from .spec import load_design
 
-    out = _output_path(args.out, "--out") if args.out else None
+    out = _output_path(args, args.out, "--out")
     design = load_design(args.spec)
     progress = _Progress()
     try:
@@ -107,12 +119,14 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         )
     finally:
         progress.done()
-    if out is not None:
-        write_atomic(out, simulation_csv(traj, all_columns=args.all_columns))
+    csv = simulation_csv(traj, all_columns=args.all_columns) if out is not None else None
     if args.json:
-        sys.stdout.write(dumps_json(simulation_json(traj, spec=args.spec)))
+        text = dumps_json(simulation_json(traj, spec=args.spec))
     else:
-        print(simulation_text(traj, spec=args.spec))
+        text = simulation_text(traj, spec=args.spec) + "\n"
+    if out is not None:
+        write_atomic(out, csv)
+    sys.stdout.write(text)
     return 0
 
 
@@ -121,19 +135,26 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     from .spec import load_design
     from .verify import verify
 
-    plot = _output_path(args.plot, "--plot") if args.plot else None
+    plot = _output_path(args, args.plot, "--plot")
     design = load_design(args.spec)
     verification = verify(design, method=args.method, duration=args.duration)
-    written = []
+    paths: list[Path] = []
+    if plot is not None:
+        from .plots import figure_paths
+
+        paths = figure_paths(plot)
+        for path in paths:
+            _output_path(args, str(path), "--plot")
+    if args.json:
+        doc = {"spec": args.spec, **verification.as_dict(), "plots": [str(p) for p in paths]}
+        text = dumps_json(doc)
+    else:
+        text = verification_text(verification, spec=args.spec, plots=paths) + "\n"
     if plot is not None:
         from .plots import save_figure, verification_figure
 
-        written = save_figure(verification_figure(design, verification), plot)
-    if args.json:
-        doc = {"spec": args.spec, **verification.as_dict(), "plots": [str(p) for p in written]}
-        sys.stdout.write(dumps_json(doc))
-    else:
-        print(verification_text(verification, spec=args.spec, plots=written))
+        save_figure(verification_figure(design, verification), plot)
+    sys.stdout.write(text)
     return 0
 
 
@@ -141,34 +162,39 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     from .api import analyze
     from .errors import SolverError
     from .optimize import optimize
+    from .outputs import write_atomic
     from .report import dumps_json, optimization_json, optimization_text
-    from .spec import load_design, save_design
+    from .spec import dumps_design, load_design, loads_design
     from .verify import verify
 
-    out = _output_path(args.out, "--out") if args.out else None
+    out = _output_path(args, args.out, "--out")
     design = load_design(args.spec)
     result = optimize(design, backend=args.backend)
     if not result.success:
         raise SolverError(f"the balancing failed: {result.message}")
     balanced = result.balanced_design(design)
+    spec_text = dumps_design(balanced)
+    loads_design(spec_text, source=str(out or "the balanced spec"))  # it must load again
     before, after = analyze(design), analyze(balanced)
     verification = None if args.no_verify else verify(balanced, duration=args.verify_duration)
-    if out is not None:
-        save_design(balanced, out)
     if args.json:
-        sys.stdout.write(dumps_json(optimization_json(result, before, after, verification,
-                                                      spec=args.spec, out=out)))
+        text = dumps_json(optimization_json(result, before, after, verification,
+                                            spec=args.spec, out=out))
     else:
-        print(optimization_text(result, before, after, verification, spec=args.spec, out=out))
+        text = optimization_text(result, before, after, verification, spec=args.spec,
+                                 out=out) + "\n"
+    if out is not None:
+        write_atomic(out, spec_text)
+    sys.stdout.write(text)
     return 0
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
     from .spec import load_design
 
-    if not args.animate:
+    if args.animate is None:
         raise SpecError("nothing to plot: give --animate PATH", key="--animate")
-    path = _output_path(args.animate, "--animate")
+    path = _output_path(args, args.animate, "--animate")
     design = load_design(args.spec)
     from .plots import animate
 
@@ -219,6 +245,8 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
+    p.add_argument("--force", action="store_true",
+                   help="allow an output path to name the input spec (it is overwritten)")
     p.add_argument("--json", action="store_true", help="print a JSON document instead of a table")
     p.add_argument("--csv", metavar="PATH", help="write the per-angle values to a CSV file")
     p.add_argument(
@@ -242,6 +270,8 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
+    p.add_argument("--force", action="store_true",
+                   help="allow an output path to name the input spec (it is overwritten)")
     p.add_argument("--method", choices=METHODS, help="formulation (default: the spec's, or "
                    "opened-loop)")
     p.add_argument("--drive", choices=DRIVES, help="free motion or constant crank speed "
@@ -268,6 +298,8 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
+    p.add_argument("--force", action="store_true",
+                   help="allow an output path to name the input spec (it is overwritten)")
     p.add_argument("--plot", metavar="PATH", help="write the figure to PATH (.png and .svg)")
     p.add_argument("--duration", type=_positive_float, metavar="T",
                    help="simulated time of each run, s (default: the spec's)")
@@ -291,6 +323,8 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML) with a [balance] section")
+    p.add_argument("--force", action="store_true",
+                   help="allow an output path to name the input spec (it is overwritten)")
     p.add_argument("--out", metavar="BALANCED.toml", help="write the balanced design as a spec")
     p.add_argument("--backend", choices=("nlp", "convex"), default="nlp",
                    help="optimiser (default nlp: convex first, then IPOPT)")
@@ -308,6 +342,8 @@ def build_parser() -> argparse.ArgumentParser:
         "total centre of mass traced.",
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
+    p.add_argument("--force", action="store_true",
+                   help="allow an output path to name the input spec (it is overwritten)")
     p.add_argument("--animate", metavar="PATH", help="write a GIF animation to PATH")
     p.add_argument("--frames", type=_count, default=72, metavar="N",
                    help="frames per revolution (default 72)")
@@ -325,16 +361,43 @@ def main(argv: Sequence[str] | None = None) -> int:
         return handler(args)
     except BalancerError as exc:
         spec = getattr(args, "spec", None)
-        if (isinstance(exc, SpecError) and exc.source is None and spec and exc.key
-                and not exc.key.startswith("-")):
+        if (isinstance(exc, SpecError) and not isinstance(exc, OutputError)
+                and exc.source is None and spec and exc.key and not exc.key.startswith("-")):
             exc = exc.with_source(spec)  # a spec key found wrong after loading: name the file
-        print(f"balancer: error: {exc}", file=sys.stderr)
+        message = str(exc)
+        if not isinstance(exc, SpecError) and spec and spec not in message:
+            message = f"{spec}: {message}"  # a failed computation: name the file it concerns
+        print(f"balancer: error: {_one_line(message)}", file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt:
         print("balancer: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
         return 0
+    except MemoryError:
+        print("balancer: error: out of memory (ask for fewer samples or outputs)",
+              file=sys.stderr)
+        return 1
+    except Exception as exc:  # a defect of ours: one line, never a traceback for the user
+        where = _innermost(exc)
+        print(f"balancer: internal error: {type(exc).__name__}: {_one_line(str(exc))} "
+              f"({where}); please report it with the spec", file=sys.stderr)
+        return 1
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+def _innermost(exc: BaseException) -> str:
+    """``file:line`` of the innermost frame of ``exc`` inside this package."""
+    import traceback
+
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if "balancer" in f.filename]
+    if not frames:
+        return "outside balancer"
+    f = frames[-1]
+    return f"{Path(f.filename).name}:{f.lineno}"
 
 
 def entry_point() -> None:

@@ -62,6 +62,14 @@ class SpecError(BalancerError, ValueError):
         """Return a copy of this error that names the file it came from."""
         return type(self)(self.detail, key=self.key, value=self.value, source=source)
 
+    def under(self, prefix: str) -> SpecError:
+        """Return a copy whose key is ``prefix.key`` (an object's field within a spec table)."""
+        if not prefix:
+            return self
+        key = prefix if not self.key else (
+            f"{prefix}{self.key}" if self.key.startswith("[") else f"{prefix}.{self.key}")
+        return type(self)(self.detail, key=key, value=self.value, source=self.source)
+
 
 class AssemblyError(SpecError):
     """A linkage cannot be assembled: at any crank angle, or at the one asked for.
@@ -69,6 +77,13 @@ class AssemblyError(SpecError):
     It is bad input (exit code 2) when the spec itself asks for an impossible linkage or crank
     angle; a motion that runs into a position where the linkage locks is a
     :class:`LockupError` instead.
+    """
+
+
+class OutputError(SpecError):
+    """An output file that cannot be written, or would overwrite the input spec (exit code 2).
+
+    The input spec is overwritten only with ``--force``.
     """
 
 

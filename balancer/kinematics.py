@@ -103,8 +103,8 @@ class AssemblyRange:
     Attributes
     ----------
     intervals
-        Closed intervals ``(start, end)`` of θ1 in rad, ``start < end``, within
-        ``[-π, 2π]``; empty if the linkage cannot be assembled at all.
+        Closed intervals ``(start, end)`` of θ1 in rad, ``start < end ≤ start + 2π``, starting
+        within ``[-π, π]``; empty if the linkage cannot be assembled at all.
     full
         Whether the crank can turn a full revolution.
     """

@@ -40,7 +40,7 @@ def require_full_revolution(mechanism: FourBar | SliderCrank, purpose: str) -> A
     """
     rng = assembly_range(mechanism)
     if not rng.full:
-        condition = " (crank + |offset| ≤ rod)" if mechanism.type == "slider-crank" else ""
+        condition = " (crank + |offset| < rod)" if mechanism.type == "slider-crank" else ""
         raise AssemblyError(
             f"{purpose} needs a crank that turns a full revolution{condition}, but this "
             f"{mechanism.type} assembles only for θ1 in {rng.describe()}",

@@ -8,7 +8,10 @@ A counter-rotor is a disc coaxial with the link's ground pivot geared to turn at
 link's angular velocity; only its inertia counts.
 
 All quantities are SI: m, kg, kg·m², rad, s, N, N·m. Objects are frozen; make variants with
-:func:`dataclasses.replace` or the ``with_*`` helpers.
+:func:`dataclasses.replace` or the ``with_*`` helpers. Every object checks its values when it is
+made (:mod:`balancer.validate`, the same checks as the spec loader's) and raises
+:class:`~balancer.errors.SpecError` naming the field: a link, a mechanism or a design built in a
+notebook is as safe as one read from a spec.
 """
 
 from __future__ import annotations
@@ -18,6 +21,9 @@ import math
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import ClassVar, Literal
+
+from . import validate as v
+from .errors import AssemblyError, SpecError
 
 Branch = Literal["+", "-"]
 Drive = Literal["free", "constant-speed"]
@@ -62,6 +68,16 @@ class Link:
     force: tuple[float, float] = (0.0, 0.0)
     moment: float = 0.0
     counter_rotor: float = 0.0
+
+    def __post_init__(self) -> None:
+        """Check the values (keys are the spec's names within the link's table)."""
+        _set(self, "mass", v.positive(self.mass, "mass"))
+        _set(self, "inertia", v.nonnegative(self.inertia, "inertia"))
+        _set(self, "e", v.number(self.e, "com.e"))
+        _set(self, "f", v.number(self.f, "com.f"))
+        _set(self, "force", v.vector2(self.force, "force"))
+        _set(self, "moment", v.number(self.moment, "moment"))
+        _set(self, "counter_rotor", v.nonnegative(self.counter_rotor, "counter_rotor"))
 
     @property
     def com(self) -> complex:
@@ -132,6 +148,25 @@ class FourBar:
     rocker: Link
     branch: Branch = "+"
 
+    def __post_init__(self) -> None:
+        """Check lengths, links and branch; raise :class:`AssemblyError` if it never assembles.
+
+        Keys are the spec's, from its root (``mechanism.lengths.crank``).
+        """
+        lengths = _check_mechanism(self)
+        from .kinematics import assembly_range
+
+        if assembly_range(lengths).empty:
+            l1, l2, l3, l4 = lengths
+            raise AssemblyError(
+                "the linkage cannot be assembled at any crank angle: the coupler and rocker "
+                f"(|l2 − l3| = {abs(l2 - l3):.6g} m to l2 + l3 = {l2 + l3:.6g} m) cannot "
+                f"bridge A1 to A3 (|l4 − l1| = {abs(l4 - l1):.6g} m to l1 + l4 = "
+                f"{l1 + l4:.6g} m)",
+                key="mechanism.lengths",
+                value=dict(zip(self.length_names, lengths, strict=True)),
+            )
+
     @property
     def links(self) -> tuple[Link, Link, Link]:
         """The moving links in order (crank, coupler, rocker)."""
@@ -191,6 +226,22 @@ class GasForce:
     angles: tuple[float, ...] = (0.0,)
     values: tuple[float, ...] = (0.0,)
     period: float = 2 * math.pi
+
+    def __post_init__(self) -> None:
+        """Check the table (keys within ``gas_force``)."""
+        period = v.positive(self.period, "period")
+        angles, values = (_numbers(x, k) for x, k in ((self.angles, "crank_angle"),
+                                                       (self.values, "force")))
+        if len(angles) != len(values):
+            raise SpecError(f"crank_angle and force must have the same length ({len(angles)} "
+                            f"and {len(values)})", key="force")
+        if (any(b <= a for a, b in zip(angles, angles[1:], strict=False)) or angles[0] < 0
+                or angles[-1] >= period):
+            raise SpecError("crank angles must increase within one period, from 0",
+                            key="crank_angle", value=list(angles))
+        _set(self, "period", period)
+        _set(self, "angles", angles)
+        _set(self, "values", values)
 
     @classmethod
     def constant(cls, value: float) -> GasForce:
@@ -258,6 +309,24 @@ class SliderCrank:
     branch: Branch = "+"
     gas_force: GasForce = field(default_factory=GasForce)
 
+    def __post_init__(self) -> None:
+        """Check lengths, links and branch; raise :class:`AssemblyError` if it never assembles.
+
+        Keys are the spec's, from its root (``mechanism.lengths.offset``).
+        """
+        if not isinstance(self.gas_force, GasForce):
+            raise SpecError("must be a GasForce", key="links.slider.gas_force",
+                            value=self.gas_force)
+        r, big_l, e = _check_mechanism(self)
+        if abs(e) > r + big_l:
+            raise AssemblyError(
+                f"the slider-crank cannot be assembled at any crank angle: the guide is "
+                f"{abs(e):.6g} m from A0, beyond the reach of crank and rod "
+                f"({r + big_l:.6g} m)",
+                key="mechanism.lengths.offset",
+                value=e,
+            )
+
     @property
     def links(self) -> tuple[Link, Link, Link]:
         """The moving links in order (crank, rod, slider)."""
@@ -299,6 +368,57 @@ class SliderCrank:
 Mechanism = FourBar | SliderCrank
 
 
+def _set(obj, name: str, value) -> None:
+    """Store a checked (normalised) value on a frozen dataclass."""
+    object.__setattr__(obj, name, value)
+
+
+def _numbers(values, key: str) -> tuple[float, ...]:
+    if isinstance(values, str | bytes) or not hasattr(values, "__iter__"):
+        raise SpecError("must be a non-empty list of numbers", key=key, value=values)
+    out = tuple(v.number(x, key) for x in values)
+    if not out:
+        raise SpecError("must be a non-empty list of numbers", key=key, value=list(values))
+    return out
+
+
+def _check_mechanism(mech) -> tuple[float, ...]:
+    """Lengths, links and branch of a mechanism; store the lengths as floats and return them.
+
+    A slider-crank's offset (its last length) is signed; every other length is positive. Link
+    keys are ``links.<name>``, lengths ``mechanism.lengths.<name>``.
+    """
+    names = mech.length_names
+    raw = mech.lengths
+    if isinstance(raw, str) or not hasattr(raw, "__len__") or len(raw) != len(names):
+        raise SpecError(f"must be {len(names)} lengths ({', '.join(names)})",
+                        key="mechanism.lengths", value=raw)
+    lengths = []
+    for name, value in zip(names, raw, strict=True):
+        key = f"mechanism.lengths.{name}"
+        if name == "offset":
+            x = v.number(value, key)
+            if x != 0:
+                v.length(abs(x), key)
+            lengths.append(x)
+        else:
+            lengths.append(v.length(value, key))
+    v.relative_lengths(dict(zip(names, lengths, strict=True)), "mechanism.lengths")
+    _set(mech, "lengths", tuple(lengths))
+    _set(mech, "branch", v.choice(mech.branch, "mechanism.branch", ("+", "-")))
+    for name in mech.link_names:
+        link = getattr(mech, name)
+        if not isinstance(link, Link):
+            raise SpecError("must be a Link", key=f"links.{name}", value=link)
+        if link.counter_rotor and name not in mech.grounded_links:
+            where = " and ".join(mech.grounded_links)
+            raise SpecError(
+                f"a counter-rotor sits on a ground pivot: only the {where} can have one",
+                key=f"links.{name}.counter_rotor", value=link.counter_rotor,
+            )
+    return tuple(lengths)
+
+
 @dataclass(frozen=True, kw_only=True)
 class Operation:
     """The operating condition a cycle analysis and a balancing refer to.
@@ -313,6 +433,17 @@ class Operation:
 
     speed: float
     samples: int = 360
+
+    #: Memory a cycle analysis or a balancing takes per sampled angle, bytes (the regressors'
+    #: complex (N, 14) arrays and the motion's, with room for temporaries).
+    BYTES_PER_SAMPLE: ClassVar[int] = 4096
+
+    def __post_init__(self) -> None:
+        """Check the values (keys within ``[operation]``)."""
+        _set(self, "speed", v.nonzero(self.speed, "speed", "the crank must turn"))
+        samples = v.integer(self.samples, "samples", minimum=8)
+        v.require_memory(samples, self.BYTES_PER_SAMPLE, "samples", "samples of a revolution")
+        _set(self, "samples", samples)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -351,6 +482,27 @@ class SimulationSettings:
     atol: float = 1e-12
     outputs: int = 501
 
+    #: Memory a simulation takes per output time, bytes (state, evaluation, CSV text).
+    BYTES_PER_OUTPUT: ClassVar[int] = 4096
+
+    def __post_init__(self) -> None:
+        """Check the values (keys within ``[simulation]``)."""
+        _set(self, "duration", v.positive(self.duration, "duration"))
+        _set(self, "theta1", v.number(self.theta1, "theta1"))
+        _set(self, "omega1", v.number(self.omega1, "omega1"))
+        _set(self, "gravity", v.vector2(self.gravity, "gravity"))
+        _set(self, "drive", v.choice(self.drive, "drive", DRIVES))
+        if self.method is not None:
+            _set(self, "method", v.choice(self.method, "method", METHODS))
+        rtol = v.number(self.rtol, "rtol")
+        if not 1e-14 <= rtol < 1:
+            raise SpecError("must be between 1e-14 and 1", key="rtol", value=self.rtol)
+        _set(self, "rtol", rtol)
+        _set(self, "atol", v.positive(self.atol, "atol"))
+        outputs = v.integer(self.outputs, "outputs", minimum=2)
+        v.require_memory(outputs, self.BYTES_PER_OUTPUT, "outputs", "output times")
+        _set(self, "outputs", outputs)
+
 
 @dataclass(frozen=True, kw_only=True)
 class Design:
@@ -378,3 +530,67 @@ class Design:
     balance: object | None = None
     original: FourBar | SliderCrank | None = None
     title: str = ""
+
+    def __post_init__(self) -> None:
+        """Check the parts' types and that the figures stay within double precision.
+
+        Keys are the spec's, from its root.
+        """
+        if not isinstance(self.mechanism, FourBar | SliderCrank):
+            raise SpecError("must be a FourBar or a SliderCrank", key="mechanism",
+                            value=type(self.mechanism).__name__)
+        for name, cls in (("operation", Operation), ("simulation", SimulationSettings)):
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, cls):
+                raise SpecError(f"must be an {cls.__name__}", key=name,
+                                value=type(value).__name__)
+        if self.original is not None and type(self.original) is not type(self.mechanism):
+            raise SpecError("must be the same kind of mechanism as the design",
+                            key="original", value=type(self.original).__name__)
+        if not isinstance(self.title, str):
+            raise SpecError("must be a string", key="title", value=self.title)
+        speeds = {"simulation.omega1": self.simulation.omega1}
+        if self.operation is not None:
+            speeds["operation.speed"] = self.operation.speed
+        for mech in (self.mechanism, self.original):
+            if mech is not None:
+                check_scales(mech, speeds, {"simulation.gravity": self.simulation.gravity})
+
+
+def check_scales(mechanism, speeds: dict[str, float],
+                 gravity: dict[str, tuple[float, float]] | None = None) -> None:
+    """Raise :class:`SpecError` if a force, moment or energy of the motion leaves double precision.
+
+    The scales (:func:`balancer.validate.check_magnitudes`): a reach ``R`` (the lengths summed,
+    plus the farthest centre of mass from its joint); forces ``m·R·ω²``, ``m·|g|`` and the
+    applied forces; moments ``R`` times those, ``(I + J_c)·ω²`` and the applied moments;
+    energies ``(I + J_c + m·R²)·ω²``. ``speeds`` and ``gravity`` are keyed by their spec keys
+    (the largest speed of a motion and its gravity).
+    """
+    links = dict(zip(mechanism.link_names, mechanism.links, strict=True))
+    reach_terms = {f"mechanism.lengths.{n}": abs(x)
+                   for n, x in zip(mechanism.length_names, mechanism.lengths, strict=True)}
+    for name, link in links.items():
+        reach_terms[f"links.{name}.com"] = math.hypot(link.e, link.f)
+    reach_key = max(reach_terms, key=reach_terms.__getitem__)
+    r = [(reach_key, math.fsum(reach_terms.values()))]  # the reach R, m
+    speed_key = max(speeds, key=lambda k: abs(speeds[k]))
+    w2 = [(speed_key, speeds[speed_key])] * 2  # ω², as two factors
+    g_key, g = next(iter((gravity or {"gravity": (0.0, 0.0)}).items()))
+    g_abs = [(g_key, math.hypot(*g))]
+    forces, moments, energies = [], [], []
+    for name, link in links.items():
+        mass = [(f"links.{name}.mass", link.mass)]
+        inertia = [(f"links.{name}.inertia", link.inertia + link.counter_rotor)]
+        force = [(f"links.{name}.force", math.hypot(*link.force))]
+        forces += [mass + r + w2, mass + g_abs, force]
+        moments += [mass + r + r + w2, mass + g_abs + r, force + r, inertia + w2,
+                    [(f"links.{name}.moment", link.moment)]]
+        energies += [inertia + w2, mass + r + r + w2]
+    if isinstance(mechanism, SliderCrank) and not mechanism.gas_force.is_zero:
+        gas = [("links.slider.gas_force", max(abs(x) for x in mechanism.gas_force.values))]
+        forces.append(gas)
+        moments.append(gas + r)
+    v.check_magnitudes(forces, "the forces", "N")
+    v.check_magnitudes(moments, "the moments", "N·m")
+    v.check_magnitudes(energies, "the kinetic energy", "J")

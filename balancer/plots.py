@@ -8,7 +8,6 @@ Each ``plot_*`` function draws on the axes it is given (or a new figure's) and r
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -18,19 +17,12 @@ from matplotlib.figure import Figure
 from . import mechanisms
 from .mechanisms import drawing_frames
 from .model import FourBar
+from .outputs import write_with
 from .simulate import Trajectory
 
 #: Colours for A0, A3 and their sum (colour-blind safe).
 COLOURS = {"A0": "#0072B2", "A3": "#D55E00", "sum": "#000000", "before": "#999999",
            "after": "#009E73"}
-
-
-def _publish(tmp: str, target: Path) -> None:
-    """Give a finished temporary file the usual permissions and move it into place."""
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
-    os.replace(tmp, target)
 
 
 def _axes(ax: Axes | None) -> Axes:
@@ -140,20 +132,19 @@ def verification_figure(design, verification) -> Figure:
 
 
 def _write_atomic(fig: Figure, out: Path, dpi: float | None) -> Path:
-    """Write ``fig`` to ``out`` (format from the suffix) via a temporary file, whole or not."""
+    """Write ``fig`` to ``out`` (format from the suffix), whole or not at all."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     FigureCanvasAgg(fig)
-    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=out.suffix,
-                               dir=out.parent if str(out.parent) else ".")
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=dpi, format=out.suffix[1:])
-        _publish(tmp, out)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return out
+    return write_with(out, lambda tmp: fig.savefig(tmp, dpi=dpi, format=out.suffix[1:]),
+                      suffix=out.suffix)
+
+
+def figure_paths(path: str | os.PathLike[str]) -> list[Path]:
+    """The files :func:`save_figure` writes for ``path``: PNG and SVG with ``path``'s stem."""
+    target = Path(path)
+    stem = target.with_suffix("") if target.suffix.lower() in (".png", ".svg") else target
+    return [stem.with_suffix(".png"), stem.with_suffix(".svg")]
 
 
 def save_figure(fig: Figure, path: str | os.PathLike[str]) -> list[Path]:
@@ -161,10 +152,8 @@ def save_figure(fig: Figure, path: str | os.PathLike[str]) -> list[Path]:
 
     Returns the files written.
     """
-    target = Path(path)
-    stem = target.with_suffix("") if target.suffix.lower() in (".png", ".svg") else target
-    return [_write_atomic(fig, stem.with_suffix(suffix), dpi)
-            for suffix, dpi in ((".png", 150), (".svg", None))]
+    return [_write_atomic(fig, out, dpi)
+            for out, dpi in zip(figure_paths(path), (150, None), strict=True)]
 
 
 def save_png(fig: Figure, path: str | os.PathLike[str], dpi: float = 100) -> Path:
@@ -227,15 +216,6 @@ def animate(linkage: FourBar, path: str | os.PathLike[str], *, frames: int = 72,
             ax.draw_artist(artist)
         rgba = np.asarray(canvas.buffer_rgba())
         images.append(Image.fromarray(rgba[..., :3].copy()).quantize(colors=64))
-    target = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".gif",
-                               dir=target.parent if str(target.parent) else ".")
-    os.close(fd)
-    try:
-        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
-                       duration=round(1000 / fps), loop=0)
-        _publish(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return target
+    return write_with(path, lambda tmp: images[0].save(
+        tmp, format="GIF", save_all=True, append_images=images[1:],
+        duration=round(1000 / fps), loop=0), suffix=".gif")

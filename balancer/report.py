@@ -221,8 +221,38 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
 
 
 def dumps_json(doc: dict[str, Any]) -> str:
-    """JSON text with a trailing newline; NaN and infinity are not allowed."""
+    """JSON text with a trailing newline; NaN and infinity are not allowed.
+
+    Raises
+    ------
+    SolverError
+        Naming the first field that holds NaN or infinity (a computation that failed; strict
+        JSON has no such numbers, and a reader must not get them).
+    """
+    where = _nonfinite(doc, "")
+    if where is not None:
+        from .errors import SolverError
+
+        raise SolverError(f"the results are not finite numbers (at {where}): the computation "
+                          "lost its precision")
     return json.dumps(doc, indent=2, allow_nan=False) + "\n"
+
+
+def _nonfinite(value: Any, path: str) -> str | None:
+    """The path of the first NaN or infinity in a JSON-like document, or ``None``."""
+    if isinstance(value, float):
+        return None if math.isfinite(value) else (path or "the top")
+    if isinstance(value, dict):
+        for key, item in value.items():
+            found = _nonfinite(item, f"{path}.{key}" if path else str(key))
+            if found is not None:
+                return found
+    elif isinstance(value, list | tuple):
+        for i, item in enumerate(value):
+            found = _nonfinite(item, f"{path}[{i}]")
+            if found is not None:
+                return found
+    return None
 
 
 #: The columns of ``simulate``'s CSV, fixed by DESIGN.md.

@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 import time as _time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -40,10 +40,15 @@ from scipy.optimize import brentq
 
 from .errors import AssemblyError, LockupError, SolverError, SpecError
 from .formulations import Formulation, make
-from .model import Design, FourBar, SimulationSettings
+from .model import Design, FourBar, SimulationSettings, check_scales
 
 #: |sin(θ3 − θ2)| at which a crank-angle formulation stops before a dead point.
 DEAD_POINT_THRESHOLD = 1e-3
+#: Most integration steps a simulation may take (tens of minutes with the slowest
+#: formulation): a duration that needs more is refused, from the rate of its first steps.
+MAX_STEPS = 2_000_000
+#: Steps after which the rate is extrapolated to the whole duration.
+PROJECT_AFTER = 200
 
 
 @dataclass(frozen=True)
@@ -195,6 +200,7 @@ class _Stepper:
             if solver.status == "failed":
                 raise SolverError(f"the integrator failed at t = {solver.t:.6g} s: {message}")
             steps += 1
+            self._check_budget(steps, solver.t)
             interp = solver.dense_output()
             if not f.minimal:
                 res = f.constraint_residual(solver.t, solver.y)
@@ -217,6 +223,20 @@ class _Stepper:
             if self.progress is not None:
                 self.progress(solver.t, self.duration)
         return times, states, drift, solver.nfev + self.extra_fev, steps, stopped
+
+    def _check_budget(self, steps: int, t: float) -> None:
+        """Refuse a duration that would take more than :data:`MAX_STEPS` steps.
+
+        After :data:`PROJECT_AFTER` steps, from the rate so far; at any time, the limit itself.
+        """
+        if steps < PROJECT_AFTER or t <= 0:
+            return
+        projected = steps * self.duration / t
+        if projected > MAX_STEPS:
+            raise SpecError(
+                f"would take about {projected:.2g} integration steps at the rate of the first "
+                f"{t:.3g} s ({steps} steps), more than the {MAX_STEPS:.0e} allowed: shorten "
+                "it, or loosen rtol", key="simulation.duration", value=self.duration)
 
     def _dead_point(self, interp, t0: float, t1: float, change_points):
         """The time at which |sin(θ3 − θ2)| falls to the threshold within a step, or None."""
@@ -316,21 +336,20 @@ def simulate(
     """
     from .formulations import FORMULATIONS, default_method
 
-    method = method or settings.method or default_method(linkage.type)
-    drive = drive or settings.drive
-    duration = settings.duration if duration is None else duration
-    rtol = settings.rtol if rtol is None else rtol
-    atol = settings.atol if atol is None else atol
-    outputs = settings.outputs if outputs is None else outputs
+    overrides = {"method": method, "drive": drive, "duration": duration, "rtol": rtol,
+                 "atol": atol, "outputs": outputs}
+    # The settings with the overrides, checked as a spec's would be (SimulationSettings).
+    settings = replace(settings, **{k: x for k, x in overrides.items() if x is not None})
+    method = settings.method or default_method(linkage.type)
+    drive, duration, rtol, atol, outputs = (settings.drive, settings.duration, settings.rtol,
+                                            settings.atol, settings.outputs)
     if method not in FORMULATIONS[linkage.type]:
         raise SpecError(
             f"the {linkage.type} has no such formulation; choose from "
             f"{', '.join(FORMULATIONS[linkage.type])}", key="method", value=method)
-    if not (duration > 0 and math.isfinite(duration)):
-        raise SpecError("must be a positive number of seconds", key="duration", value=duration)
-    if not (1e-14 <= rtol < 1):
-        raise SpecError("must be between 1e-14 and 1", key="rtol", value=rtol)
     theta1, omega1 = settings.theta1, settings.omega1
+    check_scales(linkage, {"simulation.omega1": omega1},
+                 {"simulation.gravity": settings.gravity})
     speed = None
     if drive == "constant-speed":
         if omega1 == 0:

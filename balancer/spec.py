@@ -41,16 +41,14 @@ from __future__ import annotations
 import difflib
 import math
 import os
-import tempfile
 import tomllib
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from .errors import AssemblyError, SpecError
-from .kinematics import assembly_range
+from . import validate as v
+from .errors import SpecError
 from .model import (
-    DRIVES,
     METHODS_BY_TYPE,
     Design,
     FourBar,
@@ -60,6 +58,7 @@ from .model import (
     SimulationSettings,
     SliderCrank,
 )
+from .outputs import write_atomic
 
 MECHANISMS = {"four-bar": FourBar, "slider-crank": SliderCrank}
 MECHANISM_TYPES = tuple(MECHANISMS)
@@ -135,28 +134,16 @@ class _Table:
             name, default=default, check=lambda x: x >= 0, requirement="zero or positive"
         )
 
-    def integer(self, name: str, *, default: int, minimum: int) -> int:
-        if name not in self.data:
-            return default
-        value = self.raw(name)
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise SpecError("must be an integer", key=self.key(name), value=value)
-        if value < minimum:
-            raise SpecError(f"must be at least {minimum}", key=self.key(name), value=value)
-        return value
+    def value(self, name: str, default: Any) -> Any:
+        """The raw value (checked by the model object it goes into), or ``default``."""
+        return self.raw(name) if name in self.data else default
 
     def string(self, name: str, *, choices: tuple[str, ...], default: str | None = None) -> str:
         if name not in self.data:
             if default is None:
                 raise self._missing(name)
             return default
-        value = self.raw(name)
-        if not isinstance(value, str):
-            raise SpecError("must be a string", key=self.key(name), value=value)
-        if value not in choices:
-            options = ", ".join(f'"{c}"' for c in choices)
-            raise SpecError(f"must be one of {options}", key=self.key(name), value=value)
-        return value
+        return v.choice(self.raw(name), self.key(name), choices)
 
     def text(self, name: str, *, default: str) -> str:
         if name not in self.data:
@@ -169,12 +156,7 @@ class _Table:
     def vector2(self, name: str, *, default: tuple[float, float]) -> tuple[float, float]:
         if name not in self.data:
             return default
-        value = self.raw(name)
-        if not isinstance(value, list) or len(value) != 2:
-            raise SpecError("must be a list of two numbers [x, y]", key=self.key(name), value=value)
-        x = _as_number(value[0], self.key(name) + "[0]", None, "")
-        y = _as_number(value[1], self.key(name) + "[1]", None, "")
-        return (x, y)
+        return v.vector2(self.raw(name), self.key(name))
 
     def finish(self) -> None:
         """Raise on the first key that was not used (unknown, or a typo)."""
@@ -222,11 +204,7 @@ _KNOWN_KEYS: dict[str, tuple[str, ...]] = {
 def _as_number(
     value: Any, key: str, check: Callable[[float], bool] | None, requirement: str
 ) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise SpecError("must be a number", key=key, value=value)
-    x = float(value)
-    if not math.isfinite(x):
-        raise SpecError("must be a finite number", key=key, value=value)
+    x = v.number(value, key)
     if check is not None and not check(x):
         raise SpecError(f"must be {requirement}", key=key, value=value)
     return x
@@ -237,10 +215,15 @@ def _as_number(
 
 
 def _read_link(table: _Table, name: str, mechanism_class) -> Link:
+    """One link; its values are checked by :class:`~balancer.model.Link` (keys prefixed)."""
     slider = mechanism_class is SliderCrank and name == "slider"
-    mass = table.positive("mass")
+    if not table.has("mass"):
+        raise table._missing("mass")
+    mass = table.raw("mass")
     # A slider does not turn: its inertia does not matter and may be left out.
-    inertia = table.nonnegative("inertia", default=0.0) if slider else table.positive("inertia")
+    if not slider and not table.has("inertia"):
+        raise table._missing("inertia")
+    inertia = table.value("inertia", 0.0)
     com = table.table("com")
     assert com is not None
     polar = com.has("s") or com.has("sigma")
@@ -260,27 +243,18 @@ def _read_link(table: _Table, name: str, mechanism_class) -> Link:
     else:
         raise SpecError("missing required key: give {s, sigma} or {e, f}", key=com.path)
     com.finish()
-    force = table.vector2("force", default=(0.0, 0.0))
-    moment = table.number("moment", default=0.0)
-    counter_rotor = table.nonnegative("counter_rotor", default=0.0)
-    if counter_rotor and name not in mechanism_class.grounded_links:
-        where = " and ".join(mechanism_class.grounded_links)
-        raise SpecError(
-            f"a counter-rotor sits on a ground pivot: only the {where} can have one",
-            key=table.key("counter_rotor"),
-            value=counter_rotor,
-        )
     if table.has("gas_force") and not slider:
         raise SpecError("only a slider carries a gas force", key=table.key("gas_force"))
-    return Link(
-        mass=mass,
-        inertia=inertia,
-        e=e,
-        f=f,
-        force=force,
-        moment=moment,
-        counter_rotor=counter_rotor,
-    )
+    with v.under(table.path):
+        return Link(
+            mass=mass,
+            inertia=inertia,
+            e=e,
+            f=f,
+            force=table.value("force", (0.0, 0.0)),
+            moment=table.value("moment", 0.0),
+            counter_rotor=table.value("counter_rotor", 0.0),
+        )
 
 
 def _read_gas_force(table: _Table) -> GasForce:
@@ -290,25 +264,20 @@ def _read_gas_force(table: _Table) -> GasForce:
         return GasForce()
     raw = table.raw("gas_force")
     if not isinstance(raw, dict):
-        return GasForce.constant(_as_number(raw, key, None, ""))
+        return GasForce.constant(v.number(raw, key))
     sub = _Table(raw, key)
     sub.expect(("crank_angle", "force", "period"))
-    period = sub.positive("period", default=2 * math.pi)
-    angles, values = (sub.raw(k) if sub.has(k) else None for k in ("crank_angle", "force"))
-    for k, v in (("crank_angle", angles), ("force", values)):
-        if not isinstance(v, list) or not v:
-            raise SpecError("must be a non-empty list of numbers", key=f"{key}.{k}", value=v)
-    angles = [_as_number(a, f"{key}.crank_angle", None, "") for a in angles]
-    values = [_as_number(v, f"{key}.force", None, "") for v in values]
-    if len(angles) != len(values):
-        raise SpecError(f"crank_angle and force must have the same length ({len(angles)} and "
-                        f"{len(values)})", key=key)
-    if any(b <= a for a, b in zip(angles, angles[1:], strict=False)) or angles[0] < 0 or (
-            angles[-1] >= period):
-        raise SpecError("crank angles must increase within one period, from 0",
-                        key=f"{key}.crank_angle", value=angles)
+    for name in ("crank_angle", "force"):
+        if not sub.has(name):
+            raise sub._missing(name)
+        if not isinstance(sub.data[name], list):
+            raise SpecError("must be a non-empty list of numbers", key=sub.key(name),
+                            value=sub.data[name])
+    with v.under(key):
+        gas = GasForce(angles=sub.raw("crank_angle"), values=sub.raw("force"),
+                       period=sub.value("period", 2 * math.pi))
     sub.finish()
-    return GasForce(angles=tuple(angles), values=tuple(values), period=period)
+    return gas
 
 
 def _read_links(table: _Table, mechanism_class) -> tuple[dict[str, Link], GasForce]:
@@ -336,58 +305,36 @@ def _read_mechanism(root: _Table) -> FourBar | SliderCrank:
     lengths_table = mech.table("lengths")
     assert lengths_table is not None
     lengths_table.expect(cls.length_names)
-    if cls is SliderCrank:
-        lengths = (
-            lengths_table.positive("crank"),
-            lengths_table.positive("rod"),
-            lengths_table.number("offset", default=0.0),
-        )
-    else:
-        lengths = tuple(lengths_table.positive(n) for n in cls.length_names)
+    lengths = []
+    for name in cls.length_names:
+        if name == "offset":
+            lengths.append(lengths_table.value(name, 0.0))
+        elif not lengths_table.has(name):
+            raise lengths_table._missing(name)
+        else:
+            lengths.append(lengths_table.raw(name))
     lengths_table.finish()
     mech.finish()
-    _check_assembles(cls, lengths)
     links_table = root.table("links")
     assert links_table is not None
     links, gas = _read_links(links_table, cls)
+    # The mechanism checks its lengths (keys from the root: mechanism.lengths.crank), that it
+    # assembles, and its links.
     if cls is SliderCrank:
-        return SliderCrank(lengths=lengths, branch=branch, gas_force=gas, **links)  # type: ignore[arg-type]
-    return FourBar(lengths=lengths, branch=branch, **links)  # type: ignore[arg-type]
-
-
-def _check_assembles(cls, lengths) -> None:
-    if cls is SliderCrank:
-        r, big_l, e = lengths
-        if abs(e) > r + big_l:
-            raise AssemblyError(
-                f"the slider-crank cannot be assembled at any crank angle: the guide is "
-                f"{abs(e):.6g} m from A0, beyond the reach of crank and rod "
-                f"({r + big_l:.6g} m)",
-                key="mechanism.lengths.offset",
-                value=e,
-            )
-        return
-    if assembly_range(lengths).empty:
-        l1, l2, l3, l4 = lengths
-        raise AssemblyError(
-            "the linkage cannot be assembled at any crank angle: the coupler and rocker "
-            f"(|l2 − l3| = {abs(l2 - l3):.6g} m to l2 + l3 = {l2 + l3:.6g} m) cannot bridge "
-            f"A1 to A3 (|l4 − l1| = {abs(l4 - l1):.6g} m to l1 + l4 = {l1 + l4:.6g} m)",
-            key="mechanism.lengths",
-            value=dict(zip(FourBar.length_names, lengths, strict=True)),
-        )
+        return SliderCrank(lengths=tuple(lengths), branch=branch, gas_force=gas, **links)  # type: ignore[arg-type]
+    return FourBar(lengths=tuple(lengths), branch=branch, **links)  # type: ignore[arg-type]
 
 
 def _read_operation(root: _Table) -> Operation | None:
     table = root.table("operation", required=False)
     if table is None:
         return None
-    speed = table.number(
-        "speed", check=lambda x: x != 0, requirement="non-zero (the crank must turn)"
-    )
-    samples = table.integer("samples", default=360, minimum=8)
+    if not table.has("speed"):
+        raise table._missing("speed")
+    with v.under("operation"):
+        operation = Operation(speed=table.raw("speed"), samples=table.value("samples", 360))
     table.finish()
-    return Operation(speed=speed, samples=samples)
+    return operation
 
 
 def _read_simulation(root: _Table, mechanism) -> SimulationSettings:
@@ -395,23 +342,14 @@ def _read_simulation(root: _Table, mechanism) -> SimulationSettings:
     defaults = SimulationSettings()
     if table is None:
         return defaults
-    settings = SimulationSettings(
-        duration=table.positive("duration", default=defaults.duration),
-        theta1=table.number("theta1", default=defaults.theta1),
-        omega1=table.number("omega1", default=defaults.omega1),
-        gravity=table.vector2("gravity", default=defaults.gravity),
-        drive=table.string("drive", choices=DRIVES, default=defaults.drive),  # type: ignore[arg-type]
-        method=table.string("method", choices=METHODS_BY_TYPE[mechanism.type], default="")
-        or None,
-        rtol=table.number(
-            "rtol",
-            default=defaults.rtol,
-            check=lambda x: 1e-14 <= x < 1,
-            requirement="between 1e-14 and 1",
-        ),
-        atol=table.positive("atol", default=defaults.atol),
-        outputs=table.integer("outputs", default=defaults.outputs, minimum=2),
-    )
+    method = table.string("method", choices=METHODS_BY_TYPE[mechanism.type], default="") or None
+    with v.under("simulation"):
+        settings = SimulationSettings(
+            **{name: table.value(name, getattr(defaults, name))
+               for name in ("duration", "theta1", "omega1", "gravity", "drive", "rtol", "atol",
+                            "outputs")},
+            method=method,
+        )
     table.finish()
     return settings
 
@@ -445,18 +383,18 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
             balance = read_balance(root.table("balance"), mechanism)
         original = _read_original(root, mechanism)
         root.finish()
+        return Design(
+            mechanism=mechanism,
+            operation=operation,
+            simulation=simulation,
+            balance=balance,
+            original=original,
+            title=title,
+        )
     except SpecError as exc:
         if source is not None and exc.source is None:
             raise exc.with_source(source) from None
         raise
-    return Design(
-        mechanism=mechanism,
-        operation=operation,
-        simulation=simulation,
-        balance=balance,
-        original=original,
-        title=title,
-    )
 
 
 def load_design(path: str | os.PathLike[str]) -> Design:
@@ -595,27 +533,12 @@ def dumps_design(design: Design) -> str:
     return "\n".join(out) + "\n"
 
 
-def write_atomic(path: str | os.PathLike[str], text: str | bytes) -> None:
-    """Write a file whole or not at all (temporary file in the same folder, then rename)."""
-    target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    mode = "wb" if isinstance(text, bytes) else "w"
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", dir=folder)
-    try:
-        with os.fdopen(fd, mode, **({} if mode == "wb" else {"encoding": "utf-8"})) as fh:
-            fh.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes it private; give it the usual mode
-        os.replace(tmp, target)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-
-
 def save_design(design: Design, path: str | os.PathLike[str]) -> None:
-    """Write the design to a TOML file, whole or not at all."""
+    """Write the design to a TOML file, whole or not at all.
+
+    Raises
+    ------
+    OutputError
+        If the file cannot be written.
+    """
     write_atomic(path, dumps_design(design))

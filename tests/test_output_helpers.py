@@ -7,6 +7,7 @@ import struct
 import pytest
 from matplotlib.figure import Figure
 
+from balancer.errors import OutputError
 from balancer.plots import save_figure, save_png
 from balancer.report import markdown_table
 
@@ -44,6 +45,6 @@ def test_save_figure_writes_png_and_svg_and_leaves_nothing_on_failure(tmp_path):
     assert written == [tmp_path / "report.png", tmp_path / "report.svg"]
     assert _png_size(written[0]) == (300, 150)  # 150 dpi
     assert written[1].read_text().lstrip().startswith("<?xml")
-    with pytest.raises(FileNotFoundError):
+    with pytest.raises(OutputError, match="missing/x.png: cannot write the file"):
         save_png(fig, tmp_path / "missing" / "x.png")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report.png", "report.svg"]

@@ -275,7 +275,10 @@ def test_the_objective_equals_the_newton_euler_route(seed):
     )
     data = numeric_problem(design)
     # The original, and a design with every parameter perturbed.
-    other = data.linkage_of(data.x0 * rng.uniform(0.8, 1.2, 14) + rng.uniform(0.0, 0.1, 14))
+    x = data.x0 * rng.uniform(0.8, 1.2, 14) + rng.uniform(0.0, 0.1, 14)
+    for k in (0, 4, 8):  # a realisable link: inertia about the centre of mass I ≥ 0
+        x[k + 3] = (x[k + 1] ** 2 + x[k + 2] ** 2) / x[k] + rng.uniform(0.01, 1.0)
+    other = data.linkage_of(x)
     for lk in (linkage, other):
         x = parameter_vector(lk)
         expected = _objective_by_newton_euler(data, lk)

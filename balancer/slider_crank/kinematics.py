@@ -28,7 +28,10 @@ Lengths = tuple[float, float, float]
 def assembly_range(lengths: Lengths) -> AssemblyRange:
     """Crank angles at which the slider-crank assembles: ``|e − r·sin θ1| ≤ L``.
 
-    The crank turns fully when ``r + |e| ≤ L``.
+    The crank turns fully when ``r + |e| < L``. When ``r + |e| = L`` it assembles at every angle
+    but the rod stands square to the guide at ``θ1 = −π/2`` (``e > 0``), ``+π/2``
+    (``e < 0``) or both (``e = 0``), a dead point that the smooth motion cannot be driven through: the range
+    is then reported from that dead point round to itself, not full.
     """
     r, big_l, e = lengths
     s_lo, s_hi = (e - big_l) / r, (e + big_l) / r
@@ -36,7 +39,13 @@ def assembly_range(lengths: Lengths) -> AssemblyRange:
         return AssemblyRange(intervals=(), full=False)
     lo_free, hi_free = s_lo <= -1, s_hi >= 1
     if lo_free and hi_free:
-        return AssemblyRange(intervals=((-math.pi, math.pi),), full=True)
+        if s_lo < -1 and s_hi > 1:
+            return AssemblyRange(intervals=((-math.pi, math.pi),), full=True)
+        half = math.pi / 2
+        if s_lo == -1 and s_hi == 1:  # dead points at both θ1 = ±π/2
+            return AssemblyRange(intervals=((-half, half), (half, 3 * half)), full=False)
+        dead = -half if s_lo == -1 else half  # sin θ1 = −1 or +1 reaches the rod's length
+        return AssemblyRange(intervals=((dead, dead + 2 * math.pi),), full=False)
     if lo_free:  # sin θ1 ≤ s_hi: the arc around θ1 = π/2 is excluded
         a = math.asin(s_hi)
         return AssemblyRange(intervals=((math.pi - a, 2 * math.pi + a),), full=False)
