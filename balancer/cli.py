@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -97,6 +98,10 @@ class _Progress:
             self.stream.flush()
 
 
+#: Simulation settings that a command-line option overrides (errors then name the option).
+_SIMULATE_OPTIONS = ("method", "drive", "duration", "rtol", "atol", "outputs")
+
+
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from .outputs import write_atomic
     from .report import dumps_json, simulation_csv, simulation_json, simulation_text
@@ -117,6 +122,10 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             outputs=args.outputs,
             progress=progress,
         )
+    except SpecError as exc:
+        if exc.key in _SIMULATE_OPTIONS and getattr(args, exc.key) is not None:
+            raise SpecError(exc.detail, key=f"--{exc.key}", value=exc.value) from None
+        raise
     finally:
         progress.done()
     csv = simulation_csv(traj, all_columns=args.all_columns) if out is not None else None
@@ -136,15 +145,18 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     from .verify import verify
 
     plot = _output_path(args, args.plot, "--plot")
+    if plot is not None:
+        from .plots import figure_type
+
+        figure_type(plot, "--plot")
     design = load_design(args.spec)
     verification = verify(design, method=args.method, duration=args.duration)
     paths: list[Path] = []
     if plot is not None:
-        from .plots import figure_paths
+        from .plots import figure_type
 
-        paths = figure_paths(plot)
-        for path in paths:
-            _output_path(args, str(path), "--plot")
+        figure_type(plot, "--plot")
+        paths = [plot]
     if args.json:
         doc = {"spec": args.spec, **verification.as_dict(), "plots": [str(p) for p in paths]}
         text = dumps_json(doc)
@@ -195,9 +207,13 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     if args.animate is None:
         raise SpecError("nothing to plot: give --animate PATH", key="--animate")
     path = _output_path(args, args.animate, "--animate")
-    design = load_design(args.spec)
-    from .plots import animate
+    from .plots import ANIMATION_TYPES, animate, figure_type
 
+    figure_type(path, "--animate", ANIMATION_TYPES)
+    design = load_design(args.spec)
+    from .mechanisms import require_full_revolution
+
+    require_full_revolution(design.mechanism, "an animation of one revolution")
     animate(design.mechanism, path, frames=args.frames, title=design.title)
     print(f"wrote {path}")
     return 0
@@ -223,6 +239,16 @@ def _count(text: str) -> int:
     return value
 
 
+def _version() -> str:
+    """The installed package's version."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("balancer")
+    except PackageNotFoundError:  # pragma: no cover - run from a source tree
+        return "unknown (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``balancer`` command."""
     parser = _Parser(
@@ -233,6 +259,7 @@ def build_parser() -> argparse.ArgumentParser:
             "moment, and prove the result by simulation."
         ),
     )
+    parser.add_argument("--version", action="version", version=f"balancer {_version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
 
@@ -300,7 +327,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
     p.add_argument("--force", action="store_true",
                    help="allow an output path to name the input spec (it is overwritten)")
-    p.add_argument("--plot", metavar="PATH", help="write the figure to PATH (.png and .svg)")
+    p.add_argument("--plot", metavar="PATH",
+                   help="write the report figure to PATH (.png, .svg or .pdf)")
     p.add_argument("--duration", type=_positive_float, metavar="T",
                    help="simulated time of each run, s (default: the spec's)")
     p.add_argument("--method", choices=METHODS,
@@ -358,7 +386,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         args = parser.parse_args(argv)
         handler: Callable[[argparse.Namespace], int] = args.handler
-        return handler(args)
+        # A user sees results or one line of error: the libraries' warnings (an overflow in an
+        # intermediate, a solver's note) are not theirs to read. Results are checked finite
+        # before they are written (report.dumps_json, report.csv_text).
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return handler(args)
     except BalancerError as exc:
         spec = getattr(args, "spec", None)
         if (isinstance(exc, SpecError) and not isinstance(exc, OutputError)

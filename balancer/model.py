@@ -37,6 +37,10 @@ METHODS_BY_TYPE: dict[str, tuple[str, ...]] = {
 }
 #: Ways the crank can be driven in a simulation.
 DRIVES: tuple[str, ...] = ("free", "constant-speed")
+#: Least relative tolerance of a simulation: 100 ε, below which SciPy's integrators raise it.
+RTOL_MIN = 100 * 2.220446049250313e-16
+#: Least absolute tolerance: errors over it are squared, which must not overflow (1e-150²).
+ATOL_MIN = 1e-150
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -495,10 +499,15 @@ class SimulationSettings:
         if self.method is not None:
             _set(self, "method", v.choice(self.method, "method", METHODS))
         rtol = v.number(self.rtol, "rtol")
-        if not 1e-14 <= rtol < 1:
-            raise SpecError("must be between 1e-14 and 1", key="rtol", value=self.rtol)
+        if not RTOL_MIN <= rtol < 1:
+            raise SpecError(f"must be at least {RTOL_MIN:.3g} (100 ε: the integrator's floor) "
+                            "and below 1", key="rtol", value=self.rtol)
         _set(self, "rtol", rtol)
-        _set(self, "atol", v.positive(self.atol, "atol"))
+        atol = v.positive(self.atol, "atol")
+        if atol < ATOL_MIN:
+            raise SpecError(f"must be at least {ATOL_MIN:g} (the integrator squares errors "
+                            "over it)", key="atol", value=self.atol)
+        _set(self, "atol", atol)
         outputs = v.integer(self.outputs, "outputs", minimum=2)
         v.require_memory(outputs, self.BYTES_PER_OUTPUT, "outputs", "output times")
         _set(self, "outputs", outputs)

@@ -15,6 +15,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from . import mechanisms
+from .errors import OutputError
 from .mechanisms import drawing_frames
 from .model import FourBar
 from .outputs import write_with
@@ -131,29 +132,44 @@ def verification_figure(design, verification) -> Figure:
     return fig
 
 
-def _write_atomic(fig: Figure, out: Path, dpi: float | None) -> Path:
-    """Write ``fig`` to ``out`` (format from the suffix), whole or not at all."""
+def _write_atomic(fig: Figure, out: Path, dpi: float | None, kind: str = "png") -> Path:
+    """Write ``fig`` to ``out`` as ``kind`` (``png``, ``svg``, ``pdf``), whole or not at all."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     FigureCanvasAgg(fig)
-    return write_with(out, lambda tmp: fig.savefig(tmp, dpi=dpi, format=out.suffix[1:]),
+    return write_with(out, lambda tmp: fig.savefig(tmp, dpi=dpi, format=kind),
                       suffix=out.suffix)
 
 
-def figure_paths(path: str | os.PathLike[str]) -> list[Path]:
-    """The files :func:`save_figure` writes for ``path``: PNG and SVG with ``path``'s stem."""
-    target = Path(path)
-    stem = target.with_suffix("") if target.suffix.lower() in (".png", ".svg") else target
-    return [stem.with_suffix(".png"), stem.with_suffix(".svg")]
+#: Figure formats by file extension (matplotlib's Agg, SVG and PDF backends).
+FIGURE_TYPES: dict[str, str] = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
+#: Animation formats by file extension.
+ANIMATION_TYPES: dict[str, str] = {".gif": "gif"}
 
 
-def save_figure(fig: Figure, path: str | os.PathLike[str]) -> list[Path]:
-    """Write the figure as PNG and SVG next to each other (``path``'s stem), atomically.
+def figure_type(path: str | os.PathLike[str], option: str | None = None,
+                types: dict[str, str] = FIGURE_TYPES) -> str:
+    """The file type that ``path``'s extension names, or :class:`OutputError` (exit 2)."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in types:
+        known = ", ".join(types)
+        raise OutputError(f"the file type comes from the extension: use one of {known}",
+                          key=option, value=str(path))
+    return types[suffix]
 
-    Returns the files written.
+
+def save_figure(fig: Figure, path: str | os.PathLike[str], dpi: float = 150) -> Path:
+    """Write the figure to ``path`` in the format its extension names, atomically.
+
+    PNG at ``dpi``; SVG and PDF are vector formats. Returns the path written.
+
+    Raises
+    ------
+    OutputError
+        For an extension other than :data:`FIGURE_TYPES`', or a file that cannot be written.
     """
-    return [_write_atomic(fig, out, dpi)
-            for out, dpi in zip(figure_paths(path), (150, None), strict=True)]
+    out = Path(path)
+    return _write_atomic(fig, out, dpi, figure_type(out))
 
 
 def save_png(fig: Figure, path: str | os.PathLike[str], dpi: float = 100) -> Path:

@@ -325,13 +325,20 @@ def analysis_csv(analysis: CycleAnalysis) -> str:
 
 
 def csv_text(columns: Sequence[str], values: Sequence[np.ndarray]) -> str:
-    """CSV with a header row; numbers written so that they read back exactly."""
+    """CSV with a header row; numbers written so that they read back exactly.
+
+    A value that does not exist (a reaction at the change point of a change-point linkage,
+    unbounded there) is an empty cell, never a literal ``nan``.
+    """
     data = np.column_stack([np.broadcast_to(np.asarray(v, dtype=float), np.shape(values[0]))
                             for v in values])
     buf = io.StringIO()
-    buf.write(",".join(columns) + "\n")
     np.savetxt(buf, data, delimiter=",", fmt="%.17g")
-    return buf.getvalue()
+    lines = buf.getvalue().splitlines()
+    for i in np.flatnonzero(~np.isfinite(data).all(axis=1)):
+        lines[i] = ",".join("" if not np.isfinite(x) else cell
+                            for x, cell in zip(data[i], lines[i].split(","), strict=True))
+    return "\n".join([",".join(columns), *lines]) + "\n"
 
 
 # ----------------------------------------------------------------------------------------------
@@ -501,7 +508,8 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
             "time": result.time,
             "stages": [
                 {"name": s.name, "converged": s.converged, "solver_status": s.solver_status,
-                 "iterations": s.iterations, "time": s.time, "objective": s.objective}
+                 "iterations": s.iterations, "time": s.time,
+                 "objective": s.objective if math.isfinite(s.objective) else None}
                 for s in result.stages
             ],
             "force_balanced": is_force_balanced(linkage),

@@ -137,6 +137,11 @@ def _unwrap(theta: NDArray[np.float64], omega: NDArray[np.float64], t: NDArray[n
     return theta + 2 * math.pi * np.concatenate([[0.0], np.cumsum(turns)])
 
 
+#: Distance (rad) from a change point within which a motion cannot start: √ε, where the
+#: rates of the dependent links are lost to rounding (they are 0/0 at the change point).
+CHANGE_POINT_MARGIN = 1.5e-8
+
+
 def _check_start(f: Formulation, theta1: float) -> None:
     rng = f.assembly_range()
     if not rng.contains(theta1):
@@ -146,6 +151,13 @@ def _check_start(f: Formulation, theta1: float) -> None:
             key="simulation.theta1",
             value=theta1,
         )
+    for point in f.change_points():
+        if abs(math.remainder(theta1 - point, 2 * math.pi)) < CHANGE_POINT_MARGIN:
+            raise SpecError(
+                f"is a change point of the linkage (θ1 = {point:.6g} rad: all joints in line), "
+                "where the rates of coupler and rocker are not determined by the crank's; "
+                f"start at least {CHANGE_POINT_MARGIN:g} rad away from it",
+                key="simulation.theta1", value=theta1)
 
 
 def _lock_time(f: Formulation, theta1: float, speed: float, duration: float) -> float | None:

@@ -109,16 +109,16 @@ class Verification:
     free: RunCheck
 
     @property
-    def max_shaking_force(self) -> float:
-        """Largest shaking force over both runs, N."""
-        return max(x for x in (self.driven.max_shaking_force, self.free.max_shaking_force)
-                   if x is not None)
+    def max_shaking_force(self) -> float | None:
+        """Largest shaking force over the runs that finished, N (``None``: neither did)."""
+        return max((x for x in (self.driven.max_shaking_force, self.free.max_shaking_force)
+                    if x is not None), default=None)
 
     @property
-    def max_shaking_moment(self) -> float:
-        """Largest shaking moment over both runs, N·m."""
-        return max(x for x in (self.driven.max_shaking_moment, self.free.max_shaking_moment)
-                   if x is not None)
+    def max_shaking_moment(self) -> float | None:
+        """Largest shaking moment over the runs that finished, N·m (``None``: neither did)."""
+        return max((x for x in (self.driven.max_shaking_moment, self.free.max_shaking_moment)
+                    if x is not None), default=None)
 
     def as_dict(self) -> dict:
         """Plain dictionary for JSON (``max_shaking_force``, ``max_shaking_moment`` fixed)."""

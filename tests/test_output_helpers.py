@@ -38,13 +38,18 @@ def test_save_png_writes_one_png_at_the_asked_resolution_and_no_temporary_file(t
     assert sorted(p.name for p in tmp_path.iterdir()) == ["curve.png"]
 
 
-def test_save_figure_writes_png_and_svg_and_leaves_nothing_on_failure(tmp_path):
+def test_save_figure_writes_the_type_its_extension_names_and_nothing_on_failure(tmp_path):
     fig = Figure(figsize=(2.0, 1.0))
     fig.add_subplot().plot([0, 1], [0, 1])
-    written = save_figure(fig, tmp_path / "report.png")
-    assert written == [tmp_path / "report.png", tmp_path / "report.svg"]
-    assert _png_size(written[0]) == (300, 150)  # 150 dpi
-    assert written[1].read_text().lstrip().startswith("<?xml")
+    assert save_figure(fig, tmp_path / "report.png") == tmp_path / "report.png"
+    assert _png_size(tmp_path / "report.png") == (300, 150)  # 150 dpi
+    save_figure(fig, tmp_path / "report.svg")
+    assert (tmp_path / "report.svg").read_text().lstrip().startswith("<?xml")
+    save_figure(fig, tmp_path / "report.pdf")
+    assert (tmp_path / "report.pdf").read_bytes()[:5] == b"%PDF-"
     with pytest.raises(OutputError, match="missing/x.png: cannot write the file"):
         save_png(fig, tmp_path / "missing" / "x.png")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["report.png", "report.svg"]
+    with pytest.raises(OutputError, match="use one of .png, .svg, .pdf"):
+        save_figure(fig, tmp_path / "report.jpg")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report.pdf", "report.png",
+                                                          "report.svg"]

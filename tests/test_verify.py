@@ -112,9 +112,28 @@ def test_verify_plots_and_json(tmp_path, capsys, pb2_balanced):
                  "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert {"max_shaking_force", "max_shaking_moment", "driven", "free"} <= set(doc)
-    assert plot.exists() and plot.with_suffix(".svg").exists()
+    assert doc["plots"] == [str(plot)]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report.png"]  # exactly what was asked
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert b"<svg" in plot.with_suffix(".svg").read_bytes()[:500]
+
+
+@pytest.mark.parametrize(("suffix", "magic"), [(".svg", b"<svg"), (".pdf", b"%PDF")])
+def test_verify_plot_type_comes_from_the_extension(tmp_path, capsys, pb2_balanced, suffix,
+                                                   magic):
+    plot = tmp_path / f"report{suffix}"
+    assert main(["verify", str(pb2_balanced), "--plot", str(plot), "--duration", "0.2"]) == 0
+    assert magic in plot.read_bytes()[:500]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [plot.name]
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("name", ["report.txt", "report", "report.gif"])
+def test_verify_plot_with_an_unknown_extension_is_refused_before_any_work(tmp_path, capsys,
+                                                                          pb2_balanced, name):
+    assert main(["verify", str(pb2_balanced), "--plot", str(tmp_path / name)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--plot" in err and ".png, .svg, .pdf" in err
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_verify_of_an_unbalanced_design_reports_its_shaking(capsys):
@@ -131,6 +150,9 @@ def test_animation(tmp_path, capsys):
     with Image.open(gif) as im:
         assert im.n_frames == 8
     assert main(["plot", str(EXAMPLES / "pb1.toml")]) == 2
+    for name in ("run.png", "run.txt", "run"):  # the type comes from the extension
+        assert main(["plot", str(EXAMPLES / "pb1.toml"), "--animate", str(tmp_path / name)]) == 2
+        assert not (tmp_path / name).exists()
     capsys.readouterr()
 
 

@@ -239,7 +239,8 @@ class LieGroup(Formulation):
             u2, u3 = v2 / abs(v2), v3 / abs(v3)
             q[2:6] = u2.real, u2.imag, -u3.real, -u3.imag
             y[off : off + 6] = q
-            y[7] = theta1
+            if not self.driven:
+                y[7] = theta1
             return y
         l1, l2, l3, _ = self.lengths
         phi_b = math.atan2(q[3], q[2])

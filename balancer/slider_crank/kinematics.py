@@ -28,10 +28,10 @@ Lengths = tuple[float, float, float]
 def assembly_range(lengths: Lengths) -> AssemblyRange:
     """Crank angles at which the slider-crank assembles: ``|e − r·sin θ1| ≤ L``.
 
-    The crank turns fully when ``r + |e| < L``. When ``r + |e| = L`` it assembles at every angle
-    but the rod stands square to the guide at ``θ1 = −π/2`` (``e > 0``), ``+π/2``
-    (``e < 0``) or both (``e = 0``), a dead point that the smooth motion cannot be driven through: the range
-    is then reported from that dead point round to itself, not full.
+    The crank turns fully when ``r + |e| < L``. When ``r + |e| = L`` it assembles at every
+    angle but the rod stands square to the guide at ``θ1 = −π/2`` (``e > 0``), ``+π/2``
+    (``e < 0``) or both (``e = 0``): a dead point that the smooth motion cannot be driven
+    through. The range is then reported from that dead point round to itself, not full.
     """
     r, big_l, e = lengths
     s_lo, s_hi = (e - big_l) / r, (e + big_l) / r

@@ -1,0 +1,1466 @@
+"""Campaign over random redesign problems: the optimiser's claims against an independent solve.
+
+Run::
+
+    .venv/bin/python -m tests.fuzz.redesign_campaign --problems 1000 --seed 1 --keep /tmp/fuzz
+
+Each problem is a seeded random ``[balance]`` redesign problem (four-bar of a full-turning
+crank on either branch, or slider-crank with offset), written as spec text and loaded with
+:func:`balancer.spec.loads_design`; :func:`balancer.optimize.optimize` is called with both
+backends and its claims are checked against code that shares nothing with the package but the
+spec text:
+
+- own kinematics (closed form, both branches; slider-crank from the guide constraint);
+- own linear maps from the inertial parameters to the shaking force (``−dP/dt``), the shaking
+  moment about A0 (``−dH_A0/dt``, counter-rotors with angular momentum ``−J·ω``) and the driving
+  torque (``dT/dt / ω1``), all from analytic momentum, angular momentum and kinetic energy
+  derivatives (no finite differences);
+- force balance as the null space of the sampled variation of the total first moment of mass
+  (rank test), not Eq. 57-58;
+- own reading of the bounds from the spec numbers, and an own CVXPY/Clarabel program for the
+  optimum and a phase-1 (largest uniform margin) program for feasibility.
+
+Defect classes (counted per problem and backend): load failures of the written balanced spec,
+bound violations, force-balance failures, false ``optimal`` claims, false lower bounds,
+feasible problems called infeasible, ``failed`` status (or a ``SolverError``) on a feasible
+problem, a ``SpecError`` from ``optimize`` on a spec that loaded, misreported objectives,
+crashes (exceptions other than the documented ``SpecError``/``AssemblyError``/``SolverError``/
+``InfeasibleError``) and NaN.
+
+Claims are refuted with certificates, not with a solver's word: the own program is solved with
+every inequality narrowed by 1e-10 (scaled units; a quarter of the phase-1 margin when the
+feasible set is thinner), its inertias put into their bounds exactly, and its design checked to
+meet every bound to 1e-9 (the tool's own feasibility tolerance); its ``J`` is then an upper
+bound of the optimum. A claim of global optimality is false when the tool's ``J`` exceeds it by
+more than the claim's own tolerance ``1e-6·max(|J|, 1e-10·J_ref)`` (GAP_TOLERANCE and the gap
+floor of ``balancer.optimize.result``) plus rounding; a lower bound is false when it exceeds it
+by as much. ``below-independent-optimum`` is a self-check (the tool's design better than the
+own program's optimum); in thin feasible sets it is expected, the tool's design using its 1e-9
+tolerance. "Mixed-scale" problems have link masses differing by more than 1e6; there force
+balance and feasibility are only defined relative to the total mass, and the counts are shown
+apart.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import json
+import math
+import sys
+import tempfile
+import time
+import traceback
+import warnings
+from collections import Counter, defaultdict
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import cvxpy as cp
+import numpy as np
+
+FOUR = "four-bar"
+SLIDER = "slider-crank"
+NAMES = {FOUR: ("crank", "coupler", "rocker"), SLIDER: ("crank", "rod", "slider")}
+LENGTH_NAMES = {FOUR: ("crank", "coupler", "rocker", "frame"), SLIDER: ("crank", "rod", "offset")}
+JOINTS = {
+    FOUR: {"crank": ("A0", "A1"), "coupler": ("A1", "A2"), "rocker": ("A2", "A3")},
+    SLIDER: {"crank": ("A0", "A1"), "rod": ("A1", "A2"), "slider": ("A2",)},
+}
+DEFAULT_ABOUT = {
+    FOUR: {"crank": "A0", "coupler": "A1", "rocker": "A3"},
+    SLIDER: {"crank": "A0", "rod": "A1", "slider": "A2"},
+}
+GROUNDED = {FOUR: ("crank", "rocker"), SLIDER: ("crank",)}
+WEIGHT_NAMES = (
+    "shaking_moment",
+    "driving_torque",
+    "shaking_force",
+    "shaking_force_x",
+    "shaking_force_y",
+    "added_mass",
+)
+
+#: Relative tolerance of the tool's own feasibility check (balancer.problem): a bound is
+#: "violated" in the headline count when it is broken by more than this, on the link's scale.
+BOUND_TOL = 1e-9
+#: Force balance of a balanced design: RMS shaking force over M·ω²·l, and the total centre of
+#: mass's excursion over l, above this is a failure (ten times what Eq. 58 to 1e-9 allows).
+FORCE_TOL = 1e-8
+#: ... and the RMS shaking force may not exceed this fraction of the original design's.
+FORCE_REL_TOL = 1e-6
+#: The tool's own gap tolerance and the floor of its relative gap (balancer.optimize.result).
+CLAIM_GAP = 1e-6
+CLAIM_FLOOR = 1e-10
+#: Accuracy of the independent optimum in √J, relative to √J_ref: Clarabel is run at 1e-10
+#: (gap and feasibility, scaled variables, norm objective); 100 times that covers conditioning.
+OWN_DELTA = 1e-8
+#: Phase-1 margin below which the independent program calls a problem feasible (the tool's own
+#: feasibility tolerance).
+FEASIBLE_SLACK = 1e-9
+CLARABEL = {
+    "tol_gap_abs": 1e-11,
+    "tol_gap_rel": 1e-11,
+    "tol_feas": 1e-11,
+    "tol_infeas_abs": 1e-11,
+    "tol_infeas_rel": 1e-11,
+    "tol_ktratio": 1e-9,
+    "max_iter": 400,
+}
+
+
+# ----------------------------------------------------------------------------------------------
+# Problems
+
+
+@dataclass
+class LinkData:
+    """One link as the spec gives it (com in the link frame; a slider's in global axes)."""
+
+    mass: float
+    inertia: float
+    e: float
+    f: float
+    counter_rotor: float = 0.0
+
+
+@dataclass
+class Freedom:
+    """One ``[balance.<link>]`` table (``None``: key absent)."""
+
+    mass: tuple[float, float] | None = None
+    com_radius: float | None = None
+    com_about: str | None = None
+    min_gyration: float | None = None
+    inertia: tuple[float, float] | None = None
+    counter_rotor: tuple[float, float] | None = None
+
+
+@dataclass
+class Case:
+    """A random redesign problem."""
+
+    pid: int
+    family: str
+    kind: str
+    branch: str
+    lengths: tuple[float, ...]
+    links: dict[str, LinkData]
+    speed: float
+    samples: int
+    force_balance: bool
+    weights: dict[str, float]
+    free: dict[str, Freedom]
+    notes: dict = field(default_factory=dict)
+
+    def length_of(self, name: str) -> float:
+        """The length that scales link ``name`` (a slider's: the crank's)."""
+        if name == "slider":
+            return self.lengths[0]
+        return self.lengths[NAMES[self.kind].index(name)]
+
+    @property
+    def original_mass(self) -> float:
+        """Total mass of the moving links."""
+        return sum(link.mass for link in self.links.values())
+
+
+def _num(x: float) -> str:
+    return repr(float(x))
+
+
+def _range(r: tuple[float, float]) -> str:
+    return _num(r[0]) if r[0] == r[1] else f"[{_num(r[0])}, {_num(r[1])}]"
+
+
+def spec_text(case: Case) -> str:
+    """The TOML spec of a problem (every weight written: the default moment weight is 1)."""
+    out = [f'title = "fuzz {case.pid} {case.family}"', "", "[mechanism]"]
+    out += [f'type = "{case.kind}"', f'branch = "{case.branch}"', "", "[mechanism.lengths]"]
+    for name, value in zip(LENGTH_NAMES[case.kind], case.lengths, strict=True):
+        out.append(f"{name} = {_num(value)}")
+    for name in NAMES[case.kind]:
+        link = case.links[name]
+        out += ["", f"[links.{name}]", f"mass = {_num(link.mass)}"]
+        if not (name == "slider" and link.inertia == 0.0):
+            out.append(f"inertia = {_num(link.inertia)}")
+        out.append(f"com = {{ e = {_num(link.e)}, f = {_num(link.f)} }}")
+        if link.counter_rotor:
+            out.append(f"counter_rotor = {_num(link.counter_rotor)}")
+    out += ["", "[operation]", f"speed = {_num(case.speed)}", f"samples = {case.samples}"]
+    out += ["", "[balance]", f"force_balance = {'true' if case.force_balance else 'false'}"]
+    out += ["", "[balance.objective]"]
+    out += [f"{name} = {_num(case.weights.get(name, 0.0))}" for name in WEIGHT_NAMES]
+    for name in NAMES[case.kind]:
+        fr = case.free.get(name)
+        if fr is None:
+            continue
+        out += ["", f"[balance.{name}]"]
+        if fr.mass is not None:
+            out.append(f"mass = {_range(fr.mass)}")
+        if fr.com_radius is not None:
+            out.append(f"com_radius = {_num(fr.com_radius)}")
+        if fr.com_about is not None:
+            out.append(f'com_about = "{fr.com_about}"')
+        if fr.min_gyration is not None:
+            out.append(f"min_gyration = {_num(fr.min_gyration)}")
+        if fr.inertia is not None:
+            out.append(f"inertia = {_range(fr.inertia)}")
+        if fr.counter_rotor is not None:
+            out.append(f"counter_rotor = {_range(fr.counter_rotor)}")
+    return "\n".join(out) + "\n"
+
+
+# ----------------------------------------------------------------------------------------------
+# The bounds, read from the spec's numbers (own code; see the [balance] rules of DESIGN.md and
+# the docstring of balancer.problem)
+
+
+@dataclass
+class Bounds:
+    """Resolved bounds of one link."""
+
+    name: str
+    index: int
+    length: float
+    mref: float
+    iref: float
+    listed: bool
+    mass: tuple[float, float]
+    com_fixed: complex | None
+    centre: float
+    radius: float | None
+    inertia: tuple[float, float]
+    rho: float
+    rotor: tuple[float, float] | None
+    original: LinkData
+
+
+def resolve(case: Case) -> list[Bounds]:
+    """Per link: what may change and within which bounds."""
+    out = []
+    for index, name in enumerate(NAMES[case.kind]):
+        link = case.links[name]
+        l = case.length_of(name)
+        fr = case.free.get(name)
+        grounded = name in GROUNDED[case.kind]
+        rotor = (link.counter_rotor, link.counter_rotor) if grounded else None
+        common = dict(name=name, index=index, length=l, mref=link.mass,
+                      iref=link.mass * l * l, original=link)
+        if fr is None:
+            out.append(Bounds(**common, listed=False, mass=(link.mass, link.mass),
+                              com_fixed=complex(link.e, link.f), centre=0.0, radius=None,
+                              inertia=(link.inertia, link.inertia), rho=0.0, rotor=rotor))
+            continue
+        mass = fr.mass if fr.mass is not None else (link.mass, link.mass)
+        about = fr.com_about or DEFAULT_ABOUT[case.kind][name]
+        centre = 0.0 if about == JOINTS[case.kind][name][0] else l
+        com_fixed, radius = None, fr.com_radius
+        if radius is None:
+            com_fixed = complex(link.e, link.f)
+        elif radius == 0.0:
+            com_fixed, radius = complex(centre, 0.0), None
+        if fr.inertia is not None:
+            inertia = fr.inertia
+        elif mass[0] < mass[1] or fr.com_radius is not None or fr.min_gyration is not None:
+            inertia = (0.0, math.inf)
+        else:
+            inertia = (link.inertia, link.inertia)
+        if grounded and fr.counter_rotor is not None:
+            rotor = fr.counter_rotor
+        out.append(Bounds(**common, listed=True, mass=mass, com_fixed=com_fixed, centre=centre,
+                          radius=radius, inertia=inertia, rho=fr.min_gyration or 0.0,
+                          rotor=rotor))
+    return out
+
+
+def scales_of(bounds: list[Bounds], kind: str) -> np.ndarray:
+    """Scale of each entry of the design vector (kg, kg·m, kg·m, kg·m²; rotors kg·m²)."""
+    s = np.ones(14)
+    for b in bounds:
+        k = 4 * b.index
+        s[k:k + 4] = (b.mref, b.mref * b.length, b.mref * b.length, b.iref)
+    s[12] = bounds[0].iref
+    s[13] = bounds[2].iref if kind == FOUR else 1.0
+    return s
+
+
+def physical(x: np.ndarray) -> list[tuple[float, float, float, float]]:
+    """``(m, e, f, I)`` per link from the inertial parameters."""
+    out = []
+    for k in range(3):
+        m, me, mf, j = (float(v) for v in x[4 * k:4 * k + 4])
+        e, f = me / m, mf / m
+        out.append((m, e, f, j - m * (e * e + f * f)))
+    return out
+
+
+def bound_violations(bounds: list[Bounds], phys, rotors) -> dict[str, float]:
+    """Relative violation of every bound by a design given physically (0: met)."""
+    out: dict[str, float] = {}
+    for b, (m, e, f, inertia) in zip(bounds, phys, strict=True):
+        if not m > 0 or not all(math.isfinite(v) for v in (m, e, f, inertia)):
+            out[f"{b.name}.mass"] = math.inf
+            continue
+        lo, hi = b.mass
+        out[f"{b.name}.mass"] = max(lo - m, m - hi, 0.0) / b.mref
+        s = complex(e, f)
+        if b.com_fixed is not None:
+            out[f"{b.name}.com"] = abs(s - b.com_fixed) / b.length
+        else:
+            out[f"{b.name}.com_radius"] = max(abs(s - b.centre) - b.radius, 0.0) / b.length
+        low = max(b.inertia[0], m * b.rho * b.rho)
+        out[f"{b.name}.inertia"] = max(low - inertia, inertia - b.inertia[1], 0.0) / b.iref
+    names = [b.name for b in bounds]
+    for b, cr in zip(bounds, rotors, strict=True):
+        if b.rotor is None:
+            out[f"{b.name}.counter_rotor"] = abs(cr) / b.iref
+        else:
+            lo, hi = b.rotor
+            scale = max(b.iref, hi)
+            out[f"{b.name}.counter_rotor"] = max(lo - cr, cr - hi, 0.0) / scale
+    assert len(names) == 3
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+# Own kinematics and linear maps
+
+
+def _cross(a, b):
+    return (np.conj(a) * b).imag
+
+
+class Model:
+    """Kinematics and linear maps of one mechanism at constant crank speed (own route)."""
+
+    def __init__(self, case: Case) -> None:
+        self.case = case
+        self.kind = case.kind
+        self.w1 = case.speed
+
+    def kinematics(self, theta: np.ndarray):
+        """Per link: first-joint position, velocity, acceleration; unit vector, ω, α."""
+        w1 = self.w1
+        z1 = np.exp(1j * theta)
+        sgn = 1.0 if self.case.branch == "+" else -1.0
+        if self.kind == FOUR:
+            l1, l2, l3, l4 = self.case.lengths
+            a1p = l1 * z1
+            d = l4 - a1p
+            dist = np.abs(d)
+            a = (l2 * l2 - l3 * l3 + dist * dist) / (2 * dist)
+            h = np.sqrt(np.maximum(l2 * l2 - a * a, 0.0))
+            a2p = a1p + (a + sgn * 1j * h) * d / dist
+            z2 = (a2p - a1p) / l2
+            z3 = (l4 - a2p) / l3
+            u2, u3 = 1j * l2 * z2, 1j * l3 * z3
+            det = _cross(u2, u3)
+            rhs = -1j * l1 * w1 * z1
+            w2, w3 = _cross(rhs, u3) / det, _cross(u2, rhs) / det
+            rhs2 = l1 * w1 * w1 * z1 + l2 * w2 * w2 * z2 + l3 * w3 * w3 * z3
+            al2, al3 = _cross(rhs2, u3) / det, _cross(u2, rhs2) / det
+            v1, acc1 = 1j * w1 * a1p, -w1 * w1 * a1p
+            v2 = v1 + 1j * w2 * l2 * z2
+            acc2 = acc1 + (1j * al2 - w2 * w2) * l2 * z2
+            zero = np.zeros_like(z1)
+            return [
+                (zero, zero, zero, z1, np.full(theta.shape, w1), np.zeros(theta.shape)),
+                (a1p, v1, acc1, z2, w2, al2),
+                (a2p, v2, acc2, z3, w3, al3),
+            ]
+        r, big_l, off = self.case.lengths
+        a1p = r * z1
+        s2 = (off - r * np.sin(theta)) / big_l
+        c2 = sgn * np.sqrt(1 - s2 * s2)
+        z2 = c2 + 1j * s2
+        w2 = -r * np.cos(theta) * w1 / (big_l * c2)
+        al2 = (r * np.sin(theta) * w1 * w1 + big_l * s2 * w2 * w2) / (big_l * c2)
+        v1, acc1 = 1j * w1 * a1p, -w1 * w1 * a1p
+        a2p = a1p + big_l * z2
+        v2 = v1 + 1j * w2 * big_l * z2
+        acc2 = acc1 + (1j * al2 - w2 * w2) * big_l * z2
+        zero = np.zeros_like(z1)
+        ones = np.ones_like(z1)
+        zr = np.zeros(theta.shape)
+        return [
+            (zero, zero, zero, z1, np.full(theta.shape, w1), zr),
+            (a1p, v1, acc1, z2, w2, al2),
+            (a2p, v2, acc2, ones, zr, zr),
+        ]
+
+    def maps(self, theta: np.ndarray) -> dict[str, np.ndarray]:
+        """``(N, 14)`` maps: shaking force (complex), moment, torque; first moment of mass."""
+        n = theta.size
+        force = np.zeros((n, 14), complex)
+        moment = np.zeros((n, 14))
+        torque = np.zeros((n, 14))
+        first = np.zeros((n, 14), complex)
+        kin = self.kinematics(theta)
+        for k, (p, v, acc, z, w, al) in enumerate(kin):
+            c = 4 * k
+            zdd = (1j * al - w * w) * z  # second derivative of the unit body vector
+            zd = 1j * w * z
+            force[:, c] = -acc
+            force[:, c + 1] = -zdd
+            force[:, c + 2] = -1j * zdd
+            # dH_A0/dt = m·A×a_A + A×(S̈) + S×a_A + J·α, S = (m·e + i·m·f)·z
+            moment[:, c] = -_cross(p, acc)
+            moment[:, c + 1] = -(_cross(p, zdd) + _cross(z, acc))
+            moment[:, c + 2] = -(_cross(p, 1j * zdd) + _cross(1j * z, acc))
+            moment[:, c + 3] = -al
+            # dT/dt = m·v_A·a_A + a_A·Ṡ + v_A·S̈ + J·ω·α
+            torque[:, c] = (np.conj(v) * acc).real
+            torque[:, c + 1] = (np.conj(acc) * zd).real + (np.conj(v) * zdd).real
+            torque[:, c + 2] = (np.conj(acc) * 1j * zd).real + (np.conj(v) * 1j * zdd).real
+            torque[:, c + 3] = w * al
+            first[:, c] = p
+            first[:, c + 1] = z
+            first[:, c + 2] = 1j * z
+        # Counter-rotors: angular momentum −J·ω, kinetic energy J·ω²/2.
+        moment[:, 12] = kin[0][5]
+        torque[:, 12] = kin[0][4] * kin[0][5]
+        if self.kind == FOUR:
+            moment[:, 13] = kin[2][5]
+            torque[:, 13] = kin[2][4] * kin[2][5]
+        torque /= self.w1
+        return {"force": force, "moment": moment, "torque": torque, "first": first}
+
+    def balance_rows(self, scales: np.ndarray, count: int = 97) -> tuple[np.ndarray, int]:
+        """Rows ``V`` with ``V·u[:12] = 0`` ⇔ total centre of mass stationary, and their rank.
+
+        ``u = x/scales``; from the variation of the first moment of mass over ``count``
+        crank angles, by an SVD and a rank test.
+        """
+        theta = np.linspace(0.0, 2 * np.pi, count, endpoint=False) + 0.1234
+        g = self.maps(theta)["first"][:, :12]
+        g = g - g.mean(axis=0)
+        d = np.vstack([g.real, g.imag])
+        # Rank test on unit columns (masses of very different sizes must not hide a condition)
+        norms = np.linalg.norm(d, axis=0)
+        live = norms > 1e-12 * norms.max()
+        d_unit = np.where(live, d / np.where(live, norms, 1.0), 0.0)
+        _, sv, vt = np.linalg.svd(d_unit, full_matrices=False)
+        rank = int(np.sum(sv > 1e-9 * sv[0]))
+        # back to x: d·x = d̂·(n ⊙ x), so V̂·diag(n) has the null space of d; then on
+        # u = x/scales, each row scaled to a largest entry of 1
+        rows = vt[:rank] * np.where(live, norms, 0.0)
+        rows = rows * scales[:12]
+        rows /= np.max(np.abs(rows), axis=1, keepdims=True)
+        rows[:, 3::4] = 0.0  # inertias do not move the centre of mass (exactly)
+        return rows, rank
+
+    def com_excursion(self, x: np.ndarray, count: int = 720) -> float:
+        """Largest distance of the total centre of mass from its mean position, m."""
+        theta = np.linspace(0.0, 2 * np.pi, count, endpoint=False)
+        q = self.maps(theta)["first"] @ x
+        mass = float(x[0] + x[4] + x[8])
+        return float(np.max(np.abs(q - q.mean()))) / mass
+
+
+@dataclass
+class Objective:
+    """``J(x) = ‖K·x‖² + w_m·(Σm − Σm0)`` on the problem's sampled angles."""
+
+    rows: np.ndarray
+    factor: np.ndarray
+    w_mass: float
+    mass0: float
+    reference: float
+    maps: dict[str, np.ndarray]
+
+    def __call__(self, x: np.ndarray) -> float:
+        r = self.rows @ x
+        return float(r @ r) + self.w_mass * (float(x[0] + x[4] + x[8]) - self.mass0)
+
+
+def objective_of(case: Case, model: Model, x0: np.ndarray) -> Objective:
+    """The weighted objective of the problem from the own maps."""
+    theta = np.arange(case.samples) * (2 * np.pi / case.samples)
+    maps = model.maps(theta)
+    w = case.weights
+    blocks = []
+    if w.get("shaking_moment"):
+        blocks.append(math.sqrt(w["shaking_moment"]) * maps["moment"])
+    if w.get("driving_torque"):
+        blocks.append(math.sqrt(w["driving_torque"]) * maps["torque"])
+    wx = w.get("shaking_force", 0.0) + w.get("shaking_force_x", 0.0)
+    wy = w.get("shaking_force", 0.0) + w.get("shaking_force_y", 0.0)
+    if wx:
+        blocks.append(math.sqrt(wx) * maps["force"].real)
+    if wy:
+        blocks.append(math.sqrt(wy) * maps["force"].imag)
+    rows = np.vstack(blocks) / math.sqrt(case.samples) if blocks else np.zeros((0, 14))
+    factor = np.linalg.qr(rows, mode="r") if blocks else np.zeros((0, 14))
+    w_mass = w.get("added_mass", 0.0)
+    mass0 = case.original_mass
+    r0 = rows @ x0
+    reference = float(r0 @ r0) + w_mass * mass0
+    return Objective(rows=rows, factor=factor, w_mass=w_mass, mass0=mass0,
+                     reference=reference if reference > 0 else 1.0, maps=maps)
+
+
+def x_of(case: Case, links: dict[str, LinkData] | None = None) -> np.ndarray:
+    """Design vector ``(m, m·e, m·f, J)`` per link, then the counter-rotors."""
+    links = links or case.links
+    x = np.zeros(14)
+    for k, name in enumerate(NAMES[case.kind]):
+        lk = links[name]
+        x[4 * k:4 * k + 4] = (lk.mass, lk.mass * lk.e, lk.mass * lk.f,
+                              lk.inertia + lk.mass * (lk.e ** 2 + lk.f ** 2))
+    x[12] = links["crank"].counter_rotor
+    x[13] = links["rocker"].counter_rotor if case.kind == FOUR else 0.0
+    return x
+
+
+# ----------------------------------------------------------------------------------------------
+# Own convex programs
+
+
+def _solve(problem: cp.Problem) -> str:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            problem.solve(solver=cp.CLARABEL, **CLARABEL)
+        except cp.error.SolverError as exc:
+            return f"solver error: {exc}"
+    return str(problem.status)
+
+
+def _mass_com(bounds, u, *, slack=None, skip=None, shrink: float = 0.0) -> list:
+    """Mass and centre-of-mass constraints on scaled variables.
+
+    ``slack``: a variable by which every range and disc may be exceeded (phase 1);
+    ``skip``: ``(link index, "mass")`` leaves that link's mass bounds out, ``(index, "com")``
+    its disc; ``shrink``: every range and disc made narrower by this (scaled units), so that
+    the solver's own tolerance cannot take the design outside.
+    """
+    cons = []
+    t = 0.0 if slack is None else slack
+    for b in bounds:
+        k = 4 * b.index
+        um, ue, uf = u[k], u[k + 1], u[k + 2]
+        lo, hi = b.mass[0] / b.mref, b.mass[1] / b.mref
+        if skip == (b.index, "mass"):
+            cons += [um >= 1e-6 * lo, um <= 1e3 * max(hi, 1.0)]
+        elif lo == hi:
+            cons.append(um == lo)
+        else:
+            eta = shrink if hi - lo > 4 * shrink else 0.0
+            cons += [um >= lo + eta - t, um <= hi - eta + t, um >= 1e-6 * lo]
+        if b.com_fixed is not None:
+            cons += [ue == (b.com_fixed.real / b.length) * um,
+                     uf == (b.com_fixed.imag / b.length) * um]
+        elif skip != (b.index, "com"):
+            c = b.centre / b.length
+            radius = b.radius / b.length
+            eta = shrink if radius > 4 * shrink else 0.0
+            cons.append(cp.norm(cp.hstack([ue - c * um, uf])) <= (radius - eta) * um + t)
+    return cons
+
+
+@dataclass
+class OwnOptimum:
+    """The independent optimum.
+
+    ``objective`` is ``J`` of ``x``, a design that meets every bound (to :data:`BOUND_TOL`)
+    when ``certified``: an upper bound of the optimum. ``lower`` is the convex program's own
+    optimum (a relaxation when ``tight`` is false): about a lower bound.
+    """
+
+    status: str
+    objective: float = math.nan
+    lower: float = math.nan
+    x: np.ndarray | None = None
+    tight: bool = True
+    certified: bool = False
+    violation: float = math.nan
+    time: float = 0.0
+
+
+def own_optimum(case, bounds, model, obj: Objective, vrows, shrink: float = 0.0) -> OwnOptimum:
+    """Minimise ``J`` over the bounds (+ stationary centre of mass) with CVXPY/Clarabel.
+
+    With ``shrink`` > 0 every inequality is tightened by it (scaled units): the design then
+    meets the problem's bounds despite the solver's tolerance, and its ``J`` is an upper bound
+    of the optimum (a certificate against a claim of optimality or a lower bound).
+    """
+    t0 = time.perf_counter()
+    scales = scales_of(bounds, case.kind)
+    u = cp.Variable(14)
+    cons = _mass_com(bounds, u, shrink=shrink)
+    relaxed = []
+    for b in bounds:
+        k = 4 * b.index
+        um, ue, uf, uj = u[k], u[k + 1], u[k + 2], u[k + 3]
+        lo, hi = b.inertia[0] / b.iref, b.inertia[1] / b.iref
+        eta = shrink if hi - lo > 4 * shrink else 0.0
+        rho2 = (b.rho / b.length) ** 2
+        if b.com_fixed is not None:
+            inertia = uj - (abs(b.com_fixed) / b.length) ** 2 * um
+            cons.append(inertia >= lo + eta)
+            if rho2:
+                cons.append(inertia >= rho2 * um + eta)
+            if math.isfinite(hi):
+                cons.append(inertia <= hi - eta)
+        else:
+            q = cp.quad_over_lin(cp.hstack([ue, uf]), um)
+            cons.append(q <= uj - lo - eta)
+            if rho2:
+                cons.append(q <= uj - rho2 * um - eta)
+            if math.isfinite(hi):
+                # |s|² ≤ R² + 2·c·e − c² inside the disc: a valid upper envelope of |S|²/m
+                c, radius = b.centre / b.length, b.radius / b.length
+                cons.append(uj - hi + eta <= um * (radius ** 2 - c ** 2) + 2 * c * ue)
+                relaxed.append(b)
+    for entry, b in ((12, bounds[0]), (13, bounds[2])):
+        if b.rotor is None:
+            cons.append(u[entry] == 0.0)
+            continue
+        lo, hi = (v / scales[entry] for v in b.rotor)
+        eta = shrink if hi - lo > 4 * shrink else 0.0
+        cons += [u[entry] == lo] if lo == hi else [u[entry] >= lo + eta, u[entry] <= hi - eta]
+    if case.force_balance:
+        cons.append(vrows @ u[:12] == 0)
+    p = obj.factor * scales / math.sqrt(obj.reference)
+    if obj.w_mass:
+        mass = sum(b.mref * u[4 * b.index] for b in bounds)
+        value = cp.sum_squares(p @ u) + obj.w_mass / obj.reference * (mass - obj.mass0)
+    else:
+        value = cp.norm(p @ u)
+    problem = cp.Problem(cp.Minimize(value), cons)
+    status = _solve(problem)
+    out = OwnOptimum(status=status)
+    if status not in ("optimal", "optimal_inaccurate") or u.value is None:
+        out.time = time.perf_counter() - t0
+        return out
+
+    def evaluate(values) -> tuple[np.ndarray, bool, float]:
+        x = scales * np.asarray(values)
+        tight = True
+        for b in bounds:
+            # inertias into their bounds exactly (the solver meets its cones to ~1e-8 only)
+            k = 4 * b.index
+            m, me, mf, j = x[k:k + 4]
+            q = (me * me + mf * mf) / m
+            low = max(b.inertia[0], m * b.rho ** 2)
+            if j - q > b.inertia[1]:
+                tight = tight and j - q <= b.inertia[1] + BOUND_TOL * b.iref
+                x[k + 3] = q + b.inertia[1]
+            elif j - q < low:
+                x[k + 3] = q + low
+        phys = physical(x)
+        viol = bound_violations(bounds, phys, (x[12], 0.0, x[13]) if case.kind == FOUR
+                                else (x[12], 0.0, 0.0))
+        fb = 0.0
+        if case.force_balance:
+            fb = model.com_excursion(x) / max(b.length for b in bounds)
+        return x, tight, max([*viol.values(), fb])
+
+    best = float(problem.value)
+    out.lower = (best * best if not obj.w_mass else best) * obj.reference
+    x, tight, violation = evaluate(u.value)
+    if not tight:
+        # The relaxation's optimum is not unique: among the (nearly) optimal designs take the
+        # one with the least inertias of the relaxed links, which meets I ≤ I_high if any does.
+        stage2 = cp.Problem(
+            cp.Minimize(sum(u[4 * b.index + 3] for b in relaxed)),
+            [*cons, value <= best + 1e-9 * max(1.0, abs(best))],
+        )
+        if _solve(stage2) in ("optimal", "optimal_inaccurate") and u.value is not None:
+            x2, tight2, violation2 = evaluate(u.value)
+            if tight2 or obj(x2) < obj(x):
+                x, tight, violation = x2, tight2, violation2
+                out.status = f"{status} (stage 2 {stage2.status})"
+    out.x, out.tight, out.violation = x, tight, violation
+    out.certified = violation <= BOUND_TOL
+    out.objective = obj(x)
+    out.time = time.perf_counter() - t0
+    return out
+
+
+def own_margin(case, bounds, vrows) -> tuple[float, str]:
+    """Phase 1: the least uniform slack ``t`` (negative: a margin) with which force balance
+    can be met (relative: kg over the link's mass, m·kg over its mass times its length)."""
+    u = cp.Variable(12)
+    t = cp.Variable()
+    cons = _mass_com(bounds, u, slack=t)
+    cons += [vrows @ u == 0, t >= -1e-3, u[3::4] == 0]
+    problem = cp.Problem(cp.Minimize(t), cons)
+    status = _solve(problem)
+    if status in ("infeasible", "infeasible_inaccurate"):
+        return math.inf, status
+    if status not in ("optimal", "optimal_inaccurate") or t.value is None:
+        return math.nan, status
+    return float(t.value), status
+
+
+def own_extreme(case, bounds, vrows, index: int, kind: str) -> float | None:
+    """The least (or largest) value of one bound that still allows force balance."""
+    scales = scales_of(bounds, case.kind)
+    b = bounds[index]
+    u = cp.Variable(12)
+    if kind == "com":
+        cons = _mass_com(bounds, u, skip=(index, "com"))
+        c = b.centre / b.length
+        k = 4 * index
+        objective = cp.Minimize(cp.norm(cp.hstack([u[k + 1] - c * u[k], u[k + 2]])))
+    else:
+        cons = _mass_com(bounds, u, skip=(index, "mass"))
+        sign = 1.0 if kind == "mass-high" else -1.0
+        objective = cp.Minimize(sign * u[4 * index])
+    cons += [vrows @ u == 0, u[3::4] == 0]
+    problem = cp.Problem(objective, cons)
+    status = _solve(problem)
+    if status != "optimal":
+        return None
+    value = float(problem.value)
+    if kind == "com":
+        return value * b.length / (b.mass[0] / b.mref)
+    return abs(value) * scales[4 * index]
+
+
+# ----------------------------------------------------------------------------------------------
+# Random problems
+
+
+def _logu(rng, lo, hi) -> float:
+    return float(math.exp(rng.uniform(math.log(lo), math.log(hi))))
+
+
+def _fourbar_lengths(rng, scale: float) -> tuple[float, float, float, float]:
+    while True:
+        ls = np.sort(rng.uniform(0.3, 3.0, 4))
+        s, p, q, big = ls
+        if (p + q - s - big) / ls.sum() < 0.04:
+            continue
+        rest = list(rng.permutation([p, q, big]))
+        if rng.random() < 0.75:  # crank-rocker: the crank is the shortest
+            l1, l2, l3, l4 = s, rest[0], rest[1], rest[2]
+        else:  # double crank: the frame is the shortest
+            l1, l2, l3, l4 = rest[0], rest[1], rest[2], s
+        return tuple(float(v) * scale for v in (l1, l2, l3, l4))
+
+
+def _slider_lengths(rng, scale: float) -> tuple[float, float, float]:
+    big_l = rng.uniform(1.0, 4.0)
+    r = rng.uniform(0.15, 0.6) * big_l
+    off = rng.uniform(-0.9, 0.9) * (big_l - r) * 0.9 if rng.random() < 0.8 else 0.0
+    return (float(r * scale), float(big_l * scale), float(off * scale))
+
+
+def _link(rng, l: float, mscale: float, slider: bool = False) -> LinkData:
+    m = mscale * rng.uniform(0.5, 5.0)
+    if slider:
+        e, f = rng.uniform(-0.3, 0.3, 2) * l
+        inertia = 0.0 if rng.random() < 0.5 else m * (rng.uniform(0.05, 0.4) * l) ** 2
+        return LinkData(float(m), float(inertia), float(e), float(f))
+    e = rng.uniform(-0.3, 1.2) * l
+    f = rng.uniform(-0.4, 0.4) * l
+    inertia = m * (rng.uniform(0.05, 0.5) * l) ** 2
+    return LinkData(float(m), float(inertia), float(e), float(f))
+
+
+def _freedom(rng, case: Case, name: str, *, generous: bool = False) -> Freedom:
+    link = case.links[name]
+    l = case.length_of(name)
+    m = link.mass
+    fr = Freedom()
+    u = rng.random()
+    if generous or u < 0.6:
+        fr.mass = (m * rng.uniform(0.3, 1.0), m * rng.uniform(1.0, 5.0))
+        if generous:
+            fr.mass = (m * 0.5, m * 6.0)
+    elif u < 0.7:
+        fr.mass = (m * rng.uniform(0.8, 1.5),) * 2
+    u = rng.random()
+    if generous:
+        fr.com_radius = 1.5 * l
+    elif u < 0.05:
+        fr.com_radius = 0.0
+    elif u < 0.75:
+        fr.com_radius = float(rng.uniform(0.2, 2.0) * l)
+    if fr.com_radius is not None and rng.random() < 0.5:
+        fr.com_about = str(rng.choice(JOINTS[case.kind][name]))
+    if rng.random() < (0.3 if generous else 0.55):
+        fr.min_gyration = float(rng.uniform(0.02, 0.3) * l)
+    u = rng.random()
+    if not generous and u < 0.2:
+        base = m * (rng.uniform(0.05, 0.5) * l) ** 2
+        fr.inertia = (base * rng.uniform(0.2, 1.0), base * rng.uniform(1.0, 4.0))
+    elif not generous and u < 0.25:
+        fr.inertia = (link.inertia,) * 2 if rng.random() < 0.5 else (0.0, link.inertia * 2)
+    if name in GROUNDED[case.kind]:
+        u = rng.random()
+        top = m * l * l * (200.0 if generous else rng.uniform(0.2, 50.0))
+        if generous or u < 0.5:
+            fr.counter_rotor = (0.0, float(top))
+        elif u < 0.6:
+            fr.counter_rotor = (float(link.counter_rotor),) * 2
+    return fr
+
+
+def _weights(rng, case: Case, model: Model, *, force: bool | None = None) -> dict[str, float]:
+    w: dict[str, float] = {}
+    lmax = max(abs(v) for v in case.lengths)
+    if rng.random() < 0.85:
+        w["shaking_moment"] = float(_logu(rng, 0.1, 10.0)) if rng.random() < 0.3 else 1.0
+    if rng.random() < 0.35:
+        w["driving_torque"] = float(rng.uniform(0.05, 2.0))
+    want_force = (not case.force_balance) if force is None else force
+    if want_force and rng.random() < 0.8:
+        u = rng.random()
+        scale = lmax * lmax
+        if u < 0.5:
+            w["shaking_force"] = float(scale * rng.uniform(0.1, 2.0))
+        elif u < 0.8:
+            w["shaking_force_x"] = float(scale * rng.uniform(0.1, 2.0))
+            w["shaking_force_y"] = float(scale * rng.uniform(0.1, 2.0))
+        else:
+            w["shaking_force_x" if rng.random() < 0.5 else "shaking_force_y"] = float(
+                scale * rng.uniform(0.1, 2.0))
+    if not any(w.values()):
+        w["shaking_moment"] = 1.0
+    if rng.random() < 0.2:
+        case.weights = w
+        obj = objective_of(case, model, x_of(case))
+        j0 = obj.reference
+        w["added_mass"] = float(j0 / case.original_mass * _logu(rng, 1e-3, 1.0))
+    return w
+
+
+def _base(rng, pid: int, family: str, *, kind: str | None = None, mscale: float = 1.0,
+          lscale: float = 1.0) -> Case:
+    kind = kind or (FOUR if rng.random() < 0.65 else SLIDER)
+    lengths = _fourbar_lengths(rng, lscale) if kind == FOUR else _slider_lengths(rng, lscale)
+    links = {}
+    for name in NAMES[kind]:
+        l = lengths[0] if name == "slider" else lengths[NAMES[kind].index(name)]
+        links[name] = _link(rng, l, mscale, slider=name == "slider")
+        if name in GROUNDED[kind] and rng.random() < 0.3:
+            links[name].counter_rotor = float(rng.uniform(0.0, 1.0) * links[name].mass * l * l)
+    speed = _logu(rng, 0.5, 200.0) * (1 if rng.random() < 0.8 else -1)
+    samples = int(rng.choice([12, 24, 36, 72, 90, 180, 360], p=[.05, .1, .15, .2, .15, .15, .2]))
+    return Case(pid=pid, family=family, kind=kind, branch="+" if rng.random() < 0.5 else "-",
+                lengths=lengths, links=links, speed=float(speed), samples=samples,
+                force_balance=True, weights={}, free={})
+
+
+def _random_case(rng, pid: int, family: str = "random", **kw) -> Case:
+    case = _base(rng, pid, family, **kw)
+    case.force_balance = rng.random() < 0.7
+    names = NAMES[case.kind]
+    listed = [n for n in names if rng.random() < 0.75] or [str(rng.choice(names))]
+    for name in listed:
+        case.free[name] = _freedom(rng, case, name)
+    if case.force_balance and rng.random() < 0.7:
+        # mostly balanceable: the two links whose centres of mass Eq. 57-58 can move
+        for name in (names[0], names[2] if case.kind == FOUR else names[1]):
+            fr = case.free.setdefault(name, _freedom(rng, case, name))
+            if not fr.com_radius:
+                fr.com_radius = float(rng.uniform(0.5, 2.0) * case.length_of(name))
+    case.weights = _weights(rng, case, Model(case))
+    return case
+
+
+def _complete_case(rng, pid: int) -> Case:
+    """PB2-like: every link free with generous bounds and counter-rotors: zero optimum."""
+    case = _base(rng, pid, "complete", kind=FOUR)
+    for name in NAMES[FOUR]:
+        case.free[name] = _freedom(rng, case, name, generous=True)
+    case.force_balance = True
+    case.weights = {"shaking_moment": 1.0}
+    if rng.random() < 0.3:
+        case.weights = {"shaking_moment": _logu(rng, 1e-3, 1e3)}
+    return case
+
+
+def _zero_force_case(rng, pid: int) -> Case:
+    """No force-balance constraint, only the shaking force weighted, freedom to balance it."""
+    case = _base(rng, pid, "zero-force")
+    for name in NAMES[case.kind]:
+        case.free[name] = _freedom(rng, case, name, generous=True)
+        if case.kind == SLIDER and name == "rod":
+            case.free[name].com_radius = 3.0 * case.length_of(name)
+    case.force_balance = False
+    lmax = max(abs(v) for v in case.lengths)
+    if rng.random() < 0.5:
+        case.weights = {"shaking_force": lmax * lmax}
+    else:
+        case.weights = {"shaking_force_x": lmax * lmax, "shaking_force_y": 0.5 * lmax * lmax}
+    return case
+
+
+def _borderline_case(rng, pid: int) -> Case | None:
+    """A force-balance bound within 1e-9..1e-6 (relative) of the least value that allows it."""
+    case = _base(rng, pid, "borderline")
+    case.force_balance = True
+    for name in NAMES[case.kind]:
+        if rng.random() < 0.75:
+            case.free[name] = _freedom(rng, case, name)
+            case.free[name].inertia = None
+    if not case.free:
+        return None
+    model = Model(case)
+    kinds = ["mass-high", "mass-high", "com", "mass-low"]
+    name = str(rng.choice(list(case.free)))
+    kind = str(rng.choice(kinds))
+    fr = case.free[name]
+    index = NAMES[case.kind].index(name)
+    link = case.links[name]
+    if kind == "com":
+        fr.mass = None if rng.random() < 0.5 else (link.mass * rng.uniform(0.8, 2.0),) * 2
+        fr.com_radius = 1.0
+    else:
+        if fr.mass is None or fr.mass[0] == fr.mass[1]:
+            fr.mass = (link.mass * 0.5, link.mass * 3.0)
+        if fr.com_radius is None:
+            fr.com_radius = float(rng.uniform(0.2, 1.0) * case.length_of(name))
+    bounds = resolve(case)
+    vrows, _ = model.balance_rows(scales_of(bounds, case.kind))
+    value = own_extreme(case, bounds, vrows, index, kind)
+    if value is None or not math.isfinite(value):
+        return None
+    scale = case.length_of(name) if kind == "com" else link.mass
+    if value < 1e-4 * scale or (kind == "mass-low" and value > 0.99e3 * bounds[index].mass[1]):
+        return None
+    feasible = rng.random() < 0.75
+    delta = _logu(rng, 1e-9, 1e-6) if feasible else _logu(rng, 1e-7, 1e-4)
+    if kind == "com":
+        fr.com_radius = value * (1 + delta if feasible else 1 - delta)
+    elif kind == "mass-high":
+        hi = value * (1 + delta if feasible else 1 - delta)
+        fr.mass = (min(fr.mass[0], 0.5 * hi), hi)
+    else:
+        lo = value * (1 - delta if feasible else 1 + delta)
+        fr.mass = (lo, max(fr.mass[1], 2.0 * lo))
+    case.notes = {"planted": kind, "link": name, "least": value, "delta": delta,
+                  "side": "feasible" if feasible else "infeasible"}
+    case.weights = _weights(rng, case, model)
+    return case
+
+
+def _infeasible_case(rng, pid: int) -> Case:
+    """Force balance asked of too little freedom."""
+    case = _base(rng, pid, "infeasible")
+    case.force_balance = True
+    name = "crank" if rng.random() < 0.7 else NAMES[case.kind][1]
+    link = case.links[name]
+    l = case.length_of(name)
+    case.free[name] = Freedom(mass=(link.mass, link.mass * rng.uniform(1.0, 1.5)),
+                              com_radius=float(rng.uniform(0.01, 0.3) * l),
+                              min_gyration=float(rng.uniform(0.05, 0.2) * l))
+    case.weights = _weights(rng, case, Model(case))
+    return case
+
+
+def _scaled_case(rng, pid: int) -> Case:
+    """Huge (1e12) or tiny (1e-9) masses: on every link, or on one link and its bounds."""
+    factor = 1e12 if rng.random() < 0.5 else 1e-9
+    every = rng.random() < 0.5
+    if every:
+        case = _base(rng, pid, "scale", mscale=factor)
+        case.notes = {"mass_scale": factor, "links": "all"}
+    else:
+        case = _base(rng, pid, "scale")
+        name = str(rng.choice(NAMES[case.kind]))
+        link = case.links[name]
+        link.mass *= factor
+        link.inertia *= factor
+        link.counter_rotor *= factor
+        case.notes = {"mass_scale": factor, "links": name}
+    case.force_balance = rng.random() < 0.75
+    names = NAMES[case.kind]
+    listed = [n for n in names if rng.random() < 0.7] or [str(rng.choice(names))]
+    for name in listed:
+        case.free[name] = _freedom(rng, case, name, generous=rng.random() < 0.3)
+    case.weights = _weights(rng, case, Model(case))
+    return case
+
+
+FAMILIES = (
+    ("random", 0.38),
+    ("complete", 0.12),
+    ("zero-force", 0.05),
+    ("borderline", 0.22),
+    ("infeasible", 0.08),
+    ("scale", 0.15),
+)
+
+
+def make_case(seed: int, pid: int) -> Case:
+    """The problem ``pid`` of the campaign with ``seed`` (reproducible one by one)."""
+    rng = np.random.default_rng([seed, pid])
+    names, probs = zip(*FAMILIES, strict=True)
+    family = str(rng.choice(names, p=probs))
+    for _ in range(50):
+        if family == "random":
+            case = _random_case(rng, pid)
+        elif family == "complete":
+            case = _complete_case(rng, pid)
+        elif family == "zero-force":
+            case = _zero_force_case(rng, pid)
+        elif family == "borderline":
+            case = _borderline_case(rng, pid)
+        elif family == "infeasible":
+            case = _infeasible_case(rng, pid)
+        else:
+            case = _scaled_case(rng, pid)
+        if case is not None:
+            return case
+    return _random_case(rng, pid)
+
+
+# ----------------------------------------------------------------------------------------------
+# Checks
+
+
+CLASSES = (
+    "load-failure",
+    "bound-violation",
+    "force-balance-failure",
+    "false-optimal",
+    "false-lower-bound",
+    "feasible-called-infeasible",
+    "infeasible-called-feasible",
+    "failed-while-feasible",
+    "solver-error-while-feasible",
+    "spec-error-in-optimize",
+    "objective-misreport",
+    "below-independent-optimum",
+    "nan",
+    "crash",
+)
+
+
+@dataclass
+class Run:
+    """One backend on one problem."""
+
+    pid: int
+    backend: str
+    outcome: str = ""
+    status: str = ""
+    message: str = ""
+    flags: dict[str, str] = field(default_factory=dict)
+    info: dict = field(default_factory=dict)
+    time: float = 0.0
+
+
+def _finite(values) -> bool:
+    arr = np.asarray(values, dtype=float)
+    return bool(np.all(np.isfinite(arr)))
+
+
+def check_result(case, design, result, bounds, model, obj, own, margin, run: Run,
+                 keep: Path | None) -> None:
+    """Checks a-e on one result (fills ``run.flags`` and ``run.info``)."""
+    from balancer.inverse import cycle_analysis
+    from balancer.spec import load_design, save_design
+
+    info = run.info
+    lk = result.linkage
+    failed = str(result.status) == "failed"
+
+    def flag(cls: str, text: str) -> None:
+        # A design the tool itself calls failed is not held to the bounds; kept for the record.
+        if failed and cls in ("load-failure", "bound-violation", "force-balance-failure"):
+            info.setdefault("failed_design", {})[cls] = text
+        else:
+            run.flags[cls] = text
+
+    # e. NaN anywhere in the result
+    numbers = [result.objective, result.lower_bound, result.gap, *np.asarray(result.x)]
+    for lnk in lk.links:
+        numbers += [lnk.mass, lnk.e, lnk.f, lnk.inertia, lnk.counter_rotor]
+    numbers += [v for fig in result.after.summary.as_dict().values() for v in fig.values()]
+    if not _finite(numbers):
+        flag("nan", "NaN/inf in the result (objective, bound, x, links or analysis)")
+    # a. the balanced design written by save_design loads again
+    try:
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "balanced.toml"
+            save_design(result.balanced_design(design), path)
+            text = path.read_text()
+            reloaded = load_design(path)
+        info["loaded"] = True
+        lk = reloaded.mechanism
+    except Exception as exc:  # noqa: BLE001 - any failure to read back is the finding
+        info["loaded"] = False
+        flag("load-failure", f"{type(exc).__name__}: {exc}")
+        info["balanced_links"] = {n: (v.mass, v.e, v.f, v.inertia, v.counter_rotor)
+                                  for n, v in zip(NAMES[case.kind], lk.links, strict=True)}
+        text = None
+    info["balanced_text"] = text
+    # b. every bound, from the spec's numbers
+    phys = [(v.mass, v.e, v.f, v.inertia) for v in lk.links]
+    rotors = [v.counter_rotor for v in lk.links]
+    viol = bound_violations(bounds, phys, rotors)
+    worst = max(viol.items(), key=lambda kv: kv[1])
+    info["worst_bound"] = worst
+    info["bound_exact"] = any(v > 0 for v in viol.values())
+    if worst[1] > BOUND_TOL:
+        detail = ", ".join(f"{k} {v:.3g}" for k, v in viol.items() if v > BOUND_TOL)
+        flag("bound-violation", f"relative violation: {detail}")
+    # c. force balance: balancer's cycle analysis, and the own centre of mass
+    names = NAMES[case.kind]
+    links_now = {n: LinkData(v.mass, v.inertia, v.e, v.f, v.counter_rotor)
+                 for n, v in zip(names, lk.links, strict=True)}
+    xb = x_of(case, links_now)
+    if case.force_balance:
+        lmax = max(b.length for b in bounds)
+        before = cycle_analysis(design.mechanism, case.speed, case.samples, loads=False)
+        after = cycle_analysis(lk, case.speed, case.samples, loads=False)
+        rms0 = before.summary.shaking_force.rms
+        rms1 = after.summary.shaking_force.rms
+        mass = float(xb[0] + xb[4] + xb[8])
+        fscale = mass * case.speed ** 2 * lmax
+        excursion = model.com_excursion(xb) / lmax
+        info.update(force_rms_before=rms0, force_rms_after=rms1,
+                    force_over_scale=rms1 / fscale, com_excursion=excursion)
+        problems = []
+        if not rms1 <= FORCE_TOL * fscale:
+            problems.append(f"RMS shaking force {rms1:.3g} N = {rms1 / fscale:.3g}·M·ω²·l")
+        if not excursion <= FORCE_TOL:
+            problems.append(f"total centre of mass moves {excursion:.3g}·l")
+        if rms0 > 0 and not rms1 <= FORCE_REL_TOL * rms0:
+            problems.append(f"RMS shaking force {rms1 / rms0:.3g} of the original's")
+        if problems:
+            flag("force-balance-failure", "; ".join(problems))
+    # d. the objective and the claims against the independent optimum
+    j_tool = obj(xb)
+    ref = obj.reference
+    info.update(j_tool=j_tool, j_reported=result.objective, j_ref=ref,
+                lower_bound=result.lower_bound, j_own=own.objective, j_own_lower=own.lower,
+                own_status=own.status, own_tight=own.tight, own_violation=own.violation)
+    if abs(j_tool - result.objective) > 1e-9 * ref + 1e-9 * abs(j_tool):
+        flag("objective-misreport", (
+            f"reported J = {result.objective:.12g}, own evaluation {j_tool:.12g} "
+            f"(J_ref {ref:.6g})"))
+    # The own design meets every bound to the tool's own tolerance: its J is an upper bound of
+    # the optimum, so a claim above it by more than the claim's own tolerance is refuted.
+    conclusive = own.x is not None and own.certified
+    info["conclusive"] = conclusive
+    if conclusive:
+        jo = own.objective
+        # rounding of J = ‖K·x‖² near a zero optimum: ‖K·x‖ to ~1e-14 of √J_ref
+        rounding = 1e-13 * math.sqrt(max(jo, 0.0) * ref) + 1e-26 * ref
+        claim = CLAIM_GAP * max(abs(jo), CLAIM_FLOOR * ref)
+        info["tolerance"] = claim + rounding
+        optimal = str(result.status) == "optimal" or "globally optimal" in result.message
+        if optimal and j_tool > jo + claim + rounding:
+            flag("false-optimal", (
+                f"claims globally optimal with J = {j_tool:.6g}, independent optimum "
+                f"{jo:.6g} (J_ref {ref:.3g}; excess {(j_tool - jo) / ref:.3g}·J_ref, "
+                f"√ ratio {math.sqrt(max(j_tool, 0) / ref):.3g} vs "
+                f"{math.sqrt(max(jo, 0) / ref):.3g})"))
+        if result.lower_bound > jo + claim + rounding:
+            flag("false-lower-bound", (
+                f"lower bound {result.lower_bound:.9g} above the independent optimum "
+                f"{jo:.9g} (excess {(result.lower_bound - jo) / ref:.3g}·J_ref)"))
+    if own.tight and math.isfinite(own.lower) and "inaccurate" not in own.status:
+        low = own.lower
+        eps = ref * (2 * OWN_DELTA * math.sqrt(max(low, 0.0) / ref) + OWN_DELTA ** 2)
+        if obj.w_mass:
+            eps += OWN_DELTA * ref
+        claim = CLAIM_GAP * max(abs(low), CLAIM_FLOOR * ref)
+        if j_tool < low - claim - eps and not failed and "bound-violation" not in run.flags:
+            flag("below-independent-optimum", (
+                f"J = {j_tool:.9g} below the independent optimum {low:.9g} "
+                f"({(low - j_tool) / ref:.3g}·J_ref)"))
+    if str(result.status) == "failed" and (margin is None or margin <= FEASIBLE_SLACK):
+        flag("failed-while-feasible", f"status failed; own margin {margin}")
+
+
+def run_problem(case: Case, backends, keep: Path | None) -> tuple[list[Run], dict]:
+    """Everything for one problem."""
+    from balancer.errors import AssemblyError, SolverError, SpecError
+    from balancer.optimize import InfeasibleError, optimize
+    from balancer.spec import loads_design
+
+    text = spec_text(case)
+    meta: dict = {"pid": case.pid, "family": case.family, "kind": case.kind,
+                  "notes": case.notes, "text": text}
+    t0 = time.perf_counter()
+    try:
+        design = loads_design(text, source=f"fuzz-{case.pid}.toml")
+    except (SpecError, AssemblyError) as exc:
+        meta["rejected"] = f"{type(exc).__name__}: {exc}"
+        return [], meta
+    bounds = resolve(case)
+    masses = [b.mref for b in bounds]
+    meta["mixed"] = max(masses) / min(masses) > 1e6  # e.g. one link of 1e12 kg among 1 kg
+    model = Model(case)
+    x0 = x_of(case)
+    obj = objective_of(case, model, x0)
+    # own maps against balancer's cycle analysis of the original design
+    from balancer.inverse import cycle_analysis
+
+    ca = cycle_analysis(design.mechanism, case.speed, case.samples, loads=False)
+    mine = {"shaking_force": obj.maps["force"] @ x0, "shaking_moment": obj.maps["moment"] @ x0,
+            "driving_torque": obj.maps["torque"] @ x0}
+    agree = 0.0
+    for name, values in mine.items():
+        theirs = getattr(ca.reactions, name)
+        scale = max(float(np.max(np.abs(theirs))), float(np.max(np.abs(values))), 1e-300)
+        agree = max(agree, float(np.max(np.abs(theirs - values))) / scale)
+    meta["maps_vs_cycle_analysis"] = agree
+    vrows, rank = model.balance_rows(scales_of(bounds, case.kind))
+    meta["balance_rank"] = rank
+    margin = None
+    if case.force_balance:
+        margin, mstatus = own_margin(case, bounds, vrows)
+        meta["own_margin"] = margin
+        meta["own_margin_status"] = mstatus
+    # A certificate: the optimum over bounds narrowed by 1e-10 (or a quarter of the phase-1
+    # margin, for a thinner feasible set), met despite Clarabel's tolerance of 1e-11.
+    shrink = 1e-10
+    if margin is not None and math.isfinite(margin):
+        shrink = min(shrink, max(-margin / 4, 0.0))
+    own = own_optimum(case, bounds, model, obj, vrows, shrink=shrink)
+    meta["own_shrink"] = shrink
+    if shrink < 1e-10:
+        # A thin feasible set: narrowing it costs more than the solver's tolerance. The lower
+        # value comes from the program itself; the better certified design of the two is kept.
+        plain = own_optimum(case, bounds, model, obj, vrows)
+        own.lower = plain.lower
+        own.status = f"{own.status}; unnarrowed {plain.status}"
+        if plain.certified and (not own.certified or plain.objective < own.objective):
+            own.x, own.objective, own.certified = plain.x, plain.objective, True
+            own.violation = plain.violation
+    meta["own_status"] = own.status
+    meta["own_objective"] = own.objective
+    meta["own_tight"] = own.tight
+    meta["own_time"] = own.time
+    runs = []
+    for backend in backends:
+        run = Run(case.pid, backend)
+        start = time.perf_counter()
+        try:
+            with contextlib.redirect_stdout(io.StringIO()), \
+                    warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                result = optimize(design, backend)
+            if caught:
+                run.info["warnings"] = sorted({f"{w.category.__name__}: {w.message}"
+                                               for w in caught})
+        except InfeasibleError as exc:
+            run.outcome, run.message = "infeasible", str(exc)
+            feasible = margin is not None and margin <= FEASIBLE_SLACK
+            if not case.force_balance and own.x is not None:
+                feasible = True
+            if feasible:
+                run.flags["feasible-called-infeasible"] = (
+                    f"InfeasibleError ({exc}); own phase-1 margin {margin!r} "
+                    f"(≤ {FEASIBLE_SLACK:g}: feasible)")
+        except SolverError as exc:
+            run.outcome, run.message = "solver-error", str(exc)
+            feasible = margin is not None and margin <= FEASIBLE_SLACK
+            if feasible or (not case.force_balance and own.x is not None):
+                run.flags["solver-error-while-feasible"] = (
+                    f"SolverError ({exc}); own phase-1 margin {margin!r}")
+        except (SpecError, AssemblyError) as exc:
+            # The spec loaded and has [balance] and [operation]: a bad-input error now is the
+            # computation's own (e.g. a balanced link the model refuses to build).
+            run.outcome, run.message = "spec-error", str(exc)
+            run.flags["spec-error-in-optimize"] = f"{type(exc).__name__}: {exc}"
+        except Exception as exc:  # noqa: BLE001 - undocumented exceptions are the finding
+            run.outcome, run.message = "crash", f"{type(exc).__name__}: {exc}"
+            run.flags["crash"] = traceback.format_exc()
+        else:
+            run.outcome = "result"
+            run.status = str(result.status)
+            run.message = result.message
+            try:
+                check_result(case, design, result, bounds, model, obj, own, margin, run, keep)
+                if (margin is not None and margin > 1e-7 and run.status != "failed"
+                        and not {"bound-violation", "force-balance-failure"} & set(run.flags)):
+                    run.flags["infeasible-called-feasible"] = (
+                        f"a {run.status} design that meets every bound, but the own phase-1 "
+                        f"margin is {margin:.3g} (infeasible)")
+            except Exception as exc:  # noqa: BLE001
+                run.flags["crash"] = "in the checks: " + traceback.format_exc()
+                run.message += f" [check crashed: {type(exc).__name__}: {exc}]"
+        run.time = time.perf_counter() - start
+        runs.append(run)
+    meta["time"] = time.perf_counter() - t0
+    return runs, meta
+
+
+# ----------------------------------------------------------------------------------------------
+# The campaign
+
+
+def _save(keep: Path, cls: str, run: Run, meta: dict) -> Path:
+    folder = keep / cls
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"p{run.pid:05d}-{run.backend}.toml"
+    header = [
+        f"# defect class: {cls}",
+        f"# family: {meta['family']}  backend: {run.backend}  outcome: {run.outcome} "
+        f"status: {run.status}",
+        f"# notes: {json.dumps(meta.get('notes', {}))}",
+        f"# own: status {meta.get('own_status')} J* = {meta.get('own_objective')!r} "
+        f"tight {meta.get('own_tight')} margin {meta.get('own_margin')!r}",
+    ]
+    for line in run.flags[cls].splitlines():
+        header.append(f"# finding: {line}")
+    for line in run.message.splitlines():
+        header.append(f"# message: {line}")
+    for key in ("j_tool", "j_reported", "lower_bound", "j_own", "j_ref", "tolerance",
+                "worst_bound", "force_over_scale", "com_excursion"):
+        if key in run.info:
+            header.append(f"# {key}: {run.info[key]!r}")
+    path.write_text("\n".join(header) + "\n\n" + meta["text"])
+    if run.info.get("balanced_text"):
+        (folder / f"p{run.pid:05d}-{run.backend}.balanced.toml").write_text(
+            run.info["balanced_text"])
+    return path
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command line: ``--problems N --seed S [--keep DIR]``."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--problems", type=int, default=100)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--keep", type=Path, default=None,
+                        help="folder for reproducers (spec text) and a JSON-lines log")
+    parser.add_argument("--start", type=int, default=0, help="first problem id")
+    parser.add_argument("--only", type=int, nargs="*", default=None, help="problem ids to run")
+    parser.add_argument("--backends", default="convex,nlp")
+    parser.add_argument("--reproducers", type=int, default=3)
+    parser.add_argument("--progress", type=int, default=50)
+    args = parser.parse_args(argv)
+    backends = tuple(args.backends.split(","))
+    ids = args.only if args.only else range(args.start, args.start + args.problems)
+    keep = args.keep
+    log = None
+    if keep is not None:
+        keep.mkdir(parents=True, exist_ok=True)
+        log = (keep / "log.jsonl").open("w")
+    counts: dict[str, Counter] = defaultdict(Counter)
+    examples: dict[str, list[tuple[Run, dict]]] = defaultdict(list)
+    worst_bound = (0.0, None)
+    worst_maps = 0.0
+    families = Counter()
+    times = []
+    rejected = []
+    t_start = time.perf_counter()
+    for done, pid in enumerate(ids, 1):
+        case = make_case(args.seed, pid)
+        families[case.family] += 1
+        try:
+            runs, meta = run_problem(case, backends, keep)
+        except Exception:  # noqa: BLE001 - a crash of the campaign itself, kept going
+            print(f"problem {pid}: campaign error\n{traceback.format_exc()}", file=sys.stderr)
+            counts["all"]["campaign-error"] += 1
+            continue
+        times.append(meta.get("time", 0.0))
+        counts["all"]["problems"] += 1
+        if "rejected" in meta:
+            counts["all"]["spec-rejected"] += 1
+            rejected.append((pid, meta["rejected"]))
+            continue
+        worst_maps = max(worst_maps, meta["maps_vs_cycle_analysis"])
+        if meta["maps_vs_cycle_analysis"] > 1e-8:
+            counts["all"]["maps-disagree"] += 1
+        if meta.get("balance_rank", 4) != 4:
+            counts["all"][f"balance-rank-{meta['balance_rank']}"] += 1
+        if not meta["own_status"].startswith("optimal"):
+            counts["all"][f"own-{meta['own_status']}"] += 1
+        for run in runs:
+            c = counts[run.backend]
+            c["runs"] += 1
+            c[f"outcome {run.outcome}{(' ' + run.status) if run.status else ''}"] += 1
+            if run.outcome == "result":
+                c["loaded-ok" if run.info.get("loaded") else "load-failures"] += 1
+                c["bound-exact (>0)"] += bool(run.info.get("bound_exact"))
+                c["bound (>1e-12)"] += run.info.get("worst_bound", ("", 0.0))[1] > 1e-12
+                c["runtime warnings"] += bool(run.info.get("warnings"))
+                c["inconclusive (own)"] += not run.info.get("conclusive", False)
+                wb = run.info.get("worst_bound", (None, 0.0))
+                if wb[1] > worst_bound[0]:
+                    worst_bound = (wb[1], (pid, run.backend, wb[0]))
+            for cls in run.flags:
+                c[cls] += 1
+                if meta.get("mixed"):
+                    c[f"{cls} (mixed-scale)"] += 1
+                if len(examples[cls]) < args.reproducers and not any(
+                        r.pid == run.pid for r, _ in examples[cls]):
+                    examples[cls].append((run, meta))
+            if log is not None:
+                log.write(json.dumps({
+                    "pid": pid, "family": case.family, "kind": case.kind,
+                    "backend": run.backend, "outcome": run.outcome, "status": run.status,
+                    "flags": run.flags, "message": run.message, "time": run.time,
+                    "notes": case.notes,
+                    "info": {k: v for k, v in run.info.items() if k != "balanced_text"},
+                    "own": {k: meta.get(k) for k in ("own_status", "own_objective",
+                                                     "own_tight", "own_margin", "balance_rank",
+                                                     "maps_vs_cycle_analysis")},
+                }, default=str) + "\n")
+        if args.progress and done % args.progress == 0:
+            rate = (time.perf_counter() - t_start) / done
+            found = {k: v for k, v in (counts["convex"] + counts["nlp"]).items() if k in CLASSES}
+            print(f"[{done} problems, {rate:.2f} s/problem] {dict(found)}", flush=True)
+    total = time.perf_counter() - t_start
+    if log is not None:
+        log.close()
+    # -- report
+    n = counts["all"]["problems"]
+    print()
+    print(f"problems: {n}   seed {args.seed}   families {dict(families)}")
+    print(f"spec rejected at load (expected SpecError/AssemblyError): "
+          f"{counts['all']['spec-rejected']}")
+    extra = {k: v for k, v in counts["all"].items()
+             if k not in ("problems", "spec-rejected")}
+    if extra:
+        print(f"campaign diagnostics: {extra}")
+    print(f"own maps vs balancer cycle analysis (original designs): worst relative "
+          f"difference {worst_maps:.2g}")
+    rows = ["runs", "loaded-ok", "load-failures", "bound-violation", "bound-exact (>0)",
+            "bound (>1e-12)", "runtime warnings",
+            "force-balance-failure", "false-optimal", "false-lower-bound",
+            "feasible-called-infeasible", "infeasible-called-feasible",
+            "failed-while-feasible", "solver-error-while-feasible", "spec-error-in-optimize",
+            "objective-misreport",
+            "below-independent-optimum", "nan", "crash", "inconclusive (own)"]
+    outcomes = sorted({k for b in backends for k in counts[b] if k.startswith("outcome")})
+    mixed = sorted({k for b in backends for k in counts[b] if k.endswith("(mixed-scale)")})
+    print()
+    print(f"{'class':<48}" + "".join(f"{b:>10}" for b in backends))
+    for row in rows + outcomes:
+        print(f"{row:<48}" + "".join(f"{counts[b][row]:>10}" for b in backends))
+    if mixed:
+        print("of which on problems whose link masses differ by more than 1e6:")
+        for row in mixed:
+            print(f"  {row:<46}" + "".join(f"{counts[b][row]:>10}" for b in backends))
+    if worst_bound[1] is not None:
+        print(f"\nworst relative bound violation: {worst_bound[0]:.3g} at problem "
+              f"{worst_bound[1][0]} ({worst_bound[1][1]}, {worst_bound[1][2]})")
+    if times:
+        print(f"time: {total:.0f} s in all, {np.mean(times):.2f} s/problem (median "
+              f"{np.median(times):.2f}, max {np.max(times):.1f})")
+    if rejected:
+        print("\nrejected specs (first 5):")
+        for pid, why in rejected[:5]:
+            print(f"  {pid}: {why}")
+    for cls in CLASSES:
+        if not examples[cls]:
+            continue
+        print(f"\n== {cls}: reproducers")
+        for run, meta in examples[cls]:
+            where = ""
+            if keep is not None:
+                where = f"  -> {_save(keep, cls, run, meta)}"
+            first = run.flags[cls].strip().splitlines()
+            summary = first[-1] if cls == "crash" else first[0]
+            tag = ", mixed-scale" if meta.get("mixed") else ""
+            print(f"  problem {run.pid} ({meta['family']}{tag}, {meta['kind']}, {run.backend}, "
+                  f"{run.status or run.outcome}): {summary[:300]}{where}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
