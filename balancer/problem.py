@@ -105,8 +105,22 @@ _OBJECTIVE_KEYS = (
 )
 _LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "counter_rotor")
 
-#: Relative tolerance of :meth:`NumericProblem.violations` (bounds and Eq. 57).
+#: Relative tolerance of :meth:`NumericProblem.violations` for a solver's design (bounds and
+#: Eq. 57): ten times Clarabel's tolerance (:data:`balancer.optimize.convex.CLARABEL_SETTINGS`).
 FEASIBILITY_TOLERANCE = 1e-9
+#: Relative residual of Eq. 57–58 (each row against the magnitude of its own terms) that a
+#: balanced design must meet: rounding, with room for the conditioning of the rows.
+FORCE_BALANCE_TOLERANCE = 1e-12
+#: Share of a force-balance row's magnitude at the parameters' scales below which its terms
+#: count as vanishing (:meth:`NumericProblem.force_balance_residual`).
+SMALL_ROW = 1e-6
+#: A bound met to this (relative, :meth:`NumericProblem.violations`) is met to rounding: the
+#: physical values (:meth:`NumericProblem.physical`) then meet it exactly.
+ROUNDING_TOLERANCE = 1e-12
+#: A design whose shaking is below this share of what its inertias can produce
+#: (:attr:`NumericProblem.inertial_scale`) is balanced already; the problem's scale is then
+#: that share of the inertial scale, not the (vanishing) original figures.
+BALANCED_SHARE = 1e-3
 
 
 # ----------------------------------------------------------------------------------------------
@@ -781,13 +795,51 @@ class NumericProblem:
         return value if value > 0 else 1.0
 
     @cached_property
+    def inertial_scale(self) -> float:
+        """The largest RMS a change of the parameters by their own scale makes, N·m.
+
+        ``σ_max(R·diag(scales))`` (:attr:`scales`): what the links' inertias can produce, which
+        does not vanish when the original design happens to be balanced.
+        """
+        if not self.factor.shape[0]:
+            return 0.0
+        return float(np.linalg.norm(self.factor * self.scales, 2))
+
+    @cached_property
     def objective_scale(self) -> float:
-        """``‖K·x0‖``, or a fallback when it vanishes: the scale of ``√J``, N·m."""
-        value = math.sqrt(self.quadratic(self.x0))
-        if value > 0:
-            return value
-        fallback = float(np.linalg.norm(self.factor) * np.linalg.norm(self.x0))
-        return fallback if fallback > 0 else 1.0
+        """The problem's own scale of ``√J``, N·m: the original design's ``‖K·x0‖``.
+
+        It is the RMS of the original's weighted shaking (its RMS shaking moment for the
+        default objective); for a design that is balanced already (below
+        :data:`BALANCED_SHARE` of :attr:`inertial_scale`) that share of the inertial scale.
+        Solvers scale their objective by it; optimality is judged against it.
+        """
+        value = max(math.sqrt(self.quadratic(self.x0)), BALANCED_SHARE * self.inertial_scale)
+        return value if value > 0 else 1.0
+
+    @property
+    def rms_form(self) -> bool:
+        """Whether ``J`` is a mean square (no mass term): then compared through ``√J``, N·m."""
+        return not self.weights.added_mass
+
+    def gap(self, objective: float, lower_bound: float) -> float:
+        """The gap of ``objective`` to ``lower_bound``, relative to :attr:`objective_scale`.
+
+        ``(√J − √J_low)/s`` for a mean-square objective (its RMS over the problem's scale, so
+        that a zero optimum is judged as finely as any other), else ``(J − J_low)/s²``.
+        Dimensionless.
+        """
+        s = self.objective_scale
+        if self.rms_form:
+            return (math.sqrt(max(objective, 0.0)) - math.sqrt(max(lower_bound, 0.0))) / s
+        return (objective - lower_bound) / (s * s)
+
+    def within(self, a: float, b: float, rel: float) -> bool:
+        """Whether objective ``a`` exceeds ``b`` by at most ``rel`` of the problem's scale.
+
+        In the sense of :meth:`gap`.
+        """
+        return self.gap(a, b) <= rel
 
     @cached_property
     def acceleration_rows(self) -> NDArray[np.float64]:
@@ -862,17 +914,74 @@ class NumericProblem:
                                             original_a[rotors])
         return x
 
-    def linkage_of(self, x: NDArray[np.float64]) -> Mechanism:
-        """The four-bar with inertial parameters ``x`` (loads kept from the original links).
+    def physical(self, x: NDArray[np.float64]) -> dict[str, tuple[float, float, float, float,
+                                                                   float]]:
+        """Each link's ``(m, e, f, I, counter-rotor)`` of design vector ``x``, in its bounds.
 
-        ``m``, ``e = m·e/m``, ``f = m·f/m``, ``I = J − m·(e² + f²)``, counter-rotors.
+        ``m``, ``e = m·e/m``, ``f = m·f/m``, ``I = J − m·(e² + f²)``; an inertia within
+        rounding of the original's is the original's. Each value is then put into its bounds
+        exactly (:meth:`clamp`): the conversion rounds, and a designer's spec must hold what
+        the problem promised. How far that moved anything is the caller's to check
+        (:meth:`NumericProblem.clamp_distance`).
         """
-        links = {}
+        out = {}
         for b in self.links:
             m, e, f, inertia = inertial_to_physical(x[4 * b.index : 4 * b.index + 4])
             if abs(inertia - b.original.inertia) <= 1e-12 * b.inertia_ref:
                 inertia = b.original.inertia  # only roundoff from J − m·s²
             rotor = float(x[ROTOR_ENTRY[b.name]]) if b.name in ROTOR_ENTRY else 0.0
+            out[b.name] = self.clamp(b, m, e, f, inertia, rotor)
+        return out
+
+    @staticmethod
+    def clamp(b: LinkBounds, m: float, e: float, f: float, inertia: float,
+              rotor: float) -> tuple[float, float, float, float, float]:
+        """Physical values of one link put exactly into its bounds ``b``.
+
+        Mass into its range; the centre of mass onto the disc (radially) or to its fixed
+        place; the inertia into ``[max(I_low, m·ρ²), I_high]``; the counter-rotor into its
+        range.
+        """
+        m = min(max(m, b.mass[0]), b.mass[1])
+        if b.com_fixed is not None:
+            e, f = b.com_fixed.real, b.com_fixed.imag
+        else:
+            d = complex(e - b.com_centre, f)
+            radius = b.com_radius
+            while abs(d) > radius:  # scale onto the disc; rounding may need a second nudge
+                d *= radius / abs(d) * (1 - 2.0**-52)
+            e, f = b.com_centre + d.real, d.imag
+        inertia = min(max(inertia, b.inertia[0], m * b.gyration**2), b.inertia[1])
+        if b.counter_rotor is not None:
+            rotor = min(max(rotor, b.counter_rotor[0]), b.counter_rotor[1])
+        return m, e, f, inertia, rotor
+
+    def clamp_distance(self, x: NDArray[np.float64]) -> float:
+        """How far :meth:`physical` moved ``x`` to put it in its bounds, relative.
+
+        The largest change of an inertial parameter over its scale (:attr:`scales`).
+        """
+        return float(np.max(np.abs(self.vector_of(self.physical(x)) - x) / self.scales))
+
+    def vector_of(self, physical) -> NDArray[np.float64]:
+        """The design vector of physical values (as from :meth:`physical`)."""
+        x = np.zeros(14)
+        for b in self.links:
+            m, e, f, inertia, rotor = physical[b.name]
+            x[4 * b.index : 4 * b.index + 4] = physical_to_inertial(m, e, f, inertia)
+            if b.name in ROTOR_ENTRY:
+                x[ROTOR_ENTRY[b.name]] = rotor
+        return x
+
+    def linkage_of(self, x: NDArray[np.float64]) -> Mechanism:
+        """The mechanism with inertial parameters ``x`` (loads kept from the original links).
+
+        Physical values from :meth:`physical`, in their bounds exactly.
+        """
+        links = {}
+        values = self.physical(x)
+        for b in self.links:
+            m, e, f, inertia, rotor = values[b.name]
             links[b.name] = replace(
                 b.original, mass=m, e=e, f=f, inertia=inertia, counter_rotor=rotor
             )
@@ -921,13 +1030,30 @@ class NumericProblem:
                 out.append(
                     f"{b.key}.counter_rotor: {x[index]:.9g} kg·m² outside [{lo:.9g}, {hi:.9g}]"
                 )
-        if self.force_balance is not None:
-            a, rhs = self.force_balance
-            residual = float(np.max(np.abs(a @ x[:12] - rhs)))
-            total = float(x[0] + x[4] + x[8])
-            if residual > tol * total:
-                out.append(f"force balance: residual {residual / total:.3g} of the mass")
+        residual = self.force_balance_residual(x)
+        if residual > max(tol, FORCE_BALANCE_TOLERANCE):
+            out.append(f"force balance: residual {residual:.3g} of its terms")
         return out
+
+    def force_balance_residual(self, x: NDArray[np.float64]) -> float:
+        """Largest residual of Eq. 58, each row relative to the magnitude of its own terms.
+
+        ``|A_i·x − b_i| / (Σ_j |A_ij·x_j| + |b_i|)``: rounding is relative to the terms that
+        are summed (a 1e12 kg link's first moment beside a 1 kg link's), not to the total
+        mass. A row whose terms all (nearly) vanish, the centres of mass on the links' lines
+        say, is judged against :data:`SMALL_ROW` of its magnitude at the parameters' scales
+        (:attr:`scales`), below which a residual is rounding from the other rows. 0 when force
+        balance is not imposed.
+        """
+        if self.force_balance is None:
+            return 0.0
+        a, rhs = self.force_balance
+        terms = np.abs(a) @ np.abs(x[:12]) + np.abs(rhs)
+        terms = np.maximum(terms, SMALL_ROW * (np.abs(a) @ self.scales[:12]))
+        residual = np.abs(a @ x[:12] - rhs)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel = np.where(terms > 0, residual / terms, residual)
+        return float(np.max(rel, initial=0.0))
 
 
 def numeric_problem(design: Design) -> NumericProblem:

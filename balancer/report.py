@@ -503,6 +503,9 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
             "original_objective": result.original_objective,
             "lower_bound": result.lower_bound,
             "gap": result.gap,
+            "scale": result.scale,
+            **({"rms": result.rms, "rms_lower_bound": result.rms_lower_bound,
+                "rms_gap": result.rms_gap} if result.rms_form else {}),
             "relaxation_tight": result.relaxation_tight,
             "iterations": result.iterations,
             "time": result.time,
@@ -519,7 +522,9 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
                if linkage.type == "slider-crank" else {}),
             "verification": None if verification is None else verification.as_dict(),
             "out": None if out is None else str(out),
-            "units": {"objective": "(N·m)², mean square of the inertial shaking", "time": "s",
+            "units": {"objective, lower_bound": "(N·m)², mean square of the inertial shaking",
+                      "gap": "relative to scale (of √J when rms is given, else of J)",
+                      "scale, rms, rms_lower_bound, rms_gap": "N·m", "time": "s",
                       "mass": "kg", "inertia": "kg·m²", "e, f, s": "m", "sigma": "rad"},
         }
     )

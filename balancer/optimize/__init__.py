@@ -35,7 +35,7 @@ import numpy as np
 from ..errors import SpecError
 from ..inverse import cycle_analysis
 from ..model import Design
-from ..problem import NumericProblem, numeric_problem
+from ..problem import ROUNDING_TOLERANCE, NumericProblem, numeric_problem
 from .convex import ConvexSolution, ConvexSolver
 from .nlp import NlpSolution, NlpSolver
 from .result import (
@@ -44,14 +44,12 @@ from .result import (
     InfeasibleError,
     StageReport,
     Status,
-    gap,
-    gap_floor,
 )
 
 BACKENDS: tuple[str, ...] = ("nlp", "convex")
-#: Relative objective difference within which the NLP's design does not replace the convex one
-#: (the convex design may exceed the optimum by Clarabel's tolerance and the tie-break's,
-#: :data:`.convex.TIE_ACCEPT`).
+#: Gap (relative to the problem's scale, :meth:`NumericProblem.gap`) within which the NLP's
+#: design does not replace the convex one (which may exceed the optimum by Clarabel's
+#: tolerance and the tie-break's, :data:`.convex.TIE_ACCEPT`).
 TIE_TOLERANCE = 1e-7
 
 __all__ = [
@@ -65,7 +63,6 @@ __all__ = [
     "Optimizer",
     "StageReport",
     "Status",
-    "gap",
     "optimize",
 ]
 
@@ -116,27 +113,32 @@ class Optimizer:
         t0 = time.perf_counter()
         convex = self.convex.solve()
         stages: list[StageReport] = list(convex.stages)
-        x, objective = convex.x, convex.objective
-        feasible = not data.violations(x)
+        x, feasible = convex.x, convex.converged
+        objective = data.objective(x)
         notes = []
         if backend == "nlp":
             nlp = self.nlp.solve(convex.x)
             stages.append(nlp.stage)
             if nlp.status == "optimal" and nlp.feasible:
-                scale = max(abs(objective), gap_floor(data.objective_reference))
-                if not feasible or nlp.objective < objective - TIE_TOLERANCE * scale:
-                    xb = self.convex.balanced(nlp.x)  # Eq. 58 to rounding, not to IPOPT's tol
-                    if data.violations(xb):
-                        xb = nlp.x
-                    x, objective, feasible = xb, data.objective(xb), True
+                if not feasible or not data.within(objective, nlp.objective, TIE_TOLERANCE):
+                    xb, ok = self.convex.finalize(nlp.x)  # bounds exactly, Eq. 58 to rounding
+                    if ok:
+                        x, objective, feasible = xb, data.objective(xb), True
             else:
                 notes.append(f"IPOPT: {nlp.stage.solver_status}")
+        # The design as its physical values, exactly in their bounds (what the spec will say).
+        x = data.vector_of(data.physical(x))
+        objective = data.objective(x)
+        feasible = feasible and not data.violations(x, tol=ROUNDING_TOLERANCE)
+        if not feasible and data.force_balance is not None:
+            diagnosis = self.convex.diagnose()  # a problem just on the infeasible side
+            if diagnosis is not None:
+                raise diagnosis
         elapsed = time.perf_counter() - t0
-        g = gap(objective, convex.lower_bound, data.objective_reference)
-        stages = [
-            replace(s, gap=gap(s.objective, convex.lower_bound, data.objective_reference))
-            for s in stages
-        ]
+        lower = convex.lower_bound
+        g = data.gap(objective, lower)
+        stages = [replace(s, gap=data.gap(s.objective, lower))
+                  if math.isfinite(s.objective) else s for s in stages]
         if not feasible:
             status = Status.FAILED
         elif g <= GAP_TOLERANCE:
@@ -150,19 +152,20 @@ class Optimizer:
         after = cycle_analysis(
             balanced, data.speed, data.samples, route="newton-euler", loads=False
         )
-        message = _message(status, objective, data.original_objective, g, convex, notes)
-        return BalanceResult(
+        result = BalanceResult(
             success=status is not Status.FAILED,
             status=status,
-            message=message,
+            message="",
             backend=backend,
             linkage=balanced,
             original=data.linkage,
             x=np.array(x),
             objective=objective,
             original_objective=data.original_objective,
-            lower_bound=convex.lower_bound,
+            lower_bound=lower,
             gap=g,
+            scale=data.objective_scale,
+            rms_form=data.rms_form,
             relaxation_tight=convex.relaxation_tight,
             iterations=sum(s.iterations for s in stages),
             time=elapsed,
@@ -170,25 +173,28 @@ class Optimizer:
             before=before,
             after=after,
         )
+        return replace(result, message=_message(result, convex, notes))
 
 
-def _message(
-    status: Status,
-    objective: float,
-    original: float,
-    g: float,
-    convex: ConvexSolution,
-    notes: list[str],
-) -> str:
+def _message(result: BalanceResult, convex: ConvexSolution, notes: list[str]) -> str:
+    """One line: the status, the figure, the certified bound and the gap, in N·m."""
     text = {
         Status.OPTIMAL: "globally optimal",
         Status.FEASIBLE: "feasible, not proven optimal",
         Status.FAILED: "no feasible design found",
-    }[status]
-    value = f"J = {objective:.6g} (N·m)²"
-    if original > 0 and objective >= 0:
-        value += f" (√(J/J_original) = {math.sqrt(objective / original):.3g})"
-    parts = [text, value, f"gap {g:.2g} to the lower bound {convex.lower_bound:.6g} (N·m)²"]
+    }[result.status]
+    tolerance = f"tolerance {GAP_TOLERANCE:g} of the problem's scale {result.scale:.4g} N·m"
+    if result.rms_form:
+        value = f"RMS {result.rms:.6g} N·m"
+        if result.original_objective > 0:
+            ratio = result.rms / math.sqrt(result.original_objective)
+            value += f" ({ratio:.3g} of the original's)"
+        parts = [text, value, f"certified lower bound {result.rms_lower_bound:.6g} N·m",
+                 f"gap {result.rms_gap:.2g} N·m ({tolerance})"]
+    else:
+        parts = [text, f"J = {result.objective:.6g} (N·m)²",
+                 f"certified lower bound {result.lower_bound:.6g} (N·m)²",
+                 f"gap {result.gap * result.scale**2:.2g} (N·m)² ({tolerance}, squared)"]
     if not convex.relaxation_tight:
         parts.append("convex relaxation not tight")
     return "; ".join(parts + notes)

@@ -17,33 +17,18 @@ from ..errors import SolverError
 from ..inverse import CycleAnalysis
 from ..model import Design, FourBar
 
-#: Relative gap to the convex lower bound within which a design counts as globally optimal.
+#: Gap to the certified lower bound, relative to the problem's scale (the original design's
+#: RMS; :meth:`balancer.problem.NumericProblem.gap`), within which a design is called globally
+#: optimal. Clarabel certifies the bound to ~2e-10 of that scale, the tie-break accepts 1e-8.
 GAP_TOLERANCE = 1e-6
-
-
-def gap_floor(reference: float) -> float:
-    """The least denominator of a relative gap, ``1e-10·reference`` (N·m)².
-
-    ``reference`` is a positive scale of the objective
-    (:attr:`balancer.problem.NumericProblem.objective_reference`, the original design's mean
-    squares); ``1e-10`` is Clarabel's tolerance on the objective scaled by it. A zero
-    optimum (complete balancing) would otherwise divide by zero; with this floor a gap of at
-    most :data:`GAP_TOLERANCE` there means an RMS below ``1e-8`` of the original's.
-    """
-    return max(1e-10 * abs(reference), 1e-300)
-
-
-def gap(objective: float, lower_bound: float, reference: float) -> float:
-    """Relative gap ``(J − J_low)/max(|J_low|, floor)`` (see :func:`gap_floor`), dimensionless."""
-    return (objective - lower_bound) / max(abs(lower_bound), gap_floor(reference))
 
 
 class Status(StrEnum):
     """Outcome of a balancing."""
 
     OPTIMAL = "optimal"
-    """A feasible design whose objective is within :data:`GAP_TOLERANCE` of the proven lower
-    bound: globally optimal."""
+    """A feasible design within :data:`GAP_TOLERANCE` (of the problem's scale) of the certified
+    lower bound: globally optimal."""
     FEASIBLE = "feasible"
     """A feasible design (all bounds, exact force balance) that is not proven optimal: a local
     optimum, or the convex design made feasible when its relaxation was not tight."""
@@ -71,8 +56,8 @@ class StageReport:
     objective
         The objective ``J`` at the stage's design, (N·m)² (``nan`` if it has none).
     gap
-        That objective's relative gap to the convex lower bound (see :func:`gap`; ``nan``
-        until the bound is known).
+        That objective's gap to the certified lower bound, relative to the problem's scale
+        (:meth:`balancer.problem.NumericProblem.gap`; ``nan`` until the bound is known).
     """
 
     name: str
@@ -113,11 +98,17 @@ class BalanceResult:
     original_objective
         ``J`` of the original design, (N·m)².
     lower_bound
-        The convex optimum: no feasible design has a smaller ``J`` (to the solver's tolerance),
-        (N·m)².
+        Certified by the convex program's optimum and its tolerances: no feasible design has a
+        smaller ``J``, (N·m)².
     gap
-        ``(objective − lower_bound)/max(|lower_bound|, floor)``, dimensionless; the floor is
-        ``1e-10`` of the original's mean squares (:func:`gap_floor`), for a zero optimum.
+        The design's gap to the lower bound relative to :attr:`scale`: ``(√J − √J_low)/scale``
+        for a mean-square objective, else ``(J − J_low)/scale²``; dimensionless.
+    scale
+        The problem's own scale of ``√J``: the original design's weighted RMS (or, for an
+        original that is balanced already, a share of what its inertias can produce), N·m.
+    rms_form
+        Whether ``J`` is a mean square (no mass term), so that :attr:`rms` and the bounds in
+        N·m are meaningful.
     relaxation_tight
         Whether the convex relaxation was exact at its optimum (always, unless a link has a
         bounded inertia about a centre of mass that may move).
@@ -144,12 +135,29 @@ class BalanceResult:
     original_objective: float
     lower_bound: float
     gap: float
+    scale: float
+    rms_form: bool
     relaxation_tight: bool
     iterations: int
     time: float
     stages: tuple[StageReport, ...]
     before: CycleAnalysis
     after: CycleAnalysis
+
+    @property
+    def rms(self) -> float:
+        """``√J``: the design's weighted RMS shaking (its RMS shaking moment by default), N·m."""
+        return float(np.sqrt(max(self.objective, 0.0)))
+
+    @property
+    def rms_lower_bound(self) -> float:
+        """``√J_low``: no feasible design has a smaller weighted RMS, N·m."""
+        return float(np.sqrt(max(self.lower_bound, 0.0)))
+
+    @property
+    def rms_gap(self) -> float:
+        """``√J − √J_low``, N·m."""
+        return self.rms - self.rms_lower_bound
 
     @property
     def optimal(self) -> bool:
