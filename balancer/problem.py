@@ -940,18 +940,23 @@ class NumericProblem:
 
         Mass into its range; the centre of mass onto the disc (radially) or to its fixed
         place; the inertia into ``[max(I_low, m·ρ²), I_high]``; the counter-rotor into its
-        range.
+        range. A bound derived by arithmetic (a distance, ``m·ρ²``) is met with a margin of a
+        few units in the last place, so that it holds whichever way a reader rounds it.
         """
+        ulps = 8 * 2.0**-52
         m = min(max(m, b.mass[0]), b.mass[1])
         if b.com_fixed is not None:
             e, f = b.com_fixed.real, b.com_fixed.imag
         else:
             d = complex(e - b.com_centre, f)
-            radius = b.com_radius
+            radius = b.com_radius * (1 - ulps)
             while abs(d) > radius:  # scale onto the disc; rounding may need a second nudge
-                d *= radius / abs(d) * (1 - 2.0**-52)
+                d *= radius / abs(d) * (1 - ulps)
             e, f = b.com_centre + d.real, d.imag
-        inertia = min(max(inertia, b.inertia[0], m * b.gyration**2), b.inertia[1])
+        least = m * b.gyration**2 * (1 + ulps)
+        if least > b.inertia[1]:
+            least = b.inertia[1]
+        inertia = min(max(inertia, b.inertia[0], least), b.inertia[1])
         if b.counter_rotor is not None:
             rotor = min(max(rotor, b.counter_rotor[0]), b.counter_rotor[1])
         return m, e, f, inertia, rotor

@@ -485,7 +485,9 @@ class ConvexSolver:
         data, lay = self.data, self.layout
         x = self._clip_inertias(self.balanced(np.asarray(x, float)))
         if not data.violations(x, tol=ROUNDING_TOLERANCE):
-            return x, True
+            exact = self._exact(x)
+            if exact is not None:
+                return exact, True
         if not lay.size:
             return x, False
         inert = [i for i in range(14) if data.inert[i]]
@@ -497,8 +499,34 @@ class ConvexSolver:
             x2[inert] = x[inert]  # settled already; the projection does not see them
             x2 = self._clip_inertias(x2)
             if not data.violations(x2, tol=ROUNDING_TOLERANCE):
-                return x2, True
+                exact = self._exact(x2)
+                if exact is not None:
+                    return exact, True
         return x, False
+
+    def _exact(self, x: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """The design of ``x``'s physical values, in their bounds exactly, with Eq. 58 kept.
+
+        :meth:`NumericProblem.physical` moves values that overshoot a bound by rounding onto
+        it; that can cost Eq. 58 its last digits, which the other free variables restore (the
+        ones on a bound stay); repeated until both hold (a move of rounding size each time).
+        ``None`` if they do not within a few rounds.
+        """
+        data, lay = self.data, self.layout
+        inert = [i for i in range(14) if data.inert[i]]
+        for _ in range(4):
+            xp = data.vector_of(data.physical(x))
+            if (data.force_balance_residual(xp) <= FORCE_BALANCE_TOLERANCE
+                    and not data.violations(xp, tol=ROUNDING_TOLERANCE)):
+                return xp
+            if not lay.size:
+                return None
+            up = lay.u(xp)
+            pinned = np.array([xp[i] != x[i] for i in lay.primary], dtype=bool)
+            x = lay.x(self.restore_balance(up, pinned))
+            x[inert] = xp[inert]
+            x = self._clip_inertias(x)
+        return None
 
     def _clip_and_pin(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
         """Masses and centres of mass that overshoot their bounds put on them.
@@ -535,10 +563,8 @@ class ConvexSolver:
         for entry, b in ((12, data.links[0]), (13, data.links[2])):
             if b.counter_rotor is not None:
                 x[entry] = min(max(x[entry], b.counter_rotor[0]), b.counter_rotor[1])
-        for b in data.links:
+        for b in data.links:  # inert ones too: a move of the mass or centre of mass shifts I
             k = 4 * b.index
-            if data.inert[k + 3]:
-                continue
             q = (x[k + 1] ** 2 + x[k + 2] ** 2) / x[k]
             low = max(b.inertia[0], x[k] * b.gyration**2)
             inertia = x[k + 3] - q
@@ -894,6 +920,10 @@ class ConvexSolver:
             current = b.mass[1] if high else b.mass[0]
             if b.mass[0] == b.mass[1]:
                 words = f"{key} must allow {v:.4g} kg (fixed at {current!r})"
+            elif high and b.gyration > 0 and b.mass[1] == b.inertia[1] / b.gyration**2:
+                words = (f"{key} must allow up to {v:.4g} kg (is at most {current:.6g}: "
+                         f"{b.key}.inertia ≤ {b.inertia[1]:.6g} kg·m² with min_gyration "
+                         f"{b.gyration:.6g} m caps it at I/ρ²)")
             elif high:
                 words = f"{key} must allow up to {v:.4g} kg (is at most {current!r})"
             else:

@@ -267,6 +267,9 @@ def resolve(case: Case) -> list[Bounds]:
             inertia = (0.0, math.inf)
         else:
             inertia = (link.inertia, link.inertia)
+        rho = fr.min_gyration or 0.0
+        if rho > 0 and math.isfinite(inertia[1]):  # I ≥ m·ρ² and I ≤ I_high cap the mass
+            mass = (mass[0], min(mass[1], inertia[1] / rho**2))
         if grounded and fr.counter_rotor is not None:
             rotor = fr.counter_rotor
         out.append(Bounds(**common, listed=True, mass=mass, com_fixed=com_fixed, centre=centre,
@@ -680,9 +683,15 @@ def own_optimum(case, bounds, model, obj: Objective, vrows, shrink: float = 0.0)
     return out
 
 
-def own_margin(case, bounds, vrows) -> tuple[float, str]:
+def own_margin(case, bounds, vrows, model=None) -> tuple[float, str]:
     """Phase 1: the least uniform slack ``t`` (negative: a margin) with which force balance
-    can be met (relative: kg over the link's mass, m·kg over its mass times its length)."""
+    can be met (relative: kg over the link's mass, m·kg over its mass times its length).
+
+    With ``model``, a "feasible" answer is checked on its own design: the total centre of mass
+    must stay put (to 1e-9 of the longest link). The sampled rows lose a light link's term
+    beside a link 1e12 times heavier (they are found by an SVD on the whole matrix); such an
+    answer is then inconclusive (nan).
+    """
     u = cp.Variable(12)
     t = cp.Variable()
     cons = _mass_com(bounds, u, slack=t)
@@ -693,6 +702,14 @@ def own_margin(case, bounds, vrows) -> tuple[float, str]:
         return math.inf, status
     if status not in ("optimal", "optimal_inaccurate") or t.value is None:
         return math.nan, status
+    if model is not None and float(t.value) <= FEASIBLE_SLACK:
+        x = np.zeros(14)
+        x[:12] = np.asarray(u.value) * scales_of(bounds, case.kind)[:12]
+        for b in bounds:  # any inertia: it does not move the centre of mass
+            x[4 * b.index + 3] = 1.0
+        lmax = max(b.length for b in bounds)
+        if not model.com_excursion(x) <= 1e-9 * lmax:
+            return math.nan, f"{status}, but its design's centre of mass moves"
     return float(t.value), status
 
 
@@ -1221,7 +1238,7 @@ def run_problem(case: Case, backends, keep: Path | None) -> tuple[list[Run], dic
     meta["balance_rank"] = rank
     margin = None
     if case.force_balance:
-        margin, mstatus = own_margin(case, bounds, vrows)
+        margin, mstatus = own_margin(case, bounds, vrows, model)
         meta["own_margin"] = margin
         meta["own_margin_status"] = mstatus
     # A certificate: the optimum over bounds narrowed by 1e-10 (or a quarter of the phase-1
