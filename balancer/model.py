@@ -368,8 +368,329 @@ class SliderCrank:
                        **{n: self.link(n).without_loads() for n in self.link_names})
 
 
+#: The name of the general linkage's frame: a link without mass whose points do not move.
+GROUND = "ground"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Body:
+    """One link of a general :class:`Linkage`: the points it carries and its mass properties.
+
+    Its frame has its origin at its first point and its x-axis towards its second, at the
+    reference pose; a one-point link's x-axis is the direction of the slider it runs in.
+
+    Attributes
+    ----------
+    name
+        The link's name (``"ground"`` for the frame).
+    points
+        Names of its points, first the frame's origin.
+    props
+        Mass properties and loads in that frame (:class:`Link`); ``None`` for the ground.
+    """
+
+    name: str
+    points: tuple[str, ...]
+    props: Link | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class Slider:
+    """A prismatic pair: a point of ``link`` runs on a line fixed in ``guide``.
+
+    The pair also keeps the two links' relative angle. The line passes through the point's
+    reference position with the given direction (at the reference pose).
+
+    Attributes
+    ----------
+    link, guide
+        The sliding link and the link that carries the guide (``"ground"`` for the frame).
+    point
+        The point of ``link`` on the line.
+    direction
+        The line's direction at the reference pose (any length but zero).
+    force
+        A force on ``link`` along ``direction`` from ``guide``, a function of the input's angle
+        (a gas force between piston and cylinder); internal to the machine.
+    """
+
+    link: str
+    guide: str
+    point: str
+    direction: tuple[float, float]
+    force: GasForce = field(default_factory=GasForce)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Spring:
+    """A linear spring between two points (of one or two links, or the ground).
+
+    Attributes
+    ----------
+    points
+        The two anchor points.
+    stiffness
+        N/m.
+    free_length
+        Length at which it carries no force, m.
+    """
+
+    points: tuple[str, str]
+    stiffness: float
+    free_length: float
+
+    def __post_init__(self) -> None:
+        """Check the values (keys within the spring's table)."""
+        if (isinstance(self.points, str) or not hasattr(self.points, "__len__")
+                or len(self.points) != 2 or not all(isinstance(p, str) for p in self.points)):
+            raise SpecError("must be a list of two point names", key="points",
+                            value=self.points)
+        if self.points[0] == self.points[1]:
+            raise SpecError("must be two different points", key="points",
+                            value=list(self.points))
+        _set(self, "points", tuple(self.points))
+        _set(self, "stiffness", v.nonnegative(self.stiffness, "stiffness"))
+        _set(self, "free_length", v.nonnegative(self.free_length, "free_length"))
+
+
+@dataclass(frozen=True, kw_only=True)
+class Linkage:
+    """A planar linkage with one degree of freedom, driven by a crank on a ground pivot.
+
+    See DESIGN.md, "General planar linkages". A point named by two or more links is a revolute
+    joint between them; a point of one link only is a marker. The reference pose (the
+    points' positions) fixes the assembly: every other pose is the one reached from it
+    continuously as the input turns. Mobility, a regular reference pose and a drivable input
+    are checked when the linkage's equations are built
+    (:func:`balancer.linkage.structure.Structure`); this object checks what its data alone
+    can show.
+
+    Attributes
+    ----------
+    points
+        ``(name, (x, y))`` of every point at the reference pose, m.
+    bodies
+        The links, the ground (named ``"ground"``) among them.
+    input
+        The name of the driven link; its first point is its ground pivot.
+    sliders
+        Prismatic pairs.
+    springs
+        Linear springs.
+    """
+
+    type: ClassVar[str] = "linkage"
+
+    points: tuple[tuple[str, tuple[float, float]], ...]
+    bodies: tuple[Body, ...]
+    input: str
+    sliders: tuple[Slider, ...] = ()
+    springs: tuple[Spring, ...] = ()
+
+    def __post_init__(self) -> None:
+        """Check names and references (keys are the spec's, from its root)."""
+        points = {}
+        for item in self.points:
+            if not (isinstance(item, tuple | list) and len(item) == 2
+                    and isinstance(item[0], str)):
+                raise SpecError("must be (name, (x, y)) pairs", key="mechanism.points",
+                                value=item)
+            name, xy = item
+            if name in points:
+                raise SpecError("is given twice", key=f"mechanism.points.{name}")
+            x, y = v.vector2(xy, f"mechanism.points.{name}")
+            for coord in (x, y):
+                if abs(coord) > v.LENGTH_RANGE[1]:
+                    raise SpecError(f"must be within {v.LENGTH_RANGE[1]:g} m of the origin",
+                                    key=f"mechanism.points.{name}", value=list(xy))
+            points[name] = (x, y)
+        if not points:
+            raise SpecError("a linkage needs points", key="mechanism.points")
+        _set(self, "points", tuple(points.items()))
+        names: dict[str, Body] = {}
+        for body in self.bodies:
+            if not isinstance(body, Body):
+                raise SpecError("must be a Body", key="links", value=body)
+            key = f"links.{body.name}"
+            if not isinstance(body.name, str) or not body.name:
+                raise SpecError("a link needs a name", key="links", value=body.name)
+            if body.name in names:
+                raise SpecError("is given twice", key=key)
+            if (isinstance(body.points, str) or not hasattr(body.points, "__len__")
+                    or not body.points or not all(isinstance(p, str) for p in body.points)):
+                raise SpecError("must be a non-empty list of point names", key=f"{key}.points",
+                                value=body.points)
+            for p in body.points:
+                if p not in points:
+                    raise SpecError(f"names an unknown point '{p}' (the points are "
+                                    f"{', '.join(points)})", key=f"{key}.points", value=p)
+            if len(set(body.points)) != len(body.points):
+                raise SpecError("names a point twice", key=f"{key}.points",
+                                value=list(body.points))
+            if body.name == GROUND:
+                if body.props is not None:
+                    raise SpecError("the ground has no mass properties", key=key)
+            elif not isinstance(body.props, Link):
+                raise SpecError("a moving link needs its mass properties (a Link)", key=key)
+            _set(body, "points", tuple(body.points))
+            names[body.name] = body
+        if GROUND not in names:
+            raise SpecError("a linkage needs a ground link", key=f"links.{GROUND}")
+        if len(names) < 2:
+            raise SpecError("a linkage needs a moving link", key="links")
+        on_links = {p for b in names.values() for p in b.points}
+        for p in points:
+            if p not in on_links:
+                raise SpecError("is on no link", key=f"mechanism.points.{p}")
+        for i, slider in enumerate(self.sliders):
+            self._check_slider(i, slider, names, points)
+        for i, spring in enumerate(self.springs):
+            if not isinstance(spring, Spring):
+                raise SpecError("must be a Spring", key=f"springs[{i}]", value=spring)
+            for p in spring.points:
+                if p not in points:
+                    raise SpecError(f"names an unknown point '{p}'", key=f"springs[{i}].points",
+                                    value=list(spring.points))
+        for name, body in names.items():
+            if name == GROUND or len(body.points) > 1:
+                continue
+            count = sum(s.link == name for s in self.sliders)
+            if count != 1:
+                raise SpecError(
+                    "a one-point link must be the link of exactly one slider (its frame's "
+                    f"x-axis is that slider's direction); it is the link of {count}",
+                    key=f"links.{name}.points", value=list(body.points))
+        self._check_frames(names, points)
+        ground = set(names[GROUND].points)
+        key = "mechanism.input"
+        if not isinstance(self.input, str) or self.input not in names or self.input == GROUND:
+            raise SpecError("must name a moving link", key=key, value=self.input)
+        if names[self.input].points[0] not in ground:
+            raise SpecError(f"the input's first point ({names[self.input].points[0]}) must be "
+                            "a ground point: the crank turns about it", key=key,
+                            value=self.input)
+        for name, body in names.items():
+            if name != GROUND and body.props.counter_rotor and not ground & set(body.points):
+                raise SpecError("a counter-rotor sits on a ground pivot: this link has none",
+                                key=f"links.{name}.counter_rotor",
+                                value=body.props.counter_rotor)
+        _set(self, "bodies", tuple(self.bodies))
+        _set(self, "sliders", tuple(self.sliders))
+        _set(self, "springs", tuple(self.springs))
+
+    @staticmethod
+    def _check_slider(i: int, slider, names, points) -> None:
+        key = f"mechanism.sliders[{i}]"
+        if not isinstance(slider, Slider):
+            raise SpecError("must be a Slider", key=key, value=slider)
+        for attr in ("link", "guide"):
+            value = getattr(slider, attr)
+            if value not in names:
+                raise SpecError("names an unknown link", key=f"{key}.{attr}", value=value)
+        if slider.link == GROUND:
+            raise SpecError("the sliding link must move (put the guide on the ground)",
+                            key=f"{key}.link", value=slider.link)
+        if slider.link == slider.guide:
+            raise SpecError("a link cannot slide on itself", key=f"{key}.guide",
+                            value=slider.guide)
+        if slider.point not in names[slider.link].points:
+            raise SpecError(f"must be a point of {slider.link}", key=f"{key}.point",
+                            value=slider.point)
+        dx, dy = v.vector2(slider.direction, f"{key}.direction")
+        if dx == 0 and dy == 0:
+            raise SpecError("must not be zero", key=f"{key}.direction", value=[dx, dy])
+        if not isinstance(slider.force, GasForce):
+            raise SpecError("must be a GasForce", key=f"{key}.force", value=slider.force)
+        object.__setattr__(slider, "direction", (dx, dy))
+
+    @staticmethod
+    def _check_frames(names, points) -> None:
+        """A link's first two points must be apart: they fix its frame."""
+        scale = max(math.hypot(*xy) for xy in points.values()) or 1.0
+        for name, body in names.items():
+            if len(body.points) < 2 or name == GROUND:
+                continue
+            (x0, y0), (x1, y1) = points[body.points[0]], points[body.points[1]]
+            if math.hypot(x1 - x0, y1 - y0) <= v.RELATIVE_LENGTH * scale:
+                raise SpecError(
+                    f"its first two points ({body.points[0]}, {body.points[1]}) coincide: they "
+                    "fix the link's frame", key=f"links.{name}.points",
+                    value=list(body.points))
+
+    # -- what every mechanism model offers ----------------------------------------------------
+
+    @property
+    def point_positions(self) -> dict[str, complex]:
+        """Each point's position at the reference pose, m."""
+        return {name: complex(*xy) for name, xy in self.points}
+
+    @property
+    def ground(self) -> Body:
+        """The ground link."""
+        return next(b for b in self.bodies if b.name == GROUND)
+
+    @property
+    def moving(self) -> tuple[Body, ...]:
+        """The moving links, in the spec's order."""
+        return tuple(b for b in self.bodies if b.name != GROUND)
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """Names of the moving links."""
+        return tuple(b.name for b in self.moving)
+
+    @property
+    def links(self) -> tuple[Link, ...]:
+        """Mass properties of the moving links."""
+        return tuple(b.props for b in self.moving)  # type: ignore[misc]
+
+    @property
+    def grounded_links(self) -> tuple[str, ...]:
+        """Moving links that share a point with the ground (where a counter-rotor can sit)."""
+        ground = set(self.ground.points)
+        return tuple(b.name for b in self.moving if ground & set(b.points))
+
+    @property
+    def total_mass(self) -> float:
+        """Mass of the moving links, kg."""
+        return math.fsum(link.mass for link in self.links)
+
+    @property
+    def has_loads(self) -> bool:
+        """Whether any link carries an applied force or moment, or a slider a force."""
+        return (any(link.has_loads for link in self.links)
+                or any(not s.force.is_zero for s in self.sliders))
+
+    def link(self, name: str) -> Link:
+        """The mass properties of the moving link called ``name``."""
+        for b in self.moving:
+            if b.name == name:
+                return b.props  # type: ignore[return-value]
+        raise KeyError(name)
+
+    def with_link(self, name: str, link: Link) -> Linkage:
+        """Return a copy with link ``name``'s mass properties replaced."""
+        return self.with_links({name: link})
+
+    def with_links(self, links: dict[str, Link]) -> Linkage:
+        """Return a copy with several links' mass properties replaced."""
+        unknown = set(links) - set(self.link_names)
+        if unknown:
+            raise KeyError(sorted(unknown)[0])
+        bodies = tuple(replace(b, props=links[b.name]) if b.name in links else b
+                       for b in self.bodies)
+        return replace(self, bodies=bodies)
+
+    def without_loads(self) -> Linkage:
+        """Return a copy with every applied force and moment and slider force removed."""
+        bodies = tuple(b if b.props is None else replace(b, props=b.props.without_loads())
+                       for b in self.bodies)
+        sliders = tuple(replace(s, force=GasForce()) for s in self.sliders)
+        return replace(self, bodies=bodies, sliders=sliders)
+
+
 #: A mechanism the package knows.
-Mechanism = FourBar | SliderCrank
+Mechanism = FourBar | SliderCrank | Linkage
 
 
 def _set(obj, name: str, value) -> None:

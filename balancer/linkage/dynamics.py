@@ -1,0 +1,391 @@
+"""Inverse dynamics of a general linkage: joint forces, forces on the ground, driving torque.
+
+With the motion prescribed, each moving link ``k`` obeys ``Σ_c Φ_{c,k}ᵀ·λ_c = E_k`` over the
+constraints ``c`` that touch it, with ``λ_c`` their multipliers and ``E_k = Q_k − I_k`` the
+applied generalized forces less the inertial ones, in the link's coordinates ``(x, y, θ)``:
+
+``I_k = [m·r̈ + (α·J − ω²)·R·(m·s̄),  J_O·α + (R·m·s̄) × r̈]``  (``J_O`` about the frame's origin)
+
+``Q_k = [m·ḡ + F̄,  (R·m·s̄) × ḡ + (R·s̄) × F̄ + M]`` plus springs, slider forces and, for a link
+with a counter-rotor ``J_c``, ``−J_c·α`` on ``θ``.
+
+Both are linear in the inertial parameters ``π_k = (m, m·e, m·f, J_O)`` but for the applied
+force's moment (a force at a centre of mass that moves with the design): that part and springs
+and slider forces are a constant column.
+
+The groups of :mod:`.structure` are solved in reverse order: a group's ``λ`` from its own
+links' equations (``Φ_SSᵀ·λ_S = E_S −`` what later groups put on them), then its constraints'
+forces are put on the links found before it. A constraint's generalized force on the ground
+(``−Φ_{c,ground}ᵀ·λ_c``, with the ground as a link at rest at the spec's origin) is the force
+and the moment about the origin that the mechanism exerts on the frame there; the driver's is
+the motor's reaction, ``−τ``.
+
+Every result is computed for several columns of ``E`` at once: one for a given design, or one
+per inertial parameter (and one for the constant part) for the regressors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model import GROUND
+from .kinematics import Motion
+from .structure import GROUND_INDEX, Driver, Pin, Prism, Structure, constraint_jacobian
+from .vectors import V
+
+#: Parameters of a link in the design vector, in order: kg, kg·m, kg·m, kg·m² (about the frame's
+#: origin).
+LINK_PARAMETERS = ("m", "me", "mf", "J")
+
+
+@dataclass(frozen=True)
+class Layout:
+    """The design vector of a general linkage, by name.
+
+    Entries ``(link, "m")``, ``(link, "me")``, ``(link, "mf")``, ``(link, "J")`` per moving link
+    (mass, first moments in the link's frame, inertia about its frame's origin), then
+    ``(link, "Jc")`` per link pivoted to the ground (its counter-rotor's inertia).
+    """
+
+    entries: tuple[tuple[str, str], ...]
+
+    @classmethod
+    def of(cls, structure: Structure) -> Layout:
+        """The layout of a linkage: its links in the spec's order, then the counter-rotors."""
+        links = [(name, p) for name in structure.names for p in LINK_PARAMETERS]
+        rotors = [(name, "Jc") for name in structure.linkage.grounded_links]
+        return cls(entries=tuple(links + rotors))
+
+    @property
+    def size(self) -> int:
+        """Number of entries."""
+        return len(self.entries)
+
+    def index(self, link: str, quantity: str) -> int:
+        """Position of an entry."""
+        return self.entries.index((link, quantity))
+
+    def link_slice(self, link: str) -> slice:
+        """The four entries of a link."""
+        start = self.index(link, "m")
+        return slice(start, start + 4)
+
+    def rotor(self, link: str) -> int | None:
+        """Position of a link's counter-rotor entry, or ``None``."""
+        try:
+            return self.index(link, "Jc")
+        except ValueError:
+            return None
+
+    def vector(self, linkage) -> NDArray[np.float64]:
+        """The design vector of a model's links (its mass properties)."""
+        x = np.zeros(self.size)
+        for name, link in zip(linkage.link_names, linkage.links, strict=True):
+            s = self.link_slice(name)
+            x[s] = (link.mass, link.mass * link.e, link.mass * link.f,
+                    link.inertia + link.mass * (link.e**2 + link.f**2))
+            r = self.rotor(name)
+            if r is not None:
+                x[r] = link.counter_rotor
+        return x
+
+
+@dataclass(frozen=True)
+class Forces:
+    """Inverse dynamics at arrays of crank states, for ``C`` columns (designs or parameters).
+
+    Every array has shape ``(N, C)``.
+
+    Attributes
+    ----------
+    reactions
+        Force of the mechanism on the ground at each ground point (the sum over the moving
+        links pinned there), N.
+    slider_normal, slider_couple
+        For each slider whose guide is the ground: the normal force (N) and the couple (N·m)
+        its link exerts on the guide; keyed by the sliding link's name.
+    driving_torque
+        Torque of the motor on the input, N·m.
+    shaking_force
+        Sum of all forces of the mechanism on the ground (springs and slider forces anchored
+        on it included), N.
+    shaking_moment
+        Their moment about the spec's origin with the motor's reaction and the counter-rotors,
+        N·m.
+    """
+
+    reactions: dict[str, V]
+    slider_normal: dict[str, NDArray[np.float64]]
+    slider_couple: dict[str, NDArray[np.float64]]
+    driving_torque: NDArray[np.float64]
+    shaking_force: V
+    shaking_moment: NDArray[np.float64]
+
+
+def _col(x, n: int, c: int) -> NDArray[np.float64]:
+    """``x`` (a scalar, ``(N,)`` or ``(N, C)``) as an ``(N, C)`` array."""
+    a = np.asarray(x, dtype=float)
+    if a.ndim == 1:
+        a = a[:, None]
+    return np.broadcast_to(a, (n, c))
+
+
+def inertial_columns(structure: Structure, mo: Motion, gravity: V):
+    """``−(I_k − gravity_k)`` per unit inertial parameter: the regressors' ``E_k`` columns.
+
+    Returns ``{link: [(param, (Ex, Ey, Eθ))]}`` with each component an ``(N,)`` array; params
+    ``m``, ``me``, ``mf``, ``J`` and, for a grounded link, ``Jc``.
+    """
+    out = {}
+    grounded = set(structure.linkage.grounded_links)
+    for k, name in enumerate(structure.names):
+        c, s = mo.pose.cos[k], mo.pose.sin[k]
+        w, a = mo.rate[k], mo.accel[k]
+        acc = mo.acceleration[k] - gravity  # r̈ − ḡ
+        ex, ey = V(c, s), V(-s, c)  # the frame's axes
+        cols = [("m", (-acc.x, -acc.y, 0.0 * w))]
+        for p, axis in (("me", ex), ("mf", ey)):
+            lin = axis.perp() * a - axis * (w * w)  # (α·J − ω²)·R·ê
+            cols.append((p, (-lin.x, -lin.y, -axis.cross(acc))))
+        cols.append(("J", (0.0 * w, 0.0 * w, -a)))
+        if name in grounded:
+            cols.append(("Jc", (0.0 * w, 0.0 * w, -a)))  # the rotor's reaction on its link
+        out[name] = cols
+    return out
+
+
+def applied_column(structure: Structure, mo: Motion, gravity: V, loads: bool = True):
+    """The part of ``E`` that is not linear in the inertial parameters, and its share on the ground.
+
+    Applied forces at the centres of mass and moments, springs, slider forces.
+
+    Returns ``(per_link, ground)``: ``per_link[k] = (Ex, Ey, Eθ)``, ``ground = (Fx, Fy, Mz)``
+    (arrays ``(N,)``; ``Mz`` about the origin).
+    """
+    n = mo.theta1.size
+    zero = np.zeros(n)
+    per = [[zero.copy(), zero.copy(), zero.copy()] for _ in structure.names]
+    ground = [zero.copy(), zero.copy(), zero.copy()]
+
+    def put(k: int, at: V, f: V) -> None:
+        if k == GROUND_INDEX:
+            ground[0] += f.x
+            ground[1] += f.y
+            ground[2] += at.cross(f)
+            return
+        arm = at - mo.pose.origin(k)
+        per[k][0] += f.x
+        per[k][1] += f.y
+        per[k][2] += arm.cross(f)
+
+    linkage = structure.linkage
+    if loads:
+        for k, link in enumerate(linkage.links):
+            if link.has_loads:
+                com = mo.point(k, V(link.e, link.f))
+                put(k, com, V(*link.force) + V(zero, zero))
+                per[k][2] += link.moment
+    for spring in linkage.springs:
+        (pa, ka), (pb, kb) = (_carrier(structure, p) for p in spring.points)
+        a, b = mo.point(ka, pa), mo.point(kb, pb)
+        d = b - a
+        length = np.sqrt(d.norm2())
+        tension = spring.stiffness * (length - spring.free_length)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            unit = d / length
+        put(ka, a, unit * tension)
+        put(kb, b, unit * (-tension))
+    if loads:
+        for c in structure.prisms:
+            gas = linkage.sliders[c.slider].force
+            if gas.is_zero:
+                continue
+            value = np.asarray(gas.at(mo.theta1), dtype=float)
+            d = mo.pose.rotate(c.g, c.dg)
+            at = mo.point(c.s, c.ps)
+            put(c.s, at, d * value)
+            put(c.g, at, d * (-value))
+    return [tuple(x) for x in per], tuple(ground)
+
+
+def _carrier(structure: Structure, point: str) -> tuple[V, int]:
+    """A point's local coordinates in a link that carries it (the ground first)."""
+    links = structure.point_links[point]
+    k = GROUND_INDEX if GROUND_INDEX in links else links[0]
+    return structure.local[(k, point)], k
+
+
+def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor_moment=None,
+                  ground_extra=None) -> Forces:
+    """Solve the groups in reverse order for given ``E`` columns (see the module docstring).
+
+    Parameters
+    ----------
+    structure, mo
+        The linkage and its motion (``N`` crank states).
+    effective
+        ``E_k`` per link: three arrays ``(N, C)`` (force x, force y, moment about the origin
+        of the link's frame).
+    rotor_moment
+        The counter-rotors' moment on the ground, ``(N, C)`` (``+2·J_c·α`` summed).
+    ground_extra
+        Forces and moment on the ground not through joints (springs, slider forces): three
+        ``(N, C)`` arrays.
+    """
+    n, c_count = effective[0][0].shape if effective else (mo.theta1.size, 1)
+    applied = [[np.array(e, dtype=float, copy=True) for e in row] for row in effective]
+    lam: dict[int, NDArray[np.float64]] = {}
+    ground_of: dict[int, list[NDArray[np.float64]]] = {}
+    for g in reversed(structure.groups):
+        index = {link: i for i, link in enumerate(g.links)}
+        k = 3 * len(g.links)
+        mat = np.zeros((n, k, k))
+        rhs = np.zeros((n, k, c_count))
+        for i, link in enumerate(g.links):
+            for j in range(3):
+                rhs[:, 3 * i + j, :] = applied[link][j]
+        blocks_of = []
+        row = 0
+        for c in g.constraints:
+            blocks = constraint_jacobian(c, mo.pose)
+            blocks_of.append((c, row, blocks))
+            for link, coeffs in blocks:
+                if link in index:
+                    for r in range(c.rows):
+                        for j in range(3):
+                            mat[:, 3 * index[link] + j, row + r] += coeffs[r][j]
+            row += c.rows
+        with np.errstate(divide="ignore", invalid="ignore"):
+            try:
+                sol = np.linalg.solve(mat, rhs)
+            except np.linalg.LinAlgError:
+                sol = np.full((n, k, c_count), np.nan)
+                ok = np.abs(np.linalg.det(mat)) > 0
+                if ok.any():
+                    sol[ok] = np.linalg.solve(mat[ok], rhs[ok])
+        for c, row, blocks in blocks_of:
+            values = sol[:, row : row + c.rows, :]  # (N, rows, C)
+            lam[id(c)] = values
+            for link, coeffs in blocks:
+                if link in index:
+                    continue
+                force = [sum(_times(coeffs[r][j], values[:, r, :]) for r in range(c.rows))
+                         for j in range(3)]  # Φᵀ·λ on the known link's coordinates
+                if link == GROUND_INDEX:
+                    ground_of[id(c)] = [-f for f in force]
+                else:
+                    for j in range(3):
+                        applied[link][j] = applied[link][j] - force[j]
+    return _collect(structure, lam, ground_of, n, c_count, rotor_moment, ground_extra)
+
+
+def _times(coefficient, values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """A Jacobian entry (scalar or ``(N,)``) times ``(N, C)`` values."""
+    if np.ndim(coefficient):
+        return np.asarray(coefficient, dtype=float)[:, None] * values
+    return coefficient * values
+
+
+def _collect(structure: Structure, lam, ground_of, n, c_count, rotor_moment,
+             ground_extra) -> Forces:
+    zeros = np.zeros((n, c_count))
+    reactions: dict[str, V] = {}
+    fx, fy, mz = zeros.copy(), zeros.copy(), zeros.copy()
+    driving = zeros.copy()
+    normal: dict[str, NDArray[np.float64]] = {}
+    couple: dict[str, NDArray[np.float64]] = {}
+    for g in structure.groups:
+        for c in g.constraints:
+            force = ground_of.get(id(c))
+            if isinstance(c, Driver):
+                driving = -lam[id(c)][:, 0, :]  # τ = −λ_driver
+            if force is None:
+                continue
+            fx, fy, mz = fx + force[0], fy + force[1], mz + force[2]
+            if isinstance(c, Pin):
+                old = reactions.get(c.point, V(zeros, zeros))
+                reactions[c.point] = old + V(force[0], force[1])
+            elif isinstance(c, Prism) and c.g == GROUND_INDEX:
+                name = structure.names[c.s]
+                normal[name] = lam[id(c)][:, 1, :]
+                couple[name] = lam[id(c)][:, 0, :]
+    if rotor_moment is not None:
+        mz = mz + rotor_moment
+    if ground_extra is not None:
+        fx, fy, mz = fx + ground_extra[0], fy + ground_extra[1], mz + ground_extra[2]
+    for p in structure.linkage.ground.points:
+        reactions.setdefault(p, V(zeros, zeros))
+    return Forces(reactions=reactions, slider_normal=normal, slider_couple=couple,
+                  driving_torque=driving, shaking_force=V(fx, fy), shaking_moment=mz)
+
+
+def regressors(structure: Structure, mo: Motion, gravity=(0.0, 0.0)) -> tuple[Forces, Layout]:
+    """Every result of :func:`inverse_dynamics` as a linear map of the design vector.
+
+    Columns follow :class:`Layout`; applied loads, springs and slider forces are left out (the
+    design vector's linear part only; :func:`inverse_dynamics` has the rest).
+    """
+    layout = Layout.of(structure)
+    n = mo.theta1.size
+    p = layout.size
+    g = V(*gravity)
+    effective = [[np.zeros((n, p)) for _ in range(3)] for _ in structure.names]
+    rotor = np.zeros((n, p))
+    for name, cols in inertial_columns(structure, mo, g).items():
+        k = structure.index(name)
+        for param, values in cols:
+            j = layout.index(name, param)
+            for r in range(3):
+                effective[k][r][:, j] = values[r]
+            if param == "Jc":
+                rotor[:, j] = 2 * mo.accel[k]
+    return kinetostatics(structure, mo, effective, rotor_moment=rotor), layout
+
+
+def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.0, 0.0),
+                     loads: bool = True) -> Forces:
+    """Joint forces on the ground, driving torque and shaking sums of a design (one column).
+
+    Parameters
+    ----------
+    structure, mo
+        The linkage and its motion.
+    linkage
+        The design whose mass properties to use (default: the structure's own).
+    gravity
+        ``(gx, gy)``, m/s².
+    loads
+        Include applied forces and moments and slider forces (springs always act).
+    """
+    linkage = structure.linkage if linkage is None else linkage
+    layout = Layout.of(structure)
+    x = layout.vector(linkage)
+    n = mo.theta1.size
+    g = V(*gravity)
+    structure_now = structure if linkage is structure.linkage else _with(structure, linkage)
+    per, ground = applied_column(structure_now, mo, g, loads)
+    effective = [[per[k][r][:, None] * np.ones((n, 1)) for r in range(3)]
+                 for k in range(structure.size)]
+    rotor = np.zeros((n, 1))
+    for name, cols in inertial_columns(structure, mo, g).items():
+        k = structure.index(name)
+        for param, values in cols:
+            j = layout.index(name, param)
+            for r in range(3):
+                effective[k][r] = effective[k][r] + (values[r] * x[j])[:, None]
+            if param == "Jc":
+                rotor[:, 0] += 2 * mo.accel[k] * x[j]
+    extra = tuple(np.asarray(v)[:, None] * np.ones((n, 1)) for v in ground)
+    return kinetostatics(structure, mo, effective, rotor_moment=rotor, ground_extra=extra)
+
+
+def _with(structure: Structure, linkage) -> Structure:
+    from dataclasses import replace
+
+    return replace(structure, linkage=linkage)
+
+
+__all__ = ["GROUND", "Forces", "Layout", "inverse_dynamics", "kinetostatics", "regressors"]

@@ -1,0 +1,375 @@
+"""Kinematics of a general linkage, vectorised over arrays of crank angles.
+
+Positions, group by group (:mod:`.structure`): the input from the driver, dyads in closed form,
+other groups by Newton's method from a continuation table; each on the branch of the reference
+pose. Velocities and accelerations, group by group, from the constraints' time derivatives:
+``Φ_S·q̇_S = −Φ_K·q̇_K`` and ``Φ_S·q̈_S = γ − Φ_K·q̈_K`` (``S`` the group's coordinates, ``K``
+those of the links found before), one small linear solve per group and crank angle.
+
+Closed forms of the dyads (links ``a`` and ``b``; ``P1``, ``P3`` the known ends):
+
+RRR
+    ``P2`` on the circles of radius ``|p̄a2 − p̄a1|`` about ``P1`` and ``|p̄b2 − p̄b3|`` about
+    ``P3``: ``P2 = P1 + D·u/d + σ·h·D⊥/d``, ``D = P3 − P1``, ``u = (ra² − rb² + d²)/(2d)``,
+    ``h = √(ra² − u²)``; ``σ = sign(D × (P2 − P1))`` at the reference pose.
+RRP
+    ``b`` keeps its angle to the guide (known); ``P2`` is on a known line ``Q + t·d̄`` and on
+    the circle about ``P1``: ``t = (P1 − Q)·d̄ + σ·√(ra² − (d̄ × (P1 − Q))²)``.
+RPR
+    The guide's line through a pivot must pass the slider's point, offset ``c0`` from it:
+    ``|ΔP|·sin(ψ − φ) = −c0`` for the line's direction ``φ`` (``ΔP`` from the guide's pivot to
+    the slider's, at angle ``ψ``): ``φ = ψ − atan2(−c0/|ΔP|, σ·√(1 − c0²/|ΔP|²))``.
+
+Where a group cannot be assembled the positions are NaN (see :func:`assembly_gap`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .structure import (
+    GROUND_INDEX,
+    Driver,
+    Group,
+    Pin,
+    Pose,
+    Prism,
+    Structure,
+    constraint_jacobian,
+)
+from .vectors import NUMPY, Ops, V
+
+
+def _known_point(pose: Pose, c: Pin, k: int) -> tuple[V, V]:
+    """For pin ``c`` holding group link ``k``: the partner's point (known) and ``k``'s local."""
+    if c.a == k:
+        return pose.point(c.b, c.pb), c.pa
+    return pose.point(c.a, c.pa), c.pb
+
+
+def _local(c: Pin, k: int) -> V:
+    return c.pa if c.a == k else c.pb
+
+
+def _angle_of(ops: Ops, w: V, local: V):
+    """The angle of a link whose local vector ``local`` lies along global ``w``."""
+    return ops.atan2(w.y, w.x) - math.atan2(local.y, local.x)
+
+
+class _Dyads:
+    """Closed-form positions of the dyads.
+
+    Each returns, per link, its angle and a point to place it by (with its local position, or
+    ``None`` for its origin), and a gap: ≥ 0 where the dyad assembles. Without a ``sign``,
+    the branch at the given (reference) pose instead.
+    """
+
+    @staticmethod
+    def rrr(ops: Ops, pose: Pose, g: Group, sign=None):
+        (a, b), (j1, j2, j3) = g.links, g.constraints
+        p1, pa1 = _known_point(pose, j1, a)
+        p3, pb3 = _known_point(pose, j3, b)
+        pa2, pb2 = _local(j2, a), _local(j2, b)
+        ra2 = (pa2 - pa1).norm2()
+        rb2 = (pb2 - pb3).norm2()
+        dvec = p3 - p1
+        d2 = dvec.norm2()
+        d = ops.sqrt(d2)
+        along = (ra2 - rb2 + d2) / (2 * d)
+        gap = ra2 - along * along  # ≥ 0 where the circles meet
+        if sign is None:  # the reference pose: read the branch off it
+            p2 = pose.point(a, pa2)
+            return float(np.sign(dvec.cross(p2 - p1)))
+        h = ops.sqrt(ops.where(gap >= 0, gap, np.nan)) if ops is NUMPY else ops.sqrt(gap)
+        p2 = p1 + dvec * (along / d) + dvec.perp() * (sign * h / d)
+        theta_a = _angle_of(ops, p2 - p1, pa2 - pa1)
+        theta_b = _angle_of(ops, p2 - p3, pb2 - pb3)
+        return (theta_a, p1, pa1), (theta_b, p3, pb3), gap / ra2
+
+    @staticmethod
+    def _rrp_line(ops: Ops, pose: Pose, g: Group):
+        """The line ``Q + t·d̄`` that ``P2`` runs on, and ``b``'s angle."""
+        b, (_, j2, j3) = g.links[1], g.constraints
+        other = j3.g if j3.s == b else j3.s
+        theta_k = 0.0 if other == GROUND_INDEX else pose.angles[other]
+        theta_b = theta_k + j3.delta if j3.s == b else theta_k - j3.delta
+        cb, sb = ops.cos(theta_b), ops.sin(theta_b)
+        pb2 = _local(j2, b)
+        if j3.s == b:  # b's point runs on a line of the known link
+            d = pose.rotate(other, j3.dg)
+            q = pose.point(other, j3.pg) - (j3.ps - pb2).rotated(cb, sb)
+        else:  # the known link's point runs on a line of b
+            d = j3.dg.rotated(cb, sb)
+            q = pose.point(other, j3.ps) + (pb2 - j3.pg).rotated(cb, sb)
+        return q, d, theta_b, cb, sb
+
+    @classmethod
+    def rrp(cls, ops: Ops, pose: Pose, g: Group, sign=None):
+        (a, b), (j1, j2, _) = g.links, g.constraints
+        p1, pa1 = _known_point(pose, j1, a)
+        pa2, pb2 = _local(j2, a), _local(j2, b)
+        ra2 = (pa2 - pa1).norm2()
+        q, d, theta_b, cb, sb = cls._rrp_line(ops, pose, g)
+        w = p1 - q
+        t0 = w.dot(d)
+        dist = d.cross(w)
+        gap = ra2 - dist * dist
+        if sign is None:
+            p2 = pose.point(a, pa2)
+            return float(np.sign((p2 - p1).dot(d)))
+        root = ops.sqrt(ops.where(gap >= 0, gap, np.nan)) if ops is NUMPY else ops.sqrt(gap)
+        p2 = q + d * (t0 + sign * root)
+        theta_a = _angle_of(ops, p2 - p1, pa2 - pa1)
+        origin_b = p2 - pb2.rotated(cb, sb)
+        return (theta_a, p1, pa1), (theta_b, origin_b, None), gap / ra2
+
+    @staticmethod
+    def rpr(ops: Ops, pose: Pose, g: Group, sign=None):
+        (a, b), (j1, j2, j3) = g.links, g.constraints
+        pivots = {a: _known_point(pose, j1, a), b: _known_point(pose, j3, b)}
+        s_link, g_link = j2.s, j2.g
+        p_s, ps_piv = pivots[s_link]
+        p_g, pg_piv = pivots[g_link]
+        cd, sd = math.cos(j2.delta), math.sin(j2.delta)
+        w = (j2.ps - ps_piv).rotated(cd, sd) - (j2.pg - pg_piv)
+        c0 = j2.dg.cross(w)
+        dp = p_s - p_g
+        r2 = dp.norm2()
+        gap = 1.0 - c0 * c0 / r2
+        if sign is None:
+            return float(np.sign(pose.rotate(g_link, j2.dg).dot(dp)))
+        sin_b = -c0 / ops.sqrt(r2)
+        cos_b = sign * (ops.sqrt(ops.where(gap >= 0, gap, np.nan)) if ops is NUMPY
+                        else ops.sqrt(gap))
+        phi = ops.atan2(dp.y, dp.x) - ops.atan2(sin_b, cos_b)
+        theta_g = phi - math.atan2(j2.dg.y, j2.dg.x)
+        theta_s = theta_g + j2.delta
+        thetas = {g_link: theta_g, s_link: theta_s}
+        return ((thetas[a], pivots[a][0], pivots[a][1]), (thetas[b], pivots[b][0],
+                                                           pivots[b][1]), gap)
+
+
+def dyad_branch(structure: Structure, group: Group, q_ref: NDArray[np.float64]) -> float:
+    """The branch ``σ`` of a closed-form dyad at the reference pose (+1 or -1)."""
+    n = structure.size
+    pose = Pose([V(q_ref[3 * k], q_ref[3 * k + 1]) for k in range(n)],
+                [q_ref[3 * k + 2] for k in range(n)])
+    solver = {"RRR": _Dyads.rrr, "RRP": _Dyads.rrp, "RPR": _Dyads.rpr}[group.kind]
+    sign = solver(NUMPY, pose, group)
+    return sign if sign != 0 else 1.0
+
+
+def _place(pose: Pose, k: int, theta, origin_or_pivot: V, local: V | None, ops: Ops) -> None:
+    """Set link ``k``'s frame from its angle and a point to place it by.
+
+    The point is its origin (``local`` None) or the global position of its local point
+    ``local``.
+    """
+    c, s = ops.cos(theta), ops.sin(theta)
+    pose.angles[k], pose.cos[k], pose.sin[k] = theta, c, s
+    if local is None:
+        pose.origins[k] = origin_or_pivot
+    else:
+        pose.origins[k] = origin_or_pivot - local.rotated(c, s)
+
+
+def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
+              gaps: list | None = None) -> Pose:
+    """Every link's frame at crank angles ``theta1`` (rad), on the reference pose's branch.
+
+    Parameters
+    ----------
+    structure
+        The linkage's structure.
+    theta1
+        Input angles (an array, or for CasADi a symbol).
+    ops
+        Elementary functions (numpy by default).
+    gaps
+        If a list, receives each closed-form group's assembly gap (≥ 0 where it assembles).
+
+    Returns
+    -------
+    Pose
+        Origins (m) and angles (rad; ``atan2`` values, the input's as given).
+    """
+    n = structure.size
+    if ops is NUMPY:
+        theta1 = np.asarray(theta1, dtype=float)
+    pose = Pose([V(0.0, 0.0)] * n, [0.0] * n, [1.0] * n, [0.0] * n)
+    for g in structure.groups:
+        if g.kind == "crank":
+            pin = g.constraints[0]
+            pivot, local = _known_point(pose, pin, g.links[0])
+            _place(pose, g.links[0], theta1, pivot, local, ops)
+            continue
+        if g.kind == "numeric":
+            from .numeric import solve_group
+
+            solve_group(structure, g, pose, theta1, ops)
+            continue
+        solver = {"RRR": _Dyads.rrr, "RRP": _Dyads.rrp, "RPR": _Dyads.rpr}[g.kind]
+        (ta, pa, la), (tb, pb, lb), gap = solver(ops, pose, g, g.sign)
+        _place(pose, g.links[0], ta, pa, la, ops)
+        _place(pose, g.links[1], tb, pb, lb, ops)
+        if gaps is not None:
+            gaps.append(gap)
+    return pose
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Frames of every moving link and their rates at arrays of crank states.
+
+    Attributes
+    ----------
+    theta1, omega1, alpha1
+        The input's angle (rad), rate (rad/s) and acceleration (rad/s²), shape ``(N,)``.
+    pose
+        Origins (m) and angles (rad) of the links' frames.
+    velocity, rate
+        Each link's origin velocity (m/s) and angular velocity (rad/s).
+    acceleration, accel
+        Each link's origin acceleration (m/s²) and angular acceleration (rad/s²).
+    """
+
+    theta1: NDArray[np.float64]
+    omega1: NDArray[np.float64]
+    alpha1: NDArray[np.float64]
+    pose: Pose
+    velocity: tuple[V, ...]
+    rate: tuple[NDArray[np.float64], ...]
+    acceleration: tuple[V, ...]
+    accel: tuple[NDArray[np.float64], ...]
+
+    def point(self, k: int, local: V) -> V:
+        """Position of a point of link ``k`` (``local`` in its frame), m."""
+        return self.pose.point(k, local)
+
+    def point_velocity(self, k: int, local: V) -> V:
+        """Velocity of a point of link ``k``, m/s."""
+        if k == GROUND_INDEX:
+            return V(0.0 * self.theta1, 0.0 * self.theta1)
+        return self.velocity[k] + self.pose.rotate(k, local).perp() * self.rate[k]
+
+    def point_acceleration(self, k: int, local: V) -> V:
+        """Acceleration of a point of link ``k``, m/s²."""
+        if k == GROUND_INDEX:
+            return V(0.0 * self.theta1, 0.0 * self.theta1)
+        r = self.pose.rotate(k, local)
+        return self.acceleration[k] + r.perp() * self.accel[k] - r * (self.rate[k] ** 2)
+
+
+def _group_jacobian(structure: Structure, g: Group, pose: Pose):
+    """``Φ_S`` (k×k, entries arrays) and the known links' blocks of the group's rows."""
+    index = {link: i for i, link in enumerate(g.links)}
+    k = 3 * len(g.links)
+    rows_s: list[list] = []
+    known: list[list[tuple[int, list]]] = []
+    for c in g.constraints:
+        blocks = constraint_jacobian(c, pose)
+        for r in range(c.rows):
+            row = [0.0] * k
+            row_known = []
+            for link, coeffs in blocks:
+                if link in index:
+                    for j in range(3):
+                        row[3 * index[link] + j] = row[3 * index[link] + j] + coeffs[r][j]
+                elif link != GROUND_INDEX:
+                    row_known.append((link, coeffs[r]))
+            rows_s.append(row)
+            known.append(row_known)
+    return rows_s, known
+
+
+def _gamma(c, pose: Pose, vel: list[V], rate: list, ops: Ops = NUMPY) -> list:
+    """``γ`` of one constraint (``Φ_q·q̈ = γ``): the velocity terms of its second derivative."""
+    def w(k):
+        return 0.0 if k == GROUND_INDEX else rate[k]
+
+    def v(k):
+        return V(0.0, 0.0) if k == GROUND_INDEX else vel[k]
+
+    if isinstance(c, Pin):
+        ra, rb = pose.rotate(c.a, c.pa), pose.rotate(c.b, c.pb)
+        out = ra * (w(c.a) * w(c.a)) - rb * (w(c.b) * w(c.b))
+        return [out.x, out.y]
+    if isinstance(c, Prism):
+        d = pose.rotate(c.g, c.dg)
+        ps, pg = pose.rotate(c.s, c.ps), pose.rotate(c.g, c.pg)
+        delta = pose.origin(c.s) + ps - pose.origin(c.g) - pg
+        ddot = v(c.s) + ps.perp() * w(c.s) - v(c.g) - pg.perp() * w(c.g)
+        wg, ws = w(c.g), w(c.s)
+        line = (wg * wg * (d.cross(delta) - d.cross(pg)) + 2 * wg * d.dot(ddot)
+                + ws * ws * d.cross(ps))
+        return [0.0 * line, line]
+    return [0.0]
+
+
+def rates(structure: Structure, pose: Pose, omega1, alpha1, theta1=None,
+          ops: Ops = NUMPY) -> tuple[list[V], list, list[V], list]:
+    """Velocities and accelerations of every link's frame (see the module docstring).
+
+    Returns ``(velocity, rate, acceleration, accel)``, each a list over the links.
+    """
+    n = structure.size
+    zero = 0.0 * (pose.angles[structure.input] if theta1 is None else theta1)
+    vel: list[V] = [V(zero, zero)] * n
+    rate: list = [zero] * n
+    acc: list[V] = [V(zero, zero)] * n
+    accel: list = [zero] * n
+    for g in structure.groups:
+        rows, known = _group_jacobian(structure, g, pose)
+        drivers = [isinstance(c, Driver) for c in g.constraints for _ in range(c.rows)]
+        rhs_v = []
+        for r, row_known in enumerate(known):
+            v_term = 0.0
+            for link, coeffs in row_known:
+                v_term = v_term + coeffs[0] * vel[link].x + coeffs[1] * vel[link].y \
+                    + coeffs[2] * rate[link]
+            # the driver θ_input − θ1(t) = 0: its rates are the input's
+            rhs_v.append(omega1 - v_term if drivers[r] else -v_term)
+        # velocities first: γ of the group's own rows needs the group's velocities
+        sol_v = ops.solve(rows, [[x] for x in rhs_v])
+        for i, link in enumerate(g.links):
+            vel[link] = V(sol_v[3 * i][0], sol_v[3 * i + 1][0])
+            rate[link] = sol_v[3 * i + 2][0]
+        gammas = [x for c in g.constraints for x in (_gamma(c, pose, vel, rate, ops)
+                                                     if not isinstance(c, Driver) else [0.0])]
+        rhs_a = []
+        for r, row_known in enumerate(known):
+            a_term = 0.0
+            for link, coeffs in row_known:
+                a_term = a_term + coeffs[0] * acc[link].x + coeffs[1] * acc[link].y \
+                    + coeffs[2] * accel[link]
+            rhs_a.append(alpha1 - a_term if drivers[r] else gammas[r] - a_term)
+        sol_a = ops.solve(rows, [[x] for x in rhs_a])
+        for i, link in enumerate(g.links):
+            acc[link] = V(sol_a[3 * i][0], sol_a[3 * i + 1][0])
+            accel[link] = sol_a[3 * i + 2][0]
+    return vel, rate, acc, accel
+
+
+def motion(structure: Structure, theta1: ArrayLike, omega1: ArrayLike = 0.0,
+           alpha1: ArrayLike = 0.0) -> Motion:
+    """Positions, velocities and accelerations at crank states (arrays broadcast together).
+
+    Parameters
+    ----------
+    structure
+        The linkage's structure.
+    theta1, omega1, alpha1
+        The input's angle (rad), rate (rad/s) and acceleration (rad/s²).
+    """
+    theta1, omega1, alpha1 = (np.asarray(x, dtype=float) for x in
+                              np.broadcast_arrays(theta1, omega1, alpha1))
+    theta1, omega1, alpha1 = (np.atleast_1d(x) for x in (theta1, omega1, alpha1))
+    pose = positions(structure, theta1)
+    vel, rate, acc, accel = rates(structure, pose, omega1, alpha1, theta1)
+    return Motion(theta1=theta1, omega1=omega1, alpha1=alpha1, pose=pose,
+                  velocity=tuple(vel), rate=tuple(rate), acceleration=tuple(acc),
+                  accel=tuple(accel))

@@ -1,0 +1,168 @@
+"""Positions of a group without a closed form, by Newton's method with continuation.
+
+A group that is not a dyad of :mod:`.kinematics` (the four links of a Stephenson chain driven
+from its binary link, a dyad with two prismatic pairs) is solved from its constraint equations
+(:mod:`.structure`). A table of its coordinates over one revolution is built once by
+continuation from the reference pose (:data:`TABLE_STEPS` steps, each Newton's method started
+from a quadratic extrapolation of the steps before); at any crank angle the table, interpolated,
+starts Newton's method, run on all the angles at once to rounding. Angles beyond where the
+continuation stopped (the group locks or cannot be assembled) are NaN.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .structure import GROUND_INDEX, Group, Pin, Pose, Prism, Structure, constraint_jacobian
+from .vectors import V
+
+#: Steps of the continuation table over one revolution.
+TABLE_STEPS = 720
+#: Newton iterations at most, per solve.
+MAX_ITERATIONS = 30
+
+
+def _residual(g: Group, pose: Pose) -> list:
+    out = []
+    for c in g.constraints:
+        if isinstance(c, Pin):
+            d = pose.point(c.a, c.pa) - pose.point(c.b, c.pb)
+            out += [d.x, d.y]
+        elif isinstance(c, Prism):
+            ta = 0.0 if c.s == GROUND_INDEX else pose.angles[c.s]
+            tg = 0.0 if c.g == GROUND_INDEX else pose.angles[c.g]
+            d = pose.rotate(c.g, c.dg)
+            line = d.cross(pose.point(c.s, c.ps) - pose.point(c.g, c.pg))
+            out += [ta - tg - c.delta, line]
+        else:  # pragma: no cover - the driver is never in a numeric group
+            raise TypeError(c)
+    return out
+
+
+def _set(pose: Pose, g: Group, q: NDArray[np.float64]) -> None:
+    for i, k in enumerate(g.links):
+        pose.origins[k] = V(q[:, 3 * i], q[:, 3 * i + 1])
+        pose.angles[k] = q[:, 3 * i + 2]
+        pose.cos[k] = np.cos(q[:, 3 * i + 2])
+        pose.sin[k] = np.sin(q[:, 3 * i + 2])
+
+
+def _jacobian(g: Group, pose: Pose, n: int) -> NDArray[np.float64]:
+    index = {k: i for i, k in enumerate(g.links)}
+    size = 3 * len(g.links)
+    jac = np.zeros((n, size, size))
+    row = 0
+    for c in g.constraints:
+        for link, coeffs in constraint_jacobian(c, pose):
+            if link in index:
+                for r in range(c.rows):
+                    for j in range(3):
+                        jac[:, row + r, 3 * index[link] + j] += coeffs[r][j]
+        row += c.rows
+    return jac
+
+
+def newton(g: Group, pose: Pose, q: NDArray[np.float64], scale: float,
+           tol: float = 1e-13) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Newton's method on the group's equations at every angle at once.
+
+    ``q`` is ``(N, 3·|g|)`` (each link's ``x``, ``y``, ``θ``); the links found before are in
+    ``pose``. Returns the solution and where it converged (residual below ``tol`` of
+    ``scale``, a length).
+    """
+    q = np.array(q, dtype=float)
+    n = q.shape[0]
+    done = np.zeros(n, dtype=bool)
+    for _ in range(MAX_ITERATIONS):
+        _set(pose, g, q)
+        res = np.column_stack([np.broadcast_to(np.asarray(r, dtype=float), (n,))
+                               for r in _residual(g, pose)])
+        size = np.max(np.abs(res), axis=1)
+        done = size <= tol * scale
+        if done.all():
+            break
+        jac = _jacobian(g, pose, n)
+        with np.errstate(all="ignore"):
+            try:
+                step = np.linalg.solve(jac, res[:, :, None])[:, :, 0]
+            except np.linalg.LinAlgError:
+                step = np.full_like(q, np.nan)
+                ok = np.abs(np.linalg.det(jac)) > 0
+                if ok.any():
+                    step[ok] = np.linalg.solve(jac[ok], res[ok][:, :, None])[:, :, 0]
+        q = np.where(done[:, None], q, q - step)
+    _set(pose, g, q)
+    return q, done
+
+
+def _coordinates(structure: Structure, g: Group) -> NDArray[np.float64]:
+    q = structure.reference_coordinates()
+    return np.concatenate([q[3 * k : 3 * k + 3] for k in g.links])
+
+
+def table(structure: Structure, g: Group) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The group's coordinates over one revolution from the reference pose (cached).
+
+    Returns ``(theta1, q)``: ``TABLE_STEPS + 1`` angles from the reference's input angle
+    upwards over 2π, and ``(TABLE_STEPS + 1, 3·|g|)`` coordinates (angles continuous), NaN
+    beyond where the continuation stopped. A linkage whose input cannot turn fully is
+    continued downwards from the reference too: the table then covers its range.
+    """
+    cache = structure.cache.setdefault("numeric tables", {})
+    key = structure.groups.index(g)
+    if key in cache:
+        return cache[key]
+    from .kinematics import positions
+
+    start = structure.ref_angle[structure.input]
+    step = 2 * math.pi / TABLE_STEPS
+    scale = structure.length_scale()
+    before = structure.groups[: structure.groups.index(g)]
+    partial = replace(structure, groups=tuple(before), cache={})  # places the known links
+    q_ref = _coordinates(structure, g)
+    out = np.full((2 * TABLE_STEPS + 1, q_ref.size), np.nan)
+    angles = start + step * np.arange(-TABLE_STEPS, TABLE_STEPS + 1)
+    out[TABLE_STEPS] = q_ref
+    for direction in (1, -1):
+        history = [q_ref]
+        for i in range(1, TABLE_STEPS + 1):
+            j = TABLE_STEPS + direction * i
+            guess = history[-1] if len(history) < 3 else (
+                3 * history[-1] - 3 * history[-2] + history[-3])
+            pose = positions(partial, np.array([angles[j]]))
+            q, ok = newton(g, pose, guess[None, :], scale)
+            if not ok[0] or not np.all(np.isfinite(q)):
+                break
+            out[j] = q[0]
+            history.append(q[0])
+    result = (angles, out)
+    cache[key] = result
+    return result
+
+
+def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops) -> None:
+    """Place the links of numeric group ``g`` in ``pose`` at crank angles ``theta1``."""
+    theta1 = np.atleast_1d(np.asarray(theta1, dtype=float))
+    angles, tab = table(structure, g)
+    start = angles[TABLE_STEPS]
+    lo, hi = angles[0], angles[-1]
+    # The angle of each request in the table's window (a turn either way of the reference).
+    ok_rows = np.all(np.isfinite(tab), axis=1)
+    full = ok_rows[TABLE_STEPS:].all()
+    t = start + np.mod(theta1 - start, 2 * math.pi) if full else theta1
+    if not full:  # within the range found, in the window nearest the reference
+        t = start + np.remainder(theta1 - start + math.pi, 2 * math.pi) - math.pi
+    guess = np.column_stack([np.interp(t, angles[ok_rows], tab[ok_rows, j], left=np.nan,
+                                       right=np.nan) for j in range(tab.shape[1])])
+    inside = (t >= lo) & (t <= hi)
+    if not full:
+        valid = angles[ok_rows]
+        inside &= (t >= valid.min()) & (t <= valid.max())
+    guess[~inside] = np.nan
+    q, done = newton(g, pose, np.where(np.isfinite(guess), guess, 0.0), structure.length_scale())
+    q[~(done & inside)] = np.nan
+    _set(pose, g, q)

@@ -1,0 +1,490 @@
+"""The structure of a general linkage: frames, constraints, mobility and Assur groups.
+
+Coordinates. Each moving link ``k`` has absolute coordinates ``(x_k, y_k, θ_k)``: the position of
+its frame's origin (its first point) and the angle of its frame's x-axis (towards its second
+point at the reference pose; a one-point link's is its slider's direction). A point ``p`` of
+the link, at ``p̄`` in its frame, is at ``r̄_k + R(θ_k)·p̄``. The ground is link ``-1`` with
+``r̄ = 0``, ``θ = 0`` (its frame is the spec's).
+
+Constraints (Nikravesh, *Computer-Aided Analysis of Mechanical Systems*, 1988, ch. 3–4):
+
+- a revolute joint between links ``a`` and ``b`` at a point: ``r̄_a + R_a·p̄_a − r̄_b − R_b·p̄_b
+  = 0`` (two rows); at a point named by ``k`` links, ``k − 1`` such pairs;
+- a prismatic pair, link ``s`` sliding on a line fixed in link ``g`` (direction ``d̄ =
+  R_g·d̄_g``, through ``R_g·ḡ``): the relative angle ``θ_s − θ_g − δ = 0`` and the slider point
+  on the line, ``d̄ × (r̄_s + R_s·s̄ − r̄_g − R_g·ḡ) = 0``;
+- the driver: ``θ_input − θ_ground − θ1 = 0``.
+
+A linkage is accepted when it has exactly one degree of freedom (``3·n`` coordinates, ``3·n −
+1`` independent constraints) and its reference pose is regular: the constraints' Jacobian has
+full rank, and with the driver's row it is invertible (the input drives every link).
+
+Assur groups. Starting from the ground and the input, the links are found in groups that,
+given the links found before, have no freedom left: dyads (two links, three joints) in closed
+form — RRR (two circles), RRP and PRR (a circle and a line), RPR (the angle of a line through a
+point) — and any other group (a triad of a Stephenson chain) by Newton's method. The same order
+solves velocities, accelerations and, in reverse, the joint forces (kinetostatics).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import SpecError
+from ..model import GROUND, Linkage
+from .vectors import V
+
+#: Index of the ground among the links.
+GROUND_INDEX = -1
+#: Singular values below this share of the largest (columns in common units) make the
+#: reference pose's Jacobian singular.
+RANK_TOLERANCE = 1e-10
+
+
+@dataclass(frozen=True)
+class Pin:
+    """A revolute constraint: point ``pa`` of link ``a`` on point ``pb`` of link ``b``.
+
+    ``pa``, ``pb`` are in the links' frames (the ground's frame is the spec's).
+    """
+
+    point: str
+    a: int
+    pa: V
+    b: int
+    pb: V
+
+    rows = 2
+
+
+@dataclass(frozen=True)
+class Prism:
+    """A prismatic pair: link ``s`` slides on a line fixed in link ``g``.
+
+    ``ps`` is the slider point in ``s``'s frame; ``pg`` a point of the line and ``dg`` its unit
+    direction, in ``g``'s frame; ``delta`` the constant ``θ_s − θ_g``. ``slider`` is its index
+    in the spec's list.
+    """
+
+    slider: int
+    s: int
+    ps: V
+    g: int
+    pg: V
+    dg: V
+    delta: float
+
+    rows = 2
+
+
+@dataclass(frozen=True)
+class Driver:
+    """The driver: ``θ_input − θ_ground − θ1 = 0`` (its multiplier is minus the motor torque)."""
+
+    link: int
+
+    rows = 1
+
+
+Constraint = Pin | Prism | Driver
+
+
+@dataclass(frozen=True)
+class Group:
+    """Links found together from the links found before them, and the constraints that do it.
+
+    Attributes
+    ----------
+    links
+        Indices of the group's links (each one's coordinates are unknowns of the group).
+    constraints
+        The constraints that close the group: every row touches a link of the group, the other
+        links they touch are found before.
+    kind
+        ``"crank"`` (the input, from its pivot and the driver), ``"RRR"``, ``"RRP"``, ``"PRR"``,
+        ``"RPR"`` (dyads in closed form; the letters are the joints from the first link's
+        known side to the second's) or ``"numeric"``.
+    sign
+        The branch of a closed-form dyad at the reference pose (+1 or -1).
+    """
+
+    links: tuple[int, ...]
+    constraints: tuple[Constraint, ...]
+    kind: str
+    sign: float = 1.0
+
+
+@dataclass(frozen=True)
+class Structure:
+    """A linkage as equations: frames, constraints, groups (see the module docstring).
+
+    Build it with :meth:`of`; that checks mobility and the reference pose.
+
+    Attributes
+    ----------
+    linkage
+        The model.
+    names
+        Names of the moving links; link ``k`` is ``names[k]``.
+    local
+        ``(link, point) → p̄``: each point in the frame of each link that carries it (the
+        ground's points in the spec's frame).
+    ref_angle, ref_origin
+        Each moving link's frame at the reference pose: angle (rad, principal value) and
+        origin.
+    pins, prisms
+        The joints as constraints.
+    driver
+        The input's driver.
+    groups
+        The order in which the links are found, the input's group first.
+    """
+
+    linkage: Linkage
+    names: tuple[str, ...]
+    local: dict[tuple[int, str], V]
+    ref_angle: tuple[float, ...]
+    ref_origin: tuple[V, ...]
+    pins: tuple[Pin, ...]
+    prisms: tuple[Prism, ...]
+    driver: Driver
+    groups: tuple[Group, ...]
+    point_links: dict[str, tuple[int, ...]] = field(repr=False)
+    #: Tables and other results computed once per structure (numeric groups' continuation).
+    cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def size(self) -> int:
+        """Number of moving links ``n``."""
+        return len(self.names)
+
+    @property
+    def input(self) -> int:
+        """Index of the input link."""
+        return self.driver.link
+
+    @property
+    def constraints(self) -> tuple[Constraint, ...]:
+        """All constraints but the driver (``3·n − 1`` rows)."""
+        return (*self.pins, *self.prisms)
+
+    def index(self, name: str) -> int:
+        """Index of the link called ``name`` (``-1`` for the ground)."""
+        return GROUND_INDEX if name == GROUND else self.names.index(name)
+
+    def point_position(self, point: str) -> V:
+        """A point's position at the reference pose."""
+        return V.of(self.linkage.point_positions[point])
+
+    # -- building -----------------------------------------------------------------------------
+
+    @classmethod
+    def of(cls, linkage: Linkage) -> Structure:
+        """The structure of ``linkage``; raises :class:`SpecError` if it is not a valid one.
+
+        Raises
+        ------
+        SpecError
+            If the mobility is not 1 (naming it and how it is counted), the reference pose is
+            singular or the input does not drive the linkage there, or no order of groups
+            finds every link.
+        """
+        names = linkage.link_names
+        index = {name: k for k, name in enumerate(names)}
+        index[GROUND] = GROUND_INDEX
+        positions = linkage.point_positions
+        sliders_of = {s.link: s for s in linkage.sliders}
+        ref_angle, ref_origin = [], []
+        local: dict[tuple[int, str], V] = {}
+        for body in linkage.moving:
+            k = index[body.name]
+            origin = positions[body.points[0]]
+            if len(body.points) > 1:
+                axis = positions[body.points[1]] - origin
+            else:
+                axis = complex(*sliders_of[body.name].direction)
+            angle = math.atan2(axis.imag, axis.real)
+            ref_angle.append(angle)
+            ref_origin.append(V.of(origin))
+            turn = complex(math.cos(angle), -math.sin(angle))
+            for p in body.points:
+                local[(k, p)] = V.of((positions[p] - origin) * turn)
+        for p in linkage.ground.points:
+            local[(GROUND_INDEX, p)] = V.of(positions[p])
+        point_links: dict[str, list[int]] = {}
+        for body in linkage.bodies:
+            for p in body.points:
+                point_links.setdefault(p, []).append(index[body.name])
+        pins = []
+        for p, links in point_links.items():
+            if len(links) < 2:
+                continue
+            partner = GROUND_INDEX if GROUND_INDEX in links else links[0]
+            for k in links:
+                if k != partner:
+                    pins.append(Pin(p, k, local[(k, p)], partner, local[(partner, p)]))
+        prisms = []
+        for i, s in enumerate(linkage.sliders):
+            ks, kg = index[s.link], index[s.guide]
+            theta_g = 0.0 if kg == GROUND_INDEX else ref_angle[kg]
+            theta_s = ref_angle[ks]
+            d = complex(*s.direction)
+            d /= abs(d)
+            rot_g = complex(math.cos(theta_g), -math.sin(theta_g))
+            origin_g = 0j if kg == GROUND_INDEX else ref_origin[kg].complex()
+            prisms.append(Prism(
+                slider=i, s=ks, ps=local[(ks, s.point)], g=kg,
+                pg=V.of((positions[s.point] - origin_g) * rot_g), dg=V.of(d * rot_g),
+                delta=theta_s - theta_g))
+        driver = Driver(index[linkage.input])
+        structure = cls(
+            linkage=linkage, names=names, local=local, ref_angle=tuple(ref_angle),
+            ref_origin=tuple(ref_origin), pins=tuple(pins), prisms=tuple(prisms),
+            driver=driver, groups=(), point_links={p: tuple(v) for p, v in point_links.items()})
+        structure._check_mobility()
+        object.__setattr__(structure, "groups", structure._find_groups())
+        return structure
+
+    def _check_mobility(self) -> None:
+        n = self.size
+        rows = sum(c.rows for c in self.constraints)
+        joints = len(self.pins)
+        mobility = 3 * n - rows
+        if mobility != 1:
+            raise SpecError(
+                f"the linkage has {mobility} degrees of freedom, not 1: {n} moving links "
+                f"(3·{n} = {3 * n} coordinates) less {joints} revolute pairs and "
+                f"{len(self.prisms)} prismatic pairs (2 each) — the input must drive every "
+                "link, and nothing may be locked",
+                key="mechanism", value=mobility)
+        # Rows and columns in common units: angle rows (a prism's, the driver's) times a
+        # length, angle columns over it.
+        scale = self.length_scale()
+        full = np.vstack([self.jacobian(self.reference_coordinates()), self.driver_row()])
+        angle_rows = [i for i, kind in enumerate(self.row_kinds()) if kind == "angle"]
+        full[[*angle_rows, full.shape[0] - 1]] *= scale
+        full[:, 2::3] /= scale
+        sv = np.linalg.svd(full[:-1], compute_uv=False)
+        if sv.size and sv[-1] <= RANK_TOLERANCE * sv[0]:
+            raise SpecError(
+                "the reference pose is singular (joints in line: a dead point, a change point "
+                "or a locked position) or the linkage has redundant constraints; move the "
+                "points to a regular pose of the same assembly",
+                key="mechanism.points")
+        sv = np.linalg.svd(full, compute_uv=False)
+        if sv[-1] <= RANK_TOLERANCE * sv[0]:
+            raise SpecError(
+                "the input does not drive the linkage at the reference pose (turning it "
+                "would not move the others, or they could move without it)",
+                key="mechanism.input", value=self.linkage.input)
+
+    def row_kinds(self) -> list[str]:
+        """``"length"`` or ``"angle"`` for each row of :meth:`jacobian`."""
+        out = []
+        for c in self.constraints:
+            out += ["length", "length"] if isinstance(c, Pin) else ["angle", "length"]
+        return out
+
+    def length_scale(self) -> float:
+        """The largest distance between points, m (a common unit for angles)."""
+        pts = np.array(list(self.linkage.point_positions.values()))
+        span = float(np.max(np.abs(pts[:, None] - pts[None, :]))) if pts.size > 1 else 0.0
+        return span if span > 0 else 1.0
+
+    # -- groups -------------------------------------------------------------------------------
+
+    def _closing(self, group: set[int], known: set[int]) -> list[Constraint] | None:
+        """The constraints that close ``group`` given ``known`` links, if it is a group.
+
+        Attachments of a group link at a point to a known link there (the ground first), pairs
+        within the group at a point with no known link, prismatic pairs among group and known
+        links. ``None`` unless their rows equal the group's coordinates and every link takes
+        part.
+        """
+        out: list[Constraint] = []
+        for p, links in self.point_links.items():
+            inside = [k for k in links if k in group]
+            if not inside:
+                continue
+            outside = [k for k in links if k in known]
+            if outside:
+                partner = GROUND_INDEX if GROUND_INDEX in outside else outside[0]
+                out += [Pin(p, k, self.local[(k, p)], partner, self.local[(partner, p)])
+                        for k in inside]
+            elif len(inside) > 1:
+                out += [Pin(p, k, self.local[(k, p)], inside[0], self.local[(inside[0], p)])
+                        for k in inside[1:]]
+        for c in self.prisms:
+            if (c.s in group or c.g in group) and {c.s, c.g} <= group | known:
+                out.append(c)
+        rows = sum(c.rows for c in out)
+        touched = set()
+        for c in out:
+            touched |= {c.a, c.b} if isinstance(c, Pin) else {c.s, c.g}
+        if rows != 3 * len(group) or not group <= touched:
+            return None
+        return out
+
+    def _find_groups(self) -> tuple[Group, ...]:
+        known = {GROUND_INDEX, self.input}
+        crank = [c for c in self.pins if c.a == self.input and c.b == GROUND_INDEX
+                 and c.point == self.linkage.moving[self.input].points[0]]
+        if not crank:
+            raise SpecError("the input must be pinned to the ground at its first point",
+                            key="mechanism.input", value=self.linkage.input)
+        groups = [Group((self.input,), (crank[0], self.driver), "crank")]
+        unknown = set(range(self.size)) - known
+        q_ref = self.reference_coordinates()
+        while unknown:
+            found = None
+            for size in range(2, len(unknown) + 1):
+                for combo in itertools.combinations(sorted(unknown), size):
+                    closing = self._closing(set(combo), known)
+                    if closing is not None:
+                        found = (combo, closing)
+                        break
+                if found:
+                    break
+            if found is None:
+                raise SpecError(
+                    "the links cannot be found one group after another from the input: "
+                    f"{', '.join(self.names[k] for k in sorted(unknown))} are not determined "
+                    "by the input", key="mechanism")
+            combo, closing = found
+            groups.append(self._classify(combo, closing, q_ref))
+            known |= set(combo)
+            unknown -= set(combo)
+        return tuple(groups)
+
+    def _classify(self, links: tuple[int, ...], closing: list[Constraint],
+                  q_ref: NDArray[np.float64]) -> Group:
+        """A dyad of a kind solved in closed form, with its branch; else a numeric group."""
+        if len(links) != 2 or len(closing) != 3:
+            return Group(links, tuple(closing), "numeric")
+        a, b = links
+
+        def between(c, x, y):
+            pair = {c.a, c.b} if isinstance(c, Pin) else {c.s, c.g}
+            return pair == {x, y}
+
+        middle = [c for c in closing if between(c, a, b)]
+        ends_a = [c for c in closing if not between(c, a, b) and _touches(c, a)]
+        ends_b = [c for c in closing if not between(c, a, b) and _touches(c, b)]
+        if len(middle) != 1 or len(ends_a) != 1 or len(ends_b) != 1:
+            return Group(links, tuple(closing), "numeric")
+        j1, j2, j3 = ends_a[0], middle[0], ends_b[0]
+        kind = "".join("R" if isinstance(c, Pin) else "P" for c in (j1, j2, j3))
+        if kind == "PRR":  # the mirror of RRP: name the links the other way round
+            a, b, j1, j3 = b, a, j3, j1
+            kind = "RRP"
+        if kind not in ("RRR", "RRP", "RPR"):
+            return Group(links, tuple(closing), "numeric")
+        if kind in ("RRR", "RRP") and _pin_offset(j1, a) == _pin_offset(j2, a):
+            return Group(links, tuple(closing), "numeric")  # a degenerate arm: no circle
+        group = Group((a, b), (j1, j2, j3), kind)
+        from .kinematics import dyad_branch  # the branch is read off the reference pose
+
+        return Group((a, b), (j1, j2, j3), kind, dyad_branch(self, group, q_ref))
+
+    # -- equations ----------------------------------------------------------------------------
+
+    def reference_coordinates(self) -> NDArray[np.float64]:
+        """``q`` at the reference pose: ``(x, y, θ)`` per moving link, shape ``(3n,)``."""
+        q = np.empty(3 * self.size)
+        for k in range(self.size):
+            q[3 * k : 3 * k + 2] = self.ref_origin[k].x, self.ref_origin[k].y
+            q[3 * k + 2] = self.ref_angle[k]
+        return q
+
+    def driver_row(self) -> NDArray[np.float64]:
+        """The driver's Jacobian row, shape ``(1, 3n)``."""
+        row = np.zeros((1, 3 * self.size))
+        row[0, 3 * self.input + 2] = 1.0
+        return row
+
+    def jacobian(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The constraints' Jacobian at one pose ``q``, shape ``(3n − 1, 3n)``."""
+        rows = []
+        for c in self.constraints:
+            block = np.zeros((c.rows, 3 * self.size))
+            for link, coeffs in constraint_jacobian(c, _pose_of(q)):
+                if link != GROUND_INDEX:
+                    block[:, 3 * link : 3 * link + 3] += np.array(
+                        [[float(x) for x in row] for row in coeffs])
+            rows.append(block)
+        return np.vstack(rows) if rows else np.zeros((0, 3 * self.size))
+
+
+def _touches(c: Constraint, k: int) -> bool:
+    return k in ((c.a, c.b) if isinstance(c, Pin) else (c.s, c.g))
+
+
+def _pin_offset(c: Constraint, k: int) -> tuple[float, float] | None:
+    """The local point by which pin ``c`` holds link ``k`` (``None`` for a prism)."""
+    if not isinstance(c, Pin):
+        return None
+    p = c.pa if c.a == k else c.pb
+    return (p.x, p.y)
+
+
+class Pose:
+    """Link frames at one or many poses.
+
+    Origins, angles and the rotations' cosines and sines, per moving link; the ground's frame
+    is the spec's.
+    """
+
+    def __init__(self, origins: list[V], angles: list, cos: list | None = None,
+                 sin: list | None = None, ops=None) -> None:
+        self.origins = origins
+        self.angles = angles
+        if cos is None:
+            import numpy as _np
+
+            cos = [(_np if ops is None else ops).cos(t) for t in angles]
+            sin = [(_np if ops is None else ops).sin(t) for t in angles]
+        self.cos = cos
+        self.sin = sin
+
+    def origin(self, k: int) -> V:
+        return V(0.0, 0.0) if k == GROUND_INDEX else self.origins[k]
+
+    def rotate(self, k: int, p: V) -> V:
+        """``R(θ_k)·p̄``."""
+        if k == GROUND_INDEX:
+            return p
+        return p.rotated(self.cos[k], self.sin[k])
+
+    def point(self, k: int, p: V) -> V:
+        """``r̄_k + R(θ_k)·p̄``: a point of link ``k`` in the spec's frame."""
+        return self.origin(k) + self.rotate(k, p)
+
+
+def _pose_of(q: NDArray[np.float64]) -> Pose:
+    n = q.size // 3
+    return Pose([V(q[3 * k], q[3 * k + 1]) for k in range(n)], [q[3 * k + 2] for k in range(n)])
+
+
+def constraint_jacobian(c: Constraint, pose: Pose):
+    """The Jacobian of one constraint at a pose.
+
+    ``(link, rows)`` pairs: per link, ``c.rows`` rows of three coefficients (for ``x``, ``y``,
+    ``θ``), each a value or an array.
+    """
+    if isinstance(c, Pin):
+        ra = pose.rotate(c.a, c.pa)
+        rb = pose.rotate(c.b, c.pb)
+        return [(c.a, [[1.0, 0.0, -ra.y], [0.0, 1.0, ra.x]]),
+                (c.b, [[-1.0, 0.0, rb.y], [0.0, -1.0, -rb.x]])]
+    if isinstance(c, Prism):
+        d = pose.rotate(c.g, c.dg)
+        ps = pose.rotate(c.s, c.ps)
+        reach = pose.origin(c.s) + ps - pose.origin(c.g)  # r̄_s + R_s·s̄ − r̄_g
+        return [(c.s, [[0.0, 0.0, 1.0], [-d.y, d.x, d.dot(ps)]]),
+                (c.g, [[0.0, 0.0, -1.0], [d.y, -d.x, -d.dot(reach)]])]
+    return [(c.link, [[0.0, 0.0, 1.0]]), (GROUND_INDEX, [[0.0, 0.0, -1.0]])]
