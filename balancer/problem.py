@@ -111,6 +111,8 @@ FEASIBILITY_TOLERANCE = 1e-9
 #: Relative residual of Eq. 57–58 (each row against the magnitude of its own terms) that a
 #: balanced design must meet: rounding, with room for the conditioning of the rows.
 FORCE_BALANCE_TOLERANCE = 1e-12
+#: Rounding of the objective relative to the rounding of one sum (:meth:`NumericProblem.rounding`).
+ROUNDING_FACTOR = 64.0
 #: Share of a force-balance row's magnitude at the parameters' scales below which its terms
 #: count as vanishing (:meth:`NumericProblem.force_balance_residual`).
 SMALL_ROW = 1e-6
@@ -834,6 +836,24 @@ class NumericProblem:
             return (math.sqrt(max(objective, 0.0)) - math.sqrt(max(lower_bound, 0.0))) / s
         return (objective - lower_bound) / (s * s)
 
+    def rounding(self, x: NDArray[np.float64]) -> float:
+        """How much rounding can blur the objective at ``x``, in the units of :meth:`gap`.
+
+        The weighted mean squares ``‖K·x‖`` are sums of terms as large as ``|K|·|x|``
+        (entry by entry); their rounding is ε times that, and the regressors' own rounding
+        (from the kinematics) about as much again: :data:`ROUNDING_FACTOR`·ε·``‖|K|·|x|‖``.
+        Tiny for most designs; for links of very different masses (whose terms cancel), large
+        enough that no claim of optimality finer than it can be made.
+        """
+        eps = np.finfo(float).eps
+        blur = ROUNDING_FACTOR * eps * float(np.linalg.norm(np.abs(self.rows) @ np.abs(x)))
+        s = self.objective_scale
+        if self.rms_form:
+            return blur / s
+        root = math.sqrt(max(self.quadratic(x), 0.0))
+        mass = self.weights.added_mass * ROUNDING_FACTOR * eps * self.original_mass
+        return (2 * root * blur + blur * blur + mass) / (s * s)
+
     def within(self, a: float, b: float, rel: float) -> bool:
         """Whether objective ``a`` exceeds ``b`` by at most ``rel`` of the problem's scale.
 
@@ -1041,25 +1061,38 @@ class NumericProblem:
         return out
 
     def force_balance_residual(self, x: NDArray[np.float64]) -> float:
-        """Largest residual of Eq. 58, each row relative to the magnitude of its own terms.
+        """Largest residual of Eq. 58, each row relative to the size of its own terms.
 
-        ``|A_i·x − b_i| / (Σ_j |A_ij·x_j| + |b_i|)``: rounding is relative to the terms that
-        are summed (a 1e12 kg link's first moment beside a 1 kg link's), not to the total
-        mass. A row whose terms all (nearly) vanish, the centres of mass on the links' lines
-        say, is judged against :data:`SMALL_ROW` of its magnitude at the parameters' scales
-        (:attr:`scales`), below which a residual is rounding from the other rows. 0 when force
-        balance is not imposed.
+        See :meth:`force_balance_rows`. 0 when force balance is not imposed.
+        """
+        rows = self.force_balance_rows(x)
+        return float(np.max(rows, initial=0.0))
+
+    def force_balance_rows(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Each row's residual of Eq. 58 relative to the size of its terms.
+
+        ``|A_i·x − b_i| / s_i``. The size ``s_i`` is the sum over links of the magnitude of
+        each link's contribution (a link's terms combined first: a heavy link whose centre of
+        mass sits on its pivot contributes nothing, exactly, and must not hide a light link's
+        unbalance); it is at least :data:`ROUNDING_FACTOR`·ε/:data:`FORCE_BALANCE_TOLERANCE`
+        times the raw terms ``Σ_j |A_ij·x_j|`` (their rounding, which no design can beat) and
+        :data:`SMALL_ROW` of the row at the parameters' scales.
         """
         if self.force_balance is None:
-            return 0.0
+            return np.zeros(0)
         a, rhs = self.force_balance
-        terms = np.abs(a) @ np.abs(x[:12]) + np.abs(rhs)
-        terms = np.maximum(terms, SMALL_ROW * (np.abs(a) @ self.scales[:12]))
-        residual = np.abs(a @ x[:12] - rhs)
+        x = np.asarray(x, dtype=float)[:12]
+        raw = np.abs(a) @ np.abs(x) + np.abs(rhs)
+        combined = np.abs(rhs).copy()
+        for k in range(0, 12, 4):
+            combined += np.abs(a[:, k : k + 4] @ x[k : k + 4])
+        eps = np.finfo(float).eps
+        size = np.maximum.reduce([combined,
+                                  ROUNDING_FACTOR * eps / FORCE_BALANCE_TOLERANCE * raw,
+                                  SMALL_ROW * (np.abs(a) @ self.scales[:12])])
+        residual = np.abs(a @ x - rhs)
         with np.errstate(divide="ignore", invalid="ignore"):
-            rel = np.where(terms > 0, residual / terms, residual)
-        return float(np.max(rel, initial=0.0))
-
+            return np.where(size > 0, residual / size, residual)
 
 def numeric_problem(design: Design) -> NumericProblem:
     """Build the numeric redesign problem of a design spec once.

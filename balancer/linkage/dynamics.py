@@ -279,7 +279,57 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor
                 else:
                     for j in range(3):
                         applied[link][j] = applied[link][j] - force[j]
-    return _collect(structure, lam, ground_of, n, c_count, rotor_moment, ground_extra)
+    constraints = [c for g in structure.groups for c in g.constraints]
+    return _collect(structure, constraints, lam, ground_of, n, c_count, rotor_moment,
+                    ground_extra)
+
+
+def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list],
+                         rotor_moment=None, ground_extra=None) -> Forces:
+    """The same forces from all the links' equations at once: ``Φ_qᵀ·λ = E``.
+
+    One ``3n × 3n`` solve per crank state over every constraint and the driver (the pairs of
+    :attr:`Structure.pins`, not the groups'), instead of the groups one after another: an
+    independent route to the same forces on the ground.
+    """
+    n, c_count = effective[0][0].shape
+    size = 3 * structure.size
+    constraints = [*structure.constraints, structure.driver]
+    mat = np.zeros((n, size, size))
+    rhs = np.zeros((n, size, c_count))
+    for k in range(structure.size):
+        for j in range(3):
+            rhs[:, 3 * k + j, :] = effective[k][j]
+    row = 0
+    blocks_of = []
+    for c in constraints:
+        blocks = constraint_jacobian(c, mo.pose)
+        blocks_of.append((c, row, blocks))
+        for link, coeffs in blocks:
+            if link == GROUND_INDEX:
+                continue
+            for r in range(c.rows):
+                for j in range(3):
+                    mat[:, 3 * link + j, row + r] += coeffs[r][j]
+        row += c.rows
+    with np.errstate(divide="ignore", invalid="ignore"):
+        try:
+            sol = np.linalg.solve(mat, rhs)
+        except np.linalg.LinAlgError:
+            sol = np.full((n, size, c_count), np.nan)
+            ok = np.abs(np.linalg.det(mat)) > 0
+            if ok.any():
+                sol[ok] = np.linalg.solve(mat[ok], rhs[ok])
+    lam, ground_of = {}, {}
+    for c, row, blocks in blocks_of:
+        values = sol[:, row : row + c.rows, :]
+        lam[id(c)] = values
+        for link, coeffs in blocks:
+            if link == GROUND_INDEX:
+                ground_of[id(c)] = [-sum(_times(coeffs[r][j], values[:, r, :])
+                                         for r in range(c.rows)) for j in range(3)]
+    return _collect(structure, constraints, lam, ground_of, n, c_count, rotor_moment,
+                    ground_extra)
 
 
 def _times(coefficient, values: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -289,7 +339,7 @@ def _times(coefficient, values: NDArray[np.float64]) -> NDArray[np.float64]:
     return coefficient * values
 
 
-def _collect(structure: Structure, lam, ground_of, n, c_count, rotor_moment,
+def _collect(structure: Structure, constraints, lam, ground_of, n, c_count, rotor_moment,
              ground_extra) -> Forces:
     zeros = np.zeros((n, c_count))
     reactions: dict[str, V] = {}
@@ -297,21 +347,20 @@ def _collect(structure: Structure, lam, ground_of, n, c_count, rotor_moment,
     driving = zeros.copy()
     normal: dict[str, NDArray[np.float64]] = {}
     couple: dict[str, NDArray[np.float64]] = {}
-    for g in structure.groups:
-        for c in g.constraints:
-            force = ground_of.get(id(c))
-            if isinstance(c, Driver):
-                driving = -lam[id(c)][:, 0, :]  # τ = −λ_driver
-            if force is None:
-                continue
-            fx, fy, mz = fx + force[0], fy + force[1], mz + force[2]
-            if isinstance(c, Pin):
-                old = reactions.get(c.point, V(zeros, zeros))
-                reactions[c.point] = old + V(force[0], force[1])
-            elif isinstance(c, Prism) and c.g == GROUND_INDEX:
-                name = structure.names[c.s]
-                normal[name] = lam[id(c)][:, 1, :]
-                couple[name] = lam[id(c)][:, 0, :]
+    for c in constraints:
+        if isinstance(c, Driver):
+            driving = -lam[id(c)][:, 0, :]  # τ = −λ_driver
+        force = ground_of.get(id(c))
+        if force is None:
+            continue
+        fx, fy, mz = fx + force[0], fy + force[1], mz + force[2]
+        if isinstance(c, Pin):
+            old = reactions.get(c.point, V(zeros, zeros))
+            reactions[c.point] = old + V(force[0], force[1])
+        elif isinstance(c, Prism) and c.g == GROUND_INDEX:
+            name = structure.names[c.s]
+            normal[name] = lam[id(c)][:, 1, :]
+            couple[name] = lam[id(c)][:, 0, :]
     if rotor_moment is not None:
         mz = mz + rotor_moment
     if ground_extra is not None:
@@ -346,7 +395,7 @@ def regressors(structure: Structure, mo: Motion, gravity=(0.0, 0.0)) -> tuple[Fo
 
 
 def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.0, 0.0),
-                     loads: bool = True) -> Forces:
+                     loads: bool = True, route: str = "groups") -> Forces:
     """Joint forces on the ground, driving torque and shaking sums of a design (one column).
 
     Parameters
@@ -359,6 +408,8 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.
         ``(gx, gy)``, m/s².
     loads
         Include applied forces and moments and slider forces (springs always act).
+    route
+        ``"groups"`` (:func:`kinetostatics`) or ``"global"`` (:func:`global_kinetostatics`).
     """
     linkage = structure.linkage if linkage is None else linkage
     layout = Layout.of(structure)
@@ -379,7 +430,8 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.
             if param == "Jc":
                 rotor[:, 0] += 2 * mo.accel[k] * x[j]
     extra = tuple(np.asarray(v)[:, None] * np.ones((n, 1)) for v in ground)
-    return kinetostatics(structure, mo, effective, rotor_moment=rotor, ground_extra=extra)
+    solver = kinetostatics if route == "groups" else global_kinetostatics
+    return solver(structure, mo, effective, rotor_moment=rotor, ground_extra=extra)
 
 
 def _with(structure: Structure, linkage) -> Structure:

@@ -66,6 +66,12 @@ class V:
         """From a complex number."""
         return V(z.real, z.imag)
 
+    @staticmethod
+    def of_array(z) -> V:
+        """From a complex array (real and imaginary parts as arrays)."""
+        z = np.asarray(z)
+        return V(z.real.astype(float), z.imag.astype(float))
+
     def complex(self):
         """As a complex number (numpy: a complex array)."""
         return self.x + 1j * self.y

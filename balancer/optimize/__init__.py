@@ -139,12 +139,16 @@ class Optimizer:
         g = data.gap(objective, lower)
         stages = [replace(s, gap=data.gap(s.objective, lower))
                   if math.isfinite(s.objective) else s for s in stages]
+        blur = data.rounding(x)  # rounding can hide this much of a gap
         if not feasible:
             status = Status.FAILED
-        elif g <= GAP_TOLERANCE:
+        elif g + blur <= GAP_TOLERANCE:
             status = Status.OPTIMAL
         else:
             status = Status.FEASIBLE
+            if blur > GAP_TOLERANCE:
+                notes.append(f"rounding blurs the objective by {blur:.1e} of the scale (links "
+                             "of very different masses): optimality cannot be decided finer")
         balanced = data.linkage_of(x)
         before = cycle_analysis(
             data.linkage, data.speed, data.samples, route="newton-euler", loads=False

@@ -1,0 +1,273 @@
+"""Cycle analysis: one crank revolution at constant speed, for any mechanism.
+
+Given a mechanism (:func:`balancer.mechanisms.mechanism_of`) and the operating speed, the
+crank turns through ``θ1 = 2π·j/N`` (absolute angles, whatever the reference pose) and the
+mechanism's inverse dynamics (:meth:`~balancer.mechanisms.base.Mechanism.inverse_dynamics`)
+gives what it does to its frame: the force at every ground point, the normal force and couple
+of every slider on a ground guide, the shaking force and moment and the driving torque. Samples
+exactly at a singular pose that the smooth motion passes (a four-bar's change points) take the
+limits of that motion for the shaking sums and the torque; their individual reactions, which
+grow without bound, are NaN and flagged.
+
+Long revolutions are evaluated in chunks that fit the CPU cache, on two threads (numpy runs its
+loops without the GIL), writing into preallocated arrays.
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .linkage.kinematics import Motion
+from .mechanisms import mechanism_of
+from .mechanisms.base import Mechanism
+
+#: Number of crank angles evaluated at once.
+CHUNK = 32768
+#: Threads evaluating the chunks of a long cycle.
+WORKERS = min(2, os.cpu_count() or 1)
+
+
+@dataclass(frozen=True)
+class Figure:
+    """RMS and maximum magnitude of a quantity over the samples of a cycle (same unit)."""
+
+    rms: float
+    max: float
+
+    @classmethod
+    def of(cls, values: NDArray) -> Figure:
+        """Figures of an array of real or complex values (complex: vector magnitudes).
+
+        Values that do not exist (NaN, at a change point) are left out; computed without
+        overflow for any finite values.
+        """
+        values = np.asarray(values)
+        mag = np.abs(values)
+        mag = mag[~np.isnan(mag)]
+        if not mag.size:
+            return cls(rms=float("nan"), max=float("nan"))
+        top = float(np.max(mag))
+        if top == 0 or not np.isfinite(top):
+            return cls(rms=top, max=top)
+        scaled = mag / top
+        return cls(rms=top * float(np.sqrt(np.mean(scaled * scaled))), max=top)
+
+    def as_dict(self) -> dict[str, float]:
+        """``{"rms": …, "max": …}``."""
+        return {"rms": self.rms, "max": self.max}
+
+
+@dataclass(frozen=True)
+class Reactions:
+    """What the mechanism exerts on its frame at each sample (arrays of shape ``(N,)``).
+
+    Attributes
+    ----------
+    ground
+        Force on the ground at each ground point, complex ``x + i·y``, N.
+    slider_normal, slider_couple
+        Normal force (N) and couple (N·m) of each slider on a ground guide, by link.
+    shaking_force
+        Sum of all forces on the frame, complex, N.
+    shaking_moment
+        Their moment about the origin, with the motor's reaction and counter-rotors, N·m.
+    driving_torque
+        Torque of the motor on the input, N·m.
+    """
+
+    ground: dict[str, NDArray[np.complex128]]
+    slider_normal: dict[str, NDArray[np.float64]]
+    slider_couple: dict[str, NDArray[np.float64]]
+    shaking_force: NDArray[np.complex128]
+    shaking_moment: NDArray[np.float64]
+    driving_torque: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class CycleSummary:
+    """The figures of a cycle analysis."""
+
+    shaking_force: Figure
+    shaking_moment: Figure
+    driving_torque: Figure
+    ground: dict[str, Figure]
+    slider_normal: dict[str, Figure]
+    slider_couple: dict[str, Figure]
+
+    def as_dict(self) -> dict[str, dict[str, float]]:
+        """The three fixed figures with their JSON names."""
+        return {
+            "shaking_force": self.shaking_force.as_dict(),
+            "shaking_moment": self.shaking_moment.as_dict(),
+            "driving_torque": self.driving_torque.as_dict(),
+        }
+
+
+@dataclass(frozen=True)
+class CycleAnalysis:
+    """One crank revolution at constant speed: what the mechanism does to its frame.
+
+    Attributes
+    ----------
+    mechanism
+        The analysed mechanism.
+    speed
+        Crank speed, rad/s.
+    theta1
+        The sampled crank angles, rad.
+    reactions
+        The results at those angles.
+    route
+        The inverse-dynamics route used.
+    gravity
+        ``(gx, gy)`` the figures include, m/s² (``(0, 0)``: none).
+    loads
+        Whether applied loads are included.
+    singular
+        Samples at a singular pose of the smooth motion (individual reactions NaN).
+    """
+
+    mechanism: Mechanism
+    speed: float
+    theta1: NDArray[np.float64]
+    reactions: Reactions
+    route: str
+    gravity: tuple[float, float] = (0.0, 0.0)
+    loads: bool = True
+    singular: NDArray[np.bool_] | None = None
+    summary: CycleSummary = field(init=False)
+
+    def __post_init__(self) -> None:
+        r = self.reactions
+        object.__setattr__(self, "summary", CycleSummary(
+            shaking_force=Figure.of(r.shaking_force),
+            shaking_moment=Figure.of(r.shaking_moment),
+            driving_torque=Figure.of(r.driving_torque),
+            ground={p: Figure.of(v) for p, v in r.ground.items()},
+            slider_normal={k: Figure.of(v) for k, v in r.slider_normal.items()},
+            slider_couple={k: Figure.of(v) for k, v in r.slider_couple.items()},
+        ))
+
+    @property
+    def linkage(self):
+        """The mechanism's model (a FourBar, SliderCrank or Linkage)."""
+        return self.mechanism.model
+
+    @cached_property
+    def motion(self) -> Motion:
+        """Kinematics at the sampled angles (computed when first asked for)."""
+        with np.errstate(all="ignore"):
+            return self.mechanism.motion(self.theta1, self.speed, 0.0)
+
+    @property
+    def samples(self) -> int:
+        """Number of sampled crank angles."""
+        return self.theta1.size
+
+    @property
+    def time(self) -> NDArray[np.float64]:
+        """Time at each sample from θ1 = 0, s."""
+        return self.theta1 / self.speed
+
+
+def sample_angles(samples: int) -> NDArray[np.float64]:
+    """``samples`` equally spaced crank angles over one revolution from 0, rad."""
+    return np.arange(samples) * (2 * np.pi / samples)
+
+
+def cycle_analysis(model, speed: float, samples: int = 360, *, route: str | None = None,
+                   loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0),
+                   theta1: NDArray[np.float64] | None = None) -> CycleAnalysis:
+    """Analyse one crank revolution at constant ``speed`` (rad/s) over ``samples`` angles.
+
+    Parameters
+    ----------
+    model
+        A mechanism's model (FourBar, SliderCrank, Linkage) or a :class:`Mechanism`.
+    speed
+        Crank speed, rad/s.
+    samples
+        Number of equally spaced angles from θ1 = 0.
+    route
+        Inverse-dynamics route (the mechanism's :attr:`~Mechanism.routes`; default its first).
+    loads
+        Include applied loads (forces, moments, a slider's gas force).
+    gravity
+        ``(gx, gy)``, m/s²: the frame then carries the weights too.
+    theta1
+        Angles to use instead of the equally spaced ones, rad.
+
+    Raises
+    ------
+    AssemblyError
+        If the crank cannot turn a full revolution.
+    SpecError
+        For an unknown route.
+    """
+    from .errors import SpecError
+
+    mech = model if isinstance(model, Mechanism) else mechanism_of(model)
+    route = route or mech.routes[0]
+    if route not in mech.routes:
+        raise SpecError(f"the {mech.kind} has no such route; choose from "
+                        f"{', '.join(mech.routes)}", key="route", value=route)
+    mech.require_full_revolution("a cycle analysis")
+    angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
+    n = angles.size
+    grounds = mech.ground_points
+    sliders = mech.ground_sliders
+    out = {"shaking_force": np.empty(n, complex), "shaking_moment": np.empty(n),
+           "driving_torque": np.empty(n)}
+    ground = {p: np.empty(n, complex) for p in grounds}
+    normal = {k: np.empty(n) for k in sliders}
+    couple = {k: np.empty(n) for k in sliders}
+
+    def evaluate(theta):
+        with np.errstate(all="ignore"):
+            mo = mech.motion(theta, speed, 0.0)
+            return mech.inverse_dynamics(mo, route=route, loads=loads, gravity=gravity)
+
+    def fill(start: int) -> None:
+        sl = slice(start, start + CHUNK)
+        f = evaluate(angles[sl])
+        out["shaking_force"][sl] = f.shaking_force.complex()[:, 0]
+        out["shaking_moment"][sl] = f.shaking_moment[:, 0]
+        out["driving_torque"][sl] = f.driving_torque[:, 0]
+        for p in grounds:
+            ground[p][sl] = f.reactions[p].complex()[:, 0]
+        for k in sliders:
+            normal[k][sl] = f.slider_normal[k][:, 0]
+            couple[k][sl] = f.slider_couple[k][:, 0]
+
+    starts = range(0, n, CHUNK)
+    if len(starts) > 1 and WORKERS > 1:
+        with ThreadPoolExecutor(WORKERS) as pool:
+            list(pool.map(fill, starts))
+    else:
+        for start in starts:
+            fill(start)
+    singular = np.zeros(n, bool)
+    for limit in mech.limits(angles):
+        hit = limit.mask
+        parts = [evaluate(angles[hit] + d) for d in limit.offsets]
+        out["shaking_force"][hit] = sum(w * p.shaking_force.complex()[:, 0]
+                                        for w, p in zip(limit.weights, parts, strict=True))
+        out["shaking_moment"][hit] = sum(w * p.shaking_moment[:, 0]
+                                         for w, p in zip(limit.weights, parts, strict=True))
+        out["driving_torque"][hit] = sum(w * p.driving_torque[:, 0]
+                                         for w, p in zip(limit.weights, parts, strict=True))
+        for p in grounds:
+            ground[p][hit] = np.nan
+        for k in sliders:
+            normal[k][hit] = np.nan
+            couple[k][hit] = np.nan
+        singular |= hit
+    reactions = Reactions(ground=ground, slider_normal=normal, slider_couple=couple, **out)
+    return CycleAnalysis(mechanism=mech, speed=speed, theta1=angles, reactions=reactions,
+                         route=route, gravity=tuple(gravity), loads=loads, singular=singular)

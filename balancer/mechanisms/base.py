@@ -1,0 +1,295 @@
+"""The one mechanism interface that everything downstream uses.
+
+A :class:`Mechanism` wraps a model (:class:`~balancer.model.FourBar`,
+:class:`~balancer.model.SliderCrank` or :class:`~balancer.model.Linkage`) and tells the rest of
+the package what it needs: the links and the ground points, the named layout of the design
+vector, the range of crank angles where it assembles, the motion at arrays of crank angles, the
+forces on the ground and the driving torque (and the same as linear maps of the design vector),
+the path of the total centre of mass, the formulations of its equations of motion, what to
+draw. The general linkage implements it with the general core (:mod:`balancer.linkage`); the
+four-bar and the slider-crank build their general linkage and add the seeds' closed forms where
+those are the seeds' own route or do what the general core does not (the four-bar's change
+points). Code downstream never asks which mechanism it has; :func:`mechanism_of` is the one
+registry.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC
+from dataclasses import dataclass
+from functools import cached_property
+from typing import ClassVar
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import AssemblyError
+from ..kinematics import AssemblyRange
+from ..linkage import dynamics, kinematics
+from ..linkage.dynamics import Forces, Layout
+from ..linkage.kinematics import Motion
+from ..linkage.structure import GROUND_INDEX, Structure
+from ..linkage.vectors import V
+from ..model import GROUND, Link, Linkage
+
+#: Least normalised assembly gap of a dyad over a revolution for the crank to turn fully: at
+#: or below it the dyad reaches a dead point (its links in line) within rounding.
+GAP_TOLERANCE = 1e-12
+#: Crank angles sampled to find where a linkage assembles (then refined).
+RANGE_SAMPLES = 1440
+
+
+@dataclass(frozen=True)
+class Limit:
+    """Samples of a revolution that are exactly at a singular pose of the smooth motion.
+
+    There the individual reactions are unbounded; the shaking force and moment and the driving
+    torque are the limits of the motion, the weighted sum of evaluations at the offsets.
+    """
+
+    mask: NDArray[np.bool_]
+    offsets: tuple[float, ...]
+    weights: tuple[float, ...]
+
+
+class Mechanism(ABC):
+    """What a mechanism tells the rest of the package (see the module docstring).
+
+    Parameters
+    ----------
+    model
+        The mechanism's data.
+    """
+
+    #: The spec's ``mechanism.type``.
+    kind: ClassVar[str]
+    #: Inverse-dynamics routes (``analyze --route``), the default first.
+    routes: ClassVar[tuple[str, ...]] = ("newton-euler", "mass-matrix")
+    #: Formulations of the equations of motion: name → (module, class); the default first.
+    formulations: ClassVar[dict[str, tuple[str, str]]] = {}
+    #: The formulation a check by simulation uses: one the optimiser's route does not share.
+    verify_method: ClassVar[str] = ""
+
+    def __init__(self, model) -> None:
+        self.model = model
+
+    # -- identity -----------------------------------------------------------------------------
+
+    @cached_property
+    def linkage(self) -> Linkage:
+        """The mechanism as a general linkage."""
+        return self.model
+
+    @cached_property
+    def structure(self) -> Structure:
+        """The general linkage's equations (:mod:`balancer.linkage.structure`)."""
+        return Structure.of(self.linkage)
+
+    @cached_property
+    def layout(self) -> Layout:
+        """The named layout of the design vector."""
+        return Layout.of(self.structure)
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """Names of the moving links, in order."""
+        return self.linkage.link_names
+
+    @property
+    def links(self) -> tuple[Link, ...]:
+        """Mass properties of the moving links."""
+        return self.linkage.links
+
+    @property
+    def ground_points(self) -> tuple[str, ...]:
+        """Points of the frame (where reactions act)."""
+        return self.linkage.ground.points
+
+    @property
+    def ground_sliders(self) -> tuple[str, ...]:
+        """Links that slide on a guide of the frame (their normal force and couple act)."""
+        return tuple(s.link for s in self.linkage.sliders if s.guide == GROUND)
+
+    @property
+    def grounded_links(self) -> tuple[str, ...]:
+        """Links pivoted to the frame (where a counter-rotor can sit)."""
+        return self.linkage.grounded_links
+
+    @property
+    def input(self) -> str:
+        """The driven link."""
+        return self.linkage.input
+
+    def parameters(self) -> NDArray[np.float64]:
+        """The design vector of the mechanism's own links (:attr:`layout`)."""
+        return self.layout.vector(self.linkage)
+
+    def with_links(self, links: dict[str, Link]) -> Mechanism:
+        """The same mechanism with some links' mass properties replaced."""
+        return type(self)(self.model.with_links(links))
+
+    def describe(self) -> str:
+        """A short word on how it moves: whether the crank turns fully."""
+        return "full turn" if self.assembly_range().full else "swinging crank"
+
+    # -- kinematics ---------------------------------------------------------------------------
+
+    def assembly_range(self) -> AssemblyRange:
+        """Crank angles at which the linkage assembles, on the reference pose's branch."""
+        if "assembly" not in self.structure.cache:
+            self.structure.cache["assembly"] = _assembly_range(self.structure)
+        return self.structure.cache["assembly"]
+
+    def require_full_revolution(self, purpose: str) -> AssemblyRange:
+        """The assembly range, if the crank turns a full revolution.
+
+        Raises
+        ------
+        AssemblyError
+            Otherwise (exit code 2): ``purpose`` (e.g. "a cycle analysis") needs a crank that
+            turns.
+        """
+        rng = self.assembly_range()
+        if not rng.full:
+            raise AssemblyError(
+                f"{purpose} needs a crank that turns a full revolution{self._full_turn_rule()}, "
+                f"but this {self.kind} assembles only for θ1 in {rng.describe()}",
+                key="mechanism.lengths" if self.kind != "linkage" else "mechanism.points")
+        return rng
+
+    def _full_turn_rule(self) -> str:
+        return ""
+
+    def motion(self, theta1: ArrayLike, omega1: ArrayLike = 0.0,
+               alpha1: ArrayLike = 0.0) -> Motion:
+        """Frames, rates and accelerations at crank states (arrays broadcast together)."""
+        return kinematics.motion(self.structure, theta1, omega1, alpha1)
+
+    def limits(self, theta1: NDArray[np.float64]) -> list[Limit]:
+        """Samples at singular poses that the smooth motion passes (none in general)."""
+        return []
+
+    # -- dynamics -----------------------------------------------------------------------------
+
+    def inverse_dynamics(self, mo: Motion, *, route: str | None = None, loads: bool = True,
+                         gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
+        """Forces on the ground and driving torque of the mechanism's own design (one column).
+
+        ``route`` is one of :attr:`routes`: ``"newton-euler"`` the links' equations group by
+        group (:func:`balancer.linkage.dynamics.kinetostatics`), ``"mass-matrix"`` all at once
+        with the links' mass matrices and the constraints' multipliers.
+        """
+        route = route or self.routes[0]
+        general = {"newton-euler": "groups", "mass-matrix": "global"}[route]
+        return dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
+                                         loads=loads, route=general)
+
+    def regressors(self, mo: Motion, gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
+        """:meth:`inverse_dynamics` without loads as linear maps of the design vector.
+
+        Arrays ``(N, P)`` with ``P`` the :attr:`layout`'s size.
+        """
+        forces, _ = dynamics.regressors(self.structure, mo, gravity)
+        return forces
+
+    # -- geometry -----------------------------------------------------------------------------
+
+    def centres_of_mass(self, mo: Motion) -> list[V]:
+        """Each moving link's centre of mass, m."""
+        return [mo.point(k, V(link.e, link.f)) for k, link in enumerate(self.links)]
+
+    def total_centre_of_mass(self, mo: Motion) -> NDArray[np.complex128]:
+        """The moving links' total centre of mass, complex, m."""
+        total = sum(c.complex() * link.mass
+                    for c, link in zip(self.centres_of_mass(mo), self.links, strict=True))
+        return total / self.linkage.total_mass
+
+    def points(self, mo: Motion) -> dict[str, NDArray[np.complex128]]:
+        """Every point's position, complex, m (a point of the frame: its fixed place)."""
+        out = {}
+        for p, links in self.structure.point_links.items():
+            k = GROUND_INDEX if GROUND_INDEX in links else links[0]
+            out[p] = mo.point(k, self.structure.local[(k, p)]).complex() + 0 * mo.theta1
+        return out
+
+    def drawing(self) -> dict[str, tuple[str, ...]]:
+        """What to draw: each link's points in the order to join them (the ground's too)."""
+        return {b.name: b.points for b in self.linkage.bodies}
+
+    def guides(self, mo: Motion) -> list[tuple[NDArray[np.complex128], NDArray[np.complex128]]]:
+        """Each slider's guide as a point on the line and the line's unit direction, complex."""
+        out = []
+        for c in self.structure.prisms:
+            base = mo.point(c.g, c.pg).complex() + 0 * mo.theta1
+            d = mo.pose.rotate(c.g, c.dg)
+            out.append((base, d.x + 1j * d.y + 0 * mo.theta1))
+        return out
+
+
+def _gaps(structure: Structure, theta1: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The least assembly gap of the closed-form groups at each angle.
+
+    Where a link cannot be placed (a numeric group's Newton fails) the gap is −1.
+    """
+    gaps: list = []
+    with np.errstate(all="ignore"):
+        pose = kinematics.positions(structure, theta1, gaps=gaps)
+    least = np.ones_like(theta1)
+    for g in gaps:
+        least = np.minimum(least, np.where(np.isnan(g), -1.0, g))
+    for k in range(structure.size):
+        least = np.where(np.isfinite(pose.angles[k]), least, -1.0)
+    return least
+
+
+def _assembly_range(structure: Structure) -> AssemblyRange:
+    """Where the linkage assembles on the reference branch.
+
+    Sampled, the sampled minima refined, the ends found by bisection (see
+    :data:`GAP_TOLERANCE`).
+    """
+    from scipy.optimize import brentq, minimize_scalar
+
+    start = structure.ref_angle[structure.input]
+    step = 2 * math.pi / RANGE_SAMPLES
+    theta = start + step * np.arange(RANGE_SAMPLES + 1)
+    gap = _gaps(structure, theta)
+
+    def at(t: float) -> float:
+        return float(_gaps(structure, np.array([t]))[0])
+
+    # Refine each sampled minimum: a dip between samples must not hide a dead point.
+    least = float(np.min(gap))
+    for i in np.flatnonzero((gap[1:-1] <= gap[:-2]) & (gap[1:-1] <= gap[2:])) + 1:
+        res = minimize_scalar(at, bounds=(theta[i - 1], theta[i + 1]), method="bounded",
+                              options={"xatol": 1e-10})
+        least = min(least, float(res.fun))
+    if least > GAP_TOLERANCE:
+        return AssemblyRange(intervals=((-math.pi, math.pi),), full=True)
+    # The range around the reference: walk out each way to the first bad sample, then bisect.
+    ends = []
+    for direction in (1, -1):
+        t = start
+        while True:
+            t_next = t + direction * step
+            if abs(t_next - start) > 2 * math.pi or at(t_next) <= GAP_TOLERANCE:
+                break
+            t = t_next
+        if abs(t - start) >= 2 * math.pi - step:
+            ends.append(t)
+            continue
+        lo, hi = sorted((t, t + direction * step))
+        good_is_lo = direction == 1
+        f = (lambda x: at(x) - GAP_TOLERANCE)
+        try:
+            edge = brentq(f, lo, hi, xtol=1e-12) if f(lo) * f(hi) < 0 else (
+                lo if good_is_lo else hi)
+        except ValueError:
+            edge = lo if good_is_lo else hi
+        ends.append(edge)
+    hi, lo = ends
+    if hi - lo <= 0:
+        return AssemblyRange(intervals=(), full=False)
+    shift = 2 * math.pi * math.floor((lo + math.pi) / (2 * math.pi))  # start within [−π, π)
+    return AssemblyRange(intervals=((lo - shift, hi - shift),), full=False)

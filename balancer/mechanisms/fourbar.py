@@ -1,0 +1,130 @@
+"""The four-bar as a mechanism: its general linkage, with the paper's closed forms added.
+
+Meijaard & van der Wijk (2020): the kinematics in closed form (Eq. 1–11), which follow a
+change-point linkage (a parallelogram) through its flat positions on the smooth motion — the
+general core stops at such positions — and the equivalent-mass-matrix route of inverse dynamics
+(Eq. 45–54) as the ``"mass-matrix"`` route. The links are A0→A1 (crank), A1→A2 (coupler),
+A2→A3 (rocker) with the ground pivots A0 at the origin and A3 at ``(l4, 0)``.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import kinematics as fourbar
+from ..kinematics import AssemblyRange
+from ..linkage.dynamics import Forces
+from ..linkage.kinematics import Motion
+from ..linkage.structure import Pose
+from ..linkage.vectors import V
+from ..model import Body, FourBar, Linkage
+from .base import Limit, Mechanism
+
+
+def fourbar_linkage(model: FourBar) -> Linkage:
+    """The four-bar as a general linkage, at a regular reference pose on its branch.
+
+    The reference crank angle is the one of its range's samples farthest from a dead or change
+    point (largest ``|sin(θ3 − θ2)|``).
+    """
+    rng = fourbar.assembly_range(model.lengths)
+    if rng.full:
+        candidates = np.linspace(0.0, 2 * math.pi, 73)[:-1]
+    else:
+        lo, hi = rng.intervals[0]
+        candidates = np.linspace(lo, hi, 74)[1:-1]
+    signs = fourbar.cycle_branch_signs(model.lengths, model.branch, candidates)
+    pos = fourbar.position(model.lengths, candidates, signs, check=False)
+    best = int(np.nanargmax(np.abs(pos.sin_transmission)))
+    a1, a2 = complex(pos.A1[best]), complex(pos.A2[best])
+    points = (("A0", (0.0, 0.0)), ("A1", (a1.real, a1.imag)), ("A2", (a2.real, a2.imag)),
+              ("A3", (model.lengths[3], 0.0)))
+    bodies = (Body(name="ground", points=("A0", "A3")),
+              Body(name="crank", points=("A0", "A1"), props=model.crank),
+              Body(name="coupler", points=("A1", "A2"), props=model.coupler),
+              Body(name="rocker", points=("A2", "A3"), props=model.rocker))
+    return Linkage(points=points, bodies=bodies, input="crank")
+
+
+class FourBarMechanism(Mechanism):
+    """The 4R four-bar (``type = "four-bar"``)."""
+
+    kind = "four-bar"
+    formulations = {
+        "opened-loop": ("balancer.formulations.opened_loop", "OpenedLoop"),
+        "complex-masses": ("balancer.formulations.complex_masses", "ComplexMasses"),
+        "mass-matrix": ("balancer.formulations.mass_matrix", "MassMatrix"),
+        "lie-group": ("balancer.formulations.lie_group", "LieGroup"),
+    }
+    verify_method = "opened-loop"
+
+    @cached_property
+    def linkage(self) -> Linkage:
+        return fourbar_linkage(self.model)
+
+    def describe(self) -> str:
+        """The Grashof class."""
+        return str(fourbar.classify(self.model.lengths))
+
+    def assembly_range(self) -> AssemblyRange:
+        return fourbar.assembly_range(self.model.lengths)
+
+    def motion(self, theta1: ArrayLike, omega1: ArrayLike = 0.0,
+               alpha1: ArrayLike = 0.0) -> Motion:
+        """The closed form (Eq. 2–10) on the smooth motion's branch, as a general motion."""
+        t, w, a = (np.atleast_1d(np.asarray(x, dtype=float))
+                   for x in np.broadcast_arrays(theta1, omega1, alpha1))
+        signs = fourbar.cycle_branch_signs(self.model.lengths, self.model.branch, t)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            mo = fourbar.motion(self.model.lengths, t, w, a, signs, check=False)
+        return general_motion(mo)
+
+    def limits(self, theta1: NDArray[np.float64]) -> list[Limit]:
+        from ..inverse import change_point_limits
+
+        return [Limit(mask, offsets, weights) for mask, offsets, weights
+                in change_point_limits(self.model.lengths, theta1)]
+
+    def inverse_dynamics(self, mo: Motion, *, route: str | None = None, loads: bool = True,
+                         gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
+        if (route or self.routes[0]) != "mass-matrix":
+            return super().inverse_dynamics(mo, route=route, loads=loads, gravity=gravity)
+        from ..inverse import mass_matrix
+
+        r = mass_matrix(self.model, fourbar_motion(self.model, mo), gravity=gravity,
+                        loads=loads)
+        col = (lambda z: np.asarray(z)[:, None])
+        return Forces(
+            reactions={"A0": V(col(r.RA0.real), col(r.RA0.imag)),
+                       "A3": V(col(r.RA3.real), col(r.RA3.imag))},
+            slider_normal={}, slider_couple={},
+            driving_torque=col(r.driving_torque),
+            shaking_force=V(col(r.shaking_force.real), col(r.shaking_force.imag)),
+            shaking_moment=col(r.shaking_moment))
+
+
+def general_motion(mo: fourbar.Motion) -> Motion:
+    """A four-bar's closed-form motion as the general core's (frames at A0, A1, A2)."""
+    zero = 0.0 * mo.pos.theta1
+    va1, va2 = mo.joint_velocities
+    aa1, aa2 = mo.joint_accelerations
+    origins = [V(zero, zero), V.of_array(mo.pos.A1), V.of_array(mo.pos.A2)]
+    angles = list(mo.theta)
+    cos = [np.real(v) / length for v, length in zip(mo.vectors, mo.lengths[:3], strict=True)]
+    sin = [np.imag(v) / length for v, length in zip(mo.vectors, mo.lengths[:3], strict=True)]
+    return Motion(theta1=mo.pos.theta1, omega1=mo.omega[0], alpha1=mo.alpha[0],
+                  pose=Pose(origins, angles, cos, sin),
+                  velocity=(V(zero, zero), V.of_array(va1), V.of_array(va2)),
+                  rate=tuple(mo.omega),
+                  acceleration=(V(zero, zero), V.of_array(aa1), V.of_array(aa2)),
+                  accel=tuple(mo.alpha))
+
+
+def fourbar_motion(model: FourBar, mo: Motion) -> fourbar.Motion:
+    """A general motion of a four-bar as the closed form's (angles and rates)."""
+    return fourbar.motion_from_angles(model.lengths, tuple(mo.pose.angles), tuple(mo.rate),
+                                      tuple(mo.accel))

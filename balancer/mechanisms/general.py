@@ -1,0 +1,13 @@
+"""The general linkage as a :class:`~balancer.mechanisms.base.Mechanism`: the general core."""
+
+from __future__ import annotations
+
+from .base import Mechanism
+
+
+class LinkageMechanism(Mechanism):
+    """Any planar linkage with one degree of freedom (``type = "linkage"``)."""
+
+    kind = "linkage"
+    formulations = {}
+    verify_method = ""

@@ -1,0 +1,91 @@
+"""The slider-crank as a mechanism: its general linkage, with Wunderlich's closed forms added.
+
+Wunderlich (1964), Sect. 3: crank A0→A1, connecting rod A1→A2, the slider's pin A2 on a guide
+along +x at the signed offset ``e`` from A0. The slider is a one-point link on a ground guide; a
+gas force acts between it and the cylinder (internal to the machine). The mass-matrix route
+of its inverse dynamics is the slider-crank's own (:mod:`balancer.slider_crank.dynamics`).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import cached_property
+
+import numpy as np
+
+from ..kinematics import AssemblyRange
+from ..linkage.dynamics import Forces
+from ..linkage.kinematics import Motion
+from ..linkage.vectors import V
+from ..model import Body, Linkage, Slider, SliderCrank
+from ..slider_crank import kinematics as closed
+from .base import Mechanism
+
+
+def slider_crank_linkage(model: SliderCrank) -> Linkage:
+    """The slider-crank as a general linkage, at a regular reference pose on its branch.
+
+    The reference crank angle is the one of its range's samples where the rod is farthest from
+    square to the guide (largest ``|cos θ2|``).
+    """
+    rng = closed.assembly_range(model.lengths)
+    if rng.full:
+        candidates = np.linspace(0.0, 2 * math.pi, 73)[:-1]
+    else:
+        lo, hi = rng.intervals[0]
+        candidates = np.linspace(lo, hi, 74)[1:-1]
+    with np.errstate(all="ignore"):
+        mo = closed.motion_of(model, candidates, 0.0, 0.0)
+    best = int(np.nanargmax(np.abs(np.real(mo.l2))))
+    a1, a2 = complex(mo.A1[best]), complex(mo.A2[best])
+    points = (("A0", (0.0, 0.0)), ("A1", (a1.real, a1.imag)), ("A2", (a2.real, a2.imag)))
+    bodies = (Body(name="ground", points=("A0",)),
+              Body(name="crank", points=("A0", "A1"), props=model.crank),
+              Body(name="rod", points=("A1", "A2"), props=model.rod),
+              Body(name="slider", points=("A2",), props=model.slider))
+    slider = Slider(link="slider", guide="ground", point="A2", direction=(1.0, 0.0),
+                    force=model.gas_force)
+    return Linkage(points=points, bodies=bodies, input="crank", sliders=(slider,))
+
+
+class SliderCrankMechanism(Mechanism):
+    """The slider-crank (``type = "slider-crank"``)."""
+
+    kind = "slider-crank"
+    formulations = {
+        "mass-matrix": ("balancer.slider_crank.formulations", "SliderMassMatrix"),
+        "complex-masses": ("balancer.slider_crank.formulations", "SliderComplexMasses"),
+    }
+    verify_method = "complex-masses"
+
+    @cached_property
+    def linkage(self) -> Linkage:
+        return slider_crank_linkage(self.model)
+
+    def describe(self) -> str:
+        return closed.classify(self.model.lengths)
+
+    def assembly_range(self) -> AssemblyRange:
+        return closed.assembly_range(self.model.lengths)
+
+    def _full_turn_rule(self) -> str:
+        return " (crank + |offset| < rod)"
+
+    def inverse_dynamics(self, mo: Motion, *, route: str | None = None, loads: bool = True,
+                         gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
+        if (route or self.routes[0]) != "mass-matrix":
+            return super().inverse_dynamics(mo, route=route, loads=loads, gravity=gravity)
+        from ..slider_crank.dynamics import mass_matrix
+
+        smo = closed.motion_of(self.model, mo.theta1, mo.omega1, mo.alpha1)
+        r = mass_matrix(self.model, smo, gravity=gravity, loads=loads)
+        col = (lambda z: np.asarray(z)[:, None] * np.ones((mo.theta1.size, 1)))
+        return Forces(
+            reactions={"A0": V(col(np.real(r.RA0)), col(np.imag(r.RA0)))},
+            # the normal force on the guide acts on the line x = guide_line: at the pin it is
+            # the same force and the couple (x_line − x_pin)·N
+            slider_normal={"slider": col(np.imag(r.RA3))},
+            slider_couple={"slider": col((r.guide_line - np.real(smo.A2)) * np.imag(r.RA3))},
+            driving_torque=col(r.driving_torque),
+            shaking_force=V(col(np.real(r.shaking_force)), col(np.imag(r.shaking_force))),
+            shaking_moment=col(r.shaking_moment))
