@@ -34,6 +34,7 @@ METHODS: tuple[str, ...] = ("opened-loop", "complex-masses", "mass-matrix", "lie
 METHODS_BY_TYPE: dict[str, tuple[str, ...]] = {
     "four-bar": METHODS,
     "slider-crank": ("mass-matrix", "complex-masses"),
+    "linkage": (),
 }
 #: Ways the crank can be driven in a simulation.
 DRIVES: tuple[str, ...] = ("free", "constant-speed")
@@ -866,8 +867,8 @@ class Design:
 
         Keys are the spec's, from its root.
         """
-        if not isinstance(self.mechanism, FourBar | SliderCrank):
-            raise SpecError("must be a FourBar or a SliderCrank", key="mechanism",
+        if not isinstance(self.mechanism, FourBar | SliderCrank | Linkage):
+            raise SpecError("must be a FourBar, a SliderCrank or a Linkage", key="mechanism",
                             value=type(self.mechanism).__name__)
         for name, cls in (("operation", Operation), ("simulation", SimulationSettings)):
             value = getattr(self, name)
@@ -898,8 +899,11 @@ def check_scales(mechanism, speeds: dict[str, float],
     (the largest speed of a motion and its gravity).
     """
     links = dict(zip(mechanism.link_names, mechanism.links, strict=True))
-    reach_terms = {f"mechanism.lengths.{n}": abs(x)
-                   for n, x in zip(mechanism.length_names, mechanism.lengths, strict=True)}
+    if isinstance(mechanism, Linkage):
+        reach_terms = {f"mechanism.points.{p}": math.hypot(*xy) for p, xy in mechanism.points}
+    else:
+        reach_terms = {f"mechanism.lengths.{n}": abs(x)
+                       for n, x in zip(mechanism.length_names, mechanism.lengths, strict=True)}
     for name, link in links.items():
         reach_terms[f"links.{name}.com"] = math.hypot(link.e, link.f)
     reach_key = max(reach_terms, key=reach_terms.__getitem__)
@@ -917,10 +921,13 @@ def check_scales(mechanism, speeds: dict[str, float],
         moments += [mass + r + r + w2, mass + g_abs + r, force + r, inertia + w2,
                     [(f"links.{name}.moment", link.moment)]]
         energies += [inertia + w2, mass + r + r + w2]
-    if isinstance(mechanism, SliderCrank) and not mechanism.gas_force.is_zero:
-        gas = [("links.slider.gas_force", max(abs(x) for x in mechanism.gas_force.values))]
-        forces.append(gas)
-        moments.append(gas + r)
+    gas_forces = ([mechanism.gas_force] if isinstance(mechanism, SliderCrank) else
+                  [s.force for s in mechanism.sliders] if isinstance(mechanism, Linkage) else [])
+    for g in gas_forces:
+        if not g.is_zero:
+            gas = [("links.slider.gas_force", max(abs(x) for x in g.values))]
+            forces.append(gas)
+            moments.append(gas + r)
     v.check_magnitudes(forces, "the forces", "N")
     v.check_magnitudes(moments, "the moments", "N·m")
     v.check_magnitudes(energies, "the kinetic energy", "J")

@@ -38,6 +38,7 @@ Every error names the file, the key and the value; unknown keys are errors (a ty
 
 from __future__ import annotations
 
+import cmath
 import difflib
 import math
 import os
@@ -49,18 +50,23 @@ from typing import Any
 from . import validate as v
 from .errors import SpecError
 from .model import (
+    GROUND,
     METHODS_BY_TYPE,
+    Body,
     Design,
     FourBar,
     GasForce,
     Link,
+    Linkage,
     Operation,
     SimulationSettings,
+    Slider,
     SliderCrank,
+    Spring,
 )
 from .outputs import write_atomic
 
-MECHANISMS = {"four-bar": FourBar, "slider-crank": SliderCrank}
+MECHANISMS = {"four-bar": FourBar, "slider-crank": SliderCrank, "linkage": Linkage}
 MECHANISM_TYPES = tuple(MECHANISMS)
 
 
@@ -180,12 +186,14 @@ def _generic(path: str) -> str:
 
 
 _KNOWN_KEYS: dict[str, tuple[str, ...]] = {
-    "": ("title", "mechanism", "links", "operation", "simulation", "balance", "original"),
-    "mechanism": ("type", "branch", "lengths"),
-    "links.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor", "gas_force"),
+    "": ("title", "mechanism", "links", "springs", "operation", "simulation", "balance",
+         "original"),
+    "mechanism": ("type", "branch", "lengths", "input", "points", "sliders"),
+    "links.*": ("points", "mass", "inertia", "com", "force", "moment", "counter_rotor",
+                "gas_force"),
     "original.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor", "gas_force"),
-    "links.*.com": ("s", "sigma", "e", "f"),
-    "original.*.com": ("s", "sigma", "e", "f"),
+    "links.*.com": ("s", "sigma", "e", "f", "at"),
+    "original.*.com": ("s", "sigma", "e", "f", "at"),
     "operation": ("speed", "samples"),
     "simulation": (
         "duration",
@@ -214,8 +222,12 @@ def _as_number(
 # Reading
 
 
-def _read_link(table: _Table, name: str, mechanism_class) -> Link:
-    """One link; its values are checked by :class:`~balancer.model.Link` (keys prefixed)."""
+def _read_link(table: _Table, name: str, mechanism_class, frame=None) -> Link:
+    """One link; its values are checked by :class:`~balancer.model.Link` (keys prefixed).
+
+    ``frame`` (a general linkage's link: its origin, complex, and its x-axis's angle at the
+    reference pose) allows ``com = { at = [x, y] }``, the centre of mass's global position.
+    """
     slider = mechanism_class is SliderCrank and name == "slider"
     if not table.has("mass"):
         raise table._missing("mass")
@@ -228,12 +240,21 @@ def _read_link(table: _Table, name: str, mechanism_class) -> Link:
     assert com is not None
     polar = com.has("s") or com.has("sigma")
     cartesian = com.has("e") or com.has("f")
-    if polar and cartesian:
+    at = com.has("at")
+    if polar + cartesian + at > 1:
         raise SpecError(
-            "give the centre of mass either as {s, sigma} or as {e, f}, not both",
+            "give the centre of mass one way: {s, sigma}, {e, f} or {at = [x, y]}",
             key=com.path,
         )
-    if polar:
+    if at:
+        if frame is None:
+            raise SpecError("at = [x, y] is for the links of a general linkage (type = "
+                            '"linkage"); give {e, f} or {s, sigma}', key=com.key("at"))
+        origin, angle = frame
+        x, y = com.vector2("at", default=(0.0, 0.0))
+        local = (complex(x, y) - origin) * cmath.exp(-1j * angle)
+        e, f = local.real, local.imag
+    elif polar:
         s = com.nonnegative("s")
         sigma = com.number("sigma")
         e, f = s * math.cos(sigma), s * math.sin(sigma)
@@ -241,7 +262,8 @@ def _read_link(table: _Table, name: str, mechanism_class) -> Link:
         e = com.number("e")
         f = com.number("f")
     else:
-        raise SpecError("missing required key: give {s, sigma} or {e, f}", key=com.path)
+        raise SpecError("missing required key: give {s, sigma}, {e, f} or {at = [x, y]}",
+                        key=com.path)
     com.finish()
     if table.has("gas_force") and not slider:
         raise SpecError("only a slider carries a gas force", key=table.key("gas_force"))
@@ -296,11 +318,14 @@ def _read_links(table: _Table, mechanism_class) -> tuple[dict[str, Link], GasFor
     return links, gas
 
 
-def _read_mechanism(root: _Table) -> FourBar | SliderCrank:
+def _read_mechanism(root: _Table) -> FourBar | SliderCrank | Linkage:
     mech = root.table("mechanism")
     assert mech is not None
     kind = mech.string("type", choices=MECHANISM_TYPES)
     cls = MECHANISMS[kind]
+    if cls is Linkage:
+        return _read_linkage(root, mech)
+    mech.expect(("type", "branch", "lengths"))
     branch = mech.string("branch", choices=("+", "-"), default="+")
     lengths_table = mech.table("lengths")
     assert lengths_table is not None
@@ -323,6 +348,111 @@ def _read_mechanism(root: _Table) -> FourBar | SliderCrank:
     if cls is SliderCrank:
         return SliderCrank(lengths=tuple(lengths), branch=branch, gas_force=gas, **links)  # type: ignore[arg-type]
     return FourBar(lengths=tuple(lengths), branch=branch, **links)  # type: ignore[arg-type]
+
+
+def _list_of_tables(table: _Table, name: str) -> list[_Table]:
+    """An array of tables (``[[name]]``), each as a :class:`_Table` with an indexed path."""
+    if not table.has(name):
+        return []
+    raw = table.raw(name)
+    key = table.key(name)
+    if not isinstance(raw, list) or not all(isinstance(item, dict) for item in raw):
+        raise SpecError(f"must be an array of tables ([[{key}]])", key=key, value=raw)
+    return [_Table(item, f"{key}[{i}]") for i, item in enumerate(raw)]
+
+
+def _names(table: _Table, name: str) -> tuple[str, ...]:
+    """A required list of names (strings)."""
+    if not table.has(name):
+        raise table._missing(name)
+    raw = table.raw(name)
+    if not isinstance(raw, list) or not all(isinstance(x, str) for x in raw):
+        raise SpecError("must be a list of names", key=table.key(name), value=raw)
+    return tuple(raw)
+
+
+def _read_linkage(root: _Table, mech: _Table) -> Linkage:
+    """A general linkage (``type = "linkage"``; DESIGN.md, "General planar linkages")."""
+    mech.expect(("type", "input", "points", "sliders"))
+    if not mech.has("input"):
+        raise mech._missing("input")
+    input_name = mech.raw("input")
+    if not isinstance(input_name, str):
+        raise SpecError("must be the name of a link", key=mech.key("input"), value=input_name)
+    points_table = mech.table("points")
+    assert points_table is not None
+    points_table.known = tuple(points_table.data)
+    points = {p: points_table.vector2(p, default=(0.0, 0.0)) for p in points_table.data}
+    points_table.finish()
+    sliders = []
+    for sub in _list_of_tables(mech, "sliders"):
+        sub.expect(("link", "guide", "point", "direction"))
+        fields = {}
+        for attr in ("link", "guide", "point"):
+            if not sub.has(attr):
+                raise sub._missing(attr)
+            value = sub.raw(attr)
+            if not isinstance(value, str):
+                raise SpecError("must be a name", key=sub.key(attr), value=value)
+            fields[attr] = value
+        if not sub.has("direction"):
+            raise sub._missing("direction")
+        fields["direction"] = sub.vector2("direction", default=(1.0, 0.0))
+        sub.finish()
+        sliders.append(fields)
+    mech.finish()
+    links_table = root.table("links")
+    assert links_table is not None
+    links_table.known = tuple(links_table.data)
+    positions = {p: complex(*xy) for p, xy in points.items()}
+    bodies = []
+    for name in links_table.data:
+        sub = links_table.table(name)
+        assert sub is not None
+        if name == GROUND:
+            sub.expect(("points",))
+            bodies.append(Body(name=name, points=_names(sub, "points")))
+            sub.finish()
+            continue
+        sub.expect(("points", "mass", "inertia", "com", "force", "moment", "counter_rotor"))
+        link_points = _names(sub, "points")
+        frame = _frame(name, link_points, positions, sliders)
+        props = _read_link(sub, name, Linkage, frame)
+        sub.finish()
+        bodies.append(Body(name=name, points=link_points, props=props))
+    links_table.finish()
+    springs = []
+    for sub in _list_of_tables(root, "springs"):
+        sub.expect(("points", "stiffness", "free_length"))
+        for k in ("stiffness", "free_length"):
+            if not sub.has(k):
+                raise sub._missing(k)
+        with v.under(sub.path):
+            springs.append(Spring(points=_names(sub, "points"), stiffness=sub.raw("stiffness"),
+                                  free_length=sub.raw("free_length")))
+        sub.finish()
+    return Linkage(points=tuple(points.items()), bodies=tuple(bodies), input=input_name,
+                   sliders=tuple(Slider(**f) for f in sliders), springs=tuple(springs))
+
+
+def _frame(name: str, link_points, positions, sliders) -> tuple[complex, float] | None:
+    """A general linkage's link frame at the reference pose: origin and x-axis angle.
+
+    ``None`` if its points are not all known yet (the model then reports what is wrong).
+    """
+    if not link_points or any(p not in positions for p in link_points):
+        return None
+    origin = positions[link_points[0]]
+    if len(link_points) > 1:
+        axis = positions[link_points[1]] - origin
+    else:
+        mine = [s for s in sliders if s.get("link") == name]
+        if len(mine) != 1:
+            return None
+        axis = complex(*mine[0]["direction"])
+    if axis == 0:
+        return None
+    return origin, math.atan2(axis.imag, axis.real)
 
 
 def _read_operation(root: _Table) -> Operation | None:

@@ -281,7 +281,9 @@ def _assembly_range(structure: Structure) -> AssemblyRange:
             continue
         lo, hi = sorted((t, t + direction * step))
         good_is_lo = direction == 1
-        f = (lambda x: at(x) - GAP_TOLERANCE)
+        def f(x: float) -> float:
+            return at(x) - GAP_TOLERANCE
+
         try:
             edge = brentq(f, lo, hi, xtol=1e-12) if f(lo) * f(hi) < 0 else (
                 lo if good_is_lo else hi)

@@ -97,7 +97,9 @@ class FourBarMechanism(Mechanism):
 
         r = mass_matrix(self.model, fourbar_motion(self.model, mo), gravity=gravity,
                         loads=loads)
-        col = (lambda z: np.asarray(z)[:, None])
+        def col(z):
+            return np.asarray(z)[:, None]
+
         return Forces(
             reactions={"A0": V(col(r.RA0.real), col(r.RA0.imag)),
                        "A3": V(col(r.RA3.real), col(r.RA3.imag))},

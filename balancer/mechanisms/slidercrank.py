@@ -79,7 +79,9 @@ class SliderCrankMechanism(Mechanism):
 
         smo = closed.motion_of(self.model, mo.theta1, mo.omega1, mo.alpha1)
         r = mass_matrix(self.model, smo, gravity=gravity, loads=loads)
-        col = (lambda z: np.asarray(z)[:, None] * np.ones((mo.theta1.size, 1)))
+        def col(z):
+            return np.asarray(z)[:, None] * np.ones((mo.theta1.size, 1))
+
         return Forces(
             reactions={"A0": V(col(np.real(r.RA0)), col(np.imag(r.RA0)))},
             # the normal force on the guide acts on the line x = guide_line: at the pin it is

@@ -1,0 +1,1 @@
+"""Balancing: force-balance conditions found from the mechanism, the redesign problem, solvers."""

@@ -1,0 +1,178 @@
+"""Shaking-force balance of any linkage: linear conditions found from the linkage itself.
+
+The total first moment of mass of the moving links, ``Σ_k (m_k·r̄_Ok + R(θ_k)·(m·s̄)_k)``, is
+linear in the design vector ``π`` (:class:`balancer.linkage.dynamics.Layout`) with coefficients
+that are functions of the crank angle: ``G(θ1)·π``. The shaking force vanishes for every motion
+exactly when the total centre of mass is stationary, ``(G(θ1) − G(θ0))·π = 0`` for all θ1
+(DESIGN.md; Meijaard & van der Wijk 2020, Eq. 57–58 for the four-bar; Wunderlich 1964, Eq. 10d
+and 20a–b). Those coefficient functions span a space of finite dimension, so the conditions are
+the row space of their variation sampled at enough angles: an SVD gives it, with a rank test in
+units where every column is a mass (the first moments' columns, and a mass column times a
+length) so that no link's size hides a condition, and a clear gap between the singular values
+kept and those of rounding. The conditions are then checked at angles not used to find them:
+a condition missed by the sampling would show there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import SolverError
+
+#: Singular values below this share of the largest are rounding (a condition that holds).
+NULL_TOLERANCE = 1e-11
+#: Singular values kept must be above this share of the largest: a clear gap, or the rank is
+#: in doubt.
+KEPT_TOLERANCE = 1e-7
+#: A residual below this (relative to the size of its terms) is rounding: force-balanced.
+RESIDUAL_FLOOR = 1e-9
+#: Samples per design-vector entry (and at least :data:`MIN_SAMPLES`) to find the conditions.
+SAMPLES_PER_ENTRY = 6
+MIN_SAMPLES = 64
+
+
+@dataclass(frozen=True)
+class ForceBalance:
+    """The force-balance conditions ``A·π = 0`` of a mechanism.
+
+    Attributes
+    ----------
+    matrix
+        ``A``, one row per condition, columns in the layout's order (kg per unit of the
+        entry: rows of unit norm in the scaled parameters).
+    scales
+        The column scales used (``L`` for a mass, 1 for a first moment), m or 1.
+    singular_values
+        All singular values of the sampled variation, largest first (for diagnosis).
+    """
+
+    matrix: NDArray[np.float64]
+    scales: NDArray[np.float64]
+    singular_values: NDArray[np.float64]
+    links: tuple[slice, ...] = ()
+
+    @property
+    def count(self) -> int:
+        """Number of independent conditions."""
+        return self.matrix.shape[0]
+
+    def rows(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Each condition's residual relative to the size of its terms.
+
+        The size is the sum over links of each link's contribution (its entries combined
+        first: a heavy link whose centre of mass sits on its pivot contributes nothing and
+        must not hide a light link's unbalance), at least the raw terms' rounding,
+        ``64·ε·Σ_j |A_ij·x_j|``, over :data:`RESIDUAL_FLOOR`.
+        """
+        x = np.asarray(x, dtype=float)
+        terms = self.matrix * x
+        combined = sum(np.abs(terms[:, s].sum(axis=1)) for s in self.links) if self.links \
+            else np.abs(terms).sum(axis=1)
+        raw = np.abs(terms).sum(axis=1)
+        eps = np.finfo(float).eps
+        size = np.maximum(np.maximum(combined, 64 * eps / RESIDUAL_FLOOR * raw), 1e-300)
+        return np.abs(terms.sum(axis=1)) / size
+
+    def residual(self, x: NDArray[np.float64]) -> float:
+        """The largest condition's residual relative to the size of its terms (0: balanced).
+
+        Dimensionless: the shaking force's first moment of mass left over, over the first
+        moments that make it.
+        """
+        return float(np.max(self.rows(x), initial=0.0))
+
+
+def first_moment_map(mech, theta1: NDArray[np.float64]) -> NDArray[np.complex128]:
+    """``G(θ1)``: the moving links' total first moment of mass per unit design entry.
+
+    Shape ``(N, P)``, complex (x + i·y), kg·m per kg (mass entries) or per kg·m (first
+    moments); inertias and counter-rotors do not enter.
+    """
+    layout, structure = mech.layout, mech.structure
+    with np.errstate(all="ignore"):
+        mo = mech.motion(theta1)
+    g = np.zeros((theta1.size, layout.size), dtype=complex)
+    for k, name in enumerate(structure.names):
+        s = layout.link_slice(name)
+        c, sn = mo.pose.cos[k], mo.pose.sin[k]
+        g[:, s.start] = mo.pose.origins[k].complex()
+        g[:, s.start + 1] = c + 1j * sn
+        g[:, s.start + 2] = -sn + 1j * c
+    return g
+
+
+def _angles(mech, count: int, rng: np.random.Generator) -> NDArray[np.float64]:
+    """Crank angles where the mechanism assembles, spread over its range (seeded)."""
+    r = mech.assembly_range()
+    if r.full:
+        lo, hi = 0.0, 2 * np.pi
+    else:
+        lo, hi = r.intervals[0]
+        pad = 1e-3 * (hi - lo)
+        lo, hi = lo + pad, hi - pad
+    base = lo + (hi - lo) * (np.arange(count) + 0.5) / count
+    return base + (hi - lo) / count * 0.4 * rng.uniform(-1, 1, count)
+
+
+def force_balance_conditions(mech) -> ForceBalance:
+    """The conditions of shaking-force balance of a mechanism (see the module docstring).
+
+    Cached on the mechanism's structure (they depend on its geometry only).
+
+    Raises
+    ------
+    SolverError
+        If the sampled singular values show no clear gap, or the conditions do not hold at
+        fresh angles (the rank cannot be trusted).
+    """
+    cache = mech.structure.cache
+    if "force balance" in cache:
+        return cache["force balance"]
+    layout = mech.layout
+    length = mech.structure.length_scale()
+    scales = np.ones(layout.size)
+    for name in mech.structure.names:
+        scales[layout.index(name, "m")] = length
+    count = max(MIN_SAMPLES, SAMPLES_PER_ENTRY * layout.size)
+    rng = np.random.default_rng(20260101)  # the same angles every run
+    theta = _angles(mech, count, rng)
+    g = first_moment_map(mech, theta)
+    d = g - g.mean(axis=0)
+    d = np.vstack([d.real, d.imag]) / scales  # columns in units of a first moment
+    _, sv, vt = np.linalg.svd(d, full_matrices=True)
+    top = sv[0] if sv.size else 0.0
+    if top == 0:
+        result = ForceBalance(matrix=np.zeros((0, layout.size)), scales=scales,
+                              singular_values=sv)
+        cache["force balance"] = result
+        return result
+    kept = sv > NULL_TOLERANCE * top
+    rank = int(np.sum(kept))
+    if np.any((sv > NULL_TOLERANCE * top) & (sv < KEPT_TOLERANCE * top)):
+        raise SolverError(
+            "the force-balance conditions cannot be told from rounding: singular values "
+            f"{', '.join(f'{x / top:.1e}' for x in sv)} of the largest show no clear gap")
+    rows = vt[:rank]
+    # Check at fresh angles that the null space found is stationary there too.
+    fresh = _angles(mech, count, np.random.default_rng(20260102)) + np.pi / count
+    if not mech.assembly_range().full:
+        fresh = np.clip(fresh, theta.min(), theta.max())
+    gf = first_moment_map(mech, fresh)
+    df = gf - gf.mean(axis=0)
+    df = np.vstack([df.real, df.imag]) / scales
+    null = vt[rank:].T
+    if null.size and np.max(np.abs(df @ null)) > 1e3 * NULL_TOLERANCE * top:
+        raise SolverError("the force-balance conditions found at sampled angles do not hold "
+                          "at others: the sampling missed a condition")
+    links = tuple(layout.link_slice(name) for name in mech.structure.names)
+    result = ForceBalance(matrix=rows * scales, scales=scales, singular_values=sv, links=links)
+    cache["force balance"] = result
+    return result
+
+
+def force_balance_residual(mech) -> float:
+    """How far a mechanism's own design is from shaking-force balance (0: balanced)."""
+    return force_balance_conditions(mech).residual(mech.parameters())
