@@ -172,8 +172,8 @@ def _cmd_verify(args: argparse.Namespace) -> int:
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
     from .api import analyze
+    from .balance.optimizer import optimize
     from .errors import SolverError
-    from .optimize import optimize
     from .outputs import write_atomic
     from .report import dumps_json, optimization_json, optimization_text
     from .spec import dumps_design, load_design, loads_design

@@ -243,7 +243,7 @@ def _read_link(table: _Table, name: str, mechanism_class, frame=None) -> Link:
     at = com.has("at")
     if polar + cartesian + at > 1:
         raise SpecError(
-            "give the centre of mass one way: {s, sigma}, {e, f} or {at = [x, y]}",
+            "give the centre of mass either as {s, sigma}, {e, f} or {at = [x, y]}, not two",
             key=com.path,
         )
     if at:
@@ -508,7 +508,7 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
         simulation = _read_simulation(root, mechanism)
         balance = None
         if root.has("balance"):
-            from .problem import read_balance  # the redesign problem's own reader
+            from .balance.problem import read_balance  # the redesign problem's own reader
 
             balance = read_balance(root.table("balance"), mechanism)
         original = _read_original(root, mechanism)
@@ -654,7 +654,7 @@ def dumps_design(design: Design) -> str:
         f"outputs = {_num(sim.outputs)}",
     ]
     if design.balance is not None:
-        from .problem import balance_lines
+        from .balance.problem import balance_lines
 
         out += ["", *balance_lines(design.balance)]
     if design.original is not None:

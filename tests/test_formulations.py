@@ -7,14 +7,17 @@ import math
 import numpy as np
 import pytest
 from conftest import CLASS_EXAMPLES, paper_linkage, random_angles, random_link, random_linkage
-from helpers import rel_err
+from helpers import drift_bound, growth, integration_bound, rel_err
 
 from balancer import inverse
 from balancer import kinematics as kin
 from balancer.errors import LockupError
 from balancer.formulations import make
 from balancer.model import METHODS, FourBar, Link, SimulationSettings
-from balancer.simulate import simulate
+from balancer.simulate import DEAD_POINT_THRESHOLD, simulate
+
+#: Tight integrator tolerances for comparing formulations.
+TIGHT = {"rtol": 1e-11, "atol": 1e-13}
 
 
 def _states(seed, n=60):
@@ -35,6 +38,10 @@ def _states(seed, n=60):
 @pytest.mark.parametrize("driven", [False, True])
 def test_formulations_agree_with_each_other_and_newton_euler(linkage, theta1, omega1, gravity,
                                                              driven):
+    # Formulations at one state agree to DESIGN.md's 1e-9 relative: _states keeps
+    # |sin(θ3 − θ2)| ≥ 0.05, which bounds the condition of the position and rate analyses (≤ 20)
+    # and of the equations of motion. Angles and rates come from the position and rate analyses
+    # alone (no equations of motion): rounding, ≤ ROUNDING·20 ≈ 3e-13 relative, within 1e-12.
     speed = omega1 if driven else None
     evals = {}
     for name in METHODS:
@@ -60,38 +67,54 @@ def test_formulations_agree_with_each_other_and_newton_euler(linkage, theta1, om
         assert np.max(np.abs(d)) < 1e-12, name
 
 
+#: The paper's example (Eq. 56): free from rest at θ1 = 1 rad for 5 s, no gravity.
+PAPER_FREE = SimulationSettings(duration=5.0, theta1=1.0, omega1=0.0)
+
+
 @pytest.fixture(scope="module")
 def paper_runs():
-    """The paper's example (Eq. 56): free from rest at θ1 = 1 rad for 5 s, no gravity."""
-    settings = SimulationSettings(duration=5.0, theta1=1.0, omega1=0.0)
-    return {m: simulate(paper_linkage(), settings, method=m, rtol=1e-11, atol=1e-13)
-            for m in METHODS}
+    """The paper's example by every formulation."""
+    return {m: simulate(paper_linkage(), PAPER_FREE, method=m, **TIGHT) for m in METHODS}
 
 
-def test_paper_example_final_states_agree(paper_runs):
+@pytest.fixture(scope="module")
+def paper_growth(paper_runs):
+    """How much the paper's free motion amplifies integration errors (helpers.growth)."""
+    return growth(simulate, paper_linkage(), PAPER_FREE, method="complex-masses", **TIGHT,
+                  reference=paper_runs["complex-masses"])
+
+
+def test_paper_example_final_states_agree(paper_runs, paper_growth):
     ref = paper_runs["opened-loop"]
     for name, tr in paper_runs.items():
         for key in ("theta", "omega", "alpha"):
             a = np.array(tr.state(-1)[key])
             b = np.array(ref.state(-1)[key])
-            assert np.max(np.abs(a - b)) < 1e-8, (name, key)
+            # Two integrations of one free motion: their bounds, amplified by the motion.
+            tol = paper_growth.bound(lambda run, key=key: getattr(run, key), tr, ref)
+            assert np.max(np.abs(a - b)) < tol, (name, key)
         for key in ("theta", "omega", "alpha"):
+            # No integration yet: rounding at the paper's well-conditioned start
+            # (|sin(θ3 − θ2)| ≈ 0.9), ~ROUNDING·|value| ≈ 1e-14, within 1e-12.
             assert tr.state(0)[key] == pytest.approx(ref.state(0)[key], abs=1e-12)
 
 
-def test_paper_example_reaction_histories_agree(paper_runs):
+def test_paper_example_reaction_histories_agree(paper_runs, paper_growth):
     ref = paper_runs["opened-loop"]
-    scale = max(np.max(np.abs(ref.RA0)), np.max(np.abs(ref.RA3)))
     for name, tr in paper_runs.items():
         assert np.array_equal(tr.t, ref.t)
-        assert np.max(np.abs(tr.RA0 - ref.RA0)) < 1e-8 * scale, name
-        assert np.max(np.abs(tr.RA3 - ref.RA3)) < 1e-8 * scale, name
+        for key in ("RA0", "RA3"):
+            # Reactions along two integrations of one free motion: their bounds, amplified.
+            tol = paper_growth.bound(lambda run, key=key: getattr(run, key), tr, ref)
+            assert np.max(np.abs(getattr(tr, key) - getattr(ref, key))) < tol, (name, key)
 
 
 def test_paper_example_energy_and_drift(paper_runs):
     for name, tr in paper_runs.items():
-        assert tr.energy_error < 1e-9, name
-        assert tr.drift[0] < 1e-10 and tr.drift[1] < 1e-10, name
+        # T − T0 − W is a first integral; T is quadratic in the rates: twice the bound.
+        assert tr.energy_error < 2 * integration_bound(tr), name
+        pos, vel = drift_bound(tr, paper_linkage().lengths)
+        assert tr.drift[0] < pos and tr.drift[1] < vel, name
         # The loads do work: the kinetic energy really changes.
         assert np.ptp(tr.kinetic_energy) > 0.1
 
@@ -103,9 +126,12 @@ def test_paper_example_reactions_are_the_inverse_dynamics_of_the_motion(paper_ru
     linkage = paper_linkage()
     mo = kin.motion_of(linkage, tr.theta[0], tr.omega[0], tr.alpha[0])
     ne = inverse.newton_euler(linkage, mo)
+    # Two routes at the same states (no integration between them): DESIGN.md's 1e-9 relative;
+    # the paper's motion keeps |sin(θ3 − θ2)| ≥ 0.7. A torque's scale is a force's times a
+    # length (N·m).
     scale = np.max(np.abs(tr.RA0))
     assert np.max(np.abs(ne.RA0 - tr.RA0)) < 1e-9 * scale
-    assert np.max(np.abs(ne.driving_torque)) < 1e-9 * scale
+    assert np.max(np.abs(ne.driving_torque)) < 1e-9 * scale * max(linkage.lengths)
 
 
 def _bai(lengths):
@@ -120,19 +146,33 @@ def _bai(lengths):
 
 def test_bai_crank_rocker_with_gravity():
     linkage = _bai((0.12, 0.25, 0.26, 0.3))
-    # Their initial attitudes: q_A = (1, 0), q_B = (0.3044, 0.9534), q_D = (−0.3996, 0.9167);
-    # printed to four digits (their q_B has length 1.0008), so they agree to about 1e-3.
+    # Their initial attitudes: q_A = (1, 0), q_B = (0.3044, 0.9534), q_D = (−0.3996, 0.9167),
+    # printed to four digits. Their q_B has length 1.0008: their state closes the loop with a
+    # coupler 0.25·|q_B| long (the printed vectors lie within √2·5e-5, half a unit of the
+    # fourth digit in each component, of that solution). Ours differ from theirs by what that
+    # length changes in the position analysis, plus that rounding.
+    q_b, q_d = complex(0.3044, 0.9534), complex(-0.3996, 0.9167)
     pos = kin.position_of(linkage, 0.0)
-    assert abs(pos.l2[0] / 0.25 - complex(0.3044, 0.9534)) < 2e-3
-    assert abs(-pos.l3[0] / 0.26 - complex(-0.3996, 0.9167)) < 2e-3
+    lengths = list(linkage.lengths)
+    lengths[1] *= abs(q_b)
+    theirs = kin.position(tuple(lengths), 0.0, linkage.branch)
+    rounding = math.sqrt(2) * 5e-5
+    assert abs(pos.l2[0] / 0.25 - q_b) < abs(theirs.l2[0] - pos.l2[0]) / 0.25 + rounding
+    assert abs(-pos.l3[0] / 0.26 - q_d) < abs(theirs.l3[0] - pos.l3[0]) / 0.26 + rounding
     settings = SimulationSettings(duration=5.0, theta1=0.0, omega1=0.0, gravity=(0.0, -9.81))
-    runs = {m: simulate(linkage, settings, method=m, rtol=1e-11, atol=1e-13) for m in METHODS}
+    runs = {m: simulate(linkage, settings, method=m, **TIGHT) for m in METHODS}
     ref = runs["opened-loop"]
+    amplified = growth(simulate, linkage, settings, method="complex-masses", **TIGHT,
+                       reference=runs["complex-masses"])
     for name, tr in runs.items():
-        assert tr.energy_error < 1e-9, name
-        assert np.max(np.abs(tr.theta[:, -1] - ref.theta[:, -1])) < 1e-8, name
-    # With gravity only, energy is conserved: the motion is periodic and returns to rest height.
-    assert np.max(np.abs(ref.work + (ref.kinetic_energy[0] - ref.kinetic_energy))) < 1e-9
+        assert tr.energy_error < 2 * integration_bound(tr), name  # first integral, quadratic
+        tol = amplified.bound(lambda run: run.theta, tr, ref)  # one free motion, amplified
+        assert np.max(np.abs(tr.theta[:, -1] - ref.theta[:, -1])) < tol, name
+    # With gravity only, energy is conserved: the motion is periodic and returns to rest height
+    # (to the first integral's bound, relative to the energies).
+    scale = max(np.max(np.abs(ref.kinetic_energy)), np.max(np.abs(ref.work)))
+    assert np.max(np.abs(ref.work + (ref.kinetic_energy[0] - ref.kinetic_energy))) < (
+        2 * integration_bound(ref) * scale)
 
 
 def test_bai_parallelogram_keeps_its_coupler_parallel():
@@ -141,16 +181,23 @@ def test_bai_parallelogram_keeps_its_coupler_parallel():
     # Their initial attitudes q0 = [0.6; 0.8; 1; 0; 0.6; 0.8], momentum 0.
     settings = SimulationSettings(duration=5.0, theta1=math.atan2(0.8, 0.6), omega1=0.0,
                                   gravity=(0.0, -9.81))
-    runs = {m: simulate(linkage, settings, method=m, rtol=1e-11, atol=1e-13) for m in METHODS}
+    runs = {m: simulate(linkage, settings, method=m, **TIGHT) for m in METHODS}
     ref = runs["complex-masses"]
+    amplified = growth(simulate, linkage, settings, method="complex-masses", **TIGHT,
+                       reference=ref)
     for name, tr in runs.items():
+        # Not integration error: every state is projected onto the loop closure (to 1e-15·Σl,
+        # or put on the smooth assembly near a change point), which holds the parallelogram;
+        # rounding of angles of a few radians and of that projection, within 1e-12.
         assert np.max(np.abs(np.sin(tr.theta[1]))) < 1e-12, name  # coupler ∥ frame
         rocker = np.remainder(tr.theta[2] - tr.theta[0], 2 * np.pi)  # rocker ∥ crank
         assert np.max(np.abs(rocker - np.pi)) < 1e-12, name
-        assert tr.energy_error < 1e-8, name
+        assert tr.energy_error < 2 * integration_bound(tr), name  # first integral, quadratic
         # It swings through both change points (θ1 = 0 and −π) like a pendulum.
         assert tr.theta[0].min() < -np.pi < 0 < tr.theta[0].max()
-        assert np.max(np.abs(tr.theta[0] - ref.theta[0])) < 1e-7, name
+        # A pendulum shears its errors into a phase error: the bound, amplified by the motion.
+        tol = amplified.bound(lambda run: run.theta[0], tr, ref)
+        assert np.max(np.abs(tr.theta[0] - ref.theta[0])) < tol, name
 
 
 def _triple_rocker():
@@ -165,34 +212,55 @@ def test_non_minimal_formulations_swing_through_a_dead_point():
     rng = kin.assembly_range(linkage.lengths)
     (lo, hi), = rng.intervals
     settings = SimulationSettings(duration=3.0, theta1=0.0, omega1=6.0)
-    runs = {m: simulate(linkage, settings, method=m, rtol=1e-11, atol=1e-13)
+    runs = {m: simulate(linkage, settings, method=m, **TIGHT)
             for m in ("opened-loop", "mass-matrix")}
     ref = runs["opened-loop"]
-    # The crank turns back at the ends of its range, where coupler and rocker align.
-    assert ref.theta[0].max() <= hi + 1e-9 and ref.theta[0].max() > hi - 1e-3
+    # The crank turns back at the ends of its range, where coupler and rocker align. Beyond hi
+    # the loop cannot close: the closure's residual grows at d|A1A3|/dθ1 = l1·l4·sin(hi)/(l2 +
+    # l3) per radian, and the projected states keep it within one step's drift.
+    l1, l2, l3, l4 = linkage.lengths
+    overshoot = drift_bound(ref, linkage.lengths)[0] * (l2 + l3) / (l1 * l4 * abs(math.sin(hi)))
+    # The crank stops there (ω1 = 0): the nearest output, within half an output step Δt/2 of
+    # it, is below hi by at most ½·|α1|·(Δt/2)², α1 taken at the outputs around it.
+    top = int(np.argmax(ref.theta[0]))
+    dt = ref.t[1] - ref.t[0]
+    sampling = 0.5 * np.max(np.abs(ref.alpha[0][max(top - 1, 0) : top + 2])) * (dt / 2) ** 2
+    assert hi - sampling < ref.theta[0].max() <= hi + overshoot
     assert np.any(np.diff(np.sign(np.sin(ref.theta[2] - ref.theta[1]))) != 0)
+    amplified = growth(simulate, linkage, settings, method="opened-loop", **TIGHT, reference=ref)
     for name, tr in runs.items():
-        assert tr.energy_error < 1e-8, name
-        assert np.max(np.abs(tr.theta[:, -1] - ref.theta[:, -1])) < 1e-7, name
+        assert tr.energy_error < 2 * integration_bound(tr), name  # first integral, quadratic
+        tol = amplified.bound(lambda run: run.theta, tr, ref)  # one free motion, amplified
+        assert np.max(np.abs(tr.theta[:, -1] - ref.theta[:, -1])) < tol, name
 
 
 @pytest.mark.parametrize("method", ["complex-masses", "lie-group"])
 def test_crank_angle_formulations_stop_at_a_dead_point(method):
     linkage = _triple_rocker()
     settings = SimulationSettings(duration=3.0, theta1=0.0, omega1=6.0)
-    reference = simulate(linkage, settings, method="opened-loop", rtol=1e-11, atol=1e-13,
-                         outputs=30001)
+    reference = simulate(linkage, settings, method="opened-loop", **TIGHT, outputs=30001)
     # The reference passes the dead point where sin(θ3 − θ2) changes sign, the crank at the end
     # of its range.
     s = np.sign(np.sin(reference.theta[2] - reference.theta[1]))
-    first = reference.t[np.argmax(s != s[0])]
+    k = int(np.argmax(s != s[0]))
+    first = reference.t[k]
     with pytest.raises(LockupError, match="dead point") as info:
-        simulate(linkage, settings, method=method, rtol=1e-11, atol=1e-13)
-    assert abs(info.value.time - first) < 2e-4
+        simulate(linkage, settings, method=method, **TIGHT)
+    # ``first`` is within one output step after the dead point; the run stops where
+    # |sin(θ3 − θ2)| falls to the threshold, threshold/|θ̇3 − θ̇2| before it (sin(θ3 − θ2) is
+    # linear in time there; twice that for its curvature and the rate's change over a step).
+    rate = np.min(np.abs(reference.omega[2] - reference.omega[1])[k - 1 : k + 1])
+    dt = reference.t[1] - reference.t[0]
+    assert abs(info.value.time - first) < dt + 2 * DEAD_POINT_THRESHOLD / rate
+    # Near the end hi of the crank's range |sin(θ3 − θ2)| ≈ c·√(hi − θ1): the run stops
+    # (threshold/c)² before hi; twice that for the next term and the integration error.
     (_, hi), = kin.assembly_range(linkage.lengths).intervals
-    assert abs(info.value.theta1 - hi) < 1e-5
+    c = abs(kin.position_of(linkage, hi - 1e-8).sin_transmission[0]) / 1e-4
+    assert abs(info.value.theta1 - hi) < 2 * (DEAD_POINT_THRESHOLD / c) ** 2
     partial = info.value.partial
-    assert partial.t[-1] <= info.value.time + 1e-12 and partial.energy_error < 1e-8
+    # Outputs are taken up to the event time to simulate's 1e-14·max(1, t) slack; 1e-12 ≥ it.
+    assert partial.t[-1] <= info.value.time + 1e-12
+    assert partial.energy_error < 2 * integration_bound(partial)  # first integral, quadratic
 
 
 def test_driven_crank_that_cannot_turn_locks():
@@ -204,6 +272,8 @@ def test_driven_crank_that_cannot_turn_locks():
     settings = SimulationSettings(duration=2.0, theta1=1.0, omega1=2.0, drive="constant-speed")
     with pytest.raises(LockupError, match="locks") as info:
         simulate(linkage, settings, method="opened-loop")
+    # The prescribed motion reaches hi at (hi − 1)/2 s: no integration, the rounding of θ1 taken
+    # into its 2π window and of the division, a few ε·(|hi| + 2π)/(hi − 1) ≈ 1e-14 relative.
     assert info.value.time == pytest.approx((hi - 1.0) / 2.0, rel=1e-12)
 
 
@@ -215,15 +285,20 @@ def test_driven_motion_matches_the_cycle_analysis(method):
     speed = 4.0
     settings = SimulationSettings(duration=2 * np.pi / speed, theta1=0.0, omega1=speed,
                                   drive="constant-speed", outputs=73)
-    tr = simulate(linkage, settings, method=method, rtol=1e-11, atol=1e-13)
+    tr = simulate(linkage, settings, method=method, **TIGHT)
     ca = inverse.cycle_analysis(linkage, speed, theta1=tr.theta[0])
+    # The motion is prescribed (every state is put on θ1 = θ0 + ω·t and its loop closure), so
+    # no integration error enters the reactions: the formulations' algebraic 1e-9 (DESIGN.md)
+    # at the paper's well-conditioned positions (|sin(θ3 − θ2)| ≥ 0.7).
     scale = np.max(np.abs(ca.reactions.RA0))
     assert np.max(np.abs(tr.RA0 - ca.reactions.RA0)) < 1e-9 * scale
     assert np.max(np.abs(tr.RA3 - ca.reactions.RA3)) < 1e-9 * scale
     tau_scale = np.max(np.abs(ca.reactions.driving_torque))
     assert np.max(np.abs(tr.driving_torque - ca.reactions.driving_torque)) < 1e-9 * tau_scale
     assert np.max(np.abs(tr.shaking_moment - ca.reactions.shaking_moment)) < 1e-9 * tau_scale
-    assert tr.energy_error < 1e-9
+    # The motor's work is integrated: T − T0 − W a first integral, quadratic in the rates.
+    assert tr.energy_error < 2 * integration_bound(tr)
+    # Prescribed: θ̇1 = ω and θ̈1 = 0 up to rounding.
     assert np.allclose(tr.omega[0], speed) and np.allclose(tr.alpha[0], 0.0, atol=1e-12)
 
 
@@ -234,13 +309,16 @@ def test_counter_rotors_enter_every_formulation():
     linkage = base.with_links({"crank": replace(base.crank, counter_rotor=0.7),
                                "rocker": replace(base.rocker, counter_rotor=1.3)})
     settings = SimulationSettings(duration=2.0, theta1=1.0, omega1=0.5)
-    runs = {m: simulate(linkage, settings, method=m, rtol=1e-11, atol=1e-13) for m in METHODS}
-    plain = simulate(base, settings, method="opened-loop", rtol=1e-11, atol=1e-13)
+    runs = {m: simulate(linkage, settings, method=m, **TIGHT) for m in METHODS}
+    plain = simulate(base, settings, method="opened-loop", **TIGHT)
     ref = runs["opened-loop"]
     assert np.max(np.abs(plain.theta[:, -1] - ref.theta[:, -1])) > 1e-3  # they matter
+    amplified = growth(simulate, linkage, settings, method="complex-masses", **TIGHT,
+                       reference=runs["complex-masses"])
     for name, tr in runs.items():
-        assert np.max(np.abs(tr.theta[:, -1] - ref.theta[:, -1])) < 1e-8, name
-        assert tr.energy_error < 1e-9, name
+        tol = amplified.bound(lambda run: run.theta, tr, ref)  # one free motion, amplified
+        assert np.max(np.abs(tr.theta[:, -1] - ref.theta[:, -1])) < tol, name
+        assert tr.energy_error < 2 * integration_bound(tr), name  # first integral, quadratic
 
 
 def test_formulations_agree_at_every_state_along_a_trajectory(paper_runs):
@@ -255,6 +333,8 @@ def test_formulations_agree_at_every_state_along_a_trajectory(paper_runs):
                zip(traj.theta[0], traj.omega[0], strict=True)]
         results[name] = (np.array([e.alpha for e in evs]), np.array([e.RA0 for e in evs]),
                          np.array([e.RA3 for e in evs]))
+    # One state, several formulations: DESIGN.md's 1e-9 relative (the paper's motion keeps
+    # |sin(θ3 − θ2)| ≥ 0.7, a well-conditioned set of states).
     ref = results["opened-loop"]
     acc_scale = np.max(np.abs(ref[0]))
     force_scale = max(np.max(np.abs(ref[1])), np.max(np.abs(ref[2])))
@@ -262,5 +342,6 @@ def test_formulations_agree_at_every_state_along_a_trajectory(paper_runs):
         assert np.max(np.abs(alpha - ref[0])) < 1e-9 * acc_scale, name
         assert np.max(np.abs(ra0 - ref[1])) < 1e-9 * force_scale, name
         assert np.max(np.abs(ra3 - ref[2])) < 1e-9 * force_scale, name
-    # And the simulated accelerations are those of the states themselves.
+    # And the simulated accelerations are those of the states themselves (the same state up
+    # to its projection, to 1e-15·Σl: the algebraic level again).
     assert np.max(np.abs(ref[0].T - traj.alpha)) < 1e-9 * acc_scale

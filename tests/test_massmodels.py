@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from conftest import paper_linkage, random_angles, random_linkage
-from helpers import rel_err
+from helpers import ROUNDING, rel_err
 
 from balancer import kinematics as kin
 from balancer import massmodels as mm
@@ -29,6 +29,8 @@ def test_principal_vector_centre_of_mass_equals_direct_sum(linkage, angles):
     pos = kin.position_of(linkage, angles)
     direct = mm.total_com_direct(linkage, pos)
     scale = max(linkage.lengths)
+    # Mass-weighted sums of a few vectors ≤ scale, each way: rounding ~ROUNDING·scale ≈
+    # 1.4e-14·scale (the mass ratios are ≤ 25), within 1e-12·scale.
     assert rel_err(mm.total_com_opened(linkage, pos), direct, scale=scale) < 1e-12  # Eq. 16
     assert rel_err(mm.total_com_frame(linkage, pos), direct, scale=scale) < 1e-12  # Eq. 32
 
@@ -39,12 +41,14 @@ def test_principal_vector_identities(linkage, angles):
     pv = mm.opened_loop_vectors(linkage, pos)
     fv = mm.frame_vectors(linkage, pos)
     scale = max(linkage.lengths)
-    # Eq. 12: ā23 = ā21 + l̄2; Eq. 13 derived vectors; Eq. 30: l̄4 = ā41 − ā43.
+    # Eq. 12: ā23 = ā21 + l̄2; Eq. 13 derived vectors; Eq. 30: l̄4 = ā41 − ā43. Each side a
+    # handful of operations on vectors ≤ scale: ≲ 10ε·scale ≈ 2e-15·scale, within 1e-14.
     assert rel_err(pv.a23, pv.a21 + pos.l2, scale=scale) < 1e-14
     assert rel_err(pv.a14p, pv.a12 - pos.l1, scale=scale) < 1e-14
     assert rel_err(pv.a34p, pv.a32 + pos.l3, scale=scale) < 1e-14
     assert abs(fv.a41 - fv.a43 - (-linkage.lengths[3])) < 1e-14 * scale
-    # Eq. 14–15: link centres of mass from the principal vectors.
+    # Eq. 14–15: link centres of mass from the principal vectors (rounding, as above, of
+    # terms up to (m1 + m2 + m3)·scale: within 1e-12 of m_k·scale).
     r1, r2, r3 = mm.link_centres_of_mass(linkage, pos)
     m1, m2, m3 = (c.mass for c in linkage.links)
     rs = mm.total_com_direct(linkage, pos)
@@ -61,12 +65,17 @@ def test_complex_joint_masses_reproduce_the_centre_of_mass(linkage, angles):
     pos = kin.position_of(linkage, angles)
     joints = ((0.0, pos.A1), (pos.A1, pos.A2), (pos.A2, pos.A3))
     for k, link in enumerate(linkage.links):
+        # Joint masses of magnitude ≤ m·(1 + |s̄|/l) ≤ 2.6·m, from a few operations each:
+        # rounding ≲ 8ε·m ≈ 2e-15·m, within 1e-14·m; the two forms to ROUNDING·m (a mass, not
+        # an absolute number).
         mp, mq = mm.complex_joint_masses(link, linkage.lengths[k])
         assert abs(mp + mq - link.mass) < 1e-14 * link.mass
         ma, mb, mc = mm.equivalent_masses(link, linkage.lengths[k])
-        assert abs(mp - (ma - 1j * mc)) < 1e-14 and abs(mq - (mb + 1j * mc)) < 1e-14
+        tol = ROUNDING * link.mass
+        assert abs(mp - (ma - 1j * mc)) < tol and abs(mq - (mb + 1j * mc)) < tol
         rp, rq = joints[k]
         r = mm.link_centres_of_mass(linkage, pos)[k]
+        # Rounding of m·|r| ≤ m·3 (these linkages reach ≤ 3 m): ~ROUNDING, within 1e-13.
         assert rel_err(mp * rp + mq * rq, link.mass * r, scale=link.mass * 3) < 1e-13  # Eq. 29
 
 
@@ -76,6 +85,8 @@ def test_wunderlich_similarity(linkage, angles):
     w = mm.wunderlich_linkage(linkage)
     rs = mm.total_com_direct(linkage, pos)
     scale = max(linkage.lengths)
+    # Wunderlich's similarity holds to rounding (DESIGN.md): two sums of a few vectors ≤ scale
+    # with mass-ratio coefficients, ~ROUNDING·scale; within 1e-12·scale.
     assert rel_err(w.trace(pos), rs, scale=scale) < 1e-12
     # The generating linkage B0B1B2B3 is the original scaled and rotated by γ (Eq. 4).
     b1, b2 = w.generating_joints(pos)
@@ -91,6 +102,8 @@ def test_wunderlich_theorem_2_stationary_centre_of_mass():
     assert w.is_stationary
     pos = kin.position_of(linkage, np.linspace(0, 2 * np.pi, 73))
     rs = mm.total_com_direct(linkage, pos)
+    # Rounding of mass-weighted positions ≤ 3.2 m: ~ROUNDING·3.2 m ≈ 5e-14 m; the conditions
+    # (Eq. 57, Eq. 10d below) are ratios of numbers of order one: ≲ 10ε. Within 1e-13.
     assert np.max(np.abs(rs - rs[0])) < 1e-13
     # Wunderlich: its position is m3·σ3·a (masses normalised).
     c3 = linkage.rocker
@@ -112,6 +125,8 @@ def test_wunderlich_circle_case_beta_zero():
     s3 = 1 + (c2.mass / c3.mass) * (c2.com / l2)
     linkage = linkage.with_link("rocker", replace(c3, e=(s3 * l3).real, f=(s3 * l3).imag))
     w = mm.wunderlich_linkage(linkage)
+    # β cancels terms of order one in a handful of operations: ≲ 10ε ≈ 2e-15, within 1e-14;
+    # the radius, rounding of positions ≤ 3.2 m as above.
     assert abs(w.beta) < 1e-14 and w.is_circle
     pos = kin.position_of(linkage, np.linspace(0, 2 * np.pi, 61))
     radius = np.abs(mm.total_com_direct(linkage, pos) - w.B0)
@@ -135,18 +150,24 @@ def test_equivalent_mass_matrix_gives_the_rigid_kinetic_energy(seed):
     link = Link(mass=rng.uniform(0.5, 5), inertia=rng.uniform(0.1, 3),
                 e=rng.uniform(-1, 2), f=rng.uniform(-1, 1))
     me = mm.equivalent_mass_matrix(mm.inertial_parameters(link), length)
-    assert np.allclose(me, me.T, rtol=0, atol=1e-15)
-    assert np.min(np.linalg.eigvalsh(me)) > -1e-12
+    assert np.allclose(me, me.T, rtol=0, atol=1e-15)  # symmetric by construction: exactly
+    # Positive semidefinite: eigenvalues to rounding, ~ROUNDING·|Me| ≲ 1e-12 here.
+    assert np.min(np.linalg.eigvalsh(me)) > -ROUNDING * np.max(np.abs(me))
     p, q, vp, vq, w = _rigid_motion(rng, length)
     x = np.array([vp.real, vp.imag, vq.real, vq.imag])
     v_com = vp + 1j * w * link.com / length * (q - p)
     t_rigid = 0.5 * link.mass * abs(v_com) ** 2 + 0.5 * link.inertia * w * w
-    assert abs(0.5 * x @ me @ x - t_rigid) < 1e-12 * max(1.0, t_rigid)
+    # Rounding of the quadratic form, whose terms are ≤ |Me|·|x|²: ROUNDING times those.
+    terms = np.max(np.abs(me)) * float(x @ x)
+    assert abs(0.5 * x @ me @ x - t_rigid) < ROUNDING * max(terms, t_rigid)
     # The complex application is the same matrix.
     ap, aq = complex(*rng.normal(size=2)), complex(*rng.normal(size=2))
     fp, fq = mm.equivalent_inertia_forces(mm.inertial_parameters(link), length, ap, aq)
-    y = me @ np.array([ap.real, ap.imag, aq.real, aq.imag])
-    assert np.allclose([fp.real, fp.imag, fq.real, fq.imag], y, rtol=0, atol=1e-13)
+    acc = np.array([ap.real, ap.imag, aq.real, aq.imag])
+    y = me @ acc
+    # The same products in another order: ROUNDING times the terms, |Me|·|ẍ|.
+    tol = ROUNDING * np.max(np.abs(me)) * np.sum(np.abs(acc))
+    assert np.allclose([fp.real, fp.imag, fq.real, fq.imag], y, rtol=0, atol=tol)
 
 
 @pytest.mark.parametrize("seed", range(10))
@@ -160,6 +181,8 @@ def test_equivalent_joint_forces_do_the_same_virtual_work(seed):
     work_nodes = kin.inner(dp, fp) + kin.inner(dq, fq)
     d_com = dp + 1j * dth * link.com / length * (q - p)
     work = kin.inner(d_com, link.force_complex) + link.moment * dth
+    # Rounding of products of numbers of order one and lengths ≤ 3 (terms ≲ 10):
+    # ~ROUNDING·10 ≈ 1.4e-13 at worst, well above the handful of operations here (≲ 2e-14).
     assert abs(work_nodes - work) < 1e-13
 
 
@@ -181,7 +204,10 @@ def test_assembled_matrices_match_eq48_and_eq53_written_out():
         [m13, -m14, m33, 0],
         [m14, m13, 0, m33],
     ])
-    assert np.allclose(m, expected, rtol=1e-15, atol=1e-15)
+    # The same formulas in another order: rounding of the terms, which a mass matrix bounds by
+    # its diagonal (|m13| cancels terms of that size): ROUNDING·max|diag|.
+    tol = ROUNDING * np.max(np.abs(np.diag(expected)))
+    assert np.allclose(m, expected, rtol=0, atol=tol)
     mr = mm.reaction_mass_matrix(linkage)
     r11 = (m1 * e1 * (l1 - e1) - m1 * f1**2 - i1) / l1**2
     r33 = (m3 * e3 * (l3 - e3) - m3 * f3**2 - i3) / l3**2
@@ -191,7 +217,11 @@ def test_assembled_matrices_match_eq48_and_eq53_written_out():
         [0, 0, r33, m3 * f3 / l3],
         [0, 0, -m3 * f3 / l3, r33],
     ])
-    assert np.allclose(mr, expected_r, rtol=1e-15, atol=1e-15)
+    # Its terms: m·e·(l − e), m·f², I over l², and m·f/l.
+    tol = ROUNDING * max(abs(m1 * e1 * (l1 - e1)) / l1**2, m1 * f1**2 / l1**2, i1 / l1**2,
+                         abs(m3 * e3 * (l3 - e3)) / l3**2, m3 * f3**2 / l3**2, i3 / l3**2,
+                         m1 * abs(f1) / l1, m3 * abs(f3) / l3)
+    assert np.allclose(mr, expected_r, rtol=0, atol=tol)
 
 
 def test_force_vector_matches_eq49_and_eq54_written_out():
@@ -211,6 +241,7 @@ def test_force_vector_matches_eq49_and_eq54_written_out():
           + (1 - e3 / l3) * f3x - f3_ / l3 * f3y + (0 - a2.imag) / l3**2 * M3)
     F4 = (e2 / l2 * f2y - f2 / l2 * f2x + (a2.real - a1.real) / l2**2 * M2
           + (1 - e3 / l3) * f3y + f3_ / l3 * f3x - (l4 - a2.real) / l3**2 * M3)
+    # Rounding of sums of a dozen terms ≲ 2 N: ≲ 12ε·2 N ≈ 5e-15 N, within 1e-14 N.
     assert np.allclose([fa1.real, fa1.imag, fa2.real, fa2.imag], [F1, F2, F3, F4], atol=1e-14)
     # Eq. 54 without the reactions.
     Fr1 = (1 - e1 / l1) * f1x - f1 / l1 * f1y + a1.imag / l1**2 * M1

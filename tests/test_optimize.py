@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from balancer.optimize.convex import CERTIFICATE_MARGIN, CLARABEL_SETTINGS, TIE_ACCEPT
 from conftest import random_linkage
 
 from balancer import spec
@@ -24,14 +25,11 @@ from balancer.conditions import (
     force_balance_error,
     force_balanced_by_crank_and_rocker,
 )
+from balancer.cycle import cycle_analysis
 from balancer.errors import SolverError, SpecError
-from balancer.inverse import cycle_analysis
 from balancer.model import Design, Operation
 from balancer.optimize import ConvexSolver, InfeasibleError, Optimizer, Status, optimize
-from balancer.optimize.convex import CERTIFICATE_MARGIN, CLARABEL_SETTINGS, TIE_ACCEPT
 from balancer.problem import (
-    DEFAULT_ABOUT,
-    JOINTS,
     BalanceProblem,
     LinkFreedom,
     NumericProblem,
@@ -73,11 +71,12 @@ def _random_design(seed: int) -> Design:
     force_balance = seed % 3 != 0
     anchor = force_balanced_by_crank_and_rocker(linkage) if force_balance else linkage
     links = {}
-    for index, name in enumerate(JOINTS):
+    centres = {"crank": 0.0, "coupler": 0.0, "rocker": linkage.lengths[2]}  # A0, A1, A3
+    for index, name in enumerate(centres):
         if name == "coupler" and seed % 2:
             continue  # the coupler stays fixed in half the problems
         link, length = anchor.link(name), linkage.lengths[index]
-        centre = 0.0 if DEFAULT_ABOUT[name] == JOINTS[name][0] else length
+        centre = centres[name]
         links[name] = LinkFreedom(
             mass=(link.mass * rng.uniform(0.5, 1.0), link.mass * rng.uniform(1.0, 3.0)),
             com_radius=abs(link.com - centre) * rng.uniform(1.05, 1.6) + 0.05 * length,
@@ -93,7 +92,7 @@ def _random_design(seed: int) -> Design:
     return Design(
         mechanism=linkage,
         operation=Operation(speed=float(rng.uniform(5.0, 15.0)), samples=72),
-        balance=BalanceProblem(force_balance=force_balance, objective=objective, **links),
+        balance=BalanceProblem(force_balance=force_balance, objective=objective, links=links),
     )
 
 
@@ -388,7 +387,7 @@ def test_a_fixed_centre_of_mass_that_prevents_balance_is_named():
 
 def test_force_balance_with_nothing_that_can_meet_it_is_infeasible():
     design = _load("pb1.toml")
-    problem = BalanceProblem(crank=LinkFreedom(counter_rotor=(0.0, 1.0)))
+    problem = BalanceProblem(links={"crank": LinkFreedom(counter_rotor=(0.0, 1.0))})
     with pytest.raises(InfeasibleError, match="force balance cannot be met"):
         optimize(replace(design, balance=problem))
 

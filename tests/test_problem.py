@@ -12,12 +12,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import CLASS_EXAMPLES, PAPER_LENGTHS, paper_links, random_linkage
+from conftest import CLASS_EXAMPLES, PAPER_LENGTHS, paper_linkage, paper_links, random_linkage
 
 from balancer import spec
 from balancer.cli import main
 from balancer.errors import AssemblyError, SpecError
-from balancer.inverse import cycle_analysis, parameter_vector
+from balancer.inverse import cycle_analysis  # the paper's routes: independent of the regressors
+from balancer.mechanisms import mechanism_of
 from balancer.model import Design, FourBar, Operation
 from balancer.problem import (
     BalanceProblem,
@@ -144,34 +145,34 @@ def test_a_balance_section_is_read_with_its_defaults():
     assert isinstance(problem, BalanceProblem)
     assert problem.force_balance is True
     assert problem.objective == Objective(shaking_moment=1.0)
-    assert problem.crank == LinkFreedom(
+    assert problem.link("crank") == LinkFreedom(
         mass=(2.1, 8.4), com_radius=1.0, min_gyration=0.1, counter_rotor=(0.0, 20.0)
     )
-    assert problem.coupler is None and problem.rocker is None
+    assert problem.link("coupler") is None and problem.link("rocker") is None
 
 
 def test_defaults_resolve_as_documented():
     links = paper_links(loads=False)
+    mech = mechanism_of(paper_linkage(loads=False))
     # Not listed: everything fixed at the spec's values.
-    b = resolve_link("coupler", None, links["coupler"], 3.0)
+    b = resolve_link(mech, "coupler", None)
     assert b.mass == (3.0, 3.0) and b.com_fixed == links["coupler"].com
     assert b.inertia == (3.1, 3.1) and b.counter_rotor is None
     # Mass free: inertia free (ρ = 0 by default); the rocker's radius is about A3 = l3.
-    b = resolve_link("rocker", LinkFreedom(mass=(1.0, 3.0), com_radius=0.5), links["rocker"], 2.0)
+    b = resolve_link(mech, "rocker", LinkFreedom(mass=(1.0, 3.0), com_radius=0.5))
     assert b.inertia == (0.0, math.inf) and b.com_centre == 2.0 and b.about == "A3"
     assert b.counter_rotor == (0.0, 0.0)  # fixed at the spec's (none)
     # Mass and centre of mass fixed, no min_gyration: the inertia stays.
-    b = resolve_link("crank", LinkFreedom(counter_rotor=(0.0, 1.0)), links["crank"], 1.0)
+    b = resolve_link(mech, "crank", LinkFreedom(counter_rotor=(0.0, 1.0)))
     assert b.inertia == (1.1, 1.1) and b.mass == (2.1, 2.1)
     # ... unless min_gyration is given.
-    b = resolve_link("crank", LinkFreedom(min_gyration=0.2), links["crank"], 1.0)
+    b = resolve_link(mech, "crank", LinkFreedom(min_gyration=0.2))
     assert b.inertia == (0.0, math.inf) and b.gyration == 0.2
     # A zero radius pins the centre of mass to the joint; an inertia bound caps the mass.
     b = resolve_link(
-        "crank",
+        mech, "crank",
         LinkFreedom(mass=(1.0, 9.0), com_radius=0.0, com_about="A1", min_gyration=0.5,
                     inertia=(0.0, 1.0)),
-        links["crank"], 1.0,
     )  # fmt: skip
     assert b.com_fixed == 1.0 + 0j and b.com_radius is None
     assert b.mass == (1.0, 4.0)  # I ≤ 1 and I ≥ m·0.25
@@ -207,7 +208,7 @@ def _random_problem(rng: np.random.Generator) -> BalanceProblem:
             shaking_force=float(rng.uniform(0, 1)),
             added_mass=float(rng.uniform(0, 100)),
         ),
-        **links,
+        links={name: f for name, f in links.items() if f is not None},
     )
 
 
@@ -275,12 +276,12 @@ def test_the_objective_equals_the_newton_euler_route(seed):
     )
     data = numeric_problem(design)
     # The original, and a design with every parameter perturbed.
-    x = data.x0 * rng.uniform(0.8, 1.2, 14) + rng.uniform(0.0, 0.1, 14)
+    x = data.x0 * rng.uniform(0.8, 1.2, data.size) + rng.uniform(0.0, 0.1, data.size)
     for k in (0, 4, 8):  # a realisable link: inertia about the centre of mass I ≥ 0
         x[k + 3] = (x[k + 1] ** 2 + x[k + 2] ** 2) / x[k] + rng.uniform(0.01, 1.0)
     other = data.linkage_of(x)
     for lk in (linkage, other):
-        x = parameter_vector(lk)
+        x = mechanism_of(lk).parameters()
         expected = _objective_by_newton_euler(data, lk)
         scale = abs(expected) + data.weights.added_mass * lk.total_mass
         assert abs(data.objective(x) - expected) <= 1e-9 * scale
@@ -296,7 +297,7 @@ def test_the_objective_of_a_change_point_linkage_matches_the_cycle_analysis(bran
     design = Design(
         mechanism=linkage,
         operation=Operation(speed=7.0, samples=36),  # samples at θ1 = 0 and π: change points
-        balance=BalanceProblem(crank=LinkFreedom(counter_rotor=(0.0, 1.0))),
+        balance=BalanceProblem(links={"crank": LinkFreedom(counter_rotor=(0.0, 1.0))}),
     )
     data = numeric_problem(design)
     assert np.isfinite(data.regressors.shaking_moment).all()

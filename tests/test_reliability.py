@@ -18,7 +18,7 @@ from fuzz.checks import without_dac_override
 from balancer import spec
 from balancer.cli import main
 from balancer.errors import AssemblyError, OutputError, SolverError, SpecError
-from balancer.model import Design, FourBar, Link, Operation, SimulationSettings, SliderCrank
+from balancer.model import FourBar, Link, Operation, SimulationSettings, SliderCrank
 from balancer.optimize import Status, optimize
 from balancer.problem import numeric_problem
 from balancer.report import csv_text, dumps_json
@@ -266,7 +266,7 @@ def test_command_line_overrides_are_named_as_options(capsys):
     assert "--outputs:" in capsys.readouterr().err
 
 
-# -- honest optimisation results --------------------------------------------------------------------
+# -- honest optimisation results ----------------------------------------------------------------
 
 
 def _balanced_bounds_hold(problem, linkage) -> list[str]:

@@ -132,6 +132,13 @@ def force_balance_conditions(mech) -> ForceBalance:
     if "force balance" in cache:
         return cache["force balance"]
     layout = mech.layout
+    links = tuple(layout.link_slice(name) for name in mech.structure.names)
+    closed = mech.closed_form_force_balance()
+    if closed is not None:  # the seeds' conditions, exact
+        result = ForceBalance(matrix=closed, scales=np.ones(layout.size),
+                              singular_values=np.zeros(0), links=links)
+        cache["force balance"] = result
+        return result
     length = mech.structure.length_scale()
     scales = np.ones(layout.size)
     for name in mech.structure.names:
@@ -167,7 +174,6 @@ def force_balance_conditions(mech) -> ForceBalance:
     if null.size and np.max(np.abs(df @ null)) > 1e3 * NULL_TOLERANCE * top:
         raise SolverError("the force-balance conditions found at sampled angles do not hold "
                           "at others: the sampling missed a condition")
-    links = tuple(layout.link_slice(name) for name in mech.structure.names)
     result = ForceBalance(matrix=rows * scales, scales=scales, singular_values=sv, links=links)
     cache["force balance"] = result
     return result

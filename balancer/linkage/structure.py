@@ -184,8 +184,11 @@ class Structure:
     # -- building -----------------------------------------------------------------------------
 
     @classmethod
-    def of(cls, linkage: Linkage) -> Structure:
+    def of(cls, linkage: Linkage, lengths: dict[str, float] | None = None) -> Structure:
         """The structure of ``linkage``; raises :class:`SpecError` if it is not a valid one.
+
+        ``lengths`` gives, by link, the exact distance from its first point to its second
+        (a four-bar's lengths, which its reference pose's positions carry only to rounding).
 
         Raises
         ------
@@ -212,8 +215,13 @@ class Structure:
             ref_angle.append(angle)
             ref_origin.append(V.of(origin))
             turn = complex(math.cos(angle), -math.sin(angle))
-            for p in body.points:
-                local[(k, p)] = V.of((positions[p] - origin) * turn)
+            for i, p in enumerate(body.points):
+                if i == 1:  # on the frame's x-axis: exactly
+                    exact = (lengths or {}).get(body.name)
+                    local[(k, p)] = V(abs(positions[p] - origin) if exact is None else exact,
+                                      0.0)
+                else:
+                    local[(k, p)] = V.of((positions[p] - origin) * turn)
         for p in linkage.ground.points:
             local[(GROUND_INDEX, p)] = V.of(positions[p])
         point_links: dict[str, list[int]] = {}

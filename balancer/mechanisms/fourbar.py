@@ -19,7 +19,7 @@ from .. import kinematics as fourbar
 from ..kinematics import AssemblyRange
 from ..linkage.dynamics import Forces
 from ..linkage.kinematics import Motion
-from ..linkage.structure import Pose
+from ..linkage.structure import Pose, Structure
 from ..linkage.vectors import V
 from ..model import Body, FourBar, Linkage
 from .base import Limit, Mechanism
@@ -28,8 +28,9 @@ from .base import Limit, Mechanism
 def fourbar_linkage(model: FourBar) -> Linkage:
     """The four-bar as a general linkage, at a regular reference pose on its branch.
 
-    The reference crank angle is the one of its range's samples farthest from a dead or change
-    point (largest ``|sin(θ3 − θ2)|``).
+    The reference crank angle is 0 when the crank turns fully and the pose there is regular
+    (``|sin(θ3 − θ2)| ≥ 0.3``), else the one of its range's samples farthest from a dead or
+    change point (largest ``|sin(θ3 − θ2)|``).
     """
     rng = fourbar.assembly_range(model.lengths)
     if rng.full:
@@ -39,7 +40,10 @@ def fourbar_linkage(model: FourBar) -> Linkage:
         candidates = np.linspace(lo, hi, 74)[1:-1]
     signs = fourbar.cycle_branch_signs(model.lengths, model.branch, candidates)
     pos = fourbar.position(model.lengths, candidates, signs, check=False)
-    best = int(np.nanargmax(np.abs(pos.sin_transmission)))
+    transmission = np.abs(pos.sin_transmission)
+    best = int(np.nanargmax(transmission))
+    if rng.full and transmission[0] >= 0.3:  # θ1 = 0 if it is regular: A1 = (l1, 0) exactly
+        best = 0
     a1, a2 = complex(pos.A1[best]), complex(pos.A2[best])
     points = (("A0", (0.0, 0.0)), ("A1", (a1.real, a1.imag)), ("A2", (a2.real, a2.imag)),
               ("A3", (model.lengths[3], 0.0)))
@@ -66,6 +70,11 @@ class FourBarMechanism(Mechanism):
     def linkage(self) -> Linkage:
         return fourbar_linkage(self.model)
 
+    @cached_property
+    def structure(self) -> Structure:
+        l1, l2, l3, _ = self.model.lengths
+        return Structure.of(self.linkage, {"crank": l1, "coupler": l2, "rocker": l3})
+
     def describe(self) -> str:
         """The Grashof class."""
         return str(fourbar.classify(self.model.lengths))
@@ -82,6 +91,14 @@ class FourBarMechanism(Mechanism):
         with np.errstate(divide="ignore", invalid="ignore"):
             mo = fourbar.motion(self.model.lengths, t, w, a, signs, check=False)
         return general_motion(mo)
+
+    def closed_form_force_balance(self) -> NDArray[np.float64]:
+        """Eq. 57–58 over the layout (crank, coupler, rocker, then two counter-rotors)."""
+        from ..conditions import force_balance_matrix
+
+        ab = force_balance_matrix(self.model.lengths)
+        assert not np.any(ab[:, 12]), "Eq. 58 is homogeneous"
+        return np.hstack([ab[:, :12], np.zeros((ab.shape[0], self.layout.size - 12))])
 
     def limits(self, theta1: NDArray[np.float64]) -> list[Limit]:
         from ..inverse import change_point_limits

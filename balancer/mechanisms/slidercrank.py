@@ -16,6 +16,7 @@ import numpy as np
 from ..kinematics import AssemblyRange
 from ..linkage.dynamics import Forces
 from ..linkage.kinematics import Motion
+from ..linkage.structure import Structure
 from ..linkage.vectors import V
 from ..model import Body, Linkage, Slider, SliderCrank
 from ..slider_crank import kinematics as closed
@@ -62,11 +63,24 @@ class SliderCrankMechanism(Mechanism):
     def linkage(self) -> Linkage:
         return slider_crank_linkage(self.model)
 
+    @cached_property
+    def structure(self) -> Structure:
+        r, big_l, _ = self.model.lengths
+        return Structure.of(self.linkage, {"crank": r, "rod": big_l})
+
     def describe(self) -> str:
         return closed.classify(self.model.lengths)
 
     def assembly_range(self) -> AssemblyRange:
         return closed.assembly_range(self.model.lengths)
+
+    def closed_form_force_balance(self) -> np.ndarray:
+        """Wunderlich's Eq. 20a–b over the layout (crank, rod, slider, then a counter-rotor)."""
+        from ..slider_crank.conditions import force_balance_matrix
+
+        ab = force_balance_matrix(self.model.lengths)
+        assert not np.any(ab[:, 12]), "Eq. 20 is homogeneous"
+        return np.hstack([ab[:, :12], np.zeros((ab.shape[0], self.layout.size - 12))])
 
     def _full_turn_rule(self) -> str:
         return " (crank + |offset| < rod)"

@@ -1,9 +1,10 @@
 """Convex balancing: a second-order cone program in the inertial parameters (CVXPY + Clarabel).
 
 With the crank at constant speed the shaking moment, driving torque and shaking force are
-linear in the design vector ``x`` (:data:`balancer.inverse.PARAMETER_NAMES`), Eq. 45–54, and
-force balance is four linear equations (Eq. 58). Per link, with ``S = (m·e, m·f)`` and ``c`` the
-position of ``com_about`` in the link frame (0 for the first joint, ``l`` for the second):
+linear in the design vector ``x`` (the mechanism's layout,
+:class:`balancer.linkage.dynamics.Layout`), and force balance is linear equations
+(:mod:`balancer.balance.conditions`; Eq. 58 for the four-bar). Per link, with ``S = (m·e,
+m·f)`` and ``c`` the position of ``com_about`` in the link's frame:
 
 - mass bounds ``m_low ≤ m ≤ m_high``;
 - centre of mass in a disc: ``‖S − m·c‖ ≤ m·R`` (a second-order cone);
@@ -11,14 +12,14 @@ position of ``com_about`` in the link frame (0 for the first joint, ``l`` for th
   ``‖S‖²/m ≤ J − max(I_low, m·ρ²)`` (``quad_over_lin``, a rotated cone);
 - an upper inertia bound ``I ≤ I_high`` on a link whose centre of mass may move is not convex
   (``J − I_high ≤ ‖S‖²/m``); it is replaced by its convex envelope over the disc,
-  ``J − I_high ≤ m·(R² − c²) + 2·c·m·e`` (valid because ``|s̄ − c| ≤ R``), and
+  ``J − I_high ≤ m·(R² − |c|²) + 2·c·S`` (valid because ``|s̄ − c| ≤ R``), and
   :attr:`ConvexSolution.relaxation_tight` says whether the optimum met the exact bound;
 - counter-rotor bounds; fixed entries are eliminated (a fixed centre of mass makes
   ``S = m·s̄``, a fixed inertia with it ``J = I + m·|s̄|²``: both linear).
 
 Objective: ``‖K·x‖`` (the root of the weighted mean squares, minimised as a norm so that a zero
 optimum is reached accurately), or ``‖K·x‖² + w_m·Δm`` when mass is penalised; ``K`` is
-compressed to its 14-column triangular factor ``R``.
+compressed to its square triangular factor ``R``.
 
 Two stages: the SOCP gives the optimum (the lower bound); then, because the optimum is usually
 not unique (the crank's inertia and counter-rotor do nothing at constant speed, the shaking
@@ -33,7 +34,7 @@ bounds to widen and the values that would do.
 
 Variables are scaled per link (kg by the original mass, kg·m by ``m·l``, kg·m² by ``m·l²``) and
 the objective by the original design's; both problems are built once per
-:class:`~balancer.problem.NumericProblem` with parameters, so re-solving is cheap.
+:class:`~balancer.balance.problem.NumericProblem` with parameters, so re-solving is cheap.
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import SolverError
-from ..problem import FORCE_BALANCE_TOLERANCE, ROUNDING_TOLERANCE, NumericProblem
+from .problem import FORCE_BALANCE_TOLERANCE, ROUNDING_TOLERANCE, NumericProblem
 from .result import InfeasibleError, StageReport
 
 #: Clarabel's settings for every solve here (tight: the zero optimum of complete balancing
@@ -90,9 +91,9 @@ class Layout:
     Attributes
     ----------
     c
-        Constant part, ``(14,)``.
+        Constant part, ``(P,)``.
     T
-        ``(14, n)``.
+        ``(P, n)``.
     primary
         The entry of ``x`` each variable stands for.
     """
@@ -118,8 +119,9 @@ class Layout:
 def layout(data: NumericProblem) -> Layout:
     """The affine map from the free variables to the design vector (see :class:`Layout`)."""
     scales = data.scales
-    c = np.zeros(14)
-    rows = np.zeros((14, 14))  # rows[i] = coefficients of x[i] on the variables (max 14)
+    size = data.size
+    c = np.zeros(size)
+    rows = np.zeros((size, size))  # rows[i] = coefficients of x[i] on the variables
     primary: list[int] = []
 
     def new_variable(entry: int) -> None:
@@ -127,7 +129,7 @@ def layout(data: NumericProblem) -> Layout:
         primary.append(entry)
 
     for b in data.links:
-        k = 4 * b.index
+        k = b.start
         if b.mass[0] < b.mass[1]:
             new_variable(k)
         else:
@@ -147,7 +149,8 @@ def layout(data: NumericProblem) -> Layout:
             rows[k + 3] = s2 * rows[k]
         else:
             new_variable(k + 3)
-    for entry, b in ((12, data.links[0]), (13, data.links[2])):
+    for b in data.rotor_links:
+        entry = b.rotor
         assert b.counter_rotor is not None
         lo, hi = b.counter_rotor
         if data.inert[entry]:
@@ -216,7 +219,7 @@ class ConvexSolver:
         r = data.factor / self._scale
         p_matrix, q_vector = r @ lay.T, r @ lay.c
         w_mass = data.weights.added_mass / self._scale**2
-        mass = x[0] + x[4] + x[8]
+        mass = sum(x[i] for i in data.mass_entries)
         mass_term = (mass - data.original_mass) * w_mass if w_mass else 0.0
         self._norm_form = w_mass == 0 and k > 0
         if k:
@@ -242,10 +245,11 @@ class ConvexSolver:
             _, sv, vt = np.linalg.svd(p_matrix, full_matrices=False)
             rows = list(vt[sv > 1e-12 * sv.max(initial=0.0)])
         if w_mass:
-            g = lay.T[0] + lay.T[4] + lay.T[8]
+            masses = lay.T[data.mass_entries].sum(axis=0)
+            g = masses
             for v in rows:
                 g = g - (v @ g) * v
-            if np.linalg.norm(g) > 1e-12 * np.linalg.norm(lay.T[0] + lay.T[4] + lay.T[8]):
+            if np.linalg.norm(g) > 1e-12 * np.linalg.norm(masses):
                 rows.append(g / np.linalg.norm(g))
         self._seen = np.array(rows).reshape(len(rows), n)
         self._seen_value = cp.Parameter(len(rows), name="seen")
@@ -272,18 +276,19 @@ class ConvexSolver:
             return (lo + margin, hi - margin) if hi - lo > 2 * margin else (lo, hi)
 
         for b in data.links:
-            k = 4 * b.index
+            k = b.start
             mref, l, iref = b.mass_ref, b.length, b.inertia_ref
             m = x[k] / mref
             if k in free:
                 lo, hi = inside(b.mass[0] / mref, b.mass[1] / mref)
                 out += [m >= lo, m <= hi]
             se, sf = x[k + 1] / (mref * l), x[k + 2] / (mref * l)
-            centre = b.com_centre / l
+            centre = b.com_centre / l  # complex, in the link's frame
             if b.com_fixed is None:
                 radius = b.com_radius / l
                 radius = radius - margin if radius > 2 * margin else radius
-                out.append(cp.norm(cp.hstack([se - centre * m, sf])) <= radius * m)
+                out.append(cp.norm(cp.hstack([se - centre.real * m, sf - centre.imag * m]))
+                           <= radius * m)
             if (k + 3) not in free:
                 continue  # inert, or fixed inertia with a fixed centre of mass: nothing to ask
             j = x[k + 3] / iref
@@ -306,9 +311,11 @@ class ConvexSolver:
                 out.append(q <= j - rho2 * m - margin)
             if math.isfinite(hi):
                 radius = b.com_radius / l
-                out.append(j - hi_m <= m * (radius**2 - centre**2) + 2 * centre * se)
+                out.append(j - hi_m <= m * (radius**2 - abs(centre) ** 2)
+                           + 2 * (centre.real * se + centre.imag * sf))
                 relaxed.append(b.name)
-        for entry, b in ((12, data.links[0]), (13, data.links[2])):
+        for b in data.rotor_links:
+            entry = b.rotor
             if entry in free:
                 assert b.counter_rotor is not None
                 scale = data.scales[entry]
@@ -327,9 +334,9 @@ class ConvexSolver:
             return False
         a, b = self.data.force_balance
         lay = self.layout
-        terms = np.abs(a) @ np.abs(self.data.scales[:12])  # each row's magnitude, kg
-        at = a @ lay.T[:12] / terms[:, None]
-        rhs = (b - a @ lay.c[:12]) / terms
+        terms = np.abs(a) @ np.abs(self.data.scales)  # each row's magnitude, kg
+        at = a @ lay.T / terms[:, None]
+        rhs = (b - a @ lay.c) / terms
         fixed_rows = self.data.force_balance_rows(lay.c)  # the rows with nothing free
         inconsistent = False
         keep = []
@@ -475,7 +482,7 @@ class ConvexSolver:
         rows = data.force_balance_rows(self.layout.c)
         a, _ = data.force_balance
         i = self._failed_row
-        names = [b.name for b in data.links if np.any(a[i, 4 * b.index : 4 * b.index + 3])]
+        names = [b.name for b in data.links if np.any(a[i, b.start : b.start + 3])]
         keys = " or ".join(f"balance.{n}" for n in names)
         return InfeasibleError(
             f"force balance cannot be met within the bounds: a condition of Eq. 58 among the "
@@ -495,7 +502,7 @@ class ConvexSolver:
 
         Solvers meet bounds to their tolerance. First Eq. 58 is restored by the least change
         of the free variables; if a bound is still broken by more than rounding
-        (:data:`~balancer.problem.ROUNDING_TOLERANCE`: a designer's spec must hold what the
+        (:data:`~balancer.balance.problem.ROUNDING_TOLERANCE`: a designer's spec must hold what the
         problem promised, and :meth:`NumericProblem.physical` removes only rounding), ``x``
         is projected, as the least change in scaled
         variables, onto the bounds tightened by :data:`MARGIN`, with Eq. 58 as equalities,
@@ -509,7 +516,7 @@ class ConvexSolver:
             return exact, True
         if not lay.size:
             return x, False
-        inert = [i for i in range(14) if data.inert[i]]
+        inert = [i for i in range(data.size) if data.inert[i]]
         for margin in (MARGIN, 1e-2 * MARGIN, 0.0):  # a thin feasible set takes a smaller one
             u = self._project(lay.u(x), margin)
             if u is None:
@@ -530,7 +537,7 @@ class ConvexSolver:
         ``None`` if they do not within a few rounds.
         """
         data, lay = self.data, self.layout
-        inert = [i for i in range(14) if data.inert[i]]
+        inert = [i for i in range(data.size) if data.inert[i]]
         for _ in range(4):
             xp = data.vector_of(data.physical(x))
             if (data.force_balance_residual(xp) <= FORCE_BALANCE_TOLERANCE
@@ -556,7 +563,7 @@ class ConvexSolver:
         pinned = np.zeros(u.size, dtype=bool)
         x = lay.x(u)
         for b in data.links:
-            k = 4 * b.index
+            k = b.start
             if k in index:
                 m = min(max(x[k], b.mass[0]), b.mass[1])
                 if m != x[k]:
@@ -577,11 +584,11 @@ class ConvexSolver:
         """Inertias and counter-rotors moved into their bounds (they are not in Eq. 58)."""
         data = self.data
         x = np.array(x, dtype=float)
-        for entry, b in ((12, data.links[0]), (13, data.links[2])):
+        for b in data.rotor_links:
             if b.counter_rotor is not None:
-                x[entry] = min(max(x[entry], b.counter_rotor[0]), b.counter_rotor[1])
+                x[b.rotor] = min(max(x[b.rotor], b.counter_rotor[0]), b.counter_rotor[1])
         for b in data.links:  # inert ones too: a move of the mass or centre of mass shifts I
-            k = 4 * b.index
+            k = b.start
             q = (x[k + 1] ** 2 + x[k + 2] ** 2) / x[k]
             low = max(b.inertia[0], x[k] * b.gyration**2)
             inertia = x[k + 3] - q
@@ -688,8 +695,9 @@ class ConvexSolver:
         Clarabel meets the constraints to its tolerance (``1e-10``, or ~``1e-5`` when it stops
         "almost solved"). First the least change of ``u`` restores Eq. 58 to rounding (it moves
         the design by about Clarabel's tolerance). A design that then meets every bound to
-        :data:`balancer.problem.FEASIBILITY_TOLERANCE` is kept as it is; otherwise masses and
-        counter-rotors are clipped into their bounds and centres of mass pulled into their
+        :data:`~balancer.balance.problem.FEASIBILITY_TOLERANCE` is kept as it is; otherwise
+        masses and counter-rotors are clipped into their bounds and centres of mass pulled into
+        their
         discs, Eq. 58 restored again (alternating twice), and each inertia about the centre of
         mass put into its bounds (inertias do not enter Eq. 58). Returns the design vector
         (inert entries settled) and whether the convex relaxation was tight: an upper inertia
@@ -705,7 +713,7 @@ class ConvexSolver:
         rounds = 2 if data.violations(data.settle(lay.x(u), for_motion=False)) else 0
         for _ in range(rounds):
             for b in data.links:
-                k = 4 * b.index
+                k = b.start
                 if k in index:
                     j = index[k]
                     u[j] = np.clip(u[j], b.mass[0] / data.scales[k], b.mass[1] / data.scales[k])
@@ -717,7 +725,8 @@ class ConvexSolver:
                         s = m * b.com_centre + d
                         u[index[k + 1]] = s.real / data.scales[k + 1]
                         u[index[k + 2]] = s.imag / data.scales[k + 2]
-            for entry, b in ((12, data.links[0]), (13, data.links[2])):
+            for b in data.rotor_links:
+                entry = b.rotor
                 if entry in index:
                     assert b.counter_rotor is not None
                     lo, hi = (v / data.scales[entry] for v in b.counter_rotor)
@@ -726,7 +735,7 @@ class ConvexSolver:
         x = lay.x(u)
         tight = True
         for b in data.links:
-            k = 4 * b.index
+            k = b.start
             if data.inert[k + 3] or (k + 3) not in index:
                 continue
             q = (x[k + 1] ** 2 + x[k + 2] ** 2) / x[k]
@@ -755,7 +764,7 @@ class ConvexSolver:
             return 0.0 if slack is None else slack(group)
 
         cons: list = []
-        parts = []
+        parts: list = [0.0] * data.size  # the design vector, in the layout's order
         for b in data.links:
             i, mref, l = b.index, b.mass_ref, b.length
             if skip != (i, "mass-low"):
@@ -765,7 +774,8 @@ class ConvexSolver:
             cons.append(m[i] >= 0.1 * b.mass[0] / mref * tau)
             if b.com_fixed is None:
                 group = (i, "com")
-                lhs = cp.norm(s[i] - cp.hstack([b.com_centre / l * m[i], 0.0]))
+                c = b.com_centre / l
+                lhs = cp.norm(s[i] - cp.hstack([c.real * m[i], c.imag * m[i]]))
                 rhs = b.com_radius / l * m[i]
             else:
                 group = (i, "com-fixed")
@@ -775,10 +785,10 @@ class ConvexSolver:
                 rhs = 0.0
             if skip != group:
                 cons.append(lhs <= rhs + relax(group))
-            parts += [m[i] * mref, s[i, 0] * mref * l, s[i, 1] * mref * l, 0.0]
+            parts[b.start : b.start + 3] = [m[i] * mref, s[i, 0] * mref * l, s[i, 1] * mref * l]
         assert data.force_balance is not None
         a, rhs_fb = data.force_balance
-        terms = np.abs(a) @ np.abs(data.scales[:12])  # each row by its own magnitude
+        terms = np.abs(a) @ np.abs(data.scales)  # each row by its own magnitude
         cons.append((a / terms[:, None]) @ cp.hstack(parts) == rhs_fb / terms * tau)
         return cons
 
@@ -795,8 +805,8 @@ class ConvexSolver:
         the total mass times the longest link) and minimises their weighted sum subject to
         Eq. 58; its nonzero slacks name the bounds, and its design the values that suffice
         together. (Only force balance can make the problem infeasible: every other condition
-        is met by some inertia, and :func:`balancer.problem.check_problem` has rejected empty
-        ranges.) Returns ``None`` when no bound needs widening: the problem is feasible.
+        is met by some inertia, and :func:`~balancer.balance.problem.check_problem` has rejected
+        empty ranges.) Returns ``None`` when no bound needs widening: the problem is feasible.
         """
         data = self.data
         groups = []
@@ -834,8 +844,8 @@ class ConvexSolver:
         data = self.data
         mtot = data.original_mass
         moment_unit = mtot * max(b.length for b in data.links)
-        m = cp.Variable(3)
-        s = cp.Variable((3, 2))
+        m = cp.Variable(len(data.links))
+        s = cp.Variable((len(data.links), 2))
         slacks: dict[tuple[int, str], tuple[cp.Variable, float]] = {}
 
         def slack(group: tuple[int, str]) -> cp.Variable:
@@ -890,25 +900,24 @@ class ConvexSolver:
             return value <= b.com_radius + 1e-9 * b.length
         return value <= 1e-9 * b.length  # a fixed centre of mass: it need not move
 
-    @staticmethod
-    def _centre(b, kind: str) -> float:
-        """The point a radius is measured from: ``com_about``, or the default joint."""
+    def _centre(self, b, kind: str) -> complex:
+        """The point a radius is measured from: ``com_about``, or the default point."""
         if kind == "com":
             return b.com_centre
-        return 0.0 if b.default_about == b.joints[0] else b.length
+        return self.data.mechanism.structure.local[(b.index, b.default_about)].complex()
 
     def _needed(self, group: tuple[int, str]) -> float | None:
         """The exact bound group ``group`` needs with every other bound kept (or ``None``)."""
         i, kind = group
         b = self.data.links[i]
-        m = cp.Variable(3)
-        s = cp.Variable((3, 2))
+        m = cp.Variable(len(self.data.links))
+        s = cp.Variable((len(self.data.links), 2))
         if kind.startswith("com"):
             tau = cp.Variable(nonneg=True)  # Charnes–Cooper: scale everything so that m_i = 1
             cons = self._bound_constraints(m, s, tau, skip=group)
             cons.append(m[i] == 1.0)
             centre = self._centre(b, kind) / b.length
-            objective = cp.Minimize(cp.norm(s[i] - cp.hstack([centre, 0.0])))
+            objective = cp.Minimize(cp.norm(s[i] - cp.hstack([centre.real, centre.imag])))
             scale = b.length  # ‖S/m − c‖ in metres
         else:
             cons = self._bound_constraints(m, s, 1.0, skip=group)

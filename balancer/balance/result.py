@@ -13,13 +13,13 @@ from enum import StrEnum
 import numpy as np
 from numpy.typing import NDArray
 
+from ..cycle import CycleAnalysis
 from ..errors import SolverError
-from ..inverse import CycleAnalysis
-from ..model import Design, FourBar
+from ..model import Design
 
 #: Gap to the certified lower bound, relative to the problem's scale (the original design's
-#: RMS; :meth:`balancer.problem.NumericProblem.gap`), within which a design is called globally
-#: optimal. Clarabel certifies the bound to ~2e-10 of that scale, the tie-break accepts 1e-8.
+#: RMS; :meth:`balancer.balance.problem.NumericProblem.gap`), within which a design is called
+#: globally optimal. The bound is certified to ~2e-8 of that scale, the tie-break accepts 1e-8.
 GAP_TOLERANCE = 1e-6
 
 
@@ -57,7 +57,7 @@ class StageReport:
         The objective ``J`` at the stage's design, (N·m)² (``nan`` if it has none).
     gap
         That objective's gap to the certified lower bound, relative to the problem's scale
-        (:meth:`balancer.problem.NumericProblem.gap`; ``nan`` until the bound is known).
+        (:meth:`balancer.balance.problem.NumericProblem.gap`; ``nan`` until the bound is known).
     """
 
     name: str
@@ -87,14 +87,16 @@ class BalanceResult:
     backend
         ``"convex"`` or ``"nlp"``.
     linkage
-        The balanced four-bar.
+        The balanced mechanism's model.
     original
         The design it came from.
     x
-        Its inertial parameters (:data:`balancer.inverse.PARAMETER_NAMES`): kg, kg·m, kg·m,
-        kg·m² per link, then counter-rotor inertias, kg·m².
+        Its design vector (the mechanism's layout,
+        :class:`balancer.linkage.dynamics.Layout`): kg, kg·m, kg·m, kg·m² per link, then
+        counter-rotor inertias, kg·m².
     objective
-        ``J`` of the balanced design, (N·m)² (mean-square form, see :mod:`balancer.problem`).
+        ``J`` of the balanced design, (N·m)² (mean-square form, see
+        :mod:`balancer.balance.problem`).
     original_objective
         ``J`` of the original design, (N·m)².
     lower_bound
@@ -128,8 +130,8 @@ class BalanceResult:
     status: Status
     message: str
     backend: str
-    linkage: FourBar
-    original: FourBar
+    linkage: object
+    original: object
     x: NDArray[np.float64]
     objective: float
     original_objective: float

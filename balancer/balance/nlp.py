@@ -1,17 +1,18 @@
 """Nonlinear balancing in the designer's own parameters (CasADi + IPOPT).
 
-Decision vector (scaled; only what may change): per link, in the order crank, coupler, rocker,
+Decision vector (scaled; only what may change): per link, in the mechanism's order,
 ``m/m_ref`` (kg), ``e/l`` and ``f/l`` (centre of mass in the link frame, m), ``I/(m_ref·l²)``
-(inertia about the centre of mass, kg·m²); then the counter-rotor inertias of crank and rocker
-over their link's ``m_ref·l²`` (kg·m²). Fixed quantities are constants; inert ones (see
-:attr:`balancer.problem.NumericProblem.inert`) are left out and settled afterwards.
+(inertia about the centre of mass, kg·m²); then the counter-rotor inertias of the links on a
+ground pivot over their link's ``m_ref·l²`` (kg·m²). Fixed quantities are constants; inert ones
+(see :attr:`balancer.balance.problem.NumericProblem.inert`) are left out and settled
+afterwards.
 
 The objective is the same ``J`` as the convex problem's, written through the inertial
-parameters ``π(p) = (m, m·e, m·f, I + m·(e² + f²))`` (:func:`balancer.problem.physical_to_inertial`)
-and the factor ``R`` of the mass-matrix regressors (Eq. 45–54): ``J = ‖R·π‖² + w_m·Δm``.
-Constraints: force balance (Eq. 58, bilinear equalities), the centre of mass in its disc
-``(e − c)² + f² ≤ R²``, ``I ≥ m·ρ²``, and simple bounds — an upper inertia bound is exact here,
-which is where this formulation can beat the convex relaxation.
+parameters ``π(p) = (m, m·e, m·f, I + m·(e² + f²))``
+(:func:`balancer.balance.problem.physical_to_inertial`) and the factor ``R`` of the regressors:
+``J = ‖R·π‖² + w_m·Δm``. Constraints: force balance (bilinear equalities in these variables),
+the centre of mass in its disc ``|s̄ − c|² ≤ R²``, ``I ≥ m·ρ²``, and simple bounds — an upper
+inertia bound is exact here, which is where this formulation can beat the convex relaxation.
 
 IPOPT is built once per problem (:class:`NlpSolver`) and started from the convex optimum (a
 primal warm start).
@@ -27,7 +28,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ..problem import NumericProblem, inertial_to_physical, physical_to_inertial
+from .problem import NumericProblem, inertial_to_physical, physical_to_inertial
 from .result import StageReport
 
 #: IPOPT's options, in one place: quiet and tight. The start is the convex optimum (a primal
@@ -96,7 +97,8 @@ class NlpSolver:
         g: list = []
         lbg: list[float] = []
         ubg: list[float] = []
-        varying: set[int] = set()  # entries of x[:12] that can change
+        varying: set[int] = set()  # entries of x that can change
+        parts: list = [0.0] * data.size  # the design vector, in the layout's order
 
         def variable(name: str, lo: float, hi: float, tag: tuple[int, str]):
             s = ca.SX.sym(name)
@@ -107,7 +109,7 @@ class NlpSolver:
             return s
 
         for b in data.links:
-            k, mref, l, iref = 4 * b.index, b.mass_ref, b.length, b.inertia_ref
+            k, mref, l, iref = b.start, b.mass_ref, b.length, b.inertia_ref
             if b.mass[0] < b.mass[1]:
                 m = mref * variable(
                     f"m{b.index}", b.mass[0] / mref, b.mass[1] / mref, (b.index, "m")
@@ -117,9 +119,9 @@ class NlpSolver:
                 m = b.mass[0]
             if b.com_fixed is None:
                 c, r = b.com_centre / l, b.com_radius / l
-                e = l * variable(f"e{b.index}", c - r, c + r, (b.index, "e"))
-                f = l * variable(f"f{b.index}", -r, r, (b.index, "f"))
-                g.append((e / l - c) ** 2 + (f / l) ** 2)
+                e = l * variable(f"e{b.index}", c.real - r, c.real + r, (b.index, "e"))
+                f = l * variable(f"f{b.index}", c.imag - r, c.imag + r, (b.index, "f"))
+                g.append((e / l - c.real) ** 2 + (f / l - c.imag) ** 2)
                 lbg.append(-math.inf)
                 ubg.append(r * r)
                 varying.update((k + 1, k + 2))
@@ -137,20 +139,22 @@ class NlpSolver:
                     ubg.append(math.inf)
                 elif b.gyration > 0:
                     lbx[-1] = max(lbx[-1], b.mass[0] * b.gyration**2 / iref)
-            parts += list(physical_to_inertial(m, e, f, inertia))
-        for entry, b in ((12, data.links[0]), (13, data.links[2])):
+            parts[k : k + 4] = list(physical_to_inertial(m, e, f, inertia))
+        for b in data.rotor_links:
+            entry = b.rotor
             assert b.counter_rotor is not None
             lo, hi = b.counter_rotor
             scale = data.scales[entry]
             if data.inert[entry] or lo == hi:
-                parts.append(lo)
+                parts[entry] = lo
             else:
-                parts.append(scale * variable(f"Jc{entry}", lo / scale, hi / scale, (entry, "Jc")))
+                parts[entry] = scale * variable(f"Jc{entry}", lo / scale, hi / scale,
+                                                (entry, "Jc"))
         pi = ca.vertcat(*parts)
         if data.force_balance is not None:
             a, rhs = data.force_balance
-            mtot = data.original_mass
-            residual = (ca.mtimes(ca.DM(a), pi[:12]) - ca.DM(rhs)) / mtot
+            terms = np.abs(a) @ np.abs(data.scales)  # each condition by its own size
+            residual = (ca.mtimes(ca.DM(a / terms[:, None]), pi) - ca.DM(rhs / terms))
             for i in range(a.shape[0]):
                 if any(a[i, j] != 0 for j in varying):
                     g.append(residual[i])
@@ -163,7 +167,7 @@ class NlpSolver:
             value = ca.sumsqr(r)
         if data.weights.added_mass:
             value = value + data.weights.added_mass / scale**2 * (
-                pi[0] + pi[4] + pi[8] - data.original_mass
+                sum(pi[i] for i in data.mass_entries) - data.original_mass
             )
         v = ca.vertcat(*symbols)
         self._pi = ca.Function("pi", [v], [pi])
@@ -188,7 +192,7 @@ class NlpSolver:
     def start(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The scaled decision vector for design vector ``x``, clipped into the bounds."""
         data = self.data
-        physical = [inertial_to_physical(x[4 * i : 4 * i + 4]) for i in range(3)]
+        physical = [inertial_to_physical(x[b.entries]) for b in data.links]
         out = []
         for index, kind in self._names:
             if kind == "Jc":
@@ -209,10 +213,10 @@ class NlpSolver:
             if kind == "e":
                 b = data.links[index]
                 c, r = b.com_centre / b.length, b.com_radius / b.length
-                d = math.hypot(v[i] - c, v[i + 1])
+                d = math.hypot(v[i] - c.real, v[i + 1] - c.imag)
                 if d > r:
-                    v[i] = c + (v[i] - c) * r / d
-                    v[i + 1] *= r / d
+                    v[i] = c.real + (v[i] - c.real) * r / d
+                    v[i + 1] = c.imag + (v[i + 1] - c.imag) * r / d
         return v
 
     def design(self, v: NDArray[np.float64]) -> NDArray[np.float64]:

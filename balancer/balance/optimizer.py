@@ -1,0 +1,238 @@
+"""Balancing optimisers: the redesign problem of a spec's ``[balance]`` section, solved.
+
+Two backends over one :class:`~balancer.balance.problem.NumericProblem`:
+
+``"convex"``
+    The second-order cone program in the inertial parameters (:mod:`.convex`, CVXPY +
+    Clarabel): a global optimum, or — when a link's inertia is bounded above while its centre
+    of mass may move, the one non-convex condition — a relaxation whose optimum is a lower
+    bound (then the design is moved into the inertia bounds and the gap is reported).
+``"nlp"``
+    The convex problem first (lower bound and start), then IPOPT on the designer's physical
+    parameters (:mod:`.nlp`, CasADi). The result is the better of the two designs; on a tie
+    (within ``1e-7`` relative) the convex one, which is the least change from the original
+    among the optimal designs (IPOPT, an interior-point method, stops somewhere on a
+    degenerate optimum that depends on its barrier).
+
+The objective is **inertial**: applied loads are left out (see :mod:`balancer.balance.problem`).
+
+Example::
+
+    from balancer import load_design
+    from balancer.optimize import optimize
+    result = optimize(load_design("examples/pb1.toml"))
+    result.success, result.status, result.objective, result.gap
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from ..cycle import cycle_analysis
+from ..errors import SpecError
+from ..model import Design
+from .convex import ConvexSolution, ConvexSolver
+from .nlp import NlpSolution, NlpSolver
+from .problem import ROUNDING_TOLERANCE, NumericProblem, numeric_problem
+from .result import (
+    GAP_TOLERANCE,
+    BalanceResult,
+    InfeasibleError,
+    StageReport,
+    Status,
+)
+
+BACKENDS: tuple[str, ...] = ("nlp", "convex")
+#: Gap (relative to the problem's scale, :meth:`NumericProblem.gap`) within which the NLP's
+#: design does not replace the convex one (which may exceed the optimum by Clarabel's
+#: tolerance and the tie-break's, :data:`.convex.TIE_ACCEPT`).
+TIE_TOLERANCE = 1e-7
+
+__all__ = [
+    "BACKENDS",
+    "BalanceResult",
+    "ConvexSolution",
+    "ConvexSolver",
+    "InfeasibleError",
+    "NlpSolution",
+    "NlpSolver",
+    "Optimizer",
+    "StageReport",
+    "Status",
+    "optimize",
+]
+
+
+class Optimizer:
+    """Both backends for one redesign problem, each built once (for repeated solves).
+
+    Parameters
+    ----------
+    data
+        The numeric problem (:func:`balancer.balance.problem.numeric_problem`).
+    """
+
+    def __init__(self, data: NumericProblem) -> None:
+        self.data = data
+        self.convex = ConvexSolver(data)
+        self._nlp: NlpSolver | None = None
+
+    @property
+    def nlp(self) -> NlpSolver:
+        """The NLP solver (built when first asked for)."""
+        if self._nlp is None:
+            self._nlp = NlpSolver(self.data)
+        return self._nlp
+
+    def run(self, backend: str = "nlp") -> BalanceResult:
+        """Solve with ``backend`` and assemble the result.
+
+        Parameters
+        ----------
+        backend
+            ``"nlp"`` or ``"convex"``.
+
+        Raises
+        ------
+        SpecError
+            For an unknown backend.
+        InfeasibleError
+            If no design within the bounds meets force balance.
+        SolverError
+            If Clarabel fails.
+        """
+        if backend not in BACKENDS:
+            raise SpecError(
+                f"unknown backend; choose from {', '.join(BACKENDS)}", key="backend", value=backend
+            )
+        data = self.data
+        t0 = time.perf_counter()
+        convex = self.convex.solve()
+        stages: list[StageReport] = list(convex.stages)
+        x, feasible = convex.x, convex.converged
+        objective = data.objective(x)
+        notes = []
+        if backend == "nlp":
+            nlp = self.nlp.solve(convex.x)
+            stages.append(nlp.stage)
+            if nlp.status == "optimal" and nlp.feasible:
+                if not feasible or not data.within(objective, nlp.objective, TIE_TOLERANCE):
+                    xb, ok = self.convex.finalize(nlp.x)  # bounds exactly, Eq. 58 to rounding
+                    if ok:
+                        x, objective, feasible = xb, data.objective(xb), True
+            else:
+                notes.append(f"IPOPT: {nlp.stage.solver_status}")
+        # The design as its physical values, exactly in their bounds (what the spec will say).
+        x = data.vector_of(data.physical(x))
+        objective = data.objective(x)
+        feasible = feasible and not data.violations(x, tol=ROUNDING_TOLERANCE)
+        if not feasible and data.force_balance is not None:
+            diagnosis = self.convex.diagnose()  # a problem just on the infeasible side
+            if diagnosis is not None:
+                raise diagnosis
+        elapsed = time.perf_counter() - t0
+        lower = convex.lower_bound
+        g = data.gap(objective, lower)
+        stages = [replace(s, gap=data.gap(s.objective, lower))
+                  if math.isfinite(s.objective) else s for s in stages]
+        blur = data.rounding(x)  # rounding can hide this much of a gap
+        if not feasible:
+            status = Status.FAILED
+        elif g + blur <= GAP_TOLERANCE:
+            status = Status.OPTIMAL
+        else:
+            status = Status.FEASIBLE
+            if blur > GAP_TOLERANCE:
+                notes.append(f"rounding blurs the objective by {blur:.1e} of the scale (links "
+                             "of very different masses): optimality cannot be decided finer")
+        balanced = data.linkage_of(x)
+        before = cycle_analysis(
+            data.linkage, data.speed, data.samples, route="newton-euler", loads=False
+        )
+        after = cycle_analysis(
+            balanced, data.speed, data.samples, route="newton-euler", loads=False
+        )
+        result = BalanceResult(
+            success=status is not Status.FAILED,
+            status=status,
+            message="",
+            backend=backend,
+            linkage=balanced,
+            original=data.linkage,
+            x=np.array(x),
+            objective=objective,
+            original_objective=data.original_objective,
+            lower_bound=lower,
+            gap=g,
+            scale=data.objective_scale,
+            rms_form=data.rms_form,
+            relaxation_tight=convex.relaxation_tight,
+            iterations=sum(s.iterations for s in stages),
+            time=elapsed,
+            stages=tuple(stages),
+            before=before,
+            after=after,
+        )
+        return replace(result, message=_message(result, convex, notes))
+
+
+def _message(result: BalanceResult, convex: ConvexSolution, notes: list[str]) -> str:
+    """One line: the status, the figure, the certified bound and the gap, in N·m."""
+    text = {
+        Status.OPTIMAL: "globally optimal",
+        Status.FEASIBLE: "feasible, not proven optimal",
+        Status.FAILED: "no feasible design found",
+    }[result.status]
+    tolerance = f"tolerance {GAP_TOLERANCE:g} of the problem's scale {result.scale:.4g} N·m"
+    if result.rms_form:
+        value = f"RMS {result.rms:.6g} N·m"
+        if result.original_objective > 0:
+            ratio = result.rms / math.sqrt(result.original_objective)
+            value += f" ({ratio:.3g} of the original's)"
+        parts = [text, value, f"certified lower bound {result.rms_lower_bound:.6g} N·m",
+                 f"gap {result.rms_gap:.2g} N·m ({tolerance})"]
+    else:
+        parts = [text, f"J = {result.objective:.6g} (N·m)²",
+                 f"certified lower bound {result.lower_bound:.6g} (N·m)²",
+                 f"gap {result.gap * result.scale**2:.2g} (N·m)² ({tolerance}, squared)"]
+    if not convex.relaxation_tight:
+        parts.append("convex relaxation not tight")
+    return "; ".join(parts + notes)
+
+
+def optimize(design: Design, backend: str = "nlp") -> BalanceResult:
+    """Balance a design as its ``[balance]`` section asks.
+
+    Parameters
+    ----------
+    design
+        A spec with ``[balance]`` and ``[operation]``.
+    backend
+        ``"nlp"`` (convex, then IPOPT on the physical parameters) or ``"convex"``.
+
+    Returns
+    -------
+    BalanceResult
+        The balanced design, before/after analyses, status, lower bound and gap.
+
+    Raises
+    ------
+    SpecError
+        If the spec has no ``[balance]`` or ``[operation]``, or the backend is unknown.
+    AssemblyError
+        If the crank cannot turn a full revolution.
+    InfeasibleError
+        (a :class:`~balancer.errors.SolverError`, exit code 1) if force balance cannot be met
+        within the bounds; the message names the bounds to widen and the values that would do.
+    SolverError
+        If a solver fails.
+    """
+    if backend not in BACKENDS:
+        raise SpecError(
+            f"unknown backend; choose from {', '.join(BACKENDS)}", key="backend", value=backend
+        )
+    return Optimizer(numeric_problem(design)).run(backend)
