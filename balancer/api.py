@@ -11,12 +11,12 @@ returns a result object; nothing here prints or writes files.
 
 from __future__ import annotations
 
+from .cycle import CycleAnalysis, cycle_analysis
 from .errors import SpecError
-from .inverse import CycleAnalysis, Route, cycle_analysis
 from .model import Design
 
 
-def analyze(design: Design, *, route: Route = "newton-euler") -> CycleAnalysis:
+def analyze(design: Design, *, route: str | None = None) -> CycleAnalysis:
     """One crank revolution at the design's operating speed (``[operation]``).
 
     Raises
@@ -29,6 +29,5 @@ def analyze(design: Design, *, route: Route = "newton-euler") -> CycleAnalysis:
             "missing required key: a cycle analysis needs the operating speed",
             key="operation.speed",
         )
-    return cycle_analysis(
-        design.mechanism, design.operation.speed, design.operation.samples, route=route
-    )
+    return cycle_analysis(design.mechanism, design.operation.speed, design.operation.samples,
+                          route=route)

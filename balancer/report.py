@@ -13,10 +13,10 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
-from .conditions import force_balance_error, is_force_balanced, named_force_balance_residuals
-from .inverse import CycleAnalysis, Figure
-from .kinematics import classify
+from .cycle import CycleAnalysis, Figure
+from .mechanisms import mechanism_of
 
 UNITS = {"shaking_force": "N", "shaking_moment": "N·m", "driving_torque": "N·m"}
 
@@ -66,81 +66,90 @@ def reaction_extremes(values: np.ndarray) -> dict[str, float]:
     }
 
 
-def mechanism_class(linkage) -> str:
-    """Grashof class of a four-bar, or whether a slider-crank's crank turns fully."""
-    if linkage.type == "slider-crank":
-        from .slider_crank.kinematics import classify as slider_classify
-
-        return slider_classify(linkage.lengths)
-    return str(classify(linkage.lengths))
-
-
-def reaction_names(linkage) -> tuple[str, str]:
-    """What the two ground reactions are called: A0 and A3, or A0 and the guide."""
-    return ("A0", "guide") if linkage.type == "slider-crank" else ("A0", "A3")
-
-
 def figures_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
     """The three fixed figures ``shaking_force``, ``shaking_moment``, ``driving_torque``."""
     return analysis.summary.as_dict()
 
 
+def harmonics(analysis: CycleAnalysis, orders: int = 4) -> dict[str, NDArray[np.float64]]:
+    """Amplitudes of the harmonics 0…``orders`` of the shaking over a revolution.
+
+    Keys ``shaking_force_x``, ``shaking_force_y`` (N), ``shaking_moment`` (N·m),
+    ``driving_torque`` (N·m); entry ``k`` is the amplitude at ``k`` times the crank speed
+    (entry 0 the mean). From equally spaced samples of one revolution (a discrete Fourier
+    transform); samples at a singular pose carry the limits of the smooth motion.
+    """
+    r = analysis.reactions
+    signals = {
+        "shaking_force_x": np.real(r.shaking_force),
+        "shaking_force_y": np.imag(r.shaking_force),
+        "shaking_moment": np.asarray(r.shaking_moment, float),
+        "driving_torque": np.asarray(r.driving_torque, float),
+    }
+    out = {}
+    for name, values in signals.items():
+        spectrum = np.fft.rfft(values) / values.size
+        amp = np.abs(spectrum[: orders + 1]) * 2
+        amp[0] /= 2
+        out[name] = amp
+    return out
+
+
+def _harmonics_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
+    """Primary and secondary harmonic amplitudes of the shaking (N, N·m)."""
+    h = harmonics(analysis)
+    return {name: {"primary": float(v[1]), "secondary": float(v[2])} for name, v in h.items()}
+
+
+def _force_balance(mech) -> tuple[bool, float]:
+    """Whether a mechanism is force-balanced, and its conditions' residual (relative)."""
+    from .balance.conditions import RESIDUAL_FLOOR, force_balance_residual
+
+    residual = force_balance_residual(mech)
+    return residual <= RESIDUAL_FLOOR, residual
+
+
 def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str, Any]:
     """The ``analyze --json`` document."""
-    linkage = analysis.linkage
-    residuals = named_force_balance_residuals(linkage)
+    mech = analysis.mechanism
+    balanced, residual = _force_balance(mech)
     doc: dict[str, Any] = {}
     if spec is not None:
         doc["spec"] = spec
     doc.update(
         {
-            "mechanism": linkage.type,
-            "class": mechanism_class(linkage),
-            "branch": linkage.branch,
+            "mechanism": mech.kind,
+            "class": mech.describe(),
+            **({"branch": mech.model.branch} if hasattr(mech.model, "branch") else {}),
             "speed": analysis.speed,
             "samples": int(analysis.samples),
             "route": analysis.route,
-            "gravity": "not included",
+            "gravity": list(analysis.gravity) if any(analysis.gravity) else "not included",
             **figures_dict(analysis),
-            "force_balanced": is_force_balanced(linkage),
-            "force_balance_residual": {
-                **{name: [c.real, c.imag] for name, c in residuals.items()},
-                "relative": force_balance_error(linkage),
-            },
-            "reactions": _reactions_dict(linkage, analysis.reactions.RA0,
-                                         analysis.reactions.RA3, analysis.reactions.guide_line),
+            "force_balanced": balanced,
+            "force_balance_residual": {"relative": residual},
+            "reactions": _reactions_dict(analysis),
             "change_points": _change_points(analysis),
-            **({"harmonics": _harmonics_dict(analysis)} if linkage.type == "slider-crank"
-               else {}),
+            "harmonics": _harmonics_dict(analysis),
             "units": {
                 "force": "N",
                 "moment": "N·m",
                 "speed": "rad/s",
-                "force_balance_residual": "kg (relative: dimensionless)",
+                "force_balance_residual": "dimensionless (first moments left over, over those "
+                                          "that make them)",
             },
         }
     )
     return doc
 
 
-def _reactions_dict(linkage, ra0, ra3, guide_line=None) -> dict[str, dict[str, float]]:
-    first, second = reaction_names(linkage)
-    out = {first: reaction_extremes(ra0), second: reaction_extremes(ra3)}
-    if guide_line is not None:
-        line = np.asarray(guide_line)
-        line = line[np.isfinite(line)]
-        if line.size:
-            out[second]["line_of_action_x_min"] = float(line.min())
-            out[second]["line_of_action_x_max"] = float(line.max())
+def _reactions_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
+    """Extremes of the force at each ground point; each ground slider's normal force, couple."""
+    r, s = analysis.reactions, analysis.summary
+    out: dict[str, dict[str, float]] = {p: reaction_extremes(v) for p, v in r.ground.items()}
+    for link in r.slider_normal:
+        out[link] = {"max": s.slider_normal[link].max, "couple_max": s.slider_couple[link].max}
     return out
-
-
-def _harmonics_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
-    """Primary and secondary harmonic amplitudes of a slider-crank's shaking (N, N·m)."""
-    from .slider_crank.conditions import harmonics
-
-    h = harmonics(analysis)
-    return {name: {"primary": float(v[1]), "secondary": float(v[2])} for name, v in h.items()}
 
 
 def _change_points(analysis: CycleAnalysis) -> list[float]:
@@ -152,15 +161,18 @@ def _change_points(analysis: CycleAnalysis) -> list[float]:
 
 def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
     """The readable ``analyze`` report."""
-    linkage = analysis.linkage
+    mech = analysis.mechanism
     s = analysis.summary
     rpm = analysis.speed * 60 / (2 * math.pi)
     head = f"balancer analyze — {spec}" if spec else "balancer analyze"
+    title = getattr(mech.model, "title", "")
     lines = [
         head,
-        f"{linkage.type} ({mechanism_class(linkage)}), branch {linkage.branch}; "
-        f"crank at {analysis.speed:g} rad/s ({rpm:.4g} rpm), {analysis.samples} crank angles "
-        f"over one revolution; route {analysis.route}; loads included, gravity not",
+        f"{mech.kind} ({mech.describe()}), {analysis.samples} crank angles per revolution at "
+        f"{analysis.speed:g} rad/s ({rpm:.4g} rpm), {analysis.route} route"
+        + ("" if any(analysis.gravity) else "; gravity not included")
+        + ("" if analysis.loads else "; loads left out"),
+        *([title] if title else []),
         "",
         table(
             [
@@ -176,28 +188,23 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
         "",
     ]
     rows = []
-    first, second = reaction_names(linkage)
-    for name, values in ((first, analysis.reactions.RA0), (second, analysis.reactions.RA3)):
+    for point, values in analysis.reactions.ground.items():
         ex = reaction_extremes(values)
-        label = "guide (slider on it)" if name == "guide" else f"R{name}"
-        rows.append(
-            [label, *(_fmt(ex[k]) for k in ("max", "x_min", "x_max", "y_min", "y_max"))]
-        )
+        rows.append([f"R{point}",
+                     *(_fmt(ex[k]) for k in ("max", "x_min", "x_max", "y_min", "y_max"))])
     lines.append(
         table(rows, ["reaction (N)", "|R| max", "Rx min", "Rx max", "Ry min", "Ry max"])
     )
-    line = analysis.reactions.guide_line
-    if line is not None and np.isfinite(line).any():
-        lines.append(f"the guide's normal force acts at x from {np.nanmin(line):.4g} m to "
-                     f"{np.nanmax(line):.4g} m along the guide")
-    if linkage.type == "slider-crank":
-        from .slider_crank.conditions import harmonics
-
-        h = harmonics(analysis)
-        lines += ["", table(
-            [[name, _fmt(h[name][1]), _fmt(h[name][2]), unit] for name, unit in (
-                ("shaking_force_x", "N"), ("shaking_force_y", "N"), ("shaking_moment", "N·m"))],
-            ["harmonic amplitude", "primary (1×)", "secondary (2×)", "unit"])]
+    if analysis.reactions.slider_normal:
+        rows = [[link, _fmt(s.slider_normal[link].max), _fmt(s.slider_couple[link].max)]
+                for link in analysis.reactions.slider_normal]
+        lines += ["", table(rows, ["slider on the frame", "normal force max (N)",
+                                   "couple max (N·m)"])]
+    h = harmonics(analysis)
+    lines += ["", table(
+        [[name.replace("_", " "), _fmt(h[name][1]), _fmt(h[name][2]), unit] for name, unit in (
+            ("shaking_force_x", "N"), ("shaking_force_y", "N"), ("shaking_moment", "N·m"))],
+        ["harmonic amplitude", "primary (1×)", "secondary (2×)", "unit"])]
     lines.append("")
     points = _change_points(analysis)
     if points:
@@ -208,15 +215,12 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
             "are the limits of the smooth motion)",
             "",
         ]
-    err = force_balance_error(linkage)
-    eq = "Eq. 20a–b" if linkage.type == "slider-crank" else "Eq. 57"
-    if is_force_balanced(linkage):
-        lines.append(f"force-balanced: yes ({eq} residual {err:.2e} of the total mass)")
+    balanced, residual = _force_balance(mech)
+    if balanced:
+        lines.append(f"force-balanced: yes (residual {residual:.2e} of the first moments)")
     else:
-        lines.append(
-            f"force-balanced: no ({eq} residual {err:.3g} of the total mass; "
-            "the total centre of mass moves)"
-        )
+        lines.append(f"force-balanced: no (residual {residual:.3g} of the first moments; the "
+                     "total centre of mass moves)")
     return "\n".join(lines)
 
 
@@ -276,52 +280,40 @@ SIMULATION_COLUMNS = (
 SHAKING_COLUMNS = ("shaking_force_x", "shaking_force_y", "shaking_moment", "driving_torque")
 #: Extra columns written after the fixed ones with ``simulate --all-columns``.
 SIMULATION_EXTRA_COLUMNS = (*SHAKING_COLUMNS, "kinetic_energy", "work")
-#: The columns of ``analyze --csv`` for a four-bar.
+#: The columns of ``analyze --csv`` for a four-bar (:func:`analysis_columns`).
 ANALYSIS_COLUMNS = (*SIMULATION_COLUMNS, *SHAKING_COLUMNS)
 
 
-SLIDER_ANALYSIS_COLUMNS = (
-    "t",
-    "theta1",
-    "theta2",
-    "omega1",
-    "omega2",
-    "alpha1",
-    "alpha2",
-    "x3",
-    "v3",
-    "a3",
-    "RA0x",
-    "RA0y",
-    "guide_force_y",
-    "guide_line_x",
-    *SHAKING_COLUMNS,
-)
+def analysis_columns(analysis: CycleAnalysis) -> tuple[list[str], list]:
+    """The columns of ``analyze --csv``: names and values (arrays over the samples).
+
+    ``t``; per moving link ``k`` (1, 2, … in the spec's order) ``theta{k}``, ``omega{k}``,
+    ``alpha{k}`` (rad, rad/s, rad/s²); per ground point ``P`` the force on it ``R{P}x``,
+    ``R{P}y`` (N); per slider on the frame its normal force and couple ``N_{link}`` (N),
+    ``C_{link}`` (N·m); then the shaking force's components, the shaking moment and the
+    driving torque. For a four-bar: the columns of ``simulate``'s CSV and the shaking.
+    """
+    mo, r = analysis.motion, analysis.reactions
+    n = len(mo.pose.angles)
+    names = ["t"]
+    cols: list = [analysis.time]
+    for group, values in (("theta", mo.pose.angles), ("omega", mo.rate), ("alpha", mo.accel)):
+        names += [f"{group}{k + 1}" for k in range(n)]
+        cols += [np.asarray(v, float) * np.ones(analysis.samples) for v in values]
+    for point, values in r.ground.items():
+        names += [f"R{point}x", f"R{point}y"]
+        cols += [values.real, values.imag]
+    for link in r.slider_normal:
+        names += [f"N_{link}", f"C_{link}"]
+        cols += [r.slider_normal[link], r.slider_couple[link]]
+    names += list(SHAKING_COLUMNS)
+    cols += [r.shaking_force.real, r.shaking_force.imag, r.shaking_moment, r.driving_torque]
+    return names, cols
 
 
 def analysis_csv(analysis: CycleAnalysis) -> str:
     """Per-angle values of a cycle analysis as CSV text (SI units, full precision)."""
-    mo, r = analysis.motion, analysis.reactions
-    if analysis.linkage.type == "slider-crank":
-        cols = [analysis.time, mo.theta1, mo.theta2, *mo.omega, *mo.alpha, mo.x, mo.v, mo.a,
-                r.RA0.real, r.RA0.imag, r.RA3.imag, r.guide_line, r.shaking_force.real,
-                r.shaking_force.imag, r.shaking_moment, r.driving_torque]
-        return csv_text(SLIDER_ANALYSIS_COLUMNS, cols)
-    cols = [
-        analysis.time,
-        *mo.theta,
-        *mo.omega,
-        *mo.alpha,
-        r.RA0.real,
-        r.RA0.imag,
-        r.RA3.real,
-        r.RA3.imag,
-        r.shaking_force.real,
-        r.shaking_force.imag,
-        r.shaking_moment,
-        r.driving_torque,
-    ]
-    return csv_text(ANALYSIS_COLUMNS, cols)
+    return csv_text(*analysis_columns(analysis))
 
 
 def csv_text(columns: Sequence[str], values: Sequence[np.ndarray]) -> str:
@@ -515,11 +507,9 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
                  "objective": s.objective if math.isfinite(s.objective) else None}
                 for s in result.stages
             ],
-            "force_balanced": is_force_balanced(linkage),
-            "force_balance_residual": force_balance_error(linkage),
-            **({"harmonics": {"before": _harmonics_dict(before),
-                              "after": _harmonics_dict(after)}}
-               if linkage.type == "slider-crank" else {}),
+            "force_balanced": _force_balance(mechanism_of(linkage))[0],
+            "force_balance_residual": _force_balance(mechanism_of(linkage))[1],
+            "harmonics": {"before": _harmonics_dict(before), "after": _harmonics_dict(after)},
             "verification": None if verification is None else verification.as_dict(),
             "out": None if out is None else str(out),
             "units": {"objective, lower_bound": "(N·m)², mean square of the inertial shaking",
@@ -551,12 +541,11 @@ def optimization_text(result, before, after, verification=None, spec=None, out=N
     lines.append(table(rows, ["at the operating speed", "RMS before", "RMS after", "ratio",
                               "max before", "max after", "unit"]))
     lines.append("")
-    if result.linkage.type == "slider-crank":
-        hb, ha = _harmonics_dict(before), _harmonics_dict(after)
-        rows = [[name.replace("_", " "), _fmt(hb[name][order]), _fmt(ha[name][order]), order]
-                for name in ("shaking_force_x", "shaking_force_y", "shaking_moment")
-                for order in ("primary", "secondary")]
-        lines += [table(rows, ["harmonic amplitude", "before", "after", "order"]), ""]
+    hb, ha = _harmonics_dict(before), _harmonics_dict(after)
+    rows = [[name.replace("_", " "), _fmt(hb[name][order]), _fmt(ha[name][order]), order]
+            for name in ("shaking_force_x", "shaking_force_y", "shaking_moment")
+            for order in ("primary", "secondary")]
+    lines += [table(rows, ["harmonic amplitude", "before", "after", "order"]), ""]
     rows = []
     for name in result.linkage.link_names:
         old, new = result.original.link(name), result.linkage.link(name)
@@ -569,9 +558,8 @@ def optimization_text(result, before, after, verification=None, spec=None, out=N
             rows.append([f"{name} {key}", f"{a:.6g}", f"{b:.6g}", unit, changed])
     lines.append(table(rows, ["parameter", "before", "after", "unit", ""]))
     lines.append("")
-    err = force_balance_error(result.linkage)
-    eq = "Eq. 20a–b" if result.linkage.type == "slider-crank" else "Eq. 57"
-    lines.append(f"force balance ({eq}): residual {err:.1e} of the total mass")
+    err = _force_balance(mechanism_of(result.linkage))[1]
+    lines.append(f"force balance: residual {err:.1e} of the first moments")
     if verification is not None:
         lines.append("")
         lines.append(verification_text(verification).split("\n", 1)[1].strip("\n"))

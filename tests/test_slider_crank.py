@@ -473,7 +473,9 @@ def test_slider_crank_through_the_command_line(tmp_path, capsys):
     engine = str(EXAMPLES / "engine.toml")
     assert main(["analyze", engine, "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
-    assert set(doc["reactions"]) == {"A0", "guide"} and doc["shaking_force"]["rms"] > 0
+    # Reactions by ground point, and the slider on its ground guide by its link's name.
+    assert set(doc["reactions"]) == {"A0", "slider"} and doc["shaking_force"]["rms"] > 0
+    assert set(doc["reactions"]["slider"]) == {"max", "couple_max"}
     out = tmp_path / "run.csv"
     assert main(["simulate", engine, "--out", str(out), "--duration", "0.005"]) == 0
     capsys.readouterr()
