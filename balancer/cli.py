@@ -321,7 +321,7 @@ def build_parser() -> argparse.ArgumentParser:
             "operating speed and in free motion from the spec's initial state; report the "
             "largest shaking force and moment, relative to the unbalanced original where the "
             "spec names one ([original]); optionally plot reactions, shaking moment and the "
-            "path of the total centre of mass (PNG and SVG)."
+            "path of the total centre of mass (PNG, SVG or PDF)."
         ),
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")

@@ -2,7 +2,7 @@
 
 Each ``plot_*`` function draws on the axes it is given (or a new figure's) and returns them;
 :func:`verification_figure` assembles the report figure of ``balancer verify`` and
-:func:`save_figure` writes it as PNG and SVG, whole or not at all.
+:func:`save_figure` writes it as PNG, SVG or PDF (from the extension), whole or not at all.
 """
 
 from __future__ import annotations

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import time as _time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
@@ -39,7 +40,7 @@ from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
 from .errors import AssemblyError, LockupError, SolverError, SpecError
-from .formulations import Formulation, make
+from .formulations import FORMULATIONS, Formulation, formulation_class, make
 from .model import Design, FourBar, SimulationSettings, check_scales
 
 #: |sin(θ3 − θ2)| at which a crank-angle formulation stops before a dead point.
@@ -49,6 +50,12 @@ DEAD_POINT_THRESHOLD = 1e-3
 MAX_STEPS = 2_000_000
 #: Steps after which the rate is extrapolated to the whole duration.
 PROJECT_AFTER = 200
+#: Distance in θ1 from a change point, rad, within which a motion is near it (passable by
+#: a dead-point event, named as the cause of a stall).
+CHANGE_POINT_NEAR = 0.05
+#: Steps over which the recent rate is judged: a run whose last ``STALL_WINDOW`` steps would
+#: need more than :data:`MAX_STEPS` more to finish has stalled (near-singular motion).
+STALL_WINDOW = 1000
 
 
 @dataclass(frozen=True)
@@ -207,12 +214,15 @@ class _Stepper:
             times.append(float(self.t_out[k]))
             k += 1
         stopped: tuple[float, NDArray[np.float64]] | None = None
+        recent: deque[float] = deque([0.0], maxlen=STALL_WINDOW + 1)
         while solver.status == "running":
             message = solver.step()
             if solver.status == "failed":
                 raise SolverError(f"the integrator failed at t = {solver.t:.6g} s: {message}")
             steps += 1
             self._check_budget(steps, solver.t)
+            recent.append(solver.t)
+            self._check_stall(recent, f, solver.t, solver.y, change_points)
             interp = solver.dense_output()
             if not f.minimal:
                 res = f.constraint_residual(solver.t, solver.y)
@@ -249,6 +259,33 @@ class _Stepper:
                 f"would take about {projected:.2g} integration steps at the rate of the first "
                 f"{t:.3g} s ({steps} steps), more than the {MAX_STEPS:.0e} allowed: shorten "
                 "it, or loosen rtol", key="simulation.duration", value=self.duration)
+
+    def _check_stall(self, recent: deque[float], f, t: float, y, change_points) -> None:
+        """Fail a run whose last :data:`STALL_WINDOW` steps project past :data:`MAX_STEPS`.
+
+        The integrator keeps its error within rtol and atol by shrinking its steps; near a
+        singular configuration (a change point, links whose masses differ by many orders of
+        magnitude) it may shrink them without end instead of failing.
+        """
+        if len(recent) <= STALL_WINDOW:
+            return
+        advance = recent[-1] - recent[0]
+        remaining = self.duration - t
+        if remaining <= 0 or advance * MAX_STEPS > remaining * STALL_WINDOW:
+            return
+        theta1 = f.theta1_of(t, y)
+        where = f"t = {t:.9g} s, θ1 = {theta1:.9g} rad"
+        near = [p for p in change_points
+                if abs(math.remainder(theta1 - p, 2 * math.pi)) < CHANGE_POINT_NEAR]
+        cause = (f"near the change point θ1 = {near[0]:.6g} rad (all joints in line), where "
+                 "the crank's rate does not determine the others'" if near else
+                 "where the motion is too sensitive for these tolerances (masses or loads of "
+                 "very different magnitudes, or a near-singular configuration)")
+        raise SolverError(
+            f"the integrator stalled at {where}, {cause}: its last {STALL_WINDOW} steps "
+            f"advanced {advance:.3g} s, so the remaining {remaining:.3g} s would need over "
+            f"{MAX_STEPS:.0e} steps at rtol = {self.rtol:g}, atol = {self.atol:g}; loosen "
+            f"the tolerances or end the run before t = {t:.6g} s")
 
     def _dead_point(self, interp, t0: float, t1: float, change_points):
         """The time at which |sin(θ3 − θ2)| falls to the threshold within a step, or None."""
@@ -300,9 +337,16 @@ class _WithExtraWork:
         return self.f.change_points()
 
 
+def _passing(mechanism_type: str) -> str:
+    """The formulations of a mechanism type that pass dead points, as a parenthesis."""
+    names = [n for n in FORMULATIONS[mechanism_type]
+             if formulation_class(n, mechanism_type).passes_dead_points]
+    return f" ({' and '.join(names)} can)" if names else ""
+
+
 def _near_change_point(f, t: float, y, points) -> bool:
     theta1 = f.theta1_of(t, y)
-    return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < 0.05 for p in points)
+    return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < CHANGE_POINT_NEAR for p in points)
 
 
 def simulate(
@@ -388,9 +432,10 @@ def simulate(
         t_event, y_event = stopped
         th = f.theta1_of(t_event, y_event)
         raise _lockup(
-            f"the motion reaches a dead point of the crank (coupler and rocker aligned) at "
-            f"t = {t_event:.6g} s, θ1 = {th:.6g} rad; the {f.name} formulation uses the crank "
-            "angle as its coordinate and cannot pass it (opened-loop and mass-matrix can)",
+            f"the motion reaches a dead point (sine of the transmission angle "
+            f"below {DEAD_POINT_THRESHOLD:g}) at t = {t_event:.6g} s, θ1 = {th:.6g} rad; the "
+            f"{f.name} formulation uses the crank angle as its coordinate and cannot pass it"
+            + _passing(linkage.type),
             t_event, th, traj)
     if stop_at is not None:
         th = f.crank_angle(stop_at)

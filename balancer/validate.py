@@ -28,6 +28,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+import numpy as np
+
 from .errors import SpecError
 
 #: Largest magnitude of a force (N), moment (N·m) or energy (J) scale the tool computes with.
@@ -114,7 +116,7 @@ def choice(value: Any, key: str, choices: tuple[str, ...]) -> str:
 
 def vector2(value: Any, key: str) -> tuple[float, float]:
     """A pair of finite numbers ``(x, y)``."""
-    if isinstance(value, str) or not hasattr(value, "__len__") or len(value) != 2:
+    if not isinstance(value, (list, tuple, np.ndarray)) or len(value) != 2:
         raise SpecError("must be a list of two numbers [x, y]", key=key, value=value)
     return (number(value[0], f"{key}[0]"), number(value[1], f"{key}[1]"))
 

@@ -33,11 +33,13 @@ class RunCheck:
     trajectory, original
         The simulated motion of the design and of the unbalanced original (or ``None``).
     max_shaking_force, max_shaking_moment
-        Largest ``|R̄A0 + R̄A3|`` (N) and |shaking moment| (N·m) over the run.
+        Largest ``|R̄A0 + R̄A3|`` (N) and |shaking moment| (N·m) over the run (over the part
+        before it stopped, if it stopped; ``None`` if it could not start).
     original_max_shaking_force, original_max_shaking_moment
         The same for the original, or ``None``.
     note
-        Why a run could not be made, if it could not (for example a lock-up).
+        Why a run stopped early or could not be made (for example a lock-up), and the span
+        its figures cover.
     """
 
     trajectory: Trajectory | None
@@ -110,13 +112,13 @@ class Verification:
 
     @property
     def max_shaking_force(self) -> float | None:
-        """Largest shaking force over the runs that finished, N (``None``: neither did)."""
+        """Largest shaking force over the runs, N (``None``: neither could start)."""
         return max((x for x in (self.driven.max_shaking_force, self.free.max_shaking_force)
                     if x is not None), default=None)
 
     @property
     def max_shaking_moment(self) -> float | None:
-        """Largest shaking moment over the runs that finished, N·m (``None``: neither did)."""
+        """Largest shaking moment over the runs, N·m (``None``: neither could start)."""
         return max((x for x in (self.driven.max_shaking_moment, self.free.max_shaking_moment)
                     if x is not None), default=None)
 
@@ -131,29 +133,43 @@ class Verification:
         }
 
 
-def _figures(traj: Trajectory) -> tuple[float, float]:
+def _figures(traj: Trajectory | None) -> tuple[float | None, float | None]:
+    if traj is None or traj.t.size == 0:
+        return None, None
     return float(np.max(np.abs(traj.shaking_force))), float(np.max(np.abs(traj.shaking_moment)))
 
 
-def _run(linkage: FourBar, original: FourBar | None, settings, method: str, **kw) -> RunCheck:
+def _simulate_span(linkage, settings, method: str, **kw) -> tuple[Trajectory | None, str]:
+    """The run, or the part of it before the motion stopped, and why it stopped ("" if not)."""
     try:
-        traj = simulate(linkage, settings, method=method, **kw)
+        return simulate(linkage, settings, method=method, **kw), ""
     except LockupError as exc:
-        return RunCheck(trajectory=getattr(exc, "partial", None), original=None,
-                        max_shaking_force=None, max_shaking_moment=None, note=str(exc))
+        return getattr(exc, "partial", None), str(exc)
+
+
+def _run(linkage, original, settings, method: str, **kw) -> RunCheck:
+    """Simulate the design and the original over the same span.
+
+    A run that stops early (a lock-up, a dead point its formulation cannot pass) is judged over
+    the part before it stopped, the note says where; the original is then run over that span.
+    """
+    traj, note = _simulate_span(linkage, settings, method, **kw)
     force, moment = _figures(traj)
     orig = None
     o_force = o_moment = None
-    if original is not None:
-        try:
-            orig = simulate(original, settings, method=method, **kw)
-            o_force, o_moment = _figures(orig)
-        except LockupError as exc:
-            return RunCheck(trajectory=traj, original=None, max_shaking_force=force,
-                            max_shaking_moment=moment, note=f"original: {exc}")
+    if original is not None and force is not None:
+        span = settings if not note else replace(settings, duration=float(traj.t[-1]))
+        orig, o_note = _simulate_span(original, span, method, **kw) if span.duration > 0 \
+            else (None, "")
+        o_force, o_moment = _figures(orig)
+        if o_note:
+            note = "; ".join(x for x in (note, f"original: {o_note}") if x)
+            o_force = o_moment = None  # over a shorter span: not comparable
+    if note and traj is not None and traj.t.size:
+        note += f" (figures over 0 ≤ t ≤ {float(traj.t[-1]):.6g} s)"
     return RunCheck(trajectory=traj, original=orig, max_shaking_force=force,
                     max_shaking_moment=moment, original_max_shaking_force=o_force,
-                    original_max_shaking_moment=o_moment)
+                    original_max_shaking_moment=o_moment, note=note)
 
 
 def verify(

@@ -18,7 +18,7 @@ from fuzz.checks import without_dac_override
 from balancer import spec
 from balancer.cli import main
 from balancer.errors import AssemblyError, OutputError, SolverError, SpecError
-from balancer.model import FourBar, Link, Operation, SimulationSettings, SliderCrank
+from balancer.model import Design, FourBar, Link, Operation, SimulationSettings, SliderCrank
 from balancer.optimize import Status, optimize
 from balancer.problem import numeric_problem
 from balancer.report import csv_text, dumps_json
@@ -46,6 +46,7 @@ def _spec(name: str, old: str = "", new: str = "") -> str:
     ("e", math.inf, "must be a finite number"),
     ("counter_rotor", -1.0, "must be zero or positive"),
     ("force", (1.0,), "must be a list of two numbers"),
+    ("force", {"x": 1.0, "y": 2.0}, "must be a list of two numbers"),  # was a KeyError
     ("mass", "2", "must be a number"),
     ("mass", True, "must be a number"),
 ])
@@ -250,6 +251,64 @@ def test_a_driven_lie_group_simulation_passes_a_change_point():
     settings = SimulationSettings(duration=1.0, theta1=1.0, omega1=10.0, drive="constant-speed")
     tr = simulate(linkage, settings, method="lie-group")
     assert tr.theta[0, -1] > 1.0 + 2 * math.pi  # through both change points, and on
+
+
+def test_a_run_that_stalls_at_a_change_point_fails_naming_it():
+    """At rtol 1e-11 the opened loop shrank its steps near the change point without end."""
+    from balancer.simulate import STALL_WINDOW, simulate
+
+    design = spec.loads_design("""
+        [mechanism]
+        type = "four-bar"
+        branch = "-"
+        lengths = { crank = 0.5, coupler = 1.0, rocker = 1.0, frame = 0.5 }
+        [links.crank]
+        mass = 2.151
+        inertia = 0.07055
+        com = { s = 0.4206, sigma = 1.263 }
+        moment = -1.071
+        [links.coupler]
+        mass = 1.625
+        inertia = 0.2197
+        com = { e = 0.2568, f = -0.1466 }
+        [links.rocker]
+        mass = 1.273
+        inertia = 0.1933
+        com = { s = 0.1005, sigma = 0.03413 }
+        force = [-6.269, -2.31]
+        [simulation]
+        duration = 0.319
+        theta1 = 0.7738
+        omega1 = 26.24
+        drive = "constant-speed"
+        gravity = [0.0, -9.81]
+        """.replace("\n        ", "\n"))
+    linkage, settings = design.mechanism, design.simulation
+    with pytest.raises(SolverError, match="stalled") as info:
+        simulate(linkage, settings, method="opened-loop", rtol=1e-11, atol=1e-13)
+    message = str(info.value)
+    assert "change point θ1 = 0 rad" in message and f"last {STALL_WINDOW} steps" in message
+    # The run passes it at the default tolerances (the stall test is not a blanket refusal).
+    simulate(linkage, settings, method="opened-loop")
+
+
+def test_a_run_stopped_at_a_dead_point_is_verified_over_its_span():
+    """Both runs stop at the near-dead point of a crank as long as the rod: figures over each."""
+    from balancer.verify import verify
+
+    link = Link(mass=0.7, inertia=0.09, e=0.3, f=0.13)
+    mech = SliderCrank(lengths=(0.7326, 0.7326000732600001, 0.0), crank=link,
+                       rod=Link(mass=0.3, inertia=0.025, e=0.53, f=-0.18),
+                       slider=Link(mass=2.86, inertia=0.0, e=0.0, f=0.0))
+    design = Design(mechanism=mech, operation=Operation(speed=5.596),
+                         simulation=SimulationSettings(duration=0.5, theta1=-2.324, omega1=2.525))
+    result = verify(design, method="complex-masses")
+    for run in (result.driven, result.free):
+        assert "dead point" in run.note and "figures over 0 ≤ t ≤" in run.note
+        end = float(run.trajectory.t[-1])
+        assert 0 < end < 0.5
+        assert run.max_shaking_force == float(np.max(np.abs(run.trajectory.shaking_force)))
+    assert result.max_shaking_force is not None and result.max_shaking_moment is not None
 
 
 def test_a_duration_that_would_take_too_many_steps_is_refused_early(tmp_path, capsys):

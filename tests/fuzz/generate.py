@@ -508,7 +508,7 @@ def _mutate_nonpositive(rng, doc, kind):
         elif s[0] in ("links", "original") and last == "mass":
             targets.append((p, [0.0, -v, -0.0]))
         elif s[0] in ("links", "original") and last == "inertia":
-            targets.append((p, [-v, -1.0] + ([0.0] if s[1] != "slider" else [])))
+            targets.append((p, [-v, -1.0]))  # zero: a point mass (allowed)
         elif last in ("s", "counter_rotor") and s[0] in ("links", "original"):
             targets.append((p, [-1.0, -1e-9]))
         elif s == ["operation", "speed"]:
