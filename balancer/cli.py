@@ -211,9 +211,9 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
     figure_type(path, "--animate", ANIMATION_TYPES)
     design = load_design(args.spec)
-    from .mechanisms import require_full_revolution
+    from .mechanisms import mechanism_of
 
-    require_full_revolution(design.mechanism, "an animation of one revolution")
+    mechanism_of(design.mechanism).require_full_revolution("an animation of one revolution")
     animate(design.mechanism, path, frames=args.frames, title=design.title)
     print(f"wrote {path}")
     return 0
@@ -284,11 +284,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(handler=_cmd_analyze)
 
-    from .model import DRIVES, METHODS
+    from .mechanisms import formulation_names
+    from .model import DRIVES
+
+    methods = formulation_names()
 
     p = sub.add_parser(
         "simulate",
-        help="forward dynamics in one of four formulations",
+        help="forward dynamics in a formulation of your choice",
         description=(
             "Forward dynamics of the linkage from the spec's [simulation] settings: free motion "
             "under the loads (and gravity), or the crank held at constant speed by a motor. "
@@ -299,8 +302,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
     p.add_argument("--force", action="store_true",
                    help="allow an output path to name the input spec (it is overwritten)")
-    p.add_argument("--method", choices=METHODS, help="formulation (default: the spec's, or "
-                   "opened-loop)")
+    p.add_argument("--method", choices=methods, help="formulation (default: the spec's, or "
+                   "the mechanism's first: opened-loop for a four-bar, mass-matrix for a "
+                   "slider-crank, multibody for a general linkage)")
     p.add_argument("--drive", choices=DRIVES, help="free motion or constant crank speed "
                    "(default: the spec's)")
     p.add_argument("--duration", type=_positive_float, metavar="T", help="simulated time, s")
@@ -331,9 +335,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write the report figure to PATH (.png, .svg or .pdf)")
     p.add_argument("--duration", type=_positive_float, metavar="T",
                    help="simulated time of each run, s (default: the spec's)")
-    p.add_argument("--method", choices=METHODS,
+    p.add_argument("--method", choices=methods,
                    help="formulation for the simulations (default: one the optimiser did not "
-                   "use: opened-loop for a four-bar, complex-masses for a slider-crank)")
+                   "use: opened-loop for a four-bar, complex-masses for a slider-crank, "
+                   "multibody for a general linkage)")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
     p.set_defaults(handler=_cmd_verify)
 

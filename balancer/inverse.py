@@ -48,7 +48,6 @@ from .massmodels import (
     equivalent_joint_forces,
     inertial_parameters,
 )
-from .mechanisms import require_full_revolution
 from .model import FourBar, Link
 
 Route = Literal["newton-euler", "mass-matrix"]
@@ -70,9 +69,9 @@ class Reactions:
     shaking_force
         The sum of the forces on the frame, N: ``R̄A0 + R̄A3`` for a four-bar (computed from
         them when not given).
-    guide_line
-        For a slider-crank, whose R̄A3 is the slider's normal force on its guide: the x of
-        that force's line of action, m (``None`` for a four-bar).
+    guide_couple
+        For a slider-crank, whose R̄A3 is the slider's normal force on its guide: the couple
+        of the slider on its guide about the slider's pin, N·m (``None`` for a four-bar).
     """
 
     RA0: NDArray[np.complex128]
@@ -80,7 +79,7 @@ class Reactions:
     driving_torque: NDArray[np.float64]
     shaking_moment: NDArray[np.float64]
     shaking_force: NDArray[np.complex128] = None  # type: ignore[assignment]
-    guide_line: NDArray[np.float64] | None = None
+    guide_couple: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         if self.shaking_force is None:
@@ -541,7 +540,9 @@ def cycle_analysis(
         from .slider_crank.dynamics import cycle_analysis as slider_cycle
 
         return slider_cycle(linkage, speed, samples, route=route, loads=loads, theta1=theta1)
-    require_full_revolution(linkage, "a cycle analysis")
+    from .mechanisms import mechanism_of
+
+    mechanism_of(linkage).require_full_revolution("a cycle analysis")
     angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
     n = angles.size
     signs = cycle_branch_signs(linkage.lengths, linkage.branch, angles)

@@ -28,14 +28,6 @@ from .errors import AssemblyError, SpecError
 Branch = Literal["+", "-"]
 Drive = Literal["free", "constant-speed"]
 
-#: Names of the formulations of the equations of motion (see :mod:`balancer.formulations`).
-METHODS: tuple[str, ...] = ("opened-loop", "complex-masses", "mass-matrix", "lie-group")
-#: The formulations of each mechanism type; the first is its default.
-METHODS_BY_TYPE: dict[str, tuple[str, ...]] = {
-    "four-bar": METHODS,
-    "slider-crank": ("mass-matrix", "complex-masses"),
-    "linkage": (),
-}
 #: Ways the crank can be driven in a simulation.
 DRIVES: tuple[str, ...] = ("free", "constant-speed")
 #: Least relative tolerance of a simulation: 100 ε, below which SciPy's integrators raise it.
@@ -781,7 +773,8 @@ class SimulationSettings:
     duration
         Simulated time, s.
     theta1
-        Initial crank angle, rad.
+        Initial crank angle, rad; ``None``: the mechanism's start (a general linkage's
+        reference pose, θ1 = 0 for the four-bar and slider-crank).
     omega1
         Initial crank speed, rad/s (the constant speed when ``drive`` is ``"constant-speed"``).
     gravity
@@ -799,7 +792,7 @@ class SimulationSettings:
     """
 
     duration: float = 5.0
-    theta1: float = 0.0
+    theta1: float | None = None
     omega1: float = 0.0
     gravity: tuple[float, float] = (0.0, 0.0)
     drive: Drive = "free"
@@ -814,12 +807,16 @@ class SimulationSettings:
     def __post_init__(self) -> None:
         """Check the values (keys within ``[simulation]``)."""
         _set(self, "duration", v.positive(self.duration, "duration"))
-        _set(self, "theta1", v.number(self.theta1, "theta1"))
+        if self.theta1 is not None:
+            _set(self, "theta1", v.number(self.theta1, "theta1"))
         _set(self, "omega1", v.number(self.omega1, "omega1"))
         _set(self, "gravity", v.vector2(self.gravity, "gravity"))
         _set(self, "drive", v.choice(self.drive, "drive", DRIVES))
         if self.method is not None:
-            _set(self, "method", v.choice(self.method, "method", METHODS))
+            # which formulations apply depends on the mechanism: simulate checks the name
+            if not isinstance(self.method, str) or not self.method:
+                raise SpecError("must be the name of a formulation", key="method",
+                                value=self.method)
         rtol = v.number(self.rtol, "rtol")
         if not RTOL_MIN <= rtol < 1:
             raise SpecError(f"must be at least {RTOL_MIN:.3g} (100 ε: the integrator's floor) "

@@ -14,16 +14,17 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from . import mechanisms
 from .errors import OutputError
-from .mechanisms import drawing_frames
-from .model import FourBar
+from .mechanisms import mechanism_of
+from .model import GROUND
 from .outputs import write_with
 from .simulate import Trajectory
 
-#: Colours for A0, A3 and their sum (colour-blind safe).
-COLOURS = {"A0": "#0072B2", "A3": "#D55E00", "sum": "#000000", "before": "#999999",
-           "after": "#009E73"}
+#: Colours for the sum, before and after (colour-blind safe, Okabe & Ito).
+COLOURS = {"sum": "#000000", "before": "#999999", "after": "#009E73", "link": "#0072B2",
+           "com": "#D55E00"}
+#: Colours for the forces at the ground points and guides, in order (A0, A3, … ).
+SERIES = ("#0072B2", "#D55E00", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#009E73")
 
 
 def _axes(ax: Axes | None) -> Axes:
@@ -33,19 +34,26 @@ def _axes(ax: Axes | None) -> Axes:
 
 
 def plot_reactions(traj: Trajectory, ax: Axes | None = None, title: str = "") -> Axes:
-    """Components of R̄A0, R̄A3 and of their sum over time (as the paper's Fig. 8 and 9)."""
+    """Every force on the ground over time and their sum (as the paper's Fig. 8 and 9).
+
+    The x (solid) and y (dashed) components at each ground point, the normal force (dotted) of
+    each slider on a ground guide, and the shaking force's components (black).
+    """
     ax = _axes(ax)
     t = traj.t
-    ax.plot(t, traj.RA0.real, color=COLOURS["A0"], lw=1.2, label="$R_{A0x}$")
-    ax.plot(t, traj.RA0.imag, color=COLOURS["A0"], lw=1.2, ls="--", label="$R_{A0y}$")
-    ax.plot(t, traj.RA3.real, color=COLOURS["A3"], lw=1.2, label="$R_{A3x}$")
-    ax.plot(t, traj.RA3.imag, color=COLOURS["A3"], lw=1.2, ls="--", label="$R_{A3y}$")
+    colours = iter(SERIES * (1 + (len(traj.ground) + len(traj.slider_normal)) // len(SERIES)))
+    for point, values in traj.ground.items():
+        colour = next(colours)
+        ax.plot(t, values.real, color=colour, lw=1.2, label=f"$R_{{{point}x}}$")
+        ax.plot(t, values.imag, color=colour, lw=1.2, ls="--", label=f"$R_{{{point}y}}$")
+    for link, values in traj.slider_normal.items():
+        ax.plot(t, values, color=next(colours), lw=1.2, ls=":", label=f"normal force, {link}")
     total = traj.shaking_force
-    ax.plot(t, total.real, color=COLOURS["sum"], lw=1.8, label="$R_{A0x}+R_{A3x}$")
-    ax.plot(t, total.imag, color=COLOURS["sum"], lw=1.8, ls="--", label="$R_{A0y}+R_{A3y}$")
+    ax.plot(t, total.real, color=COLOURS["sum"], lw=1.8, label="sum, x")
+    ax.plot(t, total.imag, color=COLOURS["sum"], lw=1.8, ls="--", label="sum, y")
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("force on the ground (N)")
-    ax.set_title(title or f"reactions, {traj.drive} motion")
+    ax.set_title(title or f"forces on the ground, {traj.drive} motion")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small", ncol=3, loc="upper right")
     return ax
@@ -55,7 +63,7 @@ def plot_shaking_moment(
     traj: Trajectory, original: Trajectory | None = None, ax: Axes | None = None,
     title: str = "",
 ) -> Axes:
-    """Shaking moment about A0 over time, before (the original) and after."""
+    """Shaking moment about the origin over time, before (the original) and after."""
     ax = _axes(ax)
     if original is not None:
         ax.plot(original.t, original.shaking_moment, color=COLOURS["before"], lw=1.5,
@@ -63,7 +71,7 @@ def plot_shaking_moment(
     ax.plot(traj.t, traj.shaking_moment, color=COLOURS["after"], lw=1.5,
             label="after" if original is not None else "shaking moment")
     ax.set_xlabel("time t (s)")
-    ax.set_ylabel("shaking moment about A0 (N·m)")
+    ax.set_ylabel("shaking moment about the origin (N·m)")
     ax.set_title(title or f"shaking moment, {traj.drive} motion")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")
@@ -71,31 +79,69 @@ def plot_shaking_moment(
 
 
 def centre_of_mass_path(linkage, traj: Trajectory) -> np.ndarray:
-    """Total centre of mass along a simulated motion, complex, m."""
-    return mechanisms.centre_of_mass_path(linkage, traj.theta, tuple(traj.omega),
-                                          tuple(traj.alpha))
+    """Total centre of mass along a simulated motion, complex, m.
+
+    From the crank's angle (the pose of the smooth motion there).
+    """
+    mech = mechanism_of(linkage)
+    crank = traj.links.index(mech.input)
+    mo = mech.motion(traj.theta[crank], traj.omega[crank], traj.alpha[crank])
+    return np.asarray(mech.total_centre_of_mass(mo), complex)
+
+
+def frame(linkage, samples: int = 72) -> tuple[np.ndarray, list[np.ndarray]]:
+    """What to draw of the frame: the ground points, and each ground guide's travel, m.
+
+    Returns the ground points (complex) and, per slider on a ground guide, the two ends of
+    the stretch of its line that its point covers over a revolution (or near the reference
+    pose, for a crank that does not turn fully).
+    """
+    from .cycle import sample_angles
+
+    mech = mechanism_of(linkage)
+    pivots = np.array(list(mech.ground_positions.values()), complex)
+    rng = mech.assembly_range()
+    angles = sample_angles(samples) if rng.full else np.linspace(*rng.intervals[0], samples)
+    with np.errstate(all="ignore"):
+        mo = mech.motion(angles)
+    points = mech.points(mo)
+    guides = []
+    for slider in mech.linkage.sliders:
+        if slider.guide == GROUND:
+            path = points[slider.point][np.isfinite(points[slider.point])]
+            if path.size:
+                d = complex(*slider.direction) / abs(complex(*slider.direction))
+                along = (path * np.conj(d)).real
+                base = path[0] - (path[0] * np.conj(d)).real * d
+                guides.append(base + d * np.array([along.min(), along.max()]))
+    return pivots, guides
+
+
+def _draw_frame(ax: Axes, linkage, label: str | None = "frame (pivots, guides)") -> None:
+    pivots, guides = frame(linkage)
+    ax.plot(pivots.real, pivots.imag, "k^", ms=8, label=label, zorder=5)
+    for ends in guides:
+        ax.plot(ends.real, ends.imag, "k-", lw=6, alpha=0.25, zorder=1)
 
 
 def plot_com_path(
-    linkage: FourBar, traj: Trajectory, original: FourBar | None = None,
+    linkage, traj: Trajectory, original=None,
     original_traj: Trajectory | None = None, ax: Axes | None = None,
 ) -> Axes:
-    """Path of the total centre of mass, with the ground pivots (a point when balanced)."""
+    """Path of the total centre of mass, with the frame (a point when balanced)."""
     ax = _axes(ax)
     if original is not None and original_traj is not None:
         path = centre_of_mass_path(original, original_traj)
         ax.plot(path.real, path.imag, color=COLOURS["before"], lw=1.5, label="before (original)")
     path = centre_of_mass_path(linkage, traj)
     label = "after" if original is not None else "total centre of mass"
-    if np.ptp(path.real) + np.ptp(path.imag) < 1e-9 * max(linkage.lengths):
+    size = mechanism_of(linkage).structure.length_scale()
+    if np.ptp(path.real) + np.ptp(path.imag) < 1e-9 * size:
         ax.plot(path.real[:1], path.imag[:1], "o", color=COLOURS["after"],
                 label=f"{label}: stationary")
     else:
         ax.plot(path.real, path.imag, color=COLOURS["after"], lw=1.5, label=label)
-    from .mechanisms import frame_points
-
-    ground = np.array(frame_points(linkage))
-    ax.plot(ground.real, ground.imag, "k^", ms=8, label="frame (pivots, guide)")
+    _draw_frame(ax, linkage)
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
@@ -108,8 +154,8 @@ def plot_com_path(
 def verification_figure(design, verification) -> Figure:
     """The report figure of ``balancer verify``.
 
-    Columns: the crank driven at the operating speed, free motion; rows: reactions at A0 and A3
-    and their sum, shaking moment before and after, path of the total centre of mass.
+    Columns: the crank driven at the operating speed, free motion; rows: the forces on the
+    ground and their sum, shaking moment before and after, path of the total centre of mass.
     """
     fig = Figure(figsize=(13, 14), layout="constrained")
     axes = fig.subplots(3, 2)
@@ -123,7 +169,7 @@ def verification_figure(design, verification) -> Figure:
             axes[0, col].text(0.5, 0.5, f"{label}: no simulation\n{run.note}", ha="center",
                               va="center", wrap=True, transform=axes[0, col].transAxes)
             continue
-        plot_reactions(run.trajectory, ax=axes[0, col], title=f"reactions, {label}")
+        plot_reactions(run.trajectory, ax=axes[0, col], title=f"forces on the ground, {label}")
         plot_shaking_moment(run.trajectory, run.original, ax=axes[1, col],
                             title=f"shaking moment, {label}")
         plot_com_path(design.mechanism, run.trajectory, design.original, run.original,
@@ -177,7 +223,29 @@ def save_png(fig: Figure, path: str | os.PathLike[str], dpi: float = 100) -> Pat
     return _write_atomic(fig, Path(path).with_suffix(".png"), dpi)
 
 
-def animate(linkage: FourBar, path: str | os.PathLike[str], *, frames: int = 72, fps: int = 24,
+def drawing_frames(linkage, frames: int):
+    """What an animation draws over a revolution at equally spaced crank angles.
+
+    Returns ``(links, coms, total)``: per link (the ground's left out) a ``(frames, k)``
+    complex array of its points in drawing order (a ternary link closed into a triangle),
+    ``(frames, n)`` the moving links' centres of mass and ``(frames,)`` the total, m.
+    """
+    from .cycle import sample_angles
+
+    mech = mechanism_of(linkage)
+    mo = mech.motion(sample_angles(frames), 1.0)
+    points = mech.points(mo)
+    links = {}
+    for name, names in mech.drawing().items():
+        if name == GROUND:
+            continue
+        ring = [*names, names[0]] if len(names) > 2 else list(names)
+        links[name] = np.column_stack([points[p] for p in ring])
+    coms = np.column_stack([c.complex() + 0 * mo.theta1 for c in mech.centres_of_mass(mo)])
+    return links, coms, np.asarray(mech.total_centre_of_mass(mo), complex)
+
+
+def animate(linkage, path: str | os.PathLike[str], *, frames: int = 72, fps: int = 24,
             title: str = "") -> Path:
     """Write a GIF of the linkage turning one revolution with its total centre of mass traced.
 
@@ -189,12 +257,16 @@ def animate(linkage: FourBar, path: str | os.PathLike[str], *, frames: int = 72,
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from PIL import Image
 
-    joints, coms, total = drawing_frames(linkage, frames)
+    links, coms, total = drawing_frames(linkage, frames)
+    pivots, guides = frame(linkage)
     fig = Figure(figsize=(6, 4.5), dpi=100, layout="constrained")
     canvas = FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    everything = np.concatenate([joints.ravel(), coms.ravel(), total])
-    pad = 0.08 * max(linkage.lengths)
+    everything = np.concatenate([*(v.ravel() for v in links.values()), coms.ravel(), total,
+                                 pivots, *guides])
+    everything = everything[np.isfinite(everything)]
+    extent = max(np.ptp(everything.real), np.ptp(everything.imag), 1e-300)
+    pad = 0.08 * extent
     ax.set_xlim(everything.real.min() - pad, everything.real.max() + pad)
     ax.set_ylim(everything.imag.min() - pad, everything.imag.max() + pad)
     ax.set_aspect("equal")
@@ -204,15 +276,13 @@ def animate(linkage: FourBar, path: str | os.PathLike[str], *, frames: int = 72,
     ax.grid(alpha=0.3)
     ax.plot(total.real, total.imag, color=COLOURS["before"], lw=1, ls=":",
             label="path of the total centre of mass")
-    from .mechanisms import frame_points
-
-    ground = np.array(frame_points(linkage))
-    ax.plot(ground.real[:2], ground.imag[:2], "k^", ms=10, zorder=5)
-    if linkage.type == "slider-crank":
-        ax.plot(ground.real[1:], ground.imag[1:], "k-", lw=6, alpha=0.25, zorder=1)
-    (bars,) = ax.plot([], [], "-o", color=COLOURS["A0"], lw=3, ms=6, label="links",
-                      animated=True)
-    (link_coms,) = ax.plot([], [], "s", color=COLOURS["A3"], ms=5,
+    _draw_frame(ax, linkage, label=None)
+    bars = []
+    for i, name in enumerate(links):
+        (bar,) = ax.plot([], [], "-o", color=COLOURS["link"], lw=3, ms=5, animated=True,
+                         label="links" if i == 0 else None)
+        bars.append((bar, links[name]))
+    (link_coms,) = ax.plot([], [], "s", color=COLOURS["com"], ms=5,
                            label="link centres of mass", animated=True)
     (trace,) = ax.plot([], [], color=COLOURS["after"], lw=2, animated=True)
     (com,) = ax.plot([], [], "o", color=COLOURS["after"], ms=9, label="total centre of mass",
@@ -224,11 +294,12 @@ def animate(linkage: FourBar, path: str | os.PathLike[str], *, frames: int = 72,
     images = []
     for k in range(frames):
         canvas.restore_region(background)
-        bars.set_data(joints[k].real, joints[k].imag)
+        for bar, values in bars:
+            bar.set_data(values[k].real, values[k].imag)
         link_coms.set_data(coms[k].real, coms[k].imag)
         trace.set_data(total[: k + 1].real, total[: k + 1].imag)
         com.set_data([total[k].real], [total[k].imag])
-        for artist in (trace, bars, link_coms, com):
+        for artist in (trace, *(bar for bar, _ in bars), link_coms, com):
             ax.draw_artist(artist)
         rgba = np.asarray(canvas.buffer_rgba())
         images.append(Image.fromarray(rgba[..., :3].copy()).quantize(colors=64))

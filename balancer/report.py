@@ -288,9 +288,8 @@ def analysis_columns(analysis: CycleAnalysis) -> tuple[list[str], list]:
     """The columns of ``analyze --csv``: names and values (arrays over the samples).
 
     ``t``; per moving link ``k`` (1, 2, … in the spec's order) ``theta{k}``, ``omega{k}``,
-    ``alpha{k}`` (rad, rad/s, rad/s²); per ground point ``P`` the force on it ``R{P}x``,
-    ``R{P}y`` (N); per slider on the frame its normal force and couple ``N_{link}`` (N),
-    ``C_{link}`` (N·m); then the shaking force's components, the shaking moment and the
+    ``alpha{k}`` (rad, rad/s, rad/s²); the forces on the frame (:func:`frame_force_columns`);
+    then the shaking force's components, the shaking moment and the
     driving torque. For a four-bar: the columns of ``simulate``'s CSV and the shaking.
     """
     mo, r = analysis.motion, analysis.reactions
@@ -300,14 +299,43 @@ def analysis_columns(analysis: CycleAnalysis) -> tuple[list[str], list]:
     for group, values in (("theta", mo.pose.angles), ("omega", mo.rate), ("alpha", mo.accel)):
         names += [f"{group}{k + 1}" for k in range(n)]
         cols += [np.asarray(v, float) * np.ones(analysis.samples) for v in values]
-    for point, values in r.ground.items():
-        names += [f"R{point}x", f"R{point}y"]
-        cols += [values.real, values.imag]
-    for link in r.slider_normal:
-        names += [f"N_{link}", f"C_{link}"]
-        cols += [r.slider_normal[link], r.slider_couple[link]]
+    frame_names, frame_cols = frame_force_columns(analysis.linkage, r.ground, r.slider_normal,
+                                                  r.slider_couple)
+    names += frame_names
+    cols += frame_cols
     names += list(SHAKING_COLUMNS)
     cols += [r.shaking_force.real, r.shaking_force.imag, r.shaking_moment, r.driving_torque]
+    return names, cols
+
+
+def frame_force_columns(model, ground, normal, couple) -> tuple[list[str], list]:
+    """Columns of the forces on the frame: names and values.
+
+    Per ground point ``P`` the force on it ``R{P}x``, ``R{P}y`` (N); per slider on the frame
+    its normal force and couple ``N_{link}`` (N), ``C_{link}`` (N·m) — or, for a guide that the
+    mechanism names as a point (the slider-crank's A3), the force as ``R{name}x``, ``R{name}y``
+    and the couple.
+    """
+    from .mechanisms import mechanism_of
+
+    mech = mechanism_of(model)
+    names: list[str] = []
+    cols: list = []
+    for point, values in ground.items():
+        names += [f"R{point}x", f"R{point}y"]
+        cols += [values.real, values.imag]
+    normals = mech.guide_normals()
+    for link in normal:
+        if link in mech.guide_force_names:
+            point = mech.guide_force_names[link]
+            force = normal[link] * normals[link]
+            names += [f"R{point}x", f"R{point}y"]
+            cols += [force.real, force.imag]
+        else:
+            names.append(f"N_{link}")
+            cols.append(normal[link])
+        names.append(f"C_{link}")
+        cols.append(couple[link])
     return names, cols
 
 
@@ -336,12 +364,26 @@ def csv_text(columns: Sequence[str], values: Sequence[np.ndarray]) -> str:
 # ----------------------------------------------------------------------------------------------
 # simulate
 
-def simulation_csv(traj, all_columns: bool = False) -> str:
-    """The time histories of a simulation as CSV text (the fixed columns, then optionally more)."""
-    cols = [traj.t, *traj.theta, *traj.omega, *traj.alpha, traj.RA0.real, traj.RA0.imag,
-            traj.RA3.real, traj.RA3.imag]
-    names = list(SIMULATION_COLUMNS)
-    if traj.slider is not None:  # a slider-crank: the slider along its guide
+def simulation_columns(traj, all_columns: bool = False) -> tuple[list[str], list]:
+    """The columns of ``simulate``'s CSV: names and values (arrays over the output times).
+
+    ``t``; per moving link ``k`` (1, 2, … in the mechanism's order) ``theta{k}``, ``omega{k}``,
+    ``alpha{k}``; the forces on the frame (:func:`frame_force_columns`); a formulation's own slider
+    coordinate ``x3``, ``v3``, ``a3`` (the slider-crank's); with ``all_columns`` the shaking,
+    the driving torque and the energy. For a four-bar the first columns are DESIGN.md's fixed
+    ones (:data:`SIMULATION_COLUMNS`).
+    """
+    names = ["t"]
+    cols: list = [traj.t]
+    for group in ("theta", "omega", "alpha"):
+        values = getattr(traj, group)
+        names += [f"{group}{k + 1}" for k in range(len(values))]
+        cols += list(values)
+    frame_names, frame_cols = frame_force_columns(traj.model, traj.ground, traj.slider_normal,
+                                                  traj.slider_couple)
+    names += frame_names
+    cols += frame_cols
+    if traj.slider is not None:
         cols += list(traj.slider)
         names += ["x3", "v3", "a3"]
     if all_columns:
@@ -349,7 +391,12 @@ def simulation_csv(traj, all_columns: bool = False) -> str:
         cols += [sf.real, sf.imag, traj.shaking_moment, traj.driving_torque, traj.kinetic_energy,
                  traj.work]
         names += SIMULATION_EXTRA_COLUMNS
-    return csv_text(names, cols)
+    return names, cols
+
+
+def simulation_csv(traj, all_columns: bool = False) -> str:
+    """The time histories of a simulation as CSV text (:func:`simulation_columns`)."""
+    return csv_text(*simulation_columns(traj, all_columns))
 
 
 def simulation_json(traj, spec: str | None = None) -> dict[str, Any]:
@@ -375,7 +422,11 @@ def simulation_json(traj, spec: str | None = None) -> dict[str, Any]:
             "shaking_force": Figure.of(traj.shaking_force).as_dict(),
             "shaking_moment": Figure.of(traj.shaking_moment).as_dict(),
             "driving_torque": Figure.of(traj.driving_torque).as_dict(),
-            "reactions": {"A0": reaction_extremes(traj.RA0), "A3": reaction_extremes(traj.RA3)},
+            "reactions": {
+                **{p: reaction_extremes(v) for p, v in traj.ground.items()},
+                **{link: {"max": Figure.of(traj.slider_normal[link]).max,
+                          "couple_max": Figure.of(traj.slider_couple[link]).max}
+                   for link in traj.slider_normal}},
             **({"slider": {"initial": [float(v) for v in traj.slider[:, 0]],
                            "final": [float(v) for v in traj.slider[:, -1]]}}
                if traj.slider is not None else {}),
@@ -397,10 +448,10 @@ def simulation_text(traj, spec: str | None = None) -> str:
     ]
     rows = []
     for when, index in (("initial", 0), ("final", -1)):
-        st = traj.state(index)
-        for k in range(3):
-            rows.append([f"{when} link {k + 1}", _fmt(st["theta"][k], 14), _fmt(st["omega"][k], 14),
-                         _fmt(st["alpha"][k], 14)])
+        for k, name in enumerate(traj.links):
+            label = name if traj.named_states else f"link {k + 1}"
+            rows.append([f"{when} {label}", _fmt(traj.theta[k, index], 14),
+                         _fmt(traj.omega[k, index], 14), _fmt(traj.alpha[k, index], 14)])
     lines.append(table(rows, ["state", "θ (rad)", "θ̇ (rad/s)", "θ̈ (rad/s²)"]))
     lines.append("")
     rows = [[name.replace("_", " "), _fmt(fig.rms), _fmt(fig.max), UNITS[name]] for name, fig in (

@@ -40,8 +40,9 @@ from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
 from .errors import AssemblyError, LockupError, SolverError, SpecError
-from .formulations import FORMULATIONS, Formulation, formulation_class, make
-from .model import Design, FourBar, SimulationSettings, check_scales
+from .formulations import Formulation, default_method, formulation_class, formulation_table, make
+from .mechanisms import mechanism_of
+from .model import Design, SimulationSettings, check_scales
 
 #: |sin(θ3 − θ2)| at which a crank-angle formulation stops before a dead point.
 DEAD_POINT_THRESHOLD = 1e-3
@@ -68,26 +69,31 @@ class Trajectory:
         Formulation used.
     drive
         ``"free"`` or ``"constant-speed"``.
+    links
+        Names of the moving links, in the order of the rows of ``theta``, ``omega``, ``alpha``.
     t
         Output times, s, shape ``(n,)``.
     theta, omega, alpha
         Link angles (rad, continuous from their initial values), angular velocities (rad/s)
-        and accelerations (rad/s²), each of shape ``(3, n)`` for links 1–3.
-    RA0, RA3
-        Forces of the mechanism on the ground at A0 and A3, complex, N.
+        and accelerations (rad/s²), each of shape ``(links, n)``.
+    ground
+        Force of the mechanism on the ground at each ground point, complex, N.
+    slider_normal, slider_couple
+        For each slider on a ground guide (keyed by the sliding link): the normal force on the
+        guide (N) and its couple about the slider's point (N·m).
     driving_torque
         Motor torque on the crank, N·m (zero in free motion).
+    shaking_force, shaking_moment
+        Sum of the forces on the frame (N) and their moment about the origin with the motor's
+        reaction and the counter-rotors' (N·m).
     kinetic_energy
         Kinetic energy of the moving parts, counter-rotors included, J.
     work
-        Work of the loads, gravity and the motor since t = 0, J.
+        Work of the loads, gravity, springs and the motor since t = 0, J.
     energy_error
         ``max|T − T0 − W|`` relative to the largest of ``|T|`` and ``|W|`` (dimensionless).
     drift
-        Largest loop-closure residual before projection: position (m) and velocity (m/s).
-    slider
-        For a slider-crank: the slider's position, velocity and acceleration along the guide,
-        shape ``(3, n)`` (m, m/s, m/s²).
+        Largest constraint residual before projection: position (m) and velocity (m/s).
     nfev
         Right-hand-side evaluations.
     steps
@@ -96,17 +102,28 @@ class Trajectory:
         Wall-clock time of the integration and the outputs, s.
     rtol, atol
         Integrator tolerances used.
+    named_states
+        Whether :meth:`state` keys the links by name (a general linkage) or lists them.
+    model
+        The mechanism simulated.
+    slider
+        A formulation's own slider coordinate (the slider-crank's): position, velocity and
+        acceleration along the guide, shape ``(3, n)`` (m, m/s, m/s²).
     """
 
     method: str
     drive: str
+    links: tuple[str, ...]
     t: NDArray[np.float64]
     theta: NDArray[np.float64]
     omega: NDArray[np.float64]
     alpha: NDArray[np.float64]
-    RA0: NDArray[np.complex128]
-    RA3: NDArray[np.complex128]
+    ground: dict[str, NDArray[np.complex128]]
+    slider_normal: dict[str, NDArray[np.float64]]
+    slider_couple: dict[str, NDArray[np.float64]]
     driving_torque: NDArray[np.float64]
+    shaking_force: NDArray[np.complex128]
+    shaking_moment: NDArray[np.float64]
     kinetic_energy: NDArray[np.float64]
     work: NDArray[np.float64]
     energy_error: float
@@ -116,24 +133,29 @@ class Trajectory:
     seconds: float
     rtol: float
     atol: float
-    shaking_moment: NDArray[np.float64] = field(repr=False, default=None)  # type: ignore[assignment]
-    shaking_force_values: NDArray[np.complex128] | None = field(repr=False, default=None)
+    named_states: bool = False
+    model: object = field(repr=False, default=None)
     slider: NDArray[np.float64] | None = field(repr=False, default=None)
 
     @property
-    def shaking_force(self) -> NDArray[np.complex128]:
-        """Sum of the forces on the frame (``R̄A0 + R̄A3`` for a four-bar), N."""
-        if self.shaking_force_values is not None:
-            return self.shaking_force_values
-        return self.RA0 + self.RA3
+    def largest_reaction(self) -> float:
+        """Largest magnitude of any force on the frame over the run, N (0 if none)."""
+        values = [np.max(np.abs(v), initial=0.0) for v in (
+            *self.ground.values(), *self.slider_normal.values())]
+        return float(max(values, default=0.0))
 
-    def state(self, index: int) -> dict[str, list[float]]:
-        """Angles, rates and accelerations of links 1–3 at output ``index``."""
-        return {
-            "theta": [float(x) + 0.0 for x in self.theta[:, index]],
-            "omega": [float(x) + 0.0 for x in self.omega[:, index]],
-            "alpha": [float(x) + 0.0 for x in self.alpha[:, index]],
-        }
+    def state(self, index: int) -> dict:
+        """Angles, rates and accelerations of the links at output ``index``.
+
+        Each a list in link order, or (``named_states``) an object keyed by link name.
+        """
+        out = {}
+        for key, values in (("theta", self.theta), ("omega", self.omega),
+                            ("alpha", self.alpha)):
+            numbers = [float(x) + 0.0 for x in values[:, index]]
+            out[key] = dict(zip(self.links, numbers, strict=True)) if self.named_states \
+                else numbers
+        return out
 
 
 def _unwrap(theta: NDArray[np.float64], omega: NDArray[np.float64], t: NDArray[np.float64]):
@@ -337,10 +359,10 @@ class _WithExtraWork:
         return self.f.change_points()
 
 
-def _passing(mechanism_type: str) -> str:
-    """The formulations of a mechanism type that pass dead points, as a parenthesis."""
-    names = [n for n in FORMULATIONS[mechanism_type]
-             if formulation_class(n, mechanism_type).passes_dead_points]
+def _passing(model) -> str:
+    """The formulations of a mechanism that pass dead points, as a parenthesis."""
+    names = [n for n in formulation_table(model)
+             if formulation_class(n, model).passes_dead_points]
     return f" ({' and '.join(names)} can)" if names else ""
 
 
@@ -350,7 +372,7 @@ def _near_change_point(f, t: float, y, points) -> bool:
 
 
 def simulate(
-    linkage: FourBar,
+    linkage,
     settings: SimulationSettings,
     *,
     method: str | None = None,
@@ -366,11 +388,11 @@ def simulate(
     Parameters
     ----------
     linkage
-        The four-bar.
+        The mechanism (a four-bar, slider-crank or general linkage model).
     settings
         The spec's ``[simulation]`` settings; the keyword arguments override them.
     method
-        Formulation (:data:`balancer.model.METHODS`).
+        Formulation (one of the mechanism's: :func:`balancer.formulations.formulation_table`).
     drive
         ``"free"`` or ``"constant-speed"`` (the crank held at ``settings.omega1``).
     duration
@@ -390,20 +412,17 @@ def simulate(
         If the motion reaches a position the formulation cannot pass (its ``partial``
         attribute holds the trajectory up to there).
     """
-    from .formulations import FORMULATIONS, default_method
-
     overrides = {"method": method, "drive": drive, "duration": duration, "rtol": rtol,
                  "atol": atol, "outputs": outputs}
     # The settings with the overrides, checked as a spec's would be (SimulationSettings).
     settings = replace(settings, **{k: x for k, x in overrides.items() if x is not None})
-    method = settings.method or default_method(linkage.type)
+    method = settings.method or default_method(linkage)
     drive, duration, rtol, atol, outputs = (settings.drive, settings.duration, settings.rtol,
                                             settings.atol, settings.outputs)
-    if method not in FORMULATIONS[linkage.type]:
-        raise SpecError(
-            f"the {linkage.type} has no such formulation; choose from "
-            f"{', '.join(FORMULATIONS[linkage.type])}", key="method", value=method)
+    formulation_class(method, linkage)  # a SpecError naming those that apply, if none
     theta1, omega1 = settings.theta1, settings.omega1
+    if theta1 is None:
+        theta1 = mechanism_of(linkage).start_angle
     check_scales(linkage, {"simulation.omega1": omega1},
                  {"simulation.gravity": settings.gravity})
     speed = None
@@ -412,10 +431,7 @@ def simulate(
             raise SpecError("a crank driven at constant speed needs a non-zero speed",
                             key="simulation.omega1", value=omega1)
         speed = omega1
-    try:
-        f = make(method, linkage, gravity=settings.gravity, speed=speed)
-    except ValueError as exc:
-        raise SpecError(str(exc), key="method", value=method) from None
+    f = make(method, linkage, gravity=settings.gravity, speed=speed)
     _check_start(f, theta1)
     stop_at = None if speed is None else _lock_time(f, theta1, speed, duration)
     y0 = f.initial_state(theta1, omega1)
@@ -435,7 +451,7 @@ def simulate(
             f"the motion reaches a dead point (sine of the transmission angle "
             f"below {DEAD_POINT_THRESHOLD:g}) at t = {t_event:.6g} s, θ1 = {th:.6g} rad; the "
             f"{f.name} formulation uses the crank angle as its coordinate and cannot pass it"
-            + _passing(linkage.type),
+            + _passing(linkage),
             t_event, th, traj)
     if stop_at is not None:
         th = f.crank_angle(stop_at)
@@ -472,15 +488,13 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
     states = [y[:-1] for y in states]
     ev = f.evaluate_batch(times, states)
     omega, alpha = np.asarray(ev.omega, float), np.asarray(ev.alpha, float)
-    theta = np.array([_unwrap(ev.theta[k], omega[k], t) for k in range(3)])
-    ra0 = np.asarray(ev.RA0, complex)
-    ra3 = np.asarray(ev.RA3, complex)
+    theta = np.array([_unwrap(row, omega[k], t) for k, row in enumerate(ev.theta)])
     tau = np.asarray(ev.driving_torque, float) * np.ones(t.size)
     motor = np.array([f.motor_work(y) for y in states])
     slider = None if ev.slider is None else np.asarray(ev.slider, float)
     # Energy: T − T0 = work of loads and gravity (a function of the configuration) + motor
     # + the extra work integrated with the motion (a gas force).
-    kin, work = f.energy(theta, omega, alpha, slider)
+    kin, work = f.energy(theta, omega, alpha, slider, states=states)
     work = work + motor + extra
     scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), 1e-300)
     energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
@@ -488,13 +502,19 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
     return Trajectory(
         method=f.name,
         drive="constant-speed" if f.driven else "free",
+        links=f.link_names,
         t=t,
         theta=theta,
         omega=omega,
         alpha=alpha,
-        RA0=ra0,
-        RA3=ra3,
+        ground={p: np.asarray(v, complex) * np.ones(t.size) for p, v in ev.ground.items()},
+        slider_normal={k: np.asarray(v, float) * np.ones(t.size)
+                       for k, v in ev.slider_normal.items()},
+        slider_couple={k: np.asarray(v, float) * np.ones(t.size)
+                       for k, v in ev.slider_couple.items()},
         driving_torque=tau,
+        shaking_force=np.asarray(shaking_force, complex) * np.ones(t.size),
+        shaking_moment=np.asarray(moment, float) * np.ones(t.size),
         kinetic_energy=kin,
         work=work,
         energy_error=energy_error,
@@ -504,8 +524,8 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
         seconds=float(seconds),
         rtol=rtol,
         atol=atol,
-        shaking_moment=np.asarray(moment, float) * np.ones(t.size),
-        shaking_force_values=np.asarray(shaking_force, complex) * np.ones(t.size),
+        named_states=mechanism_of(f.linkage).named_states,
+        model=f.linkage,
         slider=slider,
     )
 

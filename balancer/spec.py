@@ -51,7 +51,6 @@ from . import validate as v
 from .errors import SpecError
 from .model import (
     GROUND,
-    METHODS_BY_TYPE,
     Body,
     Design,
     FourBar,
@@ -302,12 +301,17 @@ def _read_gas_force(table: _Table) -> GasForce:
     return gas
 
 
-def _read_links(table: _Table, mechanism_class) -> tuple[dict[str, Link], GasForce]:
-    """The links of a mechanism, and the gas force on its slider (if it has one)."""
-    table.expect(mechanism_class.link_names)
+def _read_links(table: _Table, mechanism_class,
+                names: tuple[str, ...] | None = None) -> tuple[dict[str, Link], GasForce]:
+    """The links of a mechanism, and the gas force on its slider (if it has one).
+
+    ``names``: the links to read (by default the mechanism class's own).
+    """
+    names = mechanism_class.link_names if names is None else names
+    table.expect(names)
     links = {}
     gas = GasForce()
-    for name in mechanism_class.link_names:
+    for name in names:
         sub = table.table(name)
         assert sub is not None
         links[name] = _read_link(sub, name, mechanism_class)
@@ -472,7 +476,10 @@ def _read_simulation(root: _Table, mechanism) -> SimulationSettings:
     defaults = SimulationSettings()
     if table is None:
         return defaults
-    method = table.string("method", choices=METHODS_BY_TYPE[mechanism.type], default="") or None
+    from .mechanisms import mechanism_of
+
+    method = table.string("method", choices=tuple(mechanism_of(mechanism).formulation_table),
+                          default="") or None
     with v.under("simulation"):
         settings = SimulationSettings(
             **{name: table.value(name, getattr(defaults, name))
@@ -488,7 +495,7 @@ def _read_original(root: _Table, mechanism):
     table = root.table("original", required=False)
     if table is None:
         return None
-    links, _ = _read_links(table, type(mechanism))
+    links, _ = _read_links(table, type(mechanism), tuple(mechanism.link_names))
     return mechanism.with_links(links)
 
 
@@ -614,10 +621,37 @@ def _links_lines(mech, prefix: str) -> list[str]:
     out = []
     for name in mech.link_names:
         frame = "global" if mech.type == "slider-crank" and name == "slider" else "link"
-        out += ["", f"[{prefix}.{name}]", *_link_lines(mech.link(name), frame)]
+        out += ["", f"[{prefix}.{_key(name)}]", *_link_lines(mech.link(name), frame)]
         if prefix == "links" and frame == "global":
             out += _gas_lines(mech.gas_force)
     return out
+
+
+def _linkage_lines(mech: Linkage) -> list[str]:
+    """A general linkage's ``[mechanism]``, ``[links]`` and ``[[springs]]``."""
+    out = ["[mechanism]", 'type = "linkage"', f"input = {_string(mech.input)}", "",
+           "[mechanism.points]  # m, at the reference pose"]
+    out += [f"{_key(p)} = [{_num(x)}, {_num(y)}]" for p, (x, y) in mech.points]
+    for s in mech.sliders:
+        out += ["", "[[mechanism.sliders]]", f"link = {_string(s.link)}",
+                f"guide = {_string(s.guide)}", f"point = {_string(s.point)}",
+                f"direction = [{_num(s.direction[0])}, {_num(s.direction[1])}]"]
+    for body in mech.bodies:
+        names = ", ".join(map(_string, body.points))
+        out += ["", f"[links.{_key(body.name)}]", f"points = [{names}]"]
+        if body.props is not None:
+            out += _link_lines(body.props)
+    for spring in mech.springs:
+        out += ["", "[[springs]]", f"points = [{', '.join(map(_string, spring.points))}]",
+                f"stiffness = {_num(spring.stiffness)}  # N/m",
+                f"free_length = {_num(spring.free_length)}  # m"]
+    return out
+
+
+def _key(name: str) -> str:
+    """A TOML key: bare if it can be, else quoted."""
+    bare = bool(name) and name.isascii() and all(c.isalnum() or c in "-_" for c in name)
+    return name if bare else _string(name)
 
 
 def dumps_design(design: Design) -> str:
@@ -626,11 +660,14 @@ def dumps_design(design: Design) -> str:
     out: list[str] = []
     if design.title:
         out += [f"title = {_string(design.title)}", ""]
-    out += ["[mechanism]", f'type = "{mech.type}"', f'branch = "{mech.branch}"', ""]
-    out.append("[mechanism.lengths]  # m")
-    for name, length in zip(mech.length_names, mech.lengths, strict=True):
-        out.append(f"{name} = {_num(length)}")
-    out += _links_lines(mech, "links")
+    if isinstance(mech, Linkage):
+        out += _linkage_lines(mech)
+    else:
+        out += ["[mechanism]", f'type = "{mech.type}"', f'branch = "{mech.branch}"', ""]
+        out.append("[mechanism.lengths]  # m")
+        for name, length in zip(mech.length_names, mech.lengths, strict=True):
+            out.append(f"{name} = {_num(length)}")
+        out += _links_lines(mech, "links")
     if design.operation is not None:
         op = design.operation
         out += [
@@ -644,7 +681,7 @@ def dumps_design(design: Design) -> str:
         "",
         "[simulation]",
         f"duration = {_num(sim.duration)}  # s",
-        f"theta1 = {_num(sim.theta1)}  # rad",
+        *([f"theta1 = {_num(sim.theta1)}  # rad"] if sim.theta1 is not None else []),
         f"omega1 = {_num(sim.omega1)}  # rad/s",
         f"gravity = [{_num(sim.gravity[0])}, {_num(sim.gravity[1])}]  # m/s²",
         f'drive = "{sim.drive}"',

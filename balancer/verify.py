@@ -1,11 +1,13 @@
 """Proof by simulation that a design shakes its frame as little as claimed.
 
 A balanced design is simulated with a formulation other than the one the optimiser used (the
-optimiser's objective comes from the equivalent mass matrices, Eq. 45–54; the default check uses
-the opened loop with principal vectors, Eq. 22–28): once with the crank driven at the operating
-speed, once in free motion from the spec's initial state. The largest shaking force
-``|R̄A0 + R̄A3|`` and shaking moment of each run are compared with those of the unbalanced
-original when the spec names one (``[original]``, written by ``balancer optimize``).
+optimiser's objective comes from the linear maps of inverse dynamics; the default check of a
+four-bar uses the opened loop with principal vectors, Eq. 22–28, of a slider-crank its complex
+masses, of a general linkage the multibody formulation's multipliers): once with the crank
+driven at the operating speed, once in free motion from the spec's initial state. The largest
+shaking force (the sum of the forces on the frame) and shaking moment of each run are compared
+with those of the unbalanced original when the spec names one (``[original]``, written by
+``balancer optimize``).
 """
 
 from __future__ import annotations
@@ -15,13 +17,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .errors import LockupError, SpecError
-from .mechanisms import VERIFY_METHOD, require_full_revolution
-from .model import Design, FourBar
+from .mechanisms import mechanism_of
+from .model import Design
 from .simulate import Trajectory, simulate
-
-#: Formulation used by default to check a four-bar balanced with the mass-matrix objective
-#: (a slider-crank's: see :data:`balancer.mechanisms.VERIFY_METHOD`).
-DEFAULT_METHOD = VERIFY_METHOD["four-bar"]
 
 
 @dataclass(frozen=True)
@@ -33,7 +31,7 @@ class RunCheck:
     trajectory, original
         The simulated motion of the design and of the unbalanced original (or ``None``).
     max_shaking_force, max_shaking_moment
-        Largest ``|R̄A0 + R̄A3|`` (N) and |shaking moment| (N·m) over the run (over the part
+        Largest shaking force (N) and |shaking moment| (N·m) over the run (over the part
         before it stopped, if it stopped; ``None`` if it could not start).
     original_max_shaking_force, original_max_shaking_moment
         The same for the original, or ``None``.
@@ -58,7 +56,7 @@ class RunCheck:
         """
         if self.trajectory is None or self.max_shaking_force is None:
             return None
-        scale = max(np.max(np.abs(self.trajectory.RA0)), np.max(np.abs(self.trajectory.RA3)))
+        scale = self.trajectory.largest_reaction
         return self.max_shaking_force / scale if scale > 0 else None
 
     @property
@@ -189,8 +187,8 @@ def verify(
         The design; its ``[operation]`` speed is needed for the driven run, its ``[original]``
         (if any) is simulated alongside.
     method
-        Formulation for the simulations (by default one the optimiser did not use:
-        :data:`balancer.mechanisms.VERIFY_METHOD`).
+        Formulation for the simulations (by default one the optimiser did not use: the
+        mechanism's :attr:`~balancer.mechanisms.base.Mechanism.verify_method`).
     duration
         Simulated time of each run, s (default: the spec's ``[simulation] duration``).
     rtol, atol
@@ -207,14 +205,15 @@ def verify(
         raise SpecError("missing required key: the driven check runs at the operating speed",
                         key="operation.speed")
     linkage = design.mechanism
-    method = method or VERIFY_METHOD[linkage.type]
+    mech = mechanism_of(linkage)
+    method = method or mech.verify_method
     settings = design.simulation
     if duration is not None:
         settings = replace(settings, duration=duration)
     if outputs is not None:
         settings = replace(settings, outputs=outputs)
     start = settings.theta1
-    require_full_revolution(linkage, "a driven check")
+    mech.require_full_revolution("a driven check")
     driven_settings = replace(settings, drive="constant-speed", omega1=design.operation.speed,
                               theta1=start)
     free_settings = replace(settings, drive="free")

@@ -18,9 +18,12 @@ from pathlib import Path
 
 import numpy as np
 
-from balancer.model import METHODS
+from balancer.mechanisms.fourbar import FourBarMechanism
 from balancer.simulate import simulate_design
 from balancer.spec import load_design
+
+#: The paper's four formulations of the four-bar.
+METHODS = tuple(FourBarMechanism.formulations)
 
 ROOT = Path(__file__).resolve().parent.parent
 REPEATS = 5

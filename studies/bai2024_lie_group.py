@@ -37,10 +37,14 @@ from matplotlib.figure import Figure
 
 from balancer.formulations import make
 from balancer.kinematics import classify
-from balancer.model import METHODS, FourBar, Link, SimulationSettings
-from balancer.plots import COLOURS, save_png
+from balancer.mechanisms.fourbar import FourBarMechanism
+from balancer.model import FourBar, Link, SimulationSettings
+from balancer.plots import SERIES, save_png
 from balancer.report import markdown_table
 from balancer.simulate import simulate
+
+#: The paper's four formulations of the four-bar.
+METHODS = tuple(FourBarMechanism.formulations)
 
 NAME = "bai2024_lie_group"
 GRAVITY = (0.0, -9.81)
@@ -115,8 +119,8 @@ def figure_case(case: Case, mech: FourBar, traj, pi1: np.ndarray) -> Figure:
     names = (("q_A", "crank"), ("q_B", "coupler"), ("q_D", "rocker, from A3"))
     for k, (symbol, what) in enumerate(names):
         ax = fig.add_subplot(grid[k + 1, 0], sharex=axes[0])
-        ax.plot(t, q[2 * k], color=COLOURS["A0"], lw=1.4, label="x")
-        ax.plot(t, q[2 * k + 1], color=COLOURS["A3"], lw=1.4, ls="--", label="y")
+        ax.plot(t, q[2 * k], color=SERIES[0], lw=1.4, label="x")
+        ax.plot(t, q[2 * k + 1], color=SERIES[1], lw=1.4, ls="--", label="y")
         ax.set_ylabel(f"${symbol[0]}_{symbol[2]}$ ({what})", fontsize=9)
         ax.set_ylim(-1.1, 1.1)
         ax.legend(fontsize="x-small", loc="center left", bbox_to_anchor=(1.0, 0.5))
@@ -128,8 +132,8 @@ def figure_case(case: Case, mech: FourBar, traj, pi1: np.ndarray) -> Figure:
     a1 = mech.lengths[0] * np.exp(1j * traj.theta[0])
     a2 = a1 + mech.lengths[1] * np.exp(1j * traj.theta[1])
     a3 = complex(mech.lengths[3], 0.0)
-    ax.plot(a1.real, a1.imag, color=COLOURS["A0"], lw=1, label="path of A1")
-    ax.plot(a2.real, a2.imag, color=COLOURS["A3"], lw=1, label="path of A2")
+    ax.plot(a1.real, a1.imag, color=SERIES[0], lw=1, label="path of A1")
+    ax.plot(a2.real, a2.imag, color=SERIES[1], lw=1, label="path of A2")
     end = np.searchsorted(t, min(t[-1], 1.7))  # about one swing
     for k in np.linspace(0, end, 13).astype(int):
         ax.plot([0, a1[k].real, a2[k].real, a3.real], [0, a1[k].imag, a2[k].imag, a3.imag],

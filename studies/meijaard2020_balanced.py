@@ -37,12 +37,16 @@ from balancer.conditions import (
     force_balanced_by_crank_and_rocker,
 )
 from balancer.inverse import cycle_analysis
-from balancer.model import METHODS, SimulationSettings
+from balancer.mechanisms.fourbar import FourBarMechanism
+from balancer.model import SimulationSettings
 from balancer.optimize import optimize
-from balancer.plots import COLOURS, plot_reactions, save_png
+from balancer.plots import COLOURS, SERIES, plot_reactions, save_png
 from balancer.report import markdown_table
 from balancer.simulate import simulate
 from balancer.spec import dumps_design, load_design, loads_design
+
+#: The paper's four formulations of the four-bar.
+METHODS = tuple(FourBarMechanism.formulations)
 
 NAME = "meijaard2020_balanced"
 ROOT = Path(__file__).resolve().parents[1]
@@ -52,8 +56,8 @@ RTOL, ATOL = 1e-11, 1e-13
 SPEED, SAMPLES = 10.0, 360
 #: The free motion of Sect. 5.2.
 FREE = SimulationSettings(duration=5.0, theta1=1.0, omega1=1.0)
-DESIGN_COLOURS = {"original": COLOURS["before"], "force-balanced": COLOURS["A0"],
-                  "moment-minimised": COLOURS["A3"], "complete": COLOURS["after"]}
+DESIGN_COLOURS = {"original": COLOURS["before"], "force-balanced": SERIES[0],
+                  "moment-minimised": SERIES[1], "complete": COLOURS["after"]}
 
 
 def balanced_from(problem_spec: Path, linkage, title: str):
@@ -70,7 +74,7 @@ def balanced_from(problem_spec: Path, linkage, title: str):
 
 def reaction_sum_level(traj) -> float:
     """Largest |R̄A0 + R̄A3| relative to the largest individual reaction."""
-    scale = max(np.max(np.abs(traj.RA0)), np.max(np.abs(traj.RA3)))
+    scale = traj.largest_reaction
     return float(np.max(np.abs(traj.shaking_force)) / scale)
 
 

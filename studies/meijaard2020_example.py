@@ -30,11 +30,14 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from balancer.formulations import make
-from balancer.model import METHODS
-from balancer.plots import COLOURS, save_png
+from balancer.mechanisms.fourbar import FourBarMechanism
+from balancer.plots import COLOURS, SERIES, save_png
 from balancer.report import markdown_table
 from balancer.simulate import simulate
 from balancer.spec import load_design
+
+#: The paper's four formulations of the four-bar.
+METHODS = tuple(FourBarMechanism.formulations)
 
 NAME = "meijaard2020_example"
 ROOT = Path(__file__).resolve().parents[1]
@@ -82,7 +85,7 @@ def statewise_check(design, reference) -> tuple[float, float]:
         states = [f.initial_state(a, w) for a, w in zip(theta1, omega1, strict=True)]
         ev = f.evaluate_batch(reference.t, states)
         alphas.append(np.asarray(ev.alpha))
-        reactions.append(np.concatenate([ev.RA0, ev.RA3]))
+        reactions.append(np.concatenate([ev.ground["A0"], ev.ground["A3"]]))
     alpha_err = max(np.max(np.abs(a - alphas[0])) for a in alphas) / np.max(np.abs(alphas[0]))
     react_err = max(np.max(np.abs(r - reactions[0])) for r in reactions) / np.max(
         np.abs(reactions[0]))
@@ -93,7 +96,7 @@ def figure_angles(runs: dict) -> Figure:
     """Fig. 7: the link angles over time, every formulation drawn over the others."""
     fig = Figure(figsize=(8, 4), layout="constrained")
     ax = fig.add_subplot()
-    colours = (COLOURS["A0"], COLOURS["after"], COLOURS["A3"])
+    colours = (SERIES[0], COLOURS["after"], SERIES[1])
     for method in METHODS:
         traj = runs[method]
         for k in range(3):
@@ -114,10 +117,10 @@ def figure_reactions(runs: dict) -> Figure:
     fig = Figure(figsize=(7, 4), layout="constrained")
     ax = fig.add_subplot()
     traj = runs["opened-loop"]
-    ax.plot(traj.t, traj.RA0.real, color=COLOURS["A0"], lw=1.4, label="$R_{A0x}$")
-    ax.plot(traj.t, traj.RA0.imag, color=COLOURS["A0"], lw=1.4, ls="--", label="$R_{A0y}$")
-    ax.plot(traj.t, traj.RA3.real, color=COLOURS["A3"], lw=1.4, label="$R_{A3x}$")
-    ax.plot(traj.t, traj.RA3.imag, color=COLOURS["A3"], lw=1.4, ls="--", label="$R_{A3y}$")
+    ax.plot(traj.t, traj.ground["A0"].real, color=SERIES[0], lw=1.4, label="$R_{A0x}$")
+    ax.plot(traj.t, traj.ground["A0"].imag, color=SERIES[0], lw=1.4, ls="--", label="$R_{A0y}$")
+    ax.plot(traj.t, traj.ground["A3"].real, color=SERIES[1], lw=1.4, label="$R_{A3x}$")
+    ax.plot(traj.t, traj.ground["A3"].imag, color=SERIES[1], lw=1.4, ls="--", label="$R_{A3y}$")
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("force on the ground (N)")
     ax.set_title("Fig. 8: reactions at the supports (opened-loop formulation)")
@@ -134,7 +137,7 @@ def spreads_over_time(runs: dict) -> tuple[np.ndarray, np.ndarray]:
     largest reaction of the run (dimensionless).
     """
     theta = np.array([runs[m].theta for m in METHODS])
-    react = np.array([[runs[m].RA0, runs[m].RA3] for m in METHODS])
+    react = np.array([[runs[m].ground["A0"], runs[m].ground["A3"]] for m in METHODS])
     spread_theta = np.max(np.ptp(theta, axis=0), axis=0)
     spread_react = np.max(np.abs(react - react[0]), axis=(0, 1)) / np.max(np.abs(react))
     return spread_theta, spread_react
@@ -147,9 +150,9 @@ def figure_agreement(runs: dict) -> Figure:
     t = runs[METHODS[0]].t
     spread_theta, spread_react = spreads_over_time(runs)
     floor = 1e-17
-    ax.semilogy(t, np.maximum(spread_theta, floor), color=COLOURS["A0"], lw=1.2,
+    ax.semilogy(t, np.maximum(spread_theta, floor), color=SERIES[0], lw=1.2,
                 label="angles: max − min over formulations (rad)")
-    ax.semilogy(t, np.maximum(spread_react, floor), color=COLOURS["A3"], lw=1.2,
+    ax.semilogy(t, np.maximum(spread_react, floor), color=SERIES[1], lw=1.2,
                 label="reactions: largest difference / largest reaction")
     ax.axhline(RTOL, color=COLOURS["before"], ls=":", label=f"integrator rtol {RTOL:g}")
     ax.set_xlabel("time t (s)")

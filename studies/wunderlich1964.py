@@ -40,7 +40,7 @@ from balancer.inverse import sample_angles
 from balancer.kinematics import position_of
 from balancer.massmodels import link_centres_of_mass, total_com_direct, wunderlich_linkage
 from balancer.model import FourBar, Link, SimulationSettings, SliderCrank
-from balancer.plots import COLOURS, save_png
+from balancer.plots import COLOURS, SERIES, save_png
 from balancer.report import markdown_table
 from balancer.simulate import simulate
 from balancer.slider_crank import conditions as sc_cond
@@ -117,26 +117,26 @@ def figure_1(linkage: FourBar, pos, one, com, w) -> Figure:
     a1, a2, a3 = one.A1[0], one.A2[0], one.A3
     b = a1 + w.beta * one.l2[0]
     ax.plot([0, a1.real, a2.real, a3.real], [0, a1.imag, a2.imag, a3.imag], "-o",
-            color=COLOURS["A0"], lw=3, ms=6, label="four-bar A0A1A2A3")
-    ax.fill([a1.real, b.real, a2.real], [a1.imag, b.imag, a2.imag], color=COLOURS["A0"],
+            color=SERIES[0], lw=3, ms=6, label="four-bar A0A1A2A3")
+    ax.fill([a1.real, b.real, a2.real], [a1.imag, b.imag, a2.imag], color=SERIES[0],
             alpha=0.15)
     ax.plot([b.real], [b.imag], "o", color=COLOURS["before"], ms=7)
     # Link centres of mass S1, S2, S3 and S at that position.
     coms = link_centres_of_mass(linkage, one)
-    ax.plot([c[0].real for c in coms], [c[0].imag for c in coms], "s", color=COLOURS["A0"],
+    ax.plot([c[0].real for c in coms], [c[0].imag for c in coms], "s", color=SERIES[0],
             ms=6, label="link centres of mass S1, S2, S3")
     # The generating four-bar B0B1B2B3: v_k = γ·u_k, with S as its coupler point.
     b1, b2 = w.generating_joints(one)
     s = w.trace(one)[0]
     ax.plot([w.B0.real, b1[0].real, b2[0].real, w.B3.real],
-            [w.B0.imag, b1[0].imag, b2[0].imag, w.B3.imag], "-o", color=COLOURS["A3"], lw=2,
+            [w.B0.imag, b1[0].imag, b2[0].imag, w.B3.imag], "-o", color=SERIES[1], lw=2,
             ms=5, label="generating four-bar B0B1B2B3 (similar, ratio |γ|)")
     ax.fill([b1[0].real, s.real, b2[0].real], [b1[0].imag, s.imag, b2[0].imag],
-            color=COLOURS["A3"], alpha=0.15)
+            color=SERIES[1], alpha=0.15)
     ax.plot([s.real], [s.imag], "o", color=COLOURS["after"], ms=10, zorder=6,
             label="S, coupler point of B0B1B2B3")
     _ground(ax, [0j, a3])
-    _ground(ax, [w.B0, w.B3], COLOURS["A3"], 9)
+    _ground(ax, [w.B0, w.B3], SERIES[1], 9)
     for text, p, offset in (("A0", 0j, (-14, -14)), ("A3", a3, (6, -14)),
                             ("A1", a1, (-16, 4)), ("A2", a2, (6, 4)), ("B", b, (6, 4)),
                             ("B0", w.B0, (-16, -14)), ("B3", w.B3, (6, -14)),
@@ -173,14 +173,14 @@ def figure_2(linkage: FourBar, angles: np.ndarray, fixed: complex) -> Figure:
         alpha = 1.0 if n == 1 else 0.25
         label = "linkage (dimmed: other positions)" if n == 1 else None
         # Links, extended to the centres of mass that lie beyond the joints.
-        ax.plot([r1[k].real, a1.real], [r1[k].imag, a1.imag], color=COLOURS["A0"], lw=2.5,
+        ax.plot([r1[k].real, a1.real], [r1[k].imag, a1.imag], color=SERIES[0], lw=2.5,
                 alpha=alpha, label=label)
-        ax.plot([a1.real, a2.real], [a1.imag, a2.imag], color=COLOURS["A0"], lw=2.5,
+        ax.plot([a1.real, a2.real], [a1.imag, a2.imag], color=SERIES[0], lw=2.5,
                 alpha=alpha)
-        ax.plot([a2.real, r3[k].real], [a2.imag, r3[k].imag], color=COLOURS["A0"], lw=2.5,
+        ax.plot([a2.real, r3[k].real], [a2.imag, r3[k].imag], color=SERIES[0], lw=2.5,
                 alpha=alpha)
         ax.plot([r1[k].real, r2[k].real, r3[k].real], [r1[k].imag, r2[k].imag, r3[k].imag],
-                "s", color=COLOURS["A3"], ms=6 if n == 1 else 4, alpha=alpha,
+                "s", color=SERIES[1], ms=6 if n == 1 else 4, alpha=alpha,
                 label="link centres of mass S1, S2, S3" if n == 1 else None)
     ax.plot([fixed.real], [fixed.imag], "*", color=COLOURS["after"], ms=18, zorder=6,
             label="total centre of mass S = m3·σ3·a (fixed)")
@@ -240,20 +240,20 @@ def slider_crank_counterpart(out_dir: Path, quick: bool = False) -> dict:
              label="connecting-rod curve of B (A1B = β·A1A2), Eq. 12")
     ax1.plot(com.real, com.imag, color=COLOURS["after"], lw=2.4,
              label="path of the total centre of mass S")
-    ax1.plot([0, a1.real, a2.real], [0, a1.imag, a2.imag], "-o", color=COLOURS["A0"], lw=3,
+    ax1.plot([0, a1.real, a2.real], [0, a1.imag, a2.imag], "-o", color=SERIES[0], lw=3,
              ms=6, label="slider-crank A0A1A2")
-    ax1.fill([a1.real, b.real, a2.real], [a1.imag, b.imag, a2.imag], color=COLOURS["A0"],
+    ax1.fill([a1.real, b.real, a2.real], [a1.imag, b.imag, a2.imag], color=SERIES[0],
              alpha=0.15)
     b1, b2 = w.generating_joints(one)
     s_now = w.trace(one)[0]
     ax1.plot([w.B0.real, b1[0].real, b2[0].real], [w.B0.imag, b1[0].imag, b2[0].imag], "-o",
-             color=COLOURS["A3"], lw=2, ms=5, label="generating slider-crank B0B1B2 (Eq. 18)")
+             color=SERIES[1], lw=2, ms=5, label="generating slider-crank B0B1B2 (Eq. 18)")
     ax1.plot([s_now.real], [s_now.imag], "o", color=COLOURS["after"], ms=10, zorder=6,
              label="S, its connecting-rod point")
     ax1.plot([min(z.real.min(), -r) - 0.3, (r + big_l) + 0.3], [e, e], color="k", lw=5,
              alpha=0.2, label="guide of A2")
     _ground(ax1, [0j])
-    _ground(ax1, [w.B0], COLOURS["A3"], 9)
+    _ground(ax1, [w.B0], SERIES[1], 9)
     for text, p, offset in (("A0", 0j, (-14, -14)), ("A1", a1, (-16, 4)), ("A2", a2, (6, 4)),
                             ("B", b, (6, 4)), ("B0", w.B0, (-16, -14)),
                             ("B1", b1[0], (-16, 4)), ("B2", b2[0], (6, 4)),
@@ -268,9 +268,9 @@ def slider_crank_counterpart(out_dir: Path, quick: bool = False) -> dict:
     for k in range(one_still.size):
         alpha = 1.0 if k == 1 else 0.25
         pts = [r1[k], one_still.A1[k], one_still.A2[k]]
-        ax2.plot([p.real for p in pts], [p.imag for p in pts], "-", color=COLOURS["A0"],
+        ax2.plot([p.real for p in pts], [p.imag for p in pts], "-", color=SERIES[0],
                  lw=2.5, alpha=alpha, label="slider-crank with counterweights" if k == 1 else None)
-        ax2.plot([r1[k].real, r2[k].real], [r1[k].imag, r2[k].imag], "s", color=COLOURS["A3"],
+        ax2.plot([r1[k].real, r2[k].real], [r1[k].imag, r2[k].imag], "s", color=SERIES[1],
                  ms=5, alpha=alpha, label="crank and rod centres of mass" if k == 1 else None)
     ax2.plot([fixed.real], [fixed.imag], "*", color=COLOURS["after"], ms=18, zorder=6,
              label="total centre of mass at B0 = m3·s3 (fixed)")

@@ -13,8 +13,12 @@ from balancer import inverse
 from balancer import kinematics as kin
 from balancer.errors import LockupError
 from balancer.formulations import make
-from balancer.model import METHODS, FourBar, Link, SimulationSettings
+from balancer.mechanisms.fourbar import FourBarMechanism
+from balancer.model import FourBar, Link, SimulationSettings
 from balancer.simulate import DEAD_POINT_THRESHOLD, simulate
+
+#: The paper's four formulations of the four-bar.
+METHODS = tuple(FourBarMechanism.formulations)
 
 #: Tight integrator tolerances for comparing formulations.
 TIGHT = {"rtol": 1e-11, "atol": 1e-13}
@@ -60,8 +64,8 @@ def test_formulations_agree_with_each_other_and_newton_euler(linkage, theta1, om
     for name, ev in evals.items():
         assert rel_err(ev.omega, ref.omega, scale=max(1.0, abs(omega1))) < 1e-12, name
         assert rel_err(ev.alpha, ref.alpha, scale=acc) < 1e-9, name
-        assert abs(ev.RA0 - ne.RA0[0]) < 1e-9 * force, name
-        assert abs(ev.RA3 - ne.RA3[0]) < 1e-9 * force, name
+        assert abs(ev.ground["A0"] - ne.RA0[0]) < 1e-9 * force, name
+        assert abs(ev.ground["A3"] - ne.RA3[0]) < 1e-9 * force, name
         assert abs(ev.driving_torque - ref.driving_torque) < 1e-9 * moment, name
         d = np.remainder(ev.theta - ref.theta + np.pi, 2 * np.pi) - np.pi
         assert np.max(np.abs(d)) < 1e-12, name
@@ -103,10 +107,10 @@ def test_paper_example_reaction_histories_agree(paper_runs, paper_growth):
     ref = paper_runs["opened-loop"]
     for name, tr in paper_runs.items():
         assert np.array_equal(tr.t, ref.t)
-        for key in ("RA0", "RA3"):
+        for key in ("A0", "A3"):
             # Reactions along two integrations of one free motion: their bounds, amplified.
-            tol = paper_growth.bound(lambda run, key=key: getattr(run, key), tr, ref)
-            assert np.max(np.abs(getattr(tr, key) - getattr(ref, key))) < tol, (name, key)
+            tol = paper_growth.bound(lambda run, key=key: run.ground[key], tr, ref)
+            assert np.max(np.abs(tr.ground[key] - ref.ground[key])) < tol, (name, key)
 
 
 def test_paper_example_energy_and_drift(paper_runs):
@@ -129,8 +133,8 @@ def test_paper_example_reactions_are_the_inverse_dynamics_of_the_motion(paper_ru
     # Two routes at the same states (no integration between them): DESIGN.md's 1e-9 relative;
     # the paper's motion keeps |sin(θ3 − θ2)| ≥ 0.7. A torque's scale is a force's times a
     # length (N·m).
-    scale = np.max(np.abs(tr.RA0))
-    assert np.max(np.abs(ne.RA0 - tr.RA0)) < 1e-9 * scale
+    scale = np.max(np.abs(tr.ground["A0"]))
+    assert np.max(np.abs(ne.RA0 - tr.ground["A0"])) < 1e-9 * scale
     assert np.max(np.abs(ne.driving_torque)) < 1e-9 * scale * max(linkage.lengths)
 
 
@@ -291,8 +295,8 @@ def test_driven_motion_matches_the_cycle_analysis(method):
     # no integration error enters the reactions: the formulations' algebraic 1e-9 (DESIGN.md)
     # at the paper's well-conditioned positions (|sin(θ3 − θ2)| ≥ 0.7).
     scale = np.max(np.abs(ca.reactions.RA0))
-    assert np.max(np.abs(tr.RA0 - ca.reactions.RA0)) < 1e-9 * scale
-    assert np.max(np.abs(tr.RA3 - ca.reactions.RA3)) < 1e-9 * scale
+    assert np.max(np.abs(tr.ground["A0"] - ca.reactions.RA0)) < 1e-9 * scale
+    assert np.max(np.abs(tr.ground["A3"] - ca.reactions.RA3)) < 1e-9 * scale
     tau_scale = np.max(np.abs(ca.reactions.driving_torque))
     assert np.max(np.abs(tr.driving_torque - ca.reactions.driving_torque)) < 1e-9 * tau_scale
     assert np.max(np.abs(tr.shaking_moment - ca.reactions.shaking_moment)) < 1e-9 * tau_scale
@@ -331,8 +335,8 @@ def test_formulations_agree_at_every_state_along_a_trajectory(paper_runs):
         f = make(name, linkage)
         evs = [f.evaluate(0.0, f.initial_state(th, w)) for th, w in
                zip(traj.theta[0], traj.omega[0], strict=True)]
-        results[name] = (np.array([e.alpha for e in evs]), np.array([e.RA0 for e in evs]),
-                         np.array([e.RA3 for e in evs]))
+        results[name] = (np.array([e.alpha for e in evs]), np.array([e.ground["A0"] for e in evs]),
+                         np.array([e.ground["A3"] for e in evs]))
     # One state, several formulations: DESIGN.md's 1e-9 relative (the paper's motion keeps
     # |sin(θ3 − θ2)| ≥ 0.7, a well-conditioned set of states).
     ref = results["opened-loop"]

@@ -28,8 +28,8 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
-from typing import ClassVar
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -41,49 +41,84 @@ from ..model import FourBar
 
 @dataclass(frozen=True)
 class Evaluation:
-    """What a formulation says about one state.
+    """What a formulation says about one state (or, from ``evaluate_batch``, about many).
 
     Attributes
     ----------
     theta, omega, alpha
-        Angles (rad), angular velocities (rad/s) and accelerations (rad/s²) of links 1–3 (a
-        slider's are zero).
-    RA0, RA3
-        Forces of the mechanism on the ground at A0 and at A3 (a slider-crank: on the guide),
-        complex ``x + i·y``, N.
+        Angles (rad), angular velocities (rad/s) and accelerations (rad/s²) of the moving links
+        in the mechanism's order (:attr:`Formulation.link_names`), shape ``(n,)`` or
+        ``(n, count)`` (a slider's angle stays constant).
+    ground
+        Force of the mechanism on the ground at each ground point, complex ``x + i·y``, N.
     driving_torque
         Torque of the motor on the crank, N·m (zero in free motion).
     shaking_force, shaking_moment
-        Sum of the forces on the frame (N) and their moment about A0 (N·m), when the
-        formulation computes them itself (otherwise the simulation does, from the above).
+        Sum of the forces on the frame (N) and their moment about the origin (N·m), when the
+        formulation computes them itself (otherwise :meth:`Formulation.shaking` does).
+    slider_normal, slider_couple
+        For each slider on a ground guide (keyed by the sliding link): the normal force (N,
+        along the guide's direction turned by +90°) and the couple about the slider's point
+        (N·m) that it exerts on the guide.
     slider
-        Slider position, velocity and acceleration along the guide (m, m/s, m/s²), if any.
+        A formulation's own slider coordinate: position, velocity and acceleration along the
+        guide (m, m/s, m/s²), if it has one.
     """
 
     theta: NDArray[np.float64]
     omega: NDArray[np.float64]
     alpha: NDArray[np.float64]
-    RA0: complex
-    RA3: complex
-    driving_torque: float = 0.0
-    shaking_force: complex | None = None
-    shaking_moment: float | None = None
+    ground: dict[str, Any]
+    driving_torque: Any = 0.0
+    shaking_force: Any = None
+    shaking_moment: Any = None
+    slider_normal: dict[str, Any] = field(default_factory=dict)
+    slider_couple: dict[str, Any] = field(default_factory=dict)
     slider: NDArray[np.float64] | None = None
 
     def at(self, index: int) -> Evaluation:
         """The state ``index`` of an evaluation of arrays (from ``evaluate_batch``)."""
+        def pick(x, kind):
+            return None if x is None else kind(np.asarray(x)[index])
+
         return Evaluation(
             theta=self.theta[:, index],
             omega=self.omega[:, index],
             alpha=self.alpha[:, index],
-            RA0=complex(self.RA0[index]),
-            RA3=complex(self.RA3[index]),
+            ground={p: complex(np.asarray(v)[index]) for p, v in self.ground.items()},
             driving_torque=float(np.asarray(self.driving_torque)[index]),
-            shaking_force=None if self.shaking_force is None else complex(
-                np.asarray(self.shaking_force)[index]),
-            shaking_moment=None if self.shaking_moment is None else float(
-                np.asarray(self.shaking_moment)[index]),
+            shaking_force=pick(self.shaking_force, complex),
+            shaking_moment=pick(self.shaking_moment, float),
+            slider_normal={k: float(np.asarray(v)[index]) for k, v in self.slider_normal.items()},
+            slider_couple={k: float(np.asarray(v)[index]) for k, v in self.slider_couple.items()},
             slider=None if self.slider is None else np.asarray(self.slider)[:, index],
+        )
+
+    @staticmethod
+    def stack(evaluations: list[Evaluation]) -> Evaluation:
+        """Evaluations at single states as one of arrays (the inverse of :meth:`at`)."""
+        first = evaluations[0]
+
+        def arrays(name):
+            values = [getattr(e, name) for e in evaluations]
+            return None if values[0] is None else np.array(values)
+
+        def keyed(name, dtype):
+            return {k: np.array([getattr(e, name)[k] for e in evaluations], dtype)
+                    for k in getattr(first, name)}
+
+        slider = arrays("slider")
+        return Evaluation(
+            theta=np.array([e.theta for e in evaluations]).T,
+            omega=np.array([e.omega for e in evaluations]).T,
+            alpha=np.array([e.alpha for e in evaluations]).T,
+            ground=keyed("ground", complex),
+            driving_torque=np.array([e.driving_torque for e in evaluations], float),
+            shaking_force=arrays("shaking_force"),
+            shaking_moment=arrays("shaking_moment"),
+            slider_normal=keyed("slider_normal", float),
+            slider_couple=keyed("slider_couple", float),
+            slider=None if slider is None else slider.T,
         )
 
 
@@ -172,27 +207,10 @@ class Formulation(ABC):
     def evaluate_batch(self, times, states) -> Evaluation:
         """:meth:`evaluate` at many states, as an :class:`Evaluation` of arrays.
 
-        ``theta``, ``omega``, ``alpha`` have shape ``(3, n)``. Formulations override it with
-        vectorised versions of their own equations.
+        ``theta``, ``omega``, ``alpha`` have shape ``(n, count)``. Formulations override it
+        with vectorised versions of their own equations.
         """
-        evals = [self.evaluate(t, y) for t, y in zip(times, states, strict=True)]
-
-        def stack(name):
-            values = [getattr(e, name) for e in evals]
-            return None if values[0] is None else np.array(values)
-
-        slider = stack("slider")
-        return Evaluation(
-            theta=np.array([e.theta for e in evals]).T,
-            omega=np.array([e.omega for e in evals]).T,
-            alpha=np.array([e.alpha for e in evals]).T,
-            RA0=np.array([e.RA0 for e in evals]),
-            RA3=np.array([e.RA3 for e in evals]),
-            driving_torque=np.array([e.driving_torque for e in evals]),
-            shaking_force=stack("shaking_force"),
-            shaking_moment=stack("shaking_moment"),
-            slider=None if slider is None else slider.T,
-        )
+        return Evaluation.stack([self.evaluate(t, y) for t, y in zip(times, states, strict=True)])
 
     @abstractmethod
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
@@ -216,7 +234,7 @@ class Formulation(ABC):
         _, v2, v3 = position_scalar(self.lengths, theta1, float(sign))
         return abs(v2.real * v3.imag - v2.imag * v3.real) / (self.lengths[1] * self.lengths[2])
 
-    def energy(self, theta, omega, alpha, slider=None):
+    def energy(self, theta, omega, alpha, slider=None, states=None):
         """Kinetic energy and the work of loads and gravity since the first state, J.
 
         At output states (arrays over time; angles continuous).
@@ -234,16 +252,36 @@ class Formulation(ABC):
         return kin, work
 
     def shaking(self, ev: Evaluation) -> tuple:
-        """Shaking force (N) and moment about A0 (N·m) from a (batch) evaluation."""
+        """Shaking force (N) and moment about the origin (N·m) from a (batch) evaluation.
+
+        From the forces at the ground points, the motor's reaction and the counter-rotors'
+        (``+2J·α`` each), unless the formulation computed them itself.
+        """
         if ev.shaking_force is not None and ev.shaking_moment is not None:
             return ev.shaking_force, ev.shaking_moment
-        ra3 = np.asarray(ev.RA3, complex)
-        tau = np.asarray(ev.driving_torque, float)
-        moment = self.lengths[3] * ra3.imag - tau
-        for k, link in enumerate(self.linkage.links):
+        force = 0.0
+        moment = -np.asarray(ev.driving_torque, float)
+        positions = self.mechanism.ground_positions
+        for point, value in ev.ground.items():
+            value = np.asarray(value, complex)
+            force = force + value
+            moment = moment + (np.conj(positions[point]) * value).imag
+        for k, link in enumerate(self.mechanism.links):
             if link.counter_rotor:
                 moment = moment + 2 * link.counter_rotor * np.asarray(ev.alpha)[k]
-        return np.asarray(ev.RA0, complex) + ra3, moment
+        return force, moment
+
+    @property
+    def mechanism(self):
+        """The mechanism (:func:`balancer.mechanisms.mechanism_of`) of the linkage."""
+        from ..mechanisms import mechanism_of
+
+        return mechanism_of(self.linkage)
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """Names of the moving links, in the order of ``theta``, ``omega``, ``alpha``."""
+        return self.mechanism.link_names
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         """Crank angle at a state, rad."""
@@ -294,46 +332,56 @@ class Formulation(ABC):
         return float(y[-1]) if self.driven else 0.0
 
 
-#: Formulations per mechanism type: name → (module, class); the first is the default.
-FORMULATIONS: dict[str, dict[str, tuple[str, str]]] = {
-    "four-bar": {
-        "opened-loop": ("balancer.formulations.opened_loop", "OpenedLoop"),
-        "complex-masses": ("balancer.formulations.complex_masses", "ComplexMasses"),
-        "mass-matrix": ("balancer.formulations.mass_matrix", "MassMatrix"),
-        "lie-group": ("balancer.formulations.lie_group", "LieGroup"),
-    },
-    "slider-crank": {
-        "mass-matrix": ("balancer.slider_crank.formulations", "SliderMassMatrix"),
-        "complex-masses": ("balancer.slider_crank.formulations", "SliderComplexMasses"),
-    },
-}
+def formulation_table(model) -> dict[str, tuple[str, str]]:
+    """The formulations that apply to a mechanism: name → (module, class), the default first.
+
+    The mechanism's own (:attr:`balancer.mechanisms.base.Mechanism.formulation_table`), and the
+    general multibody formulation for every mechanism.
+    """
+    from ..mechanisms import mechanism_of
+
+    return mechanism_of(model).formulation_table
 
 
-def default_method(mechanism_type: str) -> str:
+def default_method(model) -> str:
     """The formulation used when none is asked for."""
-    return next(iter(FORMULATIONS[mechanism_type]))
+    return next(iter(formulation_table(model)))
 
 
-def formulation_class(name: str, mechanism_type: str = "four-bar") -> type[Formulation]:
-    """The formulation called ``name`` for a mechanism type (see :data:`FORMULATIONS`)."""
+def formulation_class(name: str, model) -> type[Formulation]:
+    """The formulation called ``name`` for a mechanism.
+
+    Raises
+    ------
+    SpecError
+        If the mechanism has no such formulation (naming those it has).
+    """
     import importlib
 
-    table = FORMULATIONS[mechanism_type]
+    from ..errors import SpecError
+
+    table = formulation_table(model)
     try:
         module, cls = table[name]
     except KeyError:
-        raise ValueError(
-            f"the {mechanism_type} has no formulation {name!r}; choose from {', '.join(table)}"
-        ) from None
+        raise SpecError(f"the {mechanism_kind(model)} has no such formulation; choose from "
+                        f"{', '.join(table)}", key="method", value=name) from None
     return getattr(importlib.import_module(module), cls)
+
+
+def mechanism_kind(model) -> str:
+    """The mechanism's kind, as the spec names it (for messages)."""
+    from ..mechanisms import mechanism_of
+
+    return mechanism_of(model).kind
 
 
 def make(
     name: str,
-    linkage: FourBar,
+    linkage,
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     speed: float | None = None,
 ) -> Formulation:
     """Instantiate the formulation called ``name`` for the mechanism."""
-    return formulation_class(name, linkage.type)(linkage, gravity=gravity, speed=speed)
+    return formulation_class(name, linkage)(linkage, gravity=gravity, speed=speed)

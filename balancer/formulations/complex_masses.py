@@ -135,7 +135,7 @@ class ComplexMasses(Formulation):
         omega = np.array([omega1 + 0.0 * w2, w2, w3])
         ra0, ra3 = self._reactions(vectors, omega, alpha)
         theta = np.array([theta1 + 0.0 * big2, np.angle(vectors[1]), np.angle(vectors[2])])
-        return Evaluation(theta=theta, omega=omega, alpha=alpha, RA0=ra0, RA3=ra3,
+        return Evaluation(theta=theta, omega=omega, alpha=alpha, ground={"A0": ra0, "A3": ra3},
                           driving_torque=tau)
 
     def _reactions(self, vectors, omega, alpha):

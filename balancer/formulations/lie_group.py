@@ -191,8 +191,8 @@ class LieGroup(Formulation):
         tau = np.array([p[3] for p in parts])
         mo = motion_from_angles(self.lengths, tuple(theta), tuple(omega), tuple(alpha))
         ne = newton_euler(self.linkage, mo, gravity=(self.gravity.real, self.gravity.imag))
-        return Evaluation(theta=theta, omega=omega, alpha=alpha, RA0=ne.RA0, RA3=ne.RA3,
-                          driving_torque=tau)
+        return Evaluation(theta=theta, omega=omega, alpha=alpha,
+                          ground={"A0": ne.RA0, "A3": ne.RA3}, driving_torque=tau)
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         """The crank angle, continuous along the motion (:meth:`continuous_crank`).

@@ -281,7 +281,7 @@ class MassMatrix(NodalTruss):
         inertia = self.m_global @ node_acc  # Eq. 52–53: rows A0 and A3 give M_r·ẍ
         ra0 = f[0] - complex(inertia[0], inertia[1]) + vectors[0] * lam[0]
         ra3 = f[3] - complex(inertia[6], inertia[7]) - vectors[2] * lam[2]
-        return Evaluation(theta=theta, omega=omega, alpha=alpha, RA0=ra0, RA3=ra3,
+        return Evaluation(theta=theta, omega=omega, alpha=alpha, ground={"A0": ra0, "A3": ra3},
                           driving_torque=tau)
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:

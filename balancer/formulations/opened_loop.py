@@ -202,8 +202,7 @@ class OpenedLoop(Formulation):
             theta=np.array(y[0:3]),
             omega=np.array(omega),
             alpha=alpha,
-            RA0=complex(ra0),
-            RA3=ra3,
+            ground={"A0": complex(ra0), "A3": ra3},
             driving_torque=tau,
         )
 

@@ -17,7 +17,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from .structure import GROUND_INDEX, Group, Pin, Pose, Prism, Structure, constraint_jacobian
+from .structure import Group, Pose, Structure, constraint_jacobian, constraint_residual
 from .vectors import V
 
 #: Steps of the continuation table over one revolution.
@@ -27,20 +27,7 @@ MAX_ITERATIONS = 30
 
 
 def _residual(g: Group, pose: Pose) -> list:
-    out = []
-    for c in g.constraints:
-        if isinstance(c, Pin):
-            d = pose.point(c.a, c.pa) - pose.point(c.b, c.pb)
-            out += [d.x, d.y]
-        elif isinstance(c, Prism):
-            ta = 0.0 if c.s == GROUND_INDEX else pose.angles[c.s]
-            tg = 0.0 if c.g == GROUND_INDEX else pose.angles[c.g]
-            d = pose.rotate(c.g, c.dg)
-            line = d.cross(pose.point(c.s, c.ps) - pose.point(c.g, c.pg))
-            out += [ta - tg - c.delta, line]
-        else:  # pragma: no cover - the driver is never in a numeric group
-            raise TypeError(c)
-    return out
+    return [r for c in g.constraints for r in constraint_residual(c, pose)]
 
 
 def _set(pose: Pose, g: Group, q: NDArray[np.float64]) -> None:

@@ -31,6 +31,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -476,6 +477,22 @@ class Pose:
 def _pose_of(q: NDArray[np.float64]) -> Pose:
     n = q.size // 3
     return Pose([V(q[3 * k], q[3 * k + 1]) for k in range(n)], [q[3 * k + 2] for k in range(n)])
+
+
+def constraint_residual(c: Constraint, pose: Pose, angle: Any = 0.0) -> list:
+    """The residual of one constraint at a pose: ``c.rows`` values (m or rad).
+
+    ``angle`` is the crank angle a driver prescribes.
+    """
+    if isinstance(c, Pin):
+        d = pose.point(c.a, c.pa) - pose.point(c.b, c.pb)
+        return [d.x, d.y]
+    if isinstance(c, Prism):
+        ts = 0.0 if c.s == GROUND_INDEX else pose.angles[c.s]
+        tg = 0.0 if c.g == GROUND_INDEX else pose.angles[c.g]
+        d = pose.rotate(c.g, c.dg)
+        return [ts - tg - c.delta, d.cross(pose.point(c.s, c.ps) - pose.point(c.g, c.pg))]
+    return [pose.angles[c.link] - angle]
 
 
 def constraint_jacobian(c: Constraint, pose: Pose):

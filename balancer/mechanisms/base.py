@@ -33,6 +33,9 @@ from ..linkage.structure import GROUND_INDEX, Structure
 from ..linkage.vectors import V
 from ..model import GROUND, Link, Linkage
 
+#: The formulation of the equations of motion that applies to every linkage.
+MULTIBODY: dict[str, tuple[str, str]] = {
+    "multibody": ("balancer.formulations.multibody", "Multibody")}
 #: Least normalised assembly gap of a dyad over a revolution for the crank to turn fully: at
 #: or below it the dyad reaches a dead point (its links in line) within rounding.
 GAP_TOLERANCE = 1e-12
@@ -69,7 +72,15 @@ class Mechanism(ABC):
     #: Formulations of the equations of motion: name → (module, class); the default first.
     formulations: ClassVar[dict[str, tuple[str, str]]] = {}
     #: The formulation a check by simulation uses: one the optimiser's route does not share.
-    verify_method: ClassVar[str] = ""
+    verify_method: ClassVar[str] = "multibody"
+    #: The spec key that holds the geometry (named by errors about it).
+    geometry_key: ClassVar[str] = "mechanism.points"
+    #: Whether ``simulate --json`` gives the link states keyed by link name (a general
+    #: linkage) or as lists of links 1–3 (the four-bar and slider-crank, fixed by DESIGN.md).
+    named_states: ClassVar[bool] = True
+    #: Sliders on ground guides whose force on the guide tables name as a force at a point
+    #: (``R{name}x``, ``R{name}y``) rather than by its normal force ``N_{link}``.
+    guide_force_names: ClassVar[dict[str, str]] = {}
 
     def __init__(self, model) -> None:
         self.model = model
@@ -121,6 +132,41 @@ class Mechanism(ABC):
         """The driven link."""
         return self.linkage.input
 
+    def guide_normals(self) -> dict[str, complex]:
+        """Unit normal of each ground guide (its direction turned by +90°), by sliding link.
+
+        The direction in which a positive normal force acts.
+        """
+        out = {}
+        for s in self.linkage.sliders:
+            if s.guide == GROUND:
+                d = complex(*s.direction)
+                out[s.link] = 1j * d / abs(d)
+        return out
+
+    @cached_property
+    def ground_positions(self) -> dict[str, complex]:
+        """Place of each ground point, complex ``x + i·y``, m."""
+        places = dict(self.linkage.points)
+        return {p: complex(*places[p]) for p in self.ground_points}
+
+    @property
+    def start_angle(self) -> float:
+        """Crank angle at which a simulation starts when the spec gives none, rad.
+
+        The reference pose's.
+        """
+        return float(self.structure.ref_angle[self.structure.input])
+
+    @property
+    def formulation_table(self) -> dict[str, tuple[str, str]]:
+        """Every formulation of the equations of motion that applies: name → (module, class).
+
+        The mechanism's own (the default first), then the general multibody formulation
+        (:mod:`balancer.formulations.multibody`), which applies to any linkage.
+        """
+        return {**self.formulations, **MULTIBODY}
+
     def parameters(self) -> NDArray[np.float64]:
         """The design vector of the mechanism's own links (:attr:`layout`)."""
         return self.layout.vector(self.linkage)
@@ -155,7 +201,7 @@ class Mechanism(ABC):
             raise AssemblyError(
                 f"{purpose} needs a crank that turns a full revolution{self._full_turn_rule()}, "
                 f"but this {self.kind} assembles only for θ1 in {rng.describe()}",
-                key="mechanism.lengths" if self.kind != "linkage" else "mechanism.points")
+                key=self.geometry_key)
         return rng
 
     def _full_turn_rule(self) -> str:

@@ -65,6 +65,10 @@ class FourBarMechanism(Mechanism):
         "lie-group": ("balancer.formulations.lie_group", "LieGroup"),
     }
     verify_method = "opened-loop"
+    geometry_key = "mechanism.lengths"
+    named_states = False
+    #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.
+    start_angle = 0.0
 
     @cached_property
     def linkage(self) -> Linkage:

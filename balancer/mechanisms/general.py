@@ -9,5 +9,4 @@ class LinkageMechanism(Mechanism):
     """Any planar linkage with one degree of freedom (``type = "linkage"``)."""
 
     kind = "linkage"
-    formulations = {}
-    verify_method = ""
+    formulations = {}  # the general multibody formulation only (Mechanism.formulation_table)

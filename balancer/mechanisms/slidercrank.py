@@ -58,6 +58,12 @@ class SliderCrankMechanism(Mechanism):
         "complex-masses": ("balancer.slider_crank.formulations", "SliderComplexMasses"),
     }
     verify_method = "complex-masses"
+    geometry_key = "mechanism.lengths"
+    named_states = False
+    #: The guide's force as the four-bar's R̄A3 (DESIGN.md's fixed CSV columns).
+    guide_force_names = {"slider": "A3"}
+    #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.
+    start_angle = 0.0
 
     @cached_property
     def linkage(self) -> Linkage:
@@ -98,10 +104,8 @@ class SliderCrankMechanism(Mechanism):
 
         return Forces(
             reactions={"A0": V(col(np.real(r.RA0)), col(np.imag(r.RA0)))},
-            # the normal force on the guide acts on the line x = guide_line: at the pin it is
-            # the same force and the couple (x_line − x_pin)·N
             slider_normal={"slider": col(np.imag(r.RA3))},
-            slider_couple={"slider": col((r.guide_line - np.real(smo.A2)) * np.imag(r.RA3))},
+            slider_couple={"slider": col(r.guide_couple)},
             driving_torque=col(r.driving_torque),
             shaking_force=V(col(np.real(r.shaking_force)), col(np.imag(r.shaking_force))),
             shaking_moment=col(r.shaking_moment))

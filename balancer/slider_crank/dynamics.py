@@ -30,7 +30,6 @@ from numpy.typing import NDArray
 from ..inverse import CycleAnalysis, Reactions, Regressors, dynamic_link, sample_angles
 from ..kinematics import cross
 from ..massmodels import equivalent_inertia_forces, equivalent_joint_forces, inertial_parameters
-from ..mechanisms import require_full_revolution
 from ..model import Link, SliderCrank
 from .kinematics import SliderMotion, motion_of
 
@@ -53,10 +52,8 @@ def _finish(mech, mo, ra0, n_guide, m_guide, tau, gas, shaking, alpha1) -> React
     moment = -mo.x * n_guide - m_guide + h * gas - tau
     if mech.crank.counter_rotor:
         moment = moment + 2 * mech.crank.counter_rotor * alpha1
-    with np.errstate(divide="ignore", invalid="ignore"):
-        line = np.where(n_guide != 0, mo.x + m_guide / n_guide, np.nan)
     return Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment,
-                     shaking_force=shaking, guide_line=line)
+                     shaking_force=shaking, guide_couple=-m_guide + 0 * mo.x)
 
 
 def newton_euler(
@@ -162,7 +159,7 @@ def mass_matrix(
     reactions = _finish(mech, mo, ra0, n_guide, m_guide, tau, gas, shaking, mo.alpha[0])
     return Reactions(RA0=reactions.RA0, RA3=reactions.RA3, driving_torque=tau,
                      shaking_moment=moment, shaking_force=shaking,
-                     guide_line=reactions.guide_line)
+                     guide_couple=reactions.guide_couple)
 
 
 ROUTES = {"newton-euler": newton_euler, "mass-matrix": mass_matrix}
@@ -237,7 +234,9 @@ def cycle_analysis(
     AssemblyError
         If the crank cannot turn a full revolution (``r + |e| > L``).
     """
-    require_full_revolution(mech, "a cycle analysis")
+    from ..mechanisms import mechanism_of
+
+    mechanism_of(mech).require_full_revolution("a cycle analysis")
     angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
     mo = motion_of(mech, angles, speed, 0.0)
     reactions = inverse_dynamics(mech, mo, route=route, loads=loads)

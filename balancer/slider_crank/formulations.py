@@ -61,7 +61,7 @@ class _SliderFormulation(Formulation):
     def motion_of(self, theta1, omega1=0.0, alpha1=0.0):
         return motion(self.lengths, theta1, omega1, alpha1, self.sign0, check=False)
 
-    def energy(self, theta, omega, alpha, slider=None):
+    def energy(self, theta, omega, alpha, slider=None, states=None):
         """Kinetic energy and the work of the loads and gravity since the start, J."""
         mo = self.motion_of(theta[0], omega[0], alpha[0])
         kin = kinetic_energy(self.linkage, mo)
@@ -88,8 +88,9 @@ class _SliderFormulation(Formulation):
             theta=theta,
             omega=np.array([mo.omega[0], mo.omega[1], 0.0 * mo.theta1]),
             alpha=np.array([mo.alpha[0], mo.alpha[1], 0.0 * mo.theta1]),
-            RA0=ne.RA0,
-            RA3=ne.RA3,
+            ground={"A0": ne.RA0},
+            slider_normal={"slider": np.imag(ne.RA3)},
+            slider_couple={"slider": ne.guide_couple},
             driving_torque=driving_torque,
             shaking_force=ne.shaking_force,
             shaking_moment=ne.shaking_moment,
@@ -290,8 +291,9 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):
             theta=np.array([theta1, math.atan2(v2.imag, v2.real), 0.0]),
             omega=np.array([omega[0], omega[1], 0.0]),
             alpha=np.array([alpha[0], alpha[1], 0.0]),
-            RA0=ra0,
-            RA3=-1j * n_guide,
+            ground={"A0": ra0},
+            slider_normal={"slider": -n_guide},
+            slider_couple={"slider": -m_guide},
             driving_torque=tau,
             shaking_force=ra0 - 1j * n_guide - gas,
             shaking_moment=moment,

@@ -1,0 +1,474 @@
+"""Forward dynamics of any linkage: absolute coordinates, constraints and multipliers.
+
+The generalisation of the paper's truss formulation (Meijaard & van der Wijk 2020, Sect. 4.2 and
+5.1) to any pin-jointed linkage with prismatic pairs and springs (Nikravesh 1988, ch. 11): each
+moving link has coordinates ``q_k = (x_k, y_k, θ_k)`` (its frame's origin and angle, as in
+:mod:`balancer.linkage.structure`), and the equations of motion are, with the constraints'
+Jacobian ``Φ_q`` (joints, and with the crank driven the driver ``θ_input − θ1(t) = 0``) and
+their multipliers ``λ``::
+
+    M(q)·q̈ + Φ_qᵀ·λ = Q(q, q̇),        Φ_q·q̈ = γ(q, q̇)
+
+Per link, with ``S̄ = R(θ)·(m·s̄)`` its first moment about the frame's origin and ``J_O`` its
+inertia about it (a counter-rotor's added)::
+
+    M_k = [[m, 0, −S_y], [0, m, S_x], [−S_y, S_x, J_O]]
+    Q_k = [m·ḡ + F̄ + ω²·S̄,  S̄ × ḡ + (R·s̄) × F̄ + M]  + springs, slider forces
+
+(``ω²·S̄`` is what is left of the inertia force's velocity terms). The multipliers give every
+joint's force; a constraint's generalized force on the ground (the ground as a link at rest)
+is the force and moment the mechanism exerts on the frame, the driver's the motor's reaction.
+The state ``(q, q̇)`` is not minimal: after each step it is projected back onto the
+constraints and their derivative. It passes dead points of the crank.
+
+The matrices are CasADi expressions of ``(q, q̇)`` built once (the constraints' equations are
+:mod:`balancer.linkage.structure`'s and :mod:`balancer.linkage.kinematics`'s, evaluated on
+symbols) and compiled into one function; the linear system is solved with numpy.
+"""
+
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from ..linkage.kinematics import _gamma
+from ..linkage.structure import (
+    GROUND_INDEX,
+    Driver,
+    Pin,
+    Pose,
+    Prism,
+    constraint_jacobian,
+    constraint_residual,
+)
+from ..linkage.vectors import Ops, V
+from ..mechanisms import mechanism_of
+from . import Evaluation, Formulation
+
+
+class _CasadiOps(Ops):
+    """The elementary functions of :class:`balancer.linkage.vectors.Ops` for CasADi symbols."""
+
+    sqrt = staticmethod(ca.sqrt)
+    sin = staticmethod(ca.sin)
+    cos = staticmethod(ca.cos)
+    atan2 = staticmethod(ca.atan2)
+
+    @staticmethod
+    def where(condition, a, b):
+        return ca.if_else(condition, a, b)
+
+
+class _Compiled:
+    """A CasADi function of one dense vector to one dense vector, called through its buffers.
+
+    CasADi's buffer interface evaluates in about a microsecond; its Python call converts every
+    argument to and from a DM, a hundred times slower, which would dominate the integration.
+    """
+
+    def __init__(self, fn: ca.Function) -> None:
+        self.fn = fn
+        self.arg = np.zeros(fn.size1_in(0))
+        self.res = np.zeros(fn.size1_out(0))
+        self._buffer, self._eval = fn.buffer()
+        self._buffer.set_arg(0, memoryview(self.arg))
+        self._buffer.set_res(0, memoryview(self.res))
+
+    def __call__(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        self.arg[:] = x
+        self._eval()
+        return self.res.copy()
+
+
+class Multibody(Formulation):
+    """Absolute coordinates with the constraints' multipliers (any linkage)."""
+
+    name = "multibody"
+    minimal = False
+    passes_dead_points = True
+
+    def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
+                 speed: float | None = None) -> None:
+        self.linkage = linkage
+        self.gravity = complex(*gravity)
+        self.speed = speed
+        self.mech = mechanism_of(linkage)
+        #: The mechanism as a general linkage (springs, sliders, ground points).
+        self.general = self.mech.linkage
+        self.structure = s = self.mech.structure
+        self.n = s.size
+        self.rotating_links = self.n
+        self.links = self.mech.links
+        self.mass = tuple(link.mass for link in self.links)
+        self.total_mass = sum(self.mass)
+        self.theta1_start = s.ref_angle[s.input]
+        self.sign0 = 1.0
+        self.constraints = [*s.constraints, *([s.driver] if self.driven else [])]
+        self.rows = sum(c.rows for c in self.constraints)
+        self.scale = s.length_scale()
+        self._build()
+
+    # -- the compiled equations ---------------------------------------------------------------
+
+    def _pose(self, q, ops) -> Pose:
+        n = self.n
+        angles = [q[3 * k + 2] for k in range(n)]
+        return Pose([V(q[3 * k], q[3 * k + 1]) for k in range(n)], angles,
+                    [ops.cos(t) for t in angles], [ops.sin(t) for t in angles])
+
+    def _build(self) -> None:
+        n, s = self.n, self.structure
+        q = ca.SX.sym("q", 3 * n)
+        qd = ca.SX.sym("qd", 3 * n)
+        gas = ca.SX.sym("gas", max(1, len(s.prisms)))
+        pose = self._pose(q, _CasadiOps)
+        vel = [V(qd[3 * k], qd[3 * k + 1]) for k in range(n)]
+        rate = [qd[3 * k + 2] for k in range(n)]
+        g = V(self.gravity.real, self.gravity.imag)
+        mass = ca.SX.zeros(3 * n, 3 * n)
+        force = ca.SX.zeros(3 * n)
+        for k, link in enumerate(self.links):
+            first = V(link.mass * link.e, link.mass * link.f).rotated(pose.cos[k], pose.sin[k])
+            j_origin = link.inertia + link.mass * (link.e**2 + link.f**2) + link.counter_rotor
+            i = 3 * k
+            mass[i, i] = mass[i + 1, i + 1] = link.mass
+            mass[i, i + 2] = mass[i + 2, i] = -first.y
+            mass[i + 1, i + 2] = mass[i + 2, i + 1] = first.x
+            mass[i + 2, i + 2] = j_origin
+            w2 = rate[k] * rate[k]
+            fx = link.mass * g.x + link.force[0] + w2 * first.x
+            fy = link.mass * g.y + link.force[1] + w2 * first.y
+            arm = V(link.e, link.f).rotated(pose.cos[k], pose.sin[k])
+            moment = first.cross(g) + arm.cross(V(*link.force)) + link.moment
+            force[i] += fx
+            force[i + 1] += fy
+            force[i + 2] += moment
+        for spring in self.general.springs:
+            for k, f_vec, at in self._spring_forces(spring, pose, _CasadiOps):
+                if k != GROUND_INDEX:
+                    arm = at - pose.origin(k)
+                    force[3 * k] += f_vec.x
+                    force[3 * k + 1] += f_vec.y
+                    force[3 * k + 2] += arm.cross(f_vec)
+        for j, c in enumerate(s.prisms):
+            d = pose.rotate(c.g, c.dg)
+            at = pose.point(c.s, c.ps)
+            for k, sign in ((c.s, 1.0), (c.g, -1.0)):
+                if k != GROUND_INDEX:
+                    f_vec = d * (sign * gas[j])
+                    arm = at - pose.origin(k)
+                    force[3 * k] += f_vec.x
+                    force[3 * k + 1] += f_vec.y
+                    force[3 * k + 2] += arm.cross(f_vec)
+        jac = ca.SX.zeros(self.rows, 3 * n)
+        gamma = ca.SX.zeros(self.rows)
+        row = 0
+        for c in self.constraints:
+            for link, coeffs in constraint_jacobian(c, pose):
+                if link == GROUND_INDEX:
+                    continue
+                for r in range(c.rows):
+                    for col in range(3):
+                        jac[row + r, 3 * link + col] += coeffs[r][col]
+            if not isinstance(c, Driver):
+                gam = _gamma(c, pose, vel, rate, _CasadiOps)
+                for r in range(c.rows):
+                    gamma[row + r] = gam[r]
+            row += c.rows
+        self._equations = ca.Function("equations", [q, qd, gas], [mass, force, jac, gamma])
+        self._build_frame(q, qd, gas, pose)
+        self._build_dynamics()
+        self._build_constraints(q, pose)
+
+    def _build_frame(self, q, qd, gas, pose: Pose) -> None:
+        """The forces on the frame from a state, its accelerations and multipliers (SX).
+
+        A constraint's generalized force on the ground (the ground as a link at rest) is
+        ``−Φ_gᵀ·λ``: the force and moment the mechanism exerts on the frame there.
+        """
+        n, s = self.n, self.structure
+        lam = ca.SX.sym("lam", self.rows)
+        acc = ca.SX.sym("acc", 3 * n)
+        ground = {p: [0, 0] for p in self.general.ground.points}
+        normal, couple = [], []
+        fx = fy = mz = ca.SX(0)
+        row = 0
+        for c in self.constraints:
+            for link, coeffs in constraint_jacobian(c, pose):
+                if link != GROUND_INDEX:
+                    continue
+                gen = [-sum(coeffs[r][col] * lam[row + r] for r in range(c.rows))
+                       for col in range(3)]
+                fx, fy, mz = fx + gen[0], fy + gen[1], mz + gen[2]
+                if isinstance(c, Pin):
+                    ground[c.point] = [ground[c.point][0] + gen[0], ground[c.point][1] + gen[1]]
+                elif isinstance(c, Prism):
+                    normal.append(lam[row + 1])
+                    couple.append(lam[row])
+            row += c.rows
+        for spring in self.general.springs:
+            for k, f_vec, at in self._spring_forces(spring, pose, _CasadiOps):
+                if k == GROUND_INDEX:
+                    fx, fy, mz = fx + f_vec.x, fy + f_vec.y, mz + at.cross(f_vec)
+        for j, c in enumerate(s.prisms):
+            if c.g == GROUND_INDEX:
+                f_vec = pose.rotate(c.g, c.dg) * (-gas[j])
+                at = pose.point(c.s, c.ps)
+                fx, fy, mz = fx + f_vec.x, fy + f_vec.y, mz + at.cross(f_vec)
+        for k, link in enumerate(self.links):
+            if link.counter_rotor:
+                mz = mz + 2 * link.counter_rotor * acc[3 * k + 2]
+        torque = -lam[-1] if self.driven else ca.SX(0)  # the driver's multiplier
+        #: Names of the outputs of :attr:`_frame` and of the dynamics after ``q̈`` and ``λ``.
+        self._ground_names = tuple(ground)
+        self._slider_names = tuple(s.names[c.s] for c in s.prisms if c.g == GROUND_INDEX)
+        flat = [x for p in ground for x in ground[p]]
+        self._frame = ca.Function("frame", [q, qd, gas, lam, acc], [
+            ca.vertcat(*flat) if flat else ca.SX(0, 1),
+            ca.vertcat(*normal) if normal else ca.SX(0, 1),
+            ca.vertcat(*couple) if couple else ca.SX(0, 1),
+            ca.vertcat(fx, fy, mz, torque)])
+
+    def _build_dynamics(self) -> None:
+        """One function from a state to ``q̈``, ``λ`` and the forces on the frame (MX).
+
+        The saddle-point system ``[[M, Φ_qᵀ], [Φ_q, 0]]·[q̈; λ] = [Q; γ]`` is solved by
+        CasADi's QR at each call: one compiled call per right-hand side.
+        """
+        k = 3 * self.n
+        q = ca.MX.sym("q", k)
+        qd = ca.MX.sym("qd", k)
+        gas = ca.MX.sym("gas", max(1, len(self.structure.prisms)))
+        mass, force, jac, gamma = self._equations(q, qd, gas)
+        kkt = ca.blockcat([[mass, jac.T], [jac, ca.MX(self.rows, self.rows)]])
+        z = ca.solve(kkt, ca.vertcat(force, gamma), "qr")
+        acc, lam = z[:k], z[k:]
+        outputs = [acc, lam, *self._frame(q, qd, gas, lam, acc)]
+        self._dynamics = ca.Function("dynamics", [q, qd, gas], outputs)
+        #: Where each output sits in the flat vector of :attr:`_fast_dynamics`.
+        sizes = np.cumsum([0, *(o.size1() for o in outputs)])
+        self._slices = [slice(a, b) for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
+        flat = ca.vertcat(q, qd, gas)
+        self._fast_dynamics = _Compiled(ca.Function(
+            "dynamics_flat", [flat], [ca.densify(ca.vertcat(*self._dynamics(
+                flat[:k], flat[k : 2 * k], flat[2 * k :])))]))
+
+    def _build_constraints(self, q, pose: Pose) -> None:
+        """The constraints' residual and Jacobian at a pose and a prescribed crank angle (SX)."""
+        angle = ca.SX.sym("angle")
+        phi = ca.vertcat(*(r for c in self.constraints
+                           for r in constraint_residual(c, pose, angle)))
+        jac = ca.densify(ca.jacobian(phi, q))
+        self._constraints = _Compiled(ca.Function(
+            "constraints", [ca.vertcat(q, angle)],
+            [ca.vertcat(phi, ca.reshape(jac, -1, 1))]))
+
+    def _spring_forces(self, spring, pose: Pose, ops):
+        """The spring's forces on its two carriers: ``(link, force, point)`` twice."""
+        out = []
+        ends = []
+        for p in spring.points:
+            links = self.structure.point_links[p]
+            k = GROUND_INDEX if GROUND_INDEX in links else links[0]
+            ends.append((k, pose.point(k, self.structure.local[(k, p)])))
+        (ka, a), (kb, b) = ends
+        d = b - a
+        length = ops.sqrt(d.norm2())
+        tension = spring.stiffness * (length - spring.free_length)
+        unit = d / length
+        out.append((ka, unit * tension, a))
+        out.append((kb, unit * (-tension), b))
+        return out
+
+    def _gas(self, theta1: float) -> NDArray[np.float64]:
+        s = self.structure
+        values = [float(self.general.sliders[c.slider].force.at(theta1)) for c in s.prisms]
+        return np.array(values if values else [0.0])
+
+    def _call(self, t: float, y: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+        """The compiled dynamics at a state: ``q̈``, ``λ``, then the forces on the frame."""
+        k = 3 * self.n
+        flat = self._fast_dynamics(np.concatenate([y[: 2 * k], self._gas(self.theta1_of(t, y))]))
+        return [flat[s] for s in self._slices]
+
+    # -- the formulation's interface ----------------------------------------------------------
+
+    def assembly_range(self):
+        return self.mech.assembly_range()
+
+    def change_points(self) -> tuple[float, ...]:
+        return ()
+
+    def transmission_of_crank(self, theta1: float) -> float:
+        from ..mechanisms.base import _gaps
+
+        return math.sqrt(max(float(_gaps(self.structure, np.array([theta1]))[0]), 0.0))
+
+    def transmission(self, t: float, y: NDArray[np.float64]) -> float:
+        return 1.0  # passes dead points: never stops for one
+
+    def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
+        if self.driven:
+            return self.crank_angle(t)
+        return float(y[3 * self.structure.input + 2])
+
+    def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
+        self.theta1_start = float(theta1)
+        if self.driven:
+            omega1 = float(self.speed)  # type: ignore[arg-type]
+        mo = self.mech.motion(theta1, omega1, 0.0)
+
+        def first(x) -> float:
+            return float(np.ravel(x)[0])
+
+        q, qd = np.empty(3 * self.n), np.empty(3 * self.n)
+        for k in range(self.n):
+            q[3 * k : 3 * k + 3] = (first(mo.pose.origins[k].x), first(mo.pose.origins[k].y),
+                                    first(mo.pose.angles[k]))
+            qd[3 * k : 3 * k + 3] = (first(mo.velocity[k].x), first(mo.velocity[k].y),
+                                     first(mo.rate[k]))
+        if not np.all(np.isfinite(q)):
+            from ..errors import AssemblyError
+
+            raise AssemblyError("the linkage cannot be assembled at the initial crank angle",
+                                key="simulation.theta1", value=theta1)
+        q[3 * self.structure.input + 2] = theta1  # the input's angle as given (continuous)
+        y = np.concatenate([q, qd])
+        return np.append(y, 0.0) if self.driven else y
+
+    def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        k = 3 * self.n
+        acc, _, _, _, _, frame = self._call(t, y)
+        dy = np.concatenate([y[k : 2 * k], acc])
+        if self.driven:
+            return np.append(dy, frame[3] * float(self.speed))  # type: ignore[arg-type]
+        return dy
+
+    def _constraint_values(self, t: float, q: NDArray[np.float64]):
+        """Residual and Jacobian of the constraints (the driver's at time ``t``)."""
+        angle = self.crank_angle(t) if self.driven else 0.0
+        out = self._constraints(np.append(q, angle))
+        rows = self.rows
+        return out[:rows], out[rows:].reshape(3 * self.n, rows).T  # column-major
+
+    def _velocity_rhs(self) -> NDArray[np.float64]:
+        out = np.zeros(self.rows)
+        if self.driven:
+            out[-1] = float(self.speed)  # type: ignore[arg-type]
+        return out
+
+    def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Least-norm Newton steps onto the constraints, then onto their derivative."""
+        y = np.array(y, dtype=float)
+        n = 3 * self.n
+        q = y[:n]
+        for _ in range(6):
+            res, jac = self._constraint_values(t, q)
+            if np.max(np.abs(res), initial=0.0) <= 1e-15 * self.scale:
+                break
+            q = q - np.linalg.lstsq(jac, res, rcond=None)[0]
+        else:
+            _, jac = self._constraint_values(t, q)
+        qd = y[n : 2 * n]
+        qd = qd - np.linalg.lstsq(jac, jac @ qd - self._velocity_rhs(), rcond=None)[0]
+        y[:n], y[n : 2 * n] = q, qd
+        return y
+
+    def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
+        n = 3 * self.n
+        q, qd = y[:n], y[n : 2 * n]
+        res, jac = self._constraint_values(t, q)
+        pos = float(np.max(np.abs(res), initial=0.0))
+        vel = float(np.max(np.abs(jac @ qd - self._velocity_rhs()), initial=0.0))
+        return pos, vel
+
+    def extra_power(self, t: float, y: NDArray[np.float64]) -> float:
+        """The slider forces' power: each force times the sliding velocity along its guide, W."""
+        if not self.structure.prisms:
+            return 0.0
+        n = self.n
+        q, qd = y[: 3 * n], y[3 * n : 6 * n]
+        gas = self._gas(self.theta1_of(t, y))
+        if not np.any(gas):
+            return 0.0
+        pose = self._pose(q, np)
+        total = 0.0
+        for j, c in enumerate(self.structure.prisms):
+            d = pose.rotate(c.g, c.dg)
+            at = pose.point(c.s, c.ps)
+            rel = self._point_velocity(pose, qd, c.s, at) - self._point_velocity(pose, qd, c.g,
+                                                                                 at)
+            total += gas[j] * d.dot(rel)
+        return float(total)
+
+    @staticmethod
+    def _point_velocity(pose: Pose, qd, k: int, at: V) -> V:
+        if k == GROUND_INDEX:
+            return V(0.0, 0.0)
+        arm = at - pose.origin(k)
+        return V(qd[3 * k], qd[3 * k + 1]) + arm.perp() * qd[3 * k + 2]
+
+    def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
+        return self.evaluate_batch([t], [y]).at(0)
+
+    def evaluate_batch(self, times, states) -> Evaluation:
+        """The compiled dynamics mapped over the states (one call)."""
+        n = 3 * self.n
+        count = len(times)
+        ys = np.array(states, dtype=float).reshape(count, -1)
+        gas = np.array([self._gas(self.theta1_of(t, y)) for t, y in zip(times, ys, strict=True)])
+        out = self._dynamics.map(count).call([ca.DM(ys[:, :n].T), ca.DM(ys[:, n : 2 * n].T),
+                                              ca.DM(gas.T)])
+        acc, _, ground, normal, couple, frame = (np.asarray(x.full()) for x in out)
+        ground = ground.reshape(-1, count)
+        return Evaluation(
+            theta=ys[:, 2:n:3].T, omega=ys[:, n + 2 : 2 * n : 3].T, alpha=acc[2::3],
+            ground={p: ground[2 * i] + 1j * ground[2 * i + 1]
+                    for i, p in enumerate(self._ground_names)},
+            driving_torque=frame[3],
+            shaking_force=frame[0] + 1j * frame[1],
+            shaking_moment=frame[2],
+            slider_normal={name: normal[i] for i, name in enumerate(self._slider_names)},
+            slider_couple={name: couple[i] for i, name in enumerate(self._slider_names)})
+
+    def energy(self, theta, omega, alpha, slider=None, states=None):
+        """Kinetic energy and the work of loads, gravity and springs since the first state, J.
+
+        From the states themselves (``states``): ``T = q̇ᵀ·M·q̇/2``; the loads' and gravity's
+        work from the centres of mass' and the angles' displacements; the springs' from their
+        potential energy.
+        """
+        n = self.n
+        g = V(self.gravity.real, self.gravity.imag)
+        kin, work = [], []
+        start = None
+        for y in states:
+            q, qd = y[: 3 * n], y[3 * n : 6 * n]
+            mass, *_ = self._equations(q, qd, np.zeros(max(1, len(self.structure.prisms))))
+            kin.append(0.5 * float(qd @ np.array(mass) @ qd))
+            pose = self._pose(q, np)
+            value = 0.0
+            coms = [pose.point(k, V(link.e, link.f)) for k, link in enumerate(self.links)]
+            if start is None:
+                start = (coms, q.copy(), self._spring_energy(pose))
+            for k, link in enumerate(self.links):
+                dr = coms[k] - start[0][k]
+                value += (g * link.mass + V(*link.force)).dot(dr)
+                value += link.moment * (q[3 * k + 2] - start[1][3 * k + 2])
+            value -= self._spring_energy(pose) - start[2]
+            work.append(value)
+        return np.array(kin), np.array(work)
+
+    def _spring_energy(self, pose: Pose) -> float:
+        total = 0.0
+        for spring in self.general.springs:
+            (_, _, a), (_, _, b) = self._spring_forces(spring, pose, np)
+            length = math.sqrt((b - a).norm2())
+            total += 0.5 * spring.stiffness * (length - spring.free_length) ** 2
+        return total
+
+    def shaking(self, ev: Evaluation) -> tuple:
+        return ev.shaking_force, ev.shaking_moment

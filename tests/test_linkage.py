@@ -1,0 +1,94 @@
+"""General linkage specs: the four-bar and slider-crank written as ``type = "linkage"``."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balancer.cli import main
+from balancer.mechanisms import mechanism_of
+from balancer.model import Design
+from balancer.spec import dumps_design, load_design, loads_design
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+
+def _as_linkage(design: Design) -> Design:
+    """The same design with its mechanism written as a general linkage."""
+    general = mechanism_of(design.mechanism).linkage
+    return replace(design, mechanism=general, original=None, balance=None,
+                   simulation=replace(design.simulation, method=None))
+
+
+def _analyze(tmp_path, design: Design, name: str, capsys) -> dict:
+    path = tmp_path / name
+    path.write_text(dumps_design(design))
+    capsys.readouterr()
+    assert main(["analyze", str(path), "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+@pytest.mark.parametrize("example", ["meijaard2020.toml", "pb2.toml"])
+def test_a_four_bar_written_as_a_linkage_has_the_same_figures(tmp_path, capsys, example):
+    # Two routes to the same numbers: the four-bar's closed forms (Eq. 1–11) and the general
+    # core's loop equations, each rounding-exact: 1e-9 relative (DESIGN.md).
+    design = replace(load_design(EXAMPLES / example), original=None, balance=None)
+    four_bar = _analyze(tmp_path, design, "four.toml", capsys)
+    linkage = _analyze(tmp_path, _as_linkage(design), "linkage.toml", capsys)
+    for key in ("shaking_force", "shaking_moment", "driving_torque"):
+        for stat in ("rms", "max"):
+            assert linkage[key][stat] == pytest.approx(four_bar[key][stat], rel=1e-9), key
+    for point in ("A0", "A3"):
+        assert linkage["reactions"][point]["max"] == pytest.approx(
+            four_bar["reactions"][point]["max"], rel=1e-9)
+
+
+def test_a_slider_crank_written_as_a_linkage_has_the_same_figures(tmp_path, capsys):
+    design = load_design(EXAMPLES / "engine.toml")
+    model = design.mechanism.without_gas_force() if hasattr(
+        design.mechanism, "without_gas_force") else replace(
+        design.mechanism, gas_force=type(design.mechanism.gas_force)())
+    design = replace(design, mechanism=model, original=None, balance=None)
+    slider = _analyze(tmp_path, design, "slider.toml", capsys)
+    linkage = _analyze(tmp_path, _as_linkage(design), "linkage.toml", capsys)
+    for key in ("shaking_force", "shaking_moment", "driving_torque"):
+        assert linkage[key]["rms"] == pytest.approx(slider[key]["rms"], rel=1e-9), key
+    assert linkage["reactions"]["slider"]["max"] == pytest.approx(
+        slider["reactions"]["slider"]["max"], rel=1e-9)
+
+
+def test_a_linkage_design_round_trips_with_its_original(tmp_path):
+    from test_multibody import WATT
+
+    design = loads_design(WATT, "watt.toml")
+    mech = design.mechanism
+    original = mech.with_links({"crank": replace(mech.link("crank"), mass=3.5)})
+    design = replace(design, original=original)
+    again = loads_design(dumps_design(design), "again.toml")
+    assert again == design
+    assert again.original == original
+
+
+def test_a_simulated_linkage_agrees_with_its_four_bar():
+    # The same free motion by the paper's opened loop and by the general multibody
+    # formulation: two integrations, each within its tolerance, carried by the motion
+    # (helpers.growth: the motion's amplification of a step's error).
+    from helpers import growth
+
+    from balancer.simulate import simulate
+
+    design = load_design(EXAMPLES / "meijaard2020.toml")
+    settings = replace(design.simulation, duration=1.0)
+    tight = {"rtol": 1e-11, "atol": 1e-13}
+    ref = simulate(design.mechanism, settings, method="opened-loop", **tight)
+    run = simulate(_as_linkage(design).mechanism, settings, **tight)
+    assert run.method == "multibody"
+    amplified = growth(simulate, design.mechanism, settings, reference=ref,
+                       method="opened-loop", **tight)
+    for key in ("theta", "omega", "alpha"):
+        bound = amplified.bound(lambda r, key=key: getattr(r, key), ref, run)
+        assert np.max(np.abs(getattr(run, key) - getattr(ref, key))) < bound, key

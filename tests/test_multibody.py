@@ -1,0 +1,198 @@
+"""The multibody formulation (any linkage) against the seeds' formulations and physics."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from helpers import integration_bound, rel_err
+from test_formulations import _states as four_bar_states
+from test_slider_crank import CASES as SLIDER_CASES
+from test_slider_crank import _angles as slider_angles
+
+from balancer.formulations import make
+from balancer.mechanisms import mechanism_of
+from balancer.model import SimulationSettings
+from balancer.simulate import simulate
+from balancer.spec import loads_design
+
+#: A Watt six-bar with a ternary rocker, loads, a spring to the frame and a counter-rotor.
+WATT = """
+[mechanism]
+type = "linkage"
+input = "crank"
+[mechanism.points]
+A0 = [0.0, 0.0]
+A1 = [0.0, 1.0]
+A2 = [2.2, 1.8]
+A3 = [3.2, 0.0]
+B  = [1.4, 2.6]
+C  = [3.6, 3.4]
+D  = [5.0, 0.5]
+[links.ground]
+points = ["A0", "A3", "D"]
+[links.crank]
+points = ["A0", "A1"]
+mass = 2.0
+inertia = 0.5
+com = { e = 0.4, f = 0.1 }
+counter_rotor = 0.3
+[links.coupler]
+points = ["A1", "A2"]
+mass = 3.0
+inertia = 3.1
+com = { e = 1.4, f = 0.3 }
+force = [1.3, -1.4]
+moment = 0.28
+[links.rocker]
+points = ["A3", "A2", "B"]
+mass = 2.2
+inertia = 2.1
+com = { e = 1.0, f = 0.2 }
+[links.link5]
+points = ["B", "C"]
+mass = 1.0
+inertia = 0.4
+com = { e = 1.0, f = -0.1 }
+moment = -0.5
+[links.link6]
+points = ["D", "C"]
+mass = 1.2
+inertia = 0.6
+com = { e = 1.0, f = 0.0 }
+[[springs]]
+points = ["B", "D"]
+stiffness = 40.0
+free_length = 2.0
+[operation]
+speed = 6.0
+[simulation]
+duration = 1.0
+omega1 = 5.0
+gravity = [0.0, -9.81]
+"""
+
+
+def _watt():
+    return loads_design(WATT, "watt.toml")
+
+
+@pytest.mark.parametrize(("linkage", "theta1", "omega1", "gravity"), four_bar_states(41, 12))
+@pytest.mark.parametrize("driven", [False, True])
+def test_multibody_agrees_with_the_opened_loop_at_four_bar_states(linkage, theta1, omega1,
+                                                                  gravity, driven):
+    # One state, two formulations: DESIGN.md's 1e-9 relative. The states keep
+    # |sin(θ3 − θ2)| ≥ 0.05, which bounds the condition of both (≤ 20) — see
+    # test_formulations_agree_with_each_other_and_newton_euler.
+    speed = omega1 if driven else None
+    evals = []
+    for name in ("opened-loop", "multibody"):
+        f = make(name, linkage, gravity=gravity, speed=speed)
+        ev = f.evaluate(0.0, f.initial_state(theta1, omega1))
+        evals.append((ev, *f.shaking(ev)))
+    (ref, ref_force, ref_moment), (mb, mb_force, mb_moment) = evals
+    force = max(abs(ref.ground["A0"]), abs(ref.ground["A3"]), 1.0)
+    moment = max(force * max(linkage.lengths), abs(ref.driving_torque), 1.0)
+    acc = max(np.max(np.abs(ref.alpha)), omega1**2, 1.0)
+    assert rel_err(mb.omega, ref.omega, scale=max(1.0, abs(omega1))) < 1e-12
+    assert rel_err(mb.alpha, ref.alpha, scale=acc) < 1e-9
+    for point in ("A0", "A3"):
+        assert abs(mb.ground[point] - ref.ground[point]) < 1e-9 * force, point
+    assert abs(mb.driving_torque - ref.driving_torque) < 1e-9 * moment
+    assert abs(mb_force - ref_force) < 1e-9 * force
+    assert abs(mb_moment - ref_moment) < 1e-9 * moment
+
+
+@pytest.mark.parametrize("mech", SLIDER_CASES[:6])
+@pytest.mark.parametrize("driven", [False, True])
+def test_multibody_agrees_with_the_slider_crank_formulation(mech, driven):
+    # One state, two formulations (gas force, gravity, loads): 1e-9 relative; the states keep
+    # the rod clear of square to the guide (slider_angles), bounding the condition.
+    rng = np.random.default_rng(8)
+    g = (0.2, -9.81)
+    for t in slider_angles(rng, mech, 3):
+        w = rng.uniform(-5, 5)
+        evs = []
+        for name in ("complex-masses", "multibody"):
+            f = make(name, mech, gravity=g, speed=w if driven else None)
+            ev = f.evaluate(0.0, f.initial_state(t, w))
+            evs.append((ev, *f.shaking(ev)))
+        (ref, ref_force, ref_moment), (mb, mb_force, mb_moment) = evs
+        force = max(abs(ref.ground["A0"]), abs(ref.slider_normal["slider"]), 1.0)
+        arm = sum(map(abs, mech.lengths))
+        acc = max(np.max(np.abs(ref.alpha)), w * w, 1.0)
+        assert rel_err(mb.alpha[:2], ref.alpha[:2], scale=acc) < 1e-9
+        assert abs(mb.ground["A0"] - ref.ground["A0"]) < 1e-9 * force
+        assert abs(mb.slider_normal["slider"] - ref.slider_normal["slider"]) < 1e-9 * force
+        assert abs(mb.slider_couple["slider"] - ref.slider_couple["slider"]) < 1e-9 * force * arm
+        assert abs(mb.driving_torque - ref.driving_torque) < 1e-9 * force * arm
+        assert abs(mb_force - ref_force) < 1e-9 * force
+        assert abs(mb_moment - ref_moment) < 1e-9 * force * arm
+
+
+def test_a_free_six_bar_with_a_spring_and_gravity_keeps_its_energy():
+    design = _watt()
+    traj = simulate(design.mechanism, design.simulation, rtol=1e-10, atol=1e-12)
+    assert traj.method == "multibody"
+    assert np.ptp(traj.kinetic_energy) > 1.0  # the spring and gravity do work
+    # T − T0 − W is a first integral of the integrated system: its error is the integration's
+    # (integration_bound: 2·steps·rtol for a quantity quadratic in the rates).
+    assert traj.energy_error < 2 * integration_bound(traj)
+    # The projection keeps the constraints: its residual before projection is a step's error.
+    assert traj.drift[0] < 1e3 * traj.rtol * mechanism_of(design.mechanism).structure.length_scale()
+
+
+def test_a_driven_six_bar_has_the_cycle_analysis_reactions():
+    # Driven, the crank angle is exact and the other coordinates are projected onto the
+    # constraints at every output: the states are exact to rounding, so the multipliers must
+    # give the inverse dynamics of the prescribed motion (the general core's kinetostatics, a
+    # different route from the multipliers of M·q̈ + Φqᵀλ = Q) to 1e-9 relative.
+    design = _watt()
+    speed = 6.0
+    settings = SimulationSettings(duration=0.6, omega1=speed, drive="constant-speed",
+                                  gravity=(0.0, -9.81))
+    traj = simulate(design.mechanism, settings, rtol=1e-10, atol=1e-12, outputs=41)
+    mech = mechanism_of(design.mechanism)
+    crank = traj.links.index(mech.input)
+    mo = mech.motion(traj.theta[crank], speed, 0.0)
+    forces = mech.inverse_dynamics(mo, gravity=(0.0, -9.81))
+    force = traj.largest_reaction
+    moment = force * mech.structure.length_scale()
+    for point, values in traj.ground.items():
+        expected = forces.reactions[point].complex()[:, 0] if forces.reactions[point].x.ndim > 1 \
+            else forces.reactions[point].complex()
+        assert np.max(np.abs(values - expected)) < 1e-9 * force, point
+    torque = np.ravel(forces.driving_torque)
+    assert np.max(np.abs(traj.driving_torque - torque)) < 1e-9 * moment
+    assert np.max(np.abs(traj.shaking_moment - np.ravel(forces.shaking_moment))) < 1e-9 * moment
+    assert np.max(np.abs(traj.omega[crank] - speed)) < 1e-12 * speed
+    for k in range(len(traj.links)):
+        assert rel_err(traj.omega[k], np.ravel(mo.rate[k]), scale=speed) < 1e-9
+
+
+def test_the_six_bar_through_every_verb(tmp_path, capsys):
+    import json
+
+    from balancer.cli import main
+
+    spec = tmp_path / "watt.toml"
+    spec.write_text(WATT)
+    assert main(["simulate", str(spec), "--json", "--duration", "0.2"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert set(doc["initial"]["theta"]) == {"crank", "coupler", "rocker", "link5", "link6"}
+    assert set(doc["reactions"]) == {"A0", "A3", "D"}
+    out = tmp_path / "watt.csv"
+    assert main(["simulate", str(spec), "--out", str(out), "--duration", "0.2"]) == 0
+    header = out.read_text().splitlines()[0].split(",")
+    assert header == ["t", *(f"{q}{k}" for q in ("theta", "omega", "alpha") for k in range(1, 6)),
+                      "RA0x", "RA0y", "RA3x", "RA3y", "RDx", "RDy"]
+    capsys.readouterr()
+    assert main(["verify", str(spec), "--json", "--duration", "0.2",
+                 "--plot", str(tmp_path / "v.png")]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["method"] == "multibody"
+    assert (tmp_path / "v.png").stat().st_size > 0
+    assert math.isfinite(doc["max_shaking_force"])
+    assert main(["plot", str(spec), "--animate", str(tmp_path / "a.gif"), "--frames", "6"]) == 0
+    assert (tmp_path / "a.gif").stat().st_size > 0
