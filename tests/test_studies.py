@@ -248,8 +248,34 @@ def test_benchmarks_pb(quick):
     assert pb2["verified_moment_ratio"] < ratio
 
 
+def test_linkages(quick):
+    r = quick("linkages")
+    assert set(r["cases"]) == {"Watt six-bar", "Stephenson six-bar", "quick-return",
+                               "Jansen's leg"}
+    for name, case in r["cases"].items():
+        convex, nlp = case["convex"], case["nlp"]
+        assert convex.optimal and nlp.optimal, name
+        # Force balance is exact: the balance rows hold to rounding (1e-16) times their
+        # conditioning (≤ 1e4), so the total centre of mass stands still to 1e-12 of the size.
+        assert case["com_excursion_before"] > 1e-3
+        assert case["com_excursion_after"] < 1e-12, name
+        assert case["force_after"] < 1e-9 * case["force_before"], name
+        # The NLP from the convex optimum and from random starts reaches no lower objective
+        # than the certified lower bound (beyond the solvers' GAP_TOLERANCE of the scale).
+        floor = convex.lower_bound - GAP_TOLERANCE * convex.scale * 2 * math.sqrt(
+            convex.objective)
+        assert nlp.objective >= floor, name
+        starts = case["multistart"]
+        assert starts["converged"] >= 1, name
+        assert all(j >= floor for j in starts["objectives"]), name
+        # Simulated by the multibody formulation: the shaking force vanishes to 1e-9 of the
+        # reactions (DESIGN.md's agreement between formulations).
+        assert case["verification"].driven.force_level < 1e-9, name
+
+
 @pytest.mark.parametrize("name", ["meijaard2020_example", "meijaard2020_balanced",
-                                  "wunderlich1964", "bai2024_lie_group", "benchmarks_pb"])
+                                  "wunderlich1964", "bai2024_lie_group", "benchmarks_pb",
+                                  "linkages"])
 def test_study_is_a_script_with_run(name):
     module = load(name)
     assert module.NAME == name and callable(module.run)

@@ -26,7 +26,8 @@ Where a group cannot be assembled the positions are NaN (see :func:`assembly_gap
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -190,7 +191,8 @@ def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
     ops
         Elementary functions (numpy by default).
     gaps
-        If a list, receives each closed-form group's assembly gap (≥ 0 where it assembles).
+        If a list, receives each group's assembly gap (≥ 0 where it assembles; a numeric
+        group's: :func:`balancer.linkage.numeric.assembly_gap`).
 
     Returns
     -------
@@ -210,7 +212,7 @@ def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
         if g.kind == "numeric":
             from .numeric import solve_group
 
-            solve_group(structure, g, pose, theta1, ops)
+            solve_group(structure, g, pose, theta1, ops, gaps)
             continue
         solver = {"RRR": _Dyads.rrr, "RRP": _Dyads.rrp, "RPR": _Dyads.rpr}[g.kind]
         (ta, pa, la), (tb, pb, lb), gap = solver(ops, pose, g, g.sign)
@@ -235,6 +237,8 @@ class Motion:
         Each link's origin velocity (m/s) and angular velocity (rad/s).
     acceleration, accel
         Each link's origin acceleration (m/s²) and angular acceleration (rad/s²).
+    closed_form
+        The motion as a mechanism's closed form computed it (the four-bar's), or ``None``.
     """
 
     theta1: NDArray[np.float64]
@@ -245,6 +249,8 @@ class Motion:
     rate: tuple[NDArray[np.float64], ...]
     acceleration: tuple[V, ...]
     accel: tuple[NDArray[np.float64], ...]
+    #: The same motion in a mechanism's own closed form, when it made it (reused by its routes).
+    closed_form: Any = field(default=None, repr=False, compare=False)
 
     def point(self, k: int, local: V) -> V:
         """Position of a point of link ``k`` (``local`` in its frame), m."""

@@ -17,7 +17,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from .structure import Group, Pose, Structure, constraint_jacobian, constraint_residual
+from .structure import Group, Pose, Prism, Structure, constraint_jacobian, constraint_residual
 from .vectors import V
 
 #: Steps of the continuation table over one revolution.
@@ -131,8 +131,12 @@ def table(structure: Structure, g: Group) -> tuple[NDArray[np.float64], NDArray[
     return result
 
 
-def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops) -> None:
-    """Place the links of numeric group ``g`` in ``pose`` at crank angles ``theta1``."""
+def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops,
+                gaps: list | None = None) -> None:
+    """Place the links of numeric group ``g`` in ``pose`` at crank angles ``theta1``.
+
+    ``gaps``, if a list, receives the group's assembly gap (:func:`assembly_gap`).
+    """
     theta1 = np.atleast_1d(np.asarray(theta1, dtype=float))
     angles, tab = table(structure, g)
     start = angles[TABLE_STEPS]
@@ -153,3 +157,28 @@ def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops) -> None
     q, done = newton(g, pose, np.where(np.isfinite(guess), guess, 0.0), structure.length_scale())
     q[~(done & inside)] = np.nan
     _set(pose, g, q)
+    if gaps is not None:
+        gaps.append(assembly_gap(structure, g, pose, q.shape[0]))
+
+
+def assembly_gap(structure: Structure, g: Group, pose: Pose, n: int) -> NDArray[np.float64]:
+    """How far the group is from a singular pose: ``(σ_min/σ_max)²`` of its Jacobian.
+
+    The Jacobian of the group's constraints in its links' coordinates, made dimensionless
+    (angles times the linkage's length scale, angle rows likewise), so that it is 1 for a
+    well-conditioned group and 0 where two of its links align (a toggle, where the crank's
+    motion no longer fixes theirs) — the counterpart of the dyads' gap, a squared sine of a
+    transmission angle. NaN where the group is not placed.
+    """
+    scale = structure.length_scale()
+    jac = _jacobian(g, pose, n)
+    columns = np.tile([1.0, 1.0, 1.0 / scale], len(g.links))
+    rows = np.concatenate([[scale, 1.0] if isinstance(c, Prism) else [1.0] * c.rows
+                           for c in g.constraints])
+    scaled = rows[None, :, None] * jac * columns[None, None, :]
+    finite = np.all(np.isfinite(scaled), axis=(1, 2))
+    out = np.full(n, np.nan)
+    if finite.any():
+        sv = np.linalg.svd(scaled[finite], compute_uv=False)
+        out[finite] = (sv[:, -1] / sv[:, 0]) ** 2
+    return out

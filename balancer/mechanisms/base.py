@@ -283,7 +283,7 @@ class Mechanism(ABC):
 
 
 def _gaps(structure: Structure, theta1: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The least assembly gap of the closed-form groups at each angle.
+    """The least assembly gap of the groups at each angle.
 
     Where a link cannot be placed (a numeric group's Newton fails) the gap is −1.
     """
@@ -316,7 +316,8 @@ def _assembly_range(structure: Structure) -> AssemblyRange:
 
     # Refine each sampled minimum: a dip between samples must not hide a dead point.
     least = float(np.min(gap))
-    for i in np.flatnonzero((gap[1:-1] <= gap[:-2]) & (gap[1:-1] <= gap[2:])) + 1:
+    # (strict on one side: a flat stretch, as of a group whose gap does not change, is none)
+    for i in np.flatnonzero((gap[1:-1] < gap[:-2]) & (gap[1:-1] <= gap[2:])) + 1:
         res = minimize_scalar(at, bounds=(theta[i - 1], theta[i + 1]), method="bounded",
                               options={"xatol": 1e-10})
         least = min(least, float(res.fun))

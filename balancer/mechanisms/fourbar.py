@@ -112,12 +112,15 @@ class FourBarMechanism(Mechanism):
 
     def inverse_dynamics(self, mo: Motion, *, route: str | None = None, loads: bool = True,
                          gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
-        if (route or self.routes[0]) != "mass-matrix":
-            return super().inverse_dynamics(mo, route=route, loads=loads, gravity=gravity)
-        from ..inverse import mass_matrix
+        """The paper's routes in closed form (the general core checks them in the tests).
 
-        r = mass_matrix(self.model, fourbar_motion(self.model, mo), gravity=gravity,
-                        loads=loads)
+        Newton–Euler on the links' free bodies with the principal vectors (Eq. 12–28), or the
+        equivalent mass matrices (Eq. 45–54).
+        """
+        from ..inverse import mass_matrix, newton_euler
+
+        route_fn = mass_matrix if (route or self.routes[0]) == "mass-matrix" else newton_euler
+        r = route_fn(self.model, fourbar_motion(self.model, mo), gravity=gravity, loads=loads)
         def col(z):
             return np.asarray(z)[:, None]
 
@@ -144,10 +147,12 @@ def general_motion(mo: fourbar.Motion) -> Motion:
                   velocity=(V(zero, zero), V.of_array(va1), V.of_array(va2)),
                   rate=tuple(mo.omega),
                   acceleration=(V(zero, zero), V.of_array(aa1), V.of_array(aa2)),
-                  accel=tuple(mo.alpha))
+                  accel=tuple(mo.alpha), closed_form=mo)
 
 
 def fourbar_motion(model: FourBar, mo: Motion) -> fourbar.Motion:
     """A general motion of a four-bar as the closed form's (angles and rates)."""
+    if isinstance(mo.closed_form, fourbar.Motion):
+        return mo.closed_form
     return fourbar.motion_from_angles(model.lengths, tuple(mo.pose.angles), tuple(mo.rate),
                                       tuple(mo.accel))

@@ -1,0 +1,77 @@
+"""Benchmark: the general linkage core on the shipped six-bars, against issue 12's targets.
+
+Run on its own: ``python benchmarks/bench_linkage.py``. Each figure is the median (and best) of
+repeated in-process runs after one warm-up run (imports and the one-time compilation of the
+CasADi functions are not counted: they are paid once per process and mechanism).
+
+Targets (issue 12), per shipped six-bar:
+
+- cycle analysis at 10⁶ crank angles ≤ 1 s;
+- the certified balanced design (convex backend, global optimum and its lower bound) ≤ 0.1 s;
+- a 5 s simulation to 1e-9 (free motion, the multibody formulation, rtol 1e-10) ≤ 0.3 s.
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = ("watt_sixbar.toml", "stephenson_sixbar.toml")
+REPEATS = 5
+
+
+def _timed(fn) -> list[float]:
+    fn()  # warm-up: imports, compiled functions, caches of the mechanism's structure
+    out = []
+    for _ in range(REPEATS):
+        t = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t)
+    return out
+
+
+def main() -> None:
+    from balancer.balance.optimizer import optimize
+    from balancer.cycle import cycle_analysis
+    from balancer.simulate import simulate
+    from balancer.spec import load_design
+
+    rows = []
+    for name in EXAMPLES:
+        path = ROOT / "examples" / name
+        if not path.exists():
+            continue
+        design = load_design(path)
+        speed = design.operation.speed if design.operation else 10.0
+        free = replace(design.simulation, duration=5.0, drive="free",
+                       omega1=design.simulation.omega1 or speed)
+        cases = [
+            ("cycle analysis, 10^6 angles", 1.0,
+             lambda d=design, s=speed: cycle_analysis(d.mechanism, s, 10**6).summary),
+            ("certified balance (convex)", 0.1,
+             lambda d=design: optimize(d, "convex")),
+            ("5 s free simulation, rtol 1e-10", 0.3,
+             lambda d=design, f=free: simulate(d.mechanism, f, rtol=1e-10, atol=1e-12)),
+        ]
+        for label, target, fn in cases:
+            if "balance" in label and design.balance is None:
+                continue
+            secs = _timed(fn)
+            med = statistics.median(secs)
+            rows.append((name, label, med, min(secs), target, "yes" if med <= target else "NO"))
+    header = ("example", "measurement", "median s", "best s", "target s", "met")
+    cells = [[f"{c:.4f}" if isinstance(c, float) else str(c) for c in r] for r in rows]
+    widths = [max(len(h), *(len(r[i]) for r in cells)) for i, h in enumerate(header)]
+    print(f"median of {REPEATS} in-process runs after a warm-up; Python {sys.version.split()[0]}")
+    print("  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)))
+    print("  ".join("-" * w for w in widths))
+    for r in cells:
+        print("  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)))
+
+
+if __name__ == "__main__":
+    main()
