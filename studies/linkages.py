@@ -86,6 +86,14 @@ def multistart(design, starts: int, seed: int) -> dict:
             "best": min(objectives) if objectives else math.nan, "objectives": objectives}
 
 
+def _curve_or_point(ax, z, colour: str, label: str, still: float) -> None:
+    """A closed curve in the plane, or one marked point where it stays within ``still``."""
+    if np.ptp(z.real) + np.ptp(z.imag) < still:
+        ax.plot(z.real[:1], z.imag[:1], "o", color=colour, ms=8, label=f"{label}: stationary")
+    else:
+        ax.plot(z.real, z.imag, color=colour, lw=1.8, label=label)
+
+
 def figure(name: str, design, result) -> Figure:
     """The linkage with its centre-of-mass paths, and the shaking over a revolution."""
     fig = Figure(figsize=(12, 8), layout="constrained")
@@ -109,7 +117,8 @@ def figure(name: str, design, result) -> Figure:
                                  (result.linkage, "after (force-balanced)", COLOURS["after"])):
         m = mechanism_of(model)
         path = m.total_centre_of_mass(m.motion(theta))
-        ax.plot(path.real, path.imag, color=colour, lw=2, label=f"total centre of mass, {label}")
+        _curve_or_point(ax, path, colour, f"total centre of mass, {label}",
+                        1e-9 * m.structure.length_scale())
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_title(f"{name} at its reference pose")
     ax.legend(fontsize="small")
@@ -129,7 +138,8 @@ def figure(name: str, design, result) -> Figure:
     for cycle, label, colour in ((result.before, "before", COLOURS["before"]),
                                  (result.after, "after", SERIES[0])):
         force = cycle.reactions.shaking_force
-        ax.plot(force.real, force.imag, color=colour, lw=1.6, label=label)
+        _curve_or_point(ax, force, colour, label,
+                        1e-9 * np.max(np.abs(result.before.reactions.shaking_force)))
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("shaking force x (N)")
     ax.set_ylabel("shaking force y (N)")

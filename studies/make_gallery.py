@@ -27,12 +27,14 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 GALLERY = ROOT / "docs" / "gallery"
 STUDIES = ("meijaard2020_example", "meijaard2020_balanced", "wunderlich1964",
-           "bai2024_lie_group", "benchmarks_pb")
+           "bai2024_lie_group", "benchmarks_pb", "linkages")
 #: (study, figure it writes, name in the gallery).
 CHOSEN = (
     ("meijaard2020_balanced", "comparison.png", "balancing_four_designs.png"),
     ("wunderlich1964", "fig1_com_path.png", "wunderlich_com_path.png"),
     ("bai2024_lie_group", "fig7_parallelogram.png", "bai_parallelogram.png"),
+    ("linkages", "jansen_s_leg.png", "jansen_leg_balanced.png"),
+    ("linkages", "stephenson_six_bar.png", "stephenson_balanced.png"),
 )
 ANIMATION = "meijaard2020.gif"
 FRAMES = 48
