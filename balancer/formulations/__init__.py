@@ -1,4 +1,10 @@
-"""Forward dynamics of the four-bar in four formulations that must agree.
+"""Forward dynamics: formulations of the equations of motion that must agree.
+
+Every mechanism has the general ``multibody`` formulation (:mod:`.multibody`: absolute
+coordinates of every link with the constraints' multipliers, any linkage); the four-bar has the
+paper's four (below), the slider-crank two of its own (:mod:`balancer.slider_crank.formulations`);
+each mechanism names its own (:attr:`balancer.mechanisms.base.Mechanism.formulation_table`).
+The four-bar's:
 
 =================  ==================================================  =========================
 name               formulation                                         state
@@ -17,9 +23,10 @@ name               formulation                                         state
 =================  ==================================================  =========================
 
 Each is a :class:`Formulation`: it turns a state into its time derivative and evaluates the link
-angles, rates, accelerations and the ground reactions at a state. The crank either moves freely
-under the loads and gravity, or a motor on the ground holds it at constant speed; then the last
-state component is the motor's work ``∫τ·θ̇1 dt`` and the driving torque is reported.
+angles, rates, accelerations and the forces on the ground at a state (an :class:`Evaluation`).
+The seeds' formulations share :mod:`.closed_form` (a chain given by its lengths). The crank
+either moves freely under the loads and gravity, or a motor on the ground holds it at constant
+speed; then the last state component is the motor's work ``∫τ·θ̇1 dt`` and the driving torque is reported.
 The integration itself (tolerances, projection of the non-minimal states, events, outputs) is
 :mod:`balancer.simulate`.
 """
@@ -33,10 +40,6 @@ from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
-
-from ..inverse import dynamic_link
-from ..kinematics import branch_sign_along, change_point_angles, position_scalar, rates_scalar
-from ..model import FourBar
 
 
 @dataclass(frozen=True)
@@ -123,12 +126,12 @@ class Evaluation:
 
 
 class Formulation(ABC):
-    """Equations of motion of a four-bar in one formulation.
+    """Equations of motion of a mechanism in one formulation.
 
     Parameters
     ----------
     linkage
-        The four-bar (its counter-rotors add to the inertia of crank and rocker).
+        The mechanism's model (a four-bar, slider-crank or general linkage).
     gravity
         Gravitational acceleration ``(gx, gy)``, m/s².
     speed
@@ -141,12 +144,10 @@ class Formulation(ABC):
     minimal: ClassVar[bool]
     #: Whether the formulation passes a dead point of the crank (coupler and rocker aligned).
     passes_dead_points: ClassVar[bool] = False
-    #: Number of links that turn (a slider does not).
-    rotating_links: ClassVar[int] = 3
 
     def __init__(
         self,
-        linkage: FourBar,
+        linkage,
         *,
         gravity: tuple[float, float] = (0.0, 0.0),
         speed: float | None = None,
@@ -154,23 +155,7 @@ class Formulation(ABC):
         self.linkage = linkage
         self.gravity = complex(*gravity)
         self.speed = speed
-        self.lengths = linkage.lengths
-        #: Links as the dynamics see them (counter-rotor inertia added).
-        self.links = tuple(dynamic_link(link) for link in linkage.links)
-        #: Applied force on each link at its centre of mass, weight included, N.
-        self.forces = tuple(link.force_complex + link.mass * self.gravity for link in linkage.links)
-        #: Applied moment on each link, N·m.
-        self.moments = tuple(link.moment for link in linkage.links)
-        self.mass = tuple(link.mass for link in linkage.links)
-        self.total_mass = sum(self.mass)
-        #: Centres of mass as fractions of the link vectors, ``ζk = s̄k/lk`` (rotating links).
-        self.zeta = tuple(
-            link.com / length
-            for link, length in zip(linkage.links[: self.rotating_links], self.lengths,
-                                    strict=False)
-        )
         self.theta1_start = 0.0
-        self.sign0 = 1.0 if linkage.branch == "+" else -1.0
 
     @property
     def driven(self) -> bool:
@@ -216,40 +201,27 @@ class Formulation(ABC):
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         """``sin(θ3 − θ2)``: zero where coupler and rocker align (dead point or change point)."""
 
-    # -- what the simulation driver needs to know of the mechanism (four-bar here) ------------
+    # -- what the simulation driver needs to know of the mechanism --------------------------
 
     def assembly_range(self):
         """Crank angles at which the mechanism assembles."""
-        from ..kinematics import assembly_range
-
-        return assembly_range(self.lengths)
+        return self.mechanism.assembly_range()
 
     def change_points(self) -> tuple[float, ...]:
-        """Crank angles at which the assemblies meet (passed on the smooth motion)."""
-        return change_point_angles(self.lengths)
+        """Crank angles at which the assemblies meet (passed on the smooth motion); none."""
+        return ()
 
+    @abstractmethod
     def transmission_of_crank(self, theta1: float) -> float:
-        """|sin(θ3 − θ2)| on the motion's assembly at ``theta1``: zero at a dead point."""
-        sign = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
-        _, v2, v3 = position_scalar(self.lengths, theta1, float(sign))
-        return abs(v2.real * v3.imag - v2.imag * v3.real) / (self.lengths[1] * self.lengths[2])
+        """How far from a dead point the motion's pose at crank angle ``theta1`` is (0 there)."""
 
+    @abstractmethod
     def energy(self, theta, omega, alpha, slider=None, states=None):
-        """Kinetic energy and the work of loads and gravity since the first state, J.
+        """Kinetic energy and the work of loads, gravity and springs since the first state, J.
 
-        At output states (arrays over time; angles continuous).
+        At output states: arrays over time of the angles (continuous), rates and
+        accelerations, the formulation's own slider coordinate, and the states themselves.
         """
-        from ..inverse import kinetic_energy, link_com_kinematics
-        from ..kinematics import motion_from_angles
-
-        mo = motion_from_angles(self.lengths, tuple(theta), tuple(omega), tuple(alpha))
-        kin = kinetic_energy(self.linkage, mo)
-        coms, _ = link_com_kinematics(self.linkage, mo)
-        work = 0.0 * kin
-        for k, r in enumerate(coms):
-            work = work + np.real(np.conj(self.forces[k]) * (r - r[0])) + self.moments[k] * (
-                theta[k] - theta[k][0])
-        return kin, work
 
     def shaking(self, ev: Evaluation) -> tuple:
         """Shaking force (N) and moment about the origin (N·m) from a (batch) evaluation.
@@ -292,27 +264,6 @@ class Formulation(ABC):
     def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         """Put a state back on the constraint manifold (identity for minimal formulations)."""
         return y
-
-    def near_change_point(self, theta1: float, width: float = 0.1) -> bool:
-        """Whether the crank angle (rad) is within ``width`` of a change point of the linkage.
-
-        There all joints become collinear, the loop-closure Jacobian loses rank and the two
-        assemblies cross: a least-norm projection cannot tell them apart, so the non-minimal
-        formulations project onto the assembly of the smooth motion instead
-        (:meth:`branch_vectors`).
-        """
-        points = change_point_angles(self.lengths)
-        return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < width for p in points)
-
-    def branch_vectors(self, theta1: float, omega1: float):
-        """Link vectors and dependent rates ``(l̄1, l̄2, l̄3), θ̇2, θ̇3`` of the smooth motion.
-
-        On the assembly the motion is on at crank angle ``theta1`` (unwrapped, rad) (Eq. 2–7).
-        """
-        sign = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
-        vectors = position_scalar(self.lengths, theta1, float(sign))
-        _, _, w2, w3, _, _ = rates_scalar(self.lengths, vectors, omega1)
-        return vectors, w2, w3
 
     def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
         """Loop-closure residuals of a state: position (m) and velocity (m/s)."""

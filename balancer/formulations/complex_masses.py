@@ -26,7 +26,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..kinematics import branch_sign_along, cross_scalar, position_scalar, rates_scalar
-from . import Evaluation, Formulation
+from . import Evaluation
+from .closed_form import FourBarFormulation
 
 
 def _ip(x: complex, y: complex) -> float:
@@ -34,7 +35,7 @@ def _ip(x: complex, y: complex) -> float:
     return x.real * y.real + x.imag * y.imag
 
 
-class ComplexMasses(Formulation):
+class ComplexMasses(FourBarFormulation):
     """Complex joint masses, Eq. 29 and 36–40, reduced to one equation in θ1."""
 
     name = "complex-masses"

@@ -38,7 +38,8 @@ from numpy.typing import NDArray
 
 from ..inverse import newton_euler
 from ..kinematics import motion_from_angles
-from . import Evaluation, Formulation
+from . import Evaluation
+from .closed_form import FourBarFormulation
 
 S1 = np.array([[0.0, -1.0], [1.0, 0.0]])  # the generator of planar rotations (Eq. 1)
 E1 = np.array([1.0, 0.0])
@@ -62,7 +63,7 @@ def _blockdiag(*blocks: NDArray[np.float64]) -> NDArray[np.float64]:
     return out
 
 
-class LieGroup(Formulation):
+class LieGroup(FourBarFormulation):
     """Bai, Xia & Ge's attitude-vector formulation, Eq. 18–85."""
 
     name = "lie-group"

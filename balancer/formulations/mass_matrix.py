@@ -33,10 +33,11 @@ from numpy.typing import NDArray
 from ..kinematics import cross_scalar, rates_scalar
 from ..massmodels import fourbar_force_vector, global_mass_matrix
 from ..model import Link
-from . import Evaluation, Formulation
+from . import Evaluation
+from .closed_form import FourBarFormulation
 
 
-class NodalTruss(Formulation):
+class NodalTruss(FourBarFormulation):
     """What a linkage of truss elements with moving nodes A1 (crank pin) and A2 shares.
 
     State ``y = (x, ẋ, a)`` with ``x = (r_A1x, r_A1y, r_A2x, r_A2y)`` (m) and ``a`` the

@@ -92,20 +92,14 @@ class Multibody(Formulation):
 
     def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
-        self.linkage = linkage
-        self.gravity = complex(*gravity)
-        self.speed = speed
+        super().__init__(linkage, gravity=gravity, speed=speed)
         self.mech = mechanism_of(linkage)
         #: The mechanism as a general linkage (springs, sliders, ground points).
         self.general = self.mech.linkage
         self.structure = s = self.mech.structure
         self.n = s.size
-        self.rotating_links = self.n
         self.links = self.mech.links
-        self.mass = tuple(link.mass for link in self.links)
-        self.total_mass = sum(self.mass)
         self.theta1_start = s.ref_angle[s.input]
-        self.sign0 = 1.0
         self.constraints = [*s.constraints, *([s.driver] if self.driven else [])]
         self.rows = sum(c.rows for c in self.constraints)
         self.scale = s.length_scale()
@@ -295,12 +289,6 @@ class Multibody(Formulation):
         return [flat[s] for s in self._slices]
 
     # -- the formulation's interface ----------------------------------------------------------
-
-    def assembly_range(self):
-        return self.mech.assembly_range()
-
-    def change_points(self) -> tuple[float, ...]:
-        return ()
 
     def transmission_of_crank(self, theta1: float) -> float:
         from ..mechanisms.base import _gaps

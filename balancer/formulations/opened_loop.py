@@ -26,7 +26,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..kinematics import cross_scalar, rates_scalar
-from . import Evaluation, Formulation
+from . import Evaluation
+from .closed_form import FourBarFormulation
 
 
 def _ip(x: complex, y: complex) -> float:
@@ -35,7 +36,7 @@ def _ip(x: complex, y: complex) -> float:
 
 
 
-class OpenedLoop(Formulation):
+class OpenedLoop(FourBarFormulation):
     """Opened loop with principal vectors, Eq. 12–28."""
 
     name = "opened-loop"

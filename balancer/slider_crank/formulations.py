@@ -26,14 +26,15 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from ..formulations import Evaluation, Formulation
+from ..formulations import Evaluation
+from ..formulations.closed_form import ClosedForm
 from ..formulations.mass_matrix import NodalTruss
 from ..kinematics import cross_scalar
 from .dynamics import kinetic_energy, newton_euler
 from .kinematics import assembly_range, motion
 
 
-class _SliderFormulation(Formulation):
+class _SliderFormulation(ClosedForm):
     """What both slider-crank formulations share: the mechanism's geometry for the driver."""
 
     rotating_links = 2
