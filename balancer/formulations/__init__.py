@@ -26,9 +26,9 @@ Each is a :class:`Formulation`: it turns a state into its time derivative and ev
 angles, rates, accelerations and the forces on the ground at a state (an :class:`Evaluation`).
 The seeds' formulations share :mod:`.closed_form` (a chain given by its lengths). The crank
 either moves freely under the loads and gravity, or a motor on the ground holds it at constant
-speed; then the last state component is the motor's work ``∫τ·θ̇1 dt`` and the driving torque is reported.
-The integration itself (tolerances, projection of the non-minimal states, events, outputs) is
-:mod:`balancer.simulate`.
+speed; then the last state component is the motor's work ``∫τ·θ̇1 dt`` and the driving torque
+is reported. The integration itself (tolerances, projection of the non-minimal states, events,
+outputs) is :mod:`balancer.simulate`.
 """
 
 from __future__ import annotations
