@@ -92,3 +92,23 @@ def test_a_simulated_linkage_agrees_with_its_four_bar():
     for key in ("theta", "omega", "alpha"):
         bound = amplified.bound(lambda r, key=key: getattr(r, key), ref, run)
         assert np.max(np.abs(getattr(run, key) - getattr(ref, key))) < bound, key
+
+
+@pytest.mark.parametrize("example", ["pb1.toml", "pb2.toml"])
+def test_a_four_bar_balanced_as_a_linkage_reaches_the_same_optimum(example):
+    # The four-bar's force balance is Eq. 57–58 in closed form; the linkage's is found from
+    # the variation of its centre of mass (balance.conditions): the same row space, so the
+    # same certified optimum. Each RMS is within GAP_TOLERANCE of the problem's scale of its
+    # certified lower bound, so the two agree within twice that.
+    from balancer.balance.optimizer import optimize
+    from balancer.balance.result import GAP_TOLERANCE
+
+    design = load_design(EXAMPLES / example)
+    general = loads_design(dumps_design(replace(_as_linkage(design), balance=design.balance)),
+                           "general.toml")
+    four_bar = optimize(design, backend="convex")
+    linkage = optimize(general, backend="convex")
+    assert four_bar.optimal and linkage.optimal
+    assert abs(linkage.rms - four_bar.rms) <= 2 * GAP_TOLERANCE * four_bar.scale
+    assert abs(linkage.before.summary.shaking_moment.rms
+               - four_bar.before.summary.shaking_moment.rms) <= 1e-9 * four_bar.scale
