@@ -83,6 +83,18 @@ class _Compiled:
         return self.res.copy()
 
 
+def _least_norm(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The least-norm ``Δ`` with ``J·Δ = r``: ``Jᵀ·(J·Jᵀ)⁻¹·r`` (J of full row rank).
+
+    At a pose where the constraints are dependent (a singular position) ``J·Jᵀ`` is singular
+    and the least-squares solution by SVD is taken instead.
+    """
+    try:
+        return jac.T @ np.linalg.solve(jac @ jac.T, res)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(jac, res, rcond=None)[0]
+
+
 class Multibody(Formulation):
     """Absolute coordinates with the constraints' multipliers (any linkage)."""
 
@@ -173,6 +185,7 @@ class Multibody(Formulation):
                     gamma[row + r] = gam[r]
             row += c.rows
         self._equations = ca.Function("equations", [q, qd, gas], [mass, force, jac, gamma])
+        self._kinetic = ca.Function("kinetic", [q, qd], [0.5 * ca.dot(qd, ca.mtimes(mass, qd))])
         self._build_frame(q, qd, gas, pose)
         self._build_dynamics()
         self._build_constraints(q, pose)
@@ -357,11 +370,11 @@ class Multibody(Formulation):
             res, jac = self._constraint_values(t, q)
             if np.max(np.abs(res), initial=0.0) <= 1e-15 * self.scale:
                 break
-            q = q - np.linalg.lstsq(jac, res, rcond=None)[0]
+            q = q - _least_norm(jac, res)
         else:
             _, jac = self._constraint_values(t, q)
         qd = y[n : 2 * n]
-        qd = qd - np.linalg.lstsq(jac, jac @ qd - self._velocity_rhs(), rcond=None)[0]
+        qd = qd - _least_norm(jac, jac @ qd - self._velocity_rhs())
         y[:n], y[n : 2 * n] = q, qd
         return y
 
@@ -425,38 +438,32 @@ class Multibody(Formulation):
     def energy(self, theta, omega, alpha, slider=None, states=None):
         """Kinetic energy and the work of loads, gravity and springs since the first state, J.
 
-        From the states themselves (``states``): ``T = q̇ᵀ·M·q̇/2``; the loads' and gravity's
-        work from the centres of mass' and the angles' displacements; the springs' from their
-        potential energy.
+        From the states themselves (``states``), all at once: ``T = q̇ᵀ·M·q̇/2`` (compiled);
+        the loads' and gravity's work from the centres of mass' and the angles'
+        displacements; the springs' from their potential energy.
         """
-        n = self.n
+        n = 3 * self.n
+        ys = np.array(states, dtype=float).reshape(len(states), -1)
+        q, qd = ys[:, :n].T, ys[:, n : 2 * n].T  # (3n, count)
+        kin = np.asarray(self._kinetic.map(ys.shape[0]).call([ca.DM(q), ca.DM(qd)])[0].full())
+        pose = self._pose(q, np)
         g = V(self.gravity.real, self.gravity.imag)
-        kin, work = [], []
-        start = None
-        for y in states:
-            q, qd = y[: 3 * n], y[3 * n : 6 * n]
-            mass, *_ = self._equations(q, qd, np.zeros(max(1, len(self.structure.prisms))))
-            kin.append(0.5 * float(qd @ np.array(mass) @ qd))
-            pose = self._pose(q, np)
-            value = 0.0
-            coms = [pose.point(k, V(link.e, link.f)) for k, link in enumerate(self.links)]
-            if start is None:
-                start = (coms, q.copy(), self._spring_energy(pose))
-            for k, link in enumerate(self.links):
-                dr = coms[k] - start[0][k]
-                value += (g * link.mass + V(*link.force)).dot(dr)
-                value += link.moment * (q[3 * k + 2] - start[1][3 * k + 2])
-            value -= self._spring_energy(pose) - start[2]
-            work.append(value)
-        return np.array(kin), np.array(work)
+        work = np.zeros(ys.shape[0])
+        for k, link in enumerate(self.links):
+            com = pose.point(k, V(link.e, link.f))
+            work += (g * link.mass + V(*link.force)).dot(com - V(com.x[0], com.y[0]))
+            work += link.moment * (q[3 * k + 2] - q[3 * k + 2, 0])
+        spring = self._spring_energy(pose) * np.ones(ys.shape[0])
+        return kin.ravel(), work - (spring - spring[0])
 
-    def _spring_energy(self, pose: Pose) -> float:
+    def _spring_energy(self, pose: Pose):
+        """Potential energy of the springs at a pose (arrays over states), J."""
         total = 0.0
         for spring in self.general.springs:
             (_, _, a), (_, _, b) = self._spring_forces(spring, pose, np)
-            length = math.sqrt((b - a).norm2())
-            total += 0.5 * spring.stiffness * (length - spring.free_length) ** 2
-        return total
+            length = np.sqrt((b - a).norm2())
+            total = total + 0.5 * spring.stiffness * (length - spring.free_length) ** 2
+        return np.asarray(total, dtype=float)
 
     def shaking(self, ev: Evaluation) -> tuple:
         return ev.shaking_force, ev.shaking_moment
