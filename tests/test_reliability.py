@@ -20,7 +20,7 @@ from balancer.cli import main
 from balancer.errors import AssemblyError, OutputError, SolverError, SpecError
 from balancer.model import Design, FourBar, Link, Operation, SimulationSettings, SliderCrank
 from balancer.optimize import Status, optimize
-from balancer.problem import numeric_problem
+from balancer.problem import FORCE_BALANCE_TOLERANCE, NumericProblem, numeric_problem
 from balancer.report import csv_text, dumps_json
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -426,3 +426,166 @@ def test_a_design_in_bounds_only_to_the_solvers_tolerance_is_projected_inside():
     assert fixed[0] >= b.mass[0]
     assert data.force_balance_residual(fixed) <= 1e-12
     assert np.max(np.abs(fixed - x_bad) / data.scales) < 1e-5  # a small move
+
+
+# Problems of the redesign campaign (tests/fuzz/redesign_campaign.py, seed 2027) whose feasible
+# set is thin: force balance can be met only within ~1e-9 (relative) of a bound.
+THIN_PROBLEMS = {
+    # the rocker's mass within 5.6e-9 of the least that allows force balance
+    132: """\
+[mechanism]
+type = "four-bar"
+branch = "+"
+[mechanism.lengths]
+crank = 1.9025094005542678
+coupler = 1.5054864551788818
+rocker = 2.2839759498839065
+frame = 0.8506631098159221
+[links.crank]
+mass = 2.6924511757364535
+inertia = 0.09623723124076551
+com = { e = 0.1339068444988697, f = -0.5796013245917159 }
+[links.coupler]
+mass = 2.035547605574011
+inertia = 0.28473693940301953
+com = { e = 0.09454130038766419, f = -0.4760174201984294 }
+[links.rocker]
+mass = 4.583007058564107
+inertia = 0.10197626532963239
+com = { e = 1.4238582015618966, f = -0.8128932405815995 }
+[operation]
+speed = 0.5444320548032998
+samples = 36
+[balance]
+force_balance = true
+[balance.objective]
+shaking_moment = 4.647844949673251
+[balance.crank]
+mass = [2.3487948603001074, 11.489099933530497]
+com_radius = 2.517855664571168
+com_about = "A1"
+min_gyration = 0.24061194370382283
+counter_rotor = [0.0, 257.1889133107569]
+[balance.rocker]
+mass = [0.24870507320506852, 0.49741014641013703]
+com_radius = 3.01304076787961
+""",
+    # the crank's mass within 3.0e-9 of the least that allows force balance
+    200: """\
+[mechanism]
+type = "four-bar"
+branch = "-"
+[mechanism.lengths]
+crank = 0.7493041139397257
+coupler = 1.4818456298499878
+rocker = 2.446119365088543
+frame = 2.5240886865224343
+[links.crank]
+mass = 3.4136172006711942
+inertia = 0.29143071256300845
+com = { e = 0.8891539306209747, f = -0.019803655803390646 }
+[links.coupler]
+mass = 3.1463683413663364
+inertia = 0.2223313314748158
+com = { e = 1.1536173799903593, f = -0.21926026360125014 }
+[links.rocker]
+mass = 1.107201096829721
+inertia = 0.5055873417898571
+com = { e = 1.874065561170579, f = -0.6140437972446278 }
+counter_rotor = 6.4787871892675435
+[operation]
+speed = 1.7664120808428514
+samples = 36
+[balance]
+force_balance = true
+[balance.objective]
+shaking_moment = 0.6451610643676318
+[balance.crank]
+mass = [1.325525380451699, 2.651050760903398]
+com_radius = 0.5941562492327486
+[balance.coupler]
+mass = [1.8247478493034788, 11.22686474245176]
+com_radius = 1.9412589931496624
+com_about = "A1"
+""",
+    # the rocker's centre of mass in a 9 mm disc 1.4e-9 wider than the least that allows it
+    557: """\
+[mechanism]
+type = "four-bar"
+branch = "-"
+[mechanism.lengths]
+crank = 0.5596787919937742
+coupler = 2.2698499324938166
+rocker = 1.8507720171428828
+frame = 1.7918606005486708
+[links.crank]
+mass = 1.4287102457332872
+inertia = 0.09563158405113079
+com = { e = 0.11703694623081215, f = 0.18754440397805539 }
+counter_rotor = 0.03390537274343337
+[links.coupler]
+mass = 2.547924135190742
+inertia = 2.5018876541328257
+com = { e = 0.8443439455012115, f = 0.3964427650759381 }
+[links.rocker]
+mass = 3.7955169539003255
+inertia = 0.8794902342866416
+com = { e = 0.5118795910169143, f = -0.12543570068148777 }
+[operation]
+speed = -13.508996651888559
+samples = 180
+[balance]
+force_balance = true
+[balance.objective]
+shaking_moment = 1.0
+[balance.crank]
+mass = [0.6912234726472767, 2.252279194116294]
+com_radius = 0.30484029823312747
+[balance.coupler]
+mass = [1.2456852811013737, 4.198954280580022]
+com_radius = 1.4837467768958708
+min_gyration = 0.4127923467251495
+[balance.rocker]
+com_radius = 0.009233664826739915
+min_gyration = 0.3917741763586528
+""",
+}
+
+
+@pytest.mark.parametrize("pid", sorted(THIN_PROBLEMS))
+def test_a_thin_feasible_set_gives_a_design_that_holds_its_bounds_exactly(pid):
+    """The convex backend called 132 and 200 failed: its repair clipped a centre of mass onto its
+    disc and held both its coordinates (two conditions for one bound), and Eq. 58 could not be
+    restored by what was left; the projections' margins were wider than the feasible set or no
+    wider than Clarabel's tolerance. 557's rocker left its 9 mm disc by rounding."""
+    design = spec.loads_design(THIN_PROBLEMS[pid])
+    data = numeric_problem(design)
+    for backend in ("convex", "nlp"):
+        result = optimize(design, backend=backend)
+        assert result.success, (backend, result.message)
+        assert _balanced_bounds_hold(data, result.linkage) == [], backend
+        assert data.force_balance_residual(result.x) <= FORCE_BALANCE_TOLERANCE, backend
+
+
+def test_a_centre_of_mass_put_onto_a_small_disc_far_from_the_frames_origin_stays_inside():
+    """The clamp judged the distance before adding the disc's centre back: stored, the
+    coordinates round to the spacing of the centre's (com_about at the far joint, l3 out), far
+    coarser than the last digits of a small radius (problem 557 above: 8.4e-18·l outside)."""
+    data = numeric_problem(spec.load_design(EXAMPLES / "pb1.toml"))
+    rocker = data.links[2]
+    assert rocker.com_centre == complex(2.0, 0.0)  # A3, in the rocker's frame
+    rng = np.random.default_rng(557)
+    eps = np.finfo(float).eps
+    for _ in range(500):
+        radius = 10 ** rng.uniform(-4, 0)
+        disc = replace(rocker, com_radius=radius)
+        out = radius * (1 + 10 ** rng.uniform(-12, -3))
+        point = disc.com_centre + out * np.exp(1j * rng.uniform(0, 2 * np.pi))
+        _, e, f, _, _ = NumericProblem.clamp(disc, 2.2, point.real, point.imag, 1.0, 0.0)
+        distance = abs(complex(e, f) - disc.com_centre)
+        assert distance <= radius
+        # pulled in by no more than the coordinates' rounding (a few spacings of |c| + R)
+        # and the 8 units in the last place of the radius kept to spare
+        spacing = np.spacing(abs(disc.com_centre) + radius)
+        assert radius - distance <= 4 * spacing + 16 * eps * radius
+

@@ -69,6 +69,10 @@ TIE_ACCEPT = 1e-8
 #: Inward margin of the bounds (scaled units) in the final projection (:meth:`finalize`): a
 #: hundred times Clarabel's feasibility tolerance, so that its solution lies inside the bounds.
 MARGIN = 1e-8
+#: Inward distance (of a link's mass, of its length) at which the active-set correction
+#: (:meth:`ConvexSolver.onto_active`) puts each bound it moves a design onto: far above the
+#: rounding of the physical values (``ε``), far below any tolerance.
+ACTIVE_INSIDE = 1e-12
 #: A slack of the elastic problem above this (in scaled units) names a bound to widen.
 SLACK_TOLERANCE = 1e-7
 
@@ -503,11 +507,13 @@ class ConvexSolver:
         Solvers meet bounds to their tolerance. First Eq. 58 is restored by the least change
         of the free variables; if a bound is still broken by more than rounding
         (:data:`~balancer.balance.problem.ROUNDING_TOLERANCE`: a designer's spec must hold what the
-        problem promised, and :meth:`NumericProblem.physical` removes only rounding), ``x``
-        is projected, as the least change in scaled
-        variables, onto the bounds tightened by :data:`MARGIN`, with Eq. 58 as equalities,
-        and Eq. 58 restored again (a change of ~Clarabel's tolerance, inside the margin).
-        Returns the design and whether it is exactly feasible.
+        problem promised, and :meth:`NumericProblem.physical` removes only rounding), the
+        broken bounds are met as equations together with Eq. 58 (:meth:`onto_active`: a move
+        of the size of the violations). Failing that, ``x`` is projected, as the least change
+        in scaled variables, onto the bounds tightened by :data:`MARGIN`, with Eq. 58 as
+        equalities, and Eq. 58 restored again (a change of ~Clarabel's tolerance, inside the
+        margin), or the bounds met as equations from there. Returns the design and whether it
+        is exactly feasible.
         """
         data, lay = self.data, self.layout
         x = self._clip_inertias(self.balanced(np.asarray(x, float)))
@@ -517,16 +523,93 @@ class ConvexSolver:
         if not lay.size:
             return x, False
         inert = [i for i in range(data.size) if data.inert[i]]
+
+        def exact_of(u: NDArray[np.float64] | None) -> NDArray[np.float64] | None:
+            if u is None:
+                return None
+            x2 = lay.x(u)
+            x2[inert] = x[inert]  # settled already; the solvers here do not see them
+            return self._exact(self._clip_inertias(x2))
+
+        exact = exact_of(self.onto_active(lay.u(x)))
+        if exact is not None:
+            return exact, True
         for margin in (MARGIN, 1e-2 * MARGIN, 0.0):  # a thin feasible set takes a smaller one
             u = self._project(lay.u(x), margin)
             if u is None:
                 continue
-            x2 = lay.x(self._clip_and_pin(self.restore_balance(u)))
-            x2[inert] = x[inert]  # settled already; the projection does not see them
-            exact = self._exact(self._clip_inertias(x2))
-            if exact is not None:
-                return exact, True
+            for candidate in (self._clip_and_pin(self.restore_balance(u)),
+                              self.onto_active(u)):
+                exact = exact_of(candidate)
+                if exact is not None:
+                    return exact, True
         return x, False
+
+    def onto_active(self, u: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """Solver variables ``u`` moved onto the bounds they break, with Eq. 58 kept.
+
+        Each mass bound and centre-of-mass disc that ``u`` breaks (or meets within
+        :data:`ACTIVE_INSIDE`) becomes one equation, putting the design that far inside it;
+        they are solved with Eq. 58 by Gauss–Newton steps of least change in the scaled
+        variables, and a bound once taken stays taken. (Clipping a centre of mass onto its
+        disc and holding both its coordinates asks two conditions for one bound: with a thin
+        feasible set, e.g. a mass that must lie within 1e-9 of the least that allows force
+        balance, Eq. 58 then cannot be restored by what is left.) ``None`` if no design that
+        meets the bounds and Eq. 58 (to rounding) is reached in a few steps.
+        """
+        data, lay = self.data, self.layout
+        if not lay.size:
+            return None
+        index = {entry: j for j, entry in enumerate(lay.primary)}
+        u = np.array(u, dtype=float)
+        taken: set[tuple[int, str]] = set()
+        for _ in range(8):
+            x = lay.x(u)
+            rows: list[NDArray[np.float64]] = []
+            values: list[float] = []
+            broken = False
+            for b in data.links:
+                k, mref, l = b.start, b.mass_ref, b.length
+                m = x[k]
+                if k in index:
+                    lo, hi = b.mass
+                    inside = min(ACTIVE_INSIDE * mref, (hi - lo) / 4)
+                    broken = broken or not lo <= m <= hi
+                    if m > hi - inside / 2 or m < lo + inside / 2 or (k, "mass") in taken:
+                        taken.add((k, "mass"))
+                        target = min(max(m, lo + inside), hi - inside)
+                        rows.append(lay.T[k] / mref)
+                        values.append((target - m) / mref)
+                if b.com_fixed is None and m > 0:
+                    d = complex(x[k + 1], x[k + 2]) - m * b.com_centre
+                    g = abs(d) - b.com_radius * m  # ≤ 0 inside, kg·m
+                    inside = min(ACTIVE_INSIDE * l, b.com_radius / 4) * m
+                    broken = broken or g > 0
+                    if (g > -inside / 2 or (k, "com") in taken) and abs(d) > 0:
+                        taken.add((k, "com"))
+                        n = d / abs(d)
+                        grad = (-(n.real * b.com_centre.real + n.imag * b.com_centre.imag)
+                                - b.com_radius, n.real, n.imag)
+                        rows.append(np.asarray(grad) @ lay.T[k:k + 3] / (mref * l))
+                        values.append((-inside - g) / (mref * l))
+            residual = 0.0
+            if self._fb is not None:
+                at, rhs, _ = self._fb
+                r = at @ u - rhs
+                residual = float(np.max(np.abs(r), initial=0.0))
+                rows.extend(at)
+                values.extend(-r)
+            if not broken and data.force_balance_residual(x) <= FORCE_BALANCE_TOLERANCE:
+                return u
+            if not rows:
+                return None
+            step = np.linalg.lstsq(np.array(rows), np.array(values), rcond=None)[0]
+            if not np.all(np.isfinite(step)):
+                return None
+            u = u + step
+            if not taken and residual == 0.0:
+                return None
+        return None
 
     def _exact(self, x: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """The design of ``x``'s physical values, in their bounds exactly, with Eq. 58 kept.

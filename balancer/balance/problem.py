@@ -980,11 +980,7 @@ class NumericProblem:
         if b.com_fixed is not None:
             e, f = b.com_fixed.real, b.com_fixed.imag
         else:
-            d = complex(e, f) - b.com_centre
-            radius = b.com_radius * (1 - ulps)
-            while abs(d) > radius:  # scale onto the disc; rounding may need a second nudge
-                d *= radius / abs(d) * (1 - ulps)
-            e, f = (b.com_centre + d).real, (b.com_centre + d).imag
+            e, f = NumericProblem._onto_disc(b.com_centre, b.com_radius, e, f)
         least = m * b.gyration**2 * (1 + ulps)
         if least > b.inertia[1]:
             least = b.inertia[1]
@@ -992,6 +988,34 @@ class NumericProblem:
         if b.counter_rotor is not None:
             rotor = min(max(rotor, b.counter_rotor[0]), b.counter_rotor[1])
         return m, e, f, inertia, rotor
+
+    @staticmethod
+    def _onto_disc(centre: complex, radius: float, e: float, f: float) -> tuple[float, float]:
+        """``(e, f)`` moved radially onto the disc ``|s̄ − centre| ≤ radius`` if outside it.
+
+        Judged on the coordinates as stored: ``centre + d`` rounds to the spacing of the
+        coordinates, which for a small disc far from the frame's origin (a ``com_about`` at the
+        far joint) is far coarser than the radius's last digits, so the point is pulled in by
+        that spacing until the stored coordinates are inside. The bound is met with 8 units in
+        the last place of the radius to spare (a reader's subtraction ``e − c`` rounds relative
+        to the distance, its ``hypot`` to a unit or so). A radius below the coordinates'
+        spacing leaves the centre itself.
+        """
+        limit = radius * (1 - 8 * 2.0**-52)
+        d = complex(e, f) - centre
+        if abs(d) <= limit:
+            return e, f
+        target = limit
+        for _ in range(8):  # one pull by twice the rounding suffices; more is a safeguard
+            if target <= 0:
+                break
+            d *= target / abs(d)
+            p = centre + d
+            e, f = p.real, p.imag
+            if abs(complex(e, f) - centre) <= limit:
+                return e, f
+            target -= 2 * float(np.spacing(max(abs(e), abs(f))))
+        return centre.real, centre.imag
 
     def clamp_distance(self, x: NDArray[np.float64]) -> float:
         """How far :meth:`physical` moved ``x`` to put it in its bounds, relative.

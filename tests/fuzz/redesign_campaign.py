@@ -16,7 +16,9 @@ spec text:
   torque (``dT/dt / ω1``), all from analytic momentum, angular momentum and kinetic energy
   derivatives (no finite differences);
 - force balance as the null space of the sampled variation of the total first moment of mass
-  (rank test), not Eq. 57-58;
+  (rank test), not Eq. 57-58, in reduced echelon form heaviest link first and with what the
+  bounds fix substituted, each row scaled by its own terms (a condition among light links
+  keeps its own precision beside a link 1e12 times heavier);
 - own reading of the bounds from the spec numbers, and an own CVXPY/Clarabel program for the
   optimum and a phase-1 (largest uniform margin) program for feasibility.
 
@@ -35,10 +37,12 @@ bound of the optimum. A claim of global optimality is false when the tool's ``J`
 more than the claim's own tolerance ``1e-6·max(|J|, 1e-10·J_ref)`` (GAP_TOLERANCE and the gap
 floor of ``balancer.optimize.result``) plus rounding; a lower bound is false when it exceeds it
 by as much. ``below-independent-optimum`` is a self-check (the tool's design better than the
-own program's optimum); in thin feasible sets it is expected, the tool's design using its 1e-9
-tolerance. "Mixed-scale" problems have link masses differing by more than 1e6; there force
-balance and feasibility are only defined relative to the total mass, and the counts are shown
-apart.
+own program's optimum over the bounds as they are: the narrowed program's optimum is no lower
+bound, and in a thin feasible set with a steep objective narrowing by 1e-10 raises it by far
+more than the solver's tolerance). "Mixed-scale" problems have link masses differing by more
+than 1e6; force balance is judged per link there too (the total first moment's variation
+against the links' own, not against the total mass, which would not see a light link's
+unbalance beside a heavy link on its pivot), and the counts are shown apart.
 """
 
 from __future__ import annotations
@@ -54,6 +58,7 @@ import time
 import traceback
 import warnings
 from collections import Counter, defaultdict
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -335,6 +340,30 @@ def _cross(a, b):
     return (np.conj(a) * b).imag
 
 
+def _echelon(basis: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """Reduced row echelon form of a row basis, pivot columns taken largest ``weight`` first.
+
+    Gauss-Jordan elimination with partial pivoting on the (orthonormal, unit-column) basis:
+    row ``i`` has zeros in every pivot column but its own, so the last rows hold only the
+    columns of least weight.
+    """
+    a = np.array(basis, dtype=float)
+    row = 0
+    for col in np.argsort(-weight, kind="stable"):
+        if row == a.shape[0] or weight[col] == 0:
+            break
+        pivot = row + int(np.argmax(np.abs(a[row:, col])))
+        if abs(a[pivot, col]) <= 1e-9:
+            continue  # dependent on the pivot columns before it
+        a[[row, pivot]] = a[[pivot, row]]
+        a[row] /= a[row, col]
+        others = np.arange(a.shape[0]) != row
+        a[others] -= np.outer(a[others, col], a[row])
+        a[others, col] = 0.0
+        row += 1
+    return a
+
+
 class Model:
     """Kinematics and linear maps of one mechanism at constant crank speed (own route)."""
 
@@ -430,11 +459,21 @@ class Model:
         torque /= self.w1
         return {"force": force, "moment": moment, "torque": torque, "first": first}
 
-    def balance_rows(self, scales: np.ndarray, count: int = 97) -> tuple[np.ndarray, int]:
+    def balance_rows(self, scales: np.ndarray, count: int = 97, *,
+                     separate: bool = True) -> tuple[np.ndarray, int]:
         """Rows ``V`` with ``V·u[:12] = 0`` ⇔ total centre of mass stationary, and their rank.
 
         ``u = x/scales``; from the variation of the first moment of mass over ``count``
         crank angles, by an SVD and a rank test.
+
+        With ``separate`` the basis of the row space is brought to reduced echelon form with
+        the columns taken heaviest first (by their term at the parameters' scales): a
+        condition among light links only (a four-bar's coupler and rocker beside a crank of
+        1e12 kg) is then a row of its own, free of the heavy columns, and each row is scaled
+        by its own largest term. (An SVD basis mixes the conditions; scaled to a largest entry
+        of 1 a mixed row keeps the light links' terms at 1e-12, below the solver's tolerance,
+        and a design that breaks their condition passes.) Without it, the SVD's own basis (as
+        the borderline problems of a seed were generated with).
         """
         theta = np.linspace(0.0, 2 * np.pi, count, endpoint=False) + 0.1234
         g = self.maps(theta)["first"][:, :12]
@@ -446,13 +485,37 @@ class Model:
         d_unit = np.where(live, d / np.where(live, norms, 1.0), 0.0)
         _, sv, vt = np.linalg.svd(d_unit, full_matrices=False)
         rank = int(np.sum(sv > 1e-9 * sv[0]))
+        basis = vt[:rank].copy()
+        if separate:
+            basis = _echelon(basis, np.where(live, norms, 0.0) * scales[:12])
         # back to x: d·x = d̂·(n ⊙ x), so V̂·diag(n) has the null space of d; then on
         # u = x/scales, each row scaled to a largest entry of 1
-        rows = vt[:rank] * np.where(live, norms, 0.0)
+        rows = basis * np.where(live, norms, 0.0)
         rows = rows * scales[:12]
         rows /= np.max(np.abs(rows), axis=1, keepdims=True)
         rows[:, 3::4] = 0.0  # inertias do not move the centre of mass (exactly)
         return rows, rank
+
+    def balance_error(self, x: np.ndarray, tol: float = BOUND_TOL, count: int = 720) -> float:
+        """How far the total centre of mass is from stationary, per link (0: balanced).
+
+        The largest variation over a revolution of the total first moment of mass, over the
+        largest sum of each link's own variation (a heavy link whose centre of mass sits on
+        its ground pivot varies not at all and cannot hide a light link's), floored by the
+        rounding of the raw terms (``64·ε·Σ|terms|/tol``): at most ``tol`` when balanced to
+        ``tol`` or to rounding. Unlike :meth:`com_excursion` it does not divide by the total
+        mass, which for links 1e12 apart sees nothing of the light ones.
+        """
+        theta = np.linspace(0.0, 2 * np.pi, count, endpoint=False)
+        g = self.maps(theta)["first"][:, :12]
+        terms = g * x[:12]
+        parts = [terms[:, 4 * k:4 * k + 3].sum(axis=1) for k in range(3)]
+        parts = [p - p.mean() for p in parts]
+        residual = float(np.max(np.abs(sum(parts))))
+        combined = float(np.max(sum(np.abs(p) for p in parts)))
+        raw = float(np.max(np.abs(terms).sum(axis=1)))
+        size = max(combined, 64 * np.finfo(float).eps * raw / tol)
+        return residual / size if size > 0 else 0.0
 
     def com_excursion(self, x: np.ndarray, count: int = 720) -> float:
         """Largest distance of the total centre of mass from its mean position, m."""
@@ -563,13 +626,52 @@ def _mass_com(bounds, u, *, slack=None, skip=None, shrink: float = 0.0) -> list:
     return cons
 
 
+def _balance_constraints(bounds, u, vrows) -> list:
+    """``vrows·u[:12] = 0`` with what the bounds fix substituted, each row scaled anew.
+
+    A fixed centre of mass makes a link's first moments multiples of its mass, a fixed mass
+    a constant. Substituted into a row, the terms of a heavy link held on its pivot (a crank
+    of 1e12 kg with ``com_radius = 0``) vanish from it, and what is left (the light links'
+    terms, ~1e-12 of the row) is scaled to a largest entry of 1, so that the solver's
+    tolerance applies to it. A row left with no variable is met when its constant is rounding
+    of its terms, and is otherwise kept (infeasible).
+    """
+    rows = np.array(vrows, dtype=float)
+    constant = np.zeros(len(rows))
+    raw = np.zeros(len(rows))
+    for b in bounds:
+        k = 4 * b.index
+        if b.com_fixed is not None:
+            c = b.com_fixed / b.length
+            rows[:, k] += rows[:, k + 1] * c.real + rows[:, k + 2] * c.imag
+            rows[:, k + 1] = rows[:, k + 2] = 0.0
+        lo, hi = b.mass[0] / b.mref, b.mass[1] / b.mref
+        if lo == hi:
+            constant -= rows[:, k] * lo
+            raw += np.abs(rows[:, k] * lo)
+            rows[:, k] = 0.0
+    out = []
+    for row, c, r in zip(rows, constant, raw, strict=True):
+        size = float(np.max(np.abs(row)))
+        if size <= 1e-14 * float(np.max(np.abs(vrows))):  # nothing free left in it
+            if abs(c) <= 1e-12 * r:
+                continue
+            size = 0.0
+        size = max(size, abs(c))
+        out.append((row / size) @ u[:12] == c / size)
+    return out
+
+
 @dataclass
 class OwnOptimum:
     """The independent optimum.
 
     ``objective`` is ``J`` of ``x``, a design that meets every bound (to :data:`BOUND_TOL`)
     when ``certified``: an upper bound of the optimum. ``lower`` is the convex program's own
-    optimum (a relaxation when ``tight`` is false): about a lower bound.
+    optimum (a relaxation when ``tight`` is false): about a lower bound, unless the program
+    was narrowed (``unnarrowed`` set): then it is not one (narrowing raises the optimum, by
+    far more than the solver's tolerance where the feasible set is thin and the objective
+    steep across it), and ``unnarrowed()`` solves the program as the bounds are.
     """
 
     status: str
@@ -580,6 +682,7 @@ class OwnOptimum:
     certified: bool = False
     violation: float = math.nan
     time: float = 0.0
+    unnarrowed: Callable[[], OwnOptimum] | None = None
 
 
 def own_optimum(case, bounds, model, obj: Objective, vrows, shrink: float = 0.0) -> OwnOptimum:
@@ -625,7 +728,7 @@ def own_optimum(case, bounds, model, obj: Objective, vrows, shrink: float = 0.0)
         eta = shrink if hi - lo > 4 * shrink else 0.0
         cons += [u[entry] == lo] if lo == hi else [u[entry] >= lo + eta, u[entry] <= hi - eta]
     if case.force_balance:
-        cons.append(vrows @ u[:12] == 0)
+        cons += _balance_constraints(bounds, u, vrows)
     p = obj.factor * scales / math.sqrt(obj.reference)
     if obj.w_mass:
         mass = sum(b.mref * u[4 * b.index] for b in bounds)
@@ -658,7 +761,8 @@ def own_optimum(case, bounds, model, obj: Objective, vrows, shrink: float = 0.0)
                                 else (x[12], 0.0, 0.0))
         fb = 0.0
         if case.force_balance:
-            fb = model.com_excursion(x) / max(b.length for b in bounds)
+            fb = max(model.com_excursion(x) / max(b.length for b in bounds),
+                     model.balance_error(x))
         return x, tight, max([*viol.values(), fb])
 
     best = float(problem.value)
@@ -688,14 +792,13 @@ def own_margin(case, bounds, vrows, model=None) -> tuple[float, str]:
     can be met (relative: kg over the link's mass, m·kg over its mass times its length).
 
     With ``model``, a "feasible" answer is checked on its own design: the total centre of mass
-    must stay put (to 1e-9 of the longest link). The sampled rows lose a light link's term
-    beside a link 1e12 times heavier (they are found by an SVD on the whole matrix); such an
-    answer is then inconclusive (nan).
+    must stay put (to 1e-9 of the longest link, and per link: :meth:`Model.balance_error`);
+    otherwise the answer is inconclusive (nan).
     """
     u = cp.Variable(12)
     t = cp.Variable()
     cons = _mass_com(bounds, u, slack=t)
-    cons += [vrows @ u == 0, t >= -1e-3, u[3::4] == 0]
+    cons += [*_balance_constraints(bounds, u, vrows), t >= -1e-3, u[3::4] == 0]
     problem = cp.Problem(cp.Minimize(t), cons)
     status = _solve(problem)
     if status in ("infeasible", "infeasible_inaccurate"):
@@ -708,7 +811,7 @@ def own_margin(case, bounds, vrows, model=None) -> tuple[float, str]:
         for b in bounds:  # any inertia: it does not move the centre of mass
             x[4 * b.index + 3] = 1.0
         lmax = max(b.length for b in bounds)
-        if not model.com_excursion(x) <= 1e-9 * lmax:
+        if not (model.com_excursion(x) <= 1e-9 * lmax and model.balance_error(x) <= 1e-9):
             return math.nan, f"{status}, but its design's centre of mass moves"
     return float(t.value), status
 
@@ -935,7 +1038,8 @@ def _borderline_case(rng, pid: int) -> Case | None:
         if fr.com_radius is None:
             fr.com_radius = float(rng.uniform(0.2, 1.0) * case.length_of(name))
     bounds = resolve(case)
-    vrows, _ = model.balance_rows(scales_of(bounds, case.kind))
+    # the SVD basis, as the seeds' problems were generated with (mass scale 1: no mixing)
+    vrows, _ = model.balance_rows(scales_of(bounds, case.kind), separate=False)
     value = own_extreme(case, bounds, vrows, index, kind)
     if value is None or not math.isfinite(value):
         return None
@@ -1134,13 +1238,18 @@ def check_result(case, design, result, bounds, model, obj, own, margin, run: Run
         mass = float(xb[0] + xb[4] + xb[8])
         fscale = mass * case.speed ** 2 * lmax
         excursion = model.com_excursion(xb) / lmax
+        per_link = model.balance_error(xb, tol=FORCE_TOL)
         info.update(force_rms_before=rms0, force_rms_after=rms1,
-                    force_over_scale=rms1 / fscale, com_excursion=excursion)
+                    force_over_scale=rms1 / fscale, com_excursion=excursion,
+                    balance_error=per_link)
         problems = []
         if not rms1 <= FORCE_TOL * fscale:
             problems.append(f"RMS shaking force {rms1:.3g} N = {rms1 / fscale:.3g}·M·ω²·l")
         if not excursion <= FORCE_TOL:
             problems.append(f"total centre of mass moves {excursion:.3g}·l")
+        if not per_link <= FORCE_TOL:
+            problems.append(f"total first moment of mass varies {per_link:.3g} of the links' "
+                            "own variations")
         if rms0 > 0 and not rms1 <= FORCE_REL_TOL * rms0:
             problems.append(f"RMS shaking force {rms1 / rms0:.3g} of the original's")
         if problems:
@@ -1187,13 +1296,24 @@ def check_result(case, design, result, bounds, model, obj, own, margin, run: Run
             flag("false-lower-bound", (
                 f"lower bound {result.lower_bound:.9g} above the independent optimum "
                 f"{jo:.9g} (excess {(result.lower_bound - jo) / ref:.3g}·J_ref)"))
-    if own.tight and math.isfinite(own.lower) and "inaccurate" not in own.status:
-        low = own.lower
+    def below(low: float) -> bool:
         eps = ref * (2 * OWN_DELTA * math.sqrt(max(low, 0.0) / ref) + OWN_DELTA ** 2)
         if obj.w_mass:
             eps += OWN_DELTA * ref
         claim = CLAIM_GAP * max(abs(low), CLAIM_FLOOR * ref)
-        if j_tool < low - claim - eps and not failed and "bound-violation" not in run.flags:
+        return j_tool < low - claim - eps and not failed and "bound-violation" not in run.flags
+
+    if (own.unnarrowed is not None and own.tight and math.isfinite(own.lower)
+            and below(own.lower)):
+        # The narrowed program's optimum is no lower bound: the program as the bounds are
+        plain = own.unnarrowed()
+        own.unnarrowed = None
+        own.lower, own.tight = plain.lower, own.tight and plain.tight
+        own.status = f"{own.status}; unnarrowed {plain.status}"
+        info.update(j_own_lower=own.lower, own_status=own.status)
+    if own.tight and math.isfinite(own.lower) and "inaccurate" not in own.status:
+        low = own.lower
+        if below(low):
             flag("below-independent-optimum", (
                 f"J = {j_tool:.9g} below the independent optimum {low:.9g} "
                 f"({(low - j_tool) / ref:.3g}·J_ref)"))
@@ -1257,6 +1377,8 @@ def run_problem(case: Case, backends, keep: Path | None) -> tuple[list[Run], dic
         if plain.certified and (not own.certified or plain.objective < own.objective):
             own.x, own.objective, own.certified = plain.x, plain.objective, True
             own.violation = plain.violation
+    else:  # its lower value is the narrowed program's: solved as the bounds are when needed
+        own.unnarrowed = lambda: own_optimum(case, bounds, model, obj, vrows)
     meta["own_status"] = own.status
     meta["own_objective"] = own.objective
     meta["own_tight"] = own.tight
