@@ -845,7 +845,7 @@ class Design:
     simulation
         Settings for forward dynamics.
     balance
-        The redesign problem (``None`` if the spec has none); see :mod:`balancer.problem`.
+        The redesign problem (``None`` if the spec has none); see :mod:`balancer.balance.problem`.
     original
         The unbalanced design this one was derived from, if any (written by ``optimize``).
     title

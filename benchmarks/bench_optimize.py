@@ -41,8 +41,8 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import differential_evolution
 
-from balancer.optimize import Optimizer
-from balancer.problem import NumericProblem, numeric_problem
+from balancer.balance.optimizer import Optimizer
+from balancer.balance.problem import NumericProblem, numeric_problem
 from balancer.spec import load_design
 
 ROOT = Path(__file__).resolve().parent.parent

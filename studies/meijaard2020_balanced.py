@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from balancer.balance.optimizer import optimize
 from balancer.conditions import (
     berkof_residuals,
     force_balance_error,
@@ -39,7 +40,6 @@ from balancer.conditions import (
 from balancer.inverse import cycle_analysis
 from balancer.mechanisms.fourbar import FourBarMechanism
 from balancer.model import SimulationSettings
-from balancer.optimize import optimize
 from balancer.plots import COLOURS, SERIES, plot_reactions, save_png
 from balancer.report import markdown_table
 from balancer.simulate import simulate

@@ -15,18 +15,18 @@ import pytest
 from conftest import CLASS_EXAMPLES, PAPER_LENGTHS, paper_linkage, paper_links, random_linkage
 
 from balancer import spec
-from balancer.cli import main
-from balancer.errors import AssemblyError, SpecError
-from balancer.inverse import cycle_analysis  # the paper's routes: independent of the regressors
-from balancer.mechanisms import mechanism_of
-from balancer.model import Design, FourBar, Operation
-from balancer.problem import (
+from balancer.balance.problem import (
     BalanceProblem,
     LinkFreedom,
     Objective,
     numeric_problem,
     resolve_link,
 )
+from balancer.cli import main
+from balancer.errors import AssemblyError, SpecError
+from balancer.inverse import cycle_analysis  # the paper's routes: independent of the regressors
+from balancer.mechanisms import mechanism_of
+from balancer.model import Design, FourBar, Operation
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

@@ -345,11 +345,10 @@ def test_partial_balancing_matches_the_classic_closed_form():
     the counterweight's force is a pure first harmonic, so the optimum balances the rotating
     masses and the fraction w_x/(w_x + w_y) of the reciprocating mass (the rod split into two
     masses at its joints; its centre of mass on its line)."""
-    from balancer.optimize.nlp import NlpSolver
-
+    from balancer.balance.nlp import NlpSolver
+    from balancer.balance.optimizer import optimize
+    from balancer.balance.problem import numeric_problem
     from balancer.mechanisms import mechanism_of
-    from balancer.optimize import optimize
-    from balancer.problem import numeric_problem
 
     base = spec.load_design(EXAMPLES / "engine.toml")
     for wx, wy in ((1.0, 1.0), (3.0, 1.0), (1.0, 4.0)):
@@ -418,7 +417,7 @@ def _least_curvature(objective, x, indices, step):
 
 def test_full_force_balance_with_a_rod_counterweight():
     """Eq. 20a–b as constraints in both backends: crank and rod counterweights."""
-    from balancer.optimize import optimize
+    from balancer.balance.optimizer import optimize
 
     text = (EXAMPLES / "engine.toml").read_text()
     text = text.replace("force_balance = false", "force_balance = true").replace(

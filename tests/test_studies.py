@@ -15,11 +15,11 @@ from types import ModuleType
 
 import numpy as np
 import pytest
-from balancer.optimize.result import GAP_TOLERANCE
 from conftest import PAPER_LENGTHS
 from helpers import drift_bound, growth, integration_bound
 
 from balancer import kinematics as kin
+from balancer.balance.result import GAP_TOLERANCE
 from balancer.model import SimulationSettings
 from balancer.simulate import simulate
 

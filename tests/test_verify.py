@@ -7,10 +7,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from balancer.optimize.result import GAP_TOLERANCE
 from helpers import integration_bound
 
 from balancer import spec
+from balancer.balance.result import GAP_TOLERANCE
 from balancer.cli import main
 from balancer.conditions import berkof_residuals, force_balance_error
 from balancer.verify import verify

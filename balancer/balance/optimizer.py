@@ -19,7 +19,7 @@ The objective is **inertial**: applied loads are left out (see :mod:`balancer.ba
 Example::
 
     from balancer import load_design
-    from balancer.optimize import optimize
+    from balancer.balance.optimizer import optimize
     result = optimize(load_design("examples/pb1.toml"))
     result.success, result.status, result.objective, result.gap
 """

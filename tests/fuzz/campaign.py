@@ -56,8 +56,8 @@ from .generate import (  # noqa: E402
 def _preload() -> None:
     """Import what the commands import, once, so that each forked child starts fast."""
     import balancer.api  # noqa: F401
+    import balancer.balance.optimizer  # noqa: F401
     import balancer.cli  # noqa: F401
-    import balancer.optimize  # noqa: F401
     import balancer.plots  # noqa: F401
     import balancer.report  # noqa: F401
     import balancer.simulate  # noqa: F401
