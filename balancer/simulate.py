@@ -300,7 +300,10 @@ class _Stepper:
         near = [p for p in change_points
                 if abs(math.remainder(theta1 - p, 2 * math.pi)) < CHANGE_POINT_NEAR]
         cause = (f"near the change point θ1 = {near[0]:.6g} rad (all joints in line), where "
-                 "the crank's rate does not determine the others'" if near else
+                 "the crank's rate does not determine the others'"
+                 + ("" if f.passes_change_points else
+                    f"; the {f.name} formulation cannot pass it{_passing_change(f.f.linkage)}")
+                 if near else
                  "where the motion is too sensitive for these tolerances (masses or loads of "
                  "very different magnitudes, or a near-singular configuration)")
         raise SolverError(
@@ -338,6 +341,8 @@ class _WithExtraWork:
         self.f = f
         self.minimal = f.minimal
         self.passes_dead_points = f.passes_dead_points
+        self.passes_change_points = f.passes_change_points
+        self.name = f.name
 
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         own = y[:-1]
@@ -357,6 +362,13 @@ class _WithExtraWork:
 
     def change_points(self) -> tuple[float, ...]:
         return self.f.change_points()
+
+
+def _passing_change(model) -> str:
+    """The formulations of a mechanism that pass change points, as a parenthesis."""
+    names = [n for n in formulation_table(model)
+             if formulation_class(n, model).passes_change_points]
+    return f" ({' and '.join(names)} can)" if names else ""
 
 
 def _passing(model) -> str:

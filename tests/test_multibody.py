@@ -196,3 +196,21 @@ def test_the_six_bar_through_every_verb(tmp_path, capsys):
     assert math.isfinite(doc["max_shaking_force"])
     assert main(["plot", str(spec), "--animate", str(tmp_path / "a.gif"), "--frames", "6"]) == 0
     assert (tmp_path / "a.gif").stat().st_size > 0
+
+
+def test_the_multibody_formulation_names_a_change_point_it_cannot_pass():
+    # A parallelogram under gravity reaches its change point (all joints in line) where the
+    # constraints are dependent: the saddle-point system is singular, so the run stalls and
+    # says where, why, and which formulations follow the smooth motion through it.
+    from balancer.errors import SolverError
+    from balancer.model import FourBar, Link
+
+    links = [Link(mass=m, inertia=0.01, e=length / 2, f=0.0)
+             for m, length in ((1.0, 0.1), (2.0, 0.25), (1.5, 0.1))]
+    mech = FourBar(lengths=(0.1, 0.25, 0.1, 0.25), crank=links[0], coupler=links[1],
+                   rocker=links[2], branch="+")
+    settings = SimulationSettings(duration=5.0, theta1=math.atan2(0.8, 0.6), omega1=0.0,
+                                  gravity=(0.0, -9.81))
+    with pytest.raises(SolverError, match=r"change point θ1 = 3\.14159 rad.*multibody "
+                                          r"formulation cannot pass it \(opened-loop"):
+        simulate(mech, settings, method="multibody", rtol=1e-10, atol=1e-12)

@@ -144,6 +144,8 @@ class Formulation(ABC):
     minimal: ClassVar[bool]
     #: Whether the formulation passes a dead point of the crank (coupler and rocker aligned).
     passes_dead_points: ClassVar[bool] = False
+    #: Whether it follows the smooth motion through a change point (all joints in line).
+    passes_change_points: ClassVar[bool] = True
 
     def __init__(
         self,

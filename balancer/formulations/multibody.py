@@ -101,6 +101,8 @@ class Multibody(Formulation):
     name = "multibody"
     minimal = False
     passes_dead_points = True
+    #: At a change point its constraints are dependent and the saddle-point system singular.
+    passes_change_points = False
 
     def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
@@ -302,6 +304,10 @@ class Multibody(Formulation):
         return [flat[s] for s in self._slices]
 
     # -- the formulation's interface ----------------------------------------------------------
+
+    def change_points(self) -> tuple[float, ...]:
+        """The mechanism's change points: the driver names them if the motion stalls there."""
+        return self.mech.change_points()
 
     def transmission_of_crank(self, theta1: float) -> float:
         from ..mechanisms.base import _gaps

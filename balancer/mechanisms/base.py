@@ -187,6 +187,14 @@ class Mechanism(ABC):
             self.structure.cache["assembly"] = _assembly_range(self.structure)
         return self.structure.cache["assembly"]
 
+    def change_points(self) -> tuple[float, ...]:
+        """Crank angles where the assemblies meet and the smooth motion passes (none in general).
+
+        There every joint of a loop is in line: the constraints are dependent, and a
+        formulation in absolute coordinates cannot tell the branches apart.
+        """
+        return ()
+
     def require_full_revolution(self, purpose: str) -> AssemblyRange:
         """The assembly range, if the crank turns a full revolution.
 

@@ -86,6 +86,9 @@ class FourBarMechanism(Mechanism):
     def assembly_range(self) -> AssemblyRange:
         return fourbar.assembly_range(self.model.lengths)
 
+    def change_points(self) -> tuple[float, ...]:
+        return fourbar.change_point_angles(self.model.lengths)
+
     def motion(self, theta1: ArrayLike, omega1: ArrayLike = 0.0,
                alpha1: ArrayLike = 0.0) -> Motion:
         """The closed form (Eq. 2–10) on the smooth motion's branch, as a general motion."""
