@@ -214,3 +214,33 @@ def test_the_multibody_formulation_names_a_change_point_it_cannot_pass():
     with pytest.raises(SolverError, match=r"change point θ1 = 3\.14159 rad.*multibody "
                                           r"formulation cannot pass it \(opened-loop"):
         simulate(mech, settings, method="multibody", rtol=1e-10, atol=1e-12)
+
+
+def test_initial_angles_are_continued_from_the_reference_pose():
+    # DESIGN.md: a link's angle is its principal value at the reference pose, continuous from
+    # there on. Independent route: the reference angle plus the integral of the link's rate
+    # (at unit crank rate) over the crank's path, by Simpson's rule; its error is estimated by
+    # halving the step (the difference of the two), and the tolerance is ten times that.
+    from pathlib import Path
+
+    from scipy.integrate import simpson
+
+    from balancer.formulations import make
+    from balancer.spec import load_design
+
+    design = load_design(Path(__file__).resolve().parent.parent / "examples" / "jansen_leg.toml")
+    f = make("multibody", design.mechanism)
+    s = f.structure
+    start = s.ref_angle[s.input]
+    for turn in (3.0, -3.0, 2 * math.pi + 1.0):
+        angles = f.initial_state(start + turn, 1.0)[2 : 3 * f.n : 3]
+        estimates = []
+        for count in (2001, 4001):
+            grid = np.linspace(start, start + turn, count)
+            rates = f.mech.motion(grid, 1.0, 0.0).rate
+            estimates.append(np.array([s.ref_angle[k] + simpson(np.broadcast_to(
+                rates[k], grid.shape), x=grid) for k in range(f.n)]))
+        error = np.max(np.abs(estimates[1] - estimates[0]))
+        assert np.max(np.abs(angles - estimates[1])) < 10 * error + 1e-12, turn
+    # a link other than the crank whose angle passes ±π: what a principal value would miss
+    assert max(abs(a) for k, a in enumerate(angles) if k != s.input) > math.pi

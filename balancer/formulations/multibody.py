@@ -342,9 +342,30 @@ class Multibody(Formulation):
 
             raise AssemblyError("the linkage cannot be assembled at the initial crank angle",
                                 key="simulation.theta1", value=theta1)
-        q[3 * self.structure.input + 2] = theta1  # the input's angle as given (continuous)
+        q[2::3] = self._continued_angles(theta1)
         y = np.concatenate([q, qd])
         return np.append(y, 0.0) if self.driven else y
+
+    def _continued_angles(self, theta1: float) -> NDArray[np.float64]:
+        """The links' angles at crank angle ``theta1``, continuous from the reference pose.
+
+        DESIGN.md: each link's angle is its principal value at the reference pose and
+        continuous from there on; the crank is followed from the reference's angle to
+        ``theta1`` in steps of at most 0.05 rad, each link's angle unwrapped along the way (the
+        input's is ``theta1`` as given).
+        """
+        s = self.structure
+        start = s.ref_angle[s.input]
+        steps = max(2, int(math.ceil(abs(theta1 - start) / 0.05)) + 1)
+        with np.errstate(all="ignore"):
+            mo = self.mech.motion(np.linspace(start, theta1, steps))
+        out = np.empty(self.n)
+        for k in range(self.n):
+            path = np.concatenate([[s.ref_angle[k]], np.broadcast_to(
+                np.asarray(mo.pose.angles[k], dtype=float), (steps,))])
+            out[k] = np.unwrap(path)[-1] if np.all(np.isfinite(path)) else path[-1]
+        out[s.input] = theta1
+        return out
 
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         k = 3 * self.n
