@@ -35,29 +35,12 @@ def force_balance_residuals(linkage: FourBar) -> tuple[complex, complex]:
     return complex(c14), complex(c34)
 
 
-def named_force_balance_residuals(linkage) -> dict[str, complex]:
-    """The force-balance residuals of either mechanism by name, kg.
-
-    Four-bar: ``c14``, ``c34`` (Eq. 57); slider-crank: ``eq20a``, ``eq20b`` (Wunderlich).
-    """
-    if linkage.type == "slider-crank":
-        from .slider_crank.conditions import force_balance_residuals as slider_residuals
-
-        a, b = slider_residuals(linkage)
-        return {"eq20a": a, "eq20b": b}
-    c14, c34 = force_balance_residuals(linkage)
-    return {"c14": c14, "c34": c34}
-
-
 def force_balance_error(linkage: FourBar) -> float:
-    """Largest force-balance residual relative to the total mass (dimensionless).
+    """Largest force-balance residual of Eq. 57 relative to the total mass (dimensionless).
 
-    Eq. 57 for a four-bar, Wunderlich's Eq. 20a–b for a slider-crank.
+    (A slider-crank's, Wunderlich's Eq. 20a–b: :func:`balancer.slider_crank.conditions.
+    force_balance_error`; any mechanism's: :mod:`balancer.balance.conditions`.)
     """
-    if linkage.type == "slider-crank":
-        from .slider_crank.conditions import force_balance_error as slider_error
-
-        return slider_error(linkage)
     c14, c34 = force_balance_residuals(linkage)
     return max(abs(c14), abs(c34)) / linkage.total_mass
 

@@ -295,14 +295,9 @@ class Regressors:
 
 
 def parameter_vector(linkage) -> NDArray[np.float64]:
-    """The design vector ``x`` of :class:`Regressors`.
-
-    For a slider-crank, rod and slider take the places of coupler and rocker, and the second
-    counter-rotor entry is zero.
-    """
+    """The design vector ``x`` of :class:`Regressors` (a four-bar's)."""
     values = [v for link in linkage.links for v in inertial_parameters(link)]
-    third = linkage.links[2].counter_rotor if linkage.type == "four-bar" else 0.0
-    values += [linkage.crank.counter_rotor, third]
+    values += [linkage.crank.counter_rotor, linkage.rocker.counter_rotor]
     return np.array(values, dtype=float)
 
 
