@@ -245,16 +245,23 @@ class Multibody(Formulation):
         """One function from a state to ``q̈``, ``λ`` and the forces on the frame (MX).
 
         The saddle-point system ``[[M, Φ_qᵀ], [Φ_q, 0]]·[q̈; λ] = [Q; γ]`` is solved by
-        CasADi's QR at each call: one compiled call per right-hand side.
+        CasADi's QR at each call: one compiled call per right-hand side. It is equilibrated
+        first with constant diagonal scalings — ``D = diag(M)^(-1/2)`` on the coordinates (M's
+        diagonal, the links' masses and inertias about their frames' origins, is constant) and
+        ``R`` making the rows of ``Φ_q·D`` unit at the reference pose — so that links whose
+        masses and inertias differ by orders of magnitude do not cost the solve its accuracy.
         """
         k = 3 * self.n
         q = ca.MX.sym("q", k)
         qd = ca.MX.sym("qd", k)
         gas = ca.MX.sym("gas", max(1, len(self.structure.prisms)))
         mass, force, jac, gamma = self._equations(q, qd, gas)
-        kkt = ca.blockcat([[mass, jac.T], [jac, ca.MX(self.rows, self.rows)]])
-        z = ca.solve(kkt, ca.vertcat(force, gamma), "qr")
-        acc, lam = z[:k], z[k:]
+        d, r = self._equilibration()
+        dq, rl = ca.diag(ca.DM(d)), ca.diag(ca.DM(r))
+        kkt = ca.blockcat([[dq @ mass @ dq, dq @ jac.T @ rl],
+                           [rl @ jac @ dq, ca.MX(self.rows, self.rows)]])
+        z = ca.solve(kkt, ca.vertcat(dq @ force, rl @ gamma), "qr")
+        acc, lam = dq @ z[:k], rl @ z[k:]
         outputs = [acc, lam, *self._frame(q, qd, gas, lam, acc)]
         self._dynamics = ca.Function("dynamics", [q, qd, gas], outputs)
         #: Where each output sits in the flat vector of :attr:`_fast_dynamics`.
@@ -264,6 +271,19 @@ class Multibody(Formulation):
         self._fast_dynamics = _Compiled(ca.Function(
             "dynamics_flat", [flat], [ca.densify(ca.vertcat(*self._dynamics(
                 flat[:k], flat[k : 2 * k], flat[2 * k :])))]))
+
+    def _equilibration(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The constant scalings ``D`` (coordinates) and ``R`` (constraint rows), diagonals."""
+        k = 3 * self.n
+        q0 = self.structure.reference_coordinates()
+        mass, _, jac, _ = (np.array(x) for x in self._equations(q0, np.zeros(k),
+                                                                 np.zeros(max(1, len(
+                                                                     self.structure.prisms)))))
+        diag = np.diag(mass)
+        d = np.where(diag > 0, 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0)), 1.0)
+        norms = np.linalg.norm(jac * d[None, :], axis=1)
+        r = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
+        return d, r
 
     def _build_constraints(self, q, pose: Pose) -> None:
         """The constraints' residual and Jacobian at a pose and a prescribed crank angle (SX)."""
@@ -448,8 +468,16 @@ class Multibody(Formulation):
         count = len(times)
         ys = np.array(states, dtype=float).reshape(count, -1)
         gas = np.array([self._gas(self.theta1_of(t, y)) for t, y in zip(times, ys, strict=True)])
-        out = self._dynamics.map(count).call([ca.DM(ys[:, :n].T), ca.DM(ys[:, n : 2 * n].T),
-                                              ca.DM(gas.T)])
+        try:
+            out = self._dynamics.map(count).call([ca.DM(ys[:, :n].T),
+                                                  ca.DM(ys[:, n : 2 * n].T), ca.DM(gas.T)])
+        except RuntimeError:  # CasADi's QR on a system singular to working precision
+            from ..errors import SolverError
+
+            raise SolverError(
+                "the multibody equations of motion are singular to working precision at an "
+                "output state (a singular pose, or masses and inertias of very different "
+                "magnitudes)") from None
         acc, _, ground, normal, couple, frame = (np.asarray(x.full()) for x in out)
         ground = ground.reshape(-1, count)
         return Evaluation(
