@@ -21,7 +21,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ("watt_sixbar.toml", "stephenson_sixbar.toml")
-REPEATS = 5
+REPEATS = 3
 
 
 def _timed(fn) -> list[float]:
