@@ -363,6 +363,8 @@ class SliderCrank:
 
 #: The name of the general linkage's frame: a link without mass whose points do not move.
 GROUND = "ground"
+#: Names a moving link may not have: the keys of ``[balance]`` beside the links' tables.
+RESERVED_LINK_NAMES = ("objective", "force_balance")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -509,6 +511,9 @@ class Linkage:
                 raise SpecError("a link needs a name", key="links", value=body.name)
             if body.name in names:
                 raise SpecError("is given twice", key=key)
+            if body.name in RESERVED_LINK_NAMES:
+                raise SpecError(f"is a name the spec reserves ([balance.{body.name}] means "
+                                "something else); call the link otherwise", key=key)
             if (isinstance(body.points, str) or not hasattr(body.points, "__len__")
                     or not body.points or not all(isinstance(p, str) for p in body.points)):
                 raise SpecError("must be a non-empty list of point names", key=f"{key}.points",

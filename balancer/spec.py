@@ -246,10 +246,14 @@ def _read_link(table: _Table, name: str, mechanism_class, frame=None) -> Link:
             key=com.path,
         )
     if at:
-        if frame is None:
+        if mechanism_class is not Linkage:
             raise SpecError("at = [x, y] is for the links of a general linkage (type = "
                             '"linkage"); give {e, f} or {s, sigma}', key=com.key("at"))
-        origin, angle = frame
+        # Without a frame (unknown or coincident points, a one-point link without its one
+        # slider or with a zero direction) the linkage itself names the cause when it is
+        # built; until then the centre of mass stays at the origin of the link.
+        origin, angle = frame if frame is not None else (complex(*com.vector2(
+            "at", default=(0.0, 0.0))), 0.0)
         x, y = com.vector2("at", default=(0.0, 0.0))
         local = (complex(x, y) - origin) * cmath.exp(-1j * angle)
         e, f = local.real, local.imag

@@ -112,3 +112,21 @@ def test_a_four_bar_balanced_as_a_linkage_reaches_the_same_optimum(example):
     assert abs(linkage.rms - four_bar.rms) <= 2 * GAP_TOLERANCE * four_bar.scale
     assert abs(linkage.before.summary.shaking_moment.rms
                - four_bar.before.summary.shaking_moment.rms) <= 1e-9 * four_bar.scale
+
+
+@pytest.mark.parametrize(("change", "key"), [
+    # a link may not take a name that [balance] reserves for itself
+    (lambda t: t.replace("[links.link5]", "[links.objective]"), "links.objective"),
+    # a centre of mass given `at` a point on a link whose frame is undefined: the linkage names
+    # the cause (its first two points coincide), not the `at`
+    (lambda t: t.replace("C  = [3.6, 3.4]", "C  = [1.4, 2.6]").replace(
+        'com = { e = 1.0, f = -0.1 }', 'com = { at = [1.0, 2.0] }'), "links.link5.points"),
+])
+def test_linkage_spec_errors_name_their_cause(tmp_path, capsys, change, key):
+    from test_multibody import WATT
+
+    path = tmp_path / "bad.toml"
+    path.write_text(change(WATT))
+    assert main(["analyze", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{key}:" in err and err.count("\n") == 1
