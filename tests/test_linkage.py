@@ -130,3 +130,14 @@ def test_linkage_spec_errors_name_their_cause(tmp_path, capsys, change, key):
     assert main(["analyze", str(path)]) == 2
     err = capsys.readouterr().err
     assert f"{key}:" in err and err.count("\n") == 1
+
+
+def test_a_radius_of_gyration_that_squares_to_zero_is_no_crash(tmp_path, capsys):
+    # min_gyration = 1e-300 (fuzz): ρ² underflows to 0, and the mass bound m ≤ I_max/ρ² that
+    # it implies was a division by zero; it implies no bound.
+    from test_multibody import WATT
+
+    path = tmp_path / "tiny.toml"
+    path.write_text(WATT + "\n[balance]\n[balance.crank]\nmass = [1.0, 3.0]\n"
+                    "inertia = [0.1, 0.6]\nmin_gyration = 1e-300\n")
+    assert main(["analyze", str(path)]) == 0

@@ -589,8 +589,8 @@ def resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> Lin
         inertia = (0.0, math.inf)
     else:
         inertia = (link.inertia, link.inertia)
-    if rho > 0 and math.isfinite(inertia[1]):
-        mass = (mass[0], min(mass[1], inertia[1] / rho**2))
+    if rho * rho > 0 and math.isfinite(inertia[1]):  # (a radius of 1e-300 squares to 0)
+        mass = (mass[0], min(mass[1], inertia[1] / (rho * rho)))
     if rotor_entry is not None and freedom.counter_rotor is not None:
         rotor = freedom.counter_rotor
     return LinkBounds(
