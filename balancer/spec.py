@@ -554,7 +554,8 @@ def load_design(path: str | os.PathLike[str]) -> Design:
     except OSError as exc:
         raise SpecError(f"cannot read the file ({exc.strerror})", source=str(p)) from None
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
+        # "utf-8-sig": a byte-order mark, as some Windows editors write, is not content
+        data = tomllib.loads(raw.decode("utf-8-sig"))
     except UnicodeDecodeError:
         raise SpecError("not a UTF-8 text file", source=str(p)) from None
     except tomllib.TOMLDecodeError as exc:

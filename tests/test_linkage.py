@@ -141,3 +141,11 @@ def test_a_radius_of_gyration_that_squares_to_zero_is_no_crash(tmp_path, capsys)
     path.write_text(WATT + "\n[balance]\n[balance.crank]\nmass = [1.0, 3.0]\n"
                     "inertia = [0.1, 0.6]\nmin_gyration = 1e-300\n")
     assert main(["analyze", str(path)]) == 0
+
+
+def test_a_spec_saved_with_a_byte_order_mark_loads(tmp_path):
+    # Some Windows editors start a UTF-8 file with a byte-order mark (fuzz: "not valid TOML at
+    # line 1, column 1"); it is not content.
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + (EXAMPLES / "meijaard2020.toml").read_bytes())
+    assert load_design(path) == load_design(EXAMPLES / "meijaard2020.toml")
