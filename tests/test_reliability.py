@@ -16,6 +16,7 @@ import pytest
 from fuzz.checks import without_dac_override
 
 from balancer import spec
+from balancer.balance.result import GAP_TOLERANCE, InfeasibleError
 from balancer.cli import main
 from balancer.errors import AssemblyError, OutputError, SolverError, SpecError
 from balancer.model import Design, FourBar, Link, Operation, SimulationSettings, SliderCrank
@@ -383,13 +384,14 @@ def test_the_optimality_claim_is_stated_in_newton_metres_against_the_problems_sc
     assert result.rms_gap <= 1e-6 * result.scale and result.gap == pytest.approx(
         result.rms_gap / result.scale, abs=1e-15)
     assert "globally optimal" in result.message and "N·m" in result.message
-    # The certified bound sits below Clarabel's optimum by CERTIFICATE_MARGIN times its
-    # tolerances (100·2e-10 of the scale in the norm's units; the tie-break may add TIE_ACCEPT):
-    # a claim of optimality can only err on the safe side.
-    from balancer.optimize.convex import CERTIFICATE_MARGIN, CLARABEL_SETTINGS, TIE_ACCEPT
+    # The certified bound holds by weak duality and sits below the optimum by no more than
+    # Clarabel's dual residual over the box of the scaled variables (within 100·2e-10 of the
+    # scale in the norm's units; the tie-break may add TIE_ACCEPT): a claim of optimality can
+    # only err on the safe side.
+    from balancer.optimize.convex import CLARABEL_SETTINGS, TIE_ACCEPT
 
-    slack = CERTIFICATE_MARGIN * (CLARABEL_SETTINGS["tol_gap_abs"] + CLARABEL_SETTINGS["tol_feas"])
-    assert 0 < result.rms - result.rms_lower_bound <= (2 * slack + TIE_ACCEPT) * result.scale
+    slack = 100 * (CLARABEL_SETTINGS["tol_gap_abs"] + CLARABEL_SETTINGS["tol_feas"])
+    assert 0 < result.rms - result.rms_lower_bound <= (slack + TIE_ACCEPT) * result.scale
 
 
 def test_masses_of_very_different_scales_are_balanced_to_the_rounding_of_each_condition():
@@ -565,6 +567,139 @@ def test_a_thin_feasible_set_gives_a_design_that_holds_its_bounds_exactly(pid):
         assert result.success, (backend, result.message)
         assert _balanced_bounds_hold(data, result.linkage) == [], backend
         assert data.force_balance_residual(result.x) <= FORCE_BALANCE_TOLERANCE, backend
+
+
+@pytest.mark.parametrize("pid", sorted(THIN_PROBLEMS))
+def test_a_thin_feasible_set_is_certified_optimal(pid):
+    """Clarabel stops "almost solved" on a thin feasible set (its cones nearly without
+    interior). The bound was then taken a hundred times its reduced tolerances (2·5e-5) below
+    its value: 200's design matched the independent optimum to 2e-11, yet the gap was 0.054
+    N·m (2.4 % of the scale), "feasible, not proven optimal". The bound is now weak duality at
+    Clarabel's multipliers, which an "almost solved" stop leaves as accurate as the others."""
+    design = spec.loads_design(THIN_PROBLEMS[pid])
+    data = numeric_problem(design)
+    for backend in ("convex", "nlp"):
+        result = optimize(design, backend=backend)
+        assert result.status is Status.OPTIMAL, (backend, result.message)
+        assert -data.rounding(result.x) <= result.gap <= GAP_TOLERANCE, backend
+
+
+# Problems of the same campaign planted infeasible: force balance needs one bound 1-2e-7
+# (relative) wider than it is. The key of that bound, and the spec.
+NEARLY_FEASIBLE = {
+    # the coupler's centre of mass within 0.24005715 m of A1; it needs 0.24005719 m
+    337: ("balance.coupler.com_radius", """\
+[mechanism]
+type = "four-bar"
+branch = "+"
+[mechanism.lengths]
+crank = 0.7928262389839612
+coupler = 1.501832056948528
+rocker = 1.373733466165018
+frame = 1.232917752791669
+[links.crank]
+mass = 1.0016583661167933
+inertia = 0.03296631525614908
+com = { e = 0.08661903424687838, f = -0.15002072015436538 }
+[links.coupler]
+mass = 2.9087554024807503
+inertia = 0.8695020469226065
+com = { e = 1.2483354736771737, f = 0.27016417249092833 }
+[links.rocker]
+mass = 3.24115375157201
+inertia = 0.16373225149434548
+com = { e = 1.0695144672002657, f = -0.22076033349716928 }
+[operation]
+speed = 0.8526252789287223
+samples = 360
+[balance]
+force_balance = true
+[balance.objective]
+shaking_moment = 0.34813893573241916
+added_mass = 0.921778684570626
+[balance.crank]
+mass = [0.9586136058601031, 4.858660450116809]
+com_radius = 1.2130596247023813
+min_gyration = 0.1101224070551655
+counter_rotor = [0.0, 0.8508667427456263]
+[balance.coupler]
+com_radius = 0.24005715309306297
+com_about = "A1"
+min_gyration = 0.077535839845908
+[balance.rocker]
+mass = [1.6992451750608975, 4.512844405247426]
+"""),
+    # the coupler's mass at most 2.2350819 kg; it needs 2.2350821 kg
+    380: ("balance.coupler.mass", """\
+[mechanism]
+type = "four-bar"
+branch = "+"
+[mechanism.lengths]
+crank = 0.48002949774252335
+coupler = 0.7986707363447685
+rocker = 0.7701385086078798
+frame = 0.82871366721545
+[links.crank]
+mass = 1.6848591589251563
+inertia = 0.009527169690890097
+com = { e = 0.483183650099573, f = -0.08451248213420864 }
+counter_rotor = 0.005882442270722753
+[links.coupler]
+mass = 3.3528975723599848
+inertia = 0.00615140878945141
+com = { e = 0.07879058048534286, f = 0.056406569850036066 }
+[links.rocker]
+mass = 3.5914840441400533
+inertia = 0.1167604086240222
+com = { e = -0.1521311012937773, f = -0.23790955837078967 }
+[operation]
+speed = 163.28019684294483
+samples = 24
+[balance]
+force_balance = true
+[balance.objective]
+shaking_moment = 1.0
+[balance.coupler]
+mass = [1.117540942682042, 2.235081885364084]
+com_radius = 0.6152132983674664
+com_about = "A2"
+min_gyration = 0.08195153599031474
+[balance.rocker]
+mass = [1.125675578083515, 12.398331206313134]
+com_radius = 1.5283832892623912
+com_about = "A3"
+min_gyration = 0.1863856940675251
+counter_rotor = [0.0, 45.3588349095985]
+"""),
+}
+
+
+@pytest.mark.parametrize("pid", sorted(NEARLY_FEASIBLE))
+def test_a_problem_infeasible_by_1e_7_is_called_infeasible_naming_the_bound(pid):
+    """Both ended "failed" (no feasible design, no diagnosis). The diagnosis took the problem
+    for feasible: on 337 from programs Clarabel solved only "almost" (their values, a crank
+    mass of 2.15 kg where none suffices, met its reduced tolerances), on 380 because the
+    crank's fixed centre of mass would have had to move only 1e-11 m, within the 1e-9·l it
+    allowed, though no design can move a fixed value. Now only accurately solved values
+    count, and a bound that needs more than it allows beyond Clarabel's tolerance decides."""
+    key, text = NEARLY_FEASIBLE[pid]
+    design = spec.loads_design(text)
+    for backend in ("convex", "nlp"):
+        with pytest.raises(InfeasibleError) as info:
+            optimize(design, backend=backend)
+        assert info.value.exit_code == 1
+        assert str(info.value).startswith("force balance cannot be met within the bounds: ")
+        needed = {k: (value, current) for k, value, current, _ in info.value.needed}
+        assert key in needed and key in str(info.value), (backend, str(info.value))
+    # The value asked for suffices.
+    value, current = needed[key]
+    if key.endswith("com_radius"):
+        old, new = f"com_radius = {current!r}", f"com_radius = {value!r}"
+    else:
+        old, new = f"{current!r}]", f"{value!r}]"
+    assert value > current and old in text
+    widened = optimize(spec.loads_design(text.replace(old, new)), backend="convex")
+    assert widened.success, widened.message
 
 
 def test_a_centre_of_mass_put_onto_a_small_disc_far_from_the_frames_origin_stays_inside():

@@ -19,18 +19,23 @@ m·f)`` and ``c`` the position of ``com_about`` in the link's frame:
 
 Objective: ``‖K·x‖`` (the root of the weighted mean squares, minimised as a norm so that a zero
 optimum is reached accurately), or ``‖K·x‖² + w_m·Δm`` when mass is penalised; ``K`` is
-compressed to its square triangular factor ``R``.
+compressed to its square triangular factor ``R``, and ``R·T`` (in the free variables) to its
+numerical rank for the solver: the shaking's harmonic content often gives it far fewer
+independent rows than the design vector has entries, and rows of rounding inside the norm's
+cone spoil Clarabel's equilibration (it then stalls "almost solved" at 1e-10).
 
-Two stages: the SOCP gives the optimum (the lower bound); then, because the optimum is usually
-not unique (the crank's inertia and counter-rotor do nothing at constant speed, the shaking
-moment sees only the difference of the rocker's inertia and its counter-rotor, and complete
-balance leaves a whole family of couplers), a **tie-break** picks, among the designs that give
-the same ``K·x`` (unique at the optimum, as ``J`` is strictly convex in it) and the same total
-mass, the one nearest the original in scaled parameters.
+Two stages: the SOCP gives the optimum, and its multipliers the certified lower bound (weak
+duality, :mod:`balancer.balance.certificate`: valid whatever Clarabel's tolerances and
+status); then, because the optimum is usually not unique (the crank's inertia and
+counter-rotor do nothing at constant speed, the shaking moment sees only the difference of the
+rocker's inertia and its counter-rotor, and complete balance leaves a whole family of
+couplers), a **tie-break** picks, among the designs that give the same ``K·x`` (unique at the
+optimum, as ``J`` is strictly convex in it) and the same total mass, the one nearest the
+original in scaled parameters.
 
-An infeasible problem (force balance cannot be met within the bounds) is diagnosed by an elastic
-(phase-1) problem with a slack on each bound and raises :class:`InfeasibleError` naming the
-bounds to widen and the values that would do.
+An infeasible problem (force balance cannot be met within the bounds) is diagnosed from the
+value each bound needs alone (or an elastic, phase-1, problem with a slack on each bound) and
+raises :class:`InfeasibleError` naming the bounds to widen and the values that would do.
 
 Variables are scaled per link (kg by the original mass, kg·m by ``m·l``, kg·m² by ``m·l²``) and
 the objective by the original design's; both problems are built once per
@@ -49,6 +54,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import SolverError
+from .certificate import Constraint, Objective, lower_bound
 from .problem import FORCE_BALANCE_TOLERANCE, ROUNDING_TOLERANCE, NumericProblem
 from .result import InfeasibleError, StageReport
 
@@ -75,12 +81,12 @@ MARGIN = 1e-8
 ACTIVE_INSIDE = 1e-12
 #: A slack of the elastic problem above this (in scaled units) names a bound to widen.
 SLACK_TOLERANCE = 1e-7
+#: How far beyond its bound (relative to the bound's scale) the value a bound needs alone
+#: must lie to be evidence (:meth:`ConvexSolver.diagnose`): ten times Clarabel's tolerance
+#: (1e-10, scaled units) on that value.
+NEEDED_TOLERANCE = 1e-9
 
 _SOLVED = ("optimal", "optimal_inaccurate")
-#: Clarabel's reduced tolerances (``reduced_tol_*``), which an "almost solved" stop meets.
-REDUCED_TOLERANCE = 5e-5
-#: How many times Clarabel's tolerances the certified lower bound lies below its optimum.
-CERTIFICATE_MARGIN = 100.0
 
 
 @dataclass(frozen=True)
@@ -178,7 +184,8 @@ class ConvexSolution:
     objective
         ``J(x)``, (N·m)².
     lower_bound
-        The SOCP's optimum: no feasible design does better (to Clarabel's tolerance), (N·m)².
+        No feasible design does better, (N·m)²: weak duality at the SOCP's multipliers
+        (:mod:`balancer.balance.certificate`), whatever Clarabel's tolerances.
     relaxation_tight
         Whether the convex optimum met the exact (non-convex) inertia bounds.
     converged
@@ -215,29 +222,57 @@ class ConvexSolver:
         self._scale = data.objective_scale
         lay = self.layout
         x = lay.c + lay.T @ self._u
-        constraints, self._relaxed = self._constraints(x)
+        constraints, self._cones, self._relaxed = self._constraints()
         self._fb: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._bound_cons = constraints[:]  # one per entry of self._cones, in order
         self._failed_row = -1  # a row of Eq. 58 with nothing free that fails
         self._inconsistent = self._force_balance(x, constraints)
         k = data.factor.shape[0]
         r = data.factor / self._scale
         p_matrix, q_vector = r @ lay.T, r @ lay.c
         w_mass = data.weights.added_mass / self._scale**2
-        mass = sum(x[i] for i in data.mass_entries)
-        mass_term = (mass - data.original_mass) * w_mass if w_mass else 0.0
+        mass_row = lay.T[data.mass_entries].sum(axis=0) * w_mass
+        mass_offset = (float(lay.c[data.mass_entries].sum()) - data.original_mass) * w_mass
         self._norm_form = w_mass == 0 and k > 0
+        # The objective as the certificate sees it: the full factor.
+        self._objective = Objective(P=p_matrix, q=q_vector, norm=self._norm_form,
+                                    g=mass_row, g0=mass_offset)
+        # The solver sees the factor compressed to its numerical rank: R·T has as many rows as
+        # the design vector but rank only as large as the shaking's harmonic content (6 for
+        # the crank-shaper against 22 rows); rows of rounding (1e-16 of the others) inside a
+        # second-order cone spoil its equilibration, and Clarabel stalled "almost solved" at
+        # 1e-10. ‖P·u + q‖² = ‖Σ₁·V₁ᵀ·u + U₁ᵀ·q‖² + ‖U₂ᵀ·q‖², dropping only σ of rounding.
         if k:
-            residual = p_matrix @ self._u + q_vector
-            if self._norm_form:
-                value = cp.norm(residual)
-            else:
-                value = cp.sum_squares(residual) + mass_term
+            u_left, sv, vt = np.linalg.svd(p_matrix, full_matrices=True)
+        else:
+            u_left, sv, vt = np.zeros((0, 0)), np.zeros(0), np.zeros((0, n))
+        eps = np.finfo(float).eps
+        rank = int(np.sum(sv > 16 * eps * max(p_matrix.shape) * sv.max(initial=0.0)))
+        p_rank = sv[:rank, None] * vt[:rank]
+        q_rank = u_left[:, :rank].T @ q_vector
+        q_rest = float(np.linalg.norm(u_left[:, rank:].T @ q_vector))
+        mass_term = mass_row @ self._u + mass_offset if w_mass else 0.0
+        # The norm's multiplier, in the full factor's rows (for the certificate): the rows
+        # kept, and the direction of q's part in the rest.
+        rest = u_left[:, rank:].T @ q_vector
+        rest_dir = u_left[:, rank:] @ (rest / q_rest) if q_rest > 0 else np.zeros(k)
+        self._dual_basis = np.column_stack([u_left[:, :rank], rest_dir]) if k else None
+        self._epigraph = None
+        if k and self._norm_form:
+            # In epigraph form, so that the norm's multiplier is the cone constraint's dual.
+            t = cp.Variable(name="t")
+            self._epigraph = cp.SOC(t, cp.hstack([p_rank @ self._u + q_rank,
+                                                   np.array([q_rest])]))
+            value = t
+        elif k:
+            value = cp.sum_squares(p_rank @ self._u + q_rank) + q_rest**2 + mass_term
         else:
             value = mass_term
         # finalize's projections by margin, built when first needed
         self._projections: dict[float, cp.Problem] = {}
         self._target = cp.Parameter(n, name="target")
-        self._stage1 = cp.Problem(cp.Minimize(value), constraints)
+        epigraph = [] if self._epigraph is None else [self._epigraph]
+        self._stage1 = cp.Problem(cp.Minimize(value), [*constraints, *epigraph])
         self._stage1_data: tuple | None = None  # CVXPY's compiled form, made on the first solve
         # Tie-break. J is strictly convex in y = P·u, so every optimal design has the same y
         # (and, with mass penalised, the same total mass): fix them at the SOCP's values, in an
@@ -246,8 +281,7 @@ class ConvexSolver:
         # meets only "almost"; its violations, once repaired, cost more than the tie-break.)
         rows = []
         if k:
-            _, sv, vt = np.linalg.svd(p_matrix, full_matrices=False)
-            rows = list(vt[sv > 1e-12 * sv.max(initial=0.0)])
+            rows = list(vt[: sv.size][sv > 1e-12 * sv.max(initial=0.0)])
         if w_mass:
             masses = lay.T[data.mass_entries].sum(axis=0)
             g = masses
@@ -265,16 +299,41 @@ class ConvexSolver:
 
     # -- building ------------------------------------------------------------------------------
 
-    def _constraints(self, x, margin: float = 0.0) -> tuple[list, list[str]]:
+    def _constraints(self, margin: float = 0.0) -> tuple[list, list[Constraint], list[str]]:
         """The bounds as cone constraints, each tightened by ``margin`` (relative, scaled units).
 
-        A range narrower than twice the margin is kept as it is (its ends are what the
-        designer gave).
+        Returns the CVXPY constraints, the same constraints in numbers
+        (:class:`~.certificate.Constraint`, in the same order: the certificate evaluates them)
+        and the links whose upper inertia bound is relaxed. A range narrower than twice the
+        margin is kept as it is (its ends are what the designer gave).
         """
         data, lay = self.data, self.layout
-        out: list = []
+        out: list[Constraint] = []
         relaxed: list[str] = []
         free = set(lay.primary)
+
+        def entry(i: int, scale: float) -> tuple[NDArray[np.float64], float]:
+            """``x[i]/scale`` as an affine function ``(a, a0)`` of the variables."""
+            return lay.T[i] / scale, float(lay.c[i] / scale)
+
+        def at_least(a, lo: float) -> None:  # a ≥ lo
+            out.append(Constraint("nonneg", a[0][None, :], np.array([a[1] - lo])))
+
+        def at_most(a, hi: float) -> None:  # a ≤ hi
+            out.append(Constraint("nonneg", -a[0][None, :], np.array([hi - a[1]])))
+
+        def norm_at_most(rows, rhs) -> None:  # ‖rows‖ ≤ rhs, each an affine (a, a0)
+            out.append(Constraint("soc", np.array([rhs[0]] + [a for a, _ in rows]),
+                                  np.array([rhs[1]] + [a0 for _, a0 in rows])))
+
+        def quad_at_most(rows, den, rhs) -> None:  # ‖rows‖²/den ≤ rhs: ‖(2·w, s − t)‖ ≤ s + t
+            norm_at_most([combine((2.0, a)) for a in rows] + [combine((1.0, den), (-1.0, rhs))],
+                         combine((1.0, den), (1.0, rhs)))
+
+        def combine(*terms) -> tuple[NDArray[np.float64], float]:
+            """``Σ w·a`` of ``(w, a)`` pairs."""
+            return (sum(w * a[0] for w, a in terms),  # type: ignore[return-value]
+                    float(sum(w * a[1] for w, a in terms)))
 
         def inside(lo: float, hi: float) -> tuple[float, float]:
             return (lo + margin, hi - margin) if hi - lo > 2 * margin else (lo, hi)
@@ -282,50 +341,100 @@ class ConvexSolver:
         for b in data.links:
             k = b.start
             mref, l, iref = b.mass_ref, b.length, b.inertia_ref
-            m = x[k] / mref
+            m = entry(k, mref)
             if k in free:
                 lo, hi = inside(b.mass[0] / mref, b.mass[1] / mref)
-                out += [m >= lo, m <= hi]
-            se, sf = x[k + 1] / (mref * l), x[k + 2] / (mref * l)
+                at_least(m, lo)
+                at_most(m, hi)
+            se, sf = entry(k + 1, mref * l), entry(k + 2, mref * l)
             centre = b.com_centre / l  # complex, in the link's frame
             if b.com_fixed is None:
                 radius = b.com_radius / l
                 radius = radius - margin if radius > 2 * margin else radius
-                out.append(cp.norm(cp.hstack([se - centre.real * m, sf - centre.imag * m]))
-                           <= radius * m)
+                norm_at_most([combine((1.0, se), (-centre.real, m)),
+                              combine((1.0, sf), (-centre.imag, m))], combine((radius, m)))
             if (k + 3) not in free:
                 continue  # inert, or fixed inertia with a fixed centre of mass: nothing to ask
-            j = x[k + 3] / iref
+            j = entry(k + 3, iref)
             rho2 = (b.gyration / l) ** 2
             lo, hi = b.inertia[0] / iref, b.inertia[1] / iref
             lo_m = lo + margin if hi - lo > 2 * margin else lo
             hi_m = hi - margin if hi - lo > 2 * margin else hi
             if b.com_fixed is not None:
-                inertia = j - m * abs(b.com_fixed / l) ** 2
-                out.append(inertia >= lo_m)
+                inertia = combine((1.0, j), (-abs(b.com_fixed / l) ** 2, m))
+                at_least(inertia, lo_m)
                 if rho2:
-                    out.append(inertia >= rho2 * m + margin)
+                    at_least(combine((1.0, inertia), (-rho2, m)), margin)
                 if math.isfinite(hi):
-                    out.append(inertia <= hi_m)
+                    at_most(inertia, hi_m)
                 continue
-            q = cp.quad_over_lin(cp.hstack([se, sf]), m)
-            if lo > 0 or not rho2:
-                out.append(q <= j - lo_m)
-            if rho2:
-                out.append(q <= j - rho2 * m - margin)
-            if math.isfinite(hi):
+            if lo > 0 or not rho2:  # ‖S‖²/m ≤ J − lo
+                quad_at_most([se, sf], m, (j[0], j[1] - lo_m))
+            if rho2:  # ‖S‖²/m ≤ J − ρ²·m − margin
+                room = combine((1.0, j), (-rho2, m))
+                quad_at_most([se, sf], m, (room[0], room[1] - margin))
+            if math.isfinite(hi):  # J − hi ≤ m·(R² − |c|²) + 2·c·S
                 radius = b.com_radius / l
-                out.append(j - hi_m <= m * (radius**2 - abs(centre) ** 2)
-                           + 2 * (centre.real * se + centre.imag * sf))
+                cap = combine((radius**2 - abs(centre) ** 2, m), (2 * centre.real, se),
+                              (2 * centre.imag, sf), (-1.0, j))
+                at_least(cap, -hi_m)
                 relaxed.append(b.name)
         for b in data.rotor_links:
-            entry = b.rotor
-            if entry in free:
+            k = b.rotor
+            if k in free:
                 assert b.counter_rotor is not None
-                scale = data.scales[entry]
+                scale = data.scales[k]
                 lo, hi = inside(b.counter_rotor[0] / scale, b.counter_rotor[1] / scale)
-                out += [x[entry] / scale >= lo, x[entry] / scale <= hi]
-        return out, relaxed
+                at_least(entry(k, scale), lo)
+                at_most(entry(k, scale), hi)
+        return [self._cvxpy(c) for c in out], out, relaxed
+
+    def _cvxpy(self, con: Constraint):
+        """The CVXPY form of one numeric constraint (:meth:`_constraints`)."""
+        u = self._u
+        if con.kind == "nonneg":
+            return con.M[0] @ u + con.m[0] >= 0
+        return cp.SOC(con.M[0] @ u + con.m[0], con.M[1:] @ u + con.m[1:])
+
+    def _box(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Bounds of each variable over the SOCP's feasible set (scaled; ``hi`` may be ∞).
+
+        A mass between its bounds; a first moment within its disc at any allowed mass; an
+        inertia about the frame's origin ``J = I + m·|s̄|²`` at least ``max(I_low, m·ρ²)``
+        (plus ``m·|s̄|²`` for a fixed centre of mass) and at most ``I_high + m·(R + |c|)²``
+        (the relaxed bound of :meth:`_constraints` allows no more), unbounded without
+        ``I_high``; a counter-rotor between its bounds.
+        """
+        data, lay = self.data, self.layout
+        lo = np.full(lay.size, -np.inf)
+        hi = np.full(lay.size, np.inf)
+        index = {entry: j for j, entry in enumerate(lay.primary)}
+        for b in data.links:
+            k = b.start
+            m_lo, m_hi = b.mass
+            ranges = {k: (m_lo, m_hi)}
+            if b.com_fixed is None:
+                for i, c in ((k + 1, b.com_centre.real), (k + 2, b.com_centre.imag)):
+                    low, high = c - b.com_radius, c + b.com_radius
+                    ranges[i] = (min(m_lo * low, m_hi * low), max(m_lo * high, m_hi * high))
+            for i, (low, high) in ranges.items():
+                if i in index:
+                    lo[index[i]], hi[index[i]] = low / data.scales[i], high / data.scales[i]
+            if k + 3 in index:
+                base = max(b.inertia[0], m_lo * b.gyration**2)
+                reach = abs(b.com_fixed) if b.com_fixed is not None else (
+                    abs(b.com_centre) + b.com_radius)
+                if b.com_fixed is not None:
+                    base += m_lo * reach**2
+                scale = data.scales[k + 3]
+                lo[index[k + 3]] = base / scale
+                hi[index[k + 3]] = (b.inertia[1] + m_hi * reach**2) / scale
+        for b in data.rotor_links:
+            if b.rotor in index:
+                assert b.counter_rotor is not None
+                j = index[b.rotor]
+                lo[j], hi[j] = (v / data.scales[b.rotor] for v in b.counter_rotor)
+        return lo, hi
 
     def _force_balance(self, x, constraints: list) -> bool:
         """Add Eq. 58 (rows that involve a free variable); say whether a fixed row fails.
@@ -393,7 +502,7 @@ class ConvexSolver:
                 cp.CLARABEL, solver_opts=self.settings
             )
         data, chain, inverse = self._stage1_data
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
             warnings.filterwarnings("ignore", message="Solution may be inaccurate")
             solution = chain.solve_via_data(self._stage1, data, solver_opts=self.settings)
             self._stage1.unpack_results(solution, chain, inverse)
@@ -426,9 +535,14 @@ class ConvexSolver:
         if not ok:
             raise self._infeasible(f"Clarabel: {report.solver_status} after "
                                    f"{report.iterations} iterations")
-        value = float(self._stage1.value)
-        lower = self._certified_lower_bound(value, str(self._stage1.status))
         u1 = np.array(self._u.value)
+        multipliers = [_dual(c, con.M.shape[0]) for c, con in zip(self._bound_cons, self._cones,
+                                                                  strict=True)]
+        norm_dual = None
+        if self._epigraph is not None and self._dual_basis is not None:
+            # CVXPY's Lagrangian is t − (μ·t + w·(P·u + q)): the norm's minorant is −w.
+            dual = _dual(self._epigraph, self._dual_basis.shape[1] + 1)
+            norm_dual = -(self._dual_basis @ dual[1:])
         x, tight = self.repair(u1)
         objective = data.objective(x)
         if tie_break and lay.size:
@@ -447,6 +561,7 @@ class ConvexSolver:
             x, objective = self.polish(x, target, objective)
         x = data.settle(x)  # the inert entries, for a crank whose speed changes
         x, feasible = self.finalize(x)
+        lower = self._lower_bound(u1, multipliers, norm_dual, x if feasible else None)
         return ConvexSolution(
             x=x,
             objective=data.objective(x),
@@ -456,29 +571,35 @@ class ConvexSolver:
             stages=tuple(stages),
         )
 
-    def _certified_lower_bound(self, value: float, status: str) -> float:
-        """A lower bound on ``J`` that the SOCP's optimum ``value`` (scaled) certifies, (N·m)².
+    def _lower_bound(self, u: NDArray[np.float64], multipliers: list[NDArray[np.float64]],
+                     norm_dual: NDArray[np.float64] | None,
+                     feasible: NDArray[np.float64] | None) -> float:
+        """The certified lower bound on ``J``, (N·m)².
 
-        Clarabel stops when its primal and dual objectives agree to ``tol_gap_abs +
-        tol_gap_rel·|value|`` and its residuals are below ``tol_feas`` (in the scaled units of
-        this problem, where the original design's objective is about 1). The dual objective is
-        a true lower bound when the dual is feasible; its residual, times the size of the
-        variables, can shift it further. Measured against an independent solve, the primal
-        value exceeded the optimum by up to ten times those tolerances at a zero optimum; the
-        bound is taken :data:`CERTIFICATE_MARGIN` times them below the primal value. An
-        "almost solved" stop has its reduced tolerances (Clarabel's ``reduced_tol_*``).
+        By weak duality from the SOCP's solution ``u`` and its multipliers, repaired
+        (:func:`.certificate.lower_bound`): valid whatever Clarabel's tolerances and status,
+        and as tight as its dual is accurate. ``feasible`` (a design that meets every bound)
+        bounds an inertia that has no upper bound on the objective's sublevel set. Where that
+        certificate cannot be made (an unbounded direction of the wrong sign that the
+        objective does not bound, a solution that is not finite), the bound that needs no
+        solver: ``J ≥ 0``, or with added mass penalised ``J ≥ w_m·(Σ m_low − Σ m_original)``.
         """
-        st = self.settings
-        if status == "optimal":
-            slack_abs = st["tol_gap_abs"] + st["tol_feas"]
-            slack_rel = st["tol_gap_rel"] + st["tol_feas"]
-        else:
-            slack_abs = slack_rel = 2 * REDUCED_TOLERANCE
-        certified = value - CERTIFICATE_MARGIN * (slack_abs + slack_rel * abs(value))
+        upper = None
+        if feasible is not None:
+            f = self._objective.value(self.layout.u(feasible))
+            upper = f + abs(f) + 1e-9  # above the optimum, whatever the design's rounding
+        equality = None if self._fb is None else self._fb[:2]
+        lo, hi = self._box()
+        bound = lower_bound(self._objective, self._cones, equality, u, multipliers, norm_dual,
+                            lo, hi, upper)
         scale = self._scale
-        if self._norm_form:
-            return (max(certified, 0.0) * scale) ** 2  # the norm ‖R·x‖ was minimised
-        return certified * scale**2
+        if bound is not None and self._norm_form:
+            return (max(bound.value, 0.0) * scale) ** 2
+        if bound is not None:
+            return bound.value * scale**2
+        data = self.data
+        least = sum(b.mass[0] for b in data.links) - data.original_mass
+        return data.weights.added_mass * least  # ‖K·x‖² ≥ 0 and every mass at least its least
 
     def _fixed_row_error(self) -> InfeasibleError:
         """A condition of Eq. 58 that nothing free enters, and fails: name its links."""
@@ -687,9 +808,7 @@ class ConvexSolver:
         With Eq. 58 as equalities; ``None`` if that set is empty or Clarabel fails.
         """
         if margin not in self._projections:
-            lay = self.layout
-            x = lay.c + lay.T @ self._u
-            constraints, _ = self._constraints(x, margin=margin)
+            constraints, _, _ = self._constraints(margin=margin)
             if self._fb is not None:
                 at, rhs, _ = self._fb
                 constraints.append(at @ self._u == rhs)
@@ -881,15 +1000,26 @@ class ConvexSolver:
         First each bound alone (a mass bound, a centre-of-mass radius; a fixed mass or centre
         of mass too): with every other bound kept, the value it needs is computed exactly (the
         least radius by the Charnes–Cooper form of ``‖S − m·c‖/m``, a mass by a linear
-        objective). The bounds that suffice alone are reported, those the spec already gives
-        as ranges first, smallest relative change first. If no single bound suffices, an
-        elastic (phase-1) problem puts a nonnegative slack on every bound (ten times the
-        weight on a fixed quantity; slacks in common units: kg over the total mass, kg·m over
-        the total mass times the longest link) and minimises their weighted sum subject to
-        Eq. 58; its nonzero slacks name the bounds, and its design the values that suffice
-        together. (Only force balance can make the problem infeasible: every other condition
-        is met by some inertia, and :func:`~balancer.balance.problem.check_problem` has rejected
-        empty ranges.) Returns ``None`` when no bound needs widening: the problem is feasible.
+        objective; only a solve that Clarabel calls "optimal" counts: one that stops "almost
+        solved" meets its constraints only to ~1e-5, and a program infeasible by 1e-7, as
+        these are when the problem is, looks solved to that). In exact arithmetic every bound
+        tells the same: the problem is feasible exactly when each needs no more than it
+        allows. Each value is off by Clarabel's tolerance, so a bound is evidence only beyond
+        :data:`NEEDED_TOLERANCE` (of its scale) either side of it: one that allows that much
+        more than it needs makes the problem feasible; otherwise one that needs that much more
+        than it allows makes it infeasible, whatever the others say within the tolerance (a
+        heavy link's fixed centre of mass may need to move only 1e-11 m where a light link
+        lacks 1e-7 of its mass; and no design moves a fixed value at all). The bounds to
+        widen are reported, those the spec already gives as ranges first, smallest relative change
+        first. If no bound alone was solved, an elastic (phase-1) problem puts a nonnegative
+        slack on every bound (ten times the weight on a fixed quantity; slacks in common
+        units: kg over the total mass, kg·m over the total mass times the longest link) and
+        minimises their weighted sum subject to Eq. 58; its nonzero slacks name the bounds,
+        and its design the values that suffice together. (Only force balance can make the
+        problem infeasible: every other condition is met by some inertia, and
+        :func:`~balancer.balance.problem.check_problem` has rejected empty ranges.) Returns
+        ``None`` when no bound needs widening (the problem is feasible), or when no value lies
+        beyond the tolerance (undecided: the problem is no more than that far from feasible).
         """
         data = self.data
         groups = []
@@ -897,15 +1027,21 @@ class ConvexSolver:
             groups += [(b.index, "mass-low"), (b.index, "mass-high")]
             groups.append((b.index, "com" if b.com_fixed is None else "com-fixed"))
         ranked = []
+        infeasible = solved = False
         for group in groups:
             value = self._needed(group)
             if value is None:
                 continue
+            solved = True
             i, kind = group
             b = data.links[i]
             lo, hi = b.mass
-            if self._allowed(b, kind, value):
+            excess = self._excess(b, kind, value)
+            if excess < -NEEDED_TOLERANCE:
                 return None  # with every bound kept, force balance is met: feasible
+            infeasible = infeasible or excess > NEEDED_TOLERANCE
+            if excess <= 0:
+                continue
             if kind == "mass-high":
                 ranked.append((lo == hi, value / hi - 1, group, value))
             elif kind == "mass-low":
@@ -914,13 +1050,15 @@ class ConvexSolver:
                 ranked.append((False, (value - b.com_radius) / b.length, group, value))
             else:
                 ranked.append((True, value / b.length, group, value))
-        if ranked:
-            ranked.sort(key=lambda item: item[:2])
-            best = [r for r in ranked if r[0] == ranked[0][0]][:3]
-            items, parts = zip(*(self._describe(g, v) for _, _, g, v in best), strict=True)
-            message = "force balance cannot be met within the bounds: " + ", or ".join(parts)
-            return InfeasibleError(message, needed=tuple(items), jointly=False)
-        return self._elastic()
+        if not solved:
+            return self._elastic()
+        if not infeasible or not ranked:
+            return None  # feasible, or undecided within Clarabel's tolerance
+        ranked.sort(key=lambda item: item[:2])
+        best = [r for r in ranked if r[0] == ranked[0][0]][:3]
+        items, parts = zip(*(self._describe(g, v) for _, _, g, v in best), strict=True)
+        message = "force balance cannot be met within the bounds: " + ", or ".join(parts)
+        return InfeasibleError(message, needed=tuple(items), jointly=False)
 
     def _elastic(self) -> InfeasibleError | None:
         """The phase-1 problem of :meth:`diagnose`, for when no single bound suffices."""
@@ -970,18 +1108,18 @@ class ConvexSolver:
         return InfeasibleError(message + " (together)", needed=tuple(items), jointly=True)
 
     @staticmethod
-    def _allowed(b, kind: str, value: float) -> bool:
-        """Whether the value a bound group needs (:meth:`_needed`) is within it already.
+    def _excess(b, kind: str, value: float) -> float:
+        """How far the value a bound group needs (:meth:`_needed`) lies beyond its bound.
 
-        To Clarabel's tolerance (1e-9 of the bound's scale).
+        Relative to the bound's scale (the link's mass or length); ``≤ 0``: within it.
         """
         if kind == "mass-high":
-            return value <= b.mass[1] + 1e-9 * b.mass_ref
+            return (value - b.mass[1]) / b.mass_ref
         if kind == "mass-low":
-            return value >= b.mass[0] - 1e-9 * b.mass_ref
+            return (b.mass[0] - value) / b.mass_ref
         if kind == "com":
-            return value <= b.com_radius + 1e-9 * b.length
-        return value <= 1e-9 * b.length  # a fixed centre of mass: it need not move
+            return (value - b.com_radius) / b.length
+        return value / b.length  # a fixed centre of mass: how far it must move
 
     def _centre(self, b, kind: str) -> complex:
         """The point a radius is measured from: ``com_about``, or the default point."""
@@ -990,7 +1128,10 @@ class ConvexSolver:
         return self.data.mechanism.structure.local[(b.index, b.default_about)].complex()
 
     def _needed(self, group: tuple[int, str]) -> float | None:
-        """The exact bound group ``group`` needs with every other bound kept (or ``None``)."""
+        """The exact bound group ``group`` needs with every other bound kept.
+
+        ``None`` if that program is infeasible too, or Clarabel did not solve it accurately.
+        """
         i, kind = group
         b = self.data.links[i]
         m = cp.Variable(len(self.data.links))
@@ -1012,7 +1153,7 @@ class ConvexSolver:
             _solve(problem, self.settings)
         except cp.error.SolverError:
             return None
-        if problem.status not in _SOLVED:
+        if problem.status != "optimal":  # "almost solved": its value is not to be trusted
             return None
         return float(problem.value) * scale
 
@@ -1051,9 +1192,23 @@ class ConvexSolver:
         )
 
 
+def _dual(constraint, size: int) -> NDArray[np.float64]:
+    """A constraint's multiplier as one flat vector (NaN where the solver gave none)."""
+    value = constraint.dual_value
+    if value is None:
+        return np.full(size, np.nan)
+    parts = value if isinstance(value, list | tuple) else [value]
+    flat = np.concatenate([np.ravel(np.asarray(p, dtype=float)) for p in parts])
+    return flat if flat.size == size else np.full(size, np.nan)
+
+
 def _solve(problem: cp.Problem, settings: dict) -> None:
-    """Solve with Clarabel; an inaccurate solution is judged by its status, not a warning."""
-    with warnings.catch_warnings():
+    """Solve with Clarabel; an inaccurate solution is judged by its status, not a warning.
+
+    (A run stopped at its iteration limit can leave iterates of 1e155, whose objective CVXPY
+    evaluates: that overflow is no news either.)
+    """
+    with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
         warnings.filterwarnings("ignore", message="Solution may be inaccurate")
         problem.solve(solver=cp.CLARABEL, **settings)
 

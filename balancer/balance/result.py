@@ -19,7 +19,8 @@ from ..model import Design
 
 #: Gap to the certified lower bound, relative to the problem's scale (the original design's
 #: RMS; :meth:`balancer.balance.problem.NumericProblem.gap`), within which a design is called
-#: globally optimal. The bound is certified to ~2e-8 of that scale, the tie-break accepts 1e-8.
+#: globally optimal. The bound holds by weak duality (:mod:`balancer.balance.certificate`) and
+#: lies ~1e-9 of that scale below the optimum; the tie-break accepts 1e-8.
 GAP_TOLERANCE = 1e-6
 
 
@@ -100,8 +101,8 @@ class BalanceResult:
     original_objective
         ``J`` of the original design, (N·m)².
     lower_bound
-        Certified by the convex program's optimum and its tolerances: no feasible design has a
-        smaller ``J``, (N·m)².
+        Certified by weak duality at the convex program's multipliers (whatever the solver's
+        tolerances): no feasible design has a smaller ``J``, (N·m)².
     gap
         The design's gap to the lower bound relative to :attr:`scale`: ``(√J − √J_low)/scale``
         for a mean-square objective, else ``(J − J_low)/scale²``; dimensionless.

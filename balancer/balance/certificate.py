@@ -1,0 +1,312 @@
+"""A lower bound on the convex balancing program's optimum by weak duality, free of tolerances.
+
+The second-order cone program of :mod:`.convex`, in its scaled variables ``u``, is
+
+    minimise f(u)  subject to  M_i·u + m_i ∈ K_i (i = 1…m),  E·u = r,
+
+with ``f`` the norm ``‖P·u + q‖`` (or ``‖P·u + q‖² + g·u + g0`` when added mass is penalised)
+and each ``K_i`` the nonnegative reals (a bound) or a second-order cone (a centre of mass in its
+disc; a realisable inertia, ``‖S‖²/m ≤ t`` as ``‖(2·S, m − t)‖ ≤ m + t``). For multipliers
+``z_i`` in the (self-dual) cones, any ``ν`` and ``‖v‖ ≤ 1``, every feasible ``u`` has
+
+    ‖P·u + q‖ ≥ v·(P·u + q) ≥ v·(P·u + q) − Σ z_i·(M_i·u + m_i) + ν·(E·u − r) = α + ρ·u
+
+(for the sum of squares, ``‖w‖² ≥ 2·v·w − ‖v‖²`` with ``v`` the solution's residual). Over a
+box ``[lo, hi]`` that holds a minimiser the optimum is therefore at least
+``α + Σ_j min(ρ_j·lo_j, ρ_j·hi_j)``: a bound that holds whatever the solver's tolerances and
+status — they only make ``ρ`` larger than zero and the bound less tight. Clarabel's dual
+``(v, z, ν)``, projected onto the cones, leaves ``ρ`` at its dual residual (``1e-10``, ~1e-8
+"almost solved"); the free ``ν`` and the multipliers of the active bounds are then refitted
+(bounded least squares, :func:`lower_bound`) to cancel what they can of it. (Not the
+multipliers' own accuracy matters, but only this residual: a multiplier taken from the
+primal point instead, e.g. ``v = ∇‖P·û + q‖``, is off by the primal error, which a flat
+optimum leaves at the square root of the solver's tolerance.) Every choice of multipliers
+gives a valid bound, so a few are tried and the highest kept: ``v`` the solver's or the
+gradient at ``û`` (the solver's can be off by its tolerance in a direction the objective
+barely sees), the inactive cones' multipliers as given or zero (at the solver's
+complementarity tolerance they still pull an unbounded inertia's coefficient below zero).
+
+The box comes from the bounds themselves (see :meth:`.convex.ConvexSolver._box`). An inertia
+with no upper bound is bounded on the objective's sublevel set ``f ≤ U`` (``U`` the objective
+of a feasible design) through the objective's own columns, when they have full rank;
+otherwise its coefficient must be surely nonnegative, or no bound is given. The evaluation's
+rounding is bounded too: sums are exactly rounded (``math.fsum``) and the bound is lowered by
+``ε`` times the magnitudes of the products summed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import lsq_linear
+
+_EPS = float(np.finfo(float).eps)
+#: Multiplier (relative to the largest) above which a bound counts as active when the
+#: multipliers are refitted: an interior-point method leaves inactive ones at its
+#: complementarity tolerance (1e-10 of the active ones or less).
+ACTIVE_MULTIPLIER = 1e-7
+#: ... and whose value at the solver's point is within this of its cone's boundary (scaled
+#: units, relative to the constraint's size): it meets its active constraints to its
+#: feasibility tolerance (1e-10, 1e-5 "almost solved").
+ACTIVE_SLACK = 1e-4
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """A cone constraint ``M·u + m ∈ K``.
+
+    ``K`` is the nonnegative reals (``kind = "nonneg"``, one row) or the second-order cone
+    ``{(t, w): ‖w‖ ≤ t}`` (``"soc"``).
+    """
+
+    kind: str
+    M: NDArray[np.float64]
+    m: NDArray[np.float64]
+
+    def slack(self, u: NDArray[np.float64]) -> float:
+        """How far ``M·u + m`` lies inside the cone, relative to its size (< 0: outside)."""
+        s = self.M @ u + self.m
+        if self.kind == "nonneg":
+            return float(s[0]) / (1.0 + float(np.abs(self.M[0]) @ np.abs(u)))
+        return (float(s[0]) - float(np.linalg.norm(s[1:]))) / (1.0 + abs(float(s[0])))
+
+    def project(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The nearest point of the (self-dual) cone to ``z``."""
+        z = np.nan_to_num(np.asarray(z, dtype=float).reshape(-1))
+        if self.kind == "nonneg":
+            return np.maximum(z, 0.0)
+        t, w = z[0], z[1:]
+        nw = float(np.linalg.norm(w))
+        if nw <= -t:
+            return np.zeros_like(z)
+        if nw > t:
+            t = (t + nw) / 2
+            w = w * (t / nw)
+            nw = float(np.linalg.norm(w))
+        # inside the cone despite the rounding of the norm computed here
+        return np.r_[max(t, nw * (1 + 4 * (w.size + 2) * _EPS)), w]
+
+
+@dataclass(frozen=True)
+class Objective:
+    """``f(u) = ‖P·u + q‖`` (``norm``), else ``‖P·u + q‖² + g·u + g0``."""
+
+    P: NDArray[np.float64]
+    q: NDArray[np.float64]
+    norm: bool
+    g: NDArray[np.float64]
+    g0: float
+
+    def value(self, u: NDArray[np.float64]) -> float:
+        """``f(u)``."""
+        r = self.P @ u + self.q
+        if self.norm:
+            return float(np.linalg.norm(r))
+        return float(r @ r) + float(self.g @ u) + self.g0
+
+
+@dataclass(frozen=True)
+class Bound:
+    """A certified lower bound on the program's optimum, in its own (scaled) units.
+
+    Attributes
+    ----------
+    value
+        No feasible ``u`` has ``f(u)`` below it.
+    dual
+        ``α + ρ·û`` at the solver's point (what the bound would be with ``ρ = 0``).
+    residual
+        ``‖ρ‖∞``.
+    """
+
+    value: float
+    dual: float
+    residual: float
+
+
+def _sublevel_box(objective: Objective, lo, hi, upper: float) -> NDArray[np.float64] | None:
+    """``hi`` with the entries at ``∞`` bounded on ``{u in the box: f(u) ≤ upper}``.
+
+    ``‖P_J·u_J‖ ≤ ‖P·u + q‖ + max over the rest of the box of ‖P_o·u_o + q‖``; with ``P_J``
+    of full column rank, ``u_J = P_J⁺·(P_J·u_J)`` and ``|u_j| ≤ ‖row j of P_J⁺‖`` times that
+    (``P_J⁺ = V·Σ⁻¹·Uᵀ``, each singular value lowered by the SVD's own rounding). ``None`` if
+    it does not bound them.
+    """
+    free = ~np.isfinite(hi)
+    P = objective.P
+    if not P.shape[0] or not math.isfinite(upper):
+        return None
+    if objective.norm:
+        radius = max(upper, 0.0)
+    else:
+        g = objective.g
+        if np.any(g[free] != 0):
+            return None
+        low = float(np.sum(np.minimum(g[~free] * lo[~free], g[~free] * hi[~free])))
+        radius = math.sqrt(max(upper - low - objective.g0, 0.0))
+    po = P[:, ~free]
+    mid, half = (lo[~free] + hi[~free]) / 2, (hi[~free] - lo[~free]) / 2
+    rest = float(np.linalg.norm(po @ mid + objective.q)) + float(
+        np.linalg.norm(po, axis=0) @ half)
+    _, sv, vt = np.linalg.svd(P[:, free], full_matrices=False)
+    if sv.size < int(free.sum()):
+        return None
+    safe = sv - 64 * _EPS * sv[0] * max(P.shape)  # the SVD's own rounding
+    if not np.all(safe > 0):
+        return None
+    rows = np.sqrt(((vt / safe[:, None]) ** 2).sum(axis=0))  # ‖row j of P_J⁺‖
+    out = np.array(hi, dtype=float)
+    out[free] = (radius + rest) * rows * (1 + 1e-9)
+    return out
+
+
+def lower_bound(objective: Objective, constraints: list[Constraint], equality,
+                u: NDArray[np.float64], duals: list[NDArray[np.float64]],
+                v: NDArray[np.float64] | None, lo: NDArray[np.float64],
+                hi: NDArray[np.float64], upper: float | None) -> Bound | None:
+    """The bound of the module docstring, or ``None`` where the box does not bound it.
+
+    Parameters
+    ----------
+    objective, constraints, equality
+        The program: ``f``, the cones, and ``(E, r)`` (or ``None``).
+    u
+        The solver's point ``û`` (for the sum of squares' tangent, and the refit's weights).
+    duals
+        The solver's multiplier of each constraint (projected onto its cone here).
+    v
+        The norm's multiplier (``‖v‖ ≤ 1`` is imposed here); ``None`` for the sum of squares.
+    lo, hi
+        A box every feasible point lies in (``hi`` may be ``inf``).
+    upper
+        The objective of a feasible design (or ``None``): bounds the entries with
+        ``hi = ∞`` on the sublevel set, which holds every minimiser.
+    """
+    u = np.asarray(u, dtype=float)
+    if not np.all(np.isfinite(u)):
+        return None
+    P, q = objective.P, objective.q
+    # α and ρ are kept as the products they sum (summed exactly, math.fsum, at the end).
+    # The objective's minorant v·(P·u + q) (norm), 2·v·(P·u + q) − ‖v‖² + g·u + g0 (squares).
+    # For the norm, two choices of v, whichever bound is higher: the solver's multiplier, and
+    # the gradient at û (the solver's multiplier can be off by its dual tolerance in a
+    # direction the objective barely sees, which a far bound of the box multiplies).
+    minorants: list[tuple[list[NDArray[np.float64]], list[NDArray[np.float64]]]] = []
+    if objective.norm:
+        r_hat = P @ u + q
+        choices = [] if v is None else [np.nan_to_num(np.asarray(v, dtype=float))]
+        if float(np.linalg.norm(r_hat)) > 0:
+            choices.append(r_hat / float(np.linalg.norm(r_hat)))
+        for vv in choices or [np.zeros(P.shape[0])]:
+            # ‖v‖ ≤ 1 despite the rounding of the norm computed here
+            vv = vv / (max(1.0, float(np.linalg.norm(vv))) * (1 + 8 * (vv.size + 1) * _EPS))
+            minorants.append(([vv * q], [P * vv[:, None]]))
+    else:
+        vv = P @ u + q
+        minorants.append(([2 * vv * q, -(vv * vv), np.array([objective.g0])],
+                          [2 * P * vv[:, None], objective.g[None, :]]))
+    # The cones' multipliers as the solver gives them, and with those of the inactive ones
+    # (at its complementarity tolerance) set to zero: an inactive inertia cone's multiplier
+    # still pulls the coefficient of an inertia with no upper bound below zero.
+    zs = [c.project(z) for c, z in zip(constraints, duals, strict=True)]
+    top = max((float(z[0]) for z in zs), default=0.0)
+    active = [top > 0 and z[0] > ACTIVE_MULTIPLIER * top and c.slack(u) <= ACTIVE_SLACK
+              for c, z in zip(constraints, zs, strict=True)]
+    best: Bound | None = None
+    for zset in (zs, [z if a else np.zeros_like(z) for z, a in zip(zs, active, strict=True)]):
+        cone_a = [-(z * c.m) for c, z in zip(constraints, zset, strict=True)]
+        cone_r = [-(c.M * z[:, None]) for c, z in zip(constraints, zset, strict=True)]
+        for obj_a, obj_r in minorants:
+            bound = _refit(objective, constraints, equality, active, obj_a + cone_a,
+                           obj_r + cone_r, u, lo, hi, upper)
+            if bound is not None and (best is None or bound.value > best.value):
+                best = bound
+    return best
+
+
+def _refit(objective: Objective, constraints: list[Constraint], equality, active, a_terms,
+           r_terms, u, lo, hi, upper: float | None) -> Bound | None:
+    """The bound of :func:`lower_bound` for one choice of multipliers, refitted."""
+    n = u.size
+    rho = _column_sums(r_terms, n)[0]
+    hi = np.array(hi, dtype=float)
+    width = np.maximum(np.abs(lo - u), np.where(np.isfinite(hi), np.abs(hi - u), 0.0))
+    weight = np.where(np.isfinite(hi), width, 1e3 * float(np.max(width, initial=1.0)))
+    weight = np.maximum(weight, 1e-300)
+    # Refit: ν free, and a nonnegative addition to each active bound's multiplier (both terms
+    # vanish at û, so they cost the bound nothing there), to cancel what they can of ρ. (The
+    # scalar part of an active cone's multiplier may grow too, keeping it in the cone, but at
+    # the cost of its term at û: it did not pay.)
+    columns, offsets = [], []
+    for c, on in zip(constraints, active, strict=True):
+        if c.kind == "nonneg" and on:
+            columns.append(-c.M[0])
+            offsets.append(-float(c.m[0]))
+    signed = len(columns)
+    if equality is not None:
+        e, r = equality
+        columns += list(e)
+        offsets += list(-r)
+    extra_a: list[NDArray[np.float64]] = []
+    extra_r: list[NDArray[np.float64]] = []
+    if columns:
+        matrix = np.array(columns).T * weight[:, None]
+        bounds = (np.r_[np.zeros(signed), np.full(len(columns) - signed, -np.inf)],
+                  np.full(len(columns), np.inf))
+        fit = lsq_linear(matrix, -rho * weight, bounds=bounds, method="bvls", tol=1e-15,
+                         max_iter=500)
+        y = np.where(np.isfinite(fit.x), fit.x, 0.0)
+        y[:signed] = np.maximum(y[:signed], 0.0)
+        extra_a.append(y * np.array(offsets))
+        extra_r.append(np.array(columns) * y[:, None])
+    return _finish(objective, a_terms + extra_a, r_terms + extra_r, u, lo, hi, upper)
+
+
+def _column_sums(rows: list[NDArray[np.float64]], n: int
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Exactly rounded sums of the columns of the stacked ``rows``, and of their magnitudes."""
+    if not n or not rows:
+        return np.zeros(n), np.zeros(n)
+    stack = np.vstack([np.reshape(r, (-1, n)) for r in rows])
+    sums = np.array([math.fsum(stack[:, j]) for j in range(n)])
+    return sums, np.abs(stack).sum(axis=0)
+
+
+def _finish(objective: Objective, a_terms, r_terms, u, lo, hi,
+            upper: float | None) -> Bound | None:
+    """``α + Σ_j min(ρ_j·lo_j, ρ_j·hi_j)`` less the rounding of its evaluation.
+
+    ``α`` and ``ρ`` are the exactly rounded sums of the products ``a_terms`` and of the
+    columns of ``r_terms``; each product is off by at most ``ε/2`` of itself, each sum by
+    ``ε/2`` of its value, and the box, computed from the bounds, is widened by ``4·ε`` of
+    itself.
+    """
+    a = np.concatenate([np.ravel(t) for t in a_terms]) if a_terms else np.zeros(0)
+    alpha = math.fsum(a)
+    rho, rmag = _column_sums(r_terms, u.size)
+    if not (math.isfinite(alpha) and np.all(np.isfinite(rho)) and np.all(np.isfinite(rmag))):
+        return None
+    finite = np.isfinite(hi)
+    # An unbounded entry whose coefficient is not surely ≥ 0 (beyond its rounding) needs a
+    # finite bound: it could lower the bound without end.
+    if np.any(~finite & (rho <= _EPS * (rmag + np.abs(rho)))):
+        box = _sublevel_box(objective, lo, hi, math.inf if upper is None else upper)
+        if box is None:
+            return None
+        hi = box
+        finite = np.isfinite(hi)
+    lo = lo - 4 * _EPS * np.abs(lo)
+    top = np.where(finite, hi + 4 * _EPS * np.abs(hi), lo)  # ρ ≥ 0 there: least at lo
+    least = np.minimum(rho * lo, rho * top)
+    extent = np.maximum(np.abs(lo), np.abs(top))
+    bound = math.fsum([alpha, *least])
+    allowance = _EPS * (float(np.abs(a).sum()) + abs(alpha) + float((rmag + np.abs(rho)) @ extent)
+                        + float(np.abs(least).sum()) + abs(bound))
+    bound -= 2 * allowance
+    if not math.isfinite(bound):
+        return None
+    return Bound(value=bound, dual=alpha + float(rho @ u),
+                 residual=float(np.max(np.abs(rho), initial=0.0)))
