@@ -16,10 +16,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from balancer.optimize.convex import CLARABEL_SETTINGS, TIE_ACCEPT
 from conftest import random_linkage
 
 from balancer import spec
+from balancer.balance.convex import CLARABEL_SETTINGS, TIE_ACCEPT
+from balancer.balance.optimizer import ConvexSolver, InfeasibleError, Optimizer, Status, optimize
+from balancer.balance.problem import (
+    BalanceProblem,
+    LinkFreedom,
+    NumericProblem,
+    Objective,
+    numeric_problem,
+    physical_to_inertial,
+)
 from balancer.balance.result import GAP_TOLERANCE
 from balancer.conditions import (
     berkof_residuals,
@@ -29,15 +38,6 @@ from balancer.conditions import (
 from balancer.cycle import cycle_analysis
 from balancer.errors import SolverError, SpecError
 from balancer.model import Design, Operation
-from balancer.optimize import ConvexSolver, InfeasibleError, Optimizer, Status, optimize
-from balancer.problem import (
-    BalanceProblem,
-    LinkFreedom,
-    NumericProblem,
-    Objective,
-    numeric_problem,
-    physical_to_inertial,
-)
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

@@ -16,12 +16,12 @@ import pytest
 from fuzz.checks import without_dac_override
 
 from balancer import spec
+from balancer.balance.optimizer import Status, optimize
+from balancer.balance.problem import FORCE_BALANCE_TOLERANCE, NumericProblem, numeric_problem
 from balancer.balance.result import GAP_TOLERANCE, InfeasibleError
 from balancer.cli import main
 from balancer.errors import AssemblyError, OutputError, SolverError, SpecError
 from balancer.model import Design, FourBar, Link, Operation, SimulationSettings, SliderCrank
-from balancer.optimize import Status, optimize
-from balancer.problem import FORCE_BALANCE_TOLERANCE, NumericProblem, numeric_problem
 from balancer.report import csv_text, dumps_json
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -388,7 +388,7 @@ def test_the_optimality_claim_is_stated_in_newton_metres_against_the_problems_sc
     # Clarabel's dual residual over the box of the scaled variables (within 100·2e-10 of the
     # scale in the norm's units; the tie-break may add TIE_ACCEPT): a claim of optimality can
     # only err on the safe side.
-    from balancer.optimize.convex import CLARABEL_SETTINGS, TIE_ACCEPT
+    from balancer.balance.convex import CLARABEL_SETTINGS, TIE_ACCEPT
 
     slack = 100 * (CLARABEL_SETTINGS["tol_gap_abs"] + CLARABEL_SETTINGS["tol_feas"])
     assert 0 < result.rms - result.rms_lower_bound <= (slack + TIE_ACCEPT) * result.scale
@@ -412,7 +412,7 @@ def test_a_design_in_bounds_only_to_the_solvers_tolerance_is_projected_inside():
     broke a bound by 1e-9..1e-7 and was taken for being cheaper."""
     design = spec.load_design(EXAMPLES / "pb1.toml")
     data = numeric_problem(design)
-    from balancer.optimize import ConvexSolver
+    from balancer.balance.optimizer import ConvexSolver
 
     solver = ConvexSolver(data)
     x = solver.solve().x

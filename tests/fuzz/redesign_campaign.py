@@ -6,7 +6,7 @@ Run::
 
 Each problem is a seeded random ``[balance]`` redesign problem (four-bar of a full-turning
 crank on either branch, or slider-crank with offset), written as spec text and loaded with
-:func:`balancer.spec.loads_design`; :func:`balancer.optimize.optimize` is called with both
+:func:`balancer.spec.loads_design`; :func:`balancer.balance.optimizer.optimize` is called with both
 backends and its claims are checked against code that shares nothing with the package but the
 spec text:
 
@@ -35,7 +35,7 @@ feasible set is thinner), its inertias put into their bounds exactly, and its de
 meet every bound to 1e-9 (the tool's own feasibility tolerance); its ``J`` is then an upper
 bound of the optimum. A claim of global optimality is false when the tool's ``J`` exceeds it by
 more than the claim's own tolerance ``1e-6·max(|J|, 1e-10·J_ref)`` (GAP_TOLERANCE and the gap
-floor of ``balancer.optimize.result``) plus rounding; a lower bound (certified for the bounds as
+floor of ``balancer.balance.result``) plus rounding; a lower bound (certified for the bounds as
 they are) is false when it exceeds it by more than rounding and what the own design's
 violations of the bounds (up to 1e-9) can buy at its program's multipliers (a thin feasible
 set makes them large). ``below-independent-optimum`` is a self-check (the tool's design better
@@ -89,7 +89,7 @@ WEIGHT_NAMES = (
     "added_mass",
 )
 
-#: Relative tolerance of the tool's own feasibility check (balancer.problem): a bound is
+#: Relative tolerance of the tool's own feasibility check (balancer.balance.problem): a bound is
 #: "violated" in the headline count when it is broken by more than this, on the link's scale.
 BOUND_TOL = 1e-9
 #: Force balance of a balanced design: RMS shaking force over M·ω²·l, and the total centre of
@@ -97,7 +97,7 @@ BOUND_TOL = 1e-9
 FORCE_TOL = 1e-8
 #: ... and the RMS shaking force may not exceed this fraction of the original design's.
 FORCE_REL_TOL = 1e-6
-#: The tool's own gap tolerance and the floor of its relative gap (balancer.optimize.result).
+#: The tool's own gap tolerance and the floor of its relative gap (balancer.balance.result).
 CLAIM_GAP = 1e-6
 CLAIM_FLOOR = 1e-10
 #: Accuracy of the independent optimum in √J, relative to √J_ref: Clarabel is run at 1e-10
@@ -221,7 +221,7 @@ def spec_text(case: Case) -> str:
 
 # ----------------------------------------------------------------------------------------------
 # The bounds, read from the spec's numbers (own code; see the [balance] rules of DESIGN.md and
-# the docstring of balancer.problem)
+# the docstring of balancer.balance.problem)
 
 
 @dataclass
@@ -1305,7 +1305,7 @@ def check_result(case, design, result, bounds, model, obj, own, margin, run: Run
         jo = own.objective
         # rounding of J = ‖K·x‖² near a zero optimum: ‖K·x‖ to ~1e-14 of √J_ref
         rounding = 1e-13 * math.sqrt(max(jo, 0.0) * ref) + 1e-26 * ref
-        # The claim (balancer.optimize.result): "globally optimal" means √J − √J_low is within
+        # The claim (balancer.balance.result): "globally optimal" means √J − √J_low is within
         # GAP_TOLERANCE of the problem's scale s (result.scale, N·m), with J_low certified
         # below the true optimum; for an objective with a mass term, J − J_low within
         # GAP_TOLERANCE·s². Refuted when the design is farther than that from the independent
@@ -1359,8 +1359,8 @@ def check_result(case, design, result, bounds, model, obj, own, margin, run: Run
 
 def run_problem(case: Case, backends, keep: Path | None) -> tuple[list[Run], dict]:
     """Everything for one problem."""
+    from balancer.balance.optimizer import InfeasibleError, optimize
     from balancer.errors import AssemblyError, SolverError, SpecError
-    from balancer.optimize import InfeasibleError, optimize
     from balancer.spec import loads_design
 
     text = spec_text(case)
