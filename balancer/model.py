@@ -28,6 +28,9 @@ from .errors import AssemblyError, SpecError
 Branch = Literal["+", "-"]
 Drive = Literal["free", "constant-speed"]
 
+#: Largest initial crank angle, rad: its rounding (2e-11 rad) stays below the integrator's
+#: relative tolerance floor times the angle.
+THETA1_MAX = 1e5
 #: Ways the crank can be driven in a simulation.
 DRIVES: tuple[str, ...] = ("free", "constant-speed")
 #: Least relative tolerance of a simulation: 100 ε, below which SciPy's integrators raise it.
@@ -814,6 +817,10 @@ class SimulationSettings:
         _set(self, "duration", v.positive(self.duration, "duration"))
         if self.theta1 is not None:
             _set(self, "theta1", v.number(self.theta1, "theta1"))
+            if abs(self.theta1) > THETA1_MAX:
+                raise SpecError(f"must be within ±{THETA1_MAX:g} rad: beyond, the integration's "
+                                "steps of the crank angle lose their digits to its size "
+                                "(give it modulo 2π)", key="theta1", value=self.theta1)
         _set(self, "omega1", v.number(self.omega1, "omega1"))
         _set(self, "gravity", v.vector2(self.gravity, "gravity"))
         _set(self, "drive", v.choice(self.drive, "drive", DRIVES))

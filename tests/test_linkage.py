@@ -149,3 +149,13 @@ def test_a_spec_saved_with_a_byte_order_mark_loads(tmp_path):
     path = tmp_path / "bom.toml"
     path.write_bytes(b"\xef\xbb\xbf" + (EXAMPLES / "meijaard2020.toml").read_bytes())
     assert load_design(path) == load_design(EXAMPLES / "meijaard2020.toml")
+
+
+def test_an_initial_crank_angle_too_large_to_integrate_is_refused(tmp_path, capsys):
+    # 1e12 rad (fuzz): its rounding (1e-4 rad) swamps the integration's steps; refused, named.
+    from test_multibody import WATT
+
+    path = tmp_path / "far.toml"
+    path.write_text(WATT.replace("omega1 = 5.0", "omega1 = 5.0\ntheta1 = 1e12"))
+    assert main(["simulate", str(path)]) == 2
+    assert "simulation.theta1:" in capsys.readouterr().err

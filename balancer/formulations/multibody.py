@@ -372,19 +372,30 @@ class Multibody(Formulation):
         DESIGN.md: each link's angle is its principal value at the reference pose and
         continuous from there on; the crank is followed from the reference's angle to
         ``theta1`` in steps of at most 0.05 rad, each link's angle unwrapped along the way (the
-        input's is ``theta1`` as given).
+        input's is ``theta1`` as given). A crank that turns fully is followed over the part of
+        a turn only, and each whole turn adds what one revolution adds to each link's angle.
         """
         s = self.structure
         start = s.ref_angle[s.input]
-        steps = max(2, int(math.ceil(abs(theta1 - start) / 0.05)) + 1)
+        turn = 2 * math.pi
+        turns = math.floor((theta1 - start) / turn) if self.mech.assembly_range().full else 0
+        out = self._followed(start, theta1 - turns * turn)
+        if turns:
+            out = out + turns * (self._followed(start, start + turn) - np.array(s.ref_angle))
+        out[s.input] = theta1
+        return out
+
+    def _followed(self, start: float, end: float) -> NDArray[np.float64]:
+        """The links' angles followed from the reference pose (at crank angle ``start``)."""
+        s = self.structure
+        steps = max(2, int(math.ceil(abs(end - start) / 0.05)) + 1)
         with np.errstate(all="ignore"):
-            mo = self.mech.motion(np.linspace(start, theta1, steps))
+            mo = self.mech.motion(np.linspace(start, end, steps))
         out = np.empty(self.n)
         for k in range(self.n):
             path = np.concatenate([[s.ref_angle[k]], np.broadcast_to(
                 np.asarray(mo.pose.angles[k], dtype=float), (steps,))])
             out[k] = np.unwrap(path)[-1] if np.all(np.isfinite(path)) else path[-1]
-        out[s.input] = theta1
         return out
 
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
