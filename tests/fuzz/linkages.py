@@ -944,7 +944,7 @@ _TYPOS = {"mass": "mas", "inertia": "inertial", "com": "centre", "points": "poin
 def m_unknown_key(rng, doc, meta):
     name = _pick(rng, meta["moving"])
     options = []
-    for k, typo in _TYPOS.items():
+    for typo in _TYPOS.values():
         options.append((("links", name), typo, 1.0, f"links.{name}.{typo}"))
     options += [
         (("links", name), "gas_force", 100.0, f"links.{name}.gas_force"),
