@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 from ..model import GROUND
 from .kinematics import Motion
 from .structure import GROUND_INDEX, Driver, Pin, Prism, Structure, constraint_jacobian
-from .vectors import V
+from .vectors import Factor, V, _plus
 
 #: Parameters of a link in the design vector, in order: kg, kg·m, kg·m, kg·m² (about the frame's
 #: origin).
@@ -242,11 +242,8 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor
     for g in reversed(structure.groups):
         index = {link: i for i, link in enumerate(g.links)}
         k = 3 * len(g.links)
-        mat = np.zeros((n, k, k))
-        rhs = np.zeros((n, k, c_count))
-        for i, link in enumerate(g.links):
-            for j in range(3):
-                rhs[:, 3 * i + j, :] = applied[link][j]
+        mat: list[list] = [[0.0] * k for _ in range(k)]  # Φ_SSᵀ, entries floats or (N,)
+        rhs = [[applied[link][j]] for link in g.links for j in range(3)]
         blocks_of = []
         row = 0
         for c in g.constraints:
@@ -256,16 +253,14 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor
                 if link in index:
                     for r in range(c.rows):
                         for j in range(3):
-                            mat[:, 3 * index[link] + j, row + r] += coeffs[r][j]
+                            mat[3 * index[link] + j][row + r] = _plus(
+                                mat[3 * index[link] + j][row + r], coeffs[r][j])
             row += c.rows
         with np.errstate(divide="ignore", invalid="ignore"):
-            try:
-                sol = np.linalg.solve(mat, rhs)
-            except np.linalg.LinAlgError:
-                sol = np.full((n, k, c_count), np.nan)
-                ok = np.abs(np.linalg.det(mat)) > 0
-                if ok.any():
-                    sol[ok] = np.linalg.solve(mat[ok], rhs[ok])
+            solved = Factor(mat).solve(rhs)
+        sol = np.empty((n, k, c_count))
+        for r in range(k):
+            sol[:, r, :] = solved[r][0]
         for c, row, blocks in blocks_of:
             values = sol[:, row : row + c.rows, :]  # (N, rows, C)
             lam[id(c)] = values

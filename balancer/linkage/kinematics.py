@@ -340,10 +340,11 @@ def rates(structure: Structure, pose: Pose, omega1, alpha1, theta1=None,
             # the driver θ_input − θ1(t) = 0: its rates are the input's
             rhs_v.append(omega1 - v_term if drivers[r] else -v_term)
         # velocities first: γ of the group's own rows needs the group's velocities
-        sol_v = ops.solve(rows, [[x] for x in rhs_v])
+        factor = ops.factor(rows)
+        sol_v = factor.solve([[x] for x in rhs_v])
         for i, link in enumerate(g.links):
-            vel[link] = V(sol_v[3 * i][0], sol_v[3 * i + 1][0])
-            rate[link] = sol_v[3 * i + 2][0]
+            vel[link] = V(zero + sol_v[3 * i][0], zero + sol_v[3 * i + 1][0])
+            rate[link] = zero + sol_v[3 * i + 2][0]
         gammas = [x for c in g.constraints for x in (_gamma(c, pose, vel, rate, ops)
                                                      if not isinstance(c, Driver) else [0.0])]
         rhs_a = []
@@ -353,10 +354,10 @@ def rates(structure: Structure, pose: Pose, omega1, alpha1, theta1=None,
                 a_term = a_term + coeffs[0] * acc[link].x + coeffs[1] * acc[link].y \
                     + coeffs[2] * accel[link]
             rhs_a.append(alpha1 - a_term if drivers[r] else gammas[r] - a_term)
-        sol_a = ops.solve(rows, [[x] for x in rhs_a])
+        sol_a = factor.solve([[x] for x in rhs_a])
         for i, link in enumerate(g.links):
-            acc[link] = V(sol_a[3 * i][0], sol_a[3 * i + 1][0])
-            accel[link] = sol_a[3 * i + 2][0]
+            acc[link] = V(zero + sol_a[3 * i][0], zero + sol_a[3 * i + 1][0])
+            accel[link] = zero + sol_a[3 * i + 2][0]
     return vel, rate, acc, accel
 
 

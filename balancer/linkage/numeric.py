@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .structure import Group, Pose, Prism, Structure, constraint_jacobian, constraint_residual
-from .vectors import V
+from .vectors import Factor, V, _plus
 
 #: Steps of the continuation table over one revolution.
 TABLE_STEPS = 720
@@ -38,18 +38,29 @@ def _set(pose: Pose, g: Group, q: NDArray[np.float64]) -> None:
         pose.sin[k] = np.sin(q[:, 3 * i + 2])
 
 
-def _jacobian(g: Group, pose: Pose, n: int) -> NDArray[np.float64]:
+def _jacobian_rows(g: Group, pose: Pose) -> list[list]:
+    """The group's Jacobian in its links' coordinates: rows of floats or arrays."""
     index = {k: i for i, k in enumerate(g.links)}
     size = 3 * len(g.links)
-    jac = np.zeros((n, size, size))
-    row = 0
+    rows: list[list] = []
     for c in g.constraints:
+        block = [[0.0] * size for _ in range(c.rows)]
         for link, coeffs in constraint_jacobian(c, pose):
             if link in index:
                 for r in range(c.rows):
                     for j in range(3):
-                        jac[:, row + r, 3 * index[link] + j] += coeffs[r][j]
-        row += c.rows
+                        block[r][3 * index[link] + j] = _plus(block[r][3 * index[link] + j],
+                                                              coeffs[r][j])
+        rows.extend(block)
+    return rows
+
+
+def _jacobian(g: Group, pose: Pose, n: int) -> NDArray[np.float64]:
+    rows = _jacobian_rows(g, pose)
+    jac = np.zeros((n, len(rows), len(rows)))
+    for i, row in enumerate(rows):
+        for j, v in enumerate(row):
+            jac[:, i, j] = v
     return jac
 
 
@@ -72,15 +83,9 @@ def newton(g: Group, pose: Pose, q: NDArray[np.float64], scale: float,
         done = size <= tol * scale
         if done.all():
             break
-        jac = _jacobian(g, pose, n)
         with np.errstate(all="ignore"):
-            try:
-                step = np.linalg.solve(jac, res[:, :, None])[:, :, 0]
-            except np.linalg.LinAlgError:
-                step = np.full_like(q, np.nan)
-                ok = np.abs(np.linalg.det(jac)) > 0
-                if ok.any():
-                    step[ok] = np.linalg.solve(jac[ok], res[ok][:, :, None])[:, :, 0]
+            solved = Factor(_jacobian_rows(g, pose)).solve([[r] for r in res.T])
+            step = np.column_stack([np.broadcast_to(x[0], (n,)) for x in solved])
         q = np.where(done[:, None], q, q - step)
     _set(pose, g, q)
     return q, done

@@ -5,7 +5,8 @@ A :class:`V` holds ``x`` and ``y`` of any type that supports arithmetic: floats,
 differ between them. The equations of the linkage are written once against these and evaluated
 with numpy (vectorised) or CasADi (compiled).
 
-:func:`solve` solves ``A·X = B`` for many small systems at once (one per crank angle).
+:class:`Factor` solves ``A·X = B`` for many small systems at once (one per crank angle),
+exploiting their structure.
 """
 
 from __future__ import annotations
@@ -91,24 +92,210 @@ class Ops:
         return np.where(condition, a, b)
 
     @staticmethod
-    def solve(a: list[list[Any]], b: list[list[Any]]) -> list[list[Any]]:
-        """``X`` with ``A·X = B``; ``A`` is k×k, ``B`` k×m, entries arrays over the systems."""
-        return solve(a, b)
+    def factor(a: list[list[Any]]) -> Factor:
+        """``A`` (k×k, entries floats or arrays over the systems) factored for its solves."""
+        return Factor(a)
 
 
 NUMPY = Ops()
 
 
-def _stack(rows: list[list[Any]], n: int) -> NDArray[np.float64]:
-    out = np.empty((len(rows), len(rows[0]), n))
-    for i, row in enumerate(rows):
-        for j, value in enumerate(row):
-            out[i, j] = value
-    return out
+def _is_zero(v: Any) -> bool:
+    return isinstance(v, float) and v == 0.0
 
 
-def solve(a: list[list[Any]], b: list[list[Any]]) -> list[list[NDArray[np.float64]]]:
-    """Solve ``A·X = B`` for many systems at once (LAPACK's LU with partial pivoting).
+def _times(m: Any, x: Any) -> Any:
+    """``m·x``, structural zeros kept as the float 0.0 (an ``(N,)`` ``m`` spans ``(N, C)``)."""
+    if _is_zero(m) or _is_zero(x):
+        return 0.0
+    if isinstance(m, np.ndarray) and isinstance(x, np.ndarray) and m.ndim < x.ndim:
+        m = m.reshape(m.shape + (1,) * (x.ndim - m.ndim))
+    return m * x
+
+
+def _plus(a: Any, b: Any) -> Any:
+    """``a + b`` with structural zeros kept."""
+    if _is_zero(b):
+        return a
+    if _is_zero(a):
+        return b
+    return a + b
+
+
+def _minus(a: Any, b: Any) -> Any:
+    """``a − b`` with structural zeros kept."""
+    if _is_zero(b):
+        return a
+    if _is_zero(a):
+        return -b
+    return a - b
+
+
+class _BatchLU:
+    """LU with partial pivoting of many small dense systems, vectorised over the systems.
+
+    Entries are arrays ``(N,)``; the pivot row of each column is chosen per system (the
+    largest magnitude, found by pairwise exchanges), so that this is LAPACK's ``getrf`` run
+    on every system at once — a few dozen vector operations instead of one call per system.
+    """
+
+    @np.errstate(divide="ignore", invalid="ignore")
+    def __init__(self, block: list[list[Any]], n: int) -> None:
+        k = len(block)
+        a = [[np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy() for v in row]
+             for row in block]
+        self.swaps: list[list[tuple[int, NDArray[np.bool_]]]] = []
+        self.lower: list[list[tuple[int, NDArray[np.float64]]]] = []
+        for p in range(k):
+            swaps = []
+            for i in range(p + 1, k):
+                bigger = np.abs(a[i][p]) > np.abs(a[p][p])
+                if bigger.any():
+                    for j in range(p, k):
+                        a[p][j], a[i][j] = (np.where(bigger, a[i][j], a[p][j]),
+                                            np.where(bigger, a[p][j], a[i][j]))
+                    swaps.append((i, bigger))
+            self.swaps.append(swaps)
+            pivot = np.where(a[p][p] == 0, np.nan, a[p][p])
+            lower = []
+            for i in range(p + 1, k):
+                m = a[i][p] / pivot
+                for j in range(p + 1, k):
+                    a[i][j] = a[i][j] - m * a[p][j]
+                lower.append((i, m))
+            self.lower.append(lower)
+        self.upper = a
+        self.diagonal = [1.0 / a[p][p] for p in range(k)]
+
+    @np.errstate(divide="ignore", invalid="ignore")
+    def solve(self, b: list[Any]) -> list[Any]:
+        """``x`` with ``A·x = b``; ``b`` a list of ``k`` entries (``(N,)`` or ``(N, C)``)."""
+        k = len(b)
+        y = list(b)
+        for p in range(k):
+            for i, bigger in self.swaps[p]:
+                mask = bigger if np.ndim(y[p]) <= 1 and np.ndim(y[i]) <= 1 else bigger[:, None]
+                y[p], y[i] = np.where(mask, y[i], y[p]), np.where(mask, y[p], y[i])
+            for i, m in self.lower[p]:
+                y[i] = _minus(y[i], _times(m, y[p]))
+        x: list[Any] = [0.0] * k
+        for p in reversed(range(k)):
+            acc = y[p]
+            for j in range(p + 1, k):
+                acc = _minus(acc, _times(self.upper[p][j], x[j]))
+            x[p] = _times(self.diagonal[p], acc)
+        return x
+
+
+class Factor:
+    """``A`` of many small systems factored once, to solve ``A·X = B`` for several ``B``.
+
+    The entries of ``A`` are floats (the same in every system) or arrays ``(N,)``. Gaussian
+    elimination takes its pivots among the constant non-zero entries first — in the
+    constraints' Jacobians in absolute coordinates, the ``±1`` of a pin's translations, the
+    ``1`` of an angle — whose multipliers are bounded by the other entries (lengths and
+    direction cosines): the ``(x, y)`` of a dyad's links drop out exactly and only a 2×2 in
+    its angles is left, as in the textbook's closed forms. That dense remainder is solved by
+    its explicit inverse (up to 2×2) or by LU with partial pivoting (:class:`_BatchLU`).
+    Floats that are exactly zero are skipped throughout, so the work is that of the
+    structure's non-zeros: a few vector operations per system instead of a LAPACK call each.
+    The pivot order depends only on which entries are constant, never on the arrays' values.
+
+    A singular system (zero determinant of the remainder) gives NaN or ±inf in its
+    solution; the caller tests what it needs.
+    """
+
+    @np.errstate(divide="ignore", invalid="ignore")
+    def __init__(self, a: list[list[Any]]) -> None:
+        k = len(a)
+        rows = [list(row) for row in a]
+        live_rows, live_cols = list(range(k)), list(range(k))
+        self.steps: list[tuple[int, int, Any, list[tuple[int, Any]]]] = []
+        while True:
+            best, size = None, 0.0
+            for i in live_rows:
+                for j in live_cols:
+                    v = rows[i][j]
+                    if isinstance(v, float) and abs(v) > size:
+                        best, size = (i, j), abs(v)
+            if best is None:
+                break
+            i, j = best
+            live_rows.remove(i)
+            live_cols.remove(j)
+            pivot = rows[i][j]
+            updates = []
+            for r in live_rows:
+                f = rows[r][j]
+                if _is_zero(f):
+                    continue
+                m = f / pivot
+                for c in live_cols:
+                    rows[r][c] = _minus(rows[r][c], _times(m, rows[i][c]))
+                rows[r][j] = 0.0
+                updates.append((r, m))
+            self.steps.append((i, j, pivot, updates))
+        self.rows = rows
+        self.rest_rows, self.rest_cols = live_rows, live_cols
+        block = [[rows[i][j] for j in live_cols] for i in live_rows]
+        self.inverse: list[list[Any]] | None = None
+        self.dense: _BatchLU | None = None
+        if len(block) == 1:
+            (a11,), = block
+            with np.errstate(divide="ignore", invalid="ignore"):
+                self.inverse = [[1.0 / np.where(a11 == 0, np.nan, a11)
+                                 if isinstance(a11, np.ndarray) else
+                                 (1.0 / a11 if a11 else np.nan)]]
+        elif len(block) == 2:
+            (a11, a12), (a21, a22) = block
+            det = _minus(_times(a11, a22), _times(a12, a21))
+            det = np.asarray(det, dtype=float)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                inv = 1.0 / np.where(det == 0, np.nan, det)
+            self.inverse = [[_times(a22, inv), _times(a12, -inv)],
+                            [_times(a21, -inv), _times(a11, inv)]]
+        elif len(block) > 2:
+            n = max(np.size(v) for row in block for v in row)
+            self.dense = _BatchLU(block, n)
+
+    @np.errstate(divide="ignore", invalid="ignore")
+    def solve(self, b: list[list[Any]]) -> list[list[Any]]:
+        """``X`` with ``A·X = B``.
+
+        ``B`` is ``k`` rows of ``m`` entries (floats, ``(N,)`` or ``(N, C)`` arrays); ``X``
+        likewise.
+        """
+        rhs = [list(row) for row in b]
+        width = len(rhs[0])
+        for i, _, _, updates in self.steps:
+            for r, m in updates:
+                for c in range(width):
+                    rhs[r][c] = _minus(rhs[r][c], _times(m, rhs[i][c]))
+        x: list[list[Any]] = [[0.0] * width for _ in self.rows]
+        if self.inverse is not None:
+            for jj, j in enumerate(self.rest_cols):
+                for c in range(width):
+                    acc: Any = 0.0
+                    for ii, i in enumerate(self.rest_rows):
+                        acc = _plus(acc, _times(self.inverse[jj][ii], rhs[i][c]))
+                    x[j][c] = acc
+        elif self.dense is not None:
+            for c in range(width):
+                sol = self.dense.solve([rhs[i][c] for i in self.rest_rows])
+                for jj, j in enumerate(self.rest_cols):
+                    x[j][c] = sol[jj]
+        for i, j, pivot, _ in reversed(self.steps):
+            for c in range(width):
+                acc = rhs[i][c]
+                for col, v in enumerate(self.rows[i]):
+                    if col != j and not _is_zero(v):
+                        acc = _minus(acc, _times(v, x[col][c]))
+                x[j][c] = acc / pivot if not _is_zero(acc) else 0.0
+        return x
+
+
+def solve(a: list[list[Any]], b: list[list[Any]]) -> list[list[Any]]:
+    """Solve ``A·X = B`` for many small systems at once (see :class:`Factor`).
 
     Parameters
     ----------
@@ -116,26 +303,11 @@ def solve(a: list[list[Any]], b: list[list[Any]]) -> list[list[NDArray[np.float6
         ``k`` rows of ``k`` entries, each a float or an array of shape ``(n,)`` (one value per
         system).
     b
-        ``k`` rows of ``m`` entries, likewise.
+        ``k`` rows of ``m`` entries, likewise (or arrays ``(n, C)``).
 
     Returns
     -------
-    list of list of numpy.ndarray
-        ``X`` as ``k`` rows of ``m`` arrays of shape ``(n,)``; a singular system gives NaN
-        (the caller tests what it needs).
+    list of list
+        ``X`` as ``k`` rows of ``m`` entries (a float where the solution is structurally zero).
     """
-    n = 1
-    for row in (*a, *b):
-        for value in row:
-            n = max(n, np.size(value))
-    k, m = len(a), len(b[0])
-    am = _stack(a, n).transpose(2, 0, 1)
-    bm = _stack(b, n).transpose(2, 0, 1)
-    try:
-        x = np.linalg.solve(am, bm)
-    except np.linalg.LinAlgError:  # some system singular: solve the others, NaN for those
-        x = np.full((n, k, m), np.nan)
-        ok = np.abs(np.linalg.det(am)) > 0
-        if ok.any():
-            x[ok] = np.linalg.solve(am[ok], bm[ok])
-    return [[x[:, i, c] for c in range(m)] for i in range(k)]
+    return Factor(a).solve(b)
