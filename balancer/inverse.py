@@ -27,22 +27,13 @@ Everything is vectorised over the states of a :class:`~balancer.kinematics.Motio
 
 from __future__ import annotations
 
-import os
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
-from functools import cached_property
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .kinematics import (
-    Motion,
-    change_point_angles,
-    cross,
-    cycle_branch_signs,
-    motion,
-)
+from .kinematics import Motion, change_point_angles, cross
 from .massmodels import (
     equivalent_inertia_forces,
     equivalent_joint_forces,
@@ -399,202 +390,6 @@ def kinetic_energy(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
     return total
 
 
-@dataclass(frozen=True)
-class Figure:
-    """RMS and maximum magnitude of a quantity over the samples of a cycle (same unit)."""
-
-    rms: float
-    max: float
-
-    @classmethod
-    def of(cls, values: NDArray) -> Figure:
-        """Figures of an array of real or complex values (complex: vector magnitudes)."""
-        if np.iscomplexobj(values):
-            mag2 = values.real * values.real + values.imag * values.imag
-        else:
-            mag2 = values * values
-        if np.isnan(mag2).any():  # unbounded values at change points are left out
-            mag2 = mag2[~np.isnan(mag2)]
-        return cls(rms=float(np.sqrt(np.mean(mag2))), max=float(np.sqrt(np.max(mag2))))
-
-    def as_dict(self) -> dict[str, float]:
-        """``{"rms": …, "max": …}``."""
-        return {"rms": self.rms, "max": self.max}
-
-
-@dataclass(frozen=True)
-class CycleSummary:
-    """The figures of a cycle analysis (see :class:`CycleAnalysis`)."""
-
-    shaking_force: Figure
-    shaking_moment: Figure
-    driving_torque: Figure
-    RA0: Figure
-    RA3: Figure
-
-    def as_dict(self) -> dict[str, dict[str, float]]:
-        """Plain dictionary with the fixed JSON names."""
-        return {
-            "shaking_force": self.shaking_force.as_dict(),
-            "shaking_moment": self.shaking_moment.as_dict(),
-            "driving_torque": self.driving_torque.as_dict(),
-        }
-
-
-@dataclass(frozen=True)
-class CycleAnalysis:
-    """One crank revolution at constant speed: what the linkage does to its frame.
-
-    Attributes
-    ----------
-    linkage
-        The analysed four-bar.
-    speed
-        Crank speed, rad/s.
-    theta1
-        The sampled crank angles ``θ1 = 2π·j/N``, rad.
-    reactions
-        Ground reactions, driving torque and shaking moment at those angles.
-    route
-        The inverse-dynamics route used.
-    singular
-        Samples at a change point, where the individual reactions are unbounded (NaN).
-    """
-
-    linkage: FourBar
-    speed: float
-    theta1: NDArray[np.float64]
-    reactions: Reactions
-    route: str
-    singular: NDArray[np.bool_] | None = None
-    summary: CycleSummary = field(init=False)
-
-    def __post_init__(self) -> None:
-        r = self.reactions
-        object.__setattr__(
-            self,
-            "summary",
-            CycleSummary(
-                shaking_force=Figure.of(r.shaking_force),
-                shaking_moment=Figure.of(r.shaking_moment),
-                driving_torque=Figure.of(r.driving_torque),
-                RA0=Figure.of(r.RA0),
-                RA3=Figure.of(r.RA3),
-            ),
-        )
-
-    @cached_property
-    def motion(self) -> Motion:
-        """Kinematics at the sampled angles (computed when first asked for)."""
-        if self.linkage.type == "slider-crank":
-            from .slider_crank.kinematics import motion_of as slider_motion
-
-            return slider_motion(self.linkage, self.theta1, self.speed, 0.0)  # type: ignore[return-value]
-        signs = cycle_branch_signs(self.linkage.lengths, self.linkage.branch, self.theta1)
-        return motion(self.linkage.lengths, self.theta1, self.speed, 0.0, signs, check=True)
-
-    @property
-    def samples(self) -> int:
-        """Number of sampled crank angles."""
-        return self.theta1.size
-
-    @property
-    def time(self) -> NDArray[np.float64]:
-        """Time at each sample from θ1 = 0, s."""
-        return self.theta1 / self.speed
-
-
-def sample_angles(samples: int) -> NDArray[np.float64]:
-    """``samples`` equally spaced crank angles over one revolution from 0, rad."""
-    return np.arange(samples) * (2 * np.pi / samples)
-
-
-def cycle_analysis(
-    linkage: FourBar,
-    speed: float,
-    samples: int = 360,
-    *,
-    route: Route = "newton-euler",
-    loads: bool = True,
-    theta1: NDArray[np.float64] | None = None,
-) -> CycleAnalysis:
-    """Analyse one crank revolution at constant ``speed`` (rad/s) over ``samples`` angles.
-
-    Gravity is not part of a cycle analysis (it belongs to ``[simulation]``); loads are, unless
-    ``loads`` is false. A change-point linkage (parallelogram, deltoid) follows its smooth
-    motion through the positions where all joints are collinear; there the shaking force and
-    moment and the driving torque are the limits of that motion, and the individual reactions,
-    which grow without bound, are NaN and flagged in :attr:`CycleAnalysis.singular`.
-
-    Raises
-    ------
-    AssemblyError
-        If the crank cannot turn a full revolution.
-    """
-    if linkage.type == "slider-crank":
-        from .slider_crank.dynamics import cycle_analysis as slider_cycle
-
-        return slider_cycle(linkage, speed, samples, route=route, loads=loads, theta1=theta1)
-    from .mechanisms import mechanism_of
-
-    mechanism_of(linkage).require_full_revolution("a cycle analysis")
-    angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
-    n = angles.size
-    signs = cycle_branch_signs(linkage.lengths, linkage.branch, angles)
-
-    def evaluate(theta, sign) -> Reactions:
-        mo = motion(linkage.lengths, theta, speed, 0.0, sign)
-        return inverse_dynamics(linkage, mo, route=route, loads=loads)
-
-    # Evaluate in chunks that fit the CPU cache, writing into preallocated arrays: faster, and a
-    # fraction of the memory of whole-array temporaries. The kinematics are not kept (the
-    # result recomputes them when asked), so a long cycle costs little memory.
-    out = {
-        "RA0": np.empty(n, complex),
-        "RA3": np.empty(n, complex),
-        "shaking_force": np.empty(n, complex),
-        "driving_torque": np.empty(n),
-        "shaking_moment": np.empty(n),
-    }
-    def fill(start: int) -> None:
-        sl = slice(start, start + CHUNK)
-        r = evaluate(angles[sl], signs if isinstance(signs, str) else signs[sl])
-        for name, array in out.items():
-            array[sl] = getattr(r, name)
-
-    starts = range(0, n, CHUNK)
-    if len(starts) > 1 and WORKERS > 1:
-        # numpy releases the GIL inside its loops: chunks on two cores, each writing its own
-        # slice of the outputs (the same numbers as one after the other).
-        with ThreadPoolExecutor(WORKERS) as pool:
-            list(pool.map(fill, starts))
-    else:
-        for start in starts:
-            fill(start)
-    singular = np.zeros(n, bool)
-    for hit, offsets, weights in change_point_limits(linkage.lengths, angles):
-        parts = [
-            evaluate(angles[hit] + d, cycle_branch_signs(linkage.lengths, linkage.branch,
-                                                         angles[hit] + d))
-            for d in offsets
-        ]
-        for name in ("shaking_force", "driving_torque", "shaking_moment"):
-            out[name][hit] = sum(
-                w * getattr(p, name) for w, p in zip(weights, parts, strict=True)
-            )
-        out["RA0"][hit] = np.nan
-        out["RA3"][hit] = np.nan
-        singular |= hit
-    return CycleAnalysis(
-        linkage=linkage,
-        speed=speed,
-        theta1=angles,
-        reactions=Reactions(**out),
-        route=route,
-        singular=singular,
-    )
-
-
 def change_point_limits(lengths, angles: NDArray[np.float64]):
     """How to evaluate a revolution's samples that fall exactly on a change point.
 
@@ -623,9 +418,3 @@ def change_point_limits(lengths, angles: NDArray[np.float64]):
         out.append((hit, tuple(k * delta for k in steps), weights))
     return out
 
-
-#: Number of crank angles evaluated at once by :func:`cycle_analysis`.
-CHUNK = 32768
-#: Threads evaluating the chunks of a long cycle (numpy's loops run without the GIL; more than
-#: two gain little against the Python between them).
-WORKERS = min(2, os.cpu_count() or 1)

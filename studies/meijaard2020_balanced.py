@@ -37,7 +37,7 @@ from balancer.conditions import (
     force_balance_error,
     force_balanced_by_crank_and_rocker,
 )
-from balancer.inverse import cycle_analysis
+from balancer.cycle import cycle_analysis
 from balancer.mechanisms.fourbar import FourBarMechanism
 from balancer.model import SimulationSettings
 from balancer.plots import COLOURS, SERIES, plot_reactions, save_png

@@ -36,7 +36,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from balancer.conditions import force_balance_error
-from balancer.inverse import sample_angles
+from balancer.cycle import sample_angles
 from balancer.kinematics import position_of
 from balancer.massmodels import link_centres_of_mass, total_com_direct, wunderlich_linkage
 from balancer.model import FourBar, Link, SimulationSettings, SliderCrank

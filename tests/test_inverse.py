@@ -9,7 +9,7 @@ import pytest
 from conftest import CLASS_EXAMPLES, paper_linkage, random_angles, random_link, random_linkage
 from helpers import ROUNDING, derivative_with_error, rel_err
 
-from balancer import inverse
+from balancer import cycle, inverse
 from balancer import kinematics as kin
 from balancer import massmodels as mm
 from balancer.conditions import berkof_counter_rotors, force_balanced_by_crank_and_rocker
@@ -229,15 +229,16 @@ def test_berkof_complete_balance_has_no_shaking_moment_at_any_motion():
 
 
 def test_cycle_analysis_samples_and_figures(paper):
-    ca = inverse.cycle_analysis(paper, 10.0, 360)
-    assert ca.samples == 360 and ca.motion.size == 360
+    ca = cycle.cycle_analysis(paper, 10.0, 360, route="newton-euler")
+    assert ca.samples == 360 and ca.motion.theta1.size == 360
     assert np.allclose(np.diff(ca.theta1), 2 * np.pi / 360)
     sf = np.abs(ca.reactions.shaking_force)
-    # The same numbers by other operations (√(re² + im²) against hypot: an ulp or two in each
-    # square, which the mean keeps and the root halves): ≤ 3ε ≈ 7e-16.
+    # The same numbers by other operations (the RMS of the magnitudes scaled by their largest
+    # against unscaled: an ulp or two in each square, which the mean keeps and the root
+    # halves): ≤ 3ε ≈ 7e-16.
     assert ca.summary.shaking_force.max == pytest.approx(sf.max(), rel=1e-15)
     assert ca.summary.shaking_force.rms == pytest.approx(np.sqrt(np.mean(sf**2)), rel=1e-15)
-    other = inverse.cycle_analysis(paper, 10.0, 360, route="mass-matrix")
+    other = cycle.cycle_analysis(paper, 10.0, 360, route="mass-matrix")
     # The two routes over the paper's well-conditioned revolution (|sin(θ3 − θ2)| ≥ 0.7): they
     # differ by rounding, ~ROUNDING·1.4 of the terms (a few times the figures): ≲ 1e-13.
     for name in ("shaking_force", "shaking_moment", "driving_torque"):
@@ -251,16 +252,18 @@ def test_cycle_analysis_in_chunks_equals_one_evaluation_of_all_angles(paper, mon
     """The chunked (and threaded) evaluation fills every sample, in order, with the values of
     one whole-array evaluation: 1000 angles in chunks of 64, the last one short. (To rounding,
     not bitwise: numpy's vectorised sin/cos may round differently at a loop's tail.)"""
-    monkeypatch.setattr(inverse, "CHUNK", 64)
-    monkeypatch.setattr(inverse, "WORKERS", workers)
-    ca = inverse.cycle_analysis(paper, 10.0, 1000)
+    monkeypatch.setattr(cycle, "CHUNK", 64)
+    monkeypatch.setattr(cycle, "WORKERS", workers)
+    ca = cycle.cycle_analysis(paper, 10.0, 1000, route="newton-euler")
     mo = kin.motion(paper.lengths, ca.theta1, 10.0, 0.0, paper.branch)
-    whole = inverse.inverse_dynamics(paper, mo)
+    whole = inverse.inverse_dynamics(paper, mo, route="newton-euler")
     # An ulp of sin/cos carried through the analysis: ROUNDING times its condition.
     condition = 1 / np.min(np.abs(mo.pos.sin_transmission))
-    for name in ("RA0", "RA3", "shaking_force", "shaking_moment", "driving_torque"):
-        got, want = getattr(ca.reactions, name), getattr(whole, name)
-        assert rel_err(got, want) < ROUNDING * condition, name
+    r = ca.reactions
+    got = {"RA0": r.ground["A0"], "RA3": r.ground["A3"], "shaking_force": r.shaking_force,
+           "shaking_moment": r.shaking_moment, "driving_torque": r.driving_torque}
+    for name, values in got.items():
+        assert rel_err(values, getattr(whole, name)) < ROUNDING * condition, name
 
 
 def test_cycle_analysis_refuses_a_crank_that_cannot_turn():
@@ -270,16 +273,16 @@ def test_cycle_analysis_refuses_a_crank_that_cannot_turn():
                       coupler=random_link(rng, 3, loads=False, rotor=False),
                       rocker=random_link(rng, 1, loads=False, rotor=False))
     with pytest.raises(AssemblyError, match="full revolution"):
-        inverse.cycle_analysis(linkage, 10.0)
+        cycle.cycle_analysis(linkage, 10.0)
 
 
 def test_speed_scaling_without_loads(paper):
     """Without loads every inertial quantity scales with the square of the speed."""
     free = paper.without_loads()
-    a = inverse.cycle_analysis(free, 3.0, 90)
-    b = inverse.cycle_analysis(free, 6.0, 90)
+    a = cycle.cycle_analysis(free, 3.0, 90, route="newton-euler")
+    b = cycle.cycle_analysis(free, 6.0, 90, route="newton-euler")
     # Rounding: ~ROUNDING·1.4 (the paper's revolution is well conditioned) ≈ 2e-14.
-    assert rel_err(b.reactions.RA0, 4 * a.reactions.RA0) < 1e-13
+    assert rel_err(b.reactions.ground["A0"], 4 * a.reactions.ground["A0"]) < 1e-13
     assert rel_err(b.reactions.shaking_moment, 4 * a.reactions.shaking_moment) < 1e-13
 
 
@@ -299,13 +302,13 @@ def test_parallelogram_cycle_passes_its_change_points_smoothly():
     linkage = FourBar(lengths=(l1, l2, l1, l2), branch="+", crank=crank, coupler=coupler,
                       rocker=rocker)
     speed = 7.0
-    ca = inverse.cycle_analysis(linkage, speed, 72)
+    ca = cycle.cycle_analysis(linkage, speed, 72, route="newton-euler")
     th = ca.theta1
     # At the change points (θ1 = 0, π) the individual reactions are unbounded: flagged, NaN.
     at_change = np.isclose(np.cos(th) ** 2, 1.0, rtol=0, atol=1e-15)
     assert np.array_equal(ca.singular, at_change) and at_change.sum() == 2
-    assert np.all(np.isnan(ca.reactions.RA0[at_change]))
-    assert np.all(np.isfinite(ca.reactions.RA0[~at_change]))
+    assert np.all(np.isnan(ca.reactions.ground["A0"][at_change]))
+    assert np.all(np.isfinite(ca.reactions.ground["A0"][~at_change]))
     for name in ("shaking_force", "shaking_moment", "driving_torque"):
         assert np.all(np.isfinite(getattr(ca.reactions, name)))
         assert np.isfinite(getattr(ca.summary, name).rms)
@@ -313,14 +316,15 @@ def test_parallelogram_cycle_passes_its_change_points_smoothly():
     # (weights Σ|w| ≤ 15), where the reactions, ~1/δ times their usual size, cancel in the
     # sums: rounding 15·ROUNDING·|R(δ)|, times a lever arm for moments. The extrapolation's
     # truncation, O(δ⁴) = 1e-16 relative, is far below it.
-    near = inverse.cycle_analysis(linkage, speed, theta1=np.array([1, 2, 3, 4]) * 1e-4)
-    r_near = max(np.max(np.abs(near.reactions.RA0)), np.max(np.abs(near.reactions.RA3)))
+    near = cycle.cycle_analysis(linkage, speed, theta1=np.array([1, 2, 3, 4]) * 1e-4,
+                                route="newton-euler")
+    r_near = max(np.max(np.abs(r)) for r in near.reactions.ground.values())
     force_tol = 15 * ROUNDING * r_near
     moment_tol = force_tol * max(linkage.lengths)
     # Constant kinetic energy: no driving torque (to the extrapolation's rounding at θ1 = 0).
     assert abs(ca.reactions.driving_torque).max() < moment_tol
-    mo = ca.motion
-    assert np.max(np.abs(np.sin(mo.theta[1]))) < 1e-12  # coupler parallel to the frame
+    coupler_angle = ca.motion.pose.angles[1]
+    assert np.max(np.abs(np.sin(coupler_angle))) < 1e-12  # coupler parallel to the frame
     z1, z3 = crank.com / l1, rocker.com / l1
     u = np.exp(1j * th)
     force = speed**2 * u * (crank.mass * z1 * l1 + coupler.mass * l1 - rocker.mass * (z3 - 1) * l1)
@@ -339,7 +343,7 @@ def test_parallelogram_cycle_passes_its_change_points_smoothly():
     moment, error = derivative_with_error(momentum)
     moment = -moment
     assert np.max(np.abs(ca.reactions.shaking_moment - moment)) < error + moment_tol
-    other = inverse.cycle_analysis(linkage, speed, 72, route="mass-matrix")
+    other = cycle.cycle_analysis(linkage, speed, 72, route="mass-matrix")
     assert np.max(np.abs(other.reactions.shaking_moment - moment)) < error + moment_tol
 
 

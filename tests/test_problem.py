@@ -1,7 +1,8 @@
 """The redesign problem: the [balance] section (errors, defaults, exact round trip) and its numbers.
 
-The objective the optimisers minimise is built from the mass-matrix regressors (Eq. 45–54); here
-it is checked against the Newton–Euler cycle analysis, an independent route.
+The objective the optimisers minimise is built from the mechanism's regressors (the general
+core's linear maps); here it is checked against the cycle analysis by the paper's Newton–Euler
+route in closed form, an independent route.
 """
 
 from __future__ import annotations
@@ -23,8 +24,8 @@ from balancer.balance.problem import (
     resolve_link,
 )
 from balancer.cli import main
+from balancer.cycle import cycle_analysis
 from balancer.errors import AssemblyError, SpecError
-from balancer.inverse import cycle_analysis  # the paper's routes: independent of the regressors
 from balancer.mechanisms import mechanism_of
 from balancer.model import Design, FourBar, Operation
 
@@ -251,7 +252,11 @@ def test_a_crank_that_cannot_turn_is_bad_input():
 
 
 def _objective_by_newton_euler(data, linkage: FourBar) -> float:
-    """The objective from the Newton–Euler cycle analysis (no loads), not the regressors."""
+    """The objective from the Newton–Euler cycle analysis (no loads), not the regressors.
+
+    A four-bar's route "newton-euler" is the paper's free-body equations in closed form
+    (:func:`balancer.inverse.newton_euler`), independent of the general core's regressors.
+    """
     w = data.weights
     s = cycle_analysis(linkage, data.speed, data.samples, route="newton-euler", loads=False)
     summary = s.summary
@@ -265,7 +270,7 @@ def _objective_by_newton_euler(data, linkage: FourBar) -> float:
 
 @pytest.mark.parametrize("seed", range(8))
 def test_the_objective_equals_the_newton_euler_route(seed):
-    """Regressors (mass-matrix route, Eq. 45–54) against free-body equations, to 1e-9."""
+    """Regressors (the general core's) against the paper's free-body equations, to 1e-9."""
     rng = np.random.default_rng(100 + seed)
     linkage = random_linkage(rng, loads=True, full_turn=True)  # loads must be left out
     problem = _random_problem(rng)

@@ -1,4 +1,4 @@
-"""Inverse dynamics of the slider-crank by two independent routes, and its cycle analysis.
+"""Inverse dynamics of the slider-crank by two independent routes.
 
 What the mechanism exerts on its frame: the force ``R̄A0`` at the crank pivot; the guide's
 normal force ``R̄A3 = −i·N`` (the slider on its guide, frictionless) with its line of action
@@ -27,11 +27,11 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..inverse import CycleAnalysis, Reactions, Regressors, dynamic_link, sample_angles
+from ..inverse import Reactions, Regressors, dynamic_link
 from ..kinematics import cross
 from ..massmodels import equivalent_inertia_forces, equivalent_joint_forces, inertial_parameters
 from ..model import Link, SliderCrank
-from .kinematics import SliderMotion, motion_of
+from .kinematics import SliderMotion
 
 
 def _loads(mech: SliderCrank, mo: SliderMotion, gravity: complex, loads: bool):
@@ -216,32 +216,6 @@ def regressors(lengths, mo: SliderMotion, *, gravity: tuple[float, float] = (0.0
         for name in names:
             cols[name].append(np.broadcast_to(values[name], (n,)))
     return Regressors(**{name: np.column_stack(c) for name, c in cols.items()})
-
-
-def cycle_analysis(
-    mech: SliderCrank,
-    speed: float,
-    samples: int = 360,
-    *,
-    route: str = "newton-euler",
-    loads: bool = True,
-    theta1: NDArray[np.float64] | None = None,
-) -> CycleAnalysis:
-    """One crank revolution at constant ``speed`` (rad/s) over ``samples`` angles.
-
-    Raises
-    ------
-    AssemblyError
-        If the crank cannot turn a full revolution (``r + |e| > L``).
-    """
-    from ..mechanisms import mechanism_of
-
-    mechanism_of(mech).require_full_revolution("a cycle analysis")
-    angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
-    mo = motion_of(mech, angles, speed, 0.0)
-    reactions = inverse_dynamics(mech, mo, route=route, loads=loads)
-    return CycleAnalysis(linkage=mech, speed=speed, theta1=angles, reactions=reactions,
-                         route=route)
 
 
 def angular_momentum(mech: SliderCrank, mo: SliderMotion) -> NDArray[np.float64]:

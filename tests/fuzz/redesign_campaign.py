@@ -1209,7 +1209,7 @@ def _finite(values) -> bool:
 def check_result(case, design, result, bounds, model, obj, own, margin, run: Run,
                  keep: Path | None) -> None:
     """Checks a-e on one result (fills ``run.flags`` and ``run.info``)."""
-    from balancer.inverse import cycle_analysis
+    from balancer.cycle import cycle_analysis
     from balancer.spec import load_design, save_design
 
     info = run.info
@@ -1379,7 +1379,7 @@ def run_problem(case: Case, backends, keep: Path | None) -> tuple[list[Run], dic
     x0 = x_of(case)
     obj = objective_of(case, model, x0)
     # own maps against balancer's cycle analysis of the original design
-    from balancer.inverse import cycle_analysis
+    from balancer.cycle import cycle_analysis
 
     ca = cycle_analysis(design.mechanism, case.speed, case.samples, loads=False)
     mine = {"shaking_force": obj.maps["force"] @ x0, "shaking_moment": obj.maps["moment"] @ x0,
