@@ -7,8 +7,7 @@ module                   what it holds
                          the crank angles where it assembles
 ``massmodels``           the total centre of mass and Wunderlich's similar slider-crank
                          (his Eq. 13–19), its circle and point cases (Eq. 14, 20a–b)
-``dynamics``             inverse dynamics by Newton–Euler and by equivalent mass matrices; the
-                         regressors for the optimiser
+``dynamics``             inverse dynamics by Newton–Euler and by equivalent mass matrices
 ``formulations``         forward dynamics: one equation in θ1 by virtual power, and truss
                          elements with the guide as a constraint (Meijaard & van der Wijk's
                          Sect. 5.1)

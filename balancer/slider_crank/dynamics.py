@@ -17,9 +17,6 @@ Routes:
     keep the lengths and the guide: a rotation of the crank for the driving torque, a
     translation of the whole for the shaking force, a turn of the rod about A1 for the guide's
     normal force, a rotation of the whole about A0 for the shaking moment.
-
-The reactions, like the four-bar's, are linear in the inertial parameters ``(m, m·e, m·f, J)``
-of crank, rod and slider and the crank's counter-rotor: :func:`regressors`.
 """
 
 from __future__ import annotations
@@ -27,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..inverse import Reactions, Regressors, dynamic_link
+from ..inverse import Reactions, dynamic_link
 from ..kinematics import cross
 from ..massmodels import equivalent_inertia_forces, equivalent_joint_forces, inertial_parameters
 from ..model import Link, SliderCrank
@@ -173,49 +170,6 @@ def inverse_dynamics(mech: SliderCrank, mo: SliderMotion, *, route: str = "newto
     except KeyError:
         raise ValueError(f"unknown route {route!r}; choose from {tuple(ROUTES)}") from None
     return fn(mech, mo, gravity=gravity, loads=loads)
-
-
-def regressors(lengths, mo: SliderMotion, *, gravity: tuple[float, float] = (0.0, 0.0)
-               ) -> Regressors:
-    """Linear maps from the design vector to the frame loads (mass-matrix route).
-
-    The design vector is the four-bar's (:data:`balancer.inverse.PARAMETER_NAMES`) with the
-    rod and the slider in the places of coupler and rocker: ``(m1, m1e1, m1f1, J1, m2, m2e2,
-    m2f2, J2, m3, m3e3, m3f3, J3, Jc1, Jc3)``; the slider's ``J3`` and ``Jc3`` do nothing. Loads
-    are left out (the gas force does not depend on the design); gravity is in.
-    """
-    n = mo.size
-    g = complex(*gravity)
-    zero = np.zeros(n, complex)
-    names = ("RA0", "RA3", "shaking_force", "driving_torque", "shaking_moment")
-    cols: dict[str, list] = {name: [] for name in names}
-    r, big_l, _ = lengths
-    for column in range(14):
-        unit = np.zeros(14)
-        unit[column] = 1.0
-        crank = tuple(unit[0:4])
-        rod = tuple(unit[4:8])
-        m3, m3e3, m3f3 = unit[8], unit[9], unit[10]
-        if column == 12:  # the crank's counter-rotor: inertia on the crank
-            crank = (0.0, 0.0, 0.0, 1.0)
-        nodes = list(_nodal(crank, rod, m3, mo, lengths))
-        nodes[0] = nodes[0] + zero
-        if g != 0:  # weights m·g at the centres of mass (Eq. 46), and the slider's at its pin
-            for params, length, p, q in ((crank, r, 0, 1), (rod, big_l, 1, 2)):
-                m_zeta = (params[1] + 1j * params[2]) / length
-                nodes[p] = nodes[p] + (params[0] - np.conj(m_zeta)) * g
-                nodes[q] = nodes[q] + np.conj(m_zeta) * g
-            nodes[2] = nodes[2] + m3 * g
-        # The slider's moment about its pin: (m3·s̄3) × (m3-weighted g − a), per unit parameter.
-        slider_moment = cross(m3e3 + 1j * m3f3, g - (mo.a + 0j))
-        rotor = 2.0 * mo.alpha[0] if column == 12 else 0.0
-        tau, shaking, n_guide, ra0, moment = _combine(lengths, mo, tuple(nodes), 0.0,
-                                                      slider_moment, rotor)
-        values = {"RA0": ra0, "RA3": -1j * n_guide, "shaking_force": shaking,
-                  "driving_torque": tau, "shaking_moment": moment}
-        for name in names:
-            cols[name].append(np.broadcast_to(values[name], (n,)))
-    return Regressors(**{name: np.column_stack(c) for name, c in cols.items()})
 
 
 def angular_momentum(mech: SliderCrank, mo: SliderMotion) -> NDArray[np.float64]:
