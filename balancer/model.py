@@ -182,6 +182,16 @@ class FourBar:
         """Whether any link carries an applied force or moment."""
         return any(link.has_loads for link in self.links)
 
+    @property
+    def sizes(self) -> dict[str, float]:
+        """The geometry's sizes by spec key, m: the lengths (see :func:`check_scales`)."""
+        return _length_sizes(self)
+
+    @property
+    def gas_forces(self) -> tuple[tuple[str, GasForce], ...]:
+        """Forces on sliders along their guides, by spec key: none on a four-bar."""
+        return ()
+
     def link(self, name: str) -> Link:
         """Return the link called ``name`` (``"crank"``, ``"coupler"`` or ``"rocker"``)."""
         if name not in self.link_names:
@@ -341,6 +351,16 @@ class SliderCrank:
     def has_loads(self) -> bool:
         """Whether any link carries an applied force or moment, or a gas force acts."""
         return any(link.has_loads for link in self.links) or not self.gas_force.is_zero
+
+    @property
+    def sizes(self) -> dict[str, float]:
+        """The geometry's sizes by spec key, m: the lengths, the offset's magnitude."""
+        return _length_sizes(self)
+
+    @property
+    def gas_forces(self) -> tuple[tuple[str, GasForce], ...]:
+        """Forces on sliders along their guides, by spec key: the gas force."""
+        return (("links.slider.gas_force", self.gas_force),)
 
     def link(self, name: str) -> Link:
         """Return the link called ``name`` (``"crank"``, ``"rod"`` or ``"slider"``)."""
@@ -662,6 +682,16 @@ class Linkage:
         return (any(link.has_loads for link in self.links)
                 or any(not s.force.is_zero for s in self.sliders))
 
+    @property
+    def sizes(self) -> dict[str, float]:
+        """The geometry's sizes by spec key, m: each point's distance from the origin."""
+        return {f"mechanism.points.{p}": math.hypot(*xy) for p, xy in self.points}
+
+    @property
+    def gas_forces(self) -> tuple[tuple[str, GasForce], ...]:
+        """Forces on sliders along their guides, by the sliding link's key."""
+        return tuple((f"links.{s.link}.gas_force", s.force) for s in self.sliders)
+
     def link(self, name: str) -> Link:
         """The mass properties of the moving link called ``name``."""
         for b in self.moving:
@@ -706,6 +736,12 @@ def _numbers(values, key: str) -> tuple[float, ...]:
     if not out:
         raise SpecError("must be a non-empty list of numbers", key=key, value=list(values))
     return out
+
+
+def _length_sizes(mech) -> dict[str, float]:
+    """A four-bar's or slider-crank's lengths by spec key (magnitudes), m."""
+    return {f"mechanism.lengths.{n}": abs(x)
+            for n, x in zip(mech.length_names, mech.lengths, strict=True)}
 
 
 def _check_mechanism(mech) -> tuple[float, ...]:
@@ -864,11 +900,11 @@ class Design:
         A free-text name for reports.
     """
 
-    mechanism: FourBar | SliderCrank
+    mechanism: Mechanism
     operation: Operation | None = None
     simulation: SimulationSettings = field(default_factory=SimulationSettings)
     balance: object | None = None
-    original: FourBar | SliderCrank | None = None
+    original: Mechanism | None = None
     title: str = ""
 
     def __post_init__(self) -> None:
@@ -876,7 +912,7 @@ class Design:
 
         Keys are the spec's, from its root.
         """
-        if not isinstance(self.mechanism, FourBar | SliderCrank | Linkage):
+        if not isinstance(self.mechanism, Mechanism):
             raise SpecError("must be a FourBar, a SliderCrank or a Linkage", key="mechanism",
                             value=type(self.mechanism).__name__)
         for name, cls in (("operation", Operation), ("simulation", SimulationSettings)):
@@ -901,18 +937,15 @@ def check_scales(mechanism, speeds: dict[str, float],
                  gravity: dict[str, tuple[float, float]] | None = None) -> None:
     """Raise :class:`SpecError` if a force, moment or energy of the motion leaves double precision.
 
-    The scales (:func:`balancer.validate.check_magnitudes`): a reach ``R`` (the lengths summed,
-    plus the farthest centre of mass from its joint); forces ``m·R·ω²``, ``m·|g|`` and the
-    applied forces; moments ``R`` times those, ``(I + J_c)·ω²`` and the applied moments;
-    energies ``(I + J_c + m·R²)·ω²``. ``speeds`` and ``gravity`` are keyed by their spec keys
-    (the largest speed of a motion and its gravity).
+    The scales (:func:`balancer.validate.check_magnitudes`): a reach ``R`` (the model's
+    ``sizes`` and the centres of mass' distances from their links' origins, summed); forces
+    ``m·R·ω²``, ``m·|g|``, the applied forces and the model's ``gas_forces``; moments ``R``
+    times those, ``(I + J_c)·ω²`` and the applied moments; energies ``(I + J_c + m·R²)·ω²``.
+    ``speeds`` and ``gravity`` are keyed by their spec keys (the largest speed of a motion
+    and its gravity).
     """
     links = dict(zip(mechanism.link_names, mechanism.links, strict=True))
-    if isinstance(mechanism, Linkage):
-        reach_terms = {f"mechanism.points.{p}": math.hypot(*xy) for p, xy in mechanism.points}
-    else:
-        reach_terms = {f"mechanism.lengths.{n}": abs(x)
-                       for n, x in zip(mechanism.length_names, mechanism.lengths, strict=True)}
+    reach_terms = dict(mechanism.sizes)
     for name, link in links.items():
         reach_terms[f"links.{name}.com"] = math.hypot(link.e, link.f)
     reach_key = max(reach_terms, key=reach_terms.__getitem__)
@@ -930,11 +963,9 @@ def check_scales(mechanism, speeds: dict[str, float],
         moments += [mass + r + r + w2, mass + g_abs + r, force + r, inertia + w2,
                     [(f"links.{name}.moment", link.moment)]]
         energies += [inertia + w2, mass + r + r + w2]
-    gas_forces = ([mechanism.gas_force] if isinstance(mechanism, SliderCrank) else
-                  [s.force for s in mechanism.sliders] if isinstance(mechanism, Linkage) else [])
-    for g in gas_forces:
+    for key, g in mechanism.gas_forces:
         if not g.is_zero:
-            gas = [("links.slider.gas_force", max(abs(x) for x in g.values))]
+            gas = [(key, max(abs(x) for x in g.values))]
             forces.append(gas)
             moments.append(gas + r)
     v.check_magnitudes(forces, "the forces", "N")
