@@ -222,7 +222,14 @@ class _Stepper:
         f = _WithExtraWork(self.f)
         y0 = np.append(y0, 0.0)
         t_end = self.duration if stop_at is None else min(stop_at, self.duration)
-        solver = DOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=self.atol)
+        symbolic = self.f.symbolic_rhs()
+        if symbolic is None:
+            solver = DOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=self.atol)
+        else:
+            from .integration import CompiledDOP853, with_extra_work
+
+            solver = CompiledDOP853(f.rhs, 0.0, y0, t_end, rhs=with_extra_work(symbolic),
+                                    rtol=self.rtol, atol=self.atol)
         states: list[NDArray[np.float64]] = []
         times: list[float] = []
         drift = [0.0, 0.0]
@@ -245,8 +252,20 @@ class _Stepper:
             self._check_budget(steps, solver.t)
             recent.append(solver.t)
             self._check_stall(recent, f, solver.t, solver.y, change_points)
-            interp = solver.dense_output()
+            # The step's dense output (three more evaluations for DOP853) is made only for a
+            # step that holds an output time or an event, and before a projection moves y.
+            dense = None
+
+            def interp(t: float, _solver=solver):
+                nonlocal dense
+                if dense is None:
+                    dense = _solver.dense_output()
+                return dense(t)
+
             if not f.minimal:
+                if not passes_dead_points or (k < self.t_out.size and self.t_out[k] <= solver.t
+                                              + 1e-14 * max(1.0, solver.t)):
+                    interp(solver.t)
                 res = f.constraint_residual(solver.t, solver.y)
                 drift = [max(drift[0], res[0]), max(drift[1], res[1])]
                 y_new = f.project(solver.t, solver.y)
@@ -254,7 +273,8 @@ class _Stepper:
                 solver.f = f.rhs(solver.t, y_new)  # the next step starts from the projection
                 self.extra_fev += 1
             if not passes_dead_points:
-                event = self._dead_point(interp, solver.t_old, solver.t, change_points)
+                event = self._dead_point(interp, solver.t_old, solver.t, solver.y,
+                                         change_points)
                 if event is not None:
                     stopped = event
                     solver.status = "finished"
@@ -312,17 +332,20 @@ class _Stepper:
             f"{MAX_STEPS:.0e} steps at rtol = {self.rtol:g}, atol = {self.atol:g}; loosen "
             f"the tolerances or end the run before t = {t:.6g} s")
 
-    def _dead_point(self, interp, t0: float, t1: float, change_points):
-        """The time at which |sin(θ3 − θ2)| falls to the threshold within a step, or None."""
+    def _dead_point(self, interp, t0: float, t1: float, y1, change_points):
+        """The time at which |sin(θ3 − θ2)| falls to the threshold within a step, or None.
+
+        ``y1`` is the state at the step's end (the dense output is made only for an event).
+        """
         f = _WithExtraWork(self.f)
 
-        def gap(t: float) -> float:
-            y = interp(t)
+        def gap(t: float, y=None) -> float:
+            y = interp(t) if y is None else y
             if change_points and _near_change_point(f, t, y, change_points):
                 return 1.0  # passable: the smooth motion goes through
             return abs(f.transmission(t, y)) - DEAD_POINT_THRESHOLD
 
-        if gap(t1) > 0:
+        if gap(t1, y1) > 0:
             return None
         t_event = brentq(gap, t0, t1, xtol=1e-12) if gap(t0) > 0 else t0
         return t_event, interp(t_event)

@@ -131,10 +131,14 @@ def test_multibody_agrees_with_the_slider_crank_formulation(mech, driven):
         assert abs(mb_moment - ref_moment) < 1e-9 * force * arm
 
 
-def test_a_free_six_bar_with_a_spring_and_gravity_keeps_its_energy():
+@pytest.mark.parametrize("method", ["multibody", "crank-angle"])
+def test_a_free_six_bar_with_a_spring_and_gravity_keeps_its_energy(method):
+    # crank-angle: its kinetic energy is computed from the links' own velocities (the core's
+    # rates at the states), a route apart from the m(θ1) it integrates with.
     design = _watt()
-    traj = simulate(design.mechanism, design.simulation, rtol=1e-10, atol=1e-12)
-    assert traj.method == "multibody"
+    traj = simulate(design.mechanism, design.simulation, method=method, rtol=1e-10,
+                    atol=1e-12)
+    assert traj.method == method
     assert np.ptp(traj.kinetic_energy) > 1.0  # the spring and gravity do work
     # T − T0 − W is a first integral of the integrated system: its error is the integration's
     # (integration_bound: 2·steps·rtol for a quantity quadratic in the rates).
@@ -152,7 +156,8 @@ def test_a_driven_six_bar_has_the_cycle_analysis_reactions():
     speed = 6.0
     settings = SimulationSettings(duration=0.6, omega1=speed, drive="constant-speed",
                                   gravity=(0.0, -9.81))
-    traj = simulate(design.mechanism, settings, rtol=1e-10, atol=1e-12, outputs=41)
+    traj = simulate(design.mechanism, settings, method="multibody", rtol=1e-10, atol=1e-12,
+                    outputs=41)
     mech = mechanism_of(design.mechanism)
     crank = traj.links.index(mech.input)
     mo = mech.motion(traj.theta[crank], speed, 0.0)
@@ -169,6 +174,49 @@ def test_a_driven_six_bar_has_the_cycle_analysis_reactions():
     assert np.max(np.abs(traj.omega[crank] - speed)) < 1e-12 * speed
     for k in range(len(traj.links)):
         assert rel_err(traj.omega[k], np.ravel(mo.rate[k]), scale=speed) < 1e-9
+
+
+def _random_crank_states(mech, count: int, seed: int):
+    rng = np.random.default_rng(seed)
+    start = mech.structure.ref_angle[mech.structure.input]
+    return start + rng.uniform(-np.pi, np.pi, count), rng.uniform(-20.0, 20.0, count)
+
+
+@pytest.mark.parametrize("example", ["watt", "quick_return.toml", "jansen_leg.toml"])
+def test_the_crank_angle_equation_agrees_with_the_multibody_at_random_states(example):
+    # Lagrange's equation in the crank angle (u = dq/dθ1 and b = d²q/dθ1² from the core's
+    # group-by-group solves, projected: m(θ1)·θ̈1 = uᵀ(Q − M·b·θ̇1²)) against the multibody's
+    # saddle-point system at the same states, free; and driven, its motor torque against the
+    # core's kinetostatics (the links' equations solved for the multipliers, no projection).
+    # Both sides are exact to rounding: 1e-9 relative.
+    from pathlib import Path
+
+    from balancer.spec import load_design
+
+    if example == "watt":
+        design = _watt()  # a spring and gravity
+        gravity = design.simulation.gravity
+    else:
+        design = load_design(Path(__file__).resolve().parent.parent / "examples" / example)
+        gravity = (0.0, -9.81)
+    mech = mechanism_of(design.mechanism)
+    crank = make("crank-angle", design.mechanism, gravity=gravity)
+    multi = make("multibody", design.mechanism, gravity=gravity)
+    theta1, omega1 = _random_crank_states(mech, 25, seed=12)
+    i = 3 * mech.structure.input + 2
+    alpha_crank, alpha_multi = [], []
+    for th, w in zip(theta1, omega1, strict=True):
+        alpha_crank.append(crank.rhs(0.0, crank.initial_state(th, w))[1])
+        alpha_multi.append(multi.rhs(0.0, multi.initial_state(th, w))[3 * multi.n + i])
+    alpha_multi = np.array(alpha_multi)
+    assert rel_err(np.array(alpha_crank), alpha_multi, scale=np.max(np.abs(alpha_multi))) < 1e-9
+    for speed in (-7.0, 11.0):
+        driven = make("crank-angle", design.mechanism, gravity=gravity, speed=speed)
+        power = np.array([driven.rhs(0.0, driven.initial_state(th, speed))[2] for th in theta1])
+        with np.errstate(all="ignore"):
+            mo = mech.motion(theta1, speed, 0.0)
+        torque = np.ravel(mech.inverse_dynamics(mo, gravity=gravity).driving_torque)
+        assert rel_err(power / speed, torque, scale=np.max(np.abs(torque))) < 1e-9
 
 
 def test_the_six_bar_through_every_verb(tmp_path, capsys):
@@ -342,3 +390,36 @@ def test_a_start_many_turns_away_is_followed_over_part_of_a_turn():
     # the same pose: the angles agree to the rounding of the crank angle (ulp(6283) ≈ 1e-12)
     # times the links' transmission (≤ 10 here)
     assert np.max(np.abs(far[others] - near[others])) < 1e-10
+
+
+@pytest.mark.parametrize("driven", [False, True])
+def test_a_compiled_dop853_step_is_scipys_step(driven):
+    # The twelve stages of a step (and the dense output's three) compiled into one call, the
+    # controller SciPy's: from the same state and first step, the same step to rounding (the
+    # stages' sums are in another order: a few ulps of the state per stage, 16 stages).
+    from scipy.integrate import DOP853
+
+    from balancer.integration import CompiledDOP853, with_extra_work
+    from balancer.simulate import _WithExtraWork
+
+    design = _watt()
+    f = make("crank-angle", design.mechanism, gravity=design.simulation.gravity,
+             speed=5.0 if driven else None)
+    own = _WithExtraWork(f)
+    y0 = np.append(f.initial_state(0.3, 4.0), 0.0)
+    options = {"rtol": 1e-10, "atol": 1e-12, "first_step": 1e-3}
+    ref = DOP853(own.rhs, 0.0, y0, 1.0, **options)
+    run = CompiledDOP853(own.rhs, 0.0, y0, 1.0, rhs=with_extra_work(f.symbolic_rhs()),
+                         **options)
+    eps = np.finfo(float).eps
+    ref.step()
+    run.step()
+    assert run.t == ref.t == 1e-3  # the first step taken as given (an error well within)
+    scale = np.max(np.abs(ref.y)) + ref.h_previous * np.max(np.abs(ref.f))
+    assert np.max(np.abs(run.y - ref.y)) < 16 * 4 * eps * scale
+    mid = 0.5 * (ref.t_old + ref.t)
+    assert np.max(np.abs(run.dense_output()(mid) - ref.dense_output()(mid))) < 16 * 4 * eps * scale
+    # The next step's size comes from the error estimate, a difference of nearly equal sums of
+    # stages: rounding moves it by about ε/rtol relative, no more.
+    assert abs(run.h_abs - ref.h_abs) <= 1e3 * eps / options["rtol"] * ref.h_abs
+    assert run.nfev == ref.nfev

@@ -199,6 +199,14 @@ class Formulation(ABC):
         """
         return Evaluation.stack([self.evaluate(t, y) for t, y in zip(times, states, strict=True)])
 
+    def symbolic_rhs(self):
+        """:meth:`rhs` as a CasADi function ``(t, y) → ẏ``, or ``None``.
+
+        Offered only where :meth:`extra_power` is zero: the integrator then evaluates a step's
+        stages in one compiled call (:mod:`balancer.integration`).
+        """
+        return None
+
     @abstractmethod
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         """``sin(θ3 − θ2)``: zero where coupler and rocker align (dead point or change point)."""

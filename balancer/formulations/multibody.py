@@ -44,43 +44,10 @@ from ..linkage.structure import (
     constraint_jacobian,
     constraint_residual,
 )
-from ..linkage.vectors import Ops, V
+from ..linkage.vectors import NUMPY, V
 from ..mechanisms import mechanism_of
 from . import Evaluation, Formulation
-
-
-class _CasadiOps(Ops):
-    """The elementary functions of :class:`balancer.linkage.vectors.Ops` for CasADi symbols."""
-
-    sqrt = staticmethod(ca.sqrt)
-    sin = staticmethod(ca.sin)
-    cos = staticmethod(ca.cos)
-    atan2 = staticmethod(ca.atan2)
-
-    @staticmethod
-    def where(condition, a, b):
-        return ca.if_else(condition, a, b)
-
-
-class _Compiled:
-    """A CasADi function of one dense vector to one dense vector, called through its buffers.
-
-    CasADi's buffer interface evaluates in about a microsecond; its Python call converts every
-    argument to and from a DM, a hundred times slower, which would dominate the integration.
-    """
-
-    def __init__(self, fn: ca.Function) -> None:
-        self.fn = fn
-        self.arg = np.zeros(fn.size1_in(0))
-        self.res = np.zeros(fn.size1_out(0))
-        self._buffer, self._eval = fn.buffer()
-        self._buffer.set_arg(0, memoryview(self.arg))
-        self._buffer.set_res(0, memoryview(self.res))
-
-    def __call__(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
-        self.arg[:] = x
-        self._eval()
-        return self.res.copy()
+from .compiled import CasadiOps, Compiled, link_equations, spring_forces
 
 
 def _least_norm(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -132,45 +99,11 @@ class Multibody(Formulation):
         q = ca.SX.sym("q", 3 * n)
         qd = ca.SX.sym("qd", 3 * n)
         gas = ca.SX.sym("gas", max(1, len(s.prisms)))
-        pose = self._pose(q, _CasadiOps)
+        pose = self._pose(q, CasadiOps)
         vel = [V(qd[3 * k], qd[3 * k + 1]) for k in range(n)]
         rate = [qd[3 * k + 2] for k in range(n)]
         g = V(self.gravity.real, self.gravity.imag)
-        mass = ca.SX.zeros(3 * n, 3 * n)
-        force = ca.SX.zeros(3 * n)
-        for k, link in enumerate(self.links):
-            first = V(link.mass * link.e, link.mass * link.f).rotated(pose.cos[k], pose.sin[k])
-            j_origin = link.inertia + link.mass * (link.e**2 + link.f**2) + link.counter_rotor
-            i = 3 * k
-            mass[i, i] = mass[i + 1, i + 1] = link.mass
-            mass[i, i + 2] = mass[i + 2, i] = -first.y
-            mass[i + 1, i + 2] = mass[i + 2, i + 1] = first.x
-            mass[i + 2, i + 2] = j_origin
-            w2 = rate[k] * rate[k]
-            fx = link.mass * g.x + link.force[0] + w2 * first.x
-            fy = link.mass * g.y + link.force[1] + w2 * first.y
-            arm = V(link.e, link.f).rotated(pose.cos[k], pose.sin[k])
-            moment = first.cross(g) + arm.cross(V(*link.force)) + link.moment
-            force[i] += fx
-            force[i + 1] += fy
-            force[i + 2] += moment
-        for spring in self.general.springs:
-            for k, f_vec, at in self._spring_forces(spring, pose, _CasadiOps):
-                if k != GROUND_INDEX:
-                    arm = at - pose.origin(k)
-                    force[3 * k] += f_vec.x
-                    force[3 * k + 1] += f_vec.y
-                    force[3 * k + 2] += arm.cross(f_vec)
-        for j, c in enumerate(s.prisms):
-            d = pose.rotate(c.g, c.dg)
-            at = pose.point(c.s, c.ps)
-            for k, sign in ((c.s, 1.0), (c.g, -1.0)):
-                if k != GROUND_INDEX:
-                    f_vec = d * (sign * gas[j])
-                    arm = at - pose.origin(k)
-                    force[3 * k] += f_vec.x
-                    force[3 * k + 1] += f_vec.y
-                    force[3 * k + 2] += arm.cross(f_vec)
+        mass, force = link_equations(self.structure, self.links, pose, rate, g, gas)
         jac = ca.SX.zeros(self.rows, 3 * n)
         gamma = ca.SX.zeros(self.rows)
         row = 0
@@ -182,7 +115,7 @@ class Multibody(Formulation):
                     for col in range(3):
                         jac[row + r, 3 * link + col] += coeffs[r][col]
             if not isinstance(c, Driver):
-                gam = _gamma(c, pose, vel, rate, _CasadiOps)
+                gam = _gamma(c, pose, vel, rate, CasadiOps)
                 for r in range(c.rows):
                     gamma[row + r] = gam[r]
             row += c.rows
@@ -219,7 +152,7 @@ class Multibody(Formulation):
                     couple.append(lam[row])
             row += c.rows
         for spring in self.general.springs:
-            for k, f_vec, at in self._spring_forces(spring, pose, _CasadiOps):
+            for k, f_vec, at in spring_forces(self.structure, spring, pose, CasadiOps):
                 if k == GROUND_INDEX:
                     fx, fy, mz = fx + f_vec.x, fy + f_vec.y, mz + at.cross(f_vec)
         for j, c in enumerate(s.prisms):
@@ -268,7 +201,7 @@ class Multibody(Formulation):
         sizes = np.cumsum([0, *(o.size1() for o in outputs)])
         self._slices = [slice(a, b) for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
         flat = ca.vertcat(q, qd, gas)
-        self._fast_dynamics = _Compiled(ca.Function(
+        self._fast_dynamics = Compiled(ca.Function(
             "dynamics_flat", [flat], [ca.densify(ca.vertcat(*self._dynamics(
                 flat[:k], flat[k : 2 * k], flat[2 * k :])))]))
 
@@ -291,26 +224,9 @@ class Multibody(Formulation):
         phi = ca.vertcat(*(r for c in self.constraints
                            for r in constraint_residual(c, pose, angle)))
         jac = ca.densify(ca.jacobian(phi, q))
-        self._constraints = _Compiled(ca.Function(
+        self._constraints = Compiled(ca.Function(
             "constraints", [ca.vertcat(q, angle)],
             [ca.vertcat(phi, ca.reshape(jac, -1, 1))]))
-
-    def _spring_forces(self, spring, pose: Pose, ops):
-        """The spring's forces on its two carriers: ``(link, force, point)`` twice."""
-        out = []
-        ends = []
-        for p in spring.points:
-            links = self.structure.point_links[p]
-            k = GROUND_INDEX if GROUND_INDEX in links else links[0]
-            ends.append((k, pose.point(k, self.structure.local[(k, p)])))
-        (ka, a), (kb, b) = ends
-        d = b - a
-        length = ops.sqrt(d.norm2())
-        tension = spring.stiffness * (length - spring.free_length)
-        unit = d / length
-        out.append((ka, unit * tension, a))
-        out.append((kb, unit * (-tension), b))
-        return out
 
     def _gas(self, theta1: float) -> NDArray[np.float64]:
         s = self.structure
@@ -362,41 +278,9 @@ class Multibody(Formulation):
 
             raise AssemblyError("the linkage cannot be assembled at the initial crank angle",
                                 key="simulation.theta1", value=theta1)
-        q[2::3] = self._continued_angles(theta1)
+        q[2::3] = self.mech.continued_angles(theta1)
         y = np.concatenate([q, qd])
         return np.append(y, 0.0) if self.driven else y
-
-    def _continued_angles(self, theta1: float) -> NDArray[np.float64]:
-        """The links' angles at crank angle ``theta1``, continuous from the reference pose.
-
-        DESIGN.md: each link's angle is its principal value at the reference pose and
-        continuous from there on; the crank is followed from the reference's angle to
-        ``theta1`` in steps of at most 0.05 rad, each link's angle unwrapped along the way (the
-        input's is ``theta1`` as given). A crank that turns fully is followed over the part of
-        a turn only, and each whole turn adds what one revolution adds to each link's angle.
-        """
-        s = self.structure
-        start = s.ref_angle[s.input]
-        turn = 2 * math.pi
-        turns = math.floor((theta1 - start) / turn) if self.mech.assembly_range().full else 0
-        out = self._followed(start, theta1 - turns * turn)
-        if turns:
-            out = out + turns * (self._followed(start, start + turn) - np.array(s.ref_angle))
-        out[s.input] = theta1
-        return out
-
-    def _followed(self, start: float, end: float) -> NDArray[np.float64]:
-        """The links' angles followed from the reference pose (at crank angle ``start``)."""
-        s = self.structure
-        steps = max(2, int(math.ceil(abs(end - start) / 0.05)) + 1)
-        with np.errstate(all="ignore"):
-            mo = self.mech.motion(np.linspace(start, end, steps))
-        out = np.empty(self.n)
-        for k in range(self.n):
-            path = np.concatenate([[s.ref_angle[k]], np.broadcast_to(
-                np.asarray(mo.pose.angles[k], dtype=float), (steps,))])
-            out[k] = np.unwrap(path)[-1] if np.all(np.isfinite(path)) else path[-1]
-        return out
 
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         k = 3 * self.n
@@ -526,7 +410,7 @@ class Multibody(Formulation):
         """Potential energy of the springs at a pose (arrays over states), J."""
         total = 0.0
         for spring in self.general.springs:
-            (_, _, a), (_, _, b) = self._spring_forces(spring, pose, np)
+            (_, _, a), (_, _, b) = spring_forces(self.structure, spring, pose, NUMPY)
             length = np.sqrt((b - a).norm2())
             total = total + 0.5 * spring.stiffness * (length - spring.free_length) ** 2
         return np.asarray(total, dtype=float)

@@ -131,6 +131,15 @@ def _minus(a: Any, b: Any) -> Any:
     return a - b
 
 
+def _reciprocal(v: Any) -> Any:
+    """``1/v``: NaN where a float or an array is zero; a symbol's as it is."""
+    if isinstance(v, float | np.ndarray):
+        v = np.asarray(v, dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return 1.0 / np.where(v == 0, np.nan, v)
+    return 1.0 / v
+
+
 class _BatchLU:
     """LU with partial pivoting of many small dense systems, vectorised over the systems.
 
@@ -242,19 +251,15 @@ class Factor:
         self.dense: _BatchLU | None = None
         if len(block) == 1:
             (a11,), = block
-            with np.errstate(divide="ignore", invalid="ignore"):
-                self.inverse = [[1.0 / np.where(a11 == 0, np.nan, a11)
-                                 if isinstance(a11, np.ndarray) else
-                                 (1.0 / a11 if a11 else np.nan)]]
+            self.inverse = [[_reciprocal(a11)]]
         elif len(block) == 2:
             (a11, a12), (a21, a22) = block
-            det = _minus(_times(a11, a22), _times(a12, a21))
-            det = np.asarray(det, dtype=float)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                inv = 1.0 / np.where(det == 0, np.nan, det)
+            inv = _reciprocal(_minus(_times(a11, a22), _times(a12, a21)))
             self.inverse = [[_times(a22, inv), _times(a12, -inv)],
                             [_times(a21, -inv), _times(a11, inv)]]
         elif len(block) > 2:
+            if not all(isinstance(v, float | np.ndarray) for row in block for v in row):
+                raise NotImplementedError("a dense remainder of symbols")
             n = max(np.size(v) for row in block for v in row)
             self.dense = _BatchLU(block, n)
 

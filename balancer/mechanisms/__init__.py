@@ -41,12 +41,13 @@ def formulation_names() -> tuple[str, ...]:
     """Every formulation of the equations of motion of any registered mechanism (``--method``)."""
     import importlib
 
-    from .base import MULTIBODY
+    from .base import CRANK_ANGLE, MULTIBODY
 
     names: dict[str, None] = {}
     for module, cls in REGISTRY.values():
         names.update(dict.fromkeys(getattr(importlib.import_module(module), cls).formulations))
     names.update(dict.fromkeys(MULTIBODY))
+    names.update(dict.fromkeys(CRANK_ANGLE))
     return tuple(names)
 
 

@@ -36,6 +36,9 @@ from ..model import GROUND, Link, Linkage
 #: The formulation of the equations of motion that applies to every linkage.
 MULTIBODY: dict[str, tuple[str, str]] = {
     "multibody": ("balancer.formulations.multibody", "Multibody")}
+#: The general formulation in the crank angle (linkages of dyads).
+CRANK_ANGLE: dict[str, tuple[str, str]] = {
+    "crank-angle": ("balancer.formulations.crank_angle", "CrankAngle")}
 #: Least normalised assembly gap of a dyad over a revolution for the crank to turn fully: at
 #: or below it the dyad reaches a dead point (its links in line) within rounding.
 GAP_TOLERANCE = 1e-12
@@ -162,10 +165,18 @@ class Mechanism(ABC):
     def formulation_table(self) -> dict[str, tuple[str, str]]:
         """Every formulation of the equations of motion that applies: name → (module, class).
 
-        The mechanism's own (the default first), then the general multibody formulation
-        (:mod:`balancer.formulations.multibody`), which applies to any linkage.
+        The mechanism's own (the default first), then the general ones: the multibody
+        formulation (:mod:`balancer.formulations.multibody`), which applies to any linkage, and
+        for a linkage of dyads the crank-angle one (:mod:`balancer.formulations.crank_angle`),
+        before the multibody where the crank turns fully.
         """
-        return {**self.formulations, **MULTIBODY}
+        general = dict(MULTIBODY)
+        if all(g.kind != "numeric" for g in self.structure.groups):
+            # Lagrange's equation in the crank angle: first where the crank turns fully (no
+            # dead point of the crank to stop it), after the multibody otherwise.
+            first = self.assembly_range().full
+            general = {**CRANK_ANGLE, **general} if first else {**general, **CRANK_ANGLE}
+        return {**self.formulations, **general}
 
     def parameters(self) -> NDArray[np.float64]:
         """The design vector of the mechanism's own links (:attr:`layout`)."""
@@ -219,6 +230,38 @@ class Mechanism(ABC):
                alpha1: ArrayLike = 0.0) -> Motion:
         """Frames, rates and accelerations at crank states (arrays broadcast together)."""
         return kinematics.motion(self.structure, theta1, omega1, alpha1)
+
+    def continued_angles(self, theta1: float) -> NDArray[np.float64]:
+        """The links' angles at crank angle ``theta1``, continuous from the reference pose.
+
+        DESIGN.md: each link's angle is its principal value at the reference pose and
+        continuous from there on; the crank is followed from the reference's angle to
+        ``theta1`` in steps of at most 0.05 rad, each link's angle unwrapped along the way (the
+        input's is ``theta1`` as given). A crank that turns fully is followed over the part of
+        a turn only, and each whole turn adds what one revolution adds to each link's angle.
+        """
+        s = self.structure
+        start = s.ref_angle[s.input]
+        turn = 2 * math.pi
+        turns = math.floor((theta1 - start) / turn) if self.assembly_range().full else 0
+        out = self._followed(start, theta1 - turns * turn)
+        if turns:
+            out = out + turns * (self._followed(start, start + turn) - np.array(s.ref_angle))
+        out[s.input] = theta1
+        return out
+
+    def _followed(self, start: float, end: float) -> NDArray[np.float64]:
+        """The links' angles followed from the reference pose (at crank angle ``start``)."""
+        s = self.structure
+        steps = max(2, int(math.ceil(abs(end - start) / 0.05)) + 1)
+        with np.errstate(all="ignore"):
+            mo = self.motion(np.linspace(start, end, steps))
+        out = np.empty(self.structure.size)
+        for k in range(self.structure.size):
+            path = np.concatenate([[s.ref_angle[k]], np.broadcast_to(
+                np.asarray(mo.pose.angles[k], dtype=float), (steps,))])
+            out[k] = np.unwrap(path)[-1] if np.all(np.isfinite(path)) else path[-1]
+        return out
 
     def limits(self, theta1: NDArray[np.float64]) -> list[Limit]:
         """Samples at singular poses that the smooth motion passes (none in general)."""

@@ -1,0 +1,114 @@
+"""What the compiled formulations of any linkage share: CasADi symbols for the linkage core.
+
+:class:`CasadiOps` lets the equations of :mod:`balancer.linkage` (written against
+:class:`~balancer.linkage.vectors.Ops`) be evaluated on CasADi's symbols; :class:`Compiled`
+calls a compiled function through its buffers; :func:`link_equations` and
+:func:`spring_forces` are the links' mass matrices and applied forces in absolute coordinates
+(Nikravesh 1988, ch. 11), used by :mod:`.multibody` and :mod:`.crank_angle` alike.
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from ..linkage.structure import GROUND_INDEX, Pose, Structure
+from ..linkage.vectors import Ops, V
+
+
+class CasadiOps(Ops):
+    """The elementary functions of :class:`balancer.linkage.vectors.Ops` for CasADi symbols."""
+
+    sqrt = staticmethod(ca.sqrt)
+    sin = staticmethod(ca.sin)
+    cos = staticmethod(ca.cos)
+    atan2 = staticmethod(ca.atan2)
+
+    @staticmethod
+    def where(condition, a, b):
+        return ca.if_else(condition, a, b)
+
+
+class Compiled:
+    """A CasADi function of one dense vector to one dense vector, called through its buffers.
+
+    CasADi's buffer interface evaluates in about a microsecond; its Python call converts every
+    argument to and from a DM, a hundred times slower, which would dominate the integration.
+    """
+
+    def __init__(self, fn: ca.Function) -> None:
+        self.fn = fn
+        self.arg = np.zeros(fn.size1_in(0))
+        self.res = np.zeros(fn.size1_out(0))
+        self._buffer, self._eval = fn.buffer()
+        self._buffer.set_arg(0, memoryview(self.arg))
+        self._buffer.set_res(0, memoryview(self.res))
+
+    def __call__(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        self.arg[:] = x
+        self._eval()
+        return self.res.copy()
+
+
+def spring_forces(structure: Structure, spring, pose: Pose, ops):
+    """The spring's forces on its two carriers: ``(link, force, point)`` twice (N, m)."""
+    ends = []
+    for p in spring.points:
+        links = structure.point_links[p]
+        k = GROUND_INDEX if GROUND_INDEX in links else links[0]
+        ends.append((k, pose.point(k, structure.local[(k, p)])))
+    (ka, a), (kb, b) = ends
+    d = b - a
+    length = ops.sqrt(d.norm2())
+    tension = spring.stiffness * (length - spring.free_length)
+    unit = d / length
+    return [(ka, unit * tension, a), (kb, unit * (-tension), b)]
+
+
+def link_equations(structure: Structure, links, pose: Pose, rate, gravity: V, gas):
+    """Mass matrix ``M`` and applied forces ``Q`` of the moving links (SX, 3n×3n and 3n).
+
+    Per link ``k``, in its coordinates ``(x, y, θ)``, with ``S̄ = R(θ)·(m·s̄)`` its first
+    moment about the frame's origin and ``J_O`` its inertia about it (a counter-rotor's
+    added)::
+
+        M_k = [[m, 0, −S_y], [0, m, S_x], [−S_y, S_x, J_O]]
+        Q_k = [m·ḡ + F̄ + ω²·S̄,  S̄ × ḡ + (R·s̄) × F̄ + M]  + springs, slider forces
+
+    (``ω²·S̄`` is what is left of the inertia force's velocity terms; ``rate`` the links'
+    angular velocities, ``gas`` the slider forces along their guides, N, per prismatic pair).
+    """
+    n = structure.size
+    mass = ca.SX.zeros(3 * n, 3 * n)
+    force = ca.SX.zeros(3 * n)
+    for k, link in enumerate(links):
+        first = V(link.mass * link.e, link.mass * link.f).rotated(pose.cos[k], pose.sin[k])
+        j_origin = link.inertia + link.mass * (link.e**2 + link.f**2) + link.counter_rotor
+        i = 3 * k
+        mass[i, i] = mass[i + 1, i + 1] = link.mass
+        mass[i, i + 2] = mass[i + 2, i] = -first.y
+        mass[i + 1, i + 2] = mass[i + 2, i + 1] = first.x
+        mass[i + 2, i + 2] = j_origin
+        w2 = rate[k] * rate[k]
+        arm = V(link.e, link.f).rotated(pose.cos[k], pose.sin[k])
+        force[i] += link.mass * gravity.x + link.force[0] + w2 * first.x
+        force[i + 1] += link.mass * gravity.y + link.force[1] + w2 * first.y
+        force[i + 2] += first.cross(gravity) + arm.cross(V(*link.force)) + link.moment
+
+    def put(k: int, f_vec: V, at: V) -> None:
+        if k != GROUND_INDEX:
+            arm = at - pose.origin(k)
+            force[3 * k] += f_vec.x
+            force[3 * k + 1] += f_vec.y
+            force[3 * k + 2] += arm.cross(f_vec)
+
+    for spring in structure.linkage.springs:
+        for k, f_vec, at in spring_forces(structure, spring, pose, CasadiOps):
+            put(k, f_vec, at)
+    for j, c in enumerate(structure.prisms):
+        d = pose.rotate(c.g, c.dg)
+        at = pose.point(c.s, c.ps)
+        put(c.s, d * gas[j], at)
+        put(c.g, d * (-gas[j]), at)
+    return mass, force

@@ -1,0 +1,247 @@
+"""Forward dynamics of any linkage in its crank angle: Lagrange's equation of one coordinate.
+
+A linkage with one degree of freedom moves as its crank angle ``θ1`` does: every link's
+coordinates ``q_k = (x_k, y_k, θ_k)`` (:mod:`balancer.linkage.structure`) are functions of it,
+``q̇ = u(θ1)·θ̇1`` and ``q̈ = u·θ̈1 + b(θ1)·θ̇1²``, with ``u = dq/dθ1`` and ``b = d²q/dθ1²``
+the velocities and accelerations of the linkage core's group-by-group solves
+(:func:`balancer.linkage.kinematics.rates`) at ``θ̇1 = 1, θ̈1 = 0``. Projecting the links'
+equations ``M·q̈ = Q + Φ_qᵀ·λ`` (:func:`~balancer.formulations.compiled.link_equations`) on
+``u``, which the constraints' forces do no work along (``Φ_q·u = 0``), leaves (Nikravesh
+1988, Sect. 11.4; the reduced form of the paper's Eq. 58 for any linkage)::
+
+    m(θ1)·θ̈1 = uᵀ·(Q − M·b·θ̇1²) + τ,        m(θ1) = uᵀ·M·u
+
+with ``τ`` the motor's torque (none in free motion; with the crank driven at constant speed,
+``θ̈1 = 0`` and ``τ = −uᵀ·(Q − M·b·θ̇1²)``). The state is ``(θ1, θ̇1)``: no constraint drifts,
+and nothing is projected.
+
+The positions are the dyads' closed forms on the reference pose's branch, so the formulation
+applies to linkages built of dyads only (a group solved numerically has none); as the crank
+angle is its coordinate it cannot pass a dead point of the crank, where ``u`` is unbounded —
+the simulation stops there and names the formulations that can. ``m``, the generalized force
+and the least assembly gap are one compiled CasADi function of ``(θ1, θ̇1)`` and the slider
+forces, built once. Outputs (reactions, shaking force and moment) come from the linkage core's
+inverse dynamics at the integrated states, vectorised.
+"""
+
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from ..linkage.kinematics import positions, rates
+from ..linkage.vectors import NUMPY, V
+from ..mechanisms import mechanism_of
+from . import Evaluation, Formulation
+from .compiled import CasadiOps, Compiled, link_equations, spring_forces
+
+
+class CrankAngle(Formulation):
+    """Lagrange's equation in the crank angle (linkages of dyads)."""
+
+    name = "crank-angle"
+    minimal = True
+    passes_dead_points = False
+    passes_change_points = False
+
+    def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
+                 speed: float | None = None) -> None:
+        super().__init__(linkage, gravity=gravity, speed=speed)
+        self.mech = mechanism_of(linkage)
+        self.structure = s = self.mech.structure
+        if any(g.kind == "numeric" for g in s.groups):
+            from ..errors import SpecError
+
+            raise SpecError("applies to linkages built of dyads: this one has a group solved "
+                            "numerically; choose multibody", key="method", value=self.name)
+        self.n = s.size
+        self.links = self.mech.links
+        #: Each link's angle at the start less its principal value there (whole turns).
+        self.turns = np.zeros(self.n)
+        self._build()
+
+    def _build(self) -> None:
+        s = self.structure
+        theta1, omega1 = ca.SX.sym("theta1"), ca.SX.sym("omega1")
+        gas = ca.SX.sym("gas", max(1, len(s.prisms)))
+        gaps: list = []
+        pose = positions(s, theta1, CasadiOps, gaps=gaps)
+        u_vel, u_rate, b_acc, b_accel = rates(s, pose, 1.0, 0.0, theta1, CasadiOps)
+        u = ca.vertcat(*[x for k in range(self.n)
+                         for x in (u_vel[k].x, u_vel[k].y, u_rate[k])])
+        b = ca.vertcat(*[x for k in range(self.n)
+                         for x in (b_acc[k].x, b_acc[k].y, b_accel[k])])
+        rate = [u_rate[k] * omega1 for k in range(self.n)]
+        g = V(self.gravity.real, self.gravity.imag)
+        mass, force = link_equations(s, self.links, pose, rate, g, gas)
+        inertia = ca.dot(u, ca.mtimes(mass, u))  # m(θ1)
+        general = ca.dot(u, force - ca.mtimes(mass, b) * omega1**2)
+        # The slider forces' generalized forces per newton (their power is θ̇1 times these).
+        per_gas = ca.jacobian(general, gas)[:, : len(s.prisms)]
+        least = gaps[0] if gaps else ca.SX(1.0)
+        for gap in gaps[1:]:
+            least = ca.fmin(least, gap)
+        outputs = ca.vertcat(inertia, general, least, per_gas.T)
+        self._equation = Compiled(ca.Function(
+            "crank_angle", [ca.vertcat(theta1, omega1, gas)], [ca.densify(outputs)]))
+        self._prisms = len(s.prisms)
+        self._sym = ca.Function("crank_angle_sym", [theta1, omega1, gas], [inertia, general])
+
+    def symbolic_rhs(self) -> ca.Function | None:
+        """``(t, y) → ẏ`` as a CasADi function (none with slider forces: tables in Python)."""
+        s = self.structure
+        if any(not s.linkage.sliders[c.slider].force.is_zero for c in s.prisms):
+            return None
+        t = ca.MX.sym("t")
+        gas = ca.MX.zeros(max(1, len(s.prisms)))
+        if self.driven:
+            speed = float(self.speed)  # type: ignore[arg-type]
+            y = ca.MX.sym("y", 3)
+            _, general = self._sym(self.theta1_start + speed * t, speed, gas)
+            dy = ca.vertcat(speed, 0, -general * speed)
+        else:
+            y = ca.MX.sym("y", 2)
+            inertia, general = self._sym(y[0], y[1], gas)
+            dy = ca.vertcat(y[1], general / inertia)
+        return ca.Function("crank_angle_rhs", [t, y], [dy])
+
+    def _gas(self, theta1: float) -> NDArray[np.float64]:
+        s = self.structure
+        values = [float(s.linkage.sliders[c.slider].force.at(theta1)) for c in s.prisms]
+        return np.array(values if values else [0.0])
+
+    def _at(self, theta1: float, omega1: float) -> NDArray[np.float64]:
+        """``m``, the generalized force without the motor's, the least gap, per-newton gas."""
+        return self._equation(np.concatenate([[theta1, omega1], self._gas(theta1)]))
+
+    # -- the formulation's interface ----------------------------------------------------------
+
+    def change_points(self) -> tuple[float, ...]:
+        return self.mech.change_points()
+
+    def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
+        self.theta1_start = float(theta1)
+        if self.driven:
+            omega1 = float(self.speed)  # type: ignore[arg-type]
+        continued = self.mech.continued_angles(theta1)
+        with np.errstate(all="ignore"):
+            principal = self.mech.motion(theta1).pose.angles
+        raw = np.array([float(np.ravel(x)[0]) for x in principal])
+        if not np.all(np.isfinite(raw)):
+            from ..errors import AssemblyError
+
+            raise AssemblyError("the linkage cannot be assembled at the initial crank angle",
+                                key="simulation.theta1", value=theta1)
+        self.turns = continued - raw
+        self.turns[self.structure.input] = 0.0
+        y = np.array([theta1, omega1])
+        return np.append(y, 0.0) if self.driven else y
+
+    def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
+        return self.crank_angle(t) if self.driven else float(y[0])
+
+    def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
+        if self.driven:
+            speed = float(self.speed)  # type: ignore[arg-type]
+            general = self._at(self.crank_angle(t), speed)[1]
+            return np.array([speed, 0.0, -general * speed])  # the motor's power: τ = −F
+        out = self._at(y[0], y[1])
+        return np.array([y[1], out[1] / out[0]])
+
+    def transmission(self, t: float, y: NDArray[np.float64]) -> float:
+        return math.sqrt(max(float(self._at(self.theta1_of(t, y), 0.0)[2]), 0.0))
+
+    def transmission_of_crank(self, theta1: float) -> float:
+        return math.sqrt(max(float(self._at(theta1, 0.0)[2]), 0.0))
+
+    def extra_power(self, t: float, y: NDArray[np.float64]) -> float:
+        """The slider forces' power, W: ``θ̇1`` times their generalized forces."""
+        if not self._prisms:
+            return 0.0
+        theta1 = self.theta1_of(t, y)
+        gas = self._gas(theta1)
+        if not np.any(gas):
+            return 0.0
+        omega1 = float(self.speed) if self.driven else float(y[1])  # type: ignore[arg-type]
+        per = self._at(theta1, 0.0)[3:]
+        return float(omega1 * np.dot(gas, per))
+
+    def _crank_states(self, states):
+        """Crank angle, rate and acceleration at states (the driven state's θ1 integrated)."""
+        ys = np.array(states, dtype=float).reshape(len(states), -1)
+        theta1, omega1 = ys[:, 0], ys[:, 1]
+        if self.driven:
+            return theta1, omega1, np.zeros(theta1.size)
+        alpha1 = np.array([self.rhs(0.0, y)[1] for y in ys])
+        return theta1, omega1, alpha1
+
+    def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
+        return self.evaluate_batch([t], [y]).at(0)
+
+    def evaluate_batch(self, times, states) -> Evaluation:
+        """The linkage core's motion and inverse dynamics at the states, vectorised."""
+        theta1, omega1, alpha1 = self._crank_states(states)
+        with np.errstate(all="ignore"):
+            mo = self.mech.motion(theta1, omega1, alpha1)
+            forces = self.mech.inverse_dynamics(mo, gravity=(self.gravity.real,
+                                                             self.gravity.imag))
+        count = theta1.size
+        theta = np.array([np.broadcast_to(np.asarray(mo.pose.angles[k], float), (count,))
+                          + self.turns[k] for k in range(self.n)])
+        theta[self.structure.input] = theta1
+        torque = forces.driving_torque[:, 0] if self.driven else np.zeros(count)
+        shaking_moment = forces.shaking_moment[:, 0]
+        if not self.driven:  # the free motion's motor exerts nothing: its rounding left out
+            shaking_moment = shaking_moment + forces.driving_torque[:, 0]
+        return Evaluation(
+            theta=theta,
+            omega=np.array([np.broadcast_to(np.asarray(w, float), (count,)) for w in mo.rate]),
+            alpha=np.array([np.broadcast_to(np.asarray(a, float), (count,)) for a in mo.accel]),
+            ground={p: v.complex()[:, 0] for p, v in forces.reactions.items()},
+            driving_torque=torque,
+            shaking_force=forces.shaking_force.complex()[:, 0],
+            shaking_moment=shaking_moment,
+            slider_normal={k: v[:, 0] for k, v in forces.slider_normal.items()},
+            slider_couple={k: v[:, 0] for k, v in forces.slider_couple.items()})
+
+    def energy(self, theta, omega, alpha, slider=None, states=None):
+        """Kinetic energy and the work of loads, gravity and springs since the first state, J.
+
+        The kinetic energy from each link's own motion at the output states (the linkage
+        core's velocities, ``Σ m·|v_G|²/2 + J_G·ω²/2`` with the counter-rotors' ``J_c·ω²/2``),
+        a route apart from the compiled ``m(θ1)·θ̇1²/2`` the motion was integrated with.
+        """
+        theta1, omega1, _ = self._crank_states(states)
+        with np.errstate(all="ignore"):
+            mo = self.mech.motion(theta1, omega1, 0.0)
+        g = V(self.gravity.real, self.gravity.imag)
+        kin = np.zeros(theta1.size)
+        work = np.zeros(theta1.size)
+        for k, link in enumerate(self.links):
+            com_local = V(link.e, link.f)
+            v = mo.point_velocity(k, com_local)
+            w = np.asarray(mo.rate[k], float)
+            kin += 0.5 * link.mass * v.norm2() + 0.5 * (link.inertia + link.counter_rotor) * w**2
+            com = mo.point(k, com_local)
+            work += (g * link.mass + V(*link.force)).dot(com - V(com.x[0], com.y[0]))
+            angle = np.asarray(theta[k], float)
+            work += link.moment * (angle - angle[0])
+        spring = self._spring_energy(mo) * np.ones(theta1.size)
+        return kin, work - (spring - spring[0])
+
+    def _spring_energy(self, mo):
+        total = 0.0
+        for spring in self.structure.linkage.springs:
+            (_, _, a), (_, _, b) = spring_forces(self.structure, spring, mo.pose, NUMPY)
+            length = np.sqrt((b - a).norm2())
+            total = total + 0.5 * spring.stiffness * (length - spring.free_length) ** 2
+        return np.asarray(total, dtype=float)
+
+    def shaking(self, ev: Evaluation) -> tuple:
+        return ev.shaking_force, ev.shaking_moment
+
+
+__all__ = ["CrankAngle"]
