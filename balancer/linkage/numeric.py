@@ -152,8 +152,7 @@ def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops,
     t = start + np.mod(theta1 - start, 2 * math.pi) if full else theta1
     if not full:  # within the range found, in the window nearest the reference
         t = start + np.remainder(theta1 - start + math.pi, 2 * math.pi) - math.pi
-    guess = np.column_stack([np.interp(t, angles[ok_rows], tab[ok_rows, j], left=np.nan,
-                                       right=np.nan) for j in range(tab.shape[1])])
+    guess = _cubic(angles, tab, t)
     inside = (t >= lo) & (t <= hi)
     if not full:
         valid = angles[ok_rows]
@@ -164,6 +163,26 @@ def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops,
     _set(pose, g, q)
     if gaps is not None:
         gaps.append(assembly_gap(structure, g, pose, q.shape[0]))
+
+
+def _cubic(angles: NDArray[np.float64], tab: NDArray[np.float64],
+           t: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The table at angles ``t`` by cubic interpolation on its uniform grid, ``(N, 3·|g|)``.
+
+    Through the four rows around each angle (Lagrange's cubic; at the table's ends, or next
+    to a row beyond the continuation, the nearest four finite rows or NaN): its error is
+    ``O(h⁴)`` of the table's step ``h``, ~1e-8 of the coordinates at 720 steps a turn, so that
+    one Newton step takes it to rounding.
+    """
+    step = angles[1] - angles[0]
+    x = (t - angles[0]) / step
+    i = np.clip(np.floor(x).astype(np.int64) - 1, 0, angles.size - 4)
+    i = np.where(np.isfinite(x), i, 0)
+    u = x - i  # in [1, 2] inside the table: the nodes are at 0, 1, 2, 3
+    weights = ((u - 1) * (u - 2) * (u - 3) / -6, u * (u - 2) * (u - 3) / 2,
+               u * (u - 1) * (u - 3) / -2, u * (u - 1) * (u - 2) / 6)
+    out = sum(w[:, None] * tab[i + j] for j, w in enumerate(weights))
+    return np.where(np.isfinite(x)[:, None], out, np.nan)
 
 
 def assembly_gap(structure: Structure, g: Group, pose: Pose, n: int) -> NDArray[np.float64]:
