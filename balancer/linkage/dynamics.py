@@ -413,17 +413,25 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.
     g = V(*gravity)
     structure_now = structure if linkage is structure.linkage else _with(structure, linkage)
     per, ground = applied_column(structure_now, mo, g, loads)
-    effective = [[per[k][r][:, None] * np.ones((n, 1)) for r in range(3)]
-                 for k in range(structure.size)]
-    rotor = np.zeros((n, 1))
-    for name, cols in inertial_columns(structure, mo, g).items():
-        k = structure.index(name)
-        for param, values in cols:
-            j = layout.index(name, param)
-            for r in range(3):
-                effective[k][r] = effective[k][r] + (values[r] * x[j])[:, None]
-            if param == "Jc":
-                rotor[:, 0] += 2 * mo.accel[k] * x[j]
+    # E_k = applied − (I_k − gravity_k) of the design: inertial_columns summed with the
+    # design's parameters, in closed form (S̄ = R·(m·s̄), the first moment about the origin).
+    effective = []
+    rotor = np.zeros(n)
+    for k, name in enumerate(structure.names):
+        m, me, mf, j_origin = x[layout.link_slice(name)]
+        r = layout.rotor(name)
+        rotor_j = 0.0 if r is None else x[r]
+        c, sn = mo.pose.cos[k], mo.pose.sin[k]
+        w, a = mo.rate[k], mo.accel[k]
+        acc = mo.acceleration[k] - g
+        first = V(c * me - sn * mf, sn * me + c * mf)
+        lin = first.perp() * a - first * (w * w)
+        effective.append([(per[k][0] - m * acc.x - lin.x)[:, None],
+                          (per[k][1] - m * acc.y - lin.y)[:, None],
+                          (per[k][2] - first.cross(acc) - (j_origin + rotor_j) * a)[:, None]])
+        if rotor_j:
+            rotor = rotor + 2 * rotor_j * a
+    rotor = np.broadcast_to(rotor, (n,))[:, None]
     extra = tuple(np.asarray(v)[:, None] * np.ones((n, 1)) for v in ground)
     solver = kinetostatics if route == "groups" else global_kinetostatics
     return solver(structure, mo, effective, rotor_moment=rotor, ground_extra=extra)
