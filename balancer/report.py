@@ -120,7 +120,7 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
         {
             "mechanism": mech.kind,
             "class": mech.describe(),
-            **({"branch": mech.model.branch} if hasattr(mech.model, "branch") else {}),
+            **({"branch": mech.branch} if mech.branch is not None else {}),
             "speed": analysis.speed,
             "samples": int(analysis.samples),
             "route": analysis.route,
@@ -165,14 +165,12 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
     s = analysis.summary
     rpm = analysis.speed * 60 / (2 * math.pi)
     head = f"balancer analyze — {spec}" if spec else "balancer analyze"
-    title = getattr(mech.model, "title", "")
     lines = [
         head,
         f"{mech.kind} ({mech.describe()}), {analysis.samples} crank angles per revolution at "
         f"{analysis.speed:g} rad/s ({rpm:.4g} rpm), {analysis.route} route"
         + ("" if any(analysis.gravity) else "; gravity not included")
         + ("" if analysis.loads else "; loads left out"),
-        *([title] if title else []),
         "",
         table(
             [

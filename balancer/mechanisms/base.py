@@ -190,6 +190,14 @@ class Mechanism(ABC):
         """A short word on how it moves: whether the crank turns fully."""
         return "full turn" if self.assembly_range().full else "swinging crank"
 
+    @property
+    def branch(self) -> str | None:
+        """The assembly branch its spec names (``"+"`` or ``"-"``), or ``None``.
+
+        ``None`` in general: the reference pose fixes the branch.
+        """
+        return None
+
     # -- kinematics ---------------------------------------------------------------------------
 
     def assembly_range(self) -> AssemblyRange:

@@ -83,6 +83,10 @@ class FourBarMechanism(Mechanism):
         """The Grashof class."""
         return str(fourbar.classify(self.model.lengths))
 
+    @property
+    def branch(self) -> str:
+        return self.model.branch
+
     def assembly_range(self) -> AssemblyRange:
         return fourbar.assembly_range(self.model.lengths)
 

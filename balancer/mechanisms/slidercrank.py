@@ -77,6 +77,10 @@ class SliderCrankMechanism(Mechanism):
     def describe(self) -> str:
         return closed.classify(self.model.lengths)
 
+    @property
+    def branch(self) -> str:
+        return self.model.branch
+
     def assembly_range(self) -> AssemblyRange:
         return closed.assembly_range(self.model.lengths)
 
