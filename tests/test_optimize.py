@@ -2,7 +2,7 @@
 
 Checks that do not re-run the optimiser's own code: force balance by
 :func:`balancer.conditions.force_balance_error` on the rebuilt links; the objective by the
-Newton–Euler cycle analysis (the optimisers use the mass-matrix regressors); optimality by a
+Newton–Euler cycle analysis (the optimisers use the general core's regressors); optimality by a
 random search over feasible designs built in closed form (Eq. 57 solved for the crank's and
 rocker's centres of mass); complete balance by Berkof's conditions; infeasibility diagnoses by
 solving again with the bound they ask for.
