@@ -25,7 +25,7 @@ REPEATS = 5
 _CYCLE = """
 import json, resource, time
 from balancer.spec import load_design
-from balancer.inverse import cycle_analysis
+from balancer.cycle import cycle_analysis
 design = load_design({example!r})
 t = time.perf_counter()
 ca = cycle_analysis(design.mechanism, 10.0, {n}, route={route!r})

@@ -345,21 +345,3 @@ def test_parallelogram_cycle_passes_its_change_points_smoothly():
     assert np.max(np.abs(ca.reactions.shaking_moment - moment)) < error + moment_tol
     other = cycle.cycle_analysis(linkage, speed, 72, route="mass-matrix")
     assert np.max(np.abs(other.reactions.shaking_moment - moment)) < error + moment_tol
-
-
-@pytest.mark.parametrize(("linkage", "t", "w", "a", "g"), _states(30, n_linkages=15))
-def test_regressors_reproduce_the_newton_euler_reactions(linkage, t, w, a, g):
-    """The linear maps (mass-matrix route, unit parameters) against Newton–Euler directly.
-
-    Two routes at the same states: 1e-9 relative (DESIGN.md), the states filtered (_states).
-    """
-    mo = kin.motion_of(linkage, t, w, a)
-    reg = inverse.regressors(linkage.lengths, mo, gravity=g)
-    x = inverse.parameter_vector(linkage)
-    ne = inverse.newton_euler(linkage, mo, gravity=g, loads=False)
-    s = _scale(ne)
-    assert rel_err(reg.RA0 @ x, ne.RA0, scale=s["force"]) < 1e-9
-    assert rel_err(reg.RA3 @ x, ne.RA3, scale=s["force"]) < 1e-9
-    assert rel_err(reg.shaking_force @ x, ne.shaking_force, scale=s["force"]) < 1e-9
-    assert rel_err(reg.driving_torque @ x, ne.driving_torque, scale=s["moment"]) < 1e-9
-    assert rel_err(reg.shaking_moment @ x, ne.shaking_moment, scale=s["moment"]) < 1e-9

@@ -47,10 +47,10 @@ def is_force_balanced(mech: SliderCrank, tol: float = FORCE_BALANCE_TOLERANCE) -
 
 
 def force_balance_matrix(lengths) -> NDArray[np.float64]:
-    """Eq. 20a–b as ``[A | b]`` (4×13) in the stacked inertial parameters.
+    """Eq. 20a–b as a 4×13 matrix ``A`` with ``A·x = 0`` for a force-balanced design.
 
-    Crank, rod and slider in the layout of :data:`balancer.inverse.PARAMETER_NAMES` (rod and
-    slider in the places of coupler and rocker).
+    Columns of ``x``: crank, rod and slider, each ``(m, m·e, m·f, J)`` (kg, kg·m, kg·m,
+    kg·m²), then the crank's counter-rotor (kg·m², no part in the force balance).
     """
     r, big_l, _ = lengths
     a = np.zeros((4, 13))
