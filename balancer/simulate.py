@@ -3,7 +3,8 @@
 The integrator is SciPy's explicit Runge–Kutta method of order 8 (DOP853), stepped by hand so
 that after every accepted step the non-minimal formulations' states are projected back onto the
 loop closure and its derivative (the drift before projection is reported). Output values come
-from the step's dense output, projected in the same way, at equally spaced times.
+from the step's dense output, projected in the same way, at equally spaced times. No component
+is held to an absolute error below 100 ε of the largest of its kind (:func:`floored_atol`).
 
 Events:
 
@@ -42,7 +43,7 @@ from scipy.optimize import brentq
 from .errors import AssemblyError, LockupError, SolverError, SpecError
 from .formulations import Formulation, default_method, formulation_class, formulation_table, make
 from .mechanisms import mechanism_of
-from .model import Design, SimulationSettings, check_scales
+from .model import RTOL_MIN, Design, SimulationSettings, check_scales
 
 #: |sin(θ3 − θ2)| at which a crank-angle formulation stops before a dead point.
 DEAD_POINT_THRESHOLD = 1e-3
@@ -222,14 +223,16 @@ class _Stepper:
         f = _WithExtraWork(self.f)
         y0 = np.append(y0, 0.0)
         t_end = self.duration if stop_at is None else min(stop_at, self.duration)
+        groups = self.f.like_components()
+        atol = floored_atol(self.atol, groups, y0)
         symbolic = self.f.symbolic_rhs()
         if symbolic is None:
-            solver = DOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=self.atol)
+            solver = DOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=atol)
         else:
             from .integration import CompiledDOP853, with_extra_work
 
             solver = CompiledDOP853(f.rhs, 0.0, y0, t_end, rhs=with_extra_work(symbolic),
-                                    rtol=self.rtol, atol=self.atol)
+                                    rtol=self.rtol, atol=atol)
         states: list[NDArray[np.float64]] = []
         times: list[float] = []
         drift = [0.0, 0.0]
@@ -272,6 +275,8 @@ class _Stepper:
                 solver.y = y_new
                 solver.f = f.rhs(solver.t, y_new)  # the next step starts from the projection
                 self.extra_fev += 1
+            if groups:
+                solver.atol = floored_atol(self.atol, groups, solver.y)
             if not passes_dead_points:
                 event = self._dead_point(interp, solver.t_old, solver.t, solver.y,
                                          change_points)
@@ -349,6 +354,27 @@ class _Stepper:
             return None
         t_event = brentq(gap, t0, t1, xtol=1e-12) if gap(t0) > 0 else t0
         return t_event, interp(t_event)
+
+
+def floored_atol(atol: float, groups, y: NDArray[np.float64]) -> float | NDArray[np.float64]:
+    """The absolute tolerance of each component of the state ``y``.
+
+    ``atol``, but for a component of one of the ``groups``
+    (:meth:`~balancer.formulations.Formulation.like_components`) at least
+    :data:`~balancer.model.RTOL_MIN` (100 ε, the tightest ``rtol`` accepted) times the group's
+    largest magnitude. A component that is zero for the motion (the velocity of a frame pinned
+    to the ground at its origin) is computed from the others and carries their rounding: in a
+    linkage 200 m across turning at 130 rad/s, with velocities of 10⁴ m/s and accelerations of
+    10⁷ m/s², a pinned origin's acceleration comes out as 10⁻⁶ m/s² of noise, and an absolute
+    tolerance of 10⁻¹³ m/s on its velocity held the steps to 10⁻⁷ s (30 000 steps a turn, a
+    minute of a 0.05 s verification; the floor: 80).
+    """
+    if not groups:
+        return atol
+    out = np.full(y.shape, float(atol))
+    for g in groups:
+        out[g] = max(float(atol), RTOL_MIN * float(np.max(np.abs(y[g]), initial=0.0)))
+    return out
 
 
 class _WithExtraWork:

@@ -279,6 +279,18 @@ class Formulation(ABC):
         """Loop-closure residuals of a state: position (m) and velocity (m/s)."""
         return 0.0, 0.0
 
+    def like_components(self) -> tuple[NDArray[np.intp], ...]:
+        """Groups of the state's components that are quantities of one kind, as indices.
+
+        Such as the links' positions, angles, velocities and rates. The integrator holds no
+        component of a group to an absolute error below the rounding of the group's largest
+        (:func:`balancer.simulate.floored_atol`): a component that is zero for the motion (the
+        velocity of a frame pinned at its origin) is computed from the others to their
+        rounding, and a tolerance below that makes the steps shrink to the noise. None by
+        default (each component is its own kind).
+        """
+        return ()
+
     def extra_power(self, t: float, y: NDArray[np.float64]) -> float:
         """Power of the loads whose work is not a function of the configuration, W.
 

@@ -320,6 +320,13 @@ class Multibody(Formulation):
         y[:n], y[n : 2 * n] = q, qd
         return y
 
+    def like_components(self) -> tuple[NDArray[np.intp], ...]:
+        """The frames' positions, their angles, their velocities, their rates."""
+        k = 3 * self.n
+        lengths = np.sort(np.concatenate([np.arange(0, k, 3), np.arange(1, k, 3)]))
+        angles = np.arange(2, k, 3)
+        return lengths, angles, lengths + k, angles + k
+
     def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
         n = 3 * self.n
         q, qd = y[:n], y[n : 2 * n]
