@@ -41,12 +41,17 @@ from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
 from .errors import AssemblyError, LockupError, SolverError, SpecError
-from .formulations import Formulation, default_method, formulation_class, formulation_table, make
+from .formulations import (
+    DEAD_POINT_THRESHOLD,
+    Formulation,
+    default_method,
+    formulation_class,
+    formulation_table,
+    make,
+)
 from .mechanisms import mechanism_of
 from .model import RTOL_MIN, Design, SimulationSettings, check_scales
 
-#: |sin(θ3 − θ2)| at which a crank-angle formulation stops before a dead point.
-DEAD_POINT_THRESHOLD = 1e-3
 #: Most integration steps a simulation may take (tens of minutes with the slowest
 #: formulation): a duration that needs more is refused, from the rate of its first steps.
 MAX_STEPS = 2_000_000

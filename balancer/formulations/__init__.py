@@ -41,6 +41,9 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+#: The transmission (|sin(θ3 − θ2)|, or the square root of a group's assembly gap) at which a
+#: formulation that cannot pass a dead point stops before it (:mod:`balancer.simulate`).
+DEAD_POINT_THRESHOLD = 1e-3
 
 @dataclass(frozen=True)
 class Evaluation:

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..linkage.structure import GROUND_INDEX, Pose, Structure
-from ..linkage.vectors import Ops, V
+from ..linkage.vectors import Factor, Ops, V
 
 
 class CasadiOps(Ops):
@@ -28,6 +28,19 @@ class CasadiOps(Ops):
     @staticmethod
     def where(condition, a, b):
         return ca.if_else(condition, a, b)
+
+    @staticmethod
+    def factor(a):
+        """``A`` factored for its solves; a dense remainder by CasADi's symbolic QR."""
+        return Factor(a, dense=_dense_solve)
+
+
+def _dense_solve(block, columns):
+    """``X`` with ``A·X = B`` for symbols: ``A`` k×k and ``B`` k×m as lists of rows."""
+    a = ca.vertcat(*[ca.horzcat(*row) for row in block])
+    b = ca.vertcat(*[ca.horzcat(*row) for row in columns])
+    x = ca.solve(a, b)
+    return [[x[i, j] for j in range(b.size2())] for i in range(b.size1())]
 
 
 class Compiled:

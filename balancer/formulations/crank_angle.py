@@ -15,13 +15,15 @@ with ``τ`` the motor's torque (none in free motion; with the crank driven at co
 ``θ̈1 = 0`` and ``τ = −uᵀ·(Q − M·b·θ̇1²)``). The state is ``(θ1, θ̇1)``: no constraint drifts,
 and nothing is projected.
 
-The positions are the dyads' closed forms on the reference pose's branch, so the formulation
-applies to linkages built of dyads only (a group solved numerically has none); as the crank
-angle is its coordinate it cannot pass a dead point of the crank, where ``u`` is unbounded —
-the simulation stops there and names the formulations that can. ``m``, the generalized force
-and the least assembly gap are one compiled CasADi function of ``(θ1, θ̇1)`` and the slider
-forces, built once. Outputs (reactions, shaking force and moment) come from the linkage core's
-inverse dynamics at the integrated states, vectorised.
+The positions are the dyads' closed forms on the reference pose's branch; a group without one
+(a Stephenson chain's four links driven from a binary link) takes two Newton steps from a
+cubic spline through its continuation table (:mod:`balancer.linkage.numeric`), checked to
+have converged at every step of the integration. As the crank angle is its coordinate it
+cannot pass a dead point of the crank, where ``u`` is unbounded — the simulation stops there
+and names the formulations that can. ``m``, the generalized force and the least assembly gap
+are one compiled CasADi function of ``(θ1, θ̇1)`` and the slider forces, built once. Outputs
+(reactions, shaking force and moment) come from the linkage core's inverse dynamics at the
+integrated states, vectorised (numpy, an independent solve of the same positions).
 """
 
 from __future__ import annotations
@@ -35,12 +37,16 @@ from numpy.typing import NDArray
 from ..linkage.kinematics import positions, rates
 from ..linkage.vectors import NUMPY, V
 from ..mechanisms import mechanism_of
-from . import Evaluation, Formulation
+from . import DEAD_POINT_THRESHOLD, Evaluation, Formulation
 from .compiled import CasadiOps, Compiled, link_equations, spring_forces
+
+#: Largest residual of a numeric group's equations after its Newton steps, relative to the
+#: linkage's length scale: a few hundred roundings.
+CLOSURE_TOLERANCE = 1e-12
 
 
 class CrankAngle(Formulation):
-    """Lagrange's equation in the crank angle (linkages of dyads)."""
+    """Lagrange's equation in the crank angle (any linkage)."""
 
     name = "crank-angle"
     minimal = True
@@ -51,13 +57,8 @@ class CrankAngle(Formulation):
                  speed: float | None = None) -> None:
         super().__init__(linkage, gravity=gravity, speed=speed)
         self.mech = mechanism_of(linkage)
-        self.structure = s = self.mech.structure
-        if any(g.kind == "numeric" for g in s.groups):
-            from ..errors import SpecError
-
-            raise SpecError("applies to linkages built of dyads: this one has a group solved "
-                            "numerically; choose multibody", key="method", value=self.name)
-        self.n = s.size
+        self.structure = self.mech.structure
+        self.n = self.structure.size
         self.links = self.mech.links
         #: Each link's angle at the start less its principal value there (whole turns).
         self.turns = np.zeros(self.n)
@@ -67,8 +68,15 @@ class CrankAngle(Formulation):
         s = self.structure
         theta1, omega1 = ca.SX.sym("theta1"), ca.SX.sym("omega1")
         gas = ca.SX.sym("gas", max(1, len(s.prisms)))
+        numeric = [i for i, g in enumerate(s.groups) if g.kind == "numeric"]
+        sizes = [3 * len(s.groups[i].links) for i in numeric]
+        guess = ca.SX.sym("guess", sum(sizes))
+        starts = np.cumsum([0, *sizes])
+        guesses = {i: [guess[j] for j in range(a, b)]
+                   for i, a, b in zip(numeric, starts[:-1], starts[1:], strict=True)}
         gaps: list = []
-        pose = positions(s, theta1, CasadiOps, gaps=gaps)
+        residuals: list = []
+        pose = positions(s, theta1, CasadiOps, gaps=gaps, guesses=guesses, residuals=residuals)
         u_vel, u_rate, b_acc, b_accel = rates(s, pose, 1.0, 0.0, theta1, CasadiOps)
         u = ca.vertcat(*[x for k in range(self.n)
                          for x in (u_vel[k].x, u_vel[k].y, u_rate[k])])
@@ -81,14 +89,66 @@ class CrankAngle(Formulation):
         general = ca.dot(u, force - ca.mtimes(mass, b) * omega1**2)
         # The slider forces' generalized forces per newton (their power is θ̇1 times these).
         per_gas = ca.jacobian(general, gas)[:, : len(s.prisms)]
-        least = gaps[0] if gaps else ca.SX(1.0)
+        least = gaps[0] if gaps else ca.SX(1.0)  # the dyads' (numeric groups: _numeric_gap)
         for gap in gaps[1:]:
             least = ca.fmin(least, gap)
-        outputs = ca.vertcat(inertia, general, least, per_gas.T)
+        closure = ca.mmax(ca.fabs(ca.vertcat(*residuals))) if residuals else ca.SX(0.0)
+        core = ca.Function("crank_angle_core", [theta1, omega1, gas, guess],
+                           [inertia, general, least, closure, per_gas.T])
+        # The numeric groups' Newton starts from their continuation tables (cubic splines).
+        th, w = ca.MX.sym("theta1"), ca.MX.sym("omega1")
+        gs = ca.MX.sym("gas", max(1, len(s.prisms)))
+        start = (ca.vertcat(*[self._table_guess(i, th) for i in numeric]) if numeric
+                 else ca.MX(0, 1))
+        out = core(th, w, gs, start)
+        self._sym = ca.Function("crank_angle", [th, w, gs], [out[0], out[1]])
         self._equation = Compiled(ca.Function(
-            "crank_angle", [ca.vertcat(theta1, omega1, gas)], [ca.densify(outputs)]))
+            "crank_angle_flat", [ca.vertcat(th, w, gs)], [ca.densify(ca.vertcat(*out))]))
         self._prisms = len(s.prisms)
-        self._sym = ca.Function("crank_angle_sym", [theta1, omega1, gas], [inertia, general])
+        self._numeric = bool(numeric)
+
+    def _table_guess(self, index: int, theta1):
+        """A numeric group's coordinates at ``theta1`` (MX) from its continuation table.
+
+        A cubic spline through the table's rows (:func:`balancer.linkage.numeric.table`),
+        with the crank angle brought into the table's window as the numpy route does.
+        """
+        from ..linkage import numeric
+
+        s = self.structure
+        angles, tab = numeric.table(s, s.groups[index])
+        start = angles[numeric.TABLE_STEPS]
+        step = angles[1] - angles[0]
+        turn = 2 * math.pi
+        finite = np.all(np.isfinite(tab), axis=1)
+        if self.mech.assembly_range().full:
+            rows = (angles >= start - 4 * step) & (angles <= start + turn + 4 * step) & finite
+            d = theta1 - start
+            t = start + d - turn * ca.floor(d / turn)
+        else:
+            rows = finite
+            d = theta1 - start + math.pi
+            t = start + d - turn * ca.floor(d / turn) - math.pi
+        spline = ca.interpolant(f"table_{index}", "bspline", [angles[rows].tolist()],
+                                tab[rows].ravel().tolist())
+        return spline(t)
+
+    def _numeric_gap(self, theta1: float) -> float:
+        """The numeric groups' least assembly gap at ``theta1``, or a lower bound of it.
+
+        Where the crank turns fully and no group comes near a dead point over the
+        revolution (the least gap over it, found with the assembly range, has a square root
+        ten times :data:`~balancer.formulations.DEAD_POINT_THRESHOLD`), that least gap: a
+        bound valid at every angle, at no cost, that keeps the simulation's dead-point event
+        from firing exactly when it must not. Otherwise the gap itself (the numpy route's
+        singular values).
+        """
+        least = self.mech.least_gap()
+        if least is not None and least > (10 * DEAD_POINT_THRESHOLD) ** 2:
+            return least
+        from ..mechanisms.base import _gaps
+
+        return float(_gaps(self.structure, np.array([theta1]))[0])
 
     def symbolic_rhs(self) -> ca.Function | None:
         """``(t, y) → ẏ`` as a CasADi function (none with slider forces: tables in Python)."""
@@ -152,10 +212,25 @@ class CrankAngle(Formulation):
         return np.array([y[1], out[1] / out[0]])
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
-        return math.sqrt(max(float(self._at(self.theta1_of(t, y), 0.0)[2]), 0.0))
+        return self.transmission_of_crank(self.theta1_of(t, y))
 
     def transmission_of_crank(self, theta1: float) -> float:
-        return math.sqrt(max(float(self._at(theta1, 0.0)[2]), 0.0))
+        """The square root of the groups' least assembly gap (0 at a dead point).
+
+        Also where a numeric group's Newton steps (a fixed number, from its table) are
+        checked: their residual must be at rounding.
+        """
+        out = self._at(theta1, 0.0)
+        if self._numeric and not out[3] <= CLOSURE_TOLERANCE * self.structure.length_scale():
+            from ..errors import SolverError
+
+            raise SolverError(
+                f"the positions of the linkage's numerically solved group did not converge at "
+                f"θ1 = {theta1:.9g} rad (residual {out[3]:.3g} m); choose multibody")
+        gap = float(out[2])
+        if self._numeric:
+            gap = min(gap, self._numeric_gap(theta1))
+        return math.sqrt(max(gap, 0.0))
 
     def extra_power(self, t: float, y: NDArray[np.float64]) -> float:
         """The slider forces' power, W: ``θ̇1`` times their generalized forces."""
@@ -166,7 +241,7 @@ class CrankAngle(Formulation):
         if not np.any(gas):
             return 0.0
         omega1 = float(self.speed) if self.driven else float(y[1])  # type: ignore[arg-type]
-        per = self._at(theta1, 0.0)[3:]
+        per = self._at(theta1, 0.0)[4:]
         return float(omega1 * np.dot(gas, per))
 
     def _crank_states(self, states):

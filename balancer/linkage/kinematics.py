@@ -179,7 +179,8 @@ def _place(pose: Pose, k: int, theta, origin_or_pivot: V, local: V | None, ops: 
 
 
 def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
-              gaps: list | None = None) -> Pose:
+              gaps: list | None = None, guesses: dict | None = None,
+              residuals: list | None = None) -> Pose:
     """Every link's frame at crank angles ``theta1`` (rad), on the reference pose's branch.
 
     Parameters
@@ -192,7 +193,11 @@ def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
         Elementary functions (numpy by default).
     gaps
         If a list, receives each group's assembly gap (≥ 0 where it assembles; a numeric
-        group's: :func:`balancer.linkage.numeric.assembly_gap`).
+        group's: :func:`balancer.linkage.numeric.assembly_gap`, with numpy only).
+    guesses, residuals
+        With symbols: each numeric group's starting coordinates for Newton's method, keyed
+        by its place in ``structure.groups``; ``residuals`` (a list) receives each such
+        group's equations at the result (:func:`~.numeric.solve_group_symbolic`).
 
     Returns
     -------
@@ -203,16 +208,23 @@ def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
     if ops is NUMPY:
         theta1 = np.asarray(theta1, dtype=float)
     pose = Pose([V(0.0, 0.0)] * n, [0.0] * n, [1.0] * n, [0.0] * n)
-    for g in structure.groups:
+    for index, g in enumerate(structure.groups):
         if g.kind == "crank":
             pin = g.constraints[0]
             pivot, local = _known_point(pose, pin, g.links[0])
             _place(pose, g.links[0], theta1, pivot, local, ops)
             continue
         if g.kind == "numeric":
-            from .numeric import solve_group
+            from .numeric import solve_group, solve_group_symbolic
 
-            solve_group(structure, g, pose, theta1, ops, gaps)
+            if ops is NUMPY:
+                solve_group(structure, g, pose, theta1, ops, gaps)
+            else:
+                if guesses is None or index not in guesses:
+                    raise ValueError("a numeric group on symbols needs a starting guess")
+                found = solve_group_symbolic(g, pose, guesses[index], ops)
+                if residuals is not None:
+                    residuals.extend(found)
             continue
         solver = {"RRR": _Dyads.rrr, "RRP": _Dyads.rrp, "RPR": _Dyads.rpr}[g.kind]
         (ta, pa, la), (tb, pb, lb), gap = solver(ops, pose, g, g.sign)

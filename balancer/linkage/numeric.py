@@ -165,6 +165,32 @@ def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops,
         gaps.append(assembly_gap(structure, g, pose, q.shape[0]))
 
 
+def solve_group_symbolic(g: Group, pose: Pose, guess: list, ops,
+                         iterations: int = 2) -> list:
+    """Place numeric group ``g``'s links in ``pose`` by Newton's method on symbols.
+
+    ``iterations`` steps from ``guess`` (the group's coordinates, ``3·|g|`` symbols: a good
+    start, within the quadratic convergence of Newton's method); returns the residual of the
+    group's equations at the result, for the caller to check that it converged.
+    """
+    q = list(guess)
+    for _ in range(iterations):
+        _place_symbols(pose, g, q, ops)
+        residual = _residual(g, pose)
+        step = ops.factor(_jacobian_rows(g, pose)).solve([[r] for r in residual])
+        q = [x - d[0] for x, d in zip(q, step, strict=True)]
+    _place_symbols(pose, g, q, ops)
+    return _residual(g, pose)
+
+
+def _place_symbols(pose: Pose, g: Group, q: list, ops) -> None:
+    for i, k in enumerate(g.links):
+        pose.origins[k] = V(q[3 * i], q[3 * i + 1])
+        pose.angles[k] = q[3 * i + 2]
+        pose.cos[k] = ops.cos(q[3 * i + 2])
+        pose.sin[k] = ops.sin(q[3 * i + 2])
+
+
 def _cubic(angles: NDArray[np.float64], tab: NDArray[np.float64],
            t: NDArray[np.float64]) -> NDArray[np.float64]:
     """The table at angles ``t`` by cubic interpolation on its uniform grid, ``(N, 3·|g|)``.

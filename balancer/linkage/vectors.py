@@ -215,7 +215,7 @@ class Factor:
     """
 
     @np.errstate(divide="ignore", invalid="ignore")
-    def __init__(self, a: list[list[Any]]) -> None:
+    def __init__(self, a: list[list[Any]], dense=None) -> None:
         k = len(a)
         rows = [list(row) for row in a]
         live_rows, live_cols = list(range(k)), list(range(k))
@@ -249,6 +249,7 @@ class Factor:
         block = [[rows[i][j] for j in live_cols] for i in live_rows]
         self.inverse: list[list[Any]] | None = None
         self.dense: _BatchLU | None = None
+        self.symbolic: tuple | None = None
         if len(block) == 1:
             (a11,), = block
             self.inverse = [[_reciprocal(a11)]]
@@ -259,9 +260,12 @@ class Factor:
                             [_times(a21, -inv), _times(a11, inv)]]
         elif len(block) > 2:
             if not all(isinstance(v, float | np.ndarray) for row in block for v in row):
-                raise NotImplementedError("a dense remainder of symbols")
-            n = max(np.size(v) for row in block for v in row)
-            self.dense = _BatchLU(block, n)
+                if dense is None:
+                    raise NotImplementedError("a dense remainder of symbols")
+                self.symbolic = (dense, block)  # ``dense(block, columns)`` solves it
+            else:
+                n = max(np.size(v) for row in block for v in row)
+                self.dense = _BatchLU(block, n)
 
     @np.errstate(divide="ignore", invalid="ignore")
     def solve(self, b: list[list[Any]]) -> list[list[Any]]:
@@ -284,6 +288,12 @@ class Factor:
                     for ii, i in enumerate(self.rest_rows):
                         acc = _plus(acc, _times(self.inverse[jj][ii], rhs[i][c]))
                     x[j][c] = acc
+        elif self.symbolic is not None:
+            dense, block = self.symbolic
+            sol = dense(block, [[rhs[i][c] for c in range(width)] for i in self.rest_rows])
+            for jj, j in enumerate(self.rest_cols):
+                for c in range(width):
+                    x[j][c] = sol[jj][c]
         elif self.dense is not None:
             for c in range(width):
                 sol = self.dense.solve([rhs[i][c] for i in self.rest_rows])

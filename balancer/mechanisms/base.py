@@ -36,7 +36,7 @@ from ..model import GROUND, Link, Linkage
 #: The formulation of the equations of motion that applies to every linkage.
 MULTIBODY: dict[str, tuple[str, str]] = {
     "multibody": ("balancer.formulations.multibody", "Multibody")}
-#: The general formulation in the crank angle (linkages of dyads).
+#: The general formulation in the crank angle.
 CRANK_ANGLE: dict[str, tuple[str, str]] = {
     "crank-angle": ("balancer.formulations.crank_angle", "CrankAngle")}
 #: Least normalised assembly gap of a dyad over a revolution for the crank to turn fully: at
@@ -165,18 +165,16 @@ class Mechanism(ABC):
     def formulation_table(self) -> dict[str, tuple[str, str]]:
         """Every formulation of the equations of motion that applies: name → (module, class).
 
-        The mechanism's own (the default first), then the general ones: the multibody
-        formulation (:mod:`balancer.formulations.multibody`), which applies to any linkage, and
-        for a linkage of dyads the crank-angle one (:mod:`balancer.formulations.crank_angle`),
-        before the multibody where the crank turns fully.
+        The mechanism's own (the default first), then the general ones, which apply to any
+        linkage: the multibody formulation (:mod:`balancer.formulations.multibody`) and the
+        crank-angle one (:mod:`balancer.formulations.crank_angle`), the latter first where the
+        crank turns fully.
         """
-        general = dict(MULTIBODY)
-        if all(g.kind != "numeric" for g in self.structure.groups):
-            # Lagrange's equation in the crank angle: first where the crank turns fully (no
-            # dead point of the crank to stop it), after the multibody otherwise.
-            first = self.assembly_range().full
-            general = {**CRANK_ANGLE, **general} if first else {**general, **CRANK_ANGLE}
-        return {**self.formulations, **general}
+        # Lagrange's equation in the crank angle: first where the crank turns fully (no dead
+        # point of the crank to stop it), after the multibody otherwise.
+        if self.assembly_range().full:
+            return {**self.formulations, **CRANK_ANGLE, **MULTIBODY}
+        return {**self.formulations, **MULTIBODY, **CRANK_ANGLE}
 
     def parameters(self) -> NDArray[np.float64]:
         """The design vector of the mechanism's own links (:attr:`layout`)."""
@@ -205,6 +203,15 @@ class Mechanism(ABC):
         if "assembly" not in self.structure.cache:
             self.structure.cache["assembly"] = _assembly_range(self.structure)
         return self.structure.cache["assembly"]
+
+    def least_gap(self) -> float | None:
+        """The groups' least assembly gap over a revolution, or ``None``.
+
+        Found with the assembly range (sampled, the minima refined); ``None`` where the crank
+        does not turn fully.
+        """
+        self.assembly_range()
+        return self.structure.cache.get("least gap")
 
     def change_points(self) -> tuple[float, ...]:
         """Crank angles where the assemblies meet and the smooth motion passes (none in general).
@@ -381,6 +388,7 @@ def _assembly_range(structure: Structure) -> AssemblyRange:
                               options={"xatol": 1e-10})
         least = min(least, float(res.fun))
     if least > GAP_TOLERANCE:
+        structure.cache["least gap"] = least
         return AssemblyRange(intervals=((-math.pi, math.pi),), full=True)
     # The range around the reference: walk out each way to the first bad sample, then bisect.
     ends = []
