@@ -276,7 +276,9 @@ def test_the_multibody_formulation_names_a_change_point_it_cannot_pass():
                    rocker=links[2], branch="+")
     settings = SimulationSettings(duration=5.0, theta1=math.atan2(0.8, 0.6), omega1=0.0,
                                   gravity=(0.0, -9.81))
-    with pytest.raises(SolverError, match=r"change point θ1 = 3\.14159 rad.*multibody "
+    # It swings down through θ1 = 0 and on to π: the stall comes at one of them, the one the
+    # integration's rounding brings it nearest.
+    with pytest.raises(SolverError, match=r"change point θ1 = (0|3\.14159) rad.*multibody "
                                           r"formulation cannot pass it \(opened-loop"):
         simulate(mech, settings, method="multibody", rtol=1e-10, atol=1e-12)
 
@@ -478,8 +480,9 @@ def test_a_start_many_turns_away_is_followed_over_part_of_a_turn():
     assert np.max(np.abs(far[others] - near[others])) < 1e-10
 
 
+@pytest.mark.parametrize("method", ["crank-angle", "multibody"])
 @pytest.mark.parametrize("driven", [False, True])
-def test_a_compiled_dop853_step_is_scipys_step(driven):
+def test_a_compiled_dop853_step_is_scipys_step(method, driven):
     # The twelve stages of a step (and the dense output's three) compiled into one call, the
     # controller SciPy's: from the same state and first step, the same step to rounding (the
     # stages' sums are in another order: a few ulps of the state per stage, 16 stages).
@@ -489,7 +492,7 @@ def test_a_compiled_dop853_step_is_scipys_step(driven):
     from balancer.simulate import _WithExtraWork
 
     design = _watt()
-    f = make("crank-angle", design.mechanism, gravity=design.simulation.gravity,
+    f = make(method, design.mechanism, gravity=design.simulation.gravity,
              speed=5.0 if driven else None)
     own = _WithExtraWork(f)
     y0 = np.append(f.initial_state(0.3, 4.0), 0.0)

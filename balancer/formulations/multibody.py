@@ -282,6 +282,21 @@ class Multibody(Formulation):
         y = np.concatenate([q, qd])
         return np.append(y, 0.0) if self.driven else y
 
+    def symbolic_rhs(self) -> ca.Function | None:
+        """``(t, y) → ẏ`` as a CasADi function (none with slider forces: tables in Python)."""
+        s = self.structure
+        if any(not s.linkage.sliders[c.slider].force.is_zero for c in s.prisms):
+            return None
+        k = 3 * self.n
+        t = ca.MX.sym("t")
+        y = ca.MX.sym("y", 2 * k + (1 if self.driven else 0))
+        out = self._dynamics(y[:k], y[k : 2 * k], ca.MX.zeros(max(1, len(s.prisms))))
+        acc, frame = out[0], out[-1]
+        dy = [y[k : 2 * k], acc]
+        if self.driven:
+            dy.append(frame[3] * float(self.speed))  # type: ignore[arg-type]
+        return ca.Function("multibody_rhs", [t, y], [ca.vertcat(*dy)])
+
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         k = 3 * self.n
         acc, _, _, _, _, frame = self._call(t, y)
