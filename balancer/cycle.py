@@ -15,6 +15,7 @@ loops without the GIL), writing into preallocated arrays.
 
 from __future__ import annotations
 
+import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -49,14 +50,16 @@ class Figure:
         """
         values = np.asarray(values)
         mag = np.abs(values)
-        mag = mag[~np.isnan(mag)]
+        missing = np.isnan(mag)
+        if missing.any():
+            mag = mag[~missing]
         if not mag.size:
             return cls(rms=float("nan"), max=float("nan"))
         top = float(np.max(mag))
         if top == 0 or not np.isfinite(top):
             return cls(rms=top, max=top)
         scaled = mag / top
-        return cls(rms=top * float(np.sqrt(np.mean(scaled * scaled))), max=top)
+        return cls(rms=top * math.sqrt(float(np.dot(scaled, scaled)) / mag.size), max=top)
 
     def as_dict(self) -> dict[str, float]:
         """``{"rms": …, "max": …}``."""
@@ -230,8 +233,8 @@ def cycle_analysis(model, speed: float, samples: int = 360, *, route: str | None
 
     def evaluate(theta):
         with np.errstate(all="ignore"):
-            mo = mech.motion(theta, speed, 0.0)
-            return mech.inverse_dynamics(mo, route=route, loads=loads, gravity=gravity)
+            return mech.crank_forces(theta, speed, 0.0, route=route, loads=loads,
+                                     gravity=gravity)
 
     def fill(start: int) -> None:
         sl = slice(start, start + CHUNK)

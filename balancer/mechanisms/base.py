@@ -297,6 +297,16 @@ class Mechanism(ABC):
         return dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
                                          loads=loads, route=general)
 
+    def crank_forces(self, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0,
+                     *, route: str | None = None, loads: bool = True,
+                     gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
+        """:meth:`inverse_dynamics` of :meth:`motion` at crank states (arrays broadcast).
+
+        A mechanism with a closed form may compute it without the general motion.
+        """
+        return self.inverse_dynamics(self.motion(theta1, omega1, alpha1), route=route,
+                                     loads=loads, gravity=gravity)
+
     def regressors(self, mo: Motion, gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         """:meth:`inverse_dynamics` without loads as linear maps of the design vector.
 

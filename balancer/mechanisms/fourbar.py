@@ -124,10 +124,24 @@ class FourBarMechanism(Mechanism):
         Newton–Euler on the links' free bodies with the principal vectors (Eq. 12–28), or the
         equivalent mass matrices (Eq. 45–54).
         """
+        return self._closed_form_forces(fourbar_motion(self.model, mo), route, loads, gravity)
+
+    def crank_forces(self, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0,
+                     *, route: str | None = None, loads: bool = True,
+                     gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
+        """:meth:`inverse_dynamics` at crank states from the closed-form motion alone."""
+        t, w, a = (np.atleast_1d(np.asarray(x, dtype=float))
+                   for x in np.broadcast_arrays(theta1, omega1, alpha1))
+        signs = fourbar.cycle_branch_signs(self.model.lengths, self.model.branch, t)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            mo = fourbar.motion(self.model.lengths, t, w, a, signs, check=False)
+        return self._closed_form_forces(mo, route, loads, gravity)
+
+    def _closed_form_forces(self, mo: fourbar.Motion, route, loads, gravity) -> Forces:
         from ..inverse import mass_matrix, newton_euler
 
         route_fn = mass_matrix if (route or self.routes[0]) == "mass-matrix" else newton_euler
-        r = route_fn(self.model, fourbar_motion(self.model, mo), gravity=gravity, loads=loads)
+        r = route_fn(self.model, mo, gravity=gravity, loads=loads)
         def col(z):
             return np.asarray(z)[:, None]
 
