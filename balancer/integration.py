@@ -46,6 +46,32 @@ def _stages(rhs: ca.Function, n: int, a, c, first: int, count: int):
     return t, y, h, known, ks
 
 
+class Stages:
+    """The compiled stages of DOP853 for a right-hand side ``(t, y) → ẏ`` (built once).
+
+    ``step(t, h, y, f)`` gives stages 2–12 and the step's end ``y``; ``extra(t, h, y, K)``
+    the dense output's three more.
+    """
+
+    def __init__(self, rhs: ca.Function) -> None:
+        n = rhs.size1_in(1)
+        stages = DOP853.n_stages
+        t, y, h, known, ks = _stages(rhs, n, DOP853.A, DOP853.C, 1, stages - 1)
+        y_new = y + h * sum((float(b) * k for b, k in zip(DOP853.B, ks, strict=True)),
+                            ca.MX.zeros(n))
+        f_new = rhs(t + h, y_new)
+        self.step = Compiled(ca.Function("dop853_step", [ca.vertcat(t, h, y, known)],
+                                         [ca.vertcat(*ks[1:], f_new, y_new)]))
+        size = stages + 1 + len(DOP853.C_EXTRA)  # K[12] is f at the step's end
+        a = np.zeros((size, size))
+        a[:stages, :stages] = DOP853.A
+        a[stages + 1 :, :] = DOP853.A_EXTRA
+        c = np.concatenate([DOP853.C, [1.0], DOP853.C_EXTRA])
+        t, y, h, known, ks = _stages(rhs, n, a, c, stages + 1, len(DOP853.C_EXTRA))
+        self.extra = Compiled(ca.Function("dop853_extra", [ca.vertcat(t, h, y, known)],
+                                          [ca.vertcat(*ks[stages + 1 :])]))
+
+
 class CompiledDOP853(DOP853):
     """:class:`scipy.integrate.DOP853` stepping through compiled stages.
 
@@ -53,28 +79,13 @@ class CompiledDOP853(DOP853):
     ----------
     fun
         The right-hand side in Python (SciPy's first step and its initial step size use it).
-    rhs
-        The same as a CasADi function ``(t, y) → ẏ``.
+    stages
+        The same right-hand side's compiled stages (:class:`Stages`).
     """
 
-    def __init__(self, fun, t0, y0, t_bound, *, rhs: ca.Function, **options) -> None:
+    def __init__(self, fun, t0, y0, t_bound, *, stages: Stages, **options) -> None:
         super().__init__(fun, t0, y0, t_bound, **options)
-        n, stages = self.n, self.n_stages
-        t, y, h, known, ks = _stages(rhs, n, self.A, self.C, 1, stages - 1)
-        y_new = y + h * sum((float(b) * k for b, k in zip(self.B, ks, strict=True)),
-                            ca.MX.zeros(n))
-        f_new = rhs(t + h, y_new)
-        flat = ca.vertcat(t, h, y, known)
-        out = ca.vertcat(*ks[1:], f_new, y_new)
-        self._step = Compiled(ca.Function("dop853_step", [flat], [out]))
-        size = stages + 1 + len(self.C_EXTRA)  # K[12] is f at the step's end
-        a = np.zeros((size, size))
-        a[:stages, :stages] = self.A
-        a[stages + 1 :, :] = self.A_EXTRA
-        c = np.concatenate([self.C, [1.0], self.C_EXTRA])
-        t, y, h, known, ks = _stages(rhs, n, a, c, stages + 1, len(self.C_EXTRA))
-        self._extra = Compiled(ca.Function("dop853_extra", [ca.vertcat(t, h, y, known)],
-                                           [ca.vertcat(*ks[stages + 1 :])]))
+        self._step, self._extra = stages.step, stages.extra
 
     def _step_impl(self):
         t, y = self.t, self.y

@@ -230,14 +230,14 @@ class _Stepper:
         t_end = self.duration if stop_at is None else min(stop_at, self.duration)
         groups = self.f.like_components()
         atol = floored_atol(self.atol, groups, y0)
-        symbolic = self.f.symbolic_rhs()
-        if symbolic is None:
+        stages = self._stages()
+        if stages is None:
             solver = DOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=atol)
         else:
-            from .integration import CompiledDOP853, with_extra_work
+            from .integration import CompiledDOP853
 
-            solver = CompiledDOP853(f.rhs, 0.0, y0, t_end, rhs=with_extra_work(symbolic),
-                                    rtol=self.rtol, atol=atol)
+            solver = CompiledDOP853(f.rhs, 0.0, y0, t_end, stages=stages, rtol=self.rtol,
+                                    atol=atol)
         states: list[NDArray[np.float64]] = []
         times: list[float] = []
         drift = [0.0, 0.0]
@@ -297,6 +297,19 @@ class _Stepper:
             if self.progress is not None:
                 self.progress(solver.t, self.duration)
         return times, states, drift, solver.nfev + self.extra_fev, steps, stopped
+
+    def _stages(self):
+        """The formulation's compiled DOP853 stages (built once per formulation), or None."""
+        cache = self.f.compiled
+        if "dop853" not in cache:
+            symbolic = self.f.symbolic_rhs()
+            if symbolic is None:
+                cache["dop853"] = None
+            else:
+                from .integration import Stages, with_extra_work
+
+                cache["dop853"] = Stages(with_extra_work(symbolic))
+        return cache["dop853"]
 
     def _check_budget(self, steps: int, t: float) -> None:
         """Refuse a duration that would take more than :data:`MAX_STEPS` steps.

@@ -488,7 +488,7 @@ def test_a_compiled_dop853_step_is_scipys_step(method, driven):
     # stages' sums are in another order: a few ulps of the state per stage, 16 stages).
     from scipy.integrate import DOP853
 
-    from balancer.integration import CompiledDOP853, with_extra_work
+    from balancer.integration import CompiledDOP853, Stages, with_extra_work
     from balancer.simulate import _WithExtraWork
 
     design = _watt()
@@ -498,7 +498,7 @@ def test_a_compiled_dop853_step_is_scipys_step(method, driven):
     y0 = np.append(f.initial_state(0.3, 4.0), 0.0)
     options = {"rtol": 1e-10, "atol": 1e-12, "first_step": 1e-3}
     ref = DOP853(own.rhs, 0.0, y0, 1.0, **options)
-    run = CompiledDOP853(own.rhs, 0.0, y0, 1.0, rhs=with_extra_work(f.symbolic_rhs()),
+    run = CompiledDOP853(own.rhs, 0.0, y0, 1.0, stages=Stages(with_extra_work(f.symbolic_rhs())),
                          **options)
     eps = np.finfo(float).eps
     ref.step()

@@ -149,6 +149,9 @@ class Formulation(ABC):
     passes_dead_points: ClassVar[bool] = False
     #: Whether it follows the smooth motion through a change point (all joints in line).
     passes_change_points: ClassVar[bool] = True
+    #: Whether one instance serves every simulation of its mechanism (compiled once; its
+    #: state is all set by :meth:`initial_state`).
+    reusable: ClassVar[bool] = False
 
     def __init__(
         self,
@@ -161,6 +164,8 @@ class Formulation(ABC):
         self.gravity = complex(*gravity)
         self.speed = speed
         self.theta1_start = 0.0
+        #: What a formulation compiles once and keeps (the integrator's stages).
+        self.compiled: dict[str, Any] = {}
 
     @property
     def driven(self) -> bool:
@@ -359,5 +364,19 @@ def make(
     gravity: tuple[float, float] = (0.0, 0.0),
     speed: float | None = None,
 ) -> Formulation:
-    """Instantiate the formulation called ``name`` for the mechanism."""
-    return formulation_class(name, linkage)(linkage, gravity=gravity, speed=speed)
+    """The formulation called ``name`` for the mechanism.
+
+    A formulation that compiles its equations (:attr:`Formulation.reusable`) is built once per
+    mechanism, gravity and speed and kept with the mechanism; its state is set again by each
+    :meth:`~Formulation.initial_state`.
+    """
+    cls = formulation_class(name, linkage)
+    if not cls.reusable:
+        return cls(linkage, gravity=gravity, speed=speed)
+    from ..mechanisms import mechanism_of
+
+    cache = mechanism_of(linkage).structure.cache.setdefault("formulations", {})
+    key = (name, complex(*gravity), speed)
+    if key not in cache:
+        cache[key] = cls(linkage, gravity=gravity, speed=speed)
+    return cache[key]

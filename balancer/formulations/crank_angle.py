@@ -49,6 +49,7 @@ class CrankAngle(Formulation):
     """Lagrange's equation in the crank angle (any linkage)."""
 
     name = "crank-angle"
+    reusable = True
     minimal = True
     passes_dead_points = False
     passes_change_points = False
@@ -159,8 +160,8 @@ class CrankAngle(Formulation):
         gas = ca.MX.zeros(max(1, len(s.prisms)))
         if self.driven:
             speed = float(self.speed)  # type: ignore[arg-type]
-            y = ca.MX.sym("y", 3)
-            _, general = self._sym(self.theta1_start + speed * t, speed, gas)
+            y = ca.MX.sym("y", 3)  # θ1 integrated at the constant speed
+            _, general = self._sym(y[0], speed, gas)
             dy = ca.vertcat(speed, 0, -general * speed)
         else:
             y = ca.MX.sym("y", 2)
@@ -206,7 +207,7 @@ class CrankAngle(Formulation):
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         if self.driven:
             speed = float(self.speed)  # type: ignore[arg-type]
-            general = self._at(self.crank_angle(t), speed)[1]
+            general = self._at(y[0], speed)[1]
             return np.array([speed, 0.0, -general * speed])  # the motor's power: τ = −F
         out = self._at(y[0], y[1])
         return np.array([y[1], out[1] / out[0]])

@@ -66,6 +66,7 @@ class Multibody(Formulation):
     """Absolute coordinates with the constraints' multipliers (any linkage)."""
 
     name = "multibody"
+    reusable = True
     minimal = False
     passes_dead_points = True
     #: At a change point its constraints are dependent and the saddle-point system singular.
