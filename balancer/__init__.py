@@ -12,12 +12,34 @@ The main entry points::
 
 Theory: Meijaard & van der Wijk (2020), Wunderlich (1964), Bai, Xia & Ge (2024); equation
 numbers in the docstrings are theirs.
+
+The names below are imported when first used (PEP 562), so that ``import balancer`` — and the
+command line's ``--help`` — does not pay for numpy, SciPy and CasADi before it needs them.
 """
 
-from .api import analyze
-from .errors import AssemblyError, BalancerError, LockupError, SolverError, SpecError
-from .model import Design, FourBar, Link, Operation, SimulationSettings
-from .spec import dumps_design, load_design, loads_design, save_design
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+#: Where each public name lives.
+_EXPORTS = {
+    "analyze": "api",
+    "AssemblyError": "errors",
+    "BalancerError": "errors",
+    "LockupError": "errors",
+    "SolverError": "errors",
+    "SpecError": "errors",
+    "Design": "model",
+    "FourBar": "model",
+    "Link": "model",
+    "Operation": "model",
+    "SimulationSettings": "model",
+    "dumps_design": "spec",
+    "load_design": "spec",
+    "loads_design": "spec",
+    "save_design": "spec",
+}
 
 __all__ = [
     "AssemblyError",
@@ -38,3 +60,23 @@ __all__ = [
 ]
 
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'balancer' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_EXPORTS})
+
+
+if TYPE_CHECKING:  # for type checkers and editors: the names as they are
+    from .api import analyze
+    from .errors import AssemblyError, BalancerError, LockupError, SolverError, SpecError
+    from .model import Design, FourBar, Link, Operation, SimulationSettings
+    from .spec import dumps_design, load_design, loads_design, save_design

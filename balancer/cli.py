@@ -17,6 +17,10 @@ from pathlib import Path
 
 from .errors import BalancerError, OutputError, SpecError
 
+#: ``--drive`` values: :data:`balancer.model.DRIVES`, here so that ``--help`` needs no model
+#: (a test keeps the two equal).
+DRIVES: tuple[str, ...] = ("free", "constant-speed")
+
 
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose errors are one line and exit code 2."""
@@ -249,6 +253,18 @@ def _version() -> str:
         return "unknown (not installed)"
 
 
+class _VersionAction(argparse.Action):
+    """``--version``: the installed version, looked up only when asked for."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS,
+                 help="show the version and exit"):  # noqa: A002 - argparse's keyword
+        super().__init__(option_strings, dest, nargs=0, default=default, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        parser._print_message(f"balancer {_version()}\n", sys.stdout)
+        parser.exit()
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``balancer`` command."""
     parser = _Parser(
@@ -259,7 +275,7 @@ def build_parser() -> argparse.ArgumentParser:
             "moment, and prove the result by simulation."
         ),
     )
-    parser.add_argument("--version", action="version", version=f"balancer {_version()}")
+    parser.add_argument("--version", action=_VersionAction)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
 
@@ -285,7 +301,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(handler=_cmd_analyze)
 
     from .mechanisms import formulation_names
-    from .model import DRIVES
 
     methods = formulation_names()
 

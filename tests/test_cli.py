@@ -204,3 +204,43 @@ def test_progress_is_shown_on_a_terminal_only():
         p(2.5, 5.0)
         p.done()
     assert "50.0 %" in tty.getvalue() and pipe.getvalue() == ""
+
+
+def test_the_command_line_lists_every_formulation_and_drive():
+    # The names the parser offers without importing the mechanisms (for a fast --help), against
+    # the mechanisms' own tables and the model's drives.
+    import importlib
+
+    from balancer import cli, model
+    from balancer.mechanisms import FORMULATION_NAMES, REGISTRY
+    from balancer.mechanisms.base import CRANK_ANGLE, MULTIBODY
+
+    names = set(MULTIBODY) | set(CRANK_ANGLE)
+    for module, cls in REGISTRY.values():
+        names |= set(getattr(importlib.import_module(module), cls).formulations)
+    assert set(FORMULATION_NAMES) == names
+    assert cli.DRIVES == model.DRIVES
+
+
+def test_help_imports_no_numerics():
+    # `balancer --help` is answered before numpy, SciPy or CasADi are imported.
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom balancer.cli import main\ntry:\n    main(['--help'])\n"
+            "except SystemExit:\n    pass\nprint(sorted(m for m in ('numpy', 'scipy', 'casadi')"
+            " if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.strip().splitlines()[-1] == "[]"
+
+
+def test_version_is_the_installed_packages(capsys):
+    from importlib.metadata import version
+
+    from balancer.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0
+    assert capsys.readouterr().out == f"balancer {version('balancer')}\n"
