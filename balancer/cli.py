@@ -319,7 +319,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="allow an output path to name the input spec (it is overwritten)")
     p.add_argument("--method", choices=methods, help="formulation (default: the spec's, or "
                    "the mechanism's first: opened-loop for a four-bar, mass-matrix for a "
-                   "slider-crank, multibody for a general linkage)")
+                   "slider-crank, crank-angle for a general linkage whose crank turns fully, "
+                   "multibody for one whose crank does not)")
     p.add_argument("--drive", choices=DRIVES, help="free motion or constant crank speed "
                    "(default: the spec's)")
     p.add_argument("--duration", type=_positive_float, metavar="T", help="simulated time, s")

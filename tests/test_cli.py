@@ -244,3 +244,15 @@ def test_version_is_the_installed_packages(capsys):
         main(["--version"])
     assert info.value.code == 0
     assert capsys.readouterr().out == f"balancer {version('balancer')}\n"
+
+
+def test_simulate_help_states_the_default_formulation_it_uses(capsys):
+    # The help said "multibody for a general linkage" after crank-angle became the default of
+    # every general linkage whose crank turns fully.
+    with pytest.raises(SystemExit):
+        main(["simulate", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "crank-angle for a general linkage whose crank turns fully" in text
+    watt = str(Path(EXAMPLE).parent / "watt_sixbar.toml")
+    assert main(["simulate", watt, "--json", "--duration", "0.01"]) == 0
+    assert json.loads(capsys.readouterr().out)["method"] == "crank-angle"

@@ -108,6 +108,12 @@ BAD = {
     "nothing free": (BASE.split("[balance.crank]")[0] + "[balance.crank]\ncounter_rotor = 0.0\n",
                      "balance", "nothing may change"),
     "nothing listed": (BASE.split("[balance.crank]")[0], "balance", "nothing may change"),
+    # From the seed-4242 linkage fuzz campaign: both were internal errors in the convex solver
+    # (an OverflowError squaring ρ, a ZeroDivisionError from the objective's scale squared).
+    "gyration past double precision": (_with("min_gyration = 0.1", "min_gyration = 1e300"),
+                                       "balance.crank.min_gyration", "at most 1e+50 m"),
+    "subnormal weight": (BASE + "[balance.objective]\nshaking_moment = 5e-324\n",
+                         "balance.objective.shaking_moment", "subnormal"),
     "gyration beyond the inertia bound": (
         _with("min_gyration = 0.1", "min_gyration = 0.5\ninertia = [0.1, 0.4]"),
         "balance.crank.min_gyration", "at least m·ρ² = 0.525"),

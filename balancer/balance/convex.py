@@ -230,7 +230,7 @@ class ConvexSolver:
         k = data.factor.shape[0]
         r = data.factor / self._scale
         p_matrix, q_vector = r @ lay.T, r @ lay.c
-        w_mass = data.weights.added_mass / self._scale**2
+        w_mass = data.weights.added_mass / self._scale / self._scale  # (scale² may underflow)
         mass_row = lay.T[data.mass_entries].sum(axis=0) * w_mass
         mass_offset = (float(lay.c[data.mass_entries].sum()) - data.original_mass) * w_mass
         self._norm_form = w_mass == 0 and k > 0

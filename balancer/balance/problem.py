@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import sys
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -64,6 +65,7 @@ from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import GROUND, Design, Link
+from ..validate import LENGTH_RANGE
 from .conditions import force_balance_conditions
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -346,6 +348,11 @@ def check_problem(problem: BalanceProblem, mechanism) -> None:
         raise SpecError(
             "every weight is zero: there is nothing to minimise", key="balance.objective"
         )
+    for name, x in zip(_OBJECTIVE_KEYS, weights, strict=True):
+        if 0 < x < sys.float_info.min:  # its square root squared is lost to underflow
+            raise SpecError(f"must be zero or at least {sys.float_info.min:.3g} (a subnormal "
+                            "weight is too small to compute with)",
+                            key=f"balance.objective.{name}", value=x)
     bodies = {b.name: b for b in mech.linkage.moving}
     for name in problem.listed:
         if name not in bodies:
@@ -377,6 +384,9 @@ def check_problem(problem: BalanceProblem, mechanism) -> None:
                 key=f"{key}.counter_rotor",
                 value=list(freedom.counter_rotor),
             )
+        if freedom.min_gyration is not None and freedom.min_gyration > LENGTH_RANGE[1]:
+            raise SpecError(f"must be at most {LENGTH_RANGE[1]:g} m (m·ρ² would leave double "
+                            "precision)", key=f"{key}.min_gyration", value=freedom.min_gyration)
         bounds = resolve_link(mech, name, freedom)
         rho = bounds.gyration
         least = bounds.mass[0] * rho * rho

@@ -1239,13 +1239,19 @@ def m_nonfinite(rng, doc, meta):
 
 #: Leaves at which 1e300 must be refused (the figures would leave double precision), and the
 #: keys the message may name.
-def _huge_expectation(path) -> str:
+def _huge_expectation(path, doc=None) -> str:
     key = _key_of(path)
     if key.startswith("mechanism.points"):
         return "error"
-    if key.startswith("links.") and key.split(".")[-1] in ("mass", "inertia", "counter_rotor",
-                                                           "moment", "force", "e", "f", "s",
-                                                           "at"):
+    last = key.split(".")[-1]
+    if key.startswith("links.") and last in ("mass", "inertia", "counter_rotor", "moment",
+                                             "force", "e", "f", "s", "at"):
+        if doc is not None and last not in ("moment", "force") and not _moves(doc):
+            # At rest (no speed anywhere) a mass property enters no force but its weight:
+            # the scales are m·R·ω² (zero) and m·|g|·R (an inertia not even that).
+            gravity = any(doc.get("simulation", {}).get("gravity", [0.0, 0.0]))
+            if last in ("inertia", "counter_rotor") or not gravity:
+                return "edge"
         return "error"
     if key in ("operation.speed", "simulation.omega1", "simulation.gravity",
                "operation.samples", "simulation.outputs"):
@@ -1255,12 +1261,18 @@ def _huge_expectation(path) -> str:
     return "edge"
 
 
+def _moves(doc) -> bool:
+    """Whether the spec gives a speed anywhere (an operating speed or an initial one)."""
+    return bool(doc.get("operation", {}).get("speed")) or bool(
+        doc.get("simulation", {}).get("omega1"))
+
+
 def m_huge(rng, doc, meta):
     leaves = [p for p, _ in _numeric_leaves(doc)]
     path = _pick(rng, leaves)
     value = _pick(rng, [1e300, -1e300, 1e200, 1.7976931348623157e308])
     _set_path(doc, path, value)
-    exp = _huge_expectation(path)
+    exp = _huge_expectation(path, doc)
     return (_bad_value_keys(path) if exp == "error" else None), f"{_key_of(path)} = {value:g}"
 
 
