@@ -222,12 +222,14 @@ class _Stepper:
         self.t_out = np.linspace(0.0, duration, outputs)
         self.progress = progress
         self.extra_fev = 0
+        self.t_end = duration
 
     def run(self, y0: NDArray[np.float64], stop_at: float | None):
         """Integrate from ``y0``; the states returned carry the extra work as a last entry."""
         f = _WithExtraWork(self.f)
         y0 = np.append(y0, 0.0)
         t_end = self.duration if stop_at is None else min(stop_at, self.duration)
+        self.t_end = t_end
         groups = self.f.like_components()
         atol = floored_atol(self.atol, groups, y0)
         stages = self._stages()
@@ -243,7 +245,9 @@ class _Stepper:
         drift = [0.0, 0.0]
         k = 0
         steps = 0
-        passes_dead_points = f.passes_dead_points
+        # A driven crank's motion is prescribed: a dead point on it is where the linkage locks,
+        # which simulate() finds from the assembly range and ends the run before.
+        passes_dead_points = f.passes_dead_points or self.f.driven
         change_points = f.change_points()
         # The first output is the initial state.
         while k < self.t_out.size and self.t_out[k] <= 0.0:
@@ -335,7 +339,7 @@ class _Stepper:
         if len(recent) <= STALL_WINDOW:
             return
         advance = recent[-1] - recent[0]
-        remaining = self.duration - t
+        remaining = self.t_end - t  # to where this run ends (before a lock, if driven)
         if remaining <= 0 or advance * MAX_STEPS > remaining * STALL_WINDOW:
             return
         theta1 = f.theta1_of(t, y)

@@ -724,3 +724,24 @@ def test_a_centre_of_mass_put_onto_a_small_disc_far_from_the_frames_origin_stays
         spacing = np.spacing(abs(disc.com_centre) + radius)
         assert radius - distance <= 4 * spacing + 16 * eps * radius
 
+
+
+@pytest.mark.parametrize("spec", ["locking_fourbar_linkage.toml", "locking_slider_linkage.toml"])
+@pytest.mark.parametrize("method", ["crank-angle", "multibody"])
+def test_a_driven_crank_that_locks_says_so_with_every_formulation(spec, method, capsys):
+    # Linkage fuzz campaign, seed 4242 (cases 165 and 61): a crank driven into the end of its
+    # range. crank-angle raced its own dead-point event against the lock (the same root) and
+    # sometimes reported a dead point "multibody can pass"; multibody's shrinking steps before
+    # the lock were judged against the whole duration and reported a stall. Both must say the
+    # linkage locks, exit 1.
+    from pathlib import Path
+
+    from balancer.cli import main
+
+    path = Path(__file__).resolve().parent / "data" / spec
+    code = main(["simulate", str(path), "--method", method, "--drive", "constant-speed",
+                 "--duration", "0.1"])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert "reaches the end of the range where the linkage assembles" in err
+    assert "the linkage locks" in err
