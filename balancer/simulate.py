@@ -245,9 +245,9 @@ class _Stepper:
         drift = [0.0, 0.0]
         k = 0
         steps = 0
-        # A driven crank's motion is prescribed: a dead point on it is where the linkage locks,
-        # which simulate() finds from the assembly range and ends the run before.
-        passes_dead_points = f.passes_dead_points or self.f.driven
+        # A driven crank that locks: the dead point ahead is the lock, which simulate() finds
+        # from the assembly range and ends the run before (the event would race it).
+        passes_dead_points = f.passes_dead_points or (self.f.driven and stop_at is not None)
         change_points = f.change_points()
         # The first output is the initial state.
         while k < self.t_out.size and self.t_out[k] <= 0.0:
