@@ -57,6 +57,9 @@ from .model import RTOL_MIN, Design, SimulationSettings, check_scales
 MAX_STEPS = 2_000_000
 #: Steps after which the rate is extrapolated to the whole duration.
 PROJECT_AFTER = 200
+#: Energy error (relative to the energy's scale, :attr:`Trajectory.energy_error`) beyond which
+#: an integration has failed, whatever its tolerances: a tenth of the energy unaccounted for.
+ENERGY_FAILURE = 0.1
 #: Distance in θ1 from a change point, rad, within which a motion is near it (passable by
 #: a dead-point event, named as the cause of a stall).
 CHANGE_POINT_NEAR = 0.05
@@ -97,7 +100,9 @@ class Trajectory:
     work
         Work of the loads, gravity, springs and the motor since t = 0, J.
     energy_error
-        ``max|T − T0 − W|`` relative to the largest of ``|T|`` and ``|W|`` (dimensionless).
+        ``max|T − T0 − W|`` relative to the largest of ``|T|``, ``|W|`` and the energy the loads,
+        gravity and springs could exchange over the linkage's size (dimensionless). A run
+        beyond :data:`ENERGY_FAILURE` raises a :class:`~balancer.errors.SolverError`.
     drift
         Largest constraint residual before projection: position (m) and velocity (m/s).
     nfev
@@ -527,6 +532,11 @@ def simulate(
         times, states, drift, nfev, steps, stopped = stepper.run(y0, end)
     traj = _trajectory(f, times, states, drift, nfev, steps, rtol, atol,
                        _time.perf_counter() - start)
+    if not traj.energy_error <= ENERGY_FAILURE:
+        raise SolverError(
+            f"the {f.name} integration lost its own energy balance (an error of "
+            f"{traj.energy_error:.2g} of the energy's scale, at rtol = {rtol:g}): its results "
+            "cannot be trusted; tighten rtol or choose another formulation")
     if stopped is not None:
         t_event, y_event = stopped
         th = f.theta1_of(t_event, y_event)
@@ -579,7 +589,7 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
     # + the extra work integrated with the motion (a gas force).
     kin, work = f.energy(theta, omega, alpha, slider, states=states)
     work = work + motor + extra
-    scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), 1e-300)
+    scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), _exchangeable_energy(f), 1e-300)
     energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
     shaking_force, moment = f.shaking(ev)
     return Trajectory(
@@ -611,6 +621,23 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
         model=f.linkage,
         slider=slider,
     )
+
+
+def _exchangeable_energy(f: Formulation) -> float:
+    """An energy the loads, gravity and springs could exchange over the linkage's size, J.
+
+    ``L·Σ(m·|g| + |F|) + 2π·Σ|M| + Σ k·(L + l0)²`` with ``L`` the linkage's length scale: the
+    energy balance's scale where the motion itself exchanges almost none (a linkage at rest in
+    equilibrium, whose kinetic energy and work are both rounding).
+    """
+    mech = mechanism_of(f.linkage)
+    length = mech.structure.length_scale()
+    g = abs(f.gravity)
+    total = sum((link.mass * g + math.hypot(*link.force)) * length
+                + 2 * math.pi * abs(link.moment) for link in mech.links)
+    for spring in mech.linkage.springs:
+        total += spring.stiffness * (length + abs(spring.free_length)) ** 2
+    return float(total)
 
 
 def simulate_design(design: Design, **overrides) -> Trajectory:
