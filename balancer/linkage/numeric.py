@@ -24,6 +24,9 @@ from .vectors import Factor, V, _plus
 TABLE_STEPS = 720
 #: Newton iterations at most, per solve.
 MAX_ITERATIONS = 30
+#: Up to this many angles at once (the continuation's single steps), Newton's steps are
+#: LAPACK's solves; beyond, the structured solve of :class:`~.vectors.Factor`.
+FEW_ANGLES = 16
 
 
 def _residual(g: Group, pose: Pose) -> list:
@@ -64,6 +67,18 @@ def _jacobian(g: Group, pose: Pose, n: int) -> NDArray[np.float64]:
     return jac
 
 
+def _dense_step(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Newton's step ``J⁻¹·r`` per system by LAPACK (NaN where ``J`` is singular)."""
+    try:
+        return np.linalg.solve(jac, res[:, :, None])[:, :, 0]
+    except np.linalg.LinAlgError:
+        step = np.full(res.shape, np.nan)
+        ok = np.abs(np.linalg.det(jac)) > 0
+        if ok.any():
+            step[ok] = np.linalg.solve(jac[ok], res[ok][:, :, None])[:, :, 0]
+        return step
+
+
 def newton(g: Group, pose: Pose, q: NDArray[np.float64], scale: float,
            tol: float = 1e-13) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """Newton's method on the group's equations at every angle at once.
@@ -84,8 +99,11 @@ def newton(g: Group, pose: Pose, q: NDArray[np.float64], scale: float,
         if done.all():
             break
         with np.errstate(all="ignore"):
-            solved = Factor(_jacobian_rows(g, pose)).solve([[r] for r in res.T])
-            step = np.column_stack([np.broadcast_to(x[0], (n,)) for x in solved])
+            if n <= FEW_ANGLES:  # LAPACK per system: less Python than the structured solve
+                step = _dense_step(_jacobian(g, pose, n), res)
+            else:
+                solved = Factor(_jacobian_rows(g, pose)).solve([[r] for r in res.T])
+                step = np.column_stack([np.broadcast_to(x[0], (n,)) for x in solved])
         q = np.where(done[:, None], q, q - step)
     _set(pose, g, q)
     return q, done
