@@ -4,7 +4,8 @@
 :class:`~balancer.linkage.vectors.Ops`) be evaluated on CasADi's symbols; :class:`Compiled`
 calls a compiled function through its buffers; :func:`link_equations` and
 :func:`spring_forces` are the links' mass matrices and applied forces in absolute coordinates
-(Nikravesh 1988, ch. 11), used by :mod:`.multibody` and :mod:`.crank_angle` alike.
+(Nikravesh 1988, ch. 11); :class:`LinkageFormulation` is what :mod:`.multibody` and
+:mod:`.crank_angle` share as formulations of any linkage.
 """
 
 from __future__ import annotations
@@ -14,7 +15,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..linkage.structure import GROUND_INDEX, Pose, Structure
-from ..linkage.vectors import Factor, Ops, V
+from ..linkage.vectors import NUMPY, Factor, Ops, V
+from ..mechanisms import mechanism_of
+from . import Formulation
 
 
 class CasadiOps(Ops):
@@ -125,3 +128,60 @@ def link_equations(structure: Structure, links, pose: Pose, rate, gravity: V, ga
         put(c.s, d * gas[j], at)
         put(c.g, d * (-gas[j]), at)
     return mass, force
+
+
+class LinkageFormulation(Formulation):
+    """What the compiled formulations of any linkage share.
+
+    The mechanism and its general core's structure, the sliders' forces, the change points,
+    and the work of the loads, gravity and springs for the energy balance. Built once per
+    mechanism (:attr:`~balancer.formulations.Formulation.reusable`).
+    """
+
+    reusable = True
+
+    def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
+                 speed: float | None = None) -> None:
+        super().__init__(linkage, gravity=gravity, speed=speed)
+        self.mech = mechanism_of(linkage)
+        self.structure = self.mech.structure
+        self.n = self.structure.size
+        self.links = self.mech.links
+
+    def change_points(self) -> tuple[float, ...]:
+        """The mechanism's change points: the driver names them if the motion stalls there."""
+        return self.mech.change_points()
+
+    @property
+    def has_slider_forces(self) -> bool:
+        """Whether a slider force acts (a table of the crank angle, evaluated in Python)."""
+        sliders = self.structure.linkage.sliders
+        return any(not sliders[c.slider].force.is_zero for c in self.structure.prisms)
+
+    def _gas(self, theta1: float) -> NDArray[np.float64]:
+        """The slider forces along their guides at crank angle ``theta1``, N (one per pair)."""
+        sliders = self.structure.linkage.sliders
+        values = [float(sliders[c.slider].force.at(theta1)) for c in self.structure.prisms]
+        return np.array(values if values else [0.0])
+
+    def configuration_work(self, pose: Pose, angles) -> NDArray[np.float64]:
+        """Work of the loads and gravity less the springs' energy gained since the first state.
+
+        ``pose`` holds the links' frames at the states (arrays over them) and ``angles`` their
+        continuous angles, ``(n, count)``: the loads' and gravity's work from the centres of
+        mass' and the angles' displacements, the springs' from their potential energy, J.
+        """
+        g = V(self.gravity.real, self.gravity.imag)
+        angles = np.asarray(angles, dtype=float)
+        count = angles.shape[1]
+        work = np.zeros(count)
+        for k, link in enumerate(self.links):
+            com = pose.point(k, V(link.e, link.f))
+            work += (g * link.mass + V(*link.force)).dot(com - V(com.x[0], com.y[0]))
+            work += link.moment * (angles[k] - angles[k, 0])
+        spring = 0.0
+        for s in self.structure.linkage.springs:
+            (_, _, a), (_, _, b) = spring_forces(self.structure, s, pose, NUMPY)
+            spring = spring + 0.5 * s.stiffness * (np.sqrt((b - a).norm2()) - s.free_length) ** 2
+        spring = np.asarray(spring, dtype=float) * np.ones(count)
+        return work - (spring - spring[0])

@@ -35,21 +35,19 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..linkage.kinematics import positions, rates
-from ..linkage.vectors import NUMPY, V
-from ..mechanisms import mechanism_of
-from . import DEAD_POINT_THRESHOLD, Evaluation, Formulation
-from .compiled import CasadiOps, Compiled, link_equations, spring_forces
+from ..linkage.vectors import V
+from . import DEAD_POINT_THRESHOLD, Evaluation
+from .compiled import CasadiOps, Compiled, LinkageFormulation, link_equations
 
 #: Largest residual of a numeric group's equations after its Newton steps, relative to the
 #: linkage's length scale: a few hundred roundings.
 CLOSURE_TOLERANCE = 1e-12
 
 
-class CrankAngle(Formulation):
+class CrankAngle(LinkageFormulation):
     """Lagrange's equation in the crank angle (any linkage)."""
 
     name = "crank-angle"
-    reusable = True
     minimal = True
     passes_dead_points = False
     passes_change_points = False
@@ -57,10 +55,6 @@ class CrankAngle(Formulation):
     def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
         super().__init__(linkage, gravity=gravity, speed=speed)
-        self.mech = mechanism_of(linkage)
-        self.structure = self.mech.structure
-        self.n = self.structure.size
-        self.links = self.mech.links
         #: Each link's angle at the start less its principal value there (whole turns).
         self.turns = np.zeros(self.n)
         self._build()
@@ -154,7 +148,7 @@ class CrankAngle(Formulation):
     def symbolic_rhs(self) -> ca.Function | None:
         """``(t, y) → ẏ`` as a CasADi function (none with slider forces: tables in Python)."""
         s = self.structure
-        if any(not s.linkage.sliders[c.slider].force.is_zero for c in s.prisms):
+        if self.has_slider_forces:
             return None
         t = ca.MX.sym("t")
         gas = ca.MX.zeros(max(1, len(s.prisms)))
@@ -169,19 +163,11 @@ class CrankAngle(Formulation):
             dy = ca.vertcat(y[1], general / inertia)
         return ca.Function("crank_angle_rhs", [t, y], [dy])
 
-    def _gas(self, theta1: float) -> NDArray[np.float64]:
-        s = self.structure
-        values = [float(s.linkage.sliders[c.slider].force.at(theta1)) for c in s.prisms]
-        return np.array(values if values else [0.0])
-
     def _at(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         """``m``, the generalized force without the motor's, the least gap, per-newton gas."""
         return self._equation(np.concatenate([[theta1, omega1], self._gas(theta1)]))
 
     # -- the formulation's interface ----------------------------------------------------------
-
-    def change_points(self) -> tuple[float, ...]:
-        return self.mech.change_points()
 
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         self.theta1_start = float(theta1)
@@ -245,21 +231,24 @@ class CrankAngle(Formulation):
         per = self._at(theta1, 0.0)[4:]
         return float(omega1 * np.dot(gas, per))
 
-    def _crank_states(self, states):
-        """Crank angle, rate and acceleration at states (the driven state's θ1 integrated)."""
-        ys = np.array(states, dtype=float).reshape(len(states), -1)
-        theta1, omega1 = ys[:, 0], ys[:, 1]
+    @staticmethod
+    def _crank_states(states) -> NDArray[np.float64]:
+        """Crank angle and rate at states, ``(count, 2)`` (the driven state's θ1 integrated)."""
+        return np.array(states, dtype=float).reshape(len(states), -1)[:, :2]
+
+    def _crank_accelerations(self, states) -> NDArray[np.float64]:
+        """The crank's angular acceleration at states, rad/s² (zero when driven)."""
         if self.driven:
-            return theta1, omega1, np.zeros(theta1.size)
-        alpha1 = np.array([self.rhs(0.0, y)[1] for y in ys])
-        return theta1, omega1, alpha1
+            return np.zeros(len(states))
+        return np.array([self.rhs(0.0, y)[1] for y in self._crank_states(states)])
 
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         return self.evaluate_batch([t], [y]).at(0)
 
     def evaluate_batch(self, times, states) -> Evaluation:
         """The linkage core's motion and inverse dynamics at the states, vectorised."""
-        theta1, omega1, alpha1 = self._crank_states(states)
+        theta1, omega1 = self._crank_states(states).T
+        alpha1 = self._crank_accelerations(states)
         with np.errstate(all="ignore"):
             mo = self.mech.motion(theta1, omega1, alpha1)
             forces = self.mech.inverse_dynamics(mo, gravity=(self.gravity.real,
@@ -290,34 +279,15 @@ class CrankAngle(Formulation):
         core's velocities, ``Σ m·|v_G|²/2 + J_G·ω²/2`` with the counter-rotors' ``J_c·ω²/2``),
         a route apart from the compiled ``m(θ1)·θ̇1²/2`` the motion was integrated with.
         """
-        theta1, omega1, _ = self._crank_states(states)
+        theta1, omega1 = self._crank_states(states).T
         with np.errstate(all="ignore"):
             mo = self.mech.motion(theta1, omega1, 0.0)
-        g = V(self.gravity.real, self.gravity.imag)
         kin = np.zeros(theta1.size)
-        work = np.zeros(theta1.size)
         for k, link in enumerate(self.links):
-            com_local = V(link.e, link.f)
-            v = mo.point_velocity(k, com_local)
+            v = mo.point_velocity(k, V(link.e, link.f))
             w = np.asarray(mo.rate[k], float)
             kin += 0.5 * link.mass * v.norm2() + 0.5 * (link.inertia + link.counter_rotor) * w**2
-            com = mo.point(k, com_local)
-            work += (g * link.mass + V(*link.force)).dot(com - V(com.x[0], com.y[0]))
-            angle = np.asarray(theta[k], float)
-            work += link.moment * (angle - angle[0])
-        spring = self._spring_energy(mo) * np.ones(theta1.size)
-        return kin, work - (spring - spring[0])
-
-    def _spring_energy(self, mo):
-        total = 0.0
-        for spring in self.structure.linkage.springs:
-            (_, _, a), (_, _, b) = spring_forces(self.structure, spring, mo.pose, NUMPY)
-            length = np.sqrt((b - a).norm2())
-            total = total + 0.5 * spring.stiffness * (length - spring.free_length) ** 2
-        return np.asarray(total, dtype=float)
-
-    def shaking(self, ev: Evaluation) -> tuple:
-        return ev.shaking_force, ev.shaking_moment
+        return kin, self.configuration_work(mo.pose, theta)
 
 
 __all__ = ["CrankAngle"]

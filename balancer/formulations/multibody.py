@@ -44,10 +44,9 @@ from ..linkage.structure import (
     constraint_jacobian,
     constraint_residual,
 )
-from ..linkage.vectors import NUMPY, V
-from ..mechanisms import mechanism_of
-from . import Evaluation, Formulation
-from .compiled import CasadiOps, Compiled, link_equations, spring_forces
+from ..linkage.vectors import V
+from . import Evaluation
+from .compiled import CasadiOps, Compiled, LinkageFormulation, link_equations, spring_forces
 
 
 def _least_norm(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -62,11 +61,10 @@ def _least_norm(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[n
         return np.linalg.lstsq(jac, res, rcond=None)[0]
 
 
-class Multibody(Formulation):
+class Multibody(LinkageFormulation):
     """Absolute coordinates with the constraints' multipliers (any linkage)."""
 
     name = "multibody"
-    reusable = True
     minimal = False
     passes_dead_points = True
     #: At a change point its constraints are dependent and the saddle-point system singular.
@@ -75,12 +73,9 @@ class Multibody(Formulation):
     def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
         super().__init__(linkage, gravity=gravity, speed=speed)
-        self.mech = mechanism_of(linkage)
         #: The mechanism as a general linkage (springs, sliders, ground points).
         self.general = self.mech.linkage
-        self.structure = s = self.mech.structure
-        self.n = s.size
-        self.links = self.mech.links
+        s = self.structure
         self.theta1_start = s.ref_angle[s.input]
         self.constraints = [*s.constraints, *([s.driver] if self.driven else [])]
         self.rows = sum(c.rows for c in self.constraints)
@@ -229,11 +224,6 @@ class Multibody(Formulation):
             "constraints", [ca.vertcat(q, angle)],
             [ca.vertcat(phi, ca.reshape(jac, -1, 1))]))
 
-    def _gas(self, theta1: float) -> NDArray[np.float64]:
-        s = self.structure
-        values = [float(self.general.sliders[c.slider].force.at(theta1)) for c in s.prisms]
-        return np.array(values if values else [0.0])
-
     def _call(self, t: float, y: NDArray[np.float64]) -> list[NDArray[np.float64]]:
         """The compiled dynamics at a state: ``q̈``, ``λ``, then the forces on the frame."""
         k = 3 * self.n
@@ -241,10 +231,6 @@ class Multibody(Formulation):
         return [flat[s] for s in self._slices]
 
     # -- the formulation's interface ----------------------------------------------------------
-
-    def change_points(self) -> tuple[float, ...]:
-        """The mechanism's change points: the driver names them if the motion stalls there."""
-        return self.mech.change_points()
 
     def transmission_of_crank(self, theta1: float) -> float:
         from ..mechanisms.base import _gaps
@@ -286,7 +272,7 @@ class Multibody(Formulation):
     def symbolic_rhs(self) -> ca.Function | None:
         """``(t, y) → ẏ`` as a CasADi function (none with slider forces: tables in Python)."""
         s = self.structure
-        if any(not s.linkage.sliders[c.slider].force.is_zero for c in s.prisms):
+        if self.has_slider_forces:
             return None
         k = 3 * self.n
         t = ca.MX.sym("t")
@@ -419,24 +405,4 @@ class Multibody(Formulation):
         ys = np.array(states, dtype=float).reshape(len(states), -1)
         q, qd = ys[:, :n].T, ys[:, n : 2 * n].T  # (3n, count)
         kin = np.asarray(self._kinetic.map(ys.shape[0]).call([ca.DM(q), ca.DM(qd)])[0].full())
-        pose = self._pose(q, np)
-        g = V(self.gravity.real, self.gravity.imag)
-        work = np.zeros(ys.shape[0])
-        for k, link in enumerate(self.links):
-            com = pose.point(k, V(link.e, link.f))
-            work += (g * link.mass + V(*link.force)).dot(com - V(com.x[0], com.y[0]))
-            work += link.moment * (q[3 * k + 2] - q[3 * k + 2, 0])
-        spring = self._spring_energy(pose) * np.ones(ys.shape[0])
-        return kin.ravel(), work - (spring - spring[0])
-
-    def _spring_energy(self, pose: Pose):
-        """Potential energy of the springs at a pose (arrays over states), J."""
-        total = 0.0
-        for spring in self.general.springs:
-            (_, _, a), (_, _, b) = spring_forces(self.structure, spring, pose, NUMPY)
-            length = np.sqrt((b - a).norm2())
-            total = total + 0.5 * spring.stiffness * (length - spring.free_length) ** 2
-        return np.asarray(total, dtype=float)
-
-    def shaking(self, ev: Evaluation) -> tuple:
-        return ev.shaking_force, ev.shaking_moment
+        return kin.ravel(), self.configuration_work(self._pose(q, np), q[2::3])

@@ -40,7 +40,7 @@ from .structure import (
     Pose,
     Prism,
     Structure,
-    constraint_jacobian,
+    group_jacobian,
 )
 from .vectors import NUMPY, Ops, V
 
@@ -282,28 +282,6 @@ class Motion:
         return self.acceleration[k] + r.perp() * self.accel[k] - r * (self.rate[k] ** 2)
 
 
-def _group_jacobian(structure: Structure, g: Group, pose: Pose):
-    """``Φ_S`` (k×k, entries arrays) and the known links' blocks of the group's rows."""
-    index = {link: i for i, link in enumerate(g.links)}
-    k = 3 * len(g.links)
-    rows_s: list[list] = []
-    known: list[list[tuple[int, list]]] = []
-    for c in g.constraints:
-        blocks = constraint_jacobian(c, pose)
-        for r in range(c.rows):
-            row = [0.0] * k
-            row_known = []
-            for link, coeffs in blocks:
-                if link in index:
-                    for j in range(3):
-                        row[3 * index[link] + j] = row[3 * index[link] + j] + coeffs[r][j]
-                elif link != GROUND_INDEX:
-                    row_known.append((link, coeffs[r]))
-            rows_s.append(row)
-            known.append(row_known)
-    return rows_s, known
-
-
 def _gamma(c, pose: Pose, vel: list[V], rate: list, ops: Ops = NUMPY) -> list:
     """``γ`` of one constraint (``Φ_q·q̈ = γ``): the velocity terms of its second derivative."""
     def w(k):
@@ -341,7 +319,7 @@ def rates(structure: Structure, pose: Pose, omega1, alpha1, theta1=None,
     acc: list[V] = [V(zero, zero)] * n
     accel: list = [zero] * n
     for g in structure.groups:
-        rows, known = _group_jacobian(structure, g, pose)
+        rows, known = group_jacobian(g, pose)
         drivers = [isinstance(c, Driver) for c in g.constraints for _ in range(c.rows)]
         rhs_v = []
         for r, row_known in enumerate(known):

@@ -17,8 +17,8 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from .structure import Group, Pose, Prism, Structure, constraint_jacobian, constraint_residual
-from .vectors import Factor, V, _plus
+from .structure import Group, Pose, Prism, Structure, constraint_residual, group_jacobian
+from .vectors import NUMPY, Factor, V
 
 #: Steps of the continuation table over one revolution.
 TABLE_STEPS = 720
@@ -34,32 +34,21 @@ def _residual(g: Group, pose: Pose) -> list:
 
 
 def _set(pose: Pose, g: Group, q: NDArray[np.float64]) -> None:
+    """Place the group's links from their coordinates ``q``, ``(N, 3·|g|)``."""
+    _place(pose, g, list(q.T), NUMPY)
+
+
+def _place(pose: Pose, g: Group, q: list, ops) -> None:
+    """Place the group's links from their coordinates, ``3·|g|`` arrays or symbols."""
     for i, k in enumerate(g.links):
-        pose.origins[k] = V(q[:, 3 * i], q[:, 3 * i + 1])
-        pose.angles[k] = q[:, 3 * i + 2]
-        pose.cos[k] = np.cos(q[:, 3 * i + 2])
-        pose.sin[k] = np.sin(q[:, 3 * i + 2])
-
-
-def _jacobian_rows(g: Group, pose: Pose) -> list[list]:
-    """The group's Jacobian in its links' coordinates: rows of floats or arrays."""
-    index = {k: i for i, k in enumerate(g.links)}
-    size = 3 * len(g.links)
-    rows: list[list] = []
-    for c in g.constraints:
-        block = [[0.0] * size for _ in range(c.rows)]
-        for link, coeffs in constraint_jacobian(c, pose):
-            if link in index:
-                for r in range(c.rows):
-                    for j in range(3):
-                        block[r][3 * index[link] + j] = _plus(block[r][3 * index[link] + j],
-                                                              coeffs[r][j])
-        rows.extend(block)
-    return rows
+        pose.origins[k] = V(q[3 * i], q[3 * i + 1])
+        pose.angles[k] = q[3 * i + 2]
+        pose.cos[k] = ops.cos(q[3 * i + 2])
+        pose.sin[k] = ops.sin(q[3 * i + 2])
 
 
 def _jacobian(g: Group, pose: Pose, n: int) -> NDArray[np.float64]:
-    rows = _jacobian_rows(g, pose)
+    rows = group_jacobian(g, pose)[0]
     jac = np.zeros((n, len(rows), len(rows)))
     for i, row in enumerate(rows):
         for j, v in enumerate(row):
@@ -102,7 +91,7 @@ def newton(g: Group, pose: Pose, q: NDArray[np.float64], scale: float,
             if n <= FEW_ANGLES:  # LAPACK per system: less Python than the structured solve
                 step = _dense_step(_jacobian(g, pose, n), res)
             else:
-                solved = Factor(_jacobian_rows(g, pose)).solve([[r] for r in res.T])
+                solved = Factor(group_jacobian(g, pose)[0]).solve([[r] for r in res.T])
                 step = np.column_stack([np.broadcast_to(x[0], (n,)) for x in solved])
         q = np.where(done[:, None], q, q - step)
     _set(pose, g, q)
@@ -193,20 +182,12 @@ def solve_group_symbolic(g: Group, pose: Pose, guess: list, ops,
     """
     q = list(guess)
     for _ in range(iterations):
-        _place_symbols(pose, g, q, ops)
+        _place(pose, g, q, ops)
         residual = _residual(g, pose)
-        step = ops.factor(_jacobian_rows(g, pose)).solve([[r] for r in residual])
+        step = ops.factor(group_jacobian(g, pose)[0]).solve([[r] for r in residual])
         q = [x - d[0] for x, d in zip(q, step, strict=True)]
-    _place_symbols(pose, g, q, ops)
+    _place(pose, g, q, ops)
     return _residual(g, pose)
-
-
-def _place_symbols(pose: Pose, g: Group, q: list, ops) -> None:
-    for i, k in enumerate(g.links):
-        pose.origins[k] = V(q[3 * i], q[3 * i + 1])
-        pose.angles[k] = q[3 * i + 2]
-        pose.cos[k] = ops.cos(q[3 * i + 2])
-        pose.sin[k] = ops.sin(q[3 * i + 2])
 
 
 def _cubic(angles: NDArray[np.float64], tab: NDArray[np.float64],

@@ -513,3 +513,30 @@ def constraint_jacobian(c: Constraint, pose: Pose):
         return [(c.s, [[0.0, 0.0, 1.0], [-d.y, d.x, d.dot(ps)]]),
                 (c.g, [[0.0, 0.0, -1.0], [d.y, -d.x, -d.dot(reach)]])]
     return [(c.link, [[0.0, 0.0, 1.0]]), (GROUND_INDEX, [[0.0, 0.0, -1.0]])]
+
+
+def group_jacobian(g: Group, pose: Pose):
+    """The Jacobian of a group's constraints at a pose, split by links.
+
+    Returns ``(rows, known)``: ``Φ_S``, the k×k block in the group's own links' coordinates
+    (entries floats — a structural 0.0 where no link term enters — or arrays), and for each
+    row the blocks ``(link, coefficients)`` of the moving links found before the group.
+    """
+    index = {link: i for i, link in enumerate(g.links)}
+    k = 3 * len(g.links)
+    rows: list[list] = []
+    known: list[list[tuple[int, list]]] = []
+    for c in g.constraints:
+        blocks = constraint_jacobian(c, pose)
+        for r in range(c.rows):
+            row = [0.0] * k
+            row_known = []
+            for link, coeffs in blocks:
+                if link in index:
+                    for j in range(3):
+                        row[3 * index[link] + j] = row[3 * index[link] + j] + coeffs[r][j]
+                elif link != GROUND_INDEX:
+                    row_known.append((link, coeffs[r]))
+            rows.append(row)
+            known.append(row_known)
+    return rows, known

@@ -307,22 +307,3 @@ class Factor:
                         acc = _minus(acc, _times(v, x[col][c]))
                 x[j][c] = acc / pivot if not _is_zero(acc) else 0.0
         return x
-
-
-def solve(a: list[list[Any]], b: list[list[Any]]) -> list[list[Any]]:
-    """Solve ``A·X = B`` for many small systems at once (see :class:`Factor`).
-
-    Parameters
-    ----------
-    a
-        ``k`` rows of ``k`` entries, each a float or an array of shape ``(n,)`` (one value per
-        system).
-    b
-        ``k`` rows of ``m`` entries, likewise (or arrays ``(n, C)``).
-
-    Returns
-    -------
-    list of list
-        ``X`` as ``k`` rows of ``m`` entries (a float where the solution is structurally zero).
-    """
-    return Factor(a).solve(b)

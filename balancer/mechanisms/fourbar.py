@@ -96,12 +96,16 @@ class FourBarMechanism(Mechanism):
     def motion(self, theta1: ArrayLike, omega1: ArrayLike = 0.0,
                alpha1: ArrayLike = 0.0) -> Motion:
         """The closed form (Eq. 2–10) on the smooth motion's branch, as a general motion."""
+        return general_motion(self._closed_form_motion(theta1, omega1, alpha1))
+
+    def _closed_form_motion(self, theta1: ArrayLike, omega1: ArrayLike,
+                            alpha1: ArrayLike) -> fourbar.Motion:
+        """The closed form (Eq. 2–10) on the smooth motion's branch (arrays broadcast)."""
         t, w, a = (np.atleast_1d(np.asarray(x, dtype=float))
                    for x in np.broadcast_arrays(theta1, omega1, alpha1))
         signs = fourbar.cycle_branch_signs(self.model.lengths, self.model.branch, t)
         with np.errstate(divide="ignore", invalid="ignore"):
-            mo = fourbar.motion(self.model.lengths, t, w, a, signs, check=False)
-        return general_motion(mo)
+            return fourbar.motion(self.model.lengths, t, w, a, signs, check=False)
 
     def closed_form_force_balance(self) -> NDArray[np.float64]:
         """Eq. 57–58 over the layout (crank, coupler, rocker, then two counter-rotors)."""
@@ -130,12 +134,8 @@ class FourBarMechanism(Mechanism):
                      *, route: str | None = None, loads: bool = True,
                      gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         """:meth:`inverse_dynamics` at crank states from the closed-form motion alone."""
-        t, w, a = (np.atleast_1d(np.asarray(x, dtype=float))
-                   for x in np.broadcast_arrays(theta1, omega1, alpha1))
-        signs = fourbar.cycle_branch_signs(self.model.lengths, self.model.branch, t)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            mo = fourbar.motion(self.model.lengths, t, w, a, signs, check=False)
-        return self._closed_form_forces(mo, route, loads, gravity)
+        return self._closed_form_forces(self._closed_form_motion(theta1, omega1, alpha1),
+                                        route, loads, gravity)
 
     def _closed_form_forces(self, mo: fourbar.Motion, route, loads, gravity) -> Forces:
         from ..inverse import mass_matrix, newton_euler

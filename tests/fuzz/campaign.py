@@ -71,8 +71,9 @@ def _preload() -> None:
             pass
 
 
-def _child(argv: tuple[str, ...], verb: str, folder: str, io_dir: str, memory: int) -> None:
-    """Run one command (in the forked child); write ``result.json`` to ``io_dir``."""
+def isolate(folder: str, io_dir: str, memory: int) -> None:
+    """In a forked child: stdout and stderr to files in ``io_dir``, no stdin, the working
+    directory ``folder``, and at most ``memory`` bytes of address space (0: no limit)."""
     out = os.open(os.path.join(io_dir, "stdout"), os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
     err = os.open(os.path.join(io_dir, "stderr"), os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
     os.dup2(out, 1)
@@ -84,6 +85,11 @@ def _child(argv: tuple[str, ...], verb: str, folder: str, io_dir: str, memory: i
     os.chdir(folder)
     if memory:
         resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+
+
+def _child(argv: tuple[str, ...], verb: str, folder: str, io_dir: str, memory: int) -> None:
+    """Run one command (in the forked child); write ``result.json`` to ``io_dir``."""
+    isolate(folder, io_dir, memory)
     drop_dac_override()
     rc, exc = execute(argv)
     reload_error = None

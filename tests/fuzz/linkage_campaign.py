@@ -39,12 +39,10 @@ if __name__ == "__main__":  # before NumPy loads: the machine is shared
 import argparse  # noqa: E402
 import collections  # noqa: E402
 import hashlib  # noqa: E402
-import io  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import multiprocessing  # noqa: E402
 import re  # noqa: E402
-import resource  # noqa: E402
 import shutil  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -54,6 +52,9 @@ from dataclasses import asdict, dataclass, field  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
+from .campaign import isolate  # noqa: E402
+from .checks import _is_number, _reject_constant  # noqa: E402
+from .checks import _missing_fields as _fixed_fields  # noqa: E402
 from .linkages import SPEC, LinkageCase, directed_cases, make_case  # noqa: E402
 
 FIGURES = ("shaking_force", "shaking_moment", "driving_torque")
@@ -91,17 +92,7 @@ def _preload() -> None:
 
 
 def _child(argv: tuple[str, ...], folder: str, io_dir: str, memory: int) -> None:
-    out = os.open(os.path.join(io_dir, "stdout"), os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
-    err = os.open(os.path.join(io_dir, "stderr"), os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
-    os.dup2(out, 1)
-    os.dup2(err, 2)
-    sys.stdout = io.TextIOWrapper(io.FileIO(1, "w", closefd=False), encoding="utf-8")
-    sys.stderr = io.TextIOWrapper(io.FileIO(2, "w", closefd=False), encoding="utf-8",
-                                  errors="backslashreplace", line_buffering=True)
-    sys.stdin = open(os.devnull)  # noqa: SIM115
-    os.chdir(folder)
-    if memory:
-        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+    isolate(folder, io_dir, memory)
     import balancer.cli as cli
 
     original = cli._innermost
@@ -208,53 +199,16 @@ def run_command(ctx, verb: str, argv: tuple[str, ...], folder: Path, scratch: Pa
 # Classification
 
 
-def _reject_constant(name: str) -> Any:
-    raise ValueError(f"non-finite JSON constant {name}")
-
-
-def _is_number(v: Any) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-
-
-def _missing_fields(verb: str, doc: Any, case: LinkageCase) -> list[str]:
-    """Fields DESIGN.md fixes that are absent or malformed."""
-    if not isinstance(doc, dict):
-        return ["<not an object>"]
-    miss: list[str] = []
-
-    def figures(d: Any, where: str) -> None:
-        for name in FIGURES:
-            item = d.get(name) if isinstance(d, dict) else None
-            for k in ("rms", "max"):
-                if not isinstance(item, dict) or not _is_number(item.get(k)):
-                    miss.append(f"{where}{name}.{k}")
-
-    if verb == "analyze":
-        figures(doc, "")
-    elif verb == "simulate":
+def _missing_fields(verb: str, doc: Any, argv: tuple[str, ...]) -> list[str]:
+    """The CLI campaign's fixed fields (:func:`.checks._missing_fields`), and a general
+    linkage's simulate states keyed by link name (DESIGN.md)."""
+    miss = _fixed_fields(verb, doc, argv)
+    if verb == "simulate" and isinstance(doc, dict):
         for state in ("initial", "final"):
+            part = doc.get(state)
             for k in ("theta", "omega", "alpha"):
-                v = doc.get(state, {}).get(k) if isinstance(doc.get(state), dict) else None
-                if not (isinstance(v, dict) and v and all(map(_is_number, v.values()))):
-                    miss.append(f"{state}.{k}")
-    elif verb == "optimize":
-        for part in ("before", "after"):
-            figures(doc.get(part), f"{part}.")
-        links = doc.get("links")
-        if not isinstance(links, dict) or not links:
-            miss.append("links")
-        else:
-            for name, link in links.items():
-                if not isinstance(link, dict) or "counter_rotor" not in link:
-                    miss.append(f"links.{name}.counter_rotor")
-        if "status" not in doc:
-            miss.append("status")
-        if "verification" not in doc:
-            miss.append("verification")
-    elif verb == "verify":
-        for k in ("max_shaking_force", "max_shaking_moment"):
-            if not _is_number(doc.get(k)):
-                miss.append(k)
+                if isinstance(part, dict) and not isinstance(part.get(k), dict):
+                    miss.append(f"{state}.{k} (not keyed by link)")
     return miss
 
 
@@ -395,7 +349,7 @@ def classify(case: LinkageCase, run: Run) -> None:
             else:
                 d.append((f"invalid or partial JSON on success ({verb})", run.stdout[-200:]))
         if isinstance(doc, dict):
-            miss = _missing_fields(verb, doc, case)
+            miss = _missing_fields(verb, doc, run.argv)
             if miss:
                 d.append((f"JSON missing fixed fields ({verb})", ", ".join(miss[:6])))
             if case.expect in ("valid", "edge"):
