@@ -1,4 +1,4 @@
-"""Convex balancing: a second-order cone program in the inertial parameters (CVXPY + Clarabel).
+"""Convex balancing: a second-order cone program in the inertial parameters (Clarabel).
 
 With the crank at constant speed the shaking moment, driving torque and shaking force are
 linear in the design vector ``x`` (the mechanism's layout,
@@ -38,8 +38,10 @@ value each bound needs alone (or an elastic, phase-1, problem with a slack on ea
 raises :class:`InfeasibleError` naming the bounds to widen and the values that would do.
 
 Variables are scaled per link (kg by the original mass, kg·m by ``m·l``, kg·m² by ``m·l²``) and
-the objective by the original design's; both problems are built once per
-:class:`~balancer.balance.problem.NumericProblem` with parameters, so re-solving is cheap.
+the objective by the original design's; both programs are assembled once per
+:class:`~balancer.balance.problem.NumericProblem`, in numbers, and handed to Clarabel directly
+(:mod:`.conic`: a solve takes about a millisecond, where CVXPY's canonicalisation took 30–40 ms);
+CVXPY builds only the diagnosis of an infeasible problem, and is the tests' second route.
 """
 
 from __future__ import annotations
@@ -48,15 +50,19 @@ import math
 import time
 import warnings
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import cvxpy as cp
 import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import SolverError
 from .certificate import Constraint, Objective, lower_bound
+from .conic import SOLVED, ConicProgram, ConicSolution
 from .problem import FORCE_BALANCE_TOLERANCE, ROUNDING_TOLERANCE, NumericProblem
 from .result import InfeasibleError, StageReport
+
+if TYPE_CHECKING:
+    import cvxpy as cp
 
 #: Clarabel's settings for every solve here (tight: the zero optimum of complete balancing
 #: must be reached to ~1e-10 of the original shaking moment).
@@ -79,6 +85,10 @@ MARGIN = 1e-8
 #: (:meth:`ConvexSolver.onto_active`) puts each bound it moves a design onto: far above the
 #: rounding of the physical values (``ε``), far below any tolerance.
 ACTIVE_INSIDE = 1e-12
+#: Eq. 58's residual, relative to its terms (:meth:`NumericProblem.force_balance_rows`), at
+#: which a design meets it to rounding: a few ε for the few products in each row.
+EQ58_ROUNDING = 16 * float(np.finfo(float).eps)
+_EPS = float(np.finfo(float).eps)
 #: A slack of the elastic problem above this (in scaled units) names a bound to widen.
 SLACK_TOLERANCE = 1e-7
 #: How far beyond its bound (relative to the bound's scale) the value a bound needs alone
@@ -86,7 +96,6 @@ SLACK_TOLERANCE = 1e-7
 #: (1e-10, scaled units) on that value.
 NEEDED_TOLERANCE = 1e-9
 
-_SOLVED = ("optimal", "optimal_inaccurate")
 
 
 @dataclass(frozen=True)
@@ -218,15 +227,13 @@ class ConvexSolver:
         self.settings = {**CLARABEL_SETTINGS, **(settings or {})}
         self.layout = layout(data)
         n = self.layout.size
-        self._u = cp.Variable(n, name="u")
         self._scale = data.objective_scale
         lay = self.layout
-        x = lay.c + lay.T @ self._u
-        constraints, self._cones, self._relaxed = self._constraints()
+        self._cones, self._relaxed = self._constraints()
         self._fb: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        self._bound_cons = constraints[:]  # one per entry of self._cones, in order
         self._failed_row = -1  # a row of Eq. 58 with nothing free that fails
-        self._inconsistent = self._force_balance(x, constraints)
+        self._inconsistent = self._force_balance()
+        equality = None if self._fb is None else self._fb[:2]
         k = data.factor.shape[0]
         r = data.factor / self._scale
         p_matrix, q_vector = r @ lay.T, r @ lay.c
@@ -251,29 +258,21 @@ class ConvexSolver:
         p_rank = sv[:rank, None] * vt[:rank]
         q_rank = u_left[:, :rank].T @ q_vector
         q_rest = float(np.linalg.norm(u_left[:, rank:].T @ q_vector))
-        mass_term = mass_row @ self._u + mass_offset if w_mass else 0.0
         # The norm's multiplier, in the full factor's rows (for the certificate): the rows
         # kept, and the direction of q's part in the rest.
         rest = u_left[:, rank:].T @ q_vector
         rest_dir = u_left[:, rank:] @ (rest / q_rest) if q_rest > 0 else np.zeros(k)
         self._dual_basis = np.column_stack([u_left[:, :rank], rest_dir]) if k else None
-        self._epigraph = None
-        if k and self._norm_form:
-            # In epigraph form, so that the norm's multiplier is the cone constraint's dual.
-            t = cp.Variable(name="t")
-            self._epigraph = cp.SOC(t, cp.hstack([p_rank @ self._u + q_rank,
-                                                   np.array([q_rest])]))
-            value = t
-        elif k:
-            value = cp.sum_squares(p_rank @ self._u + q_rank) + q_rest**2 + mass_term
-        else:
-            value = mass_term
+        if self._norm_form:
+            # In epigraph form, so that the norm's multiplier is the cone's dual.
+            self._stage1 = ConicProgram(
+                n, self._cones, equality=equality, objective="norm",
+                P=np.vstack([p_rank, np.zeros((1, n))]), q=np.append(q_rank, q_rest))
+        else:  # ‖P·u + q‖² + w_m·Δm, constants dropped
+            self._stage1 = ConicProgram(n, self._cones, equality=equality, objective="squares",
+                                        P=p_rank, q=q_rank, g=mass_row)
         # finalize's projections by margin, built when first needed
-        self._projections: dict[float, cp.Problem] = {}
-        self._target = cp.Parameter(n, name="target")
-        epigraph = [] if self._epigraph is None else [self._epigraph]
-        self._stage1 = cp.Problem(cp.Minimize(value), [*constraints, *epigraph])
-        self._stage1_data: tuple | None = None  # CVXPY's compiled form, made on the first solve
+        self._projections: dict[float, ConicProgram] = {}
         # Tie-break. J is strictly convex in y = P·u, so every optimal design has the same y
         # (and, with mass penalised, the same total mass): fix them at the SOCP's values, in an
         # orthonormal basis of the directions they measure, and pick the design nearest the
@@ -290,21 +289,22 @@ class ConvexSolver:
             if np.linalg.norm(g) > 1e-12 * np.linalg.norm(masses):
                 rows.append(g / np.linalg.norm(g))
         self._seen = np.array(rows).reshape(len(rows), n)
-        self._seen_value = cp.Parameter(len(rows), name="seen")
-        self._prefer = cp.Parameter(n, name="prefer")
-        fixed = [self._seen @ self._u == self._seen_value] if rows else []
-        self._stage2 = cp.Problem(
-            cp.Minimize(cp.sum_squares(self._u - self._prefer)), [*constraints, *fixed]
-        )
+        fixed = [] if equality is None else [equality]
+        if rows:
+            fixed.append((self._seen, np.zeros(len(rows))))
+        self._stage2 = ConicProgram(
+            n, self._cones, objective="nearest",
+            equality=(np.vstack([e for e, _ in fixed]), np.concatenate([r for _, r in fixed]))
+            if fixed else None)
 
     # -- building ------------------------------------------------------------------------------
 
-    def _constraints(self, margin: float = 0.0) -> tuple[list, list[Constraint], list[str]]:
+    def _constraints(self, margin: float = 0.0) -> tuple[list[Constraint], list[str]]:
         """The bounds as cone constraints, each tightened by ``margin`` (relative, scaled units).
 
-        Returns the CVXPY constraints, the same constraints in numbers
-        (:class:`~.certificate.Constraint`, in the same order: the certificate evaluates them)
-        and the links whose upper inertia bound is relaxed. A range narrower than twice the
+        Returns the constraints (:class:`~.certificate.Constraint`, in the order their
+        multipliers come back: the certificate evaluates them) and the links whose upper
+        inertia bound is relaxed. A range narrower than twice the
         margin is kept as it is (its ends are what the designer gave).
         """
         data, lay = self.data, self.layout
@@ -387,14 +387,7 @@ class ConvexSolver:
                 lo, hi = inside(b.counter_rotor[0] / scale, b.counter_rotor[1] / scale)
                 at_least(entry(k, scale), lo)
                 at_most(entry(k, scale), hi)
-        return [self._cvxpy(c) for c in out], out, relaxed
-
-    def _cvxpy(self, con: Constraint):
-        """The CVXPY form of one numeric constraint (:meth:`_constraints`)."""
-        u = self._u
-        if con.kind == "nonneg":
-            return con.M[0] @ u + con.m[0] >= 0
-        return cp.SOC(con.M[0] @ u + con.m[0], con.M[1:] @ u + con.m[1:])
+        return out, relaxed
 
     def _box(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Bounds of each variable over the SOCP's feasible set (scaled; ``hi`` may be ∞).
@@ -436,8 +429,8 @@ class ConvexSolver:
                 lo[j], hi[j] = (v / data.scales[b.rotor] for v in b.counter_rotor)
         return lo, hi
 
-    def _force_balance(self, x, constraints: list) -> bool:
-        """Add Eq. 58 (rows that involve a free variable); say whether a fixed row fails.
+    def _force_balance(self) -> bool:
+        """Eq. 58's rows that involve a free variable (scaled); say whether a fixed row fails.
 
         Each row is scaled by the magnitude of its own terms at the design's scale (a row that
         involves only light links is not drowned by a heavy one's, as it would be by the
@@ -460,52 +453,27 @@ class ConvexSolver:
                 inconsistent = True
                 self._failed_row = i
         if keep:
-            constraints.append(at[keep] @ self._u == rhs[keep])
             self._fb = (at[keep], rhs[keep], np.linalg.pinv(at[keep]))
         return inconsistent
 
     # -- solving -------------------------------------------------------------------------------
 
-    def _run(self, problem: cp.Problem, name: str) -> tuple[StageReport, bool]:
+    def _run(self, program: ConicProgram, name: str,
+             **data: NDArray[np.float64]) -> tuple[StageReport, ConicSolution]:
+        """Solve one of the programs; its report, and Clarabel's answer."""
         start = time.perf_counter()
-        try:
-            if problem is self._stage1:
-                self._solve_stage1()
-            else:
-                _solve(problem, self.settings)
-            status = str(problem.status)
-        except cp.error.SolverError as exc:  # numerical failure inside Clarabel
-            status = f"solver error: {exc}"
+        solution = program.solve(self.settings, **data)
         elapsed = time.perf_counter() - start
-        ok = status in _SOLVED and self._u.value is not None
-        stats = problem.solver_stats
-        iterations = int(stats.num_iters) if stats is not None and stats.num_iters else 0
-        objective = self.data.objective(self.layout.x(self._u.value)) if ok else math.nan
+        ok = solution.u is not None
         report = StageReport(
             name=name,
             converged=ok,
-            solver_status=status,
-            iterations=iterations,
+            solver_status=solution.status,
+            iterations=solution.iterations,
             time=elapsed,
-            objective=objective,
+            objective=self.data.objective(self.layout.x(solution.u)) if ok else math.nan,
         )
-        return report, ok
-
-    def _solve_stage1(self) -> None:
-        """Solve the SOCP from its solver data, compiled by CVXPY on the first solve only.
-
-        The SOCP has no parameters, so its canonical form (CVXPY's most expensive step,
-        about as long as Clarabel's solve) does not change between solves.
-        """
-        if self._stage1_data is None:
-            self._stage1_data = self._stage1.get_problem_data(
-                cp.CLARABEL, solver_opts=self.settings
-            )
-        data, chain, inverse = self._stage1_data
-        with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
-            warnings.filterwarnings("ignore", message="Solution may be inaccurate")
-            solution = chain.solve_via_data(self._stage1, data, solver_opts=self.settings)
-            self._stage1.unpack_results(solution, chain, inverse)
+        return report, solution
 
     def solve(
         self, *, prefer: NDArray[np.float64] | None = None, tie_break: bool = True
@@ -530,29 +498,27 @@ class ConvexSolver:
         data, lay = self.data, self.layout
         if self._inconsistent:
             raise self.diagnose() or self._fixed_row_error()
-        report, ok = self._run(self._stage1, "convex")
+        report, first = self._run(self._stage1, "convex")
         stages = [report]
-        if not ok:
+        if first.u is None:
             raise self._infeasible(f"Clarabel: {report.solver_status} after "
                                    f"{report.iterations} iterations")
-        u1 = np.array(self._u.value)
-        multipliers = [_dual(c, con.M.shape[0]) for c, con in zip(self._bound_cons, self._cones,
-                                                                  strict=True)]
+        u1 = first.u
+        multipliers = list(first.duals)
         norm_dual = None
-        if self._epigraph is not None and self._dual_basis is not None:
-            # CVXPY's Lagrangian is t − (μ·t + w·(P·u + q)): the norm's minorant is −w.
-            dual = _dual(self._epigraph, self._dual_basis.shape[1] + 1)
-            norm_dual = -(self._dual_basis @ dual[1:])
+        if first.epigraph_dual is not None and self._dual_basis is not None:
+            # The Lagrangian is t − (μ·t + w·(P·u + q)): the norm's minorant is −w.
+            norm_dual = -(self._dual_basis @ first.epigraph_dual[1:])
         x, tight = self.repair(u1)
         objective = data.objective(x)
         if tie_break and lay.size:
             target = data.x0 if prefer is None else np.asarray(prefer, float)
-            self._prefer.value = lay.u(target)
-            self._seen_value.value = self._seen @ u1
-            report2, ok2 = self._run(self._stage2, "tie-break")
+            fixed = [] if self._fb is None else [self._fb[1]]
+            report2, second = self._run(self._stage2, "tie-break", target=lay.u(target),
+                                        equality_rhs=np.concatenate([*fixed, self._seen @ u1]))
             stages.append(report2)
-            if ok2:
-                x2, tight2 = self.repair(np.array(self._u.value))
+            if second.u is not None:
+                x2, tight2 = self.repair(second.u)
                 objective2 = data.objective(x2)
                 # Only a feasible tie-break design replaces the SOCP's (an "almost solved"
                 # one, repaired, can be cheaper by violating a bound).
@@ -737,24 +703,33 @@ class ConvexSolver:
 
         :meth:`NumericProblem.physical` moves values that overshoot a bound by rounding onto
         it; that can cost Eq. 58 its last digits, which the other free variables restore (the
-        ones on a bound stay); repeated until both hold (a move of rounding size each time).
-        ``None`` if they do not within a few rounds.
+        ones moved onto a bound stay there in the rounds that follow); repeated until both
+        hold and Eq. 58 is met to the rounding of its terms, or a few rounds have passed (a
+        move of rounding size each time); the design with the least residual is kept.
+        ``None`` if none meets both.
         """
         data, lay = self.data, self.layout
         inert = [i for i in range(data.size) if data.inert[i]]
+        best: tuple[float, NDArray[np.float64]] | None = None
+        pinned = np.zeros(lay.size, dtype=bool)
         for _ in range(4):
             xp = data.vector_of(data.physical(x))
-            if (data.force_balance_residual(xp) <= FORCE_BALANCE_TOLERANCE
-                    and not data.violations(xp, tol=ROUNDING_TOLERANCE)):
-                return xp
-            if not lay.size:
-                return None
+            residual = data.force_balance_residual(xp)
+            if (residual <= FORCE_BALANCE_TOLERANCE
+                    and not data.violations(xp, tol=ROUNDING_TOLERANCE)
+                    and (best is None or residual < best[0])):
+                best = (residual, xp)
+            if best is not None and best[0] <= EQ58_ROUNDING or not lay.size:
+                break
             up = lay.u(xp)
-            pinned = np.array([xp[i] != x[i] for i in lay.primary], dtype=bool)
+            # The entries the conversion moved by more than its own rounding (onto a bound),
+            # in this round or an earlier one: they stay.
+            moved = np.abs(xp - x) > 8 * _EPS * np.maximum(np.abs(x), np.abs(xp))
+            pinned = pinned | moved[list(lay.primary)]
             x = lay.x(self.restore_balance(up, pinned))
             x[inert] = xp[inert]
             x = self._clip_inertias(x)
-        return None
+        return None if best is None else best[1]
 
     def _clip_and_pin(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
         """Masses and centres of mass that overshoot their bounds put on them.
@@ -808,21 +783,11 @@ class ConvexSolver:
         With Eq. 58 as equalities; ``None`` if that set is empty or Clarabel fails.
         """
         if margin not in self._projections:
-            constraints, _, _ = self._constraints(margin=margin)
-            if self._fb is not None:
-                at, rhs, _ = self._fb
-                constraints.append(at @ self._u == rhs)
-            self._projections[margin] = cp.Problem(
-                cp.Minimize(cp.sum_squares(self._u - self._target)), constraints)
-        problem = self._projections[margin]
-        self._target.value = u0
-        try:
-            _solve(problem, self.settings)
-        except cp.error.SolverError:
-            return None
-        if problem.status not in _SOLVED or self._u.value is None:
-            return None
-        return np.array(self._u.value)
+            constraints, _ = self._constraints(margin=margin)
+            self._projections[margin] = ConicProgram(
+                self.layout.size, constraints, objective="nearest",
+                equality=None if self._fb is None else self._fb[:2])
+        return self._projections[margin].solve(self.settings, target=u0).u
 
     def polish(
         self, x: NDArray[np.float64], target: NDArray[np.float64], objective: float
@@ -883,12 +848,24 @@ class ConvexSolver:
         if self._fb is None:
             return u
         at, rhs, pinv = self._fb
+        free = None if pinned is None or not pinned.any() else ~pinned
+        if free is not None and not free.any():
+            return u
         residual = at @ u - rhs
-        if pinned is None or not pinned.any():
-            return u - pinv @ residual
-        free = ~pinned
-        if free.any():
-            u[free] -= np.linalg.lstsq(at[:, free], residual, rcond=None)[0]
+        size = np.linalg.norm(residual)
+        # The correction's own rounding (the rows' conditioning times ε) leaves a residual
+        # above rounding of the terms: refine while it shrinks (one or two more steps).
+        for _ in range(4):
+            if free is None:
+                trial = u - pinv @ residual
+            else:
+                trial = u.copy()
+                trial[free] -= np.linalg.lstsq(at[:, free], residual, rcond=None)[0]
+            trial_residual = at @ trial - rhs
+            trial_size = np.linalg.norm(trial_residual)
+            if not trial_size < size:
+                break
+            u, residual, size = trial, trial_residual, trial_size
         return u
 
     def repair(self, u: NDArray[np.float64]) -> tuple[NDArray[np.float64], bool]:
@@ -960,6 +937,8 @@ class ConvexSolver:
         Groups are ``(i, kind)`` with kind ``mass-low``, ``mass-high``, ``com`` (the disc of a
         listed radius) or ``com-fixed`` (a centre of mass that may not move).
         """
+        import cvxpy as cp
+
         data = self.data
 
         def relax(group):
@@ -1062,6 +1041,8 @@ class ConvexSolver:
 
     def _elastic(self) -> InfeasibleError | None:
         """The phase-1 problem of :meth:`diagnose`, for when no single bound suffices."""
+        import cvxpy as cp
+
         data = self.data
         mtot = data.original_mass
         moment_unit = mtot * max(b.length for b in data.links)
@@ -1087,7 +1068,7 @@ class ConvexSolver:
             _solve(problem, self.settings)
         except cp.error.SolverError as exc:
             return InfeasibleError(f"force balance cannot be met within the bounds ({exc})")
-        if problem.status not in _SOLVED:
+        if problem.status not in SOLVED:
             return InfeasibleError(
                 "force balance cannot be met within the bounds (the elastic problem failed: "
                 f"{problem.status})"
@@ -1132,6 +1113,8 @@ class ConvexSolver:
 
         ``None`` if that program is infeasible too, or Clarabel did not solve it accurately.
         """
+        import cvxpy as cp
+
         i, kind = group
         b = self.data.links[i]
         m = cp.Variable(len(self.data.links))
@@ -1192,16 +1175,6 @@ class ConvexSolver:
         )
 
 
-def _dual(constraint, size: int) -> NDArray[np.float64]:
-    """A constraint's multiplier as one flat vector (NaN where the solver gave none)."""
-    value = constraint.dual_value
-    if value is None:
-        return np.full(size, np.nan)
-    parts = value if isinstance(value, list | tuple) else [value]
-    flat = np.concatenate([np.ravel(np.asarray(p, dtype=float)) for p in parts])
-    return flat if flat.size == size else np.full(size, np.nan)
-
-
 def _solve(problem: cp.Problem, settings: dict) -> None:
     """Solve with Clarabel; an inaccurate solution is judged by its status, not a warning.
 
@@ -1210,7 +1183,7 @@ def _solve(problem: cp.Problem, settings: dict) -> None:
     """
     with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
         warnings.filterwarnings("ignore", message="Solution may be inaccurate")
-        problem.solve(solver=cp.CLARABEL, **settings)
+        problem.solve(solver="CLARABEL", **settings)
 
 
 def _up(x: float, digits: int = 4) -> float:

@@ -1,0 +1,194 @@
+"""A second-order cone program in numbers, handed to Clarabel as it is.
+
+The convex balancing problem (:mod:`.convex`) is small (tens of variables, a few dozen cone
+rows) and its data are already numbers: the bounds as :class:`~.certificate.Constraint`
+``M·u + m ∈ K``, force balance as ``E·u = r``, the objective a norm or a sum of squares of an
+affine map. Clarabel solves it in about a millisecond; CVXPY's canonicalisation of the same
+program took 30–40 ms per solve. So the program is assembled here once, in Clarabel's standard
+form (its documented Python interface: ``DefaultSolver(P, q, A, b, cones, settings)``)
+
+    minimise ½·yᵀ·H·y + hᵀ·y  subject to  A·y + s = b,  s ∈ K,
+
+with ``y = u`` (or ``(u, t)`` in epigraph form), equalities first (the zero cone), then the
+bounds (nonnegative rows), then the second-order cones, each constraint as ``A = −M``,
+``b = m``: ``s = M·u + m``. Clarabel's dual ``z ∈ K*`` then satisfies
+``H·y + h = Σ Mᵀ·z``: each constraint's multiplier in the convention of the Lagrangian
+``f − Σ zᵀ·(M·u + m)``, which :mod:`.certificate` uses. CVXPY stays the tests' independent
+route to the same optimum (``tests/test_conic.py``) and builds the rarely solved programs of the
+infeasibility diagnosis.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .certificate import Constraint
+
+#: Clarabel's statuses in CVXPY's words (what the reports have always said).
+STATUS: dict[str, str] = {
+    "Solved": "optimal",
+    "AlmostSolved": "optimal_inaccurate",
+    "PrimalInfeasible": "infeasible",
+    "AlmostPrimalInfeasible": "infeasible_inaccurate",
+    "DualInfeasible": "unbounded",
+    "AlmostDualInfeasible": "unbounded_inaccurate",
+    "MaxIterations": "user_limit",
+    "MaxTime": "user_limit",
+}
+#: The statuses whose point is a solution.
+SOLVED = ("optimal", "optimal_inaccurate")
+
+
+@dataclass(frozen=True)
+class ConicSolution:
+    """What one solve returned.
+
+    ``u`` is ``None`` unless the status is one of :data:`SOLVED`; ``duals`` holds one
+    multiplier per constraint (in the order given), ``epigraph_dual`` the norm's cone
+    multiplier ``(μ, w)`` in epigraph form.
+    """
+
+    status: str
+    u: NDArray[np.float64] | None
+    duals: tuple[NDArray[np.float64], ...]
+    epigraph_dual: NDArray[np.float64] | None
+    iterations: int
+    time: float
+
+
+class ConicProgram:
+    """``min f(u)`` subject to ``M_i·u + m_i ∈ K_i`` and ``E·u = r``, assembled once.
+
+    The objective is one of
+
+    - ``norm``: ``‖P·u + q‖`` (epigraph form: a variable ``t`` and the cone ``‖P·u + q‖ ≤ t``);
+    - ``squares``: ``‖P·u + q‖² + g·u`` (a quadratic objective);
+    - ``nearest``: ``‖u − target‖²``, the target given at each solve.
+
+    Parameters
+    ----------
+    n
+        Number of variables ``u``.
+    constraints
+        The cone constraints, in the order their multipliers are returned.
+    equality
+        ``(E, r)``, or ``None``; ``r`` may be replaced at each solve.
+    objective
+        ``"norm"``, ``"squares"`` or ``"nearest"``.
+    P, q, g
+        The objective's data (``norm`` and ``squares``).
+    """
+
+    def __init__(self, n: int, constraints: list[Constraint], *,
+                 equality: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+                 objective: str, P: NDArray[np.float64] | None = None,
+                 q: NDArray[np.float64] | None = None,
+                 g: NDArray[np.float64] | None = None) -> None:
+        self.n = n
+        self.objective = objective
+        epigraph = objective == "norm"
+        width = n + 1 if epigraph else n
+        self.width = width
+        rows: list[NDArray[np.float64]] = []  # blocks of A
+        rhs: list[NDArray[np.float64]] = []
+        cones: list[tuple[str, int]] = []  # (kind, dimension), merged where consecutive
+        if equality is not None:
+            e, r = (np.atleast_2d(np.asarray(equality[0], float)),
+                    np.asarray(equality[1], float).reshape(-1))
+            self._equality_rows = e.shape[0]
+            rows.append(np.hstack([e, np.zeros((e.shape[0], width - n))]))
+            rhs.append(r)
+            cones.append(("zero", e.shape[0]))
+        else:
+            self._equality_rows = 0
+        # The nonnegative rows first, then the cones, each in the order given (as CVXPY
+        # orders them: Clarabel's iterates, and so its last digits, depend on the order).
+        self._slices: list[slice] = [slice(0, 0)] * len(constraints)
+        start = self._equality_rows
+        for kind in ("nonneg", "soc"):
+            for i, con in enumerate(constraints):
+                if con.kind != kind:
+                    continue
+                k = con.M.shape[0]
+                rows.append(np.hstack([-con.M, np.zeros((k, width - n))]))
+                rhs.append(np.asarray(con.m, float))
+                self._slices[i] = slice(start, start + k)
+                start += k
+                if kind == "nonneg" and cones and cones[-1][0] == "nonneg":
+                    cones[-1] = ("nonneg", cones[-1][1] + k)
+                else:
+                    cones.append((kind, k))
+        self._epigraph: slice | None = None
+        hessian = np.zeros((width, width))
+        linear = np.zeros(width)
+        self._offset = 0.0
+        if epigraph:
+            assert P is not None and q is not None
+            k = P.shape[0]
+            block = np.zeros((k + 1, width))
+            block[0, n] = -1.0  # t
+            block[1:, :n] = -P
+            rows.append(block)
+            rhs.append(np.concatenate([[0.0], q]))
+            self._epigraph = slice(start, start + k + 1)
+            cones.append(("soc", k + 1))
+            linear[n] = 1.0
+        elif objective == "squares":
+            assert P is not None and q is not None
+            hessian[:n, :n] = 2.0 * P.T @ P
+            linear[:n] = 2.0 * P.T @ q + (0.0 if g is None else g)
+        elif objective == "nearest":
+            hessian[:n, :n] = 2.0 * np.eye(n)
+        else:
+            raise ValueError(f"unknown objective {objective!r}")
+        self._A = np.vstack(rows) if rows else np.zeros((0, width))
+        self._b = np.concatenate(rhs) if rhs else np.zeros(0)
+        self._H = np.triu(hessian)
+        self._h = linear
+        self._cones = cones
+
+    def solve(self, settings: dict, *, target: NDArray[np.float64] | None = None,
+              equality_rhs: NDArray[np.float64] | None = None) -> ConicSolution:
+        """Solve with Clarabel (``settings``: names of its ``DefaultSettings``).
+
+        ``target`` is the ``nearest`` objective's point; ``equality_rhs`` replaces ``r``.
+        """
+        import clarabel
+        from scipy.sparse import csc_array
+
+        b = self._b
+        if equality_rhs is not None:
+            b = b.copy()
+            b[: self._equality_rows] = equality_rhs
+        h = self._h
+        if self.objective == "nearest":
+            assert target is not None
+            h = np.zeros(self.width)
+            h[: self.n] = -2.0 * np.asarray(target, float)
+        cones = []
+        for kind, k in self._cones:
+            cones.append({"zero": clarabel.ZeroConeT, "nonneg": clarabel.NonnegativeConeT,
+                          "soc": clarabel.SecondOrderConeT}[kind](k))
+        options = clarabel.DefaultSettings()
+        options.verbose = False
+        for key, value in settings.items():
+            setattr(options, key, value)
+        solver = clarabel.DefaultSolver(csc_array(self._H), h, csc_array(self._A), b, cones,
+                                        options)
+        with np.errstate(over="ignore", invalid="ignore"):
+            result = solver.solve()
+        status = STATUS.get(str(result.status), "solver_error")
+        z = np.asarray(result.z, dtype=float)
+        duals = tuple(z[s] for s in self._slices) if z.size == self._b.size else tuple(
+            np.full(s.stop - s.start, np.nan) for s in self._slices)
+        epigraph = None
+        if self._epigraph is not None and z.size == self._b.size:
+            epigraph = z[self._epigraph]
+        u = np.asarray(result.x, dtype=float)[: self.n] if status in SOLVED else None
+        if u is not None and not np.all(np.isfinite(u)):
+            u, status = None, "solver_error"
+        return ConicSolution(status=status, u=u, duals=duals, epigraph_dual=epigraph,
+                             iterations=int(result.iterations), time=float(result.solve_time))

@@ -1,0 +1,133 @@
+"""The conic program handed to Clarabel directly (balance/conic.py) against CVXPY's.
+
+CVXPY canonicalises the same program by its own route (its cone ordering, variables and
+duals); both end in Clarabel, so the optimum must agree to Clarabel's tolerance (1e-10 on the
+gap and feasibility, here on problems of unit scale: a value to ~1e-8). The multipliers are
+checked by what defines them: stationarity of the Lagrangian f − Σ zᵀ·(M·u + m) − νᵀ·(E·u − r)
+in the convention the certificate uses, and membership of the (self-dual) cones.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import cvxpy as cp
+import numpy as np
+import pytest
+
+from balancer.balance.certificate import Constraint
+from balancer.balance.conic import ConicProgram
+from balancer.balance.convex import CLARABEL_SETTINGS
+
+#: Agreement of two solves to Clarabel's tolerances (1e-10) on problems of unit scale, with
+#: room for the conditioning of a random problem (a hundredfold).
+AGREE = 1e-8
+
+
+def _random_program(seed: int, n: int = 6):
+    """Bounds |u_j| ≤ 2, two cones ‖B·u + c‖ ≤ d + a·u strictly met at a point u0, E·u = E·u0."""
+    rng = np.random.default_rng(seed)
+    u0 = rng.uniform(-0.5, 0.5, n)
+    constraints = []
+    for j in range(n):
+        row = np.zeros((1, n))
+        row[0, j] = 1.0
+        constraints.append(Constraint("nonneg", row, np.array([2.0])))  # u_j + 2 ≥ 0
+        constraints.append(Constraint("nonneg", -row, np.array([2.0])))  # 2 − u_j ≥ 0
+    for _ in range(2):
+        b, c, a = rng.normal(size=(3, n)), rng.normal(size=3), 0.1 * rng.normal(size=n)
+        d = np.linalg.norm(b @ u0 + c) - a @ u0 + 0.5
+        constraints.append(Constraint("soc", np.vstack([a, b]), np.concatenate([[d], c])))
+    e = rng.normal(size=(2, n))
+    p, q = rng.normal(size=(4, n)), rng.normal(size=4)
+    return constraints, (e, e @ u0), p, q
+
+
+def _cvxpy(constraints, equality, objective):
+    u = cp.Variable(constraints[0].M.shape[1])
+    cons = [c.M[0] @ u + c.m[0] >= 0 if c.kind == "nonneg"
+            else cp.SOC(c.M[0] @ u + c.m[0], c.M[1:] @ u + c.m[1:]) for c in constraints]
+    cons.append(equality[0] @ u == equality[1])
+    problem = cp.Problem(cp.Minimize(objective(u)), cons)
+    problem.solve(solver=cp.CLARABEL, **CLARABEL_SETTINGS)
+    assert problem.status == "optimal"
+    return np.array(u.value), float(problem.value)
+
+
+def _stationarity(constraints, equality, solution, gradient):
+    """‖∇f − Σ Mᵀz − Eᵀν‖ with ν fitted by least squares (Clarabel's ν is internal)."""
+    g = gradient - sum(c.M.T @ z for c, z in zip(constraints, solution.duals, strict=True))
+    e = equality[0]
+    nu = np.linalg.lstsq(e.T, g, rcond=None)[0]
+    return float(np.linalg.norm(g - e.T @ nu))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_norm_objective_agrees_with_cvxpy(seed):
+    constraints, equality, p, q = _random_program(seed)
+    program = ConicProgram(p.shape[1], constraints, equality=equality, objective="norm",
+                           P=p, q=q)
+    solution = program.solve(CLARABEL_SETTINGS)
+    assert solution.status == "optimal"
+    u_ref, value_ref = _cvxpy(constraints, equality, lambda u: cp.norm(p @ u + q))
+    value = float(np.linalg.norm(p @ solution.u + q))
+    assert value == pytest.approx(value_ref, rel=AGREE, abs=AGREE)
+    assert np.max(np.abs(solution.u - u_ref)) < 1e-6  # a unique optimum, to √tolerance
+    # The epigraph's multiplier (μ, w): μ = 1 at the optimum and ∇‖P·u + q‖ = −Pᵀ·w... in
+    # the Lagrangian t − μ·t − wᵀ(P·u + q), so stationarity in u reads Σ Mᵀz + Eᵀν = −Pᵀw.
+    mu, w = solution.epigraph_dual[0], solution.epigraph_dual[1:]
+    assert mu == pytest.approx(1.0, abs=AGREE)
+    assert _stationarity(constraints, equality, solution, -p.T @ w) < AGREE
+    for c, z in zip(constraints, solution.duals, strict=True):
+        assert np.linalg.norm(z - c.project(z)) < AGREE  # in the cone
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_squares_objective_agrees_with_cvxpy(seed):
+    constraints, equality, p, q = _random_program(seed)
+    g = np.random.default_rng(100 + seed).normal(size=p.shape[1])
+    program = ConicProgram(p.shape[1], constraints, equality=equality, objective="squares",
+                           P=p, q=q, g=g)
+    solution = program.solve(CLARABEL_SETTINGS)
+    assert solution.status == "optimal"
+    u_ref, value_ref = _cvxpy(constraints, equality,
+                              lambda u: cp.sum_squares(p @ u + q) + g @ u)
+    value = float(np.sum((p @ solution.u + q) ** 2) + g @ solution.u)
+    assert value == pytest.approx(value_ref, rel=AGREE, abs=AGREE)
+    gradient = 2 * p.T @ (p @ solution.u + q) + g
+    assert _stationarity(constraints, equality, solution, gradient) < AGREE
+
+
+def test_nearest_point_and_new_right_hand_side():
+    constraints, (e, r), _, _ = _random_program(7)
+    program = ConicProgram(e.shape[1], constraints, equality=(e, r), objective="nearest")
+    target = np.full(e.shape[1], 3.0)  # outside the box: the projection meets bounds
+    r2 = r + 0.1
+    solution = program.solve(CLARABEL_SETTINGS, target=target, equality_rhs=r2)
+    u_ref, _ = _cvxpy(constraints, (e, r2), lambda u: cp.sum_squares(u - target))
+    assert np.max(np.abs(solution.u - u_ref)) < AGREE ** 0.5
+    assert np.max(np.abs(e @ solution.u - r2)) < AGREE
+    # ... and the program is unchanged for the next solve.
+    again = program.solve(CLARABEL_SETTINGS, target=target)
+    assert np.max(np.abs(e @ again.u - r)) < AGREE
+
+
+def test_infeasible_program_has_no_point():
+    row = np.ones((1, 2))
+    constraints = [Constraint("nonneg", row, np.array([-1.0])),  # u1 + u2 ≥ 1
+                   Constraint("nonneg", -row, np.array([0.0]))]  # u1 + u2 ≤ 0
+    solution = ConicProgram(2, constraints, objective="nearest").solve(
+        CLARABEL_SETTINGS, target=np.zeros(2))
+    assert solution.status == "infeasible" and solution.u is None
+
+
+def test_convex_balancing_does_not_import_cvxpy():
+    """The certified optimum needs Clarabel only (CVXPY's import alone takes ~1 s)."""
+    code = ("import sys; from balancer.spec import load_design; "
+            "from balancer.balance.optimizer import optimize; "
+            "optimize(load_design('examples/pb1.toml'), 'convex'); "
+            "print('cvxpy' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, cwd=__file__.rsplit("/tests/", 1)[0])
+    assert out.stdout.strip() == "False"
