@@ -49,17 +49,25 @@ class Figure:
         overflow for any finite values.
         """
         values = np.asarray(values)
-        mag = np.abs(values)
-        missing = np.isnan(mag)
-        if missing.any():
-            mag = mag[~missing]
-        if not mag.size:
-            return cls(rms=float("nan"), max=float("nan"))
-        top = float(np.max(mag))
-        if top == 0 or not np.isfinite(top):
+        if not values.size:
+            return cls(rms=math.nan, max=math.nan)
+        if np.iscomplexobj(values):
+            mag = np.abs(values)
+            top = float(np.max(mag))
+        else:
+            mag = values
+            top = float(max(np.max(values), -np.min(values)))
+        if math.isnan(top):  # samples that do not exist (NaN, at a change point): left out
+            mag = np.abs(values)
+            mag = mag[~np.isnan(mag)]
+            return cls.of(mag) if mag.size else cls(rms=math.nan, max=math.nan)
+        if top == 0 or not math.isfinite(top):
             return cls(rms=top, max=top)
+        if 1e-100 < top < 1e100:  # the sum of squares neither overflows nor underflows
+            total = float(np.vdot(values, values).real)
+            return cls(rms=math.sqrt(total / values.size), max=top)
         scaled = mag / top
-        return cls(rms=top * math.sqrt(float(np.dot(scaled, scaled)) / mag.size), max=top)
+        return cls(rms=top * math.sqrt(float(np.dot(scaled, scaled)) / values.size), max=top)
 
     def as_dict(self) -> dict[str, float]:
         """``{"rms": …, "max": …}``."""

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import math
 import zlib
+from fractions import Fraction
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from conftest import CLASS_EXAMPLES, paper_linkage, random_angles, random_link, random_linkage
 from helpers import ROUNDING, derivative_with_error, rel_err
 
@@ -245,6 +249,43 @@ def test_cycle_analysis_samples_and_figures(paper):
         a, b = getattr(ca.summary, name), getattr(other.summary, name)
         assert a.rms == pytest.approx(b.rms, rel=1e-12)
         assert a.max == pytest.approx(b.max, rel=1e-12)
+
+
+_VALUE = st.floats(allow_nan=False, allow_infinity=False, min_value=-1e300, max_value=1e300)
+
+
+@settings(max_examples=200, deadline=None)
+@given(re=st.lists(_VALUE, min_size=1, max_size=40), im=st.lists(_VALUE, min_size=1,
+                                                                 max_size=40),
+       complex_=st.booleans(), holes=st.sets(st.integers(0, 39), max_size=5))
+def test_figures_of_any_samples_against_exact_arithmetic(re, im, complex_, holes):
+    """Figure.of (its fast sums of squares, its scaled fallback, its NaN samples left out)
+    against the RMS and maximum of the same magnitudes in exact rational arithmetic. Each
+    magnitude is one correctly rounded hypot (ε/2); the float sum of n squares is off by
+    n·ε of the sum at most, and the root halves it: (n + 2)·ε relative covers both routes."""
+    n = min(len(re), len(im)) if complex_ else len(re)
+    values = (np.array(re[:n]) + 1j * np.array(im[:n])) if complex_ else np.array(re[:n])
+    for i in holes:
+        if i < n:
+            values[i] = np.nan
+    figure = cycle.Figure.of(values)
+    kept = [abs(complex(v)) for v in values if not np.isnan(v)]
+    if not kept:
+        assert math.isnan(figure.rms) and math.isnan(figure.max)
+        return
+    top = max(kept)
+    # The largest of the magnitudes: each a correctly rounded hypot here, numpy's within an
+    # ulp of it (overflow aside).
+    assert figure.max == pytest.approx(top, rel=2.3e-16, abs=0.0) or math.isinf(figure.max)
+    if not math.isfinite(top) or math.isinf(figure.max):  # a magnitude above 1.8e308
+        assert figure.rms == figure.max
+        return
+    if top == 0:
+        assert figure.rms == 0
+        return
+    exact = top * math.sqrt(float(sum((Fraction(v) / Fraction(top)) ** 2 for v in kept)
+                                  / len(kept)))
+    assert figure.rms == pytest.approx(exact, rel=(len(kept) + 2) * 2.3e-16, abs=0.0)
 
 
 @pytest.mark.parametrize("workers", [1, 2])

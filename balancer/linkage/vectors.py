@@ -55,8 +55,16 @@ class V:
         return V(-self.y, self.x)
 
     def rotated(self, c: Any, s: Any) -> V:
-        """The vector turned by the angle whose cosine and sine are ``c`` and ``s``."""
-        return V(c * self.x - s * self.y, s * self.x + c * self.y)
+        """The vector turned by the angle whose cosine and sine are ``c`` and ``s``.
+
+        A component that is the float 0.0 (a point on a link's axis) costs nothing.
+        """
+        x, y = self.x, self.y
+        if isinstance(y, float) and y == 0.0:
+            return V(c * x, s * x)
+        if isinstance(x, float) and x == 0.0:
+            return V(-(s * y), c * y)
+        return V(c * x - s * y, s * x + c * y)
 
     def norm2(self) -> Any:
         """Squared length."""
