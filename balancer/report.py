@@ -124,7 +124,8 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
             "speed": analysis.speed,
             "samples": int(analysis.samples),
             "route": analysis.route,
-            "gravity": list(analysis.gravity) if any(analysis.gravity) else "not included",
+            # Always [gx, gy] (one type for a reader): [0, 0] when the figures include none.
+            "gravity": [float(g) for g in analysis.gravity],
             **figures_dict(analysis),
             "force_balanced": balanced,
             "force_balance_residual": {"relative": residual},
@@ -135,6 +136,7 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
                 "force": "N",
                 "moment": "N·m",
                 "speed": "rad/s",
+                "gravity": "m/s²",
                 "force_balance_residual": "dimensionless (first moments left over, over those "
                                           "that make them)",
             },
@@ -169,7 +171,8 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
         head,
         f"{mech.kind} ({mech.describe()}), {analysis.samples} crank angles per revolution at "
         f"{analysis.speed:g} rad/s ({rpm:.4g} rpm), {analysis.route} route"
-        + ("" if any(analysis.gravity) else "; gravity not included")
+        + (f"; gravity ({analysis.gravity[0]:g}, {analysis.gravity[1]:g}) m/s² included"
+           if any(analysis.gravity) else "; gravity not included")
         + ("" if analysis.loads else "; loads left out"),
         "",
         table(
@@ -540,6 +543,8 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
             "links": {name: link_parameters(linkage.link(name)) for name in linkage.link_names},
             "original_links": {name: link_parameters(result.original.link(name))
                                for name in linkage.link_names},
+            "counterweights": {name: w.as_dict() for name, w in result.counterweights.items()},
+            "added_mass": result.added_mass,
             "objective": result.objective,
             "original_objective": result.original_objective,
             "lower_bound": result.lower_bound,
@@ -564,10 +569,38 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
             "units": {"objective, lower_bound": "(N·m)², mean square of the inertial shaking",
                       "gap": "relative to scale (of √J when rms is given, else of J)",
                       "scale, rms, rms_lower_bound, rms_gap": "N·m", "time": "s",
-                      "mass": "kg", "inertia": "kg·m²", "e, f, s": "m", "sigma": "rad"},
+                      "mass, added_mass": "kg", "inertia": "kg·m²", "e, f, s": "m",
+                      "sigma": "rad", "disc radius, thickness": "m"},
         }
     )
     return doc
+
+
+#: What each kind of counterweight asks of the workshop.
+_COUNTERWEIGHT_KINDS = {
+    "none": "unchanged",
+    "add": "add this body",
+    "remove": "remove this material",
+    "rebuild": "no single body does it: rebuild the link",
+}
+
+
+def counterweight_text(weights) -> str:
+    """The counterweights as a table a workshop can build from (mm, kg, kg·m²)."""
+    rows = []
+    for name, w in weights.items():
+        placed = w.mass != 0
+        disc = (f"Ø {2e3 * w.disc_radius:.4g} × {1e3 * w.disc_thickness:.4g}"
+                if w.disc_radius is not None else "")
+        rows.append([name, _COUNTERWEIGHT_KINDS[w.kind],
+                     f"{w.mass:.6g}" if w.kind != "none" else "",
+                     f"{1e3 * w.e:.6g}" if placed else "", f"{1e3 * w.f:.6g}" if placed else "",
+                     f"{w.inertia:.6g}" if w.kind != "none" else "", disc])
+    total = sum(w.mass for w in weights.values())
+    return (table(rows, ["counterweight", "to do", "mass kg", "e mm", "f mm",
+                         "inertia kg·m²", "steel disc mm"])
+            + f"\nadded mass {total:.6g} kg (e, f: its centre in the link's frame; inertia "
+            "about its own centre)")
 
 
 def optimization_text(result, before, after, verification=None, spec=None, out=None) -> str:
@@ -606,7 +639,7 @@ def optimization_text(result, before, after, verification=None, spec=None, out=N
             changed = "" if abs(a - b) <= 1e-12 * max(1.0, abs(a)) else "changed"
             rows.append([f"{name} {key}", f"{a:.6g}", f"{b:.6g}", unit, changed])
     lines.append(table(rows, ["parameter", "before", "after", "unit", ""]))
-    lines.append("")
+    lines += ["", counterweight_text(result.counterweights), ""]
     err = _force_balance(mechanism_of(result.linkage))[1]
     lines.append(f"force balance: residual {err:.1e} of the first moments")
     if verification is not None:

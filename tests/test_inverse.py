@@ -8,10 +8,10 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 from conftest import CLASS_EXAMPLES, paper_linkage, random_angles, random_link, random_linkage
 from helpers import ROUNDING, derivative_with_error, rel_err
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from balancer import cycle, inverse
 from balancer import kinematics as kin

@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 from ..cycle import CycleAnalysis
 from ..errors import SolverError
 from ..model import Design
+from .counterweights import Counterweight, added_mass, counterweights
 
 #: Gap to the certified lower bound, relative to the problem's scale (the original design's
 #: RMS; :meth:`balancer.balance.problem.NumericProblem.gap`), within which a design is called
@@ -146,6 +147,16 @@ class BalanceResult:
     stages: tuple[StageReport, ...]
     before: CycleAnalysis
     after: CycleAnalysis
+
+    @property
+    def counterweights(self) -> dict[str, Counterweight]:
+        """Per link, the body to add to the original link to build the balanced one."""
+        return counterweights(self.original, self.linkage)
+
+    @property
+    def added_mass(self) -> float:
+        """Total mass of the counterweights, kg (material removed counts negative)."""
+        return added_mass(self.counterweights)
 
     @property
     def rms(self) -> float:

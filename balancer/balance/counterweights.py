@@ -1,0 +1,125 @@
+"""What to build: the counterweight that turns each original link into the balanced one.
+
+A balanced design gives each link new inertial parameters: mass ``m``, centre of mass
+``s̄ = e + i·f`` in the link's frame, inertia ``I`` about the centre of mass. Kept as it is and
+with one rigid body added, the original link becomes the balanced one exactly when the added
+body has (all in the link's frame, first moments and inertias about the frame's origin adding
+as they do for any union of bodies)
+
+    m_c = m − m₀,   m_c·c̄ = m·s̄ − m₀·s̄₀,   I_c + m_c·|c̄|² = (I + m·|s̄|²) − (I₀ + m₀·|s̄₀|²),
+
+so ``c̄`` is the counterweight's centre and ``I_c`` its inertia about it. It is a body that can
+be added when ``m_c > 0`` and ``I_c ≥ 0``; with ``m_c < 0`` it is material to remove (its
+inertia about its centre then ``−I_c``); a change of first moment or inertia with no change of
+mass is no single body: the link must be rebuilt. A steel disc of mass ``m_c`` and inertia
+``I_c = m_c·R²/2`` about its axis has radius ``R = √(2·I_c/m_c)`` and thickness
+``m_c/(ρ·π·R²)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+#: Density of steel, kg/m³ (the disc that realises a counterweight).
+STEEL_DENSITY = 7850.0
+#: A change of mass, first moment or inertia below this, relative to the link's own (its mass,
+#: its mass times its reach, its inertia about the frame's origin), is rounding: nothing to add.
+UNCHANGED = 1e-12
+
+
+@dataclass(frozen=True)
+class Counterweight:
+    """The body to add to (``kind = "add"``) or remove from (``"remove"``) a link.
+
+    Attributes
+    ----------
+    link
+        The link's name.
+    mass
+        kg; negative for material removed.
+    e, f
+        Its centre in the link's frame, m (0 when nothing changes).
+    inertia
+        About its own centre, kg·m² (negative for material removed: the removed body's is
+        ``−inertia``).
+    kind
+        ``"none"`` (the link is unchanged), ``"add"``, ``"remove"``, or ``"rebuild"`` (no single
+        body added or removed does it: a first moment or inertia changed with the mass kept,
+        or an added body would need a negative inertia).
+    disc_radius, disc_thickness
+        The steel disc (:data:`STEEL_DENSITY`) of that mass and inertia, m; ``None`` unless
+        ``kind`` is ``"add"`` with an inertia above zero.
+    exact
+        Whether the original link plus this body (mass, first moment, inertia, signed: a
+        negative mass or inertia is taken away) is the balanced link. Always, except for a
+        first moment changed with the mass kept (no centre carries it).
+    """
+
+    link: str
+    mass: float
+    e: float
+    f: float
+    inertia: float
+    kind: str
+    disc_radius: float | None = None
+    disc_thickness: float | None = None
+    exact: bool = True
+
+    def as_dict(self) -> dict[str, object]:
+        """The JSON form (``mass``, ``e``, ``f``, ``inertia`` are fixed names)."""
+        disc = None
+        if self.disc_radius is not None:
+            disc = {"radius": self.disc_radius, "thickness": self.disc_thickness,
+                    "material": "steel", "density": STEEL_DENSITY}
+        return {"mass": self.mass, "e": self.e, "f": self.f, "inertia": self.inertia,
+                "kind": self.kind, "exact": self.exact, "disc": disc}
+
+
+def counterweight(name: str, original, balanced) -> Counterweight:
+    """The counterweight that makes link ``original`` into ``balanced``.
+
+    Both are links with ``mass`` (kg), ``e``, ``f`` (m, the centre of mass in the link's frame)
+    and ``inertia`` (kg·m², about the centre of mass). See the module docstring.
+    """
+    m0, m1 = original.mass, balanced.mass
+    s0, s1 = complex(original.e, original.f), complex(balanced.e, balanced.f)
+    j0 = original.inertia + m0 * abs(s0) ** 2  # about the frame's origin
+    j1 = balanced.inertia + m1 * abs(s1) ** 2
+    dm, ds, dj = m1 - m0, m1 * s1 - m0 * s0, j1 - j0
+    mass_scale = max(m0, m1)
+    reach = max(abs(s0), abs(s1), math.sqrt(max(j0, j1) / mass_scale) if mass_scale else 0.0)
+    mass_same = abs(dm) <= UNCHANGED * mass_scale
+    moment_same = abs(ds) <= UNCHANGED * mass_scale * reach
+    inertia_same = abs(dj) <= UNCHANGED * max(j0, j1)
+    if mass_same and moment_same and inertia_same:
+        return Counterweight(name, 0.0, 0.0, 0.0, 0.0, "none")
+    if mass_same:  # a first moment or an inertia moved with no mass to carry it
+        # (With the first moment kept, a massless "body" of inertia dj still adds up.)
+        return Counterweight(name, dm, 0.0, 0.0, dj, "rebuild", exact=moment_same)
+    centre = ds / dm
+    inertia = dj - dm * abs(centre) ** 2
+    if dm > 0 and inertia >= -UNCHANGED * max(j0, j1):
+        inertia = max(inertia, 0.0)
+        radius = thickness = None
+        if inertia > 0:
+            radius = math.sqrt(2 * inertia / dm)
+            thickness = dm / (STEEL_DENSITY * math.pi * radius**2)
+        return Counterweight(name, dm, centre.real, centre.imag, inertia, "add", radius,
+                             thickness)
+    kind = "remove" if dm < 0 and inertia <= UNCHANGED * max(j0, j1) else "rebuild"
+    return Counterweight(name, dm, centre.real, centre.imag, inertia, kind)
+
+
+def counterweights(original, balanced) -> dict[str, Counterweight]:
+    """Each moving link's counterweight, from the original mechanism model to the balanced one.
+
+    The models are any mechanism's (``link_names`` and ``link(name)``), with the same links.
+    """
+    return {name: counterweight(name, original.link(name), balanced.link(name))
+            for name in balanced.link_names}
+
+
+def added_mass(weights: dict[str, Counterweight]) -> float:
+    """The total mass added, kg (material removed counts negative)."""
+    return math.fsum(w.mass for w in weights.values())
