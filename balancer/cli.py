@@ -55,7 +55,13 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
 
     csv_path = _output_path(args, args.csv, "--csv")
     design = load_design(args.spec)
-    analysis = analyze(design, route=args.route)
+    try:
+        analysis = analyze(design, route=args.route, gravity=args.gravity)
+    except SpecError as exc:
+        if exc.key == "gravity":  # the option's value, not the spec's
+            raise SpecError(exc.detail, key="--gravity", value=",".join(
+                map(format, args.gravity))) from None
+        raise
     csv = analysis_csv(analysis) if csv_path is not None else None
     if args.json:
         text = dumps_json(analysis_json(analysis, spec=args.spec))
@@ -233,6 +239,18 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _gravity(text: str) -> tuple[float, float]:
+    """``GX,GY``: two finite numbers, m/s²."""
+    parts = text.split(",")
+    try:
+        gx, gy = (float(p) for p in parts)
+    except ValueError:
+        gx = gy = float("nan")
+    if not all(abs(x) < float("inf") for x in (gx, gy)):
+        raise argparse.ArgumentTypeError(f"must be two finite numbers GX,GY in m/s²: {text!r}")
+    return gx, gy
+
+
 def _count(text: str) -> int:
     try:
         value = int(text)
@@ -297,6 +315,12 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("newton-euler", "mass-matrix"),
         default="newton-euler",
         help="inverse-dynamics route (both agree to rounding; default newton-euler)",
+    )
+    p.add_argument(
+        "--gravity", type=_gravity, metavar="GX,GY",
+        help="gravitational acceleration, m/s², instead of the spec's [operation] gravity "
+        "(default none): the frame then carries the weights too. Write a negative first "
+        "value as --gravity=-1,-9.81",
     )
     p.set_defaults(handler=_cmd_analyze)
 

@@ -828,10 +828,14 @@ class Operation:
         Constant crank speed, rad/s (counter-clockwise positive).
     samples
         Number of equally spaced crank angles over one revolution, starting at θ1 = 0.
+    gravity
+        Gravitational acceleration ``(gx, gy)`` the cycle analysis includes, m/s² (``(0, 0)``:
+        none): the frame then carries the links' weights too.
     """
 
     speed: float
     samples: int = 360
+    gravity: tuple[float, float] = (0.0, 0.0)
 
     #: Memory a cycle analysis or a balancing takes per sampled angle, bytes (the regressors'
     #: complex (N, 14) arrays and the motion's, with room for temporaries).
@@ -843,6 +847,7 @@ class Operation:
         samples = v.integer(self.samples, "samples", minimum=8)
         v.require_memory(samples, self.BYTES_PER_SAMPLE, "samples", "samples of a revolution")
         _set(self, "samples", samples)
+        _set(self, "gravity", v.vector2(self.gravity, "gravity"))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -963,11 +968,13 @@ class Design:
         if not isinstance(self.title, str):
             raise SpecError("must be a string", key="title", value=self.title)
         speeds = {"simulation.omega1": self.simulation.omega1}
+        gravity = {"simulation.gravity": self.simulation.gravity}
         if self.operation is not None:
             speeds["operation.speed"] = self.operation.speed
+            gravity["operation.gravity"] = self.operation.gravity
         for mech in (self.mechanism, self.original):
             if mech is not None:
-                check_scales(mech, speeds, {"simulation.gravity": self.simulation.gravity})
+                check_scales(mech, speeds, gravity)
 
 
 def check_scales(mechanism, speeds: dict[str, float],
@@ -978,8 +985,7 @@ def check_scales(mechanism, speeds: dict[str, float],
     ``sizes`` and the centres of mass' distances from their links' origins, summed); forces
     ``m·R·ω²``, ``m·|g|``, the applied forces and the model's ``gas_forces``; moments ``R``
     times those, ``(I + J_c)·ω²`` and the applied moments; energies ``(I + J_c + m·R²)·ω²``.
-    ``speeds`` and ``gravity`` are keyed by their spec keys (the largest speed of a motion
-    and its gravity).
+    ``speeds`` and ``gravity`` are keyed by their spec keys (the largest of each counts).
     """
     links = dict(zip(mechanism.link_names, mechanism.links, strict=True))
     reach_terms = dict(mechanism.sizes)
@@ -989,7 +995,9 @@ def check_scales(mechanism, speeds: dict[str, float],
     r = [(reach_key, math.fsum(reach_terms.values()))]  # the reach R, m
     speed_key = max(speeds, key=lambda k: abs(speeds[k]))
     w2 = [(speed_key, speeds[speed_key])] * 2  # ω², as two factors
-    g_key, g = next(iter((gravity or {"gravity": (0.0, 0.0)}).items()))
+    gravity = gravity or {"gravity": (0.0, 0.0)}
+    g_key = max(gravity, key=lambda k: math.hypot(*gravity[k]))
+    g = gravity[g_key]
     g_abs = [(g_key, math.hypot(*g))]
     forces, moments, energies = [], [], []
     for name, link in links.items():

@@ -24,6 +24,7 @@ The key names are fixed (see the project's DESIGN.md)::
     [operation]
     speed = 10.0                      # rad/s
     samples = 360
+    gravity = [0.0, -9.81]            # m/s², in the cycle analysis (optional)
 
     [simulation]
     duration = 5.0                    # s
@@ -193,7 +194,7 @@ _KNOWN_KEYS: dict[str, tuple[str, ...]] = {
     "original.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor", "gas_force"),
     "links.*.com": ("s", "sigma", "e", "f", "at"),
     "original.*.com": ("s", "sigma", "e", "f", "at"),
-    "operation": ("speed", "samples"),
+    "operation": ("speed", "samples", "gravity"),
     "simulation": (
         "duration",
         "theta1",
@@ -470,7 +471,8 @@ def _read_operation(root: _Table) -> Operation | None:
     if not table.has("speed"):
         raise table._missing("speed")
     with v.under("operation"):
-        operation = Operation(speed=table.raw("speed"), samples=table.value("samples", 360))
+        operation = Operation(speed=table.raw("speed"), samples=table.value("samples", 360),
+                              gravity=table.value("gravity", (0.0, 0.0)))
     table.finish()
     return operation
 
@@ -680,6 +682,8 @@ def dumps_design(design: Design) -> str:
             "[operation]",
             f"speed = {_num(op.speed)}  # rad/s",
             f"samples = {_num(op.samples)}",
+            *([f"gravity = [{_num(op.gravity[0])}, {_num(op.gravity[1])}]  # m/s²"]
+              if any(op.gravity) else []),
         ]
     sim = design.simulation
     out += [
