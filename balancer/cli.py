@@ -32,19 +32,30 @@ class _Parser(argparse.ArgumentParser):
 def _output_path(args: argparse.Namespace, value: str | None, option: str) -> Path | None:
     """An output path given as ``option``, checked before any work is done.
 
-    Its folder must exist and take a file; it must not be the input spec unless ``--force``.
+    Its folder must exist and take a file; it must not name an existing file (the input spec
+    included) unless ``--force``.
     """
     if value is None:
         return None
     from .outputs import check_writable
 
     path = check_writable(value, option)
-    spec = Path(args.spec)
+    if args.force:
+        return path
+    spec = Path(getattr(args, "spec", None) or os.devnull)
     same = path.exists() and spec.exists() and os.path.samefile(path, spec)
-    if (same or os.path.realpath(path) == os.path.realpath(spec)) and not args.force:
+    if spec.name != os.devnull and (same or os.path.realpath(path) == os.path.realpath(spec)):
         raise OutputError("would overwrite the input spec; give another path, or --force",
                           key=option, value=value)
+    if os.path.lexists(path):
+        raise OutputError("the file exists; give another path, or --force to overwrite it",
+                          key=option, value=value)
     return path
+
+
+#: ``--force``: the one switch for every output path of a command.
+_FORCE_HELP = ("overwrite output files that exist (without it, an output path that names an "
+               "existing file, the input spec included, is refused with exit code 2)")
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
@@ -73,54 +84,20 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
     return 0
 
 
-class _Progress:
-    """Progress of a long simulation on a terminal.
-
-    Shown after the first second, then updated a few times a second; nothing when the stream is
-    not a terminal.
-    """
-
-    def __init__(self, stream=None, delay: float = 1.0) -> None:
-        import time
-
-        self.stream = sys.stderr if stream is None else stream
-        self.clock = time.perf_counter
-        self.start = self.clock()
-        self.delay = delay
-        self.last = 0.0
-        self.shown = False
-
-    def __call__(self, t: float, duration: float) -> None:
-        now = self.clock()
-        if now - self.start < self.delay or now - self.last < 0.25:
-            return
-        if not getattr(self.stream, "isatty", lambda: False)():
-            return
-        self.last = now
-        self.shown = True
-        self.stream.write(f"\rsimulating: {100 * t / duration:5.1f} % (t = {t:.4g} s of "
-                          f"{duration:g} s)")
-        self.stream.flush()
-
-    def done(self) -> None:
-        if self.shown:
-            self.stream.write("\r" + " " * 60 + "\r")
-            self.stream.flush()
-
-
 #: Simulation settings that a command-line option overrides (errors then name the option).
 _SIMULATE_OPTIONS = ("method", "drive", "duration", "rtol", "atol", "outputs")
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from .outputs import write_atomic
+    from .progress import Progress
     from .report import dumps_json, simulation_csv, simulation_json, simulation_text
     from .simulate import simulate_design
     from .spec import load_design
 
     out = _output_path(args, args.out, "--out")
     design = load_design(args.spec)
-    progress = _Progress()
+    progress = Progress("simulating", enabled=not args.json)
     try:
         traj = simulate_design(
             design,
@@ -137,7 +114,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             raise SpecError(exc.detail, key=f"--{exc.key}", value=exc.value) from None
         raise
     finally:
-        progress.done()
+        progress.close()
     csv = simulation_csv(traj, all_columns=args.all_columns) if out is not None else None
     if args.json:
         text = dumps_json(simulation_json(traj, spec=args.spec))
@@ -229,6 +206,29 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_example(args: argparse.Namespace) -> int:
+    from . import examples
+
+    if args.name is None:
+        if args.out is not None:
+            raise SpecError("give the NAME of the example to write", key="--out",
+                            value=args.out)
+        width = max(map(len, examples.names()))
+        for name in examples.names():
+            print(f"{name:<{width}}  {examples.title(name)}")
+        return 0
+    path = _output_path(args, args.out, "--out")
+    text = examples.text(args.name)
+    if path is None:
+        sys.stdout.write(text)
+        return 0
+    from .outputs import write_atomic
+
+    write_atomic(path, text)
+    print(f"wrote {path}")
+    return 0
+
+
 def _positive_float(text: str) -> float:
     try:
         value = float(text)
@@ -306,8 +306,7 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
-    p.add_argument("--force", action="store_true",
-                   help="allow an output path to name the input spec (it is overwritten)")
+    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
     p.add_argument("--json", action="store_true", help="print a JSON document instead of a table")
     p.add_argument("--csv", metavar="PATH", help="write the per-angle values to a CSV file")
     p.add_argument(
@@ -339,14 +338,14 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
-    p.add_argument("--force", action="store_true",
-                   help="allow an output path to name the input spec (it is overwritten)")
+    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
     p.add_argument("--method", choices=methods, help="formulation (default: the spec's, or "
                    "the mechanism's first: opened-loop for a four-bar, mass-matrix for a "
                    "slider-crank, crank-angle for a general linkage whose crank turns fully, "
                    "multibody for one whose crank does not)")
     p.add_argument("--drive", choices=DRIVES, help="free motion or constant crank speed "
-                   "(default: the spec's)")
+                   "(default: the spec's); the constant speed is [simulation] omega1 where "
+                   "the spec gives it non-zero, else the operating speed [operation] speed")
     p.add_argument("--duration", type=_positive_float, metavar="T", help="simulated time, s")
     p.add_argument("--rtol", type=_positive_float, metavar="R", help="relative tolerance")
     p.add_argument("--atol", type=_positive_float, metavar="A", help="absolute tolerance")
@@ -369,8 +368,7 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
-    p.add_argument("--force", action="store_true",
-                   help="allow an output path to name the input spec (it is overwritten)")
+    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
     p.add_argument("--plot", metavar="PATH",
                    help="write the report figure to PATH (.png, .svg or .pdf)")
     p.add_argument("--duration", type=_positive_float, metavar="T",
@@ -396,8 +394,7 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML) with a [balance] section")
-    p.add_argument("--force", action="store_true",
-                   help="allow an output path to name the input spec (it is overwritten)")
+    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
     p.add_argument("--out", metavar="BALANCED.toml", help="write the balanced design as a spec")
     p.add_argument("--backend", choices=("nlp", "convex"), default="nlp",
                    help="optimiser (default nlp: convex first, then IPOPT)")
@@ -415,12 +412,23 @@ def build_parser() -> argparse.ArgumentParser:
         "total centre of mass traced.",
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
-    p.add_argument("--force", action="store_true",
-                   help="allow an output path to name the input spec (it is overwritten)")
+    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
     p.add_argument("--animate", metavar="PATH", help="write a GIF animation to PATH")
     p.add_argument("--frames", type=_count, default=72, metavar="N",
                    help="frames per revolution (default 72)")
     p.set_defaults(handler=_cmd_plot)
+
+    p = sub.add_parser(
+        "example",
+        help="write a shipped example spec (without NAME: list them)",
+        description="The example specs shipped with the package: the paper's four-bar "
+        "(meijaard2020), its balancing problems PB1 and PB2, an engine, six-bars and more. "
+        "Without NAME, list them; with NAME, print its spec, or write it to --out PATH.",
+    )
+    p.add_argument("name", metavar="NAME", nargs="?", help="the example (e.g. pb1)")
+    p.add_argument("--out", metavar="PATH", help="write the spec to PATH instead of printing it")
+    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+    p.set_defaults(handler=_cmd_example)
     return parser
 
 

@@ -189,23 +189,6 @@ def test_simulate_initial_angle_outside_the_assembly_range(tmp_path, capsys):
     assert "simulation.theta1" in capsys.readouterr().err
 
 
-def test_progress_is_shown_on_a_terminal_only():
-    import io
-
-    from balancer.cli import _Progress
-
-    class Tty(io.StringIO):
-        def isatty(self):
-            return True
-
-    tty, pipe = Tty(), io.StringIO()
-    for stream in (tty, pipe):
-        p = _Progress(stream=stream, delay=0.0)
-        p(2.5, 5.0)
-        p.done()
-    assert "50.0 %" in tty.getvalue() and pipe.getvalue() == ""
-
-
 def test_the_command_line_lists_every_formulation_and_drive():
     # The names the parser offers without importing the mechanisms (for a fast --help), against
     # the mechanisms' own tables and the model's drives.
@@ -256,3 +239,193 @@ def test_simulate_help_states_the_default_formulation_it_uses(capsys):
     watt = str(Path(EXAMPLE).parent / "watt_sixbar.toml")
     assert main(["simulate", watt, "--json", "--duration", "0.01"]) == 0
     assert json.loads(capsys.readouterr().out)["method"] == "crank-angle"
+
+
+# ----------------------------------------------------------------------------------------------
+# Polish (issue 14): one prefix, true help, output paths, the constant-speed drive, examples
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _one_error_line(err: str) -> str:
+    assert err.count("\n") == 1, err
+    assert err.startswith("balancer: error: ") and err.count("balancer:") == 1, err
+    assert "error: error" not in err and "Traceback" not in err
+    return err
+
+
+@pytest.mark.parametrize("argv", [
+    [],
+    ["frobnicate"],
+    ["analyze"],
+    ["analyze", EXAMPLE, "--frobnicate"],
+    ["analyze", EXAMPLE, "--route", "guess"],
+    ["analyze", EXAMPLE, "--gravity", "x"],
+    ["analyze", "no-such-spec.toml"],
+    ["analyze", EXAMPLE, "--csv", ""],
+    ["simulate", EXAMPLE, "--duration", "-1"],
+    ["simulate", EXAMPLE, "--method", "euler"],
+    ["optimize", EXAMPLE],
+    ["example", "nope"],
+])
+def test_errors_carry_one_prefix(capsys, argv):
+    assert main(argv) == 2
+    _one_error_line(capsys.readouterr().err)
+
+
+def test_errors_carry_one_prefix_from_the_installed_script(tmp_path):
+    exe = Path(sys.executable).parent / "balancer"
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "balancer"]
+    for argv in (["analyze"], ["analyze", EXAMPLE, "--route", "x"], ["nope"]):
+        done = subprocess.run([*cmd, *argv], capture_output=True, text=True, check=False,
+                              cwd=tmp_path)
+        assert done.returncode == 2
+        _one_error_line(done.stderr)
+
+
+def test_help_names_each_mechanisms_default_formulations(capsys):
+    # Against the mechanisms' own tables: simulate's default is the first formulation that
+    # applies (formulations.default_method), verify's the mechanism's verify_method.
+    from balancer.formulations import default_method
+    from balancer.mechanisms import mechanism_of
+    from balancer.mechanisms.fourbar import fourbar_linkage
+    from balancer.model import FourBar
+
+    with pytest.raises(SystemExit):
+        main(["simulate", "--help"])
+    simulate_help = " ".join(capsys.readouterr().out.split())
+    with pytest.raises(SystemExit):
+        main(["verify", "--help"])
+    verify_help = " ".join(capsys.readouterr().out.split())
+    fourbar = spec.load_design(ROOT / "examples" / "meijaard2020.toml").mechanism
+    engine = spec.load_design(ROOT / "examples" / "engine.toml").mechanism
+    watt = spec.load_design(ROOT / "examples" / "watt_sixbar.toml").mechanism
+    rocking = fourbar_linkage(FourBar(lengths=(2.9, 3.0, 2.0, 3.2), branch="+",
+                                      crank=fourbar.crank, coupler=fourbar.coupler,
+                                      rocker=fourbar.rocker))
+    assert not mechanism_of(rocking).assembly_range().full
+    for model, words in ((fourbar, "for a four-bar"), (engine, "for a slider-crank"),
+                         (watt, "for a general linkage whose crank turns fully"),
+                         (rocking, "for one whose crank does not")):
+        assert f"{default_method(model)} {words}" in simulate_help
+    for model, words in ((fourbar, "for a four-bar"), (engine, "for a slider-crank"),
+                         (watt, "for a general linkage")):
+        assert f"{mechanism_of(model).verify_method} {words}" in verify_help
+    assert "opened-loop for a slider-crank" not in simulate_help + verify_help
+
+
+@pytest.mark.parametrize("argv", [
+    ["analyze", EXAMPLE, "--csv"],
+    ["simulate", EXAMPLE, "--out"],
+    ["optimize", str(ROOT / "examples" / "pb1.toml"), "--no-verify", "--out"],
+    ["verify", EXAMPLE, "--plot"],
+    ["plot", EXAMPLE, "--animate"],
+    ["example", "pb1", "--out"],
+])
+def test_empty_output_paths_are_bad_input(tmp_path, capsys, monkeypatch, argv):
+    monkeypatch.chdir(tmp_path)
+    option = argv[-1]
+    for args in ([*argv, ""], [*argv[:-1], f"{option}="]):
+        assert main(args) == 2
+        err = _one_error_line(capsys.readouterr().err)
+        assert option in err and "must not be empty" in err
+        assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv", [
+    ["analyze", EXAMPLE, "--csv"],
+    ["simulate", EXAMPLE, "--duration", "0.01", "--out"],
+    ["optimize", str(ROOT / "examples" / "pb1.toml"), "--no-verify", "--out"],
+    ["verify", EXAMPLE, "--plot"],
+    ["plot", EXAMPLE, "--animate"],
+    ["example", "pb1", "--out"],
+])
+def test_an_existing_output_file_is_kept_without_force(tmp_path, capsys, argv):
+    suffix = {"--plot": ".png", "--animate": ".gif", "--csv": ".csv"}.get(argv[-1], ".toml")
+    path = tmp_path / f"mine{suffix}"
+    path.write_bytes(b"precious")
+    assert main([*argv, str(path)]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert argv[-1] in err and "exists" in err and "--force" in err
+    assert path.read_bytes() == b"precious"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+
+
+@pytest.mark.parametrize("argv", [
+    ["analyze", EXAMPLE, "--csv"],
+    ["simulate", EXAMPLE, "--duration", "0.01", "--outputs", "3", "--out"],
+    ["example", "pb1", "--out"],
+])
+def test_force_overwrites_an_existing_output_file(tmp_path, capsys, argv):
+    path = tmp_path / "mine.out"
+    path.write_bytes(b"old")
+    assert main([*argv, str(path), "--force"]) == 0
+    assert path.read_bytes() != b"old" and len(path.read_bytes()) > 100
+    capsys.readouterr()
+
+
+def test_constant_speed_drive_takes_the_operating_speed(tmp_path, capsys):
+    # meijaard2020: [simulation] omega1 = 0 (a free run from rest), [operation] speed = 10.
+    assert main(["simulate", EXAMPLE, "--drive", "constant-speed", "--duration", "0.2",
+                 "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["drive"] == "constant-speed"
+    assert doc["initial"]["omega"][0] == doc["final"]["omega"][0] == 10.0
+    # A non-zero omega1 in the spec is the user's own choice of speed.
+    text = Path(EXAMPLE).read_text().replace("omega1 = 0.0", "omega1 = 4.0")
+    own = tmp_path / "own.toml"
+    own.write_text(text)
+    assert main(["simulate", str(own), "--drive", "constant-speed", "--duration", "0.2",
+                 "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["final"]["omega"][0] == 4.0
+    # Neither: bad input naming both places a speed can come from.
+    start, end = text.index("[operation]"), text.index("[simulation]")
+    none = tmp_path / "none.toml"
+    none.write_text((text[:start] + text[end:]).replace("omega1 = 4.0", "omega1 = 0.0"))
+    assert main(["simulate", str(none), "--drive", "constant-speed"]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert "simulation.omega1" in err and "[operation] speed" in err
+    # The help says so.
+    with pytest.raises(SystemExit):
+        main(["simulate", "--help"])
+    assert "else the operating speed [operation] speed" in " ".join(
+        capsys.readouterr().out.split())
+
+
+def test_example_lists_prints_and_writes_the_shipped_specs(tmp_path, capsys):
+    from balancer import examples
+
+    assert main(["example"]) == 0
+    listed = [line.split()[0] for line in capsys.readouterr().out.splitlines()]
+    assert listed == list(examples.names())
+    assert {"meijaard2020", "pb1", "pb2", "engine", "watt_sixbar"} <= set(listed)
+    assert main(["example", "pb2"]) == 0
+    assert capsys.readouterr().out == (ROOT / "examples" / "pb2.toml").read_text()
+    out = tmp_path / "mine.toml"
+    assert main(["example", "pb1.toml", "--out", str(out)]) == 0
+    assert f"wrote {out}" in capsys.readouterr().out
+    assert out.read_bytes() == (ROOT / "examples" / "pb1.toml").read_bytes()
+    assert spec.load_design(out) == examples.load("pb1")
+    assert main(["example", "--out", str(tmp_path / "x.toml")]) == 2
+    assert "NAME" in _one_error_line(capsys.readouterr().err)
+
+
+def test_examples_are_package_data_with_one_source():
+    # The specs live in the package (a pip user has them: hatch's wheel takes every file
+    # under balancer/); examples/ at the root is a link to that folder, not a copy.
+    import tomllib
+    from importlib import resources
+
+    from balancer import examples
+
+    folder = Path(str(resources.files("balancer.examples")))
+    assert folder == ROOT / "balancer" / "examples"
+    assert (ROOT / "examples").is_symlink()
+    assert (ROOT / "examples").resolve() == folder.resolve()
+    assert sorted(p.stem for p in folder.glob("*.toml")) == list(examples.names())
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    assert config["tool"]["hatch"]["build"]["targets"]["wheel"]["packages"] == ["balancer"]
+    ignored = (ROOT / ".gitignore").read_text().split()
+    assert not any(p in ignored for p in ("*.toml", "examples/", "balancer/examples/"))
+    for name in examples.names():  # every shipped example loads
+        examples.load(name)
