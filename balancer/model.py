@@ -862,12 +862,14 @@ class SimulationSettings:
         Initial crank angle, rad; ``None``: the mechanism's start (a general linkage's
         reference pose, θ1 = 0 for the four-bar and slider-crank).
     omega1
-        Initial crank speed, rad/s (the constant speed when ``drive`` is ``"constant-speed"``).
+        Initial crank speed, rad/s; when ``drive`` is ``"constant-speed"``, the constant speed
+        (where it is zero, a design's simulation takes the operating speed ``[operation] speed``:
+        :func:`balancer.simulate.simulate_design`).
     gravity
         Gravitational acceleration ``(gx, gy)``, m/s² (``(0, 0)``: none).
     drive
         ``"free"``: the crank moves under the loads alone; ``"constant-speed"``: a motor on the
-        ground holds the crank at ``omega1``.
+        ground holds the crank at ``omega1`` (or at the operating speed, see ``omega1``).
     method
         Formulation of the equations of motion (see :mod:`balancer.formulations`); ``None``:
         the mechanism's default.

@@ -516,7 +516,8 @@ def simulate(
     speed = None
     if drive == "constant-speed":
         if omega1 == 0:
-            raise SpecError("a crank driven at constant speed needs a non-zero speed",
+            raise SpecError("a crank driven at constant speed needs a non-zero speed: give it "
+                            "here or as the operating speed [operation] speed",
                             key="simulation.omega1", value=omega1)
         speed = omega1
     f = make(method, linkage, gravity=settings.gravity, speed=speed)
@@ -641,5 +642,14 @@ def _exchangeable_energy(f: Formulation) -> float:
 
 
 def simulate_design(design: Design, **overrides) -> Trajectory:
-    """:func:`simulate` with a design's own linkage and ``[simulation]`` settings."""
-    return simulate(design.mechanism, design.simulation, **overrides)
+    """:func:`simulate` with a design's own linkage and ``[simulation]`` settings.
+
+    A crank driven at constant speed turns at ``[simulation] omega1`` where that is given and
+    non-zero, else at the operating speed ``[operation] speed`` (a constant speed of zero is no
+    motion: ``omega1 = 0`` is a free motion's start from rest).
+    """
+    settings = design.simulation
+    drive = overrides.get("drive") or settings.drive
+    if drive == "constant-speed" and settings.omega1 == 0 and design.operation is not None:
+        settings = replace(settings, omega1=design.operation.speed)
+    return simulate(design.mechanism, settings, **overrides)
