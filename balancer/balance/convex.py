@@ -152,7 +152,7 @@ def layout(data: NumericProblem) -> Layout:
         if b.mass[0] < b.mass[1]:
             new_variable(k)
         else:
-            c[k] = b.mass[0]
+            c[k] = b.mass[0] + data.offset[k]
         if b.com_fixed is None:
             new_variable(k + 1)
             new_variable(k + 2)
@@ -313,8 +313,11 @@ class ConvexSolver:
         free = set(lay.primary)
 
         def entry(i: int, scale: float) -> tuple[NDArray[np.float64], float]:
-            """``x[i]/scale`` as an affine function ``(a, a0)`` of the variables."""
-            return lay.T[i] / scale, float(lay.c[i] / scale)
+            """``x[i]/scale`` as an affine function ``(a, a0)`` of the variables.
+
+            A counterweight's own entry: less the kept link's.
+            """
+            return lay.T[i] / scale, float((lay.c[i] - data.offset[i]) / scale)
 
         def at_least(a, lo: float) -> None:  # a ≥ lo
             out.append(Constraint("nonneg", a[0][None, :], np.array([a[1] - lo])))
@@ -410,9 +413,11 @@ class ConvexSolver:
                 for i, c in ((k + 1, b.com_centre.real), (k + 2, b.com_centre.imag)):
                     low, high = c - b.com_radius, c + b.com_radius
                     ranges[i] = (min(m_lo * low, m_hi * low), max(m_lo * high, m_hi * high))
+            shift = data.offset
             for i, (low, high) in ranges.items():
                 if i in index:
-                    lo[index[i]], hi[index[i]] = low / data.scales[i], high / data.scales[i]
+                    lo[index[i]] = (low + shift[i]) / data.scales[i]
+                    hi[index[i]] = (high + shift[i]) / data.scales[i]
             if k + 3 in index:
                 base = max(b.inertia[0], m_lo * b.gyration**2)
                 reach = abs(b.com_fixed) if b.com_fixed is not None else (
@@ -420,8 +425,8 @@ class ConvexSolver:
                 if b.com_fixed is not None:
                     base += m_lo * reach**2
                 scale = data.scales[k + 3]
-                lo[index[k + 3]] = base / scale
-                hi[index[k + 3]] = (b.inertia[1] + m_hi * reach**2) / scale
+                lo[index[k + 3]] = (base + shift[k + 3]) / scale
+                hi[index[k + 3]] = (b.inertia[1] + m_hi * reach**2 + shift[k + 3]) / scale
         for b in data.rotor_links:
             if b.rotor in index:
                 assert b.counter_rotor is not None
@@ -651,7 +656,7 @@ class ConvexSolver:
         u = np.array(u, dtype=float)
         taken: set[tuple[int, str]] = set()
         for _ in range(8):
-            x = lay.x(u)
+            x = data.own(lay.x(u))  # what the bounds concern
             rows: list[NDArray[np.float64]] = []
             values: list[float] = []
             broken = False
@@ -686,7 +691,8 @@ class ConvexSolver:
                 residual = float(np.max(np.abs(r), initial=0.0))
                 rows.extend(at)
                 values.extend(-r)
-            if not broken and data.force_balance_residual(x) <= FORCE_BALANCE_TOLERANCE:
+            if (not broken and data.force_balance_residual(lay.x(u))
+                    <= FORCE_BALANCE_TOLERANCE):
                 return u
             if not rows:
                 return None
@@ -740,22 +746,23 @@ class ConvexSolver:
         u = np.array(u, dtype=float)
         index = {entry: j for j, entry in enumerate(lay.primary)}
         pinned = np.zeros(u.size, dtype=bool)
-        x = lay.x(u)
+        shift = data.offset
+        x = data.own(lay.x(u))
         for b in data.links:
             k = b.start
             if k in index:
                 m = min(max(x[k], b.mass[0]), b.mass[1])
                 if m != x[k]:
-                    u[index[k]] = m / data.scales[k]
+                    u[index[k]] = (m + shift[k]) / data.scales[k]
                     pinned[index[k]] = True
             if b.com_fixed is None:
-                x = lay.x(u)
+                x = data.own(lay.x(u))
                 m, d = x[k], complex(x[k + 1], x[k + 2]) - x[k] * b.com_centre
                 if abs(d) > m * b.com_radius:
                     d *= m * b.com_radius / abs(d) * (1 - 4 * 2.0**-52)
                     s_ = m * b.com_centre + d
-                    u[index[k + 1]] = s_.real / data.scales[k + 1]
-                    u[index[k + 2]] = s_.imag / data.scales[k + 2]
+                    u[index[k + 1]] = (s_.real + shift[k + 1]) / data.scales[k + 1]
+                    u[index[k + 2]] = (s_.imag + shift[k + 2]) / data.scales[k + 2]
                     pinned[[index[k + 1], index[k + 2]]] = True
         return self.restore_balance(u, pinned) if pinned.any() else u
 
@@ -766,14 +773,16 @@ class ConvexSolver:
         for b in data.rotor_links:
             if b.counter_rotor is not None:
                 x[b.rotor] = min(max(x[b.rotor], b.counter_rotor[0]), b.counter_rotor[1])
+        own = data.own(x)
         for b in data.links:  # inert ones too: a move of the mass or centre of mass shifts I
             k = b.start
-            q = (x[k + 1] ** 2 + x[k + 2] ** 2) / x[k]
-            low = max(b.inertia[0], x[k] * b.gyration**2)
-            inertia = x[k + 3] - q
+            q = (own[k + 1] ** 2 + own[k + 2] ** 2) / own[k]
+            low = max(b.inertia[0], own[k] * b.gyration**2)
+            inertia = own[k + 3] - q
             if not low <= inertia <= b.inertia[1]:
-                x[k + 3] = min(max(inertia, low), b.inertia[1]) + q
-                while x[k + 3] - q < low:  # rounding in J − q
+                shift = data.offset[k + 3]
+                x[k + 3] = min(max(inertia, low), b.inertia[1]) + q + shift
+                while x[k + 3] - shift - q < low:  # rounding in J − q
                     x[k + 3] = np.nextafter(x[k + 3], np.inf)
         return x
 
@@ -890,20 +899,22 @@ class ConvexSolver:
         # Met to the feasibility tolerance: leave the solver's design alone (a "repair" of a
         # 1e-12 violation would cost more objective than it is worth at a zero optimum).
         rounds = 2 if data.violations(data.settle(lay.x(u), for_motion=False)) else 0
+        shift = data.offset
         for _ in range(rounds):
             for b in data.links:
                 k = b.start
                 if k in index:
                     j = index[k]
-                    u[j] = np.clip(u[j], b.mass[0] / data.scales[k], b.mass[1] / data.scales[k])
+                    u[j] = np.clip(u[j], (b.mass[0] + shift[k]) / data.scales[k],
+                                   (b.mass[1] + shift[k]) / data.scales[k])
                 if b.com_fixed is None:
-                    x = lay.x(u)
+                    x = data.own(lay.x(u))
                     m, d = x[k], complex(x[k + 1], x[k + 2]) - x[k] * b.com_centre
                     if abs(d) > m * b.com_radius:
                         d *= m * b.com_radius / abs(d)
                         s = m * b.com_centre + d
-                        u[index[k + 1]] = s.real / data.scales[k + 1]
-                        u[index[k + 2]] = s.imag / data.scales[k + 2]
+                        u[index[k + 1]] = (s.real + shift[k + 1]) / data.scales[k + 1]
+                        u[index[k + 2]] = (s.imag + shift[k + 2]) / data.scales[k + 2]
             for b in data.rotor_links:
                 entry = b.rotor
                 if entry in index:
@@ -912,18 +923,19 @@ class ConvexSolver:
                     u[index[entry]] = np.clip(u[index[entry]], lo, hi)
             u = self.restore_balance(u)
         x = lay.x(u)
+        own = data.own(x)
         tight = True
         for b in data.links:
             k = b.start
             if data.inert[k + 3] or (k + 3) not in index:
                 continue
-            q = (x[k + 1] ** 2 + x[k + 2] ** 2) / x[k]
-            inertia = x[k + 3] - q
+            q = (own[k + 1] ** 2 + own[k + 2] ** 2) / own[k]
+            inertia = own[k + 3] - q
             if inertia > b.inertia[1] * (1 + 1e-6) + 1e-9 * b.inertia_ref:
                 tight = False
-            low = max(b.inertia[0], x[k] * b.gyration**2)
+            low = max(b.inertia[0], own[k] * b.gyration**2)
             if rounds and not low <= inertia <= b.inertia[1]:
-                x[k + 3] = min(max(inertia, low), b.inertia[1]) + q
+                x[k + 3] = min(max(inertia, low), b.inertia[1]) + q + shift[k + 3]
         return data.settle(x, for_motion=False), tight
 
     # -- infeasibility -------------------------------------------------------------------------
@@ -966,7 +978,10 @@ class ConvexSolver:
                 rhs = 0.0
             if skip != group:
                 cons.append(lhs <= rhs + relax(group))
-            parts[b.start : b.start + 3] = [m[i] * mref, s[i, 0] * mref * l, s[i, 1] * mref * l]
+            shift = data.offset[b.start : b.start + 3]  # a kept link's own, under a counterweight
+            parts[b.start : b.start + 3] = [m[i] * mref + shift[0] * tau,
+                                            s[i, 0] * mref * l + shift[1] * tau,
+                                            s[i, 1] * mref * l + shift[2] * tau]
         assert data.force_balance is not None
         a, rhs_fb = data.force_balance
         terms = np.abs(a) @ np.abs(data.scales)  # each row by its own magnitude
@@ -1147,7 +1162,7 @@ class ConvexSolver:
         i, kind = group
         b = self.data.links[i]
         if kind in ("mass-high", "mass-low"):
-            key = f"{b.key}.mass"
+            key = b.bound_key("mass")
             high = kind == "mass-high"
             v = _up(value) if high else _down(value)
             current = b.mass[1] if high else b.mass[0]
@@ -1162,7 +1177,7 @@ class ConvexSolver:
             else:
                 words = f"{key} must allow down to {v:.4g} kg (is at least {current!r})"
             return (key, v, current, "kg"), words
-        key = f"{b.key}.com_radius"
+        key = b.bound_key("com_radius")
         v = _up(value)
         if kind == "com":
             return (key, v, b.com_radius, "m"), (

@@ -128,7 +128,9 @@ class NlpSolver:
             else:
                 e, f = b.com_fixed.real, b.com_fixed.imag
             if data.inert[k + 3] or b.inertia_fixed:
-                inertia = b.original.inertia if data.inert[k + 3] else b.inertia[0]
+                # (An inert one is settled afterwards; a counterweight has no original.)
+                kept = b.original.inertia if b.offset is None else b.inertia[0]
+                inertia = kept if data.inert[k + 3] else b.inertia[0]
             else:
                 inertia = iref * variable(
                     f"I{b.index}", b.inertia[0] / iref, b.inertia[1] / iref, (b.index, "I")
@@ -139,7 +141,10 @@ class NlpSolver:
                     ubg.append(math.inf)
                 elif b.gyration > 0:
                     lbx[-1] = max(lbx[-1], b.mass[0] * b.gyration**2 / iref)
-            parts[k : k + 4] = list(physical_to_inertial(m, e, f, inertia))
+            # A counterweight's variables are its own; the link's entries add the kept link's.
+            shift = (0.0,) * 4 if b.offset is None else b.offset
+            parts[k : k + 4] = [p + d for p, d in zip(physical_to_inertial(m, e, f, inertia),
+                                                       shift, strict=True)]
         for b in data.rotor_links:
             entry = b.rotor
             assert b.counter_rotor is not None
@@ -192,7 +197,8 @@ class NlpSolver:
     def start(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The scaled decision vector for design vector ``x``, clipped into the bounds."""
         data = self.data
-        physical = [inertial_to_physical(x[b.entries]) for b in data.links]
+        own = data.own(x)
+        physical = [inertial_to_physical(own[b.entries]) for b in data.links]
         out = []
         for index, kind in self._names:
             if kind == "Jc":

@@ -21,12 +21,25 @@ A design spec's ``[balance]`` section describes it; any link of any mechanism ma
                                   #     fixes it (see below)
     counter_rotor = [0.0, 20.0]   # kg·m²: a range or one number (links on a ground pivot);
                                   #     absent: fixed at the spec's counter_rotor
+    [balance.rocker]
+    counterweight = { mass = [0.1, 3.0], radius = 0.5, gyration = 0.02 }
+                                  # keep the link as it is and add one counterweight: its mass
+                                  #     within [lo, hi] kg, its centre within `radius` m of
+                                  #     com_about (default: the link's first point), its own
+                                  #     radius of gyration at least `gyration` m (default 0)
 
 The inertia about the centre of mass ``I`` is free (``I ≥ m·ρ²``, ``ρ`` = ``min_gyration``,
 default 0) when the mass or the centre of mass may change or ``min_gyration`` is given; when the
 mass and the centre of mass are fixed and ``min_gyration`` is absent it stays at the spec's
 value. ``inertia`` bounds or fixes it explicitly. The objective is evaluated at ``[operation]
 speed`` over ``[operation] samples`` equally spaced crank angles ``θ1 = 2π·j/N``.
+
+**Counterweights.** A link with ``counterweight`` keeps its own body; the redesign adds one
+rigid body to it, and the bounds (mass, centre in a disc about ``com_about``, least radius of
+gyration) are those of that body: the same cone constraints as a free link's, on the design
+vector minus the original link's entries (:attr:`LinkBounds.offset`; the original link and the
+added body together are then realisable whatever the added body is). ``mass``, ``com_radius``,
+``min_gyration`` and ``inertia`` describe a free link and are refused beside it.
 
 **Inertial balancing only.** With the crank at constant speed every reaction, the shaking force,
 the shaking moment and the driving torque are linear in the design vector of the mechanism's
@@ -79,7 +92,9 @@ _OBJECTIVE_KEYS = (
     "shaking_force_y",
     "added_mass",
 )
-_LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "counter_rotor")
+_LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "counter_rotor",
+              "counterweight")
+_COUNTERWEIGHT_KEYS = ("mass", "radius", "gyration")
 
 #: Relative tolerance of :meth:`NumericProblem.violations` for a solver's design (bounds and
 #: force balance): ten times Clarabel's tolerance.
@@ -136,6 +151,25 @@ class Objective:
 
 
 @dataclass(frozen=True, kw_only=True)
+class CounterweightFreedom:
+    """The one counterweight a kept link may get (``[balance.<link>] counterweight``).
+
+    Attributes
+    ----------
+    mass
+        ``(low, high)``, kg (``low > 0``; equal ends fix it).
+    radius
+        Its centre lies within this distance of the link's ``com_about`` point, m.
+    gyration
+        Least radius of gyration about its own centre, m.
+    """
+
+    mass: tuple[float, float]
+    radius: float
+    gyration: float = 0.0
+
+
+@dataclass(frozen=True, kw_only=True)
 class LinkFreedom:
     """What may change on one link, as written in ``[balance.<link>]``.
 
@@ -157,6 +191,9 @@ class LinkFreedom:
     counter_rotor
         ``(low, high)`` range of the counter-rotor inertia, kg·m² (links on a ground pivot);
         ``None``: fixed at the spec's ``counter_rotor``.
+    counterweight
+        The link is kept and one counterweight added (:class:`CounterweightFreedom`); then
+        ``mass``, ``com_radius``, ``min_gyration`` and ``inertia`` are ``None``.
     """
 
     mass: tuple[float, float] | None = None
@@ -165,6 +202,7 @@ class LinkFreedom:
     min_gyration: float | None = None
     inertia: tuple[float, float] | None = None
     counter_rotor: tuple[float, float] | None = None
+    counterweight: CounterweightFreedom | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -251,6 +289,26 @@ def _read_link_freedom(table: _Table, points: tuple[str, ...]) -> LinkFreedom:
     com_about = None
     if table.has("com_about"):
         com_about = table.string("com_about", choices=points)
+    counterweight = None
+    sub = table.table("counterweight", required=False)
+    if sub is not None:
+        for name in ("mass", "com_radius", "min_gyration", "inertia"):
+            if table.has(name):
+                raise SpecError("a link with a counterweight is kept as it is: give the "
+                                "counterweight's bounds only (counterweight = {mass, radius, "
+                                "gyration})", key=table.key(name), value=table.raw(name))
+        _check_keys(sub, _COUNTERWEIGHT_KEYS)
+        mass = _read_range(sub, "mass", positive=True, unit="kg")
+        if mass is None:
+            raise SpecError("missing required key (the counterweight's mass, [low, high] kg)",
+                            key=sub.key("mass"))
+        counterweight = CounterweightFreedom(
+            mass=mass, radius=sub.nonnegative("radius"),
+            gyration=sub.nonnegative("gyration", default=0.0))
+        if counterweight.gyration > LENGTH_RANGE[1]:
+            raise SpecError(f"must be at most {LENGTH_RANGE[1]:g} m", key=sub.key("gyration"),
+                            value=counterweight.gyration)
+        sub.finish()
     freedom = LinkFreedom(
         mass=_read_range(table, "mass", positive=True, unit="kg"),
         com_radius=table.nonnegative("com_radius") if table.has("com_radius") else None,
@@ -258,6 +316,7 @@ def _read_link_freedom(table: _Table, points: tuple[str, ...]) -> LinkFreedom:
         min_gyration=table.nonnegative("min_gyration") if table.has("min_gyration") else None,
         inertia=_read_range(table, "inertia", positive=False, unit="kg·m²"),
         counter_rotor=_read_range(table, "counter_rotor", positive=False, unit="kg·m²"),
+        counterweight=counterweight,
     )
     table.finish()
     return freedom
@@ -371,7 +430,7 @@ def check_problem(problem: BalanceProblem, mechanism) -> None:
                     key=f"{key}.com_about",
                     value=freedom.com_about,
                 )
-            if freedom.com_radius is None:
+            if freedom.com_radius is None and freedom.counterweight is None:
                 raise SpecError(
                     "com_about needs com_radius (without it the centre of mass is fixed)",
                     key=f"{key}.com_about",
@@ -412,6 +471,10 @@ def _num(x: float) -> str:
     return repr(float(x))
 
 
+def _bracketed(bounds: tuple[float, float]) -> str:
+    return f"[{_num(bounds[0])}, {_num(bounds[1])}]"
+
+
 def _range_text(bounds: tuple[float, float]) -> str:
     lo, hi = bounds
     return _num(lo) if lo == hi else f"[{_num(lo)}, {_num(hi)}]"
@@ -446,6 +509,10 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
             lines.append(f"min_gyration = {_num(freedom.min_gyration)}  # m")
         if freedom.inertia is not None:
             lines.append(f"inertia = {_range_text(freedom.inertia)}  # kg·m² about the COM")
+        if freedom.counterweight is not None:
+            cw = freedom.counterweight
+            lines.append(f"counterweight = {{ mass = {_bracketed(cw.mass)}, radius = "
+                         f"{_num(cw.radius)}, gyration = {_num(cw.gyration)} }}  # kg, m, m")
         if freedom.counter_rotor is not None:
             lines.append(f"counter_rotor = {_range_text(freedom.counter_rotor)}  # kg·m²")
     return lines
@@ -497,6 +564,11 @@ class LinkBounds:
         ``(low, high)``, kg·m², or ``None`` (no counter-rotor can sit on it).
     default_about
         The point ``com_radius`` is measured from by default.
+    offset
+        With a counterweight: the original link's four entries ``(m, m·e, m·f, J)``, which
+        the design vector's entries exceed by the counterweight's; every bound above is then
+        the counterweight's (:meth:`NumericProblem.own`). ``None`` for a link that is free or
+        fixed.
     """
 
     name: str
@@ -516,11 +588,19 @@ class LinkBounds:
     gyration: float
     counter_rotor: tuple[float, float] | None
     default_about: str
+    offset: tuple[float, float, float, float] | None = None
 
     @property
     def key(self) -> str:
         """Spec key of the link's table, ``balance.<name>``."""
         return f"balance.{self.name}"
+
+    def bound_key(self, bound: str) -> str:
+        """Spec key of one of its bounds (``mass``, ``com_radius``, ``min_gyration``)."""
+        if self.offset is None:
+            return f"{self.key}.{bound}"
+        word = {"mass": "mass", "com_radius": "radius", "min_gyration": "gyration"}[bound]
+        return f"{self.key}.counterweight.{word}"
 
     @property
     def about(self) -> str:
@@ -582,6 +662,18 @@ def resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> Lin
             com_centre=mech.structure.local[(k, about_default)].complex(), com_radius=None,
             inertia=(link.inertia, link.inertia), gyration=0.0, counter_rotor=rotor,
         )  # fmt: skip
+    if rotor_entry is not None and freedom.counter_rotor is not None:
+        rotor = freedom.counter_rotor
+    if freedom.counterweight is not None:
+        cw = freedom.counterweight
+        about = freedom.com_about or points[0]
+        return LinkBounds(
+            **common, listed=True, mass=cw.mass, com_fixed=None, com_about=about,
+            com_centre=mech.structure.local[(k, about)].complex(), com_radius=cw.radius,
+            inertia=(0.0, math.inf), gyration=cw.gyration, counter_rotor=rotor,
+            offset=tuple(float(v) for v in physical_to_inertial(
+                link.mass, link.com.real, link.com.imag, link.inertia)),
+        )  # fmt: skip
     mass = freedom.mass if freedom.mass is not None else (link.mass, link.mass)
     about = freedom.com_about or about_default
     centre = mech.structure.local[(k, about)].complex()
@@ -601,8 +693,6 @@ def resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> Lin
         inertia = (link.inertia, link.inertia)
     if rho * rho > 0 and math.isfinite(inertia[1]):  # (a radius of 1e-300 squares to 0)
         mass = (mass[0], min(mass[1], inertia[1] / (rho * rho)))
-    if rotor_entry is not None and freedom.counter_rotor is not None:
-        rotor = freedom.counter_rotor
     return LinkBounds(
         **common, listed=True, mass=mass, com_fixed=com_fixed, com_about=about,
         com_centre=centre, com_radius=radius, inertia=inertia, gyration=rho,
@@ -767,6 +857,23 @@ class NumericProblem:
         return [b.start for b in self.links]
 
     @cached_property
+    def offset(self) -> NDArray[np.float64]:
+        """The design vector's part that no bound concerns: the kept links' own entries.
+
+        Zero except for a link with a counterweight, whose four entries hold the original
+        link's (:attr:`LinkBounds.offset`).
+        """
+        out = np.zeros(self.size)
+        for b in self.links:
+            if b.offset is not None:
+                out[b.entries] = b.offset
+        return out
+
+    def own(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The entries the bounds concern: ``x`` less :attr:`offset` (a counterweight's own)."""
+        return np.asarray(x, dtype=float) - self.offset
+
+    @cached_property
     def rotor_links(self) -> list[LinkBounds]:
         """The links that have a counter-rotor entry."""
         return [b for b in self.links if b.rotor is not None]
@@ -921,18 +1028,24 @@ class NumericProblem:
         balance for every motion.
         """
         x = np.array(x, dtype=float)
+        own = self.own(x)
         entries, lower, upper, original = [], [], [], []
         for b in self.links:
             k = b.start
             if not self.inert[k + 3]:
                 continue
-            m, me, mf = x[k], x[k + 1], x[k + 2]
+            m, me, mf = own[k], own[k + 1], own[k + 2]
+            if not m > 0:  # no counterweight (the original design): nothing to settle
+                continue
             q = (me * me + mf * mf) / m
             lo = max(b.inertia[0], m * b.gyration**2)
+            shift = self.offset[k + 3]
+            # A counterweight's inertia nearest its least (it has no original).
+            kept = lo if b.offset is not None else min(max(b.original.inertia, lo), b.inertia[1])
             entries.append(k + 3)
-            lower.append(lo + q)
-            upper.append(b.inertia[1] + q)
-            original.append(min(max(b.original.inertia, lo), b.inertia[1]) + q)
+            lower.append(lo + q + shift)
+            upper.append(b.inertia[1] + q + shift)
+            original.append(kept + q + shift)
         for b in self.rotor_links:
             if self.inert[b.rotor] and b.counter_rotor is not None:
                 lo, hi = b.counter_rotor
@@ -968,10 +1081,16 @@ class NumericProblem:
         """
         out = {}
         for b in self.links:
+            rotor = float(x[b.rotor]) if b.rotor is not None else 0.0
+            if b.offset is not None:  # the counterweight in its bounds, added to the link
+                m, e, f, inertia, rotor = self.clamp(
+                    b, *inertial_to_physical(x[b.entries] - self.offset[b.entries]), rotor)
+                total = np.add(physical_to_inertial(m, e, f, inertia), b.offset)
+                out[b.name] = (*inertial_to_physical(total), rotor)
+                continue
             m, e, f, inertia = inertial_to_physical(x[b.entries])
             if abs(inertia - b.original.inertia) <= 1e-12 * b.inertia_ref:
                 inertia = b.original.inertia  # only roundoff from J − m·s²
-            rotor = float(x[b.rotor]) if b.rotor is not None else 0.0
             out[b.name] = self.clamp(b, m, e, f, inertia, rotor)
         return out
 
@@ -1066,29 +1185,33 @@ class NumericProblem:
         ``max(tol, FORCE_BALANCE_TOLERANCE)``. An empty list means ``x`` is a feasible design.
         """
         out = []
+        own = self.own(x)
         for b in self.links:
             k = b.start
-            m, me, mf, j = x[k : k + 4]
+            m, me, mf, j = own[k : k + 4]
+            whose = b.name if b.offset is None else f"{b.name}'s counterweight"
             if not m > 0:
-                out.append(f"{b.name}: mass {m:.6g} kg is not positive")
+                out.append(f"{whose}: mass {m:.6g} kg is not positive")
                 continue
             l, mref, iref = b.length, b.mass_ref, b.inertia_ref
             if m < b.mass[0] - tol * mref or m > b.mass[1] + tol * mref:
-                out.append(f"{b.key}.mass: {m:.9g} kg outside [{b.mass[0]:.9g}, {b.mass[1]:.9g}]")
+                out.append(f"{b.bound_key('mass')}: {m:.9g} kg outside [{b.mass[0]:.9g}, "
+                           f"{b.mass[1]:.9g}]")
             com = complex(me, mf) / m
             if b.com_fixed is not None:
                 if abs(com - b.com_fixed) > tol * l:
                     out.append(f"{b.name}: centre of mass moved by {abs(com - b.com_fixed):.3g} m")
             elif abs(com - b.com_centre) > b.com_radius + tol * l:
                 out.append(
-                    f"{b.key}.com_radius: centre of mass {abs(com - b.com_centre):.9g} m from "
-                    f"{b.about} (at most {b.com_radius:.9g})"
+                    f"{b.bound_key('com_radius')}: centre of {whose} "
+                    f"{abs(com - b.com_centre):.9g} m from {b.about} (at most "
+                    f"{b.com_radius:.9g})"
                 )
             inertia = j - (me * me + mf * mf) / m
             lo = max(b.inertia[0], m * b.gyration**2)
             if inertia < lo - tol * iref or inertia > b.inertia[1] + tol * iref:
                 out.append(
-                    f"{b.name}: inertia {inertia:.9g} kg·m² outside [{lo:.9g}, {b.inertia[1]:.9g}]"
+                    f"{whose}: inertia {inertia:.9g} kg·m² outside [{lo:.9g}, {b.inertia[1]:.9g}]"
                 )
         for b in self.rotor_links:
             value = x[b.rotor]
