@@ -240,3 +240,33 @@ def test_counterweight_spec_round_trips_and_refuses_what_contradicts_it():
         with pytest.raises(SpecError) as info:
             loads_design(bad)
         assert info.value.key == key, (replacement, info.value)
+
+
+def test_a_counterweight_too_small_to_balance_is_diagnosed_with_what_it_needs():
+    """Force balance fixes the crank's first moment (Eq. 57: m1·s̄1 = −m2·(1 − s̄2/l2)·l1), so
+    its counterweight must carry ΔS = that − m1₀·s̄1₀: mass × distance from A0 = |ΔS|. The
+    diagnosis (each bound alone, by its own conic program) must say so: the least radius at the
+    largest mass, and the least mass at the given radius, both |ΔS| (to the 4 significant
+    digits it rounds up to)."""
+    import math as m
+
+    from balancer.balance.result import InfeasibleError
+    from balancer.spec import loads_design
+
+    text = Path("examples/pb1_counterweights.toml").read_text().replace(
+        "radius = 1.0, gyration", "radius = 0.1, gyration")
+    design = loads_design(text)
+    with pytest.raises(InfeasibleError) as info:
+        optimize(design, "convex")
+    needed = {key: value for key, value, _, _ in info.value.needed}
+    linkage = design.mechanism
+    l1, l2, _, _ = linkage.lengths
+    crank, coupler = linkage.link("crank"), linkage.link("coupler")
+    required = -coupler.mass * (1 - coupler.com / l2) * l1
+    delta = abs(required - crank.mass * crank.com)
+    radius, mass = needed["balance.crank.counterweight.radius"], needed[
+        "balance.crank.counterweight.mass"]
+    top = dict(design.balance.links)["crank"].counterweight.mass[1]
+    assert radius == pytest.approx(delta / top, rel=1e-3) and radius >= delta / top
+    assert mass == pytest.approx(delta / 0.1, rel=1e-3) and mass >= delta / 0.1
+    assert m.isfinite(radius) and m.isfinite(mass)
