@@ -53,6 +53,12 @@ def _output_path(args: argparse.Namespace, value: str | None, option: str) -> Pa
     return path
 
 
+#: The CSV files' units (their header keeps the plain names a csv reader expects).
+_CSV_UNITS = ("columns in SI units: t s; theta rad, omega rad/s, alpha rad/s² per link; "
+              "R<point>x, R<point>y, N_<link> N; C_<link> N·m; x<k> m, v<k> m/s, a<k> m/s² "
+              "along a slider's guide; shaking_force_x, shaking_force_y N; shaking_moment, "
+              "driving_torque N·m")
+
 #: ``--force``: the one switch for every output path of a command.
 _FORCE_HELP = ("overwrite output files that exist (without it, an output path that names an "
                "existing file, the input spec included, is refused with exit code 2)")
@@ -191,18 +197,40 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 def _cmd_plot(args: argparse.Namespace) -> int:
     from .spec import load_design
 
-    if args.animate is None:
-        raise SpecError("nothing to plot: give --animate PATH", key="--animate")
-    path = _output_path(args, args.animate, "--animate")
-    from .plots import ANIMATION_TYPES, animate, figure_type
+    if args.animate is None and args.cycle is None:
+        raise SpecError("nothing to plot: give --cycle PATH or --animate PATH", key="--cycle")
+    cycle = _output_path(args, args.cycle, "--cycle")
+    animation = _output_path(args, args.animate, "--animate")
+    if cycle is not None and animation is not None and \
+            os.path.realpath(cycle) == os.path.realpath(animation):
+        raise OutputError("names the same file as --cycle", key="--animate",
+                          value=args.animate)
+    from .plots import animation_type, figure_type
 
-    figure_type(path, "--animate", ANIMATION_TYPES)
+    if cycle is not None:
+        figure_type(cycle, "--cycle")
+    if animation is not None:
+        animation_type(animation, "--animate")
     design = load_design(args.spec)
     from .mechanisms import mechanism_of
 
-    mechanism_of(design.mechanism).require_full_revolution("an animation of one revolution")
-    animate(design.mechanism, path, frames=args.frames, title=design.title)
-    print(f"wrote {path}")
+    mechanism_of(design.mechanism).require_full_revolution(
+        "a cycle plot" if animation is None else "an animation of one revolution")
+    figure = None
+    if cycle is not None:
+        from .plots import cycle_analyses, cycle_figure
+
+        figure = cycle_figure(*cycle_analyses(design), title=design.title)
+    if animation is not None:
+        from .plots import animate
+
+        animate(design.mechanism, animation, frames=args.frames, title=design.title)
+        print(f"wrote {animation}")
+    if figure is not None:
+        from .plots import save_figure
+
+        save_figure(figure, cycle)
+        print(f"wrote {cycle}")
     return 0
 
 
@@ -308,7 +336,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
     p.add_argument("--force", action="store_true", help=_FORCE_HELP)
     p.add_argument("--json", action="store_true", help="print a JSON document instead of a table")
-    p.add_argument("--csv", metavar="PATH", help="write the per-angle values to a CSV file")
+    p.add_argument("--csv", metavar="PATH", help="write the per-angle values to a CSV file; "
+                   + _CSV_UNITS)
     p.add_argument(
         "--route",
         choices=("newton-euler", "mass-matrix"),
@@ -350,7 +379,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rtol", type=_positive_float, metavar="R", help="relative tolerance")
     p.add_argument("--atol", type=_positive_float, metavar="A", help="absolute tolerance")
     p.add_argument("--outputs", type=_count, metavar="N", help="number of output times")
-    p.add_argument("--out", metavar="CSV", help="write the time histories to a CSV file")
+    p.add_argument("--out", metavar="CSV", help="write the time histories to a CSV file; "
+                   + _CSV_UNITS + "; kinetic_energy, work J")
     p.add_argument("--all-columns", action="store_true",
                    help="add shaking force and moment, driving torque, energy to the CSV")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
@@ -407,13 +437,19 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "plot",
-        help="pictures of the linkage (an animation of it running)",
-        description="Draw the linkage: --animate writes a GIF of one crank revolution with the "
-        "total centre of mass traced.",
+        help="pictures for a report: one revolution's shaking, an animation",
+        description="Pictures of one crank revolution at the operating speed. --cycle: the "
+        "shaking force's polar diagram, and the shaking moment and driving torque over the "
+        "crank angle, of the design and (for a balanced spec that names its [original]) of "
+        "the original before it. --animate: the linkage turning, its total centre of mass "
+        "traced. The file type comes from the extension.",
     )
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
     p.add_argument("--force", action="store_true", help=_FORCE_HELP)
-    p.add_argument("--animate", metavar="PATH", help="write a GIF animation to PATH")
+    p.add_argument("--cycle", metavar="PATH",
+                   help="write the figure of one revolution to PATH (.png, .svg or .pdf)")
+    p.add_argument("--animate", metavar="PATH",
+                   help="write an animation to PATH (.gif, or .mp4 with ffmpeg)")
     p.add_argument("--frames", type=_count, default=72, metavar="N",
                    help="frames per revolution (default 72)")
     p.set_defaults(handler=_cmd_plot)

@@ -151,6 +151,242 @@ def plot_com_path(
     return ax
 
 
+#: Largest distance, between two samples, of a drawn curve from the line through them,
+#: relative to the span of its panel: about a pixel of a panel 500 pixels high.
+DRAWING_TOLERANCE = 2e-3
+#: Fewest and most crank angles of a drawn revolution (the spec's ``samples`` if more).
+PLOT_SAMPLES = (720, 2**17)
+#: A curve whose span is below this fraction of its natural scale (the largest force on the
+#: ground, times the linkage's size for a moment) is drawn as rounding: not refined further.
+ROUNDING_SPAN = 1e-9
+
+
+def _legend_outside(ax: Axes, **kw) -> None:
+    """The axes' legend to the right of its frame, clear of the data."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0,
+              fontsize="small", **kw)
+
+
+def cycle_analyses(design, *, samples: int | None = None,
+                   tolerance: float = DRAWING_TOLERANCE):
+    """One revolution of the design and of its original, sampled finely enough to draw.
+
+    At the operating speed (and the spec's gravity), from at least the spec's ``samples`` and
+    :data:`PLOT_SAMPLES`' least, doubled until every drawn curve (the shaking force's tip, the
+    shaking moment, the driving torque) lies within ``tolerance`` of its panel's span from
+    the straight lines between its samples (checked at the midpoints), or the most.
+
+    Parameters
+    ----------
+    design
+        A design with an operating speed; its ``original`` (``[original]``) is analysed too.
+    samples
+        Take exactly this many crank angles instead.
+    tolerance
+        Largest midpoint deviation relative to the panel's span (dimensionless).
+
+    Returns
+    -------
+    tuple
+        ``(design's, original's or None)`` :class:`~balancer.cycle.CycleAnalysis`, both at
+        the same crank angles.
+
+    Raises
+    ------
+    SpecError
+        If the design has no operating speed; :class:`~balancer.errors.AssemblyError` if the
+        crank cannot turn a full revolution.
+    """
+    from dataclasses import replace
+
+    from .api import analyze
+    from .errors import SpecError
+
+    if design.operation is None:
+        raise SpecError("missing required key: a cycle analysis needs the operating speed",
+                        key="operation.speed")
+    designs = [design]
+    if design.original is not None:
+        designs.append(replace(design, mechanism=design.original, original=None))
+
+    def at(n: int) -> list:
+        return [analyze(replace(d, operation=replace(d.operation, samples=n))) for d in designs]
+
+    n = samples or max(design.operation.samples, PLOT_SAMPLES[0])
+    coarse = at(n)
+    while samples is None and 2 * n <= PLOT_SAMPLES[1]:
+        fine = at(2 * n)
+        if _drawn_within(fine, tolerance):
+            coarse = fine
+            break
+        coarse, n = fine, 2 * n
+    return coarse[0], (coarse[1] if len(coarse) > 1 else None)
+
+
+def _cycle_panels(analysis) -> dict[str, np.ndarray]:
+    """What the cycle figure draws of an analysis, by panel."""
+    r = analysis.reactions
+    return {"force": r.shaking_force, "moment": r.shaking_moment, "torque": r.driving_torque}
+
+
+def _drawn_within(analyses, tolerance: float) -> bool:
+    """Whether every curve at the even samples is drawn within ``tolerance`` of its panel.
+
+    The odd samples are the midpoints: their distance from the chords of the even ones,
+    relative to the panel's span over all the analyses (floored at :data:`ROUNDING_SPAN` of
+    its natural scale).
+    """
+    force_scale = max(max((float(np.nanmax(np.abs(v), initial=0.0)) for v in
+                           (*a.reactions.ground.values(), *a.reactions.slider_normal.values())),
+                          default=0.0) for a in analyses)
+    length = analyses[0].mechanism.structure.length_scale()
+    panels = [_cycle_panels(a) for a in analyses]
+    for key in panels[0]:
+        curves = [p[key] for p in panels]
+        span = max(max(np.ptp(c.real), np.ptp(c.imag)) if np.iscomplexobj(c) else np.ptp(c)
+                   for c in curves)
+        natural = force_scale * (1.0 if key == "force" else length)
+        span = max(span, ROUNDING_SPAN * natural, 1e-300)
+        for c in curves:
+            even, odd = c[0::2], c[1::2]
+            chord = 0.5 * (even + np.roll(even, -1))
+            if not np.nanmax(np.abs(odd - chord), initial=0.0) <= tolerance * span:
+                return False
+    return True
+
+
+def _closed(values: np.ndarray) -> np.ndarray:
+    """A revolution's samples with the first repeated at the end (the curve closes)."""
+    return np.append(values, values[:1])
+
+
+def _cycle_label(role: str, values: np.ndarray, unit: str) -> str:
+    from .cycle import Figure as Figures
+
+    f = Figures.of(values)
+    return f"{role}: RMS {_number(f.rms)} {unit}, max {_number(f.max)} {unit}"
+
+
+def _roles(before) -> tuple[str, str]:
+    return ("balanced design", "original") if before is not None else ("design", "")
+
+
+def plot_shaking_force_polar(analysis, before=None, ax: Axes | None = None,
+                             legend: bool = True) -> Axes:
+    """Polar diagram of the shaking force: its vector's tip over one revolution, N.
+
+    ``analysis`` and ``before`` (the original's, optional) are
+    :class:`~balancer.cycle.CycleAnalysis`; a dot marks θ1 = 0 and an arrow the sense of
+    travel. A force-balanced design's curve is a point at the origin.
+    """
+    ax = _axes(ax)
+    after_role, before_role = _roles(before)
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    ax.axvline(0.0, color="0.6", lw=0.8)
+    for a, role, colour, lw in ((before, before_role, COLOURS["before"], 1.5),
+                                (analysis, after_role, COLOURS["after"], 1.8)):
+        if a is None:
+            continue
+        f = _closed(a.reactions.shaking_force)
+        ax.plot(f.real, f.imag, color=colour, lw=lw,
+                label=_cycle_label(role, a.reactions.shaking_force, "N"))
+        ax.plot(f.real[:1], f.imag[:1], "o", color=colour, ms=6, mec="k", mew=0.6)
+        k = max(1, f.size // 8)
+        if abs(f[k + 1] - f[k]) > 0:
+            ax.annotate("", xy=(f[k + 1].real, f[k + 1].imag), xytext=(f[k].real, f[k].imag),
+                        arrowprops={"arrowstyle": "-|>", "color": colour, "lw": lw,
+                                    "mutation_scale": 14})
+    ax.plot([], [], "o", color="w", mec="k", mew=0.6, label="θ1 = 0, arrow: sense of travel")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("shaking force, x (N)")
+    ax.set_ylabel("shaking force, y (N)")
+    ax.set_title("shaking force over one revolution (polar diagram)")
+    ax.grid(alpha=0.3)
+    if legend:
+        _legend_outside(ax)
+    return ax
+
+
+def plot_over_crank_angle(analysis, quantity: str, before=None, ax: Axes | None = None,
+                          legend: bool = True) -> Axes:
+    """``quantity`` (``"shaking_moment"`` or ``"driving_torque"``, N·m) over the crank angle.
+
+    Of ``analysis`` and, if given, ``before`` (the original's), over one revolution in degrees.
+    """
+    ax = _axes(ax)
+    names = {"shaking_moment": ("shaking moment about the origin", "shaking moment"),
+             "driving_torque": ("driving torque on the crank", "driving torque")}
+    if quantity not in names:
+        raise ValueError(f"no such quantity: {quantity!r}")
+    after_role, before_role = _roles(before)
+    for a, role, colour, lw in ((before, before_role, COLOURS["before"], 1.5),
+                                (analysis, after_role, COLOURS["after"], 1.8)):
+        if a is None:
+            continue
+        values = getattr(a.reactions, quantity)
+        ax.plot(np.degrees(np.append(a.theta1, 2 * np.pi)), _closed(values), color=colour,
+                lw=lw, label=_cycle_label(role, values, "N·m"))
+    ax.set_xlim(0.0, 360.0)
+    ax.set_xticks(np.arange(0, 361, 45))
+    ax.set_xlabel("crank angle θ1 (°)")
+    ax.set_ylabel(f"{names[quantity][0]} (N·m)")
+    ax.set_title(f"{names[quantity][1]} over one revolution")
+    ax.grid(alpha=0.3)
+    if legend:
+        _legend_outside(ax)
+    return ax
+
+
+def cycle_figure(analysis, before=None, title: str = "") -> Figure:
+    """The picture a balancing report starts with: one revolution at the operating speed.
+
+    The shaking force's polar diagram, and the shaking moment and driving torque over the
+    crank angle; of the design, and of the original before it (``before``) if given. Each
+    panel's title gives its RMS and maximum (original → design); one legend below the panels.
+    """
+    fig = Figure(figsize=(12, 7), layout="constrained")
+    axes = fig.subplot_mosaic([["force", "moment"], ["force", "torque"]],
+                              width_ratios=[1.0, 1.3])
+    plot_shaking_force_polar(analysis, before, ax=axes["force"], legend=False)
+    plot_over_crank_angle(analysis, "shaking_moment", before, ax=axes["moment"], legend=False)
+    plot_over_crank_angle(analysis, "driving_torque", before, ax=axes["torque"], legend=False)
+    for key, unit in (("force", "N"), ("moment", "N·m"), ("torque", "N·m")):
+        ax = axes[key]
+        after = _cycle_panels(analysis)[key]
+        figures = [_figure_pair(_cycle_panels(before)[key] if before is not None else None,
+                                after, stat) for stat in ("rms", "max")]
+        ax.set_title(f"{ax.get_title()}\nRMS {figures[0]} {unit}, max {figures[1]} {unit}",
+                     fontsize="medium")
+    handles, labels = axes["force"].get_legend_handles_labels()
+    fig.legend(handles, [label.split(": RMS")[0] for label in labels],
+               loc="outside lower center",
+               ncols=len(handles), fontsize="small")
+    what = f"one revolution at {analysis.speed:g} rad/s"
+    if any(analysis.gravity):
+        what += f", gravity ({analysis.gravity[0]:g}, {analysis.gravity[1]:g}) m/s²"
+    if before is not None:
+        what += ", before and after balancing"
+    fig.suptitle(f"{title}: {what}" if title else what)
+    return fig
+
+
+def _figure_pair(before: np.ndarray | None, after: np.ndarray, stat: str) -> str:
+    """``"b → a"`` (or ``"a"``) of a figure of one revolution's values, to 3 digits."""
+    from .cycle import Figure as Figures
+
+    text = _number(getattr(Figures.of(after), stat))
+    if before is None:
+        return text
+    return f"{_number(getattr(Figures.of(before), stat))} → {text}"
+
+
+def _number(x: float) -> str:
+    """Three significant digits, whole numbers below a million written out (1800, not 1.8e+03)."""
+    if 1.0 <= abs(x) < 1e6:
+        return f"{x:.{max(3, int(np.log10(abs(x))) + 1)}g}"
+    return f"{x:.3g}"
+
+
 def verification_figure(design, verification) -> Figure:
     """The report figure of ``balancer verify``.
 
@@ -189,8 +425,8 @@ def _write_atomic(fig: Figure, out: Path, dpi: float | None, kind: str = "png") 
 
 #: Figure formats by file extension (matplotlib's Agg, SVG and PDF backends).
 FIGURE_TYPES: dict[str, str] = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
-#: Animation formats by file extension.
-ANIMATION_TYPES: dict[str, str] = {".gif": "gif"}
+#: Animation formats by file extension (GIF by Pillow, MP4 by ffmpeg: :func:`ffmpeg`).
+ANIMATION_TYPES: dict[str, str] = {".gif": "gif", ".mp4": "mp4"}
 
 
 def figure_type(path: str | os.PathLike[str], option: str | None = None,
@@ -202,6 +438,46 @@ def figure_type(path: str | os.PathLike[str], option: str | None = None,
         raise OutputError(f"the file type comes from the extension: use one of {known}",
                           key=option, value=str(path))
     return types[suffix]
+
+
+def ffmpeg() -> str | None:
+    """The ffmpeg program that writes MP4 animations, or ``None`` if there is none.
+
+    matplotlib's ``animation.ffmpeg_path`` setting (``ffmpeg`` on ``PATH`` by default), else
+    the one the ``imageio-ffmpeg`` package ships (``pip install 'balancer[video]'``).
+    """
+    import shutil
+
+    import matplotlib
+
+    found = shutil.which(matplotlib.rcParams["animation.ffmpeg_path"])
+    if found:
+        return found
+    try:
+        import imageio_ffmpeg
+    except ImportError:
+        return None
+    try:
+        return imageio_ffmpeg.get_ffmpeg_exe()
+    except RuntimeError:  # the package without its binary for this platform
+        return None
+
+
+def animation_type(path: str | os.PathLike[str], option: str | None = None) -> str:
+    """The animation type that ``path``'s extension names, if it can be written here.
+
+    Raises
+    ------
+    OutputError
+        (exit 2) For an extension other than :data:`ANIMATION_TYPES`', or ``.mp4`` where there
+        is no ffmpeg (:func:`ffmpeg`).
+    """
+    kind = figure_type(path, option, ANIMATION_TYPES)
+    if kind == "mp4" and ffmpeg() is None:
+        raise OutputError("an MP4 animation needs ffmpeg, which is not installed: install it "
+                          "(or pip install 'balancer[video]'), or write a .gif", key=option,
+                          value=str(path))
+    return kind
 
 
 def save_figure(fig: Figure, path: str | os.PathLike[str], dpi: float = 150) -> Path:
@@ -247,16 +523,23 @@ def drawing_frames(linkage, frames: int):
 
 def animate(linkage, path: str | os.PathLike[str], *, frames: int = 72, fps: int = 24,
             title: str = "") -> Path:
-    """Write a GIF of the linkage turning one revolution with its total centre of mass traced.
+    """Write an animation of the linkage turning one revolution, its centre of mass traced.
 
-    Frames are equally spaced crank angles (the crank at constant speed). The still parts are
-    drawn once and each frame only blits the moving artists onto them (matplotlib's animation
-    machinery would redraw the whole figure three times a frame); Pillow writes the GIF.
-    Written whole or not at all.
+    The type comes from the extension (:func:`animation_type`): a GIF (Pillow) or an MP4
+    (H.264 by ffmpeg). Frames are equally spaced crank angles (the crank at constant speed).
+    The still parts are drawn once and each frame only blits the moving artists onto them
+    (matplotlib's animation writers would redraw the whole figure for every frame, and draw no
+    artist marked animated). Written whole or not at all.
+
+    Raises
+    ------
+    OutputError
+        For an extension other than :data:`ANIMATION_TYPES`', an MP4 without ffmpeg (both
+        before any work), or a file that cannot be written.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from PIL import Image
 
+    kind = animation_type(path)
     links, coms, total = drawing_frames(linkage, frames)
     pivots, guides = frame(linkage)
     fig = Figure(figsize=(6, 4.5), dpi=100, layout="constrained")
@@ -301,8 +584,42 @@ def animate(linkage, path: str | os.PathLike[str], *, frames: int = 72, fps: int
         com.set_data([total[k].real], [total[k].imag])
         for artist in (trace, *(bar for bar, _ in bars), link_coms, com):
             ax.draw_artist(artist)
-        rgba = np.asarray(canvas.buffer_rgba())
-        images.append(Image.fromarray(rgba[..., :3].copy()).quantize(colors=64))
-    return write_with(path, lambda tmp: images[0].save(
-        tmp, format="GIF", save_all=True, append_images=images[1:],
-        duration=round(1000 / fps), loop=0), suffix=".gif")
+        images.append(np.asarray(canvas.buffer_rgba())[..., :3].copy())
+    writer = _write_mp4 if kind == "mp4" else _write_gif
+    return write_with(path, lambda tmp: writer(tmp, images, fps), suffix=f".{kind}")
+
+
+def _write_gif(path: str, images: list[np.ndarray], fps: int) -> None:
+    """Write RGB frames as a looping GIF (64 colours a frame)."""
+    from PIL import Image
+
+    frames = [Image.fromarray(rgb).quantize(colors=64) for rgb in images]
+    frames[0].save(path, format="GIF", save_all=True, append_images=frames[1:],
+                   duration=round(1000 / fps), loop=0)
+
+
+def _write_mp4(path: str, images: list[np.ndarray], fps: int) -> None:
+    """Write RGB frames as an H.264 MP4 by piping them to ffmpeg.
+
+    Raises
+    ------
+    OutputError
+        If there is no ffmpeg, or it fails (its last line of error).
+    """
+    import subprocess
+
+    exe = ffmpeg()
+    if exe is None:
+        raise OutputError("an MP4 animation needs ffmpeg, which is not installed",
+                          source=path)
+    height, width = images[0].shape[:2]
+    command = [exe, "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
+               "-s", f"{width}x{height}", "-r", str(fps), "-i", "-", "-an",
+               "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264",
+               "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4", path]
+    done = subprocess.run(command, input=b"".join(rgb.tobytes() for rgb in images),
+                          capture_output=True, check=False)
+    if done.returncode != 0:
+        lines = done.stderr.decode(errors="replace").strip().splitlines() or ["no message"]
+        raise OutputError(f"ffmpeg could not write the MP4 (exit {done.returncode}: "
+                          f"{lines[-1]})", source=path)
