@@ -290,8 +290,9 @@ def analysis_columns(analysis: CycleAnalysis) -> tuple[list[str], list]:
 
     ``t``; per moving link ``k`` (1, 2, … in the spec's order) ``theta{k}``, ``omega{k}``,
     ``alpha{k}`` (rad, rad/s, rad/s²); the forces on the frame (:func:`frame_force_columns`);
-    then the shaking force's components, the shaking moment and the
-    driving torque. For a four-bar: the columns of ``simulate``'s CSV and the shaking.
+    the sliders on the frame (:func:`slider_columns`); then the shaking force's components,
+    the shaking moment and the driving torque. For every mechanism: the columns of
+    ``simulate``'s CSV (whatever its formulation), then the shaking.
     """
     mo, r = analysis.motion, analysis.reactions
     n = len(mo.pose.angles)
@@ -304,6 +305,9 @@ def analysis_columns(analysis: CycleAnalysis) -> tuple[list[str], list]:
                                                   r.slider_couple)
     names += frame_names
     cols += frame_cols
+    slider_names, slider_cols = slider_columns(analysis.linkage, mo.theta1, mo.omega1, mo.alpha1)
+    names += slider_names
+    cols += slider_cols
     names += list(SHAKING_COLUMNS)
     cols += [r.shaking_force.real, r.shaking_force.imag, r.shaking_moment, r.driving_torque]
     return names, cols
@@ -340,6 +344,37 @@ def frame_force_columns(model, ground, normal, couple) -> tuple[list[str], list]
     return names, cols
 
 
+def slider_columns(model, theta1, omega1, alpha1) -> tuple[list[str], list]:
+    """Columns of each slider on the frame: where its point runs along the guide.
+
+    For the sliding link ``k`` (numbered as in ``theta{k}``): ``x{k}``, ``v{k}``, ``a{k}``,
+    the position (m), velocity (m/s) and acceleration (m/s²) of the slider's point along the
+    guide's direction, the position measured from the foot of the origin on the guide's line
+    (the slider-crank's ``x3``: the pin's x). From the mechanism's kinematics at the crank's
+    states, so that every formulation and the cycle analysis give the same columns; none
+    where the crank states do not fix the pose (a crank that does not turn fully, whose free
+    motion may change branch at a dead point, or a linkage with change points).
+    """
+    mech = mechanism_of(model)
+    sliders = [s for s in mech.linkage.sliders if s.link in mech.ground_sliders]
+    if not sliders or mech.change_points() or not mech.assembly_range().full:
+        return [], []
+    with np.errstate(all="ignore"):
+        mo = mech.motion(theta1, omega1, alpha1)
+    names: list[str] = []
+    cols: list = []
+    for s in sliders:
+        k = mech.link_names.index(s.link)
+        local = mech.structure.local[(k, s.point)]
+        d = complex(*s.direction) / math.hypot(*s.direction)
+        for prefix, vector in (("x", mo.point(k, local)), ("v", mo.point_velocity(k, local)),
+                               ("a", mo.point_acceleration(k, local))):
+            names.append(f"{prefix}{k + 1}")
+            cols.append(np.asarray(vector.x * d.real + vector.y * d.imag, float)
+                        * np.ones(np.shape(theta1)))
+    return names, cols
+
+
 def analysis_csv(analysis: CycleAnalysis) -> str:
     """Per-angle values of a cycle analysis as CSV text (SI units, full precision)."""
     return csv_text(*analysis_columns(analysis))
@@ -369,9 +404,10 @@ def simulation_columns(traj, all_columns: bool = False) -> tuple[list[str], list
     """The columns of ``simulate``'s CSV: names and values (arrays over the output times).
 
     ``t``; per moving link ``k`` (1, 2, … in the mechanism's order) ``theta{k}``, ``omega{k}``,
-    ``alpha{k}``; the forces on the frame (:func:`frame_force_columns`); a formulation's own slider
-    coordinate ``x3``, ``v3``, ``a3`` (the slider-crank's); with ``all_columns`` the shaking,
-    the driving torque and the energy. For a four-bar the first columns are DESIGN.md's fixed
+    ``alpha{k}``; the forces on the frame (:func:`frame_force_columns`); the sliders on the
+    frame (:func:`slider_columns`: the slider-crank's ``x3``, ``v3``, ``a3``); with
+    ``all_columns`` the shaking, the driving torque and the energy. The same columns whatever
+    the formulation; for the four-bar and the slider-crank the first are DESIGN.md's fixed
     ones (:data:`SIMULATION_COLUMNS`).
     """
     names = ["t"]
@@ -384,9 +420,11 @@ def simulation_columns(traj, all_columns: bool = False) -> tuple[list[str], list
                                                   traj.slider_couple)
     names += frame_names
     cols += frame_cols
-    if traj.slider is not None:
-        cols += list(traj.slider)
-        names += ["x3", "v3", "a3"]
+    crank = list(traj.links).index(mechanism_of(traj.model).input)
+    slider_names, slider_cols = slider_columns(traj.model, traj.theta[crank], traj.omega[crank],
+                                               traj.alpha[crank])
+    names += slider_names
+    cols += slider_cols
     if all_columns:
         sf = traj.shaking_force
         cols += [sf.real, sf.imag, traj.shaking_moment, traj.driving_torque, traj.kinetic_energy,

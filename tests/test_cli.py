@@ -429,3 +429,80 @@ def test_examples_are_package_data_with_one_source():
     assert not any(p in ignored for p in ("*.toml", "examples/", "balancer/examples/"))
     for name in examples.names():  # every shipped example loads
         examples.load(name)
+
+
+def _csv_header(path: Path) -> list[str]:
+    with path.open() as fh:
+        rows = list(csv.reader(fh))
+    text = path.read_text()
+    assert "nan" not in text.lower() and "inf" not in text.lower()
+    return rows[0]
+
+
+@pytest.mark.parametrize(("name", "methods"), [
+    ("meijaard2020", ["opened-loop", "lie-group", "multibody", "crank-angle"]),
+    ("engine", ["mass-matrix", "complex-masses", "multibody", "crank-angle"]),
+    ("quick_return", ["crank-angle", "multibody"]),
+])
+def test_csv_columns_are_the_mechanisms_whatever_the_route(tmp_path, capsys, name, methods):
+    from balancer.report import SHAKING_COLUMNS, SIMULATION_COLUMNS
+
+    example = str(ROOT / "examples" / f"{name}.toml")
+    headers = []
+    for method in methods:
+        path = tmp_path / f"{method}.csv"
+        assert main(["simulate", example, "--method", method, "--duration", "0.005",
+                     "--outputs", "3", "--out", str(path)]) == 0
+        headers.append(_csv_header(path))
+    assert all(h == headers[0] for h in headers), headers
+    cycle = tmp_path / "cycle.csv"
+    assert main(["analyze", example, "--csv", str(cycle)]) == 0
+    assert _csv_header(cycle) == [*headers[0], *SHAKING_COLUMNS]
+    if name in ("meijaard2020", "engine"):  # DESIGN.md's fixed columns, first and unchanged
+        assert tuple(headers[0][:len(SIMULATION_COLUMNS)]) == SIMULATION_COLUMNS
+    if name == "engine":
+        assert headers[0][len(SIMULATION_COLUMNS):] == ["C_slider", "x3", "v3", "a3"]
+    capsys.readouterr()
+
+
+def test_slider_columns_agree_with_the_slider_cranks_own_closed_form():
+    # The slider-crank formulation's own slider coordinate (its closed form, x = r·cos θ1 +
+    # L·cos θ2) against the general kinematics' point on the guide, at the run's crank states.
+    from helpers import ROUNDING
+
+    from balancer.report import simulation_columns
+
+    design = spec.load_design(ROOT / "examples" / "engine.toml")
+    traj = simulate(design.mechanism, design.simulation, method="mass-matrix", duration=0.004,
+                    outputs=9)
+    names, cols = simulation_columns(traj)
+    mine = {n: c for n, c in zip(names, cols, strict=True)}
+    reach = sum(design.mechanism.lengths)
+    omega = float(np.max(np.abs(traj.omega[0])))
+    alpha = float(np.max(np.abs(traj.alpha[0])))
+    # Rounding of a position of size `reach` through a well-conditioned slider-crank
+    # (rod/crank ≈ 3.6: the condition 1/cos of the rod's angle ≤ 1.05), and its rates.
+    for key, row, scale in (("x3", 0, reach), ("v3", 1, reach * omega),
+                            ("a3", 2, reach * (omega**2 + alpha))):
+        assert np.max(np.abs(mine[key] - traj.slider[row])) < 4 * ROUNDING * scale
+
+
+def test_slider_columns_rates_are_the_positions_derivatives():
+    # The quick-return's ram: v and a from the kinematics against finite differences of x
+    # over the crank angle (at ω1 = 1, α1 = 0: v = dx/dθ1, a = d²x/dθ1²).
+    from helpers import derivative_with_error
+
+    from balancer.report import slider_columns
+
+    model = spec.load_design(ROOT / "examples" / "quick_return.toml").mechanism
+
+    def column(theta, index):
+        return slider_columns(model, np.atleast_1d(theta), 1.0, 0.0)[1][index]
+
+    names = slider_columns(model, np.zeros(1), 1.0, 0.0)[0]
+    assert [n[0] for n in names] == ["x", "v", "a"]
+    for theta in np.linspace(0.1, 2 * np.pi, 7):
+        dx, err1 = derivative_with_error(lambda t: column(t, 0), theta, h=1e-3)
+        d2x, err2 = derivative_with_error(lambda t: column(t, 0), theta, h=1e-2, order=2)
+        assert abs(column(theta, 1)[0] - dx[0]) < err1
+        assert abs(column(theta, 2)[0] - d2x[0]) < err2
