@@ -234,6 +234,33 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_pareto(args: argparse.Namespace) -> int:
+    from .balance.pareto import pareto_front
+    from .outputs import write_atomic
+    from .report import dumps_json, front_csv, front_json, front_text
+    from .spec import load_design
+
+    csv_path = _output_path(args, args.csv, "--csv")
+    plot = _output_path(args, args.plot, "--plot")
+    if plot is not None:
+        from .plots import figure_type
+
+        figure_type(plot, "--plot")
+    design = load_design(args.spec)
+    front = pareto_front(design, args.against, args.points)
+    csv = front_csv(front) if csv_path is not None else None
+    text = (dumps_json(front_json(front, spec=args.spec)) if args.json
+            else front_text(front, spec=args.spec) + "\n")
+    if plot is not None:
+        from .plots import front_figure, save_figure
+
+        save_figure(front_figure(front, title=design.title), plot)
+    if csv_path is not None:
+        write_atomic(csv_path, csv)
+    sys.stdout.write(text)
+    return 0
+
+
 def _cmd_example(args: argparse.Namespace) -> int:
     from . import examples
 
@@ -453,6 +480,27 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--frames", type=_count, default=72, metavar="N",
                    help="frames per revolution (default 72)")
     p.set_defaults(handler=_cmd_plot)
+
+    p = sub.add_parser(
+        "pareto",
+        help="the exact front of shaking moment against driving torque, added mass or force",
+        description="The least RMS shaking moment against a second objective, under the "
+        "balancing constraints of the spec's [balance] section (force balance and every "
+        "link's bounds): an even grid of bounds on the second objective between its two "
+        "ends, each point the global optimum of a convex program with its certified lower "
+        "bound; the knee marked.",
+    )
+    p.add_argument("spec", metavar="SPEC", help="design spec (TOML) with a [balance] section")
+    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+    p.add_argument("--against", required=True,
+                   choices=("driving-torque", "added-mass", "shaking-force"),
+                   help="the second objective")
+    p.add_argument("--points", type=_count, default=11, metavar="N",
+                   help="number of points, both ends included (default 11)")
+    p.add_argument("--plot", metavar="PATH", help="draw the front to PATH (.png, .svg or .pdf)")
+    p.add_argument("--csv", metavar="PATH", help="write the points to a CSV file")
+    p.add_argument("--json", action="store_true", help="print a JSON document instead")
+    p.set_defaults(handler=_cmd_pareto)
 
     p = sub.add_parser(
         "example",

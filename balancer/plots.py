@@ -623,3 +623,33 @@ def _write_mp4(path: str, images: list[np.ndarray], fps: int) -> None:
         lines = done.stderr.decode(errors="replace").strip().splitlines() or ["no message"]
         raise OutputError(f"ffmpeg could not write the MP4 (exit {done.returncode}: "
                           f"{lines[-1]})", source=path)
+
+
+def front_figure(front, title: str | None = None) -> Figure:
+    """A trade-off front as a designer puts it in a report.
+
+    The least RMS shaking moment against the second objective, each point's certified lower
+    bound beside it, the knee marked.
+    """
+    fig = Figure(figsize=(7.5, 4.5), layout="constrained")
+    ax = fig.add_subplot()
+    xs = [p.value for p in front.points]
+    ys = [p.shaking_moment for p in front.points]
+    ax.plot(xs, ys, "o-", color="C0", label="least RMS shaking moment")
+    ax.plot(xs, [p.lower_bound for p in front.points], "_", color="k", markersize=12,
+            label="certified lower bound")
+    if all(np.isfinite(front.original)):
+        ax.plot([front.original[0]], [front.original[1]], "s", color="0.5",
+                label="original design")
+    knee = [p for p in front.points if p.knee]
+    if knee:
+        ax.plot([knee[0].value], [knee[0].shaking_moment], "*", color="C3", markersize=14,
+                label="knee")
+    ax.set_xlabel(f"{front.name.replace('_', ' ')} ({'RMS, ' if front.unit != 'kg' else ''}"
+                  f"{front.unit})")
+    ax.set_ylabel("RMS shaking moment (N·m)")
+    ax.set_ylim(bottom=0)
+    ax.grid(True, alpha=0.3)
+    ax.set_title(title or f"Shaking moment against {front.name.replace('_', ' ')}")
+    _legend_outside(ax)
+    return fig

@@ -686,3 +686,39 @@ def optimization_text(result, before, after, verification=None, spec=None, out=N
     if out is not None:
         lines.append(f"wrote {out}")
     return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------------------------
+# Trade-off fronts
+
+
+def front_json(front, spec=None) -> dict:
+    """The ``pareto --json`` document: ``against`` and ``points`` are fixed names."""
+    doc: dict[str, Any] = {} if spec is None else {"spec": spec}
+    doc.update(front.as_dict())
+    return doc
+
+
+def front_text(front, spec=None) -> str:
+    """The readable front: one row per point, the knee marked."""
+    head = f"balancer pareto — {spec}" if spec else "balancer pareto"
+    name = front.name.replace("_", " ")
+    rows = [[f"{i + 1}", _fmt(p.value), _fmt(p.shaking_moment), _fmt(p.lower_bound),
+             "knee" if p.knee else ""] for i, p in enumerate(front.points)]
+    lines = [head,
+             f"least RMS shaking moment against {name} ({len(front.points)} points, each a "
+             "global optimum with its certified lower bound; the balancing constraints of "
+             "[balance] hold at every point)", "",
+             table(rows, ["point", f"{name} {front.unit}", "RMS shaking moment N·m",
+                          "certified bound N·m", ""])]
+    return "\n".join(lines)
+
+
+def front_csv(front) -> str:
+    """The front as CSV: one row per point (knee: 1 at the knee, else 0)."""
+    points = front.points
+    return csv_text(
+        ["shaking_moment", front.name, "epsilon", "lower_bound", "knee"],
+        [np.array([p.shaking_moment for p in points]), np.array([p.value for p in points]),
+         np.array([p.epsilon for p in points]), np.array([p.lower_bound for p in points]),
+         np.array([1.0 if p.knee else 0.0 for p in points])])

@@ -181,6 +181,44 @@ def layout(data: NumericProblem) -> Layout:
     return Layout(c=c, T=rows[:, : len(primary)].copy(), primary=tuple(primary))
 
 
+@dataclass(frozen=True)
+class Compressed:
+    """An objective's factor ``‖P·u + q‖`` compressed to its numerical rank, for the solver.
+
+    ``R·T`` has as many rows as the design vector but rank only as large as the shaking's
+    harmonic content (6 for the crank-shaper against 22 rows); rows of rounding (1e-16 of the
+    others) inside a second-order cone spoil its equilibration, and Clarabel stalled "almost
+    solved" at 1e-10. ``‖P·u + q‖² = ‖Σ₁·V₁ᵀ·u + U₁ᵀ·q‖² + ‖U₂ᵀ·q‖²``, dropping only singular
+    values of rounding: :attr:`P` and :attr:`q` are the kept rows and one last row
+    ``(0, ‖U₂ᵀ·q‖)``. A multiplier ``w`` of those rows is ``basis·w`` in the full factor's
+    rows (the rows kept, and the direction of ``q``'s part in the rest).
+    """
+
+    P: NDArray[np.float64]
+    q: NDArray[np.float64]
+    basis: NDArray[np.float64]
+    singular_values: NDArray[np.float64]
+    vt: NDArray[np.float64]
+
+    @classmethod
+    def of(cls, p: NDArray[np.float64], q: NDArray[np.float64]) -> Compressed:
+        """The compression of ``‖p·u + q‖`` (``p`` of shape ``(k, n)``)."""
+        k, n = p.shape
+        if k:
+            u_left, sv, vt = np.linalg.svd(p, full_matrices=True)
+        else:
+            u_left, sv, vt = np.zeros((0, 0)), np.zeros(0), np.zeros((0, n))
+        eps = np.finfo(float).eps
+        rank = int(np.sum(sv > 16 * eps * max(p.shape) * sv.max(initial=0.0)))
+        rest = u_left[:, rank:].T @ q
+        q_rest = float(np.linalg.norm(rest))
+        rest_dir = u_left[:, rank:] @ (rest / q_rest) if q_rest > 0 else np.zeros(k)
+        return cls(P=np.vstack([sv[:rank, None] * vt[:rank], np.zeros((1, n))]),
+                   q=np.append(u_left[:, :rank].T @ q, q_rest),
+                   basis=np.column_stack([u_left[:, :rank], rest_dir]),
+                   singular_values=sv, vt=vt)
+
+
 @dataclass(frozen=True, kw_only=True)
 class ConvexSolution:
     """The convex optimum (after the tie-break) and its lower bound.
@@ -244,33 +282,16 @@ class ConvexSolver:
         # The objective as the certificate sees it: the full factor.
         self._objective = Objective(P=p_matrix, q=q_vector, norm=self._norm_form,
                                     g=mass_row, g0=mass_offset)
-        # The solver sees the factor compressed to its numerical rank: R·T has as many rows as
-        # the design vector but rank only as large as the shaking's harmonic content (6 for
-        # the crank-shaper against 22 rows); rows of rounding (1e-16 of the others) inside a
-        # second-order cone spoil its equilibration, and Clarabel stalled "almost solved" at
-        # 1e-10. ‖P·u + q‖² = ‖Σ₁·V₁ᵀ·u + U₁ᵀ·q‖² + ‖U₂ᵀ·q‖², dropping only σ of rounding.
-        if k:
-            u_left, sv, vt = np.linalg.svd(p_matrix, full_matrices=True)
-        else:
-            u_left, sv, vt = np.zeros((0, 0)), np.zeros(0), np.zeros((0, n))
-        eps = np.finfo(float).eps
-        rank = int(np.sum(sv > 16 * eps * max(p_matrix.shape) * sv.max(initial=0.0)))
-        p_rank = sv[:rank, None] * vt[:rank]
-        q_rank = u_left[:, :rank].T @ q_vector
-        q_rest = float(np.linalg.norm(u_left[:, rank:].T @ q_vector))
-        # The norm's multiplier, in the full factor's rows (for the certificate): the rows
-        # kept, and the direction of q's part in the rest.
-        rest = u_left[:, rank:].T @ q_vector
-        rest_dir = u_left[:, rank:] @ (rest / q_rest) if q_rest > 0 else np.zeros(k)
-        self._dual_basis = np.column_stack([u_left[:, :rank], rest_dir]) if k else None
+        compressed = Compressed.of(p_matrix, q_vector)
+        self._dual_basis = compressed.basis if k else None
+        sv, vt = compressed.singular_values, compressed.vt
         if self._norm_form:
             # In epigraph form, so that the norm's multiplier is the cone's dual.
-            self._stage1 = ConicProgram(
-                n, self._cones, equality=equality, objective="norm",
-                P=np.vstack([p_rank, np.zeros((1, n))]), q=np.append(q_rank, q_rest))
+            self._stage1 = ConicProgram(n, self._cones, equality=equality, objective="norm",
+                                        P=compressed.P, q=compressed.q)
         else:  # ‖P·u + q‖² + w_m·Δm, constants dropped
             self._stage1 = ConicProgram(n, self._cones, equality=equality, objective="squares",
-                                        P=p_rank, q=q_rank, g=mass_row)
+                                        P=compressed.P[:-1], q=compressed.q[:-1], g=mass_row)
         # finalize's projections by margin, built when first needed
         self._projections: dict[float, ConicProgram] = {}
         # Tie-break. J is strictly convex in y = P·u, so every optimal design has the same y

@@ -1,0 +1,307 @@
+"""Exact trade-off fronts: the least RMS shaking moment against a second objective.
+
+A designer chooses between the shaking moment and the driving torque, the mass added, or (when
+force balance is not imposed) the shaking force. With the redesign problem's constraints (force
+balance, every link's bounds: :mod:`.convex`), each of them is convex in the design vector —
+the RMS driving torque and RMS shaking force are norms ``‖R·x‖`` of their regressor factors, the
+added mass is linear — so the front is traced by the ε-constraint method, each point a second-
+order cone program solved to its global optimum:
+
+    S(ε) = min ‖R_M·x‖  subject to  g(x) ≤ ε  and the balancing constraints,
+
+with ``ε`` on an even grid from ``g``'s least value over the feasible designs to its least
+value among the designs of least shaking moment (the two ends of the front; a lexicographic
+solve each). ``S`` is convex and non-increasing in ``ε``; each point carries the certified lower
+bound of its program (weak duality, :func:`.certificate.lower_bound`, with the ε-constraint
+as one more cone). The designs are repaired onto the bounds exactly
+(:meth:`.convex.ConvexSolver.finalize`), and both objectives are reported for the design that
+results. The knee is the point farthest from the chord between the ends, each objective
+measured over its range.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import SolverError, SpecError
+from ..model import Design
+from .certificate import Constraint, lower_bound
+from .certificate import Objective as Certified
+from .conic import ConicProgram
+from .convex import Compressed, ConvexSolver
+from .problem import NumericProblem, Objective, numeric_problem
+
+#: The second objectives, and the name and unit each is reported under.
+AGAINST: dict[str, tuple[str, str]] = {
+    "driving-torque": ("driving_torque", "N·m"),
+    "added-mass": ("added_mass", "kg"),
+    "shaking-force": ("shaking_force", "N"),
+}
+#: Room given to an end of the front when it becomes a constraint (relative to the objective's
+#: scale): a hundred times Clarabel's tolerance, so that the constrained program stays feasible.
+END_ROOM = 1e-8
+
+
+@dataclass(frozen=True)
+class FrontPoint:
+    """One point of a front: a design and its two objectives.
+
+    Attributes
+    ----------
+    shaking_moment
+        RMS shaking moment of the design (inertial, at the operating speed), N·m.
+    value
+        Its second objective (RMS driving torque N·m, added mass kg, or RMS shaking force N).
+    epsilon
+        The bound on the second objective this point was solved under (same unit).
+    lower_bound
+        No design within the bounds with the second objective at most ``epsilon`` has a
+        smaller RMS shaking moment, N·m (certified).
+    x
+        The design vector.
+    knee
+        Whether this is the front's knee.
+    """
+
+    shaking_moment: float
+    value: float
+    epsilon: float
+    lower_bound: float
+    x: NDArray[np.float64]
+    knee: bool = False
+
+
+@dataclass(frozen=True)
+class Front:
+    """A trade-off front, its points ordered by the second objective.
+
+    ``original`` is the original design's ``(second objective, RMS shaking moment)``: where the
+    designer starts from (it need not meet the balancing constraints).
+    """
+
+    against: str
+    points: tuple[FrontPoint, ...]
+    original: tuple[float, float] = (math.nan, math.nan)
+
+    @property
+    def name(self) -> str:
+        """The second objective's report name (``driving_torque``, …)."""
+        return AGAINST[self.against][0]
+
+    @property
+    def unit(self) -> str:
+        """The second objective's unit."""
+        return AGAINST[self.against][1]
+
+    def as_dict(self) -> dict[str, object]:
+        """The ``pareto --json`` document's ``against`` and ``points``."""
+        return {
+            "against": self.against,
+            "points": [{"shaking_moment": p.shaking_moment, self.name: p.value,
+                        "epsilon": p.epsilon, "lower_bound": p.lower_bound, "knee": p.knee}
+                       for p in self.points],
+            "original": {"shaking_moment": self.original[1], self.name: self.original[0]},
+            "units": {"shaking_moment, lower_bound": "N·m",
+                      f"{self.name}, epsilon": self.unit},
+        }
+
+
+class _Programs:
+    """The ε-constraint programs of one redesign problem, in the convex solver's variables."""
+
+    def __init__(self, data: NumericProblem, against: str) -> None:
+        self.data = data
+        self.solver = solver = ConvexSolver(data)
+        lay = solver.layout
+        self.n = lay.size
+        self.equality = None if solver._fb is None else solver._fb[:2]
+        n_samples = data.samples
+        reg = data.regressors
+        moment = np.linalg.qr(reg.shaking_moment / math.sqrt(n_samples), mode="r")
+        self.moment_scale = _scale(moment, data)
+        self.moment = Compressed.of(moment @ lay.T / self.moment_scale,
+                                    moment @ lay.c / self.moment_scale)
+        self.moment_full = Certified(P=moment @ lay.T / self.moment_scale,
+                                     q=moment @ lay.c / self.moment_scale, norm=True,
+                                     g=np.zeros(self.n), g0=0.0)
+        self.against = against
+        if against == "added-mass":
+            self.other_scale = data.original_mass
+            self.mass_row = lay.T[data.mass_entries].sum(axis=0) / self.other_scale
+            self.mass_offset = (float(lay.c[data.mass_entries].sum()) - data.original_mass) \
+                / self.other_scale
+        else:
+            if against == "driving-torque":
+                rows = reg.driving_torque
+            else:
+                rows = np.vstack([reg.shaking_force.real, reg.shaking_force.imag])
+            factor = np.linalg.qr(rows / math.sqrt(n_samples), mode="r")
+            self.other_scale = _scale(factor, data)
+            self.other = Compressed.of(factor @ lay.T / self.other_scale,
+                                       factor @ lay.c / self.other_scale)
+
+    def other_value(self, x: NDArray[np.float64]) -> float:
+        """The second objective of design vector ``x`` (its unit), from the full regressors."""
+        data = self.data
+        reg = data.regressors
+        if self.against == "added-mass":
+            return data.total_mass(x) - data.original_mass
+        if self.against == "driving-torque":
+            return float(np.sqrt(np.mean((reg.driving_torque @ x) ** 2)))
+        return float(np.sqrt(np.mean(np.abs(reg.shaking_force @ x) ** 2)))
+
+    def moment_value(self, x: NDArray[np.float64]) -> float:
+        """RMS shaking moment of design vector ``x``, N·m, from the full regressors."""
+        return float(np.sqrt(np.mean((self.data.regressors.shaking_moment @ x) ** 2)))
+
+    def cap(self, epsilon: float) -> Constraint:
+        """``g ≤ ε`` as a cone constraint in the solver's variables (``ε`` in its unit)."""
+        e = epsilon / self.other_scale
+        if self.against == "added-mass":
+            return Constraint("nonneg", -self.mass_row[None, :],
+                              np.array([e - self.mass_offset]))
+        c = self.other
+        return Constraint("soc", np.vstack([np.zeros((1, self.n)), c.P]),
+                          np.concatenate([[e], c.q]))
+
+    def moment_cap(self, value: float) -> Constraint:
+        """``RMS shaking moment ≤ value`` (N·m) as a cone constraint."""
+        c = self.moment
+        return Constraint("soc", np.vstack([np.zeros((1, self.n)), c.P]),
+                          np.concatenate([[value / self.moment_scale], c.q]))
+
+    def least_other(self, extra: list[Constraint]):
+        """The program ``min g`` within the bounds and ``extra``; its solution."""
+        cones = [*self.solver._cones, *extra]
+        if self.against == "added-mass":
+            program = ConicProgram(self.n, cones, equality=self.equality, objective="squares",
+                                   P=np.zeros((0, self.n)), q=np.zeros(0), g=self.mass_row)
+        else:
+            program = ConicProgram(self.n, cones, equality=self.equality, objective="norm",
+                                   P=self.other.P, q=self.other.q)
+        return program.solve(self.solver.settings)
+
+    def least_moment(self, extra: list[Constraint]):
+        """The program ``min ‖R_M·x‖`` within the bounds and ``extra``; its solution."""
+        program = ConicProgram(self.n, [*self.solver._cones, *extra], equality=self.equality,
+                               objective="norm", P=self.moment.P, q=self.moment.q)
+        return program.solve(self.solver.settings)
+
+
+def _scale(factor: NDArray[np.float64], data: NumericProblem) -> float:
+    """A positive scale of ``‖factor·x‖``: the original design's, else what the inertias make."""
+    value = float(np.linalg.norm(factor @ data.x0))
+    if value > 0:
+        return value
+    value = float(np.linalg.norm(factor * data.scales, 2))
+    return value if value > 0 else 1.0
+
+
+def pareto_front(design: Design, against: str, points: int = 11) -> Front:
+    """The front of least RMS shaking moment against ``against`` (see the module docstring).
+
+    Parameters
+    ----------
+    design
+        A design with ``[balance]`` and ``[operation]``.
+    against
+        ``"driving-torque"``, ``"added-mass"`` or ``"shaking-force"``.
+    points
+        Number of points, the two ends included (at least 2).
+
+    Raises
+    ------
+    SpecError
+        For an unknown second objective or fewer than two points.
+    InfeasibleError, SolverError
+        If the balancing problem has no feasible design, or Clarabel fails.
+    """
+    if against not in AGAINST:
+        raise SpecError(f"must be one of {', '.join(AGAINST)}", key="--against", value=against)
+    if design.balance is None:
+        raise SpecError("missing required table: the redesign problem ([balance])",
+                        key="balance")
+    if points < 2:
+        raise SpecError("a front needs at least 2 points", key="--points", value=points)
+    # The problem with both objectives weighted, so that the entries it leaves out as inert
+    # (:attr:`NumericProblem.inert`) are those that neither sees.
+    weights = Objective(shaking_moment=1.0,
+                        driving_torque=1.0 if against == "driving-torque" else 0.0,
+                        shaking_force=1.0 if against == "shaking-force" else 0.0)
+    data = numeric_problem(replace(design, balance=replace(design.balance, objective=weights)))
+    programs = _Programs(data, against)
+    solver = programs.solver
+    if solver._inconsistent:
+        raise solver.diagnose() or solver._fixed_row_error()
+    # The moment's end: its least value, then the least g among the designs that reach it.
+    best = programs.least_moment([])
+    if best.u is None:
+        raise solver._infeasible(f"Clarabel: {best.status}")
+    moment_min = programs.moment_value(solver.layout.x(best.u))
+    room = END_ROOM * programs.moment_scale
+    top = programs.least_other([programs.moment_cap(moment_min + room)])
+    high_u = top.u if top.u is not None else best.u
+    high = programs.other_value(solver.layout.x(high_u))
+    # The other end: g's least value.
+    low_solution = programs.least_other([])
+    if low_solution.u is None:
+        raise SolverError(f"the least {AGAINST[against][0]} could not be found "
+                          f"(Clarabel: {low_solution.status})")
+    low = programs.other_value(solver.layout.x(low_solution.u))
+    slack = END_ROOM * programs.other_scale
+    if high - low <= slack:
+        grid = [high + slack]
+    else:
+        grid = list(np.linspace(low + slack, high + slack, points))
+    out = []
+    for epsilon in grid:
+        cap = programs.cap(epsilon)
+        solution = programs.least_moment([cap])
+        if solution.u is None:
+            raise SolverError(f"a point of the front (ε = {epsilon:.6g} {programs.against}) "
+                              f"could not be solved (Clarabel: {solution.status})")
+        x, _ = solver.repair(solution.u)
+        x = data.settle(x)
+        x, _ = solver.finalize(x)
+        bound = _certified(programs, cap, solution, x)
+        out.append(FrontPoint(shaking_moment=programs.moment_value(x),
+                              value=programs.other_value(x), epsilon=float(epsilon),
+                              lower_bound=bound, x=x))
+    out.sort(key=lambda p: p.value)
+    original = (programs.other_value(data.x0), programs.moment_value(data.x0))
+    return Front(against=against, points=tuple(_mark_knee(out)), original=original)
+
+
+def _certified(programs: _Programs, cap: Constraint, solution, x) -> float:
+    """The certified least RMS shaking moment under ``cap``, N·m (0 where none is made)."""
+    solver = programs.solver
+    lo, hi = solver._box()
+    upper = programs.moment_full.value(solver.layout.u(x))
+    norm_dual = None
+    if solution.epigraph_dual is not None:
+        norm_dual = -(programs.moment.basis @ solution.epigraph_dual[1:])
+    bound = lower_bound(programs.moment_full, [*solver._cones, cap], programs.equality,
+                        solution.u, list(solution.duals), norm_dual, lo, hi,
+                        upper + abs(upper) + 1e-9)
+    if bound is None:
+        return 0.0
+    return max(bound.value, 0.0) * programs.moment_scale
+
+
+def _mark_knee(points: list[FrontPoint]) -> list[FrontPoint]:
+    """The points, the one farthest from the chord between the ends marked as the knee."""
+    if len(points) < 3:
+        return points
+    xs = np.array([p.value for p in points])
+    ys = np.array([p.shaking_moment for p in points])
+    span_x, span_y = xs[-1] - xs[0], ys[0] - ys[-1]
+    if not (span_x > 0 and span_y > 0):
+        return points
+    u, v = (xs - xs[0]) / span_x, (ys - ys[-1]) / span_y  # the ends at (0, 1) and (1, 0)
+    distance = 1.0 - u - v  # below the chord u + v = 1 (a convex front lies below it)
+    k = int(np.argmax(distance))
+    return [FrontPoint(**{**p.__dict__, "knee": i == k}) for i, p in enumerate(points)]
