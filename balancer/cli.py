@@ -143,13 +143,12 @@ def _cmd_verify(args: argparse.Namespace) -> int:
 
         figure_type(plot, "--plot")
     design = load_design(args.spec)
-    verification = verify(design, method=args.method, duration=args.duration)
-    paths: list[Path] = []
-    if plot is not None:
-        from .plots import figure_type
+    from .progress import Progress
 
-        figure_type(plot, "--plot")
-        paths = [plot]
+    with Progress("verifying by simulation", enabled=not args.json) as progress:
+        verification = verify(design, method=args.method, duration=args.duration,
+                              progress=progress)
+    paths = [] if plot is None else [plot]
     if args.json:
         doc = {"spec": args.spec, **verification.as_dict(), "plots": [str(p) for p in paths]}
         text = dumps_json(doc)
@@ -181,7 +180,12 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     spec_text = dumps_design(balanced)
     loads_design(spec_text, source=str(out or "the balanced spec"))  # it must load again
     before, after = analyze(design), analyze(balanced)
-    verification = None if args.no_verify else verify(balanced, duration=args.verify_duration)
+    verification = None
+    if not args.no_verify:
+        from .progress import Progress
+
+        with Progress("verifying by simulation", enabled=not args.json) as progress:
+            verification = verify(balanced, duration=args.verify_duration, progress=progress)
     if args.json:
         text = dumps_json(optimization_json(result, before, after, verification,
                                             spec=args.spec, out=out))

@@ -33,30 +33,60 @@ def _axes(ax: Axes | None) -> Axes:
     return Figure(figsize=(7, 4), layout="constrained").add_subplot()
 
 
-def plot_reactions(traj: Trajectory, ax: Axes | None = None, title: str = "") -> Axes:
+def _legend_outside(ax: Axes, **kw) -> None:
+    """The axes' legend to the right of its frame, clear of the data."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0,
+              fontsize="small", **kw)
+
+
+def plot_reactions(traj: Trajectory, ax: Axes | None = None, title: str = "",
+                   original: Trajectory | None = None) -> Axes:
     """Every force on the ground over time and their sum (as the paper's Fig. 8 and 9).
 
     The x (solid) and y (dashed) components at each ground point, the normal force (dotted) of
-    each slider on a ground guide, and the shaking force's components (black).
+    each slider on a ground guide, and the shaking force's components (black). With the
+    ``original``'s motion, before and after instead: the magnitude of each force on the ground
+    and of their sum, the original's thin and faint, the design's solid.
     """
     ax = _axes(ax)
-    t = traj.t
-    colours = iter(SERIES * (1 + (len(traj.ground) + len(traj.slider_normal)) // len(SERIES)))
-    for point, values in traj.ground.items():
-        colour = next(colours)
-        ax.plot(t, values.real, color=colour, lw=1.2, label=f"$R_{{{point}x}}$")
-        ax.plot(t, values.imag, color=colour, lw=1.2, ls="--", label=f"$R_{{{point}y}}$")
-    for link, values in traj.slider_normal.items():
-        ax.plot(t, values, color=next(colours), lw=1.2, ls=":", label=f"normal force, {link}")
-    total = traj.shaking_force
-    ax.plot(t, total.real, color=COLOURS["sum"], lw=1.8, label="sum, x")
-    ax.plot(t, total.imag, color=COLOURS["sum"], lw=1.8, ls="--", label="sum, y")
+    if original is not None:
+        _plot_reaction_magnitudes(ax, traj, original)
+    else:
+        t = traj.t
+        colours = iter(SERIES * (1 + (len(traj.ground) + len(traj.slider_normal))
+                                 // len(SERIES)))
+        for point, values in traj.ground.items():
+            colour = next(colours)
+            ax.plot(t, values.real, color=colour, lw=1.2, label=f"$R_{{{point}x}}$")
+            ax.plot(t, values.imag, color=colour, lw=1.2, ls="--", label=f"$R_{{{point}y}}$")
+        for link, values in traj.slider_normal.items():
+            ax.plot(t, values, color=next(colours), lw=1.2, ls=":", label=f"normal force, {link}")
+        total = traj.shaking_force
+        ax.plot(t, total.real, color=COLOURS["sum"], lw=1.8, label="sum, x")
+        ax.plot(t, total.imag, color=COLOURS["sum"], lw=1.8, ls="--", label="sum, y")
+        ax.set_ylabel("force on the ground (N)")
     ax.set_xlabel("time t (s)")
-    ax.set_ylabel("force on the ground (N)")
     ax.set_title(title or f"forces on the ground, {traj.drive} motion")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", ncol=3, loc="upper right")
+    _legend_outside(ax)
     return ax
+
+
+def _plot_reaction_magnitudes(ax: Axes, traj: Trajectory, original: Trajectory) -> None:
+    """Magnitudes of the forces on the ground and of their sum, before and after."""
+    names = [*traj.ground, *traj.slider_normal]
+    colours = dict(zip(names, SERIES * (1 + len(names) // len(SERIES)), strict=False))
+    for run, role, lw, alpha in ((original, "before", 1.0, 0.55), (traj, "after", 1.6, 1.0)):
+        for point, values in run.ground.items():
+            ax.plot(run.t, np.abs(values), color=colours[point], lw=lw, alpha=alpha,
+                    label=f"$|R_{{{point}}}|$, {role}")
+        for link, values in run.slider_normal.items():
+            ax.plot(run.t, np.abs(values), color=colours[link], lw=lw, alpha=alpha, ls=":",
+                    label=f"normal force, {link}, {role}")
+        ax.plot(run.t, np.abs(run.shaking_force), color=COLOURS["sum"], lw=lw + 0.4,
+                alpha=alpha, ls="--" if role == "before" else "-",
+                label=f"|sum| (shaking force), {role}")
+    ax.set_ylabel("magnitude of the force on the ground (N)")
 
 
 def plot_shaking_moment(
@@ -74,7 +104,7 @@ def plot_shaking_moment(
     ax.set_ylabel("shaking moment about the origin (N·m)")
     ax.set_title(title or f"shaking moment, {traj.drive} motion")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize="small")
+    _legend_outside(ax)
     return ax
 
 
@@ -147,7 +177,7 @@ def plot_com_path(
     ax.set_ylabel("y (m)")
     ax.set_title("path of the total centre of mass")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize="small")
+    _legend_outside(ax)
     return ax
 
 
@@ -159,12 +189,6 @@ PLOT_SAMPLES = (720, 2**17)
 #: A curve whose span is below this fraction of its natural scale (the largest force on the
 #: ground, times the linkage's size for a moment) is drawn as rounding: not refined further.
 ROUNDING_SPAN = 1e-9
-
-
-def _legend_outside(ax: Axes, **kw) -> None:
-    """The axes' legend to the right of its frame, clear of the data."""
-    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0,
-              fontsize="small", **kw)
 
 
 def cycle_analyses(design, *, samples: int | None = None,
@@ -391,9 +415,10 @@ def verification_figure(design, verification) -> Figure:
     """The report figure of ``balancer verify``.
 
     Columns: the crank driven at the operating speed, free motion; rows: the forces on the
-    ground and their sum, shaking moment before and after, path of the total centre of mass.
+    ground and their sum, shaking moment, path of the total centre of mass; each before and
+    after where the design names its original. Legends beside the panels.
     """
-    fig = Figure(figsize=(13, 14), layout="constrained")
+    fig = Figure(figsize=(17, 14), layout="constrained")
     axes = fig.subplots(3, 2)
     title = design.title or "design"
     fig.suptitle(f"{title}: verification by simulation ({verification.method} formulation)")
@@ -405,7 +430,8 @@ def verification_figure(design, verification) -> Figure:
             axes[0, col].text(0.5, 0.5, f"{label}: no simulation\n{run.note}", ha="center",
                               va="center", wrap=True, transform=axes[0, col].transAxes)
             continue
-        plot_reactions(run.trajectory, ax=axes[0, col], title=f"forces on the ground, {label}")
+        plot_reactions(run.trajectory, ax=axes[0, col], title=f"forces on the ground, {label}",
+                       original=run.original)
         plot_shaking_moment(run.trajectory, run.original, ax=axes[1, col],
                             title=f"shaking moment, {label}")
         plot_com_path(design.mechanism, run.trajectory, design.original, run.original,

@@ -8,10 +8,18 @@ driven at the operating speed, once in free motion from the spec's initial state
 shaking force (the sum of the forces on the frame) and shaking moment of each run are compared
 with those of the unbalanced original when the spec names one (``[original]``, written by
 ``balancer optimize``).
+
+The runs are sampled finely enough for their largest values and their plots: output times at
+which the crank turns at most one part in :data:`PER_REVOLUTION` of a revolution. A driven
+run's number follows from its speed; a free one's from its initial speed with
+:data:`FREE_MARGIN` to spare, and a free run whose crank turned faster still is run again with
+enough.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -20,6 +28,14 @@ from .errors import LockupError, SpecError
 from .mechanisms import mechanism_of
 from .model import Design
 from .simulate import Trajectory, simulate
+
+#: Output times per crank revolution at least: 2°, some fifteen across the engine example's
+#: sharpest peak (its gas force's).
+PER_REVOLUTION = 180
+#: A free run's outputs allow for its crank turning this much faster than at the start.
+FREE_MARGIN = 1.5
+#: Most output times of a run.
+MAX_OUTPUTS = 100_000
 
 
 @dataclass(frozen=True)
@@ -137,28 +153,89 @@ def _figures(traj: Trajectory | None) -> tuple[float | None, float | None]:
     return float(np.max(np.abs(traj.shaking_force))), float(np.max(np.abs(traj.shaking_moment)))
 
 
-def _simulate_span(linkage, settings, method: str, **kw) -> tuple[Trajectory | None, str]:
-    """The run, or the part of it before the motion stopped, and why it stopped ("" if not)."""
-    try:
-        return simulate(linkage, settings, method=method, **kw), ""
-    except LockupError as exc:
-        return getattr(exc, "partial", None), str(exc)
+class _Tally:
+    """Progress over all the simulations of a verification, in simulated seconds."""
+
+    def __init__(self, progress: Callable[[float, float], None] | None, total: float) -> None:
+        self.progress = progress
+        self.total = total
+        self.done = 0.0
+
+    def simulate(self, linkage, settings, method: str, **kw) -> Trajectory:
+        """:func:`~balancer.simulate.simulate`, reporting its progress within the whole."""
+        report = None
+        if self.progress is not None:
+            progress, done, total = self.progress, self.done, self.total
+
+            def report(t: float, duration: float) -> None:
+                progress(done + t, total)
+
+        try:
+            return simulate(linkage, settings, method=method, progress=report, **kw)
+        finally:
+            self.done += settings.duration
 
 
-def _run(linkage, original, settings, method: str, **kw) -> RunCheck:
+def _simulate_span(tally: _Tally, linkage, settings, method: str, resolution: float | None,
+                   **kw) -> tuple[Trajectory | None, str, object]:
+    """The run (or its part before the motion stopped), why it stopped, its settings.
+
+    The reason is "" for a run that did not stop. With a ``resolution`` (rad), a run whose
+    crank turned farther than that between two output times is run again with enough of them.
+    """
+    for _ in range(2):
+        try:
+            traj, note = tally.simulate(linkage, settings, method, **kw), ""
+        except LockupError as exc:
+            traj, note = getattr(exc, "partial", None), str(exc)
+        more = _outputs_needed(traj, settings, resolution)
+        if more is None:
+            break
+        settings = replace(settings, outputs=more)
+        tally.total += settings.duration
+    return traj, note, settings
+
+
+def _outputs_needed(traj: Trajectory | None, settings, resolution: float | None) -> int | None:
+    """More output times if ``traj``'s crank turned farther than ``resolution`` between two.
+
+    From its fastest output (with a tenth to spare); ``None`` if it is resolved (or cannot be
+    made more so).
+    """
+    if resolution is None or traj is None or traj.t.size < 2:
+        return None
+    crank = traj.links.index(mechanism_of(traj.model).input)
+    step = float(np.max(np.abs(np.diff(traj.theta[crank]))))
+    if step <= resolution * (1 + 1e-9) or settings.outputs >= MAX_OUTPUTS:
+        return None
+    fastest = float(np.max(np.abs(traj.omega[crank])))
+    need = 1.1 * fastest * settings.duration / resolution
+    return min(MAX_OUTPUTS, max(math.ceil(need) + 1, 2 * settings.outputs))
+
+
+def _resolved(settings, speed: float, resolution: float | None):
+    """``settings`` with output times enough for a crank at ``speed`` (rad/s)."""
+    if resolution is None:
+        return settings
+    need = math.ceil(abs(speed) * settings.duration / resolution) + 1
+    return replace(settings, outputs=min(MAX_OUTPUTS, max(settings.outputs, need)))
+
+
+def _run(tally: _Tally, linkage, original, settings, method: str,
+         resolution: float | None = None, **kw) -> RunCheck:
     """Simulate the design and the original over the same span.
 
     A run that stops early (a lock-up, a dead point its formulation cannot pass) is judged over
     the part before it stopped, the note says where; the original is then run over that span.
     """
-    traj, note = _simulate_span(linkage, settings, method, **kw)
+    traj, note, settings = _simulate_span(tally, linkage, settings, method, resolution, **kw)
     force, moment = _figures(traj)
     orig = None
     o_force = o_moment = None
     if original is not None and force is not None:
         span = settings if not note else replace(settings, duration=float(traj.t[-1]))
-        orig, o_note = _simulate_span(original, span, method, **kw) if span.duration > 0 \
-            else (None, "")
+        orig, o_note, _ = _simulate_span(tally, original, span, method, resolution, **kw) \
+            if span.duration > 0 else (None, "", span)
         o_force, o_moment = _figures(orig)
         if o_note:
             note = "; ".join(x for x in (note, f"original: {o_note}") if x)
@@ -178,6 +255,7 @@ def verify(
     rtol: float = 1e-11,
     atol: float = 1e-13,
     outputs: int | None = None,
+    progress: Callable[[float, float], None] | None = None,
 ) -> Verification:
     """Simulate the design driven at its operating speed and in free motion.
 
@@ -194,7 +272,11 @@ def verify(
     rtol, atol
         Integrator tolerances (tight: the balanced figures are at integration-error level).
     outputs
-        Output times per run (default: the spec's).
+        Output times per run (default: the spec's, or more: enough that the crank turns at
+        most a :data:`PER_REVOLUTION`'th of a revolution between two).
+    progress
+        Called as ``progress(done, total)`` in simulated seconds over all the runs (the
+        original's included) as they go (see :class:`balancer.progress.Progress`).
 
     Raises
     ------
@@ -210,16 +292,23 @@ def verify(
     settings = design.simulation
     if duration is not None:
         settings = replace(settings, duration=duration)
+    resolution = None
     if outputs is not None:
         settings = replace(settings, outputs=outputs)
+    else:
+        resolution = 2 * math.pi / PER_REVOLUTION
     start = settings.theta1
     mech.require_full_revolution("a driven check")
-    driven_settings = replace(settings, drive="constant-speed", omega1=design.operation.speed,
-                              theta1=start)
-    free_settings = replace(settings, drive="free")
-    kw = {"rtol": rtol, "atol": atol}
+    speed = design.operation.speed
+    driven_settings = _resolved(replace(settings, drive="constant-speed", omega1=speed,
+                                        theta1=start), speed, resolution)
+    free_settings = _resolved(replace(settings, drive="free"), FREE_MARGIN * settings.omega1,
+                              resolution)
+    kw = {"rtol": rtol, "atol": atol, "resolution": resolution}
+    runs = 2 * (1 + (design.original is not None))
+    tally = _Tally(progress, runs * settings.duration)
     return Verification(
         method=method,
-        driven=_run(linkage, design.original, driven_settings, method, **kw),
-        free=_run(linkage, design.original, free_settings, method, **kw),
+        driven=_run(tally, linkage, design.original, driven_settings, method, **kw),
+        free=_run(tally, linkage, design.original, free_settings, method, **kw),
     )

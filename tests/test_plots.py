@@ -235,3 +235,94 @@ def test_every_animation_extension_is_checked(tmp_path):
     assert set(plots.FIGURE_TYPES) == {".png", ".svg", ".pdf"}
     for name in ("a.GIF", "a.Mp4"):
         assert plots.figure_type(tmp_path / name, types=plots.ANIMATION_TYPES) in {"gif", "mp4"}
+
+
+# --- verify's figure: before and after on every panel, legends outside, no aliasing -------
+
+
+def _verify(path, **kw):
+    from balancer.verify import verify
+
+    return verify(load_design(path), **kw)
+
+
+def test_the_verification_figure_draws_before_and_after_on_every_panel(pb1_balanced):
+    design = load_design(pb1_balanced)
+    from balancer.verify import verify
+
+    v = verify(design, duration=0.3)
+    fig = plots.verification_figure(design, v)
+    axes = np.array(fig.axes).reshape(3, 2)
+    for col, run in enumerate((v.driven, v.free)):
+        after, before = run.trajectory, run.original
+        assert after is not None and before is not None
+        forces, moment, com = axes[:, col]
+        # Forces on the ground: each ground point's magnitude and the sum's, before then after.
+        lines = _lines(forces)
+        expected = [np.abs(values) for r in (before, after) for values in r.ground.values()]
+        sums = [np.abs(r.shaking_force) for r in (before, after)]
+        drawn = [line.get_ydata() for line in lines]
+        assert len(drawn) == len(expected) + len(sums)
+        for values in [*expected, *sums]:
+            assert any(np.array_equal(values, d) for d in drawn)
+        for line in lines:
+            t = line.get_xdata()
+            assert np.array_equal(t, before.t) or np.array_equal(t, after.t)
+        # Shaking moment, before and after.
+        drawn = [line.get_ydata() for line in _lines(moment)]
+        assert len(drawn) == 2
+        np.testing.assert_array_equal(drawn[0], before.shaking_moment)
+        np.testing.assert_array_equal(drawn[1], after.shaking_moment)
+        # Path of the total centre of mass: the original's curve, the balanced one's point.
+        labels = [line.get_label() for line in com.get_lines()]
+        assert "before (original)" in labels and any(x.startswith("after") for x in labels)
+        assert forces.get_ylabel().endswith("(N)") and moment.get_ylabel().endswith("(N·m)")
+        assert com.get_xlabel() == "x (m)" and forces.get_xlabel() == "time t (s)"
+    _check_legends_outside(fig)
+
+
+def test_a_design_without_an_original_keeps_the_papers_components():
+    v = _verify(EXAMPLES / "meijaard2020.toml", duration=0.2)
+    design = load_design(EXAMPLES / "meijaard2020.toml")
+    fig = plots.verification_figure(design, v)
+    labels = [line.get_label() for line in fig.axes[0].get_lines()]
+    assert labels == ["$R_{A0x}$", "$R_{A0y}$", "$R_{A3x}$", "$R_{A3y}$", "sum, x", "sum, y"]
+    np.testing.assert_array_equal(fig.axes[0].get_lines()[4].get_ydata(),
+                                  v.driven.trajectory.shaking_force.real)
+    _check_legends_outside(fig)
+
+
+def test_verify_samples_every_run_finely_enough_to_draw_it():
+    # The paper's four-bar driven at 10 rad/s for 5 s turns eight times: 501 outputs would
+    # give 6° steps; verify takes at least PER_REVOLUTION a turn.
+    from balancer import verify as verify_module
+
+    v = _verify(EXAMPLES / "meijaard2020.toml")
+    step = 2 * np.pi / verify_module.PER_REVOLUTION
+    driven = v.driven.trajectory
+    assert driven.t.size > 501
+    assert np.max(np.abs(np.diff(driven.theta[0]))) <= step * (1 + 1e-9)
+    assert np.max(np.abs(np.diff(v.free.trajectory.theta[0]))) <= step
+
+
+def test_a_free_run_faster_than_estimated_is_run_again_finer(tmp_path, monkeypatch):
+    from balancer import verify as verify_module
+
+    monkeypatch.setattr(verify_module, "FREE_MARGIN", 0.01)  # a poor first estimate
+    text = (EXAMPLES / "meijaard2020.toml").read_text().replace("omega1 = 0.0", "omega1 = 30.0")
+    spec = tmp_path / "fast.toml"
+    spec.write_text(text)
+    calls = []
+    v = _verify(spec, duration=1.0, progress=lambda done, total: calls.append((done, total)))
+    free = v.free.trajectory
+    assert free.t.size > 501  # 30 rad/s for 1 s in 500 steps would be 3.4° a step
+    assert np.max(np.abs(np.diff(free.theta[0]))) <= 2 * np.pi / verify_module.PER_REVOLUTION
+    # The progress counts every simulation, the one run again included, in simulated seconds.
+    done, total = np.array(calls).T
+    assert np.all(np.diff(done) >= 0) and total[0] == pytest.approx(2.0)
+    assert total[-1] == pytest.approx(3.0) and done[-1] == pytest.approx(total[-1])
+
+
+def test_verify_with_given_outputs_takes_them_as_they_are():
+    v = _verify(EXAMPLES / "meijaard2020.toml", duration=1.0, outputs=11)
+    assert v.driven.trajectory.t.size == 11 and v.free.trajectory.t.size == 11

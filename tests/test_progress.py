@@ -70,3 +70,14 @@ def test_simulate_shows_progress_on_a_terminal_unless_json(monkeypatch, capsys, 
     assert main(args + (["--json"] if json else [])) == 0
     assert ("simulating:" in stream.getvalue()) is shown
     capsys.readouterr()
+
+
+@pytest.mark.parametrize(("json", "shown"), [(False, True), (True, False)])
+def test_verify_shows_the_progress_of_its_simulations(monkeypatch, capsys, json, shown):
+    monkeypatch.setattr(progress_module, "DELAY", 0.0)
+    stream = Tty()
+    monkeypatch.setattr(sys, "stderr", stream)
+    args = ["verify", str(EXAMPLES / "meijaard2020.toml"), "--duration", "0.2"]
+    assert main(args + (["--json"] if json else [])) == 0
+    assert ("verifying by simulation:" in stream.getvalue()) is shown
+    capsys.readouterr()
