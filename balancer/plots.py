@@ -596,7 +596,7 @@ def animate(linkage, path: str | os.PathLike[str], *, frames: int = 72, fps: int
     (trace,) = ax.plot([], [], color=COLOURS["after"], lw=2, animated=True)
     (com,) = ax.plot([], [], "o", color=COLOURS["after"], ms=9, label="total centre of mass",
                      animated=True)
-    ax.legend(fontsize="small", loc="upper right")
+    fig.legend(loc="outside lower center", ncols=2, fontsize="small")
     canvas.draw()
     fig.set_layout_engine("none")
     background = canvas.copy_from_bbox(fig.bbox)
@@ -678,4 +678,43 @@ def front_figure(front, title: str | None = None) -> Figure:
     ax.grid(True, alpha=0.3)
     ax.set_title(title or f"Shaking moment against {front.name.replace('_', ' ')}")
     _legend_outside(ax)
+    return fig
+
+
+def sweep_figure(path, keys) -> Figure:
+    """The atlas of a sweep's table: the balanced RMS shaking moment over the varied keys.
+
+    Two keys on a grid: a heat map (points without an optimum — bad geometry, infeasible —
+    left blank); one key: the RMS shaking moment before and after against it; otherwise a
+    scatter over the first two keys, coloured by the balanced RMS shaking moment.
+    """
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(path).to_pydict()
+    after = np.array([np.nan if v is None else v for v in table["shaking_moment_after"]])
+    before = np.array([np.nan if v is None else v for v in table["shaking_moment_before"]])
+    fig = Figure(figsize=(7.5, 5.0), layout="constrained")
+    ax = fig.add_subplot()
+    if len(keys) == 1:
+        x = np.array(table[keys[0]])
+        ax.plot(x, before, "o-", color="0.5", label="original design")
+        ax.plot(x, after, "o-", color="C0", label="balanced (certified optimum)")
+        ax.set_xlabel(keys[0])
+        ax.set_ylabel("RMS shaking moment (N·m)")
+        ax.grid(True, alpha=0.3)
+        _legend_outside(ax)
+        return fig
+    x, y = np.array(table[keys[0]]), np.array(table[keys[1]])
+    xs, ys = np.unique(x), np.unique(y)
+    if xs.size * ys.size == x.size:  # a grid
+        grid = np.full((ys.size, xs.size), np.nan)
+        grid[np.searchsorted(ys, y), np.searchsorted(xs, x)] = after
+        mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(grid), shading="nearest",
+                             cmap="viridis")
+    else:
+        mesh = ax.scatter(x, y, c=after, cmap="viridis", s=12)
+    fig.colorbar(mesh, ax=ax, label="balanced RMS shaking moment (N·m)")
+    ax.set_xlabel(keys[0])
+    ax.set_ylabel(keys[1])
+    ax.set_title("Least RMS shaking moment with exact force balance (blank: no design)")
     return fig
