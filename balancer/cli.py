@@ -265,6 +265,36 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from .progress import Progress
+    from .report import dumps_json, sweep_text
+    from .sweep import Vary, sweep
+
+    varies = [Vary.parse(text) for text in args.vary or ()]
+    if not varies:
+        raise SpecError("nothing to vary: give --vary KEY=LOW:HIGH:N", key="--vary")
+    if not args.out.endswith(".parquet"):
+        raise OutputError("must name a .parquet file", key="--out", value=args.out)
+    out = _output_path(args, args.out, "--out") if not args.resume else Path(args.out)
+    plot = _output_path(args, args.plot, "--plot")
+    if plot is not None:
+        from .plots import figure_type
+
+        figure_type(plot, "--plot")
+    with Progress("sweeping", unit="points", enabled=not args.json) as progress:
+        result = sweep(args.spec, varies, out, method=args.method, samples=args.samples,
+                       seed=args.seed, workers=args.workers, scheduler=args.scheduler,
+                       resume=args.resume, force=args.force, batch=args.batch,
+                       progress=progress)
+    if plot is not None:
+        from .plots import save_figure, sweep_figure
+
+        save_figure(sweep_figure(result.out, [v.key for v in varies]), plot)
+    sys.stdout.write(dumps_json(result.as_dict()) if args.json
+                     else sweep_text(result, spec=args.spec) + "\n")
+    return 0
+
+
 def _cmd_example(args: argparse.Namespace) -> int:
     from . import examples
 
@@ -505,6 +535,42 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", metavar="PATH", help="write the points to a CSV file")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
     p.set_defaults(handler=_cmd_pareto)
+
+    p = sub.add_parser(
+        "sweep",
+        help="the certified balanced optimum over a design space, on a Dask cluster",
+        description="Vary spec keys over ranges (a grid, or --samples points of a Latin "
+        "hypercube or a Sobol' sequence); at each point analyse the design and solve its "
+        "redesign problem to the certified global optimum (the convex backend), one row per "
+        "point in a Parquet table. The batches run on dask.distributed: a local cluster on "
+        "this machine's cores, or the scheduler at --scheduler. Each finished batch is kept "
+        "beside the table, so that an interrupted sweep resumes with --resume.",
+    )
+    p.add_argument("spec", metavar="SPEC", help="design spec (TOML) with a [balance] section")
+    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+    p.add_argument("--vary", action="append", metavar="KEY=LOW:HIGH:N",
+                   help="a dotted spec key and its range, e.g. mechanism.lengths.coupler="
+                   "2.5:3.5:11 (N values on a grid; repeat for more keys)")
+    p.add_argument("--out", required=True, metavar="FILE.parquet",
+                   help="the table to write (Parquet)")
+    p.add_argument("--method", choices=("grid", "lhs", "sobol"), default="grid",
+                   help="how the points are placed (default grid)")
+    p.add_argument("--samples", type=_count, metavar="N",
+                   help="number of points for lhs and sobol")
+    p.add_argument("--seed", type=int, default=0, help="seed of lhs and sobol (default 0)")
+    p.add_argument("--workers", type=int, metavar="N",
+                   help="worker processes of the local cluster (default: the machine's "
+                   "cores; 0: in this process, without Dask)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the interrupted sweep whose parts lie beside --out")
+    p.add_argument("--batch", type=int, default=25, metavar="N",
+                   help="points per task (default 25)")
+    p.add_argument("--plot", metavar="PATH",
+                   help="draw the atlas (.png, .svg or .pdf): a heat map over two keys")
+    p.add_argument("--json", action="store_true", help="print a JSON summary instead")
+    p.set_defaults(handler=_cmd_sweep)
 
     p = sub.add_parser(
         "example",

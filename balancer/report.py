@@ -722,3 +722,16 @@ def front_csv(front) -> str:
         [np.array([p.shaking_moment for p in points]), np.array([p.value for p in points]),
          np.array([p.epsilon for p in points]), np.array([p.lower_bound for p in points]),
          np.array([1.0 if p.knee else 0.0 for p in points])])
+
+
+def sweep_text(result, spec=None) -> str:
+    """The readable summary of a sweep."""
+    head = f"balancer sweep — {spec}" if spec else "balancer sweep"
+    rows = [[status, str(count)] for status, count in sorted(result.statuses.items())]
+    rate = result.points / result.seconds if result.seconds else float("nan")
+    where = (f"{result.workers} Dask workers" if result.workers else "this process")
+    lines = [head, f"{result.points} points in {result.seconds:.1f} s ({rate:.3g} points/s, "
+             f"{where}" + (f"; {result.resumed} batches from before" if result.resumed
+                           else "") + ")", "", table(rows, ["status", "points"]), "",
+             f"wrote {result.out}"]
+    return "\n".join(lines)

@@ -1,0 +1,420 @@
+"""Design-space sweeps: the certified balanced optimum at every point, on a Dask cluster.
+
+A sweep varies dotted spec keys (``mechanism.lengths.coupler``) over ranges — on a grid, or at
+``samples`` points of a Latin hypercube or a Sobol' sequence (SciPy's ``qmc``) — and at each
+point builds the design, analyses it and solves its redesign problem with the convex backend
+(:func:`balancer.balance.optimizer.optimize`: the certified global optimum, exactly what a
+single ``balancer optimize --backend convex`` run gives). Each point becomes one row:
+
+- the varied keys (one column each, named as given), ``point`` (its index);
+- ``status``: ``optimal`` (or the optimiser's other statuses), ``infeasible`` (no design within
+  the bounds meets force balance), ``bad-geometry`` (the design does not assemble, or its crank
+  does not turn fully), ``failed`` (the solver failed);
+- ``shaking_moment_before``, ``shaking_moment_after`` (RMS, N·m), ``shaking_force_before``,
+  ``shaking_force_after`` (RMS, N): the inertial figures of the design and of its optimum at the
+  operating speed (``after`` empty unless solved); ``lower_bound`` (N·m, the certificate),
+  ``added_mass`` (kg), ``message``.
+
+**On Dask.** The points are cut into batches (each task solves many points, and imports and
+builds once per worker); the batches run on ``dask.distributed`` — a ``LocalCluster`` on this
+machine's cores by default, or the scheduler at ``scheduler`` — and each finished batch is
+written at once, atomically, as its own Parquet part in ``<out>.parts/`` beside a manifest of
+the sweep. A worker that dies has its tasks rerun by the scheduler (a batch's part is written
+whole or not at all, and a rerun writes the same part again), an interrupted sweep resumes
+from the parts it finished (``resume``), and the final table, assembled from the parts once
+all are there, has every point exactly once, in order (checked), after which the parts go.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import math
+import os
+import shutil
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .errors import OutputError, SpecError
+
+#: Sampling methods of the varied keys.
+METHODS = ("grid", "lhs", "sobol")
+#: Points per task (a task's fixed costs — transfer, scheduling — spread over this many solves).
+BATCH = 25
+#: The table's fixed columns after the varied keys, in order.
+COLUMNS = ("point", "status", "shaking_moment_before", "shaking_moment_after",
+           "shaking_force_before", "shaking_force_after", "lower_bound", "added_mass",
+           "message")
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One varied key: ``key`` from ``low`` to ``high`` (``count`` values on a grid)."""
+
+    key: str
+    low: float
+    high: float
+    count: int
+
+    @classmethod
+    def parse(cls, text: str) -> Vary:
+        """From ``KEY=LOW:HIGH:N`` (``N`` may be left out when sampling: ``KEY=LOW:HIGH``)."""
+        key, sep, rest = text.partition("=")
+        parts = rest.split(":")
+        if not sep or not key or len(parts) not in (2, 3):
+            raise SpecError("must be KEY=LOW:HIGH:N, e.g. mechanism.lengths.coupler=2.5:3.5:11",
+                            key="--vary", value=text)
+        try:
+            low, high = float(parts[0]), float(parts[1])
+            count = int(parts[2]) if len(parts) == 3 else 0
+        except ValueError:
+            raise SpecError("LOW and HIGH must be numbers, N a whole number", key="--vary",
+                            value=text) from None
+        if not (math.isfinite(low) and math.isfinite(high)) or low > high:
+            raise SpecError("needs finite LOW ≤ HIGH", key="--vary", value=text)
+        if len(parts) == 3 and count < 1:
+            raise SpecError("N must be at least 1", key="--vary", value=text)
+        return cls(key=key.strip(), low=low, high=high, count=count)
+
+
+def design_points(varies: Sequence[Vary], method: str = "grid", samples: int | None = None,
+                  seed: int = 0) -> list[dict[str, float]]:
+    """The sweep's points: each a ``{key: value}``, in the table's order.
+
+    ``grid``: every combination of each key's ``count`` evenly spaced values (the last key
+    varying fastest). ``lhs``, ``sobol``: ``samples`` points of a Latin hypercube or a scrambled
+    Sobol' sequence (seeded) scaled to the ranges.
+    """
+    if method not in METHODS:
+        raise SpecError(f"must be one of {', '.join(METHODS)}", key="--method", value=method)
+    if not varies:
+        raise SpecError("nothing to vary: give --vary KEY=LOW:HIGH:N", key="--vary")
+    keys = [v.key for v in varies]
+    if len(set(keys)) != len(keys):
+        raise SpecError("a key is varied twice", key="--vary", value=", ".join(keys))
+    if method == "grid":
+        for v in varies:
+            if v.count < 1:
+                raise SpecError("a grid needs N for every key (KEY=LOW:HIGH:N)", key="--vary",
+                                value=v.key)
+        axes = [[v.low] if v.count == 1 else
+                [v.low + (v.high - v.low) * i / (v.count - 1) for i in range(v.count)]
+                for v in varies]
+        return [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*axes)]
+    if not samples or samples < 1:
+        raise SpecError(f"--method {method} needs --samples N", key="--samples", value=samples)
+    from scipy.stats import qmc
+
+    sampler = (qmc.LatinHypercube(d=len(varies), seed=seed) if method == "lhs"
+               else qmc.Sobol(d=len(varies), scramble=True, seed=seed))
+    unit = sampler.random(samples)
+    return [{v.key: v.low + (v.high - v.low) * float(u[i]) for i, v in enumerate(varies)}
+            for u in unit]
+
+
+def with_values(data: dict[str, Any], values: dict[str, float]) -> dict[str, Any]:
+    """A copy of a parsed spec with each dotted key set (a list's entry by its index).
+
+    The key must name a number in the spec (``mechanism.lengths.coupler``,
+    ``mechanism.points.B.1``, ``links.crank.mass``).
+    """
+    out = copy.deepcopy(data)
+    for key, value in values.items():
+        node: Any = out
+        parts = key.split(".")
+        for i, part in enumerate(parts):
+            last = i == len(parts) - 1
+            if isinstance(node, list) and part.isdigit() and int(part) < len(node):
+                index: Any = int(part)
+            elif isinstance(node, dict) and part in node:
+                index = part
+            else:
+                raise SpecError("no such number in the spec", key=key)
+            if last:
+                if isinstance(node[index], bool) or not isinstance(node[index], int | float):
+                    raise SpecError("names no number in the spec", key=key)
+                node[index] = float(value)
+            else:
+                node = node[index]
+    return out
+
+
+def evaluate_point(data: dict[str, Any], values: dict[str, float], index: int) -> dict:
+    """One row of the table: the design at ``values``, analysed and balanced."""
+    from .balance.optimizer import optimize
+    from .balance.result import InfeasibleError
+    from .errors import AssemblyError, LockupError, SolverError
+    from .spec import design_from_dict
+
+    row: dict[str, Any] = {**values, "point": index, "status": "", "message": ""}
+    for name in COLUMNS[2:-1]:
+        row[name] = None
+    try:
+        design = design_from_dict(with_values(data, values))
+        result = optimize(design, "convex")
+    except InfeasibleError as exc:
+        row.update(status="infeasible", message=str(exc))
+        _before(row, data, values)
+        return row
+    except (AssemblyError, LockupError) as exc:
+        row.update(status="bad-geometry", message=str(exc))
+        return row
+    except SpecError as exc:  # a length that makes the spec invalid (a negative length, …)
+        row.update(status="bad-geometry", message=str(exc))
+        return row
+    except SolverError as exc:
+        row.update(status="failed", message=str(exc))
+        _before(row, data, values)
+        return row
+    before, after = result.before.summary, result.after.summary
+    row.update(status=str(result.status), message=result.message,
+               shaking_moment_before=before.shaking_moment.rms,
+               shaking_moment_after=after.shaking_moment.rms,
+               shaking_force_before=before.shaking_force.rms,
+               shaking_force_after=after.shaking_force.rms,
+               lower_bound=result.rms_lower_bound if result.rms_form else None,
+               added_mass=result.linkage.total_mass - result.original.total_mass)
+    return row
+
+
+def _before(row: dict, data: dict[str, Any], values: dict[str, float]) -> None:
+    """The design's own figures, for a point whose redesign has no solution."""
+    from .cycle import cycle_analysis
+    from .spec import design_from_dict
+
+    try:
+        design = design_from_dict(with_values(data, values))
+        summary = cycle_analysis(design.mechanism, design.operation.speed,
+                                 design.operation.samples, loads=False).summary
+    except Exception:  # noqa: BLE001 - the row keeps its status; figures stay empty
+        return
+    row.update(shaking_moment_before=summary.shaking_moment.rms,
+               shaking_force_before=summary.shaking_force.rms)
+
+
+def run_batch(data: dict[str, Any], batch: list[tuple[int, dict[str, float]]]) -> list[dict]:
+    """Evaluate a batch of points (a Dask task): their rows, in order."""
+    return [evaluate_point(data, values, index) for index, values in batch]
+
+
+# ----------------------------------------------------------------------------------------------
+# The table and its parts
+
+
+def _parts_dir(out: Path) -> Path:
+    return out.with_name(out.name + ".parts")
+
+
+def _manifest(data: dict[str, Any], points: list[dict[str, float]], batch: int) -> dict:
+    text = json.dumps({"spec": data, "points": points, "batch": batch}, sort_keys=True,
+                      default=str)
+    return {"version": 1, "points": len(points), "batch": batch,
+            "digest": hashlib.sha256(text.encode()).hexdigest()}
+
+
+def _schema(keys: Sequence[str]):
+    import pyarrow as pa
+
+    fields = [pa.field(k, pa.float64()) for k in keys]
+    fields += [pa.field("point", pa.int64()), pa.field("status", pa.string())]
+    fields += [pa.field(name, pa.float64()) for name in COLUMNS[2:-1]]
+    fields.append(pa.field("message", pa.string()))
+    return pa.schema(fields)
+
+
+def _write_part(path: Path, rows: list[dict], keys: Sequence[str]) -> None:
+    """A batch's rows as a Parquet file, written whole or not at all."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pylist(rows, schema=_schema(keys))
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    pq.write_table(table, tmp)
+    os.replace(tmp, path)
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """What a sweep did: the table's path, its rows' statuses, and how long it took."""
+
+    out: Path
+    points: int
+    statuses: dict[str, int]
+    seconds: float
+    workers: int
+    resumed: int
+
+    def as_dict(self) -> dict[str, Any]:
+        """The ``sweep --json`` summary."""
+        return {"out": str(self.out), "points": self.points, "statuses": self.statuses,
+                "seconds": self.seconds, "workers": self.workers,
+                "resumed_batches": self.resumed,
+                "points_per_second": self.points / self.seconds if self.seconds else None}
+
+
+def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.PathLike[str],
+          *, method: str = "grid", samples: int | None = None, seed: int = 0,
+          workers: int | None = None, scheduler: str | None = None, resume: bool = False,
+          force: bool = False, batch: int = BATCH,
+          progress: Callable[[int, int], None] | None = None,
+          on_batch: Callable[[int, Any], None] | None = None) -> SweepResult:
+    """Run a sweep and write its table (see the module docstring).
+
+    Parameters
+    ----------
+    spec
+        The design spec (TOML) every point starts from.
+    varies, method, samples, seed
+        The points (:func:`design_points`).
+    out
+        The Parquet table to write.
+    workers
+        Worker processes of the local cluster (default: this machine's cores); ``0`` runs the
+        batches in this process, without Dask.
+    scheduler
+        Address of a running Dask scheduler (``tcp://host:8786``) instead of a local cluster.
+    resume
+        Continue the interrupted sweep whose parts are beside ``out``.
+    force
+        Overwrite an existing table (never an interrupted sweep's parts: resume or remove).
+    batch
+        Points per task.
+    progress
+        Called as ``progress(points done, points)``.
+    on_batch
+        Called as ``on_batch(batches done, client)`` after each batch is written (tests use it
+        to stop a worker or interrupt the sweep).
+    """
+    import tomllib
+
+    start = time.perf_counter()
+    out = Path(out)
+    parts = _parts_dir(out)
+    try:
+        data = tomllib.loads(Path(spec).read_text(encoding="utf-8-sig"))
+    except OSError as exc:
+        raise SpecError(f"cannot read the spec ({exc.strerror})", value=str(spec)) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(f"not valid TOML: {exc}", value=str(spec)) from None
+    from .spec import design_from_dict
+
+    design_from_dict(data, source=str(spec))  # the spec itself must be valid
+    points = design_points(varies, method, samples, seed)
+    for key in points[0]:
+        with_values(data, {key: points[0][key]})  # every key names a number of the spec
+    if batch < 1:
+        raise SpecError("must be at least 1", key="--batch", value=batch)
+    manifest = _manifest(data, points, batch)
+    keys = [v.key for v in varies]
+    if out.exists() and not force:
+        raise OutputError("exists; give --force to overwrite it", key="--out", value=str(out))
+    done: set[int] = set()
+    if parts.exists():
+        if not resume:
+            raise OutputError(f"an interrupted sweep's results are in {parts}: --resume to "
+                              "continue it, or remove that folder", key="--out", value=str(out))
+        try:
+            old = json.loads((parts / "manifest.json").read_text())
+        except (OSError, ValueError):
+            old = None
+        if old != manifest:
+            raise OutputError(f"the interrupted sweep in {parts} was run with another spec, "
+                              "other keys or other points; remove that folder to start anew",
+                              key="--resume")
+        done = {int(p.stem.split("-")[1]) for p in parts.glob("batch-*.parquet")}
+    else:
+        if resume:
+            raise OutputError(f"no interrupted sweep to resume ({parts} does not exist)",
+                              key="--resume")
+        parts.mkdir()
+        (parts / "manifest.json").write_text(json.dumps(manifest))
+    batches = [list(enumerate(points))[i:i + batch] for i in range(0, len(points), batch)]
+    todo = [i for i in range(len(batches)) if i not in done]
+    count = sum(len(batches[i]) for i in done)
+    if progress is not None:
+        progress(count, len(points))
+    used = 0
+    finished = len(done)
+
+    def record(i: int, rows: list[dict], client) -> None:
+        nonlocal count, finished
+        _write_part(parts / f"batch-{i:06d}.parquet", rows, keys)
+        count += len(rows)
+        finished += 1
+        if progress is not None:
+            progress(count, len(points))
+        if on_batch is not None:
+            on_batch(finished, client)
+
+    if workers == 0 and scheduler is None:
+        for i in todo:
+            record(i, run_batch(data, batches[i]), None)
+    elif todo:
+        used = _run_on_dask(data, batches, todo, record, workers, scheduler)
+    _assemble(parts, out, keys, len(points), len(batches))
+    statuses: dict[str, int] = {}
+    import pyarrow.parquet as pq
+
+    for status in pq.read_table(out, columns=["status"]).column("status").to_pylist():
+        statuses[status] = statuses.get(status, 0) + 1
+    return SweepResult(out=out, points=len(points), statuses=statuses,
+                       seconds=time.perf_counter() - start, workers=used, resumed=len(done))
+
+
+def _run_on_dask(data, batches, todo, record, workers, scheduler) -> int:
+    """Run the batches ``todo`` on a cluster; ``record`` each as it finishes. Its workers."""
+    import logging
+
+    from distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    if scheduler is None:
+        n = workers or os.cpu_count() or 1
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR)
+        client = Client(cluster)
+    else:
+        try:
+            client = Client(scheduler, timeout=10)
+        except OSError as exc:
+            raise SpecError(f"cannot reach the Dask scheduler ({exc})", key="--scheduler",
+                            value=scheduler) from None
+    try:
+        used = len(client.scheduler_info()["workers"])
+        scattered = client.scatter(data, broadcast=True)
+        futures = {client.submit(run_batch, scattered, batches[i], pure=False,
+                                 key=f"balancer-sweep-batch-{i}-{time.time_ns()}"): i
+                   for i in todo}
+        for future in as_completed(futures):
+            record(futures[future], future.result(), client)
+        return used
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _assemble(parts: Path, out: Path, keys: Sequence[str], points: int, batches: int) -> None:
+    """The parts as one table, every point once and in order; then the parts removed."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    files = sorted(parts.glob("batch-*.parquet"))
+    if len(files) != batches:
+        raise OutputError(f"the sweep is incomplete: {len(files)} of {batches} batches in "
+                          f"{parts}; --resume to finish it", key="--out", value=str(out))
+    table = pa.concat_tables([pq.read_table(f, schema=_schema(keys)) for f in files])
+    table = table.sort_by("point")
+    index = table.column("point").to_pylist()
+    if index != list(range(points)):
+        raise OutputError(f"the parts in {parts} do not hold every point exactly once",
+                          key="--out", value=str(out))
+    from .outputs import write_with
+
+    write_with(out, lambda tmp: pq.write_table(table, tmp), suffix=".parquet")
+    shutil.rmtree(parts)

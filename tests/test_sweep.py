@@ -1,0 +1,164 @@
+"""Design-space sweeps (balancer/sweep.py, ``balancer sweep``), on Dask and in process."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tomllib
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+from balancer.balance.optimizer import optimize
+from balancer.cli import main
+from balancer.errors import OutputError, SpecError
+from balancer.spec import design_from_dict
+from balancer.sweep import Vary, design_points, sweep, with_values
+
+ROOT = Path(__file__).resolve().parent.parent
+PB1 = ROOT / "examples" / "pb1.toml"
+COUPLER = "mechanism.lengths.coupler"
+FRAME = "mechanism.lengths.frame"
+
+
+def _rows(path) -> list[dict]:
+    return pq.read_table(path).to_pylist()
+
+
+def test_varied_keys_are_parsed_and_placed():
+    v = Vary.parse(f"{COUPLER}=2.5:3.5:3")
+    assert (v.key, v.low, v.high, v.count) == (COUPLER, 2.5, 3.5, 3)
+    grid = design_points([v, Vary.parse(f"{FRAME}=3.0:3.2:2")])
+    assert grid == [{COUPLER: c, FRAME: f} for c in (2.5, 3.0, 3.5) for f in (3.0, 3.2)]
+    for method in ("lhs", "sobol"):
+        pts = design_points([Vary.parse(f"{COUPLER}=2.5:3.5"), Vary.parse(f"{FRAME}=3:4")],
+                            method, samples=16, seed=3)
+        assert len(pts) == 16
+        assert all(2.5 <= p[COUPLER] <= 3.5 and 3.0 <= p[FRAME] <= 4.0 for p in pts)
+        again = design_points([Vary.parse(f"{COUPLER}=2.5:3.5"), Vary.parse(f"{FRAME}=3:4")],
+                              method, samples=16, seed=3)
+        assert pts == again  # seeded
+    # A Latin hypercube puts one point in each of the 16 strata of every key.
+    strata = sorted(int((p[COUPLER] - 2.5) / 1.0 * 16) for p in
+                    design_points([Vary.parse(f"{COUPLER}=2.5:3.5")], "lhs", 16, 3))
+    assert strata == list(range(16))
+
+
+@pytest.mark.parametrize("text", ["coupler", "k=1", "k=a:2:3", "k=2:1:3", "k=1:2:0",
+                                  "k=nan:1:2"])
+def test_bad_varied_keys_are_refused(text):
+    with pytest.raises(SpecError) as info:
+        Vary.parse(text)
+    assert info.value.key == "--vary"
+
+
+def test_a_key_must_name_a_number_of_the_spec():
+    data = tomllib.loads(PB1.read_text())
+    assert with_values(data, {COUPLER: 2.75})["mechanism"]["lengths"]["coupler"] == 2.75
+    assert data["mechanism"]["lengths"]["coupler"] == 3.0  # a copy
+    for key in ("mechanism.lengths.coupling", "mechanism.type", "links.crank.com.s.x"):
+        with pytest.raises(SpecError) as info:
+            with_values(data, {key: 1.0})
+        assert info.value.key == key
+
+
+def test_rows_equal_single_optimize_runs_and_name_bad_geometry(tmp_path):
+    out = tmp_path / "sweep.parquet"
+    result = sweep(PB1, [Vary.parse(f"{COUPLER}=2.0:4.0:3"), Vary.parse(f"{FRAME}=2.5:3.5:2")],
+                   out, workers=0, batch=2)
+    rows = _rows(out)
+    assert [r["point"] for r in rows] == list(range(6)) and result.points == 6
+    data = tomllib.loads(PB1.read_text())
+    for row in rows:
+        values = {COUPLER: row[COUPLER], FRAME: row[FRAME]}
+        design = design_from_dict(with_values(data, values))
+        if row["status"] == "bad-geometry":
+            # The crank cannot turn fully (a Grashof crank-rocker no longer).
+            assert "revolution" in row["message"] or "assemble" in row["message"]
+            assert row["shaking_moment_after"] is None
+            continue
+        single = optimize(design, "convex")
+        assert row["status"] == str(single.status)
+        assert row["shaking_moment_after"] == single.after.summary.shaking_moment.rms
+        assert row["shaking_moment_before"] == single.before.summary.shaking_moment.rms
+        assert row["shaking_force_after"] == single.after.summary.shaking_force.rms
+        assert row["lower_bound"] == single.rms_lower_bound
+    assert result.statuses == {"optimal": 4, "bad-geometry": 2}
+
+
+def test_an_interrupted_sweep_resumes_and_equals_an_uninterrupted_one(tmp_path):
+    varies = [Vary.parse(f"{COUPLER}=2.6:3.4:5")]
+    whole = tmp_path / "whole.parquet"
+    sweep(PB1, varies, whole, workers=0, batch=1)
+    out = tmp_path / "sweep.parquet"
+
+    def stop(done, client):
+        if done == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        sweep(PB1, varies, out, workers=0, batch=1, on_batch=stop)
+    assert not out.exists()
+    parts = tmp_path / "sweep.parquet.parts"
+    assert len(list(parts.glob("batch-*.parquet"))) == 2
+    with pytest.raises(OutputError):  # computed work is not thrown away silently
+        sweep(PB1, varies, out, workers=0, batch=1)
+    with pytest.raises(OutputError):  # nor resumed with other points
+        sweep(PB1, [Vary.parse(f"{COUPLER}=2.6:3.4:6")], out, workers=0, batch=1, resume=True)
+    result = sweep(PB1, varies, out, workers=0, batch=1, resume=True)
+    assert result.resumed == 2 and not parts.exists()
+    assert _rows(out) == _rows(whole)
+
+
+def test_on_a_dask_cluster_a_killed_worker_loses_no_point(tmp_path):
+    """Two local worker processes; after the first batch one of them is killed (os._exit).
+    The scheduler reruns what it held, its nanny starts it again, and the table has every
+    point exactly once, equal to the same sweep run in process."""
+    varies = [Vary.parse(f"{COUPLER}=2.4:3.6:4"), Vary.parse(f"{FRAME}=2.8:3.4:4")]
+    killed = []
+
+    def kill(done, client):
+        if done == 1 and not killed:
+            victim = sorted(client.scheduler_info()["workers"])[0]
+            killed.append(victim)
+            try:
+                client.run(os._exit, 1, workers=[victim], wait=False)
+            except Exception:  # noqa: BLE001 - the connection dies with the worker
+                pass
+
+    out = tmp_path / "dask.parquet"
+    result = sweep(PB1, varies, out, workers=2, batch=1, on_batch=kill)
+    assert killed and result.workers == 2
+    rows = _rows(out)
+    assert [r["point"] for r in rows] == list(range(16))
+    reference = tmp_path / "local.parquet"
+    sweep(PB1, varies, reference, workers=0, batch=4)
+    assert rows == _rows(reference)
+
+
+def test_sweep_command(tmp_path, capsys):
+    out, png = tmp_path / "atlas.parquet", tmp_path / "atlas.png"
+    code = main(["sweep", str(PB1), "--vary", f"{COUPLER}=2.6:3.4:3", "--vary",
+                 f"{FRAME}=3.0:3.4:2", "--out", str(out), "--workers", "0", "--plot",
+                 str(png), "--json"])
+    assert code == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["points"] == 6 and doc["statuses"] == {"optimal": 6}
+    rows = _rows(out)
+    assert set(rows[0]) >= {COUPLER, FRAME, "status", "shaking_moment_before",
+                            "shaking_moment_after", "shaking_force_before",
+                            "shaking_force_after"}
+    assert all(math.isfinite(r["shaking_moment_after"]) for r in rows)
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    # Bad input: one line, exit 2, nothing written.
+    for args in (["--vary", "nonsense"], ["--vary", f"{COUPLER}=1:2:3", "--out", "x.csv"],
+                 ["--vary", "mechanism.lengths.nope=1:2:2"]):
+        argv = ["sweep", str(PB1), *args]
+        if "--out" not in args:
+            argv += ["--out", str(tmp_path / "bad.parquet")]
+        assert main([*argv, "--workers", "0"]) == 2
+        assert len(capsys.readouterr().err.strip().splitlines()) == 1
+    assert not (tmp_path / "bad.parquet").exists()
+    assert not (tmp_path / "bad.parquet.parts").exists()
