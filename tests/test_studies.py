@@ -273,9 +273,35 @@ def test_linkages(quick):
         assert case["verification"].driven.force_level < 1e-9, name
 
 
+def test_atlas_and_fronts(quick):
+    r = quick("atlas_and_fronts")
+    rows = r["rows"]
+    assert [row["point"] for row in rows] == list(range(len(rows)))
+    # The sweep's "bad-geometry" rows are exactly the geometries Grashof's condition says
+    # are no crank-rockers (computed from the lengths alone, in the study).
+    assert r["grashof_mismatch"] == 0
+    assert {row["status"] for row in rows} == {"optimal", "bad-geometry"}
+    for row in rows:
+        if row["status"] == "optimal":
+            # Certified: the bound below the design's RMS by at most the gap tolerance.
+            assert row["lower_bound"] <= row["shaking_moment_after"] * (1 + 1e-12)
+            assert row["shaking_moment_after"] - row["lower_bound"] <= (
+                GAP_TOLERANCE * row["shaking_moment_before"] + 1e-9)
+    for front in r["fronts"].values():
+        moments = [p.shaking_moment for p in front.points]
+        values = [p.value for p in front.points]
+        assert values == sorted(values)
+        assert all(b <= a * (1 + GAP_TOLERANCE) for a, b in zip(moments, moments[1:],
+                                                                  strict=False))
+        assert all(p.lower_bound <= p.shaking_moment * (1 + 1e-12) for p in front.points)
+    # Both fronts end at PB1's optimum (the counterweights reach what free links reach).
+    ends = [front.points[-1].shaking_moment for front in r["fronts"].values()]
+    assert ends[0] == pytest.approx(ends[1], rel=GAP_TOLERANCE)
+
+
 @pytest.mark.parametrize("name", ["meijaard2020_example", "meijaard2020_balanced",
                                   "wunderlich1964", "bai2024_lie_group", "benchmarks_pb",
-                                  "linkages"])
+                                  "linkages", "atlas_and_fronts"])
 def test_study_is_a_script_with_run(name):
     module = load(name)
     assert module.NAME == name and callable(module.run)
