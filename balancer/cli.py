@@ -268,11 +268,13 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from .progress import Progress
     from .report import dumps_json, sweep_text
-    from .sweep import Vary, sweep
+    from .sweep import Perturb, Vary, sweep
 
     varies = [Vary.parse(text) for text in args.vary or ()]
-    if not varies:
-        raise SpecError("nothing to vary: give --vary KEY=LOW:HIGH:N", key="--vary")
+    perturbs = [Perturb.parse(text) for text in args.perturb or ()]
+    if not varies and not perturbs:
+        raise SpecError("nothing to vary: give --vary KEY=LOW:HIGH:N (or --perturb KEY=SIGMA)",
+                        key="--vary")
     if not args.out.endswith(".parquet"):
         raise OutputError("must name a .parquet file", key="--out", value=args.out)
     out = _output_path(args, args.out, "--out") if not args.resume else Path(args.out)
@@ -282,14 +284,15 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
         figure_type(plot, "--plot")
     with Progress("sweeping", unit="points", enabled=not args.json) as progress:
-        result = sweep(args.spec, varies, out, method=args.method, samples=args.samples,
+        result = sweep(args.spec, varies, out, perturbs=perturbs, method=args.method,
+                       samples=args.samples,
                        seed=args.seed, workers=args.workers, scheduler=args.scheduler,
                        resume=args.resume, force=args.force, batch=args.batch,
                        progress=progress)
     if plot is not None:
         from .plots import save_figure, sweep_figure
 
-        save_figure(sweep_figure(result.out, [v.key for v in varies]), plot)
+        save_figure(sweep_figure(result.out, [v.key for v in varies] or None), plot)
     sys.stdout.write(dumps_json(result.as_dict()) if args.json
                      else sweep_text(result, spec=args.spec) + "\n")
     return 0
@@ -551,6 +554,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--vary", action="append", metavar="KEY=LOW:HIGH:N",
                    help="a dotted spec key and its range, e.g. mechanism.lengths.coupler="
                    "2.5:3.5:11 (N values on a grid; repeat for more keys)")
+    p.add_argument("--perturb", action="append", metavar="KEY=SIGMA",
+                   help="instead of --vary: --samples draws of a key around its spec value, "
+                   "normal with deviation SIGMA (its unit), e.g. links.crank.mass=0.01; each "
+                   "row the perturbed design's own figures (robust balancing)")
     p.add_argument("--out", required=True, metavar="FILE.parquet",
                    help="the table to write (Parquet)")
     p.add_argument("--method", choices=("grid", "lhs", "sobol"), default="grid",

@@ -23,6 +23,10 @@ from .simulate import Trajectory
 #: Colours for the sum, before and after (colour-blind safe, Okabe & Ito).
 COLOURS = {"sum": "#000000", "before": "#999999", "after": "#009E73", "link": "#0072B2",
            "com": "#D55E00"}
+#: How a curve of the original (before) and of the design (after) is drawn where both are: the
+#: original dashed on top, so that it shows where the two coincide.
+BEFORE_STYLE = {"color": COLOURS["before"], "lw": 1.4, "ls": (0, (5, 2)), "zorder": 3}
+AFTER_STYLE = {"color": COLOURS["after"], "lw": 2.2, "zorder": 2}
 #: Colours for the forces at the ground points and guides, in order (A0, A3, … ).
 SERIES = ("#0072B2", "#D55E00", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#009E73")
 
@@ -96,9 +100,9 @@ def plot_shaking_moment(
     """Shaking moment about the origin over time, before (the original) and after."""
     ax = _axes(ax)
     if original is not None:
-        ax.plot(original.t, original.shaking_moment, color=COLOURS["before"], lw=1.5,
-                label="before (original)")
-    ax.plot(traj.t, traj.shaking_moment, color=COLOURS["after"], lw=1.5,
+        ax.plot(original.t, original.shaking_moment, **BEFORE_STYLE, label="before (original)")
+    ax.plot(traj.t, traj.shaking_moment, **(AFTER_STYLE if original is not None else
+                                            {"color": COLOURS["after"], "lw": 1.5}),
             label="after" if original is not None else "shaking moment")
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("shaking moment about the origin (N·m)")
@@ -307,14 +311,14 @@ def plot_shaking_force_polar(analysis, before=None, ax: Axes | None = None,
     after_role, before_role = _roles(before)
     ax.axhline(0.0, color="0.6", lw=0.8)
     ax.axvline(0.0, color="0.6", lw=0.8)
-    for a, role, colour, lw in ((before, before_role, COLOURS["before"], 1.5),
-                                (analysis, after_role, COLOURS["after"], 1.8)):
+    for a, role, style in ((before, before_role, BEFORE_STYLE),
+                           (analysis, after_role, AFTER_STYLE)):
         if a is None:
             continue
+        colour, lw = style["color"], style["lw"]
         f = _closed(a.reactions.shaking_force)
-        ax.plot(f.real, f.imag, color=colour, lw=lw,
-                label=_cycle_label(role, a.reactions.shaking_force, "N"))
-        ax.plot(f.real[:1], f.imag[:1], "o", color=colour, ms=6, mec="k", mew=0.6)
+        ax.plot(f.real, f.imag, **style, label=_cycle_label(role, a.reactions.shaking_force, "N"))
+        ax.plot(f.real[:1], f.imag[:1], "o", color=colour, ms=6, mec="k", mew=0.6, zorder=4)
         k = max(1, f.size // 8)
         if abs(f[k + 1] - f[k]) > 0:
             ax.annotate("", xy=(f[k + 1].real, f[k + 1].imag), xytext=(f[k].real, f[k].imag),
@@ -343,13 +347,13 @@ def plot_over_crank_angle(analysis, quantity: str, before=None, ax: Axes | None 
     if quantity not in names:
         raise ValueError(f"no such quantity: {quantity!r}")
     after_role, before_role = _roles(before)
-    for a, role, colour, lw in ((before, before_role, COLOURS["before"], 1.5),
-                                (analysis, after_role, COLOURS["after"], 1.8)):
+    for a, role, style in ((before, before_role, BEFORE_STYLE),
+                           (analysis, after_role, AFTER_STYLE)):
         if a is None:
             continue
         values = getattr(a.reactions, quantity)
-        ax.plot(np.degrees(np.append(a.theta1, 2 * np.pi)), _closed(values), color=colour,
-                lw=lw, label=_cycle_label(role, values, "N·m"))
+        ax.plot(np.degrees(np.append(a.theta1, 2 * np.pi)), _closed(values), **style,
+                label=_cycle_label(role, values, "N·m"))
     ax.set_xlim(0.0, 360.0)
     ax.set_xticks(np.arange(0, 361, 45))
     ax.set_xlabel("crank angle θ1 (°)")
@@ -684,13 +688,25 @@ def front_figure(front, title: str | None = None) -> Figure:
 def sweep_figure(path, keys) -> Figure:
     """The atlas of a sweep's table: the balanced RMS shaking moment over the varied keys.
 
-    Two keys on a grid: a heat map (points without an optimum — bad geometry, infeasible —
+    ``keys`` ``None``: a perturbation sweep's histogram of the residual shaking force. Two
+    keys on a grid: a heat map (points without an optimum — bad geometry, infeasible —
     left blank); one key: the RMS shaking moment before and after against it; otherwise a
     scatter over the first two keys, coloured by the balanced RMS shaking moment.
     """
     import pyarrow.parquet as pq
 
     table = pq.read_table(path).to_pydict()
+    if keys is None:  # a perturbation sweep: the residual shaking force's distribution
+        force = np.array([v for v in table["shaking_force_before"] if v is not None])
+        fig = Figure(figsize=(7.5, 4.5), layout="constrained")
+        ax = fig.add_subplot()
+        ax.hist(force, bins=max(10, min(60, force.size // 10)), color="C0")
+        ax.axvline(float(np.percentile(force, 95)), color="C3", ls="--", label="95th percentile")
+        ax.set_xlabel("RMS shaking force of the perturbed designs (N)")
+        ax.set_ylabel("designs")
+        ax.grid(True, alpha=0.3)
+        _legend_outside(ax)
+        return fig
     after = np.array([np.nan if v is None else v for v in table["shaking_moment_after"]])
     before = np.array([np.nan if v is None else v for v in table["shaking_moment_before"]])
     fig = Figure(figsize=(7.5, 5.0), layout="constrained")

@@ -732,6 +732,10 @@ def sweep_text(result, spec=None) -> str:
     where = (f"{result.workers} Dask workers" if result.workers else "this process")
     lines = [head, f"{result.points} points in {result.seconds:.1f} s ({rate:.3g} points/s, "
              f"{where}" + (f"; {result.resumed} batches from before" if result.resumed
-                           else "") + ")", "", table(rows, ["status", "points"]), "",
-             f"wrote {result.out}"]
+                           else "") + ")", "", table(rows, ["status", "points"]), ""]
+    if result.residual_force is not None:
+        r = result.residual_force
+        lines += [f"residual RMS shaking force of the perturbed designs: mean {r['mean']:.4g} "
+                  f"N, 95th percentile {r['p95']:.4g} N, largest {r['max']:.4g} N", ""]
+    lines.append(f"wrote {result.out}")
     return "\n".join(lines)

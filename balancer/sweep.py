@@ -53,6 +53,77 @@ COLUMNS = ("point", "status", "shaking_moment_before", "shaking_moment_after",
 
 
 @dataclass(frozen=True)
+class Perturb:
+    """One perturbed key: the spec's value plus a normal deviate of deviation ``sigma``."""
+
+    key: str
+    sigma: float
+
+    @classmethod
+    def parse(cls, text: str) -> Perturb:
+        """From ``KEY=SIGMA`` (SIGMA in the key's own unit)."""
+        key, sep, rest = text.partition("=")
+        try:
+            sigma = float(rest)
+        except ValueError:
+            sigma = math.nan
+        if not sep or not key or not (math.isfinite(sigma) and sigma > 0):
+            raise SpecError("must be KEY=SIGMA with SIGMA > 0, e.g. links.crank.mass=0.01",
+                            key="--perturb", value=text)
+        return cls(key=key.strip(), sigma=sigma)
+
+
+def perturbed_points(data: dict[str, Any], perturbs: Sequence[Perturb], samples: int,
+                     seed: int = 0) -> list[dict[str, float]]:
+    """``samples`` draws of the perturbed keys around the spec's values (seeded)."""
+    import numpy as np
+
+    if not samples or samples < 1:
+        raise SpecError("--perturb needs --samples N", key="--samples", value=samples)
+    keys = [p.key for p in perturbs]
+    if len(set(keys)) != len(keys):
+        raise SpecError("a key is perturbed twice", key="--perturb", value=", ".join(keys))
+    base = [_value(data, p.key) for p in perturbs]
+    rng = np.random.default_rng(seed)
+    draws = rng.standard_normal((samples, len(perturbs)))
+    return [{p.key: b + p.sigma * float(d) for p, b, d in zip(perturbs, base, row, strict=True)}
+            for row in draws]
+
+
+def _value(data: dict[str, Any], key: str) -> float:
+    """The number a dotted key names in a parsed spec."""
+    probe = with_values(data, {key: 0.0})  # raises for a key that names no number
+    del probe
+    node: Any = data
+    for part in key.split("."):
+        node = node[int(part)] if isinstance(node, list) else node[part]
+    return float(node)
+
+
+def analyse_point(data: dict[str, Any], values: dict[str, float], index: int) -> dict:
+    """One row of a perturbation sweep: the perturbed design's own figures (no redesign)."""
+    from .cycle import cycle_analysis
+    from .errors import AssemblyError, LockupError
+    from .spec import design_from_dict
+
+    row: dict[str, Any] = {**values, "point": index, "status": "", "message": ""}
+    for name in COLUMNS[2:-1]:
+        row[name] = None
+    try:
+        design = design_from_dict(with_values(data, values))
+        if design.operation is None:
+            raise SpecError("missing required key", key="operation.speed")
+        summary = cycle_analysis(design.mechanism, design.operation.speed,
+                                 design.operation.samples, loads=False).summary
+    except (AssemblyError, LockupError, SpecError) as exc:
+        row.update(status="bad-geometry", message=str(exc))
+        return row
+    row.update(status="analysed", shaking_moment_before=summary.shaking_moment.rms,
+               shaking_force_before=summary.shaking_force.rms)
+    return row
+
+
+@dataclass(frozen=True)
 class Vary:
     """One varied key: ``key`` from ``low`` to ``high`` (``count`` values on a grid)."""
 
@@ -197,9 +268,14 @@ def _before(row: dict, data: dict[str, Any], values: dict[str, float]) -> None:
                shaking_force_before=summary.shaking_force.rms)
 
 
-def run_batch(data: dict[str, Any], batch: list[tuple[int, dict[str, float]]]) -> list[dict]:
-    """Evaluate a batch of points (a Dask task): their rows, in order."""
-    return [evaluate_point(data, values, index) for index, values in batch]
+def run_batch(data: dict[str, Any], batch: list[tuple[int, dict[str, float]]],
+              analyse_only: bool = False) -> list[dict]:
+    """Evaluate a batch of points (a Dask task): their rows, in order.
+
+    ``analyse_only``: the designs' own figures (a perturbation sweep), no redesign.
+    """
+    evaluate = analyse_point if analyse_only else evaluate_point
+    return [evaluate(data, values, index) for index, values in batch]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -248,17 +324,21 @@ class SweepResult:
     seconds: float
     workers: int
     resumed: int
+    residual_force: dict[str, float] | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """The ``sweep --json`` summary."""
         return {"out": str(self.out), "points": self.points, "statuses": self.statuses,
                 "seconds": self.seconds, "workers": self.workers,
                 "resumed_batches": self.resumed,
-                "points_per_second": self.points / self.seconds if self.seconds else None}
+                "points_per_second": self.points / self.seconds if self.seconds else None,
+                **({"residual_shaking_force": self.residual_force}
+                   if self.residual_force is not None else {})}
 
 
 def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.PathLike[str],
-          *, method: str = "grid", samples: int | None = None, seed: int = 0,
+          *, perturbs: Sequence[Perturb] = (), method: str = "grid",
+          samples: int | None = None, seed: int = 0,
           workers: int | None = None, scheduler: str | None = None, resume: bool = False,
           force: bool = False, batch: int = BATCH,
           progress: Callable[[int, int], None] | None = None,
@@ -271,6 +351,11 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
         The design spec (TOML) every point starts from.
     varies, method, samples, seed
         The points (:func:`design_points`).
+    perturbs
+        Instead of ``varies``: ``samples`` draws of manufacturing deviations around the spec's
+        values (:func:`perturbed_points`); each row then holds the perturbed design's own
+        figures (status ``analysed``, the ``before`` columns): the distribution of the residual
+        shaking force of a balanced design.
     out
         The Parquet table to write.
     workers
@@ -304,13 +389,17 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
     from .spec import design_from_dict
 
     design_from_dict(data, source=str(spec))  # the spec itself must be valid
-    points = design_points(varies, method, samples, seed)
+    if perturbs and varies:
+        raise SpecError("give --vary or --perturb, not both", key="--perturb")
+    points = (perturbed_points(data, perturbs, samples, seed) if perturbs
+              else design_points(varies, method, samples, seed))
     for key in points[0]:
         with_values(data, {key: points[0][key]})  # every key names a number of the spec
     if batch < 1:
         raise SpecError("must be at least 1", key="--batch", value=batch)
     manifest = _manifest(data, points, batch)
-    keys = [v.key for v in varies]
+    keys = [v.key for v in varies] or [p.key for p in perturbs]
+    analyse_only = bool(perturbs)
     if out.exists() and not force:
         raise OutputError("exists; give --force to overwrite it", key="--out", value=str(out))
     done: set[int] = set()
@@ -353,20 +442,30 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
 
     if workers == 0 and scheduler is None:
         for i in todo:
-            record(i, run_batch(data, batches[i]), None)
+            record(i, run_batch(data, batches[i], analyse_only), None)
     elif todo:
-        used = _run_on_dask(data, batches, todo, record, workers, scheduler)
+        used = _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only)
     _assemble(parts, out, keys, len(points), len(batches))
     statuses: dict[str, int] = {}
     import pyarrow.parquet as pq
 
     for status in pq.read_table(out, columns=["status"]).column("status").to_pylist():
         statuses[status] = statuses.get(status, 0) + 1
+    residual = None
+    if perturbs:
+        import numpy as np
+
+        force = np.array([v for v in pq.read_table(out, columns=["shaking_force_before"])
+                          .column(0).to_pylist() if v is not None])
+        if force.size:
+            residual = {"mean": float(force.mean()), "p95": float(np.percentile(force, 95)),
+                        "max": float(force.max()), "unit": "N (RMS over a revolution)"}
     return SweepResult(out=out, points=len(points), statuses=statuses,
-                       seconds=time.perf_counter() - start, workers=used, resumed=len(done))
+                       seconds=time.perf_counter() - start, workers=used, resumed=len(done),
+                       residual_force=residual)
 
 
-def _run_on_dask(data, batches, todo, record, workers, scheduler) -> int:
+def _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only) -> int:
     """Run the batches ``todo`` on a cluster; ``record`` each as it finishes. Its workers."""
     import logging
 
@@ -387,7 +486,7 @@ def _run_on_dask(data, batches, todo, record, workers, scheduler) -> int:
     try:
         used = len(client.scheduler_info()["workers"])
         scattered = client.scatter(data, broadcast=True)
-        futures = {client.submit(run_batch, scattered, batches[i], pure=False,
+        futures = {client.submit(run_batch, scattered, batches[i], analyse_only, pure=False,
                                  key=f"balancer-sweep-batch-{i}-{time.time_ns()}"): i
                    for i in todo}
         for future in as_completed(futures):

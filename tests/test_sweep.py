@@ -14,7 +14,7 @@ import pytest
 from balancer.balance.optimizer import optimize
 from balancer.cli import main
 from balancer.errors import OutputError, SpecError
-from balancer.spec import design_from_dict
+from balancer.spec import design_from_dict, load_design
 from balancer.sweep import Vary, design_points, sweep, with_values
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -154,7 +154,11 @@ def test_sweep_command(tmp_path, capsys):
     assert png.read_bytes()[:4] == b"\x89PNG"
     # Bad input: one line, exit 2, nothing written.
     for args in (["--vary", "nonsense"], ["--vary", f"{COUPLER}=1:2:3", "--out", "x.csv"],
-                 ["--vary", "mechanism.lengths.nope=1:2:2"]):
+                 ["--vary", "mechanism.lengths.nope=1:2:2"],
+                 ["--perturb", "links.crank.mass=-1", "--samples", "5"],
+                 ["--perturb", "links.crank.mass=0.1"],
+                 ["--perturb", "links.crank.mass=0.1", "--samples", "5", "--vary",
+                  f"{COUPLER}=2.6:3.4:3"]):
         argv = ["sweep", str(PB1), *args]
         if "--out" not in args:
             argv += ["--out", str(tmp_path / "bad.parquet")]
@@ -162,3 +166,40 @@ def test_sweep_command(tmp_path, capsys):
         assert len(capsys.readouterr().err.strip().splitlines()) == 1
     assert not (tmp_path / "bad.parquet").exists()
     assert not (tmp_path / "bad.parquet.parts").exists()
+
+
+def test_perturbed_designs_have_the_residual_force_that_linearity_predicts(tmp_path):
+    """Around a force-balanced design (PB1's optimum) the shaking force is linear in the
+    crank's mass at its fixed centre of mass: F(θ) = δm·f(θ), f the force per kilogram. So every
+    perturbed design's RMS shaking force is |δm|·RMS(f), with RMS(f) found here by one cycle
+    analysis of the balanced design with 1 kg more (exact, by linearity; the balanced design's
+    own residual is rounding, 1e-12 of its terms)."""
+    import numpy as np
+
+    from balancer.cycle import cycle_analysis
+    from balancer.spec import dumps_design, loads_design
+    from balancer.sweep import Perturb
+
+    design = load_design(PB1)
+    balanced = optimize(design, "convex").balanced_design(design)
+    spec = tmp_path / "balanced.toml"
+    spec.write_text(dumps_design(balanced))
+    data = tomllib.loads(spec.read_text())
+    heavier = loads_design(dumps_design(balanced).replace(
+        f"mass = {balanced.mechanism.crank.mass!r}",
+        f"mass = {balanced.mechanism.crank.mass + 1.0!r}", 1))
+    assert heavier.mechanism.crank.mass == balanced.mechanism.crank.mass + 1.0
+    per_kg = cycle_analysis(heavier.mechanism, 10.0, 360, loads=False).summary.shaking_force.rms
+    out = tmp_path / "perturbed.parquet"
+    result = sweep(spec, [], out, perturbs=[Perturb.parse("links.crank.mass=0.01")],
+                   samples=40, seed=7, workers=0)
+    rows = _rows(out)
+    assert result.statuses == {"analysed": 40}
+    base = data["links"]["crank"]["mass"]
+    for row in rows:
+        delta = row["links.crank.mass"] - base
+        assert row["shaking_force_before"] == pytest.approx(abs(delta) * per_kg, rel=1e-9)
+    # The draws are normal with the deviation asked for (40 draws: within 3 standard errors).
+    deltas = np.array([r["links.crank.mass"] - base for r in rows])
+    assert abs(deltas.std(ddof=1) / 0.01 - 1) < 3 / np.sqrt(2 * 39)
+    assert set(result.residual_force) >= {"mean", "p95", "max"}
