@@ -1,9 +1,12 @@
-"""Regenerate ``docs/gallery/``: the studies in full mode, a few of their figures, an animation.
+"""Regenerate ``docs/gallery/``: the studies' figures, report pictures, an animation.
 
 Runs every study (``studies/*.py`` with a ``run``) in full mode into ``studies/out/<name>/``,
-copies the figures listed in :data:`CHOSEN` into ``docs/gallery/`` under stable names, and
-writes an animation of the example of Meijaard & van der Wijk (2020), Eq. 56
-(``examples/meijaard2020.toml``) with :func:`balancer.plots.animate`. The gallery is committed,
+copies the figures listed in :data:`CHOSEN` into ``docs/gallery/`` under stable names, runs the
+``balancer`` commands of :data:`COMMANDS` (the README's, word for word: the report pictures of
+``plot --cycle`` and ``verify --plot``, from designs balanced by ``optimize`` into
+``studies/out/gallery/``), and writes an animation of the example of Meijaard & van der Wijk
+(2020), Eq. 56 (``examples/meijaard2020.toml``) with :func:`balancer.plots.animate`. The
+gallery is committed,
 so each file must stay small (:data:`MAX_BYTES`); the script says which one does not and exits
 with status 1.
 
@@ -14,12 +17,14 @@ holds the README text that shows them.
 from __future__ import annotations
 
 import importlib.util
+import shlex
 import shutil
 import sys
 import time
 from pathlib import Path
 from types import ModuleType
 
+from balancer.cli import main as balancer
 from balancer.plots import animate
 from balancer.spec import load_design
 
@@ -35,6 +40,19 @@ CHOSEN = (
     ("bai2024_lie_group", "fig7_parallelogram.png", "bai_parallelogram.png"),
     ("linkages", "jansen_s_leg.png", "jansen_leg_balanced.png"),
     ("linkages", "stephenson_six_bar.png", "stephenson_balanced.png"),
+)
+#: Report pictures by the command line, as the README shows them: (gallery name, commands run
+#: from the repository's root; ``OUT`` is ``studies/out/gallery``). Each command overwrites.
+COMMANDS = (
+    ("pb1_cycle.png", (
+        "balancer optimize examples/pb1.toml --out OUT/pb1_balanced.toml",
+        "balancer plot OUT/pb1_balanced.toml --cycle docs/gallery/pb1_cycle.png")),
+    ("pb1_verify.png", (
+        "balancer verify OUT/pb1_balanced.toml --duration 2 --plot docs/gallery/pb1_verify.png",
+    )),
+    ("engine_cycle.png", (
+        "balancer optimize examples/engine.toml --out OUT/engine_balanced.toml",
+        "balancer plot OUT/engine_balanced.toml --cycle docs/gallery/engine_cycle.png")),
 )
 ANIMATION = "meijaard2020.gif"
 FRAMES = 48
@@ -52,6 +70,36 @@ def load_study(name: str) -> ModuleType:
     return module
 
 
+def command_argv(command: str) -> list[str]:
+    """The arguments of a :data:`COMMANDS` line, paths from the repository's root."""
+    words = shlex.split(command.replace("OUT/", "studies/out/gallery/"))
+    assert words[0] == "balancer"
+    return [str(ROOT / w) if "/" in w else w for w in words[1:]]
+
+
+def run_commands() -> list[Path]:
+    """Run :data:`COMMANDS` (overwriting their outputs); the gallery files they wrote."""
+    (HERE / "out" / "gallery").mkdir(parents=True, exist_ok=True)
+    for _, commands in COMMANDS:
+        for command in commands:
+            start = time.perf_counter()
+            status = balancer([*command_argv(command), "--force"])
+            if status != 0:
+                raise SystemExit(f"{command}: exit {status}")
+            print(f"{command:<88} {time.perf_counter() - start:6.1f} s")
+    return [palette_png(GALLERY / target) for target, _ in COMMANDS]
+
+
+def palette_png(path: Path) -> Path:
+    """Rewrite a PNG with a palette of 256 colours (a plot has few): a third of the bytes."""
+    from PIL import Image
+
+    with Image.open(path) as image:
+        small = image.convert("RGB").quantize(colors=256, method=Image.Quantize.MEDIANCUT)
+    small.save(path, format="PNG", optimize=True)
+    return path
+
+
 def main() -> int:
     """Run the studies, fill the gallery, report sizes; 0 if every file is within budget."""
     GALLERY.mkdir(parents=True, exist_ok=True)
@@ -62,6 +110,7 @@ def main() -> int:
         print(f"{name:<24} {time.perf_counter() - start:6.1f} s")
     for study, figure, target in CHOSEN:
         written.append(Path(shutil.copyfile(HERE / "out" / study / figure, GALLERY / target)))
+    written.extend(run_commands())
     design = load_design(ROOT / "examples" / "meijaard2020.toml")
     written.append(animate(design.mechanism, GALLERY / ANIMATION, frames=FRAMES,
                            title=design.title))

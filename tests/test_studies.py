@@ -318,3 +318,21 @@ def test_gallery_shows_figures_the_studies_make(quick):
         assert committed.stat().st_size <= gallery.MAX_BYTES[committed.suffix]
     animation = gallery.GALLERY / gallery.ANIMATION
     assert animation.stat().st_size <= gallery.MAX_BYTES[".gif"]
+
+
+def test_gallery_report_pictures_come_from_the_readmes_commands():
+    # docs/gallery's pictures of `plot --cycle` and `verify --plot` are made by make_gallery
+    # running these commands; the README shows each picture and its commands.
+    from balancer.cli import build_parser
+
+    gallery = load("make_gallery")
+    readme = (STUDIES.parent / "README.md").read_text(encoding="utf-8")
+    parser = build_parser()
+    for target, commands in gallery.COMMANDS:
+        picture = gallery.GALLERY / target
+        assert picture.stat().st_size <= gallery.MAX_BYTES[picture.suffix]
+        assert f"](docs/gallery/{target})" in readme
+        for command in commands:
+            parser.parse_args(gallery.command_argv(command))  # a valid command line
+            shown = command.replace("OUT/", "").replace("docs/gallery/", "")
+            assert shown in readme, shown
