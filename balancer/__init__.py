@@ -25,6 +25,24 @@ from typing import TYPE_CHECKING, Any
 #: Where each public name lives.
 _EXPORTS = {
     "analyze": "api",
+    "example": "api",
+    "optimize": "api",
+    "pareto": "api",
+    "simulate": "api",
+    "to_dict": "api",
+    "to_table": "api",
+    "verify": "api",
+    "sweep": "sweeps",
+    "Vary": "sweeps",
+    "Perturb": "sweeps",
+    "SliderCrank": "model",
+    "GasForce": "model",
+    "Linkage": "model",
+    "animate": "plots",
+    "cycle_figure": "plots",
+    "front_figure": "plots",
+    "save_figure": "plots",
+    "verification_figure": "plots",
     "AssemblyError": "errors",
     "BalancerError": "errors",
     "LockupError": "errors",
@@ -42,6 +60,24 @@ _EXPORTS = {
 }
 
 __all__ = [
+    "example",
+    "optimize",
+    "pareto",
+    "simulate",
+    "sweep",
+    "to_dict",
+    "to_table",
+    "verify",
+    "Vary",
+    "Perturb",
+    "SliderCrank",
+    "GasForce",
+    "Linkage",
+    "animate",
+    "cycle_figure",
+    "front_figure",
+    "save_figure",
+    "verification_figure",
     "AssemblyError",
     "BalancerError",
     "Design",
@@ -76,7 +112,18 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # for type checkers and editors: the names as they are
-    from .api import analyze
+    from .api import analyze, example, optimize, pareto, simulate, to_dict, to_table, verify
     from .errors import AssemblyError, BalancerError, LockupError, SolverError, SpecError
-    from .model import Design, FourBar, Link, Operation, SimulationSettings
+    from .model import (
+        Design,
+        FourBar,
+        GasForce,
+        Link,
+        Linkage,
+        Operation,
+        SimulationSettings,
+        SliderCrank,
+    )
+    from .plots import animate, cycle_figure, front_figure, save_figure, verification_figure
     from .spec import dumps_design, load_design, loads_design, save_design
+    from .sweeps import Perturb, Vary, sweep

@@ -51,3 +51,107 @@ def analyze(design: Design, *, route: str | None = None,
         gravity = v.vector2(gravity, "gravity")
         check_scales(design.mechanism, {"operation.speed": op.speed}, {"gravity": gravity})
     return cycle_analysis(design.mechanism, op.speed, op.samples, route=route, gravity=gravity)
+
+
+def optimize(design: Design, *, backend: str = "nlp"):
+    """The balanced design of the spec's ``[balance]`` problem (:class:`BalanceResult`).
+
+    ``backend`` ``"nlp"`` (the certified convex optimum, then IPOPT on the designer's own
+    parameters) or ``"convex"``. See :func:`balancer.balance.optimizer.optimize`.
+    """
+    from .balance.optimizer import optimize as run
+
+    return run(design, backend)
+
+
+def simulate(design: Design, *, method: str | None = None, drive: str | None = None,
+             duration: float | None = None, rtol: float | None = None,
+             atol: float | None = None, outputs: int | None = None):
+    """Forward dynamics from the spec's ``[simulation]``, each keyword overriding it.
+
+    Returns a :class:`~balancer.simulation.Trajectory`. See
+    :func:`balancer.simulation.simulate_design`.
+    """
+    from .simulation import simulate_design
+
+    return simulate_design(design, method=method, drive=drive, duration=duration, rtol=rtol,
+                           atol=atol, outputs=outputs)
+
+
+def verify(design: Design, *, method: str | None = None, duration: float | None = None):
+    """Proof by simulation (driven and free) that a design is balanced (:class:`Verification`).
+
+    See :func:`balancer.verification.verify`.
+    """
+    from .verification import verify as run
+
+    return run(design, method=method, duration=duration)
+
+
+def pareto(design: Design, *, against: str, points: int = 11):
+    """The exact front of least RMS shaking moment against ``against`` (:class:`Front`).
+
+    ``against``: ``"driving-torque"``, ``"added-mass"`` or ``"shaking-force"``. See
+    :func:`balancer.balance.pareto.pareto_front`.
+    """
+    from .balance.pareto import pareto_front
+
+    return pareto_front(design, against, points)
+
+
+def example(name: str) -> Design:
+    """A design spec shipped with the package, by name (``balancer example`` lists them)."""
+    from . import examples
+
+    return examples.load(name)
+
+
+def to_dict(result) -> dict:
+    """Any result as the plain dictionary the command line prints with ``--json``.
+
+    A cycle analysis (``analyze``), a balancing result (``optimize``: before and after are its
+    own inertial analyses), a trajectory (``simulate``), a verification (``verify``) or a front
+    (``pareto``).
+    """
+    from . import report
+    from .balance.pareto import Front
+    from .balance.result import BalanceResult
+    from .simulation import Trajectory
+    from .verification import Verification
+
+    if isinstance(result, CycleAnalysis):
+        return report.analysis_json(result)
+    if isinstance(result, BalanceResult):
+        return report.optimization_json(result, result.before, result.after)
+    if isinstance(result, Trajectory):
+        return report.simulation_json(result)
+    if isinstance(result, Verification | Front):
+        return result.as_dict()
+    raise TypeError(f"no dictionary form for {type(result).__name__}")
+
+
+def to_table(result):
+    """A cycle analysis or a trajectory as a tidy table (``pyarrow.Table``, one row per sample).
+
+    The columns of ``analyze --csv`` or ``simulate --out --all-columns`` (SI units); a front's
+    points, one row each. ``.to_pandas()`` gives a DataFrame where pandas is installed.
+    """
+    import numpy as np
+    import pyarrow as pa
+
+    from . import report
+    from .balance.pareto import Front
+    from .simulation import Trajectory
+
+    if isinstance(result, CycleAnalysis):
+        names, values = report.analysis_columns(result)
+    elif isinstance(result, Trajectory):
+        names, values = report.simulation_columns(result, all_columns=True)
+    elif isinstance(result, Front):
+        rows = result.as_dict()["points"]
+        return pa.Table.from_pylist(rows)
+    else:
+        raise TypeError(f"no table form for {type(result).__name__}")
+    n = np.shape(values[0])
+    return pa.table({name: np.broadcast_to(np.asarray(v, dtype=float), n)
+                     for name, v in zip(names, values, strict=True)})

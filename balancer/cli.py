@@ -98,7 +98,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from .outputs import write_atomic
     from .progress import Progress
     from .report import dumps_json, simulation_csv, simulation_json, simulation_text
-    from .simulate import simulate_design
+    from .simulation import simulate_design
     from .spec import load_design
 
     out = _output_path(args, args.out, "--out")
@@ -135,7 +135,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 def _cmd_verify(args: argparse.Namespace) -> int:
     from .report import dumps_json, verification_text
     from .spec import load_design
-    from .verify import verify
+    from .verification import verify
 
     plot = _output_path(args, args.plot, "--plot")
     if plot is not None:
@@ -169,7 +169,7 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     from .outputs import write_atomic
     from .report import dumps_json, optimization_json, optimization_text
     from .spec import dumps_design, load_design, loads_design
-    from .verify import verify
+    from .verification import verify
 
     out = _output_path(args, args.out, "--out")
     design = load_design(args.spec)
@@ -268,7 +268,7 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from .progress import Progress
     from .report import dumps_json, sweep_text
-    from .sweep import Perturb, Vary, sweep
+    from .sweeps import Perturb, Vary, sweep
 
     varies = [Vary.parse(text) for text in args.vary or ()]
     perturbs = [Perturb.parse(text) for text in args.perturb or ()]

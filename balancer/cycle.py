@@ -165,6 +165,13 @@ class CycleAnalysis:
             slider_couple={k: Figure.of(v) for k, v in r.slider_couple.items()},
         ))
 
+    def __repr__(self) -> str:
+        s = self.summary
+        return (f"CycleAnalysis({self.mechanism.kind}, {self.samples} angles at "
+                f"{self.speed:g} rad/s: RMS shaking force {s.shaking_force.rms:.4g} N, "
+                f"shaking moment {s.shaking_moment.rms:.4g} N·m, driving torque "
+                f"{s.driving_torque.rms:.4g} N·m)")
+
     @property
     def linkage(self):
         """The mechanism's model (a FourBar, SliderCrank or Linkage)."""

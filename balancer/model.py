@@ -864,7 +864,7 @@ class SimulationSettings:
     omega1
         Initial crank speed, rad/s; when ``drive`` is ``"constant-speed"``, the constant speed
         (where it is zero, a design's simulation takes the operating speed ``[operation] speed``:
-        :func:`balancer.simulate.simulate_design`).
+        :func:`balancer.simulation.simulate_design`).
     gravity
         Gravitational acceleration ``(gx, gy)``, m/s² (``(0, 0)``: none).
     drive

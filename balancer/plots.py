@@ -18,7 +18,7 @@ from .errors import OutputError
 from .mechanisms import mechanism_of
 from .model import GROUND
 from .outputs import write_with
-from .simulate import Trajectory
+from .simulation import Trajectory
 
 #: Colours for the sum, before and after (colour-blind safe, Okabe & Ito).
 COLOURS = {"sum": "#000000", "before": "#999999", "after": "#009E73", "link": "#0072B2",

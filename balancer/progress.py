@@ -1,8 +1,9 @@
 """Progress of long work, for a person watching a terminal (tqdm, on stderr).
 
 A :class:`Progress` is a callable ``progress(done, total)`` that the long computations accept
-(:func:`balancer.simulate.simulate` with simulated seconds, :func:`balancer.verify.verify` with
-the simulated seconds of all its runs). It draws a bar only when its stream is a terminal and
+(:func:`balancer.simulation.simulate` with simulated seconds,
+:func:`balancer.verification.verify` with the simulated seconds of all its runs). It draws a
+bar only when its stream is a terminal and
 the command was not asked for a machine-readable document (``--json``), and only once the work
 has lasted :data:`DELAY` seconds: a quick command, a pipe, a log file or a JSON reader sees
 nothing. tqdm is imported only when a bar is first drawn.

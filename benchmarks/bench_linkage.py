@@ -39,7 +39,7 @@ def main() -> None:
     from balancer.balance.optimizer import optimize
     from balancer.cycle import cycle_analysis
     from balancer.formulations import default_method
-    from balancer.simulate import simulate
+    from balancer.simulation import simulate
     from balancer.spec import load_design
 
     rows = []

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from balancer.mechanisms.fourbar import FourBarMechanism
-from balancer.simulate import simulate_design
+from balancer.simulation import simulate_design
 from balancer.spec import load_design
 
 #: The paper's four formulations of the four-bar.

@@ -25,7 +25,7 @@ SPEC = ROOT / "examples" / "pb1.toml"
 
 
 def _grid(n: int):
-    from balancer.sweep import Vary
+    from balancer.sweeps import Vary
 
     side = round(n**0.5)
     return [Vary.parse(f"mechanism.lengths.coupler=2.0:4.0:{side}"),
@@ -33,7 +33,7 @@ def _grid(n: int):
 
 
 def _loop(n: int) -> float:
-    from balancer.sweep import design_points, evaluate_point
+    from balancer.sweeps import design_points, evaluate_point
 
     data = tomllib.loads(SPEC.read_text())
     points = design_points(_grid(n))
@@ -44,7 +44,7 @@ def _loop(n: int) -> float:
 
 
 def _sweep(n: int, workers: int) -> float:
-    from balancer.sweep import sweep
+    from balancer.sweeps import sweep
 
     with tempfile.TemporaryDirectory() as tmp:
         start = time.perf_counter()
@@ -53,7 +53,7 @@ def _sweep(n: int, workers: int) -> float:
 
 
 def main() -> None:
-    from balancer.sweep import design_points, evaluate_point
+    from balancer.sweeps import design_points, evaluate_point
 
     # Warm-up: imports and first-call costs of this process.
     data = tomllib.loads(SPEC.read_text())

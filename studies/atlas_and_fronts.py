@@ -31,7 +31,7 @@ from balancer.balance.pareto import pareto_front
 from balancer.plots import front_figure, save_png, sweep_figure
 from balancer.report import markdown_table
 from balancer.spec import load_design
-from balancer.sweep import Vary, sweep
+from balancer.sweeps import Vary, sweep
 
 NAME = "atlas_and_fronts"
 ROOT = Path(__file__).resolve().parents[1]

@@ -41,7 +41,7 @@ from balancer.mechanisms.fourbar import FourBarMechanism
 from balancer.model import FourBar, Link, SimulationSettings
 from balancer.plots import SERIES, save_png
 from balancer.report import markdown_table
-from balancer.simulate import simulate
+from balancer.simulation import simulate
 
 #: The paper's four formulations of the four-bar.
 METHODS = tuple(FourBarMechanism.formulations)

@@ -34,7 +34,7 @@ from balancer.conditions import berkof_residuals, force_balance_error
 from balancer.plots import COLOURS, save_png, verification_figure
 from balancer.report import markdown_table
 from balancer.spec import load_design
-from balancer.verify import verify
+from balancer.verification import verify
 
 NAME = "benchmarks_pb"
 ROOT = Path(__file__).resolve().parents[1]

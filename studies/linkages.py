@@ -38,7 +38,7 @@ from balancer.mechanisms import mechanism_of
 from balancer.plots import COLOURS, SERIES, frame, save_png
 from balancer.report import markdown_table
 from balancer.spec import load_design
-from balancer.verify import verify
+from balancer.verification import verify
 
 NAME = "linkages"
 ROOT = Path(__file__).resolve().parents[1]

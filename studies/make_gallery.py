@@ -32,7 +32,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 GALLERY = ROOT / "docs" / "gallery"
 STUDIES = ("meijaard2020_example", "meijaard2020_balanced", "wunderlich1964",
-           "bai2024_lie_group", "benchmarks_pb", "linkages")
+           "bai2024_lie_group", "benchmarks_pb", "linkages", "atlas_and_fronts")
 #: (study, figure it writes, name in the gallery).
 CHOSEN = (
     ("meijaard2020_balanced", "comparison.png", "balancing_four_designs.png"),
@@ -40,6 +40,9 @@ CHOSEN = (
     ("bai2024_lie_group", "fig7_parallelogram.png", "bai_parallelogram.png"),
     ("linkages", "jansen_s_leg.png", "jansen_leg_balanced.png"),
     ("linkages", "stephenson_six_bar.png", "stephenson_balanced.png"),
+    ("atlas_and_fronts", "atlas.png", "pb1_atlas.png"),
+    ("atlas_and_fronts", "front_torque.png", "pb1_front_torque.png"),
+    ("atlas_and_fronts", "front_mass.png", "pb1_front_mass.png"),
 )
 #: Report pictures by the command line, as the README shows them: (gallery name, commands run
 #: from the repository's root; ``OUT`` is ``studies/out/gallery``). Each command overwrites.

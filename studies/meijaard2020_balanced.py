@@ -42,7 +42,7 @@ from balancer.mechanisms.fourbar import FourBarMechanism
 from balancer.model import SimulationSettings
 from balancer.plots import COLOURS, SERIES, plot_reactions, save_png
 from balancer.report import markdown_table
-from balancer.simulate import simulate
+from balancer.simulation import simulate
 from balancer.spec import dumps_design, load_design, loads_design
 
 #: The paper's four formulations of the four-bar.

@@ -33,7 +33,7 @@ from balancer.formulations import make
 from balancer.mechanisms.fourbar import FourBarMechanism
 from balancer.plots import COLOURS, SERIES, save_png
 from balancer.report import markdown_table
-from balancer.simulate import simulate
+from balancer.simulation import simulate
 from balancer.spec import load_design
 
 #: The paper's four formulations of the four-bar.

@@ -42,7 +42,7 @@ from balancer.massmodels import link_centres_of_mass, total_com_direct, wunderli
 from balancer.model import FourBar, Link, SimulationSettings, SliderCrank
 from balancer.plots import COLOURS, SERIES, save_png
 from balancer.report import markdown_table
-from balancer.simulate import simulate
+from balancer.simulation import simulate
 from balancer.slider_crank import conditions as sc_cond
 from balancer.slider_crank import kinematics as sk
 from balancer.slider_crank import massmodels as sm

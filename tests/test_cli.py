@@ -16,7 +16,7 @@ from helpers import growth, integration_bound
 from balancer import spec
 from balancer.cli import main
 from balancer.report import ANALYSIS_COLUMNS
-from balancer.simulate import simulate
+from balancer.simulation import simulate
 
 EXAMPLE = str(Path(__file__).resolve().parent.parent / "examples" / "meijaard2020.toml")
 

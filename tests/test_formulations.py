@@ -16,7 +16,7 @@ from balancer.errors import LockupError
 from balancer.formulations import make
 from balancer.mechanisms.fourbar import FourBarMechanism
 from balancer.model import FourBar, Link, SimulationSettings
-from balancer.simulate import DEAD_POINT_THRESHOLD, simulate
+from balancer.simulation import DEAD_POINT_THRESHOLD, simulate
 
 #: The paper's four formulations of the four-bar.
 METHODS = tuple(FourBarMechanism.formulations)

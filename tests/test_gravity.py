@@ -27,7 +27,7 @@ from balancer.cli import main
 from balancer.cycle import cycle_analysis
 from balancer.errors import SpecError
 from balancer.model import SimulationSettings
-from balancer.simulate import simulate
+from balancer.simulation import simulate
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 G = (0.7, -9.81)

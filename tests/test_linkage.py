@@ -81,7 +81,7 @@ def test_a_simulated_linkage_agrees_with_its_four_bar(method):
     # motion's amplification of a step's error).
     from helpers import growth
 
-    from balancer.simulate import simulate
+    from balancer.simulation import simulate
 
     design = load_design(EXAMPLES / "meijaard2020.toml")
     settings = replace(design.simulation, duration=1.0)

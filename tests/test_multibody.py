@@ -14,7 +14,7 @@ from test_slider_crank import _angles as slider_angles
 from balancer.formulations import make
 from balancer.mechanisms import mechanism_of
 from balancer.model import SimulationSettings
-from balancer.simulate import simulate
+from balancer.simulation import simulate
 from balancer.spec import loads_design
 
 #: A Watt six-bar with a ternary rocker, loads, a spring to the frame and a counter-rotor.
@@ -489,7 +489,7 @@ def test_a_compiled_dop853_step_is_scipys_step(method, driven):
     from scipy.integrate import DOP853
 
     from balancer.integration import CompiledDOP853, Stages, with_extra_work
-    from balancer.simulate import _WithExtraWork
+    from balancer.simulation import _WithExtraWork
 
     design = _watt()
     f = make(method, design.mechanism, gravity=design.simulation.gravity,

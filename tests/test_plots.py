@@ -241,14 +241,14 @@ def test_every_animation_extension_is_checked(tmp_path):
 
 
 def _verify(path, **kw):
-    from balancer.verify import verify
+    from balancer.verification import verify
 
     return verify(load_design(path), **kw)
 
 
 def test_the_verification_figure_draws_before_and_after_on_every_panel(pb1_balanced):
     design = load_design(pb1_balanced)
-    from balancer.verify import verify
+    from balancer.verification import verify
 
     v = verify(design, duration=0.3)
     fig = plots.verification_figure(design, v)
@@ -295,7 +295,7 @@ def test_a_design_without_an_original_keeps_the_papers_components():
 def test_verify_samples_every_run_finely_enough_to_draw_it():
     # The paper's four-bar driven at 10 rad/s for 5 s turns eight times: 501 outputs would
     # give 6° steps; verify takes at least PER_REVOLUTION a turn.
-    from balancer import verify as verify_module
+    from balancer import verification as verify_module
 
     v = _verify(EXAMPLES / "meijaard2020.toml")
     step = 2 * np.pi / verify_module.PER_REVOLUTION
@@ -306,7 +306,7 @@ def test_verify_samples_every_run_finely_enough_to_draw_it():
 
 
 def test_a_free_run_faster_than_estimated_is_run_again_finer(tmp_path, monkeypatch):
-    from balancer import verify as verify_module
+    from balancer import verification as verify_module
 
     monkeypatch.setattr(verify_module, "FREE_MARGIN", 0.01)  # a poor first estimate
     text = (EXAMPLES / "meijaard2020.toml").read_text().replace("omega1 = 0.0", "omega1 = 30.0")

@@ -245,7 +245,7 @@ def test_a_simulation_cannot_start_at_a_change_point(tmp_path, capsys):
 
 def test_a_driven_lie_group_simulation_passes_a_change_point():
     """It projected its state by writing past the end of the driven state (IndexError)."""
-    from balancer.simulate import simulate
+    from balancer.simulation import simulate
 
     link = Link(mass=1.0, inertia=0.1, e=0.3, f=0.0)
     linkage = FourBar(lengths=(1.0, 2.0, 1.0, 2.0), crank=link, coupler=link, rocker=link)
@@ -256,7 +256,7 @@ def test_a_driven_lie_group_simulation_passes_a_change_point():
 
 def test_a_run_that_stalls_at_a_change_point_fails_naming_it():
     """At rtol 1e-11 the opened loop shrank its steps near the change point without end."""
-    from balancer.simulate import STALL_WINDOW, simulate
+    from balancer.simulation import STALL_WINDOW, simulate
 
     design = spec.loads_design("""
         [mechanism]
@@ -295,7 +295,7 @@ def test_a_run_that_stalls_at_a_change_point_fails_naming_it():
 
 def test_a_run_stopped_at_a_dead_point_is_verified_over_its_span():
     """Both runs stop at the near-dead point of a crank as long as the rod: figures over each."""
-    from balancer.verify import verify
+    from balancer.verification import verify
 
     link = Link(mass=0.7, inertia=0.09, e=0.3, f=0.13)
     mech = SliderCrank(lengths=(0.7326, 0.7326000732600001, 0.0), crank=link,
@@ -754,7 +754,7 @@ def test_a_linkage_at_rest_in_equilibrium_keeps_its_energy_balance(method):
     # springs, loads and gravity could exchange over the linkage's size: the error is rounding.
     from pathlib import Path
 
-    from balancer.simulate import simulate
+    from balancer.simulation import simulate
     from balancer.spec import load_design
 
     design = load_design(Path(__file__).resolve().parent / "data" / "spring_linkage_at_rest.toml")

@@ -20,7 +20,7 @@ from balancer.errors import AssemblyError, SpecError
 from balancer.formulations import make
 from balancer.kinematics import cross
 from balancer.model import GasForce, Link, SimulationSettings, SliderCrank
-from balancer.simulate import simulate
+from balancer.simulation import simulate
 from balancer.slider_crank import conditions as sc_cond
 from balancer.slider_crank import dynamics as sd
 from balancer.slider_crank import kinematics as sk

@@ -21,7 +21,7 @@ from helpers import drift_bound, growth, integration_bound
 from balancer import kinematics as kin
 from balancer.balance.result import GAP_TOLERANCE
 from balancer.model import SimulationSettings
-from balancer.simulate import simulate
+from balancer.simulation import simulate
 
 STUDIES = Path(__file__).resolve().parent.parent / "studies"
 PNG = b"\x89PNG\r\n\x1a\n"

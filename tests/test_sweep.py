@@ -1,4 +1,4 @@
-"""Design-space sweeps (balancer/sweep.py, ``balancer sweep``), on Dask and in process."""
+"""Design-space sweeps (balancer/sweeps.py, ``balancer sweep``), on Dask and in process."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from balancer.balance.optimizer import optimize
 from balancer.cli import main
 from balancer.errors import OutputError, SpecError
 from balancer.spec import design_from_dict, load_design
-from balancer.sweep import Vary, design_points, sweep, with_values
+from balancer.sweeps import Vary, design_points, sweep, with_values
 
 ROOT = Path(__file__).resolve().parent.parent
 PB1 = ROOT / "examples" / "pb1.toml"
@@ -178,7 +178,7 @@ def test_perturbed_designs_have_the_residual_force_that_linearity_predicts(tmp_p
 
     from balancer.cycle import cycle_analysis
     from balancer.spec import dumps_design, loads_design
-    from balancer.sweep import Perturb
+    from balancer.sweeps import Perturb
 
     design = load_design(PB1)
     balanced = optimize(design, "convex").balanced_design(design)

@@ -13,7 +13,7 @@ from balancer import spec
 from balancer.balance.result import GAP_TOLERANCE
 from balancer.cli import main
 from balancer.conditions import berkof_residuals, force_balance_error
-from balancer.verify import verify
+from balancer.verification import verify
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

@@ -22,7 +22,7 @@ measured over its range.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -71,7 +71,7 @@ class FrontPoint:
     value: float
     epsilon: float
     lower_bound: float
-    x: NDArray[np.float64]
+    x: NDArray[np.float64] = field(repr=False)
     knee: bool = False
 
 
@@ -86,6 +86,11 @@ class Front:
     against: str
     points: tuple[FrontPoint, ...]
     original: tuple[float, float] = (math.nan, math.nan)
+
+    def __repr__(self) -> str:
+        ends = (f"{self.points[0].value:.4g}–{self.points[-1].value:.4g} {self.unit}, "
+                f"{self.points[0].shaking_moment:.4g}–{self.points[-1].shaking_moment:.4g} N·m")
+        return f"Front(against {self.against}, {len(self.points)} points: {ends})"
 
     @property
     def name(self) -> str:

@@ -148,6 +148,10 @@ class BalanceResult:
     before: CycleAnalysis
     after: CycleAnalysis
 
+    def __repr__(self) -> str:
+        return (f"BalanceResult({self.status}, {self.backend}: {self.message}; added mass "
+                f"{self.added_mass:.4g} kg)")
+
     @property
     def counterweights(self) -> dict[str, Counterweight]:
         """Per link, the body to add to the original link to build the balanced one."""

@@ -28,7 +28,7 @@ The seeds' formulations share :mod:`.closed_form` (a chain given by its lengths)
 either moves freely under the loads and gravity, or a motor on the ground holds it at constant
 speed; then the last state component is the motor's work ``∫τ·θ̇1 dt`` and the driving torque
 is reported. The integration itself (tolerances, projection of the non-minimal states, events,
-outputs) is :mod:`balancer.simulate`.
+outputs) is :mod:`balancer.simulation`.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 #: The transmission (|sin(θ3 − θ2)|, or the square root of a group's assembly gap) at which a
-#: formulation that cannot pass a dead point stops before it (:mod:`balancer.simulate`).
+#: formulation that cannot pass a dead point stops before it (:mod:`balancer.simulation`).
 DEAD_POINT_THRESHOLD = 1e-3
 
 @dataclass(frozen=True)
@@ -292,7 +292,7 @@ class Formulation(ABC):
 
         Such as the links' positions, angles, velocities and rates. The integrator holds no
         component of a group to an absolute error below the rounding of the group's largest
-        (:func:`balancer.simulate.floored_atol`): a component that is zero for the motion (the
+        (:func:`balancer.simulation.floored_atol`): a component that is zero for the motion (the
         velocity of a frame pinned at its origin) is computed from the others to their
         rounding, and a tolerance below that makes the steps shrink to the noise. None by
         default (each component is its own kind).
@@ -303,7 +303,7 @@ class Formulation(ABC):
         """Power of the loads whose work is not a function of the configuration, W.
 
         Such as a force that depends on the crank angle. The driver integrates it with the
-        motion (:mod:`balancer.simulate`); constant loads and gravity need none (their work is
+        motion (:mod:`balancer.simulation`); constant loads and gravity need none (their work is
         in :meth:`energy`), nor the motor (its work is a state of the driven formulations).
         """
         return 0.0

@@ -60,8 +60,8 @@ def _preload() -> None:
     import balancer.cli  # noqa: F401
     import balancer.plots  # noqa: F401
     import balancer.report  # noqa: F401
-    import balancer.simulate  # noqa: F401
-    import balancer.verify  # noqa: F401
+    import balancer.simulation  # noqa: F401
+    import balancer.verification  # noqa: F401
 
     for name in ("cvxpy", "casadi", "scipy.integrate", "matplotlib.figure", "PIL.Image",
                  "matplotlib.backends.backend_agg"):

@@ -79,9 +79,9 @@ def _preload() -> None:
     import balancer.balance.optimizer  # noqa: F401
     import balancer.cli  # noqa: F401
     import balancer.report  # noqa: F401
-    import balancer.simulate  # noqa: F401
+    import balancer.simulation  # noqa: F401
     import balancer.spec  # noqa: F401
-    import balancer.verify  # noqa: F401
+    import balancer.verification  # noqa: F401
 
     for name in ("balancer.balance.convex", "balancer.balance.nlp", "balancer.linkage.numeric",
                  "balancer.formulations.multibody", "cvxpy", "casadi", "scipy.integrate"):

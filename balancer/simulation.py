@@ -148,6 +148,11 @@ class Trajectory:
     model: object = field(repr=False, default=None)
     slider: NDArray[np.float64] | None = field(repr=False, default=None)
 
+    def __repr__(self) -> str:
+        return (f"Trajectory({self.method}, {self.drive}, {self.t.size} outputs over "
+                f"{self.t[-1] - self.t[0]:g} s, {self.steps} steps; energy balance to "
+                f"{self.energy_error:.2g})")
+
     @property
     def largest_reaction(self) -> float:
         """Largest magnitude of any force on the frame over the run, N (0 if none)."""

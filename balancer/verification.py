@@ -27,7 +27,7 @@ import numpy as np
 from .errors import LockupError, SpecError
 from .mechanisms import mechanism_of
 from .model import Design
-from .simulate import Trajectory, simulate
+from .simulation import Trajectory, simulate
 
 #: Output times per crank revolution at least: 2°, some fifteen across the engine example's
 #: sharpest peak (its gas force's).
@@ -124,6 +124,13 @@ class Verification:
     driven: RunCheck
     free: RunCheck
 
+    def __repr__(self) -> str:
+        def fmt(x):
+            return "none" if x is None else f"{x:.4g}"
+
+        return (f"Verification({self.method}: largest shaking force "
+                f"{fmt(self.max_shaking_force)} N, moment {fmt(self.max_shaking_moment)} N·m)")
+
     @property
     def max_shaking_force(self) -> float | None:
         """Largest shaking force over the runs, N (``None``: neither could start)."""
@@ -162,7 +169,7 @@ class _Tally:
         self.done = 0.0
 
     def simulate(self, linkage, settings, method: str, **kw) -> Trajectory:
-        """:func:`~balancer.simulate.simulate`, reporting its progress within the whole."""
+        """:func:`~balancer.simulation.simulate`, reporting its progress within the whole."""
         report = None
         if self.progress is not None:
             progress, done, total = self.progress, self.done, self.total
