@@ -109,9 +109,9 @@ def example(name: str) -> Design:
 def to_dict(result) -> dict:
     """Any result as the plain dictionary the command line prints with ``--json``.
 
-    A cycle analysis (``analyze``), a balancing result (``optimize``: before and after are its
-    own inertial analyses), a trajectory (``simulate``), a verification (``verify``) or a front
-    (``pareto``).
+    A cycle analysis (``analyze``), a balancing result (``optimize``: ``before`` and ``after``
+    with loads and gravity, ``inertial`` without, as the command prints them), a trajectory
+    (``simulate``), a verification (``verify``) or a front (``pareto``).
     """
     from . import report
     from .balance.pareto import Front
@@ -122,7 +122,7 @@ def to_dict(result) -> dict:
     if isinstance(result, CycleAnalysis):
         return report.analysis_json(result)
     if isinstance(result, BalanceResult):
-        return report.optimization_json(result, result.before, result.after)
+        return report.optimization_json(result, *result.operating)
     if isinstance(result, Trajectory):
         return report.simulation_json(result)
     if isinstance(result, Verification | Front):

@@ -163,7 +163,6 @@ def _cmd_verify(args: argparse.Namespace) -> int:
 
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
-    from .api import analyze
     from .balance.optimizer import optimize
     from .errors import SolverError
     from .outputs import write_atomic
@@ -179,7 +178,7 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     balanced = result.balanced_design(design)
     spec_text = dumps_design(balanced)
     loads_design(spec_text, source=str(out or "the balanced spec"))  # it must load again
-    before, after = analyze(design), analyze(balanced)
+    before, after = result.operating  # the analyze figures of both (loads and gravity)
     verification = None
     if not args.no_verify:
         from .progress import Progress

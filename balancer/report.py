@@ -578,6 +578,9 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
             "message": result.message,
             "before": before.summary.as_dict(),
             "after": after.summary.as_dict(),
+            # The inertial part alone, which the optimiser balances (loads and gravity left out).
+            "inertial": {"before": result.before.summary.as_dict(),
+                         "after": result.after.summary.as_dict()},
             "links": {name: link_parameters(linkage.link(name)) for name in linkage.link_names},
             "original_links": {name: link_parameters(result.original.link(name))
                                for name in linkage.link_names},

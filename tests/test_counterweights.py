@@ -270,3 +270,32 @@ def test_a_counterweight_too_small_to_balance_is_diagnosed_with_what_it_needs():
     assert radius == pytest.approx(delta / top, rel=1e-3) and radius >= delta / top
     assert mass == pytest.approx(delta / 0.1, rel=1e-3) and mass >= delta / 0.1
     assert m.isfinite(radius) and m.isfinite(mass)
+
+
+def test_optimize_reports_the_analyze_figures_and_the_inertial_ones_apart(tmp_path, capsys):
+    """The engine carries a gas force: ``optimize --json``'s ``before`` and ``after`` are
+    ``analyze --json``'s figures of the spec and of the balanced spec it writes (loads
+    included), ``inertial`` the optimiser's own view (the result's ``before``/``after``), and the
+    Python API's document is the same."""
+    import json
+
+    import balancer
+    from balancer.cli import main
+
+    out = tmp_path / "engine_balanced.toml"
+    assert main(["optimize", "examples/engine.toml", "--backend", "convex", "--no-verify",
+                 "--json", "--out", str(out)]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    for spec, key in (("examples/engine.toml", "before"), (str(out), "after")):
+        assert main(["analyze", spec, "--json"]) == 0
+        analysed = json.loads(capsys.readouterr().out)
+        for name in ("shaking_force", "shaking_moment", "driving_torque"):
+            assert doc[key][name] == analysed[name], (key, name)
+    result = balancer.optimize(balancer.load_design("examples/engine.toml"), backend="convex")
+    assert doc["inertial"]["before"] == result.before.summary.as_dict()
+    assert doc["inertial"]["after"] == result.after.summary.as_dict()
+    # The gas force makes the two differ: the inertial view leaves it out.
+    assert doc["before"]["shaking_force"]["rms"] != doc["inertial"]["before"]["shaking_force"][
+        "rms"]
+    api = balancer.to_dict(result)
+    assert api["before"] == doc["before"] and api["after"] == doc["after"]

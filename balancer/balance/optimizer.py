@@ -235,4 +235,5 @@ def optimize(design: Design, backend: str = "nlp") -> BalanceResult:
         raise SpecError(
             f"unknown backend; choose from {', '.join(BACKENDS)}", key="backend", value=backend
         )
-    return Optimizer(numeric_problem(design)).run(backend)
+    result = Optimizer(numeric_problem(design)).run(backend)
+    return replace(result, gravity=tuple(design.operation.gravity))

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from enum import StrEnum
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -125,7 +126,9 @@ class BalanceResult:
     before, after
         Cycle analyses of the original and the balanced design without loads (Newton–Euler
         route: an independent check of the objective, which the optimisers compute from the
-        mass-matrix regressors).
+        mass-matrix regressors); :attr:`operating` gives them with loads and gravity.
+    gravity
+        The spec's ``[operation] gravity`` (m/s²), for :attr:`operating`.
     """
 
     success: bool
@@ -147,10 +150,26 @@ class BalanceResult:
     stages: tuple[StageReport, ...]
     before: CycleAnalysis
     after: CycleAnalysis
+    gravity: tuple[float, float] = (0.0, 0.0)
 
     def __repr__(self) -> str:
         return (f"BalanceResult({self.status}, {self.backend}: {self.message}; added mass "
                 f"{self.added_mass:.4g} kg)")
+
+    @cached_property
+    def operating(self) -> tuple[CycleAnalysis, CycleAnalysis]:
+        """The original's and the balanced design's figures as ``analyze`` gives them.
+
+        At the operating speed with the links' loads (a gas force, applied forces) and the
+        spec's ``[operation] gravity``: what the machine's frame feels. :attr:`before` and
+        :attr:`after` are the inertial part alone, which the optimiser balances; without loads
+        and gravity the two agree.
+        """
+        from ..cycle import cycle_analysis
+
+        speed, samples = self.before.speed, self.before.samples
+        return tuple(cycle_analysis(model, speed, samples, gravity=self.gravity)
+                     for model in (self.original, self.linkage))  # type: ignore[return-value]
 
     @property
     def counterweights(self) -> dict[str, Counterweight]:
