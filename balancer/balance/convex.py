@@ -155,7 +155,8 @@ def layout(data: NumericProblem) -> Layout:
             c[k] = b.mass[0] + data.offset[k]
         if b.com_fixed is None:
             new_variable(k + 1)
-            new_variable(k + 2)
+            if not b.on_line:  # on the link's line, m·f stays 0
+                new_variable(k + 2)
         else:
             for i, part in ((k + 1, b.com_fixed.real), (k + 2, b.com_fixed.imag)):
                 c[i] = part * c[k]
@@ -601,6 +602,10 @@ class ConvexSolver:
         i = self._failed_row
         names = [b.name for b in data.links if np.any(a[i, b.start : b.start + 3])]
         keys = " or ".join(f"balance.{n}" for n in names)
+        lines = [b.key for b in data.links if b.on_line and b.name in names]
+        if lines:
+            keys += (f"; {', '.join(k + '.com_on_line' for k in lines)} keeps a centre of "
+                     "mass on its link's line, which this condition does not allow")
         return InfeasibleError(
             f"force balance cannot be met within the bounds: a condition of Eq. 58 among the "
             f"{', '.join(names)} fails by {rows[i]:.3g} of its terms and nothing in it may "
@@ -776,7 +781,14 @@ class ConvexSolver:
                 if m != x[k]:
                     u[index[k]] = (m + shift[k]) / data.scales[k]
                     pinned[index[k]] = True
-            if b.com_fixed is None:
+            if b.on_line:
+                x = data.own(lay.x(u))
+                lo, hi = b.line_span
+                s_x = min(max(x[k + 1], x[k] * lo), x[k] * hi)
+                if s_x != x[k + 1]:
+                    u[index[k + 1]] = s_x / data.scales[k + 1]
+                    pinned[index[k + 1]] = True
+            elif b.com_fixed is None:
                 x = data.own(lay.x(u))
                 m, d = x[k], complex(x[k + 1], x[k + 2]) - x[k] * b.com_centre
                 if abs(d) > m * b.com_radius:
@@ -928,7 +940,12 @@ class ConvexSolver:
                     j = index[k]
                     u[j] = np.clip(u[j], (b.mass[0] + shift[k]) / data.scales[k],
                                    (b.mass[1] + shift[k]) / data.scales[k])
-                if b.com_fixed is None:
+                if b.on_line:
+                    x = data.own(lay.x(u))
+                    lo, hi = b.line_span
+                    u[index[k + 1]] = min(max(x[k + 1], x[k] * lo), x[k] * hi) \
+                        / data.scales[k + 1]
+                elif b.com_fixed is None:
                     x = data.own(lay.x(u))
                     m, d = x[k], complex(x[k + 1], x[k + 2]) - x[k] * b.com_centre
                     if abs(d) > m * b.com_radius:
@@ -999,6 +1016,8 @@ class ConvexSolver:
                 rhs = 0.0
             if skip != group:
                 cons.append(lhs <= rhs + relax(group))
+            if b.on_line:
+                cons.append(s[i, 1] == 0)
             shift = data.offset[b.start : b.start + 3]  # a kept link's own, under a counterweight
             parts[b.start : b.start + 3] = [m[i] * mref + shift[0] * tau,
                                             s[i, 0] * mref * l + shift[1] * tau,

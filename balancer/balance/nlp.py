@@ -117,7 +117,12 @@ class NlpSolver:
                 varying.update((k, k + 1, k + 2))
             else:
                 m = b.mass[0]
-            if b.com_fixed is None:
+            if b.on_line:  # on the link's line: f = 0, e within the disc's chord
+                lo, hi = b.line_span
+                e = l * variable(f"e{b.index}", lo / l, hi / l, (b.index, "e"))
+                f = 0.0
+                varying.add(k + 1)
+            elif b.com_fixed is None:
                 c, r = b.com_centre / l, b.com_radius / l
                 e = l * variable(f"e{b.index}", c.real - r, c.real + r, (b.index, "e"))
                 f = l * variable(f"f{b.index}", c.imag - r, c.imag + r, (b.index, "f"))
@@ -216,7 +221,7 @@ class NlpSolver:
             )
         v = np.clip(np.array(out, float), self._lbx, self._ubx)
         for i, (index, kind) in enumerate(self._names):  # pull the centre of mass into its disc
-            if kind == "e":
+            if kind == "e" and not data.links[index].on_line:
                 b = data.links[index]
                 c, r = b.com_centre / b.length, b.com_radius / b.length
                 d = math.hypot(v[i] - c.real, v[i + 1] - c.imag)

@@ -93,7 +93,7 @@ _OBJECTIVE_KEYS = (
     "added_mass",
 )
 _LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "counter_rotor",
-              "counterweight")
+              "counterweight", "com_on_line")
 _COUNTERWEIGHT_KEYS = ("mass", "radius", "gyration")
 
 #: Relative tolerance of :meth:`NumericProblem.violations` for a solver's design (bounds and
@@ -194,6 +194,9 @@ class LinkFreedom:
     counterweight
         The link is kept and one counterweight added (:class:`CounterweightFreedom`); then
         ``mass``, ``com_radius``, ``min_gyration`` and ``inertia`` are ``None``.
+    com_on_line
+        The centre of mass stays on the link's line (its frame's x-axis, through its first
+        two points: ``f = 0``), within ``com_radius`` of ``com_about``.
     """
 
     mass: tuple[float, float] | None = None
@@ -203,6 +206,7 @@ class LinkFreedom:
     inertia: tuple[float, float] | None = None
     counter_rotor: tuple[float, float] | None = None
     counterweight: CounterweightFreedom | None = None
+    com_on_line: bool = False
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -317,9 +321,20 @@ def _read_link_freedom(table: _Table, points: tuple[str, ...]) -> LinkFreedom:
         inertia=_read_range(table, "inertia", positive=False, unit="kg·m²"),
         counter_rotor=_read_range(table, "counter_rotor", positive=False, unit="kg·m²"),
         counterweight=counterweight,
+        com_on_line=_read_flag(table, "com_on_line"),
     )
     table.finish()
     return freedom
+
+
+def _read_flag(table: _Table, name: str) -> bool:
+    """A ``true``/``false`` key (absent: false)."""
+    if not table.has(name):
+        return False
+    value = table.raw(name)
+    if not isinstance(value, bool):
+        raise SpecError("must be true or false", key=table.key(name), value=value)
+    return value
 
 
 def read_balance(table: _Table, mechanism) -> BalanceProblem:
@@ -436,6 +451,18 @@ def check_problem(problem: BalanceProblem, mechanism) -> None:
                     key=f"{key}.com_about",
                     value=freedom.com_about,
                 )
+        if freedom.com_on_line:
+            if freedom.counterweight is not None or freedom.com_radius is None:
+                raise SpecError("keeps a centre of mass that may move on the link's line: give "
+                                "com_radius (and no counterweight)", key=f"{key}.com_on_line",
+                                value=True)
+            bounds = resolve_link(mech, name, freedom)
+            if abs(bounds.com_centre.imag) > freedom.com_radius:
+                raise SpecError(
+                    f"the disc of com_radius {freedom.com_radius:.6g} m about "
+                    f"{bounds.com_about} does not reach the {name}'s line (it lies "
+                    f"{abs(bounds.com_centre.imag):.6g} m off it)", key=f"{key}.com_on_line",
+                    value=True)
         if freedom.counter_rotor is not None and name not in mech.grounded_links:
             where = " and the ".join(mech.grounded_links)
             raise SpecError(
@@ -509,6 +536,8 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
             lines.append(f"min_gyration = {_num(freedom.min_gyration)}  # m")
         if freedom.inertia is not None:
             lines.append(f"inertia = {_range_text(freedom.inertia)}  # kg·m² about the COM")
+        if freedom.com_on_line:
+            lines.append("com_on_line = true")
         if freedom.counterweight is not None:
             cw = freedom.counterweight
             lines.append(f"counterweight = {{ mass = {_bracketed(cw.mass)}, radius = "
@@ -569,6 +598,8 @@ class LinkBounds:
         the design vector's entries exceed by the counterweight's; every bound above is then
         the counterweight's (:meth:`NumericProblem.own`). ``None`` for a link that is free or
         fixed.
+    on_line
+        The centre of mass stays on the link's line: ``f = 0`` (``m·f`` is no variable).
     """
 
     name: str
@@ -589,11 +620,22 @@ class LinkBounds:
     counter_rotor: tuple[float, float] | None
     default_about: str
     offset: tuple[float, float, float, float] | None = None
+    on_line: bool = False
 
     @property
     def key(self) -> str:
         """Spec key of the link's table, ``balance.<name>``."""
         return f"balance.{self.name}"
+
+    @property
+    def line_span(self) -> tuple[float, float]:
+        """Where on the link's line (``e``, m) the disc allows the centre of mass.
+
+        With 8 units in the last place of the radius to spare, as :meth:`_onto_disc` keeps.
+        """
+        c, r = self.com_centre, self.com_radius * (1 - 8 * 2.0**-52)
+        half = math.sqrt(max(r * r - c.imag * c.imag, 0.0))
+        return c.real - half, c.real + half
 
     def bound_key(self, bound: str) -> str:
         """Spec key of one of its bounds (``mass``, ``com_radius``, ``min_gyration``)."""
@@ -696,7 +738,7 @@ def resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> Lin
     return LinkBounds(
         **common, listed=True, mass=mass, com_fixed=com_fixed, com_about=about,
         com_centre=centre, com_radius=radius, inertia=inertia, gyration=rho,
-        counter_rotor=rotor,
+        counter_rotor=rotor, on_line=freedom.com_on_line and com_fixed is None,
     )  # fmt: skip
 
 
@@ -1108,6 +1150,8 @@ class NumericProblem:
         m = min(max(m, b.mass[0]), b.mass[1])
         if b.com_fixed is not None:
             e, f = b.com_fixed.real, b.com_fixed.imag
+        elif b.on_line:
+            e, f = min(max(e, b.line_span[0]), b.line_span[1]), 0.0
         else:
             e, f = NumericProblem._onto_disc(b.com_centre, b.com_radius, e, f)
         least = m * b.gyration**2 * (1 + ulps)
@@ -1198,6 +1242,8 @@ class NumericProblem:
                 out.append(f"{b.bound_key('mass')}: {m:.9g} kg outside [{b.mass[0]:.9g}, "
                            f"{b.mass[1]:.9g}]")
             com = complex(me, mf) / m
+            if b.on_line and abs(com.imag) > tol * l:
+                out.append(f"{b.key}.com_on_line: centre of mass {com.imag:.3g} m off the line")
             if b.com_fixed is not None:
                 if abs(com - b.com_fixed) > tol * l:
                     out.append(f"{b.name}: centre of mass moved by {abs(com - b.com_fixed):.3g} m")

@@ -1,0 +1,102 @@
+"""[balance.<link>] com_on_line: the centre of mass stays on the link's line (f = 0).
+
+The optimum is checked against a CVXPY program written here from the spec's bounds with the
+extra equation m·f = 0 (the product instead drops m·f from its variables), by both backends.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from balancer.balance.optimizer import optimize
+from balancer.balance.problem import numeric_problem
+from balancer.errors import SpecError
+from balancer.spec import dumps_design, loads_design
+
+PB1 = (Path(__file__).resolve().parent.parent / "examples" / "pb1.toml").read_text()
+#: PB1 with the coupler's centre of mass on its line (σ2 = 0): then Eq. 57's imaginary parts
+#: let crank and rocker have theirs on their lines too (with σ2 = 0.4 they cannot).
+ON_AXIS = PB1.replace("com = { s = 1.45, sigma = 0.4 }", "com = { s = 1.45, sigma = 0.0 }")
+ROCKER = '''[balance.rocker]
+mass = [2.2, 8.8]                 # kg: 1x–4x
+com_radius = 2.0                  # m: l3 around A3
+com_about = "A3"'''
+
+
+def _on_line(text: str = ON_AXIS) -> str:
+    assert ROCKER in text
+    return text.replace(ROCKER, ROCKER + "\ncom_on_line = true", 1)
+
+
+def _least_by_cvxpy(design) -> float:
+    import cvxpy as cp
+
+    data = numeric_problem(design)
+    reg = data.regressors
+    y = cp.Variable(data.size)
+    x = cp.multiply(data.scales, y)
+    cons = []
+    for b in data.links:
+        k = b.start
+        m, s, j = x[k], x[k + 1 : k + 3], x[k + 3]
+        if not b.listed:
+            cons.append(x[b.entries] == data.x0[b.entries])
+            continue
+        c = np.array([b.com_centre.real, b.com_centre.imag])
+        cons += [m >= b.mass[0], m <= b.mass[1], cp.norm(s - m * c) <= b.com_radius * m,
+                 cp.quad_over_lin(s, m) <= j - b.gyration**2 * m]
+        if b.name == "rocker":
+            cons.append(x[k + 2] == 0)  # m·f = 0: on the line A2→A3
+    for b in data.rotor_links:
+        lo, hi = b.counter_rotor
+        cons += [x[b.rotor] >= lo, x[b.rotor] <= hi]
+    a, rhs = data.force_balance
+    cons.append(a @ x == rhs)
+    _, sv, vt = np.linalg.svd(reg.shaking_moment, full_matrices=False)
+    rows = sv[sv > 1e-12 * sv[0], None] * vt[sv > 1e-12 * sv[0]]
+    scale = float(np.linalg.norm(rows @ data.x0))
+    problem = cp.Problem(cp.Minimize(cp.norm(rows @ x) / scale), cons)
+    problem.solve(solver=cp.CLARABEL, tol_gap_abs=1e-9, tol_gap_rel=1e-9, tol_feas=1e-9)
+    assert problem.status == "optimal"
+    return float(problem.value) * scale / math.sqrt(data.samples)
+
+
+@pytest.mark.parametrize("backend", ["convex", "nlp"])
+def test_a_centre_of_mass_kept_on_the_line_is_optimal_and_on_it(backend):
+    design = loads_design(_on_line())
+    result = optimize(design, backend)
+    assert result.success and result.optimal, result.message
+    rocker = result.linkage.link("rocker")
+    assert rocker.f == 0.0  # exactly on the line
+    assert abs(complex(rocker.e, rocker.f) - 2.0) <= 2.0  # within com_radius of A3 (e = 2)
+    assert result.rms == pytest.approx(_least_by_cvxpy(design), rel=1e-6)
+    # It costs: the free rocker's optimum is no higher.
+    free = optimize(loads_design(ON_AXIS), "convex")
+    assert result.rms >= free.rms * (1 - 1e-9)
+
+
+def test_a_line_that_force_balance_forbids_is_named():
+    """PB1's coupler has its centre of mass off its line, so Eq. 57 asks the rocker's to be
+    off its line too: infeasible, and the message says that com_on_line is why."""
+    from balancer.balance.result import InfeasibleError
+
+    with pytest.raises(InfeasibleError) as info:
+        optimize(loads_design(_on_line(PB1)), "convex")
+    assert "balance.rocker.com_on_line" in str(info.value)
+
+
+def test_com_on_line_round_trips_and_refuses_what_contradicts_it():
+    design = loads_design(_on_line())
+    assert loads_design(dumps_design(design)).balance == design.balance
+    with pytest.raises(SpecError) as info:
+        loads_design(_on_line().replace("com_on_line = true", "com_on_line = 1"))
+    assert info.value.key == "balance.rocker.com_on_line"
+    without_radius = _on_line().replace("com_radius = 2.0                  # m: l3 around A3\n"
+                                        "com_about = \"A3\"\n", "")
+    with pytest.raises(SpecError) as info:
+        loads_design(without_radius)
+    assert info.value.key == "balance.rocker.com_on_line"
