@@ -227,7 +227,13 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     if animation is not None:
         from .plots import animate
 
-        animate(design.mechanism, animation, frames=args.frames, title=design.title)
+        weights = None
+        if design.original is not None:  # a balanced spec: draw what was added to the links
+            from .balance.counterweights import counterweights
+
+            weights = counterweights(design.original, design.mechanism)
+        animate(design.mechanism, animation, frames=args.frames, title=design.title,
+                counterweights=weights)
         print(f"wrote {animation}")
     if figure is not None:
         from .plots import save_figure

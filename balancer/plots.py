@@ -551,9 +551,34 @@ def drawing_frames(linkage, frames: int):
     return links, coms, np.asarray(mech.total_centre_of_mass(mo), complex)
 
 
+def counterweight_paths(linkage, counterweights, frames: int) -> dict[str, tuple]:
+    """Where each counterweight to add is over a revolution: ``(centres, radius)`` per link.
+
+    ``centres`` a ``(frames,)`` complex array (m): the counterweight's centre ``(e, f)`` in its
+    link's frame, carried by the link; ``radius`` its steel disc's (m; 0 for a point).
+    """
+    from .cycle import sample_angles
+    from .linkage.vectors import V
+
+    mech = mechanism_of(linkage)
+    mo = mech.motion(sample_angles(frames), 1.0)
+    out = {}
+    for k, name in enumerate(mech.link_names):
+        w = counterweights.get(name)
+        if w is None or w.kind != "add":
+            continue
+        centre = mo.point(k, V(w.e, w.f)).complex() + 0 * mo.theta1
+        out[name] = (np.asarray(centre, complex), w.disc_radius or 0.0)
+    return out
+
+
 def animate(linkage, path: str | os.PathLike[str], *, frames: int = 72, fps: int = 24,
-            title: str = "") -> Path:
+            title: str = "", counterweights=None) -> Path:
     """Write an animation of the linkage turning one revolution, its centre of mass traced.
+
+    ``counterweights`` (per link, as :attr:`BalanceResult.counterweights` gives them): the
+    bodies added to the original links are drawn as their steel discs, turning with their
+    links.
 
     The type comes from the extension (:func:`animation_type`): a GIF (Pillow) or an MP4
     (H.264 by ffmpeg). Frames are equally spaced crank angles (the crank at constant speed).
@@ -568,15 +593,18 @@ def animate(linkage, path: str | os.PathLike[str], *, frames: int = 72, fps: int
         before any work), or a file that cannot be written.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.patches import Circle
 
     kind = animation_type(path)
     links, coms, total = drawing_frames(linkage, frames)
     pivots, guides = frame(linkage)
+    weights = counterweight_paths(linkage, counterweights or {}, frames)
     fig = Figure(figsize=(6, 4.5), dpi=100, layout="constrained")
     canvas = FigureCanvasAgg(fig)
     ax = fig.add_subplot()
+    rims = [c + r * s for c, r in weights.values() for s in (1, -1, 1j, -1j)]
     everything = np.concatenate([*(v.ravel() for v in links.values()), coms.ravel(), total,
-                                 pivots, *guides])
+                                 pivots, *guides, *rims])
     everything = everything[np.isfinite(everything)]
     extent = max(np.ptp(everything.real), np.ptp(everything.imag), 1e-300)
     pad = 0.08 * extent
@@ -595,6 +623,21 @@ def animate(linkage, path: str | os.PathLike[str], *, frames: int = 72, fps: int
         (bar,) = ax.plot([], [], "-o", color=COLOURS["link"], lw=3, ms=5, animated=True,
                          label="links" if i == 0 else None)
         bars.append((bar, links[name]))
+    discs = []
+    for name, (centres, _) in weights.items():  # an arm from the link's nearest point
+        near = int(np.argmin(np.abs(links[name][0] - centres[0]))) if name in links else None
+        if near is not None:
+            (arm,) = ax.plot([], [], "-", color="0.35", lw=2, animated=True)
+            bars.append((arm, np.column_stack([links[name][:, near], centres])))
+    for i, (centres, radius) in enumerate(weights.values()):
+        if radius > 0:
+            disc = Circle((centres[0].real, centres[0].imag), radius, color="0.35", alpha=0.8,
+                          animated=True, label="counterweights" if i == 0 else None)
+            ax.add_patch(disc)
+        else:
+            (disc,) = ax.plot([], [], "D", color="0.35", ms=7, animated=True,
+                              label="counterweights" if i == 0 else None)
+        discs.append((disc, centres, radius))
     (link_coms,) = ax.plot([], [], "s", color=COLOURS["com"], ms=5,
                            label="link centres of mass", animated=True)
     (trace,) = ax.plot([], [], color=COLOURS["after"], lw=2, animated=True)
@@ -612,7 +655,13 @@ def animate(linkage, path: str | os.PathLike[str], *, frames: int = 72, fps: int
         link_coms.set_data(coms[k].real, coms[k].imag)
         trace.set_data(total[: k + 1].real, total[: k + 1].imag)
         com.set_data([total[k].real], [total[k].imag])
-        for artist in (trace, *(bar for bar, _ in bars), link_coms, com):
+        for disc, centres, radius in discs:
+            if radius > 0:
+                disc.set_center((centres[k].real, centres[k].imag))
+            else:
+                disc.set_data([centres[k].real], [centres[k].imag])
+        for artist in (trace, *(bar for bar, _ in bars), *(d for d, _, _ in discs), link_coms,
+                       com):
             ax.draw_artist(artist)
         images.append(np.asarray(canvas.buffer_rgba())[..., :3].copy())
     writer = _write_mp4 if kind == "mp4" else _write_gif

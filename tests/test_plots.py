@@ -326,3 +326,35 @@ def test_a_free_run_faster_than_estimated_is_run_again_finer(tmp_path, monkeypat
 def test_verify_with_given_outputs_takes_them_as_they_are():
     v = _verify(EXAMPLES / "meijaard2020.toml", duration=1.0, outputs=11)
     assert v.driven.trajectory.t.size == 11 and v.free.trajectory.t.size == 11
+
+
+def test_counterweights_turn_with_their_links_in_the_animation(tmp_path):
+    """Each counterweight's centre is carried rigidly by its link: at every frame it lies at
+    its (e, f) in the link's frame, i.e. A0 + e^{iθ1}·(e + i·f) for the crank, whose angle the
+    frames sample evenly; the animation of a balanced spec draws them."""
+    import balancer
+    from balancer.plots import counterweight_paths
+
+    design = balancer.example("pb1_counterweights")
+    result = balancer.optimize(design, backend="convex")
+    balanced = result.balanced_design(design)
+    frames = 16
+    paths = counterweight_paths(balanced.mechanism, result.counterweights, frames)
+    assert set(paths) == {"crank", "rocker"}
+    centres, radius = paths["crank"]
+    w = result.counterweights["crank"]
+    theta = 2 * np.pi * np.arange(frames) / frames
+    expected = np.exp(1j * theta) * complex(w.e, w.f)  # A0 at the origin
+    assert np.max(np.abs(centres - expected)) <= 8 * np.finfo(float).eps * abs(expected[0])
+    assert radius == w.disc_radius
+    rocker, _ = paths["rocker"]
+    pivot = complex(design.mechanism.lengths[3], 0.0)  # A3
+    distance = np.abs(rocker - pivot)  # rigid: constant distance from the rocker's pivot
+    assert np.ptp(distance) <= 1e-12 * distance[0]
+    out = tmp_path / "balanced.gif"
+    spec = tmp_path / "balanced.toml"
+    balancer.save_design(balanced, spec)
+    from balancer.cli import main
+
+    assert main(["plot", str(spec), "--animate", str(out), "--frames", "6"]) == 0
+    assert out.read_bytes()[:6] == b"GIF89a"
