@@ -115,7 +115,8 @@ def test_a_moment_moved_with_the_mass_kept_is_a_rebuild():
 
 
 @pytest.mark.parametrize("example", ["pb1", "pb2", "engine", "watt_sixbar",
-                                     "pb1_counterweights"])
+                                     "pb1_counterweights", "pb2_counterweights",
+                                     "engine_counterweights"])
 def test_optimized_examples_report_counterweights_that_rebuild_the_balanced_links(example):
     design = load_design(f"examples/{example}.toml")
     result = optimize(design, "convex")
@@ -299,3 +300,20 @@ def test_optimize_reports_the_analyze_figures_and_the_inertial_ones_apart(tmp_pa
         "rms"]
     api = balancer.to_dict(result)
     assert api["before"] == doc["before"] and api["after"] == doc["after"]
+
+
+@pytest.mark.parametrize("example", ["pb1_counterweights", "pb2_counterweights",
+                                     "engine_counterweights"])
+def test_counterweight_examples_are_built_from_the_original_links_exactly(example):
+    """With counterweights only, every changed link is its original plus one added body (to
+    rounding), and PB2's complete balance is reached by them: zero shaking moment."""
+    design = load_design(f"examples/{example}.toml")
+    result = optimize(design, "convex")
+    assert result.optimal, result.message
+    for name, w in result.counterweights.items():
+        assert w.kind in ("add", "none") and w.exact, name
+        assert_reproduces(result.original.link(name), result.linkage.link(name), w)
+    if example == "pb2_counterweights":
+        # Within the optimiser's gap tolerance of the original's RMS (PB2's optimum is zero).
+        assert result.rms <= 1e-6 * result.before.summary.shaking_moment.rms
+        assert set(result.counterweights) == {"crank", "coupler", "rocker"}

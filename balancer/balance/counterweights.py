@@ -23,6 +23,9 @@ from dataclasses import dataclass
 
 #: Density of steel, kg/m³ (the disc that realises a counterweight).
 STEEL_DENSITY = 7850.0
+#: A disc thicker than this many diameters is no disc (the body is as good as a point mass,
+#: of any compact shape): none is proposed.
+MAX_ASPECT = 10.0
 #: A change of mass, first moment or inertia below this, relative to the link's own (its mass,
 #: its mass times its reach, its inertia about the frame's origin), is rounding: nothing to add.
 UNCHANGED = 1e-12
@@ -49,7 +52,8 @@ class Counterweight:
         or an added body would need a negative inertia).
     disc_radius, disc_thickness
         The steel disc (:data:`STEEL_DENSITY`) of that mass and inertia, m; ``None`` unless
-        ``kind`` is ``"add"`` with an inertia above zero.
+        ``kind`` is ``"add"`` with an inertia that a disc no thicker than :data:`MAX_ASPECT`
+        diameters has.
     exact
         Whether the original link plus this body (mass, first moment, inertia, signed: a
         negative mass or inertia is taken away) is the balanced link. Always, except for a
@@ -105,6 +109,8 @@ def counterweight(name: str, original, balanced) -> Counterweight:
         if inertia > 0:
             radius = math.sqrt(2 * inertia / dm)
             thickness = dm / (STEEL_DENSITY * math.pi * radius**2)
+            if thickness > MAX_ASPECT * 2 * radius:  # a point mass, not a disc
+                radius = thickness = None
         return Counterweight(name, dm, centre.real, centre.imag, inertia, "add", radius,
                              thickness)
     kind = "remove" if dm < 0 and inertia <= UNCHANGED * max(j0, j1) else "rebuild"

@@ -1125,8 +1125,14 @@ class NumericProblem:
         for b in self.links:
             rotor = float(x[b.rotor]) if b.rotor is not None else 0.0
             if b.offset is not None:  # the counterweight in its bounds, added to the link
-                m, e, f, inertia, rotor = self.clamp(
-                    b, *inertial_to_physical(x[b.entries] - self.offset[b.entries]), rotor)
+                own = inertial_to_physical(x[b.entries] - self.offset[b.entries])
+                m, e, f, inertia, rotor = self.clamp(b, *own, rotor)
+                if (m, e, f, inertia) == own:  # in its bounds: the link's values as they are
+                    out[b.name] = (*inertial_to_physical(x[b.entries]), rotor)
+                    continue
+                # (Through the counterweight's own values only when a bound moved it: a
+                # counterweight that nearly cancels the link's first moment loses digits of
+                # the sum on the way.)
                 total = np.add(physical_to_inertial(m, e, f, inertia), b.offset)
                 out[b.name] = (*inertial_to_physical(total), rotor)
                 continue
