@@ -317,3 +317,52 @@ def test_counterweight_examples_are_built_from_the_original_links_exactly(exampl
         # Within the optimiser's gap tolerance of the original's RMS (PB2's optimum is zero).
         assert result.rms <= 1e-6 * result.before.summary.shaking_moment.rms
         assert set(result.counterweights) == {"crank", "coupler", "rocker"}
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_random_counterweight_problems_end_feasible_or_say_what_is_missing(seed):
+    """Random crank-rockers, counterweights on crank and rocker with random bounds: either an
+    optimum whose counterweights meet their bounds and rebuild the balanced links exactly, with
+    force balance to rounding, or an InfeasibleError naming a counterweight's bound."""
+    import numpy as np
+    from conftest import random_linkage
+
+    from balancer.balance.problem import (
+        BalanceProblem,
+        CounterweightFreedom,
+        LinkFreedom,
+        Objective,
+    )
+    from balancer.balance.result import InfeasibleError
+    from balancer.conditions import force_balance_error
+    from balancer.model import Design, Operation
+
+    rng = np.random.default_rng(seed)
+    linkage = random_linkage(rng, loads=False, rotors=True, full_turn=True)
+    links = {}
+    for name, about, length in (("crank", "A0", linkage.lengths[0]),
+                                ("rocker", "A3", linkage.lengths[2])):
+        mass = linkage.link(name).mass
+        links[name] = LinkFreedom(
+            com_about=about, counter_rotor=(0.0, rng.uniform(0.5, 5.0)),
+            counterweight=CounterweightFreedom(
+                mass=(0.01 * mass, mass * rng.uniform(2.0, 6.0)),
+                radius=length * rng.uniform(1.0, 3.0), gyration=0.05 * length))
+    design = Design(mechanism=linkage, operation=Operation(speed=10.0, samples=72),
+                    balance=BalanceProblem(objective=Objective(), links=links))
+    try:
+        result = optimize(design, "convex")
+    except InfeasibleError as exc:
+        assert ".counterweight." in str(exc)
+        return
+    assert result.success, result.message
+    assert force_balance_error(result.linkage) < 1e-12
+    for name, freedom in links.items():
+        w = result.counterweights[name]
+        assert w.kind == "add" and w.exact, (name, w)
+        assert_reproduces(result.original.link(name), result.linkage.link(name), w)
+        cw = freedom.counterweight
+        assert cw.mass[0] * (1 - 1e-12) <= w.mass <= cw.mass[1] * (1 + 1e-12)
+        about = 0.0 if name == "crank" else linkage.lengths[2]
+        assert abs(complex(w.e, w.f) - about) <= cw.radius * (1 + 1e-12)
+        assert w.inertia >= w.mass * cw.gyration**2 * (1 - 1e-12)
