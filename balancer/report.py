@@ -709,7 +709,8 @@ def front_text(front, spec=None) -> str:
     rows = [[f"{i + 1}", _fmt(p.value), _fmt(p.shaking_moment), _fmt(p.lower_bound),
              "knee" if p.knee else ""] for i, p in enumerate(front.points)]
     lines = [head,
-             f"least RMS shaking moment against {name} ({len(front.points)} points, each a "
+             f"least RMS shaking moment against {name} ({len(front.points)} "
+             f"point{'s' if len(front.points) != 1 else ''}, each a "
              "global optimum with its certified lower bound; the balancing constraints of "
              "[balance] hold at every point)", "",
              table(rows, ["point", f"{name} {front.unit}", "RMS shaking moment N·m",

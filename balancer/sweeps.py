@@ -46,6 +46,9 @@ from .errors import OutputError, SpecError
 METHODS = ("grid", "lhs", "sobol")
 #: Points per task (a task's fixed costs — transfer, scheduling — spread over this many solves).
 BATCH = 25
+#: Most points one sweep takes (a million certified optima: hours on a laptop, and the table's
+#: points are held in memory while it runs); a larger design space is several sweeps.
+MAX_POINTS = 1_000_000
 #: The table's fixed columns after the varied keys, in order.
 COLUMNS = ("point", "status", "shaking_moment_before", "shaking_moment_after",
            "shaking_force_before", "shaking_force_after", "lower_bound", "added_mass",
@@ -78,8 +81,7 @@ def perturbed_points(data: dict[str, Any], perturbs: Sequence[Perturb], samples:
     """``samples`` draws of the perturbed keys around the spec's values (seeded)."""
     import numpy as np
 
-    if not samples or samples < 1:
-        raise SpecError("--perturb needs --samples N", key="--samples", value=samples)
+    _check_samples(samples, "--perturb")
     keys = [p.key for p in perturbs]
     if len(set(keys)) != len(keys):
         raise SpecError("a key is perturbed twice", key="--perturb", value=", ".join(keys))
@@ -88,6 +90,15 @@ def perturbed_points(data: dict[str, Any], perturbs: Sequence[Perturb], samples:
     draws = rng.standard_normal((samples, len(perturbs)))
     return [{p.key: b + p.sigma * float(d) for p, b, d in zip(perturbs, base, row, strict=True)}
             for row in draws]
+
+
+def _check_samples(samples: int | None, what: str) -> None:
+    """``--samples`` given, and within :data:`MAX_POINTS`."""
+    if not samples or samples < 1:
+        raise SpecError(f"{what} needs --samples N", key="--samples", value=samples)
+    if samples > MAX_POINTS:
+        raise SpecError(f"must be at most {MAX_POINTS:,} (several sweeps for more)",
+                        key="--samples", value=samples)
 
 
 def _value(data: dict[str, Any], key: str) -> float:
@@ -173,12 +184,16 @@ def design_points(varies: Sequence[Vary], method: str = "grid", samples: int | N
             if v.count < 1:
                 raise SpecError("a grid needs N for every key (KEY=LOW:HIGH:N)", key="--vary",
                                 value=v.key)
+        total = math.prod(v.count for v in varies)
+        if total > MAX_POINTS:
+            raise SpecError(f"makes {total:.3g} points, more than the {MAX_POINTS:,} one sweep "
+                            "takes: use fewer values per key, or several sweeps",
+                            key="--vary", value=", ".join(f"{v.key}:{v.count}" for v in varies))
         axes = [[v.low] if v.count == 1 else
                 [v.low + (v.high - v.low) * i / (v.count - 1) for i in range(v.count)]
                 for v in varies]
         return [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*axes)]
-    if not samples or samples < 1:
-        raise SpecError(f"--method {method} needs --samples N", key="--samples", value=samples)
+    _check_samples(samples, f"--method {method}")
     from scipy.stats import qmc
 
     sampler = (qmc.LatinHypercube(d=len(varies), seed=seed) if method == "lhs"
@@ -388,7 +403,14 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
         raise SpecError(f"not valid TOML: {exc}", value=str(spec)) from None
     from .spec import design_from_dict
 
-    design_from_dict(data, source=str(spec))  # the spec itself must be valid
+    design = design_from_dict(data, source=str(spec))  # the spec itself must be valid
+    if not perturbs and design.balance is None:
+        raise SpecError("missing required table: a sweep balances each point as the spec's "
+                        "[balance] asks (or give --perturb to analyse perturbed designs)",
+                        key="balance", source=str(spec))
+    if design.operation is None:
+        raise SpecError("missing required key: the figures are taken at the operating speed",
+                        key="operation.speed", source=str(spec))
     if perturbs and varies:
         raise SpecError("give --vary or --perturb, not both", key="--perturb")
     points = (perturbed_points(data, perturbs, samples, seed) if perturbs

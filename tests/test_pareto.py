@@ -140,6 +140,7 @@ def test_pareto_command_writes_json_csv_and_plot(tmp_path, capsys):
     (["--against", "speed"], "--against"),
     (["--against", "driving-torque", "--plot", "front.txt"], "--plot"),
     (["--against", "driving-torque", "--points", "1"], "--points"),
+    (["--against", "driving-torque", "--points", "100000"], "--points"),
 ])
 def test_pareto_command_refuses_bad_arguments(args, key, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)

@@ -158,12 +158,19 @@ def test_sweep_command(tmp_path, capsys):
                  ["--perturb", "links.crank.mass=-1", "--samples", "5"],
                  ["--perturb", "links.crank.mass=0.1"],
                  ["--perturb", "links.crank.mass=0.1", "--samples", "5", "--vary",
-                  f"{COUPLER}=2.6:3.4:3"]):
+                  f"{COUPLER}=2.6:3.4:3"],
+                 ["--vary", f"{COUPLER}=2:4:100000", "--vary", f"{FRAME}=2:4:100000"],
+                 ["--vary", f"{COUPLER}=2:4", "--method", "sobol", "--samples", "10000000"]):
         argv = ["sweep", str(PB1), *args]
         if "--out" not in args:
             argv += ["--out", str(tmp_path / "bad.parquet")]
         assert main([*argv, "--workers", "0"]) == 2
         assert len(capsys.readouterr().err.strip().splitlines()) == 1
+    # A spec without [balance] has nothing to balance at any point.
+    no_balance = ROOT / "examples" / "meijaard2020.toml"
+    assert main(["sweep", str(no_balance), "--vary", f"{COUPLER}=2.8:3.2:2", "--out",
+                 str(tmp_path / "bad.parquet"), "--workers", "0"]) == 2
+    assert "[balance]" in capsys.readouterr().err
     assert not (tmp_path / "bad.parquet").exists()
     assert not (tmp_path / "bad.parquet.parts").exists()
 

@@ -41,6 +41,8 @@ AGAINST: dict[str, tuple[str, str]] = {
     "added-mass": ("added_mass", "kg"),
     "shaking-force": ("shaking_force", "N"),
 }
+#: Most points of one front (each a conic program: ~10 ms).
+MAX_POINTS = 1000
 #: Room given to an end of the front when it becomes a constraint (relative to the objective's
 #: scale): a hundred times Clarabel's tolerance, so that the constrained program stays feasible.
 END_ROOM = 1e-8
@@ -230,8 +232,9 @@ def pareto_front(design: Design, against: str, points: int = 11) -> Front:
     if design.balance is None:
         raise SpecError("missing required table: the redesign problem ([balance])",
                         key="balance")
-    if points < 2:
-        raise SpecError("a front needs at least 2 points", key="--points", value=points)
+    if not 2 <= points <= MAX_POINTS:
+        raise SpecError(f"a front has from 2 to {MAX_POINTS} points", key="--points",
+                        value=points)
     # The problem with both objectives weighted, so that the entries it leaves out as inert
     # (:attr:`NumericProblem.inert`) are those that neither sees.
     weights = Objective(shaking_moment=1.0,
