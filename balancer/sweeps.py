@@ -462,11 +462,16 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
         if on_batch is not None:
             on_batch(finished, client)
 
-    if workers == 0 and scheduler is None:
-        for i in todo:
-            record(i, run_batch(data, batches[i], analyse_only), None)
-    elif todo:
-        used = _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only)
+    try:
+        if workers == 0 and scheduler is None:
+            for i in todo:
+                record(i, run_batch(data, batches[i], analyse_only), None)
+        elif todo:
+            used = _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only)
+    except BaseException:
+        if finished == 0:  # nothing computed to keep (a scheduler out of reach, …)
+            shutil.rmtree(parts, ignore_errors=True)
+        raise
     _assemble(parts, out, keys, len(points), len(batches))
     statuses: dict[str, int] = {}
     import pyarrow.parquet as pq
