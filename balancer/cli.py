@@ -474,8 +474,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="simulated time of each run, s (default: the spec's)")
     p.add_argument("--method", choices=methods,
                    help="formulation for the simulations (default: one the optimiser did not "
-                   "use: opened-loop for a four-bar, complex-masses for a slider-crank, "
-                   "multibody for a general linkage)")
+                   "use: complex-masses for a four-bar whose crank turns fully, opened-loop for "
+                   "one that swings or passes change points, complex-masses for a "
+                   "slider-crank, multibody for a general linkage)")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
     p.set_defaults(handler=_cmd_verify)
 

@@ -308,7 +308,10 @@ def test_help_names_each_mechanisms_default_formulations(capsys):
                          (watt, "for a general linkage whose crank turns fully"),
                          (rocking, "for one whose crank does not")):
         assert f"{default_method(model)} {words}" in simulate_help
-    for model, words in ((fourbar, "for a four-bar"), (engine, "for a slider-crank"),
+    swinging = FourBar(lengths=(2.9, 3.0, 2.0, 3.2), branch="+", crank=fourbar.crank,
+                       coupler=fourbar.coupler, rocker=fourbar.rocker)
+    for model, words in ((fourbar, "for a four-bar whose crank turns fully"),
+                         (swinging, "for one that swings"), (engine, "for a slider-crank"),
                          (watt, "for a general linkage")):
         assert f"{mechanism_of(model).verify_method} {words}" in verify_help
     assert "opened-loop for a slider-crank" not in simulate_help + verify_help
