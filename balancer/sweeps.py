@@ -103,34 +103,23 @@ def _check_samples(samples: int | None, what: str) -> None:
 
 def _value(data: dict[str, Any], key: str) -> float:
     """The number a dotted key names in a parsed spec."""
-    probe = with_values(data, {key: 0.0})  # raises for a key that names no number
-    del probe
-    node: Any = data
-    for part in key.split("."):
-        node = node[int(part)] if isinstance(node, list) else node[part]
-    return float(node)
+    node, index = _locate(data, key)
+    return float(node[index])
 
 
 def analyse_point(data: dict[str, Any], values: dict[str, float], index: int) -> dict:
     """One row of a perturbation sweep: the perturbed design's own figures (no redesign)."""
-    from .cycle import cycle_analysis
     from .errors import AssemblyError, LockupError
     from .spec import design_from_dict
 
-    row: dict[str, Any] = {**values, "point": index, "status": "", "message": ""}
-    for name in COLUMNS[2:-1]:
-        row[name] = None
+    row = _empty_row(values, index)
     try:
         design = design_from_dict(with_values(data, values))
         if design.operation is None:
             raise SpecError("missing required key", key="operation.speed")
-        summary = cycle_analysis(design.mechanism, design.operation.speed,
-                                 design.operation.samples, loads=False).summary
+        row.update(_own_figures(design), status="analysed")
     except (AssemblyError, LockupError, SpecError) as exc:
         row.update(status="bad-geometry", message=str(exc))
-        return row
-    row.update(status="analysed", shaking_moment_before=summary.shaking_moment.rms,
-               shaking_force_before=summary.shaking_force.rms)
     return row
 
 
@@ -203,31 +192,55 @@ def design_points(varies: Sequence[Vary], method: str = "grid", samples: int | N
             for u in unit]
 
 
+def _locate(data: dict[str, Any], key: str) -> tuple[Any, Any]:
+    """The container and index of the number a dotted key names.
+
+    A list's entry is named by its index; :class:`SpecError` names the key if it names none.
+    """
+    node: Any = data
+    parts = key.split(".")
+    for i, part in enumerate(parts):
+        if isinstance(node, list) and part.isdigit() and int(part) < len(node):
+            index: Any = int(part)
+        elif isinstance(node, dict) and part in node:
+            index = part
+        else:
+            raise SpecError("no such number in the spec", key=key)
+        if i == len(parts) - 1:
+            if isinstance(node[index], bool) or not isinstance(node[index], int | float):
+                raise SpecError("names no number in the spec", key=key)
+            return node, index
+        node = node[index]
+    raise SpecError("no such number in the spec", key=key)  # an empty key
+
+
 def with_values(data: dict[str, Any], values: dict[str, float]) -> dict[str, Any]:
-    """A copy of a parsed spec with each dotted key set (a list's entry by its index).
+    """A copy of a parsed spec with each dotted key set.
 
     The key must name a number in the spec (``mechanism.lengths.coupler``,
     ``mechanism.points.B.1``, ``links.crank.mass``).
     """
     out = copy.deepcopy(data)
     for key, value in values.items():
-        node: Any = out
-        parts = key.split(".")
-        for i, part in enumerate(parts):
-            last = i == len(parts) - 1
-            if isinstance(node, list) and part.isdigit() and int(part) < len(node):
-                index: Any = int(part)
-            elif isinstance(node, dict) and part in node:
-                index = part
-            else:
-                raise SpecError("no such number in the spec", key=key)
-            if last:
-                if isinstance(node[index], bool) or not isinstance(node[index], int | float):
-                    raise SpecError("names no number in the spec", key=key)
-                node[index] = float(value)
-            else:
-                node = node[index]
+        node, index = _locate(out, key)
+        node[index] = float(value)
     return out
+
+
+def _empty_row(values: dict[str, float], index: int) -> dict[str, Any]:
+    """A row with the point's values and every figure still empty."""
+    return {**values, "point": index, "status": "", "message": "",
+            **{name: None for name in COLUMNS[2:-1]}}
+
+
+def _own_figures(design) -> dict[str, float]:
+    """The design's own inertial figures at the operating speed (the ``before`` columns)."""
+    from .cycle import cycle_analysis
+
+    summary = cycle_analysis(design.mechanism, design.operation.speed,
+                             design.operation.samples, loads=False).summary
+    return {"shaking_moment_before": summary.shaking_moment.rms,
+            "shaking_force_before": summary.shaking_force.rms}
 
 
 def evaluate_point(data: dict[str, Any], values: dict[str, float], index: int) -> dict:
@@ -237,25 +250,22 @@ def evaluate_point(data: dict[str, Any], values: dict[str, float], index: int) -
     from .errors import AssemblyError, LockupError, SolverError
     from .spec import design_from_dict
 
-    row: dict[str, Any] = {**values, "point": index, "status": "", "message": ""}
-    for name in COLUMNS[2:-1]:
-        row[name] = None
+    row = _empty_row(values, index)
     try:
         design = design_from_dict(with_values(data, values))
         result = optimize(design, "convex")
-    except InfeasibleError as exc:
-        row.update(status="infeasible", message=str(exc))
-        _before(row, data, values)
-        return row
-    except (AssemblyError, LockupError) as exc:
+    except (AssemblyError, LockupError, SpecError) as exc:
+        # It does not assemble, its crank does not turn fully, or a value makes the spec
+        # invalid (a negative length, …).
         row.update(status="bad-geometry", message=str(exc))
         return row
-    except SpecError as exc:  # a length that makes the spec invalid (a negative length, …)
-        row.update(status="bad-geometry", message=str(exc))
-        return row
-    except SolverError as exc:
-        row.update(status="failed", message=str(exc))
-        _before(row, data, values)
+    except SolverError as exc:  # InfeasibleError among them: the design's own figures
+        row.update(status="infeasible" if isinstance(exc, InfeasibleError) else "failed",
+                   message=str(exc))
+        try:
+            row.update(_own_figures(design))
+        except Exception:  # noqa: BLE001 - the row keeps its status; figures stay empty
+            pass
         return row
     before, after = result.before.summary, result.after.summary
     row.update(status=str(result.status), message=result.message,
@@ -266,21 +276,6 @@ def evaluate_point(data: dict[str, Any], values: dict[str, float], index: int) -
                lower_bound=result.rms_lower_bound if result.rms_form else None,
                added_mass=result.linkage.total_mass - result.original.total_mass)
     return row
-
-
-def _before(row: dict, data: dict[str, Any], values: dict[str, float]) -> None:
-    """The design's own figures, for a point whose redesign has no solution."""
-    from .cycle import cycle_analysis
-    from .spec import design_from_dict
-
-    try:
-        design = design_from_dict(with_values(data, values))
-        summary = cycle_analysis(design.mechanism, design.operation.speed,
-                                 design.operation.samples, loads=False).summary
-    except Exception:  # noqa: BLE001 - the row keeps its status; figures stay empty
-        return
-    row.update(shaking_moment_before=summary.shaking_moment.rms,
-               shaking_force_before=summary.shaking_force.rms)
 
 
 def run_batch(data: dict[str, Any], batch: list[tuple[int, dict[str, float]]],

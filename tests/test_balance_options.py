@@ -6,11 +6,10 @@ extra equation m·f = 0 (the product instead drops m·f from its variables), by 
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
-import numpy as np
 import pytest
+from helpers import least_rms_moment_by_cvxpy
 
 from balancer.balance.optimizer import optimize
 from balancer.balance.problem import numeric_problem
@@ -33,36 +32,9 @@ def _on_line(text: str = ON_AXIS) -> str:
 
 
 def _least_by_cvxpy(design) -> float:
-    import cvxpy as cp
-
-    data = numeric_problem(design)
-    reg = data.regressors
-    y = cp.Variable(data.size)
-    x = cp.multiply(data.scales, y)
-    cons = []
-    for b in data.links:
-        k = b.start
-        m, s, j = x[k], x[k + 1 : k + 3], x[k + 3]
-        if not b.listed:
-            cons.append(x[b.entries] == data.x0[b.entries])
-            continue
-        c = np.array([b.com_centre.real, b.com_centre.imag])
-        cons += [m >= b.mass[0], m <= b.mass[1], cp.norm(s - m * c) <= b.com_radius * m,
-                 cp.quad_over_lin(s, m) <= j - b.gyration**2 * m]
-        if b.name == "rocker":
-            cons.append(x[k + 2] == 0)  # m·f = 0: on the line A2→A3
-    for b in data.rotor_links:
-        lo, hi = b.counter_rotor
-        cons += [x[b.rotor] >= lo, x[b.rotor] <= hi]
-    a, rhs = data.force_balance
-    cons.append(a @ x == rhs)
-    _, sv, vt = np.linalg.svd(reg.shaking_moment, full_matrices=False)
-    rows = sv[sv > 1e-12 * sv[0], None] * vt[sv > 1e-12 * sv[0]]
-    scale = float(np.linalg.norm(rows @ data.x0))
-    problem = cp.Problem(cp.Minimize(cp.norm(rows @ x) / scale), cons)
-    problem.solve(solver=cp.CLARABEL, tol_gap_abs=1e-9, tol_gap_rel=1e-9, tol_feas=1e-9)
-    assert problem.status == "optimal"
-    return float(problem.value) * scale / math.sqrt(data.samples)
+    """The oracle of :func:`helpers.least_rms_moment_by_cvxpy`, with the rocker's m·f = 0."""
+    rocker = next(b for b in numeric_problem(design).links if b.name == "rocker")
+    return least_rms_moment_by_cvxpy(design, lambda x, data: [x[rocker.start + 2] == 0])
 
 
 @pytest.mark.parametrize("backend", ["convex", "nlp"])

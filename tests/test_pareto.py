@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import least_rms_moment_by_cvxpy, rank_rows
 
 from balancer.balance.optimizer import optimize
 from balancer.balance.pareto import pareto_front
-from balancer.balance.problem import numeric_problem
 from balancer.cli import main
 from balancer.spec import load_design
 
@@ -26,51 +26,16 @@ from balancer.spec import load_design
 GAP = 1e-6
 
 
-def _rank_rows(rows):
-    """Rows with the same ``‖rows·x‖`` for every x, only as many as their rank.
-
-    (N samples of a few harmonics have rank ~6; rows of rounding inside a cone stall Clarabel
-    "almost solved".) The singular values dropped are 1e-12 of the largest: a change of
-    1e-24 relative in the squared norm.
-    """
-    _, sv, vt = np.linalg.svd(rows, full_matrices=False)
-    keep = sv > 1e-12 * sv[0]
-    return sv[keep, None] * vt[keep]
-
-
 def _least_moment_by_cvxpy(design, epsilon: float) -> float:
     """min RMS shaking moment s.t. RMS driving torque ≤ ε, force balance and PB1's bounds."""
     import cvxpy as cp
 
-    data = numeric_problem(design)
-    reg = data.regressors
-    n = data.samples
-    y = cp.Variable(data.size)  # x scaled per entry (kg, kg·m, kg·m²), for the solver
-    x = cp.multiply(data.scales, y)
-    cons = []
-    for b in data.links:
-        k = b.start
-        m, s, j = x[k], x[k + 1 : k + 3], x[k + 3]
-        if not b.listed:
-            cons.append(x[b.entries] == data.x0[b.entries])
-            continue
-        c = np.array([b.com_centre.real, b.com_centre.imag])
-        cons += [m >= b.mass[0], m <= b.mass[1], cp.norm(s - m * c) <= b.com_radius * m,
-                 cp.quad_over_lin(s, m) <= j - b.gyration**2 * m]
-    for b in data.rotor_links:
-        lo, hi = b.counter_rotor
-        cons += [x[b.rotor] >= lo, x[b.rotor] <= hi]
-    a, rhs = data.force_balance
-    cons.append(a @ x == rhs)
-    moment, torque = _rank_rows(reg.shaking_moment), _rank_rows(reg.driving_torque)
-    m_scale = float(np.linalg.norm(moment @ data.x0))
-    t_scale = float(np.linalg.norm(torque @ data.x0))
-    cons.append(cp.norm(torque @ x) / t_scale <= epsilon * math.sqrt(n) / t_scale)
-    problem = cp.Problem(cp.Minimize(cp.norm(moment @ x) / m_scale), cons)
-    # Tolerances 1e-9: far below the comparison's 1e-6, and met where 1e-10 stalls.
-    problem.solve(solver=cp.CLARABEL, tol_gap_abs=1e-9, tol_gap_rel=1e-9, tol_feas=1e-9)
-    assert problem.status == "optimal"
-    return float(problem.value) * m_scale / math.sqrt(n)
+    def torque_cap(x, data):
+        torque = rank_rows(data.regressors.driving_torque)
+        scale = float(np.linalg.norm(torque @ data.x0))
+        return [cp.norm(torque @ x) / scale <= epsilon * math.sqrt(data.samples) / scale]
+
+    return least_rms_moment_by_cvxpy(design, torque_cap)
 
 
 @pytest.fixture(scope="module")

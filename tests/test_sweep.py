@@ -210,3 +210,20 @@ def test_perturbed_designs_have_the_residual_force_that_linearity_predicts(tmp_p
     deltas = np.array([r["links.crank.mass"] - base for r in rows])
     assert abs(deltas.std(ddof=1) / 0.01 - 1) < 3 / np.sqrt(2 * 39)
     assert set(result.residual_force) >= {"mean", "p95", "max"}
+
+
+def test_an_infeasible_point_keeps_its_own_figures():
+    """A counterweight too light to balance: status infeasible, the message says which bound,
+    and the row still holds the design's own figures (its inertial cycle analysis)."""
+    from balancer.cycle import cycle_analysis
+    from balancer.sweeps import evaluate_point
+
+    data = tomllib.loads((ROOT / "examples" / "pb1_counterweights.toml").read_text())
+    data["balance"]["crank"]["counterweight"]["mass"] = [0.01, 0.02]
+    row = evaluate_point(data, {COUPLER: 3.0}, 0)
+    assert row["status"] == "infeasible" and "counterweight" in row["message"]
+    design = design_from_dict(with_values(data, {COUPLER: 3.0}))
+    own = cycle_analysis(design.mechanism, 10.0, 360, loads=False).summary
+    assert row["shaking_moment_before"] == own.shaking_moment.rms
+    assert row["shaking_force_before"] == own.shaking_force.rms
+    assert row["shaking_moment_after"] is None

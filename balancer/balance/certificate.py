@@ -26,7 +26,7 @@ gradient at ``û`` (the solver's can be off by its tolerance in a direction the 
 barely sees), the inactive cones' multipliers as given or zero (at the solver's
 complementarity tolerance they still pull an unbounded inertia's coefficient below zero).
 
-The box comes from the bounds themselves (see :meth:`.convex.ConvexSolver._box`). An inertia
+The box comes from the bounds themselves (see :meth:`.convex.ConvexSolver.box`). An inertia
 with no upper bound is bounded on the objective's sublevel set ``f ≤ U`` (``U`` the objective
 of a feasible design) through the objective's own columns, when they have full rank;
 otherwise its coefficient must be surely nonnegative, or no bound is given. The evaluation's

@@ -319,6 +319,27 @@ class ConvexSolver:
             equality=(np.vstack([e for e, _ in fixed]), np.concatenate([r for _, r in fixed]))
             if fixed else None)
 
+    @property
+    def constraints(self) -> list[Constraint]:
+        """The bounds as cone constraints in the scaled variables (:meth:`_constraints`)."""
+        return self._cones
+
+    @property
+    def equality(self) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+        """Eq. 58's rows that a free variable enters, ``(E, r)`` scaled, or ``None``."""
+        return None if self._fb is None else self._fb[:2]
+
+    def check_consistent(self) -> None:
+        """Raise the diagnosis if a row of Eq. 58 that nothing free enters fails.
+
+        Raises
+        ------
+        InfeasibleError
+            Naming the bounds to widen.
+        """
+        if self._inconsistent:
+            raise self.diagnose() or self._fixed_row_error()
+
     # -- building ------------------------------------------------------------------------------
 
     def _constraints(self, margin: float = 0.0) -> tuple[list[Constraint], list[str]]:
@@ -414,7 +435,7 @@ class ConvexSolver:
                 at_most(entry(k, scale), hi)
         return out, relaxed
 
-    def _box(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def box(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Bounds of each variable over the SOCP's feasible set (scaled; ``hi`` may be ∞).
 
         A mass between its bounds; a first moment within its disc at any allowed mass; an
@@ -523,12 +544,11 @@ class ConvexSolver:
             If Clarabel fails.
         """
         data, lay = self.data, self.layout
-        if self._inconsistent:
-            raise self.diagnose() or self._fixed_row_error()
+        self.check_consistent()
         report, first = self._run(self._stage1, "convex")
         stages = [report]
         if first.u is None:
-            raise self._infeasible(f"Clarabel: {report.solver_status} after "
+            raise self.infeasible(f"Clarabel: {report.solver_status} after "
                                    f"{report.iterations} iterations")
         u1 = first.u
         multipliers = list(first.duals)
@@ -582,7 +602,7 @@ class ConvexSolver:
             f = self._objective.value(self.layout.u(feasible))
             upper = f + abs(f) + 1e-9  # above the optimum, whatever the design's rounding
         equality = None if self._fb is None else self._fb[:2]
-        lo, hi = self._box()
+        lo, hi = self.box()
         bound = lower_bound(self._objective, self._cones, equality, u, multipliers, norm_dual,
                             lo, hi, upper)
         scale = self._scale
@@ -611,7 +631,7 @@ class ConvexSolver:
             f"{', '.join(names)} fails by {rows[i]:.3g} of its terms and nothing in it may "
             f"change; let a mass or a centre of mass change ({keys})")
 
-    def _infeasible(self, why: str) -> SolverError:
+    def infeasible(self, why: str) -> SolverError:
         """The error for an SOCP that could not be solved: diagnosed infeasibility, or not."""
         diagnosis = self.diagnose() if self.data.force_balance is not None else None
         if diagnosis is not None:

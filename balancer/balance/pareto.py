@@ -125,7 +125,7 @@ class _Programs:
         self.solver = solver = ConvexSolver(data)
         lay = solver.layout
         self.n = lay.size
-        self.equality = None if solver._fb is None else solver._fb[:2]
+        self.equality = solver.equality
         n_samples = data.samples
         reg = data.regressors
         moment = np.linalg.qr(reg.shaking_moment / math.sqrt(n_samples), mode="r")
@@ -183,7 +183,7 @@ class _Programs:
 
     def least_other(self, extra: list[Constraint]):
         """The program ``min g`` within the bounds and ``extra``; its solution."""
-        cones = [*self.solver._cones, *extra]
+        cones = [*self.solver.constraints, *extra]
         if self.against == "added-mass":
             program = ConicProgram(self.n, cones, equality=self.equality, objective="squares",
                                    P=np.zeros((0, self.n)), q=np.zeros(0), g=self.mass_row)
@@ -194,7 +194,7 @@ class _Programs:
 
     def least_moment(self, extra: list[Constraint]):
         """The program ``min ‖R_M·x‖`` within the bounds and ``extra``; its solution."""
-        program = ConicProgram(self.n, [*self.solver._cones, *extra], equality=self.equality,
+        program = ConicProgram(self.n, [*self.solver.constraints, *extra], equality=self.equality,
                                objective="norm", P=self.moment.P, q=self.moment.q)
         return program.solve(self.solver.settings)
 
@@ -243,12 +243,11 @@ def pareto_front(design: Design, against: str, points: int = 11) -> Front:
     data = numeric_problem(replace(design, balance=replace(design.balance, objective=weights)))
     programs = _Programs(data, against)
     solver = programs.solver
-    if solver._inconsistent:
-        raise solver.diagnose() or solver._fixed_row_error()
+    solver.check_consistent()
     # The moment's end: its least value, then the least g among the designs that reach it.
     best = programs.least_moment([])
     if best.u is None:
-        raise solver._infeasible(f"Clarabel: {best.status}")
+        raise solver.infeasible(f"Clarabel: {best.status}")
     moment_min = programs.moment_value(solver.layout.x(best.u))
     room = END_ROOM * programs.moment_scale
     top = programs.least_other([programs.moment_cap(moment_min + room)])
@@ -287,12 +286,12 @@ def pareto_front(design: Design, against: str, points: int = 11) -> Front:
 def _certified(programs: _Programs, cap: Constraint, solution, x) -> float:
     """The certified least RMS shaking moment under ``cap``, N·m (0 where none is made)."""
     solver = programs.solver
-    lo, hi = solver._box()
+    lo, hi = solver.box()
     upper = programs.moment_full.value(solver.layout.u(x))
     norm_dual = None
     if solution.epigraph_dual is not None:
         norm_dual = -(programs.moment.basis @ solution.epigraph_dual[1:])
-    bound = lower_bound(programs.moment_full, [*solver._cones, cap], programs.equality,
+    bound = lower_bound(programs.moment_full, [*solver.constraints, cap], programs.equality,
                         solution.u, list(solution.duals), norm_dual, lo, hi,
                         upper + abs(upper) + 1e-9)
     if bound is None:
