@@ -47,6 +47,32 @@ def _place(pose: Pose, g: Group, q: list, ops) -> None:
         pose.sin[k] = ops.sin(q[3 * i + 2])
 
 
+#: Largest angle step (rad) after which the cosine and sine are updated by the step's
+#: Taylor polynomial instead of computed anew: its remainder ``δ³/6`` is then below 2e-19.
+TAYLOR_STEP = 1e-6
+
+
+def _moved(pose: Pose, g: Group, q: list, step: list) -> list:
+    """Place the group's links at ``q − step`` (lists of ``3·|g|`` arrays); return those.
+
+    A link whose angle moves by at most :data:`TAYLOR_STEP` everywhere has its cosine and
+    sine rotated by ``−δ`` through ``cos δ ≈ 1 − δ²/2``, ``sin δ ≈ δ`` (remainders below
+    rounding) instead of two transcendental evaluations: Newton's last step from a good start.
+    """
+    out = [x - d for x, d in zip(q, step, strict=True)]
+    for i, k in enumerate(g.links):
+        pose.origins[k] = V(out[3 * i], out[3 * i + 1])
+        pose.angles[k] = theta = out[3 * i + 2]
+        delta = step[3 * i + 2]
+        if np.all(np.abs(delta) <= TAYLOR_STEP):  # NaN fails it: computed anew
+            c, s = pose.cos[k], pose.sin[k]
+            half = 1.0 - 0.5 * delta * delta
+            pose.cos[k], pose.sin[k] = c * half + s * delta, s * half - c * delta
+        else:
+            pose.cos[k], pose.sin[k] = np.cos(theta), np.sin(theta)
+    return out
+
+
 def _jacobian(g: Group, pose: Pose, n: int) -> NDArray[np.float64]:
     rows = group_jacobian(g, pose)[0]
     jac = np.zeros((n, len(rows), len(rows)))
@@ -74,28 +100,30 @@ def newton(g: Group, pose: Pose, q: NDArray[np.float64], scale: float,
 
     ``q`` is ``(N, 3·|g|)`` (each link's ``x``, ``y``, ``θ``); the links found before are in
     ``pose``. Returns the solution and where it converged (residual below ``tol`` of
-    ``scale``, a length).
+    ``scale``, a length); on return ``pose`` holds the group's links at the solution.
     """
-    q = np.array(q, dtype=float)
     n = q.shape[0]
+    columns = list(np.array(np.asarray(q, dtype=float).T, order="C"))  # contiguous columns
+    _place(pose, g, columns, NUMPY)
     done = np.zeros(n, dtype=bool)
     for _ in range(MAX_ITERATIONS):
-        _set(pose, g, q)
-        res = np.column_stack([np.broadcast_to(np.asarray(r, dtype=float), (n,))
-                               for r in _residual(g, pose)])
-        size = np.max(np.abs(res), axis=1)
+        res = [np.broadcast_to(np.asarray(r, dtype=float), (n,)) for r in _residual(g, pose)]
+        size = np.abs(res[0])
+        for r in res[1:]:
+            size = np.maximum(size, np.abs(r))
         done = size <= tol * scale
         if done.all():
             break
         with np.errstate(all="ignore"):
             if n <= FEW_ANGLES:  # LAPACK per system: less Python than the structured solve
-                step = _dense_step(_jacobian(g, pose, n), res)
+                dense = _dense_step(_jacobian(g, pose, n), np.column_stack(res))
+                step = list(dense.T)
             else:
-                solved = Factor(group_jacobian(g, pose)[0]).solve([[r] for r in res.T])
-                step = np.column_stack([np.broadcast_to(x[0], (n,)) for x in solved])
-        q = np.where(done[:, None], q, q - step)
-    _set(pose, g, q)
-    return q, done
+                solved = Factor(group_jacobian(g, pose)[0]).solve([[r] for r in res])
+                step = [np.broadcast_to(x[0], (n,)) for x in solved]
+            step = [np.where(done, 0.0, d) for d in step]
+            columns = _moved(pose, g, columns, step)
+    return np.column_stack(columns), done
 
 
 def _coordinates(structure: Structure, g: Group) -> NDArray[np.float64]:
@@ -159,15 +187,21 @@ def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops,
     t = start + np.mod(theta1 - start, 2 * math.pi) if full else theta1
     if not full:  # within the range found, in the window nearest the reference
         t = start + np.remainder(theta1 - start + math.pi, 2 * math.pi) - math.pi
-    guess = _cubic(angles, tab, t)
+    cubics = structure.cache.setdefault("numeric cubics", {})
+    key = structure.groups.index(g)
+    if key not in cubics:
+        cubics[key] = _cubic_coefficients(tab)
+    guess = _cubic(angles, cubics[key], t)
     inside = (t >= lo) & (t <= hi)
     if not full:
         valid = angles[ok_rows]
         inside &= (t >= valid.min()) & (t <= valid.max())
     guess[~inside] = np.nan
     q, done = newton(g, pose, np.where(np.isfinite(guess), guess, 0.0), structure.length_scale())
-    q[~(done & inside)] = np.nan
-    _set(pose, g, q)
+    lost = ~(done & inside)
+    if lost.any():
+        q[lost] = np.nan
+        _set(pose, g, q)
     if gaps is not None:
         gaps.append(assembly_gap(structure, g, pose, q.shape[0]))
 
@@ -190,24 +224,40 @@ def solve_group_symbolic(g: Group, pose: Pose, guess: list, ops,
     return _residual(g, pose)
 
 
-def _cubic(angles: NDArray[np.float64], tab: NDArray[np.float64],
+def _cubic(angles: NDArray[np.float64], coefficients: NDArray[np.float64],
            t: NDArray[np.float64]) -> NDArray[np.float64]:
     """The table at angles ``t`` by cubic interpolation on its uniform grid, ``(N, 3·|g|)``.
 
     Through the four rows around each angle (Lagrange's cubic; at the table's ends, or next
     to a row beyond the continuation, the nearest four finite rows or NaN): its error is
     ``O(h⁴)`` of the table's step ``h``, ~1e-8 of the coordinates at 720 steps a turn, so that
-    one Newton step takes it to rounding.
+    one Newton step takes it to rounding. ``coefficients`` are the cubics' per four rows
+    (:func:`_cubic_coefficients`): an angle costs one gather and Horner's rule.
     """
     step = angles[1] - angles[0]
     x = (t - angles[0]) / step
-    i = np.clip(np.floor(x).astype(np.int64) - 1, 0, angles.size - 4)
-    i = np.where(np.isfinite(x), i, 0)
+    finite = np.isfinite(x)
+    i = np.clip(np.floor(np.where(finite, x, 0.0)).astype(np.int64) - 1, 0, angles.size - 4)
     u = x - i  # in [1, 2] inside the table: the nodes are at 0, 1, 2, 3
-    weights = ((u - 1) * (u - 2) * (u - 3) / -6, u * (u - 2) * (u - 3) / 2,
-               u * (u - 1) * (u - 3) / -2, u * (u - 1) * (u - 2) / 6)
-    out = sum(w[:, None] * tab[i + j] for j, w in enumerate(weights))
-    return np.where(np.isfinite(x)[:, None], out, np.nan)
+    width = coefficients.shape[1]
+    picked = np.take(coefficients.reshape(4 * width, -1), i, axis=1).reshape(4, width, -1)
+    out = ((picked[3] * u + picked[2]) * u + picked[1]) * u + picked[0]
+    out[:, ~finite] = np.nan
+    return out.T
+
+
+def _cubic_coefficients(tab: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Power-basis coefficients of Lagrange's cubic through rows ``i … i+3`` at ``u = 0 … 3``.
+
+    ``(4, 3·|g|, rows − 3)``: ``p(u) = a0 + a1·u + a2·u² + a3·u³`` for every start row ``i``.
+    """
+    y0, y1, y2, y3 = (tab[j : tab.shape[0] - 3 + j].T for j in range(4))
+    return np.ascontiguousarray(np.stack([
+        y0,
+        (-11 * y0 + 18 * y1 - 9 * y2 + 2 * y3) / 6,
+        y0 - 2.5 * y1 + 2 * y2 - 0.5 * y3,
+        (-y0 + 3 * y1 - 3 * y2 + y3) / 6,
+    ]))
 
 
 def assembly_gap(structure: Structure, g: Group, pose: Pose, n: int) -> NDArray[np.float64]:
