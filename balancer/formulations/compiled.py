@@ -1,8 +1,8 @@
 """What the compiled formulations of any linkage share: CasADi symbols for the linkage core.
 
-:class:`CasadiOps` lets the equations of :mod:`balancer.linkage` (written against
-:class:`~balancer.linkage.vectors.Ops`) be evaluated on CasADi's symbols; :class:`Compiled`
-calls a compiled function through its buffers; :func:`link_equations` and
+The equations of :mod:`balancer.linkage` are evaluated on CasADi's symbols through
+:class:`~balancer.linkage.symbols.CasadiOps`; :class:`Compiled` calls a compiled function
+through its buffers; :func:`link_equations` and
 :func:`spring_forces` are the links' mass matrices and applied forces in absolute coordinates
 (Nikravesh 1988, ch. 11); :class:`LinkageFormulation` is what :mod:`.multibody` and
 :mod:`.crank_angle` share as formulations of any linkage.
@@ -15,35 +15,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..linkage.structure import GROUND_INDEX, Pose, Structure
-from ..linkage.vectors import NUMPY, Factor, Ops, V
+from ..linkage.symbols import CasadiOps
+from ..linkage.vectors import NUMPY, V
 from ..mechanisms import mechanism_of
 from . import Formulation
-
-
-class CasadiOps(Ops):
-    """The elementary functions of :class:`balancer.linkage.vectors.Ops` for CasADi symbols."""
-
-    sqrt = staticmethod(ca.sqrt)
-    sin = staticmethod(ca.sin)
-    cos = staticmethod(ca.cos)
-    atan2 = staticmethod(ca.atan2)
-
-    @staticmethod
-    def where(condition, a, b):
-        return ca.if_else(condition, a, b)
-
-    @staticmethod
-    def factor(a):
-        """``A`` factored for its solves; a dense remainder by CasADi's symbolic QR."""
-        return Factor(a, dense=_dense_solve)
-
-
-def _dense_solve(block, columns):
-    """``X`` with ``A·X = B`` for symbols: ``A`` k×k and ``B`` k×m as lists of rows."""
-    a = ca.vertcat(*[ca.horzcat(*row) for row in block])
-    b = ca.vertcat(*[ca.horzcat(*row) for row in columns])
-    x = ca.solve(a, b)
-    return [[x[i, j] for j in range(b.size2())] for i in range(b.size1())]
 
 
 class Compiled:

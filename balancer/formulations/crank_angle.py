@@ -35,9 +35,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..linkage.kinematics import positions, rates
+from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import V
 from . import DEAD_POINT_THRESHOLD, Evaluation
-from .compiled import CasadiOps, Compiled, LinkageFormulation, link_equations
+from .compiled import Compiled, LinkageFormulation, link_equations
 
 #: Largest residual of a numeric group's equations after its Newton steps, relative to the
 #: linkage's length scale: a few hundred roundings.

@@ -44,9 +44,10 @@ from ..linkage.structure import (
     constraint_jacobian,
     constraint_residual,
 )
+from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import V
 from . import Evaluation
-from .compiled import CasadiOps, Compiled, LinkageFormulation, link_equations, spring_forces
+from .compiled import Compiled, LinkageFormulation, link_equations, spring_forces
 
 
 def _least_norm(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -27,6 +27,7 @@ per inertial parameter (and one for the constant part) for the regressors.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,7 +35,7 @@ from numpy.typing import NDArray
 from ..model import GROUND
 from .kinematics import Motion
 from .structure import GROUND_INDEX, Driver, Pin, Prism, Structure, constraint_jacobian
-from .vectors import Factor, V, _plus
+from .vectors import NUMPY, Ops, V, _plus, _times
 
 #: Parameters of a link in the design vector, in order: kg, kg·m, kg·m, kg·m² (about the frame's
 #: origin).
@@ -157,18 +158,24 @@ def inertial_columns(structure: Structure, mo: Motion, gravity: V):
     return out
 
 
-def applied_column(structure: Structure, mo: Motion, gravity: V, loads: bool = True):
+def applied_column(structure: Structure, mo: Motion, gravity: V, loads: bool = True,
+                   ops: Ops = NUMPY, gas: list | None = None):
     """The part of ``E`` that is not linear in the inertial parameters, and its share on the ground.
 
     Applied forces at the centres of mass and moments, springs, slider forces.
 
     Returns ``(per_link, ground)``: ``per_link[k] = (Ex, Ey, Eθ)``, ``ground = (Fx, Fy, Mz)``
-    (arrays ``(N,)``; ``Mz`` about the origin).
+    (arrays ``(N,)``; ``Mz`` about the origin). On symbols (``ops`` CasADi's), ``gas`` gives
+    each prismatic pair's slider force along its guide (N), instead of its table.
     """
-    n = mo.theta1.size
-    zero = np.zeros(n)
-    per = [[zero.copy(), zero.copy(), zero.copy()] for _ in structure.names]
-    ground = [zero.copy(), zero.copy(), zero.copy()]
+    if ops is NUMPY:
+        zero = np.zeros(mo.theta1.size)
+        per = [[zero.copy(), zero.copy(), zero.copy()] for _ in structure.names]
+        ground = [zero.copy(), zero.copy(), zero.copy()]
+    else:
+        zero = 0.0
+        per = [[0.0, 0.0, 0.0] for _ in structure.names]
+        ground = [0.0, 0.0, 0.0]
 
     def put(k: int, at: V, f: V) -> None:
         if k == GROUND_INDEX:
@@ -192,18 +199,19 @@ def applied_column(structure: Structure, mo: Motion, gravity: V, loads: bool = T
         (pa, ka), (pb, kb) = (_carrier(structure, p) for p in spring.points)
         a, b = mo.point(ka, pa), mo.point(kb, pb)
         d = b - a
-        length = np.sqrt(d.norm2())
+        length = ops.sqrt(d.norm2())
         tension = spring.stiffness * (length - spring.free_length)
         with np.errstate(divide="ignore", invalid="ignore"):
             unit = d / length
         put(ka, a, unit * tension)
         put(kb, b, unit * (-tension))
     if loads:
-        for c in structure.prisms:
-            gas = linkage.sliders[c.slider].force
-            if gas.is_zero:
+        for j, c in enumerate(structure.prisms):
+            table = linkage.sliders[c.slider].force
+            if table.is_zero:
                 continue
-            value = np.asarray(gas.at(mo.theta1), dtype=float)
+            value = (np.asarray(table.at(mo.theta1), dtype=float) if gas is None
+                     else gas[j])
             d = mo.pose.rotate(c.g, c.dg)
             at = mo.point(c.s, c.ps)
             put(c.s, at, d * value)
@@ -219,7 +227,7 @@ def _carrier(structure: Structure, point: str) -> tuple[V, int]:
 
 
 def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor_moment=None,
-                  ground_extra=None) -> Forces:
+                  ground_extra=None, ops: Ops = NUMPY) -> Forces:
     """Solve the groups in reverse order for given ``E`` columns (see the module docstring).
 
     Parameters
@@ -234,11 +242,20 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor
     ground_extra
         Forces and moment on the ground not through joints (springs, slider forces): three
         ``(N, C)`` arrays.
+    ops
+        Elementary functions: numpy (the default), or CasADi's for one design on symbols
+        (every entry then a scalar symbol, :mod:`balancer.linkage.program`).
     """
-    n, c_count = effective[0][0].shape if effective else (mo.theta1.size, 1)
-    applied = [[np.array(e, dtype=float, copy=True) for e in row] for row in effective]
-    lam: dict[int, NDArray[np.float64]] = {}
-    ground_of: dict[int, list[NDArray[np.float64]]] = {}
+    numeric = ops is NUMPY
+    if numeric:
+        n, c_count = effective[0][0].shape if effective else (mo.theta1.size, 1)
+        applied = [[np.array(e, dtype=float, copy=True) for e in row] for row in effective]
+        zero: Any = np.zeros((n, c_count))
+    else:
+        applied = [list(row) for row in effective]
+        zero = 0.0
+    lam: dict[int, list] = {}
+    ground_of: dict[int, list] = {}
     for g in reversed(structure.groups):
         index = {link: i for i, link in enumerate(g.links)}
         k = 3 * len(g.links)
@@ -257,17 +274,14 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor
                                 mat[3 * index[link] + j][row + r], coeffs[r][j])
             row += c.rows
         with np.errstate(divide="ignore", invalid="ignore"):
-            solved = Factor(mat).solve(rhs)
-        sol = np.empty((n, k, c_count))
-        for r in range(k):
-            sol[:, r, :] = solved[r][0]
+            solved = ops.factor(mat).solve(rhs)
         for c, row, blocks in blocks_of:
-            values = sol[:, row : row + c.rows, :]  # (N, rows, C)
+            values = [solved[row + r][0] for r in range(c.rows)]  # (N, C) each, or symbols
             lam[id(c)] = values
             for link, coeffs in blocks:
                 if link in index:
                     continue
-                force = [sum(_times(coeffs[r][j], values[:, r, :]) for r in range(c.rows))
+                force = [_sum(_times(coeffs[r][j], values[r]) for r in range(c.rows))
                          for j in range(3)]  # Φᵀ·λ on the known link's coordinates
                 if link == GROUND_INDEX:
                     ground_of[id(c)] = [-f for f in force]
@@ -275,8 +289,15 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor
                     for j in range(3):
                         applied[link][j] = applied[link][j] - force[j]
     constraints = [c for g in structure.groups for c in g.constraints]
-    return _collect(structure, constraints, lam, ground_of, n, c_count, rotor_moment,
-                    ground_extra)
+    return _collect(structure, constraints, lam, ground_of, zero, rotor_moment, ground_extra)
+
+
+def _sum(terms) -> Any:
+    """The sum of ``terms``, structural zeros (the float 0.0) skipped."""
+    total: Any = 0.0
+    for t in terms:
+        total = _plus(total, t)
+    return total
 
 
 def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list],
@@ -317,51 +338,51 @@ def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list]
                 sol[ok] = np.linalg.solve(mat[ok], rhs[ok])
     lam, ground_of = {}, {}
     for c, row, blocks in blocks_of:
-        values = sol[:, row : row + c.rows, :]
+        values = [sol[:, row + r, :] for r in range(c.rows)]
         lam[id(c)] = values
         for link, coeffs in blocks:
             if link == GROUND_INDEX:
-                ground_of[id(c)] = [-sum(_times(coeffs[r][j], values[:, r, :])
-                                         for r in range(c.rows)) for j in range(3)]
-    return _collect(structure, constraints, lam, ground_of, n, c_count, rotor_moment,
-                    ground_extra)
+                ground_of[id(c)] = [-_sum(_times(coeffs[r][j], values[r])
+                                          for r in range(c.rows)) for j in range(3)]
+    return _collect(structure, constraints, lam, ground_of, np.zeros((n, c_count)),
+                    rotor_moment, ground_extra)
 
 
-def _times(coefficient, values: NDArray[np.float64]) -> NDArray[np.float64]:
-    """A Jacobian entry (scalar or ``(N,)``) times ``(N, C)`` values."""
-    if np.ndim(coefficient):
-        return np.asarray(coefficient, dtype=float)[:, None] * values
-    return coefficient * values
-
-
-def _collect(structure: Structure, constraints, lam, ground_of, n, c_count, rotor_moment,
+def _collect(structure: Structure, constraints, lam, ground_of, zero, rotor_moment,
              ground_extra) -> Forces:
-    zeros = np.zeros((n, c_count))
+    """The forces on the ground from the constraints' multipliers.
+
+    ``zero`` fills what no constraint puts there: an ``(N, C)`` array, or the float 0.0 on
+    symbols.
+    """
     reactions: dict[str, V] = {}
-    fx, fy, mz = zeros.copy(), zeros.copy(), zeros.copy()
-    driving = zeros.copy()
-    normal: dict[str, NDArray[np.float64]] = {}
-    couple: dict[str, NDArray[np.float64]] = {}
+    fx: Any = zero
+    fy: Any = zero
+    mz: Any = zero
+    driving: Any = zero
+    normal: dict[str, Any] = {}
+    couple: dict[str, Any] = {}
     for c in constraints:
         if isinstance(c, Driver):
-            driving = -lam[id(c)][:, 0, :]  # τ = −λ_driver
+            driving = -lam[id(c)][0]  # τ = −λ_driver
         force = ground_of.get(id(c))
         if force is None:
             continue
-        fx, fy, mz = fx + force[0], fy + force[1], mz + force[2]
+        fx, fy, mz = _plus(fx, force[0]), _plus(fy, force[1]), _plus(mz, force[2])
         if isinstance(c, Pin):
-            old = reactions.get(c.point, V(zeros, zeros))
-            reactions[c.point] = old + V(force[0], force[1])
+            old = reactions.get(c.point, V(zero, zero))
+            reactions[c.point] = V(_plus(old.x, force[0]), _plus(old.y, force[1]))
         elif isinstance(c, Prism) and c.g == GROUND_INDEX:
             name = structure.names[c.s]
-            normal[name] = lam[id(c)][:, 1, :]
-            couple[name] = lam[id(c)][:, 0, :]
+            normal[name] = lam[id(c)][1]
+            couple[name] = lam[id(c)][0]
     if rotor_moment is not None:
-        mz = mz + rotor_moment
+        mz = _plus(mz, rotor_moment)
     if ground_extra is not None:
-        fx, fy, mz = fx + ground_extra[0], fy + ground_extra[1], mz + ground_extra[2]
+        fx, fy, mz = (_plus(fx, ground_extra[0]), _plus(fy, ground_extra[1]),
+                      _plus(mz, ground_extra[2]))
     for p in structure.linkage.ground.points:
-        reactions.setdefault(p, V(zeros, zeros))
+        reactions.setdefault(p, V(zero, zero))
     return Forces(reactions=reactions, slider_normal=normal, slider_couple=couple,
                   driving_torque=driving, shaking_force=V(fx, fy), shaking_moment=mz)
 
@@ -390,7 +411,8 @@ def regressors(structure: Structure, mo: Motion, gravity=(0.0, 0.0)) -> tuple[Fo
 
 
 def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.0, 0.0),
-                     loads: bool = True, route: str = "groups") -> Forces:
+                     loads: bool = True, route: str = "groups", ops: Ops = NUMPY,
+                     gas: list | None = None) -> Forces:
     """Joint forces on the ground, driving torque and shaking sums of a design (one column).
 
     Parameters
@@ -405,6 +427,10 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.
         Include applied forces and moments and slider forces (springs always act).
     route
         ``"groups"`` (:func:`kinetostatics`) or ``"global"`` (:func:`global_kinetostatics`).
+    ops, gas
+        CasADi's elementary functions to build the forces on symbols (one crank state, the
+        ``"groups"`` route; ``gas`` the slider forces, :func:`applied_column`); every result
+        is then a scalar symbol instead of an ``(N, 1)`` array.
     """
     linkage = structure.linkage if linkage is None else linkage
     layout = Layout.of(structure)
@@ -412,11 +438,16 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.
     n = mo.theta1.size
     g = V(*gravity)
     structure_now = structure if linkage is structure.linkage else _with(structure, linkage)
-    per, ground = applied_column(structure_now, mo, g, loads)
+    per, ground = applied_column(structure_now, mo, g, loads, ops, gas)
+    numeric = ops is NUMPY
+
+    def column(v):
+        return v[:, None] if numeric else v
+
     # E_k = applied − (I_k − gravity_k) of the design: inertial_columns summed with the
     # design's parameters, in closed form (S̄ = R·(m·s̄), the first moment about the origin).
     effective = []
-    rotor = np.zeros(n)
+    rotor: Any = np.zeros(n) if numeric else 0.0
     for k, name in enumerate(structure.names):
         m, me, mf, j_origin = x[layout.link_slice(name)]
         r = layout.rotor(name)
@@ -426,11 +457,14 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.
         acc = mo.acceleration[k] - g
         first = V(c * me - sn * mf, sn * me + c * mf)
         lin = first.perp() * a - first * (w * w)
-        effective.append([(per[k][0] - m * acc.x - lin.x)[:, None],
-                          (per[k][1] - m * acc.y - lin.y)[:, None],
-                          (per[k][2] - first.cross(acc) - (j_origin + rotor_j) * a)[:, None]])
+        effective.append([column(per[k][0] - m * acc.x - lin.x),
+                          column(per[k][1] - m * acc.y - lin.y),
+                          column(per[k][2] - first.cross(acc) - (j_origin + rotor_j) * a)])
         if rotor_j:
             rotor = rotor + 2 * rotor_j * a
+    if not numeric:
+        return kinetostatics(structure, mo, effective, rotor_moment=rotor,
+                             ground_extra=tuple(ground), ops=ops)
     rotor = np.broadcast_to(rotor, (n,))[:, None]
     extra = tuple(np.asarray(v)[:, None] * np.ones((n, 1)) for v in ground)
     solver = kinetostatics if route == "groups" else global_kinetostatics

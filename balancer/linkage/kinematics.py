@@ -61,11 +61,23 @@ def _angle_of(ops: Ops, w: V, local: V):
     return ops.atan2(w.y, w.x) - math.atan2(local.y, local.x)
 
 
+def _frame_of(ops: Ops, w: V, local: V) -> tuple:
+    """Angle, cosine and sine of a link that turns ``local`` into global ``w`` (``|w| = |local|``).
+
+    ``w = R(θ)·local`` gives ``cos θ = w·local/|local|²`` and ``sin θ = (local × w)/|local|²``:
+    a few products instead of two transcendental functions (the dyads' ``w`` has the link's
+    length to rounding).
+    """
+    inverse = 1.0 / local.norm2()
+    return _angle_of(ops, w, local), w.dot(local) * inverse, local.cross(w) * inverse
+
+
 class _Dyads:
     """Closed-form positions of the dyads.
 
-    Each returns, per link, its angle and a point to place it by (with its local position, or
-    ``None`` for its origin), and a gap: ≥ 0 where the dyad assembles. Without a ``sign``,
+    Each returns, per link, its frame — angle, cosine and sine (``None`` for those to compute
+    from the angle) — and a point to place it by (with its local position, or ``None`` for
+    its origin), and a gap: ≥ 0 where the dyad assembles. Without a ``sign``,
     the branch at the given (reference) pose instead.
     """
 
@@ -87,9 +99,9 @@ class _Dyads:
             return float(np.sign(dvec.cross(p2 - p1)))
         h = ops.sqrt(ops.where(gap >= 0, gap, np.nan)) if ops is NUMPY else ops.sqrt(gap)
         p2 = p1 + dvec * (along / d) + dvec.perp() * (sign * h / d)
-        theta_a = _angle_of(ops, p2 - p1, pa2 - pa1)
-        theta_b = _angle_of(ops, p2 - p3, pb2 - pb3)
-        return (theta_a, p1, pa1), (theta_b, p3, pb3), gap / ra2
+        frame_a = _frame_of(ops, p2 - p1, pa2 - pa1)
+        frame_b = _frame_of(ops, p2 - p3, pb2 - pb3)
+        return (frame_a, p1, pa1), (frame_b, p3, pb3), gap / ra2
 
     @staticmethod
     def _rrp_line(ops: Ops, pose: Pose, g: Group):
@@ -124,9 +136,9 @@ class _Dyads:
             return float(np.sign((p2 - p1).dot(d)))
         root = ops.sqrt(ops.where(gap >= 0, gap, np.nan)) if ops is NUMPY else ops.sqrt(gap)
         p2 = q + d * (t0 + sign * root)
-        theta_a = _angle_of(ops, p2 - p1, pa2 - pa1)
+        frame_a = _frame_of(ops, p2 - p1, pa2 - pa1)
         origin_b = p2 - pb2.rotated(cb, sb)
-        return (theta_a, p1, pa1), (theta_b, origin_b, None), gap / ra2
+        return (frame_a, p1, pa1), ((theta_b, cb, sb), origin_b, None), gap / ra2
 
     @staticmethod
     def rpr(ops: Ops, pose: Pose, g: Group, sign=None):
@@ -149,9 +161,9 @@ class _Dyads:
         phi = ops.atan2(dp.y, dp.x) - ops.atan2(sin_b, cos_b)
         theta_g = phi - math.atan2(j2.dg.y, j2.dg.x)
         theta_s = theta_g + j2.delta
-        thetas = {g_link: theta_g, s_link: theta_s}
-        return ((thetas[a], pivots[a][0], pivots[a][1]), (thetas[b], pivots[b][0],
-                                                           pivots[b][1]), gap)
+        frames = {g_link: (theta_g, None, None), s_link: (theta_s, None, None)}
+        return ((frames[a], pivots[a][0], pivots[a][1]), (frames[b], pivots[b][0],
+                                                          pivots[b][1]), gap)
 
 
 def dyad_branch(structure: Structure, group: Group, q_ref: NDArray[np.float64]) -> float:
@@ -164,13 +176,16 @@ def dyad_branch(structure: Structure, group: Group, q_ref: NDArray[np.float64]) 
     return sign if sign != 0 else 1.0
 
 
-def _place(pose: Pose, k: int, theta, origin_or_pivot: V, local: V | None, ops: Ops) -> None:
+def _place(pose: Pose, k: int, frame, origin_or_pivot: V, local: V | None, ops: Ops) -> None:
     """Set link ``k``'s frame from its angle and a point to place it by.
 
-    The point is its origin (``local`` None) or the global position of its local point
+    ``frame`` is the angle or ``(angle, cos, sin)`` (``None`` cosine and sine computed from the
+    angle). The point is its origin (``local`` None) or the global position of its local point
     ``local``.
     """
-    c, s = ops.cos(theta), ops.sin(theta)
+    theta, c, s = frame if isinstance(frame, tuple) else (frame, None, None)
+    if c is None:
+        c, s = ops.cos(theta), ops.sin(theta)
     pose.angles[k], pose.cos[k], pose.sin[k] = theta, c, s
     if local is None:
         pose.origins[k] = origin_or_pivot
@@ -180,7 +195,7 @@ def _place(pose: Pose, k: int, theta, origin_or_pivot: V, local: V | None, ops: 
 
 def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
               gaps: list | None = None, guesses: dict | None = None,
-              residuals: list | None = None) -> Pose:
+              residuals: list | None = None, steps: list | None = None) -> Pose:
     """Every link's frame at crank angles ``theta1`` (rad), on the reference pose's branch.
 
     Parameters
@@ -198,6 +213,10 @@ def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
         With symbols: each numeric group's starting coordinates for Newton's method, keyed
         by its place in ``structure.groups``; ``residuals`` (a list) receives each such
         group's equations at the result (:func:`~.numeric.solve_group_symbolic`).
+    steps
+        With symbols and a list: each numeric group takes one Newton step from its guess,
+        its last cosines and sines by the step's Taylor polynomial, and the list receives its
+        angles' changes (:func:`~.numeric.solve_group_symbolic`).
 
     Returns
     -------
@@ -222,7 +241,8 @@ def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
             else:
                 if guesses is None or index not in guesses:
                     raise ValueError("a numeric group on symbols needs a starting guess")
-                found = solve_group_symbolic(g, pose, guesses[index], ops)
+                found = (solve_group_symbolic(g, pose, guesses[index], ops) if steps is None
+                         else solve_group_symbolic(g, pose, guesses[index], ops, 1, steps))
                 if residuals is not None:
                     residuals.extend(found)
             continue

@@ -24,6 +24,9 @@ from .vectors import NUMPY, Factor, V
 TABLE_STEPS = 720
 #: Newton iterations at most, per solve.
 MAX_ITERATIONS = 30
+#: Newton's method has converged where every residual is at most this fraction of the
+#: linkage's length scale.
+NEWTON_TOLERANCE = 1e-13
 #: Up to this many angles at once (the continuation's single steps), Newton's steps are
 #: LAPACK's solves; beyond, the structured solve of :class:`~.vectors.Factor`.
 FEW_ANGLES = 16
@@ -52,19 +55,20 @@ def _place(pose: Pose, g: Group, q: list, ops) -> None:
 TAYLOR_STEP = 1e-6
 
 
-def _moved(pose: Pose, g: Group, q: list, step: list) -> list:
+def _moved(pose: Pose, g: Group, q: list, step: list, ops=NUMPY) -> list:
     """Place the group's links at ``q − step`` (lists of ``3·|g|`` arrays); return those.
 
     A link whose angle moves by at most :data:`TAYLOR_STEP` everywhere has its cosine and
     sine rotated by ``−δ`` through ``cos δ ≈ 1 − δ²/2``, ``sin δ ≈ δ`` (remainders below
     rounding) instead of two transcendental evaluations: Newton's last step from a good start.
+    On symbols (``ops`` not numpy) always so: the caller checks the steps.
     """
     out = [x - d for x, d in zip(q, step, strict=True)]
     for i, k in enumerate(g.links):
         pose.origins[k] = V(out[3 * i], out[3 * i + 1])
         pose.angles[k] = theta = out[3 * i + 2]
         delta = step[3 * i + 2]
-        if np.all(np.abs(delta) <= TAYLOR_STEP):  # NaN fails it: computed anew
+        if ops is not NUMPY or np.all(np.abs(delta) <= TAYLOR_STEP):  # NaN: computed anew
             c, s = pose.cos[k], pose.sin[k]
             half = 1.0 - 0.5 * delta * delta
             pose.cos[k], pose.sin[k] = c * half + s * delta, s * half - c * delta
@@ -95,7 +99,7 @@ def _dense_step(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[n
 
 
 def newton(g: Group, pose: Pose, q: NDArray[np.float64], scale: float,
-           tol: float = 1e-13) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+           tol: float = NEWTON_TOLERANCE) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """Newton's method on the group's equations at every angle at once.
 
     ``q`` is ``(N, 3·|g|)`` (each link's ``x``, ``y``, ``θ``); the links found before are in
@@ -171,22 +175,24 @@ def table(structure: Structure, g: Group) -> tuple[NDArray[np.float64], NDArray[
     return result
 
 
-def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops,
-                gaps: list | None = None) -> None:
-    """Place the links of numeric group ``g`` in ``pose`` at crank angles ``theta1``.
+def start(structure: Structure, g: Group,
+          theta1: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Where Newton's method starts for numeric group ``g`` at crank angles ``theta1``.
 
-    ``gaps``, if a list, receives the group's assembly gap (:func:`assembly_gap`).
+    Returns the group's coordinates from its continuation table (:func:`table`, by
+    :func:`_cubic`), ``(N, 3·|g|)``, NaN where the table has none, and where it has
+    (``inside``).
     """
     theta1 = np.atleast_1d(np.asarray(theta1, dtype=float))
     angles, tab = table(structure, g)
-    start = angles[TABLE_STEPS]
+    begin = angles[TABLE_STEPS]
     lo, hi = angles[0], angles[-1]
     # The angle of each request in the table's window (a turn either way of the reference).
     ok_rows = np.all(np.isfinite(tab), axis=1)
     full = ok_rows[TABLE_STEPS:].all()
-    t = start + np.mod(theta1 - start, 2 * math.pi) if full else theta1
+    t = begin + np.mod(theta1 - begin, 2 * math.pi) if full else theta1
     if not full:  # within the range found, in the window nearest the reference
-        t = start + np.remainder(theta1 - start + math.pi, 2 * math.pi) - math.pi
+        t = begin + np.remainder(theta1 - begin + math.pi, 2 * math.pi) - math.pi
     cubics = structure.cache.setdefault("numeric cubics", {})
     key = structure.groups.index(g)
     if key not in cubics:
@@ -197,6 +203,16 @@ def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops,
         valid = angles[ok_rows]
         inside &= (t >= valid.min()) & (t <= valid.max())
     guess[~inside] = np.nan
+    return guess, inside
+
+
+def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops,
+                gaps: list | None = None) -> None:
+    """Place the links of numeric group ``g`` in ``pose`` at crank angles ``theta1``.
+
+    ``gaps``, if a list, receives the group's assembly gap (:func:`assembly_gap`).
+    """
+    guess, inside = start(structure, g, theta1)
     q, done = newton(g, pose, np.where(np.isfinite(guess), guess, 0.0), structure.length_scale())
     lost = ~(done & inside)
     if lost.any():
@@ -207,20 +223,30 @@ def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops,
 
 
 def solve_group_symbolic(g: Group, pose: Pose, guess: list, ops,
-                         iterations: int = 2) -> list:
+                         iterations: int = 2, steps: list | None = None) -> list:
     """Place numeric group ``g``'s links in ``pose`` by Newton's method on symbols.
 
     ``iterations`` steps from ``guess`` (the group's coordinates, ``3·|g|`` symbols: a good
     start, within the quadratic convergence of Newton's method); returns the residual of the
     group's equations at the result, for the caller to check that it converged.
+
+    With a list ``steps``, the last step's cosines and sines come from the previous ones by
+    the step's Taylor polynomial (as :func:`_moved`; valid where every angle moves by at
+    most :data:`TAYLOR_STEP`) and ``steps`` receives the angles' changes for the caller to
+    check that.
     """
     q = list(guess)
-    for _ in range(iterations):
-        _place(pose, g, q, ops)
-        residual = _residual(g, pose)
-        step = ops.factor(group_jacobian(g, pose)[0]).solve([[r] for r in residual])
-        q = [x - d[0] for x, d in zip(q, step, strict=True)]
     _place(pose, g, q, ops)
+    for i in range(iterations):
+        residual = _residual(g, pose)
+        step = [d[0] for d in
+                ops.factor(group_jacobian(g, pose)[0]).solve([[r] for r in residual])]
+        if steps is not None and i == iterations - 1:
+            q = _moved(pose, g, q, step, ops)
+            steps.extend(step[3 * j + 2] for j in range(len(g.links)))
+        else:
+            q = [x - d for x, d in zip(q, step, strict=True)]
+            _place(pose, g, q, ops)
     return _residual(g, pose)
 
 

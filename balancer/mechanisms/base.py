@@ -16,6 +16,7 @@ registry.
 from __future__ import annotations
 
 import math
+import threading
 from abc import ABC
 from dataclasses import dataclass
 from functools import cached_property
@@ -47,6 +48,29 @@ RANGE_SAMPLES = 1440
 #: Points per bracket, and rounds, of the refinement of the sampled minima of the gap.
 ZOOM_POINTS = 33
 ZOOM_ROUNDS = 5
+#: From this many crank states on, :meth:`Mechanism.crank_forces` evaluates the groups' route
+#: as a straight-line program (:mod:`balancer.linkage.program`): the same arithmetic in
+#: fewer operations, whose one-time build (about 0.1 s) then pays off.
+PROGRAM_STATES = 8192
+
+
+#: One build of a program at a time (a cycle analysis runs its chunks on threads).
+_PROGRAM_LOCK = threading.Lock()
+
+
+def _put(forces: Forces, part: Forces, where: NDArray[np.bool_]) -> None:
+    """Write ``part``'s rows into ``forces`` at the states ``where`` (in place)."""
+    for mine, theirs in ((forces.driving_torque, part.driving_torque),
+                         (forces.shaking_moment, part.shaking_moment),
+                         (forces.shaking_force.x, part.shaking_force.x),
+                         (forces.shaking_force.y, part.shaking_force.y),
+                         *((forces.reactions[p].x, part.reactions[p].x) for p in forces.reactions),
+                         *((forces.reactions[p].y, part.reactions[p].y) for p in forces.reactions),
+                         *((forces.slider_normal[k], part.slider_normal[k])
+                           for k in forces.slider_normal),
+                         *((forces.slider_couple[k], part.slider_couple[k])
+                           for k in forces.slider_couple)):
+        mine[where] = theirs
 
 
 @dataclass(frozen=True)
@@ -305,10 +329,40 @@ class Mechanism(ABC):
                      gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         """:meth:`inverse_dynamics` of :meth:`motion` at crank states (arrays broadcast).
 
-        A mechanism with a closed form may compute it without the general motion.
+        A mechanism with a closed form may compute it without the general motion. At
+        :data:`PROGRAM_STATES` states or more, the groups' route runs as a straight-line
+        program (:class:`~balancer.linkage.program.CrankForcesProgram`, the same figures to
+        rounding); the states it leaves out, the numpy route computes.
         """
+        route = route or self.routes[0]
+        states = np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))
+                                       for x in (theta1, omega1, alpha1)))
+        if route == "newton-euler" and states[0].size >= PROGRAM_STATES:
+            program = self._program(loads, tuple(gravity))
+            if program is not None:
+                forces, ok = program.evaluate(*(np.ascontiguousarray(x) for x in states))
+                if not ok.all():
+                    rest = self.inverse_dynamics(self.motion(*(x[~ok] for x in states)),
+                                                 route=route, loads=loads, gravity=gravity)
+                    _put(forces, rest, ~ok)
+                return forces
         return self.inverse_dynamics(self.motion(theta1, omega1, alpha1), route=route,
                                      loads=loads, gravity=gravity)
+
+    def _program(self, loads: bool, gravity: tuple[float, float]):
+        """The mechanism's crank-forces program for these loads and gravity (built once)."""
+        from ..linkage.program import CrankForcesProgram
+
+        key = (loads, gravity)
+        with _PROGRAM_LOCK:
+            cache = self.__dict__.setdefault("_programs", {})  # of this design only
+            if key not in cache:
+                try:
+                    cache[key] = CrankForcesProgram(self.structure, loads=loads,
+                                                    gravity=gravity)
+                except NotImplementedError:  # an operation numpy has no counterpart for
+                    cache[key] = None
+            return cache[key]
 
     def regressors(self, mo: Motion, gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         """:meth:`inverse_dynamics` without loads as linear maps of the design vector.

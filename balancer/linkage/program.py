@@ -1,0 +1,322 @@
+"""The inverse dynamics of one design as a straight-line program over arrays of crank angles.
+
+The equations of :mod:`.kinematics` and :mod:`.dynamics` are written once against
+:class:`~.vectors.Ops`; evaluated on numpy arrays they run operation by operation through
+Python, each making a temporary array, and recompute what several steps share (a link's
+rotations, the constraints' Jacobians of the velocity and the force solves). Evaluated once on
+CasADi's symbols for a single crank state, they become an expression graph that CasADi reduces
+to a short algorithm (common subexpressions shared, structural zeros and constants folded,
+registers reused). :class:`Tape` turns that algorithm into a Python function of numpy calls that
+write into a fixed set of work arrays: the same arithmetic with a fraction of the operations and
+no temporaries. CasADi's own virtual machine evaluates it one crank state at a time, which is
+slower than numpy's loops over many.
+
+:class:`CrankForcesProgram` is the program of :func:`~.dynamics.inverse_dynamics` (the
+groups' route) of a linkage at crank states ``(θ1, ω1, α1)``. A numeric group (a Stephenson
+triad) takes one Newton step from its continuation table's cubic (as the numpy route does) and
+reports its residual: a state where it did not converge is left to the numpy route.
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+from numpy.typing import NDArray
+
+from . import numeric
+from .dynamics import Forces, inverse_dynamics
+from .kinematics import Motion, positions, rates
+from .structure import Structure
+from .symbols import CasadiOps
+from .vectors import Factor, V, _is_zero, _minus, _times
+
+_OPS = {getattr(ca, name): name[3:] for name in dir(ca) if name.startswith("OP_")}
+
+_UNARY = {"SIN": "sin", "COS": "cos", "TAN": "tan", "SQRT": "sqrt", "NEG": "negative",
+          "SQ": "square", "FABS": "absolute", "EXP": "exp", "LOG": "log", "ATAN": "arctan",
+          "ASIN": "arcsin", "ACOS": "arccos", "FLOOR": "floor", "CEIL": "ceil",
+          "NOT": "logical_not", "INV": "reciprocal", "SIGN": "sign", "TANH": "tanh"}
+_BINARY = {"ADD": "add", "SUB": "subtract", "MUL": "multiply", "DIV": "divide",
+           "ATAN2": "arctan2", "POW": "power", "CONSTPOW": "power", "FMIN": "fmin",
+           "FMAX": "fmax", "LT": "less", "LE": "less_equal", "EQ": "equal",
+           "NE": "not_equal", "AND": "logical_and", "OR": "logical_or",
+           "COPYSIGN": "copysign", "HYPOT": "hypot", "FMOD": "fmod"}
+
+
+class Tape:
+    """A CasADi SX function's algorithm as numpy calls over arrays of its scalar inputs.
+
+    Every input and output is a dense column vector of scalars; :meth:`__call__` takes each
+    input as an ``(nnz, N)`` array and returns each output likewise, evaluating the
+    algorithm on ``N`` states at once in blocks of :attr:`block` (so that its work arrays
+    stay in the processor's cache). Constants are folded when the program is generated.
+
+    Raises
+    ------
+    NotImplementedError
+        If the algorithm has an operation numpy has no elementwise counterpart for.
+    """
+
+    #: States per block of the evaluation: its work arrays then stay in the processor's
+    #: cache, and Python's share (a call per operation and block) stays small.
+    block = 8192
+
+    def __init__(self, fn: ca.Function) -> None:
+        self.sizes_in = [fn.nnz_in(i) for i in range(fn.n_in())]
+        self.sizes_out = [fn.nnz_out(i) for i in range(fn.n_out())]
+        self.registers = fn.sz_w()
+        self.source = _generate(fn)
+        scope = {"np": np}
+        exec(compile(self.source, f"<tape {fn.name()}>", "exec"), scope)  # noqa: S102
+        self._run = scope["run"]
+
+    def __call__(self, inputs: list[NDArray[np.float64]], n: int,
+                 outs: list[NDArray[np.float64]] | None = None) -> list[NDArray[np.float64]]:
+        """The outputs at ``n`` states: ``inputs[i]`` is ``(nnz_i, n)`` (or broadcasts to it).
+
+        ``outs``, if given, receives them (arrays ``(nnz_j, n)``).
+        """
+        if outs is None:
+            outs = [np.empty((m, n)) for m in self.sizes_out]
+        size = min(self.block, n)
+        work = [np.empty(size) for _ in range(self.registers)]
+        with np.errstate(all="ignore"):
+            for start in range(0, n, size):
+                stop = min(start + size, n)
+                if stop - start != size:
+                    work = [w[: stop - start] for w in work]
+                part_in = [np.broadcast_to(a, (a.shape[0], n))[:, start:stop] for a in inputs]
+                part_out = [o[:, start:stop] for o in outs]
+                self._run(work, part_in, part_out)
+        return outs
+
+
+def _generate(fn: ca.Function) -> str:
+    """Python source of ``run(w, inputs, outs)``: ``fn``'s algorithm as numpy calls."""
+    lines = ["def run(w, inputs, outs):"]
+    lines.append("    " + ", ".join(f"w{r}" for r in range(fn.sz_w())) + ", = w"
+                 if fn.sz_w() else "    pass")
+    constant: dict[int, float] = {}  # registers that hold a constant, by the algorithm's order
+
+    def arg(r: int) -> str:
+        return repr(constant[r]) if r in constant else f"w{r}"
+
+    for k in range(fn.n_instructions()):
+        op = _OPS[fn.instruction_id(k)]
+        ins, outs = fn.instruction_input(k), fn.instruction_output(k)
+        if op == "INPUT":
+            constant.pop(outs[0], None)
+            lines.append(f"    w{outs[0]}[:] = inputs[{ins[0]}][{ins[1]}]")
+        elif op == "OUTPUT":
+            lines.append(f"    outs[{outs[0]}][{outs[1]}] = {arg(ins[0])}")
+        elif op == "CONST":
+            constant[outs[0]] = float(fn.instruction_constant(k))
+        elif op == "TWICE":
+            _emit(lines, constant, "multiply", [ins[0]], outs[0], extra=2.0)
+        elif op in _UNARY:
+            _emit(lines, constant, _UNARY[op], [ins[0]], outs[0])
+        elif op in _BINARY:
+            _emit(lines, constant, _BINARY[op], [ins[0], ins[1]], outs[0])
+        elif op == "IF_ELSE_ZERO":
+            c, x = ins[0], ins[1]
+            if c in constant:
+                if constant[c] != 0:
+                    _copy(lines, constant, x, outs[0])
+                else:
+                    constant[outs[0]] = 0.0
+            else:
+                constant.pop(outs[0], None)
+                lines.append(f"    w{outs[0]}[:] = np.where({arg(c)} != 0, {arg(x)}, 0.0)")
+        elif op == "ASSIGN":
+            _copy(lines, constant, ins[0], outs[0])
+        else:
+            raise NotImplementedError(f"CasADi operation {op} in a tape")
+    return "\n".join(lines) + "\n"
+
+
+def _emit(lines: list[str], constant: dict[int, float], ufunc: str, ins: list[int], out: int,
+          extra: float | None = None) -> None:
+    """One elementwise operation into register ``out`` (folded when its inputs are constants)."""
+    args = [constant.get(r) for r in ins] + ([] if extra is None else [extra])
+    if all(a is not None for a in args):
+        with np.errstate(all="ignore"):
+            constant[out] = float(getattr(np, ufunc)(*args))
+        return
+    names = [repr(constant[r]) if r in constant else f"w{r}" for r in ins]
+    if extra is not None:
+        names.append(repr(extra))
+    constant.pop(out, None)
+    lines.append(f"    np.{ufunc}({', '.join(names)}, out=w{out})")
+
+
+def _copy(lines: list[str], constant: dict[int, float], source: int, out: int) -> None:
+    if source in constant:
+        constant[out] = constant[source]
+    else:
+        constant.pop(out, None)
+        if source != out:
+            lines.append(f"    w{out}[:] = w{source}")
+
+
+#: A pivot of the fixed order is accepted where no entry below it in its column is larger
+#: than this many times it (threshold partial pivoting, as sparse LU codes do): the growth of
+#: the elimination stays bounded; elsewhere the state is left to the numpy route's LU.
+PIVOT_GROWTH = 4.0
+
+
+class _FixedPivotOps(CasadiOps):
+    """CasADi's functions with a dense remainder solved by LU in a fixed pivot order.
+
+    The numpy route pivots per crank state (:class:`~.vectors._BatchLU`); a program cannot
+    branch, and CasADi's symbolic QR costs four times the operations. So the order is the
+    one partial pivoting takes at the reference state, and :attr:`health` collects, per
+    elimination step and row below, ``|a_ip| − PIVOT_GROWTH·|a_pp|``: where all are ≤ 0 the
+    order is a valid threshold pivoting.
+    """
+
+    def __init__(self, reference) -> None:
+        #: ``reference(entries)``: the symbols' values at the reference state, as floats.
+        self.reference = reference
+        self.health: list = []
+
+    def factor(self, a):
+        return Factor(a, dense=self._solve)
+
+    def _solve(self, block: list[list], columns: list[list]) -> list[list]:
+        k = len(block)
+        a = [list(row) for row in block]
+        b = [list(row) for row in columns]
+        values = self.reference([v for row in a for v in row])
+        num = [list(values[i * k:(i + 1) * k]) for i in range(k)]
+        inverse = []
+        for p in range(k):
+            best = max(range(p, k), key=lambda i: abs(num[i][p]))
+            for rows in (a, b, num):
+                rows[p], rows[best] = rows[best], rows[p]
+            inverse.append(1.0 / a[p][p])
+            for i in range(p + 1, k):
+                if _is_zero(a[i][p]):
+                    continue
+                self.health.append(ca.fabs(a[i][p]) - PIVOT_GROWTH * ca.fabs(a[p][p]))
+                m = a[i][p] * inverse[p]
+                for j in range(p + 1, k):
+                    a[i][j] = _minus(a[i][j], _times(m, a[p][j]))
+                    num[i][j] -= num[i][p] / num[p][p] * num[p][j]
+                for j in range(len(b[i])):
+                    b[i][j] = _minus(b[i][j], _times(m, b[p][j]))
+        x: list[list] = [[0.0] * len(b[0]) for _ in range(k)]
+        for p in reversed(range(k)):
+            for j in range(len(b[p])):
+                acc = b[p][j]
+                for c in range(p + 1, k):
+                    acc = _minus(acc, _times(a[p][c], x[c][j]))
+                x[p][j] = _times(acc, inverse[p])
+        return x
+
+
+class CrankForcesProgram:
+    """:func:`~.dynamics.inverse_dynamics` of a linkage's own design as a :class:`Tape`.
+
+    Built once per linkage, loads and gravity (a fraction of a second); then
+    :meth:`evaluate` gives the same :class:`~.dynamics.Forces` as the numpy route at any crank
+    states, to rounding.
+    """
+
+    def __init__(self, structure: Structure, *, loads: bool, gravity: tuple[float, float]) -> None:
+        self.structure = s = structure
+        theta1, omega1, alpha1 = (ca.SX.sym(n) for n in ("theta1", "omega1", "alpha1"))
+        self.numeric = [i for i, g in enumerate(s.groups) if g.kind == "numeric"]
+        sizes = [3 * len(s.groups[i].links) for i in self.numeric]
+        guess = ca.SX.sym("guess", sum(sizes))
+        starts = np.cumsum([0, *sizes])
+        guesses = {i: [guess[j] for j in range(a, b)]
+                   for i, a, b in zip(self.numeric, starts[:-1], starts[1:], strict=True)}
+        gas = ca.SX.sym("gas", len(s.prisms))
+        inputs = [theta1, omega1, alpha1, guess, gas]
+        q_ref = s.reference_coordinates()
+        at_reference = [s.ref_angle[s.input], 1.0, 0.0,
+                        np.concatenate([[q_ref[3 * k + j] for k in s.groups[i].links
+                                         for j in range(3)] for i in self.numeric]
+                                       or [np.zeros(0)]),
+                        np.zeros(len(s.prisms))]
+
+        def reference(entries: list) -> list[float]:
+            probe = ca.Function("probe", inputs, [ca.vertcat(*[ca.SX(e) for e in entries])])
+            return [float(v) for v in np.asarray(probe(*at_reference)).ravel()]
+
+        ops = _FixedPivotOps(reference)
+        residuals: list = []
+        steps: list = []
+        pose = positions(s, theta1, ops, guesses=guesses, residuals=residuals, steps=steps)
+        vel, rate, acc, accel = rates(s, pose, omega1, alpha1, theta1, ops)
+        mo = Motion(theta1=theta1, omega1=omega1, alpha1=alpha1, pose=pose,
+                    velocity=tuple(vel), rate=tuple(rate), acceleration=tuple(acc),
+                    accel=tuple(accel))
+        forces = inverse_dynamics(s, mo, gravity=gravity, loads=loads, ops=ops,
+                                  gas=[gas[j] for j in range(len(s.prisms))])
+        self.points = sorted(forces.reactions)
+        self.normal = sorted(forces.slider_normal)
+        entries = [forces.driving_torque, forces.shaking_force.x, forces.shaking_force.y,
+                   forces.shaking_moment]
+        for p in self.points:
+            entries += [forces.reactions[p].x, forces.reactions[p].y]
+        for k in self.normal:
+            entries += [forces.slider_normal[k], forces.slider_couple[k]]
+        # Checks: the groups' residuals (≤ the numpy route's tolerance), their angle steps
+        # (≤ TAYLOR_STEP), the pivots' health (≤ 0).
+        entries += [_largest([ca.fabs(r) for r in residuals]),
+                    _largest([ca.fabs(d) for d in steps]), _largest(ops.health)]
+        self.tape = Tape(ca.Function("crank_forces", inputs,
+                                     [ca.cse(ca.vertcat(*[ca.SX(e) for e in entries]))]))
+        self.loads = loads
+
+    def evaluate(self, theta1: NDArray[np.float64], omega1: NDArray[np.float64],
+                 alpha1: NDArray[np.float64]) -> tuple[Forces, NDArray[np.bool_]]:
+        """The forces at crank states (arrays ``(N,)``) and where they are the numpy route's.
+
+        A state is left out (``False``) where a numeric group's Newton step did not converge
+        to the numpy route's tolerance or the group cannot be placed there: its forces are
+        then to be computed by the numpy route.
+        """
+        s = self.structure
+        n = theta1.size
+        ok = np.ones(n, dtype=bool)
+        out = np.empty((self.tape.sizes_out[0], n))
+        for a in range(0, n, Tape.block):  # a block at a time: the starts stay in the cache
+            b = min(a + Tape.block, n)
+            theta = theta1[a:b]
+            guesses = []
+            for i in self.numeric:
+                guess, inside = numeric.start(s, s.groups[i], theta)
+                ok[a:b] &= inside
+                guesses.append(np.where(np.isfinite(guess), guess, 0.0).T)
+            guess = np.concatenate(guesses) if guesses else np.zeros((0, 1))
+            gas = [np.asarray(s.linkage.sliders[c.slider].force.at(theta), dtype=float)
+                   * np.ones(b - a) if self.loads else np.zeros(b - a) for c in s.prisms]
+            gas_in = np.array(gas) if gas else np.zeros((0, 1))
+            self.tape([theta[None, :], omega1[None, a:b], alpha1[None, a:b], guess, gas_in],
+                      b - a, [out[:, a:b]])
+        closure, step, health = out[-3], out[-2], out[-1]
+        ok &= ((closure <= numeric.NEWTON_TOLERANCE * s.length_scale())
+               & (step <= numeric.TAYLOR_STEP) & (health <= 0))
+        column = [row[:, None] for row in out]
+        reactions = {p: V(column[4 + 2 * i], column[5 + 2 * i])
+                     for i, p in enumerate(self.points)}
+        base = 4 + 2 * len(self.points)
+        normal = {k: column[base + 2 * i] for i, k in enumerate(self.normal)}
+        couple = {k: column[base + 2 * i + 1] for i, k in enumerate(self.normal)}
+        forces = Forces(reactions=reactions, slider_normal=normal, slider_couple=couple,
+                        driving_torque=column[0], shaking_force=V(column[1], column[2]),
+                        shaking_moment=column[3])
+        return forces, ok
+
+
+__all__ = ["CrankForcesProgram", "Tape"]
+
+
+def _largest(values: list):
+    """The largest of ``values`` (symbols), or −1 for none."""
+    out = ca.SX(-1.0)
+    for v in values:
+        out = ca.fmax(out, v)
+    return out

@@ -1,0 +1,42 @@
+"""CasADi's symbols for the linkage equations.
+
+The equations of :mod:`balancer.linkage` are written against
+:class:`~balancer.linkage.vectors.Ops`; :class:`CasadiOps` evaluates them on CasADi's SX
+symbols, for the compiled formulations (:mod:`balancer.formulations`) and the straight-line
+programs of :mod:`.program`.
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+
+from .vectors import Factor, Ops
+
+
+class CasadiOps(Ops):
+    """The elementary functions of :class:`balancer.linkage.vectors.Ops` for CasADi symbols."""
+
+    sqrt = staticmethod(ca.sqrt)
+    sin = staticmethod(ca.sin)
+    cos = staticmethod(ca.cos)
+    atan2 = staticmethod(ca.atan2)
+
+    @staticmethod
+    def where(condition, a, b):
+        return ca.if_else(condition, a, b)
+
+    @staticmethod
+    def factor(a):
+        """``A`` factored for its solves; a dense remainder by CasADi's symbolic QR."""
+        return Factor(a, dense=_dense_solve)
+
+
+def _dense_solve(block, columns):
+    """``X`` with ``A·X = B`` for symbols: ``A`` k×k and ``B`` k×m as lists of rows."""
+    a = ca.vertcat(*[ca.horzcat(*row) for row in block])
+    b = ca.vertcat(*[ca.horzcat(*row) for row in columns])
+    x = ca.solve(a, b)
+    return [[x[i, j] for j in range(b.size2())] for i in range(b.size1())]
+
+
+__all__ = ["CasadiOps"]
