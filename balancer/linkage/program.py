@@ -92,70 +92,99 @@ class Tape:
 
 
 def _generate(fn: ca.Function) -> str:
-    """Python source of ``run(w, inputs, outs)``: ``fn``'s algorithm as numpy calls."""
+    """Python source of ``run(w, inputs, outs)``: ``fn``'s algorithm as numpy calls.
+
+    A register that holds a constant or an input is not filled: its uses name the constant
+    or the input's row instead, until an operation writes the register.
+    """
     lines = ["def run(w, inputs, outs):"]
     lines.append("    " + ", ".join(f"w{r}" for r in range(fn.sz_w())) + ", = w"
                  if fn.sz_w() else "    pass")
-    constant: dict[int, float] = {}  # registers that hold a constant, by the algorithm's order
-
-    def arg(r: int) -> str:
-        return repr(constant[r]) if r in constant else f"w{r}"
-
+    regs = _Registers()
     for k in range(fn.n_instructions()):
         op = _OPS[fn.instruction_id(k)]
         ins, outs = fn.instruction_input(k), fn.instruction_output(k)
         if op == "INPUT":
-            constant.pop(outs[0], None)
-            lines.append(f"    w{outs[0]}[:] = inputs[{ins[0]}][{ins[1]}]")
+            regs.alias(outs[0], f"inputs[{ins[0]}][{ins[1]}]")
         elif op == "OUTPUT":
-            lines.append(f"    outs[{outs[0]}][{outs[1]}] = {arg(ins[0])}")
+            lines.append(f"    outs[{outs[0]}][{outs[1]}] = {regs.name(ins[0])}")
         elif op == "CONST":
-            constant[outs[0]] = float(fn.instruction_constant(k))
+            regs.fix(outs[0], float(fn.instruction_constant(k)))
         elif op == "TWICE":
-            _emit(lines, constant, "multiply", [ins[0]], outs[0], extra=2.0)
+            _emit(lines, regs, "multiply", [ins[0]], outs[0], extra=2.0)
         elif op in _UNARY:
-            _emit(lines, constant, _UNARY[op], [ins[0]], outs[0])
+            _emit(lines, regs, _UNARY[op], [ins[0]], outs[0])
         elif op in _BINARY:
-            _emit(lines, constant, _BINARY[op], [ins[0], ins[1]], outs[0])
+            _emit(lines, regs, _BINARY[op], [ins[0], ins[1]], outs[0])
         elif op == "IF_ELSE_ZERO":
             c, x = ins[0], ins[1]
-            if c in constant:
-                if constant[c] != 0:
-                    _copy(lines, constant, x, outs[0])
+            if c in regs.constant:
+                if regs.constant[c] != 0:
+                    regs.copy(x, outs[0], lines)
                 else:
-                    constant[outs[0]] = 0.0
+                    regs.fix(outs[0], 0.0)
             else:
-                constant.pop(outs[0], None)
-                lines.append(f"    w{outs[0]}[:] = np.where({arg(c)} != 0, {arg(x)}, 0.0)")
+                condition, value = regs.name(c), regs.name(x)
+                regs.write(outs[0])
+                lines.append(f"    w{outs[0]}[:] = np.where({condition} != 0, {value}, 0.0)")
         elif op == "ASSIGN":
-            _copy(lines, constant, ins[0], outs[0])
+            regs.copy(ins[0], outs[0], lines)
         else:
             raise NotImplementedError(f"CasADi operation {op} in a tape")
     return "\n".join(lines) + "\n"
 
 
-def _emit(lines: list[str], constant: dict[int, float], ufunc: str, ins: list[int], out: int,
+class _Registers:
+    """What each work register holds while the program is generated, in its order."""
+
+    def __init__(self) -> None:
+        self.constant: dict[int, float] = {}
+        self.aliases: dict[int, str] = {}
+
+    def name(self, r: int) -> str:
+        """How the program names register ``r``'s value now."""
+        if r in self.constant:
+            return repr(self.constant[r])
+        return self.aliases.get(r, f"w{r}")
+
+    def fix(self, r: int, value: float) -> None:
+        self.aliases.pop(r, None)
+        self.constant[r] = value
+
+    def alias(self, r: int, expression: str) -> None:
+        self.constant.pop(r, None)
+        self.aliases[r] = expression
+
+    def write(self, r: int) -> None:
+        """Register ``r`` is written: it holds its own array from now on."""
+        self.constant.pop(r, None)
+        self.aliases.pop(r, None)
+
+    def copy(self, source: int, r: int, lines: list[str]) -> None:
+        """Register ``r`` takes ``source``'s value.
+
+        An array is copied: ``source`` may be written before ``r`` is read.
+        """
+        if source in self.constant:
+            self.fix(r, self.constant[source])
+        elif source in self.aliases:  # an input: never written
+            self.alias(r, self.aliases[source])
+        elif source != r:
+            self.write(r)
+            lines.append(f"    w{r}[:] = w{source}")
+
+
+def _emit(lines: list[str], regs: _Registers, ufunc: str, ins: list[int], out: int,
           extra: float | None = None) -> None:
     """One elementwise operation into register ``out`` (folded when its inputs are constants)."""
-    args = [constant.get(r) for r in ins] + ([] if extra is None else [extra])
+    args = [regs.constant.get(r) for r in ins] + ([] if extra is None else [extra])
     if all(a is not None for a in args):
         with np.errstate(all="ignore"):
-            constant[out] = float(getattr(np, ufunc)(*args))
+            regs.fix(out, float(getattr(np, ufunc)(*args)))
         return
-    names = [repr(constant[r]) if r in constant else f"w{r}" for r in ins]
-    if extra is not None:
-        names.append(repr(extra))
-    constant.pop(out, None)
+    names = [regs.name(r) for r in ins] + ([] if extra is None else [repr(extra)])
+    regs.write(out)
     lines.append(f"    np.{ufunc}({', '.join(names)}, out=w{out})")
-
-
-def _copy(lines: list[str], constant: dict[int, float], source: int, out: int) -> None:
-    if source in constant:
-        constant[out] = constant[source]
-    else:
-        constant.pop(out, None)
-        if source != out:
-            lines.append(f"    w{out}[:] = w{source}")
 
 
 #: A pivot of the fixed order is accepted where no entry below it in its column is larger
