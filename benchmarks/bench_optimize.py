@@ -15,7 +15,8 @@ Rows:
 ``run(...)``
     :meth:`Optimizer.run`, which adds the before/after cycle analyses (Newton–Euler route).
 ``DE``
-    :func:`scipy.optimize.differential_evolution` on the physical parameters of the free
+    :func:`scipy.optimize.differential_evolution` (the problem of ``anchors/de_pb1.py``, the
+    whole-command benchmark's anchor) on the physical parameters of the free
     links, ``m``, ``e``, ``f``, ``I − m·ρ²`` (≥ 0) and the counter-rotors, with the same
     objective (the same regressor matrices, evaluated for the whole population at once:
     ``vectorized=True``). Force balance is enforced exactly by elimination: the crank's and
@@ -38,7 +39,7 @@ import statistics
 import time
 from pathlib import Path
 
-import numpy as np
+from anchors.de_pb1 import de_problem
 from scipy.optimize import differential_evolution
 
 from balancer.balance.optimizer import Optimizer
@@ -58,75 +59,8 @@ def _timed(fn, repeats: int):
     return statistics.median(times), min(times), out
 
 
-def _de_problem(data: NumericProblem):
-    """Bounds and a vectorised objective for differential evolution (see the module docstring)."""
-    l1, l2, l3, _ = data.linkage.lengths
-    crank, coupler, rocker = data.links
-    bounds = []
-    names = []
-
-    def add(name, lo, hi):
-        names.append(name)
-        bounds.append((lo, hi))
-
-    for b in data.links:
-        if b.mass[0] < b.mass[1]:
-            add(f"m{b.index}", *b.mass)
-        if b.name == "coupler" and b.com_fixed is None:
-            add("e2", b.com_centre - b.com_radius, b.com_centre + b.com_radius)
-            add("f2", -b.com_radius, b.com_radius)
-        if not b.inertia_fixed:
-            add(f"dI{b.index}", 0.0, b.mass[1] * b.length**2)  # I − max(I_low, m·ρ²)
-    for entry, b in ((12, crank), (13, rocker)):
-        if b.counter_rotor[0] < b.counter_rotor[1]:
-            add(f"Jc{entry}", *b.counter_rotor)
-    index = {n: i for i, n in enumerate(names)}
-    j0 = data.original_objective
-
-    def designs(z):
-        """Design vectors (columns) and penalties of a population ``z`` (variables × members)."""
-        z = z[:, None] if z.ndim == 1 else z
-        pop = z.shape[1]
-
-        def value(name, fixed):
-            return z[index[name]] if name in index else np.full(pop, fixed)
-
-        m = [value(f"m{b.index}", b.mass[0]) for b in data.links]
-        if "e2" in index:
-            s2 = z[index["e2"]] + 1j * z[index["f2"]]
-        else:
-            s2 = np.full(pop, coupler.com_fixed)
-        s1 = -(m[1] / m[0]) * (1 - s2 / l2) * l1  # Eq. 57
-        s3 = l3 * (1 + (m[1] / m[2]) * s2 / l2)
-        coms = (s1, s2, s3)
-        x = np.zeros((14, pop))
-        penalty = np.zeros(pop)
-        for b, s in zip(data.links, coms, strict=True):
-            k = 4 * b.index
-            mi = m[b.index]
-            if b.com_fixed is None:
-                excess = np.maximum(np.abs(s - b.com_centre) - b.com_radius, 0.0)
-                bad = np.where(excess > 0, j0 * (1 + 10 * excess / b.length), 0.0)
-                penalty = np.maximum(penalty, bad)
-            low = np.maximum(b.inertia[0], mi * b.gyration**2)
-            inertia = np.minimum(low + value(f"dI{b.index}", 0.0), b.inertia[1])
-            x[k], x[k + 1], x[k + 2] = mi, mi * s.real, mi * s.imag
-            x[k + 3] = inertia + mi * np.abs(s) ** 2
-        x[12] = value("Jc12", crank.counter_rotor[0])
-        x[13] = value("Jc13", rocker.counter_rotor[0])
-        return x, penalty
-
-    def objective(z):
-        x, penalty = designs(z)
-        quad = np.sum((data.rows @ x) ** 2, axis=0)
-        mass = data.weights.added_mass * (x[0] + x[4] + x[8] - data.original_mass)
-        return np.where(penalty > 0, penalty, quad + mass)
-
-    return bounds, objective, designs
-
-
 def _run_de(data: NumericProblem):
-    bounds, objective, designs = _de_problem(data)
+    _, bounds, objective, designs = de_problem(data)
     result = differential_evolution(
         objective,
         bounds,
