@@ -48,14 +48,13 @@ class Figure:
         Values that do not exist (NaN, at a change point) are left out; computed without
         overflow for any finite values.
         """
-        values = np.asarray(values)
+        values = np.asarray(values).ravel()
         if not values.size:
             return cls(rms=math.nan, max=math.nan)
-        if np.iscomplexobj(values):
-            mag = np.abs(values)
-            top = float(np.max(mag))
+        if np.iscomplexobj(values):  # by chunks: no copy of a long cycle's magnitudes
+            top = max(float(np.max(np.abs(values[i : i + CHUNK])))
+                      for i in range(0, values.size, CHUNK))
         else:
-            mag = values
             top = float(max(np.max(values), -np.min(values)))
         if math.isnan(top):  # samples that do not exist (NaN, at a change point): left out
             mag = np.abs(values)
@@ -66,8 +65,11 @@ class Figure:
         if 1e-100 < top < 1e100:  # the sum of squares neither overflows nor underflows
             total = float(np.vdot(values, values).real)
             return cls(rms=math.sqrt(total / values.size), max=top)
-        scaled = mag / top
-        return cls(rms=top * math.sqrt(float(np.dot(scaled, scaled)) / values.size), max=top)
+        total = 0.0
+        for i in range(0, values.size, CHUNK):
+            scaled = np.abs(values[i : i + CHUNK]) / top
+            total += float(np.dot(scaled, scaled))
+        return cls(rms=top * math.sqrt(total / values.size), max=top)
 
     def as_dict(self) -> dict[str, float]:
         """``{"rms": …, "max": …}``."""
@@ -196,7 +198,9 @@ class CycleAnalysis:
 
 def sample_angles(samples: int) -> NDArray[np.float64]:
     """``samples`` equally spaced crank angles over one revolution from 0, rad."""
-    return np.arange(samples) * (2 * np.pi / samples)
+    angles = np.arange(samples, dtype=float)
+    angles *= 2 * np.pi / samples  # in place: no second array of a long cycle's size
+    return angles
 
 
 def cycle_analysis(model, speed: float, samples: int = 360, *, route: str | None = None,

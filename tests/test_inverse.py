@@ -386,3 +386,21 @@ def test_parallelogram_cycle_passes_its_change_points_smoothly():
     assert np.max(np.abs(ca.reactions.shaking_moment - moment)) < error + moment_tol
     other = cycle.cycle_analysis(linkage, speed, 72, route="mass-matrix")
     assert np.max(np.abs(other.reactions.shaking_moment - moment)) < error + moment_tol
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e200, 1e-200])
+def test_figures_of_a_cycle_longer_than_a_chunk(scale):
+    """Figure.of takes a long cycle's magnitudes a chunk at a time (no copy of them): the
+    figures of 2·CHUNK + 5 random complex samples, at ordinary and extreme magnitudes (the
+    scaled route), against math.fsum of the squares of the exactly scaled parts (each
+    magnitude one hypot, ε/2; the chunked float sums of n squares within n·ε, halved by the
+    root)."""
+    rng = np.random.default_rng(11)
+    n = 2 * cycle.CHUNK + 5
+    parts = rng.normal(size=n) + 1j * rng.normal(size=n)
+    figure = cycle.Figure.of(parts * scale)
+    mags = [math.hypot(z.real, z.imag) for z in parts]
+    top = max(mags)
+    assert figure.max == pytest.approx(top * scale, rel=4.5e-16, abs=0.0)
+    rms = math.sqrt(math.fsum(m * m for m in mags) / n) * scale
+    assert figure.rms == pytest.approx(rms, rel=(n + 4) * 2.3e-16, abs=0.0)
