@@ -185,3 +185,73 @@ def test_the_least_assembly_gap_is_brents_minimum(example):
                                 bounds=(theta[i - 1], theta[i + 1]), method="bounded",
                                 options={"xatol": 1e-10}).fun for i in dips)
     assert abs(mech.least_gap() - min(brent, float(np.min(gap)))) < 1e-12
+
+
+def _fine_table(monkeypatch, structure, group):
+    """The numeric group's table continued one row at a time both ways (no strides, no
+    periodicity): the continuation in its plainest form."""
+    from balancer.linkage import numeric
+
+    with monkeypatch.context() as patch:
+        patch.setattr(numeric, "STRIDE", 1)
+        patch.setattr(numeric, "_turn", lambda *args: None)
+        structure.cache.clear()
+        out = numeric.table(structure, group)
+    structure.cache.clear()
+    return out
+
+
+_STEPHENSON = (Path(__file__).resolve().parent.parent / "balancer" / "examples"
+               / "stephenson_sixbar.toml")
+
+
+def _stephenson_with_crank_pin(pin: str | None) -> Design:
+    """The shipped Stephenson six-bar, its crank pin D moved (a longer crank: the head then
+    cannot follow a whole turn)."""
+    text = _STEPHENSON.read_text()
+    if pin is not None:
+        text = text.replace("D  = [0.02, 0.0346410161514]", f"D  = {pin}")
+    return loads_design(text)
+
+
+def _scotch_yoke(seed: int) -> Design:
+    from fuzz.linkages import _random_transform, build_topology, spec_from_topology
+
+    from balancer.spec import design_from_dict
+
+    rng = np.random.default_rng(seed)
+    topo, kind, _, _ = build_topology(rng, want="valid", family="scotch-yoke")
+    assert kind == "valid"
+    doc, _ = spec_from_topology(rng, topo, _random_transform(rng))
+    return design_from_dict(doc)
+
+
+@pytest.mark.parametrize("make", [
+    lambda: _stephenson_with_crank_pin(None),
+    lambda: _stephenson_with_crank_pin("[0.06, 0.103923048454]"),
+    lambda: _stephenson_with_crank_pin("[0.08, 0.138564064606]"),
+    lambda: _scotch_yoke(0), lambda: _scotch_yoke(5)],
+    ids=["stephenson", "stephenson-swinging", "stephenson-swinging-less", "yoke-0", "yoke-5"])
+def test_the_strided_continuation_finds_the_plain_ones_table(monkeypatch, make):
+    """The table by strides (filled between by one Newton solve, the turn downwards by
+    periodicity where the turn upwards closes) is the one-row-at-a-time continuation's: the
+    same rows found, each solved to the Newton tolerance (1e-13 of the length scale; the
+    group's condition, below 1e3 away from its toggles, makes the coordinates agree to
+    1e-10 of it). Full turns and cranks that swing; a four-link group and a yoke's two
+    prismatic pairs."""
+    from balancer.linkage import numeric
+
+    structure = mechanism_of(make().mechanism).structure
+    groups = [g for g in structure.groups if g.kind == "numeric"]
+    assert groups, "a group solved numerically"
+    for g in groups:
+        structure.cache.clear()
+        _, strided = numeric.table(structure, g)
+        _, plain = _fine_table(monkeypatch, structure, g)
+        np.testing.assert_array_equal(np.isfinite(strided), np.isfinite(plain))
+        both = np.isfinite(plain)
+        assert both.any(axis=1).sum() > 50
+        scale = structure.length_scale()
+        tol = np.broadcast_to(np.tile([1e-10 * scale, 1e-10 * scale, 1e-10],
+                                      plain.shape[1] // 3), plain.shape)
+        assert np.all(np.abs(strided - plain)[both] <= tol[both])

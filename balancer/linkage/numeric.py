@@ -138,41 +138,131 @@ def _coordinates(structure: Structure, g: Group) -> NDArray[np.float64]:
 def table(structure: Structure, g: Group) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The group's coordinates over one revolution from the reference pose (cached).
 
-    Returns ``(theta1, q)``: ``TABLE_STEPS + 1`` angles from the reference's input angle
-    upwards over 2π, and ``(TABLE_STEPS + 1, 3·|g|)`` coordinates (angles continuous), NaN
-    beyond where the continuation stopped. A linkage whose input cannot turn fully is
-    continued downwards from the reference too: the table then covers its range.
+    Returns ``(theta1, q)``: ``2·TABLE_STEPS + 1`` angles a turn either way of the reference's
+    input angle, and their coordinates (angles continuous), NaN beyond where the continuation
+    stopped (the group locks or cannot be assembled).
+
+    The continuation takes :data:`STRIDE` table steps at a time (:func:`_continue`) and fills
+    the rows between by one Newton solve over all of them at once (:func:`_fill`). Where the
+    turn upwards comes back to the reference pose, the turn downwards is the same poses, each
+    link's angle less what it turns in a revolution; otherwise it is continued too.
     """
     cache = structure.cache.setdefault("numeric tables", {})
     key = structure.groups.index(g)
     if key in cache:
         return cache[key]
-    from .kinematics import positions
-
     start = structure.ref_angle[structure.input]
     step = 2 * math.pi / TABLE_STEPS
-    scale = structure.length_scale()
     before = structure.groups[: structure.groups.index(g)]
     partial = replace(structure, groups=tuple(before), cache={})  # places the known links
     q_ref = _coordinates(structure, g)
     out = np.full((2 * TABLE_STEPS + 1, q_ref.size), np.nan)
     angles = start + step * np.arange(-TABLE_STEPS, TABLE_STEPS + 1)
     out[TABLE_STEPS] = q_ref
-    for direction in (1, -1):
-        history = [q_ref]
-        for i in range(1, TABLE_STEPS + 1):
-            j = TABLE_STEPS + direction * i
-            guess = history[-1] if len(history) < 3 else (
-                3 * history[-1] - 3 * history[-2] + history[-3])
-            pose = positions(partial, np.array([angles[j]]))
-            q, ok = newton(g, pose, guess[None, :], scale)
-            if not ok[0] or not np.all(np.isfinite(q)):
-                break
-            out[j] = q[0]
-            history.append(q[0])
+    _continue(structure, partial, g, angles, out, 1)
+    turn = _turn(structure, out[-1] - q_ref)
+    if turn is not None:
+        out[:TABLE_STEPS] = out[TABLE_STEPS:-1] - turn
+    else:
+        _continue(structure, partial, g, angles, out, -1)
     result = (angles, out)
     cache[key] = result
     return result
+
+
+#: Table steps per step of the continuation (the rows between are filled at once).
+STRIDE = 16
+
+
+def _continue(structure: Structure, partial: Structure, g: Group, angles, out, direction: int
+              ) -> None:
+    """Fill ``out``'s rows from the reference's (the middle row) towards ``direction``.
+
+    Each step of :data:`STRIDE` rows starts Newton's method from the quadratic extrapolation
+    of the rows found a stride apart; it is taken where Newton's method converges there to
+    within a tenth of the last stride's change of its start, and the rows between converge
+    likewise (:func:`_fill`): a branch the continuation did not leave. Otherwise (near the
+    start, a toggle or the end) the rows are continued one at a time, up to the first that
+    does not converge (the table stops there).
+    """
+    from .kinematics import positions
+
+    scale = structure.length_scale()
+    middle = TABLE_STEPS
+    done = [middle]  # rows found, in order away from the middle
+
+    def solve_at(rows, guess):
+        pose = positions(partial, angles[rows])
+        with np.errstate(all="ignore"):
+            return newton(g, pose, guess, scale)
+
+    def extrapolated(rows):
+        """The next row (as far on as ``rows`` are apart) by the quadratic through them."""
+        h = [out[j] for j in rows]
+        return h[-1] if len(h) < 3 else 3 * h[-1] - 3 * h[-2] + h[-3]
+
+    i = 0
+    while i < TABLE_STEPS:
+        if STRIDE > 1 and i + STRIDE <= TABLE_STEPS and len(done) > 2 * STRIDE:
+            j = middle + direction * (i + STRIDE)
+            guess = extrapolated(done[-1 - 2 * STRIDE :: STRIDE])
+            q, ok = solve_at(np.array([j]), guess[None, :])
+            moved = float(np.max(np.abs(out[done[-1]] - out[done[-1 - STRIDE]])))
+            if (ok[0] and np.all(np.isfinite(q))
+                    and np.max(np.abs(q[0] - guess)) <= 0.1 * moved + 1e-12 * scale):
+                out[j] = q[0]
+                if _fill(structure, angles, out, done[-1 - STRIDE], done[-1], j, direction,
+                         solve_at):
+                    done.extend(middle + direction * np.arange(i + 1, i + STRIDE + 1))
+                    i += STRIDE
+                    continue
+                out[j] = np.nan
+        j = middle + direction * (i + 1)  # one row: near the start, a toggle or the end
+        q, ok = solve_at(np.array([j]), extrapolated(done[-3:])[None, :])
+        if not ok[0] or not np.all(np.isfinite(q)):
+            return
+        out[j] = q[0]
+        done.append(j)
+        i += 1
+
+
+def _fill(structure, angles, out, back: int, a: int, b: int, direction: int,
+          solve_at) -> bool:
+    """Rows strictly between ``a`` and ``b`` (``STRIDE`` apart, found) by one Newton solve.
+
+    Started from the quadratic through the rows ``back``, ``a`` and ``b`` (``STRIDE`` apart);
+    accepted where every row converges to within a tenth of the stride's change of its start,
+    which a jump to another branch (a whole link length away) cannot meet.
+    """
+    between = np.arange(a + direction, b, direction)
+    u = (angles[between] - angles[a]) / (angles[b] - angles[a])  # in (0, 1)
+    y0, y1, y2 = out[back], out[a], out[b]  # at −1, 0, 1 strides
+    guess = (y1[None, :] + 0.5 * u[:, None] * (y2 - y0)[None, :]
+             + 0.5 * (u * u)[:, None] * (y2 - 2 * y1 + y0)[None, :])
+    q, ok = solve_at(between, guess)
+    change = float(np.max(np.abs(y2 - y1)))
+    near = np.max(np.abs(q - guess), axis=1) <= 0.1 * change + 1e-12 * structure.length_scale()
+    if not (ok.all() and np.all(np.isfinite(q)) and near.all()):
+        return False
+    out[between] = q
+    return True
+
+
+def _turn(structure: Structure, change: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """What one revolution adds to the group's coordinates, if it ends at the reference pose.
+
+    ``change`` is the coordinates after a turn less the reference's: the pose is the same if
+    the origins are back (to 1e-9 of the length scale) and each angle has turned by a whole
+    number of revolutions (to 1e-9 rad); then the exact change (zero or ``2πk``), else None.
+    """
+    if not np.all(np.isfinite(change)):
+        return None
+    turns = np.round(change[2::3] / (2 * math.pi))
+    exact = np.zeros_like(change)
+    exact[2::3] = 2 * math.pi * turns
+    tol = np.tile([1e-9 * structure.length_scale(), 1e-9 * structure.length_scale(), 1e-9],
+                  change.size // 3)
+    return exact if np.all(np.abs(change - exact) <= tol) else None
 
 
 def start(structure: Structure, g: Group,
