@@ -1,10 +1,11 @@
 """Forward dynamics: integrate a formulation, project, detect events, report what happened.
 
-The integrator is SciPy's explicit Runge–Kutta method of order 8 (DOP853), stepped by hand so
-that after every accepted step the non-minimal formulations' states are projected back onto the
-loop closure and its derivative (the drift before projection is reported). Output values come
-from the step's dense output, projected in the same way, at equally spaced times. No component
-is held to an absolute error below 100 ε of the largest of its kind (:func:`floored_atol`).
+The integrator is the explicit Runge–Kutta method of order 8, DOP853 (:mod:`.integration`),
+stepped by hand so that after every accepted step the non-minimal formulations' states are
+projected back onto the loop closure and its derivative (the drift before projection is
+reported). Output values come from the step's dense output, all those within a step in one
+evaluation, projected in the same way, at equally spaced times. No component is held to an
+absolute error below 100 ε of the largest of its kind (:func:`floored_atol`).
 
 Events:
 
@@ -37,8 +38,6 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.integrate import DOP853
-from scipy.optimize import brentq
 
 from .errors import AssemblyError, LockupError, SolverError, SpecError
 from .formulations import (
@@ -49,6 +48,7 @@ from .formulations import (
     formulation_table,
     make,
 )
+from .integration import DOP853, CompiledDOP853, Stages, with_extra_work
 from .mechanisms import mechanism_of
 from .model import RTOL_MIN, Design, SimulationSettings, check_scales
 
@@ -246,8 +246,6 @@ class _Stepper:
         if stages is None:
             solver = DOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=atol)
         else:
-            from .integration import CompiledDOP853
-
             solver = CompiledDOP853(f.rhs, 0.0, y0, t_end, stages=stages, rtol=self.rtol,
                                     atol=atol)
         states: list[NDArray[np.float64]] = []
@@ -278,7 +276,7 @@ class _Stepper:
             # step that holds an output time or an event, and before a projection moves y.
             dense = None
 
-            def interp(t: float, _solver=solver):
+            def interp(t, _solver=solver):
                 nonlocal dense
                 if dense is None:
                     dense = _solver.dense_output()
@@ -303,11 +301,16 @@ class _Stepper:
                     stopped = event
                     solver.status = "finished"
             t_hi = solver.t if stopped is None else stopped[0]
-            while k < self.t_out.size and self.t_out[k] <= t_hi + 1e-14 * max(1.0, t_hi):
-                y = interp(min(self.t_out[k], solver.t))
-                states.append(f.project(self.t_out[k], y) if not f.minimal else y)
-                times.append(float(self.t_out[k]))
-                k += 1
+            end = k
+            while end < self.t_out.size and self.t_out[end] <= t_hi + 1e-14 * max(1.0, t_hi):
+                end += 1
+            if end > k:  # the outputs within this step, in one evaluation
+                t_step = self.t_out[k:end]
+                ys = interp(np.minimum(t_step, solver.t)).T
+                states += list(ys) if f.minimal else [
+                    f.project(t, y) for t, y in zip(t_step, ys, strict=True)]
+                times += t_step.tolist()
+                k = end
             if self.progress is not None:
                 self.progress(solver.t, self.duration)
         return times, states, drift, solver.nfev + self.extra_fev, steps, stopped
@@ -320,8 +323,6 @@ class _Stepper:
             if symbolic is None:
                 cache["dop853"] = None
             else:
-                from .integration import Stages, with_extra_work
-
                 cache["dop853"] = Stages(with_extra_work(symbolic))
         return cache["dop853"]
 
@@ -384,6 +385,8 @@ class _Stepper:
 
         if gap(t1, y1) > 0:
             return None
+        from scipy.optimize import brentq  # only for an event (its import costs 0.3–0.5 s)
+
         t_event = brentq(gap, t0, t1, xtol=1e-12) if gap(t0) > 0 else t0
         return t_event, interp(t_event)
 
@@ -571,6 +574,8 @@ def _before_lock(f: Formulation, t_lock: float) -> float:
 
     if gap(0.0) <= 0:
         return 0.0
+    from scipy.optimize import brentq  # only for a lock (its import costs 0.3–0.5 s)
+
     return brentq(gap, 0.0, t_lock, xtol=1e-14)
 
 
