@@ -16,7 +16,9 @@ formulation whose right-hand side is a CasADi function
 (:meth:`~balancer.formulations.Formulation.symbolic_rhs`) in one compiled call per step: the
 twelve stages of a step (and the three more of the dense output) are one function of
 ``(t, h, y, f)``, one call instead of twelve Python calls of the right-hand side, which
-dominate the integration of a small system. Everything else is :class:`DOP853`'s.
+dominate the integration of a small system. :class:`TimeOnlyDOP853` skips the stages'
+combinations for a right-hand side of the time alone (a driven crank's motor work).
+Everything else is :class:`DOP853`'s.
 """
 
 from __future__ import annotations
@@ -471,6 +473,31 @@ class DenseOutput:
                 y *= 1 - x
         y += self.y_old
         return y.T
+
+
+class TimeOnlyDOP853(DOP853):
+    """:class:`DOP853` for a right-hand side that depends on the time alone, not on the state.
+
+    A step's stages are then the right-hand side at known times, with no combination of the
+    earlier stages to form (numpy calls that cost as much as a small formulation's right-hand
+    side): a driven crank's motor work is such a quadrature
+    (:attr:`~balancer.formulations.Formulation.time_only`). The same steps as
+    :class:`DOP853`'s, bit for bit.
+    """
+
+    def _stages(self, t: float, y, h: float) -> NDArray[np.float64]:
+        K, fun = self.K, self.fun
+        K[0] = self.f
+        for s, c in enumerate(self.C[1:], start=1):
+            K[s] = fun(t + c * h, y)
+        y_new = y + h * np.dot(K[:-1].T, self.B)
+        K[-1] = fun(t + h, y_new)
+        return y_new
+
+    def _extra_stages(self, h: float) -> None:
+        K = self.K_extended
+        for s, c in enumerate(self.C_EXTRA, start=self.n_stages + 1):
+            K[s] = self.fun(self.t_old + c * h, self.y_old)
 
 
 # -- compiled stages --------------------------------------------------------------------------

@@ -48,7 +48,7 @@ from .formulations import (
     formulation_table,
     make,
 )
-from .integration import DOP853, CompiledDOP853, Stages, with_extra_work
+from .integration import DOP853, CompiledDOP853, Stages, TimeOnlyDOP853, with_extra_work
 from .mechanisms import mechanism_of
 from .model import RTOL_MIN, Design, SimulationSettings, check_scales
 
@@ -243,7 +243,9 @@ class _Stepper:
         groups = self.f.like_components()
         atol = floored_atol(self.atol, groups, y0)
         stages = self._stages()
-        if stages is None:
+        if stages is None and f.time_only:
+            solver = TimeOnlyDOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=atol)
+        elif stages is None:
             solver = DOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=atol)
         else:
             solver = CompiledDOP853(f.rhs, 0.0, y0, t_end, stages=stages, rtol=self.rtol,
@@ -427,10 +429,14 @@ class _WithExtraWork:
         self.passes_dead_points = f.passes_dead_points
         self.passes_change_points = f.passes_change_points
         self.name = f.name
+        self.time_only = f.time_only
 
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         own = y[:-1]
-        return np.append(self.f.rhs(t, own), self.f.extra_power(t, own))
+        out = np.empty(y.size)  # (np.append costs as much as a small formulation's rhs)
+        out[:-1] = self.f.rhs(t, own)
+        out[-1] = self.f.extra_power(t, own)
+        return out
 
     def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.append(self.f.project(t, y[:-1]), y[-1])

@@ -207,6 +207,15 @@ class Formulation(ABC):
         """
         return Evaluation.stack([self.evaluate(t, y) for t, y in zip(times, states, strict=True)])
 
+    @property
+    def time_only(self) -> bool:
+        """Whether :meth:`rhs` depends on the time alone, not on the state.
+
+        So it is for a minimal formulation with the crank driven: the motion is prescribed and
+        the state is only the motor's work.
+        """
+        return self.minimal and self.driven
+
     def symbolic_rhs(self):
         """:meth:`rhs` as a CasADi function ``(t, y) → ẏ``, or ``None``.
 
