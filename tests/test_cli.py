@@ -218,6 +218,32 @@ def test_help_imports_no_numerics():
     assert out.strip().splitlines()[-1] == "[]"
 
 
+#: What each command may not import (SciPy alone costs 0.3–0.7 s of a command that should
+#: take well under a second; CVXPY ~1 s; matplotlib, pyarrow and Dask are for plots, tables
+#: and sweeps).
+_HEAVY = ("scipy", "cvxpy", "matplotlib", "pyarrow", "dask")
+
+
+@pytest.mark.parametrize(("args", "also"), [
+    (["analyze", "meijaard2020.toml"], ("casadi", "clarabel")),
+    (["analyze", "engine.toml"], ("casadi", "clarabel")),
+    (["analyze", "watt_sixbar.toml", "--json"], ("casadi", "clarabel")),
+    (["verify", "meijaard2020.toml", "--duration", "0.2"], ("casadi", "clarabel")),
+    (["optimize", "pb1.toml", "--verify-duration", "0.2"], ()),
+])
+def test_commands_import_only_what_they_need(args, also):
+    examples = Path(EXAMPLE).parent
+    args = [str(examples / a) if a.endswith(".toml") else a for a in args]
+    code = ("import io, json, sys, contextlib\nfrom balancer.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            f"    assert main({args!r}) == 0\n"
+            "print(json.dumps(sorted({m.split('.')[0] for m in sys.modules})))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    loaded = set(json.loads(out.strip().splitlines()[-1]))
+    assert not loaded & {*_HEAVY, *also}
+
+
 def test_version_is_the_installed_packages(capsys):
     from importlib.metadata import version
 

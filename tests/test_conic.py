@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from balancer.balance.certificate import Constraint
-from balancer.balance.conic import ConicProgram
+from balancer.balance.conic import ConicProgram, CscMatrix
 from balancer.balance.convex import CLARABEL_SETTINGS
 
 #: Agreement of two solves to Clarabel's tolerances (1e-10) on problems of unit scale, with
@@ -131,3 +131,17 @@ def test_convex_balancing_does_not_import_cvxpy():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, cwd=__file__.rsplit("/tests/", 1)[0])
     assert out.stdout.strip() == "False"
+
+
+def test_the_matrices_clarabel_reads_are_scipys_csc_arrays():
+    # Clarabel reads shape, indptr, indices, data: the same as scipy.sparse would give it.
+    from scipy.sparse import csc_array
+
+    rng = np.random.default_rng(3)
+    for shape in ((5, 3), (1, 7), (9, 9), (4, 0), (0, 2)):
+        dense = rng.standard_normal(shape) * (rng.uniform(size=shape) < 0.4)
+        mine, ref = CscMatrix.of(dense), csc_array(dense)
+        assert mine.shape == ref.shape
+        assert np.array_equal(mine.indptr, ref.indptr)
+        assert np.array_equal(mine.indices, ref.indices)
+        assert np.array_equal(mine.data, ref.data)

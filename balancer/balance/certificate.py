@@ -17,7 +17,7 @@ box ``[lo, hi]`` that holds a minimiser the optimum is therefore at least
 status — they only make ``ρ`` larger than zero and the bound less tight. Clarabel's dual
 ``(v, z, ν)``, projected onto the cones, leaves ``ρ`` at its dual residual (``1e-10``, ~1e-8
 "almost solved"); the free ``ν`` and the multipliers of the active bounds are then refitted
-(bounded least squares, :func:`lower_bound`) to cancel what they can of it. (Not the
+(bounded least squares, :func:`lower_bound` and :mod:`.lsq`) to cancel what they can of it. (Not the
 multipliers' own accuracy matters, but only this residual: a multiplier taken from the
 primal point instead, e.g. ``v = ∇‖P·û + q‖``, is off by the primal error, which a flat
 optimum leaves at the square root of the solver's tolerance.) Every choice of multipliers
@@ -41,7 +41,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import lsq_linear
+
+from .lsq import bounded_lstsq
 
 _EPS = float(np.finfo(float).eps)
 #: Multiplier (relative to the largest) above which a bound counts as active when the
@@ -254,12 +255,9 @@ def _refit(objective: Objective, constraints: list[Constraint], equality, active
     extra_r: list[NDArray[np.float64]] = []
     if columns:
         matrix = np.array(columns).T * weight[:, None]
-        bounds = (np.r_[np.zeros(signed), np.full(len(columns) - signed, -np.inf)],
-                  np.full(len(columns), np.inf))
-        fit = lsq_linear(matrix, -rho * weight, bounds=bounds, method="bvls", tol=1e-15,
-                         max_iter=500)
+        lower = np.r_[np.zeros(signed), np.full(len(columns) - signed, -np.inf)]
+        fit = bounded_lstsq(matrix, -rho * weight, lower, np.inf, tol=1e-15, max_iter=500)
         y = np.where(np.isfinite(fit.x), fit.x, 0.0)
-        y[:signed] = np.maximum(y[:signed], 0.0)
         extra_a.append(y * np.array(offsets))
         extra_r.append(np.array(columns) * y[:, None])
     return _finish(objective, a_terms + extra_a, r_terms + extra_r, u, lo, hi, upper)

@@ -43,6 +43,34 @@ SOLVED = ("optimal", "optimal_inaccurate")
 
 
 @dataclass(frozen=True)
+class CscMatrix:
+    """A dense matrix's nonzeros in compressed sparse columns, as Clarabel reads a matrix.
+
+    Clarabel takes any object with the attributes of SciPy's CSC arrays that it reads
+    (``shape``, ``indptr``, ``indices``, ``data``, ``has_canonical_format``); built here with
+    numpy, without importing ``scipy.sparse`` (0.1–0.2 s) for a few hundred numbers. The
+    entries are those ``scipy.sparse.csc_array(dense)`` stores, in its order: column by
+    column, rows ascending.
+    """
+
+    shape: tuple[int, int]
+    indptr: NDArray[np.int64]
+    indices: NDArray[np.int64]
+    data: NDArray[np.float64]
+    has_canonical_format = True  # sorted rows, no duplicates
+
+    @classmethod
+    def of(cls, dense: NDArray[np.float64]) -> CscMatrix:
+        """The nonzeros of a dense 2-D array."""
+        dense = np.asarray(dense, dtype=float)
+        cols, rows = np.nonzero(dense.T)  # column-major: each column's rows ascending
+        indptr = np.zeros(dense.shape[1] + 1, dtype=np.int64)
+        np.cumsum(np.bincount(cols, minlength=dense.shape[1]), out=indptr[1:])
+        return cls(shape=dense.shape, indptr=indptr, indices=rows.astype(np.int64),
+                   data=dense[rows, cols])
+
+
+@dataclass(frozen=True)
 class ConicSolution:
     """What one solve returned.
 
@@ -157,7 +185,6 @@ class ConicProgram:
         ``target`` is the ``nearest`` objective's point; ``equality_rhs`` replaces ``r``.
         """
         import clarabel
-        from scipy.sparse import csc_array
 
         b = self._b
         if equality_rhs is not None:
@@ -176,8 +203,8 @@ class ConicProgram:
         options.verbose = False
         for key, value in settings.items():
             setattr(options, key, value)
-        solver = clarabel.DefaultSolver(csc_array(self._H), h, csc_array(self._A), b, cones,
-                                        options)
+        solver = clarabel.DefaultSolver(CscMatrix.of(self._H), h, CscMatrix.of(self._A), b,
+                                        cones, options)
         with np.errstate(over="ignore", invalid="ignore"):
             result = solver.solve()
         status = STATUS.get(str(result.status), "solver_error")

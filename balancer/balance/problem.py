@@ -80,6 +80,7 @@ from ..mechanisms.base import Mechanism
 from ..model import GROUND, Design, Link
 from ..validate import LENGTH_RANGE
 from .conditions import force_balance_conditions
+from .lsq import bounded_lstsq
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..spec import _Table
@@ -748,8 +749,6 @@ def _bounded_least_squares(a, x, entries, lower, upper, original) -> NDArray[np.
     A light pull towards the original (1e-6 of the problem's scale) picks one among equally
     good choices.
     """
-    from scipy.optimize import lsq_linear
-
     lower, upper = np.asarray(lower, float), np.asarray(upper, float)
     original = np.asarray(original, float)
     free = lower < upper
@@ -766,7 +765,7 @@ def _bounded_least_squares(a, x, entries, lower, upper, original) -> NDArray[np.
     weight = 1e-6 * max(float(np.linalg.norm(cols)), 1e-300)
     lhs = np.vstack([cols * scale, weight * np.eye(len(entries))])
     rhs = np.concatenate([-rest, weight * original / scale])
-    sol = lsq_linear(lhs, rhs, bounds=(lower / scale, upper / scale), method="bvls", tol=1e-14)
+    sol = bounded_lstsq(lhs, rhs, lower / scale, upper / scale, tol=1e-14)
     out[free] = np.clip(sol.x * scale, lower, upper)
     return out
 
