@@ -10,7 +10,6 @@ reason. :func:`check_writable` lets a command find a bad output path before it c
 from __future__ import annotations
 
 import os
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
@@ -40,6 +39,8 @@ def check_writable(path: str | os.PathLike[str], option: str | None = None) -> P
                           value=str(path))
     if target.is_dir():
         raise OutputError("is a folder, not a file", key=option, value=str(path))
+    import tempfile  # here: a command that writes nothing does not load it
+
     try:
         fd, probe = tempfile.mkstemp(prefix=f".{target.name}.", dir=folder)
     except OSError as exc:
@@ -62,6 +63,8 @@ def write_with(path: str | os.PathLike[str], writer: Callable[[str], None],
     OutputError
         If the file cannot be written (naming the path and the reason).
     """
+    import tempfile
+
     target = Path(path)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=suffix,

@@ -7,7 +7,6 @@ names that other tools rely on are fixed in DESIGN.md.
 from __future__ import annotations
 
 import io
-import json
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -240,6 +239,8 @@ def dumps_json(doc: dict[str, Any]) -> str:
 
         raise SolverError(f"the results are not finite numbers (at {where}): the computation "
                           "lost its precision")
+    import json  # here: a table needs no JSON
+
     return json.dumps(doc, indent=2, allow_nan=False) + "\n"
 
 

@@ -40,7 +40,6 @@ Every error names the file, the key and the value; unknown keys are errors (a ty
 from __future__ import annotations
 
 import cmath
-import difflib
 import math
 import os
 import tomllib
@@ -171,6 +170,8 @@ class _Table:
                 self._unknown(name)
 
     def _unknown(self, name: str) -> None:
+        import difflib  # only for a spec that is wrong
+
         known = sorted(self.known or ())
         close = difflib.get_close_matches(name, known, n=1)
         hint = f"; did you mean '{close[0]}'?" if close else ""

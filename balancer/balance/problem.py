@@ -63,7 +63,6 @@ This module imports neither CVXPY nor CasADi.
 
 from __future__ import annotations
 
-import difflib
 import math
 import sys
 from dataclasses import dataclass, field, replace
@@ -248,6 +247,8 @@ def _check_keys(table: _Table, known: tuple[str, ...]) -> None:
     """Reject unknown keys first, with a suggestion for a typo."""
     for name in table.data:
         if name not in known:
+            import difflib  # only for a spec that is wrong
+
             close = difflib.get_close_matches(name, known, n=1)
             hint = f"; did you mean '{close[0]}'?" if close else ""
             raise SpecError(f"unknown key '{name}'{hint}", key=table.key(name))
