@@ -309,8 +309,7 @@ class _Stepper:
             if end > k:  # the outputs within this step, in one evaluation
                 t_step = self.t_out[k:end]
                 ys = interp(np.minimum(t_step, solver.t)).T
-                states += list(ys) if f.minimal else [
-                    f.project(t, y) for t, y in zip(t_step, ys, strict=True)]
+                states += list(ys) if f.minimal else f.project_many(t_step, ys)
                 times += t_step.tolist()
                 k = end
             if self.progress is not None:
@@ -440,6 +439,10 @@ class _WithExtraWork:
 
     def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.append(self.f.project(t, y[:-1]), y[-1])
+
+    def project_many(self, times, states) -> list[NDArray[np.float64]]:
+        own = self.f.project_many(times, [y[:-1] for y in states])
+        return [np.append(p, y[-1]) for p, y in zip(own, states, strict=True)]
 
     def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
         return self.f.constraint_residual(t, y[:-1])

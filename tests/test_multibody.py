@@ -512,3 +512,27 @@ def test_a_compiled_dop853_step_is_scipys_step(method, driven):
     # stages: rounding moves it by about ε/rtol relative, no more.
     assert abs(run.h_abs - ref.h_abs) <= 1e3 * eps / options["rtol"] * ref.h_abs
     assert run.nfev == ref.nfev
+
+
+@pytest.mark.parametrize("driven", [False, True])
+def test_projecting_many_states_together_is_projecting_each(driven):
+    # A step's output times are projected together (the Newton steps' linear systems
+    # stacked): the same states as one by one, but for the rounding of the stacked products.
+    design = _watt()
+    f = make("multibody", design.mechanism, gravity=design.simulation.gravity,
+             speed=4.0 if driven else None)
+    rng = np.random.default_rng(7)
+    times = np.linspace(0.0, 0.3, 6)
+    states = []
+    for t in times:
+        y = f.initial_state(0.3 + (0.0 if driven else 4.0 * t), 4.0)
+        f.theta1_start = 0.3
+        k = 2 * 3 * f.n
+        y[:k] += 1e-7 * rng.standard_normal(k) * np.maximum(np.abs(y[:k]), 1.0)  # off the
+        states.append(y)  # constraints, as an interpolated output is
+    together = f.project_many(times, states)
+    for t, y, mine in zip(times, states, together, strict=True):
+        alone = f.project(t, y)
+        assert rel_err(mine, alone) < 1e-13
+        pos, vel = f.constraint_residual(t, mine)
+        assert pos < 1e-13 * f.scale and vel < 1e-12 * np.max(np.abs(alone))

@@ -292,6 +292,13 @@ class Formulation(ABC):
         """Put a state back on the constraint manifold (identity for minimal formulations)."""
         return y
 
+    def project_many(self, times, states) -> list[NDArray[np.float64]]:
+        """:meth:`project` at many states (a step's output times), as a list.
+
+        One by one, unless a formulation projects them together.
+        """
+        return [self.project(t, y) for t, y in zip(times, states, strict=True)]
+
     def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
         """Loop-closure residuals of a state: position (m) and velocity (m/s)."""
         return 0.0, 0.0
