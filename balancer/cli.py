@@ -654,5 +654,14 @@ def _innermost(exc: BaseException) -> str:
 
 
 def entry_point() -> None:
-    """Console-script entry point."""
+    """Console-script entry point (``balancer`` and ``python -m balancer``).
+
+    OpenBLAS runs on one thread unless the user chose otherwise: the commands' linear algebra
+    is small (tens to hundreds of rows), where its threads only cost — they spin while numpy
+    loads and wait on every small solve, some 60 ms of a 0.3 s ``analyze`` on a busy 2-core
+    machine, and a small QR took 150 ms threaded against 1 ms on one thread. Set before numpy
+    is imported; a sweep's worker processes inherit it (one worker per core). The results are
+    the same either way.
+    """
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     sys.exit(main())

@@ -244,6 +244,22 @@ def test_commands_import_only_what_they_need(args, also):
     assert not loaded & {*_HEAVY, *also}
 
 
+@pytest.mark.parametrize(("given", "used"), [(None, "1"), ("3", "3")])
+def test_the_command_runs_openblas_on_one_thread_unless_told(given, used):
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    code = ("import os, sys\nsys.argv = ['balancer', '--version']\n"
+            "from balancer.cli import entry_point\ntry:\n    entry_point()\n"
+            "except SystemExit:\n    pass\nprint(os.environ['OPENBLAS_NUM_THREADS'], "
+            "'numpy' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, env=env).stdout
+    assert out.strip().splitlines()[-1] == f"{used} False"  # set before numpy loads
+
+
 def test_version_is_the_installed_packages(capsys):
     from importlib.metadata import version
 
