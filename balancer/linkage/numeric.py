@@ -271,7 +271,8 @@ def start(structure: Structure, g: Group,
 
     Returns the group's coordinates from its continuation table (:func:`table`, by
     :func:`_cubic`), ``(N, 3·|g|)``, NaN where the table has none, and where it has
-    (``inside``).
+    (``inside``). A table that stops both ways spans less than a turn in general: an angle
+    is then taken where it falls in that span, whichever side of the reference.
     """
     theta1 = np.atleast_1d(np.asarray(theta1, dtype=float))
     angles, tab = table(structure, g)
@@ -280,17 +281,22 @@ def start(structure: Structure, g: Group,
     # The angle of each request in the table's window (a turn either way of the reference).
     ok_rows = np.all(np.isfinite(tab), axis=1)
     full = ok_rows[TABLE_STEPS:].all()
-    t = begin + np.mod(theta1 - begin, 2 * math.pi) if full else theta1
-    if not full:  # within the range found, in the window nearest the reference
+    valid = angles[ok_rows]
+    if full:
+        t = begin + np.mod(theta1 - begin, 2 * math.pi)
+    elif valid.max() - valid.min() < 2 * math.pi:  # the range found is less than a turn:
+        # its one angle there (an angle in it as it is)
+        t = theta1 - 2 * math.pi * np.floor((theta1 - valid.min()) / (2 * math.pi))
+    else:  # within the range found, in the window nearest the reference
         t = begin + np.remainder(theta1 - begin + math.pi, 2 * math.pi) - math.pi
     cubics = structure.cache.setdefault("numeric cubics", {})
     key = structure.groups.index(g)
     if key not in cubics:
         cubics[key] = _cubic_coefficients(tab)
-    guess = _cubic(angles, cubics[key], t)
+    finite_rows = np.flatnonzero(ok_rows)  # one run: the continuation stops at its ends
+    guess = _cubic(angles, cubics[key], t, (int(finite_rows[0]), int(finite_rows[-1])))
     inside = (t >= lo) & (t <= hi)
     if not full:
-        valid = angles[ok_rows]
         inside &= (t >= valid.min()) & (t <= valid.max())
     guess[~inside] = np.nan
     return guess, inside
@@ -341,20 +347,23 @@ def solve_group_symbolic(g: Group, pose: Pose, guess: list, ops,
 
 
 def _cubic(angles: NDArray[np.float64], coefficients: NDArray[np.float64],
-           t: NDArray[np.float64]) -> NDArray[np.float64]:
+           t: NDArray[np.float64], rows: tuple[int, int] | None = None
+           ) -> NDArray[np.float64]:
     """The table at angles ``t`` by cubic interpolation on its uniform grid, ``(N, 3·|g|)``.
 
-    Through the four rows around each angle (Lagrange's cubic; at the table's ends, or next
-    to a row beyond the continuation, the nearest four finite rows or NaN): its error is
-    ``O(h⁴)`` of the table's step ``h``, ~1e-8 of the coordinates at 720 steps a turn, so that
-    one Newton step takes it to rounding. ``coefficients`` are the cubics' per four rows
-    (:func:`_cubic_coefficients`): an angle costs one gather and Horner's rule.
+    Through the four rows around each angle (Lagrange's cubic; at the ends of the table or of
+    its finite rows ``rows`` (first, last), the nearest four of those, or NaN if it has fewer):
+    its error is ``O(h⁴)`` of the table's step ``h``, ~1e-8 of the coordinates at 720 steps a
+    turn, so that one Newton step takes it to rounding. ``coefficients`` are the cubics' per
+    four rows (:func:`_cubic_coefficients`): an angle costs one gather and Horner's rule.
     """
     step = angles[1] - angles[0]
     x = (t - angles[0]) / step
     finite = np.isfinite(x)
-    i = np.clip(np.floor(np.where(finite, x, 0.0)).astype(np.int64) - 1, 0, angles.size - 4)
-    u = x - i  # in [1, 2] inside the table: the nodes are at 0, 1, 2, 3
+    first, last = (0, angles.size - 1) if rows is None else rows
+    i = np.clip(np.floor(np.where(finite, x, 0.0)).astype(np.int64) - 1, first,
+                max(first, last - 3))
+    u = x - i  # in [1, 2] inside the table (the nodes are at 0, 1, 2, 3), [0, 3] at its ends
     width = coefficients.shape[1]
     picked = np.take(coefficients.reshape(4 * width, -1), i, axis=1).reshape(4, width, -1)
     out = ((picked[3] * u + picked[2]) * u + picked[1]) * u + picked[0]

@@ -144,7 +144,7 @@ class _Registers:
     def name(self, r: int) -> str:
         """How the program names register ``r``'s value now."""
         if r in self.constant:
-            return repr(self.constant[r])
+            return _literal(self.constant[r])
         return self.aliases.get(r, f"w{r}")
 
     def fix(self, r: int, value: float) -> None:
@@ -174,6 +174,17 @@ class _Registers:
             lines.append(f"    w{r}[:] = w{source}")
 
 
+def _literal(value: float) -> str:
+    """``value`` as Python source: ``repr`` of a finite float, numpy's name of ±inf or NaN.
+
+    CasADi folds ``1/0`` to a constant inf; ``repr`` writes it ``inf``, a name the program
+    does not know.
+    """
+    if np.isfinite(value):
+        return repr(value)
+    return "np.nan" if np.isnan(value) else ("np.inf" if value > 0 else "-np.inf")
+
+
 def _emit(lines: list[str], regs: _Registers, ufunc: str, ins: list[int], out: int,
           extra: float | None = None) -> None:
     """One elementwise operation into register ``out`` (folded when its inputs are constants)."""
@@ -182,7 +193,7 @@ def _emit(lines: list[str], regs: _Registers, ufunc: str, ins: list[int], out: i
         with np.errstate(all="ignore"):
             regs.fix(out, float(getattr(np, ufunc)(*args)))
         return
-    names = [regs.name(r) for r in ins] + ([] if extra is None else [repr(extra)])
+    names = [regs.name(r) for r in ins] + ([] if extra is None else [_literal(extra)])
     regs.write(out)
     lines.append(f"    np.{ufunc}({', '.join(names)}, out=w{out})")
 
@@ -304,8 +315,11 @@ class CrankForcesProgram:
         """The forces at crank states (arrays ``(N,)``) and where they are the numpy route's.
 
         A state is left out (``False``) where a numeric group's Newton step did not converge
-        to the numpy route's tolerance or the group cannot be placed there: its forces are
-        then to be computed by the numpy route.
+        to the numpy route's tolerance or the group cannot be placed there, and where any
+        figure is not finite: its forces are then to be computed by the numpy route. (CasADi
+        folds ``0·x`` to 0, so a figure that is structurally zero, such as the couple of a
+        piston whose centre of mass is on its guide, stays 0 where the numpy route's
+        ``0·NaN`` is NaN: outside the assembly range, or at a non-finite input.)
         """
         s = self.structure
         n = theta1.size
@@ -327,7 +341,7 @@ class CrankForcesProgram:
                       b - a, [out[:, a:b]])
         closure, step, health = out[-3], out[-2], out[-1]
         ok &= ((closure <= numeric.NEWTON_TOLERANCE * s.length_scale())
-               & (step <= numeric.TAYLOR_STEP) & (health <= 0))
+               & (step <= numeric.TAYLOR_STEP) & (health <= 0) & np.isfinite(out).all(axis=0))
         column = [row[:, None] for row in out]
         reactions = {p: V(column[4 + 2 * i], column[5 + 2 * i])
                      for i, p in enumerate(self.points)}
