@@ -18,6 +18,8 @@ import sys
 import time
 from pathlib import Path
 
+from tables import print_table
+
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE = ROOT / "examples" / "meijaard2020.toml"
 REPEATS = 5
@@ -70,14 +72,9 @@ def main() -> None:
     rows.append(("balancer analyze examples/meijaard2020.toml", statistics.median(times),
                  min(times), "-", "0.5 s", "yes" if statistics.median(times) <= 0.5 else "NO"))
     header = ("measurement", "median s", "best s", "peak memory", "target", "met")
-    widths = [max(len(str(r[i])) if not isinstance(r[i], float) else 8 for r in [header, *rows])
-              for i in range(len(header))]
     print(f"{REPEATS} fresh-process runs each; Python {sys.version.split()[0]}")
-    print("  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)))
-    print("  ".join("-" * w for w in widths))
-    for r in rows:
-        cells = [f"{c:.3f}" if isinstance(c, float) else str(c) for c in r]
-        print("  ".join(c.ljust(w) for c, w in zip(cells, widths, strict=True)))
+    print_table(header, [[f"{c:.3f}" if isinstance(c, float) else str(c) for c in r]
+                         for r in rows])
 
 
 if __name__ == "__main__":

@@ -65,6 +65,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import tables
+
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "balancer" / "examples"
 ANCHORS = Path(__file__).resolve().parent / "anchors"
@@ -486,18 +488,7 @@ def cells(row: Row) -> tuple[str, ...]:
 
 
 def print_table(rows: list[Row], markdown: bool) -> None:
-    table = [HEADER, *map(cells, rows)]
-    if markdown:
-        for i, r in enumerate(table):
-            print("| " + " | ".join(c.replace("|", "\\|") for c in r) + " |")
-            if i == 0:
-                print("|" + "---|" * len(HEADER))
-        return
-    widths = [max(len(r[i]) for r in table) for i in range(len(HEADER))]
-    for i, r in enumerate(table):
-        print("  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)).rstrip())
-        if i == 0:
-            print("  ".join("-" * w for w in widths))
+    tables.print_table(HEADER, [cells(r) for r in rows], markdown=markdown)
 
 
 def machine() -> str:

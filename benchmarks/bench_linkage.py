@@ -20,6 +20,8 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from tables import print_table
+
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ("watt_sixbar.toml", "stephenson_sixbar.toml")
 REPEATS = 3
@@ -67,12 +69,8 @@ def main() -> None:
             rows.append((name, label, med, min(secs), target, "yes" if med <= target else "NO"))
     header = ("example", "measurement", "median s", "best s", "target s", "met")
     cells = [[f"{c:.4f}" if isinstance(c, float) else str(c) for c in r] for r in rows]
-    widths = [max(len(h), *(len(r[i]) for r in cells)) for i, h in enumerate(header)]
     print(f"median of {REPEATS} in-process runs after a warm-up; Python {sys.version.split()[0]}")
-    print("  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)))
-    print("  ".join("-" * w for w in widths))
-    for r in cells:
-        print("  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)))
+    print_table(header, cells)
 
 
 if __name__ == "__main__":

@@ -41,6 +41,7 @@ from pathlib import Path
 
 from anchors.de_pb1 import de_problem
 from scipy.optimize import differential_evolution
+from tables import print_table
 
 from balancer.balance.optimizer import Optimizer
 from balancer.balance.problem import NumericProblem, numeric_problem
@@ -132,18 +133,13 @@ def main() -> None:
                                                                  args.de_repeats)
     header = ("problem", "method", "median ms", "best ms", "iterations", "J (N·m)²",
               "√(J/J_orig)")  # fmt: skip
-    table = [header]
+    table = []
     for name, method, med, best, iters, obj, j0 in rows:
         ratio = math.sqrt(obj / j0) if obj >= 0 else float("nan")
         table.append((name, method, f"{med * 1e3:.2f}", f"{best * 1e3:.2f}", str(iters),
                       f"{obj:.12g}", f"{ratio:.3g}"))  # fmt: skip
-    widths = [max(len(r[i]) for r in table) for i in range(len(header))]
     print()
-    for i, r in enumerate(table):
-        print("  ".join(c.ljust(w) if j < 2 else c.rjust(w)
-                        for j, (c, w) in enumerate(zip(r, widths, strict=True))))  # fmt: skip
-        if i == 0:
-            print("  ".join("-" * w for w in widths))
+    print_table(header, table, right=range(2, len(header)))
     print()
     for name in ("pb1", "pb2"):
         sel = {m: (med, obj, j0) for n, m, med, _, _, obj, j0 in rows if n == name}

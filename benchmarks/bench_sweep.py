@@ -20,6 +20,8 @@ import time
 import tomllib
 from pathlib import Path
 
+from tables import print_table
+
 ROOT = Path(__file__).resolve().parent.parent
 SPEC = ROOT / "examples" / "pb1.toml"
 
@@ -71,12 +73,8 @@ def main() -> None:
         rows.append(("sweep, 2 Dask workers (target ≤ 300 s)", 10_000, _sweep(10_000, 2)))
     header = ("run", "points", "seconds", "points/s")
     cells = [(r, str(n), f"{s:.2f}", f"{n / s:.1f}") for r, n, s in rows]
-    widths = [max(len(h), *(len(c[i]) for c in cells)) for i, h in enumerate(header)]
     print(f"PB1 family (coupler × frame grid); Python {sys.version.split()[0]}")
-    print("  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)))
-    print("  ".join("-" * w for w in widths))
-    for c in cells:
-        print("  ".join(x.ljust(w) for x, w in zip(c, widths, strict=True)))
+    print_table(header, cells)
 
 
 if __name__ == "__main__":
