@@ -125,6 +125,32 @@ class Forces:
     shaking_force: V
     shaking_moment: NDArray[np.float64]
 
+    def arrays(self) -> list:
+        """Every figure in one fixed order (what :meth:`with_arrays` reads back).
+
+        Driving torque, shaking force ``x`` and ``y``, shaking moment; each ground point's
+        reaction ``x`` and ``y``, by name; each ground slider's normal force and couple, by
+        name.
+        """
+        out = [self.driving_torque, self.shaking_force.x, self.shaking_force.y,
+               self.shaking_moment]
+        for p in sorted(self.reactions):
+            out += [self.reactions[p].x, self.reactions[p].y]
+        for k in sorted(self.slider_normal):
+            out += [self.slider_normal[k], self.slider_couple[k]]
+        return out
+
+    def with_arrays(self, values: list) -> Forces:
+        """Forces with the same names holding ``values`` in :meth:`arrays`' order."""
+        points, sliders = sorted(self.reactions), sorted(self.slider_normal)
+        at = 4 + 2 * len(points)
+        return Forces(
+            reactions={p: V(values[4 + 2 * i], values[5 + 2 * i]) for i, p in enumerate(points)},
+            slider_normal={k: values[at + 2 * i] for i, k in enumerate(sliders)},
+            slider_couple={k: values[at + 2 * i + 1] for i, k in enumerate(sliders)},
+            driving_torque=values[0], shaking_force=V(values[1], values[2]),
+            shaking_moment=values[3])
+
 
 def _col(x, n: int, c: int) -> NDArray[np.float64]:
     """``x`` (a scalar, ``(N,)`` or ``(N, C)``) as an ``(N, C)`` array."""

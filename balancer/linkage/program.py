@@ -28,7 +28,7 @@ from .dynamics import Forces, inverse_dynamics
 from .kinematics import Motion, positions, rates
 from .structure import Structure
 from .symbols import CasadiOps
-from .vectors import Factor, V, _is_zero, _minus, _times
+from .vectors import Factor, _is_zero, _minus, _times
 
 _OPS = {getattr(ca, name): name[3:] for name in dir(ca) if name.startswith("OP_")}
 
@@ -294,14 +294,8 @@ class CrankForcesProgram:
                     accel=tuple(accel))
         forces = inverse_dynamics(s, mo, gravity=gravity, loads=loads, ops=ops,
                                   gas=[gas[j] for j in range(len(s.prisms))])
-        self.points = sorted(forces.reactions)
-        self.normal = sorted(forces.slider_normal)
-        entries = [forces.driving_torque, forces.shaking_force.x, forces.shaking_force.y,
-                   forces.shaking_moment]
-        for p in self.points:
-            entries += [forces.reactions[p].x, forces.reactions[p].y]
-        for k in self.normal:
-            entries += [forces.slider_normal[k], forces.slider_couple[k]]
+        self.forces = forces  # the names, in :meth:`Forces.arrays`' order
+        entries = forces.arrays()
         # Checks: the groups' residuals (≤ the numpy route's tolerance), their angle steps
         # (≤ TAYLOR_STEP), the pivots' health (≤ 0).
         entries += [_largest([ca.fabs(r) for r in residuals]),
@@ -342,16 +336,7 @@ class CrankForcesProgram:
         closure, step, health = out[-3], out[-2], out[-1]
         ok &= ((closure <= numeric.NEWTON_TOLERANCE * s.length_scale())
                & (step <= numeric.TAYLOR_STEP) & (health <= 0) & np.isfinite(out).all(axis=0))
-        column = [row[:, None] for row in out]
-        reactions = {p: V(column[4 + 2 * i], column[5 + 2 * i])
-                     for i, p in enumerate(self.points)}
-        base = 4 + 2 * len(self.points)
-        normal = {k: column[base + 2 * i] for i, k in enumerate(self.normal)}
-        couple = {k: column[base + 2 * i + 1] for i, k in enumerate(self.normal)}
-        forces = Forces(reactions=reactions, slider_normal=normal, slider_couple=couple,
-                        driving_torque=column[0], shaking_force=V(column[1], column[2]),
-                        shaking_moment=column[3])
-        return forces, ok
+        return self.forces.with_arrays([row[:, None] for row in out[:-3]]), ok
 
 
 __all__ = ["CrankForcesProgram", "Tape"]

@@ -60,16 +60,7 @@ _PROGRAM_LOCK = threading.Lock()
 
 def _put(forces: Forces, part: Forces, where: NDArray[np.bool_]) -> None:
     """Write ``part``'s rows into ``forces`` at the states ``where`` (in place)."""
-    for mine, theirs in ((forces.driving_torque, part.driving_torque),
-                         (forces.shaking_moment, part.shaking_moment),
-                         (forces.shaking_force.x, part.shaking_force.x),
-                         (forces.shaking_force.y, part.shaking_force.y),
-                         *((forces.reactions[p].x, part.reactions[p].x) for p in forces.reactions),
-                         *((forces.reactions[p].y, part.reactions[p].y) for p in forces.reactions),
-                         *((forces.slider_normal[k], part.slider_normal[k])
-                           for k in forces.slider_normal),
-                         *((forces.slider_couple[k], part.slider_couple[k])
-                           for k in forces.slider_couple)):
+    for mine, theirs in zip(forces.arrays(), part.arrays(), strict=True):
         mine[where] = theirs
 
 
