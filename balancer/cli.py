@@ -64,6 +64,13 @@ _FORCE_HELP = ("overwrite output files that exist (without it, an output path th
                "existing file, the input spec included, is refused with exit code 2)")
 
 
+def _spec_and_force(p: argparse.ArgumentParser, balance: bool = False) -> None:
+    """The arguments every verb on a spec takes: the spec, and ``--force``."""
+    p.add_argument("spec", metavar="SPEC", help="design spec (TOML)"
+                   + (" with a [balance] section" if balance else ""))
+    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+
+
 def _cmd_analyze(args: argparse.Namespace) -> int:
     from .api import analyze
     from .outputs import write_atomic
@@ -402,8 +409,7 @@ def build_parser() -> argparse.ArgumentParser:
             "torque over one crank revolution at the operating speed ([operation] speed)."
         ),
     )
-    p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
-    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+    _spec_and_force(p)
     p.add_argument("--json", action="store_true", help="print a JSON document instead of a table")
     p.add_argument("--csv", metavar="PATH", help="write the per-angle values to a CSV file; "
                    + _CSV_UNITS)
@@ -435,8 +441,7 @@ def build_parser() -> argparse.ArgumentParser:
             "the energy balance and the constraint drift."
         ),
     )
-    p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
-    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+    _spec_and_force(p)
     p.add_argument("--method", choices=methods, help="formulation (default: the spec's, or "
                    "the mechanism's first: opened-loop for a four-bar, mass-matrix for a "
                    "slider-crank, crank-angle for a general linkage whose crank turns fully, "
@@ -466,8 +471,7 @@ def build_parser() -> argparse.ArgumentParser:
             "path of the total centre of mass (PNG, SVG or PDF)."
         ),
     )
-    p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
-    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+    _spec_and_force(p)
     p.add_argument("--plot", metavar="PATH",
                    help="write the report figure to PATH (.png, .svg or .pdf)")
     p.add_argument("--duration", type=_positive_float, metavar="T",
@@ -493,8 +497,7 @@ def build_parser() -> argparse.ArgumentParser:
             "simulation and can be written as a complete spec."
         ),
     )
-    p.add_argument("spec", metavar="SPEC", help="design spec (TOML) with a [balance] section")
-    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+    _spec_and_force(p, balance=True)
     p.add_argument("--out", metavar="BALANCED.toml", help="write the balanced design as a spec")
     p.add_argument("--backend", choices=("nlp", "convex"), default="nlp",
                    help="optimiser (default nlp: convex first, then IPOPT)")
@@ -514,8 +517,7 @@ def build_parser() -> argparse.ArgumentParser:
         "the original before it. --animate: the linkage turning, its total centre of mass "
         "traced. The file type comes from the extension.",
     )
-    p.add_argument("spec", metavar="SPEC", help="design spec (TOML)")
-    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+    _spec_and_force(p)
     p.add_argument("--cycle", metavar="PATH",
                    help="write the figure of one revolution to PATH (.png, .svg or .pdf)")
     p.add_argument("--animate", metavar="PATH",
@@ -533,8 +535,7 @@ def build_parser() -> argparse.ArgumentParser:
         "ends, each point the global optimum of a convex program with its certified lower "
         "bound; the knee marked.",
     )
-    p.add_argument("spec", metavar="SPEC", help="design spec (TOML) with a [balance] section")
-    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+    _spec_and_force(p, balance=True)
     p.add_argument("--against", required=True,
                    choices=("driving-torque", "added-mass", "shaking-force"),
                    help="the second objective")
@@ -555,8 +556,7 @@ def build_parser() -> argparse.ArgumentParser:
         "this machine's cores, or the scheduler at --scheduler. Each finished batch is kept "
         "beside the table, so that an interrupted sweep resumes with --resume.",
     )
-    p.add_argument("spec", metavar="SPEC", help="design spec (TOML) with a [balance] section")
-    p.add_argument("--force", action="store_true", help=_FORCE_HELP)
+    _spec_and_force(p, balance=True)
     p.add_argument("--vary", action="append", metavar="KEY=LOW:HIGH:N",
                    help="a dotted spec key and its range, e.g. mechanism.lengths.coupler="
                    "2.5:3.5:11 (N values on a grid; repeat for more keys)")
