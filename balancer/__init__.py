@@ -27,6 +27,7 @@ _EXPORTS = {
     "analyze": "api",
     "example": "api",
     "optimize": "api",
+    "Optimizer": "balance.optimizer",
     "pareto": "api",
     "simulate": "api",
     "to_dict": "api",
@@ -62,6 +63,7 @@ _EXPORTS = {
 __all__ = [
     "example",
     "optimize",
+    "Optimizer",
     "pareto",
     "simulate",
     "sweep",
@@ -113,6 +115,7 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .api import analyze, example, optimize, pareto, simulate, to_dict, to_table, verify
+    from .balance.optimizer import Optimizer
     from .errors import AssemblyError, BalancerError, LockupError, SolverError, SpecError
     from .model import (
         Design,

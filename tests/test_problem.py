@@ -296,8 +296,81 @@ def test_the_objective_equals_the_newton_euler_route(seed):
         expected = _objective_by_newton_euler(data, lk)
         scale = abs(expected) + data.weights.added_mass * lk.total_mass
         assert abs(data.objective(x) - expected) <= 1e-9 * scale
-        # The factor R the optimisers use gives the same quadratic part.
+        # The factor R the optimisers use gives the same quadratic part, and the objective
+        # through it (what the solvers' inner loops compare) the same figure.
         assert float(np.sum((data.factor @ x) ** 2)) == pytest.approx(data.quadratic(x), rel=1e-12)
+        assert abs(data.reduced_objective(x) - expected) <= 1e-9 * scale
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_a_problem_under_new_bounds_equals_one_built_afresh(seed):
+    """``with_problem`` (what it keeps, what it makes anew) against ``numeric_problem``.
+
+    Random problems change bounds, free links, the objective's weights and whether force
+    balance is imposed; every field, cached scale and figure of the derived problem must be
+    those of the problem built from the spec with the new ``[balance]``.
+    """
+    rng = np.random.default_rng(300 + seed)
+    linkage = random_linkage(rng, loads=False, full_turn=True)
+    first, second = _random_problem(rng), _random_problem(rng)
+    if seed % 2:  # the same objective: its reduction is kept, not rebuilt
+        second = replace(second, objective=first.objective)
+    operation = Operation(speed=float(rng.uniform(-20, 20)), samples=int(rng.integers(8, 200)))
+    data = numeric_problem(Design(mechanism=linkage, operation=operation, balance=first))
+    derived = data.with_problem(second)
+    fresh = numeric_problem(Design(mechanism=linkage, operation=operation, balance=second))
+    assert derived.problem == second
+    assert derived.links == fresh.links
+    assert derived.inert == fresh.inert
+    np.testing.assert_array_equal(derived.rows, fresh.rows)
+    np.testing.assert_array_equal(derived.factor, fresh.factor)
+    assert (derived.force_balance is None) == (fresh.force_balance is None)
+    if fresh.force_balance is not None:
+        for a, b in zip(derived.force_balance, fresh.force_balance, strict=True):
+            np.testing.assert_array_equal(a, b)
+    for name in ("objective_scale", "objective_reference", "inertial_scale",
+                 "original_objective", "original_mass"):
+        assert getattr(derived, name) == getattr(fresh, name), name
+    np.testing.assert_array_equal(derived.scales, fresh.scales)
+    np.testing.assert_array_equal(derived.offset, fresh.offset)
+    np.testing.assert_array_equal(derived.acceleration_rows, fresh.acceleration_rows)
+    x = data.x0 * rng.uniform(0.8, 1.2, data.size)
+    assert derived.objective(x) == fresh.objective(x)
+    np.testing.assert_array_equal(derived.force_balance_rows(x), fresh.force_balance_rows(x))
+    assert derived.violations(x) == fresh.violations(x)
+
+
+def test_a_problem_under_new_bounds_is_checked():
+    """A contradictory problem is refused as the spec's would be, naming the key."""
+    data = numeric_problem(spec.load_design(EXAMPLES / "pb1.toml"))
+    with pytest.raises(SpecError, match="balance.objective"):
+        data.with_problem(replace(data.problem, objective=Objective(shaking_moment=0.0)))
+    with pytest.raises(SpecError, match="balance.bogus"):
+        data.with_problem(data.problem.with_link("bogus", LinkFreedom(mass=(1.0, 2.0))))
+
+
+def test_force_balance_rows_against_their_definition():
+    """Each row's residual over the sum of its links' combined terms (the definition, a link
+    at a time), on designs whose links' terms cancel within a link and between links."""
+    rng = np.random.default_rng(7)
+    data = numeric_problem(spec.load_design(EXAMPLES / "pb2.toml"))
+    a, b = data.force_balance
+    eps = np.finfo(float).eps
+    for _ in range(20):
+        x = data.x0 * rng.uniform(0.5, 1.5, data.size)
+        x[data.links[0].start + 1 : data.links[0].start + 3] = 0.0  # a link with no terms
+        expected = []
+        for i in range(a.shape[0]):
+            combined = abs(b[i]) + sum(abs(math.fsum(a[i, k] * x[k] for k in range(
+                l.start, l.start + 4))) for l in data.links)
+            raw = math.fsum(abs(a[i, k] * x[k]) for k in range(data.size)) + abs(b[i])
+            floor = 1e-6 * math.fsum(abs(a[i, k]) * data.scales[k] for k in range(data.size))
+            size = max(combined, 64 * eps / 1e-12 * raw, floor)
+            expected.append(abs(math.fsum(a[i] * x) - b[i]) / size)
+        # A·x rounds by at most P·ε of the raw terms, which are at most 1e-12/(64·ε) of the
+        # size: that is the absolute rounding of a ratio.
+        np.testing.assert_allclose(data.force_balance_rows(x), expected, rtol=1e-12,
+                                   atol=data.size * eps * 1e-12 / (64 * eps))
 
 
 @pytest.mark.parametrize("branch", ["+", "-"])

@@ -37,6 +37,7 @@ rounding is bounded too: sums are exactly rounded (``math.fsum``) and the bound 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -76,7 +77,9 @@ class Constraint:
 
     def project(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
         """The nearest point of the (self-dual) cone to ``z``."""
-        z = np.nan_to_num(np.asarray(z, dtype=float).reshape(-1))
+        z = np.asarray(z, dtype=float).reshape(-1)
+        if not np.isfinite(z).all():
+            z = np.nan_to_num(z)
         if self.kind == "nonneg":
             return np.maximum(z, 0.0)
         t, w = z[0], z[1:]
@@ -216,51 +219,86 @@ def lower_bound(objective: Objective, constraints: list[Constraint], equality,
     top = max((float(z[0]) for z in zs), default=0.0)
     active = [top > 0 and z[0] > ACTIVE_MULTIPLIER * top and c.slack(u) <= ACTIVE_SLACK
               for c, z in zip(constraints, zs, strict=True)]
+    refit = _Refit(objective, constraints, equality, active, u, lo, hi, upper)
+    stacked_m = np.concatenate([c.m for c in constraints]) if constraints else np.zeros(0)
+    stacked_M = (np.vstack([c.M for c in constraints]) if constraints
+                 else np.zeros((0, u.size)))
     best: Bound | None = None
     for zset in (zs, [z if a else np.zeros_like(z) for z, a in zip(zs, active, strict=True)]):
-        cone_a = [-(z * c.m) for c, z in zip(constraints, zset, strict=True)]
-        cone_r = [-(c.M * z[:, None]) for c, z in zip(constraints, zset, strict=True)]
+        z = np.concatenate(zset) if zset else np.zeros(0)
+        cone_a, cone_r = -(z * stacked_m), -(stacked_M * z[:, None])
         for obj_a, obj_r in minorants:
-            bound = _refit(objective, constraints, equality, active, obj_a + cone_a,
-                           obj_r + cone_r, u, lo, hi, upper)
+            bound = refit(obj_a + [cone_a], obj_r + [cone_r])
             if bound is not None and (best is None or bound.value > best.value):
                 best = bound
     return best
 
 
-def _refit(objective: Objective, constraints: list[Constraint], equality, active, a_terms,
-           r_terms, u, lo, hi, upper: float | None) -> Bound | None:
-    """The bound of :func:`lower_bound` for one choice of multipliers, refitted."""
-    n = u.size
-    rho = _column_sums(r_terms, n)[0]
-    hi = np.array(hi, dtype=float)
-    width = np.maximum(np.abs(lo - u), np.where(np.isfinite(hi), np.abs(hi - u), 0.0))
-    weight = np.where(np.isfinite(hi), width, 1e3 * float(np.max(width, initial=1.0)))
-    weight = np.maximum(weight, 1e-300)
-    # Refit: ν free, and a nonnegative addition to each active bound's multiplier (both terms
-    # vanish at û, so they cost the bound nothing there), to cancel what they can of ρ. (The
-    # scalar part of an active cone's multiplier may grow too, keeping it in the cone, but at
-    # the cost of its term at û: it did not pay.)
-    columns, offsets = [], []
-    for c, on in zip(constraints, active, strict=True):
-        if c.kind == "nonneg" and on:
-            columns.append(-c.M[0])
-            offsets.append(-float(c.m[0]))
-    signed = len(columns)
-    if equality is not None:
-        e, r = equality
-        columns += list(e)
-        offsets += list(-r)
-    extra_a: list[NDArray[np.float64]] = []
-    extra_r: list[NDArray[np.float64]] = []
-    if columns:
-        matrix = np.array(columns).T * weight[:, None]
-        lower = np.r_[np.zeros(signed), np.full(len(columns) - signed, -np.inf)]
-        fit = bounded_lstsq(matrix, -rho * weight, lower, np.inf, tol=1e-15, max_iter=500)
-        y = np.where(np.isfinite(fit.x), fit.x, 0.0)
-        extra_a.append(y * np.array(offsets))
-        extra_r.append(np.array(columns) * y[:, None])
-    return _finish(objective, a_terms + extra_a, r_terms + extra_r, u, lo, hi, upper)
+class _Refit:
+    """The bound of :func:`lower_bound` for one choice of multipliers, refitted.
+
+    What the choices share is built once: the refit's matrix (the active bounds' and the
+    equalities' rows, weighted by the box around ``û``) and, when first needed, the box on the
+    objective's sublevel set (:func:`_sublevel_box`).
+    """
+
+    def __init__(self, objective: Objective, constraints: list[Constraint], equality, active,
+                 u, lo, hi, upper: float | None) -> None:
+        self.objective, self.u, self.lo, self.upper = objective, u, lo, upper
+        self.hi = np.array(hi, dtype=float)
+        finite = np.isfinite(self.hi)
+        width = np.maximum(np.abs(lo - u), np.where(finite, np.abs(self.hi - u), 0.0))
+        weight = np.where(finite, width, 1e3 * float(np.max(width, initial=1.0)))
+        self.weight = np.maximum(weight, 1e-300)
+        # Refit: ν free, and a nonnegative addition to each active bound's multiplier (both
+        # terms vanish at û, so they cost the bound nothing there), to cancel what they can of
+        # ρ. (The scalar part of an active cone's multiplier may grow too, keeping it in the
+        # cone, but at the cost of its term at û: it did not pay.)
+        columns, offsets = [], []
+        for c, on in zip(constraints, active, strict=True):
+            if c.kind == "nonneg" and on:
+                columns.append(-c.M[0])
+                offsets.append(-float(c.m[0]))
+        signed = len(columns)
+        if equality is not None:
+            e, r = equality
+            columns += list(e)
+            offsets += list(-r)
+        self.columns = np.array(columns).reshape(len(columns), u.size)
+        self.offsets = np.array(offsets)
+        self.matrix = self.columns.T * self.weight[:, None]
+        self.lower = np.r_[np.zeros(signed), np.full(len(columns) - signed, -np.inf)]
+        self.signed = signed
+        # The unconstrained least-squares solution of every choice, as LAPACK's lstsq gives it
+        # (singular values below ε of the largest dropped); where it keeps the active bounds'
+        # additions ≥ 0 it is BVLS's answer too.
+        self.inverse = np.linalg.pinv(self.matrix, rcond=_EPS) if columns else None
+        self._box: list[NDArray[np.float64] | None] = []
+
+    def box(self) -> NDArray[np.float64] | None:
+        """:func:`_sublevel_box` of the program (computed once)."""
+        if not self._box:
+            upper = math.inf if self.upper is None else self.upper
+            self._box.append(_sublevel_box(self.objective, self.lo, self.hi, upper))
+        return self._box[0]
+
+    def __call__(self, a_terms, r_terms) -> Bound | None:
+        """The bound for the products ``a_terms`` (of ``α``) and rows ``r_terms`` (of ``ρ``)."""
+        extra_a: list[NDArray[np.float64]] = []
+        extra_r: list[NDArray[np.float64]] = []
+        if self.offsets.size:
+            # The fit's target needs no exact sums: any multipliers give a valid bound.
+            rho = np.vstack(r_terms).sum(axis=0)
+            target = -rho * self.weight
+            y = self.inverse @ target
+            if not np.all(y[: self.signed] >= 0):
+                y = bounded_lstsq(self.matrix, target, self.lower, np.inf, tol=1e-15,
+                                  max_iter=500).x
+            y = np.where(np.isfinite(y), y, 0.0)
+            extra_a.append(y * self.offsets)
+            extra_r.append(self.columns * y[:, None])
+        return _finish(a_terms + extra_a, r_terms + extra_r, self.u, self.lo, self.hi,
+                       self.box)
 
 
 def _column_sums(rows: list[NDArray[np.float64]], n: int
@@ -269,21 +307,22 @@ def _column_sums(rows: list[NDArray[np.float64]], n: int
     if not n or not rows:
         return np.zeros(n), np.zeros(n)
     stack = np.vstack([np.reshape(r, (-1, n)) for r in rows])
-    sums = np.array([math.fsum(stack[:, j]) for j in range(n)])
+    sums = np.array([math.fsum(column) for column in stack.T.tolist()])
     return sums, np.abs(stack).sum(axis=0)
 
 
-def _finish(objective: Objective, a_terms, r_terms, u, lo, hi,
-            upper: float | None) -> Bound | None:
+def _finish(a_terms, r_terms, u, lo, hi,
+            sublevel_box: Callable[[], NDArray[np.float64] | None]) -> Bound | None:
     """``α + Σ_j min(ρ_j·lo_j, ρ_j·hi_j)`` less the rounding of its evaluation.
 
     ``α`` and ``ρ`` are the exactly rounded sums of the products ``a_terms`` and of the
     columns of ``r_terms``; each product is off by at most ``ε/2`` of itself, each sum by
     ``ε/2`` of its value, and the box, computed from the bounds, is widened by ``4·ε`` of
-    itself.
+    itself. ``sublevel_box()`` gives the box on the objective's sublevel set
+    (:func:`_sublevel_box`).
     """
     a = np.concatenate([np.ravel(t) for t in a_terms]) if a_terms else np.zeros(0)
-    alpha = math.fsum(a)
+    alpha = math.fsum(a.tolist())
     rho, rmag = _column_sums(r_terms, u.size)
     if not (math.isfinite(alpha) and np.all(np.isfinite(rho)) and np.all(np.isfinite(rmag))):
         return None
@@ -291,7 +330,7 @@ def _finish(objective: Objective, a_terms, r_terms, u, lo, hi,
     # An unbounded entry whose coefficient is not surely ≥ 0 (beyond its rounding) needs a
     # finite bound: it could lower the bound without end.
     if np.any(~finite & (rho <= _EPS * (rmag + np.abs(rho)))):
-        box = _sublevel_box(objective, lo, hi, math.inf if upper is None else upper)
+        box = sublevel_box()
         if box is None:
             return None
         hi = box

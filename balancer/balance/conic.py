@@ -120,47 +120,46 @@ class ConicProgram:
         epigraph = objective == "norm"
         width = n + 1 if epigraph else n
         self.width = width
-        rows: list[NDArray[np.float64]] = []  # blocks of A
-        rhs: list[NDArray[np.float64]] = []
-        cones: list[tuple[str, int]] = []  # (kind, dimension), merged where consecutive
         if equality is not None:
             e, r = (np.atleast_2d(np.asarray(equality[0], float)),
                     np.asarray(equality[1], float).reshape(-1))
-            self._equality_rows = e.shape[0]
-            rows.append(np.hstack([e, np.zeros((e.shape[0], width - n))]))
-            rhs.append(r)
-            cones.append(("zero", e.shape[0]))
         else:
-            self._equality_rows = 0
+            e, r = np.zeros((0, n)), np.zeros(0)
+        self._equality_rows = e.shape[0]
         # The nonnegative rows first, then the cones, each in the order given (as CVXPY
         # orders them: Clarabel's iterates, and so its last digits, depend on the order).
+        order = ([i for i, c in enumerate(constraints) if c.kind == "nonneg"]
+                 + [i for i, c in enumerate(constraints) if c.kind == "soc"])
+        if epigraph and (P is None or q is None):
+            raise ValueError("the norm objective needs P and q")
+        total = e.shape[0] + sum(constraints[i].M.shape[0] for i in order) + (
+            P.shape[0] + 1 if epigraph else 0)
+        a_matrix = np.zeros((total, width))
+        b_vector = np.zeros(total)
+        a_matrix[: e.shape[0], :n] = e
+        b_vector[: e.shape[0]] = r
+        cones: list[tuple[str, int]] = [("zero", e.shape[0])] if e.shape[0] else []
         self._slices: list[slice] = [slice(0, 0)] * len(constraints)
-        start = self._equality_rows
-        for kind in ("nonneg", "soc"):
-            for i, con in enumerate(constraints):
-                if con.kind != kind:
-                    continue
-                k = con.M.shape[0]
-                rows.append(np.hstack([-con.M, np.zeros((k, width - n))]))
-                rhs.append(np.asarray(con.m, float))
-                self._slices[i] = slice(start, start + k)
-                start += k
-                if kind == "nonneg" and cones and cones[-1][0] == "nonneg":
-                    cones[-1] = ("nonneg", cones[-1][1] + k)
-                else:
-                    cones.append((kind, k))
+        start = e.shape[0]
+        for i in order:
+            con = constraints[i]
+            k = con.M.shape[0]
+            a_matrix[start : start + k, :n] = -con.M
+            b_vector[start : start + k] = con.m
+            self._slices[i] = slice(start, start + k)
+            start += k
+            if con.kind == "nonneg" and cones and cones[-1][0] == "nonneg":
+                cones[-1] = ("nonneg", cones[-1][1] + k)
+            else:
+                cones.append((con.kind, k))
         self._epigraph: slice | None = None
         hessian = np.zeros((width, width))
         linear = np.zeros(width)
-        self._offset = 0.0
         if epigraph:
-            assert P is not None and q is not None
             k = P.shape[0]
-            block = np.zeros((k + 1, width))
-            block[0, n] = -1.0  # t
-            block[1:, :n] = -P
-            rows.append(block)
-            rhs.append(np.concatenate([[0.0], q]))
+            a_matrix[start, n] = -1.0  # t
+            a_matrix[start + 1 : start + 1 + k, :n] = -P
+            b_vector[start + 1 : start + 1 + k] = q
             self._epigraph = slice(start, start + k + 1)
             cones.append(("soc", k + 1))
             linear[n] = 1.0
@@ -172,11 +171,13 @@ class ConicProgram:
             hessian[:n, :n] = 2.0 * np.eye(n)
         else:
             raise ValueError(f"unknown objective {objective!r}")
-        self._A = np.vstack(rows) if rows else np.zeros((0, width))
-        self._b = np.concatenate(rhs) if rhs else np.zeros(0)
+        self._A = a_matrix
+        self._b = b_vector
         self._H = np.triu(hessian)
         self._h = linear
         self._cones = cones
+        # Clarabel's forms of what every solve shares
+        self._csc = (CscMatrix.of(self._H), CscMatrix.of(self._A))
 
     def solve(self, settings: dict, *, target: NDArray[np.float64] | None = None,
               equality_rhs: NDArray[np.float64] | None = None) -> ConicSolution:
@@ -195,16 +196,14 @@ class ConicProgram:
             assert target is not None
             h = np.zeros(self.width)
             h[: self.n] = -2.0 * np.asarray(target, float)
-        cones = []
-        for kind, k in self._cones:
-            cones.append({"zero": clarabel.ZeroConeT, "nonneg": clarabel.NonnegativeConeT,
-                          "soc": clarabel.SecondOrderConeT}[kind](k))
+        kinds = {"zero": clarabel.ZeroConeT, "nonneg": clarabel.NonnegativeConeT,
+                 "soc": clarabel.SecondOrderConeT}
+        cones = [kinds[kind](k) for kind, k in self._cones]
         options = clarabel.DefaultSettings()
         options.verbose = False
         for key, value in settings.items():
             setattr(options, key, value)
-        solver = clarabel.DefaultSolver(CscMatrix.of(self._H), h, CscMatrix.of(self._A), b,
-                                        cones, options)
+        solver = clarabel.DefaultSolver(self._csc[0], h, self._csc[1], b, cones, options)
         with np.errstate(over="ignore", invalid="ignore"):
             result = solver.solve()
         status = STATUS.get(str(result.status), "solver_error")

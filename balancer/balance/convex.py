@@ -259,9 +259,13 @@ class ConvexSolver:
         The numeric problem.
     settings
         Clarabel settings to override :data:`CLARABEL_SETTINGS`.
+    like
+        A solver of the same mechanism under other bounds (:meth:`NumericProblem.with_problem`)
+        whose work this one may share where the free variables are the same.
     """
 
-    def __init__(self, data: NumericProblem, *, settings: dict | None = None) -> None:
+    def __init__(self, data: NumericProblem, *, settings: dict | None = None,
+                 like: ConvexSolver | None = None) -> None:
         self.data = data
         self.settings = {**CLARABEL_SETTINGS, **(settings or {})}
         self.layout = layout(data)
@@ -271,6 +275,13 @@ class ConvexSolver:
         self._cones, self._relaxed = self._constraints()
         self._fb: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._failed_row = -1  # a row of Eq. 58 with nothing free that fails
+        # restore_balance's least-squares inverse of Eq. 58's rows per set of pinned entries
+        # (they depend on the free variables alone: shared with a solver `like` this one)
+        self._pinned_inverses: dict[bytes, NDArray[np.float64]] = {}
+        if (like is not None and like.data.force_balance is data.force_balance
+                and like.layout.primary == self.layout.primary
+                and np.array_equal(like.layout.T, self.layout.T)):
+            self._pinned_inverses = like._pinned_inverses
         self._inconsistent = self._force_balance()
         equality = None if self._fb is None else self._fb[:2]
         k = data.factor.shape[0]
@@ -519,7 +530,7 @@ class ConvexSolver:
             solver_status=solution.status,
             iterations=solution.iterations,
             time=elapsed,
-            objective=self.data.objective(self.layout.x(solution.u)) if ok else math.nan,
+            objective=self.data.reduced_objective(self.layout.x(solution.u)) if ok else math.nan,
         )
         return report, solution
 
@@ -557,7 +568,7 @@ class ConvexSolver:
             # The Lagrangian is t − (μ·t + w·(P·u + q)): the norm's minorant is −w.
             norm_dual = -(self._dual_basis @ first.epigraph_dual[1:])
         x, tight = self.repair(u1)
-        objective = data.objective(x)
+        objective = data.reduced_objective(x)
         if tie_break and lay.size:
             target = data.x0 if prefer is None else np.asarray(prefer, float)
             fixed = [] if self._fb is None else [self._fb[1]]
@@ -566,7 +577,7 @@ class ConvexSolver:
             stages.append(report2)
             if second.u is not None:
                 x2, tight2 = self.repair(second.u)
-                objective2 = data.objective(x2)
+                objective2 = data.reduced_objective(x2)
                 # Only a feasible tie-break design replaces the SOCP's (an "almost solved"
                 # one, repaired, can be cheaper by violating a bound).
                 if not data.violations(x2) and data.within(objective2, objective, TIE_ACCEPT):
@@ -875,10 +886,10 @@ class ConvexSolver:
             trial_pinned[j] = True
             trial = self.restore_balance(trial, trial_pinned)
             xt = data.settle(lay.x(trial), for_motion=False)
-            if data.violations(xt):
+            jt = data.reduced_objective(xt)
+            if not (data.within(jt, objective, 1e-12) and data.within(objective, jt, 1e-12)):
                 continue
-            jt = data.objective(xt)
-            if data.within(jt, objective, 1e-12) and data.within(objective, jt, 1e-12):
+            if not data.violations(xt):
                 u, x, objective, pinned = trial, xt, jt, trial_pinned
         return x, objective
 
@@ -913,6 +924,11 @@ class ConvexSolver:
         free = None if pinned is None or not pinned.any() else ~pinned
         if free is not None and not free.any():
             return u
+        if free is not None:
+            key = free.tobytes()
+            if key not in self._pinned_inverses:  # the same few patterns recur: keep them
+                self._pinned_inverses[key] = np.linalg.pinv(at[:, free])
+            pinv = self._pinned_inverses[key]
         residual = at @ u - rhs
         size = np.linalg.norm(residual)
         # The correction's own rounding (the rows' conditioning times ε) leaves a residual
@@ -922,7 +938,7 @@ class ConvexSolver:
                 trial = u - pinv @ residual
             else:
                 trial = u.copy()
-                trial[free] -= np.linalg.lstsq(at[:, free], residual, rcond=None)[0]
+                trial[free] -= pinv @ residual
             trial_residual = at @ trial - rhs
             trial_size = np.linalg.norm(trial_residual)
             if not trial_size < size:

@@ -22,6 +22,16 @@ Example::
     from balancer.balance.optimizer import optimize
     result = optimize(load_design("examples/pb1.toml"))
     result.success, result.status, result.objective, result.gap
+
+The same problem under new bounds, without rebuilding what does not depend on them::
+
+    import dataclasses
+    from balancer.balance.optimizer import Optimizer
+    design = load_design("examples/pb1.toml")
+    optimizer = Optimizer.of(design)
+    wider = dataclasses.replace(design.balance.link("rocker"), mass=(1.0, 6.0))
+    problem = design.balance.with_link("rocker", wider)
+    optimizer.with_problem(problem).run("convex")
 """
 
 from __future__ import annotations
@@ -37,7 +47,7 @@ from ..errors import SpecError
 from ..model import Design
 from .convex import ConvexSolution, ConvexSolver
 from .nlp import NlpSolution, NlpSolver
-from .problem import ROUNDING_TOLERANCE, NumericProblem, numeric_problem
+from .problem import ROUNDING_TOLERANCE, BalanceProblem, NumericProblem, numeric_problem
 from .result import (
     GAP_TOLERANCE,
     BalanceResult,
@@ -76,10 +86,39 @@ class Optimizer:
         The numeric problem (:func:`balancer.balance.problem.numeric_problem`).
     """
 
-    def __init__(self, data: NumericProblem) -> None:
+    def __init__(self, data: NumericProblem, *, like: Optimizer | None = None,
+                 gravity: tuple[float, float] = (0.0, 0.0)) -> None:
         self.data = data
-        self.convex = ConvexSolver(data)
+        self.gravity = gravity if like is None else like.gravity
+        self.convex = ConvexSolver(data, like=None if like is None else like.convex)
         self._nlp: NlpSolver | None = None
+        # The original design's cycle analysis: the same under any bounds.
+        self._before = None if like is None else like._before
+
+    @classmethod
+    def of(cls, design: Design) -> Optimizer:
+        """The optimiser of a design spec's ``[balance]`` problem.
+
+        Raises as :func:`~balancer.balance.problem.numeric_problem`.
+        """
+        data = numeric_problem(design)  # it has checked that [operation] is there
+        return cls(data, gravity=tuple(design.operation.gravity))
+
+    def with_problem(self, problem: BalanceProblem) -> Optimizer:
+        """The optimiser of the same design under another redesign problem (new bounds).
+
+        It shares what does not depend on the bounds
+        (:meth:`~balancer.balance.problem.NumericProblem.with_problem`): a sweep over bounds
+        re-solves without rebuilding the regressors. ``problem`` is a
+        :class:`~balancer.balance.problem.BalanceProblem`, e.g. ``dataclasses.replace`` of
+        ``design.balance``, or another spec's.
+
+        Raises
+        ------
+        SpecError
+            If ``problem`` is contradictory.
+        """
+        return Optimizer(self.data.with_problem(problem), like=self)
 
     @property
     def nlp(self) -> NlpSolver:
@@ -150,9 +189,11 @@ class Optimizer:
                 notes.append(f"rounding blurs the objective by {blur:.1e} of the scale (links "
                              "of very different masses): optimality cannot be decided finer")
         balanced = data.linkage_of(x)
-        before = cycle_analysis(
-            data.linkage, data.speed, data.samples, route="newton-euler", loads=False
-        )
+        if self._before is None:
+            self._before = cycle_analysis(
+                data.linkage, data.speed, data.samples, route="newton-euler", loads=False
+            )
+        before = self._before
         after = cycle_analysis(
             balanced, data.speed, data.samples, route="newton-euler", loads=False
         )
@@ -176,6 +217,7 @@ class Optimizer:
             stages=tuple(stages),
             before=before,
             after=after,
+            gravity=self.gravity,
         )
         return replace(result, message=_message(result, convex, notes))
 
@@ -235,5 +277,4 @@ def optimize(design: Design, backend: str = "nlp") -> BalanceResult:
         raise SpecError(
             f"unknown backend; choose from {', '.join(BACKENDS)}", key="backend", value=backend
         )
-    result = Optimizer(numeric_problem(design)).run(backend)
-    return replace(result, gravity=tuple(design.operation.gravity))
+    return Optimizer.of(design).run(backend)

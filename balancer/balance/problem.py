@@ -107,6 +107,8 @@ ROUNDING_FACTOR = 64.0
 #: Share of a force-balance row's magnitude at the parameters' scales below which its terms
 #: count as vanishing (:meth:`NumericProblem.force_balance_rows`).
 SMALL_ROW = 1e-6
+#: The share of a row's raw terms that its size is at least: their rounding over the tolerance.
+_RAW_SHARE = ROUNDING_FACTOR * float(np.finfo(float).eps) / FORCE_BALANCE_TOLERANCE
 #: A bound met to this (relative, :meth:`NumericProblem.violations`) is met to rounding: the
 #: physical values (:meth:`NumericProblem.physical`) then meet it exactly.
 ROUNDING_TOLERANCE = 1e-12
@@ -236,6 +238,13 @@ class BalanceProblem:
     def link(self, name: str) -> LinkFreedom | None:
         """The freedom of link ``name``, or ``None`` if it is not listed."""
         return dict(self.links).get(name)
+
+    def with_link(self, name: str, freedom: LinkFreedom | None) -> BalanceProblem:
+        """The problem with link ``name``'s freedom replaced (listed anew; ``None``: fixed)."""
+        links = [(n, f) for n, f in self.links if n != name]
+        if freedom is not None:
+            links.append((name, freedom))
+        return replace(self, links=tuple(links))
 
     @property
     def listed(self) -> tuple[str, ...]:
@@ -873,6 +882,45 @@ class NumericProblem:
     force_balance: tuple[NDArray[np.float64], NDArray[np.float64]] | None
     inert: tuple[bool, ...]
 
+    def with_problem(self, problem: BalanceProblem) -> NumericProblem:
+        """The same design at the same operating point under another redesign problem.
+
+        For new bounds (or other links free, another objective) without rebuilding what does
+        not depend on them: the regressors, the force-balance conditions and the rows of
+        :attr:`acceleration_rows` are kept; with the same objective weights also their
+        reduction (:attr:`rows`, :attr:`factor`, :attr:`inert`) and the objective's scales.
+        The result equals what :func:`numeric_problem` builds for the design with ``problem``
+        as its ``[balance]``.
+
+        Raises
+        ------
+        SpecError
+            If ``problem`` is contradictory (:func:`check_problem`).
+        """
+        problem = _checked_problem(problem)
+        mech = self.mechanism
+        check_problem(problem, mech)
+        links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
+        same_objective = problem.objective == self.problem.objective
+        if same_objective:
+            rows, factor, inert = self.rows, self.factor, self.inert
+        else:
+            rows, factor, inert = _reduced(self.regressors, problem.objective, links, self.size)
+        fb = None
+        if problem.force_balance:
+            fb = self.force_balance if self.force_balance is not None else _force_balance(mech)
+        new = replace(self, problem=problem, links=links, rows=rows, factor=factor,
+                      force_balance=fb, inert=inert)
+        kept = ["acceleration_rows", "scales", "original_mass"]
+        if same_objective:
+            kept += ["objective_reference", "inertial_scale", "objective_scale",
+                     "original_objective"]
+        if fb is not None and fb is self.force_balance:
+            kept.append("_force_balance_sizes")
+        for name in kept:  # cached properties that the new problem shares (made once)
+            new.__dict__[name] = getattr(self, name)
+        return new
+
     @property
     def linkage(self):
         """The original design's model."""
@@ -965,6 +1013,18 @@ class NumericProblem:
             total += wx * float(np.mean(force.real**2)) + wy * float(np.mean(force.imag**2))
         if w.added_mass:
             total += w.added_mass * (self.total_mass(x) - self.original_mass)
+        return total
+
+    def reduced_objective(self, x: NDArray[np.float64]) -> float:
+        """``J(x)`` through the factor: ``‖R·x‖² + w_m·(Σm − Σm_original)``, (N·m)².
+
+        Equal to :meth:`objective` up to rounding, at a cost independent of the number of
+        sampled angles: what the solvers' inner loops compare.
+        """
+        r = self.factor @ x
+        total = float(r @ r)
+        if self.weights.added_mass:
+            total += self.weights.added_mass * (self.total_mass(x) - self.original_mass)
         return total
 
     @cached_property
@@ -1070,7 +1130,8 @@ class NumericProblem:
         balance for every motion.
         """
         x = np.array(x, dtype=float)
-        own = self.own(x)
+        own = self.own(x).tolist()
+        offset = self.offset.tolist()
         entries, lower, upper, original = [], [], [], []
         for b in self.links:
             k = b.start
@@ -1081,7 +1142,7 @@ class NumericProblem:
                 continue
             q = (me * me + mf * mf) / m
             lo = max(b.inertia[0], m * b.gyration**2)
-            shift = self.offset[k + 3]
+            shift = offset[k + 3]
             # A counterweight's inertia nearest its least (it has no original).
             kept = lo if b.offset is not None else min(max(b.original.inertia, lo), b.inertia[1])
             entries.append(k + 3)
@@ -1235,7 +1296,7 @@ class NumericProblem:
         ``max(tol, FORCE_BALANCE_TOLERANCE)``. An empty list means ``x`` is a feasible design.
         """
         out = []
-        own = self.own(x)
+        own = self.own(x).tolist()  # Python floats: the same arithmetic, a scalar at a time
         for b in self.links:
             k = b.start
             m, me, mf, j = own[k : k + 4]
@@ -1266,7 +1327,7 @@ class NumericProblem:
                     f"{whose}: inertia {inertia:.9g} kg·m² outside [{lo:.9g}, {b.inertia[1]:.9g}]"
                 )
         for b in self.rotor_links:
-            value = x[b.rotor]
+            value = float(x[b.rotor])
             if b.counter_rotor is None:
                 if abs(value) > tol * b.inertia_ref:
                     out.append(f"{b.name}: has no counter-rotor, got {value:.6g} kg·m²")
@@ -1289,6 +1350,20 @@ class NumericProblem:
         """
         return float(np.max(self.force_balance_rows(x), initial=0.0))
 
+    @cached_property
+    def _force_balance_sizes(self) -> tuple[NDArray[np.float64], ...]:
+        """What :meth:`force_balance_rows` needs of ``(A, b)`` alone.
+
+        ``|A|``, the indicator ``(P, links)`` of each link's entries (a link's terms are
+        combined before their magnitude is taken), each row's :data:`SMALL_ROW` floor, and
+        ``|b|``.
+        """
+        a, rhs = self.force_balance
+        by_link = np.zeros((self.size, len(self.links)))
+        for j, b in enumerate(self.links):
+            by_link[b.entries, j] = 1.0
+        return np.abs(a), by_link, SMALL_ROW * (np.abs(a) @ self.scales), np.abs(rhs)
+
     def force_balance_rows(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """Each condition's residual relative to the size of its terms.
 
@@ -1303,21 +1378,22 @@ class NumericProblem:
             return np.zeros(0)
         a, rhs = self.force_balance
         x = np.asarray(x, dtype=float)
-        raw = np.abs(a) @ np.abs(x) + np.abs(rhs)
-        combined = np.abs(rhs).copy()
-        for b in self.links:
-            combined += np.abs(a[:, b.entries] @ x[b.entries])
-        eps = np.finfo(float).eps
-        size = np.maximum.reduce([combined,
-                                  ROUNDING_FACTOR * eps / FORCE_BALANCE_TOLERANCE * raw,
-                                  SMALL_ROW * (np.abs(a) @ self.scales)])
+        abs_a, by_link, floor, abs_rhs = self._force_balance_sizes
+        raw = abs_a @ np.abs(x) + abs_rhs
+        combined = np.abs((a * x) @ by_link).sum(axis=1) + abs_rhs
+        size = np.maximum(np.maximum(combined, _RAW_SHARE * raw), floor)
         residual = np.abs(a @ x - rhs)
+        if floor.all():  # every row has a positive size
+            return residual / size
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(size > 0, residual / size, residual)
 
 
 def numeric_problem(design: Design) -> NumericProblem:
     """Build the numeric redesign problem of a design spec once.
+
+    For the same design under other bounds, :meth:`NumericProblem.with_problem` reuses what
+    does not depend on them.
 
     Raises
     ------
@@ -1327,12 +1403,7 @@ def numeric_problem(design: Design) -> NumericProblem:
     AssemblyError
         If the crank cannot turn a full revolution.
     """
-    problem = design.balance
-    if problem is None:
-        raise SpecError("missing required table: the redesign problem ([balance])",
-                        key="balance")
-    if not isinstance(problem, BalanceProblem):
-        raise TypeError(f"design.balance must be a BalanceProblem, not {type(problem).__name__}")
+    problem = _checked_problem(design.balance)
     if design.operation is None:
         raise SpecError(
             "missing required key: the balancing objective is evaluated at the operating speed",
@@ -1344,9 +1415,47 @@ def numeric_problem(design: Design) -> NumericProblem:
     speed = design.operation.speed
     angles = sample_angles(design.operation.samples)
     reg = cycle_regressors(mech, angles, speed)
-    n = angles.size
-    p = mech.layout.size
-    w = problem.objective
+    links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
+    rows, factor, inert = _reduced(reg, problem.objective, links, mech.layout.size)
+    return NumericProblem(
+        problem=problem,
+        mechanism=mech,
+        speed=speed,
+        theta1=angles,
+        regressors=reg,
+        links=links,
+        x0=mech.parameters(),
+        rows=rows,
+        factor=factor,
+        force_balance=_force_balance(mech) if problem.force_balance else None,
+        inert=inert,
+    )
+
+
+def _checked_problem(problem) -> BalanceProblem:
+    """``problem`` if it is a redesign problem; :class:`SpecError` if there is none."""
+    if problem is None:
+        raise SpecError("missing required table: the redesign problem ([balance])",
+                        key="balance")
+    if not isinstance(problem, BalanceProblem):
+        raise TypeError(f"design.balance must be a BalanceProblem, not {type(problem).__name__}")
+    return problem
+
+
+def _force_balance(mech: Mechanism) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(A, b)`` of shaking-force balance (:func:`.conditions.force_balance_conditions`)."""
+    conditions = force_balance_conditions(mech)
+    return conditions.matrix, np.zeros(conditions.count)
+
+
+def _reduced(reg: CycleRegressors, w: Objective, links: tuple[LinkBounds, ...], p: int
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], tuple[bool, ...]]:
+    """The objective's rows ``K``, their triangular factor ``R`` and the inert entries.
+
+    ``K`` stacks the weighted regressor rows divided by ``√N`` (see :class:`NumericProblem`);
+    an entry is inert where its column of ``R`` vanishes (to ``1e-12`` of the largest).
+    """
+    n = reg.shaking_moment.shape[0]
     blocks = []
     if w.shaking_moment:
         blocks.append(math.sqrt(w.shaking_moment) * reg.shaking_moment)
@@ -1359,28 +1468,11 @@ def numeric_problem(design: Design) -> NumericProblem:
         blocks.append(math.sqrt(wy) * reg.shaking_force.imag)
     rows = np.vstack(blocks) / math.sqrt(n) if blocks else np.zeros((0, p))
     factor = np.linalg.qr(rows, mode="r") if blocks else np.zeros((0, p))
-    links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
-    fb = None
-    if problem.force_balance:
-        conditions = force_balance_conditions(mech)
-        fb = (conditions.matrix, np.zeros(conditions.count))
     norms = np.linalg.norm(factor, axis=0) if blocks else np.zeros(p)
     threshold = 1e-12 * max(float(norms.max(initial=0.0)), 1e-300)
     candidates = {b.start + 3 for b in links} | {b.rotor for b in links if b.rotor is not None}
     inert = tuple(i in candidates and norms[i] <= threshold for i in range(p))
-    return NumericProblem(
-        problem=problem,
-        mechanism=mech,
-        speed=speed,
-        theta1=angles,
-        regressors=reg,
-        links=links,
-        x0=mech.parameters(),
-        rows=rows,
-        factor=factor,
-        force_balance=fb,
-        inert=inert,
-    )
+    return rows, factor, inert
 
 
 __all__ = [
