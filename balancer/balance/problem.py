@@ -887,7 +887,7 @@ class NumericProblem:
 
         For new bounds (or other links free, another objective) without rebuilding what does
         not depend on them: the regressors, the force-balance conditions and the rows of
-        :attr:`acceleration_rows` are kept; with the same objective weights also their
+        :attr:`acceleration_factor` are kept; with the same objective weights also their
         reduction (:attr:`rows`, :attr:`factor`, :attr:`inert`) and the objective's scales.
         The result equals what :func:`numeric_problem` builds for the design with ``problem``
         as its ``[balance]``.
@@ -911,7 +911,7 @@ class NumericProblem:
             fb = self.force_balance if self.force_balance is not None else _force_balance(mech)
         new = replace(self, problem=problem, links=links, rows=rows, factor=factor,
                       force_balance=fb, inert=inert)
-        kept = ["acceleration_rows", "scales", "original_mass"]
+        kept = ["acceleration_factor", "scales", "original_mass"]
         if same_objective:
             kept += ["objective_reference", "inertial_scale", "objective_scale",
                      "original_objective"]
@@ -1104,15 +1104,18 @@ class NumericProblem:
         return self.gap(a, b) <= rel
 
     @cached_property
-    def acceleration_rows(self) -> NDArray[np.float64]:
-        """Shaking moment per unit crank acceleration at rest, ``(N, P)/√N``, N·m/(rad/s²).
+    def acceleration_factor(self) -> NDArray[np.float64]:
+        """Shaking moment per unit crank acceleration at rest, reduced: ``(P, P)``, N·m/(rad/s²).
 
-        The regressors at ``(θ1, θ̇1 = 0, θ̈1 = 1)`` on the sampled angles. The objective, at
-        constant speed, does not see what the crank's rotary inertia does when the speed
-        changes; this does.
+        The regressors at ``(θ1, θ̇1 = 0, θ̈1 = 1)`` on the sampled angles, divided by ``√N``
+        (``A``), as their triangular factor ``R`` (``‖R·x‖ = ‖A·x‖``, the root mean square of
+        that shaking moment), so that settling costs the same at any number of samples. The
+        objective, at constant speed, does not see what the crank's rotary inertia does when
+        the speed changes; this does.
         """
         reg = cycle_regressors(self.mechanism, self.theta1, 0.0, 1.0)
-        return reg.shaking_moment / math.sqrt(self.theta1.size)
+        rows = reg.shaking_moment / math.sqrt(self.theta1.size)
+        return np.linalg.qr(rows, mode="r")
 
     def settle(self, x: NDArray[np.float64], *, for_motion: bool = True) -> NDArray[np.float64]:
         """Give the :attr:`inert` entries their values.
@@ -1124,7 +1127,7 @@ class NumericProblem:
         centre of mass keeps the allowed value nearest the original's (a designer's crankshaft
         or flywheel is not shrunk behind their back). A counter-rotor is chosen, within its
         bounds, to minimise the mean square of the shaking moment per unit crank acceleration
-        (:attr:`acceleration_rows`): what a change of crank speed (start-up, fluctuation, free
+        (:attr:`acceleration_factor`): what a change of crank speed (start-up, fluctuation, free
         motion) makes the frame feel; among equally good choices the one nearest the original.
         With Berkof's conditions met this gives the crank the counter-rotor that completes the
         balance for every motion.
@@ -1161,7 +1164,7 @@ class NumericProblem:
         x[entries] = original
         if not for_motion:
             return x
-        a = self.acceleration_rows
+        a = self.acceleration_factor
         lower_a, upper_a, original_a = (np.array(v, dtype=float) for v in (lower, upper,
                                                                              original))
         rotor_entries = {b.rotor for b in self.rotor_links}
