@@ -268,13 +268,15 @@ class GasForce:
         return _PeriodicCubic(self.angles, self.values, self.period)
 
     def at(self, theta1):
-        """The force (N) at crank angle(s) ``theta1`` (rad)."""
+        """The force (N) at crank angle(s) ``theta1`` (rad): a float for a float."""
+        if len(self.values) == 1:
+            return self.values[0] + 0.0 * theta1
+        start = self.angles[0]
+        if isinstance(theta1, float):  # one state of an integration: no arrays
+            return self._spline.at(start + (theta1 - start) % self.period)
         import numpy as np
 
         t = np.asarray(theta1, dtype=float)
-        if len(self.values) == 1:
-            return self.values[0] + 0.0 * t
-        start = self.angles[0]
         return self._spline(start + np.mod(t - start, self.period))
 
 
@@ -305,6 +307,7 @@ class _PeriodicCubic:
         a[i, (i + 1) % n] += h
         m = np.linalg.solve(a, 6 * (slope - np.roll(slope, 1)))
         self.h, self.y, self.m = h, np.append(y, y[0]), np.append(m, m[0])
+        self._knots = self.knots.tolist()
 
     def __call__(self, t):
         """The spline at ``t`` (within one period from the first knot)."""
@@ -312,6 +315,17 @@ class _PeriodicCubic:
 
         t = np.asarray(t, dtype=float)
         i = np.clip(np.searchsorted(self.knots, t, side="right") - 1, 0, self.h.size - 1)
+        return self._piece(i, t, np)
+
+    def at(self, t: float) -> float:
+        """:meth:`__call__` at one time, in plain floats (an integrator's single state)."""
+        import bisect
+
+        i = min(max(bisect.bisect_right(self._knots, t) - 1, 0), len(self._knots) - 2)
+        return float(self._piece(i, t, None))
+
+    def _piece(self, i, t, np):
+        """The cubic of interval ``i`` at ``t`` (indices and times arrays, or numbers)."""
         h = self.h[i]
         a = (self.knots[i + 1] - t) / h
         b = 1.0 - a

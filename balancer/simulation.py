@@ -26,6 +26,13 @@ the driver appends one component ``W_extra`` with ``Ẇ_extra`` =
 :meth:`~balancer.formulations.Formulation.extra_power`. ``T − T0 − W`` is then a first integral
 of the integrated system, which the integrator keeps to its tolerance: the reported
 :attr:`Trajectory.energy_error` is a check of the integration, at no extra cost.
+
+A driven crank's motion is prescribed. A formulation whose coordinate is the crank angle
+(``complex-masses``) then has nothing to integrate but the work, a function of the time alone:
+it is found by adaptive Gauss–Kronrod quadrature of the vectorised power at the output times
+(:mod:`balancer.quadrature`, to the same tolerances), and the energy balance checks the driving
+torque of the formulation against its kinetic energy and the loads' work. Where the power is not
+vectorised, or the motion comes near a dead point, the integrator steps as for any motion.
 """
 
 from __future__ import annotations
@@ -63,6 +70,10 @@ ENERGY_FAILURE = 0.1
 #: Distance in θ1 from a change point, rad, within which a motion is near it (passable by
 #: a dead-point event, named as the cause of a stall).
 CHANGE_POINT_NEAR = 0.05
+#: Largest angle, rad, the crank turns over one quadrature panel of a driven motion's work
+#: (:meth:`_Stepper._prescribed`): a sixteenth of a revolution, so that the panels resolve the
+#: power's harmonics and the Gauss and Kronrod rules cannot agree on a wrong value.
+PANEL_ANGLE = math.pi / 8
 #: Steps over which the recent rate is judged: a run whose last ``STALL_WINDOW`` steps would
 #: need more than :data:`MAX_STEPS` more to finish has stalled (near-singular motion).
 STALL_WINDOW = 1000
@@ -108,7 +119,8 @@ class Trajectory:
     nfev
         Right-hand-side evaluations.
     steps
-        Accepted integration steps.
+        Accepted integration steps (of a driven crank's prescribed motion whose work is found
+        by quadrature: the quadrature's panels).
     seconds
         Wall-clock time of the integration and the outputs, s.
     rtol, atol
@@ -236,6 +248,10 @@ class _Stepper:
 
     def run(self, y0: NDArray[np.float64], stop_at: float | None):
         """Integrate from ``y0``; the states returned carry the extra work as a last entry."""
+        if self.f.time_only and stop_at is None:
+            prescribed = self._prescribed(y0)
+            if prescribed is not None:
+                return prescribed
         f = _WithExtraWork(self.f)
         y0 = np.append(y0, 0.0)
         t_end = self.duration if stop_at is None else min(stop_at, self.duration)
@@ -315,6 +331,48 @@ class _Stepper:
             if self.progress is not None:
                 self.progress(solver.t, self.duration)
         return times, states, drift, solver.nfev + self.extra_fev, steps, stopped
+
+    def _prescribed(self, y0: NDArray[np.float64]):
+        """A driven crank's prescribed motion, its work by quadrature instead of steps.
+
+        The state of a :attr:`~balancer.formulations.Formulation.time_only` formulation is a
+        function of the time whose derivative is known at every time: its values at the output
+        times are the cumulative integrals of :meth:`~balancer.formulations.Formulation.
+        driven_rates` (:func:`balancer.quadrature.cumulative`, to the run's tolerances; a panel
+        is reported as a step). ``None`` where the formulation has no vectorised rates, or the
+        motion comes within :data:`~balancer.formulations.DEAD_POINT_THRESHOLD` of a dead point
+        (away from a change point): the integrator then steps, and its event stops the run.
+        """
+        from .quadrature import cumulative
+
+        f = self.f
+        if f.driven_rates(self.t_out[:1]) is None:
+            return None
+        near_dead_point = False
+        points = f.change_points()
+
+        def integrand(t: NDArray[np.float64]) -> NDArray[np.float64]:
+            nonlocal near_dead_point
+            rates = f.driven_rates(t)
+            if not f.passes_dead_points:
+                low = np.abs(rates.transmission) <= DEAD_POINT_THRESHOLD
+                if np.any(low):
+                    theta1 = f.crank_angle(t[low])
+                    near = [np.abs(np.remainder(theta1 - p + math.pi, 2 * math.pi) - math.pi)
+                            < CHANGE_POINT_NEAR for p in points]
+                    near_dead_point |= not np.all(np.logical_or.reduce(near)) if near else True
+            return np.column_stack([rates.rates, rates.extra_power])
+
+        with np.errstate(divide="ignore", invalid="ignore"):
+            work = cumulative(integrand, self.t_out, rtol=self.rtol, atol=self.atol,
+                              max_width=PANEL_ANGLE / abs(f.speed))
+        if near_dead_point:
+            return None
+        start = np.append(y0, 0.0)
+        states = list(start + work.values)
+        if self.progress is not None:
+            self.progress(self.duration, self.duration)
+        return self.t_out.tolist(), states, [0.0, 0.0], work.evaluations, work.panels, None
 
     def _stages(self):
         """The formulation's compiled DOP853 stages (built once per formulation), or None."""

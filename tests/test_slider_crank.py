@@ -522,3 +522,8 @@ def test_a_gas_force_table_is_scipys_periodic_cubic_spline(n):
     t = np.linspace(-3 * np.pi, 3 * np.pi, 2001)
     assert np.max(np.abs(gas.at(t) - ref(np.mod(t, 2 * np.pi)))) < 1e-12 * np.max(
         np.abs(values))
+    # One angle at a time (an integrator's state), in plain floats: the same spline.
+    one = np.array([gas.at(float(x)) for x in t[::50]])
+    assert all(isinstance(gas.at(float(x)), float) for x in t[:3])
+    assert np.max(np.abs(one - ref(np.mod(t[::50], 2 * np.pi)))) < 1e-12 * np.max(
+        np.abs(values))

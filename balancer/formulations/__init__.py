@@ -45,6 +45,28 @@ from numpy.typing import NDArray
 #: formulation that cannot pass a dead point stops before it (:mod:`balancer.simulation`).
 DEAD_POINT_THRESHOLD = 1e-3
 
+
+@dataclass(frozen=True)
+class DrivenRates:
+    """A driven crank's prescribed motion at many times (:meth:`Formulation.driven_rates`).
+
+    Attributes
+    ----------
+    rates
+        The time derivative of the formulation's state, shape ``(times, state size)``: the
+        motor's power ``τ·θ̇1`` for its work (W), the crank's speed for a carried crank angle.
+    extra_power
+        :meth:`Formulation.extra_power` at those times, W, shape ``(times,)``.
+    transmission
+        How far each pose is from a dead point, as :meth:`Formulation.transmission` measures
+        it (0 there), shape ``(times,)``.
+    """
+
+    rates: NDArray[np.float64]
+    extra_power: NDArray[np.float64]
+    transmission: NDArray[np.float64]
+
+
 @dataclass(frozen=True)
 class Evaluation:
     """What a formulation says about one state (or, from ``evaluate_batch``, about many).
@@ -172,8 +194,8 @@ class Formulation(ABC):
         """Whether a motor holds the crank at constant speed."""
         return self.speed is not None
 
-    def crank_angle(self, t: float) -> float:
-        """Prescribed crank angle at time ``t`` (driven motion), rad."""
+    def crank_angle(self, t):
+        """Prescribed crank angle at time ``t`` (s, a number or an array; driven motion), rad."""
         assert self.speed is not None
         return self.theta1_start + self.speed * t
 
@@ -215,6 +237,15 @@ class Formulation(ABC):
         the state is only the motor's work.
         """
         return self.minimal and self.driven
+
+    def driven_rates(self, times: NDArray[np.float64]) -> DrivenRates | None:
+        """:meth:`rhs` and :meth:`extra_power` at many times of a :attr:`time_only` motion.
+
+        Vectorised over the times: the simulation then finds the motor's work at its output
+        times by quadrature (:mod:`balancer.quadrature`) instead of stepping an integrator.
+        ``None`` (the default) where a formulation has no vectorised form.
+        """
+        return None
 
     def symbolic_rhs(self):
         """:meth:`rhs` as a CasADi function ``(t, y) → ẏ``, or ``None``.

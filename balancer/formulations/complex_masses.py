@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..kinematics import branch_sign_along, cross_scalar, position_scalar, rates_scalar
-from . import Evaluation
+from . import DrivenRates, Evaluation
 from .closed_form import FourBarFormulation
 
 
@@ -113,18 +113,36 @@ class ComplexMasses(FourBarFormulation):
         inertia, force, kin = self._reduced(theta1, omega1)
         return self._evaluation(theta1, omega1, inertia, force, kin)
 
-    def evaluate_batch(self, times, states) -> Evaluation:
-        """The same equations on arrays of states, with the vectorised kinematics (Eq. 2–10)."""
+    def _kinematics_batch(self, theta1, omega1):
+        """``kin`` of :meth:`_dynamics` at arrays of crank states (Eq. 2–10, vectorised)."""
         from ..kinematics import motion
 
+        signs = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
+        mo = motion(self.lengths, theta1, omega1, 0.0, signs * np.ones_like(theta1), check=False)
+        return (mo.vectors, *mo.transfer, mo.omega[1], mo.omega[2], mo.alpha[1], mo.alpha[2])
+
+    def evaluate_batch(self, times, states) -> Evaluation:
+        """The same equations on arrays of states, with the vectorised kinematics (Eq. 2–10)."""
         cranks = [self._crank(t, y) for t, y in zip(times, states, strict=True)]
         theta1 = np.array([c[0] for c in cranks])
         omega1 = np.array([c[1] for c in cranks])
-        signs = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
-        mo = motion(self.lengths, theta1, omega1, 0.0, signs * np.ones_like(theta1), check=False)
-        kin = (mo.vectors, *mo.transfer, mo.omega[1], mo.omega[2], mo.alpha[1], mo.alpha[2])
+        kin = self._kinematics_batch(theta1, omega1)
         inertia, force = self._dynamics(kin, omega1)
         return self._evaluation(theta1, omega1, inertia, force, kin)
+
+    def driven_rates(self, times) -> DrivenRates | None:
+        """The motor's power ``τ·θ̇1`` (``τ = −force``, as :meth:`rhs`) at many times."""
+        if not self.time_only:
+            return None
+        theta1 = self.crank_angle(np.asarray(times, dtype=float))
+        omega1 = np.full(theta1.shape, float(self.speed))  # type: ignore[arg-type]
+        kin = self._kinematics_batch(theta1, omega1)
+        _, force = self._dynamics(kin, omega1)
+        _, v2, v3 = kin[0]
+        transmission = (v2.real * v3.imag - v2.imag * v3.real) / (self.lengths[1]
+                                                                  * self.lengths[2])
+        return DrivenRates(rates=(-force * omega1)[:, None], extra_power=np.zeros(theta1.shape),
+                           transmission=transmission)
 
     def _evaluation(self, theta1, omega1, inertia, force, kin) -> Evaluation:
         vectors, big2, big3, w2, w3, b2, b3 = kin

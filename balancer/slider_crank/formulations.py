@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from ..formulations import Evaluation
+from ..formulations import DrivenRates, Evaluation
 from ..formulations.closed_form import ClosedForm
 from ..formulations.mass_matrix import NodalTruss
 from ..kinematics import cross_scalar
@@ -121,15 +121,28 @@ class SliderComplexMasses(_SliderFormulation):
         """``(Σ, Σ'/2, Q)`` at a state.
 
         The generalised inertia, half its derivative, and the generalised force of loads,
-        gravity, gas force and motor torque.
+        gravity, gas force and motor torque. The kinematics of one state in plain floats
+        (:func:`~balancer.slider_crank.kinematics.motion`'s equations, which :meth:`_terms`
+        uses on arrays: a free motion's integrator calls this thousands of times).
         """
+        return self._combine(*self._transfer(theta1), float(self.gas(theta1)), torque)
+
+    def _transfer(self, theta1: float) -> tuple[complex, float, float, float, float]:
+        """``(l̄1, Θ2, X, dΘ2/dθ1, dX/dθ1)`` at one crank angle, in plain floats."""
+        r, big_l, e = self.lengths
+        c1, s1 = math.cos(theta1), math.sin(theta1)
+        s2 = (e - r * s1) / big_l
+        c2 = self.sign0 * math.sqrt(max((big_l - e + r * s1) * (big_l + e - r * s1), 0.0)) / big_l
+        big2 = -r * c1 / (big_l * c2)  # Θ2 = dθ2/dθ1
+        big_x = -r * s1 - big_l * s2 * big2  # X = dx/dθ1
+        d_big2 = (r * s1 + big_l * s2 * big2 * big2) / (big_l * c2)  # dΘ2/dθ1
+        d_big_x = -r * c1 - big_l * (s2 * d_big2 + c2 * big2 * big2)  # dX/dθ1
+        return complex(r * c1, r * s1), big2, big_x, d_big2, d_big_x
+
+    def _combine(self, v1, big2, big_x, d_big2, d_big_x, gas, torque=0.0):
+        """``(Σ, Σ'/2, Q)`` from the kinematics' transfer functions, for numbers or arrays."""
         c1, c2, c3 = self.links
         m2 = c2.mass
-        at_rest = self.motion_of(theta1, 0.0, 1.0)  # velocity maps: accelerations for θ̈1 = 1
-        turning = self.motion_of(theta1, 1.0, 0.0)  # their derivatives: for θ̇1 = 1
-        v1 = at_rest.l1[0]
-        big2, big_x = at_rest.transfer[0][0], at_rest.transfer[1][0]
-        d_big2, d_big_x = turning.alpha[1][0], turning.a[0]
         p = self.m2p * 1j * v1 + self.m2q * big_x  # rod momentum per unit θ̇1 (times m2)
         dp = -self.m2p * v1 + self.m2q * d_big_x
         sigma = (self.crank_inertia + abs(p) ** 2 / m2 + c2.inertia * big2 * big2
@@ -140,8 +153,20 @@ class SliderComplexMasses(_SliderFormulation):
         z1 = self.zeta[0]
         q = (self.moments[0] + torque + cross_scalar(z1 * v1, f1)
              + (p.real * f2.real + p.imag * f2.imag) / m2 + self.moments[1] * big2
-             + (f3.real + float(self.gas(theta1))) * big_x)
-        return sigma, half_dsigma, float(q)
+             + (f3.real + gas) * big_x)
+        return sigma, half_dsigma, q
+
+    def _terms(self, theta1: NDArray[np.float64]):
+        """``(Σ, Σ'/2, Q, X)`` at an array of crank angles (``Q`` without the motor's torque).
+
+        ``X = dx/dθ1``, the slider's velocity per unit crank rate.
+        """
+        at_rest = self.motion_of(theta1, 0.0, 1.0)  # velocity maps: accelerations for θ̈1 = 1
+        turning = self.motion_of(theta1, 1.0, 0.0)  # their derivatives: for θ̇1 = 1
+        big2, big_x = at_rest.transfer
+        sigma, half_dsigma, q = self._combine(at_rest.l1, big2, big_x, turning.alpha[1],
+                                              turning.a, self.gas(theta1))
+        return sigma, half_dsigma, q, big_x
 
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         self.theta1_start = float(theta1)
@@ -160,19 +185,30 @@ class SliderComplexMasses(_SliderFormulation):
         return self.evaluate_batch([t], [y]).at(0)
 
     def evaluate_batch(self, times, states) -> Evaluation:
-        cranks = [self._crank(t, y) for t, y in zip(times, states, strict=True)]
-        alphas, torques = [], []
-        for theta1, omega1 in cranks:
-            sigma, half_dsigma, q = self.reduced(theta1, omega1)
-            if self.driven:
-                alphas.append(0.0)
-                torques.append(half_dsigma * omega1 * omega1 - q)
-            else:
-                alphas.append((q - half_dsigma * omega1 * omega1) / sigma)
-                torques.append(0.0)
-        theta1 = np.array([c[0] for c in cranks])
-        omega1 = np.array([c[1] for c in cranks])
-        return self._evaluation(theta1, omega1, np.array(alphas), np.array(torques))
+        cranks = np.array([self._crank(t, y) for t, y in zip(times, states, strict=True)],
+                          dtype=float).reshape(-1, 2)
+        theta1, omega1 = cranks[:, 0], cranks[:, 1]
+        sigma, half_dsigma, q, _ = self._terms(theta1)
+        if self.driven:
+            alphas, torques = 0.0 * theta1, half_dsigma * omega1 * omega1 - q
+        else:
+            alphas, torques = (q - half_dsigma * omega1 * omega1) / sigma, 0.0 * theta1
+        return self._evaluation(theta1, omega1, alphas, torques)
+
+    def driven_rates(self, times) -> DrivenRates | None:
+        """The motor's power ``τ·θ̇1`` and the gas force's ``G·X·θ̇1`` at many times."""
+        if not self.time_only:
+            return None
+        theta1 = self.crank_angle(np.asarray(times, dtype=float))
+        omega1 = float(self.speed)  # type: ignore[arg-type]
+        _, half_dsigma, q, big_x = self._terms(theta1)
+        tau = half_dsigma * omega1 * omega1 - q  # as rhs
+        extra = (0.0 * theta1 if self.linkage.gas_force.is_zero
+                 else self.gas(theta1) * big_x * omega1)
+        r, big_l, e = self.lengths
+        s2 = (e - r * np.sin(theta1)) / big_l
+        return DrivenRates(rates=(tau * omega1)[:, None], extra_power=extra,
+                           transmission=np.sqrt(np.maximum(1 - s2 * s2, 0.0)))
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         return self.crank_angle(t) if self.driven else float(y[0])
@@ -182,7 +218,7 @@ class SliderComplexMasses(_SliderFormulation):
         if self.linkage.gas_force.is_zero:
             return 0.0
         theta1, omega1 = self._crank(t, y)
-        return float(self.gas(theta1)) * float(self.motion_of(theta1, omega1, 0.0).v[0])
+        return float(self.gas(theta1)) * self._transfer(theta1)[2] * omega1
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         return self.transmission_of_crank(self._crank(t, y)[0])

@@ -1,0 +1,111 @@
+"""A driven crank's prescribed motion: the motor's work by quadrature, against the integrator.
+
+A formulation whose state is the crank angle (``complex-masses``) has nothing to integrate when
+a motor holds the crank at constant speed but the work of the motor (and of a gas force): the
+simulation takes it by quadrature of the vectorised power (``driven_rates``) at the output
+times. Here the vectorised power against the formulation's own scalar right-hand side, and the
+quadrature's runs against the integrator's (the route it replaces, still taken where the power
+is not vectorised or the motion nears a dead point).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import paper_linkage, random_linkage
+from helpers import integration_bound
+from test_slider_crank import random_slider_crank
+
+from balancer import simulation
+from balancer.errors import LockupError
+from balancer.formulations import make
+from balancer.formulations.complex_masses import ComplexMasses
+from balancer.model import SimulationSettings
+from balancer.slider_crank.formulations import SliderComplexMasses
+
+
+def _cases():
+    cases = []
+    for seed in range(6):
+        rng = np.random.default_rng(700 + seed)
+        cases.append((random_linkage(rng, full_turn=True), tuple(rng.uniform(-10, 10, 2))))
+        cases.append((random_slider_crank(rng), tuple(rng.uniform(-10, 10, 2))))
+    return cases
+
+
+@pytest.mark.parametrize(("linkage", "gravity"), _cases())
+def test_the_vectorised_power_is_the_right_hand_side(linkage, gravity):
+    # Two routes through the same equations: the vectorised kinematics over arrays of angles
+    # against the scalar ones of the integrator's right-hand side (four-bar: Eq. 2–10 on arrays
+    # against position_scalar/rates_scalar; slider-crank: motion() against _transfer). Both
+    # round to ε times the terms, magnified by the condition of the position analysis at the
+    # angle (1/|sin μ|, μ the transmission angle, here ≥ 0.02): 1e-9 of the largest power.
+    rng = np.random.default_rng(1)
+    f = make("complex-masses", linkage, gravity=gravity, speed=rng.uniform(-20, 20))
+    y0 = f.initial_state(rng.uniform(-math.pi, math.pi), 0.0)
+    times = np.linspace(0.0, 3 * math.pi / abs(f.speed), 97)
+    rates = f.driven_rates(times)
+    keep = np.abs(rates.transmission) > 0.02
+    scalar = np.array([f.rhs(t, y0) for t in times[keep]])
+    extra = np.array([f.extra_power(t, y0) for t in times[keep]])
+    transmission = np.array([f.transmission(t, y0) for t in times[keep]])
+    scale = np.max(np.abs(scalar)) + np.max(np.abs(extra))
+    assert rates.rates.shape == (times.size, 1)
+    assert np.max(np.abs(rates.rates[keep] - scalar)) <= 1e-9 * scale
+    assert np.max(np.abs(rates.extra_power[keep] - extra)) <= 1e-9 * scale
+    assert np.max(np.abs(np.abs(rates.transmission[keep]) - np.abs(transmission))) < 1e-12
+    assert keep.sum() > 48
+    free = make("complex-masses", linkage, gravity=gravity)
+    assert free.driven_rates(times) is None  # only a prescribed motion has them
+
+
+def _stepped(monkeypatch, cls):
+    """Make ``cls`` step its integrator for the motor's work, as before the quadrature."""
+    monkeypatch.setattr(cls, "driven_rates", lambda self, times: None)
+
+
+@pytest.mark.parametrize(("linkage", "gravity"), _cases()[:4])
+def test_the_quadrature_takes_the_integrators_work(linkage, gravity, monkeypatch):
+    # The same prescribed motion, its work by quadrature (panels) and by DOP853 (steps): each
+    # within its steps·rtol of the truth relative to the energy (tests/helpers.py), so within the
+    # sum of both of each other. The states at the output times are the same: the crank angle
+    # is prescribed; the kinetic energy is computed from them alike.
+    settings = SimulationSettings(duration=1.3, theta1=0.4, omega1=7.0, gravity=gravity,
+                                  drive="constant-speed")
+    quad = simulation.simulate(linkage, settings, method="complex-masses", rtol=1e-10,
+                               atol=1e-12, outputs=77)
+    _stepped(monkeypatch, type(make("complex-masses", linkage)))
+    steps = simulation.simulate(linkage, settings, method="complex-masses", rtol=1e-10,
+                                atol=1e-12, outputs=77)
+    # Kronrod panels, one per output interval at least, 15 points each.
+    assert quad.steps >= 76 and quad.nfev % 15 == 0 and quad.nfev >= 15 * quad.steps
+    assert np.array_equal(quad.t, steps.t) and np.array_equal(quad.theta, steps.theta)
+    assert np.array_equal(quad.kinetic_energy, steps.kinetic_energy)
+    scale = max(np.max(np.abs(quad.kinetic_energy)), np.max(np.abs(quad.work)))
+    assert np.max(np.abs(quad.work - steps.work)) <= integration_bound(quad, steps) * scale
+    assert quad.energy_error < 2 * integration_bound(quad)  # T − T0 = W: the torque is right
+
+
+def test_a_dead_point_ahead_is_left_to_the_integrators_event(monkeypatch):
+    # The quadrature has no events: a prescribed motion that comes within the dead-point
+    # threshold of a dead point is stepped, and stops there as before. Raising the threshold to
+    # the middle of PB1's transmission range makes such a point of the paper's linkage.
+    linkage = paper_linkage()
+    f = make("complex-masses", linkage, speed=10.0)
+    f.initial_state(0.0, 0.0)
+    times = np.linspace(0, 2 * math.pi / 10, 721)
+    sines = np.abs(f.driven_rates(times).transmission)
+    monkeypatch.setattr(simulation, "DEAD_POINT_THRESHOLD", 0.5 * (sines.min() + sines.max()))
+    start = float(10 * times[np.argmax(sines)])  # from the best transmission onwards
+    settings = SimulationSettings(duration=1.0, theta1=start, omega1=10.0,
+                                  drive="constant-speed")
+    with pytest.raises(LockupError) as quad:
+        simulation.simulate(linkage, settings, method="complex-masses")
+    for cls in (ComplexMasses, SliderComplexMasses):
+        _stepped(monkeypatch, cls)
+    with pytest.raises(LockupError) as steps:
+        simulation.simulate(linkage, settings, method="complex-masses")
+    assert quad.value.time == steps.value.time and 0 < quad.value.time < 1.0
+    assert "dead point" in str(quad.value)
