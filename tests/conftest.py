@@ -4,11 +4,20 @@ from __future__ import annotations
 
 import math
 
+import os
+
 import numpy as np
 import pytest
+from hypothesis import settings
 
 from balancer.kinematics import assembly_range
 from balancer.model import FourBar, Link
+
+# Property tests draw the same examples on every machine and run (reproducible, like the seeded
+# random tests); HYPOTHESIS_PROFILE=explore draws new ones and keeps what fails (a fuzz campaign).
+settings.register_profile("reproducible", derandomize=True, database=None)
+settings.register_profile("explore")
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "reproducible"))
 
 #: Meijaard & van der Wijk (2020), Eq. 56.
 PAPER_LENGTHS = (1.0, 3.0, 2.0, 3.2)
