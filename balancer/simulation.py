@@ -4,7 +4,8 @@ The integrator is the explicit Runge–Kutta method of order 8, DOP853 (:mod:`.i
 stepped by hand so that after every accepted step the non-minimal formulations' states are
 projected back onto the loop closure and its derivative (the drift before projection is
 reported). Output values come from the step's dense output, all those within a step in one
-evaluation, projected in the same way, at equally spaced times. No component is held to an
+evaluation, at equally spaced times; they are projected in the same way, all together at the
+end of the run. No component is held to an
 absolute error below 100 ε of the largest of its kind (:func:`floored_atol`).
 
 Events:
@@ -74,6 +75,8 @@ CHANGE_POINT_NEAR = 0.05
 #: (:meth:`_Stepper._prescribed`): a sixteenth of a revolution, so that the panels resolve the
 #: power's harmonics and the Gauss and Kronrod rules cannot agree on a wrong value.
 PANEL_ANGLE = math.pi / 8
+#: Most output times of a run that resamples its outputs to a resolution.
+MAX_OUTPUTS = 100_000
 #: Steps over which the recent rate is judged: a run whose last ``STALL_WINDOW`` steps would
 #: need more than :data:`MAX_STEPS` more to finish has stalled (near-singular motion).
 STALL_WINDOW = 1000
@@ -236,7 +239,8 @@ class _Stepper:
     """One integration with projection, dense outputs and events."""
 
     def __init__(self, f: Formulation, duration: float, rtol: float, atol: float,
-                 outputs: int, progress: Callable[[float, float], None] | None) -> None:
+                 outputs: int, progress: Callable[[float, float], None] | None,
+                 resolution: float | None = None) -> None:
         self.f = f
         self.duration = duration
         self.rtol = rtol
@@ -245,6 +249,9 @@ class _Stepper:
         self.progress = progress
         self.extra_fev = 0
         self.t_end = duration
+        self.resolution = resolution
+        #: Each step's end and dense output, kept where the outputs may be resampled.
+        self.pieces: list[tuple[float, object]] = []
 
     def run(self, y0: NDArray[np.float64], stop_at: float | None):
         """Integrate from ``y0``; the states returned carry the extra work as a last entry."""
@@ -280,6 +287,7 @@ class _Stepper:
             states.append(np.array(y0))
             times.append(float(self.t_out[k]))
             k += 1
+        initial = len(states)
         stopped: tuple[float, NDArray[np.float64]] | None = None
         recent: deque[float] = deque([0.0], maxlen=STALL_WINDOW + 1)
         while solver.status == "running":
@@ -300,6 +308,9 @@ class _Stepper:
                     dense = _solver.dense_output()
                 return dense(t)
 
+            if self.resolution is not None:
+                interp(solver.t)
+                self.pieces.append((solver.t, dense))
             if not f.minimal:
                 if not passes_dead_points or (k < self.t_out.size and self.t_out[k] <= solver.t
                                               + 1e-14 * max(1.0, solver.t)):
@@ -324,13 +335,45 @@ class _Stepper:
                 end += 1
             if end > k:  # the outputs within this step, in one evaluation
                 t_step = self.t_out[k:end]
-                ys = interp(np.minimum(t_step, solver.t)).T
-                states += list(ys) if f.minimal else f.project_many(t_step, ys)
+                states += list(interp(np.minimum(t_step, solver.t)).T)
                 times += t_step.tolist()
                 k = end
             if self.progress is not None:
                 self.progress(solver.t, self.duration)
+        if self.resolution is not None and len(times) >= 2:
+            times, states = self._resampled(f, times, states, initial)
+        if not f.minimal and len(states) > initial:  # every output onto the constraints at once
+            states[initial:] = f.project_many(times[initial:], states[initial:])
         return times, states, drift, solver.nfev + self.extra_fev, steps, stopped
+
+    def _resampled(self, f, times: list[float], states: list, initial: int):
+        """The outputs, more of them where the crank turned farther than the resolution.
+
+        From the steps' dense outputs (:attr:`pieces`), without integrating again: output times
+        at least twice as many each round, until the crank turns at most :attr:`resolution`
+        between two (or :data:`MAX_OUTPUTS`).
+        """
+        last = times[-1]
+        ends = np.array([end for end, _ in self.pieces])
+        outputs = self.t_out.size
+        while outputs < MAX_OUTPUTS:
+            theta1 = np.array([f.theta1_of(t, y) for t, y in zip(times, states, strict=True)])
+            step = float(np.max(np.abs(np.diff(theta1))))
+            if not step > self.resolution * (1 + 1e-9):
+                break
+            need = math.ceil(1.1 * step / self.resolution * (outputs - 1)) + 1
+            outputs = min(MAX_OUTPUTS, max(need, 2 * outputs))
+            grid = np.linspace(0.0, self.duration, outputs)
+            grid = grid[grid <= last + 1e-14 * max(1.0, last)]
+            head = int(np.count_nonzero(grid <= 0.0))
+            where = np.minimum(np.searchsorted(ends, grid[head:], side="left"), ends.size - 1)
+            fresh = [states[0]] * head
+            for index in np.unique(where):
+                at = grid[head:][where == index]
+                fresh += list(self.pieces[index][1](np.minimum(at, ends[index])).T)
+            times, states = grid.tolist(), fresh
+            self.t_out = np.linspace(0.0, self.duration, outputs)
+        return times, states
 
     def _prescribed(self, y0: NDArray[np.float64]):
         """A driven crank's prescribed motion, its work by quadrature instead of steps.
@@ -545,6 +588,7 @@ def simulate(
     atol: float | None = None,
     outputs: int | None = None,
     progress: Callable[[float, float], None] | None = None,
+    resolution: float | None = None,
 ) -> Trajectory:
     """Simulate the linkage's motion.
 
@@ -566,6 +610,10 @@ def simulate(
         Number of equally spaced output times.
     progress
         Called as ``progress(t, duration)`` after every step.
+    resolution
+        Most angle, rad, the crank may turn between two output times: more outputs than
+        ``outputs`` where it turns faster (from the steps' dense outputs, at most
+        :data:`MAX_OUTPUTS`).
 
     Raises
     ------
@@ -600,7 +648,10 @@ def simulate(
     stop_at = None if speed is None else _lock_time(f, theta1, speed, duration)
     y0 = f.initial_state(theta1, omega1)
     start = _time.perf_counter()
-    stepper = _Stepper(f, duration, rtol, atol, outputs, progress)
+    if resolution is not None and speed is not None:  # the crank's prescribed turning
+        need = math.ceil(abs(speed) * duration / resolution) + 1
+        outputs = min(MAX_OUTPUTS, max(outputs, need))
+    stepper = _Stepper(f, duration, rtol, atol, outputs, progress, resolution)
     # A driven crank that locks: integrate up to just before the dead point, where the torque
     # it would need grows without bound.
     end = None if stop_at is None else _before_lock(f, stop_at)

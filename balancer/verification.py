@@ -12,8 +12,8 @@ with those of the unbalanced original when the spec names one (``[original]``, w
 The runs are sampled finely enough for their largest values and their plots: output times at
 which the crank turns at most one part in :data:`PER_REVOLUTION` of a revolution. A driven
 run's number follows from its speed; a free one's from its initial speed with
-:data:`FREE_MARGIN` to spare, and a free run whose crank turned faster still is run again with
-enough.
+:data:`FREE_MARGIN` to spare, and a free run whose crank turned faster still has its outputs
+resampled from the integration's steps.
 """
 
 from __future__ import annotations
@@ -27,15 +27,14 @@ import numpy as np
 from .errors import LockupError, SpecError
 from .mechanisms import mechanism_of
 from .model import Design
-from .simulation import Trajectory, simulate
+from .simulation import MAX_OUTPUTS, Trajectory, simulate
 
 #: Output times per crank revolution at least: 2°, some fifteen across the engine example's
 #: sharpest peak (its gas force's).
 PER_REVOLUTION = 180
-#: A free run's outputs allow for its crank turning this much faster than at the start.
+#: A free run's outputs allow for its crank turning this much faster than at the start (more
+#: are resampled from the integration where it turns faster still).
 FREE_MARGIN = 1.5
-#: Most output times of a run.
-MAX_OUTPUTS = 100_000
 #: Integrator tolerances of the runs: what the check needs. A balanced design's shaking force
 #: (and, balanced completely, its moment) vanishes at every state the formulation evaluates,
 #: however accurately the motion reached it, and a driven run's motion is prescribed; what the
@@ -196,37 +195,17 @@ def _simulate_span(tally: _Tally, linkage, settings, method: str, resolution: fl
                    **kw) -> tuple[Trajectory | None, str, object]:
     """The run (or its part before the motion stopped), why it stopped, its settings.
 
-    The reason is "" for a run that did not stop. With a ``resolution`` (rad), a run whose
-    crank turned farther than that between two output times is run again with enough of them.
+    The reason is "" for a run that did not stop. With a ``resolution`` (rad), the crank
+    turns at most that far between two output times (:func:`~balancer.simulation.simulate`
+    resamples the outputs of a crank that turned faster).
     """
-    for _ in range(2):
-        try:
-            traj, note = tally.simulate(linkage, settings, method, **kw), ""
-        except LockupError as exc:
-            traj, note = getattr(exc, "partial", None), str(exc)
-        more = _outputs_needed(traj, settings, resolution)
-        if more is None:
-            break
-        settings = replace(settings, outputs=more)
-        tally.total += settings.duration
+    try:
+        traj, note = tally.simulate(linkage, settings, method, resolution=resolution, **kw), ""
+    except LockupError as exc:
+        traj, note = getattr(exc, "partial", None), str(exc)
+    if traj is not None and not note:  # as many outputs as it took (the original's too)
+        settings = replace(settings, outputs=int(traj.t.size))
     return traj, note, settings
-
-
-def _outputs_needed(traj: Trajectory | None, settings, resolution: float | None) -> int | None:
-    """More output times if ``traj``'s crank turned farther than ``resolution`` between two.
-
-    From its fastest output (with a tenth to spare); ``None`` if it is resolved (or cannot be
-    made more so).
-    """
-    if resolution is None or traj is None or traj.t.size < 2:
-        return None
-    crank = traj.links.index(mechanism_of(traj.model).input)
-    step = float(np.max(np.abs(np.diff(traj.theta[crank]))))
-    if step <= resolution * (1 + 1e-9) or settings.outputs >= MAX_OUTPUTS:
-        return None
-    fastest = float(np.max(np.abs(traj.omega[crank])))
-    need = 1.1 * fastest * settings.duration / resolution
-    return min(MAX_OUTPUTS, max(math.ceil(need) + 1, 2 * settings.outputs))
 
 
 def _resolved(settings, speed: float, resolution: float | None):

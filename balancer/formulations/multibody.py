@@ -332,30 +332,41 @@ class Multibody(LinkageFormulation):
         y[:n], y[n : 2 * n] = q, qd
         return y
 
+    def _constraint_values_many(self, times, q: NDArray[np.float64]):
+        """:meth:`_constraint_values` at many states in one call.
+
+        Residuals ``(k, rows)`` and Jacobians ``(k, rows, n)``.
+        """
+        count, n = q.shape
+        angles = (self.crank_angle(np.asarray(times, dtype=float)) if self.driven
+                  else np.zeros(count))
+        out = np.asarray(self._constraints.fn(np.vstack([q.T, angles])))  # one column each
+        rows = self.rows
+        return out[:rows].T, out[rows:].T.reshape(count, n, rows).transpose(0, 2, 1)
+
     def project_many(self, times, states) -> list[NDArray[np.float64]]:
         """:meth:`project` at many states, the Newton steps of all of them taken together.
 
-        The same steps, state by state, with the small linear systems of all the states
-        stacked into one call of numpy's solver (whose cost per call, not per system,
-        dominated the projection of a verification's output times).
+        The same steps, state by state, with the constraints of all the states evaluated in one
+        call of the compiled function and the small linear systems stacked into one call of
+        numpy's solver (whose cost per call, not per system, dominated the projection of a
+        verification's output times).
         """
         ys = np.array(states, dtype=float)
+        times = np.asarray(times, dtype=float)
         n = 3 * self.n
         q, qd = ys[:, :n], ys[:, n : 2 * n]  # views: the steps land in ys
         jacs = np.empty((len(ys), self.rows, n))
         todo = np.arange(len(ys))
         for _ in range(6):
-            values = [self._constraint_values(times[i], q[i]) for i in todo]
-            res = np.array([r for r, _ in values]).reshape(len(todo), self.rows)
-            jacs[todo] = np.array([j for _, j in values]).reshape(len(todo), self.rows, n)
+            res, jacs[todo] = self._constraint_values_many(times[todo], q[todo])
             moving = np.max(np.abs(res), axis=1, initial=0.0) > 1e-15 * self.scale
             todo = todo[moving]
             if not todo.size:
                 break
             q[todo] -= _least_norm_many(jacs[todo], res[moving])
         else:
-            for i in todo:
-                jacs[i] = self._constraint_values(times[i], q[i])[1]
+            jacs[todo] = self._constraint_values_many(times[todo], q[todo])[1]
         qd -= _least_norm_many(jacs, np.einsum("kri,ki->kr", jacs, qd) - self._velocity_rhs())
         return list(ys)
 
