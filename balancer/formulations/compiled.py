@@ -41,6 +41,23 @@ class Compiled:
         self._eval()
         return self.res.copy()
 
+    def columns(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The function at each column of ``x`` (inputs × count): outputs × count.
+
+        One call of the function mapped over the columns, through its buffers (a call with a
+        matrix argument maps it too, but converts the result from a DM element by element,
+        several times the cost of the evaluation).
+        """
+        count = x.shape[1]
+        mapped = self.fn.map(count)
+        arg = np.ravel(x, order="F").astype(float)  # column by column, as CasADi stores it
+        res = np.empty(self.res.size * count)
+        buffer, evaluate = mapped.buffer()
+        buffer.set_arg(0, memoryview(arg))
+        buffer.set_res(0, memoryview(res))
+        evaluate()
+        return res.reshape(count, self.res.size).T
+
 
 def spring_forces(structure: Structure, spring, pose: Pose, ops):
     """The spring's forces on its two carriers: ``(link, force, point)`` twice (N, m)."""

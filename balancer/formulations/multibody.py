@@ -340,7 +340,7 @@ class Multibody(LinkageFormulation):
         count, n = q.shape
         angles = (self.crank_angle(np.asarray(times, dtype=float)) if self.driven
                   else np.zeros(count))
-        out = np.asarray(self._constraints.fn(np.vstack([q.T, angles])))  # one column each
+        out = self._constraints.columns(np.vstack([q.T, angles]))  # one column each
         rows = self.rows
         return out[:rows].T, out[rows:].T.reshape(count, n, rows).transpose(0, 2, 1)
 
@@ -420,17 +420,15 @@ class Multibody(LinkageFormulation):
         count = len(times)
         ys = np.array(states, dtype=float).reshape(count, -1)
         gas = np.array([self._gas(self.theta1_of(t, y)) for t, y in zip(times, ys, strict=True)])
-        try:
-            out = self._dynamics.map(count).call([ca.DM(ys[:, :n].T),
-                                                  ca.DM(ys[:, n : 2 * n].T), ca.DM(gas.T)])
-        except RuntimeError:  # CasADi's QR on a system singular to working precision
+        flat = self._fast_dynamics.columns(np.hstack([ys[:, : 2 * n], gas.reshape(count, -1)]).T)
+        if not np.all(np.isfinite(flat)):  # QR of a system singular to working precision
             from ..errors import SolverError
 
             raise SolverError(
                 "the multibody equations of motion are singular to working precision at an "
                 "output state (a singular pose, or masses and inertias of very different "
                 "magnitudes)") from None
-        acc, _, ground, normal, couple, frame = (np.asarray(x.full()) for x in out)
+        acc, _, ground, normal, couple, frame = (flat[s] for s in self._slices)
         ground = ground.reshape(-1, count)
         return Evaluation(
             theta=ys[:, 2:n:3].T, omega=ys[:, n + 2 : 2 * n : 3].T, alpha=acc[2::3],
