@@ -29,7 +29,7 @@ MAX_ITERATIONS = 30
 NEWTON_TOLERANCE = 1e-13
 #: Up to this many angles at once (the continuation's single steps), Newton's steps are
 #: LAPACK's solves; beyond, the structured solve of :class:`~.vectors.Factor`.
-FEW_ANGLES = 16
+FEW_ANGLES = 128
 
 
 def _residual(g: Group, pose: Pose) -> list:
@@ -142,10 +142,10 @@ def table(structure: Structure, g: Group) -> tuple[NDArray[np.float64], NDArray[
     input angle, and their coordinates (angles continuous), NaN beyond where the continuation
     stopped (the group locks or cannot be assembled).
 
-    The continuation takes :data:`STRIDE` table steps at a time (:func:`_continue`) and fills
-    the rows between by one Newton solve over all of them at once (:func:`_fill`). Where the
-    turn upwards comes back to the reference pose, the turn downwards is the same poses, each
-    link's angle less what it turns in a revolution; otherwise it is continued too.
+    The continuation solves up to :data:`STRIDE` table rows at a time by one Newton solve
+    over all of them (:func:`_continue`). Where the turn upwards comes back to the reference
+    pose, the turn downwards is the same poses, each link's angle less what it turns in a
+    revolution; otherwise it is continued too.
     """
     cache = structure.cache.setdefault("numeric tables", {})
     key = structure.groups.index(g)
@@ -170,20 +170,22 @@ def table(structure: Structure, g: Group) -> tuple[NDArray[np.float64], NDArray[
     return result
 
 
-#: Table steps per step of the continuation (the rows between are filled at once).
-STRIDE = 16
+#: The largest stride of the continuation, in table steps.
+STRIDE = 32
 
 
 def _continue(structure: Structure, partial: Structure, g: Group, angles, out, direction: int
               ) -> None:
     """Fill ``out``'s rows from the reference's (the middle row) towards ``direction``.
 
-    Each step of :data:`STRIDE` rows starts Newton's method from the quadratic extrapolation
-    of the rows found a stride apart; it is taken where Newton's method converges there to
-    within a tenth of the last stride's change of its start, and the rows between converge
-    likewise (:func:`_fill`): a branch the continuation did not leave. Otherwise (near the
-    start, a toggle or the end) the rows are continued one at a time, up to the first that
-    does not converge (the table stops there).
+    The continuation steps by a stride of table rows that adapts: each step solves the next
+    ``stride`` rows by one Newton solve over all of them at once, started from the quadratic
+    through the rows found a stride and two strides back. The step is taken where every row
+    converges to within a tenth of the last stride's change of its start: a branch the
+    continuation did not leave (a jump to another branch is a whole link length away). After
+    two steps taken the stride doubles (up to :data:`STRIDE`); a step refused halves it. At a
+    stride of one row (the start, near a toggle or the end) the row is taken where Newton's
+    method converges, and the table stops at the first that does not.
     """
     from .kinematics import positions
 
@@ -196,56 +198,35 @@ def _continue(structure: Structure, partial: Structure, g: Group, angles, out, d
         with np.errstate(all="ignore"):
             return newton(g, pose, guess, scale)
 
-    def extrapolated(rows):
-        """The next row (as far on as ``rows`` are apart) by the quadratic through them."""
-        h = [out[j] for j in rows]
-        return h[-1] if len(h) < 3 else 3 * h[-1] - 3 * h[-2] + h[-3]
-
-    i = 0
+    i, stride, taken = 0, 1, 0
     while i < TABLE_STEPS:
-        if STRIDE > 1 and i + STRIDE <= TABLE_STEPS and len(done) > 2 * STRIDE:
-            j = middle + direction * (i + STRIDE)
-            guess = extrapolated(done[-1 - 2 * STRIDE :: STRIDE])
-            q, ok = solve_at(np.array([j]), guess[None, :])
-            moved = float(np.max(np.abs(out[done[-1]] - out[done[-1 - STRIDE]])))
-            if (ok[0] and np.all(np.isfinite(q))
-                    and np.max(np.abs(q[0] - guess)) <= 0.1 * moved + 1e-12 * scale):
-                out[j] = q[0]
-                if _fill(structure, angles, out, done[-1 - STRIDE], done[-1], j, direction,
-                         solve_at):
-                    done.extend(middle + direction * np.arange(i + 1, i + STRIDE + 1))
-                    i += STRIDE
-                    continue
-                out[j] = np.nan
-        j = middle + direction * (i + 1)  # one row: near the start, a toggle or the end
-        q, ok = solve_at(np.array([j]), extrapolated(done[-3:])[None, :])
-        if not ok[0] or not np.all(np.isfinite(q)):
-            return
-        out[j] = q[0]
-        done.append(j)
-        i += 1
-
-
-def _fill(structure, angles, out, back: int, a: int, b: int, direction: int,
-          solve_at) -> bool:
-    """Rows strictly between ``a`` and ``b`` (``STRIDE`` apart, found) by one Newton solve.
-
-    Started from the quadratic through the rows ``back``, ``a`` and ``b`` (``STRIDE`` apart);
-    accepted where every row converges to within a tenth of the stride's change of its start,
-    which a jump to another branch (a whole link length away) cannot meet.
-    """
-    between = np.arange(a + direction, b, direction)
-    u = (angles[between] - angles[a]) / (angles[b] - angles[a])  # in (0, 1)
-    y0, y1, y2 = out[back], out[a], out[b]  # at −1, 0, 1 strides
-    guess = (y1[None, :] + 0.5 * u[:, None] * (y2 - y0)[None, :]
-             + 0.5 * (u * u)[:, None] * (y2 - 2 * y1 + y0)[None, :])
-    q, ok = solve_at(between, guess)
-    change = float(np.max(np.abs(y2 - y1)))
-    near = np.max(np.abs(q - guess), axis=1) <= 0.1 * change + 1e-12 * structure.length_scale()
-    if not (ok.all() and np.all(np.isfinite(q)) and near.all()):
-        return False
-    out[between] = q
-    return True
+        if taken >= 2 and 2 * stride <= STRIDE and len(done) > 4 * stride:
+            stride, taken = 2 * stride, 0
+        while stride > 1 and i + stride > TABLE_STEPS:
+            stride //= 2
+        rows = middle + direction * np.arange(i + 1, i + stride + 1)
+        back = [out[j] for j in done[-1 - 2 * stride :: stride]]  # two strides back, one, now
+        if len(back) < 3:  # the first rows: from the reference pose, then a line
+            guess = np.broadcast_to(2 * back[-1] - back[0], (1, back[0].size))
+        else:  # Newton's form at t = u/stride strides on: y0 + t·Δ + t(t+1)/2·Δ²
+            t = (np.arange(1, stride + 1) / stride)[:, None]
+            d1, d2 = back[2] - back[1], back[2] - 2 * back[1] + back[0]
+            guess = back[2] + t * d1 + 0.5 * t * (t + 1) * d2
+        q, ok = solve_at(rows, guess)
+        if not (ok.all() and np.all(np.isfinite(q))):
+            if stride == 1:
+                return
+            stride, taken = stride // 2, 0
+            continue
+        if stride > 1:
+            moved = float(np.max(np.abs(back[2] - back[1])))
+            if np.max(np.abs(q - guess)) > 0.1 * moved + 1e-12 * scale:
+                stride, taken = stride // 2, 0
+                continue
+        out[rows] = q
+        done.extend(rows)
+        i += stride
+        taken += 1
 
 
 def _turn(structure: Structure, change: NDArray[np.float64]) -> NDArray[np.float64] | None:
