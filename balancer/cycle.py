@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -269,6 +268,8 @@ def cycle_analysis(model, speed: float, samples: int = 360, *, route: str | None
 
     starts = range(0, n, CHUNK)
     if len(starts) > 1 and WORKERS > 1:
+        from concurrent.futures import ThreadPoolExecutor  # a long cycle only: 3 ms to import
+
         with ThreadPoolExecutor(WORKERS) as pool:
             list(pool.map(fill, starts))
     else:
