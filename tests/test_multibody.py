@@ -543,3 +543,20 @@ def test_projecting_many_states_together_is_projecting_each(driven):
     for i, (t, y) in enumerate(zip(times, together, strict=True)):
         single = f.rhs(t, y)[k + 2 : 2 * k : 3]
         assert np.array_equal(batch.alpha[:, i], single)
+
+
+def test_a_compiled_function_over_columns_is_its_single_calls():
+    # Compiled.columns calls a function mapped over BLOCK columns block by block, the last
+    # block padded: across every kind of block boundary, each column's outputs are exactly
+    # the single call's (the same compiled code on the same inputs).
+    from balancer.formulations.compiled import BLOCK
+
+    f = make("multibody", _watt().mechanism)
+    rng = np.random.default_rng(11)
+    for fn in (f._constraints, f._fast_dynamics):
+        for count in (1, BLOCK - 1, BLOCK, BLOCK + 1, 3 * BLOCK + 5):
+            x = rng.uniform(-1.0, 1.0, (fn.arg.size, count))
+            together = fn.columns(x)
+            assert together.shape == (fn.res.size, count)
+            for j in range(count):
+                assert np.array_equal(together[:, j], fn(x[:, j]), equal_nan=True)
