@@ -352,3 +352,53 @@ def test_formulations_agree_at_every_state_along_a_trajectory(paper_runs):
     # And the simulated accelerations are those of the states themselves (the same state up
     # to its projection, to 1e-15·Σl: the algebraic level again).
     assert np.max(np.abs(ref[0].T - traj.alpha)) < 1e-9 * acc_scale
+
+
+@pytest.mark.parametrize("driven", [False, True])
+@pytest.mark.parametrize("cls", ["crank-rocker", "change-point"])
+def test_the_opened_loops_outputs_at_many_states_are_its_single_state_equations(cls, driven):
+    # The opened loop evaluates and projects a run's outputs all at once (Eq. 22, 27 as a
+    # stack of 5×5 systems; least-norm Gauss–Newton steps by the pseudo-inverse). Against the
+    # integrator's own single-state route (its right-hand side: the pose by cmath, one LAPACK
+    # solve) the accelerations agree to rounding of a system whose condition the states'
+    # transmission (≥ 0.05) bounds; states near a change point take the reduced equation in
+    # both. Projected states close the loop (Eq. 26) and its rate (Eq. 5) to rounding, and
+    # move least-norm: the correction of the free angles lies in the row space of G.
+    rng = np.random.default_rng(3)
+    lengths = CLASS_EXAMPLES[cls]
+    linkage = FourBar(lengths=lengths, branch="+", **{
+        name: random_link(rng, length, loads=True, rotor=name != "coupler")
+        for name, length in zip(FourBar.link_names, lengths, strict=False)})
+    f = make("opened-loop", linkage, gravity=(0.3, -9.81), speed=3.0 if driven else None)
+    times, states = [], []
+    for theta1 in np.linspace(0.05, 2 * np.pi - 0.05, 40):
+        if kin.position_of(linkage, theta1, check=False).sin_transmission[0] ** 2 < 0.05**2 \
+                and not f.near_change_point(theta1):
+            continue
+        f.theta1_start = theta1
+        y = f.initial_state(theta1, rng.uniform(-4, 4))
+        times.append(0.0)
+        states.append(y)
+    assert any(f.near_change_point(y[0]) for y in states) == (cls == "change-point")
+    f.theta1_start = 0.05  # one run's: the smooth motion's branch near a change point
+    batch = f.evaluate_batch(times, states)
+    for i, (t, y) in enumerate(zip(times, states, strict=True)):
+        alpha = f.rhs(t, y)[3:6]
+        acc = max(np.max(np.abs(alpha)), y[3] ** 2, 1.0)
+        assert rel_err(batch.alpha[:, i], alpha, scale=acc) < 1e-12
+    scale = sum(lengths)
+    off = [y + np.r_[1e-7 * rng.standard_normal(6), np.zeros(y.size - 6)] for y in states]
+    f.theta1_start = 0.0  # driven: the crank angle prescribed at each state's time
+    times = [y[0] / f.speed if driven else 0.0 for y in off]
+    projected = f.project_many(times, off)
+    for t, y0, y in zip(times, off, projected, strict=True):
+        if f.near_change_point(y[0]):
+            continue
+        pos, vel = f.constraint_residual(t, y)
+        assert pos < 1e-14 * scale and vel < 1e-13 * max(1.0, np.max(np.abs(y[3:6]))) * scale
+        free = slice(1, 3) if driven else slice(0, 3)
+        _, g = f._closure(y[0:3])
+        move = (y - y0)[free]
+        rows = g[:, free]
+        along = rows.T @ np.linalg.lstsq(rows.T, move, rcond=None)[0]
+        assert np.linalg.norm(move - along) < 1e-6 * np.linalg.norm(move) + 1e-15

@@ -70,6 +70,32 @@ class OpenedLoop(FourBarFormulation):
         a14p = a12 - v1
         return a12, a21, a23, a32, a14p
 
+    def _terms(self, vectors):
+        """The entries of Eq. 22–25 that depend on the pose, from the link vectors.
+
+        ``vectors`` are ``l̄1, l̄2, l̄3`` as complex numbers or complex arrays (many states);
+        returns ``(m12, m13, m23), (c12, c13, c23), (Q1, Q2, Q3), pv``: the mass matrix's
+        off-diagonal (Eq. 23), the convective coefficients, the generalised forces without a
+        motor (Eq. 25) and the principal vectors (Eq. 12–13).
+        """
+        v1, v2, v3 = vectors
+        pv = a12, a21, a23, a32, a14p = self.principal_vectors(vectors)
+        mt = self.total_mass
+        m1, m2, m3 = self.mass
+        f1, f2, f3 = self.forces
+        mo1, mo2, mo3 = self.moments
+        inertia = (-mt * _ip(v1, a21), -mt * _ip(v1, a32), -mt * _ip(v2, a32))
+        convective = (mt * cross_scalar(v1, a21), mt * cross_scalar(v1, a32),
+                      mt * cross_scalar(v2, a32))
+        forces = (
+            mo1 - cross_scalar(a14p, f1) - (m2 + m3) / m1 * cross_scalar(a12, f1)
+            + cross_scalar(v1, f2 + f3),
+            mo2 - (m1 + m2) / m2 * cross_scalar(a21, f2) - m3 / m2 * cross_scalar(a23, f2)
+            + cross_scalar(v2, f3),
+            mo3 - mt / m3 * cross_scalar(a32, f3),
+        )  # Eq. 25
+        return inertia, convective, forces, pv
+
     def system(self, theta: NDArray[np.float64], omega: NDArray[np.float64]):
         """Matrices of Eq. 22 and 27 at a state.
 
@@ -81,13 +107,7 @@ class OpenedLoop(FourBarFormulation):
         l1, l2, l3, _ = self.lengths
         vectors = tuple(length * cmath.exp(1j * th) for length, th in zip(
             (l1, l2, l3), theta, strict=True))
-        v1, v2, v3 = vectors
-        pv = a12, a21, a23, a32, a14p = self.principal_vectors(vectors)
-        mt = self.total_mass
-        m1, m2, m3 = self.mass
-        m12 = -mt * _ip(v1, a21)
-        m13 = -mt * _ip(v1, a32)
-        m23 = -mt * _ip(v2, a32)
+        (m12, m13, m23), (c12, c13, c23), q, pv = self._terms(vectors)
         big_m = np.array(
             [
                 [self.m_diag[0], m12, m13],
@@ -95,24 +115,34 @@ class OpenedLoop(FourBarFormulation):
                 [m13, m23, self.m_diag[2]],
             ]
         )
-        c12 = mt * cross_scalar(v1, a21)
-        c13 = mt * cross_scalar(v1, a32)
-        c23 = mt * cross_scalar(v2, a32)
         big_c = np.array([[0.0, c12, c13], [-c12, 0.0, c23], [-c13, -c23, 0.0]])
-        f1, f2, f3 = self.forces
-        mo1, mo2, mo3 = self.moments
-        q = np.array(
-            [
-                mo1 - cross_scalar(a14p, f1) - (m2 + m3) / m1 * cross_scalar(a12, f1)
-                + cross_scalar(v1, f2 + f3),
-                mo2 - (m1 + m2) / m2 * cross_scalar(a21, f2) - m3 / m2 * cross_scalar(a23, f2)
-                + cross_scalar(v2, f3),
-                mo3 - mt / m3 * cross_scalar(a32, f3),
-            ]
-        )  # Eq. 25
         g = np.array([[-v.imag for v in vectors], [v.real for v in vectors]])
         rhs = sum(v * w * w for v, w in zip(vectors, omega, strict=True))
-        return big_m, big_c, g, q, np.array([rhs.real, rhs.imag]), pv, vectors
+        return big_m, big_c, g, np.array(q), np.array([rhs.real, rhs.imag]), pv, vectors
+
+    def _system_batch(self, theta: NDArray[np.float64], omega: NDArray[np.float64]):
+        """:meth:`system` at many states, ``theta`` and ``omega`` of shape ``(3, N)``.
+
+        ``M``, ``C`` and ``G`` come as ``(N, 3, 3)``, ``(N, 3, 3)``, ``(N, 2, 3)``, ``Q`` and
+        ``b`` as ``(N, 3)``, ``(N, 2)``; the principal and link vectors as complex arrays.
+        """
+        vectors = tuple(length * np.exp(1j * th) for length, th in zip(
+            self.lengths[:3], theta, strict=True))
+        (m12, m13, m23), (c12, c13, c23), q, pv = self._terms(vectors)
+        count = theta.shape[1]
+        big_m = np.empty((count, 3, 3))
+        big_m[:, [0, 1, 2], [0, 1, 2]] = self.m_diag
+        big_m[:, 0, 1] = big_m[:, 1, 0] = m12
+        big_m[:, 0, 2] = big_m[:, 2, 0] = m13
+        big_m[:, 1, 2] = big_m[:, 2, 1] = m23
+        big_c = np.zeros((count, 3, 3))
+        big_c[:, 0, 1], big_c[:, 0, 2], big_c[:, 1, 2] = c12, c13, c23
+        big_c[:, 1, 0], big_c[:, 2, 0], big_c[:, 2, 1] = -c12, -c13, -c23
+        g = np.stack([np.stack([-v.imag for v in vectors], axis=-1),
+                      np.stack([v.real for v in vectors], axis=-1)], axis=1)
+        rhs = sum(v * w * w for v, w in zip(vectors, omega, strict=True))
+        return (big_m, big_c, g, np.stack(q, axis=-1), np.stack([rhs.real, rhs.imag], axis=-1),
+                pv, vectors)
 
     # -- the formulation ---------------------------------------------------------------------
 
@@ -128,25 +158,37 @@ class OpenedLoop(FourBarFormulation):
         if self.near_change_point(theta[0]):
             return self._solve_reduced(theta[0], omega[0])
         big_m, big_c, g, q, b, pv, vectors = self.system(theta, omega)
-        rhs_top = q - big_c @ (omega * omega)
-        a = np.zeros((5, 5))
-        a[3:5, 3:5] = 0.0
+        alpha, ra3, tau = self._kkt(big_m, big_c, g, q, b, omega)
+        return alpha, complex(ra3), float(tau), pv, vectors
+
+    def _kkt(self, big_m, big_c, g, q, b, omega):
+        """Eq. 22 and 27 solved: ``θ̈`` (…, 3), ``R̄A3`` and the motor torque (…).
+
+        For one state (``M`` of shape ``(3, 3)``, ``omega`` ``(3,)``) or many (``(N, 3, 3)``,
+        ``omega`` ``(N, 3)``); LAPACK's LU with partial pivoting on each 5×5 system.
+        """
+        w2 = omega * omega
+        rhs = np.empty((*q.shape[:-1], 5))
+        rhs[..., 0:3] = q - (big_c @ w2[..., None])[..., 0]
+        rhs[..., 3:5] = b
+        a = np.zeros((*big_m.shape[:-2], 5, 5))
+        g_t = g.swapaxes(-1, -2)
         if not self.driven:
-            a[0:3, 0:3] = big_m
-            a[0:3, 3:5] = g.T
-            a[3:5, 0:3] = g
-            z = np.linalg.solve(a, np.concatenate([rhs_top, b]))
-            alpha, ra3, tau = z[0:3], complex(z[3], z[4]), 0.0
-        else:
-            # θ̈1 = 0 imposed; unknowns θ̈2, θ̈3, RA3x, RA3y and the motor torque τ (in Q1).
-            a[0:3, 0:2] = big_m[:, 1:3]
-            a[0:3, 2:4] = g.T
-            a[0, 4] = -1.0
-            a[3:5, 0:2] = g[:, 1:3]
-            z = np.linalg.solve(a, np.concatenate([rhs_top, b]))
-            alpha = np.array([0.0, z[0], z[1]])
-            ra3, tau = complex(z[2], z[3]), float(z[4])
-        return alpha, ra3, tau, pv, vectors
+            a[..., 0:3, 0:3] = big_m
+            a[..., 0:3, 3:5] = g_t
+            a[..., 3:5, 0:3] = g
+            z = np.linalg.solve(a, rhs[..., None])[..., 0]
+            return z[..., 0:3], z[..., 3] + 1j * z[..., 4], 0.0 * z[..., 4]
+        # θ̈1 = 0 imposed; unknowns θ̈2, θ̈3, RA3x, RA3y and the motor torque τ (in Q1).
+        a[..., 0:3, 0:2] = big_m[..., 1:3]
+        a[..., 0:3, 2:4] = g_t
+        a[..., 0, 4] = -1.0
+        a[..., 3:5, 0:2] = g[..., 1:3]
+        z = np.linalg.solve(a, rhs[..., None])[..., 0]
+        alpha = np.empty((*z.shape[:-1], 3))
+        alpha[..., 0] = 0.0
+        alpha[..., 1:3] = z[..., 0:2]
+        return alpha, z[..., 2] + 1j * z[..., 3], z[..., 4]
 
     def _solve_reduced(self, theta1: float, omega1: float):
         """The single equation in θ1 with ``θ̈k = Θk·θ̈1 + bk`` (Eq. 7, 9–10).
@@ -191,21 +233,46 @@ class OpenedLoop(FourBarFormulation):
         return dy
 
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
-        alpha, ra3, tau, pv, _ = self.solve(t, y)
-        omega = y[3:6]
+        return self.evaluate_batch([t], [y]).at(0)
+
+    def _near(self, theta1: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Which crank angles are near a change point (:meth:`near_change_point`)."""
+        if not self.change_points():
+            return np.zeros(theta1.shape, bool)
+        return np.array([self.near_change_point(float(x)) for x in theta1], bool)
+
+    def evaluate_batch(self, times, states) -> Evaluation:
+        """:meth:`evaluate` at every state at once.
+
+        Eq. 22 and 27 (the reduced equation near a change point); R̄A0 from the motion of the
+        centre of mass, Eq. 28 with r̄S from Eq. 16.
+        """
+        ys = np.array(states, dtype=float).reshape(len(states), -1)
+        theta, omega = ys[:, 0:3].T, ys[:, 3:6].T
+        count = ys.shape[0]
+        alpha, ra3, tau = np.empty((3, count)), np.empty(count, complex), np.empty(count)
+        pv = [np.empty(count, complex) for _ in range(5)]
+        near = self._near(theta[0])
+        regular = ~near
+        if regular.any():
+            big_m, big_c, g, q, b, pvs, _ = self._system_batch(theta[:, regular],
+                                                               omega[:, regular])
+            acc, ra3[regular], tau[regular] = self._kkt(big_m, big_c, g, q, b,
+                                                        omega[:, regular].T)
+            alpha[:, regular] = acc.T
+            for whole, part in zip(pv, pvs, strict=True):
+                whole[regular] = part
+        for i in np.flatnonzero(near):
+            acc, r, torque, pvs, _ = self._solve_reduced(theta[0, i], omega[0, i])
+            alpha[:, i], ra3[i], tau[i] = acc, r, torque
+            for whole, part in zip(pv, pvs, strict=True):
+                whole[i] = part
         _, a21, _, a32, a14p = pv
-        # Eq. 28 with r̄S from Eq. 16: m_tot·r̈S = F1 + F2 + F3 − R̄A0 − R̄A3.
-        acc_s = -sum(
-            a * (1j * al - w * w) for a, al, w in zip((a14p, a21, a32), alpha, omega, strict=True)
-        )
+        acc_s = -sum(a * (1j * al - w * w)
+                     for a, al, w in zip((a14p, a21, a32), alpha, omega, strict=True))
         ra0 = sum(self.forces) - self.total_mass * acc_s - ra3
-        return Evaluation(
-            theta=np.array(y[0:3]),
-            omega=np.array(omega),
-            alpha=alpha,
-            ground={"A0": complex(ra0), "A3": ra3},
-            driving_torque=tau,
-        )
+        return Evaluation(theta=theta.copy(), omega=omega.copy(), alpha=alpha,
+                          ground={"A0": ra0, "A3": ra3}, driving_torque=tau)
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         return self.crank_angle(t) if self.driven else float(y[0])
@@ -215,44 +282,69 @@ class OpenedLoop(FourBarFormulation):
 
     # -- constraints -------------------------------------------------------------------------
 
-    def _closure(self, theta) -> tuple[complex, NDArray[np.float64]]:
-        l1, l2, l3, l4 = self.lengths
-        vectors = [length * cmath.exp(1j * th) for length, th in zip((l1, l2, l3), theta,
-                                                                       strict=True)]
-        g = np.array([[-v.imag for v in vectors], [v.real for v in vectors]])
-        return sum(vectors) - l4, g
+    def _closure(self, theta) -> tuple:
+        """Loop closure ``Σ l̄k − l4`` (Eq. 26) and its Jacobian ``G`` at angles ``(…, 3)``.
+
+        Complex residuals ``(…)`` and Jacobians ``(…, 2, 3)``.
+        """
+        vectors = np.asarray(self.lengths[:3]) * np.exp(1j * np.asarray(theta, dtype=float))
+        g = np.stack([-vectors.imag, vectors.real], axis=-2)
+        return vectors.sum(axis=-1) - self.lengths[3], g
 
     def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
         phi, g = self._closure(y[0:3])
         return abs(phi), float(np.linalg.norm(g @ y[3:6]))
 
     def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Least-norm Gauss–Newton correction onto the loop closure (Eq. 26) and its rate (Eq. 5).
+        return self.project_many([t], [y])[0]
 
-        With the crank driven, θ1 and θ̇1 are prescribed and only θ2, θ3 and their rates are
-        corrected; near a change point the state is put on the smooth motion's assembly.
+    def project_many(self, times, states) -> list[NDArray[np.float64]]:
+        """Least-norm Gauss–Newton corrections onto the loop closure, at every state at once.
+
+        The closure is Eq. 26, its rate Eq. 5. With the crank driven, θ1 and θ̇1 are
+        prescribed and only θ2, θ3 and their rates are corrected; near a change point the state
+        is put on the smooth motion's assembly.
+        The least-norm step is the pseudo-inverse's (singular values below rounding left
+        out, as LAPACK's least squares leaves them).
         """
-        y = np.array(y, dtype=float)
-        free = slice(0, 3) if not self.driven else slice(1, 3)
+        ys = np.array(states, dtype=float).reshape(len(states), -1)
+        times = np.asarray(times, dtype=float)
+        free = np.arange(3) if not self.driven else np.arange(1, 3)
         if self.driven:
-            y[0] = self.crank_angle(t)
-            y[3] = float(self.speed)  # type: ignore[arg-type]
-        if self.near_change_point(y[0]):
-            # On the assembly of the smooth motion, with θ1 and θ̇1 kept.
-            vectors, w2, w3 = self.branch_vectors(y[0], y[3])
-            y[1] += math.remainder(cmath.phase(vectors[1]) - y[1], 2 * math.pi)
-            y[2] += math.remainder(cmath.phase(vectors[2]) - y[2], 2 * math.pi)
-            y[4], y[5] = w2, w3
-            return y
+            ys[:, 0] = self.crank_angle(times)
+            ys[:, 3] = float(self.speed)  # type: ignore[arg-type]
+        near = self._near(ys[:, 0])
+        for i in np.flatnonzero(near):
+            self._onto_smooth_motion(ys[i])
+        regular = np.flatnonzero(~near)
         scale = sum(self.lengths)
+        active = regular
         for _ in range(4):
-            phi, g = self._closure(y[0:3])
-            if abs(phi) <= 1e-15 * scale:
+            phi, g = self._closure(ys[active, 0:3])
+            off = np.abs(phi) > 1e-15 * scale
+            active, phi, g = active[off], phi[off], g[off]
+            if not active.size:
                 break
-            gf = g[:, free]
-            y[free] -= np.linalg.lstsq(gf, np.array([phi.real, phi.imag]), rcond=None)[0]
-        _, g = self._closure(y[0:3])
-        gf = g[:, free]
-        resid = g @ y[3:6]
-        y[3 + free.start : 3 + free.stop] -= np.linalg.lstsq(gf, resid, rcond=None)[0]
-        return y
+            step = _least_norm(g[:, :, free], np.stack([phi.real, phi.imag], axis=-1))
+            ys[active[:, None], free] -= step
+        _, g = self._closure(ys[regular, 0:3])
+        resid = np.matmul(g, ys[regular, 3:6, None])[..., 0]
+        ys[regular[:, None], 3 + free] -= _least_norm(g[:, :, free], resid)
+        return list(ys)
+
+    def _onto_smooth_motion(self, y: NDArray[np.float64]) -> None:
+        """Put a state near a change point on the smooth motion's assembly (θ1, θ̇1 kept)."""
+        vectors, w2, w3 = self.branch_vectors(y[0], y[3])
+        y[1] += math.remainder(cmath.phase(vectors[1]) - y[1], 2 * math.pi)
+        y[2] += math.remainder(cmath.phase(vectors[2]) - y[2], 2 * math.pi)
+        y[4], y[5] = w2, w3
+
+
+def _least_norm(g: NDArray[np.float64], r: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The least-norm ``x`` of least ``‖g·x − r‖`` per system.
+
+    ``g`` is ``(N, 2, k)``, ``r`` ``(N, 2)``; singular values below ``ε·max(2, k)`` of the
+    largest are left out (LAPACK's least squares with its default cutoff).
+    """
+    pinv = np.linalg.pinv(g, rcond=np.finfo(float).eps * max(g.shape[-2:]))
+    return np.matmul(pinv, r[..., None])[..., 0]
