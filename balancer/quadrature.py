@@ -4,10 +4,13 @@ A driven crank's motion is prescribed: the only quantity a simulation has to int
 work of the motor (and of a force that depends on the crank angle), ``W(t) = ∫₀ᵗ P dt``, whose
 integrand is a function of the time alone. :func:`cumulative` finds it at every output time
 with the 7-point Gauss and 15-point Kronrod pair (Piessens et al., *QUADPACK*, 1983, ``qk15``;
-the constants below are QUADPACK's) on panels that subdivide the intervals between the output
-times: all the panels' nodes in one call of the integrand, every panel whose error estimate
-``|K15 − G7|`` exceeds ``atol + rtol·|W|`` (the value at its ends, as an integrator's step is
-judged against its state) halved, and the halves evaluated together, until none does.
+the constants below are QUADPACK's) on panels that tile the span: all the panels' nodes in one
+call of the integrand, every panel whose error estimate ``|K15 − G7|`` exceeds
+``atol + rtol·|W|`` (the value at its ends, as an integrator's step is judged against its
+state) halved, and the halves evaluated together, until none does. An output time inside a
+panel takes the integral of the interpolant through the panel's nodes up to it, its error
+measured by the interpolant's last Legendre terms: the panels are as many as the integrand
+needs, not one per output interval (a formulation's power costs a compiled solve per node).
 
 ``scipy.integrate.quad_vec`` is adaptive and vector-valued, but it calls the integrand once per
 node (a Python call of a formulation's equations, about as costly as a whole panel of nodes
@@ -88,10 +91,50 @@ class Cumulative:
     evaluations: int
 
 
+def _partial_basis() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The partial integrals of the 15 nodes' Lagrange basis, and of its last two terms.
+
+    ``A``, ``B`` with ``legvander(u, 15)·A`` the integrals ``∫₋₁ᵘ L_j`` of the Lagrange basis
+    of the 15 nodes, and ``legvander(u, 15)·B`` those of its last two Legendre terms. The
+    interpolant through the nodes as a Legendre series (whose Vandermonde matrix at these
+    nodes is well conditioned, unlike the monomials'), integrated term by term from −1
+    (``numpy.polynomial.legendre``).
+    """
+    lagrange = np.linalg.inv(np.polynomial.legendre.legvander(NODES, 14))  # row n: c_n's weights
+    tail = lagrange.copy()
+    tail[:13] = 0.0  # the terms of degree 13 and 14 only
+    return (np.polynomial.legendre.legint(lagrange, lbnd=-1.0),
+            np.polynomial.legendre.legint(tail, lbnd=-1.0))
+
+
+_PARTIAL, _TAIL = _partial_basis()
+
+
+def partial_weights(u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Weights on the 15 nodes of ``∫₋₁ᵘ`` of the integrand's interpolant, and of its tail.
+
+    The interpolant through the 15 nodes (degree 14) and the part of it that its Legendre
+    terms of degree 13 and 14 make, each shape ``(len(u), 15)``. At ``u = 1`` the first are
+    the Kronrod weights (the rule is interpolatory) and the second vanish; inside a panel the
+    tail's integral measures the error of the interpolant's, as ``|K15 − G7|`` (G7 exact to
+    degree 13) does at its end: a series whose last terms are below the tolerance has
+    converged (the Clenshaw–Curtis and Chebfun criterion).
+    """
+    basis = np.polynomial.legendre.legvander(np.asarray(u, dtype=float), 15)
+    return basis @ _PARTIAL, basis @ _TAIL
+
+
 def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
                times: NDArray[np.float64], *, rtol: float, atol: float,
                max_width: float = math.inf) -> Cumulative:
     """``∫ integrand`` from ``times[0]`` to each of ``times`` (increasing), adaptively.
+
+    The span is split into panels (of at most ``max_width``), which need not end at the
+    times: a time inside a panel gets the integral of the integrand's interpolant through the
+    panel's 15 nodes from the panel's start, its error measured by the interpolant's last
+    Legendre terms (:func:`partial_weights`). A panel is accepted when every
+    such error (its end's and its times') is within its tolerance, else halved; the panels are
+    as many as the integrand needs, however many times are asked for.
 
     Parameters
     ----------
@@ -102,11 +145,10 @@ def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
     rtol, atol
         A panel is accepted when ``|K15 − G7| ≤ atol + rtol·max(|W(a)|, |W(b)|)`` for each
         component, ``W`` the integral at its ends (the global error is then at most the panels'
-        count times that).
+        count times that), and so at each time inside it.
     max_width
-        Widest first panel: each interval between two times is split evenly into panels no
-        wider (a periodic integrand needs several per period, or both rules can agree on a
-        wrong value).
+        Widest first panel: the span is split evenly into panels no wider (a periodic
+        integrand needs several per period, or both rules can agree on a wrong value).
 
     Raises
     ------
@@ -118,53 +160,99 @@ def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
     if times.size < 2:  # nothing to integrate over: the components' count from one value
         shape = np.asarray(integrand(times[:1]), dtype=float).shape[1:]
         return Cumulative(values=np.zeros((times.size, *shape)), panels=0, evaluations=0)
-    widths = np.diff(times)
-    pieces = np.maximum(1, np.ceil(widths / max_width)).astype(int)
-    owner = np.repeat(np.arange(widths.size), pieces)  # the interval each panel belongs to
-    first = np.cumsum(pieces) - pieces
-    within = np.arange(owner.size) - first[owner]
-    step = widths[owner] / pieces[owner]
-    left = times[owner] + step * within
-    right = np.where(within + 1 == pieces[owner], times[owner + 1], left + step)
-    done_value = []  # (owner, value) of the accepted panels
-    done_owner = []
-    evaluations = panels = 0
+    start, end = float(times[0]), float(times[-1])
+    pieces = max(1, math.ceil((end - start) / max_width))
+    edges = start + (end - start) * np.arange(pieces + 1) / pieces
+    edges[-1] = end
+    left, right = edges[:-1], edges[1:]
+    accepted = []  # (left, right, kronrod sum, node values) of the accepted panels
+    evaluations = 0
     for _ in range(MAX_ROUNDS + 1):
-        kronrod, gauss = _rules(integrand, left, right)
+        values, kronrod, gauss = _rules(integrand, left, right)
         evaluations += left.size * NODES.size
-        # Each panel's tolerance from the integral at its ends (all the panels so far).
-        per_interval = np.zeros((widths.size, kronrod.shape[1]))
-        for own, val in zip(done_owner, done_value, strict=True):
-            np.add.at(per_interval, own, val)
-        np.add.at(per_interval, owner, kronrod)
-        at_times = np.concatenate([np.zeros((1, kronrod.shape[1])),
-                                   np.cumsum(per_interval, axis=0)])
-        size = np.maximum(np.abs(at_times[owner]), np.abs(at_times[owner + 1]))
+        # The integral at each panel's ends, from all the panels so far in time order.
+        lefts = np.concatenate([left, *(a[0] for a in accepted)])
+        sums = np.concatenate([kronrod, *(a[2] for a in accepted)])
+        order = np.argsort(lefts, kind="stable")
+        at_end = np.empty_like(sums)
+        at_end[order] = np.cumsum(sums[order], axis=0)
+        at_end = at_end[: left.size]
+        size = np.maximum(np.abs(at_end - kronrod), np.abs(at_end))
         good = np.all(np.abs(kronrod - gauss) <= atol + rtol * size, axis=1)
-        done_owner.append(owner[good])
-        done_value.append(kronrod[good])
-        panels += int(np.count_nonzero(good))
+        inside, owner = _times_inside(times, left, right)
+        if inside.size:
+            u = (2 * times[inside] - left[owner] - right[owner]) / (right[owner] - left[owner])
+            w_k, w_tail = partial_weights(u)
+            half = (0.5 * (right - left))[owner, None]
+            part = half * np.einsum("tn,tnc->tc", w_k, values[owner])
+            error = half * np.einsum("tn,tnc->tc", w_tail, values[owner])
+            before = (at_end - kronrod)[owner]
+            scale = np.maximum(np.abs(before), np.abs(before + part))
+            ok = np.all(np.abs(error) <= atol + rtol * scale, axis=1)
+            np.logical_and.at(good, owner, ok)
+        accepted.append((left[good], right[good], kronrod[good], values[good]))
         if good.all():
-            return Cumulative(values=at_times, panels=panels, evaluations=evaluations)
+            return _assemble(times, accepted, evaluations)
         bad = ~good
+        finite = np.isfinite(values).all(axis=2)
+        if not finite.all():  # halving cannot help: where the power first is not finite
+            nodes = (0.5 * (left + right))[:, None] + (0.5 * (right - left))[:, None] * NODES
+            raise SolverError(f"the driven motion's power is not finite at t = "
+                              f"{float(np.min(nodes[~finite])):.6g} s")
         mid = 0.5 * (left[bad] + right[bad])
-        left = np.concatenate([left[bad], mid])
-        right = np.concatenate([mid, right[bad]])
-        owner = np.concatenate([owner[bad], owner[bad]])
-        if not np.all(np.isfinite(kronrod[bad])):
-            break
-    where = float(left[0])
+        left, right = np.concatenate([left[bad], mid]), np.concatenate([mid, right[bad]])
+    where = float(np.min(left))
     raise SolverError(f"the quadrature of the driven motion's power did not converge near "
                       f"t = {where:.6g} s (rtol = {rtol:g}, atol = {atol:g}): the power is not "
                       "finite or not smooth enough there")
 
 
+def _times_inside(times: NDArray[np.float64], left: NDArray[np.float64],
+                  right: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The times strictly inside the panels, and the panel each is in."""
+    order = np.argsort(left)
+    first = np.searchsorted(times, left[order], side="right")
+    last = np.searchsorted(times, right[order], side="left")
+    counts = last - first
+    owner = np.repeat(order, counts)
+    inside = np.repeat(first - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
+    return inside, owner
+
+
+def _assemble(times: NDArray[np.float64], accepted, evaluations: int) -> Cumulative:
+    """The integral at every time from the accepted panels (they tile the span)."""
+    left = np.concatenate([a[0] for a in accepted])
+    right = np.concatenate([a[1] for a in accepted])
+    kronrod = np.concatenate([a[2] for a in accepted])
+    values = np.concatenate([a[3] for a in accepted])
+    order = np.argsort(left)
+    left, right, kronrod, values = left[order], right[order], kronrod[order], values[order]
+    at_start = np.concatenate([np.zeros((1, kronrod.shape[1])), np.cumsum(kronrod, axis=0)])
+    out = np.empty((times.size, kronrod.shape[1]))
+    out[0] = 0.0
+    ends = np.searchsorted(times, right, side="left")  # a time at a panel's end: its sum
+    at = ends < times.size
+    hit = at.copy()
+    hit[at] = times[ends[at]] == right[at]
+    out[ends[hit]] = at_start[1:][hit]
+    inside, owner = _times_inside(times, left, right)
+    if inside.size:
+        u = (2 * times[inside] - left[owner] - right[owner]) / (right[owner] - left[owner])
+        w_k, _ = partial_weights(u)
+        half = (0.5 * (right - left))[owner, None]
+        out[inside] = at_start[owner] + half * np.einsum("tn,tnc->tc", w_k, values[owner])
+    return Cumulative(values=out, panels=left.size, evaluations=evaluations)
+
+
 def _rules(integrand, left: NDArray[np.float64], right: NDArray[np.float64]):
-    """The Kronrod and Gauss sums on each panel, shape ``(panels, components)``."""
+    """The integrand at the panels' nodes, and the Kronrod and Gauss sums on each panel.
+
+    Shapes ``(panels, 15, components)`` and ``(panels, components)``.
+    """
     half = 0.5 * (right - left)
     nodes = (0.5 * (left + right))[:, None] + half[:, None] * NODES[None, :]
     values = np.asarray(integrand(nodes.ravel()), dtype=float)
     values = values.reshape(left.size, NODES.size, -1)
     kronrod = half[:, None] * np.einsum("n,pnc->pc", KRONROD, values)
     gauss = half[:, None] * np.einsum("n,pnc->pc", GAUSS, values)
-    return kronrod, gauss
+    return values, kronrod, gauss

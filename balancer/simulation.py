@@ -51,6 +51,7 @@ from .errors import AssemblyError, LockupError, SolverError, SpecError
 from .formulations import (
     DEAD_POINT_THRESHOLD,
     Formulation,
+    continuous_angles,
     default_method,
     formulation_class,
     formulation_table,
@@ -189,14 +190,6 @@ class Trajectory:
         return out
 
 
-def _unwrap(theta: NDArray[np.float64], omega: NDArray[np.float64], t: NDArray[np.float64]):
-    """Continuous angles: each step takes the 2π branch nearest to the trapezoidal prediction."""
-    theta = np.asarray(theta, dtype=float)
-    predicted = 0.5 * (omega[:-1] + omega[1:]) * np.diff(t)
-    turns = np.round((predicted - np.diff(theta)) / (2 * math.pi))
-    return theta + 2 * math.pi * np.concatenate([[0.0], np.cumsum(turns)])
-
-
 #: Distance (rad) from a change point within which a motion cannot start: √ε, where the
 #: rates of the dependent links are lost to rounding (they are 0/0 at the change point).
 CHANGE_POINT_MARGIN = 1.5e-8
@@ -255,8 +248,9 @@ class _Stepper:
 
     def run(self, y0: NDArray[np.float64], stop_at: float | None):
         """Integrate from ``y0``; the states returned carry the extra work as a last entry."""
-        if self.f.time_only and stop_at is None:
-            prescribed = self._prescribed(y0)
+        if self.f.driven and stop_at is None:
+            prescribed = (self._prescribed(y0) if self.f.time_only
+                          else self._prescribed_motion(y0))
             if prescribed is not None:
                 return prescribed
         f = _WithExtraWork(self.f)
@@ -416,6 +410,44 @@ class _Stepper:
         if self.progress is not None:
             self.progress(self.duration, self.duration)
         return self.t_out.tolist(), states, [0.0, 0.0], work.evaluations, work.panels, None
+
+    def _prescribed_motion(self, y0: NDArray[np.float64]):
+        """A driven crank's prescribed motion in a formulation that is not minimal.
+
+        The states at the output times are the motion itself
+        (:meth:`~balancer.formulations.Formulation.driven_motion`: the mechanism's position
+        and rate analysis); the motor's work and the extra work are the cumulative integrals of
+        their powers, the formulation's own driving torque times the crank's speed and
+        :meth:`~balancer.formulations.Formulation.extra_power`, by quadrature
+        (:func:`balancer.quadrature.cumulative`, to the run's tolerances; a panel is reported
+        as a step). The drift is the constraints' residual at the output states. ``None`` where
+        the formulation has no such route: the integrator then steps.
+        """
+        from .quadrature import cumulative
+
+        f = self.f
+        motion = f.driven_motion(self.t_out, y0)
+        if motion is None:
+            return None
+        speed = float(f.speed)  # type: ignore[arg-type]
+
+        def integrand(t: NDArray[np.float64]) -> NDArray[np.float64]:
+            states = f.driven_motion(t, y0)
+            if states is None:
+                raise SolverError("the prescribed motion does not exist at a quadrature node "
+                                  f"within 0 ≤ t ≤ {self.duration:.6g} s")
+            states = [np.append(y, 0.0) for y in states]  # the motor's work: not used
+            torque = np.asarray(f.evaluate_batch(t, states).driving_torque, float)
+            extra = [f.extra_power(ti, y) for ti, y in zip(t, states, strict=True)]
+            return np.column_stack([torque * speed, extra])
+
+        work = cumulative(integrand, self.t_out, rtol=self.rtol, atol=self.atol,
+                          max_width=PANEL_ANGLE / abs(speed))
+        states = [np.concatenate([y, w]) for y, w in zip(motion, work.values, strict=True)]
+        drift = f.constraint_residuals(self.t_out, [y[:-1] for y in states])
+        if self.progress is not None:
+            self.progress(self.duration, self.duration)
+        return self.t_out.tolist(), states, list(drift), work.evaluations, work.panels, None
 
     def _stages(self):
         """The formulation's compiled DOP853 stages (built once per formulation), or None."""
@@ -710,7 +742,8 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
     states = [y[:-1] for y in states]
     ev = f.evaluate_batch(times, states)
     omega, alpha = np.asarray(ev.omega, float), np.asarray(ev.alpha, float)
-    theta = np.array([_unwrap(row, omega[k], t) for k, row in enumerate(ev.theta)])
+    theta = np.array([continuous_angles(row, omega[k], t)
+                      for k, row in enumerate(ev.theta)])
     tau = np.asarray(ev.driving_torque, float) * np.ones(t.size)
     motor = np.array([f.motor_work(y) for y in states])
     slider = None if ev.slider is None else np.asarray(ev.slider, float)

@@ -13,9 +13,10 @@ from balancer.kinematics import assembly_range
 from balancer.model import FourBar, Link
 
 # Property tests draw the same examples on every machine and run (reproducible, like the seeded
-# random tests); HYPOTHESIS_PROFILE=explore draws new ones and keeps what fails (a fuzz campaign).
+# random tests); HYPOTHESIS_PROFILE=explore draws new ones and keeps what fails (a fuzz campaign),
+# HYPOTHESIS_EXAMPLES of them per test (default Hypothesis's 100).
 settings.register_profile("reproducible", derandomize=True, database=None)
-settings.register_profile("explore")
+settings.register_profile("explore", max_examples=int(os.environ.get("HYPOTHESIS_EXAMPLES", 100)))
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "reproducible"))
 
 #: Meijaard & van der Wijk (2020), Eq. 56.

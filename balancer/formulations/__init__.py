@@ -46,6 +46,20 @@ from numpy.typing import NDArray
 DEAD_POINT_THRESHOLD = 1e-3
 
 
+def continuous_angles(theta: NDArray[np.float64], omega: NDArray[np.float64],
+                      t: NDArray[np.float64]) -> NDArray[np.float64]:
+    """An angle continuous over time from its values modulo 2π, rad.
+
+    ``theta`` at increasing times ``t`` (s), ``omega`` its rate there (rad/s): each step takes
+    the 2π branch nearest to the trapezoidal prediction ``(ω_i + ω_{i+1})·Δt/2``; the first
+    value is kept.
+    """
+    theta = np.asarray(theta, dtype=float)
+    predicted = 0.5 * (omega[:-1] + omega[1:]) * np.diff(t)
+    turns = np.round((predicted - np.diff(theta)) / (2 * math.pi))
+    return theta + 2 * math.pi * np.concatenate([[0.0], np.cumsum(turns)])
+
+
 @dataclass(frozen=True)
 class DrivenRates:
     """A driven crank's prescribed motion at many times (:meth:`Formulation.driven_rates`).
@@ -247,6 +261,20 @@ class Formulation(ABC):
         """
         return None
 
+    def driven_motion(self, times: NDArray[np.float64],
+                      start: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """The states of a driven crank's prescribed motion at many times, or ``None``.
+
+        For a formulation that is not minimal: its coordinates and rates at the times (in
+        increasing order), shape ``(times, state size − 1)`` (all but the motor's work, the
+        last entry), found from the mechanism's position and rate analysis at the crank angles
+        :meth:`crank_angle` gives, on the constraints, angles continuous from the state
+        ``start`` at ``t = 0``. The simulation then takes the motor's work by quadrature
+        instead of stepping an integrator. ``None`` (the default) where a formulation has no
+        such route, or the motion does not exist at some time.
+        """
+        return None
+
     def symbolic_rhs(self):
         """:meth:`rhs` as a CasADi function ``(t, y) → ẏ``, or ``None``.
 
@@ -333,6 +361,14 @@ class Formulation(ABC):
     def constraint_residual(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
         """Loop-closure residuals of a state: position (m) and velocity (m/s)."""
         return 0.0, 0.0
+
+    def constraint_residuals(self, times, states) -> tuple[float, float]:
+        """The largest :meth:`constraint_residual` over many states: position and velocity."""
+        pos = vel = 0.0
+        for t, y in zip(times, states, strict=True):
+            p, v = self.constraint_residual(t, y)
+            pos, vel = max(pos, p), max(vel, v)
+        return pos, vel
 
     def like_components(self) -> tuple[NDArray[np.intp], ...]:
         """Groups of the state's components that are quantities of one kind, as indices.

@@ -46,7 +46,7 @@ from ..linkage.structure import (
 )
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import V
-from . import Evaluation
+from . import Evaluation, continuous_angles
 from .compiled import Compiled, LinkageFormulation, link_equations, spring_forces
 
 
@@ -279,6 +279,33 @@ class Multibody(LinkageFormulation):
         y = np.concatenate([q, qd])
         return np.append(y, 0.0) if self.driven else y
 
+    def driven_motion(self, times, start) -> NDArray[np.float64] | None:
+        """The frames' coordinates and rates from the mechanism's motion at the crank angles.
+
+        The crank angle ``θ1(t)`` exactly; the other links' angles continuous from ``start``'s
+        (:func:`~balancer.formulations.continuous_angles` over the times, in increasing order:
+        the first time's branch nearest ``start``'s angle).
+        """
+        times = np.asarray(times, dtype=float)
+        theta1 = self.crank_angle(times)
+        with np.errstate(all="ignore"):
+            mo = self.mech.motion(theta1, float(self.speed), 0.0)  # type: ignore[arg-type]
+        count, n = times.size, self.n
+        q, qd = np.empty((count, 3 * n)), np.empty((count, 3 * n))
+        for k in range(n):
+            q[:, 3 * k], q[:, 3 * k + 1] = mo.pose.origins[k].x, mo.pose.origins[k].y
+            q[:, 3 * k + 2] = mo.pose.angles[k]
+            qd[:, 3 * k], qd[:, 3 * k + 1] = mo.velocity[k].x, mo.velocity[k].y
+            qd[:, 3 * k + 2] = mo.rate[k]
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
+            return None
+        angles, rates = q[:, 2::3], qd[:, 2::3]
+        angles += 2 * np.pi * np.round((start[2 : 3 * n : 3] - angles[0]) / (2 * np.pi))
+        for k in range(n):
+            angles[:, k] = continuous_angles(angles[:, k], rates[:, k], times)
+        angles[:, self.structure.input] = theta1
+        return np.hstack([q, qd])
+
     def symbolic_rhs(self) -> ca.Function | None:
         """``(t, y) → ẏ`` as a CasADi function (none with slider forces: tables in Python)."""
         s = self.structure
@@ -369,6 +396,14 @@ class Multibody(LinkageFormulation):
             jacs[todo] = self._constraint_values_many(times[todo], q[todo])[1]
         qd -= _least_norm_many(jacs, np.einsum("kri,ki->kr", jacs, qd) - self._velocity_rhs())
         return list(ys)
+
+    def constraint_residuals(self, times, states) -> tuple[float, float]:
+        """:meth:`constraint_residual` at many states, the constraints in one call."""
+        n = 3 * self.n
+        ys = np.array(states, dtype=float).reshape(len(states), -1)
+        res, jacs = self._constraint_values_many(times, ys[:, :n])
+        vel = np.einsum("kri,ki->kr", jacs, ys[:, n : 2 * n]) - self._velocity_rhs()
+        return float(np.max(np.abs(res), initial=0.0)), float(np.max(np.abs(vel), initial=0.0))
 
     def like_components(self) -> tuple[NDArray[np.intp], ...]:
         """The frames' positions, their angles, their velocities, their rates."""
