@@ -61,9 +61,10 @@ from .integration import DOP853, CompiledDOP853, Stages, TimeOnlyDOP853, with_ex
 from .mechanisms import mechanism_of
 from .model import RTOL_MIN, Design, SimulationSettings, check_scales
 
-#: Most integration steps a simulation may take (tens of minutes with the slowest
-#: formulation): a duration that needs more is refused, from the rate of its first steps.
-MAX_STEPS = 2_000_000
+#: Most integration steps a simulation may take (about a minute with the slowest formulation on
+#: a 2-core machine, some 4000 steps a second): a duration that needs more is refused, from
+#: the rate of its first steps.
+MAX_STEPS = 200_000
 #: Steps after which the rate is extrapolated to the whole duration.
 PROJECT_AFTER = 200
 #: Energy error (relative to the energy's scale, :attr:`Trajectory.energy_error`) beyond which
@@ -464,6 +465,7 @@ class _Stepper:
         """Refuse a duration that would take more than :data:`MAX_STEPS` steps.
 
         After :data:`PROJECT_AFTER` steps, from the rate so far; at any time, the limit itself.
+        (A motion whose steps come ever faster is caught by :meth:`_check_stall`.)
         """
         if steps < PROJECT_AFTER or t <= 0:
             return
