@@ -329,6 +329,12 @@ class DOP853:
         d0, d1 = _rms(y0 / scale), _rms(f0 / scale)
         h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
         h0 = min(h0, length)
+        if not h0 > 0:  # a rate that is not finite, or beyond double precision's range
+            from .errors import SolverError
+
+            raise SolverError(f"the integrator cannot start at t = {t0:.6g} s: the state's "
+                              "rate of change is not finite (loads, springs or masses of "
+                              "magnitudes double precision cannot follow)")
         f1 = self.fun(t0 + h0 * self.direction, y0 + h0 * self.direction * f0)
         d2 = _rms((f1 - f0) / scale) / h0
         if d1 <= 1e-15 and d2 <= 1e-15:

@@ -999,8 +999,9 @@ def check_scales(mechanism, speeds: dict[str, float],
 
     The scales (:func:`balancer.validate.check_magnitudes`): a reach ``R`` (the model's
     ``sizes`` and the centres of mass' distances from their links' origins, summed); forces
-    ``m·R·ω²``, ``m·|g|``, the applied forces and the model's ``gas_forces``; moments ``R``
-    times those, ``(I + J_c)·ω²`` and the applied moments; energies ``(I + J_c + m·R²)·ω²``.
+    ``m·R·ω²``, ``m·|g|``, the applied forces, the model's ``gas_forces`` and its springs'
+    ``k·(R + |l0|)``; moments ``R`` times those, ``(I + J_c)·ω²`` and the applied moments;
+    energies ``(I + J_c + m·R²)·ω²`` and ``k·(R + |l0|)²``.
     ``speeds`` and ``gravity`` are keyed by their spec keys (the largest of each counts).
     """
     links = dict(zip(mechanism.link_names, mechanism.links, strict=True))
@@ -1029,6 +1030,13 @@ def check_scales(mechanism, speeds: dict[str, float],
             gas = [(key, max(abs(x) for x in g.values))]
             forces.append(gas)
             moments.append(gas + r)
+    for i, spring in enumerate(getattr(mechanism, "springs", ())):
+        # Its force k·(R + |l0|) at most, moment R times that, energy k·(R + |l0|)²/2.
+        stiffness = [(f"springs[{i}].stiffness", spring.stiffness)]
+        stretch = [(f"springs[{i}].free_length", r[0][1] + abs(spring.free_length))]
+        forces.append(stiffness + stretch)
+        moments.append(stiffness + stretch + r)
+        energies.append(stiffness + stretch + stretch)
     v.check_magnitudes(forces, "the forces", "N")
     v.check_magnitudes(moments, "the moments", "N·m")
     v.check_magnitudes(energies, "the kinetic energy", "J")

@@ -719,13 +719,19 @@ def simulate(
 def _before_lock(f: Formulation, t_lock: float) -> float:
     """The time before ``t_lock`` at which the prescribed motion's |sin(θ3 − θ2)| is small.
 
-    That is, where it falls to :data:`DEAD_POINT_THRESHOLD`.
+    That is, where it falls to :data:`DEAD_POINT_THRESHOLD`; a pose that does not assemble
+    counts as below it. Where it is still above at ``t_lock`` (the end of the assembly range
+    is known to the precision of its search, and the transmission falls as the square root of
+    the distance to it), ``t_lock`` itself.
     """
     def gap(t: float) -> float:
-        return f.transmission_of_crank(f.crank_angle(t)) - DEAD_POINT_THRESHOLD
+        value = f.transmission_of_crank(f.crank_angle(t)) - DEAD_POINT_THRESHOLD
+        return value if math.isfinite(value) else -1.0
 
     if gap(0.0) <= 0:
         return 0.0
+    if gap(t_lock) > 0:
+        return t_lock
     from scipy.optimize import brentq  # only for a lock (its import costs 0.3–0.5 s)
 
     return brentq(gap, 0.0, t_lock, xtol=1e-14)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -726,14 +727,17 @@ def test_a_centre_of_mass_put_onto_a_small_disc_far_from_the_frames_origin_stays
 
 
 
-@pytest.mark.parametrize("spec", ["locking_fourbar_linkage.toml", "locking_slider_linkage.toml"])
+@pytest.mark.parametrize("spec", ["locking_fourbar_linkage.toml", "locking_slider_linkage.toml",
+                                  "locking_stephenson_linkage.toml"])
 @pytest.mark.parametrize("method", ["crank-angle", "multibody"])
 def test_a_driven_crank_that_locks_says_so_with_every_formulation(spec, method, capsys):
     # Linkage fuzz campaign, seed 4242 (cases 165 and 61): a crank driven into the end of its
     # range. crank-angle raced its own dead-point event against the lock (the same root) and
     # sometimes reported a dead point "multibody can pass"; multibody's shrinking steps before
-    # the lock were judged against the whole duration and reported a stall. Both must say the
-    # linkage locks, exit 1.
+    # the lock were judged against the whole duration and reported a stall. Seed 1126, case
+    # 359: the transmission was still above the dead-point threshold at the range's end as
+    # its search found it, and the search for where it falls below had no bracket (an internal
+    # error). All must say the linkage locks, exit 1.
     from pathlib import Path
 
     from balancer.cli import main
@@ -777,3 +781,33 @@ def test_an_integration_that_loses_its_energy_balance_fails(capsys):
     assert main([*args, "multibody"]) == 1
     assert "lost its own energy balance" in capsys.readouterr().err
     assert main([*args, "crank-angle"]) == 0
+
+
+def test_a_spring_beyond_double_precision_is_refused_by_name(tmp_path, capsys):
+    # Linkage fuzz campaign, seed 1126, case 368: a spring of 1e200 N/m passed the scale
+    # checks (they knew loads, gas forces and speeds) and its forces overflowed the
+    # integrator's first step (an internal ZeroDivisionError). Its force k·(R + |l0|) and
+    # energy are scales like the others': refused naming the key, exit 2, every verb.
+    from pathlib import Path
+
+    from balancer.cli import main
+
+    text = (Path(__file__).resolve().parent / "data" / "spring_linkage_at_rest.toml").read_text()
+    assert "stiffness = " in text
+    spec = tmp_path / "spring.toml"
+    spec.write_text(re.sub(r"stiffness = [^\n]*", "stiffness = 1e200", text, count=1))
+    for verb in ("analyze", "simulate", "verify"):
+        assert main([verb, str(spec)]) == 2
+        err = capsys.readouterr().err
+        assert "springs[0].stiffness" in err and "1e+200" in err and err.count("\n") == 1
+
+
+def test_an_integrator_whose_rate_is_not_finite_cannot_start():
+    # The first step's size (Hairer, Nørsett & Wanner) divides by the rate's size: a rate that
+    # is not finite gives no step, a SolverError (exit 1), not a division by zero.
+    from balancer.errors import SolverError
+    from balancer.integration import DOP853
+
+    with pytest.raises(SolverError, match="not finite"):
+        DOP853(lambda t, y: np.array([np.inf, 1.0]), 0.0, np.array([1.0, 1.0]), 1.0,
+               rtol=1e-9, atol=1e-12)
