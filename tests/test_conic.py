@@ -9,6 +9,7 @@ in the convention the certificate uses, and membership of the (self-dual) cones.
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 
@@ -97,6 +98,28 @@ def test_squares_objective_agrees_with_cvxpy(seed):
     assert value == pytest.approx(value_ref, rel=AGREE, abs=AGREE)
     gradient = 2 * p.T @ (p @ solution.u + q) + g
     assert _stationarity(constraints, equality, solution, gradient) < AGREE
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_an_objective_far_from_unity_is_solved_as_it_would_be_divided(seed):
+    # Linkage fuzz campaign, seed 2611, case 142: an added-mass weight that dwarfed the
+    # shaking of a linkage a third of a millimetre across gave a linear term of 3.5e13 beside
+    # a Hessian of order one, and Clarabel called the bounded program unbounded. The program
+    # divides such an objective by its size: the point is the one of the objective divided by
+    # hand (the other route, the same program at unit scale), and the multipliers, multiplied
+    # back, make the original objective's Lagrangian stationary, relative to its gradient.
+    constraints, equality, p, q = _random_program(seed)
+    g = np.random.default_rng(200 + seed).normal(size=p.shape[1])
+    big = ConicProgram(p.shape[1], constraints, equality=equality, objective="squares",
+                       P=p, q=q, g=3.5e13 * g)
+    unit = ConicProgram(p.shape[1], constraints, equality=equality, objective="squares",
+                        P=p / math.sqrt(3.5e13), q=q / math.sqrt(3.5e13), g=g)
+    solution, reference = big.solve(CLARABEL_SETTINGS), unit.solve(CLARABEL_SETTINGS)
+    assert solution.status == reference.status == "optimal"
+    assert np.max(np.abs(solution.u - reference.u)) < AGREE
+    gradient = 2 * p.T @ (p @ solution.u + q) + 3.5e13 * g
+    assert _stationarity(constraints, equality, solution, gradient) < AGREE * np.linalg.norm(
+        gradient)
 
 
 def test_nearest_point_and_new_right_hand_side():

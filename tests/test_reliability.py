@@ -811,3 +811,20 @@ def test_an_integrator_whose_rate_is_not_finite_cannot_start():
     with pytest.raises(SolverError, match="not finite"):
         DOP853(lambda t, y: np.array([np.inf, 1.0]), 0.0, np.array([1.0, 1.0]), 1.0,
                rtol=1e-9, atol=1e-12)
+
+
+def test_a_tiny_linkage_whose_mass_weight_dominates_is_balanced(capsys):
+    # Linkage fuzz campaign, seed 2611, case 142: Clarabel called the convex program unbounded
+    # (an objective whose linear term was 1e13 times its quadratic one); it is divided by its
+    # size now, and the valid spec is balanced: its inertial shaking force cancelled, exit 0.
+    from pathlib import Path
+
+    from balancer.cli import main
+
+    path = Path(__file__).resolve().parent / "data" / "tiny_stephenson_mass_weighted.toml"
+    assert main(["optimize", str(path), "--json", "--no-verify"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["success"] and doc["force_balanced"]
+    inertial = doc["inertial"]  # the loads' share of the shaking force is no inertia's to cancel
+    assert (inertial["after"]["shaking_force"]["max"]
+            <= 1e-9 * inertial["before"]["shaking_force"]["max"])

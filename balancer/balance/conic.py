@@ -40,6 +40,11 @@ STATUS: dict[str, str] = {
 }
 #: The statuses whose point is a solution.
 SOLVED = ("optimal", "optimal_inaccurate")
+#: Largest entry of an objective's data (Hessian, linear term) that Clarabel is given as it
+#: is; an objective with a larger one is divided by it (the point is the same, the
+#: multipliers are multiplied back). Those of the balancing problems are of order one, in
+#: scaled units, unless weights of different units meet scales far apart.
+COST_SCALE_LIMIT = 1e6
 
 
 @dataclass(frozen=True)
@@ -173,8 +178,15 @@ class ConicProgram:
             raise ValueError(f"unknown objective {objective!r}")
         self._A = a_matrix
         self._b = b_vector
-        self._H = np.triu(hessian)
-        self._h = linear
+        # An objective whose data are far from unity (a penalty on added mass that dwarfs the
+        # shaking of a linkage a millimetre across) is divided by their size: Clarabel's
+        # equilibration leaves such a cost as it is, and it then declared a bounded problem
+        # unbounded. The multipliers are multiplied back.
+        size = max(float(np.max(np.abs(hessian), initial=0.0)),
+                   float(np.max(np.abs(linear), initial=0.0)))
+        self._cost_scale = size if size > COST_SCALE_LIMIT else 1.0
+        self._H = np.triu(hessian) / self._cost_scale
+        self._h = linear / self._cost_scale
         self._cones = cones
         # Clarabel's forms of what every solve shares
         self._csc = (CscMatrix.of(self._H), CscMatrix.of(self._A))
@@ -195,7 +207,7 @@ class ConicProgram:
         if self.objective == "nearest":
             assert target is not None
             h = np.zeros(self.width)
-            h[: self.n] = -2.0 * np.asarray(target, float)
+            h[: self.n] = -2.0 * np.asarray(target, float) / self._cost_scale
         kinds = {"zero": clarabel.ZeroConeT, "nonneg": clarabel.NonnegativeConeT,
                  "soc": clarabel.SecondOrderConeT}
         cones = [kinds[kind](k) for kind, k in self._cones]
@@ -207,7 +219,7 @@ class ConicProgram:
         with np.errstate(over="ignore", invalid="ignore"):
             result = solver.solve()
         status = STATUS.get(str(result.status), "solver_error")
-        z = np.asarray(result.z, dtype=float)
+        z = np.asarray(result.z, dtype=float) * self._cost_scale
         duals = tuple(z[s] for s in self._slices) if z.size == self._b.size else tuple(
             np.full(s.stop - s.start, np.nan) for s in self._slices)
         epigraph = None
