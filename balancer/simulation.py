@@ -77,6 +77,9 @@ CHANGE_POINT_NEAR = 0.05
 #: (:meth:`_Stepper._prescribed`): a sixteenth of a revolution, so that the panels resolve the
 #: power's harmonics and the Gauss and Kronrod rules cannot agree on a wrong value.
 PANEL_ANGLE = math.pi / 8
+#: Largest crank angle, rad, between two states through which a prescribed motion's angles
+#: are followed from one output time to the next (a link turns a few times that at most).
+GUIDE_ANGLE = 0.1
 #: Most output times of a run that resamples its outputs to a resolution.
 MAX_OUTPUTS = 100_000
 #: Steps over which the recent rate is judged: a run whose last ``STALL_WINDOW`` steps would
@@ -246,6 +249,10 @@ class _Stepper:
         self.resolution = resolution
         #: Each step's end and dense output, kept where the outputs may be resampled.
         self.pieces: list[tuple[float, object]] = []
+        #: States between the output times (the steps' ends; a prescribed motion's at every
+        #: :data:`GUIDE_ANGLE` of crank), as ``(times, states)``: the angles are followed
+        #: through them from one output to the next (:func:`_trajectory`).
+        self.guide: tuple[list[float], list[NDArray[np.float64]]] = ([], [])
 
     def run(self, y0: NDArray[np.float64], stop_at: float | None):
         """Integrate from ``y0``; the states returned carry the extra work as a last entry."""
@@ -318,6 +325,8 @@ class _Stepper:
                 self.extra_fev += 1
             if groups:
                 solver.atol = floored_atol(self.atol, groups, solver.y)
+            self.guide[0].append(float(solver.t))
+            self.guide[1].append(np.array(solver.y))
             if not passes_dead_points:
                 event = self._dead_point(interp, solver.t_old, solver.t, solver.y,
                                          change_points)
@@ -408,9 +417,16 @@ class _Stepper:
             return None
         start = np.append(y0, 0.0)
         states = list(start + work.values)
+        guide = self._crank_grid()
+        self.guide = (guide.tolist(), [start] * guide.size)  # the angles are the crank's alone
         if self.progress is not None:
             self.progress(self.duration, self.duration)
         return self.t_out.tolist(), states, [0.0, 0.0], work.evaluations, work.panels, None
+
+    def _crank_grid(self) -> NDArray[np.float64]:
+        """Times at which a driven crank has turned by :data:`GUIDE_ANGLE` since the last."""
+        count = math.ceil(abs(float(self.f.speed)) * self.duration / GUIDE_ANGLE)  # type: ignore[arg-type]
+        return np.linspace(0.0, self.duration, count + 1) if count > 1 else np.zeros(0)
 
     def _prescribed_motion(self, y0: NDArray[np.float64]):
         """A driven crank's prescribed motion in a formulation that is not minimal.
@@ -446,6 +462,11 @@ class _Stepper:
                           max_width=PANEL_ANGLE / abs(speed))
         states = [np.concatenate([y, w]) for y, w in zip(motion, work.values, strict=True)]
         drift = f.constraint_residuals(self.t_out, [y[:-1] for y in states])
+        guide = self._crank_grid()
+        if guide.size:
+            zeros = np.zeros(2)  # the works: no part of the angles
+            self.guide = (guide.tolist(), [np.concatenate([y, zeros])
+                                           for y in f.driven_motion(guide, y0)])
         if self.progress is not None:
             self.progress(self.duration, self.duration)
         return self.t_out.tolist(), states, list(drift), work.evaluations, work.panels, None
@@ -692,7 +713,7 @@ def simulate(
     with np.errstate(divide="ignore", invalid="ignore"):
         times, states, drift, nfev, steps, stopped = stepper.run(y0, end)
     traj = _trajectory(f, times, states, drift, nfev, steps, rtol, atol,
-                       _time.perf_counter() - start)
+                       _time.perf_counter() - start, guide=stepper.guide)
     if not traj.energy_error <= ENERGY_FAILURE:
         raise SolverError(
             f"the {f.name} integration lost its own energy balance (an error of "
@@ -744,14 +765,13 @@ def _lockup(message: str, t: float, theta1: float, partial: Trajectory) -> Locku
 
 
 def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
-                seconds) -> Trajectory:
+                seconds, guide=None) -> Trajectory:
     t = np.array(times)
     extra = np.array([y[-1] for y in states])
     states = [y[:-1] for y in states]
     ev = f.evaluate_batch(times, states)
     omega, alpha = np.asarray(ev.omega, float), np.asarray(ev.alpha, float)
-    theta = np.array([continuous_angles(row, omega[k], t)
-                      for k, row in enumerate(ev.theta)])
+    theta = _followed_angles(f, t, np.asarray(ev.theta, float), omega, guide)
     tau = np.asarray(ev.driving_torque, float) * np.ones(t.size)
     motor = np.array([f.motor_work(y) for y in states])
     slider = None if ev.slider is None else np.asarray(ev.slider, float)
@@ -791,6 +811,33 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
         model=f.linkage,
         slider=slider,
     )
+
+
+def _followed_angles(f: Formulation, t, theta, omega, guide) -> NDArray[np.float64]:
+    """The links' angles at the output times, continuous over the motion, rad.
+
+    Each step from one time to the next takes the 2π branch nearest to the trapezoidal
+    prediction from the rates (:func:`~balancer.formulations.continuous_angles`), through the
+    ``guide`` states (the integrator's steps, a prescribed motion's crank grid) that lie
+    between two output times: coarse output times (a whole turn of a link apart, or more) would
+    leave the prediction unable to count the turns.
+    """
+    if guide is not None and len(guide[0]) and t.size:
+        g_t = np.asarray(guide[0], dtype=float)
+        inside = (g_t > t[0]) & (g_t < t[-1]) & ~np.isin(g_t, t)
+        if inside.any():
+            ev = f.evaluate_batch(g_t[inside], [y[:-1] for y, keep
+                                                 in zip(guide[1], inside, strict=True) if keep])
+            merged = np.concatenate([t, g_t[inside]])
+            order = np.argsort(merged, kind="stable")
+            rank = np.empty_like(order)
+            rank[order] = np.arange(order.size)
+            both_theta = np.hstack([theta, np.asarray(ev.theta, float)])[:, order]
+            both_omega = np.hstack([omega, np.asarray(ev.omega, float)])[:, order]
+            followed = np.array([continuous_angles(row, both_omega[k], merged[order])
+                                 for k, row in enumerate(both_theta)])
+            return followed[:, rank[: t.size]]
+    return np.array([continuous_angles(row, omega[k], t) for k, row in enumerate(theta)])
 
 
 def _exchangeable_energy(f: Formulation) -> float:
