@@ -47,6 +47,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from . import tomltext as toml
 from . import validate as v
 from .errors import SpecError
 from .model import (
@@ -583,34 +584,20 @@ def loads_design(text: str, source: str = "<string>") -> Design:
 # exactly) and adds unit comments a designer can read.
 
 
-def _num(x: float) -> str:
-    if isinstance(x, bool):
-        raise TypeError("a bool is not a number")
-    if isinstance(x, int):
-        return str(x)
-    text = repr(float(x))
-    return text
-
-
-def _string(text: str) -> str:
-    escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
-    return f'"{escaped}"'
-
-
 def _link_lines(link: Link, frame: str = "link") -> list[str]:
     lines = [
-        f"mass = {_num(link.mass)}  # kg",
-        f"inertia = {_num(link.inertia)}  # kg·m² about the centre of mass",
-        f"com = {{ e = {_num(link.e)}, f = {_num(link.f)} }}  "
+        f"mass = {toml.number(link.mass)}  # kg",
+        f"inertia = {toml.number(link.inertia)}  # kg·m² about the centre of mass",
+        f"com = {{ e = {toml.number(link.e)}, f = {toml.number(link.f)} }}  "
         + (f"# m (s = {link.s:.6g} m, sigma = {link.sigma:.6g} rad)" if frame == "link"
            else "# m from the pin, in global axes"),
     ]
     if link.force != (0.0, 0.0):
-        lines.append(f"force = [{_num(link.force[0])}, {_num(link.force[1])}]  # N")
+        lines.append(f"force = [{toml.number(link.force[0])}, {toml.number(link.force[1])}]  # N")
     if link.moment != 0.0:
-        lines.append(f"moment = {_num(link.moment)}  # N·m")
+        lines.append(f"moment = {toml.number(link.moment)}  # N·m")
     if link.counter_rotor != 0.0:
-        lines.append(f"counter_rotor = {_num(link.counter_rotor)}  # kg·m²")
+        lines.append(f"counter_rotor = {toml.number(link.counter_rotor)}  # kg·m²")
     return lines
 
 
@@ -618,18 +605,18 @@ def _gas_lines(gas: GasForce) -> list[str]:
     if gas.is_zero:
         return []
     if len(gas.values) == 1:
-        return [f"gas_force = {_num(gas.values[0])}  # N along the guide"]
-    angles = ", ".join(_num(a) for a in gas.angles)
-    values = ", ".join(_num(v) for v in gas.values)
+        return [f"gas_force = {toml.number(gas.values[0])}  # N along the guide"]
+    angles = ", ".join(toml.number(a) for a in gas.angles)
+    values = ", ".join(toml.number(v) for v in gas.values)
     return [f"gas_force = {{ crank_angle = [{angles}], force = [{values}], "
-            f"period = {_num(gas.period)} }}  # rad, N"]
+            f"period = {toml.number(gas.period)} }}  # rad, N"]
 
 
 def _links_lines(mech, prefix: str) -> list[str]:
     out = []
     for name in mech.link_names:
         frame = "global" if mech.type == "slider-crank" and name == "slider" else "link"
-        out += ["", f"[{prefix}.{_key(name)}]", *_link_lines(mech.link(name), frame)]
+        out += ["", f"[{prefix}.{toml.key(name)}]", *_link_lines(mech.link(name), frame)]
         if prefix == "links" and frame == "global":
             out += _gas_lines(mech.gas_force)
     return out
@@ -637,29 +624,23 @@ def _links_lines(mech, prefix: str) -> list[str]:
 
 def _linkage_lines(mech: Linkage) -> list[str]:
     """A general linkage's ``[mechanism]``, ``[links]`` and ``[[springs]]``."""
-    out = ["[mechanism]", 'type = "linkage"', f"input = {_string(mech.input)}", "",
+    out = ["[mechanism]", 'type = "linkage"', f"input = {toml.string(mech.input)}", "",
            "[mechanism.points]  # m, at the reference pose"]
-    out += [f"{_key(p)} = [{_num(x)}, {_num(y)}]" for p, (x, y) in mech.points]
+    out += [f"{toml.key(p)} = [{toml.number(x)}, {toml.number(y)}]" for p, (x, y) in mech.points]
     for s in mech.sliders:
-        out += ["", "[[mechanism.sliders]]", f"link = {_string(s.link)}",
-                f"guide = {_string(s.guide)}", f"point = {_string(s.point)}",
-                f"direction = [{_num(s.direction[0])}, {_num(s.direction[1])}]"]
+        out += ["", "[[mechanism.sliders]]", f"link = {toml.string(s.link)}",
+                f"guide = {toml.string(s.guide)}", f"point = {toml.string(s.point)}",
+                f"direction = [{toml.number(s.direction[0])}, {toml.number(s.direction[1])}]"]
     for body in mech.bodies:
-        names = ", ".join(map(_string, body.points))
-        out += ["", f"[links.{_key(body.name)}]", f"points = [{names}]"]
+        names = ", ".join(map(toml.string, body.points))
+        out += ["", f"[links.{toml.key(body.name)}]", f"points = [{names}]"]
         if body.props is not None:
             out += _link_lines(body.props)
     for spring in mech.springs:
-        out += ["", "[[springs]]", f"points = [{', '.join(map(_string, spring.points))}]",
-                f"stiffness = {_num(spring.stiffness)}  # N/m",
-                f"free_length = {_num(spring.free_length)}  # m"]
+        out += ["", "[[springs]]", f"points = [{', '.join(map(toml.string, spring.points))}]",
+                f"stiffness = {toml.number(spring.stiffness)}  # N/m",
+                f"free_length = {toml.number(spring.free_length)}  # m"]
     return out
-
-
-def _key(name: str) -> str:
-    """A TOML key: bare if it can be, else quoted."""
-    bare = bool(name) and name.isascii() and all(c.isalnum() or c in "-_" for c in name)
-    return name if bare else _string(name)
 
 
 def dumps_design(design: Design) -> str:
@@ -667,38 +648,38 @@ def dumps_design(design: Design) -> str:
     mech = design.mechanism
     out: list[str] = []
     if design.title:
-        out += [f"title = {_string(design.title)}", ""]
+        out += [f"title = {toml.string(design.title)}", ""]
     if isinstance(mech, Linkage):
         out += _linkage_lines(mech)
     else:
         out += ["[mechanism]", f'type = "{mech.type}"', f'branch = "{mech.branch}"', ""]
         out.append("[mechanism.lengths]  # m")
         for name, length in zip(mech.length_names, mech.lengths, strict=True):
-            out.append(f"{name} = {_num(length)}")
+            out.append(f"{name} = {toml.number(length)}")
         out += _links_lines(mech, "links")
     if design.operation is not None:
         op = design.operation
         out += [
             "",
             "[operation]",
-            f"speed = {_num(op.speed)}  # rad/s",
-            f"samples = {_num(op.samples)}",
-            *([f"gravity = [{_num(op.gravity[0])}, {_num(op.gravity[1])}]  # m/s²"]
+            f"speed = {toml.number(op.speed)}  # rad/s",
+            f"samples = {toml.number(op.samples)}",
+            *([f"gravity = [{toml.number(op.gravity[0])}, {toml.number(op.gravity[1])}]  # m/s²"]
               if any(op.gravity) else []),
         ]
     sim = design.simulation
     out += [
         "",
         "[simulation]",
-        f"duration = {_num(sim.duration)}  # s",
-        *([f"theta1 = {_num(sim.theta1)}  # rad"] if sim.theta1 is not None else []),
-        f"omega1 = {_num(sim.omega1)}  # rad/s",
-        f"gravity = [{_num(sim.gravity[0])}, {_num(sim.gravity[1])}]  # m/s²",
+        f"duration = {toml.number(sim.duration)}  # s",
+        *([f"theta1 = {toml.number(sim.theta1)}  # rad"] if sim.theta1 is not None else []),
+        f"omega1 = {toml.number(sim.omega1)}  # rad/s",
+        f"gravity = [{toml.number(sim.gravity[0])}, {toml.number(sim.gravity[1])}]  # m/s²",
         f'drive = "{sim.drive}"',
         *([f'method = "{sim.method}"'] if sim.method else []),
-        f"rtol = {_num(sim.rtol)}",
-        f"atol = {_num(sim.atol)}",
-        f"outputs = {_num(sim.outputs)}",
+        f"rtol = {toml.number(sim.rtol)}",
+        f"atol = {toml.number(sim.atol)}",
+        f"outputs = {toml.number(sim.outputs)}",
     ]
     if design.balance is not None:
         from .balance.problem import balance_lines

@@ -173,3 +173,42 @@ def test_save_design_is_atomic(tmp_path):
     spec.save_design(design, target)
     assert spec.load_design(target) == design
     assert [p.name for p in tmp_path.iterdir()] == ["out.toml"]
+
+
+def test_strings_and_keys_read_back_as_written():
+    # balancer.tomltext against Python's TOML reader (the other route): every ASCII character,
+    # the control characters among them, and some beyond, as a key and as a string value.
+    import tomllib
+
+    from balancer import tomltext
+
+    texts = [chr(c) for c in range(128)] + ["a.b", "a b", 'q"uote', "back\\slash", "ü", "", "é.x"]
+    for text in texts:
+        if not text:
+            continue  # TOML has no empty bare key; quoted, "" is a key, checked below
+        doc = tomllib.loads(f"{tomltext.key(text)} = {tomltext.string(text)}\n")
+        assert doc == {text: text}, repr(text)
+    assert tomllib.loads(f"{tomltext.key('')} = 1") == {"": 1}
+    for x in (0.1, -2.5e-300, 1e300, 3, 5e-324):
+        assert tomllib.loads(f"x = {tomltext.number(x)}")["x"] == x
+
+
+def test_a_linkage_with_names_toml_must_quote_round_trips_through_its_balanced_spec():
+    # Linkage fuzz campaign, seed 9090, case 298: a link named "a.b" was written as
+    # [balance.a.b], a table b inside a table a, and the balanced spec did not load again. Link
+    # and point names that are no bare keys (a dot, a space, a quote) are quoted wherever the
+    # spec names them: links, points, [balance.<link>] and its com_about.
+    text = (Path(spec.__file__).parent / "examples" / "watt_sixbar.toml").read_text()
+    text = text.replace("[links.crank]", '[links."a.b"]').replace(
+        "[balance.crank]", '[balance."a.b"]').replace('input = "crank"', 'input = "a.b"')
+    point = 'A "0"'  # a quote and a space: a quoted key, an escaped string
+    quoted = '"A \\"0\\""'
+    text = text.replace("A0 = [", f"{quoted} = [").replace('"A0"', quoted)
+    design = spec.loads_design(text)
+    assert "a.b" in design.mechanism.link_names
+    assert point in dict(design.mechanism.points)
+    assert design.balance.link("a.b").com_about == point
+    written = spec.dumps_design(design)
+    again = spec.loads_design(written)
+    assert again == design
+    assert spec.dumps_design(again) == written

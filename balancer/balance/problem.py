@@ -72,6 +72,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import tomltext as toml
 from ..cycle import sample_angles
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
@@ -504,18 +505,13 @@ def check_problem(problem: BalanceProblem, mechanism) -> None:
         )
 
 
-def _num(x: float) -> str:
-    """Shortest text that reads back to the same float (``repr``)."""
-    return repr(float(x))
-
-
 def _bracketed(bounds: tuple[float, float]) -> str:
-    return f"[{_num(bounds[0])}, {_num(bounds[1])}]"
+    return f"[{toml.number(bounds[0])}, {toml.number(bounds[1])}]"
 
 
 def _range_text(bounds: tuple[float, float]) -> str:
     lo, hi = bounds
-    return _num(lo) if lo == hi else f"[{_num(lo)}, {_num(hi)}]"
+    return toml.number(lo) if lo == hi else f"[{toml.number(lo)}, {toml.number(hi)}]"
 
 
 def balance_lines(problem: BalanceProblem) -> list[str]:
@@ -527,24 +523,24 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
         "",
         "[balance.objective]  # J = mean(Msh²) + w_tau·mean(tau²) + w_force·mean(|Fsh|²)"
         " + w_mass·Δmass",
-        f"shaking_moment = {_num(w.shaking_moment)}",
-        f"driving_torque = {_num(w.driving_torque)}  # (N·m)²/(N·m)²",
-        f"shaking_force = {_num(w.shaking_force)}  # (N·m)²/N²",
-        *([f"shaking_force_x = {_num(w.shaking_force_x)}  # (N·m)²/N², along x",
-           f"shaking_force_y = {_num(w.shaking_force_y)}  # (N·m)²/N², along y"]
+        f"shaking_moment = {toml.number(w.shaking_moment)}",
+        f"driving_torque = {toml.number(w.driving_torque)}  # (N·m)²/(N·m)²",
+        f"shaking_force = {toml.number(w.shaking_force)}  # (N·m)²/N²",
+        *([f"shaking_force_x = {toml.number(w.shaking_force_x)}  # (N·m)²/N², along x",
+           f"shaking_force_y = {toml.number(w.shaking_force_y)}  # (N·m)²/N², along y"]
           if w.shaking_force_x or w.shaking_force_y else []),
-        f"added_mass = {_num(w.added_mass)}  # (N·m)²/kg",
+        f"added_mass = {toml.number(w.added_mass)}  # (N·m)²/kg",
     ]
     for name, freedom in problem.links:
-        lines += ["", f"[balance.{name}]"]
+        lines += ["", f"[balance.{toml.key(name)}]"]
         if freedom.mass is not None:
             lines.append(f"mass = {_range_text(freedom.mass)}  # kg")
         if freedom.com_radius is not None:
-            lines.append(f"com_radius = {_num(freedom.com_radius)}  # m")
+            lines.append(f"com_radius = {toml.number(freedom.com_radius)}  # m")
         if freedom.com_about is not None:
-            lines.append(f'com_about = "{freedom.com_about}"')
+            lines.append(f"com_about = {toml.string(freedom.com_about)}")
         if freedom.min_gyration is not None:
-            lines.append(f"min_gyration = {_num(freedom.min_gyration)}  # m")
+            lines.append(f"min_gyration = {toml.number(freedom.min_gyration)}  # m")
         if freedom.inertia is not None:
             lines.append(f"inertia = {_range_text(freedom.inertia)}  # kg·m² about the COM")
         if freedom.com_on_line:
@@ -552,7 +548,8 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
         if freedom.counterweight is not None:
             cw = freedom.counterweight
             lines.append(f"counterweight = {{ mass = {_bracketed(cw.mass)}, radius = "
-                         f"{_num(cw.radius)}, gyration = {_num(cw.gyration)} }}  # kg, m, m")
+                         f"{toml.number(cw.radius)}, gyration = {toml.number(cw.gyration)} }}"
+                         "  # kg, m, m")
         if freedom.counter_rotor is not None:
             lines.append(f"counter_rotor = {_range_text(freedom.counter_rotor)}  # kg·m²")
     return lines
