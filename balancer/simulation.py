@@ -463,10 +463,10 @@ class _Stepper:
         states = [np.concatenate([y, w]) for y, w in zip(motion, work.values, strict=True)]
         drift = f.constraint_residuals(self.t_out, [y[:-1] for y in states])
         guide = self._crank_grid()
-        if guide.size:
+        along = f.driven_motion(guide, y0) if guide.size else None
+        if along is not None:
             zeros = np.zeros(2)  # the works: no part of the angles
-            self.guide = (guide.tolist(), [np.concatenate([y, zeros])
-                                           for y in f.driven_motion(guide, y0)])
+            self.guide = (guide.tolist(), [np.concatenate([y, zeros]) for y in along])
         if self.progress is not None:
             self.progress(self.duration, self.duration)
         return self.t_out.tolist(), states, list(drift), work.evaluations, work.panels, None
