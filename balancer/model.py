@@ -1000,8 +1000,9 @@ def check_scales(mechanism, speeds: dict[str, float],
     The scales (:func:`balancer.validate.check_magnitudes`): a reach ``R`` (the model's
     ``sizes`` and the centres of mass' distances from their links' origins, summed); forces
     ``m·R·ω²``, ``m·|g|``, the applied forces, the model's ``gas_forces`` and its springs'
-    ``k·(R + |l0|)``; moments ``R`` times those, ``(I + J_c)·ω²`` and the applied moments;
-    energies ``(I + J_c + m·R²)·ω²`` and ``k·(R + |l0|)²``.
+    ``k·R`` and ``k·|l0|``; moments ``R`` times those, ``I·ω²``, ``J_c·ω²`` and the applied
+    moments; energies ``I·ω²``, ``J_c·ω²``, ``m·R²·ω²``, ``k·R²`` and ``k·l0²``. Each
+    input that enters a scale is a term of its own, so that the one at fault is named.
     ``speeds`` and ``gravity`` are keyed by their spec keys (the largest of each counts).
     """
     links = dict(zip(mechanism.link_names, mechanism.links, strict=True))
@@ -1019,24 +1020,27 @@ def check_scales(mechanism, speeds: dict[str, float],
     forces, moments, energies = [], [], []
     for name, link in links.items():
         mass = [(f"links.{name}.mass", link.mass)]
-        inertia = [(f"links.{name}.inertia", link.inertia + link.counter_rotor)]
+        inertia = [(f"links.{name}.inertia", link.inertia)]
+        rotor = [(f"links.{name}.counter_rotor", link.counter_rotor)]
         force = [(f"links.{name}.force", math.hypot(*link.force))]
         forces += [mass + r + w2, mass + g_abs, force]
-        moments += [mass + r + r + w2, mass + g_abs + r, force + r, inertia + w2,
+        moments += [mass + r + r + w2, mass + g_abs + r, force + r, inertia + w2, rotor + w2,
                     [(f"links.{name}.moment", link.moment)]]
-        energies += [inertia + w2, mass + r + r + w2]
+        energies += [inertia + w2, rotor + w2, mass + r + r + w2]
     for key, g in mechanism.gas_forces:
         if not g.is_zero:
             gas = [(key, max(abs(x) for x in g.values))]
             forces.append(gas)
             moments.append(gas + r)
     for i, spring in enumerate(getattr(mechanism, "springs", ())):
-        # Its force k·(R + |l0|) at most, moment R times that, energy k·(R + |l0|)²/2.
+        # Its force k·(R + |l0|) at most, moment R times that, energy k·(R + |l0|)²/2: the
+        # reach's and the free length's terms apart, each named by its own key.
         stiffness = [(f"springs[{i}].stiffness", spring.stiffness)]
-        stretch = [(f"springs[{i}].free_length", r[0][1] + abs(spring.free_length))]
-        forces.append(stiffness + stretch)
-        moments.append(stiffness + stretch + r)
-        energies.append(stiffness + stretch + stretch)
+        free = [(f"springs[{i}].free_length", spring.free_length)]
+        for stretch in (r, free):
+            forces.append(stiffness + stretch)
+            moments.append(stiffness + stretch + r)
+            energies.append(stiffness + stretch + stretch)
     v.check_magnitudes(forces, "the forces", "N")
     v.check_magnitudes(moments, "the moments", "N·m")
     v.check_magnitudes(energies, "the kinetic energy", "J")

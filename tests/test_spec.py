@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -212,3 +213,30 @@ def test_a_linkage_with_names_toml_must_quote_round_trips_through_its_balanced_s
     again = spec.loads_design(written)
     assert again == design
     assert spec.dumps_design(again) == written
+
+
+@pytest.mark.parametrize(("edit", "key"), [
+    ('counter_rotor = 0.0', "links.crank.counter_rotor"),
+    ('stiffness = 6313.2', "springs[0].stiffness"),
+    ('free_length = ', "springs[0].free_length"),
+    ('com = { e = -0.53901', "links.coupler.com"),
+])
+def test_an_absurd_scale_names_its_own_key(edit, key, tmp_path, capsys):
+    # Linkage fuzz campaign, seed 777: a counter-rotor of 1e200 kg·m² was named as the link's
+    # inertia (the two were one term of the moment's scale) and a centre of mass 1e200 m out
+    # as a spring's free length (the reach entered the spring's force under its key). Each
+    # input is a term of its own: the message names the one at fault.
+    text = (Path(__file__).resolve().parent / "data" / "spring_linkage_at_rest.toml").read_text()
+    if edit == "counter_rotor = 0.0":
+        text = text.replace("[links.crank]\n", "[links.crank]\ncounter_rotor = 1e200\n", 1)
+    elif edit.startswith("stiffness"):
+        text = re.sub(r"stiffness = [^\n]*", "stiffness = 1e200", text, count=1)
+    elif edit.startswith("free_length"):
+        text = re.sub(r"free_length = [^\n]*", "free_length = 1e200", text, count=1)
+    else:
+        text = text.replace(edit, "com = { e = 1e200", 1)
+    path = tmp_path / "spec.toml"
+    path.write_text(text)
+    assert main(["analyze", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{key}:" in err and "1e+200" in err, err

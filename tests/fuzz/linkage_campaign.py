@@ -388,7 +388,11 @@ def classify(case: LinkageCase, run: Run) -> None:
             d.append((f"{verb}: solver failure on a valid spec (exit 1)", message[:240]))
         if rc == 2:
             keys = case.expected_keys(verb)
-            if keys and not any(k in message for k in keys):
+            # A key, or the inline table it sits in (a centre of mass "links.x.com" whose
+            # e, f, s or at is absurd: the model knows its magnitude, not how it was written).
+            named = [*keys, *(k.rsplit(".", 1)[0] + ":" for k in keys
+                              if k.split(".")[-2:-1] == ["com"])]
+            if keys and not any(k in message for k in named):
                 d.append((f"exit 2 without the key named [{tag}]",
                           f"expected one of {list(keys)}; {'; '.join(case.notes[2:])} -> "
                           f"{message[:240]}"))
