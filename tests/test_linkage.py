@@ -255,3 +255,23 @@ def test_the_strided_continuation_finds_the_plain_ones_table(monkeypatch, make):
         tol = np.broadcast_to(np.tile([1e-10 * scale, 1e-10 * scale, 1e-10],
                                       plain.shape[1] // 3), plain.shape)
         assert np.all(np.abs(strided - plain)[both] <= tol[both])
+
+
+def test_a_slider_direction_of_any_length_is_its_direction():
+    # Linkage fuzz campaign (directed): a guide direction [1.7e308, 1.7e308] overflowed its
+    # length (an internal error) and [5e-324, 5e-324] lost its digits (a guide at another
+    # angle); both are 45°. Scaled by its larger component first, each is the unit vector of
+    # [1, 1], exactly as that is (the same rounding: (1 + i)/√2 from the same operations).
+    from balancer.linkage.structure import unit
+
+    reference = unit(1.0, 1.0)
+    for x, y in ((1.7e308, 1.7e308), (5e-324, 5e-324), (3.0, 3.0)):
+        assert unit(x, y) == reference
+    assert unit(-2.0, 0.0) == -1 and unit(0.0, 1e-310) == 1j
+    text = (Path(__file__).resolve().parent.parent / "balancer" / "examples"
+            / "quick_return.toml").read_text()
+    structures = [mechanism_of(loads_design(text.replace("direction = [1.0, 0.0]",
+                                                         f"direction = {d}", 1)).mechanism)
+                  .structure for d in ("[1.0, 1.0]", "[1.7e308, 1.7e308]", "[5e-324, 5e-324]")]
+    for s in structures[1:]:
+        assert s.prisms == structures[0].prisms

@@ -120,6 +120,17 @@ class Group:
     sign: float = 1.0
 
 
+def unit(x: float, y: float) -> complex:
+    """The unit vector along ``(x, y)``, any length but zero.
+
+    Subnormal or near overflow alike: scaled by its larger component first, so that neither
+    its length overflows nor its components lose their digits.
+    """
+    m = max(abs(x), abs(y))
+    d = complex(x / m, y / m)
+    return d / abs(d)
+
+
 @dataclass(frozen=True)
 class Structure:
     """A linkage as equations: frames, constraints, groups (see the module docstring).
@@ -242,8 +253,7 @@ class Structure:
             ks, kg = index[s.link], index[s.guide]
             theta_g = 0.0 if kg == GROUND_INDEX else ref_angle[kg]
             theta_s = ref_angle[ks]
-            d = complex(*s.direction)
-            d /= abs(d)
+            d = unit(*s.direction)
             rot_g = complex(math.cos(theta_g), -math.sin(theta_g))
             origin_g = 0j if kg == GROUND_INDEX else ref_origin[kg].complex()
             prisms.append(Prism(

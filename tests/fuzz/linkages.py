@@ -1932,11 +1932,16 @@ def directed_cases(seed: int = 0) -> list[LinkageCase]:
                "ground": qr["links"][GROUND]["points"], "input": "crank",
                "sliders": qr["mechanism"]["sliders"], "theta1": None, "has_operation": True,
                "has_balance": True, "force_balance": True}
+    # A direction of any length is its direction: the two extremes read as the 45° reference
+    # does (whose crank cannot turn fully: exit 2 naming mechanism.points), or are refused
+    # naming the direction.
     items = [
-        ("directed/direction-overflow", "edge", ("mechanism.sliders[1].direction",),
+        ("directed/direction-overflow", "edge", ("mechanism.sliders[1].direction",
+                                                 "mechanism.points"),
          _quick_return_with_ram_direction("[1.7e308, 1.7e308]"), qr_info,
          "ram's guide direction [1.7e308, 1.7e308] (45°; its length overflows)"),
-        ("directed/direction-subnormal", "edge", ("mechanism.sliders[1].direction",),
+        ("directed/direction-subnormal", "edge", ("mechanism.sliders[1].direction",
+                                                  "mechanism.points"),
          _quick_return_with_ram_direction("[5e-324, 5e-324]"), qr_info,
          "ram's guide direction [5e-324, 5e-324] (45°, subnormal)"),
         ("directed/direction-45", "edge", (), _quick_return_with_ram_direction("[1.0, 1.0]"),
