@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 from ..linkage.kinematics import positions, rates
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import V
-from . import DEAD_POINT_THRESHOLD, Evaluation
+from . import DEAD_POINT_THRESHOLD, DrivenRates, Evaluation
 from .compiled import Compiled, LinkageFormulation, link_equations
 
 #: Largest residual of a numeric group's equations after its Newton steps, relative to the
@@ -192,12 +192,40 @@ class CrankAngle(LinkageFormulation):
         return self.crank_angle(t) if self.driven else float(y[0])
 
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
-        if self.driven:
+        if self.driven:  # the prescribed angle (the state's, integrated, is the same)
             speed = float(self.speed)  # type: ignore[arg-type]
-            general = self._at(y[0], speed)[1]
+            general = self._at(self.crank_angle(t), speed)[1]
             return np.array([speed, 0.0, -general * speed])  # the motor's power: τ = −F
         out = self._at(y[0], y[1])
         return np.array([y[1], out[1] / out[0]])
+
+    def driven_rates(self, times: NDArray[np.float64]) -> DrivenRates | None:
+        """:meth:`rhs`, :meth:`extra_power` and :meth:`transmission` at many times, driven.
+
+        The compiled equation mapped over the prescribed crank angles
+        (:meth:`~balancer.formulations.compiled.Compiled.columns`): the same numbers as the
+        integrator's single calls of it. The numeric groups' closure is checked as
+        :meth:`transmission_of_crank` checks it.
+        """
+        if not self.driven:
+            return None
+        speed = float(self.speed)  # type: ignore[arg-type]
+        theta1 = self.crank_angle(np.asarray(times, dtype=float))
+        gas = np.array([self._gas(x) for x in theta1]).reshape(theta1.size, -1)
+        out = self._equation.columns(np.vstack([theta1, np.full(theta1.size, speed), gas.T]))
+        general, least, closure = out[1], out[2], out[3]
+        scale = self.structure.length_scale()
+        if self._numeric and not np.all(closure <= CLOSURE_TOLERANCE * scale):
+            bad = int(np.argmax(~(closure <= CLOSURE_TOLERANCE * scale)))
+            self.transmission_of_crank(float(theta1[bad]))  # raises, naming the angle
+        if self._numeric:
+            least = np.minimum(least, [self._numeric_gap(float(x)) for x in theta1])
+        rates = np.column_stack([np.full(theta1.size, speed), np.zeros(theta1.size),
+                                 -general * speed])  # the motor's power: τ = −F
+        extra = speed * np.einsum("ij,ji->i", gas, out[4 : 4 + gas.shape[1]]) if (
+            self._prisms) else np.zeros(theta1.size)
+        return DrivenRates(rates=rates, extra_power=extra,
+                           transmission=np.sqrt(np.maximum(least, 0.0)))
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         return self.transmission_of_crank(self.theta1_of(t, y))
