@@ -828,3 +828,22 @@ def test_a_tiny_linkage_whose_mass_weight_dominates_is_balanced(capsys):
     inertial = doc["inertial"]  # the loads' share of the shaking force is no inertia's to cancel
     assert (inertial["after"]["shaking_force"]["max"]
             <= 1e-9 * inertial["before"]["shaking_force"]["max"])
+
+
+def test_a_fixed_centre_of_mass_that_must_move_is_named(capsys):
+    # Linkage fuzz campaign, seed 4243, case 594: force balance needs the rocker's centre of
+    # mass (fixed: the spec frees only crank and coupler) at its pivot, 96 m from where it is.
+    # The diagnosis measured a fixed centre of mass from the link's default point instead of
+    # from itself, found it "needed" 7e-10 m from that point, within tolerance, and called the
+    # problem undecided: "numerical trouble". A fixed centre's value is how far it must move;
+    # the advice, the radius to give about the default point.
+    from pathlib import Path
+
+    from balancer.cli import main
+
+    path = Path(__file__).resolve().parent / "data" / "fixed_rocker_com_infeasible.toml"
+    assert main(["optimize", str(path), "--no-verify"]) == 1
+    err = capsys.readouterr().err
+    assert "force balance cannot be met within the bounds" in err
+    assert "balance.rocker.com_radius must be given" in err and "about A3" in err
+    assert "numerical trouble" not in err

@@ -341,15 +341,18 @@ class ConvexSolver:
         return None if self._fb is None else self._fb[:2]
 
     def check_consistent(self) -> None:
-        """Raise the diagnosis if a row of Eq. 58 that nothing free enters fails.
+        """Raise if a row of Eq. 58 that nothing free enters fails.
+
+        The row itself is the diagnosis: its links, one of which must be let change (and a
+        ``com_on_line`` that forbids what it asks); no bound widened within what is free helps.
 
         Raises
         ------
         InfeasibleError
-            Naming the bounds to widen.
+            Naming the links to free.
         """
         if self._inconsistent:
-            raise self.diagnose() or self._fixed_row_error()
+            raise self._fixed_row_error()
 
     # -- building ------------------------------------------------------------------------------
 
@@ -1126,6 +1129,9 @@ class ConvexSolver:
             return None  # feasible, or undecided within Clarabel's tolerance
         ranked.sort(key=lambda item: item[:2])
         best = [r for r in ranked if r[0] == ranked[0][0]][:3]
+        # A fixed centre of mass is reported as the radius to give about the default point.
+        best = [(*r[:3], self._radius_about_default(r[2], r[3])) if r[2][1] == "com-fixed"
+                else r for r in best]
         items, parts = zip(*(self._describe(g, v) for _, _, g, v in best), strict=True)
         message = "force balance cannot be met within the bounds: " + ", or ".join(parts)
         return InfeasibleError(message, needed=tuple(items), jointly=False)
@@ -1172,7 +1178,8 @@ class ConvexSolver:
             b = data.links[i]
             mi = float(m.value[i]) * b.mass_ref
             com = complex(*(s.value[i] * b.mass_ref * b.length)) / mi
-            value = mi if kind.startswith("mass") else abs(com - self._centre(b, kind))
+            value = mi if kind.startswith("mass") else abs(com - (
+                b.com_centre if kind == "com" else self._about(b)))
             item, text = self._describe((i, kind), value)
             items.append(item)
             parts.append(text)
@@ -1194,14 +1201,24 @@ class ConvexSolver:
         return value / b.length  # a fixed centre of mass: how far it must move
 
     def _centre(self, b, kind: str) -> complex:
-        """The point a radius is measured from: ``com_about``, or the default point."""
+        """Where a centre-of-mass group's value is measured from (local, m).
+
+        A radius's ``com_about``; for a fixed centre of mass, the fixed centre itself: the
+        value is then how far it must move, which is what makes the problem infeasible (the
+        radius a designer would give, about the link's default point, is :meth:`_about`'s).
+        """
         if kind == "com":
             return b.com_centre
+        return b.com_fixed
+
+    def _about(self, b) -> complex:
+        """The link's default ``com_about`` point (local, m)."""
         return self.data.mechanism.structure.local[(b.index, b.default_about)].complex()
 
-    def _needed(self, group: tuple[int, str]) -> float | None:
+    def _needed(self, group: tuple[int, str], centre: complex | None = None) -> float | None:
         """The exact bound group ``group`` needs with every other bound kept.
 
+        For a centre of mass, its least distance from ``centre`` (default :meth:`_centre`).
         ``None`` if that program is infeasible too, or Clarabel did not solve it accurately.
         """
         import cvxpy as cp
@@ -1214,7 +1231,7 @@ class ConvexSolver:
             tau = cp.Variable(nonneg=True)  # Charnes–Cooper: scale everything so that m_i = 1
             cons = self._bound_constraints(m, s, tau, skip=group)
             cons.append(m[i] == 1.0)
-            centre = self._centre(b, kind) / b.length
+            centre = (self._centre(b, kind) if centre is None else centre) / b.length
             objective = cp.Minimize(cp.norm(s[i] - cp.hstack([centre.real, centre.imag])))
             scale = b.length  # ‖S/m − c‖ in metres
         else:
@@ -1230,6 +1247,17 @@ class ConvexSolver:
         if problem.status != "optimal":  # "almost solved": its value is not to be trusted
             return None
         return float(problem.value) * scale
+
+    def _radius_about_default(self, group: tuple[int, str], move: float) -> float:
+        """The least ``com_radius`` about the default point that a fixed centre of mass needs.
+
+        Its least distance from that point with every other bound kept; where that program
+        is not solved accurately, the fixed centre's distance from it plus how far it must
+        move (a radius that suffices).
+        """
+        b = self.data.links[group[0]]
+        value = self._needed(group, centre=self._about(b))
+        return value if value is not None else abs(b.com_fixed - self._about(b)) + move
 
     def _describe(
         self, group: tuple[int, str], value: float
