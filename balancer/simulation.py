@@ -410,15 +410,20 @@ class _Stepper:
                     near_dead_point |= not np.all(np.logical_or.reduce(near)) if near else True
             return np.column_stack([rates.rates, rates.extra_power])
 
+        # The state at the guide's times too (a carried crank angle is part of it): the
+        # quadrature takes times inside its panels at no cost.
+        guide = self._crank_grid()
+        guide = guide[(guide > 0) & (guide < self.duration) & ~np.isin(guide, self.t_out)]
+        times = np.union1d(self.t_out, guide)
         with np.errstate(divide="ignore", invalid="ignore"):
-            work = cumulative(integrand, self.t_out, rtol=self.rtol, atol=self.atol,
+            work = cumulative(integrand, times, rtol=self.rtol, atol=self.atol,
                               max_width=PANEL_ANGLE / abs(f.speed))
         if near_dead_point:
             return None
         start = np.append(y0, 0.0)
-        states = list(start + work.values)
-        guide = self._crank_grid()
-        self.guide = (guide.tolist(), [start] * guide.size)  # the angles are the crank's alone
+        states = list(start + work.values[np.searchsorted(times, self.t_out)])
+        self.guide = (guide.tolist(),
+                      list(start + work.values[np.searchsorted(times, guide)]))
         if self.progress is not None:
             self.progress(self.duration, self.duration)
         return self.t_out.tolist(), states, [0.0, 0.0], work.evaluations, work.panels, None
