@@ -1690,8 +1690,9 @@ def text_variant(rng, text: str) -> tuple[bytes, str, str, tuple[str, ...], str]
         return b"\xef\xbb\xbf" + text.encode(), "UTF-8 byte-order mark", "edge", (), kind
     if kind == "latin1":
         return ("# caf\u00e9\n" + text).encode("latin-1"), "Latin-1 comment", "error", (), kind
-    if kind == "duplicate-table":
-        return (text + "\n[operation]\nspeed = 1.0\n").encode(), "[operation] twice", \
+    if kind == "duplicate-table":  # a table the spec has (not every spec has [operation])
+        table = "operation" if "\n[operation]" in text else "mechanism"
+        return (text + f"\n[{table}]\nspeed = 1.0\n").encode(), f"[{table}] twice", \
             "error", (), kind
     return b"", "empty file", "error", ("mechanism",), kind
 
