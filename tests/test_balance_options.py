@@ -72,3 +72,26 @@ def test_com_on_line_round_trips_and_refuses_what_contradicts_it():
     with pytest.raises(SpecError) as info:
         loads_design(without_radius)
     assert info.value.key == "balance.rocker.com_on_line"
+
+
+@pytest.mark.parametrize(("line", "wide", "key"), [
+    ("mass = [2.1, 8.4]", "mass = [2.1, 1e308]", "balance.crank.mass"),
+    ("com_radius = 1.0", "com_radius = 1.79769e308", "balance.crank.com_radius"),
+    ("counter_rotor = [0.0, 20.0]", "counter_rotor = [0.0, 1e15]", "balance.crank.counter_rotor"),
+])
+def test_a_bound_wider_than_the_optimiser_can_hold_is_refused_by_name(line, wide, key):
+    # Linkage fuzz campaign, seed 111, case 1768: a com_radius of 1.8e308 m reached CVXPY as
+    # infinity (an internal error); on PB1 a bound 1e12 times the link's scale lost the proof
+    # of optimality and 1e15 failed the solve. Beyond BOUND_RANGE (1e6) times the link's mass,
+    # length or inertia scale a bound is bad input, named; within it PB1 still solves.
+    from balancer.balance.problem import BOUND_RANGE
+
+    crank = PB1.index("[balance.crank]")
+    assert line in PB1[crank:]
+    with pytest.raises(SpecError) as info:
+        loads_design(PB1[:crank] + PB1[crank:].replace(line, wide, 1))
+    assert info.value.key == key and "times the link's" in str(info.value)
+    assert BOUND_RANGE == 1e6
+    within = PB1[:crank] + PB1[crank:].replace(line, wide.replace("1e308", "1e6").replace(
+        "1.79769e308", "1e6").replace("1e15", "1e6"), 1)
+    assert optimize(loads_design(within), "convex").success

@@ -486,6 +486,7 @@ def check_problem(problem: BalanceProblem, mechanism) -> None:
             raise SpecError(f"must be at most {LENGTH_RANGE[1]:g} m (m·ρ² would leave double "
                             "precision)", key=f"{key}.min_gyration", value=freedom.min_gyration)
         bounds = resolve_link(mech, name, freedom)
+        _check_widths(freedom, bounds, key)
         rho = bounds.gyration
         least = bounds.mass[0] * rho * rho
         if least > bounds.inertia[1]:
@@ -503,6 +504,39 @@ def check_problem(problem: BalanceProblem, mechanism) -> None:
             "inertia range or a counter_rotor range",
             key="balance",
         )
+
+
+#: Widest bound the optimiser is given, as a multiple of the link's own scale (its mass, its
+#: length, ``m·l²`` for inertias). Interior-point iterates span the bounds: on PB1, a mass,
+#: radius or counter-rotor bound 1e9 times the scale still solved, 1e12 lost the proof of
+#: optimality and 1e15 failed. No design needs a link a million times heavier or wider.
+BOUND_RANGE = 1e6
+
+
+def _check_widths(freedom: LinkFreedom, bounds: LinkBounds, key: str) -> None:
+    """Refuse a bound beyond :data:`BOUND_RANGE` times the link's scale, naming it."""
+    mass = max(bounds.original.mass, bounds.mass[0])
+    length = bounds.length
+    inertia = bounds.original.inertia + mass * length * length
+    checks = [("mass", freedom.mass, mass, "kg", "mass"),
+              ("com_radius", freedom.com_radius, length, "m", "length"),
+              ("inertia", freedom.inertia, inertia, "kg·m²", "inertia scale m·l²"),
+              ("counter_rotor", freedom.counter_rotor, inertia, "kg·m²",
+               "inertia scale m·l²")]
+    if freedom.counterweight is not None:
+        checks += [("counterweight.mass", freedom.counterweight.mass, mass, "kg", "mass"),
+                   ("counterweight.radius", freedom.counterweight.radius, length, "m",
+                    "length")]
+    for name, value, scale, unit, what in checks:
+        if value is None:
+            continue
+        top = value[1] if isinstance(value, tuple) else value
+        if top > BOUND_RANGE * scale:
+            raise SpecError(
+                f"must be at most {BOUND_RANGE:g} times the link's {what} "
+                f"({BOUND_RANGE * scale:.6g} {unit}): a wider bound leaves the optimiser's "
+                "precision", key=f"{key}.{name}", value=list(value) if isinstance(
+                    value, tuple) else value)
 
 
 def _bracketed(bounds: tuple[float, float]) -> str:
