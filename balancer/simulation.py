@@ -256,15 +256,15 @@ class _Stepper:
 
     def run(self, y0: NDArray[np.float64], stop_at: float | None):
         """Integrate from ``y0``; the states returned carry the extra work as a last entry."""
-        if self.f.driven and stop_at is None:
+        t_end = self.duration if stop_at is None else min(stop_at, self.duration)
+        self.t_end = t_end
+        if self.f.driven:  # up to t_end: before the lock of a crank driven into one
             prescribed = (self._prescribed(y0) if self.f.time_only
                           else self._prescribed_motion(y0))
             if prescribed is not None:
                 return prescribed
         f = _WithExtraWork(self.f)
         y0 = np.append(y0, 0.0)
-        t_end = self.duration if stop_at is None else min(stop_at, self.duration)
-        self.t_end = t_end
         groups = self.f.like_components()
         atol = floored_atol(self.atol, groups, y0)
         stages = self._stages()
@@ -395,6 +395,7 @@ class _Stepper:
         f = self.f
         if f.driven_rates(self.t_out[:1]) is None:
             return None
+        outs = self._outputs()
         near_dead_point = False
         points = f.change_points()
 
@@ -413,25 +414,29 @@ class _Stepper:
         # The state at the guide's times too (a carried crank angle is part of it): the
         # quadrature takes times inside its panels at no cost.
         guide = self._crank_grid()
-        guide = guide[(guide > 0) & (guide < self.duration) & ~np.isin(guide, self.t_out)]
-        times = np.union1d(self.t_out, guide)
+        guide = guide[(guide > 0) & (guide < outs[-1]) & ~np.isin(guide, outs)]
+        times = np.union1d(outs, guide)
         with np.errstate(divide="ignore", invalid="ignore"):
             work = cumulative(integrand, times, rtol=self.rtol, atol=self.atol,
                               max_width=PANEL_ANGLE / abs(f.speed))
         if near_dead_point:
             return None
         start = np.append(y0, 0.0)
-        states = list(start + work.values[np.searchsorted(times, self.t_out)])
+        states = list(start + work.values[np.searchsorted(times, outs)])
         self.guide = (guide.tolist(),
                       list(start + work.values[np.searchsorted(times, guide)]))
         if self.progress is not None:
             self.progress(self.duration, self.duration)
-        return self.t_out.tolist(), states, [0.0, 0.0], work.evaluations, work.panels, None
+        return outs.tolist(), states, [0.0, 0.0], work.evaluations, work.panels, None
+
+    def _outputs(self) -> NDArray[np.float64]:
+        """The output times up to where the run ends (before a lock, if driven into one)."""
+        return self.t_out[self.t_out <= self.t_end]
 
     def _crank_grid(self) -> NDArray[np.float64]:
         """Times at which a driven crank has turned by :data:`GUIDE_ANGLE` since the last."""
-        count = math.ceil(abs(float(self.f.speed)) * self.duration / GUIDE_ANGLE)  # type: ignore[arg-type]
-        return np.linspace(0.0, self.duration, count + 1) if count > 1 else np.zeros(0)
+        count = math.ceil(abs(float(self.f.speed)) * self.t_end / GUIDE_ANGLE)  # type: ignore[arg-type]
+        return np.linspace(0.0, self.t_end, count + 1) if count > 1 else np.zeros(0)
 
     def _prescribed_motion(self, y0: NDArray[np.float64]):
         """A driven crank's prescribed motion in a formulation that is not minimal.
@@ -448,7 +453,8 @@ class _Stepper:
         from .quadrature import cumulative
 
         f = self.f
-        motion = f.driven_motion(self.t_out, y0)
+        outs = self._outputs()
+        motion = f.driven_motion(outs, y0)
         if motion is None:
             return None
         speed = float(f.speed)  # type: ignore[arg-type]
@@ -457,16 +463,16 @@ class _Stepper:
             states = f.driven_motion(t, y0)
             if states is None:
                 raise SolverError("the prescribed motion does not exist at a quadrature node "
-                                  f"within 0 ≤ t ≤ {self.duration:.6g} s")
+                                  f"within 0 ≤ t ≤ {self.t_end:.6g} s")
             states = [np.append(y, 0.0) for y in states]  # the motor's work: not used
             torque = np.asarray(f.evaluate_batch(t, states).driving_torque, float)
             extra = [f.extra_power(ti, y) for ti, y in zip(t, states, strict=True)]
             return np.column_stack([torque * speed, extra])
 
-        work = cumulative(integrand, self.t_out, rtol=self.rtol, atol=self.atol,
+        work = cumulative(integrand, outs, rtol=self.rtol, atol=self.atol,
                           max_width=PANEL_ANGLE / abs(speed))
         states = [np.concatenate([y, w]) for y, w in zip(motion, work.values, strict=True)]
-        drift = f.constraint_residuals(self.t_out, [y[:-1] for y in states])
+        drift = f.constraint_residuals(outs, [y[:-1] for y in states])
         guide = self._crank_grid()
         along = f.driven_motion(guide, y0) if guide.size else None
         if along is not None:
@@ -474,7 +480,7 @@ class _Stepper:
             self.guide = (guide.tolist(), [np.concatenate([y, zeros]) for y in along])
         if self.progress is not None:
             self.progress(self.duration, self.duration)
-        return self.t_out.tolist(), states, list(drift), work.evaluations, work.panels, None
+        return outs.tolist(), states, list(drift), work.evaluations, work.panels, None
 
     def _stages(self):
         """The formulation's compiled DOP853 stages (built once per formulation), or None."""
@@ -495,7 +501,7 @@ class _Stepper:
         """
         if steps < PROJECT_AFTER or t <= 0:
             return
-        projected = steps * self.duration / t
+        projected = steps * self.t_end / t  # to where this run ends (before a lock, if driven)
         if projected > MAX_STEPS:
             raise SpecError(
                 f"would take about {projected:.2g} integration steps at the rate of the first "
@@ -707,6 +713,10 @@ def simulate(
     _check_start(f, theta1)
     stop_at = None if speed is None else _lock_time(f, theta1, speed, duration)
     y0 = f.initial_state(theta1, omega1)
+    if not np.all(np.isfinite(y0)):  # the pose assembles, its rates are not determined
+        raise SpecError(f"is a singular pose of the linkage (θ1 = {theta1:.9g} rad: a dead "
+                        "point, where the crank's rate does not determine the others'); start "
+                        "the motion elsewhere", key="simulation.theta1", value=theta1)
     start = _time.perf_counter()
     if resolution is not None and speed is not None:  # the crank's prescribed turning
         need = math.ceil(abs(speed) * duration / resolution) + 1

@@ -728,7 +728,8 @@ def test_a_centre_of_mass_put_onto_a_small_disc_far_from_the_frames_origin_stays
 
 
 @pytest.mark.parametrize("spec", ["locking_fourbar_linkage.toml", "locking_slider_linkage.toml",
-                                  "locking_stephenson_linkage.toml"])
+                                  "locking_stephenson_linkage.toml",
+                                  "locking_quick_return_linkage.toml"])
 @pytest.mark.parametrize("method", ["crank-angle", "multibody"])
 def test_a_driven_crank_that_locks_says_so_with_every_formulation(spec, method, capsys):
     # Linkage fuzz campaign, seed 4242 (cases 165 and 61): a crank driven into the end of its
@@ -737,7 +738,9 @@ def test_a_driven_crank_that_locks_says_so_with_every_formulation(spec, method, 
     # the lock were judged against the whole duration and reported a stall. Seed 1126, case
     # 359: the transmission was still above the dead-point threshold at the range's end as
     # its search found it, and the search for where it falls below had no bracket (an internal
-    # error). All must say the linkage locks, exit 1.
+    # error). Seed 111, case 660: a quick-return's stepped run crept towards its lock for the
+    # whole step budget (the motion up to the lock is prescribed now, as a whole run's is).
+    # All must say the linkage locks, exit 1.
     from pathlib import Path
 
     from balancer.cli import main
@@ -847,3 +850,18 @@ def test_a_fixed_centre_of_mass_that_must_move_is_named(capsys):
     assert "force balance cannot be met within the bounds" in err
     assert "balance.rocker.com_radius must be given" in err and "about A3" in err
     assert "numerical trouble" not in err
+
+
+def test_a_motion_that_starts_at_a_dead_point_is_refused_by_name(capsys):
+    # Linkage fuzz campaign, seed 111, case 581: a Whitworth mechanism whose reference pose
+    # (the motion's start) is the end of its assembly range; the multibody state's rates there
+    # are not finite, and the integrator refused them with an internal error. It is bad input:
+    # the start, simulation.theta1, named; exit 2.
+    from pathlib import Path
+
+    from balancer.cli import main
+
+    path = Path(__file__).resolve().parent / "data" / "whitworth_starting_at_a_dead_point.toml"
+    assert main(["simulate", str(path), "--duration", "0.05"]) == 2
+    err = capsys.readouterr().err
+    assert "simulation.theta1" in err and "singular pose" in err and err.count("\n") == 1

@@ -204,8 +204,8 @@ class CrankAngle(LinkageFormulation):
 
         The compiled equation mapped over the prescribed crank angles
         (:meth:`~balancer.formulations.compiled.Compiled.columns`): the same numbers as the
-        integrator's single calls of it. The numeric groups' closure is checked as
-        :meth:`transmission_of_crank` checks it.
+        integrator's single calls of it (which, like these, do not check the numeric groups'
+        closure: only :meth:`transmission_of_crank`, at the events, does).
         """
         if not self.driven:
             return None
@@ -213,11 +213,7 @@ class CrankAngle(LinkageFormulation):
         theta1 = self.crank_angle(np.asarray(times, dtype=float))
         gas = np.array([self._gas(x) for x in theta1]).reshape(theta1.size, -1)
         out = self._equation.columns(np.vstack([theta1, np.full(theta1.size, speed), gas.T]))
-        general, least, closure = out[1], out[2], out[3]
-        scale = self.structure.length_scale()
-        if self._numeric and not np.all(closure <= CLOSURE_TOLERANCE * scale):
-            bad = int(np.argmax(~(closure <= CLOSURE_TOLERANCE * scale)))
-            self.transmission_of_crank(float(theta1[bad]))  # raises, naming the angle
+        general, least = out[1], out[2]
         if self._numeric:
             least = np.minimum(least, [self._numeric_gap(float(x)) for x in theta1])
         rates = np.column_stack([np.full(theta1.size, speed), np.zeros(theta1.size),
