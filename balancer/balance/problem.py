@@ -507,10 +507,11 @@ def check_problem(problem: BalanceProblem, mechanism) -> None:
 
 
 #: Widest bound the optimiser is given, as a multiple of the link's own scale (its mass, its
-#: length, ``m·l²`` for inertias). Interior-point iterates span the bounds: on PB1, a mass,
-#: radius or counter-rotor bound 1e9 times the scale still solved, 1e12 lost the proof of
-#: optimality and 1e15 failed. No design needs a link a million times heavier or wider.
-BOUND_RANGE = 1e6
+#: length, its inertia plus ``m·l²`` for inertias). Interior-point iterates span the bounds:
+#: on PB1, a mass, radius or counter-rotor bound 1e9 times the scale still solved, 1e12 lost
+#: the proof of optimality and 1e15 failed. (A flywheel on a short crank has an inertia many
+#: times ``m·l²``: the limit is the solver's, not a judgment of what is physical.)
+BOUND_RANGE = 1e9
 
 
 def _check_widths(freedom: LinkFreedom, bounds: LinkBounds, key: str) -> None:
