@@ -659,8 +659,8 @@ def optimization_text(result, before, after, verification=None, spec=None, out=N
     rows = []
     for name in ("shaking_force", "shaking_moment", "driving_torque"):
         b, a = getattr(before.summary, name), getattr(after.summary, name)
-        ratio = a.rms / b.rms if b.rms > 0 else float("nan")
-        rows.append([name.replace("_", " "), _fmt(b.rms), _fmt(a.rms), f"{ratio:.3g}",
+        ratio = f"{a.rms / b.rms:.3g}" if b.rms > 0 else "—"  # nothing to compare with
+        rows.append([name.replace("_", " "), _fmt(b.rms), _fmt(a.rms), ratio,
                      _fmt(b.max), _fmt(a.max), UNITS[name]])
     lines.append(table(rows, ["at the operating speed", "RMS before", "RMS after", "ratio",
                               "max before", "max after", "unit"]))
@@ -733,9 +733,10 @@ def sweep_text(result, spec=None) -> str:
     """The readable summary of a sweep."""
     head = f"balancer sweep — {spec}" if spec else "balancer sweep"
     rows = [[status, str(count)] for status, count in sorted(result.statuses.items())]
-    rate = result.points / result.seconds if result.seconds else float("nan")
+    rate = (f"{result.points / result.seconds:.3g} points/s" if result.seconds > 0
+            else "no time to measure")
     where = (f"{result.workers} Dask workers" if result.workers else "this process")
-    lines = [head, f"{result.points} points in {result.seconds:.1f} s ({rate:.3g} points/s, "
+    lines = [head, f"{result.points} points in {result.seconds:.1f} s ({rate}, "
              f"{where}" + (f"; {result.resumed} batches from before" if result.resumed
                            else "") + ")", "", table(rows, ["status", "points"]), ""]
     if result.residual_force is not None:

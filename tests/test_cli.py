@@ -551,3 +551,20 @@ def test_slider_columns_rates_are_the_positions_derivatives():
         d2x, err2 = derivative_with_error(lambda t: column(t, 0), theta, h=1e-2, order=2)
         assert abs(column(theta, 1)[0] - dx[0]) < err1
         assert abs(column(theta, 2)[0] - d2x[0]) < err2
+
+
+def test_a_ratio_to_nothing_is_a_dash_not_nan(tmp_path, capsys):
+    # CLI fuzz campaign, seed 3333, case 982: an operating speed of 1e-300 rad/s leaves no
+    # inertial shaking force before or after, and the report printed its ratio as "nan". A
+    # ratio to zero has no value: the report says so with a dash, and prints no nan or inf.
+    import re
+
+    text = (Path(__file__).resolve().parent.parent / "examples" / "pb1.toml").read_text()
+    text = re.sub(r"(?m)^speed = .*$", "speed = 1e-300", text, count=1)
+    spec = tmp_path / "slow.toml"
+    spec.write_text(text)
+    assert main(["optimize", str(spec), "--no-verify"]) == 0
+    out = capsys.readouterr().out
+    assert not re.search(r"\b(nan|inf)\b", out, re.IGNORECASE)
+    row = next(line for line in out.splitlines() if line.startswith("shaking force "))
+    assert "—" in row.split()
