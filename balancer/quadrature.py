@@ -70,6 +70,11 @@ GAUSS[9:15:2] = _WG[-2::-1]
 #: Rounds of halving after which a panel that still fails its tolerance is an error (a panel
 #: 2⁻⁶⁰ of its interval is below the rounding of the time).
 MAX_ROUNDS = 60
+#: Panels halved, at most, beyond this many per first panel (and this many more): an integrand
+#: whose estimates do not fall with halving (not smooth at the tolerance: a driven motion that
+#: starts at a dead point, where the torque is singular) would double its panels each round.
+MAX_REFINED = 20
+EXTRA_REFINED = 10_000
 
 
 @dataclass(frozen=True)
@@ -165,6 +170,7 @@ def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
     edges = start + (end - start) * np.arange(pieces + 1) / pieces
     edges[-1] = end
     left, right = edges[:-1], edges[1:]
+    refined = 0  # panels made by halving
     accepted = []  # (left, right, kronrod sum, node values) of the accepted panels
     evaluations = 0
     for _ in range(MAX_ROUNDS + 1):
@@ -201,6 +207,9 @@ def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
                               f"{float(np.min(nodes[~finite])):.6g} s")
         mid = 0.5 * (left[bad] + right[bad])
         left, right = np.concatenate([left[bad], mid]), np.concatenate([mid, right[bad]])
+        refined += left.size
+        if refined > MAX_REFINED * pieces + EXTRA_REFINED:
+            break
     where = float(np.min(left))
     raise SolverError(f"the quadrature of the driven motion's power did not converge near "
                       f"t = {where:.6g} s (rtol = {rtol:g}, atol = {atol:g}): the power is not "

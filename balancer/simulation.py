@@ -61,10 +61,10 @@ from .integration import DOP853, CompiledDOP853, Stages, TimeOnlyDOP853, with_ex
 from .mechanisms import mechanism_of
 from .model import RTOL_MIN, Design, SimulationSettings, check_scales
 
-#: Most integration steps a simulation may take (about a minute with the slowest formulation on
-#: a 2-core machine, some 4000 steps a second): a duration that needs more is refused, from
-#: the rate of its first steps.
-MAX_STEPS = 200_000
+#: Most integration steps a simulation may take (under a minute with the slowest formulation,
+#: multibody with its projections, at some 2 000 steps a second on a 2-core machine): a
+#: duration that needs more is refused, from the rate of its first steps.
+MAX_STEPS = 100_000
 #: Steps after which the rate is extrapolated to the whole duration.
 PROJECT_AFTER = 200
 #: Energy error (relative to the energy's scale, :attr:`Trajectory.energy_error`) beyond which

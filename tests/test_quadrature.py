@@ -106,3 +106,23 @@ def test_an_integrand_that_is_not_finite_is_an_error():
 def test_one_time_integrates_nothing():
     got = cumulative(_smooth, np.array([3.0]), rtol=1e-9, atol=1e-12)
     assert got.values.shape == (1, 2) and np.all(got.values == 0) and got.panels == 0
+
+
+def test_an_integrand_that_halving_does_not_resolve_stops_within_a_budget():
+    # Linkage fuzz campaign, seed 4444, case 141: a driven motion starting at a dead point
+    # (the torque singular there) doubled its failing panels each round, a minute and more of
+    # a simulate that looked hung. An integrand whose estimates do not fall with halving
+    # (here an oscillation far finer than any panel reached) is an error after
+    # MAX_REFINED panels per first panel (and EXTRA_REFINED more) have been made.
+    from balancer.quadrature import EXTRA_REFINED, MAX_REFINED
+
+    calls = []
+
+    def rough(t):
+        calls.append(t.size)
+        return np.sin(1e12 * t)[:, None]
+
+    with pytest.raises(SolverError, match="did not converge"):
+        cumulative(rough, np.linspace(0.0, 1.0, 11), rtol=1e-10, atol=1e-12, max_width=0.5)
+    budget = 2 + MAX_REFINED * 2 + EXTRA_REFINED + 2 * (MAX_REFINED * 2 + EXTRA_REFINED)
+    assert sum(calls) <= 15 * budget
