@@ -506,6 +506,10 @@ def check_problem(problem: BalanceProblem, mechanism) -> None:
         )
 
 
+#: Least scale of a link's parameters (kg, kg·m, kg·m²): far above the least normal double,
+#: so that products and squares of scales stay normal.
+LEAST_SCALE = 1e-150
+
 #: Widest bound the optimiser is given, as a multiple of the link's own scale (its mass, its
 #: length, its inertia plus ``m·l²`` for inertias). Interior-point iterates span the bounds:
 #: on PB1, a mass, radius or counter-rotor bound 1e9 times the scale still solved, 1e12 lost
@@ -704,13 +708,21 @@ class LinkBounds:
 
     @property
     def mass_ref(self) -> float:
-        """Mass scale, kg."""
-        return self.original.mass
+        """Mass scale, kg: the link's mass.
+
+        Where that is so small that its ``m·l²`` would fall below :data:`LEAST_SCALE` (a
+        subnormal mass: valid input, as good as none, whose scales underflow to zero), its
+        largest allowed mass, or what makes ``m·l²`` that least scale.
+        """
+        m, reach = self.original.mass, min(self.length**2, 1.0)
+        if m * reach >= LEAST_SCALE:
+            return m
+        return max(self.mass[1], LEAST_SCALE / reach)
 
     @property
     def inertia_ref(self) -> float:
-        """Inertia scale ``m·l²``, kg·m²."""
-        return self.original.mass * self.length**2
+        """Inertia scale ``m·l²``, kg·m² (with :attr:`mass_ref`)."""
+        return max(self.mass_ref * self.length**2, LEAST_SCALE)
 
 
 def link_length(mech: Mechanism, name: str) -> float:
