@@ -192,6 +192,11 @@ class FourBar:
         """Forces on sliders along their guides, by spec key: none on a four-bar."""
         return ()
 
+    @property
+    def springs(self) -> tuple:
+        """Linear springs: none on a four-bar."""
+        return ()
+
     def link(self, name: str) -> Link:
         """Return the link called ``name`` (``"crank"``, ``"coupler"`` or ``"rocker"``)."""
         if name not in self.link_names:
@@ -412,6 +417,11 @@ class SliderCrank:
     def gas_forces(self) -> tuple[tuple[str, GasForce], ...]:
         """Forces on sliders along their guides, by spec key: the gas force."""
         return (("links.slider.gas_force", self.gas_force),)
+
+    @property
+    def springs(self) -> tuple:
+        """Linear springs: none on a slider-crank."""
+        return ()
 
     def link(self, name: str) -> Link:
         """Return the link called ``name`` (``"crank"``, ``"rod"`` or ``"slider"``)."""
@@ -1032,7 +1042,7 @@ def check_scales(mechanism, speeds: dict[str, float],
             gas = [(key, max(abs(x) for x in g.values))]
             forces.append(gas)
             moments.append(gas + r)
-    for i, spring in enumerate(getattr(mechanism, "springs", ())):
+    for i, spring in enumerate(mechanism.springs):
         # Its force k·(R + |l0|) at most, moment R times that, energy k·(R + |l0|)²/2: the
         # reach's and the free length's terms apart, each named by its own key.
         stiffness = [(f"springs[{i}].stiffness", spring.stiffness)]

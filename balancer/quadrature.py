@@ -171,7 +171,8 @@ def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
     edges[-1] = end
     left, right = edges[:-1], edges[1:]
     refined = 0  # panels made by halving
-    accepted = []  # (left, right, kronrod sum, node values) of the accepted panels
+    accepted = []  # (left, right, kronrod sum) of the accepted panels
+    interior = []  # (time index, its panel's left end, integral from it) of the times inside
     evaluations = 0
     for _ in range(MAX_ROUNDS + 1):
         values, kronrod, gauss = _rules(integrand, left, right)
@@ -196,9 +197,11 @@ def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
             scale = np.maximum(np.abs(before), np.abs(before + part))
             ok = np.all(np.abs(error) <= atol + rtol * scale, axis=1)
             np.logical_and.at(good, owner, ok)
-        accepted.append((left[good], right[good], kronrod[good], values[good]))
+            kept = good[owner]
+            interior.append((inside[kept], left[owner[kept]], part[kept]))
+        accepted.append((left[good], right[good], kronrod[good]))
         if good.all():
-            return _assemble(times, accepted, evaluations)
+            return _assemble(times, accepted, interior, evaluations)
         bad = ~good
         finite = np.isfinite(values).all(axis=2)
         if not finite.all():  # halving cannot help: where the power first is not finite
@@ -228,14 +231,17 @@ def _times_inside(times: NDArray[np.float64], left: NDArray[np.float64],
     return inside, owner
 
 
-def _assemble(times: NDArray[np.float64], accepted, evaluations: int) -> Cumulative:
-    """The integral at every time from the accepted panels (they tile the span)."""
+def _assemble(times: NDArray[np.float64], accepted, interior, evaluations: int) -> Cumulative:
+    """The integral at every time from the accepted panels (they tile the span).
+
+    A time at a panel's end takes the sum of the panels up to it; a time inside one, the sum
+    up to the panel's start and the partial integral found when the panel was accepted.
+    """
     left = np.concatenate([a[0] for a in accepted])
     right = np.concatenate([a[1] for a in accepted])
     kronrod = np.concatenate([a[2] for a in accepted])
-    values = np.concatenate([a[3] for a in accepted])
     order = np.argsort(left)
-    left, right, kronrod, values = left[order], right[order], kronrod[order], values[order]
+    left, right, kronrod = left[order], right[order], kronrod[order]
     at_start = np.concatenate([np.zeros((1, kronrod.shape[1])), np.cumsum(kronrod, axis=0)])
     out = np.empty((times.size, kronrod.shape[1]))
     out[0] = 0.0
@@ -244,12 +250,8 @@ def _assemble(times: NDArray[np.float64], accepted, evaluations: int) -> Cumulat
     hit = at.copy()
     hit[at] = times[ends[at]] == right[at]
     out[ends[hit]] = at_start[1:][hit]
-    inside, owner = _times_inside(times, left, right)
-    if inside.size:
-        u = (2 * times[inside] - left[owner] - right[owner]) / (right[owner] - left[owner])
-        w_k, _ = partial_weights(u)
-        half = (0.5 * (right - left))[owner, None]
-        out[inside] = at_start[owner] + half * np.einsum("tn,tnc->tc", w_k, values[owner])
+    for inside, panel_left, part in interior:
+        out[inside] = at_start[np.searchsorted(left, panel_left)] + part
     return Cumulative(values=out, panels=left.size, evaluations=evaluations)
 
 

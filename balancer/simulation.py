@@ -250,8 +250,8 @@ class _Stepper:
         #: Each step's end and dense output, kept where the outputs may be resampled.
         self.pieces: list[tuple[float, object]] = []
         #: States between the output times (the steps' ends; a prescribed motion's at every
-        #: :data:`GUIDE_ANGLE` of crank), as ``(times, states)``: the angles are followed
-        #: through them from one output to the next (:func:`_trajectory`).
+        #: :data:`GUIDE_ANGLE` of crank, :meth:`_guide_times`), as ``(times, states)``: the
+        #: angles are followed through them from one output to the next (:func:`_trajectory`).
         self.guide: tuple[list[float], list[NDArray[np.float64]]] = ([], [])
 
     def run(self, y0: NDArray[np.float64], stop_at: float | None):
@@ -413,8 +413,7 @@ class _Stepper:
 
         # The state at the guide's times too (a carried crank angle is part of it): the
         # quadrature takes times inside its panels at no cost.
-        guide = self._crank_grid()
-        guide = guide[(guide > 0) & (guide < outs[-1]) & ~np.isin(guide, outs)]
+        guide = self._guide_times(outs)
         times = np.union1d(outs, guide)
         with np.errstate(divide="ignore", invalid="ignore"):
             work = cumulative(integrand, times, rtol=self.rtol, atol=self.atol,
@@ -433,10 +432,17 @@ class _Stepper:
         """The output times up to where the run ends (before a lock, if driven into one)."""
         return self.t_out[self.t_out <= self.t_end]
 
-    def _crank_grid(self) -> NDArray[np.float64]:
-        """Times at which a driven crank has turned by :data:`GUIDE_ANGLE` since the last."""
-        count = math.ceil(abs(float(self.f.speed)) * self.t_end / GUIDE_ANGLE)  # type: ignore[arg-type]
-        return np.linspace(0.0, self.t_end, count + 1) if count > 1 else np.zeros(0)
+    def _guide_times(self, outs: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Times between the outputs through which a driven crank's angles are followed.
+
+        Every :data:`GUIDE_ANGLE` of crank; none where the (equally spaced) output times
+        ``outs`` are that close already.
+        """
+        turn = abs(float(self.f.speed))  # type: ignore[arg-type]
+        if outs.size < 2 or turn * (outs[1] - outs[0]) <= GUIDE_ANGLE:
+            return np.zeros(0)
+        grid = np.linspace(0.0, outs[-1], math.ceil(turn * outs[-1] / GUIDE_ANGLE) + 1)
+        return grid[(grid > 0) & (grid < outs[-1]) & ~np.isin(grid, outs)]
 
     def _prescribed_motion(self, y0: NDArray[np.float64]):
         """A driven crank's prescribed motion in a formulation that is not minimal.
@@ -454,7 +460,9 @@ class _Stepper:
 
         f = self.f
         outs = self._outputs()
-        motion = f.driven_motion(outs, y0)
+        guide = self._guide_times(outs)
+        times = np.union1d(outs, guide)
+        motion = f.driven_motion(times, y0)
         if motion is None:
             return None
         speed = float(f.speed)  # type: ignore[arg-type]
@@ -469,15 +477,12 @@ class _Stepper:
             extra = [f.extra_power(ti, y) for ti, y in zip(t, states, strict=True)]
             return np.column_stack([torque * speed, extra])
 
-        work = cumulative(integrand, outs, rtol=self.rtol, atol=self.atol,
+        work = cumulative(integrand, times, rtol=self.rtol, atol=self.atol,
                           max_width=PANEL_ANGLE / abs(speed))
-        states = [np.concatenate([y, w]) for y, w in zip(motion, work.values, strict=True)]
+        everywhere = [np.concatenate([y, w]) for y, w in zip(motion, work.values, strict=True)]
+        states = [everywhere[i] for i in np.searchsorted(times, outs)]
+        self.guide = (guide.tolist(), [everywhere[i] for i in np.searchsorted(times, guide)])
         drift = f.constraint_residuals(outs, [y[:-1] for y in states])
-        guide = self._crank_grid()
-        along = f.driven_motion(guide, y0) if guide.size else None
-        if along is not None:
-            zeros = np.zeros(2)  # the works: no part of the angles
-            self.guide = (guide.tolist(), [np.concatenate([y, zeros]) for y in along])
         if self.progress is not None:
             self.progress(self.duration, self.duration)
         return outs.tolist(), states, list(drift), work.evaluations, work.panels, None

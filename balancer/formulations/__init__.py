@@ -60,6 +60,31 @@ def continuous_angles(theta: NDArray[np.float64], omega: NDArray[np.float64],
     return theta + 2 * math.pi * np.concatenate([[0.0], np.cumsum(turns)])
 
 
+def least_norm(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The least-norm ``Δ`` with ``J·Δ = r``: ``Jᵀ·(J·Jᵀ)⁻¹·r`` (J of full row rank).
+
+    At a pose where the constraints are dependent (a singular position) ``J·Jᵀ`` is singular
+    and the least-squares solution by SVD is taken instead.
+    """
+    try:
+        return jac.T @ np.linalg.solve(jac @ jac.T, res)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(jac, res, rcond=None)[0]
+
+
+def least_norm_many(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:
+    """:func:`least_norm` of each of a stack of Jacobians ``(k, rows, n)`` and residuals.
+
+    Shared by the formulations that project onto their constraints (the opened loop's loop
+    closure, the multibody formulation's joints).
+    """
+    try:
+        x = np.linalg.solve(jac @ jac.transpose(0, 2, 1), res[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # one of them singular: each by itself
+        return np.array([least_norm(j, r) for j, r in zip(jac, res, strict=True)])
+    return np.einsum("kri,kr->ki", jac, x)
+
+
 @dataclass(frozen=True)
 class DrivenRates:
     """A driven crank's prescribed motion at many times (:meth:`Formulation.driven_rates`).

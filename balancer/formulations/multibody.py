@@ -46,29 +46,8 @@ from ..linkage.structure import (
 )
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import V
-from . import Evaluation, continuous_angles
+from . import Evaluation, continuous_angles, least_norm, least_norm_many
 from .compiled import Compiled, LinkageFormulation, link_equations, spring_forces
-
-
-def _least_norm(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The least-norm ``Δ`` with ``J·Δ = r``: ``Jᵀ·(J·Jᵀ)⁻¹·r`` (J of full row rank).
-
-    At a pose where the constraints are dependent (a singular position) ``J·Jᵀ`` is singular
-    and the least-squares solution by SVD is taken instead.
-    """
-    try:
-        return jac.T @ np.linalg.solve(jac @ jac.T, res)
-    except np.linalg.LinAlgError:
-        return np.linalg.lstsq(jac, res, rcond=None)[0]
-
-
-def _least_norm_many(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:
-    """:func:`_least_norm` of each of a stack of Jacobians ``(k, rows, n)`` and residuals."""
-    try:
-        x = np.linalg.solve(jac @ jac.transpose(0, 2, 1), res[..., None])[..., 0]
-    except np.linalg.LinAlgError:  # one of them singular: each by itself
-        return np.array([_least_norm(j, r) for j, r in zip(jac, res, strict=True)])
-    return np.einsum("kri,kr->ki", jac, x)
 
 
 class Multibody(LinkageFormulation):
@@ -351,11 +330,11 @@ class Multibody(LinkageFormulation):
             res, jac = self._constraint_values(t, q)
             if np.max(np.abs(res), initial=0.0) <= 1e-15 * self.scale:
                 break
-            q = q - _least_norm(jac, res)
+            q = q - least_norm(jac, res)
         else:
             _, jac = self._constraint_values(t, q)
         qd = y[n : 2 * n]
-        qd = qd - _least_norm(jac, jac @ qd - self._velocity_rhs())
+        qd = qd - least_norm(jac, jac @ qd - self._velocity_rhs())
         y[:n], y[n : 2 * n] = q, qd
         return y
 
@@ -391,10 +370,10 @@ class Multibody(LinkageFormulation):
             todo = todo[moving]
             if not todo.size:
                 break
-            q[todo] -= _least_norm_many(jacs[todo], res[moving])
+            q[todo] -= least_norm_many(jacs[todo], res[moving])
         else:
             jacs[todo] = self._constraint_values_many(times[todo], q[todo])[1]
-        qd -= _least_norm_many(jacs, np.einsum("kri,ki->kr", jacs, qd) - self._velocity_rhs())
+        qd -= least_norm_many(jacs, np.einsum("kri,ki->kr", jacs, qd) - self._velocity_rhs())
         return list(ys)
 
     def constraint_residuals(self, times, states) -> tuple[float, float]:

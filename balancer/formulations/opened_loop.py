@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..kinematics import cross_scalar, rates_scalar
-from . import Evaluation
+from . import Evaluation, least_norm_many
 from .closed_form import FourBarFormulation
 
 
@@ -304,8 +304,6 @@ class OpenedLoop(FourBarFormulation):
         The closure is Eq. 26, its rate Eq. 5. With the crank driven, θ1 and θ̇1 are
         prescribed and only θ2, θ3 and their rates are corrected; near a change point the state
         is put on the smooth motion's assembly.
-        The least-norm step is the pseudo-inverse's (singular values below rounding left
-        out, as LAPACK's least squares leaves them).
         """
         ys = np.array(states, dtype=float).reshape(len(states), -1)
         times = np.asarray(times, dtype=float)
@@ -325,11 +323,11 @@ class OpenedLoop(FourBarFormulation):
             active, phi, g = active[off], phi[off], g[off]
             if not active.size:
                 break
-            step = _least_norm(g[:, :, free], np.stack([phi.real, phi.imag], axis=-1))
+            step = least_norm_many(g[:, :, free], np.stack([phi.real, phi.imag], axis=-1))
             ys[active[:, None], free] -= step
         _, g = self._closure(ys[regular, 0:3])
         resid = np.matmul(g, ys[regular, 3:6, None])[..., 0]
-        ys[regular[:, None], 3 + free] -= _least_norm(g[:, :, free], resid)
+        ys[regular[:, None], 3 + free] -= least_norm_many(g[:, :, free], resid)
         return list(ys)
 
     def _onto_smooth_motion(self, y: NDArray[np.float64]) -> None:
@@ -339,12 +337,3 @@ class OpenedLoop(FourBarFormulation):
         y[2] += math.remainder(cmath.phase(vectors[2]) - y[2], 2 * math.pi)
         y[4], y[5] = w2, w3
 
-
-def _least_norm(g: NDArray[np.float64], r: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The least-norm ``x`` of least ``‖g·x − r‖`` per system.
-
-    ``g`` is ``(N, 2, k)``, ``r`` ``(N, 2)``; singular values below ``ε·max(2, k)`` of the
-    largest are left out (LAPACK's least squares with its default cutoff).
-    """
-    pinv = np.linalg.pinv(g, rcond=np.finfo(float).eps * max(g.shape[-2:]))
-    return np.matmul(pinv, r[..., None])[..., 0]
