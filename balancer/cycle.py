@@ -112,6 +112,18 @@ class CycleSummary:
     slider_normal: dict[str, Figure]
     slider_couple: dict[str, Figure]
 
+    @property
+    def max_ground_reaction(self) -> float:
+        """The largest force on the frame at any one ground point or guide over the cycle, N.
+
+        The magnitudes of the forces at the ground points and the normal forces of the sliders
+        on ground guides (what the frame's bearings carry one by one, beside their sum, the
+        shaking force); 0 for a mechanism with neither.
+        """
+        values = [f.max for f in (*self.ground.values(), *self.slider_normal.values())
+                  if not math.isnan(f.max)]
+        return max(values, default=0.0)
+
     def as_dict(self) -> dict[str, dict[str, float]]:
         """The three fixed figures with their JSON names."""
         return {
@@ -183,6 +195,22 @@ class CycleAnalysis:
         """Kinematics at the sampled angles (computed when first asked for)."""
         with np.errstate(all="ignore"):
             return self.mechanism.motion(self.theta1, self.speed, 0.0)
+
+    @cached_property
+    def centre_of_mass_excursion(self) -> float:
+        """How far the moving links' total centre of mass strays from its mean place, m.
+
+        The largest distance over the samples from the mean of the sampled positions: zero
+        (to rounding) exactly when the design is force-balanced; what a designer can picture
+        of an unbalance. Samples at a singular pose are left out.
+        """
+        with np.errstate(all="ignore"):
+            path = self.mechanism.total_centre_of_mass(self.motion)
+        path = np.asarray(path, dtype=complex) * np.ones(self.samples)
+        path = path[np.isfinite(path)]
+        if not path.size:
+            return math.nan
+        return float(np.max(np.abs(path - path.mean())))
 
     @property
     def samples(self) -> int:

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .balance.counterweights import UNCHANGED
 from .cycle import CycleAnalysis, Figure
 from .mechanisms import mechanism_of
 
@@ -128,6 +129,7 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
             **figures_dict(analysis),
             "force_balanced": balanced,
             "force_balance_residual": {"relative": residual},
+            "centre_of_mass_excursion": analysis.centre_of_mass_excursion,
             "reactions": _reactions_dict(analysis),
             "change_points": _change_points(analysis),
             "harmonics": _harmonics_dict(analysis),
@@ -138,6 +140,8 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
                 "gravity": "m/s²",
                 "force_balance_residual": "dimensionless (first moments left over, over those "
                                           "that make them)",
+                "centre_of_mass_excursion": "m (largest distance of the total centre of mass "
+                                            "from its mean place over the cycle)",
             },
         }
     )
@@ -215,13 +219,26 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
             "are the limits of the smooth motion)",
             "",
         ]
-    balanced, residual = _force_balance(mech)
-    if balanced:
-        lines.append(f"force-balanced: yes (residual {residual:.2e} of the first moments)")
-    else:
-        lines.append(f"force-balanced: no (residual {residual:.3g} of the first moments; the "
-                     "total centre of mass moves)")
+    lines.append(_force_balance_line(analysis))
     return "\n".join(lines)
+
+
+def _force_balance_line(analysis: CycleAnalysis) -> str:
+    """Whether the design is force-balanced, in words a designer pictures."""
+    balanced, residual = _force_balance(analysis.mechanism)
+    if balanced:
+        return ("force-balanced: yes (the total centre of mass stands still; the conditions, "
+                f"Eq. 57–58, hold to {residual:.1e} of the links' first moments)")
+    excursion = analysis.centre_of_mass_excursion
+    return ("force-balanced: no (the total centre of mass moves up to "
+            f"{_length(excursion)} from its mean place over a revolution)")
+
+
+def _length(metres: float) -> str:
+    """A length for a reader: mm below a metre, else m."""
+    if abs(metres) < 1.0:
+        return f"{1e3 * metres:.4g} mm"
+    return f"{metres:.4g} m"
 
 
 def dumps_json(doc: dict[str, Any]) -> str:
@@ -448,6 +465,7 @@ def simulation_json(traj, spec: str | None = None) -> dict[str, Any]:
         {
             "method": traj.method,
             "drive": traj.drive,
+            **({"speed": traj.speed} if traj.speed is not None else {}),
             "duration": float(traj.t[-1]),
             "outputs": int(traj.t.size),
             "rtol": traj.rtol,
@@ -470,7 +488,8 @@ def simulation_json(traj, spec: str | None = None) -> dict[str, Any]:
             **({"slider": {"initial": [float(v) for v in traj.slider[:, 0]],
                            "final": [float(v) for v in traj.slider[:, -1]]}}
                if traj.slider is not None else {}),
-            "units": {"theta": "rad", "omega": "rad/s", "alpha": "rad/s²", "force": "N",
+            "units": {"theta": "rad", "omega": "rad/s", "alpha": "rad/s²", "speed": "rad/s",
+                      "force": "N",
                       "moment": "N·m", "constraint_drift": "m, m/s"},
         }
     )
@@ -482,7 +501,10 @@ def simulation_text(traj, spec: str | None = None) -> str:
     head = f"balancer simulate — {spec}" if spec else "balancer simulate"
     lines = [
         head,
-        f"{traj.drive} motion for {traj.t[-1]:g} s, formulation {traj.method}, rtol "
+        f"{traj.drive} motion"
+        + (f" at {traj.speed:g} rad/s ({traj.speed * 30 / math.pi:.4g} rpm)"
+           if traj.speed is not None else "")
+        + f" for {traj.t[-1]:g} s, formulation {traj.method}, rtol "
         f"{traj.rtol:g}: {traj.steps} steps, {traj.nfev} right-hand sides, {traj.seconds:.3g} s",
         "",
     ]
@@ -577,8 +599,9 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
             "status": str(result.status),
             "success": result.success,
             "message": result.message,
-            "before": before.summary.as_dict(),
-            "after": after.summary.as_dict(),
+            "before": _operating_figures(before),
+            "after": _operating_figures(after),
+            "warnings": worse_figures(before, after),
             # The inertial part alone, which the optimiser balances (loads and gravity left out).
             "inertial": {"before": result.before.summary.as_dict(),
                          "after": result.after.summary.as_dict()},
@@ -588,6 +611,7 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
             "counterweights": {name: w.as_dict() for name, w in result.counterweights.items()},
             "added_mass": result.added_mass,
             "objective": result.objective,
+            "objective_terms": _objective_terms(result),
             "original_objective": result.original_objective,
             "lower_bound": result.lower_bound,
             "gap": result.gap,
@@ -608,7 +632,11 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
             "harmonics": {"before": _harmonics_dict(before), "after": _harmonics_dict(after)},
             "verification": None if verification is None else verification.as_dict(),
             "out": None if out is None else str(out),
-            "units": {"objective, lower_bound": "(N·m)², mean square of the inertial shaking",
+            "units": {"objective, lower_bound": "(N·m)², the weighted mean squares of the "
+                      "inertial shaking (J of [balance.objective])",
+                      "objective_terms": "each term's RMS in its 'unit' (N for a force, N·m "
+                      "for a moment or torque; added_mass: kg added)",
+                      "max_ground_reaction": "N",
                       "gap": "relative to scale (of √J when rms is given, else of J)",
                       "scale, rms, rms_lower_bound, rms_gap": "N·m", "time": "s",
                       "mass, added_mass": "kg", "inertia": "kg·m²", "e, f, s": "m",
@@ -618,31 +646,94 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
     return doc
 
 
+#: A figure that balancing multiplies by more than this is reported as made worse.
+WORSE_RATIO = 2.0
+#: The figures watched for getting worse, with their names and units.
+_WATCHED = (("shaking_force", "shaking force", "N"), ("shaking_moment", "shaking moment", "N·m"),
+            ("driving_torque", "driving torque", "N·m"))
+
+
+def _operating_figures(analysis: CycleAnalysis) -> dict[str, Any]:
+    """``optimize``'s ``before``/``after``: the analyze figures and the largest ground load."""
+    return {**analysis.summary.as_dict(),
+            "max_ground_reaction": analysis.summary.max_ground_reaction}
+
+
+def worse_figures(before: CycleAnalysis, after: CycleAnalysis) -> list[str]:
+    """One sentence for each figure that the balanced design more than doubles.
+
+    The RMS and maximum of the shaking force, shaking moment and driving torque, and the largest
+    force at a ground point (:attr:`~balancer.cycle.CycleSummary.max_ground_reaction`), at the
+    operating speed with the loads; a figure that was zero is not compared.
+    """
+    out = []
+    b, a = before.summary, after.summary
+    for name, words, unit in _WATCHED:
+        for stat in ("rms", "max"):
+            old, new = getattr(getattr(b, name), stat), getattr(getattr(a, name), stat)
+            if old > 0 and new > WORSE_RATIO * old:
+                label = "RMS" if stat == "rms" else "maximum"
+                out.append(f"the {words}'s {label} rises {new / old:.3g}× "
+                           f"({_fmt(old).strip()} → {_fmt(new).strip()} {unit})")
+    old, new = b.max_ground_reaction, a.max_ground_reaction
+    if old > 0 and new > WORSE_RATIO * old:
+        out.append(f"the largest force on a ground pivot or guide rises {new / old:.3g}× "
+                   f"({_fmt(old).strip()} → {_fmt(new).strip()} N)")
+    return out
+
+
+def _objective_terms(result) -> dict[str, dict[str, float | str]]:
+    """Each term of the objective: its weight and unit, its RMS before and after (inertial)."""
+    before, after = result.term_rms(result.before), result.term_rms(result.after)
+    return {t.name: {"weight": t.weight, "unit": t.unit, "before": before[t.name],
+                     "after": after[t.name]} for t in result.weights.terms}
+
+
 #: What each kind of counterweight asks of the workshop.
 _COUNTERWEIGHT_KINDS = {
     "none": "unchanged",
     "add": "add this body",
     "remove": "remove this material",
-    "rebuild": "no single body does it: rebuild the link",
+    "rebuild": "rebuild the link as",
 }
 
 
 def counterweight_text(weights) -> str:
-    """The counterweights as a table a workshop can build from (mm, kg, kg·m²)."""
+    """The counterweights as a table a workshop can build from (mm, kg, kg·m²).
+
+    A body to add: its mass, centre and inertia about its centre; material to remove: the
+    removed body's (its mass and inertia as positive numbers); a link to rebuild: the new
+    link's own mass, centre of mass and inertia about it, never a difference that no body has.
+    """
     rows = []
     for name, w in weights.items():
-        placed = w.mass != 0
         disc = (f"Ø {2e3 * w.disc_radius:.4g} × {1e3 * w.disc_thickness:.4g}"
                 if w.disc_radius is not None else "")
-        rows.append([name, _COUNTERWEIGHT_KINDS[w.kind],
-                     f"{w.mass:.6g}" if w.kind != "none" else "",
-                     f"{1e3 * w.e:.6g}" if placed else "", f"{1e3 * w.f:.6g}" if placed else "",
-                     f"{w.inertia:.6g}" if w.kind != "none" else "", disc])
-    total = sum(w.mass for w in weights.values())
+        if w.kind == "none":
+            values: tuple[str, ...] = ("", "", "", "")
+        else:
+            if w.kind == "rebuild" and w.rebuilt is not None:
+                mass, e, f, inertia = w.rebuilt
+            else:
+                sign = -1.0 if w.kind == "remove" else 1.0
+                mass, e, f, inertia = sign * w.mass, w.e, w.f, sign * w.inertia
+            # A component within rounding of the centre's distance is none (a balanced
+            # centre of mass on the link's line comes out 1e-12 m off it).
+            reach = math.hypot(e, f)
+            e, f = (0.0 if abs(v) <= UNCHANGED * reach else v for v in (e, f))
+            values = (f"{mass:.6g}", f"{1e3 * e:.6g}", f"{1e3 * f:.6g}", f"{inertia:.6g}")
+        rows.append([name, _COUNTERWEIGHT_KINDS[w.kind], *values, disc])
+    total = math.fsum(w.mass for w in weights.values())
+    notes = [f"added mass {total:.6g} kg (e, f: the centre in the link's frame; inertia about "
+             "that centre)"]
+    if any(w.kind == "rebuild" for w in weights.values()):
+        notes.append("rebuild: no single body added or removed makes the balanced link; the "
+                     "row gives the new link's own mass, centre of mass and inertia")
+    if any(w.kind == "remove" for w in weights.values()):
+        notes.append("remove: the mass and inertia of the material taken away")
     return (table(rows, ["counterweight", "to do", "mass kg", "e mm", "f mm",
                          "inertia kg·m²", "steel disc mm"])
-            + f"\nadded mass {total:.6g} kg (e, f: its centre in the link's frame; inertia "
-            "about its own centre)")
+            + "\n" + "\n".join(notes))
 
 
 def optimization_text(result, before, after, verification=None, spec=None, out=None) -> str:
@@ -662,9 +753,21 @@ def optimization_text(result, before, after, verification=None, spec=None, out=N
         ratio = f"{a.rms / b.rms:.3g}" if b.rms > 0 else "—"  # nothing to compare with
         rows.append([name.replace("_", " "), _fmt(b.rms), _fmt(a.rms), ratio,
                      _fmt(b.max), _fmt(a.max), UNITS[name]])
+    b, a = before.summary.max_ground_reaction, after.summary.max_ground_reaction
+    rows.append(["largest ground load", "", "", f"{a / b:.3g}" if b > 0 else "—",
+                 _fmt(b), _fmt(a), "N"])
     lines.append(table(rows, ["at the operating speed", "RMS before", "RMS after", "ratio",
                               "max before", "max after", "unit"]))
+    lines += [f"warning: {w}" for w in worse_figures(before, after)]
     lines.append("")
+    if result.single_term is None:
+        terms = _objective_terms(result)
+        rows = [[name.replace("_", " "), f"{t['weight']:.4g}",
+                 _fmt(float(t["before"])), _fmt(float(t["after"])), str(t["unit"])]
+                for name, t in terms.items()]
+        lines += ["objective J = Σ weight × mean square (added mass: weight × kg added), "
+                  "inertial shaking at the operating speed:",
+                  table(rows, ["term", "weight", "RMS before", "RMS after", "unit"]), ""]
     hb, ha = _harmonics_dict(before), _harmonics_dict(after)
     rows = [[name.replace("_", " "), _fmt(hb[name][order]), _fmt(ha[name][order]), order]
             for name in ("shaking_force_x", "shaking_force_y", "shaking_moment")
@@ -682,8 +785,7 @@ def optimization_text(result, before, after, verification=None, spec=None, out=N
             rows.append([f"{name} {key}", f"{a:.6g}", f"{b:.6g}", unit, changed])
     lines.append(table(rows, ["parameter", "before", "after", "unit", ""]))
     lines += ["", counterweight_text(result.counterweights), ""]
-    err = _force_balance(mechanism_of(result.linkage))[1]
-    lines.append(f"force balance: residual {err:.1e} of the first moments")
+    lines.append(_force_balance_line(after))
     if verification is not None:
         lines.append("")
         lines.append(verification_text(verification).split("\n", 1)[1].strip("\n"))

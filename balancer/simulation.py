@@ -97,6 +97,8 @@ class Trajectory:
         Formulation used.
     drive
         ``"free"`` or ``"constant-speed"``.
+    speed
+        The crank's constant speed of a driven run, rad/s (``None`` in free motion).
     links
         Names of the moving links, in the order of the rows of ``theta``, ``omega``, ``alpha``.
     t
@@ -165,6 +167,7 @@ class Trajectory:
     rtol: float
     atol: float
     named_states: bool = False
+    speed: float | None = None
     model: object = field(repr=False, default=None)
     slider: NDArray[np.float64] | None = field(repr=False, default=None)
 
@@ -395,6 +398,15 @@ class _Stepper:
         f = self.f
         if f.driven_rates(self.t_out[:1]) is None:
             return None
+        # At least one panel per PANEL_ANGLE of crank: refused, as a run of as many steps
+        # would be, before the panels' nodes are laid out (a 1e5 s run: 1e8 nodes).
+        panels = abs(f.speed) * self.t_end / PANEL_ANGLE
+        if panels > MAX_STEPS:
+            raise SpecError(
+                f"would take about {panels:.2g} quadrature panels of the crank's prescribed "
+                f"motion (one per {math.degrees(PANEL_ANGLE):g}° of crank at the least), more "
+                f"than the {MAX_STEPS:.0e} allowed: shorten it", key="simulation.duration",
+                value=self.duration)
         outs = self._outputs()
         near_dead_point = False
         points = f.change_points()
@@ -805,6 +817,7 @@ def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
     return Trajectory(
         method=f.name,
         drive="constant-speed" if f.driven else "free",
+        speed=f.speed,
         links=f.link_names,
         t=t,
         theta=theta,

@@ -233,7 +233,7 @@ def test_counterweight_spec_round_trips_and_refuses_what_contradicts_it():
     cases = {
         "mass = [1.0, 2.0]\n" + line: "balance.crank.mass",
         "counterweight = { radius = 1.0 }": "balance.crank.counterweight.mass",
-        "counterweight = { mass = [0.0, 1.0], radius = 1.0 }":
+        "counterweight = { mass = [-0.1, 1.0], radius = 1.0 }":
             "balance.crank.counterweight.mass",
         "counterweight = { mass = [0.1, 1.0], radius = 1.0, gyraton = 0.1 }":
             "balance.crank.counterweight.gyraton",

@@ -321,6 +321,16 @@ def test_a_duration_that_would_take_too_many_steps_is_refused_early(tmp_path, ca
     assert "simulation.duration" in err and "integration steps" in err
 
 
+def test_a_prescribed_motion_too_long_for_its_panels_is_refused_before_laying_them_out(capsys):
+    """A driven crank's motion is a quadrature, not steps: 1e5 s of the Stephenson six-bar at
+    31.4 rad/s is 8e6 panels (one per 22.5° of crank), whose nodes took 15 GB before it was
+    refused. The panels count against the step budget before any is laid out."""
+    code = main(["simulate", str(EXAMPLES / "stephenson_sixbar.toml"), "--duration", "1e5"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "simulation.duration" in err and "quadrature panels" in err
+
+
 def test_command_line_overrides_are_named_as_options(capsys):
     assert main(["simulate", str(EXAMPLES / "meijaard2020.toml"), "--outputs",
                  str(10**13)]) == 2

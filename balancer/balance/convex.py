@@ -89,6 +89,9 @@ ACTIVE_INSIDE = 1e-12
 #: which a design meets it to rounding: a few ε for the few products in each row.
 EQ58_ROUNDING = 16 * float(np.finfo(float).eps)
 _EPS = float(np.finfo(float).eps)
+#: A counterweight whose mass may be zero and that the optimum gives less than this share of
+#: its link's mass is tried at none (:meth:`ConvexSolver._without_small_counterweights`).
+SMALL_COUNTERWEIGHT = 1e-3
 #: A slack of the elastic problem above this (in scaled units) names a bound to widen.
 SLACK_TOLERANCE = 1e-7
 #: How far beyond its bound (relative to the bound's scale) the value a bound needs alone
@@ -578,13 +581,17 @@ class ConvexSolver:
             report2, second = self._run(self._stage2, "tie-break", target=lay.u(target),
                                         equality_rhs=np.concatenate([*fixed, self._seen @ u1]))
             stages.append(report2)
+            probe = x
             if second.u is not None:
                 x2, tight2 = self.repair(second.u)
                 objective2 = data.reduced_objective(x2)
+                probe = x2
                 # Only a feasible tie-break design replaces the SOCP's (an "almost solved"
                 # one, repaired, can be cheaper by violating a bound).
                 if not data.violations(x2) and data.within(objective2, objective, TIE_ACCEPT):
                     x, tight, objective = x2, tight2, objective2
+            x, objective = self._without_small_counterweights(x, probe, u1, target, objective,
+                                                              stages)
             x, objective = self.polish(x, target, objective)
         x = data.settle(x)  # the inert entries, for a crank whose speed changes
         x, feasible = self.finalize(x)
@@ -597,6 +604,55 @@ class ConvexSolver:
             converged=feasible,
             stages=tuple(stages),
         )
+
+    def _without_small_counterweights(
+        self, x: NDArray[np.float64], probe: NDArray[np.float64], u1: NDArray[np.float64],
+        target: NDArray[np.float64], objective: float, stages: list[StageReport],
+    ) -> tuple[NDArray[np.float64], float]:
+        """The design with the counterweights it barely uses taken off, where that costs nothing.
+
+        A counterweight whose mass may be zero and that the optimum does without lies at the
+        apex of its cone, which the interior-point solver approaches only to about the square
+        root of its tolerance (a crank's 30 mg where none is needed). Those lighter than
+        :data:`SMALL_COUNTERWEIGHT` of their link's mass are fixed at none and the tie-break
+        solved again; its design replaces ``x`` where it is feasible and no worse
+        (:data:`TIE_ACCEPT`). The small ones are those of ``probe``, the tie-break's design
+        (whether it was kept or not: at the apex of a cone it may break a bound by the
+        solver's accuracy).
+        """
+        data, lay = self.data, self.layout
+        own = data.own(probe)
+        small = [b for b in data.links
+                 if b.offset is not None and b.mass[0] == 0 and not data.absent(b, own)
+                 and own[b.start] <= SMALL_COUNTERWEIGHT * b.mass_ref]
+        if not small:
+            return x, objective
+        rows, values = [], []
+        for b in small:
+            for i in range(b.start, b.start + 4):
+                if np.any(lay.T[i]):  # (an inert entry is settled afterwards)
+                    rows.append(lay.T[i] / data.scales[i])
+                    values.append((data.offset[i] - lay.c[i]) / data.scales[i])
+        equality = [np.array(rows)]
+        rhs = [np.array(values)]
+        if self._fb is not None:
+            equality.insert(0, self._fb[0])
+            rhs.insert(0, self._fb[1])
+        if self._seen.shape[0]:
+            equality.append(self._seen)
+            rhs.append(self._seen @ u1)
+        program = ConicProgram(lay.size, self._cones, objective="nearest",
+                               equality=(np.vstack(equality), np.concatenate(rhs)))
+        report, solution = self._run(program, "counterweights off",
+                                     target=lay.u(target))
+        stages.append(report)
+        if solution.u is None:
+            return x, objective
+        x2, _ = self.repair(solution.u)
+        objective2 = data.reduced_objective(x2)
+        if not data.violations(x2) and data.within(objective2, objective, TIE_ACCEPT):
+            return x2, objective2
+        return x, objective
 
     def _lower_bound(self, u: NDArray[np.float64], multipliers: list[NDArray[np.float64]],
                      norm_dual: NDArray[np.float64] | None,
@@ -843,6 +899,8 @@ class ConvexSolver:
         own = data.own(x)
         for b in data.links:  # inert ones too: a move of the mass or centre of mass shifts I
             k = b.start
+            if data.absent(b, own):
+                continue
             q = (own[k + 1] ** 2 + own[k + 2] ** 2) / own[k]
             low = max(b.inertia[0], own[k] * b.gyration**2)
             inertia = own[k + 3] - q
@@ -879,6 +937,21 @@ class ConvexSolver:
         u = lay.u(x)
         preferred = lay.u(target)
         pinned = np.zeros(u.size, dtype=bool)  # entries put back: Eq. 58 may not move them
+        primary = list(lay.primary)
+        for b in data.links:  # a counterweight that may be none, taken off whole
+            if b.offset is None or b.mass[0] > 0 or data.absent(b, data.own(x)):
+                continue
+            trial_x = lay.x(u)
+            trial_x[b.entries] = data.offset[b.entries]
+            none = np.zeros(data.size, dtype=bool)
+            none[b.entries] = True
+            trial_pinned = pinned | none[primary]
+            trial = self.restore_balance(lay.u(trial_x), trial_pinned)
+            xt = data.settle(lay.x(trial), for_motion=False)
+            jt = data.reduced_objective(xt)
+            if (data.within(jt, objective, 1e-12) and data.within(objective, jt, 1e-12)
+                    and not data.violations(xt)):
+                u, x, objective, pinned = trial, xt, jt, trial_pinned
         for j in range(u.size):
             if u[j] == preferred[j]:
                 pinned[j] = True
@@ -907,7 +980,20 @@ class ConvexSolver:
         if not lay.size:
             return x
         u = lay.u(x)
-        return x + lay.T @ (self.restore_balance(u) - u)
+        return x + lay.T @ (self.drop_absent(self.restore_balance(u)) - u)
+
+    def drop_absent(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Solver variables ``u`` with every counterweight that is none exactly none.
+
+        A counterweight whose mass may be zero is approached by the interior-point solver only
+        as the apex of its cone (:meth:`NumericProblem.absent`); it is set to nothing and
+        Eq. 58 restored by the other free variables.
+        """
+        data, lay = self.data, self.layout
+        x, mask = data.without_absent(lay.x(u))
+        if not mask.any():
+            return u
+        return self.restore_balance(lay.u(x), mask[list(lay.primary)])
 
     def restore_balance(
         self, u: NDArray[np.float64], pinned: NDArray[np.bool_] | None = None
@@ -967,7 +1053,7 @@ class ConvexSolver:
         data, lay = self.data, self.layout
         u = np.array(u, dtype=float)
         index = {entry: j for j, entry in enumerate(lay.primary)}
-        u = self.restore_balance(u)  # Eq. 58 to rounding, not to Clarabel's tolerance
+        u = self.drop_absent(self.restore_balance(u))  # Eq. 58 to rounding
         # Met to the feasibility tolerance: leave the solver's design alone (a "repair" of a
         # 1e-12 violation would cost more objective than it is worth at a zero optimum).
         rounds = 2 if data.violations(data.settle(lay.x(u), for_motion=False)) else 0
@@ -1004,7 +1090,7 @@ class ConvexSolver:
         tight = True
         for b in data.links:
             k = b.start
-            if data.inert[k + 3] or (k + 3) not in index:
+            if data.inert[k + 3] or (k + 3) not in index or data.absent(b, own):
                 continue
             q = (own[k + 1] ** 2 + own[k + 2] ** 2) / own[k]
             inertia = own[k + 3] - q

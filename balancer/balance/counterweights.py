@@ -26,9 +26,11 @@ STEEL_DENSITY = 7850.0
 #: A disc thicker than this many diameters is no disc (the body is as good as a point mass,
 #: of any compact shape): none is proposed.
 MAX_ASPECT = 10.0
-#: A change of mass, first moment or inertia below this, relative to the link's own (its mass,
-#: its mass times its reach, its inertia about the frame's origin), is rounding: nothing to add.
-UNCHANGED = 1e-12
+#: A change of mass, first moment or inertia within this share of the link's own (its mass, its
+#: mass times its reach, its inertia about the frame's origin) is rounding: nothing to add. A
+#: solver meets its bounds and force balance to about 1e-10 of those scales; the figures it
+#: leaves are not a body to build.
+UNCHANGED = 1e-9
 
 
 @dataclass(frozen=True)
@@ -40,16 +42,20 @@ class Counterweight:
     link
         The link's name.
     mass
-        kg; negative for material removed.
+        kg; negative for material removed; 0 where the mass does not change.
     e, f
-        Its centre in the link's frame, m (0 when nothing changes).
+        Its centre in the link's frame, m (0 where the mass does not change: no centre).
     inertia
         About its own centre, kg·m² (negative for material removed: the removed body's is
-        ``−inertia``).
+        ``−inertia``). Where the mass does not change, the change of the link's inertia about
+        its frame's origin.
     kind
-        ``"none"`` (the link is unchanged), ``"add"``, ``"remove"``, or ``"rebuild"`` (no single
-        body added or removed does it: a first moment or inertia changed with the mass kept,
-        or an added body would need a negative inertia).
+        ``"none"`` (the link is unchanged to :data:`UNCHANGED`), ``"add"``, ``"remove"``, or
+        ``"rebuild"`` (no single body added or removed does it: a first moment or inertia
+        changed with the mass kept, or an added body would need a negative inertia).
+    first_moment
+        Its mass times its centre, ``m·(e + i·f)`` in the link's frame, kg·m: the change of the
+        link's first moment (which a change of first moment with the mass kept still has).
     disc_radius, disc_thickness
         The steel disc (:data:`STEEL_DENSITY`) of that mass and inertia, m; ``None`` unless
         ``kind`` is ``"add"`` with an inertia that a disc no thicker than :data:`MAX_ASPECT`
@@ -58,6 +64,9 @@ class Counterweight:
         Whether the original link plus this body (mass, first moment, inertia, signed: a
         negative mass or inertia is taken away) is the balanced link. Always, except for a
         first moment changed with the mass kept (no centre carries it).
+    rebuilt
+        For ``kind = "rebuild"``: the balanced link's own ``(mass, e, f, inertia)`` (kg, m, m,
+        kg·m² about its centre of mass), what the workshop builds instead.
     """
 
     link: str
@@ -66,17 +75,30 @@ class Counterweight:
     f: float
     inertia: float
     kind: str
+    first_moment: complex = 0j
     disc_radius: float | None = None
     disc_thickness: float | None = None
     exact: bool = True
+    rebuilt: tuple[float, float, float, float] | None = None
+
+    @property
+    def has_centre(self) -> bool:
+        """Whether the body has a centre (a mass): :attr:`e`, :attr:`f` mean something."""
+        return self.kind != "none" and self.mass != 0
 
     def as_dict(self) -> dict[str, object]:
-        """The JSON form (``mass``, ``e``, ``f``, ``inertia`` are fixed names)."""
+        """The JSON form (``mass``, ``e``, ``f``, ``inertia`` are fixed names).
+
+        ``e`` and ``f`` are ``null`` where the mass is 0 (nothing has a centre there).
+        """
         disc = None
         if self.disc_radius is not None:
             disc = {"radius": self.disc_radius, "thickness": self.disc_thickness,
                     "material": "steel", "density": STEEL_DENSITY}
-        return {"mass": self.mass, "e": self.e, "f": self.f, "inertia": self.inertia,
+        centre = self.has_centre
+        return {"mass": self.mass, "e": self.e if centre else None,
+                "f": self.f if centre else None, "inertia": self.inertia,
+                "first_moment": [self.first_moment.real, self.first_moment.imag],
                 "kind": self.kind, "exact": self.exact, "disc": disc}
 
 
@@ -96,11 +118,13 @@ def counterweight(name: str, original, balanced) -> Counterweight:
     mass_same = abs(dm) <= UNCHANGED * mass_scale
     moment_same = abs(ds) <= UNCHANGED * mass_scale * reach
     inertia_same = abs(dj) <= UNCHANGED * max(j0, j1)
+    rebuilt = (m1, s1.real, s1.imag, balanced.inertia)
     if mass_same and moment_same and inertia_same:
         return Counterweight(name, 0.0, 0.0, 0.0, 0.0, "none")
     if mass_same:  # a first moment or an inertia moved with no mass to carry it
         # (With the first moment kept, a massless "body" of inertia dj still adds up.)
-        return Counterweight(name, dm, 0.0, 0.0, dj, "rebuild", exact=moment_same)
+        return Counterweight(name, 0.0, 0.0, 0.0, dj, "rebuild", first_moment=ds,
+                             exact=moment_same, rebuilt=rebuilt)
     centre = ds / dm
     inertia = dj - dm * abs(centre) ** 2
     if dm > 0 and inertia >= -UNCHANGED * max(j0, j1):
@@ -111,10 +135,12 @@ def counterweight(name: str, original, balanced) -> Counterweight:
             thickness = dm / (STEEL_DENSITY * math.pi * radius**2)
             if thickness > MAX_ASPECT * 2 * radius:  # a point mass, not a disc
                 radius = thickness = None
-        return Counterweight(name, dm, centre.real, centre.imag, inertia, "add", radius,
+        return Counterweight(name, dm, centre.real, centre.imag, inertia, "add", ds, radius,
                              thickness)
-    kind = "remove" if dm < 0 and inertia <= UNCHANGED * max(j0, j1) else "rebuild"
-    return Counterweight(name, dm, centre.real, centre.imag, inertia, kind)
+    if dm < 0 and inertia <= UNCHANGED * max(j0, j1):
+        return Counterweight(name, dm, centre.real, centre.imag, min(inertia, 0.0), "remove", ds)
+    return Counterweight(name, dm, centre.real, centre.imag, inertia, "rebuild", ds,
+                         rebuilt=rebuilt)
 
 
 def counterweights(original, balanced) -> dict[str, Counterweight]:

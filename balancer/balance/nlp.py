@@ -203,7 +203,9 @@ class NlpSolver:
         """The scaled decision vector for design vector ``x``, clipped into the bounds."""
         data = self.data
         own = data.own(x)
-        physical = [inertial_to_physical(own[b.entries]) for b in data.links]
+        # A counterweight of no mass has no centre: it starts at its disc's centre.
+        physical = [(0.0, b.com_centre.real, b.com_centre.imag, 0.0) if data.absent(b, own)
+                    else inertial_to_physical(own[b.entries]) for b in data.links]
         out = []
         for index, kind in self._names:
             if kind == "Jc":

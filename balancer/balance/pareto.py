@@ -223,7 +223,8 @@ def pareto_front(design: Design, against: str, points: int = 11) -> Front:
     Raises
     ------
     SpecError
-        For an unknown second objective or fewer than two points.
+        For an unknown second objective, fewer than two points, or a front against the shaking
+        force of a problem that imposes force balance (it is zero at every point).
     InfeasibleError, SolverError
         If the balancing problem has no feasible design, or Clarabel fails.
     """
@@ -232,6 +233,11 @@ def pareto_front(design: Design, against: str, points: int = 11) -> Front:
     if design.balance is None:
         raise SpecError("missing required table: the redesign problem ([balance])",
                         key="balance")
+    if against == "shaking-force" and design.balance.force_balance:
+        raise SpecError("with force balance imposed the shaking force is zero at every point: "
+                        "there is no front against it; set [balance] force_balance = false to "
+                        "trade the shaking force against the shaking moment",
+                        key="--against", value=against)
     if not 2 <= points <= MAX_POINTS:
         raise SpecError(f"a front has from 2 to {MAX_POINTS} points", key="--points",
                         value=points)

@@ -113,6 +113,12 @@ _RAW_SHARE = ROUNDING_FACTOR * float(np.finfo(float).eps) / FORCE_BALANCE_TOLERA
 #: A bound met to this (relative, :meth:`NumericProblem.violations`) is met to rounding: the
 #: physical values (:meth:`NumericProblem.physical`) then meet it exactly.
 ROUNDING_TOLERANCE = 1e-12
+#: A counterweight whose mass may be zero (``counterweight = { mass = [0, hi], … }``) and whose
+#: own mass, first moments and inertia are all within this share of the link's scales (``m``,
+#: ``m·l``, ``m·l²``) is none: the link is kept as it is (:meth:`NumericProblem.absent`). An
+#: interior-point solver approaches a counterweight of no mass only as the apex of its cone, with
+#: a centre of mass that the ratio of two vanishing first moments puts anywhere.
+ABSENT = 1e-9
 #: A design whose shaking is below this share of what its inertias can produce
 #: (:attr:`NumericProblem.inertial_scale`) is balanced already; the problem's scale is then
 #: that share of the inertial scale, not the (vanishing) original figures.
@@ -152,6 +158,44 @@ class Objective:
     shaking_force_y: float = 0.0
     added_mass: float = 0.0
 
+    @property
+    def terms(self) -> tuple[ObjectiveTerm, ...]:
+        """The quantities ``J`` weighs, each once, with their weights (non-zero ones only).
+
+        The shaking force's components weighted alike are the shaking force (its mean-square
+        magnitude); weighted apart, each component is a term of its own.
+        """
+        fx = self.shaking_force + self.shaking_force_x
+        fy = self.shaking_force + self.shaking_force_y
+        forces = ([ObjectiveTerm("shaking_force", fx, "N")] if fx == fy else
+                  [ObjectiveTerm("shaking_force_x", fx, "N"),
+                   ObjectiveTerm("shaking_force_y", fy, "N")])
+        terms = [ObjectiveTerm("shaking_moment", self.shaking_moment, "N·m"),
+                 ObjectiveTerm("driving_torque", self.driving_torque, "N·m"), *forces,
+                 ObjectiveTerm("added_mass", self.added_mass, "kg")]
+        return tuple(t for t in terms if t.weight > 0)
+
+    @property
+    def single(self) -> ObjectiveTerm | None:
+        """The one mean-square quantity ``J`` weighs (``J = w·mean(q²)``), or ``None``."""
+        terms = self.terms
+        if len(terms) == 1 and terms[0].name != "added_mass":
+            return terms[0]
+        return None
+
+
+@dataclass(frozen=True)
+class ObjectiveTerm:
+    """One quantity of the objective: its JSON name, weight and unit.
+
+    ``added_mass`` enters ``J`` as ``w·Δm`` (``w`` in (N·m)²/kg); every other term as
+    ``w·mean(q²)`` over the cycle, ``q`` in ``unit`` (``w`` in (N·m)²/unit²).
+    """
+
+    name: str
+    weight: float
+    unit: str
+
 
 @dataclass(frozen=True, kw_only=True)
 class CounterweightFreedom:
@@ -160,7 +204,8 @@ class CounterweightFreedom:
     Attributes
     ----------
     mass
-        ``(low, high)``, kg (``low > 0``; equal ends fix it).
+        ``(low, high)``, kg (``low ≥ 0``: with ``low = 0`` none may be the answer; equal ends
+        fix it).
     radius
         Its centre lies within this distance of the link's ``com_about`` point, m.
     gyration
@@ -314,7 +359,7 @@ def _read_link_freedom(table: _Table, points: tuple[str, ...]) -> LinkFreedom:
                                 "counterweight's bounds only (counterweight = {mass, radius, "
                                 "gyration})", key=table.key(name), value=table.raw(name))
         _check_keys(sub, _COUNTERWEIGHT_KEYS)
-        mass = _read_range(sub, "mass", positive=True, unit="kg")
+        mass = _read_range(sub, "mass", positive=False, unit="kg")
         if mass is None:
             raise SpecError("missing required key (the counterweight's mass, [low, high] kg)",
                             key=sub.key("mass"))
@@ -1007,6 +1052,36 @@ class NumericProblem:
         """The entries the bounds concern: ``x`` less :attr:`offset` (a counterweight's own)."""
         return np.asarray(x, dtype=float) - self.offset
 
+    def absent(self, b: LinkBounds, own: NDArray[np.float64] | list[float]) -> bool:
+        """Whether link ``b``'s counterweight in ``own`` (:meth:`own`) is none at all.
+
+        Only a counterweight whose mass may be zero; its own ``m``, ``m·e``, ``m·f``, ``J``
+        all within :data:`ABSENT` of the link's scales.
+        """
+        if b.offset is None or b.mass[0] > 0:
+            return False
+        k = b.start
+        m, me, mf, j = (float(v) for v in own[k : k + 4])
+        return (abs(m) <= ABSENT * b.mass_ref and abs(me) <= ABSENT * b.mass_ref * b.length
+                and abs(mf) <= ABSENT * b.mass_ref * b.length
+                and abs(j) <= ABSENT * b.inertia_ref)
+
+    def without_absent(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64],
+                                                             NDArray[np.bool_]]:
+        """``x`` with every counterweight that is none (:meth:`absent`) exactly none.
+
+        Returns the design vector and the mask of the entries so set (to be kept by what
+        restores Eq. 58 afterwards).
+        """
+        x = np.array(x, dtype=float)
+        own = self.own(x)
+        mask = np.zeros(self.size, dtype=bool)
+        for b in self.links:
+            if self.absent(b, own):
+                x[b.entries] = self.offset[b.entries]
+                mask[b.entries] = True
+        return x, mask
+
     @cached_property
     def rotor_links(self) -> list[LinkBounds]:
         """The links that have a counter-rotor entry."""
@@ -1185,7 +1260,7 @@ class NumericProblem:
             if not self.inert[k + 3]:
                 continue
             m, me, mf = own[k], own[k + 1], own[k + 2]
-            if not m > 0:  # no counterweight (the original design): nothing to settle
+            if not m > 0 or self.absent(b, own):  # no counterweight: nothing to settle
                 continue
             q = (me * me + mf * mf) / m
             lo = max(b.inertia[0], m * b.gyration**2)
@@ -1232,6 +1307,10 @@ class NumericProblem:
         out = {}
         for b in self.links:
             rotor = float(x[b.rotor]) if b.rotor is not None else 0.0
+            if self.absent(b, self.own(x)):  # no counterweight: the link as it is
+                original = b.original
+                out[b.name] = (original.mass, original.e, original.f, original.inertia, rotor)
+                continue
             if b.offset is not None:  # the counterweight in its bounds, added to the link
                 own = inertial_to_physical(x[b.entries] - self.offset[b.entries])
                 m, e, f, inertia, rotor = self.clamp(b, *own, rotor)
@@ -1348,6 +1427,8 @@ class NumericProblem:
             k = b.start
             m, me, mf, j = own[k : k + 4]
             whose = b.name if b.offset is None else f"{b.name}'s counterweight"
+            if self.absent(b, own):
+                continue  # none added: the link as it is
             if not m > 0:
                 out.append(f"{whose}: mass {m:.6g} kg is not positive")
                 continue

@@ -18,6 +18,7 @@ from ..cycle import CycleAnalysis
 from ..errors import SolverError
 from ..model import Design
 from .counterweights import Counterweight, added_mass, counterweights
+from .problem import Objective, ObjectiveTerm
 
 #: Gap to the certified lower bound, relative to the problem's scale (the original design's
 #: RMS; :meth:`balancer.balance.problem.NumericProblem.gap`), within which a design is called
@@ -129,6 +130,8 @@ class BalanceResult:
         mass-matrix regressors); :attr:`operating` gives them with loads and gravity.
     gravity
         The spec's ``[operation] gravity`` (m/s²), for :attr:`operating`.
+    weights
+        The objective's weights (``[balance.objective]``).
     """
 
     success: bool
@@ -151,6 +154,7 @@ class BalanceResult:
     before: CycleAnalysis
     after: CycleAnalysis
     gravity: tuple[float, float] = (0.0, 0.0)
+    weights: Objective = Objective()
 
     def __repr__(self) -> str:
         return (f"BalanceResult({self.status}, {self.backend}: {self.message}; added mass "
@@ -195,6 +199,38 @@ class BalanceResult:
     def rms_gap(self) -> float:
         """``√J − √J_low``, N·m."""
         return self.rms - self.rms_lower_bound
+
+    @property
+    def single_term(self) -> ObjectiveTerm | None:
+        """The one quantity the objective weighs, or ``None`` (:attr:`Objective.single`).
+
+        Then ``√(J/w)`` is that quantity's RMS in its own unit: :meth:`in_unit`.
+        """
+        return self.weights.single
+
+    def in_unit(self, rms: float) -> float:
+        """A figure of ``√J`` (N·m) as the RMS of :attr:`single_term` in its unit (N, N·m).
+
+        ``√J = √w·RMS(q)``; without a single term, ``rms`` unchanged.
+        """
+        term = self.single_term
+        return rms if term is None else rms / float(np.sqrt(term.weight))
+
+    def term_rms(self, analysis: CycleAnalysis) -> dict[str, float]:
+        """Each mean-square term's RMS in ``analysis`` (inertial: :attr:`before`, :attr:`after`).
+
+        Keyed by the term's name (:attr:`Objective.terms`), in its unit; ``added_mass`` gives
+        the mass added to the original, kg.
+        """
+        r = analysis.reactions
+        force = r.shaking_force
+        values = {"shaking_moment": analysis.summary.shaking_moment.rms,
+                  "driving_torque": analysis.summary.driving_torque.rms,
+                  "shaking_force": analysis.summary.shaking_force.rms,
+                  "shaking_force_x": float(np.sqrt(np.mean(force.real**2))),
+                  "shaking_force_y": float(np.sqrt(np.mean(force.imag**2))),
+                  "added_mass": analysis.linkage.total_mass - self.original.total_mass}
+        return {t.name: values[t.name] for t in self.weights.terms}
 
     @property
     def optimal(self) -> bool:
