@@ -303,8 +303,12 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                        progress=progress)
     if plot is not None:
         from .plots import save_figure, sweep_figure
+        from .sweeps import spec_values
 
-        save_figure(sweep_figure(result.out, [v.key for v in varies] or None), plot)
+        keys = [v.key for v in varies]
+        original = spec_values(args.spec, keys or [p.key for p in perturbs])
+        save_figure(sweep_figure(result.out, keys or None, original=original,
+                                 perturbs=perturbs), plot)
     sys.stdout.write(dumps_json(result.as_dict()) if args.json
                      else sweep_text(result, spec=args.spec) + "\n")
     return 0

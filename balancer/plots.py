@@ -734,52 +734,244 @@ def front_figure(front, title: str | None = None) -> Figure:
     return fig
 
 
-def sweep_figure(path, keys) -> Figure:
+def _key_label(key: str) -> str:
+    """A spec key as an axis label, with its unit (:func:`balancer.sweeps.key_unit`)."""
+    from .sweeps import key_unit
+
+    unit = key_unit(key)
+    return f"{key} ({unit})" if unit else key
+
+
+def _key_value(key: str, value: float) -> str:
+    """``key = value unit``, the value to 4 significant digits."""
+    from .sweeps import key_unit
+
+    return f"{key} = {value:.4g} {key_unit(key)}".rstrip()
+
+
+def _mark_point(ax: Axes, x: float, y: float, label: str, where: str, **style):
+    """Mark the point ``(x, y)`` (data) on ``ax`` labelled ``label``, keeping its limits.
+
+    Inside the limits: a marker of ``style`` there. Outside: the marker just inside the frame
+    on the line from the axes' centre towards the point, an arrow from it to the frame
+    pointing the point's way, and ``where`` (the point's coordinates, with units) beside it.
+    Returns the marker (a ``Line2D``, for a legend).
+    """
+    xlim, ylim = ax.get_xlim(), ax.get_ylim()
+    u = (x - xlim[0]) / (xlim[1] - xlim[0])
+    v = (y - ylim[0]) / (ylim[1] - ylim[0])
+    if 0.0 <= u <= 1.0 and 0.0 <= v <= 1.0:
+        (marker,) = ax.plot([x], [y], linestyle="none", label=label, zorder=6, **style)
+    else:
+        d = np.array([u - 0.5, v - 0.5])
+        reach = 0.5 / np.max(np.abs(d))  # from the centre to the frame along d
+        frame_point = 0.5 + reach * d
+        inside = 0.5 + (reach - 0.09 / np.linalg.norm(d)) * d
+        (marker,) = ax.plot([inside[0]], [inside[1]], linestyle="none", transform=ax.transAxes,
+                            label=f"{label} (off the axes: arrow)", zorder=6, clip_on=False,
+                            **style)
+        ax.annotate("", xy=frame_point, xytext=inside, xycoords="axes fraction",
+                    arrowprops={"arrowstyle": "-|>", "color": style.get("mec", "k"),
+                                "lw": 1.2, "shrinkA": 7, "shrinkB": 0})
+        inward = -d / np.linalg.norm(d)
+        ax.annotate(where, xy=inside, xycoords="axes fraction", xytext=12 * inward,
+                    textcoords="offset points", fontsize="small",
+                    bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
+                          "alpha": 0.8},
+                    ha="left" if inward[0] > 0.3 else "right" if inward[0] < -0.3 else "center",
+                    va="bottom" if inward[1] > 0.3 else "top" if inward[1] < -0.3 else "center")
+    ax.set_xlim(xlim)
+    ax.set_ylim(ylim)
+    return marker
+
+
+#: How an atlas shows a point without a balanced design, by its row's ``status``
+#: (:mod:`balancer.sweeps`): the legend's words, a heat map cell's fill, hatch and hatch colour
+#: (``edgecolor``), a scattered point's marker.
+NO_DESIGN: dict[str, dict[str, str]] = {
+    "infeasible": {"label": "infeasible: no design within the [balance] bounds",
+                   "facecolor": "0.85", "hatch": "//", "edgecolor": "0.3", "marker": "x"},
+    "bad-geometry": {"label": "bad geometry: does not assemble, or the crank cannot turn fully",
+                     "facecolor": "white", "hatch": "xx", "edgecolor": "#D55E00",
+                     "marker": "+"},
+    "failed": {"label": "the solver failed", "facecolor": "white", "hatch": "..",
+               "edgecolor": "#CC79A7", "marker": "1"},
+}
+#: How the spec's own design is marked on an atlas.
+ORIGINAL_STYLE = {"marker": "*", "ms": 16, "mfc": "white", "mec": "k", "mew": 1.2}
+
+
+def _no_design(status: str) -> dict[str, str]:
+    """:data:`NO_DESIGN`'s entry for ``status`` (a generic one for any other status)."""
+    return NO_DESIGN.get(status, {"label": f"no design ({status})", "facecolor": "white",
+                                  "hatch": "--", "edgecolor": "0.5", "marker": "o"})
+
+
+def sweep_figure(path, keys, *, original: dict[str, float] | None = None,
+                 perturbs=()) -> Figure:
     """The atlas of a sweep's table: the balanced RMS shaking moment over the varied keys.
 
-    ``keys`` ``None``: a perturbation sweep's histogram of the residual shaking force. Two
-    keys on a grid: a heat map (points without an optimum — bad geometry, infeasible —
-    left blank); one key: the RMS shaking moment before and after against it; otherwise a
-    scatter over the first two keys, coloured by the balanced RMS shaking moment.
+    Parameters
+    ----------
+    path
+        The sweep's Parquet table (:func:`balancer.sweeps.sweep`).
+    keys
+        The varied keys, in the table's order; ``None`` for a perturbation sweep.
+    original
+        The spec's own value of each key (its unit's): the original design, marked.
+    perturbs
+        A perturbation sweep's :class:`~balancer.sweeps.Perturb` (``key``, ``sigma``): named
+        in its histogram's title.
+
+    Returns
+    -------
+    Figure
+        ``keys`` ``None``: the histogram of the perturbed designs' RMS shaking force (N). Two
+        keys on a grid: a heat map; the cells without a balanced design hatched, their legend
+        telling infeasible from bad geometry (and a failed solver). One key: the RMS shaking
+        moment before and after against it, the points without a design marked along the
+        bottom. Otherwise a scatter over the first two keys coloured by the balanced RMS
+        shaking moment, the points without a design as markers. Axes in the keys' units
+        (:func:`balancer.sweeps.key_unit`); the original design a white star (a line for one
+        key), or an arrow at the edge where it lies outside the swept ranges.
     """
     import pyarrow.parquet as pq
 
     table = pq.read_table(path).to_pydict()
-    if keys is None:  # a perturbation sweep: the residual shaking force's distribution
-        force = np.array([v for v in table["shaking_force_before"] if v is not None])
-        fig = Figure(figsize=(7.5, 4.5), layout="constrained")
-        ax = fig.add_subplot()
-        ax.hist(force, bins=max(10, min(60, force.size // 10)), color="C0")
-        ax.axvline(float(np.percentile(force, 95)), color="C3", ls="--", label="95th percentile")
-        ax.set_xlabel("RMS shaking force of the perturbed designs (N)")
-        ax.set_ylabel("designs")
-        ax.grid(True, alpha=0.3)
-        _legend_outside(ax)
-        return fig
+    if keys is None:
+        return _perturbation_figure(table, perturbs, original or {})
     after = np.array([np.nan if v is None else v for v in table["shaking_moment_after"]])
-    before = np.array([np.nan if v is None else v for v in table["shaking_moment_before"]])
+    status = np.array(table["status"], dtype=object)
     fig = Figure(figsize=(7.5, 5.0), layout="constrained")
     ax = fig.add_subplot()
     if len(keys) == 1:
-        x = np.array(table[keys[0]])
-        ax.plot(x, before, "o-", color="0.5", label="original design")
-        ax.plot(x, after, "o-", color="C0", label="balanced (certified optimum)")
-        ax.set_xlabel(keys[0])
-        ax.set_ylabel("RMS shaking moment (N·m)")
-        ax.grid(True, alpha=0.3)
-        _legend_outside(ax)
-        return fig
-    x, y = np.array(table[keys[0]]), np.array(table[keys[1]])
-    xs, ys = np.unique(x), np.unique(y)
-    if xs.size * ys.size == x.size:  # a grid
-        grid = np.full((ys.size, xs.size), np.nan)
-        grid[np.searchsorted(ys, y), np.searchsorted(xs, x)] = after
-        mesh = ax.pcolormesh(xs, ys, np.ma.masked_invalid(grid), shading="nearest",
-                             cmap="viridis")
+        before = np.array([np.nan if v is None else v for v in table["shaking_moment_before"]])
+        _atlas_line(ax, np.array(table[keys[0]], float), keys[0], before, after, status,
+                    original)
     else:
-        mesh = ax.scatter(x, y, c=after, cmap="viridis", s=12)
-    fig.colorbar(mesh, ax=ax, label="balanced RMS shaking moment (N·m)")
-    ax.set_xlabel(keys[0])
-    ax.set_ylabel(keys[1])
-    ax.set_title("Least RMS shaking moment with exact force balance (blank: no design)")
+        _atlas_map(fig, ax, [np.array(table[k], float) for k in keys[:2]], keys[:2], after,
+                   status, original)
+    return fig
+
+
+def _no_design_masks(after: np.ndarray, status: np.ndarray) -> dict[str, np.ndarray]:
+    """The points without a balanced design, by status (in :data:`NO_DESIGN`'s order)."""
+    missing = ~np.isfinite(after)
+    order = [*NO_DESIGN, *sorted(set(status[missing]) - set(NO_DESIGN))]
+    return {s: missing & (status == s) for s in order if np.any(missing & (status == s))}
+
+
+def _atlas_line(ax: Axes, x: np.ndarray, key: str, before: np.ndarray, after: np.ndarray,
+                status: np.ndarray, original: dict[str, float] | None) -> None:
+    """One varied key: the RMS shaking moment before and after balancing against it."""
+    ax.plot(x, before, "o-", color="0.5", label="before balancing (each point's own design)")
+    ax.plot(x, after, "o-", color="C0", label="balanced (certified optimum)")
+    ax.set_ylim(bottom=0)
+    for s, mask in _no_design_masks(after, status).items():
+        style = _no_design(s)
+        ax.plot(x[mask], np.full(mask.sum(), 0.03), linestyle="none", marker=style["marker"],
+                color=style["edgecolor"], ms=8, mew=1.5, transform=ax.get_xaxis_transform(),
+                label=style["label"])
+    if original is not None and key in original:
+        value = original[key]
+        xlim = ax.get_xlim()
+        if xlim[0] <= value <= xlim[1]:
+            ax.axvline(value, color="k", ls=":", lw=1.2,
+                       label=f"original design: {_key_value(key, value)}")
+            ax.set_xlim(xlim)
+        else:
+            ylim = ax.get_ylim()
+            _mark_point(ax, value, 0.5 * (ylim[0] + ylim[1]), "original design",
+                        _key_value(key, value), **ORIGINAL_STYLE)
+    ax.set_xlabel(_key_label(key))
+    ax.set_ylabel("RMS shaking moment (N·m)")
+    ax.set_title("RMS shaking moment before and after balancing")
+    ax.grid(True, alpha=0.3)
+    ax.figure.legend(loc="outside lower center", ncols=2, fontsize="small")
+
+
+def _atlas_map(fig: Figure, ax: Axes, values: list[np.ndarray], keys: list[str],
+               after: np.ndarray, status: np.ndarray,
+               original: dict[str, float] | None) -> None:
+    """Two varied keys: a heat map (a grid) or a scatter of the balanced RMS shaking moment."""
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    x, y = values
+    xs, ys = np.unique(x), np.unique(y)
+    solved = np.isfinite(after)
+    masks = _no_design_masks(after, status)
+    handles = []
+    mesh = None
+    if xs.size * ys.size == x.size:  # a grid: a cell per point
+        cell = np.searchsorted(ys, y), np.searchsorted(xs, x)
+
+        def on_grid(v: np.ndarray) -> np.ndarray:
+            grid = np.full((ys.size, xs.size), np.nan)
+            grid[cell] = v
+            return np.ma.masked_invalid(grid)
+
+        if solved.any():
+            mesh = ax.pcolormesh(xs, ys, on_grid(after), shading="nearest", cmap="viridis")
+        for s, mask in masks.items():
+            style = _no_design(s)
+            ax.pcolor(xs, ys, on_grid(np.where(mask, 0.0, np.nan)), shading="nearest",
+                      cmap=ListedColormap([style["facecolor"]]), hatch=style["hatch"],
+                      edgecolor=style["edgecolor"], linewidth=0.0)
+            handles.append(Patch(facecolor=style["facecolor"], hatch=style["hatch"],
+                                 edgecolor=style["edgecolor"], label=style["label"]))
+    else:
+        if solved.any():
+            mesh = ax.scatter(x[solved], y[solved], c=after[solved], cmap="viridis", s=14)
+        for s, mask in masks.items():
+            style = _no_design(s)
+            handles.append(ax.scatter(x[mask], y[mask], marker=style["marker"], s=24,
+                                      color=style["edgecolor"], label=style["label"]))
+    if mesh is not None:
+        fig.colorbar(mesh, ax=ax, label="balanced RMS shaking moment (N·m)")
+    if original is not None and all(k in original for k in keys):
+        ox, oy = (original[k] for k in keys)
+        handles.append(_mark_point(ax, ox, oy, "original design: the spec",
+                                   f"{_key_value(keys[0], ox)}\n{_key_value(keys[1], oy)}",
+                                   **ORIGINAL_STYLE))
+    ax.set_xlabel(_key_label(keys[0]))
+    ax.set_ylabel(_key_label(keys[1]))
+    ax.set_title("RMS shaking moment of the balanced design at each point"
+                 if mesh is not None else "No point has a balanced design")
+    if handles:
+        fig.legend(handles=handles, loc="outside lower center", ncols=1, fontsize="small")
+
+
+def _perturbation_figure(table: dict, perturbs, original: dict[str, float]) -> Figure:
+    """A perturbation sweep's histogram of the perturbed designs' RMS shaking force, N.
+
+    Its title names each perturbed key, the spec's value (where ``original`` gives it) and the
+    standard deviation σ of its normal draws, and how many designs were drawn and analysed.
+    """
+    from .sweeps import key_unit
+
+    draws = len(table["status"])
+    force = np.array([v for v in table["shaking_force_before"] if v is not None])
+    fig = Figure(figsize=(7.5, 4.5), layout="constrained")
+    ax = fig.add_subplot()
+    if force.size:
+        ax.hist(force, bins=max(10, min(60, force.size // 10)), color="C0",
+                label="perturbed designs")
+        p95 = float(np.percentile(force, 95))
+        ax.axvline(p95, color="C3", ls="--", label=f"95th percentile: {_number(p95)} N")
+    analysed = (f"{draws} designs drawn" if force.size == draws else
+                f"{draws} designs drawn, {force.size} analysed (the others: bad geometry)")
+    spread = []
+    for p in perturbs:
+        unit = f" {key_unit(p.key)}".rstrip()
+        about = f" = {original[p.key]:.4g}{unit}" if p.key in original else ""
+        spread.append(f"{p.key}{about}, σ = {p.sigma:.3g}{unit}")
+    title = f"Residual shaking force: {analysed}"
+    if spread:
+        title += ", each key normal about the spec's value\n" + "; ".join(spread)
+    ax.set_title(title, fontsize="medium")
+    ax.set_xlabel("RMS shaking force of the perturbed design (N)")
+    ax.set_ylabel("designs")
+    ax.grid(True, alpha=0.3)
+    _legend_outside(ax)
     return fig

@@ -31,7 +31,7 @@ from balancer.balance.pareto import pareto_front
 from balancer.plots import front_figure, save_png, sweep_figure
 from balancer.report import markdown_table
 from balancer.spec import load_design
-from balancer.sweeps import Vary, sweep
+from balancer.sweeps import Vary, spec_values, sweep
 
 NAME = "atlas_and_fronts"
 ROOT = Path(__file__).resolve().parents[1]
@@ -71,7 +71,8 @@ def run(out_dir: Path, quick: bool = False) -> dict:
                 != grashof_crank_rocker(crank, r[KEYS[0]], rocker, r[KEYS[1]])]
     solved = [r for r in rows if r["shaking_moment_after"] is not None]
     best = min(solved, key=lambda r: r["shaking_moment_after"])
-    figures = [save_png(sweep_figure(table_path, list(KEYS)), out_dir / "atlas.png")]
+    figures = [save_png(sweep_figure(table_path, list(KEYS), original=spec_values(PB1, KEYS)),
+                        out_dir / "atlas.png")]
     fronts = {
         "PB1 against driving torque": pareto_front(design, "driving-torque", points),
         "PB1 with counterweights against added mass": pareto_front(

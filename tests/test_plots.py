@@ -359,3 +359,132 @@ def test_counterweights_turn_with_their_links_in_the_animation(tmp_path):
 
     assert main(["plot", str(spec), "--animate", str(out), "--frames", "6"]) == 0
     assert out.read_bytes()[:6] == b"GIF89a"
+
+
+# --- sweep atlases: axes in units, the original marked, no-design cells told apart --------
+
+
+COUPLER, FRAME = "mechanism.lengths.coupler", "mechanism.lengths.frame"
+
+
+def _atlas_table(path, statuses, keys=(COUPLER, FRAME), values=((2.5, 3.0, 3.5), (3.0, 3.2))):
+    """A sweep's table over a grid of ``keys``; the given statuses row by row (those without
+    a balanced design have no ``after``)."""
+    import itertools
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    points = list(itertools.product(*values))
+    rows = [{**dict(zip(keys, p, strict=True)), "point": i, "status": s,
+             "shaking_moment_before": 200.0 + i, "shaking_force_before": 400.0,
+             "shaking_moment_after": 100.0 + i if s == "optimal" else None}
+            for i, (p, s) in enumerate(zip(points, statuses, strict=True))]
+    pq.write_table(pa.Table.from_pylist(rows), path)
+    return path
+
+
+@pytest.mark.parametrize(("key", "unit"), [
+    ("mechanism.lengths.coupler", "m"), ("mechanism.points.B.1", "m"), ("links.crank.com.e", "m"),
+    ("links.crank.com.f", "m"), ("links.rocker.com.s", "m"), ("links.crank.mass", "kg"),
+    ("links.crank.inertia", "kg·m²"), ("links.rocker.counter_rotor", "kg·m²"),
+    ("links.crank.com.sigma", "rad"), ("operation.speed", "rad/s"),
+    ("links.coupler.force.0", "N"), ("links.coupler.moment", "N·m"),
+    ("balance.crank.mass.1", "kg"), ("balance.crank.counterweight.radius", "m"),
+    ("operation.samples", ""), ("balance.objective.driving_torque", "")])
+def test_a_spec_keys_unit_comes_from_the_key(key, unit):
+    from balancer.sweeps import key_unit
+
+    assert key_unit(key) == unit
+
+
+def test_the_atlas_names_its_axes_with_units_marks_the_original_and_tells_empty_cells_apart(
+        tmp_path):
+    from matplotlib.collections import PolyCollection
+
+    statuses = ["bad-geometry", "infeasible", "optimal", "infeasible", "optimal", "optimal"]
+    path = _atlas_table(tmp_path / "atlas.parquet", statuses)
+    fig = plots.sweep_figure(path, [COUPLER, FRAME], original={COUPLER: 3.0, FRAME: 3.2})
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == f"{COUPLER} (m)" and ax.get_ylabel() == f"{FRAME} (m)"
+    # The original design: a marker at the spec's values.
+    marks = [line for line in ax.get_lines() if line.get_label().startswith("original design")]
+    assert len(marks) == 1
+    assert list(marks[0].get_xdata()) == [3.0] and list(marks[0].get_ydata()) == [3.2]
+    # The cells without a design: one hatched layer per status, covering exactly its cells,
+    # and a legend entry for each that a reader tells apart.
+    layers = [c for c in ax.collections if isinstance(c, PolyCollection) and c.get_hatch()]
+    assert sorted(int(np.ma.count(c.get_array())) for c in layers) == [1, 2]
+    assert len({c.get_hatch() for c in layers}) == 2
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert any(label.startswith("infeasible") for label in labels)
+    assert any(label.startswith("bad geometry") for label in labels)
+    assert any(label.startswith("original design") for label in labels)
+
+
+def test_an_original_outside_the_swept_ranges_is_an_arrow_at_the_edge(tmp_path):
+    path = _atlas_table(tmp_path / "atlas.parquet", ["optimal"] * 6)
+    fig = plots.sweep_figure(path, [COUPLER, FRAME], original={COUPLER: 3.0, FRAME: 4.5})
+    ax = fig.axes[0]
+    limits = ax.get_ylim()
+    assert limits[1] < 4.0  # the map keeps the swept ranges
+    assert any(t.arrow_patch is not None for t in ax.texts)
+    assert any(f"{FRAME} = 4.5 m" in t.get_text() for t in ax.texts)
+
+
+def test_one_varied_key_has_its_unit_and_the_original_and_no_design_points(tmp_path):
+    path = _atlas_table(tmp_path / "line.parquet", ["bad-geometry", "infeasible", "optimal"],
+                        keys=("links.crank.mass",), values=((2.0, 3.0, 4.0),))
+    fig = plots.sweep_figure(path, ["links.crank.mass"], original={"links.crank.mass": 2.1})
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "links.crank.mass (kg)"
+    labels = {line.get_label(): line for line in ax.get_lines()}
+    assert "original design: links.crank.mass = 2.1 kg" in labels
+    assert list(labels["original design: links.crank.mass = 2.1 kg"].get_xdata()) == [2.1, 2.1]
+    missing = [line for name, line in labels.items()
+               if name.startswith(("infeasible", "bad geometry"))]
+    assert sorted(float(line.get_xdata()[0]) for line in missing) == [2.0, 3.0]
+
+
+def test_a_scattered_atlas_marks_the_points_without_a_design(tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    rows = [{COUPLER: c, FRAME: f, "point": i, "status": s, "shaking_moment_before": 1.0,
+             "shaking_force_before": 1.0, "shaking_moment_after": 1.0 if s == "optimal" else None}
+            for i, (c, f, s) in enumerate([(2.1, 3.0, "optimal"), (2.6, 3.3, "infeasible"),
+                                           (3.4, 2.9, "bad-geometry"), (3.0, 3.1, "optimal")])]
+    pq.write_table(pa.Table.from_pylist(rows), tmp_path / "lhs.parquet")
+    fig = plots.sweep_figure(tmp_path / "lhs.parquet", [COUPLER, FRAME],
+                             original={COUPLER: 3.0, FRAME: 3.2})
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert [label.split(":")[0] for label in labels] == ["infeasible", "bad geometry",
+                                                         "original design"]
+
+
+def test_the_sweep_command_marks_the_specs_design_on_its_atlas(tmp_path, monkeypatch, capsys):
+    drawn = []
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path: drawn.append(fig))
+    out = tmp_path / "atlas.parquet"
+    assert main(["sweep", str(EXAMPLES / "pb1.toml"), "--vary", f"{COUPLER}=2.6:3.4:2",
+                 "--vary", f"{FRAME}=3.0:3.4:2", "--out", str(out), "--workers", "0",
+                 "--plot", str(tmp_path / "atlas.png"), "--json"]) == 0
+    capsys.readouterr()
+    (ax, *_), = (fig.axes for fig in drawn)
+    (mark,) = (line for line in ax.get_lines() if line.get_label().startswith("original"))
+    assert list(mark.get_xdata()) == [3.0] and list(mark.get_ydata()) == [3.2]
+
+
+def test_the_tolerance_histogram_names_the_key_its_sigma_and_the_draws(tmp_path, monkeypatch,
+                                                                        capsys, pb1_balanced):
+    drawn = []
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path: drawn.append(fig))
+    assert main(["sweep", str(pb1_balanced), "--perturb", "links.crank.mass=0.01",
+                 "--samples", "30", "--out", str(tmp_path / "p.parquet"), "--workers", "0",
+                 "--plot", str(tmp_path / "hist.png"), "--json"]) == 0
+    capsys.readouterr()
+    (fig,) = drawn
+    title = fig.axes[0].get_title()
+    assert "links.crank.mass = 2.1 kg" in title and "σ = 0.01 kg" in title
+    assert "30 designs drawn" in title
+    assert fig.axes[0].get_xlabel().endswith("(N)")
