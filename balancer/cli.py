@@ -268,9 +268,14 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
     text = (dumps_json(front_json(front, spec=args.spec)) if args.json
             else front_text(front, spec=args.spec) + "\n")
     if plot is not None:
+        from .balance.conditions import RESIDUAL_FLOOR, force_balance_residual
+        from .mechanisms import mechanism_of
         from .plots import front_figure, save_figure
 
-        save_figure(front_figure(front, title=design.title), plot)
+        balanced = force_balance_residual(mechanism_of(design.mechanism)) <= RESIDUAL_FLOOR
+        save_figure(front_figure(front, title=design.title,
+                                 force_balance=design.balance.force_balance,
+                                 original_force_balanced=balanced), plot)
     if csv_path is not None:
         write_atomic(csv_path, csv)
     sys.stdout.write(text)

@@ -488,3 +488,60 @@ def test_the_tolerance_histogram_names_the_key_its_sigma_and_the_draws(tmp_path,
     assert "links.crank.mass = 2.1 kg" in title and "σ = 0.01 kg" in title
     assert "30 designs drawn" in title
     assert fig.axes[0].get_xlabel().endswith("(N)")
+
+
+# --- trade-off fronts: the axes on the front, the original marked and explained -----------
+
+
+def _front_figure_of(tmp_path, monkeypatch, capsys, spec, against):
+    drawn = []
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path: drawn.append(fig))
+    assert main(["pareto", str(spec), "--against", against, "--points", "5", "--plot",
+                 str(tmp_path / "front.png"), "--json"]) == 0
+    import json
+
+    doc = json.loads(capsys.readouterr().out)
+    (fig,) = drawn
+    return fig, doc
+
+
+def _legend_texts(fig):
+    return [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+
+
+def test_a_front_far_from_the_original_keeps_the_axes_on_the_front(tmp_path, monkeypatch,
+                                                                   capsys):
+    # PB2's front reaches zero shaking moment with a driving torque of a few N·m; the original
+    # (not force-balanced) lies at some 150 N·m and 215 N·m, far outside it.
+    fig, doc = _front_figure_of(tmp_path, monkeypatch, capsys, EXAMPLES / "pb2.toml",
+                                "driving-torque")
+    ax = fig.axes[0]
+    xs = [p["driving_torque"] for p in doc["points"]]
+    ys = [max(p["shaking_moment"], p["lower_bound"]) for p in doc["points"]]
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    assert x0 <= min(xs) and max(xs) <= x1 and y0 <= min(ys) and max(ys) <= y1
+    # The front fills the axes: they reach no more than a third beyond it each way.
+    assert x1 - x0 <= 1.34 * (max(xs) - min(xs)) and y1 <= 1.34 * max(ys)
+    original = doc["original"]
+    assert original["driving_torque"] > x1 and original["shaking_moment"] > y1
+    # The original is marked at the edge by an arrow that gives its coordinates.
+    (arrow,) = (t for t in ax.texts if t.arrow_patch is not None and not t.get_text())
+    (where,) = (t for t in ax.texts if "original design" in t.get_text())
+    assert f"{original['shaking_moment']:.3g}" in where.get_text()
+    labels = _legend_texts(fig)
+    assert any(label.startswith("original design") and "not force-balanced" in label
+               for label in labels)
+    assert any("force-balanced" in label for label in labels if label.startswith("least"))
+
+
+def test_an_original_within_reach_of_the_front_is_drawn_where_it_is(tmp_path, monkeypatch,
+                                                                    capsys):
+    fig, doc = _front_figure_of(tmp_path, monkeypatch, capsys, EXAMPLES / "pb1.toml",
+                                "driving-torque")
+    ax = fig.axes[0]
+    (mark,) = (line for line in ax.get_lines() if line.get_label().startswith("original"))
+    original = doc["original"]
+    assert list(mark.get_xdata()) == [original["driving_torque"]]
+    assert list(mark.get_ydata()) == [original["shaking_moment"]]
+    assert "not force-balanced" in mark.get_label()
+    assert not [t for t in ax.texts if t.arrow_patch is not None]
