@@ -545,3 +545,75 @@ def test_an_original_within_reach_of_the_front_is_drawn_where_it_is(tmp_path, mo
     assert list(mark.get_ydata()) == [original["shaking_moment"]]
     assert "not force-balanced" in mark.get_label()
     assert not [t for t in ax.texts if t.arrow_patch is not None]
+
+
+# --- animations: a title inside the picture, the crank angle, what the balancing added ----
+
+
+def _drawn_animation(design, frames, **kw):
+    fig, update = plots.animation_figure(design.mechanism, frames=frames, title=design.title,
+                                         **kw)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return fig, update, canvas.get_renderer()
+
+
+def test_the_animations_title_lies_inside_the_picture(pb1_balanced):
+    design = load_design(pb1_balanced)  # PB1's title is long for a 6-inch animation
+    fig, _, renderer = _drawn_animation(design, 4)
+    box, page = fig.axes[0].title.get_window_extent(renderer), fig.bbox
+    assert fig.axes[0].title.get_text().replace("\n", " ") == design.title
+    assert page.x0 <= box.x0 and box.x1 <= page.x1 and page.y0 <= box.y0 and box.y1 <= page.y1
+
+
+def test_the_animation_reads_the_crank_angle_of_every_frame():
+    design = load_design(EXAMPLES / "watt_sixbar.toml")
+    fig, update, _ = _drawn_animation(design, 8)
+    readouts = []
+    for k in range(8):
+        (text,) = (a for a in update(k) if hasattr(a, "get_text"))
+        readouts.append(text.get_text())
+    assert readouts[0].endswith("θ1 =   0.0°") and readouts[2].endswith("θ1 =  90.0°")
+    assert len(set(readouts)) == 8
+
+
+def test_the_animation_carries_each_centre_of_mass_and_counterweight_with_its_link(
+        pb1_balanced):
+    """PB1's balanced crank and rocker keep their masses and move their centres of mass off
+    the links: each is drawn on an arm from a point of its link, at the same distance from it
+    in every frame; a spec with counterweights draws their discs where they are carried."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Circle
+
+    import balancer
+    from balancer.balance.counterweights import counterweights
+
+    design = load_design(pb1_balanced)
+    frames = 6
+    weights = counterweights(design.original, design.mechanism)
+    fig, update, _ = _drawn_animation(design, frames, counterweights=weights)
+    _, coms, _ = plots.drawing_frames(design.mechanism, frames)
+    reach = {}  # per link: the length of its centre of mass's arm
+    for k in range(frames):
+        arms = [a.get_xydata() for a in update(k) if isinstance(a, Line2D)
+                and a.get_color() == plots.COLOURS["com"] and a.get_linestyle() == "-"]
+        for name, path in coms.items():
+            (arm,) = (xy for xy in arms if abs(complex(*xy[1]) - path[k]) < 1e-12)
+            length = reach.setdefault(name, np.hypot(*(arm[1] - arm[0])))
+            assert np.hypot(*(arm[1] - arm[0])) == pytest.approx(length, rel=1e-9)
+    assert reach["crank"] > 0.3 and reach["rocker"] > 0.3  # off the links
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert any(label.startswith("rebuilt") and "crank" in label for label in labels)
+    # Counterweights added to the paper's links: discs that move with them.
+    cw = balancer.example("pb1_counterweights")
+    result = balancer.optimize(cw, backend="convex")
+    balanced = result.balanced_design(cw)
+    fig, update, _ = _drawn_animation(balanced, frames, counterweights=result.counterweights)
+    paths = plots.counterweight_paths(balanced.mechanism, result.counterweights, frames)
+    discs = [p for p in fig.axes[0].patches if isinstance(p, Circle)]
+    assert len(discs) == len(paths) == 2
+    for k in (0, 3):
+        update(k)
+        centres = sorted(d.get_center() for d in discs)
+        expected = sorted((c[k].real, c[k].imag) for c, _ in paths.values())
+        np.testing.assert_allclose(centres, expected, rtol=0, atol=1e-12)
