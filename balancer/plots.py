@@ -43,14 +43,101 @@ def _legend_outside(ax: Axes, **kw) -> None:
               fontsize="small", **kw)
 
 
+#: Quantiles of a time panel's samples (all its curves together) that bound its bulk.
+SPIKE_QUANTILES = (0.02, 0.98)
+#: A time panel whose samples span more than this many times its bulk is clipped: a few
+#: spikes (a free motion through a near-toggle) would squash every other curve to a line.
+SPIKE_RATIO = 3.0
+#: Room left beyond the bulk of a clipped panel, a fraction of the bulk's span.
+SPIKE_ROOM = 0.25
+#: Two curves closer than this fraction of their panel's height at every sample coincide.
+COINCIDENT = 2e-3
+
+
+def _curves(ax: Axes) -> list:
+    """The axes' data curves (lines with more than two samples)."""
+    return [line for line in ax.get_lines() if len(line.get_xdata()) > 2]
+
+
+def _clip_spikes(ax: Axes, unit: str) -> None:
+    """Keep a time panel's y-limits on the bulk of its samples, the spikes clipped and marked.
+
+    The bulk of the samples (all the curves') lies between their :data:`SPIKE_QUANTILES`. A
+    side is clipped where its extreme would make the panel more than :data:`SPIKE_RATIO`
+    times the bulk's height: its limit is the bulk's, widened by :data:`SPIKE_ROOM` of it
+    (the other side keeps its extreme). Each stretch of a curve beyond a limit
+    is marked at the edge, at its peak, by a triangle of the curve's colour; the legend
+    gives the largest value clipped, in ``unit``. What a designer reads: the motion's
+    ordinary forces at a readable scale, and how large its brief peaks are.
+    """
+    curves = _curves(ax)
+    if not curves:
+        return
+    values = np.concatenate([np.asarray(line.get_ydata(), float) for line in curves])
+    values = values[np.isfinite(values)]
+    low, high = float(values.min()), float(values.max())
+    q_low, q_high = (float(q) for q in np.quantile(values, SPIKE_QUANTILES))
+    bulk = q_high - q_low
+    clip_top = bulk > 0 and high - q_low > SPIKE_RATIO * bulk
+    clip_bottom = bulk > 0 and q_high - low > SPIKE_RATIO * bulk
+    if not (clip_top or clip_bottom):
+        return
+    top = q_high + SPIKE_ROOM * bulk if clip_top else high
+    bottom = q_low - SPIKE_ROOM * bulk if clip_bottom else low
+    margin = 0.05 * (top - bottom)  # matplotlib's, on a side that is not clipped
+    top, bottom = top + (0.0 if clip_top else margin), bottom - (0.0 if clip_bottom else margin)
+    ax.set_ylim(bottom, top)
+    edge = ax.get_xaxis_transform()  # x in data, y in axes fractions
+    clipped = []
+    for line in curves:
+        t, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+        for beyond, at, marker, sign in ((y > top, 1.0, "^", 1.0),
+                                         (y < bottom, 0.0, "v", -1.0)):
+            starts = np.flatnonzero(np.diff(np.r_[0, beyond.astype(int)]) == 1)
+            ends = np.flatnonzero(np.diff(np.r_[beyond.astype(int), 0]) == -1) + 1
+            for a, b in zip(starts, ends, strict=True):
+                peak = a + int(np.argmax(sign * y[a:b]))
+                ax.plot([t[peak]], [at], marker, color=line.get_color(), ms=8, mec="k",
+                        mew=0.5, transform=edge, clip_on=False, zorder=6)
+                clipped.append(abs(y[peak]))
+    ax.plot([], [], "^", color="w", mec="k", mew=0.5, ms=8,
+            label=f"clipped peaks (▲▼ at the edge): up to {_number(max(clipped))} {unit}")
+
+
+def _reveal_coincident(ax: Axes) -> None:
+    """Keep both of two curves visible where one lies on the other.
+
+    Where a curve coincides (within :data:`COINCIDENT` of the panel's height at every
+    sample, at the same times) with one drawn before it, it is drawn on top of it dashed and
+    thinner, and its legend entry says which one it coincides with.
+    """
+    low, high = ax.get_ylim()
+    tolerance = COINCIDENT * (high - low)
+    curves = _curves(ax)
+    for j, later in enumerate(curves):
+        for earlier in curves[:j]:
+            t, y = later.get_xdata(), np.asarray(later.get_ydata(), float)
+            if not (np.array_equal(t, earlier.get_xdata()) and
+                    np.nanmax(np.abs(y - np.asarray(earlier.get_ydata(), float)),
+                              initial=0.0) <= tolerance):
+                continue
+            later.set_linestyle((0, (4, 3)))
+            later.set_linewidth(0.6 * min(later.get_linewidth(), earlier.get_linewidth()))
+            later.set_zorder(max(later.get_zorder(), earlier.get_zorder()) + 0.1)
+            later.set_label(f"{later.get_label()} (coincides with {earlier.get_label()})")
+            break
+
+
 def plot_reactions(traj: Trajectory, ax: Axes | None = None, title: str = "",
-                   original: Trajectory | None = None) -> Axes:
-    """Every force on the ground over time and their sum (as the paper's Fig. 8 and 9).
+                   original: Trajectory | None = None, clip_spikes: bool = False) -> Axes:
+    """Every force on the ground over time and their sum (as the paper's Fig. 8 and 9), N.
 
     The x (solid) and y (dashed) components at each ground point, the normal force (dotted) of
     each slider on a ground guide, and the shaking force's components (black). With the
     ``original``'s motion, before and after instead: the magnitude of each force on the ground
-    and of their sum, the original's thin and faint, the design's solid.
+    and of their sum, the original's thin and faint, the design's solid. A curve that lies on
+    an earlier one is drawn dashed on top of it (:func:`_reveal_coincident`); with
+    ``clip_spikes``, brief spikes are clipped and marked (:func:`_clip_spikes`).
     """
     ax = _axes(ax)
     if original is not None:
@@ -72,6 +159,9 @@ def plot_reactions(traj: Trajectory, ax: Axes | None = None, title: str = "",
     ax.set_xlabel("time t (s)")
     ax.set_title(title or f"forces on the ground, {traj.drive} motion")
     ax.grid(alpha=0.3)
+    if clip_spikes:
+        _clip_spikes(ax, "N")
+    _reveal_coincident(ax)
     _legend_outside(ax)
     return ax
 
@@ -95,9 +185,12 @@ def _plot_reaction_magnitudes(ax: Axes, traj: Trajectory, original: Trajectory) 
 
 def plot_shaking_moment(
     traj: Trajectory, original: Trajectory | None = None, ax: Axes | None = None,
-    title: str = "",
+    title: str = "", clip_spikes: bool = False,
 ) -> Axes:
-    """Shaking moment about the origin over time, before (the original) and after."""
+    """Shaking moment about the origin over time, before (the original) and after, N·m.
+
+    As :func:`plot_reactions`: coinciding curves both visible, spikes clipped if asked.
+    """
     ax = _axes(ax)
     if original is not None:
         ax.plot(original.t, original.shaking_moment, **BEFORE_STYLE, label="before (original)")
@@ -108,6 +201,9 @@ def plot_shaking_moment(
     ax.set_ylabel("shaking moment about the origin (N·m)")
     ax.set_title(title or f"shaking moment, {traj.drive} motion")
     ax.grid(alpha=0.3)
+    if clip_spikes:
+        _clip_spikes(ax, "N·m")
+    _reveal_coincident(ax)
     _legend_outside(ax)
     return ax
 
@@ -420,7 +516,10 @@ def verification_figure(design, verification) -> Figure:
 
     Columns: the crank driven at the operating speed, free motion; rows: the forces on the
     ground and their sum, shaking moment, path of the total centre of mass; each before and
-    after where the design names its original. Legends beside the panels.
+    after where the design names its original. Legends beside the panels. The free motion's
+    panels are set on the bulk of their samples, brief spikes (a pass near a toggle) clipped
+    and marked with their size; the driven run's show every sample, its peaks being the
+    loads at the operating speed.
     """
     fig = Figure(figsize=(17, 14), layout="constrained")
     axes = fig.subplots(3, 2)
@@ -430,14 +529,15 @@ def verification_figure(design, verification) -> Figure:
     runs = ((verification.driven, f"crank driven at {speed:g} rad/s", 0),
             (verification.free, "free motion", 1))
     for run, label, col in runs:
+        free = run is verification.free
         if run.trajectory is None:
             axes[0, col].text(0.5, 0.5, f"{label}: no simulation\n{run.note}", ha="center",
                               va="center", wrap=True, transform=axes[0, col].transAxes)
             continue
         plot_reactions(run.trajectory, ax=axes[0, col], title=f"forces on the ground, {label}",
-                       original=run.original)
+                       original=run.original, clip_spikes=free)
         plot_shaking_moment(run.trajectory, run.original, ax=axes[1, col],
-                            title=f"shaking moment, {label}")
+                            title=f"shaking moment, {label}", clip_spikes=free)
         plot_com_path(design.mechanism, run.trajectory, design.original, run.original,
                       ax=axes[2, col])
         axes[2, col].set_title(f"path of the total centre of mass, {label}")

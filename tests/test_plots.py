@@ -617,3 +617,65 @@ def test_the_animation_carries_each_centre_of_mass_and_counterweight_with_its_li
         centres = sorted(d.get_center() for d in discs)
         expected = sorted((c[k].real, c[k].imag) for c, _ in paths.values())
         np.testing.assert_allclose(centres, expected, rtol=0, atol=1e-12)
+
+
+# --- verify's figure: coinciding curves both visible, spikes clipped and said so ---------
+
+
+@pytest.fixture(scope="module")
+def watt_balanced(tmp_path_factory):
+    out = tmp_path_factory.mktemp("watt") / "balanced.toml"
+    assert main(["optimize", str(EXAMPLES / "watt_sixbar.toml"), "--out", str(out),
+                 "--no-verify", "--backend", "convex", "--json"]) == 0
+    return out
+
+
+def test_a_curve_that_coincides_with_another_is_drawn_over_it_visibly(pb1_balanced):
+    # A force-balanced four-bar's ground reactions are equal and opposite: |R_A0| = |R_A3|
+    # after balancing, one curve exactly on the other. The later one is drawn on top, dashed
+    # and thinner, and its legend entry says which one it hides.
+    design = load_design(pb1_balanced)
+    v = _verify(pb1_balanced, duration=0.3)
+    fig = plots.verification_figure(design, v)
+    forces = fig.axes[0]
+    lines = {line.get_label(): line for line in _lines(forces)}
+    (a3,) = (line for name, line in lines.items() if name.startswith("$|R_{A3}|$, after"))
+    a0 = lines["$|R_{A0}|$, after"]
+    np.testing.assert_allclose(a3.get_ydata(), a0.get_ydata(), rtol=1e-9, atol=1e-9)
+    assert "coincides with $|R_{A0}|$, after" in a3.get_label()
+    assert a3.get_linestyle() != "-" and a3.get_linewidth() < a0.get_linewidth()
+    assert a3.get_zorder() > a0.get_zorder()
+    legend = [t.get_text() for t in forces.get_legend().get_texts()]
+    assert a3.get_label() in legend
+    # Curves that differ keep their own style.
+    assert lines["$|R_{A0}|$, before"].get_label() == "$|R_{A0}|$, before"
+
+
+def test_free_motion_spikes_are_clipped_and_marked_not_squashing_the_rest(watt_balanced):
+    # The Watt six-bar's free motion passes near a toggle: brief spikes of the forces on the
+    # ground some 30 times the rest of the motion. The axes are set on the bulk of the samples
+    # (most of every curve visible); the spikes are marked at the edge and their size given.
+    design = load_design(watt_balanced)
+    v = _verify(watt_balanced, duration=1.0)
+    fig = plots.verification_figure(design, v)
+    axes = np.array(fig.axes).reshape(3, 2)
+    for ax, unit in ((axes[0, 1], "N"), (axes[1, 1], "N·m")):
+        curves = _lines(ax)
+        values = np.concatenate([line.get_ydata() for line in curves])
+        low, high = ax.get_ylim()
+        inside = (values >= low) & (values <= high)
+        assert high < np.max(values)  # clipped
+        assert np.mean(inside) > 0.95
+        assert high - low < 0.25 * np.ptp(values)  # the bulk is no longer squashed
+        marks = [line for line in ax.get_lines() if line.get_label().startswith("clipped")]
+        (mark,) = marks
+        peak = np.max(np.abs(values))
+        assert f"{plots._number(peak)} {unit}" in mark.get_label()
+        labels = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert mark.get_label() in labels
+    # The driven run has no spikes: its axes hold every sample.
+    for ax in axes[:2, 0]:
+        values = np.concatenate([line.get_ydata() for line in _lines(ax)])
+        low, high = ax.get_ylim()
+        assert low <= np.min(values) and np.max(values) <= high
+        assert not [line for line in ax.get_lines() if line.get_label().startswith("clipped")]
