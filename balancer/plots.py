@@ -970,13 +970,18 @@ def _key_value(key: str, value: float) -> str:
     return f"{key} = {value:.4g} {key_unit(key)}".rstrip()
 
 
+#: How far inside the frame (a fraction of the axes) a point beyond the limits is marked.
+EDGE_INSET = 0.08
+
+
 def _mark_point(ax: Axes, x: float, y: float, label: str, where: str, **style):
     """Mark the point ``(x, y)`` (data) on ``ax`` labelled ``label``, keeping its limits.
 
-    Inside the limits: a marker of ``style`` there. Outside: the marker just inside the frame
-    on the line from the axes' centre towards the point, an arrow from it to the frame
-    pointing the point's way, and ``where`` (the point's coordinates, with units) beside it.
-    Returns the marker (a ``Line2D``, for a legend).
+    Inside the limits: a marker of ``style`` there. Outside: the marker where the point would
+    be with each coordinate beyond the limits brought :data:`EDGE_INSET` inside the frame (a
+    coordinate within its limits stays exact), an arrow from it to the frame pointing the
+    point's way, and ``where`` (the point's coordinates, with units) beside it. Returns the
+    marker (a ``Line2D``, for a legend).
     """
     xlim, ylim = ax.get_xlim(), ax.get_ylim()
     u = (x - xlim[0]) / (xlim[1] - xlim[0])
@@ -984,23 +989,23 @@ def _mark_point(ax: Axes, x: float, y: float, label: str, where: str, **style):
     if 0.0 <= u <= 1.0 and 0.0 <= v <= 1.0:
         (marker,) = ax.plot([x], [y], linestyle="none", label=label, zorder=6, **style)
     else:
-        d = np.array([u - 0.5, v - 0.5])
-        reach = 0.5 / np.max(np.abs(d))  # from the centre to the frame along d
-        frame_point = 0.5 + reach * d
-        inside = 0.5 + (reach - 0.09 / np.linalg.norm(d)) * d
+        inside = np.clip([u, v], EDGE_INSET, 1.0 - EDGE_INSET)
+        d = np.array([u, v]) - inside
+        d /= np.linalg.norm(d)
+        reach = min((1.0 - inside[i]) / d[i] if d[i] > 0 else -inside[i] / d[i]
+                    for i in (0, 1) if d[i] != 0)
         (marker,) = ax.plot([inside[0]], [inside[1]], linestyle="none", transform=ax.transAxes,
                             label=f"{label} (off the axes: arrow)", zorder=6, clip_on=False,
                             **style)
-        ax.annotate("", xy=frame_point, xytext=inside, xycoords="axes fraction",
+        ax.annotate("", xy=inside + reach * d, xytext=inside, xycoords="axes fraction",
                     arrowprops={"arrowstyle": "-|>", "color": style.get("mec", "k"),
                                 "lw": 1.2, "shrinkA": 7, "shrinkB": 0})
-        inward = -d / np.linalg.norm(d)
-        ax.annotate(where, xy=inside, xycoords="axes fraction", xytext=12 * inward,
+        ax.annotate(where, xy=inside, xycoords="axes fraction", xytext=-12 * d,
                     textcoords="offset points", fontsize="small",
                     bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
                           "alpha": 0.8},
-                    ha="left" if inward[0] > 0.3 else "right" if inward[0] < -0.3 else "center",
-                    va="bottom" if inward[1] > 0.3 else "top" if inward[1] < -0.3 else "center")
+                    ha="right" if d[0] > 0.3 else "left" if d[0] < -0.3 else "center",
+                    va="top" if d[1] > 0.3 else "bottom" if d[1] < -0.3 else "center")
     ax.set_xlim(xlim)
     ax.set_ylim(ylim)
     return marker

@@ -430,6 +430,11 @@ def test_an_original_outside_the_swept_ranges_is_an_arrow_at_the_edge(tmp_path):
     assert limits[1] < 4.0  # the map keeps the swept ranges
     assert any(t.arrow_patch is not None for t in ax.texts)
     assert any(f"{FRAME} = 4.5 m" in t.get_text() for t in ax.texts)
+    # The marker keeps the coordinate that lies within the limits: the coupler's 3.0 m.
+    (mark,) = (line for line in ax.get_lines() if line.get_label().startswith("original"))
+    (x0, x1) = ax.get_xlim()
+    assert mark.get_xdata()[0] == pytest.approx((3.0 - x0) / (x1 - x0))
+    assert mark.get_ydata()[0] == pytest.approx(1.0 - plots.EDGE_INSET)
 
 
 def test_one_varied_key_has_its_unit_and_the_original_and_no_design_points(tmp_path):
