@@ -268,9 +268,14 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
     text = (dumps_json(front_json(front, spec=args.spec)) if args.json
             else front_text(front, spec=args.spec) + "\n")
     if plot is not None:
+        from .balance.conditions import RESIDUAL_FLOOR, force_balance_residual
+        from .mechanisms import mechanism_of
         from .plots import front_figure, save_figure
 
-        save_figure(front_figure(front, title=design.title), plot)
+        balanced = force_balance_residual(mechanism_of(design.mechanism)) <= RESIDUAL_FLOOR
+        save_figure(front_figure(front, title=design.title,
+                                 force_balance=design.balance.force_balance,
+                                 original_force_balanced=balanced), plot)
     if csv_path is not None:
         write_atomic(csv_path, csv)
     sys.stdout.write(text)
@@ -303,8 +308,12 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                        progress=progress)
     if plot is not None:
         from .plots import save_figure, sweep_figure
+        from .sweeps import spec_values
 
-        save_figure(sweep_figure(result.out, [v.key for v in varies] or None), plot)
+        keys = [v.key for v in varies]
+        original = spec_values(args.spec, keys or [p.key for p in perturbs])
+        save_figure(sweep_figure(result.out, keys or None, original=original,
+                                 perturbs=perturbs), plot)
     sys.stdout.write(dumps_json(result.as_dict()) if args.json
                      else sweep_text(result, spec=args.spec) + "\n")
     return 0

@@ -107,6 +107,36 @@ def _value(data: dict[str, Any], key: str) -> float:
     return float(node[index])
 
 
+def spec_values(spec: str | os.PathLike[str], keys: Sequence[str]) -> dict[str, float]:
+    """The spec's own value of each dotted key: where its design lies among a sweep's points."""
+    import tomllib
+
+    data = tomllib.loads(Path(spec).read_text(encoding="utf-8-sig"))
+    return {key: _value(data, key) for key in keys}
+
+
+#: The unit of a spec key by its last name (list indices skipped): SI, as the spec takes them.
+KEY_UNITS = {"mass": "kg", "inertia": "kg·m²", "counter_rotor": "kg·m²",
+             "e": "m", "f": "m", "s": "m", "at": "m", "com_radius": "m", "min_gyration": "m",
+             "radius": "m", "gyration": "m", "free_length": "m", "sigma": "rad",
+             "theta1": "rad", "speed": "rad/s", "omega1": "rad/s", "force": "N",
+             "moment": "N·m", "stiffness": "N/m", "gravity": "m/s²", "duration": "s"}
+
+
+def key_unit(key: str) -> str:
+    """The unit of the number a dotted spec key names (``""`` if it has none, or is unknown).
+
+    Every entry of ``mechanism.lengths`` and ``mechanism.points`` is a length (m); otherwise
+    :data:`KEY_UNITS` by the key's last name (``links.crank.com.s`` m, ``links.crank.mass``
+    kg, ``balance.crank.mass.1`` kg, ``links.crank.force.0`` N).
+    """
+    parts = key.split(".")
+    if parts[:2] in (["mechanism", "lengths"], ["mechanism", "points"]):
+        return "m"
+    names = [part for part in parts if not part.isdigit()]
+    return KEY_UNITS.get(names[-1], "") if names else ""
+
+
 def analyse_point(data: dict[str, Any], values: dict[str, float], index: int) -> dict:
     """One row of a perturbation sweep: the perturbed design's own figures (no redesign)."""
     from .errors import AssemblyError, LockupError

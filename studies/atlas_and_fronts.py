@@ -8,7 +8,7 @@ force balance, Eq. 57–58); Grashof's condition for which four-bars are crank-r
 
 - **Atlas.** The coupler and the frame of PB1 varied over a grid (``balancer sweep``): at each
   geometry the certified least RMS shaking moment at 10 rad/s with exact force balance, or no
-  design at all where the four-bar is not a crank-rocker. The blank region must be exactly
+  design at all where the four-bar is not a crank-rocker. The hatched region must be exactly
   Grashof's (the crank the shortest link and ``s + l ≤ p + q`` for a crank that turns fully):
   an independent check of the sweep's "bad-geometry" rows.
 - **Fronts** (``balancer pareto``): PB1's least RMS shaking moment against the RMS driving
@@ -27,11 +27,13 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 
+from balancer.balance.conditions import RESIDUAL_FLOOR, force_balance_residual
 from balancer.balance.pareto import pareto_front
+from balancer.mechanisms import mechanism_of
 from balancer.plots import front_figure, save_png, sweep_figure
 from balancer.report import markdown_table
 from balancer.spec import load_design
-from balancer.sweeps import Vary, sweep
+from balancer.sweeps import Vary, spec_values, sweep
 
 NAME = "atlas_and_fronts"
 ROOT = Path(__file__).resolve().parents[1]
@@ -71,15 +73,21 @@ def run(out_dir: Path, quick: bool = False) -> dict:
                 != grashof_crank_rocker(crank, r[KEYS[0]], rocker, r[KEYS[1]])]
     solved = [r for r in rows if r["shaking_moment_after"] is not None]
     best = min(solved, key=lambda r: r["shaking_moment_after"])
-    figures = [save_png(sweep_figure(table_path, list(KEYS)), out_dir / "atlas.png")]
-    fronts = {
-        "PB1 against driving torque": pareto_front(design, "driving-torque", points),
-        "PB1 with counterweights against added mass": pareto_front(
-            load_design(PB1_COUNTERWEIGHTS), "added-mass", points),
-    }
+    figures = [save_png(sweep_figure(table_path, list(KEYS), original=spec_values(PB1, KEYS)),
+                        out_dir / "atlas.png")]
+    designs = {"PB1 against driving torque": (design, "driving-torque"),
+               "PB1 with counterweights against added mass": (
+                   load_design(PB1_COUNTERWEIGHTS), "added-mass")}
+    fronts = {title: pareto_front(d, against, points)
+              for title, (d, against) in designs.items()}
     for (title, front), name in zip(fronts.items(), ("front_torque.png", "front_mass.png"),
                                     strict=True):
-        figures.append(save_png(front_figure(front, title=title), out_dir / name))
+        spec = designs[title][0]
+        balanced = force_balance_residual(mechanism_of(spec.mechanism)) <= RESIDUAL_FLOOR
+        figures.append(save_png(front_figure(front, title=title,
+                                             force_balance=spec.balance.force_balance,
+                                             original_force_balanced=balanced),
+                                out_dir / name))
     results = {
         "atlas": atlas, "rows": rows, "grashof_mismatch": len(mismatch), "best": best,
         "fronts": fronts, "figures": figures, "seconds": time.perf_counter() - start,

@@ -359,3 +359,328 @@ def test_counterweights_turn_with_their_links_in_the_animation(tmp_path):
 
     assert main(["plot", str(spec), "--animate", str(out), "--frames", "6"]) == 0
     assert out.read_bytes()[:6] == b"GIF89a"
+
+
+# --- sweep atlases: axes in units, the original marked, no-design cells told apart --------
+
+
+COUPLER, FRAME = "mechanism.lengths.coupler", "mechanism.lengths.frame"
+
+
+def _atlas_table(path, statuses, keys=(COUPLER, FRAME), values=((2.5, 3.0, 3.5), (3.0, 3.2))):
+    """A sweep's table over a grid of ``keys``; the given statuses row by row (those without
+    a balanced design have no ``after``)."""
+    import itertools
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    points = list(itertools.product(*values))
+    rows = [{**dict(zip(keys, p, strict=True)), "point": i, "status": s,
+             "shaking_moment_before": 200.0 + i, "shaking_force_before": 400.0,
+             "shaking_moment_after": 100.0 + i if s == "optimal" else None}
+            for i, (p, s) in enumerate(zip(points, statuses, strict=True))]
+    pq.write_table(pa.Table.from_pylist(rows), path)
+    return path
+
+
+@pytest.mark.parametrize(("key", "unit"), [
+    ("mechanism.lengths.coupler", "m"), ("mechanism.points.B.1", "m"), ("links.crank.com.e", "m"),
+    ("links.crank.com.f", "m"), ("links.rocker.com.s", "m"), ("links.crank.mass", "kg"),
+    ("links.crank.inertia", "kg·m²"), ("links.rocker.counter_rotor", "kg·m²"),
+    ("links.crank.com.sigma", "rad"), ("operation.speed", "rad/s"),
+    ("links.coupler.force.0", "N"), ("links.coupler.moment", "N·m"),
+    ("balance.crank.mass.1", "kg"), ("balance.crank.counterweight.radius", "m"),
+    ("operation.samples", ""), ("balance.objective.driving_torque", "")])
+def test_a_spec_keys_unit_comes_from_the_key(key, unit):
+    from balancer.sweeps import key_unit
+
+    assert key_unit(key) == unit
+
+
+def test_the_atlas_names_its_axes_with_units_marks_the_original_and_tells_empty_cells_apart(
+        tmp_path):
+    from matplotlib.collections import PolyCollection
+
+    statuses = ["bad-geometry", "infeasible", "optimal", "infeasible", "optimal", "optimal"]
+    path = _atlas_table(tmp_path / "atlas.parquet", statuses)
+    fig = plots.sweep_figure(path, [COUPLER, FRAME], original={COUPLER: 3.0, FRAME: 3.2})
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == f"{COUPLER} (m)" and ax.get_ylabel() == f"{FRAME} (m)"
+    # The original design: a marker at the spec's values.
+    marks = [line for line in ax.get_lines() if line.get_label().startswith("original design")]
+    assert len(marks) == 1
+    assert list(marks[0].get_xdata()) == [3.0] and list(marks[0].get_ydata()) == [3.2]
+    # The cells without a design: one hatched layer per status, covering exactly its cells,
+    # and a legend entry for each that a reader tells apart.
+    layers = [c for c in ax.collections if isinstance(c, PolyCollection) and c.get_hatch()]
+    assert sorted(int(np.ma.count(c.get_array())) for c in layers) == [1, 2]
+    assert len({c.get_hatch() for c in layers}) == 2
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert any(label.startswith("infeasible") for label in labels)
+    assert any(label.startswith("bad geometry") for label in labels)
+    assert any(label.startswith("original design") for label in labels)
+
+
+def test_an_original_outside_the_swept_ranges_is_an_arrow_at_the_edge(tmp_path):
+    path = _atlas_table(tmp_path / "atlas.parquet", ["optimal"] * 6)
+    fig = plots.sweep_figure(path, [COUPLER, FRAME], original={COUPLER: 3.0, FRAME: 4.5})
+    ax = fig.axes[0]
+    limits = ax.get_ylim()
+    assert limits[1] < 4.0  # the map keeps the swept ranges
+    assert any(t.arrow_patch is not None for t in ax.texts)
+    assert any(f"{FRAME} = 4.5 m" in t.get_text() for t in ax.texts)
+    # The marker keeps the coordinate that lies within the limits: the coupler's 3.0 m.
+    (mark,) = (line for line in ax.get_lines() if line.get_label().startswith("original"))
+    (x0, x1) = ax.get_xlim()
+    assert mark.get_xdata()[0] == pytest.approx((3.0 - x0) / (x1 - x0))
+    assert mark.get_ydata()[0] == pytest.approx(1.0 - plots.EDGE_INSET)
+
+
+def test_one_varied_key_has_its_unit_and_the_original_and_no_design_points(tmp_path):
+    path = _atlas_table(tmp_path / "line.parquet", ["bad-geometry", "infeasible", "optimal"],
+                        keys=("links.crank.mass",), values=((2.0, 3.0, 4.0),))
+    fig = plots.sweep_figure(path, ["links.crank.mass"], original={"links.crank.mass": 2.1})
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "links.crank.mass (kg)"
+    labels = {line.get_label(): line for line in ax.get_lines()}
+    assert "original design: links.crank.mass = 2.1 kg" in labels
+    assert list(labels["original design: links.crank.mass = 2.1 kg"].get_xdata()) == [2.1, 2.1]
+    missing = [line for name, line in labels.items()
+               if name.startswith(("infeasible", "bad geometry"))]
+    assert sorted(float(line.get_xdata()[0]) for line in missing) == [2.0, 3.0]
+
+
+def test_a_scattered_atlas_marks_the_points_without_a_design(tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    rows = [{COUPLER: c, FRAME: f, "point": i, "status": s, "shaking_moment_before": 1.0,
+             "shaking_force_before": 1.0, "shaking_moment_after": 1.0 if s == "optimal" else None}
+            for i, (c, f, s) in enumerate([(2.1, 3.0, "optimal"), (2.6, 3.3, "infeasible"),
+                                           (3.4, 2.9, "bad-geometry"), (3.0, 3.1, "optimal")])]
+    pq.write_table(pa.Table.from_pylist(rows), tmp_path / "lhs.parquet")
+    fig = plots.sweep_figure(tmp_path / "lhs.parquet", [COUPLER, FRAME],
+                             original={COUPLER: 3.0, FRAME: 3.2})
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert [label.split(":")[0] for label in labels] == ["infeasible", "bad geometry",
+                                                         "original design"]
+
+
+def test_the_sweep_command_marks_the_specs_design_on_its_atlas(tmp_path, monkeypatch, capsys):
+    drawn = []
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path: drawn.append(fig))
+    out = tmp_path / "atlas.parquet"
+    assert main(["sweep", str(EXAMPLES / "pb1.toml"), "--vary", f"{COUPLER}=2.6:3.4:2",
+                 "--vary", f"{FRAME}=3.0:3.4:2", "--out", str(out), "--workers", "0",
+                 "--plot", str(tmp_path / "atlas.png"), "--json"]) == 0
+    capsys.readouterr()
+    (ax, *_), = (fig.axes for fig in drawn)
+    (mark,) = (line for line in ax.get_lines() if line.get_label().startswith("original"))
+    assert list(mark.get_xdata()) == [3.0] and list(mark.get_ydata()) == [3.2]
+
+
+def test_the_tolerance_histogram_names_the_key_its_sigma_and_the_draws(tmp_path, monkeypatch,
+                                                                        capsys, pb1_balanced):
+    drawn = []
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path: drawn.append(fig))
+    assert main(["sweep", str(pb1_balanced), "--perturb", "links.crank.mass=0.01",
+                 "--samples", "30", "--out", str(tmp_path / "p.parquet"), "--workers", "0",
+                 "--plot", str(tmp_path / "hist.png"), "--json"]) == 0
+    capsys.readouterr()
+    (fig,) = drawn
+    title = fig.axes[0].get_title()
+    assert "links.crank.mass = 2.1 kg" in title and "σ = 0.01 kg" in title
+    assert "30 designs drawn" in title
+    assert fig.axes[0].get_xlabel().endswith("(N)")
+
+
+# --- trade-off fronts: the axes on the front, the original marked and explained -----------
+
+
+def _front_figure_of(tmp_path, monkeypatch, capsys, spec, against):
+    drawn = []
+    monkeypatch.setattr(plots, "save_figure", lambda fig, path: drawn.append(fig))
+    assert main(["pareto", str(spec), "--against", against, "--points", "5", "--plot",
+                 str(tmp_path / "front.png"), "--json"]) == 0
+    import json
+
+    doc = json.loads(capsys.readouterr().out)
+    (fig,) = drawn
+    return fig, doc
+
+
+def _legend_texts(fig):
+    return [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+
+
+def test_a_front_far_from_the_original_keeps_the_axes_on_the_front(tmp_path, monkeypatch,
+                                                                   capsys):
+    # PB2's front reaches zero shaking moment with a driving torque of a few N·m; the original
+    # (not force-balanced) lies at some 150 N·m and 215 N·m, far outside it.
+    fig, doc = _front_figure_of(tmp_path, monkeypatch, capsys, EXAMPLES / "pb2.toml",
+                                "driving-torque")
+    ax = fig.axes[0]
+    xs = [p["driving_torque"] for p in doc["points"]]
+    ys = [max(p["shaking_moment"], p["lower_bound"]) for p in doc["points"]]
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    assert x0 <= min(xs) and max(xs) <= x1 and y0 <= min(ys) and max(ys) <= y1
+    # The front fills the axes: they reach no more than a third beyond it each way.
+    assert x1 - x0 <= 1.34 * (max(xs) - min(xs)) and y1 <= 1.34 * max(ys)
+    original = doc["original"]
+    assert original["driving_torque"] > x1 and original["shaking_moment"] > y1
+    # The original is marked at the edge by an arrow that gives its coordinates.
+    (arrow,) = (t for t in ax.texts if t.arrow_patch is not None and not t.get_text())
+    (where,) = (t for t in ax.texts if "original design" in t.get_text())
+    assert f"{original['shaking_moment']:.3g}" in where.get_text()
+    labels = _legend_texts(fig)
+    assert any(label.startswith("original design") and "not force-balanced" in label
+               for label in labels)
+    assert any("force-balanced" in label for label in labels if label.startswith("least"))
+
+
+def test_an_original_within_reach_of_the_front_is_drawn_where_it_is(tmp_path, monkeypatch,
+                                                                    capsys):
+    fig, doc = _front_figure_of(tmp_path, monkeypatch, capsys, EXAMPLES / "pb1.toml",
+                                "driving-torque")
+    ax = fig.axes[0]
+    (mark,) = (line for line in ax.get_lines() if line.get_label().startswith("original"))
+    original = doc["original"]
+    assert list(mark.get_xdata()) == [original["driving_torque"]]
+    assert list(mark.get_ydata()) == [original["shaking_moment"]]
+    assert "not force-balanced" in mark.get_label()
+    assert not [t for t in ax.texts if t.arrow_patch is not None]
+
+
+# --- animations: a title inside the picture, the crank angle, what the balancing added ----
+
+
+def _drawn_animation(design, frames, **kw):
+    fig, update = plots.animation_figure(design.mechanism, frames=frames, title=design.title,
+                                         **kw)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return fig, update, canvas.get_renderer()
+
+
+def test_the_animations_title_lies_inside_the_picture(pb1_balanced):
+    design = load_design(pb1_balanced)  # PB1's title is long for a 6-inch animation
+    fig, _, renderer = _drawn_animation(design, 4)
+    box, page = fig.axes[0].title.get_window_extent(renderer), fig.bbox
+    assert fig.axes[0].title.get_text().replace("\n", " ") == design.title
+    assert page.x0 <= box.x0 and box.x1 <= page.x1 and page.y0 <= box.y0 and box.y1 <= page.y1
+
+
+def test_the_animation_reads_the_crank_angle_of_every_frame():
+    design = load_design(EXAMPLES / "watt_sixbar.toml")
+    fig, update, _ = _drawn_animation(design, 8)
+    readouts = []
+    for k in range(8):
+        (text,) = (a for a in update(k) if hasattr(a, "get_text"))
+        readouts.append(text.get_text())
+    assert readouts[0].endswith("θ1 =   0.0°") and readouts[2].endswith("θ1 =  90.0°")
+    assert len(set(readouts)) == 8
+
+
+def test_the_animation_carries_each_centre_of_mass_and_counterweight_with_its_link(
+        pb1_balanced):
+    """PB1's balanced crank and rocker keep their masses and move their centres of mass off
+    the links: each is drawn on an arm from a point of its link, at the same distance from it
+    in every frame; a spec with counterweights draws their discs where they are carried."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Circle
+
+    import balancer
+    from balancer.balance.counterweights import counterweights
+
+    design = load_design(pb1_balanced)
+    frames = 6
+    weights = counterweights(design.original, design.mechanism)
+    fig, update, _ = _drawn_animation(design, frames, counterweights=weights)
+    _, coms, _ = plots.drawing_frames(design.mechanism, frames)
+    reach = {}  # per link: the length of its centre of mass's arm
+    for k in range(frames):
+        arms = [a.get_xydata() for a in update(k) if isinstance(a, Line2D)
+                and a.get_color() == plots.COLOURS["com"] and a.get_linestyle() == "-"]
+        for name, path in coms.items():
+            (arm,) = (xy for xy in arms if abs(complex(*xy[1]) - path[k]) < 1e-12)
+            length = reach.setdefault(name, np.hypot(*(arm[1] - arm[0])))
+            assert np.hypot(*(arm[1] - arm[0])) == pytest.approx(length, rel=1e-9)
+    assert reach["crank"] > 0.3 and reach["rocker"] > 0.3  # off the links
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert any(label.startswith("rebuilt") and "crank" in label for label in labels)
+    # Counterweights added to the paper's links: discs that move with them.
+    cw = balancer.example("pb1_counterweights")
+    result = balancer.optimize(cw, backend="convex")
+    balanced = result.balanced_design(cw)
+    fig, update, _ = _drawn_animation(balanced, frames, counterweights=result.counterweights)
+    paths = plots.counterweight_paths(balanced.mechanism, result.counterweights, frames)
+    discs = [p for p in fig.axes[0].patches if isinstance(p, Circle)]
+    assert len(discs) == len(paths) == 2
+    for k in (0, 3):
+        update(k)
+        centres = sorted(d.get_center() for d in discs)
+        expected = sorted((c[k].real, c[k].imag) for c, _ in paths.values())
+        np.testing.assert_allclose(centres, expected, rtol=0, atol=1e-12)
+
+
+# --- verify's figure: coinciding curves both visible, spikes clipped and said so ---------
+
+
+@pytest.fixture(scope="module")
+def watt_balanced(tmp_path_factory):
+    out = tmp_path_factory.mktemp("watt") / "balanced.toml"
+    assert main(["optimize", str(EXAMPLES / "watt_sixbar.toml"), "--out", str(out),
+                 "--no-verify", "--backend", "convex", "--json"]) == 0
+    return out
+
+
+def test_a_curve_that_coincides_with_another_is_drawn_over_it_visibly(pb1_balanced):
+    # A force-balanced four-bar's ground reactions are equal and opposite: |R_A0| = |R_A3|
+    # after balancing, one curve exactly on the other. The later one is drawn on top, dashed
+    # and thinner, and its legend entry says which one it hides.
+    design = load_design(pb1_balanced)
+    v = _verify(pb1_balanced, duration=0.3)
+    fig = plots.verification_figure(design, v)
+    forces = fig.axes[0]
+    lines = {line.get_label(): line for line in _lines(forces)}
+    (a3,) = (line for name, line in lines.items() if name.startswith("$|R_{A3}|$, after"))
+    a0 = lines["$|R_{A0}|$, after"]
+    np.testing.assert_allclose(a3.get_ydata(), a0.get_ydata(), rtol=1e-9, atol=1e-9)
+    assert "coincides with $|R_{A0}|$, after" in a3.get_label()
+    assert a3.get_linestyle() != "-" and a3.get_linewidth() < a0.get_linewidth()
+    assert a3.get_zorder() > a0.get_zorder()
+    legend = [t.get_text() for t in forces.get_legend().get_texts()]
+    assert a3.get_label() in legend
+    # Curves that differ keep their own style.
+    assert lines["$|R_{A0}|$, before"].get_label() == "$|R_{A0}|$, before"
+
+
+def test_free_motion_spikes_are_clipped_and_marked_not_squashing_the_rest(watt_balanced):
+    # The Watt six-bar's free motion passes near a toggle: brief spikes of the forces on the
+    # ground some 30 times the rest of the motion. The axes are set on the bulk of the samples
+    # (most of every curve visible); the spikes are marked at the edge and their size given.
+    design = load_design(watt_balanced)
+    v = _verify(watt_balanced, duration=1.0)
+    fig = plots.verification_figure(design, v)
+    axes = np.array(fig.axes).reshape(3, 2)
+    for ax, unit in ((axes[0, 1], "N"), (axes[1, 1], "N·m")):
+        curves = _lines(ax)
+        values = np.concatenate([line.get_ydata() for line in curves])
+        low, high = ax.get_ylim()
+        inside = (values >= low) & (values <= high)
+        assert high < np.max(values)  # clipped
+        assert np.mean(inside) > 0.95
+        assert high - low < 0.25 * np.ptp(values)  # the bulk is no longer squashed
+        marks = [line for line in ax.get_lines() if line.get_label().startswith("clipped")]
+        (mark,) = marks
+        peak = np.max(np.abs(values))
+        assert f"{plots._number(peak)} {unit}" in mark.get_label()
+        labels = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert mark.get_label() in labels
+    # The driven run has no spikes: its axes hold every sample.
+    for ax in axes[:2, 0]:
+        values = np.concatenate([line.get_ydata() for line in _lines(ax)])
+        low, high = ax.get_ylim()
+        assert low <= np.min(values) and np.max(values) <= high
+        assert not [line for line in ax.get_lines() if line.get_label().startswith("clipped")]
