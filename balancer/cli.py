@@ -1,7 +1,8 @@
 """The ``balancer`` command: a thin layer over the Python API.
 
-Exit codes: 0 success; 2 bad input (spec or arguments); 1 a computation that fails. Every error
-is one line on stderr naming the cause and where; never a traceback for a user error. Heavy
+Exit codes: 0 success; 2 bad input (spec or arguments); 1 a computation that fails; 130
+interrupted (SIGINT, Ctrl-C, at any moment: :mod:`balancer.interrupts`). Every error is one
+line on stderr naming the cause and where; never a traceback for a user error. Heavy
 libraries (SciPy's integrators, CVXPY, CasADi, matplotlib) are imported only by the commands that
 use them.
 """
@@ -600,7 +601,40 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; return the exit code."""
+    """Run the command line; return the exit code.
+
+    A SIGINT at any moment of the command — also one a library swallowed, or one that came
+    while an error was being reported — ends it with exit code 130 and the one line
+    ``balancer: interrupted`` (:mod:`balancer.interrupts`).
+    """
+    from . import interrupts
+
+    with interrupts.handling():
+        try:
+            try:
+                code, line = _run(argv)
+            except KeyboardInterrupt as exc:
+                code, line = 130, _interrupted(exc)
+            with interrupts.shielded():  # from here on a SIGINT only counts
+                if code != 130 and interrupts.received():
+                    code, line = 130, _interrupted(None)
+                if line:
+                    print(line, file=sys.stderr)
+        except KeyboardInterrupt:  # a second one, before the shield was up
+            with interrupts.shielded():
+                code = 130
+                print(_interrupted(None), file=sys.stderr)
+    return code
+
+
+def _interrupted(exc: KeyboardInterrupt | None) -> str:
+    """The line that says the command was interrupted (and what it kept, if it says)."""
+    what = str(exc) if exc is not None else ""
+    return f"balancer: interrupted: {what}" if what else "balancer: interrupted"
+
+
+def _run(argv: Sequence[str] | None) -> tuple[int, str | None]:
+    """Parse and run the command: its exit code and the error line to print, if any."""
     parser = build_parser()
     args = None
     try:
@@ -611,7 +645,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         # before they are written (report.dumps_json, report.csv_text).
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return handler(args)
+            return handler(args), None
     except BalancerError as exc:
         spec = getattr(args, "spec", None)
         if (isinstance(exc, SpecError) and not isinstance(exc, OutputError)
@@ -620,22 +654,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         message = str(exc)
         if not isinstance(exc, SpecError) and spec and spec not in message:
             message = f"{spec}: {message}"  # a failed computation: name the file it concerns
-        print(f"balancer: error: {_one_line(message)}", file=sys.stderr)
-        return exc.exit_code
-    except KeyboardInterrupt:
-        print("balancer: interrupted", file=sys.stderr)
-        return 130
+        return exc.exit_code, f"balancer: error: {_one_line(message)}"
     except BrokenPipeError:
-        return 0
+        return 0, None
     except MemoryError:
-        print("balancer: error: out of memory (ask for fewer samples or outputs)",
-              file=sys.stderr)
-        return 1
+        return 1, "balancer: error: out of memory (ask for fewer samples or outputs)"
     except Exception as exc:  # a defect of ours: one line, never a traceback for the user
         where = _innermost(exc)
-        print(f"balancer: internal error: {type(exc).__name__}: {_one_line(str(exc))} "
-              f"({where}); please report it with the spec", file=sys.stderr)
-        return 1
+        return 1, (f"balancer: internal error: {type(exc).__name__}: {_one_line(str(exc))} "
+                   f"({where}); please report it with the spec")
 
 
 def _one_line(text: str) -> str:
@@ -662,6 +689,17 @@ def entry_point() -> None:
     machine, and a small QR took 150 ms threaded against 1 ms on one thread. Set before numpy
     is imported; a sweep's worker processes inherit it (one worker per core). The results are
     the same either way.
+
+    A SIGINT from the moment this runs until the process ends gives exit code 130.
     """
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    sys.exit(main())
+    from . import interrupts
+
+    # main() handles SIGINT itself; one that comes just before or after it is counted (and
+    # decides the exit code), never raised as a traceback.
+    with interrupts.handling(), interrupts.shielded():
+        code = main()
+        if interrupts.closing() and code != 130:
+            print(_interrupted(None), file=sys.stderr)
+            code = 130
+    sys.exit(code)
