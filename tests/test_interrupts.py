@@ -1,17 +1,19 @@
 """Ctrl-C: a SIGINT at any moment ends a command with exit code 130 and one line on stderr.
 
 Each test runs the command in a child process and sends it a real SIGINT once it is at work
-(it has used a second of CPU); nothing here measures time.
+(it has used a second of CPU, or written a sweep's first part); nothing here measures time.
 """
 
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
 from pathlib import Path
 
+import pyarrow.parquet as pq
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -154,3 +156,54 @@ print("returned", solution.stage.solver_status, file=sys.stderr)
     out, err = proc.communicate(timeout=900)
     assert proc.returncode == 130, err
     assert err.strip() == "interrupted"
+
+
+def _group(pgid: int) -> list[tuple[str, str]]:
+    """The live processes of a process group: ``(pid, command line)``."""
+    members = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            fields = _stat(int(entry.name))
+            command = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except (OSError, ValueError):
+            continue
+        if int(fields[2]) == pgid and fields[0] != "Z":
+            members.append((entry.name, command))
+    return members
+
+
+def _rows(parts: Path) -> int:
+    return sum(pq.read_metadata(p).num_rows for p in parts.glob("batch-*.parquet"))
+
+
+@pytest.mark.parametrize("workers", ["2", "0"])
+def test_ctrl_c_on_a_sweep_says_what_it_kept_and_resume_finishes_it(tmp_path, workers):
+    """Ctrl-C at a terminal reaches the whole process group, the local cluster's worker
+    processes too. The sweep says in one line how many points it kept, where, and how to
+    finish; no traceback, no Dask log; the workers are gone when it exits; exit 130. Then the
+    same command with --resume finishes the table."""
+    out = tmp_path / "a.parquet"
+    parts = tmp_path / "a.parquet.parts"
+    args = ["sweep", PB1, "--vary", "mechanism.lengths.coupler=2:4:20", "--vary",
+            "mechanism.lengths.frame=2.5:3.5:20", "--out", out, "--workers", workers,
+            "--batch", "10"]
+    proc = _start(args, session=True)
+    code, stdout, err = _interrupt(proc, lambda: any(parts.glob("batch-*.parquet")),
+                                   group=True)
+    assert code == 130, err
+    assert stdout == ""
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    match = re.fullmatch(r"balancer: interrupted: (\d+) of 400 points kept in (.+); run the "
+                         r"same command with --resume to finish", lines[0])
+    assert match, lines[0]
+    assert int(match[1]) == _rows(parts) >= 10 and Path(match[2]) == parts
+    # multiprocessing's resource tracker leaves by itself once its parent has gone.
+    left = [m for m in _group(proc.pid) if "resource_tracker" not in m[1]]
+    assert left == []
+    done = subprocess.run([sys.executable, "-m", "balancer", *map(str, args), "--resume"],
+                          capture_output=True, text=True, env=_env(), check=False)
+    assert done.returncode == 0, done.stderr
+    assert pq.read_table(out).column("point").to_pylist() == list(range(400))
