@@ -362,7 +362,27 @@ class SweepInterrupted(KeyboardInterrupt):
 
 @dataclass(frozen=True)
 class SweepResult:
-    """What a sweep did: the table's path, its rows' statuses, and how long it took."""
+    """What a sweep did: the table's path, its rows' statuses, and how long it took.
+
+    Attributes
+    ----------
+    out
+        The table written.
+    points
+        Its rows: every point of the sweep.
+    statuses
+        Rows by status.
+    seconds
+        Wall time of this run, s.
+    workers
+        Dask workers used (0: in this process).
+    resumed
+        Batches finished by the interrupted runs before this one (``resume``).
+    computed
+        Points computed by this run: ``points`` less those of the ``resumed`` batches.
+    residual_force
+        A perturbation sweep's residual RMS shaking force (``mean``, ``p95``, ``max``, N).
+    """
 
     out: Path
     points: int
@@ -370,14 +390,20 @@ class SweepResult:
     seconds: float
     workers: int
     resumed: int
+    computed: int
     residual_force: dict[str, float] | None = None
+
+    @property
+    def rate(self) -> float | None:
+        """Points computed per second of this run (``None``: no time, or none computed)."""
+        return self.computed / self.seconds if self.seconds > 0 and self.computed else None
 
     def as_dict(self) -> dict[str, Any]:
         """The ``sweep --json`` summary."""
         return {"out": str(self.out), "points": self.points, "statuses": self.statuses,
                 "seconds": self.seconds, "workers": self.workers,
                 "resumed_batches": self.resumed,
-                "points_per_second": self.points / self.seconds if self.seconds else None,
+                "points_per_second": self.rate,
                 **({"residual_shaking_force": self.residual_force}
                    if self.residual_force is not None else {})}
 
@@ -531,6 +557,7 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
                         "max": float(force.max()), "unit": "N (RMS over a revolution)"}
     return SweepResult(out=out, points=len(points), statuses=statuses,
                        seconds=time.perf_counter() - start, workers=used, resumed=len(done),
+                       computed=len(points) - sum(len(batches[i]) for i in done),
                        residual_force=residual)
 
 

@@ -159,7 +159,7 @@ print("returned", solution.stage.solver_status, file=sys.stderr)
 
 
 def _group(pgid: int) -> list[tuple[str, str]]:
-    """The live processes of a process group: ``(pid, command line)``."""
+    """The live processes of a process group: ``(pid, command line)`` (a zombie is dead)."""
     members = []
     for entry in Path("/proc").iterdir():
         if not entry.name.isdigit():
@@ -190,8 +190,15 @@ def test_ctrl_c_on_a_sweep_says_what_it_kept_and_resume_finishes_it(tmp_path, wo
             "mechanism.lengths.frame=2.5:3.5:20", "--out", out, "--workers", workers,
             "--batch", "10"]
     proc = _start(args, session=True)
-    code, stdout, err = _interrupt(proc, lambda: any(parts.glob("batch-*.parquet")),
-                                   group=True)
+    workers_seen: list[str] = []
+
+    def ready() -> bool:  # the first part written; the worker processes, as they are then
+        if not any(parts.glob("batch-*.parquet")):
+            return False
+        workers_seen[:] = [pid for pid, command in _group(proc.pid) if "spawn_main" in command]
+        return True
+
+    code, stdout, err = _interrupt(proc, ready, group=True)
     assert code == 130, err
     assert stdout == ""
     lines = err.splitlines()
@@ -200,10 +207,11 @@ def test_ctrl_c_on_a_sweep_says_what_it_kept_and_resume_finishes_it(tmp_path, wo
                          r"same command with --resume to finish", lines[0])
     assert match, lines[0]
     assert int(match[1]) == _rows(parts) >= 10 and Path(match[2]) == parts
-    # multiprocessing's resource tracker leaves by itself once its parent has gone.
-    left = [m for m in _group(proc.pid) if "resource_tracker" not in m[1]]
-    assert left == []
+    assert len(workers_seen) == int(workers)
+    assert not [pid for pid, _ in _group(proc.pid) if pid in workers_seen]  # none left
     done = subprocess.run([sys.executable, "-m", "balancer", *map(str, args), "--resume"],
                           capture_output=True, text=True, env=_env(), check=False)
     assert done.returncode == 0, done.stderr
     assert pq.read_table(out).column("point").to_pylist() == list(range(400))
+    assert done.stdout.splitlines()[1].startswith(
+        f"400 points: {match[1]} from the interrupted run before ("), done.stdout
