@@ -54,6 +54,44 @@ def _output_path(args: argparse.Namespace, value: str | None, option: str) -> Pa
     return path
 
 
+#: Figure and animation types by extension: :data:`balancer.plots.FIGURE_TYPES` and
+#: :data:`balancer.plots.ANIMATION_TYPES`, here so that a path of another type is refused before
+#: matplotlib loads (a test keeps them equal).
+FIGURE_EXTENSIONS: tuple[str, ...] = (".png", ".svg", ".pdf")
+ANIMATION_EXTENSIONS: tuple[str, ...] = (".gif", ".mp4")
+#: Most frames per revolution of an animation: ten a degree, more than any screen shows.
+MAX_FRAMES = 3600
+
+
+def _figure_path(args: argparse.Namespace, value: str | None, option: str,
+                 extensions: tuple[str, ...] = FIGURE_EXTENSIONS) -> Path | None:
+    """An output path for a figure (or animation), checked before any work.
+
+    It must be writable (:func:`_output_path`), and its extension must name a type
+    (:func:`_of_type`).
+    """
+    return _of_type(_output_path(args, value, option), option, extensions)
+
+
+def _of_type(path: Path | None, option: str,
+             extensions: tuple[str, ...] = FIGURE_EXTENSIONS) -> Path | None:
+    """``path``, if its extension is one of ``extensions``; else :class:`OutputError`.
+
+    :func:`balancer.plots.figure_type`'s check and message, without loading matplotlib.
+    """
+    if path is not None and path.suffix.lower() not in extensions:
+        raise OutputError("the file type comes from the extension: use one of "
+                          + ", ".join(extensions), key=option, value=str(path))
+    return path
+
+
+def _as_option(exc: SpecError, key: str, option: str, value: object) -> SpecError:
+    """``exc`` naming the command-line ``option`` that gave the spec ``key`` its ``value``."""
+    if exc.key == key and value is not None:
+        return SpecError(exc.detail, key=option, value=value)
+    return exc
+
+
 #: The CSV files' units (their header keeps the plain names a csv reader expects).
 _CSV_UNITS = ("columns in SI units: t s; theta rad, omega rad/s, alpha rad/s² per link; "
               "R<point>x, R<point>y, N_<link> N; C_<link> N·m; x<k> m, v<k> m/s, a<k> m/s² "
@@ -124,8 +162,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             progress=progress,
         )
     except SpecError as exc:
-        if exc.key in _SIMULATE_OPTIONS and getattr(args, exc.key) is not None:
-            raise SpecError(exc.detail, key=f"--{exc.key}", value=exc.value) from None
+        name = (exc.key or "").removeprefix("simulation.")  # a setting, or the spec's key
+        if name in _SIMULATE_OPTIONS and getattr(args, name) is not None:
+            raise SpecError(exc.detail, key=f"--{name}", value=exc.value) from None
         raise
     finally:
         progress.close()
@@ -145,17 +184,16 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     from .spec import load_design
     from .verification import verify
 
-    plot = _output_path(args, args.plot, "--plot")
-    if plot is not None:
-        from .plots import figure_type
-
-        figure_type(plot, "--plot")
+    plot = _figure_path(args, args.plot, "--plot")
     design = load_design(args.spec)
     from .progress import Progress
 
-    with Progress("verifying by simulation", enabled=not args.json) as progress:
-        verification = verify(design, method=args.method, duration=args.duration,
-                              progress=progress)
+    try:
+        with Progress("verifying by simulation", enabled=not args.json) as progress:
+            verification = verify(design, method=args.method, duration=args.duration,
+                                  progress=progress)
+    except SpecError as exc:
+        raise _as_option(exc, "simulation.duration", "--duration", args.duration) from None
     paths = [] if plot is None else [plot]
     if args.json:
         doc = {"spec": args.spec, **verification.as_dict(), "plots": [str(p) for p in paths]}
@@ -180,6 +218,14 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 
     out = _output_path(args, args.out, "--out")
     design = load_design(args.spec)
+    if not args.no_verify:  # the check at the end refuses nothing after the work
+        from .verification import check_verification
+
+        try:
+            check_verification(design, duration=args.verify_duration)
+        except SpecError as exc:
+            raise _as_option(exc, "simulation.duration", "--verify-duration",
+                             args.verify_duration) from None
     result = optimize(design, backend=args.backend)
     if not result.success:
         raise SolverError(f"the balancing failed: {result.message}")
@@ -191,8 +237,13 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     if not args.no_verify:
         from .progress import Progress
 
-        with Progress("verifying by simulation", enabled=not args.json) as progress:
-            verification = verify(balanced, duration=args.verify_duration, progress=progress)
+        try:
+            with Progress("verifying by simulation", enabled=not args.json) as progress:
+                verification = verify(balanced, duration=args.verify_duration,
+                                      progress=progress)
+        except SpecError as exc:
+            raise _as_option(exc, "simulation.duration", "--verify-duration",
+                             args.verify_duration) from None
     if args.json:
         text = dumps_json(optimization_json(result, before, after, verification,
                                             spec=args.spec, out=out))
@@ -216,12 +267,12 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             os.path.realpath(cycle) == os.path.realpath(animation):
         raise OutputError("names the same file as --cycle", key="--animate",
                           value=args.animate)
-    from .plots import animation_type, figure_type
-
-    if cycle is not None:
-        figure_type(cycle, "--cycle")
+    _of_type(cycle, "--cycle")
+    _of_type(animation, "--animate", ANIMATION_EXTENSIONS)
     if animation is not None:
-        animation_type(animation, "--animate")
+        from .plots import animation_type
+
+        animation_type(animation, "--animate")  # an MP4 needs ffmpeg
     design = load_design(args.spec)
     from .mechanisms import mechanism_of
 
@@ -258,11 +309,7 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
     from .spec import load_design
 
     csv_path = _output_path(args, args.csv, "--csv")
-    plot = _output_path(args, args.plot, "--plot")
-    if plot is not None:
-        from .plots import figure_type
-
-        figure_type(plot, "--plot")
+    plot = _figure_path(args, args.plot, "--plot")
     design = load_design(args.spec)
     front = pareto_front(design, args.against, args.points)
     csv = front_csv(front) if csv_path is not None else None
@@ -291,11 +338,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if not args.out.endswith(".parquet"):
         raise OutputError("must name a .parquet file", key="--out", value=args.out)
     out = _output_path(args, args.out, "--out") if not args.resume else Path(args.out)
-    plot = _output_path(args, args.plot, "--plot")
-    if plot is not None:
-        from .plots import figure_type
-
-        figure_type(plot, "--plot")
+    plot = _figure_path(args, args.plot, "--plot")
     with Progress("sweeping", unit="points", enabled=not args.json) as progress:
         result = sweep(args.spec, varies, out, perturbs=perturbs, method=args.method,
                        samples=args.samples,
@@ -354,6 +397,15 @@ def _gravity(text: str) -> tuple[float, float]:
     if not all(abs(x) < float("inf") for x in (gx, gy)):
         raise argparse.ArgumentTypeError(f"must be two finite numbers GX,GY in m/s²: {text!r}")
     return gx, gy
+
+
+def _frames(text: str) -> int:
+    """Frames per revolution: from 2 to :data:`MAX_FRAMES`."""
+    value = _count(text)
+    if value > MAX_FRAMES:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_FRAMES} frames per "
+                                          f"revolution (ten a degree): {text!r}")
+    return value
 
 
 def _count(text: str) -> int:
@@ -523,8 +575,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write the figure of one revolution to PATH (.png, .svg or .pdf)")
     p.add_argument("--animate", metavar="PATH",
                    help="write an animation to PATH (.gif, or .mp4 with ffmpeg)")
-    p.add_argument("--frames", type=_count, default=72, metavar="N",
-                   help="frames per revolution (default 72)")
+    p.add_argument("--frames", type=_frames, default=72, metavar="N",
+                   help=f"frames per revolution (default 72, at most {MAX_FRAMES})")
     p.set_defaults(handler=_cmd_plot)
 
     p = sub.add_parser(
