@@ -92,6 +92,11 @@ def _as_option(exc: SpecError, key: str, option: str, value: object) -> SpecErro
     return exc
 
 
+def _wrote(path: str | os.PathLike[str]) -> None:
+    """Say on stderr that ``path`` was written: stdout is the report (or the JSON document)."""
+    print(f"wrote {path}", file=sys.stderr)
+
+
 #: The CSV files' units (their header keeps the plain names a csv reader expects).
 _CSV_UNITS = ("columns in SI units: t s; theta rad, omega rad/s, alpha rad/s² per link; "
               "R<point>x, R<point>y, N_<link> N; C_<link> N·m; x<k> m, v<k> m/s, a<k> m/s² "
@@ -132,6 +137,7 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         text = analysis_text(analysis, spec=args.spec) + "\n"
     if csv_path is not None:
         write_atomic(csv_path, csv)
+        _wrote(csv_path)
     sys.stdout.write(text)
     return 0
 
@@ -175,6 +181,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         text = simulation_text(traj, spec=args.spec) + "\n"
     if out is not None:
         write_atomic(out, csv)
+        _wrote(out)
     sys.stdout.write(text)
     return 0
 
@@ -199,11 +206,12 @@ def _cmd_verify(args: argparse.Namespace) -> int:
         doc = {"spec": args.spec, **verification.as_dict(), "plots": [str(p) for p in paths]}
         text = dumps_json(doc)
     else:
-        text = verification_text(verification, spec=args.spec, plots=paths) + "\n"
+        text = verification_text(verification, spec=args.spec) + "\n"
     if plot is not None:
         from .plots import save_figure, verification_figure
 
         save_figure(verification_figure(design, verification), plot)
+        _wrote(plot)
     sys.stdout.write(text)
     return 0
 
@@ -248,10 +256,11 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
         text = dumps_json(optimization_json(result, before, after, verification,
                                             spec=args.spec, out=out))
     else:
-        text = optimization_text(result, before, after, verification, spec=args.spec,
-                                 out=out) + "\n"
+        text = optimization_text(result, before, after, verification,
+                                 spec=args.spec) + "\n"
     if out is not None:
         write_atomic(out, spec_text)
+        _wrote(out)
     sys.stdout.write(text)
     return 0
 
@@ -293,12 +302,12 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             weights = counterweights(design.original, design.mechanism)
         animate(design.mechanism, animation, frames=args.frames, title=design.title,
                 counterweights=weights)
-        print(f"wrote {animation}")
+        _wrote(animation)
     if figure is not None:
         from .plots import save_figure
 
         save_figure(figure, cycle)
-        print(f"wrote {cycle}")
+        _wrote(cycle)
     return 0
 
 
@@ -319,8 +328,10 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
         from .plots import front_figure, save_figure
 
         save_figure(front_figure(front, title=design.title), plot)
+        _wrote(plot)
     if csv_path is not None:
         write_atomic(csv_path, csv)
+        _wrote(csv_path)
     sys.stdout.write(text)
     return 0
 
@@ -345,12 +356,15 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                        seed=args.seed, workers=args.workers, scheduler=args.scheduler,
                        resume=args.resume, force=args.force, batch=args.batch,
                        progress=progress)
+    _wrote(result.out)
     if plot is not None:
         from .plots import save_figure, sweep_figure
 
         save_figure(sweep_figure(result.out, [v.key for v in varies] or None), plot)
     sys.stdout.write(dumps_json(result.as_dict()) if args.json
                      else sweep_text(result, spec=args.spec) + "\n")
+    if plot is not None:
+        _wrote(plot)
     return 0
 
 
@@ -373,7 +387,7 @@ def _cmd_example(args: argparse.Namespace) -> int:
     from .outputs import write_atomic
 
     write_atomic(path, text)
-    print(f"wrote {path}")
+    _wrote(path)
     return 0
 
 

@@ -851,5 +851,4 @@ def sweep_text(result, spec=None) -> str:
         r = result.residual_force
         lines += [f"residual RMS shaking force of the perturbed designs: mean {r['mean']:.4g} "
                   f"N, 95th percentile {r['p95']:.4g} N, largest {r['max']:.4g} N", ""]
-    lines.append(f"wrote {result.out}")
-    return "\n".join(lines)
+    return "\n".join(lines).rstrip("\n")
