@@ -24,10 +24,34 @@ DRIVES: tuple[str, ...] = ("free", "constant-speed")
 
 
 class _Parser(argparse.ArgumentParser):
-    """An argument parser whose errors are one line and exit code 2."""
+    """An argument parser whose errors are one line and exit code 2.
+
+    An option's value that begins with ``-`` (``--gravity -1,-9.81``) reads as another
+    option, and argparse says only that the option expected an argument: the error then
+    shows the ``=`` form that takes it (``--gravity=-1,-9.81``).
+    """
+
+    def parse_known_args(self, args=None, namespace=None):  # type: ignore[override]
+        self._given = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(args, namespace)
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        raise SpecError(f"{message} (see '{self.prog} --help')")
+        raise SpecError(f"{message}{self._dash_hint(message)} (see '{self.prog} --help')")
+
+    def _dash_hint(self, message: str) -> str:
+        """For an option whose value begins with '-': its ``=`` form, else nothing."""
+        prefix, sep, rest = message.partition(": expected one argument")
+        if not sep or rest or not prefix.startswith("argument "):
+            return ""
+        names = prefix.removeprefix("argument ").split("/")
+        given = getattr(self, "_given", [])
+        for i, token in enumerate(given[:-1]):
+            value = given[i + 1]
+            if (token in names and value.startswith("-")
+                    and value.split("=")[0] not in self._option_string_actions):
+                return (f"; a value that begins with '-' is given after '=': "
+                        f"{token}={value}")
+        return ""
 
 
 def _output_path(args: argparse.Namespace, value: str | None, option: str) -> Path | None:

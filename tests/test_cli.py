@@ -603,3 +603,22 @@ def test_every_file_written_is_said_on_stderr_and_never_on_stdout(tmp_path, caps
         if as_json:
             json.loads(captured.out)
         assert sorted(p.name for p in folder.iterdir()) == sorted(files)
+
+
+@pytest.mark.parametrize(("verb", "option", "value"), [
+    ("analyze", "--gravity", "-1,-9.81"),
+    ("simulate", "--duration", "-1e3"),
+    ("simulate", "--atol", "-1e-9"),
+    ("verify", "--duration", "-0.5e1"),
+    ("plot", "--frames", "-1e2"),
+    ("sweep", "--seed", "-1e3"),
+])
+def test_a_value_that_begins_with_a_dash_is_shown_in_its_equals_form(capsys, verb, option,
+                                                                       value):
+    """`--gravity -1,-9.81` reads as an option of its own, and argparse said only 'expected
+    one argument': the line now shows the form that takes it, --gravity=-1,-9.81."""
+    assert main([verb, _PB1, option, value]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert option in err and f"{option}={value}" in err and "'-'" in err
+    assert main(["analyze", _PB1, "--csv", "--json"]) == 2  # a missing value: no such hint
+    assert "=" not in _one_error_line(capsys.readouterr().err)
