@@ -221,6 +221,35 @@ def _locate(data: dict[str, Any], key: str) -> tuple[Any, Any]:
     raise SpecError("no such number in the spec", key=key)  # an empty key
 
 
+def number_keys(data: Any, prefix: str = "") -> list[str]:
+    """Every dotted key that names a number in a parsed spec (a list's entries by index)."""
+    if isinstance(data, dict):
+        items = data.items()
+    elif isinstance(data, list):
+        items = ((str(i), x) for i, x in enumerate(data))
+    else:
+        return [prefix] if isinstance(data, int | float) and not isinstance(data, bool) \
+            else []
+    return [key for name, value in items
+            for key in number_keys(value, f"{prefix}.{name}" if prefix else str(name))]
+
+
+def check_key(data: dict[str, Any], key: str, option: str) -> None:
+    """Raise :class:`SpecError` naming ``option`` if ``key`` names no number of the spec.
+
+    The message suggests the spec's closest keys (a typo such as ``links.crank.mas``).
+    """
+    try:
+        _locate(data, key)
+    except SpecError:
+        import difflib  # only for a key that is wrong
+
+        close = difflib.get_close_matches(key, number_keys(data), n=3, cutoff=0.6)
+        hint = ("; did you mean " + " or ".join(f"'{c}'" for c in close) + "?") if close \
+            else "; give the dotted key of a number of the spec, e.g. links.crank.mass"
+        raise SpecError(f"names no number of the spec{hint}", key=option, value=key) from None
+
+
 def with_values(data: dict[str, Any], values: dict[str, float]) -> dict[str, Any]:
     """A copy of a parsed spec with each dotted key set.
 
@@ -475,6 +504,8 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
                         key="operation.speed", source=str(spec))
     if perturbs and varies:
         raise SpecError("give --vary or --perturb, not both", key="--perturb")
+    for given in perturbs or varies:
+        check_key(data, given.key, "--perturb" if perturbs else "--vary")
     points = (perturbed_points(data, perturbs, samples, seed) if perturbs
               else design_points(varies, method, samples, seed))
     for key in points[0]:

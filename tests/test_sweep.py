@@ -252,3 +252,22 @@ def test_an_infeasible_point_keeps_its_own_figures():
     assert row["shaking_moment_before"] == own.shaking_moment.rms
     assert row["shaking_force_before"] == own.shaking_force.rms
     assert row["shaking_moment_after"] is None
+
+
+@pytest.mark.parametrize(("option", "text", "close"), [
+    ("--vary", "links.crank.mas=1:2:3", "links.crank.mass"),
+    ("--perturb", "links.crank.mas=0.1", "links.crank.mass"),
+    ("--vary", "mechanism.lengths.coupling=2:3:2", COUPLER),
+])
+def test_an_unknown_key_suggests_the_closest_naming_the_option(tmp_path, capsys, option, text,
+                                                               close):
+    """`--vary links.crank.mas` said 'no such number in the spec' under the key itself: now
+    the option, the key given and the spec's closest keys."""
+    argv = ["sweep", str(PB1), option, text, "--out", str(tmp_path / "x.parquet"),
+            "--workers", "0", *(["--samples", "3"] if option == "--perturb" else [])]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    key = text.partition("=")[0]
+    assert err.count("\n") == 1 and err.startswith(f"balancer: error: {option}: ")
+    assert f"'{close}'" in err and f"(got '{key}')" in err
+    assert list(tmp_path.iterdir()) == []
