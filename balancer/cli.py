@@ -116,6 +116,32 @@ def _as_option(exc: SpecError, key: str, option: str, value: object) -> SpecErro
     return exc
 
 
+def _load(args: argparse.Namespace):
+    """The design of ``args.spec``, with a note on stderr for a unit that looks wrong.
+
+    The lengths as written are judged before the spec is validated (a linkage with a length in
+    millimetres may not assemble: the note then comes before the error), the speed of its
+    points after (:mod:`balancer.plausibility`). A note never changes the exit code.
+    """
+    import tomllib
+
+    from .plausibility import length_note, speed_note
+    from .spec import load_design
+
+    try:
+        note = length_note(tomllib.loads(Path(args.spec).read_text(encoding="utf-8-sig")))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        note = None  # load_design says what is wrong with the file
+    if note is not None:
+        print(f"balancer: note: {note}", file=sys.stderr)
+    design = load_design(args.spec)
+    if note is None:  # lengths in millimetres make every point fast: one note is enough
+        note = speed_note(design)
+        if note is not None:
+            print(f"balancer: note: {note}", file=sys.stderr)
+    return design
+
+
 def _wrote(path: str | os.PathLike[str]) -> None:
     """Say on stderr that ``path`` was written: stdout is the report (or the JSON document)."""
     print(f"wrote {path}", file=sys.stderr)
@@ -143,10 +169,9 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
     from .api import analyze
     from .outputs import write_atomic
     from .report import analysis_csv, analysis_json, analysis_text, dumps_json
-    from .spec import load_design
 
     csv_path = _output_path(args, args.csv, "--csv")
-    design = load_design(args.spec)
+    design = _load(args)
     try:
         analysis = analyze(design, route=args.route, gravity=args.gravity)
     except SpecError as exc:
@@ -175,10 +200,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from .progress import Progress
     from .report import dumps_json, simulation_csv, simulation_json, simulation_text
     from .simulation import simulate_design
-    from .spec import load_design
 
     out = _output_path(args, args.out, "--out")
-    design = load_design(args.spec)
+    design = _load(args)
     progress = Progress("simulating", enabled=not args.json)
     try:
         traj = simulate_design(
@@ -212,11 +236,10 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 def _cmd_verify(args: argparse.Namespace) -> int:
     from .report import dumps_json, verification_text
-    from .spec import load_design
     from .verification import verify
 
     plot = _figure_path(args, args.plot, "--plot")
-    design = load_design(args.spec)
+    design = _load(args)
     from .progress import Progress
 
     try:
@@ -245,11 +268,11 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     from .errors import SolverError
     from .outputs import write_atomic
     from .report import dumps_json, optimization_json, optimization_text
-    from .spec import dumps_design, load_design, loads_design
+    from .spec import dumps_design, loads_design
     from .verification import verify
 
     out = _output_path(args, args.out, "--out")
-    design = load_design(args.spec)
+    design = _load(args)
     if not args.no_verify:  # the check at the end refuses nothing after the work
         from .verification import check_verification
 
@@ -290,8 +313,6 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from .spec import load_design
-
     if args.animate is None and args.cycle is None:
         raise SpecError("nothing to plot: give --cycle PATH or --animate PATH", key="--cycle")
     cycle = _output_path(args, args.cycle, "--cycle")
@@ -306,7 +327,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         from .plots import animation_type
 
         animation_type(animation, "--animate")  # an MP4 needs ffmpeg
-    design = load_design(args.spec)
+    design = _load(args)
     from .mechanisms import mechanism_of
 
     mechanism_of(design.mechanism).require_full_revolution(
@@ -339,11 +360,10 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
     from .balance.pareto import pareto_front
     from .outputs import write_atomic
     from .report import dumps_json, front_csv, front_json, front_text
-    from .spec import load_design
 
     csv_path = _output_path(args, args.csv, "--csv")
     plot = _figure_path(args, args.plot, "--plot")
-    design = load_design(args.spec)
+    design = _load(args)
     front = pareto_front(design, args.against, args.points)
     csv = front_csv(front) if csv_path is not None else None
     text = (dumps_json(front_json(front, spec=args.spec)) if args.json
@@ -374,6 +394,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         raise OutputError("must name a .parquet file", key="--out", value=args.out)
     out = _output_path(args, args.out, "--out") if not args.resume else Path(args.out)
     plot = _figure_path(args, args.plot, "--plot")
+    _load(args)  # its own errors, and a note for a unit that looks wrong
     with Progress("sweeping", unit="points", enabled=not args.json) as progress:
         result = sweep(args.spec, varies, out, perturbs=perturbs, method=args.method,
                        samples=args.samples,
