@@ -88,9 +88,10 @@ def _busy(proc: subprocess.Popen, seconds: float = 1.0):
 
 def _long_commands(tmp: Path) -> dict[str, list]:
     """A command of every verb that works long enough to be interrupted."""
-    big = tmp / "big.toml"
-    big.write_text(PB1.read_text().replace("samples = 360", "samples = 3000000"))
-    assert "samples = 3000000" in big.read_text()
+    big = tmp / "big.toml"  # some 5 s of a cycle analysis (2.5 GB by its own estimate)
+    big.write_text((EXAMPLES / "stephenson_sixbar.toml").read_text().replace(
+        "samples = 360", "samples = 600000"))
+    assert "samples = 600000" in big.read_text()
     return {
         "analyze": ["analyze", big],
         "simulate": ["simulate", EXAMPLES / "stephenson_sixbar.toml", "--drive", "free",
