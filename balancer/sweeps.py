@@ -637,7 +637,9 @@ def _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only) 
             record(futures[future], future.result(), client)
         return used
     except KeyboardInterrupt:
-        with interrupts.shielded(), _silenced("distributed", "tornado", "asyncio"):
+        # Whatever the closing meets (a scheduler gone too), the interrupt is what to report.
+        with (interrupts.shielded(), _silenced("distributed", "tornado", "asyncio"),
+              contextlib.suppress(Exception)):
             _close(client, cluster, list(futures))
         raise
     finally:
