@@ -1,7 +1,8 @@
 """The ``balancer`` command: a thin layer over the Python API.
 
-Exit codes: 0 success; 2 bad input (spec or arguments); 1 a computation that fails. Every error
-is one line on stderr naming the cause and where; never a traceback for a user error. Heavy
+Exit codes: 0 success; 2 bad input (spec or arguments); 1 a computation that fails; 130
+interrupted (SIGINT, Ctrl-C, at any moment: :mod:`balancer.interrupts`). Every error is one
+line on stderr naming the cause and where; never a traceback for a user error. Heavy
 libraries (SciPy's integrators, CVXPY, CasADi, matplotlib) are imported only by the commands that
 use them.
 """
@@ -23,10 +24,34 @@ DRIVES: tuple[str, ...] = ("free", "constant-speed")
 
 
 class _Parser(argparse.ArgumentParser):
-    """An argument parser whose errors are one line and exit code 2."""
+    """An argument parser whose errors are one line and exit code 2.
+
+    An option's value that begins with ``-`` (``--gravity -1,-9.81``) reads as another
+    option, and argparse says only that the option expected an argument: the error then
+    shows the ``=`` form that takes it (``--gravity=-1,-9.81``).
+    """
+
+    def parse_known_args(self, args=None, namespace=None):  # type: ignore[override]
+        self._given = list(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(args, namespace)
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        raise SpecError(f"{message} (see '{self.prog} --help')")
+        raise SpecError(f"{message}{self._dash_hint(message)} (see '{self.prog} --help')")
+
+    def _dash_hint(self, message: str) -> str:
+        """For an option whose value begins with '-': its ``=`` form, else nothing."""
+        prefix, sep, rest = message.partition(": expected one argument")
+        if not sep or rest or not prefix.startswith("argument "):
+            return ""
+        names = prefix.removeprefix("argument ").split("/")
+        given = getattr(self, "_given", [])
+        for i, token in enumerate(given[:-1]):
+            value = given[i + 1]
+            if (token in names and value.startswith("-")
+                    and value.split("=")[0] not in self._option_string_actions):
+                return (f"; a value that begins with '-' is given after '=': "
+                        f"{token}={value}")
+        return ""
 
 
 def _output_path(args: argparse.Namespace, value: str | None, option: str) -> Path | None:
@@ -53,6 +78,75 @@ def _output_path(args: argparse.Namespace, value: str | None, option: str) -> Pa
     return path
 
 
+#: Figure and animation types by extension: :data:`balancer.plots.FIGURE_TYPES` and
+#: :data:`balancer.plots.ANIMATION_TYPES`, here so that a path of another type is refused before
+#: matplotlib loads (a test keeps them equal).
+FIGURE_EXTENSIONS: tuple[str, ...] = (".png", ".svg", ".pdf")
+ANIMATION_EXTENSIONS: tuple[str, ...] = (".gif", ".mp4")
+#: Most frames per revolution of an animation: ten a degree, more than any screen shows.
+MAX_FRAMES = 3600
+
+
+def _figure_path(args: argparse.Namespace, value: str | None, option: str,
+                 extensions: tuple[str, ...] = FIGURE_EXTENSIONS) -> Path | None:
+    """An output path for a figure (or animation), checked before any work.
+
+    It must be writable (:func:`_output_path`), and its extension must name a type
+    (:func:`_of_type`).
+    """
+    return _of_type(_output_path(args, value, option), option, extensions)
+
+
+def _of_type(path: Path | None, option: str,
+             extensions: tuple[str, ...] = FIGURE_EXTENSIONS) -> Path | None:
+    """``path``, if its extension is one of ``extensions``; else :class:`OutputError`.
+
+    :func:`balancer.plots.figure_type`'s check and message, without loading matplotlib.
+    """
+    if path is not None and path.suffix.lower() not in extensions:
+        raise OutputError("the file type comes from the extension: use one of "
+                          + ", ".join(extensions), key=option, value=str(path))
+    return path
+
+
+def _as_option(exc: SpecError, key: str, option: str, value: object) -> SpecError:
+    """``exc`` naming the command-line ``option`` that gave the spec ``key`` its ``value``."""
+    if exc.key == key and value is not None:
+        return SpecError(exc.detail, key=option, value=value)
+    return exc
+
+
+def _load(args: argparse.Namespace):
+    """The design of ``args.spec``, with a note on stderr for a unit that looks wrong.
+
+    The lengths as written are judged before the spec is validated (a linkage with a length in
+    millimetres may not assemble: the note then comes before the error), the speed of its
+    points after (:mod:`balancer.plausibility`). A note never changes the exit code.
+    """
+    import tomllib
+
+    from .plausibility import length_note, speed_note
+    from .spec import load_design
+
+    try:
+        note = length_note(tomllib.loads(Path(args.spec).read_text(encoding="utf-8-sig")))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        note = None  # load_design says what is wrong with the file
+    if note is not None:
+        print(f"balancer: note: {note}", file=sys.stderr)
+    design = load_design(args.spec)
+    if note is None:  # lengths in millimetres make every point fast: one note is enough
+        note = speed_note(design)
+        if note is not None:
+            print(f"balancer: note: {note}", file=sys.stderr)
+    return design
+
+
+def _wrote(path: str | os.PathLike[str]) -> None:
+    """Say on stderr that ``path`` was written: stdout is the report (or the JSON document)."""
+    print(f"wrote {path}", file=sys.stderr)
+
+
 #: The CSV files' units (their header keeps the plain names a csv reader expects).
 _CSV_UNITS = ("columns in SI units: t s; theta rad, omega rad/s, alpha rad/s² per link; "
               "R<point>x, R<point>y, N_<link> N; C_<link> N·m; x<k> m, v<k> m/s, a<k> m/s² "
@@ -75,10 +169,9 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
     from .api import analyze
     from .outputs import write_atomic
     from .report import analysis_csv, analysis_json, analysis_text, dumps_json
-    from .spec import load_design
 
     csv_path = _output_path(args, args.csv, "--csv")
-    design = load_design(args.spec)
+    design = _load(args)
     try:
         analysis = analyze(design, route=args.route, gravity=args.gravity)
     except SpecError as exc:
@@ -93,6 +186,7 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         text = analysis_text(analysis, spec=args.spec) + "\n"
     if csv_path is not None:
         write_atomic(csv_path, csv)
+        _wrote(csv_path)
     sys.stdout.write(text)
     return 0
 
@@ -106,10 +200,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from .progress import Progress
     from .report import dumps_json, simulation_csv, simulation_json, simulation_text
     from .simulation import simulate_design
-    from .spec import load_design
 
     out = _output_path(args, args.out, "--out")
-    design = load_design(args.spec)
+    design = _load(args)
     progress = Progress("simulating", enabled=not args.json)
     try:
         traj = simulate_design(
@@ -123,8 +216,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             progress=progress,
         )
     except SpecError as exc:
-        if exc.key in _SIMULATE_OPTIONS and getattr(args, exc.key) is not None:
-            raise SpecError(exc.detail, key=f"--{exc.key}", value=exc.value) from None
+        name = (exc.key or "").removeprefix("simulation.")  # a setting, or the spec's key
+        if name in _SIMULATE_OPTIONS and getattr(args, name) is not None:
+            raise SpecError(exc.detail, key=f"--{name}", value=exc.value) from None
         raise
     finally:
         progress.close()
@@ -135,36 +229,36 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         text = simulation_text(traj, spec=args.spec) + "\n"
     if out is not None:
         write_atomic(out, csv)
+        _wrote(out)
     sys.stdout.write(text)
     return 0
 
 
 def _cmd_verify(args: argparse.Namespace) -> int:
     from .report import dumps_json, verification_text
-    from .spec import load_design
     from .verification import verify
 
-    plot = _output_path(args, args.plot, "--plot")
-    if plot is not None:
-        from .plots import figure_type
-
-        figure_type(plot, "--plot")
-    design = load_design(args.spec)
+    plot = _figure_path(args, args.plot, "--plot")
+    design = _load(args)
     from .progress import Progress
 
-    with Progress("verifying by simulation", enabled=not args.json) as progress:
-        verification = verify(design, method=args.method, duration=args.duration,
-                              progress=progress)
+    try:
+        with Progress("verifying by simulation", enabled=not args.json) as progress:
+            verification = verify(design, method=args.method, duration=args.duration,
+                                  progress=progress)
+    except SpecError as exc:
+        raise _as_option(exc, "simulation.duration", "--duration", args.duration) from None
     paths = [] if plot is None else [plot]
     if args.json:
         doc = {"spec": args.spec, **verification.as_dict(), "plots": [str(p) for p in paths]}
         text = dumps_json(doc)
     else:
-        text = verification_text(verification, spec=args.spec, plots=paths) + "\n"
+        text = verification_text(verification, spec=args.spec) + "\n"
     if plot is not None:
         from .plots import save_figure, verification_figure
 
         save_figure(verification_figure(design, verification), plot)
+        _wrote(plot)
     sys.stdout.write(text)
     return 0
 
@@ -174,11 +268,19 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     from .errors import SolverError
     from .outputs import write_atomic
     from .report import dumps_json, optimization_json, optimization_text
-    from .spec import dumps_design, load_design, loads_design
+    from .spec import dumps_design, loads_design
     from .verification import verify
 
     out = _output_path(args, args.out, "--out")
-    design = load_design(args.spec)
+    design = _load(args)
+    if not args.no_verify:  # the check at the end refuses nothing after the work
+        from .verification import check_verification
+
+        try:
+            check_verification(design, duration=args.verify_duration)
+        except SpecError as exc:
+            raise _as_option(exc, "simulation.duration", "--verify-duration",
+                             args.verify_duration) from None
     result = optimize(design, backend=args.backend)
     if not result.success:
         raise SolverError(f"the balancing failed: {result.message}")
@@ -190,23 +292,27 @@ def _cmd_optimize(args: argparse.Namespace) -> int:
     if not args.no_verify:
         from .progress import Progress
 
-        with Progress("verifying by simulation", enabled=not args.json) as progress:
-            verification = verify(balanced, duration=args.verify_duration, progress=progress)
+        try:
+            with Progress("verifying by simulation", enabled=not args.json) as progress:
+                verification = verify(balanced, duration=args.verify_duration,
+                                      progress=progress)
+        except SpecError as exc:
+            raise _as_option(exc, "simulation.duration", "--verify-duration",
+                             args.verify_duration) from None
     if args.json:
         text = dumps_json(optimization_json(result, before, after, verification,
                                             spec=args.spec, out=out))
     else:
-        text = optimization_text(result, before, after, verification, spec=args.spec,
-                                 out=out) + "\n"
+        text = optimization_text(result, before, after, verification,
+                                 spec=args.spec) + "\n"
     if out is not None:
         write_atomic(out, spec_text)
+        _wrote(out)
     sys.stdout.write(text)
     return 0
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from .spec import load_design
-
     if args.animate is None and args.cycle is None:
         raise SpecError("nothing to plot: give --cycle PATH or --animate PATH", key="--cycle")
     cycle = _output_path(args, args.cycle, "--cycle")
@@ -215,13 +321,13 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             os.path.realpath(cycle) == os.path.realpath(animation):
         raise OutputError("names the same file as --cycle", key="--animate",
                           value=args.animate)
-    from .plots import animation_type, figure_type
-
-    if cycle is not None:
-        figure_type(cycle, "--cycle")
+    _of_type(cycle, "--cycle")
+    _of_type(animation, "--animate", ANIMATION_EXTENSIONS)
     if animation is not None:
-        animation_type(animation, "--animate")
-    design = load_design(args.spec)
+        from .plots import animation_type
+
+        animation_type(animation, "--animate")  # an MP4 needs ffmpeg
+    design = _load(args)
     from .mechanisms import mechanism_of
 
     mechanism_of(design.mechanism).require_full_revolution(
@@ -241,12 +347,12 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             weights = counterweights(design.original, design.mechanism)
         animate(design.mechanism, animation, frames=args.frames, title=design.title,
                 counterweights=weights)
-        print(f"wrote {animation}")
+        _wrote(animation)
     if figure is not None:
         from .plots import save_figure
 
         save_figure(figure, cycle)
-        print(f"wrote {cycle}")
+        _wrote(cycle)
     return 0
 
 
@@ -254,15 +360,10 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
     from .balance.pareto import pareto_front
     from .outputs import write_atomic
     from .report import dumps_json, front_csv, front_json, front_text
-    from .spec import load_design
 
     csv_path = _output_path(args, args.csv, "--csv")
-    plot = _output_path(args, args.plot, "--plot")
-    if plot is not None:
-        from .plots import figure_type
-
-        figure_type(plot, "--plot")
-    design = load_design(args.spec)
+    plot = _figure_path(args, args.plot, "--plot")
+    design = _load(args)
     front = pareto_front(design, args.against, args.points)
     csv = front_csv(front) if csv_path is not None else None
     text = (dumps_json(front_json(front, spec=args.spec)) if args.json
@@ -276,8 +377,10 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
         save_figure(front_figure(front, title=design.title,
                                  force_balance=design.balance.force_balance,
                                  original_force_balanced=balanced), plot)
+        _wrote(plot)
     if csv_path is not None:
         write_atomic(csv_path, csv)
+        _wrote(csv_path)
     sys.stdout.write(text)
     return 0
 
@@ -295,17 +398,15 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if not args.out.endswith(".parquet"):
         raise OutputError("must name a .parquet file", key="--out", value=args.out)
     out = _output_path(args, args.out, "--out") if not args.resume else Path(args.out)
-    plot = _output_path(args, args.plot, "--plot")
-    if plot is not None:
-        from .plots import figure_type
-
-        figure_type(plot, "--plot")
+    plot = _figure_path(args, args.plot, "--plot")
+    _load(args)  # its own errors, and a note for a unit that looks wrong
     with Progress("sweeping", unit="points", enabled=not args.json) as progress:
         result = sweep(args.spec, varies, out, perturbs=perturbs, method=args.method,
                        samples=args.samples,
                        seed=args.seed, workers=args.workers, scheduler=args.scheduler,
                        resume=args.resume, force=args.force, batch=args.batch,
                        progress=progress)
+    _wrote(result.out)
     if plot is not None:
         from .plots import save_figure, sweep_figure
         from .sweeps import spec_values
@@ -316,6 +417,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                                  perturbs=perturbs), plot)
     sys.stdout.write(dumps_json(result.as_dict()) if args.json
                      else sweep_text(result, spec=args.spec) + "\n")
+    if plot is not None:
+        _wrote(plot)
     return 0
 
 
@@ -338,7 +441,7 @@ def _cmd_example(args: argparse.Namespace) -> int:
     from .outputs import write_atomic
 
     write_atomic(path, text)
-    print(f"wrote {path}")
+    _wrote(path)
     return 0
 
 
@@ -362,6 +465,15 @@ def _gravity(text: str) -> tuple[float, float]:
     if not all(abs(x) < float("inf") for x in (gx, gy)):
         raise argparse.ArgumentTypeError(f"must be two finite numbers GX,GY in m/s²: {text!r}")
     return gx, gy
+
+
+def _frames(text: str) -> int:
+    """Frames per revolution: from 2 to :data:`MAX_FRAMES`."""
+    value = _count(text)
+    if value > MAX_FRAMES:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_FRAMES} frames per "
+                                          f"revolution (ten a degree): {text!r}")
+    return value
 
 
 def _count(text: str) -> int:
@@ -531,8 +643,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write the figure of one revolution to PATH (.png, .svg or .pdf)")
     p.add_argument("--animate", metavar="PATH",
                    help="write an animation to PATH (.gif, or .mp4 with ffmpeg)")
-    p.add_argument("--frames", type=_count, default=72, metavar="N",
-                   help="frames per revolution (default 72)")
+    p.add_argument("--frames", type=_frames, default=72, metavar="N",
+                   help=f"frames per revolution (default 72, at most {MAX_FRAMES})")
     p.set_defaults(handler=_cmd_plot)
 
     p = sub.add_parser(
@@ -609,7 +721,40 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; return the exit code."""
+    """Run the command line; return the exit code.
+
+    A SIGINT at any moment of the command — also one a library swallowed, or one that came
+    while an error was being reported — ends it with exit code 130 and the one line
+    ``balancer: interrupted`` (:mod:`balancer.interrupts`).
+    """
+    from . import interrupts
+
+    with interrupts.handling():
+        try:
+            try:
+                code, line = _run(argv)
+            except KeyboardInterrupt as exc:
+                code, line = 130, _interrupted(exc)
+            with interrupts.shielded():  # from here on a SIGINT only counts
+                if code != 130 and interrupts.received():
+                    code, line = 130, _interrupted(None)
+                if line:
+                    print(line, file=sys.stderr)
+        except KeyboardInterrupt:  # a second one, before the shield was up
+            with interrupts.shielded():
+                code = 130
+                print(_interrupted(None), file=sys.stderr)
+    return code
+
+
+def _interrupted(exc: KeyboardInterrupt | None) -> str:
+    """The line that says the command was interrupted (and what it kept, if it says)."""
+    what = str(exc) if exc is not None else ""
+    return f"balancer: interrupted: {what}" if what else "balancer: interrupted"
+
+
+def _run(argv: Sequence[str] | None) -> tuple[int, str | None]:
+    """Parse and run the command: its exit code and the error line to print, if any."""
     parser = build_parser()
     args = None
     try:
@@ -620,7 +765,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         # before they are written (report.dumps_json, report.csv_text).
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return handler(args)
+            return handler(args), None
     except BalancerError as exc:
         spec = getattr(args, "spec", None)
         if (isinstance(exc, SpecError) and not isinstance(exc, OutputError)
@@ -629,22 +774,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         message = str(exc)
         if not isinstance(exc, SpecError) and spec and spec not in message:
             message = f"{spec}: {message}"  # a failed computation: name the file it concerns
-        print(f"balancer: error: {_one_line(message)}", file=sys.stderr)
-        return exc.exit_code
-    except KeyboardInterrupt:
-        print("balancer: interrupted", file=sys.stderr)
-        return 130
+        return exc.exit_code, f"balancer: error: {_one_line(message)}"
     except BrokenPipeError:
-        return 0
+        return 0, None
     except MemoryError:
-        print("balancer: error: out of memory (ask for fewer samples or outputs)",
-              file=sys.stderr)
-        return 1
+        return 1, "balancer: error: out of memory (ask for fewer samples or outputs)"
     except Exception as exc:  # a defect of ours: one line, never a traceback for the user
         where = _innermost(exc)
-        print(f"balancer: internal error: {type(exc).__name__}: {_one_line(str(exc))} "
-              f"({where}); please report it with the spec", file=sys.stderr)
-        return 1
+        return 1, (f"balancer: internal error: {type(exc).__name__}: {_one_line(str(exc))} "
+                   f"({where}); please report it with the spec")
 
 
 def _one_line(text: str) -> str:
@@ -671,6 +809,17 @@ def entry_point() -> None:
     machine, and a small QR took 150 ms threaded against 1 ms on one thread. Set before numpy
     is imported; a sweep's worker processes inherit it (one worker per core). The results are
     the same either way.
+
+    A SIGINT from the moment this runs until the process ends gives exit code 130.
     """
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    sys.exit(main())
+    from . import interrupts
+
+    # main() handles SIGINT itself; one that comes just before or after it is counted (and
+    # decides the exit code), never raised as a traceback.
+    with interrupts.handling(), interrupts.shielded():
+        code = main()
+        if interrupts.closing() and code != 130:
+            print(_interrupted(None), file=sys.stderr)
+            code = 130
+    sys.exit(code)

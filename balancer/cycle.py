@@ -298,8 +298,11 @@ def cycle_analysis(model, speed: float, samples: int = 360, *, route: str | None
     if len(starts) > 1 and WORKERS > 1:
         from concurrent.futures import ThreadPoolExecutor  # a long cycle only: 3 ms to import
 
-        with ThreadPoolExecutor(WORKERS) as pool:
+        pool = ThreadPoolExecutor(WORKERS)
+        try:
             list(pool.map(fill, starts))
+        finally:  # interrupted (Ctrl-C): the chunks not begun are dropped, not waited for
+            pool.shutdown(wait=True, cancel_futures=True)
     else:
         for start in starts:
             fill(start)

@@ -631,7 +631,8 @@ class Linkage:
                 raise SpecError("must be a Spring", key=f"springs[{i}]", value=spring)
             for p in spring.points:
                 if p not in points:
-                    raise SpecError(f"names an unknown point '{p}'", key=f"springs[{i}].points",
+                    raise SpecError(f"names an unknown point '{p}' (the points are "
+                                    f"{', '.join(points)})", key=f"springs[{i}].points",
                                     value=list(spring.points))
         for name, body in names.items():
             if name == GROUND or len(body.points) > 1:
@@ -646,7 +647,8 @@ class Linkage:
         ground = set(names[GROUND].points)
         key = "mechanism.input"
         if not isinstance(self.input, str) or self.input not in names or self.input == GROUND:
-            raise SpecError("must name a moving link", key=key, value=self.input)
+            raise SpecError(f"must name a moving link ({_link_list(names)})", key=key,
+                            value=self.input)
         if names[self.input].points[0] not in ground:
             raise SpecError(f"the input's first point ({names[self.input].points[0]}) must be "
                             "a ground point: the crank turns about it", key=key,
@@ -668,7 +670,8 @@ class Linkage:
         for attr in ("link", "guide"):
             value = getattr(slider, attr)
             if value not in names:
-                raise SpecError("names an unknown link", key=f"{key}.{attr}", value=value)
+                raise SpecError(f"names an unknown link ({_link_list(names)})",
+                                key=f"{key}.{attr}", value=value)
         if slider.link == GROUND:
             raise SpecError("the sliding link must move (put the guide on the ground)",
                             key=f"{key}.link", value=slider.link)
@@ -676,7 +679,8 @@ class Linkage:
             raise SpecError("a link cannot slide on itself", key=f"{key}.guide",
                             value=slider.guide)
         if slider.point not in names[slider.link].points:
-            raise SpecError(f"must be a point of {slider.link}", key=f"{key}.point",
+            raise SpecError(f"must be a point of {slider.link} "
+                            f"({', '.join(names[slider.link].points)})", key=f"{key}.point",
                             value=slider.point)
         dx, dy = v.vector2(slider.direction, f"{key}.direction")
         if dx == 0 and dy == 0:
@@ -1001,6 +1005,12 @@ class Design:
         for mech in (self.mechanism, self.original):
             if mech is not None:
                 check_scales(mech, speeds, gravity)
+
+
+def _link_list(names) -> str:
+    """The links of a spec by name, for a message: the moving ones, and the frame's name."""
+    moving = [n for n in names if n != GROUND]
+    return f"the moving links are {', '.join(moving)}; the frame is called {GROUND}"
 
 
 def check_scales(mechanism, speeds: dict[str, float],

@@ -835,15 +835,20 @@ def sweep_text(result, spec=None) -> str:
     """The readable summary of a sweep."""
     head = f"balancer sweep — {spec}" if spec else "balancer sweep"
     rows = [[status, str(count)] for status, count in sorted(result.statuses.items())]
-    rate = (f"{result.points / result.seconds:.3g} points/s" if result.seconds > 0
-            else "no time to measure")
     where = (f"{result.workers} Dask workers" if result.workers else "this process")
-    lines = [head, f"{result.points} points in {result.seconds:.1f} s ({rate}, "
-             f"{where}" + (f"; {result.resumed} batches from before" if result.resumed
-                           else "") + ")", "", table(rows, ["status", "points"]), ""]
+    # The rate counts this run's own points, not those kept from an interrupted run.
+    rate = f"{result.rate:.3g} points/s" if result.rate is not None else "no time to measure"
+    timing = f"{result.seconds:.1f} s ({rate}, {where})"
+    if not result.resumed:
+        summary = f"{result.points} points in {timing}"
+    else:
+        now = (f"{result.computed} computed in {timing}" if result.computed
+               else "none left to compute")
+        summary = (f"{result.points} points: {result.points - result.computed} from the "
+                   f"interrupted run before ({result.resumed} batches), {now}")
+    lines = [head, summary, "", table(rows, ["status", "points"]), ""]
     if result.residual_force is not None:
         r = result.residual_force
         lines += [f"residual RMS shaking force of the perturbed designs: mean {r['mean']:.4g} "
                   f"N, 95th percentile {r['p95']:.4g} N, largest {r['max']:.4g} N", ""]
-    lines.append(f"wrote {result.out}")
-    return "\n".join(lines)
+    return "\n".join(lines).rstrip("\n")

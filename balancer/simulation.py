@@ -396,17 +396,9 @@ class _Stepper:
         from .quadrature import cumulative
 
         f = self.f
-        if f.driven_rates(self.t_out[:1]) is None:
+        if not self.prescribes(y0):
             return None
-        # At least one panel per PANEL_ANGLE of crank: refused, as a run of as many steps
-        # would be, before the panels' nodes are laid out (a 1e5 s run: 1e8 nodes).
-        panels = abs(f.speed) * self.t_end / PANEL_ANGLE
-        if panels > MAX_STEPS:
-            raise SpecError(
-                f"would take about {panels:.2g} quadrature panels of the crank's prescribed "
-                f"motion (one per {math.degrees(PANEL_ANGLE):g}° of crank at the least), more "
-                f"than the {MAX_STEPS:.0e} allowed: shorten it", key="simulation.duration",
-                value=self.duration)
+        self._check_panels(self.t_end)
         outs = self._outputs()
         near_dead_point = False
         points = f.change_points()
@@ -440,6 +432,40 @@ class _Stepper:
             self.progress(self.duration, self.duration)
         return outs.tolist(), states, [0.0, 0.0], work.evaluations, work.panels, None
 
+    def prescribes(self, y0: NDArray[np.float64]) -> bool:
+        """Whether a driven crank's motion is prescribed (its work by quadrature, no steps).
+
+        So it is where the formulation gives its rates (a minimal one) or its motion (one that
+        is not) at the first output time.
+        """
+        f = self.f
+        if not f.driven:
+            return False
+        if f.time_only:
+            return f.driven_rates(self.t_out[:1]) is not None
+        return not f.minimal and f.driven_motion(self.t_out[:1], y0) is not None
+
+    def check_up_front(self, y0: NDArray[np.float64], stop_at: float | None) -> None:
+        """Raise what :meth:`run` would refuse before it works (a prescribed motion's panels)."""
+        if self.prescribes(y0):
+            self._check_panels(self.duration if stop_at is None else min(stop_at,
+                                                                         self.duration))
+
+    def _check_panels(self, t_end: float) -> None:
+        """Refuse a prescribed motion that needs more than :data:`MAX_STEPS` panels.
+
+        At least one panel per :data:`PANEL_ANGLE` of crank up to ``t_end`` (s): refused, as
+        a run of as many steps would be, before the panels' nodes are laid out (a 1e5 s run:
+        1e8 nodes).
+        """
+        panels = abs(float(self.f.speed)) * t_end / PANEL_ANGLE  # type: ignore[arg-type]
+        if panels > MAX_STEPS:
+            raise SpecError(
+                f"would take about {panels:.2g} quadrature panels of the crank's prescribed "
+                f"motion (one per {math.degrees(PANEL_ANGLE):g}° of crank at the least), more "
+                f"than the {MAX_STEPS:.0e} allowed: shorten it", key="simulation.duration",
+                value=self.duration)
+
     def _outputs(self) -> NDArray[np.float64]:
         """The output times up to where the run ends (before a lock, if driven into one)."""
         return self.t_out[self.t_out <= self.t_end]
@@ -471,6 +497,9 @@ class _Stepper:
         from .quadrature import cumulative
 
         f = self.f
+        if not self.prescribes(y0):
+            return None
+        self._check_panels(self.t_end)  # before the outputs and guide times are laid out
         outs = self._outputs()
         guide = self._guide_times(outs)
         times = np.union1d(outs, guide)
@@ -660,6 +689,83 @@ def _near_change_point(f, t: float, y, points) -> bool:
     return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < CHANGE_POINT_NEAR for p in points)
 
 
+@dataclass(frozen=True)
+class _Setup:
+    """A simulation's checked settings and formulation, before any integration."""
+
+    f: Formulation
+    settings: SimulationSettings
+    y0: NDArray[np.float64]
+    #: The output times' number (more for a driven crank at a resolution).
+    outputs: int
+    #: When a driven crank reaches the end of its assembly range, s (``None``: never).
+    stop_at: float | None
+    #: Where the run ends before that lock, s (``None``: at its duration).
+    end: float | None
+
+
+def _prepare(linkage, settings: SimulationSettings, *, resolution: float | None = None,
+             **overrides) -> _Setup:
+    """The settings with the overrides, checked, and the formulation at its initial state.
+
+    Raises :class:`SpecError` for what :func:`simulate` refuses before it integrates (bad
+    settings, forces beyond double precision, a start where the linkage does not assemble).
+    """
+    # The settings with the overrides, checked as a spec's would be (SimulationSettings).
+    settings = replace(settings, **{k: x for k, x in overrides.items() if x is not None})
+    method = settings.method or default_method(linkage)
+    drive, duration, outputs = settings.drive, settings.duration, settings.outputs
+    formulation_class(method, linkage)  # a SpecError naming those that apply, if none
+    theta1, omega1 = settings.theta1, settings.omega1
+    if theta1 is None:
+        theta1 = mechanism_of(linkage).start_angle
+    check_scales(linkage, {"simulation.omega1": omega1},
+                 {"simulation.gravity": settings.gravity})
+    speed = None
+    if drive == "constant-speed":
+        if omega1 == 0:
+            raise SpecError("a crank driven at constant speed needs a non-zero speed: give it "
+                            "here or as the operating speed [operation] speed",
+                            key="simulation.omega1", value=omega1)
+        speed = omega1
+    f = make(method, linkage, gravity=settings.gravity, speed=speed)
+    _check_start(f, theta1)
+    stop_at = None if speed is None else _lock_time(f, theta1, speed, duration)
+    y0 = f.initial_state(theta1, omega1)
+    if not np.all(np.isfinite(y0)):  # the pose assembles, its rates are not determined
+        raise SpecError(f"is a singular pose of the linkage (θ1 = {theta1:.9g} rad: a dead "
+                        "point, where the crank's rate does not determine the others'); start "
+                        "the motion elsewhere", key="simulation.theta1", value=theta1)
+    if resolution is not None and speed is not None:  # the crank's prescribed turning
+        need = math.ceil(abs(speed) * duration / resolution) + 1
+        outputs = min(MAX_OUTPUTS, max(outputs, need))
+    # A driven crank that locks: integrate up to just before the dead point, where the torque
+    # it would need grows without bound.
+    end = None if stop_at is None else _before_lock(f, stop_at)
+    return _Setup(f=f, settings=settings, y0=y0, outputs=outputs, stop_at=stop_at, end=end)
+
+
+def check(linkage, settings: SimulationSettings, *, resolution: float | None = None,
+          **overrides) -> None:
+    """Raise what :func:`simulate` with these arguments would refuse before it integrates.
+
+    Its settings, scales and start, and a driven crank's prescribed motion that would need more
+    than :data:`MAX_STEPS` quadrature panels; nothing is integrated. (A run whose steps exceed
+    the budget is refused from the rate of its first :data:`PROJECT_AFTER` steps, which only
+    the run finds.)
+
+    Parameters
+    ----------
+    linkage, settings, resolution, **overrides
+        As for :func:`simulate` (``method``, ``drive``, ``duration`` in s, ``rtol``, ``atol``,
+        ``outputs``).
+    """
+    run = _prepare(linkage, settings, resolution=resolution, **overrides)
+    stepper = _Stepper(run.f, run.settings.duration, run.settings.rtol, run.settings.atol,
+                       run.outputs, None, resolution)
+    stepper.check_up_front(run.y0, run.end)
+
+
 def simulate(
     linkage,
     settings: SimulationSettings,
@@ -706,42 +812,12 @@ def simulate(
         If the motion reaches a position the formulation cannot pass (its ``partial``
         attribute holds the trajectory up to there).
     """
-    overrides = {"method": method, "drive": drive, "duration": duration, "rtol": rtol,
-                 "atol": atol, "outputs": outputs}
-    # The settings with the overrides, checked as a spec's would be (SimulationSettings).
-    settings = replace(settings, **{k: x for k, x in overrides.items() if x is not None})
-    method = settings.method or default_method(linkage)
-    drive, duration, rtol, atol, outputs = (settings.drive, settings.duration, settings.rtol,
-                                            settings.atol, settings.outputs)
-    formulation_class(method, linkage)  # a SpecError naming those that apply, if none
-    theta1, omega1 = settings.theta1, settings.omega1
-    if theta1 is None:
-        theta1 = mechanism_of(linkage).start_angle
-    check_scales(linkage, {"simulation.omega1": omega1},
-                 {"simulation.gravity": settings.gravity})
-    speed = None
-    if drive == "constant-speed":
-        if omega1 == 0:
-            raise SpecError("a crank driven at constant speed needs a non-zero speed: give it "
-                            "here or as the operating speed [operation] speed",
-                            key="simulation.omega1", value=omega1)
-        speed = omega1
-    f = make(method, linkage, gravity=settings.gravity, speed=speed)
-    _check_start(f, theta1)
-    stop_at = None if speed is None else _lock_time(f, theta1, speed, duration)
-    y0 = f.initial_state(theta1, omega1)
-    if not np.all(np.isfinite(y0)):  # the pose assembles, its rates are not determined
-        raise SpecError(f"is a singular pose of the linkage (θ1 = {theta1:.9g} rad: a dead "
-                        "point, where the crank's rate does not determine the others'); start "
-                        "the motion elsewhere", key="simulation.theta1", value=theta1)
+    run = _prepare(linkage, settings, method=method, drive=drive, duration=duration,
+                   rtol=rtol, atol=atol, outputs=outputs, resolution=resolution)
+    f, y0, end = run.f, run.y0, run.end
+    duration, rtol, atol = run.settings.duration, run.settings.rtol, run.settings.atol
     start = _time.perf_counter()
-    if resolution is not None and speed is not None:  # the crank's prescribed turning
-        need = math.ceil(abs(speed) * duration / resolution) + 1
-        outputs = min(MAX_OUTPUTS, max(outputs, need))
-    stepper = _Stepper(f, duration, rtol, atol, outputs, progress, resolution)
-    # A driven crank that locks: integrate up to just before the dead point, where the torque
-    # it would need grows without bound.
-    end = None if stop_at is None else _before_lock(f, stop_at)
+    stepper = _Stepper(f, duration, rtol, atol, run.outputs, progress, resolution)
     with np.errstate(divide="ignore", invalid="ignore"):
         times, states, drift, nfev, steps, stopped = stepper.run(y0, end)
     traj = _trajectory(f, times, states, drift, nfev, steps, rtol, atol,
@@ -760,12 +836,12 @@ def simulate(
             f"{f.name} formulation uses the crank angle as its coordinate and cannot pass it"
             + _passing(linkage),
             t_event, th, traj)
-    if stop_at is not None:
-        th = f.crank_angle(stop_at)
+    if run.stop_at is not None:
+        th = f.crank_angle(run.stop_at)
         raise _lockup(
-            f"the crank, driven at {speed:g} rad/s, reaches the end of the range where the "
-            f"linkage assembles at t = {stop_at:.6g} s, θ1 = {th:.6g} rad: the linkage locks",
-            stop_at, th, traj)
+            f"the crank, driven at {f.speed:g} rad/s, reaches the end of the range where the "
+            f"linkage assembles at t = {run.stop_at:.6g} s, θ1 = {th:.6g} rad: the linkage "
+            "locks", run.stop_at, th, traj)
     return traj
 
 

@@ -23,10 +23,16 @@ the sweep. A worker that dies has its tasks rerun by the scheduler (a batch's pa
 whole or not at all, and a rerun writes the same part again), an interrupted sweep resumes
 from the parts it finished (``resume``), and the final table, assembled from the parts once
 all are there, has every point exactly once, in order (checked), after which the parts go.
+
+**Interrupted** (Ctrl-C, SIGINT): :func:`sweep` raises :class:`SweepInterrupted`, which says how
+many points are kept and where. The local cluster's worker processes never see the signal
+(:func:`balancer.interrupts.blocked`; a Ctrl-C at a terminal reaches the whole process group):
+the sweep cancels their tasks and closes the cluster itself, quietly, before it raises.
 """
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import hashlib
 import itertools
@@ -40,6 +46,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from . import interrupts
 from .errors import OutputError, SpecError
 
 #: Sampling methods of the varied keys.
@@ -244,6 +251,35 @@ def _locate(data: dict[str, Any], key: str) -> tuple[Any, Any]:
     raise SpecError("no such number in the spec", key=key)  # an empty key
 
 
+def number_keys(data: Any, prefix: str = "") -> list[str]:
+    """Every dotted key that names a number in a parsed spec (a list's entries by index)."""
+    if isinstance(data, dict):
+        items = data.items()
+    elif isinstance(data, list):
+        items = ((str(i), x) for i, x in enumerate(data))
+    else:
+        return [prefix] if isinstance(data, int | float) and not isinstance(data, bool) \
+            else []
+    return [key for name, value in items
+            for key in number_keys(value, f"{prefix}.{name}" if prefix else str(name))]
+
+
+def check_key(data: dict[str, Any], key: str, option: str) -> None:
+    """Raise :class:`SpecError` naming ``option`` if ``key`` names no number of the spec.
+
+    The message suggests the spec's closest keys (a typo such as ``links.crank.mas``).
+    """
+    try:
+        _locate(data, key)
+    except SpecError:
+        import difflib  # only for a key that is wrong
+
+        close = difflib.get_close_matches(key, number_keys(data), n=3, cutoff=0.6)
+        hint = ("; did you mean " + " or ".join(f"'{c}'" for c in close) + "?") if close \
+            else "; give the dotted key of a number of the spec, e.g. links.crank.mass"
+        raise SpecError(f"names no number of the spec{hint}", key=option, value=key) from None
+
+
 def with_values(data: dict[str, Any], values: dict[str, float]) -> dict[str, Any]:
     """A copy of a parsed spec with each dotted key set.
 
@@ -354,9 +390,58 @@ def _write_part(path: Path, rows: list[dict], keys: Sequence[str]) -> None:
     os.replace(tmp, path)
 
 
+class SweepInterrupted(KeyboardInterrupt):
+    """A sweep stopped by SIGINT (Ctrl-C): what it kept for ``resume``.
+
+    Parameters
+    ----------
+    kept
+        Points whose rows are kept (this run's and those of the runs before it).
+    points
+        Points of the whole sweep.
+    parts
+        The folder that keeps them (``None``: nothing kept, and no folder left).
+    """
+
+    def __init__(self, kept: int, points: int, parts: Path | None) -> None:
+        self.kept, self.points, self.parts = kept, points, parts
+        super().__init__(self.summary)
+
+    @property
+    def summary(self) -> str:
+        """One line for the person who pressed Ctrl-C."""
+        if self.parts is None:
+            return f"no point of {self.points} was finished; nothing kept"
+        return (f"{self.kept} of {self.points} points kept in {self.parts}; run the same "
+                "command with --resume to finish")
+
+    def __str__(self) -> str:
+        return self.summary
+
+
 @dataclass(frozen=True)
 class SweepResult:
-    """What a sweep did: the table's path, its rows' statuses, and how long it took."""
+    """What a sweep did: the table's path, its rows' statuses, and how long it took.
+
+    Attributes
+    ----------
+    out
+        The table written.
+    points
+        Its rows: every point of the sweep.
+    statuses
+        Rows by status.
+    seconds
+        Wall time of this run, s.
+    workers
+        Dask workers used (0: in this process).
+    resumed
+        Batches finished by the interrupted runs before this one (``resume``).
+    computed
+        Points computed by this run: ``points`` less those of the ``resumed`` batches.
+    residual_force
+        A perturbation sweep's residual RMS shaking force (``mean``, ``p95``, ``max``, N).
+    """
 
     out: Path
     points: int
@@ -364,14 +449,20 @@ class SweepResult:
     seconds: float
     workers: int
     resumed: int
+    computed: int
     residual_force: dict[str, float] | None = None
+
+    @property
+    def rate(self) -> float | None:
+        """Points computed per second of this run (``None``: no time, or none computed)."""
+        return self.computed / self.seconds if self.seconds > 0 and self.computed else None
 
     def as_dict(self) -> dict[str, Any]:
         """The ``sweep --json`` summary."""
         return {"out": str(self.out), "points": self.points, "statuses": self.statuses,
                 "seconds": self.seconds, "workers": self.workers,
                 "resumed_batches": self.resumed,
-                "points_per_second": self.points / self.seconds if self.seconds else None,
+                "points_per_second": self.rate,
                 **({"residual_shaking_force": self.residual_force}
                    if self.residual_force is not None else {})}
 
@@ -414,6 +505,11 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
     on_batch
         Called as ``on_batch(batches done, client)`` after each batch is written (tests use it
         to stop a worker or interrupt the sweep).
+
+    Raises
+    ------
+    SweepInterrupted
+        On SIGINT (a :class:`KeyboardInterrupt`), once the cluster is closed: what is kept.
     """
     import tomllib
 
@@ -438,6 +534,8 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
                         key="operation.speed", source=str(spec))
     if perturbs and varies:
         raise SpecError("give --vary or --perturb, not both", key="--perturb")
+    for given in perturbs or varies:
+        check_key(data, given.key, "--perturb" if perturbs else "--vary")
     points = (perturbed_points(data, perturbs, samples, seed) if perturbs
               else design_points(varies, method, samples, seed))
     for key in points[0]:
@@ -462,7 +560,7 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
             raise OutputError(f"the interrupted sweep in {parts} was run with another spec, "
                               "other keys or other points; remove that folder to start anew",
                               key="--resume")
-        done = {int(p.stem.split("-")[1]) for p in parts.glob("batch-*.parquet")}
+        done = _finished(parts)
     else:
         if resume:
             raise OutputError(f"no interrupted sweep to resume ({parts} does not exist)",
@@ -493,6 +591,12 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
                 record(i, run_batch(data, batches[i], analyse_only), None)
         elif todo:
             used = _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only)
+    except KeyboardInterrupt:
+        with interrupts.shielded():  # a second Ctrl-C must not leave the parts half told
+            kept = sum(len(batches[i]) for i in _finished(parts))
+            if not kept:
+                shutil.rmtree(parts, ignore_errors=True)
+        raise SweepInterrupted(kept, len(points), parts if kept else None) from None
     except BaseException:
         if finished == 0:  # nothing computed to keep (a scheduler out of reach, …)
             shutil.rmtree(parts, ignore_errors=True)
@@ -514,28 +618,46 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
                         "max": float(force.max()), "unit": "N (RMS over a revolution)"}
     return SweepResult(out=out, points=len(points), statuses=statuses,
                        seconds=time.perf_counter() - start, workers=used, resumed=len(done),
+                       computed=len(points) - sum(len(batches[i]) for i in done),
                        residual_force=residual)
 
 
+def _finished(parts: Path) -> set[int]:
+    """The batches whose parts are written in ``parts``."""
+    return {int(p.stem.split("-")[1]) for p in parts.glob("batch-*.parquet")}
+
+
 def _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only) -> int:
-    """Run the batches ``todo`` on a cluster; ``record`` each as it finishes. Its workers."""
+    """Run the batches ``todo`` on a cluster; ``record`` each as it finishes. Its workers.
+
+    Interrupted, it cancels the tasks and closes the client and its local cluster before the
+    :class:`KeyboardInterrupt` goes on, with Dask's logs silenced (its workers' tasks cut short
+    would log errors a person who pressed Ctrl-C has no use for).
+    """
     import logging
 
     from distributed import Client, LocalCluster, as_completed
 
-    cluster = None
-    if scheduler is None:
-        n = workers or os.cpu_count() or 1
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR)
-        client = Client(cluster)
-    else:
-        try:
-            client = Client(scheduler, timeout=10)
-        except OSError as exc:
-            raise SpecError(f"cannot reach the Dask scheduler ({exc})", key="--scheduler",
-                            value=scheduler) from None
+    cluster = client = None
+    futures: dict = {}
     try:
+        if scheduler is None:
+            n = workers or os.cpu_count() or 1
+            # multiprocessing's resource tracker, started with the first worker, unblocks
+            # SIGINT in the thread that starts it: started here first, it leaves the block be.
+            from multiprocessing import resource_tracker
+
+            resource_tracker.ensure_running()
+            with interrupts.blocked():  # its threads and worker processes: no SIGINT, ever
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, silence_logs=logging.ERROR)
+                client = Client(cluster)
+        else:
+            try:
+                client = Client(scheduler, timeout=10)
+            except OSError as exc:
+                raise SpecError(f"cannot reach the Dask scheduler ({exc})", key="--scheduler",
+                                value=scheduler) from None
         used = len(client.scheduler_info()["workers"])
         scattered = client.scatter(data, broadcast=True)
         futures = {client.submit(run_batch, scattered, batches[i], analyse_only, pure=False,
@@ -544,10 +666,41 @@ def _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only) 
         for future in as_completed(futures):
             record(futures[future], future.result(), client)
         return used
+    except KeyboardInterrupt:
+        # Whatever the closing meets (a scheduler gone too), the interrupt is what to report.
+        with (interrupts.shielded(), _silenced("distributed", "tornado", "asyncio"),
+              contextlib.suppress(Exception)):
+            _close(client, cluster, list(futures))
+        raise
     finally:
+        with interrupts.shielded():
+            _close(client, cluster, [])
+
+
+def _close(client, cluster, futures: list) -> None:
+    """Cancel ``futures`` and close the client and the cluster (each once)."""
+    if client is not None and client.status not in ("closed", "closing"):
+        if futures:
+            client.cancel(futures)
         client.close()
-        if cluster is not None:
-            cluster.close()
+    if cluster is not None and cluster.status.name not in ("closed", "closing"):
+        cluster.close()
+
+
+@contextlib.contextmanager
+def _silenced(*names: str):
+    """The loggers ``names`` silent (above CRITICAL) for the block."""
+    import logging
+
+    loggers = [logging.getLogger(name) for name in names]
+    levels = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for lg, level in zip(loggers, levels, strict=True):
+            lg.setLevel(level)
 
 
 def _assemble(parts: Path, out: Path, keys: Sequence[str], points: int, batches: int) -> None:

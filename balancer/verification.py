@@ -27,7 +27,7 @@ import numpy as np
 from .errors import LockupError, SpecError
 from .mechanisms import mechanism_of
 from .model import Design
-from .simulation import MAX_OUTPUTS, Trajectory, simulate
+from .simulation import MAX_OUTPUTS, Trajectory, check, simulate
 
 #: Output times per crank revolution at least: 2°, some fifteen across the engine example's
 #: sharpest peak (its gas force's).
@@ -276,7 +276,34 @@ def verify(
     Raises
     ------
     SpecError
-        If the spec has no operating speed, or the crank cannot turn fully when driven.
+        If the spec has no operating speed, or the crank cannot turn fully when driven; for
+        whatever :func:`~balancer.simulation.simulate` refuses of any of the runs, before
+        the first starts (:func:`~balancer.simulation.check`).
+    """
+    method, runs = _plan(design, method, duration, rtol, atol, outputs)
+    total = sum(r.settings.duration for r in runs) * (1 + (design.original is not None))
+    tally = _Tally(progress, total)
+    # The free run first: a duration too long for the step budget is refused from the rate
+    # of its first steps, before the driven run's work.
+    free, driven = [_run(tally, design.mechanism, design.original, run.settings, method,
+                         **run.kw) for run in runs]
+    return Verification(method=method, driven=driven, free=free)
+
+
+@dataclass(frozen=True)
+class _Planned:
+    """One run of a verification: its settings and :func:`simulate`'s keywords."""
+
+    settings: object
+    kw: dict
+
+
+def _plan(design: Design, method, duration, rtol, atol, outputs) -> tuple[str, list[_Planned]]:
+    """The method and the runs (free, then driven) of :func:`verify`, checked.
+
+    Everything :func:`~balancer.simulation.simulate` refuses before it integrates is refused
+    here, for every run of the design and of its original, before any is made
+    (:func:`~balancer.simulation.check`).
     """
     if design.operation is None:
         raise SpecError("missing required key: the driven check runs at the operating speed",
@@ -300,10 +327,20 @@ def verify(
     free_settings = _resolved(replace(settings, drive="free"), FREE_MARGIN * settings.omega1,
                               resolution)
     kw = {"rtol": rtol, "atol": atol, "resolution": resolution}
-    runs = 2 * (1 + (design.original is not None))
-    tally = _Tally(progress, runs * settings.duration)
-    return Verification(
-        method=method,
-        driven=_run(tally, linkage, design.original, driven_settings, method, **kw),
-        free=_run(tally, linkage, design.original, free_settings, method, **kw),
-    )
+    runs = [_Planned(settings=free_settings, kw=kw), _Planned(settings=driven_settings, kw=kw)]
+    for model in (linkage, design.original):
+        for run in runs:
+            if model is not None:
+                check(model, run.settings, method=method, **run.kw)
+    return method, runs
+
+
+def check_verification(design: Design, *, method: str | None = None,
+                       duration: float | None = None, rtol: float = RTOL, atol: float = ATOL,
+                       outputs: int | None = None) -> None:
+    """Raise what :func:`verify` with these arguments would refuse before it simulates.
+
+    For a command that verifies at its end (``optimize``): its bad input is found before its
+    work. The arguments are :func:`verify`'s.
+    """
+    _plan(design, method, duration, rtol, atol, outputs)

@@ -448,7 +448,7 @@ def test_example_lists_prints_and_writes_the_shipped_specs(tmp_path, capsys):
     assert capsys.readouterr().out == (ROOT / "examples" / "pb2.toml").read_text()
     out = tmp_path / "mine.toml"
     assert main(["example", "pb1.toml", "--out", str(out)]) == 0
-    assert f"wrote {out}" in capsys.readouterr().out
+    assert capsys.readouterr().err == f"wrote {out}\n"
     assert out.read_bytes() == (ROOT / "examples" / "pb1.toml").read_bytes()
     assert spec.load_design(out) == examples.load("pb1")
     assert main(["example", "--out", str(tmp_path / "x.toml")]) == 2
@@ -568,3 +568,57 @@ def test_a_ratio_to_nothing_is_a_dash_not_nan(tmp_path, capsys):
     assert not re.search(r"\b(nan|inf)\b", out, re.IGNORECASE)
     row = next(line for line in out.splitlines() if line.startswith("shaking force "))
     assert "—" in row.split()
+
+
+_PB1 = str(ROOT / "examples" / "pb1.toml")
+
+
+@pytest.mark.parametrize(("argv", "files", "json_too"), [
+    (["analyze", EXAMPLE, "--csv", "{tmp}/cycle.csv"], ["cycle.csv"], True),
+    (["simulate", EXAMPLE, "--duration", "0.2", "--out", "{tmp}/t.csv"], ["t.csv"], True),
+    (["verify", EXAMPLE, "--duration", "0.2", "--plot", "{tmp}/r.png"], ["r.png"], True),
+    (["optimize", _PB1, "--no-verify", "--out", "{tmp}/b.toml"], ["b.toml"], True),
+    (["plot", _PB1, "--cycle", "{tmp}/c.svg"], ["c.svg"], False),
+    (["pareto", _PB1, "--against", "driving-torque", "--points", "3", "--plot",
+      "{tmp}/f.svg", "--csv", "{tmp}/f.csv"], ["f.svg", "f.csv"], True),
+    (["sweep", _PB1, "--vary", "mechanism.lengths.coupler=2.8:3.2:2", "--out",
+      "{tmp}/s.parquet", "--plot", "{tmp}/s.svg", "--workers", "0"], ["s.parquet", "s.svg"],
+     True),
+    (["example", "pb1", "--out", "{tmp}/e.toml"], ["e.toml"], False),
+])
+def test_every_file_written_is_said_on_stderr_and_never_on_stdout(tmp_path, capsys, argv,
+                                                                  files, json_too):
+    """Some verbs said 'wrote PATH' on stdout (plot, example, inside optimize's, verify's and
+    sweep's reports), others wrote silently (analyze --csv, simulate --out, pareto, sweep
+    --plot): now each file written is one 'wrote PATH' line on stderr, and with --json stdout
+    is the JSON document alone."""
+    for as_json in (False, True) if json_too else (False,):
+        folder = tmp_path / ("json" if as_json else "text")
+        folder.mkdir()
+        args = [a.format(tmp=folder) for a in argv] + (["--json"] if as_json else [])
+        assert main(args) == 0
+        captured = capsys.readouterr()
+        assert captured.err.splitlines() == [f"wrote {folder / name}" for name in files]
+        assert "wrote" not in captured.out
+        if as_json:
+            json.loads(captured.out)
+        assert sorted(p.name for p in folder.iterdir()) == sorted(files)
+
+
+@pytest.mark.parametrize(("verb", "option", "value"), [
+    ("analyze", "--gravity", "-1,-9.81"),
+    ("simulate", "--duration", "-1e3"),
+    ("simulate", "--atol", "-1e-9"),
+    ("verify", "--duration", "-0.5e1"),
+    ("plot", "--frames", "-1e2"),
+    ("sweep", "--seed", "-1e3"),
+])
+def test_a_value_that_begins_with_a_dash_is_shown_in_its_equals_form(capsys, verb, option,
+                                                                       value):
+    """`--gravity -1,-9.81` reads as an option of its own, and argparse said only 'expected
+    one argument': the line now shows the form that takes it, --gravity=-1,-9.81."""
+    assert main([verb, _PB1, option, value]) == 2
+    err = _one_error_line(capsys.readouterr().err)
+    assert option in err and f"{option}={value}" in err and "'-'" in err
+    assert main(["analyze", _PB1, "--csv", "--json"]) == 2  # a missing value: no such hint
+    assert "=" not in _one_error_line(capsys.readouterr().err)

@@ -151,7 +151,7 @@ def test_plot_cycle_writes_the_type_its_extension_names(tmp_path, capsys, pb1_ba
     assert main(["plot", str(pb1_balanced), "--cycle", str(out)]) == 0
     assert magic in out.read_bytes()[:500]
     assert sorted(p.name for p in tmp_path.iterdir()) == [out.name]
-    assert capsys.readouterr().out == f"wrote {out}\n"
+    assert capsys.readouterr().err == f"wrote {out}\n"
 
 
 @pytest.mark.parametrize("name", ["cycle.jpg", "cycle", "cycle.gif", "cycle.mp4"])

@@ -328,7 +328,7 @@ def test_a_prescribed_motion_too_long_for_its_panels_is_refused_before_laying_th
     code = main(["simulate", str(EXAMPLES / "stephenson_sixbar.toml"), "--duration", "1e5"])
     assert code == 2
     err = capsys.readouterr().err
-    assert "simulation.duration" in err and "quadrature panels" in err
+    assert "--duration" in err and "quadrature panels" in err  # the option that gave it
 
 
 def test_command_line_overrides_are_named_as_options(capsys):
@@ -874,7 +874,9 @@ def test_a_motion_that_starts_at_a_dead_point_is_refused_by_name(capsys):
     path = Path(__file__).resolve().parent / "data" / "whitworth_starting_at_a_dead_point.toml"
     assert main(["simulate", str(path), "--duration", "0.05"]) == 2
     err = capsys.readouterr().err
-    assert "simulation.theta1" in err and "singular pose" in err and err.count("\n") == 1
+    # (A 40 m linkage at 17.5 rad/s: a note on its points' speed comes first.)
+    [line] = [x for x in err.splitlines() if not x.startswith("balancer: note: ")]
+    assert "simulation.theta1" in line and "singular pose" in line
 
 
 @pytest.mark.parametrize(("spec", "code"), [("subnormal_mass_184.toml", 0),

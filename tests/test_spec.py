@@ -240,3 +240,43 @@ def test_an_absurd_scale_names_its_own_key(edit, key, tmp_path, capsys):
     assert main(["analyze", str(path)]) == 2
     err = capsys.readouterr().err
     assert f"{key}:" in err and "1e+200" in err, err
+
+
+_QUICK_RETURN = (EXAMPLES / "quick_return.toml").read_text()
+_QR_LINKS = ("crank", "block", "rocker", "rod", "ram")
+
+
+@pytest.mark.parametrize(("old", "new", "key", "names"), [
+    ('guide = "ground"', 'guide = "frame"', "mechanism.sliders[1].guide", (*_QR_LINKS, "ground")),
+    ('link = "ram"', 'link = "slide"', "mechanism.sliders[1].link", (*_QR_LINKS, "ground")),
+    ('input = "crank"', 'input = "ground"', "mechanism.input", (*_QR_LINKS, "ground")),
+    ('point = "D"', 'point = "C"', "mechanism.sliders[1].point", ("D",)),
+])
+def test_an_unknown_link_or_point_is_named_with_those_the_spec_has(old, new, key, names):
+    """`guide = "frame"` said 'unknown link' without the links or that the frame is called
+    ground: every such message now lists the names that would do."""
+    assert _QUICK_RETURN.count(old) == 1
+    with pytest.raises(SpecError) as info:
+        spec.loads_design(_QUICK_RETURN.replace(old, new))
+    assert info.value.key == key
+    message = str(info.value)
+    assert all(re.search(rf"\b{name}\b", message) for name in names), message
+    if "ground" in names:
+        assert "the frame is called ground" in message
+
+
+def test_a_spring_on_an_unknown_point_names_the_points():
+    text = _QUICK_RETURN + '\n[[springs]]\npoints = ["Q9", "D"]\nstiffness = 1.0\n' \
+        'free_length = 1.0\n'
+    with pytest.raises(SpecError) as info:
+        spec.loads_design(text)
+    assert info.value.key == "springs[0].points"
+    assert "'Q9'" in str(info.value) and "the points are A0, " in str(info.value)
+
+
+def test_a_balance_table_for_a_link_the_mechanism_lacks_lists_its_links():
+    text = (EXAMPLES / "pb1.toml").read_text() + "\n[balance.frame]\nmass = [1.0, 2.0]\n"
+    with pytest.raises(SpecError) as info:
+        spec.loads_design(text)
+    assert info.value.key == "balance.frame"
+    assert "crank, coupler, rocker" in str(info.value)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import tomllib
 from pathlib import Path
 
@@ -110,6 +111,30 @@ def test_an_interrupted_sweep_resumes_and_equals_an_uninterrupted_one(tmp_path):
     result = sweep(PB1, varies, out, workers=0, batch=1, resume=True)
     assert result.resumed == 2 and not parts.exists()
     assert _rows(out) == _rows(whole)
+
+
+def test_a_resumed_sweep_rates_only_the_points_it_computed(tmp_path):
+    """Two of five points computed before the interruption: the resumed run computed three,
+    and its rate is theirs over its own time; the summary says how many came from before."""
+    from balancer.report import sweep_text
+
+    varies = [Vary.parse(f"{COUPLER}=2.6:3.4:5")]
+    out = tmp_path / "sweep.parquet"
+
+    def stop(done, client):
+        if done == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        sweep(PB1, varies, out, workers=0, batch=1, on_batch=stop)
+    result = sweep(PB1, varies, out, workers=0, batch=1, resume=True)
+    assert (result.points, result.resumed, result.computed) == (5, 2, 3)
+    assert result.as_dict()["points_per_second"] == 3 / result.seconds
+    line = sweep_text(result).splitlines()[1]
+    assert line.startswith("5 points: 2 from the interrupted run before (2 batches), 3 "
+                           "computed in "), line
+    rate = float(re.search(r"\(([0-9.e+-]+) points/s", line)[1])
+    assert rate == pytest.approx(3 / result.seconds, rel=5e-3)
 
 
 def test_on_a_dask_cluster_a_killed_worker_loses_no_point(tmp_path):
@@ -227,3 +252,22 @@ def test_an_infeasible_point_keeps_its_own_figures():
     assert row["shaking_moment_before"] == own.shaking_moment.rms
     assert row["shaking_force_before"] == own.shaking_force.rms
     assert row["shaking_moment_after"] is None
+
+
+@pytest.mark.parametrize(("option", "text", "close"), [
+    ("--vary", "links.crank.mas=1:2:3", "links.crank.mass"),
+    ("--perturb", "links.crank.mas=0.1", "links.crank.mass"),
+    ("--vary", "mechanism.lengths.coupling=2:3:2", COUPLER),
+])
+def test_an_unknown_key_suggests_the_closest_naming_the_option(tmp_path, capsys, option, text,
+                                                               close):
+    """`--vary links.crank.mas` said 'no such number in the spec' under the key itself: now
+    the option, the key given and the spec's closest keys."""
+    argv = ["sweep", str(PB1), option, text, "--out", str(tmp_path / "x.parquet"),
+            "--workers", "0", *(["--samples", "3"] if option == "--perturb" else [])]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    key = text.partition("=")[0]
+    assert err.count("\n") == 1 and err.startswith(f"balancer: error: {option}: ")
+    assert f"'{close}'" in err and f"(got '{key}')" in err
+    assert list(tmp_path.iterdir()) == []

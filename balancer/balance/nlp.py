@@ -15,12 +15,17 @@ the centre of mass in its disc ``|s̄ − c|² ≤ R²``, ``I ≥ m·ρ²``, and
 inertia bound is exact here, which is where this formulation can beat the convex relaxation.
 
 IPOPT is built once per problem (:class:`NlpSolver`) and started from the convex optimum (a
-primal warm start).
+primal warm start). CasADi stops IPOPT at a SIGINT and returns normally (status
+``NonIpopt_Exception_Thrown``, and a warning on stderr): :meth:`NlpSolver.solve` raises
+:class:`KeyboardInterrupt` instead (:func:`balancer.interrupts.checked`), without the warning.
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import math
+import sys
 import time
 from dataclasses import dataclass
 
@@ -28,6 +33,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import interrupts
 from .problem import NumericProblem, inertial_to_physical, physical_to_inertial
 from .result import StageReport
 
@@ -241,7 +247,11 @@ class NlpSolver:
         data = self.data
         v0 = self.start(np.asarray(x_start, float))
         t0 = time.perf_counter()
-        sol = self._solver(x0=v0, lbx=self._lbx, ubx=self._ubx, lbg=self._lbg, ubg=self._ubg)
+        said = io.StringIO()  # CasADi's messages: dropped if it was interrupted
+        with interrupts.checked(), contextlib.redirect_stderr(said):
+            sol = self._solver(x0=v0, lbx=self._lbx, ubx=self._ubx, lbg=self._lbg,
+                               ubg=self._ubg)
+        sys.stderr.write(said.getvalue())
         elapsed = time.perf_counter() - t0
         stats = self._solver.stats()
         word = str(stats.get("return_status", "unknown"))

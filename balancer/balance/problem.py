@@ -412,6 +412,15 @@ def read_balance(table: _Table, mechanism) -> BalanceProblem:
     """
     mech = mechanism_of(mechanism)
     names = mech.link_names
+    for name, value in table.data.items():  # a table for a link the mechanism does not have
+        if isinstance(value, dict) and name not in ("objective", *names):
+            import difflib  # only for a spec that is wrong
+
+            close = difflib.get_close_matches(name, names, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise SpecError(f"names no moving link of the {mech.kind}{hint} (its moving links "
+                            f"are {', '.join(names)}; the frame stays as it is)",
+                            key=table.key(name))
     _check_keys(table, ("force_balance", "objective", *names))
     force_balance = True
     if table.has("force_balance"):
@@ -487,7 +496,8 @@ def check_problem(problem: BalanceProblem, mechanism) -> None:
     bodies = {b.name: b for b in mech.linkage.moving}
     for name in problem.listed:
         if name not in bodies:
-            raise SpecError(f"the {mech.kind} has no moving link {name}", key=f"balance.{name}")
+            raise SpecError(f"the {mech.kind} has no moving link {name} (its moving links are "
+                            f"{', '.join(bodies)})", key=f"balance.{name}")
     free = False
     for name in mech.link_names:
         freedom = problem.link(name)

@@ -322,8 +322,11 @@ def classify(case: Case, run: Run, before: dict[str, str], after: dict[str, str]
         d.append(f"exit code {rc} (not 0/1/2)")
     if "Traceback" in run.stderr and run.exception is None:
         d.append("'Traceback' in stderr")
+    # Besides its one error line, a command may say what it wrote ('wrote PATH') and note a
+    # unit that looks wrong ('balancer: note: …'), on failure as on success.
+    lines = [line for line in run.stderr.splitlines() if line.strip()
+             and not line.startswith(("wrote ", "balancer: note: "))]
     if done and rc != 0:
-        lines = run.stderr.rstrip("\n").split("\n") if run.stderr.strip() else []
         if run.exception is None and (len(lines) != 1 or not lines[0].startswith("balancer")):
             d.append("stderr not exactly one line on failure")  # (every traceback is too)
         if run.stdout.strip():
@@ -331,7 +334,7 @@ def classify(case: Case, run: Run, before: dict[str, str], after: dict[str, str]
         if (rc == 2 and case.kind.startswith(("spec/", "text/")) and SPEC not in run.stderr
                 and len(lines) == 1 and "--" not in lines[0]):
             d.append("exit-2 message does not name the spec file")
-    if done and rc == 0 and run.stderr.strip():
+    if done and rc == 0 and lines:
         d.append("stderr output on success")
     if done and case.expect is not None and rc not in case.expect and rc in (0, 1, 2):
         family = case.kind.split("/")[0]

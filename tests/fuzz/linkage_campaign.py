@@ -323,7 +323,9 @@ def classify(case: LinkageCase, run: Run) -> None:
         d.append(("'Traceback' in stderr", run.stderr[-300:]))
     done = run.status == "exit"
     rc = run.rc
-    lines = run.stderr.rstrip("\n").split("\n") if run.stderr.strip() else []
+    # Besides its one error line: 'wrote PATH' and a note on a unit that looks wrong.
+    lines = [line for line in run.stderr.splitlines() if line.strip()
+             and not line.startswith(("wrote ", "balancer: note: "))]
     if done and rc not in (0, 1, 2):
         d.append((f"exit code {rc} (not 0/1/2)", ""))
     if done and rc != 0:

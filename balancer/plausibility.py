@@ -1,0 +1,134 @@
+"""Plausibility of a design's sizes and speed: a note for a designer who slipped a unit.
+
+Nothing here is an error — a design may be huge or fast — but some numbers are almost always a
+unit written wrong: a length of more than :data:`MAX_LENGTH` (millimetres written as metres),
+or a point of the mechanism that would move faster than sound at the operating speed
+(:data:`MAX_TIP_SPEED`: revolutions per minute written as radians per second, or millimetres
+as metres). :func:`length_note` reads the spec as written, so that its note comes even when
+the spec then fails to load (a linkage with one length in millimetres does not assemble);
+:func:`speed_note` needs the loaded design's motion. Each returns one line naming the key, or
+``None``; the command line prints it on stderr and its exit code does not change.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+#: Longest length that is plausibly meant, m: no planar linkage this tool balances is longer.
+MAX_LENGTH = 100.0
+#: Fastest plausible tip speed ω·R of a point of the mechanism, m/s: the speed of sound in air.
+MAX_TIP_SPEED = 340.0
+#: Lengths named in a note at most (the rest are counted).
+NAMED = 3
+
+
+def _number(x: Any) -> bool:
+    return isinstance(x, int | float) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _pair(x: Any) -> bool:
+    return isinstance(x, list) and len(x) == 2 and all(map(_number, x))
+
+
+def _lengths(data: dict[str, Any]) -> list[tuple[str, float, str]]:
+    """The spec's lengths as written: ``(key, size in m, what the size is)``."""
+    out: list[tuple[str, float, str]] = []
+    mechanism = data.get("mechanism")
+    mechanism = mechanism if isinstance(mechanism, dict) else {}
+    for table, words in (("lengths", ""), ("points", "from the origin")):
+        entries = mechanism.get(table)
+        for name, value in (entries.items() if isinstance(entries, dict) else ()):
+            key = f"mechanism.{table}.{name}"
+            if _number(value):
+                out.append((key, abs(value), f"{key} = {value:g} m"))
+            elif _pair(value):
+                size = math.hypot(*value)
+                out.append((key, size, f"{key} = [{value[0]:g}, {value[1]:g}] m ({size:.4g} m "
+                                       f"{words})"))
+    links = data.get("links")
+    for name, link in (links.items() if isinstance(links, dict) else ()):
+        com = link.get("com") if isinstance(link, dict) else None
+        if not isinstance(com, dict):
+            continue
+        key = f"links.{name}.com"
+        if _pair(com.get("at")):  # a point, in global coordinates
+            size = math.hypot(*com["at"])
+            out.append((key, size, f"{key}.at ({size:.4g} m from the origin)"))
+            continue
+        parts = [com.get(k) for k in ("e", "f") if k in com] or [com.get("s")]
+        if all(map(_number, parts)):
+            size = math.hypot(*parts)
+            out.append((key, size, f"{key} ({size:.4g} m from its link's first point)"))
+    springs = data.get("springs")
+    for i, spring in enumerate(springs if isinstance(springs, list) else ()):
+        value = spring.get("free_length") if isinstance(spring, dict) else None
+        if _number(value):
+            key = f"springs[{i}].free_length"
+            out.append((key, abs(value), f"{key} = {value:g} m"))
+    return out
+
+
+def length_note(data: dict[str, Any]) -> str | None:
+    """A note on the lengths longer than :data:`MAX_LENGTH` in a parsed spec, or ``None``.
+
+    Parameters
+    ----------
+    data
+        The spec as parsed from TOML, before it is validated: lengths (m), points (m), the
+        links' centres of mass (m) and the springs' free lengths (m) as written.
+    """
+    long = [text for _, size, text in _lengths(data) if size > MAX_LENGTH]
+    if not long:
+        return None
+    named = ", ".join(long[:NAMED]) + (f" and {len(long) - NAMED} more" if len(long) > NAMED
+                                       else "")
+    verb = "is" if len(long) == 1 else "are"
+    return (f"{named} {verb} longer than {MAX_LENGTH:g} m: lengths are in metres (mm written "
+            "as m?)")
+
+
+def tip_radius(mechanism, samples: int = 72) -> float | None:
+    """The largest distance of a point or centre of mass from the crank's pivot, m.
+
+    Over ``samples`` crank angles of a revolution (those where the linkage assembles);
+    ``None`` where its motion cannot be found.
+    """
+    import numpy as np
+
+    from .cycle import sample_angles
+    from .errors import BalancerError
+    from .mechanisms import mechanism_of
+
+    try:
+        mech = mechanism_of(mechanism)
+        body = next(b for b in mech.linkage.bodies if b.name == mech.input)
+        with np.errstate(all="ignore"):
+            mo = mech.motion(sample_angles(samples), 1.0)
+            points = mech.points(mo)
+            pivot = points[body.points[0]]
+            where = [np.abs(np.asarray(p, complex) - pivot) for p in points.values()]
+            where += [np.abs(c.complex() + 0 * mo.theta1 - pivot)
+                      for c in mech.centres_of_mass(mo)]
+            radius = float(np.nanmax(np.concatenate([np.ravel(w) for w in where])))
+    except (BalancerError, ValueError, KeyError, StopIteration, FloatingPointError):
+        return None
+    return radius if math.isfinite(radius) else None
+
+
+def speed_note(design) -> str | None:
+    """A note if a point would move faster than :data:`MAX_TIP_SPEED`, or ``None``.
+
+    The tip speed is ``ω·R``: ω the operating speed ``[operation] speed`` (rad/s), R the
+    :func:`tip_radius` (m). ``None`` too for a design without an operating speed.
+    """
+    if design.operation is None:
+        return None
+    speed = abs(design.operation.speed)
+    radius = tip_radius(design.mechanism)
+    if radius is None or not speed * radius > MAX_TIP_SPEED:
+        return None
+    return (f"operation.speed = {design.operation.speed:g} rad/s moves a point {radius:.4g} m "
+            f"from the crank's pivot at {speed * radius:.4g} m/s, faster than sound "
+            f"({MAX_TIP_SPEED:g} m/s): the speed is in rad/s (rpm written as rad/s?) and "
+            "lengths in metres (mm written as m?)")
