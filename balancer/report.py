@@ -539,7 +539,7 @@ def _opt(x: float | None, fmt: str = ".4g") -> str:
     return "—" if x is None else format(x, fmt)
 
 
-def verification_text(verification, spec: str | None = None, plots=()) -> str:
+def verification_text(verification, spec: str | None = None) -> str:
     """The readable ``verify`` report."""
     head = f"balancer verify — {spec}" if spec else "balancer verify"
     lines = [head, f"simulated with the {verification.method} formulation", ""]
@@ -562,8 +562,6 @@ def verification_text(verification, spec: str | None = None, plots=()) -> str:
               if r.force_level is not None]
     if levels and max(levels) < 1e-8:
         lines.append("the reaction sums vanish to integration-error level: force-balanced")
-    for path in plots:
-        lines.append(f"wrote {path}")
     return "\n".join(lines)
 
 
@@ -736,7 +734,7 @@ def counterweight_text(weights) -> str:
             + "\n" + "\n".join(notes))
 
 
-def optimization_text(result, before, after, verification=None, spec=None, out=None) -> str:
+def optimization_text(result, before, after, verification=None, spec=None) -> str:
     """The readable ``optimize`` report."""
     head = f"balancer optimize — {spec}" if spec else "balancer optimize"
     lines = [
@@ -789,8 +787,6 @@ def optimization_text(result, before, after, verification=None, spec=None, out=N
     if verification is not None:
         lines.append("")
         lines.append(verification_text(verification).split("\n", 1)[1].strip("\n"))
-    if out is not None:
-        lines.append(f"wrote {out}")
     return "\n".join(lines)
 
 
