@@ -38,6 +38,59 @@ _MASKS = (
 )
 
 
+#: A number as the outputs print it (JSON, tables, CSV).
+_NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.])")
+#: Counters of a solver's or an integrator's path, which rounding on another machine's
+#: arithmetic (another BLAS kernel) may lengthen or shorten by a step: not compared.
+_COUNTERS = re.compile(r'("(?:iterations|steps|nfev|evaluations)": )\d+'
+                       r"|\b\d+( solver iterations| steps| right-hand sides)")
+#: Agreement of two figures: relative, and as a share of the largest figure of the same
+#: output (a rounding-level figure, such as a balanced design's 4e-14 N, is noise on another
+#: machine's arithmetic).
+RELATIVE = 1e-9
+OF_LARGEST = 1e-12
+
+
+def _counters_masked(text: str) -> str:
+    return _COUNTERS.sub(lambda m: (m.group(1) or "") + "<n>" + (m.group(2) or ""), text)
+
+
+def difference(recorded: str, now: str, *, table: bool = False) -> str | None:
+    """Where ``now`` differs from ``recorded`` beyond another machine's rounding, or ``None``.
+
+    The text between the numbers must be the same; each number the same to :data:`RELATIVE`,
+    or to :data:`OF_LARGEST` of the output's largest number; in a readable ``table`` (figures
+    printed to a few significant digits), or to the last digit it is printed with. (JSON, CSV
+    and TOML print the shortest text that reads back as the same double: every digit counts.)
+    """
+    a, b = _counters_masked(recorded), _counters_masked(now)
+    if a == b:
+        return None
+    if _NUMBER.split(a) != _NUMBER.split(b):
+        for line_a, line_b in zip(a.splitlines(), b.splitlines(), strict=False):
+            if _NUMBER.split(line_a) != _NUMBER.split(line_b):
+                return f"text differs:\n  recorded: {line_a}\n  now:      {line_b}"
+        return "a different number of lines"
+    xs, ys = _NUMBER.findall(a), _NUMBER.findall(b)
+    largest = max((abs(float(x)) for x in xs), default=0.0)
+    for x, y in zip(xs, ys, strict=True):
+        fx, fy = float(x), float(y)
+        printed = 1.000001 * max(_last_digit(x), _last_digit(y)) if table else 0.0
+        if abs(fx - fy) > max(RELATIVE * max(abs(fx), abs(fy)), OF_LARGEST * largest, printed):
+            return f"a figure differs: recorded {x}, now {y}"
+    return None
+
+
+def _last_digit(token: str) -> float:
+    """The value of one unit in the last printed digit of a number of fewer than 15 digits."""
+    mantissa, _, exponent = token.lower().lstrip("+-").partition("e")
+    digits = mantissa.replace(".", "").lstrip("0")
+    if len(digits) >= 15:  # a full repr: compared relatively
+        return 0.0
+    decimals = len(mantissa.partition(".")[2])
+    return 10.0 ** (int(exponent or 0) - decimals)
+
+
 def mask(text: str, folder: Path | None = None) -> str:
     """``text`` with wall-clock times and the temporary ``folder`` replaced by markers."""
     for pattern, replacement in _MASKS:
@@ -64,12 +117,12 @@ def commands(name: str) -> dict[str, list[str]]:
         "simulate.json": ["simulate", spec, "--json", "--outputs", "41"],
         "simulate.csv": ["simulate", spec, "--outputs", "41", "--all-columns", "--out",
                          "{tmp}/out.csv"],
-        "verify.json": ["verify", spec, "--json", "--duration", "0.5"],
+        "verify.json": ["verify", spec, "--json"],
     }
     if name not in UNBALANCED:
         out.update({
             "optimize.txt": ["optimize", spec, "--no-verify"],
-            "optimize.json": ["optimize", spec, "--json", "--verify-duration", "0.5"],
+            "optimize.json": ["optimize", spec, "--json"],
             "optimize-convex.json": ["optimize", spec, "--json", "--no-verify", "--backend",
                                      "convex"],
             "optimize.toml": ["optimize", spec, "--no-verify", "--out", "{tmp}/out.toml"],
