@@ -3,8 +3,8 @@
 Implements Meijaard & van der Wijk (2020), Sect. 2: dependent angles for either assembly
 (Eq. 2–4), first-order transfer functions and angular velocities (Eq. 5–7), angular
 accelerations (Eq. 8–10) and the θ2-free form of the coupler's rate and acceleration (Eq. 11),
-which serves as a cross-check. Also the Grashof classification and the crank angles at which the
-linkage can be assembled.
+which serves as a cross-check. The Grashof classification and the crank angles at which the
+linkage can be assembled are the model's (:mod:`balancer.model.assembly`).
 
 Vectors in the plane are complex numbers, as in the paper: ``l̄k = lk·exp(iθk)``. Two helpers
 give the scalar and the cross product of such vectors: ``inner(x, y) = Re(x*·y)`` (the paper's
@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from enum import StrEnum
 from functools import cached_property, lru_cache
 
 import numpy as np
@@ -24,14 +23,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import AssemblyError
 from .model import FourBar
+from .model.assembly import BOUND_TOLERANCE, Lengths, assembly_range, cosine_bounds
 
-#: Relative tolerance within which a position at a triangle-inequality bound counts as reached
-#: (rounding) rather than outside the assembly range.
-BOUND_TOLERANCE = 1e-12
 #: |sin(θ3 − θ2)| below which a position is flagged as (near) a dead or change point.
 SINGULAR_TOLERANCE = 1e-6
-
-Lengths = tuple[float, float, float, float]
 
 
 def inner(x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
@@ -54,127 +49,6 @@ def cross_scalar(x: complex, y: complex) -> float:
     The formulations' right-hand sides call it thousands of times per simulation.
     """
     return x.real * y.imag - x.imag * y.real
-
-
-class LinkageClass(StrEnum):
-    """Grashof classification of a four-bar (which links can turn fully)."""
-
-    CRANK_ROCKER = "crank-rocker"
-    """Grashof, crank shortest: the crank turns fully, the rocker oscillates."""
-    DOUBLE_CRANK = "double-crank"
-    """Grashof, frame shortest: crank and rocker both turn fully (drag link)."""
-    ROCKER_CRANK = "rocker-crank"
-    """Grashof, rocker shortest: the rocker turns fully, the crank only oscillates."""
-    DOUBLE_ROCKER = "double-rocker"
-    """Grashof, coupler shortest: the coupler turns fully, crank and rocker oscillate."""
-    TRIPLE_ROCKER = "triple-rocker"
-    """Non-Grashof: no link turns fully relative to the frame."""
-    CHANGE_POINT = "change-point"
-    """s + l = p + q: all joints become collinear and the assembly can switch (parallelogram,
-    deltoid)."""
-
-
-def classify(lengths: Lengths, rtol: float = BOUND_TOLERANCE) -> LinkageClass:
-    """Grashof classification of a four-bar with lengths ``(l1, l2, l3, l4)``.
-
-    Grashof's condition ``s + l ≤ p + q`` (shortest plus longest at most the sum of the other
-    two); equality within ``rtol`` of the perimeter is a change-point linkage.
-    """
-    ordered = sorted(lengths)
-    s, p, q, long_ = ordered
-    slack = (p + q) - (s + long_)
-    if abs(slack) <= rtol * sum(lengths):
-        return LinkageClass.CHANGE_POINT
-    if slack < 0:
-        return LinkageClass.TRIPLE_ROCKER
-    shortest = int(np.argmin(lengths))
-    return (
-        LinkageClass.CRANK_ROCKER,
-        LinkageClass.DOUBLE_ROCKER,
-        LinkageClass.ROCKER_CRANK,
-        LinkageClass.DOUBLE_CRANK,
-    )[shortest]
-
-
-@dataclass(frozen=True)
-class AssemblyRange:
-    """The crank angles at which the linkage can be assembled.
-
-    Attributes
-    ----------
-    intervals
-        Closed intervals ``(start, end)`` of θ1 in rad, ``start < end ≤ start + 2π``, starting
-        within ``[-π, π]``; empty if the linkage cannot be assembled at all.
-    full
-        Whether the crank can turn a full revolution.
-    """
-
-    intervals: tuple[tuple[float, float], ...]
-    full: bool
-
-    @property
-    def empty(self) -> bool:
-        """Whether no crank angle assembles."""
-        return not self.intervals
-
-    def contains(self, theta1: ArrayLike, atol: float = 1e-12) -> NDArray[np.bool_]:
-        """Whether each crank angle (rad) lies in the range."""
-        t = np.asarray(theta1, dtype=float)
-        if self.full:
-            return np.ones(t.shape, dtype=bool)
-        inside = np.zeros(t.shape, dtype=bool)
-        for a, b in self.intervals:
-            # Bring the angle into [a, a + 2π).
-            w = a + np.mod(t - a, 2 * math.pi)
-            inside |= (w <= b + atol) | (w >= a + 2 * math.pi - atol)
-        return inside
-
-    def describe(self) -> str:
-        """Human-readable form, in degrees."""
-        if self.full:
-            return "full revolution"
-        if self.empty:
-            return "none"
-        return ", ".join(
-            f"[{math.degrees(a):.4g}°, {math.degrees(b):.4g}°]" for a, b in self.intervals
-        )
-
-
-def cosine_bounds(lengths: Lengths) -> tuple[float, float]:
-    """Bounds ``(c_lo, c_hi)`` on cos θ1 for assembly (from Eq. 2 and the triangle inequalities).
-
-    ``|l2 − l3| ≤ l23 ≤ l2 + l3`` with ``l23² = l1² + l4² − 2·l1·l4·cos θ1`` gives
-    ``c_lo ≤ cos θ1 ≤ c_hi``.
-    """
-    l1, l2, l3, l4 = lengths
-    base = l1 * l1 + l4 * l4
-    c_lo = (base - (l2 + l3) ** 2) / (2 * l1 * l4)
-    c_hi = (base - (l2 - l3) ** 2) / (2 * l1 * l4)
-    return c_lo, c_hi
-
-
-def assembly_range(lengths: Lengths, rtol: float = BOUND_TOLERANCE) -> AssemblyRange:
-    """Crank angles at which a four-bar with lengths ``(l1, l2, l3, l4)`` assembles."""
-    c_lo, c_hi = cosine_bounds(lengths)
-    tol = rtol * 4  # the bounds are O(1) numbers; allow a few roundings
-    if c_lo > 1 + tol or c_hi < -1 - tol or c_lo > c_hi:
-        return AssemblyRange(intervals=(), full=False)
-    lo_free = c_lo <= -1 + tol  # no upper bound on l23 binds
-    hi_free = c_hi >= 1 - tol  # no lower bound on l23 binds
-    if lo_free and hi_free:
-        return AssemblyRange(intervals=((-math.pi, math.pi),), full=True)
-    a_lo = math.acos(min(1.0, max(-1.0, c_lo)))  # cos θ1 ≥ c_lo  ⇔  |θ1| ≤ a_lo
-    a_hi = math.acos(min(1.0, max(-1.0, c_hi)))  # cos θ1 ≤ c_hi  ⇔  |θ1| ≥ a_hi
-    if hi_free:
-        return AssemblyRange(intervals=((-a_lo, a_lo),), full=False)
-    if lo_free:
-        return AssemblyRange(intervals=((a_hi, 2 * math.pi - a_hi),), full=False)
-    return AssemblyRange(intervals=((-a_lo, -a_hi), (a_hi, a_lo)), full=False)
-
-
-def crank_turns_fully(lengths: Lengths) -> bool:
-    """Whether the crank can turn a full revolution."""
-    return assembly_range(lengths).full
 
 
 def _sign(branch: str) -> float:

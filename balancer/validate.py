@@ -235,3 +235,18 @@ def _bytes(n: float) -> str:
             return f"{n:.3g} {unit}"
         n /= 1000
     return f"{n:.3g} PB"  # pragma: no cover
+
+
+def store(obj: object, name: str, value: object) -> None:
+    """Store a checked (normalised) value on a frozen dataclass."""
+    object.__setattr__(obj, name, value)
+
+
+def numbers(values: object, key: str) -> tuple[float, ...]:
+    """A non-empty list of finite numbers, as floats; a :class:`SpecError` naming ``key``."""
+    if isinstance(values, str | bytes) or not hasattr(values, "__iter__"):
+        raise SpecError("must be a non-empty list of numbers", key=key, value=values)
+    out = tuple(number(x, key) for x in values)
+    if not out:
+        raise SpecError("must be a non-empty list of numbers", key=key, value=list(values))
+    return out

@@ -36,9 +36,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from balancer.formulations import make
-from balancer.kinematics import classify
 from balancer.mechanisms.fourbar import FourBarMechanism
 from balancer.model import FourBar, Link, SimulationSettings
+from balancer.model.assembly import classify
 from balancer.plots import SERIES, save_png
 from balancer.report import markdown_table
 from balancer.simulation import simulate

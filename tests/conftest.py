@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
-from balancer.kinematics import assembly_range
 from balancer.model import FourBar, Link
+from balancer.model.assembly import assembly_range
 
 # Property tests draw the same examples on every machine and run (reproducible, like the seeded
 # random tests); HYPOTHESIS_PROFILE=explore draws new ones and keeps what fails (a fuzz campaign),

@@ -15,7 +15,7 @@ from balancer.cycle import cycle_analysis
 from balancer.errors import LockupError
 from balancer.formulations import make
 from balancer.mechanisms.fourbar import FourBarMechanism
-from balancer.model import FourBar, Link, SimulationSettings
+from balancer.model import FourBar, Link, SimulationSettings, assembly
 from balancer.simulation import DEAD_POINT_THRESHOLD, simulate
 
 #: The paper's four formulations of the four-bar.
@@ -182,7 +182,7 @@ def test_bai_crank_rocker_with_gravity():
 
 def test_bai_parallelogram_keeps_its_coupler_parallel():
     linkage = _bai((0.1, 0.25, 0.1, 0.25))
-    assert str(kin.classify(linkage.lengths)) == "change-point"
+    assert str(assembly.classify(linkage.lengths)) == "change-point"
     # Their initial attitudes q0 = [0.6; 0.8; 1; 0; 0.6; 0.8], momentum 0.
     settings = SimulationSettings(duration=5.0, theta1=math.atan2(0.8, 0.6), omega1=0.0,
                                   gravity=(0.0, -9.81))
@@ -214,7 +214,7 @@ def _triple_rocker():
 
 def test_non_minimal_formulations_swing_through_a_dead_point():
     linkage = _triple_rocker()
-    rng = kin.assembly_range(linkage.lengths)
+    rng = assembly.assembly_range(linkage.lengths)
     (lo, hi), = rng.intervals
     settings = SimulationSettings(duration=3.0, theta1=0.0, omega1=6.0)
     runs = {m: simulate(linkage, settings, method=m, **TIGHT)
@@ -259,7 +259,7 @@ def test_crank_angle_formulations_stop_at_a_dead_point(method):
     assert abs(info.value.time - first) < dt + 2 * DEAD_POINT_THRESHOLD / rate
     # Near the end hi of the crank's range |sin(θ3 − θ2)| ≈ c·√(hi − θ1): the run stops
     # (threshold/c)² before hi; twice that for the next term and the integration error.
-    (_, hi), = kin.assembly_range(linkage.lengths).intervals
+    (_, hi), = assembly.assembly_range(linkage.lengths).intervals
     c = abs(kin.position_of(linkage, hi - 1e-8).sin_transmission[0]) / 1e-4
     assert abs(info.value.theta1 - hi) < 2 * (DEAD_POINT_THRESHOLD / c) ** 2
     partial = info.value.partial
@@ -273,7 +273,7 @@ def test_driven_crank_that_cannot_turn_locks():
     lengths = CLASS_EXAMPLES["rocker-crank"]
     links = [random_link(rng, length, loads=False, rotor=False) for length in lengths[:3]]
     linkage = FourBar(lengths=lengths, crank=links[0], coupler=links[1], rocker=links[2])
-    _, (_, hi) = kin.assembly_range(lengths).intervals  # the interval of θ1 = 1 rad
+    _, (_, hi) = assembly.assembly_range(lengths).intervals  # the interval of θ1 = 1 rad
     settings = SimulationSettings(duration=2.0, theta1=1.0, omega1=2.0, drive="constant-speed")
     with pytest.raises(LockupError, match="locks") as info:
         simulate(linkage, settings, method="opened-loop")

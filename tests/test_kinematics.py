@@ -11,18 +11,19 @@ from helpers import ROUNDING, derivative_with_error, rel_err
 
 from balancer import kinematics as kin
 from balancer.errors import AssemblyError
+from balancer.model import assembly
 
 
 def test_class_examples_are_what_they_claim():
     for name, lengths in CLASS_EXAMPLES.items():
-        assert str(kin.classify(lengths)) == name
+        assert str(assembly.classify(lengths)) == name
 
 
 @pytest.mark.parametrize("name", list(CLASS_EXAMPLES))
 @pytest.mark.parametrize("branch", ["+", "-"])
 def test_loop_closure_and_lengths(name, branch):
     lengths = CLASS_EXAMPLES[name]
-    rng = kin.assembly_range(lengths)
+    rng = assembly.assembly_range(lengths)
     assert not rng.empty
     t = np.concatenate([np.linspace(a, b, 2001) for a, b in rng.intervals])
     pos = kin.position(lengths, t, branch)
@@ -154,9 +155,9 @@ def test_transfer_functions_are_derivatives_of_the_angles():
 def test_assembly_range_ends_are_triangle_bounds(name):
     lengths = CLASS_EXAMPLES[name]
     l1, l2, l3, l4 = lengths
-    rng = kin.assembly_range(lengths)
+    rng = assembly.assembly_range(lengths)
     if rng.full:
-        assert kin.crank_turns_fully(lengths)
+        assert assembly.crank_turns_fully(lengths)
         return
     for a, b in rng.intervals:
         for end in (a, b):
@@ -177,15 +178,15 @@ def test_assembly_range_ends_are_triangle_bounds(name):
 
 
 def test_classification_rules():
-    assert kin.classify((1, 3, 2, 3.2)) == kin.LinkageClass.CRANK_ROCKER
-    assert kin.classify((2, 2, 2, 2)) == kin.LinkageClass.CHANGE_POINT
-    assert kin.classify((1, 1, 1, 5)) == kin.LinkageClass.TRIPLE_ROCKER
-    assert kin.assembly_range((1, 1, 1, 5)).empty
+    assert assembly.classify((1, 3, 2, 3.2)) == assembly.LinkageClass.CRANK_ROCKER
+    assert assembly.classify((2, 2, 2, 2)) == assembly.LinkageClass.CHANGE_POINT
+    assert assembly.classify((1, 1, 1, 5)) == assembly.LinkageClass.TRIPLE_ROCKER
+    assert assembly.assembly_range((1, 1, 1, 5)).empty
 
 
 def test_positions_near_a_dead_point_are_flagged_not_nan():
     lengths = CLASS_EXAMPLES["rocker-crank"]
-    rng = kin.assembly_range(lengths)
+    rng = assembly.assembly_range(lengths)
     a, _ = rng.intervals[0]
     pos = kin.position(lengths, [a, a + 1e-14, a + 1e-3])
     assert np.all(np.isfinite(pos.l2))

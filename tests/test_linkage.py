@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from balancer.cli import main
+from balancer.linkage.kinematics import numeric_table
 from balancer.mechanisms import mechanism_of
 from balancer.model import Design
 from balancer.spec import dumps_design, load_design, loads_design
@@ -196,7 +197,7 @@ def _fine_table(monkeypatch, structure, group):
         patch.setattr(numeric, "STRIDE", 1)
         patch.setattr(numeric, "_turn", lambda *args: None)
         structure.cache.clear()
-        out = numeric.table(structure, group)
+        out = numeric_table(structure, group)
     structure.cache.clear()
     return out
 
@@ -239,14 +240,13 @@ def test_the_strided_continuation_finds_the_plain_ones_table(monkeypatch, make):
     group's condition, below 1e3 away from its toggles, makes the coordinates agree to
     1e-10 of it). Full turns and cranks that swing; a four-link group and a yoke's two
     prismatic pairs."""
-    from balancer.linkage import numeric
 
     structure = mechanism_of(make().mechanism).structure
     groups = [g for g in structure.groups if g.kind == "numeric"]
     assert groups, "a group solved numerically"
     for g in groups:
         structure.cache.clear()
-        _, strided = numeric.table(structure, g)
+        _, strided = numeric_table(structure, g)
         _, plain = _fine_table(monkeypatch, structure, g)
         np.testing.assert_array_equal(np.isfinite(strided), np.isfinite(plain))
         both = np.isfinite(plain)
@@ -262,7 +262,7 @@ def test_a_slider_direction_of_any_length_is_its_direction():
     # length (an internal error) and [5e-324, 5e-324] lost its digits (a guide at another
     # angle); both are 45°. Scaled by its larger component first, each is the unit vector of
     # [1, 1], exactly as that is (the same rounding: (1 + i)/√2 from the same operations).
-    from balancer.linkage.structure import unit
+    from balancer.linkage.constraints import unit
 
     reference = unit(1.0, 1.0)
     for x, y in ((1.7e308, 1.7e308), (5e-324, 5e-324), (3.0, 3.0)):

@@ -20,6 +20,7 @@ from fuzz.linkages import _random_transform, build_topology, spec_from_topology
 
 from balancer.linkage import kinematics, numeric
 from balancer.linkage import program as program_module
+from balancer.linkage.kinematics import numeric_table
 from balancer.linkage.program import CrankForcesProgram, Tape
 from balancer.mechanisms import base, mechanism_of
 from balancer.spec import design_from_dict, load_design
@@ -213,7 +214,7 @@ def test_a_numeric_group_follows_its_branch_to_both_ends_of_its_table():
     s = mech.structure
     group = s.groups[-1]
     assert group.kind == "numeric"
-    angles, tab = numeric.table(s, group)
+    angles, tab = numeric_table(s, group)
     rows = np.flatnonzero(np.all(np.isfinite(tab), axis=1))
     h = angles[1] - angles[0]
     bands = []

@@ -7,8 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from balancer.linkage.constraints import group_jacobian
 from balancer.linkage.kinematics import positions
-from balancer.linkage.structure import Structure, group_jacobian
+from balancer.linkage.structure import Structure
 from balancer.linkage.vectors import Factor
 from balancer.mechanisms import mechanism_of
 from balancer.spec import load_design

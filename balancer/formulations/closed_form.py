@@ -61,7 +61,7 @@ class FourBarFormulation(ClosedForm):
 
     def assembly_range(self):
         """Crank angles at which the mechanism assembles."""
-        from ..kinematics import assembly_range
+        from ..model.assembly import assembly_range
 
         return assembly_range(self.lengths)
 

@@ -14,7 +14,8 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ..linkage.structure import GROUND_INDEX, Pose, Structure
+from ..linkage.constraints import GROUND_INDEX, Pose
+from ..linkage.structure import Structure
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import NUMPY, V
 from ..mechanisms import mechanism_of

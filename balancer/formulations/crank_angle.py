@@ -34,7 +34,8 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ..linkage.kinematics import positions, rates
+from ..linkage.kinematics import numeric_table, positions, rates
+from ..linkage.numeric import TABLE_STEPS
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import V
 from . import DEAD_POINT_THRESHOLD, DrivenRates, Evaluation
@@ -109,11 +110,9 @@ class CrankAngle(LinkageFormulation):
         A cubic spline through the table's rows (:func:`balancer.linkage.numeric.table`),
         with the crank angle brought into the table's window as the numpy route does.
         """
-        from ..linkage import numeric
-
         s = self.structure
-        angles, tab = numeric.table(s, s.groups[index])
-        start = angles[numeric.TABLE_STEPS]
+        angles, tab = numeric_table(s, s.groups[index])
+        start = angles[TABLE_STEPS]
         step = angles[1] - angles[0]
         turn = 2 * math.pi
         finite = np.all(np.isfinite(tab), axis=1)

@@ -34,8 +34,7 @@ import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
-from ..linkage.kinematics import _gamma
-from ..linkage.structure import (
+from ..linkage.constraints import (
     GROUND_INDEX,
     Driver,
     Pin,
@@ -44,6 +43,7 @@ from ..linkage.structure import (
     constraint_jacobian,
     constraint_residual,
 )
+from ..linkage.kinematics import _gamma
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import V
 from . import Evaluation, continuous_angles, least_norm, least_norm_many

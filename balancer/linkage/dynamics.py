@@ -33,8 +33,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model import GROUND
+from .constraints import GROUND_INDEX, Driver, Pin, Prism, constraint_jacobian
 from .kinematics import Motion
-from .structure import GROUND_INDEX, Driver, Pin, Prism, Structure, constraint_jacobian
+from .structure import Structure
 from .vectors import NUMPY, Ops, V, _plus, _times
 
 #: Parameters of a link in the design vector, in order: kg, kg·m, kg·m, kg·m² (about the frame's

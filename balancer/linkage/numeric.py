@@ -12,13 +12,21 @@ continuation stopped (the group locks or cannot be assembled) are NaN.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .structure import Group, Pose, Prism, Structure, constraint_residual, group_jacobian
+from .constraints import Group, Pose, Prism, constraint_residual, group_jacobian
+from .structure import Structure
 from .vectors import NUMPY, Factor, V
+
+#: How the links found before a group are placed at crank angles: the general kinematics'
+#: positions (:func:`balancer.linkage.kinematics.positions`), which solves the groups in order
+#: and calls this module for a numeric one; passed in, so that the two modules do not import
+#: each other.
+Positions = Callable[[Structure, NDArray[np.float64]], Pose]
 
 #: Steps of the continuation table over one revolution.
 TABLE_STEPS = 720
@@ -135,8 +143,11 @@ def _coordinates(structure: Structure, g: Group) -> NDArray[np.float64]:
     return np.concatenate([q[3 * k : 3 * k + 3] for k in g.links])
 
 
-def table(structure: Structure, g: Group) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def table(structure: Structure, g: Group, place: Positions
+          ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The group's coordinates over one revolution from the reference pose (cached).
+
+    ``place`` places the links found before the group (:data:`Positions`).
 
     Returns ``(theta1, q)``: ``2·TABLE_STEPS + 1`` angles a turn either way of the reference's
     input angle, and their coordinates (angles continuous), NaN beyond where the continuation
@@ -159,12 +170,12 @@ def table(structure: Structure, g: Group) -> tuple[NDArray[np.float64], NDArray[
     out = np.full((2 * TABLE_STEPS + 1, q_ref.size), np.nan)
     angles = start + step * np.arange(-TABLE_STEPS, TABLE_STEPS + 1)
     out[TABLE_STEPS] = q_ref
-    _continue(structure, partial, g, angles, out, 1)
+    _continue(structure, partial, g, angles, out, 1, place)
     turn = _turn(structure, out[-1] - q_ref)
     if turn is not None:
         out[:TABLE_STEPS] = out[TABLE_STEPS:-1] - turn
     else:
-        _continue(structure, partial, g, angles, out, -1)
+        _continue(structure, partial, g, angles, out, -1, place)
     result = (angles, out)
     cache[key] = result
     return result
@@ -174,8 +185,8 @@ def table(structure: Structure, g: Group) -> tuple[NDArray[np.float64], NDArray[
 STRIDE = 32
 
 
-def _continue(structure: Structure, partial: Structure, g: Group, angles, out, direction: int
-              ) -> None:
+def _continue(structure: Structure, partial: Structure, g: Group, angles, out, direction: int,
+              place: Positions) -> None:
     """Fill ``out``'s rows from the reference's (the middle row) towards ``direction``.
 
     The continuation steps by a stride of table rows that adapts: each step solves the next
@@ -187,14 +198,12 @@ def _continue(structure: Structure, partial: Structure, g: Group, angles, out, d
     stride of one row (the start, near a toggle or the end) the row is taken where Newton's
     method converges, and the table stops at the first that does not.
     """
-    from .kinematics import positions
-
     scale = structure.length_scale()
     middle = TABLE_STEPS
     done = [middle]  # rows found, in order away from the middle
 
     def solve_at(rows, guess):
-        pose = positions(partial, angles[rows])
+        pose = place(partial, angles[rows])
         with np.errstate(all="ignore"):
             return newton(g, pose, guess, scale)
 
@@ -246,8 +255,8 @@ def _turn(structure: Structure, change: NDArray[np.float64]) -> NDArray[np.float
     return exact if np.all(np.abs(change - exact) <= tol) else None
 
 
-def start(structure: Structure, g: Group,
-          theta1: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+def start(structure: Structure, g: Group, theta1: NDArray[np.float64],
+          place: Positions) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """Where Newton's method starts for numeric group ``g`` at crank angles ``theta1``.
 
     Returns the group's coordinates from its continuation table (:func:`table`, by
@@ -256,7 +265,7 @@ def start(structure: Structure, g: Group,
     is then taken where it falls in that span, whichever side of the reference.
     """
     theta1 = np.atleast_1d(np.asarray(theta1, dtype=float))
-    angles, tab = table(structure, g)
+    angles, tab = table(structure, g, place)
     begin = angles[TABLE_STEPS]
     lo, hi = angles[0], angles[-1]
     # The angle of each request in the table's window (a turn either way of the reference).
@@ -283,13 +292,14 @@ def start(structure: Structure, g: Group,
     return guess, inside
 
 
-def solve_group(structure: Structure, g: Group, pose: Pose, theta1, ops,
+def solve_group(structure: Structure, g: Group, pose: Pose, theta1, place: Positions,
                 gaps: list | None = None) -> None:
     """Place the links of numeric group ``g`` in ``pose`` at crank angles ``theta1``.
 
-    ``gaps``, if a list, receives the group's assembly gap (:func:`assembly_gap`).
+    ``place`` places links found before it (:data:`Positions`); ``gaps``, if a list,
+    receives the group's assembly gap (:func:`assembly_gap`).
     """
-    guess, inside = start(structure, g, theta1)
+    guess, inside = start(structure, g, theta1, place)
     q, done = newton(g, pose, np.where(np.isfinite(guess), guess, 0.0), structure.length_scale())
     lost = ~(done & inside)
     if lost.any():

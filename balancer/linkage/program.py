@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from . import numeric
 from .dynamics import Forces, inverse_dynamics
-from .kinematics import Motion, positions, rates
+from .kinematics import Motion, numeric_start, positions, rates
 from .structure import Structure
 from .symbols import CasadiOps
 from .vectors import Factor, _is_zero, _minus, _times
@@ -324,7 +324,7 @@ class CrankForcesProgram:
             theta = theta1[a:b]
             guesses = []
             for i in self.numeric:
-                guess, inside = numeric.start(s, s.groups[i], theta)
+                guess, inside = numeric_start(s, s.groups[i], theta)
                 ok[a:b] &= inside
                 guesses.append(np.where(np.isfinite(guess), guess, 0.0).T)
             guess = np.concatenate(guesses) if guesses else np.zeros((0, 1))

@@ -26,13 +26,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import AssemblyError
-from ..kinematics import AssemblyRange
 from ..linkage import dynamics, kinematics
+from ..linkage.constraints import GROUND_INDEX
 from ..linkage.dynamics import Forces, Layout
 from ..linkage.kinematics import Motion
-from ..linkage.structure import GROUND_INDEX, Structure
+from ..linkage.structure import Structure
 from ..linkage.vectors import V
 from ..model import GROUND, Link, Linkage
+from ..model.assembly import AssemblyRange
 
 #: The formulation of the equations of motion that applies to every linkage.
 MULTIBODY: dict[str, tuple[str, str]] = {

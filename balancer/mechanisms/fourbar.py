@@ -16,12 +16,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import kinematics as fourbar
-from ..kinematics import AssemblyRange
+from ..linkage.constraints import Pose
 from ..linkage.dynamics import Forces
 from ..linkage.kinematics import Motion
-from ..linkage.structure import Pose, Structure
+from ..linkage.structure import Structure
 from ..linkage.vectors import V
 from ..model import Body, FourBar, Linkage
+from ..model.assembly import AssemblyRange, assembly_range, classify
 from .base import Limit, Mechanism
 
 
@@ -32,7 +33,7 @@ def fourbar_linkage(model: FourBar) -> Linkage:
     (``|sin(θ3 − θ2)| ≥ 0.3``), else the one of its range's samples farthest from a dead or
     change point (largest ``|sin(θ3 − θ2)|``).
     """
-    rng = fourbar.assembly_range(model.lengths)
+    rng = assembly_range(model.lengths)
     if rng.full:
         candidates = np.linspace(0.0, 2 * math.pi, 73)[:-1]
     else:
@@ -93,14 +94,14 @@ class FourBarMechanism(Mechanism):
 
     def describe(self) -> str:
         """The Grashof class."""
-        return str(fourbar.classify(self.model.lengths))
+        return str(classify(self.model.lengths))
 
     @property
     def branch(self) -> str:
         return self.model.branch
 
     def assembly_range(self) -> AssemblyRange:
-        return fourbar.assembly_range(self.model.lengths)
+        return assembly_range(self.model.lengths)
 
     def change_points(self) -> tuple[float, ...]:
         return fourbar.change_point_angles(self.model.lengths)

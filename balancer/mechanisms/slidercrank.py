@@ -13,12 +13,12 @@ from functools import cached_property
 
 import numpy as np
 
-from ..kinematics import AssemblyRange
 from ..linkage.dynamics import Forces
 from ..linkage.kinematics import Motion
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
 from ..model import Body, Linkage, Slider, SliderCrank
+from ..model.assembly import AssemblyRange
 from ..slider_crank import kinematics as closed
 from .base import Mechanism
 

@@ -20,7 +20,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import AssemblyError
-from ..kinematics import SINGULAR_TOLERANCE, AssemblyRange, _as_1d
+from ..kinematics import SINGULAR_TOLERANCE, _as_1d
+from ..model.assembly import AssemblyRange
 
 Lengths = tuple[float, float, float]
 

@@ -1,0 +1,532 @@
+"""The mechanisms a spec describes: the four-bar, the slider-crank and the general linkage.
+
+Each is frozen data that checks itself when made (:mod:`balancer.validate`, the same checks as
+the spec loader's). Conventions (DESIGN.md): the four-bar's ground pivots A0 at the origin and
+A3 at ``(l4, 0)``, links crank A0→A1, coupler A1→A2, rocker A2→A3; the slider-crank's guide
+along +x at ``offset`` from A0; a general linkage's points at a reference pose that fixes its
+assembly branch.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import ClassVar, Literal
+
+from .. import validate as v
+from ..errors import AssemblyError, SpecError
+from .assembly import assembly_range
+from .links import GROUND, RESERVED_LINK_NAMES, Body, GasForce, Link, Slider, Spring
+
+Branch = Literal["+", "-"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class FourBar:
+    """A planar 4R four-bar linkage A0 A1 A2 A3 (Meijaard & van der Wijk 2020, Fig. 1).
+
+    Ground pivots A0 at the origin and A3 at ``(l4, 0)``. Link 1 (crank) A0→A1, link 2 (coupler)
+    A1→A2, link 3 (rocker) A2→A3, link 4 the frame A3→A0 (θ4 = π).
+
+    Attributes
+    ----------
+    lengths
+        ``(l1, l2, l3, l4)``: crank, coupler, rocker and frame lengths, m.
+    crank, coupler, rocker
+        The three moving links.
+    branch
+        ``"+"``: A2 to the left of the directed line A1→A3 (the paper's Fig. 1); ``"-"``: the
+        other assembly.
+    """
+
+    type: ClassVar[str] = "four-bar"
+    link_names: ClassVar[tuple[str, str, str]] = ("crank", "coupler", "rocker")
+    length_names: ClassVar[tuple[str, ...]] = ("crank", "coupler", "rocker", "frame")
+    #: Links whose pivot is on the ground, where a counter-rotor can sit.
+    grounded_links: ClassVar[tuple[str, ...]] = ("crank", "rocker")
+
+    lengths: tuple[float, float, float, float]
+    crank: Link
+    coupler: Link
+    rocker: Link
+    branch: Branch = "+"
+
+    def __post_init__(self) -> None:
+        """Check lengths, links and branch; raise :class:`AssemblyError` if it never assembles.
+
+        Keys are the spec's, from its root (``mechanism.lengths.crank``).
+        """
+        lengths = _check_mechanism(self)
+        if assembly_range(lengths).empty:
+            l1, l2, l3, l4 = lengths
+            raise AssemblyError(
+                "the linkage cannot be assembled at any crank angle: the coupler and rocker "
+                f"(|l2 − l3| = {abs(l2 - l3):.6g} m to l2 + l3 = {l2 + l3:.6g} m) cannot "
+                f"bridge A1 to A3 (|l4 − l1| = {abs(l4 - l1):.6g} m to l1 + l4 = "
+                f"{l1 + l4:.6g} m)",
+                key="mechanism.lengths",
+                value=dict(zip(self.length_names, lengths, strict=True)),
+            )
+
+    @property
+    def links(self) -> tuple[Link, Link, Link]:
+        """The moving links in order (crank, coupler, rocker)."""
+        return (self.crank, self.coupler, self.rocker)
+
+    @property
+    def total_mass(self) -> float:
+        """Mass of the moving links ``m_tot = m1 + m2 + m3``, kg."""
+        return self.crank.mass + self.coupler.mass + self.rocker.mass
+
+    @property
+    def has_loads(self) -> bool:
+        """Whether any link carries an applied force or moment."""
+        return any(link.has_loads for link in self.links)
+
+    @property
+    def sizes(self) -> dict[str, float]:
+        """The geometry's sizes by spec key, m: the lengths (see :func:`check_scales`)."""
+        return _length_sizes(self)
+
+    @property
+    def gas_forces(self) -> tuple[tuple[str, GasForce], ...]:
+        """Forces on sliders along their guides, by spec key: none on a four-bar."""
+        return ()
+
+    @property
+    def springs(self) -> tuple:
+        """Linear springs: none on a four-bar."""
+        return ()
+
+    def link(self, name: str) -> Link:
+        """Return the link called ``name`` (``"crank"``, ``"coupler"`` or ``"rocker"``)."""
+        if name not in self.link_names:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def with_link(self, name: str, link: Link) -> FourBar:
+        """Return a copy with link ``name`` replaced."""
+        if name not in self.link_names:
+            raise KeyError(name)
+        return replace(self, **{name: link})
+
+    def with_links(self, links: dict[str, Link]) -> FourBar:
+        """Return a copy with several links replaced."""
+        return replace(self, **links)
+
+    def without_loads(self) -> FourBar:
+        """Return a copy with every applied force and moment removed."""
+        return replace(self, **{n: self.link(n).without_loads() for n in self.link_names})
+
+
+@dataclass(frozen=True, kw_only=True)
+class SliderCrank:
+    """A slider-crank A0 A1 A2 with the slider's pin A2 on a straight guide.
+
+    Wunderlich (1964), Sect. 3.
+
+    A0 at the origin; link 1 (crank) A0→A1, link 2 (connecting rod) A1→A2; the slider's pin A2
+    moves on the guide line ``y = offset`` along x. θ1, θ2 are the angles of A0→A1 and A1→A2.
+
+    Attributes
+    ----------
+    lengths
+        ``(r, L, e)``: crank and rod lengths (m, positive) and the signed offset of the guide
+        from A0 (m).
+    crank, rod
+        The rotating links (centre of mass in the link frame, as for the four-bar).
+    slider
+        The slider: its centre of mass relative to the pin is in global axes; its inertia does
+        not matter (it does not turn).
+    branch
+        ``"+"``: the slider on the +x side of the crank pin; ``"-"``: the other assembly.
+    gas_force
+        Force on the slider along the guide, from the frame (see :class:`GasForce`).
+    """
+
+    type: ClassVar[str] = "slider-crank"
+    link_names: ClassVar[tuple[str, str, str]] = ("crank", "rod", "slider")
+    length_names: ClassVar[tuple[str, ...]] = ("crank", "rod", "offset")
+    grounded_links: ClassVar[tuple[str, ...]] = ("crank",)
+
+    lengths: tuple[float, float, float]
+    crank: Link
+    rod: Link
+    slider: Link
+    branch: Branch = "+"
+    gas_force: GasForce = field(default_factory=GasForce)
+
+    def __post_init__(self) -> None:
+        """Check lengths, links and branch; raise :class:`AssemblyError` if it never assembles.
+
+        Keys are the spec's, from its root (``mechanism.lengths.offset``).
+        """
+        if not isinstance(self.gas_force, GasForce):
+            raise SpecError("must be a GasForce", key="links.slider.gas_force",
+                            value=self.gas_force)
+        r, big_l, e = _check_mechanism(self)
+        if abs(e) > r + big_l:
+            raise AssemblyError(
+                f"the slider-crank cannot be assembled at any crank angle: the guide is "
+                f"{abs(e):.6g} m from A0, beyond the reach of crank and rod "
+                f"({r + big_l:.6g} m)",
+                key="mechanism.lengths.offset",
+                value=e,
+            )
+
+    @property
+    def links(self) -> tuple[Link, Link, Link]:
+        """The moving links in order (crank, rod, slider)."""
+        return (self.crank, self.rod, self.slider)
+
+    @property
+    def total_mass(self) -> float:
+        """Mass of the moving parts, kg."""
+        return self.crank.mass + self.rod.mass + self.slider.mass
+
+    @property
+    def has_loads(self) -> bool:
+        """Whether any link carries an applied force or moment, or a gas force acts."""
+        return any(link.has_loads for link in self.links) or not self.gas_force.is_zero
+
+    @property
+    def sizes(self) -> dict[str, float]:
+        """The geometry's sizes by spec key, m: the lengths, the offset's magnitude."""
+        return _length_sizes(self)
+
+    @property
+    def gas_forces(self) -> tuple[tuple[str, GasForce], ...]:
+        """Forces on sliders along their guides, by spec key: the gas force."""
+        return (("links.slider.gas_force", self.gas_force),)
+
+    @property
+    def springs(self) -> tuple:
+        """Linear springs: none on a slider-crank."""
+        return ()
+
+    def link(self, name: str) -> Link:
+        """Return the link called ``name`` (``"crank"``, ``"rod"`` or ``"slider"``)."""
+        if name not in self.link_names:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def with_link(self, name: str, link: Link) -> SliderCrank:
+        """Return a copy with link ``name`` replaced."""
+        if name not in self.link_names:
+            raise KeyError(name)
+        return replace(self, **{name: link})
+
+    def with_links(self, links: dict[str, Link]) -> SliderCrank:
+        """Return a copy with several links replaced."""
+        return replace(self, **links)
+
+    def without_loads(self) -> SliderCrank:
+        """Return a copy with every applied force, moment and gas force removed."""
+        return replace(self, gas_force=GasForce(),
+                       **{n: self.link(n).without_loads() for n in self.link_names})
+
+
+@dataclass(frozen=True, kw_only=True)
+class Linkage:
+    """A planar linkage with one degree of freedom, driven by a crank on a ground pivot.
+
+    See DESIGN.md, "General planar linkages". A point named by two or more links is a revolute
+    joint between them; a point of one link only is a marker. The reference pose (the
+    points' positions) fixes the assembly: every other pose is the one reached from it
+    continuously as the input turns. Mobility, a regular reference pose and a drivable input
+    are checked when the linkage's equations are built
+    (:func:`balancer.linkage.structure.Structure`); this object checks what its data alone
+    can show.
+
+    Attributes
+    ----------
+    points
+        ``(name, (x, y))`` of every point at the reference pose, m.
+    bodies
+        The links, the ground (named ``"ground"``) among them.
+    input
+        The name of the driven link; its first point is its ground pivot.
+    sliders
+        Prismatic pairs.
+    springs
+        Linear springs.
+    """
+
+    type: ClassVar[str] = "linkage"
+
+    points: tuple[tuple[str, tuple[float, float]], ...]
+    bodies: tuple[Body, ...]
+    input: str
+    sliders: tuple[Slider, ...] = ()
+    springs: tuple[Spring, ...] = ()
+
+    def __post_init__(self) -> None:
+        """Check names and references (keys are the spec's, from its root)."""
+        points = {}
+        for item in self.points:
+            if not (isinstance(item, tuple | list) and len(item) == 2
+                    and isinstance(item[0], str)):
+                raise SpecError("must be (name, (x, y)) pairs", key="mechanism.points",
+                                value=item)
+            name, xy = item
+            if name in points:
+                raise SpecError("is given twice", key=f"mechanism.points.{name}")
+            x, y = v.vector2(xy, f"mechanism.points.{name}")
+            for coord in (x, y):
+                if abs(coord) > v.LENGTH_RANGE[1]:
+                    raise SpecError(f"must be within {v.LENGTH_RANGE[1]:g} m of the origin",
+                                    key=f"mechanism.points.{name}", value=list(xy))
+            points[name] = (x, y)
+        if not points:
+            raise SpecError("a linkage needs points", key="mechanism.points")
+        v.store(self, "points", tuple(points.items()))
+        names: dict[str, Body] = {}
+        for body in self.bodies:
+            if not isinstance(body, Body):
+                raise SpecError("must be a Body", key="links", value=body)
+            key = f"links.{body.name}"
+            if not isinstance(body.name, str) or not body.name:
+                raise SpecError("a link needs a name", key="links", value=body.name)
+            if body.name in names:
+                raise SpecError("is given twice", key=key)
+            if body.name in RESERVED_LINK_NAMES:
+                raise SpecError(f"is a name the spec reserves ([balance.{body.name}] means "
+                                "something else); call the link otherwise", key=key)
+            if (isinstance(body.points, str) or not hasattr(body.points, "__len__")
+                    or not body.points or not all(isinstance(p, str) for p in body.points)):
+                raise SpecError("must be a non-empty list of point names", key=f"{key}.points",
+                                value=body.points)
+            for p in body.points:
+                if p not in points:
+                    raise SpecError(f"names an unknown point '{p}' (the points are "
+                                    f"{', '.join(points)})", key=f"{key}.points", value=p)
+            if len(set(body.points)) != len(body.points):
+                raise SpecError("names a point twice", key=f"{key}.points",
+                                value=list(body.points))
+            if body.name == GROUND:
+                if body.props is not None:
+                    raise SpecError("the ground has no mass properties", key=key)
+            elif not isinstance(body.props, Link):
+                raise SpecError("a moving link needs its mass properties (a Link)", key=key)
+            v.store(body, "points", tuple(body.points))
+            names[body.name] = body
+        if GROUND not in names:
+            raise SpecError("a linkage needs a ground link", key=f"links.{GROUND}")
+        if len(names) < 2:
+            raise SpecError("a linkage needs a moving link", key="links")
+        on_links = {p for b in names.values() for p in b.points}
+        for p in points:
+            if p not in on_links:
+                raise SpecError("is on no link", key=f"mechanism.points.{p}")
+        for i, slider in enumerate(self.sliders):
+            self._check_slider(i, slider, names, points)
+        for i, spring in enumerate(self.springs):
+            if not isinstance(spring, Spring):
+                raise SpecError("must be a Spring", key=f"springs[{i}]", value=spring)
+            for p in spring.points:
+                if p not in points:
+                    raise SpecError(f"names an unknown point '{p}' (the points are "
+                                    f"{', '.join(points)})", key=f"springs[{i}].points",
+                                    value=list(spring.points))
+        for name, body in names.items():
+            if name == GROUND or len(body.points) > 1:
+                continue
+            count = sum(s.link == name for s in self.sliders)
+            if count != 1:
+                raise SpecError(
+                    "a one-point link must be the link of exactly one slider (its frame's "
+                    f"x-axis is that slider's direction); it is the link of {count}",
+                    key=f"links.{name}.points", value=list(body.points))
+        self._check_frames(names, points)
+        ground = set(names[GROUND].points)
+        key = "mechanism.input"
+        if not isinstance(self.input, str) or self.input not in names or self.input == GROUND:
+            raise SpecError(f"must name a moving link ({_link_list(names)})", key=key,
+                            value=self.input)
+        if names[self.input].points[0] not in ground:
+            raise SpecError(f"the input's first point ({names[self.input].points[0]}) must be "
+                            "a ground point: the crank turns about it", key=key,
+                            value=self.input)
+        for name, body in names.items():
+            if name != GROUND and body.props.counter_rotor and not ground & set(body.points):
+                raise SpecError("a counter-rotor sits on a ground pivot: this link has none",
+                                key=f"links.{name}.counter_rotor",
+                                value=body.props.counter_rotor)
+        v.store(self, "bodies", tuple(self.bodies))
+        v.store(self, "sliders", tuple(self.sliders))
+        v.store(self, "springs", tuple(self.springs))
+
+    @staticmethod
+    def _check_slider(i: int, slider, names, points) -> None:
+        key = f"mechanism.sliders[{i}]"
+        if not isinstance(slider, Slider):
+            raise SpecError("must be a Slider", key=key, value=slider)
+        for attr in ("link", "guide"):
+            value = getattr(slider, attr)
+            if value not in names:
+                raise SpecError(f"names an unknown link ({_link_list(names)})",
+                                key=f"{key}.{attr}", value=value)
+        if slider.link == GROUND:
+            raise SpecError("the sliding link must move (put the guide on the ground)",
+                            key=f"{key}.link", value=slider.link)
+        if slider.link == slider.guide:
+            raise SpecError("a link cannot slide on itself", key=f"{key}.guide",
+                            value=slider.guide)
+        if slider.point not in names[slider.link].points:
+            raise SpecError(f"must be a point of {slider.link} "
+                            f"({', '.join(names[slider.link].points)})", key=f"{key}.point",
+                            value=slider.point)
+        dx, dy = v.vector2(slider.direction, f"{key}.direction")
+        if dx == 0 and dy == 0:
+            raise SpecError("must not be zero", key=f"{key}.direction", value=[dx, dy])
+        if not isinstance(slider.force, GasForce):
+            raise SpecError("must be a GasForce", key=f"{key}.force", value=slider.force)
+        object.__setattr__(slider, "direction", (dx, dy))
+
+    @staticmethod
+    def _check_frames(names, points) -> None:
+        """A link's first two points must be apart: they fix its frame."""
+        scale = max(math.hypot(*xy) for xy in points.values()) or 1.0
+        for name, body in names.items():
+            if len(body.points) < 2 or name == GROUND:
+                continue
+            (x0, y0), (x1, y1) = points[body.points[0]], points[body.points[1]]
+            if math.hypot(x1 - x0, y1 - y0) <= v.RELATIVE_LENGTH * scale:
+                raise SpecError(
+                    f"its first two points ({body.points[0]}, {body.points[1]}) coincide: they "
+                    "fix the link's frame", key=f"links.{name}.points",
+                    value=list(body.points))
+
+    # -- what every mechanism model offers ----------------------------------------------------
+
+    @property
+    def point_positions(self) -> dict[str, complex]:
+        """Each point's position at the reference pose, m."""
+        return {name: complex(*xy) for name, xy in self.points}
+
+    @property
+    def ground(self) -> Body:
+        """The ground link."""
+        return next(b for b in self.bodies if b.name == GROUND)
+
+    @property
+    def moving(self) -> tuple[Body, ...]:
+        """The moving links, in the spec's order."""
+        return tuple(b for b in self.bodies if b.name != GROUND)
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """Names of the moving links."""
+        return tuple(b.name for b in self.moving)
+
+    @property
+    def links(self) -> tuple[Link, ...]:
+        """Mass properties of the moving links."""
+        return tuple(b.props for b in self.moving)  # type: ignore[misc]
+
+    @property
+    def grounded_links(self) -> tuple[str, ...]:
+        """Moving links that share a point with the ground (where a counter-rotor can sit)."""
+        ground = set(self.ground.points)
+        return tuple(b.name for b in self.moving if ground & set(b.points))
+
+    @property
+    def total_mass(self) -> float:
+        """Mass of the moving links, kg."""
+        return math.fsum(link.mass for link in self.links)
+
+    @property
+    def has_loads(self) -> bool:
+        """Whether any link carries an applied force or moment, or a slider a force."""
+        return (any(link.has_loads for link in self.links)
+                or any(not s.force.is_zero for s in self.sliders))
+
+    @property
+    def sizes(self) -> dict[str, float]:
+        """The geometry's sizes by spec key, m: each point's distance from the origin."""
+        return {f"mechanism.points.{p}": math.hypot(*xy) for p, xy in self.points}
+
+    @property
+    def gas_forces(self) -> tuple[tuple[str, GasForce], ...]:
+        """Forces on sliders along their guides, by the sliding link's key."""
+        return tuple((f"links.{s.link}.gas_force", s.force) for s in self.sliders)
+
+    def link(self, name: str) -> Link:
+        """The mass properties of the moving link called ``name``."""
+        for b in self.moving:
+            if b.name == name:
+                return b.props  # type: ignore[return-value]
+        raise KeyError(name)
+
+    def with_link(self, name: str, link: Link) -> Linkage:
+        """Return a copy with link ``name``'s mass properties replaced."""
+        return self.with_links({name: link})
+
+    def with_links(self, links: dict[str, Link]) -> Linkage:
+        """Return a copy with several links' mass properties replaced."""
+        unknown = set(links) - set(self.link_names)
+        if unknown:
+            raise KeyError(sorted(unknown)[0])
+        bodies = tuple(replace(b, props=links[b.name]) if b.name in links else b
+                       for b in self.bodies)
+        return replace(self, bodies=bodies)
+
+    def without_loads(self) -> Linkage:
+        """Return a copy with every applied force and moment and slider force removed."""
+        bodies = tuple(b if b.props is None else replace(b, props=b.props.without_loads())
+                       for b in self.bodies)
+        sliders = tuple(replace(s, force=GasForce()) for s in self.sliders)
+        return replace(self, bodies=bodies, sliders=sliders)
+
+
+#: A mechanism the package knows.
+Mechanism = FourBar | SliderCrank | Linkage
+
+
+def _length_sizes(mech) -> dict[str, float]:
+    """A four-bar's or slider-crank's lengths by spec key (magnitudes), m."""
+    return {f"mechanism.lengths.{n}": abs(x)
+            for n, x in zip(mech.length_names, mech.lengths, strict=True)}
+
+
+def _check_mechanism(mech) -> tuple[float, ...]:
+    """Lengths, links and branch of a mechanism; store the lengths as floats and return them.
+
+    A slider-crank's offset (its last length) is signed; every other length is positive. Link
+    keys are ``links.<name>``, lengths ``mechanism.lengths.<name>``.
+    """
+    names = mech.length_names
+    raw = mech.lengths
+    if isinstance(raw, str) or not hasattr(raw, "__len__") or len(raw) != len(names):
+        raise SpecError(f"must be {len(names)} lengths ({', '.join(names)})",
+                        key="mechanism.lengths", value=raw)
+    lengths = []
+    for name, value in zip(names, raw, strict=True):
+        key = f"mechanism.lengths.{name}"
+        if name == "offset":
+            x = v.number(value, key)
+            if x != 0:
+                v.length(abs(x), key)
+            lengths.append(x)
+        else:
+            lengths.append(v.length(value, key))
+    v.relative_lengths(dict(zip(names, lengths, strict=True)), "mechanism.lengths")
+    v.store(mech, "lengths", tuple(lengths))
+    v.store(mech, "branch", v.choice(mech.branch, "mechanism.branch", ("+", "-")))
+    for name in mech.link_names:
+        link = getattr(mech, name)
+        if not isinstance(link, Link):
+            raise SpecError("must be a Link", key=f"links.{name}", value=link)
+        if link.counter_rotor and name not in mech.grounded_links:
+            where = " and ".join(mech.grounded_links)
+            raise SpecError(
+                f"a counter-rotor sits on a ground pivot: only the {where} can have one",
+                key=f"links.{name}.counter_rotor", value=link.counter_rotor,
+            )
+    return tuple(lengths)
+
+
+def _link_list(names) -> str:
+    """The links of a spec by name, for a message: the moving ones, and the frame's name."""
+    moving = [n for n in names if n != GROUND]
+    return f"the moving links are {', '.join(moving)}; the frame is called {GROUND}"
