@@ -21,6 +21,10 @@ from .errors import BalancerError, OutputError, SpecError
 #: ``--drive`` values: :data:`balancer.model.DRIVES`, here so that ``--help`` needs no model
 #: (a test keeps the two equal).
 DRIVES: tuple[str, ...] = ("free", "constant-speed")
+#: ``--method`` values: every formulation of any mechanism (:mod:`balancer.formulations`), here
+#: so that ``--help`` needs no numerics (a test keeps them equal to the registry's).
+FORMULATION_NAMES: tuple[str, ...] = (
+    "opened-loop", "complex-masses", "mass-matrix", "lie-group", "multibody", "crank-angle")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -548,9 +552,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(handler=_cmd_analyze)
 
-    from .mechanisms import formulation_names
-
-    methods = formulation_names()
+    methods = FORMULATION_NAMES
 
     p = sub.add_parser(
         "simulate",

@@ -23,6 +23,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
+from .errors import SpecError
 from .linkage.kinematics import Motion
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism
@@ -259,8 +260,6 @@ def cycle_analysis(model, speed: float, samples: int = 360, *, route: str | None
     SpecError
         For an unknown route.
     """
-    from .errors import SpecError
-
     mech = model if isinstance(model, Mechanism) else mechanism_of(model)
     route = route or mech.routes[0]
     if route not in mech.routes:

@@ -28,6 +28,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from .errors import SolverError
+from .formulations.compiled import Compiled
+
 if TYPE_CHECKING:
     import casadi as ca
 
@@ -330,7 +333,6 @@ class DOP853:
         h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
         h0 = min(h0, length)
         if not h0 > 0:  # a rate that is not finite, or beyond double precision's range
-            from .errors import SolverError
 
             raise SolverError(f"the integrator cannot start at t = {t0:.6g} s: the state's "
                               "rate of change is not finite (loads, springs or masses of "
@@ -545,7 +547,6 @@ class Stages:
     def __init__(self, rhs: ca.Function) -> None:
         import casadi as ca
 
-        from .formulations.compiled import Compiled
 
         n = rhs.size1_in(1)
         stages = DOP853.n_stages

@@ -15,6 +15,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from .cycle import sample_angles
+from .errors import BalancerError
+from .mechanisms import mechanism_of
+
 #: Longest length that is plausibly meant, m: no planar linkage this tool balances is longer.
 MAX_LENGTH = 100.0
 #: Fastest plausible tip speed ω·R of a point of the mechanism, m/s: the speed of sound in air.
@@ -96,9 +100,6 @@ def tip_radius(mechanism, samples: int = 72) -> float | None:
     """
     import numpy as np
 
-    from .cycle import sample_angles
-    from .errors import BalancerError
-    from .mechanisms import mechanism_of
 
     try:
         mech = mechanism_of(mechanism)

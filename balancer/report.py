@@ -14,8 +14,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .balance.conditions import RESIDUAL_FLOOR, force_balance_residual
 from .balance.counterweights import UNCHANGED
 from .cycle import CycleAnalysis, Figure
+from .errors import SolverError
 from .mechanisms import mechanism_of
 
 UNITS = {"shaking_force": "N", "shaking_moment": "N·m", "driving_torque": "N·m"}
@@ -103,8 +105,6 @@ def _harmonics_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
 
 def _force_balance(mech) -> tuple[bool, float]:
     """Whether a mechanism is force-balanced, and its conditions' residual (relative)."""
-    from .balance.conditions import RESIDUAL_FLOOR, force_balance_residual
-
     residual = force_balance_residual(mech)
     return residual <= RESIDUAL_FLOOR, residual
 
@@ -252,8 +252,6 @@ def dumps_json(doc: dict[str, Any]) -> str:
     """
     where = _nonfinite(doc, "")
     if where is not None:
-        from .errors import SolverError
-
         raise SolverError(f"the results are not finite numbers (at {where}): the computation "
                           "lost its precision")
     import json  # here: a table needs no JSON
@@ -339,8 +337,6 @@ def frame_force_columns(model, ground, normal, couple) -> tuple[list[str], list]
     mechanism names as a point (the slider-crank's A3), the force as ``R{name}x``, ``R{name}y``
     and the couple.
     """
-    from .mechanisms import mechanism_of
-
     mech = mechanism_of(model)
     names: list[str] = []
     cols: list = []

@@ -54,12 +54,13 @@ from .formulations import (
     continuous_angles,
     default_method,
     formulation_class,
-    formulation_table,
+    formulation_names,
     make,
 )
 from .integration import DOP853, CompiledDOP853, Stages, TimeOnlyDOP853, with_extra_work
 from .mechanisms import mechanism_of
 from .model import RTOL_MIN, Design, SimulationSettings, check_scales
+from .quadrature import cumulative
 
 #: Most integration steps a simulation may take (under a minute with the slowest formulation,
 #: multibody with its projections, at some 2 000 steps a second on a 2-core machine): a
@@ -393,8 +394,6 @@ class _Stepper:
         motion comes within :data:`~balancer.formulations.DEAD_POINT_THRESHOLD` of a dead point
         (away from a change point): the integrator then steps, and its event stops the run.
         """
-        from .quadrature import cumulative
-
         f = self.f
         if not self.prescribes(y0):
             return None
@@ -494,8 +493,6 @@ class _Stepper:
         as a step). The drift is the constraints' residual at the output states. ``None`` where
         the formulation has no such route: the integrator then steps.
         """
-        from .quadrature import cumulative
-
         f = self.f
         if not self.prescribes(y0):
             return None
@@ -672,14 +669,14 @@ class _WithExtraWork:
 
 def _passing_change(model) -> str:
     """The formulations of a mechanism that pass change points, as a parenthesis."""
-    names = [n for n in formulation_table(model)
+    names = [n for n in formulation_names(model)
              if formulation_class(n, model).passes_change_points]
     return f" ({' and '.join(names)} can)" if names else ""
 
 
 def _passing(model) -> str:
     """The formulations of a mechanism that pass dead points, as a parenthesis."""
-    names = [n for n in formulation_table(model)
+    names = [n for n in formulation_names(model)
              if formulation_class(n, model).passes_dead_points]
     return f" ({' and '.join(names)} can)" if names else ""
 

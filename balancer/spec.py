@@ -486,7 +486,7 @@ def _read_simulation(root: _Table, mechanism) -> SimulationSettings:
         return defaults
     from .mechanisms import mechanism_of
 
-    method = table.string("method", choices=tuple(mechanism_of(mechanism).formulation_table),
+    method = table.string("method", choices=mechanism_of(mechanism).formulation_names,
                           default="") or None
     with v.under("simulation"):
         settings = SimulationSettings(

@@ -47,7 +47,12 @@ from pathlib import Path
 from typing import Any
 
 from . import interrupts
-from .errors import OutputError, SpecError
+from .balance.optimizer import optimize
+from .balance.result import InfeasibleError
+from .cycle import cycle_analysis
+from .errors import AssemblyError, LockupError, OutputError, SolverError, SpecError
+from .outputs import write_with
+from .spec import design_from_dict
 
 #: Sampling methods of the varied keys.
 METHODS = ("grid", "lhs", "sobol")
@@ -146,9 +151,6 @@ def key_unit(key: str) -> str:
 
 def analyse_point(data: dict[str, Any], values: dict[str, float], index: int) -> dict:
     """One row of a perturbation sweep: the perturbed design's own figures (no redesign)."""
-    from .errors import AssemblyError, LockupError
-    from .spec import design_from_dict
-
     row = _empty_row(values, index)
     try:
         design = design_from_dict(with_values(data, values))
@@ -301,8 +303,6 @@ def _empty_row(values: dict[str, float], index: int) -> dict[str, Any]:
 
 def _own_figures(design) -> dict[str, float]:
     """The design's own inertial figures at the operating speed (the ``before`` columns)."""
-    from .cycle import cycle_analysis
-
     summary = cycle_analysis(design.mechanism, design.operation.speed,
                              design.operation.samples, loads=False).summary
     return {"shaking_moment_before": summary.shaking_moment.rms,
@@ -311,11 +311,6 @@ def _own_figures(design) -> dict[str, float]:
 
 def evaluate_point(data: dict[str, Any], values: dict[str, float], index: int) -> dict:
     """One row of the table: the design at ``values``, analysed and balanced."""
-    from .balance.optimizer import optimize
-    from .balance.result import InfeasibleError
-    from .errors import AssemblyError, LockupError, SolverError
-    from .spec import design_from_dict
-
     row = _empty_row(values, index)
     try:
         design = design_from_dict(with_values(data, values))
@@ -522,7 +517,6 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
         raise SpecError(f"cannot read the spec ({exc.strerror})", value=str(spec)) from None
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(f"not valid TOML: {exc}", value=str(spec)) from None
-    from .spec import design_from_dict
 
     design = design_from_dict(data, source=str(spec))  # the spec itself must be valid
     if not perturbs and design.balance is None:
@@ -718,7 +712,6 @@ def _assemble(parts: Path, out: Path, keys: Sequence[str], points: int, batches:
     if index != list(range(points)):
         raise OutputError(f"the parts in {parts} do not hold every point exactly once",
                           key="--out", value=str(out))
-    from .outputs import write_with
 
     write_with(out, lambda tmp: pq.write_table(table, tmp), suffix=".parquet")
     shutil.rmtree(parts)

@@ -29,7 +29,6 @@ import sys
 import time
 from dataclasses import dataclass
 
-import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
@@ -93,6 +92,7 @@ class NlpSolver:
     """
 
     def __init__(self, data: NumericProblem, *, options: dict | None = None) -> None:
+        import casadi as ca  # heavy: only where symbols are built
         self.data = data
         self.options = {**IPOPT_OPTIONS, **(options or {})}
         self._names: list[tuple[int, str]] = []  # (link index or entry, kind) per variable

@@ -16,6 +16,7 @@ import tomllib
 from importlib import resources
 
 from ..errors import SpecError
+from ..spec import loads_design
 
 
 def names() -> tuple[str, ...]:
@@ -57,6 +58,4 @@ def title(name: str) -> str:
 
 def load(name: str):
     """The example's :class:`~balancer.model.Design` (its errors name the example's file)."""
-    from ..spec import loads_design
-
     return loads_design(text(name), source=f"example {name}")

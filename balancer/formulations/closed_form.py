@@ -15,9 +15,16 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..inverse import dynamic_link
-from ..kinematics import branch_sign_along, change_point_angles, position_scalar, rates_scalar
-from . import Formulation
+from ..inverse import dynamic_link, kinetic_energy, link_com_kinematics
+from ..kinematics import (
+    branch_sign_along,
+    change_point_angles,
+    motion_from_angles,
+    position_scalar,
+    rates_scalar,
+)
+from ..model.assembly import assembly_range
+from .base import Formulation
 
 
 class ClosedForm(Formulation):
@@ -61,8 +68,6 @@ class FourBarFormulation(ClosedForm):
 
     def assembly_range(self):
         """Crank angles at which the mechanism assembles."""
-        from ..model.assembly import assembly_range
-
         return assembly_range(self.lengths)
 
     def change_points(self) -> tuple[float, ...]:
@@ -80,9 +85,6 @@ class FourBarFormulation(ClosedForm):
 
         At output states (arrays over time; angles continuous).
         """
-        from ..inverse import kinetic_energy, link_com_kinematics
-        from ..kinematics import motion_from_angles
-
         mo = motion_from_angles(self.lengths, tuple(theta), tuple(omega), tuple(alpha))
         kin = kinetic_energy(self.linkage, mo)
         coms, _ = link_com_kinematics(self.linkage, mo)

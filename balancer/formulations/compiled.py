@@ -10,7 +10,8 @@ through its buffers; :func:`link_equations` and
 
 from __future__ import annotations
 
-import casadi as ca
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -19,7 +20,10 @@ from ..linkage.structure import Structure
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import NUMPY, V
 from ..mechanisms import mechanism_of
-from . import Formulation
+from .base import Formulation
+
+if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
+    import casadi as ca
 
 #: Columns per call of a function mapped by :meth:`Compiled.columns`.
 BLOCK = 64
@@ -105,6 +109,7 @@ def link_equations(structure: Structure, links, pose: Pose, rate, gravity: V, ga
     (``ω²·S̄`` is what is left of the inertia force's velocity terms; ``rate`` the links'
     angular velocities, ``gas`` the slider forces along their guides, N, per prismatic pair).
     """
+    import casadi as ca  # heavy: only where symbols are built
     n = structure.size
     mass = ca.SX.zeros(3 * n, 3 * n)
     force = ca.SX.zeros(3 * n)

@@ -25,8 +25,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..kinematics import branch_sign_along, cross_scalar, position_scalar, rates_scalar
-from . import DrivenRates, Evaluation
+from ..kinematics import branch_sign_along, cross_scalar, motion, position_scalar, rates_scalar
+from .base import DrivenRates, Evaluation
 from .closed_form import FourBarFormulation
 
 
@@ -115,8 +115,6 @@ class ComplexMasses(FourBarFormulation):
 
     def _kinematics_batch(self, theta1, omega1):
         """``kin`` of :meth:`_dynamics` at arrays of crank states (Eq. 2–10, vectorised)."""
-        from ..kinematics import motion
-
         signs = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
         mo = motion(self.lengths, theta1, omega1, 0.0, signs * np.ones_like(theta1), check=False)
         return (mo.vectors, *mo.transfer, mo.omega[1], mo.omega[2], mo.alpha[1], mo.alpha[2])

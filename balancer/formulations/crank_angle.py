@@ -29,17 +29,22 @@ integrated states, vectorised (numpy, an independent solve of the same positions
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
-import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ..errors import AssemblyError, SolverError
 from ..linkage.kinematics import numeric_table, positions, rates
 from ..linkage.numeric import TABLE_STEPS
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import V
-from . import DEAD_POINT_THRESHOLD, DrivenRates, Evaluation
+from ..mechanisms.base import _gaps
+from .base import DEAD_POINT_THRESHOLD, DrivenRates, Evaluation
 from .compiled import Compiled, LinkageFormulation, link_equations
+
+if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
+    import casadi as ca
 
 #: Largest residual of a numeric group's equations after its Newton steps, relative to the
 #: linkage's length scale: a few hundred roundings.
@@ -62,6 +67,7 @@ class CrankAngle(LinkageFormulation):
         self._build()
 
     def _build(self) -> None:
+        import casadi as ca  # heavy: only where symbols are built
         s = self.structure
         theta1, omega1 = ca.SX.sym("theta1"), ca.SX.sym("omega1")
         gas = ca.SX.sym("gas", max(1, len(s.prisms)))
@@ -110,6 +116,7 @@ class CrankAngle(LinkageFormulation):
         A cubic spline through the table's rows (:func:`balancer.linkage.numeric.table`),
         with the crank angle brought into the table's window as the numpy route does.
         """
+        import casadi as ca  # heavy: only where symbols are built
         s = self.structure
         angles, tab = numeric_table(s, s.groups[index])
         start = angles[TABLE_STEPS]
@@ -141,12 +148,12 @@ class CrankAngle(LinkageFormulation):
         least = self.mech.least_gap()
         if least is not None and least > (10 * DEAD_POINT_THRESHOLD) ** 2:
             return least
-        from ..mechanisms.base import _gaps
 
         return float(_gaps(self.structure, np.array([theta1]))[0])
 
     def symbolic_rhs(self) -> ca.Function | None:
         """``(t, y) → ẏ`` as a CasADi function (none with slider forces: tables in Python)."""
+        import casadi as ca  # heavy: only where symbols are built
         s = self.structure
         if self.has_slider_forces:
             return None
@@ -178,8 +185,6 @@ class CrankAngle(LinkageFormulation):
             principal = self.mech.motion(theta1).pose.angles
         raw = np.array([float(np.ravel(x)[0]) for x in principal])
         if not np.all(np.isfinite(raw)):
-            from ..errors import AssemblyError
-
             raise AssemblyError("the linkage cannot be assembled at the initial crank angle",
                                 key="simulation.theta1", value=theta1)
         self.turns = continued - raw
@@ -233,8 +238,6 @@ class CrankAngle(LinkageFormulation):
         """
         out = self._at(theta1, 0.0)
         if self._numeric and not out[3] <= CLOSURE_TOLERANCE * self.structure.length_scale():
-            from ..errors import SolverError
-
             raise SolverError(
                 f"the positions of the linkage's numerically solved group did not converge at "
                 f"θ1 = {theta1:.9g} rad (residual {out[3]:.3g} m); choose multibody")

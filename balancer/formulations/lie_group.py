@@ -37,8 +37,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..inverse import newton_euler
-from ..kinematics import motion_from_angles
-from . import Evaluation
+from ..kinematics import motion_from_angles, motion_of
+from .base import Evaluation
 from .closed_form import FourBarFormulation
 
 S1 = np.array([[0.0, -1.0], [1.0, 0.0]])  # the generator of planar rotations (Eq. 1)
@@ -140,8 +140,6 @@ class LieGroup(FourBarFormulation):
         return y[0:6] if driven else y[1:7]
 
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
-        from ..kinematics import motion_of
-
         self.theta1_start = float(theta1)
         mo = motion_of(self.linkage, theta1, omega1, 0.0)
         u1, u2, u3 = (v[0] / abs(v[0]) for v in mo.vectors)

@@ -30,10 +30,10 @@ from types import SimpleNamespace
 import numpy as np
 from numpy.typing import NDArray
 
-from ..kinematics import cross_scalar, rates_scalar
+from ..kinematics import cross_scalar, motion_of, rates_scalar
 from ..massmodels import fourbar_force_vector, global_mass_matrix
 from ..model import Link
-from . import Evaluation
+from .base import Evaluation
 from .closed_form import FourBarFormulation
 
 
@@ -255,8 +255,6 @@ class MassMatrix(NodalTruss):
         return acc, lam, tau, vectors
 
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
-        from ..kinematics import motion_of
-
         self.theta1_start = float(theta1)
         if self.driven:
             omega1 = float(self.speed)  # type: ignore[arg-type]

@@ -29,11 +29,12 @@ symbols) and compiled into one function; the linear system is solved with numpy.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
-import casadi as ca
 import numpy as np
 from numpy.typing import NDArray
 
+from ..errors import AssemblyError, SolverError
 from ..linkage.constraints import (
     GROUND_INDEX,
     Driver,
@@ -46,8 +47,12 @@ from ..linkage.constraints import (
 from ..linkage.kinematics import _gamma
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import V
-from . import Evaluation, continuous_angles, least_norm, least_norm_many
+from ..mechanisms.base import _gaps
+from .base import Evaluation, continuous_angles, least_norm, least_norm_many
 from .compiled import Compiled, LinkageFormulation, link_equations, spring_forces
+
+if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
+    import casadi as ca
 
 
 class Multibody(LinkageFormulation):
@@ -80,6 +85,7 @@ class Multibody(LinkageFormulation):
                     [ops.cos(t) for t in angles], [ops.sin(t) for t in angles])
 
     def _build(self) -> None:
+        import casadi as ca  # heavy: only where symbols are built
         n, s = self.n, self.structure
         q = ca.SX.sym("q", 3 * n)
         qd = ca.SX.sym("qd", 3 * n)
@@ -116,6 +122,7 @@ class Multibody(LinkageFormulation):
         A constraint's generalized force on the ground (the ground as a link at rest) is
         ``−Φ_gᵀ·λ``: the force and moment the mechanism exerts on the frame there.
         """
+        import casadi as ca  # heavy: only where symbols are built
         n, s = self.n, self.structure
         lam = ca.SX.sym("lam", self.rows)
         acc = ca.SX.sym("acc", 3 * n)
@@ -169,6 +176,7 @@ class Multibody(LinkageFormulation):
         ``R`` making the rows of ``Φ_q·D`` unit at the reference pose — so that links whose
         masses and inertias differ by orders of magnitude do not cost the solve its accuracy.
         """
+        import casadi as ca  # heavy: only where symbols are built
         k = 3 * self.n
         q = ca.MX.sym("q", k)
         qd = ca.MX.sym("qd", k)
@@ -205,6 +213,7 @@ class Multibody(LinkageFormulation):
 
     def _build_constraints(self, q, pose: Pose) -> None:
         """The constraints' residual and Jacobian at a pose and a prescribed crank angle (SX)."""
+        import casadi as ca  # heavy: only where symbols are built
         angle = ca.SX.sym("angle")
         phi = ca.vertcat(*(r for c in self.constraints
                            for r in constraint_residual(c, pose, angle)))
@@ -222,8 +231,6 @@ class Multibody(LinkageFormulation):
     # -- the formulation's interface ----------------------------------------------------------
 
     def transmission_of_crank(self, theta1: float) -> float:
-        from ..mechanisms.base import _gaps
-
         return math.sqrt(max(float(_gaps(self.structure, np.array([theta1]))[0]), 0.0))
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
@@ -250,8 +257,6 @@ class Multibody(LinkageFormulation):
             qd[3 * k : 3 * k + 3] = (first(mo.velocity[k].x), first(mo.velocity[k].y),
                                      first(mo.rate[k]))
         if not np.all(np.isfinite(q)):
-            from ..errors import AssemblyError
-
             raise AssemblyError("the linkage cannot be assembled at the initial crank angle",
                                 key="simulation.theta1", value=theta1)
         q[2::3] = self.mech.continued_angles(theta1)
@@ -287,6 +292,7 @@ class Multibody(LinkageFormulation):
 
     def symbolic_rhs(self) -> ca.Function | None:
         """``(t, y) → ẏ`` as a CasADi function (none with slider forces: tables in Python)."""
+        import casadi as ca  # heavy: only where symbols are built
         s = self.structure
         if self.has_slider_forces:
             return None
@@ -436,7 +442,6 @@ class Multibody(LinkageFormulation):
         gas = np.array([self._gas(self.theta1_of(t, y)) for t, y in zip(times, ys, strict=True)])
         flat = self._fast_dynamics.columns(np.hstack([ys[:, : 2 * n], gas.reshape(count, -1)]).T)
         if not np.all(np.isfinite(flat)):  # QR of a system singular to working precision
-            from ..errors import SolverError
 
             raise SolverError(
                 "the multibody equations of motion are singular to working precision at an "
@@ -461,6 +466,7 @@ class Multibody(LinkageFormulation):
         the loads' and gravity's work from the centres of mass' and the angles'
         displacements; the springs' from their potential energy.
         """
+        import casadi as ca  # heavy: only where symbols are built
         n = 3 * self.n
         ys = np.array(states, dtype=float).reshape(len(states), -1)
         q, qd = ys[:, :n].T, ys[:, n : 2 * n].T  # (3n, count)

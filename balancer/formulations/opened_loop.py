@@ -25,8 +25,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from ..kinematics import cross_scalar, rates_scalar
-from . import Evaluation, least_norm_many
+from ..kinematics import cross_scalar, motion_of, rates_scalar
+from .base import Evaluation, least_norm_many
 from .closed_form import FourBarFormulation
 
 
@@ -213,8 +213,6 @@ class OpenedLoop(FourBarFormulation):
         return alpha, complex(r[0], r[1]), tau, pv, vectors
 
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
-        from ..kinematics import motion_of
-
         self.theta1_start = float(theta1)
         if self.driven:
             omega1 = float(self.speed)  # type: ignore[arg-type]

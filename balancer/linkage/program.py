@@ -19,7 +19,9 @@ reports its residual: a state where it did not converge is left to the numpy rou
 
 from __future__ import annotations
 
-import casadi as ca
+from functools import cache
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -30,7 +32,17 @@ from .structure import Structure
 from .symbols import CasadiOps
 from .vectors import Factor, _is_zero, _minus, _times
 
-_OPS = {getattr(ca, name): name[3:] for name in dir(ca) if name.startswith("OP_")}
+if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
+    import casadi as ca
+
+
+@cache
+def _op_names() -> dict[int, str]:
+    """CasADi's operation codes by name without the ``OP_`` prefix (``OP_SIN`` → ``SIN``)."""
+    import casadi
+
+    return {getattr(casadi, name): name[3:] for name in dir(casadi) if name.startswith("OP_")}
+
 
 _UNARY = {"SIN": "sin", "COS": "cos", "TAN": "tan", "SQRT": "sqrt", "NEG": "negative",
           "SQ": "square", "FABS": "absolute", "EXP": "exp", "LOG": "log", "ATAN": "arctan",
@@ -102,7 +114,7 @@ def _generate(fn: ca.Function) -> str:
                  if fn.sz_w() else "    pass")
     regs = _Registers()
     for k in range(fn.n_instructions()):
-        op = _OPS[fn.instruction_id(k)]
+        op = _op_names()[fn.instruction_id(k)]
         ins, outs = fn.instruction_input(k), fn.instruction_output(k)
         if op == "INPUT":
             regs.alias(outs[0], f"inputs[{ins[0]}][{ins[1]}]")
@@ -223,6 +235,7 @@ class _FixedPivotOps(CasadiOps):
         return Factor(a, dense=self._solve)
 
     def _solve(self, block: list[list], columns: list[list]) -> list[list]:
+        import casadi as ca  # heavy: only where symbols are built
         k = len(block)
         a = [list(row) for row in block]
         b = [list(row) for row in columns]
@@ -263,6 +276,7 @@ class CrankForcesProgram:
     """
 
     def __init__(self, structure: Structure, *, loads: bool, gravity: tuple[float, float]) -> None:
+        import casadi as ca  # heavy: only where symbols are built
         self.structure = s = structure
         theta1, omega1, alpha1 = (ca.SX.sym(n) for n in ("theta1", "omega1", "alpha1"))
         self.numeric = [i for i, g in enumerate(s.groups) if g.kind == "numeric"]
@@ -344,6 +358,7 @@ __all__ = ["CrankForcesProgram", "Tape"]
 
 def _largest(values: list):
     """The largest of ``values`` (symbols), or −1 for none."""
+    import casadi as ca  # heavy: only where symbols are built
     out = ca.SX(-1.0)
     for v in values:
         out = ca.fmax(out, v)

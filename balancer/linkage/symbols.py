@@ -8,21 +8,46 @@ programs of :mod:`.program`.
 
 from __future__ import annotations
 
-import casadi as ca
+from typing import Any
 
 from .vectors import Factor, Ops
 
 
 class CasadiOps(Ops):
-    """The elementary functions of :class:`balancer.linkage.vectors.Ops` for CasADi symbols."""
+    """The elementary functions of :class:`balancer.linkage.vectors.Ops` for CasADi symbols.
 
-    sqrt = staticmethod(ca.sqrt)
-    sin = staticmethod(ca.sin)
-    cos = staticmethod(ca.cos)
-    atan2 = staticmethod(ca.atan2)
+    CasADi is imported by each function (once loaded, a dictionary lookup): importing this
+    module does not load it.
+    """
 
     @staticmethod
-    def where(condition, a, b):
+    def sqrt(x: Any) -> Any:
+        import casadi as ca
+
+        return ca.sqrt(x)
+
+    @staticmethod
+    def sin(x: Any) -> Any:
+        import casadi as ca
+
+        return ca.sin(x)
+
+    @staticmethod
+    def cos(x: Any) -> Any:
+        import casadi as ca
+
+        return ca.cos(x)
+
+    @staticmethod
+    def atan2(y: Any, x: Any) -> Any:
+        import casadi as ca
+
+        return ca.atan2(y, x)
+
+    @staticmethod
+    def where(condition: Any, a: Any, b: Any) -> Any:
+        import casadi as ca
+
         return ca.if_else(condition, a, b)
 
     @staticmethod
@@ -33,6 +58,8 @@ class CasadiOps(Ops):
 
 def _dense_solve(block, columns):
     """``X`` with ``A·X = B`` for symbols: ``A`` k×k and ``B`` k×m as lists of rows."""
+    import casadi as ca
+
     a = ca.vertcat(*[ca.horzcat(*row) for row in block])
     b = ca.vertcat(*[ca.horzcat(*row) for row in columns])
     x = ca.solve(a, b)

@@ -8,15 +8,21 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-#: The mechanism classes by model type: (module, class).
-REGISTRY: dict[str, tuple[str, str]] = {
-    "four-bar": ("balancer.mechanisms.fourbar", "FourBarMechanism"),
-    "slider-crank": ("balancer.mechanisms.slidercrank", "SliderCrankMechanism"),
-    "linkage": ("balancer.mechanisms.general", "LinkageMechanism"),
+from ..errors import SpecError
+from .base import Mechanism
+from .fourbar import FourBarMechanism
+from .general import LinkageMechanism
+from .slidercrank import SliderCrankMechanism
+
+#: The mechanism classes by the spec's ``mechanism.type``.
+REGISTRY: dict[str, type[Mechanism]] = {
+    "four-bar": FourBarMechanism,
+    "slider-crank": SliderCrankMechanism,
+    "linkage": LinkageMechanism,
 }
 
 
-def mechanism_of(model):
+def mechanism_of(model) -> Mechanism:
     """The :class:`~.base.Mechanism` of a model (a FourBar, SliderCrank or Linkage).
 
     Built once per model (models are frozen and hashable); a mechanism is returned as it is.
@@ -27,8 +33,6 @@ def mechanism_of(model):
         If the model is not a mechanism the package knows, or a general linkage is not a valid
         one (mobility, reference pose; see :class:`balancer.linkage.structure.Structure`).
     """
-    from .base import Mechanism
-
     if isinstance(model, Mechanism):
         return model
     try:
@@ -37,33 +41,16 @@ def mechanism_of(model):
         return _build(model)
 
 
-#: Every formulation of the equations of motion of a registered mechanism (``--method``): the
-#: registry's names, kept here so that the command line lists them without importing the
-#: mechanisms (a test checks them against the mechanisms' own tables).
-FORMULATION_NAMES: tuple[str, ...] = (
-    "opened-loop", "complex-masses", "mass-matrix", "lie-group", "multibody", "crank-angle")
-
-
-def formulation_names() -> tuple[str, ...]:
-    """Every formulation of the equations of motion of any registered mechanism (``--method``)."""
-    return FORMULATION_NAMES
-
-
 @lru_cache(maxsize=64)
-def _cached(model):
+def _cached(model) -> Mechanism:
     return _build(model)
 
 
-def _build(model):
-    import importlib
-
-    from ..errors import SpecError
-
+def _build(model) -> Mechanism:
     kind = getattr(model, "type", None)
     if kind not in REGISTRY:
         raise SpecError("must be a mechanism (a FourBar, SliderCrank or Linkage)",
                         key="mechanism", value=type(model).__name__)
-    module, cls = REGISTRY[kind]
-    mech = getattr(importlib.import_module(module), cls)(model)
+    mech = REGISTRY[kind](model)
     mech.structure  # noqa: B018 - build (and so check) the equations now
     return mech

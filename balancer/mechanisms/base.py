@@ -30,17 +30,16 @@ from ..linkage import dynamics, kinematics
 from ..linkage.constraints import GROUND_INDEX
 from ..linkage.dynamics import Forces, Layout
 from ..linkage.kinematics import Motion
+from ..linkage.program import CrankForcesProgram
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
 from ..model import GROUND, Link, Linkage
 from ..model.assembly import AssemblyRange
 
-#: The formulation of the equations of motion that applies to every linkage.
-MULTIBODY: dict[str, tuple[str, str]] = {
-    "multibody": ("balancer.formulations.multibody", "Multibody")}
-#: The general formulation in the crank angle.
-CRANK_ANGLE: dict[str, tuple[str, str]] = {
-    "crank-angle": ("balancer.formulations.crank_angle", "CrankAngle")}
+#: The formulations of the equations of motion that apply to every linkage: in absolute
+#: coordinates with the constraints' multipliers, and in the crank angle.
+MULTIBODY = "multibody"
+CRANK_ANGLE = "crank-angle"
 #: Least normalised assembly gap of a dyad over a revolution for the crank to turn fully: at
 #: or below it the dyad reaches a dead point (its links in line) within rounding.
 GAP_TOLERANCE = 1e-12
@@ -91,8 +90,9 @@ class Mechanism(ABC):
     kind: ClassVar[str]
     #: Inverse-dynamics routes (``analyze --route``), the default first.
     routes: ClassVar[tuple[str, ...]] = ("newton-euler", "mass-matrix")
-    #: Formulations of the equations of motion: name → (module, class); the default first.
-    formulations: ClassVar[dict[str, tuple[str, str]]] = {}
+    #: The mechanism's own formulations of the equations of motion (:mod:`balancer.formulations`
+    #: has them by name), the default first.
+    formulations: ClassVar[tuple[str, ...]] = ()
     #: The formulation a check by simulation uses: one the optimiser's route does not share.
     verify_method: ClassVar[str] = "multibody"
     #: The spec key that holds the geometry (named by errors about it).
@@ -181,19 +181,17 @@ class Mechanism(ABC):
         return float(self.structure.ref_angle[self.structure.input])
 
     @property
-    def formulation_table(self) -> dict[str, tuple[str, str]]:
-        """Every formulation of the equations of motion that applies: name → (module, class).
+    def formulation_names(self) -> tuple[str, ...]:
+        """Every formulation of the equations of motion that applies, the default first.
 
-        The mechanism's own (the default first), then the general ones, which apply to any
-        linkage: the multibody formulation (:mod:`balancer.formulations.multibody`) and the
-        crank-angle one (:mod:`balancer.formulations.crank_angle`), the latter first where the
-        crank turns fully.
+        The mechanism's own, then the general ones, which apply to any linkage: the multibody
+        formulation (:mod:`balancer.formulations.multibody`) and the crank-angle one
+        (:mod:`balancer.formulations.crank_angle`), the latter first where the crank turns fully
+        (no dead point of the crank to stop it).
         """
-        # Lagrange's equation in the crank angle: first where the crank turns fully (no dead
-        # point of the crank to stop it), after the multibody otherwise.
         if self.assembly_range().full:
-            return {**self.formulations, **CRANK_ANGLE, **MULTIBODY}
-        return {**self.formulations, **MULTIBODY, **CRANK_ANGLE}
+            return (*self.formulations, CRANK_ANGLE, MULTIBODY)
+        return (*self.formulations, MULTIBODY, CRANK_ANGLE)
 
     def parameters(self) -> NDArray[np.float64]:
         """The design vector of the mechanism's own links (:attr:`layout`)."""
@@ -343,8 +341,6 @@ class Mechanism(ABC):
 
     def _program(self, loads: bool, gravity: tuple[float, float]):
         """The mechanism's crank-forces program for these loads and gravity (built once)."""
-        from ..linkage.program import CrankForcesProgram
-
         key = (loads, gravity)
         with _PROGRAM_LOCK:
             cache = self.__dict__.setdefault("_programs", {})  # of this design only

@@ -16,6 +16,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .. import kinematics as fourbar
+from ..conditions import force_balance_matrix
+from ..inverse import change_point_limits, mass_matrix, newton_euler
 from ..linkage.constraints import Pose
 from ..linkage.dynamics import Forces
 from ..linkage.kinematics import Motion
@@ -59,12 +61,7 @@ class FourBarMechanism(Mechanism):
     """The 4R four-bar (``type = "four-bar"``)."""
 
     kind = "four-bar"
-    formulations = {
-        "opened-loop": ("balancer.formulations.opened_loop", "OpenedLoop"),
-        "complex-masses": ("balancer.formulations.complex_masses", "ComplexMasses"),
-        "mass-matrix": ("balancer.formulations.mass_matrix", "MassMatrix"),
-        "lie-group": ("balancer.formulations.lie_group", "LieGroup"),
-    }
+    formulations = ("opened-loop", "complex-masses", "mass-matrix", "lie-group")
     geometry_key = "mechanism.lengths"
     named_states = False
     #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.
@@ -122,15 +119,11 @@ class FourBarMechanism(Mechanism):
 
     def closed_form_force_balance(self) -> NDArray[np.float64]:
         """Eq. 57–58 over the layout (crank, coupler, rocker, then two counter-rotors)."""
-        from ..conditions import force_balance_matrix
-
         ab = force_balance_matrix(self.model.lengths)
         assert not np.any(ab[:, 12]), "Eq. 58 is homogeneous"
         return np.hstack([ab[:, :12], np.zeros((ab.shape[0], self.layout.size - 12))])
 
     def limits(self, theta1: NDArray[np.float64]) -> list[Limit]:
-        from ..inverse import change_point_limits
-
         return [Limit(mask, offsets, weights) for mask, offsets, weights
                 in change_point_limits(self.model.lengths, theta1)]
 
@@ -151,8 +144,6 @@ class FourBarMechanism(Mechanism):
                                         route, loads, gravity)
 
     def _closed_form_forces(self, mo: fourbar.Motion, route, loads, gravity) -> Forces:
-        from ..inverse import mass_matrix, newton_euler
-
         route_fn = mass_matrix if (route or self.routes[0]) == "mass-matrix" else newton_euler
         r = route_fn(self.model, mo, gravity=gravity, loads=loads)
         def col(z):

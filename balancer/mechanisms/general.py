@@ -9,4 +9,4 @@ class LinkageMechanism(Mechanism):
     """Any planar linkage with one degree of freedom (``type = "linkage"``)."""
 
     kind = "linkage"
-    formulations = {}  # the general multibody formulation only (Mechanism.formulation_table)
+    formulations = ()  # the general formulations only (Mechanism.formulation_names)

@@ -20,6 +20,8 @@ from ..linkage.vectors import V
 from ..model import Body, Linkage, Slider, SliderCrank
 from ..model.assembly import AssemblyRange
 from ..slider_crank import kinematics as closed
+from ..slider_crank.conditions import force_balance_matrix
+from ..slider_crank.dynamics import mass_matrix
 from .base import Mechanism
 
 
@@ -53,10 +55,7 @@ class SliderCrankMechanism(Mechanism):
     """The slider-crank (``type = "slider-crank"``)."""
 
     kind = "slider-crank"
-    formulations = {
-        "mass-matrix": ("balancer.slider_crank.formulations", "SliderMassMatrix"),
-        "complex-masses": ("balancer.slider_crank.formulations", "SliderComplexMasses"),
-    }
+    formulations = ("mass-matrix", "complex-masses")
     verify_method = "complex-masses"
     geometry_key = "mechanism.lengths"
     named_states = False
@@ -86,8 +85,6 @@ class SliderCrankMechanism(Mechanism):
 
     def closed_form_force_balance(self) -> np.ndarray:
         """Wunderlich's Eq. 20a–b over the layout (crank, rod, slider, then a counter-rotor)."""
-        from ..slider_crank.conditions import force_balance_matrix
-
         ab = force_balance_matrix(self.model.lengths)
         assert not np.any(ab[:, 12]), "Eq. 20 is homogeneous"
         return np.hstack([ab[:, :12], np.zeros((ab.shape[0], self.layout.size - 12))])
@@ -99,8 +96,6 @@ class SliderCrankMechanism(Mechanism):
                          gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         if (route or self.routes[0]) != "mass-matrix":
             return super().inverse_dynamics(mo, route=route, loads=loads, gravity=gravity)
-        from ..slider_crank.dynamics import mass_matrix
-
         smo = closed.motion_of(self.model, mo.theta1, mo.omega1, mo.alpha1)
         r = mass_matrix(self.model, smo, gravity=gravity, loads=loads)
         def col(z):

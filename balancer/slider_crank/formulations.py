@@ -26,10 +26,12 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from ..formulations import DrivenRates, Evaluation
+from ..formulations.base import DrivenRates, Evaluation
 from ..formulations.closed_form import ClosedForm
 from ..formulations.mass_matrix import NodalTruss
 from ..kinematics import cross_scalar
+from ..massmodels import equivalent_joint_forces, equivalent_mass_matrix, inertial_parameters
+from ..model import Link
 from .dynamics import kinetic_energy, newton_euler
 from .kinematics import assembly_range, motion
 
@@ -264,9 +266,6 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):
 
     def _forces(self, x, tau: float, gas: float):
         """Nodal applied forces at A0, A1, A2 (Eq. 46), the gas force and the motor torque in."""
-        from ..massmodels import equivalent_joint_forces
-        from ..model import Link
-
         r, big_l, _ = self.lengths
         a1, a2 = complex(x[0], x[1]), complex(x[2], x[3])
         out = [0j, 0j, 0j]
@@ -355,6 +354,4 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):
 
 
 def _element(link, length: float) -> NDArray[np.float64]:
-    from ..massmodels import equivalent_mass_matrix, inertial_parameters
-
     return equivalent_mass_matrix(inertial_parameters(link), length)
