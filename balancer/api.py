@@ -11,7 +11,7 @@ returns a result object; nothing here prints or writes files.
 
 from __future__ import annotations
 
-from .cycle import CycleAnalysis, cycle_analysis
+from .cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses
 from .errors import SpecError
 from .model import Design
 
@@ -51,6 +51,37 @@ def analyze(design: Design, *, route: str | None = None,
         gravity = v.vector2(gravity, "gravity")
         check_scales(design.mechanism, {"operation.speed": op.speed}, {"gravity": gravity})
     return cycle_analysis(design.mechanism, op.speed, op.samples, route=route, gravity=gravity)
+
+
+def cycle_analyses(design: Design, *, samples: int | None = None,
+                   tolerance: float = DRAWING_TOLERANCE) -> tuple[CycleAnalysis,
+                                                                   CycleAnalysis | None]:
+    """One revolution of the design and of its original, sampled finely enough to draw.
+
+    At the operating speed with the spec's gravity, from at least the spec's ``samples``
+    (:func:`balancer.cycle.drawn_analyses`, to ``tolerance`` of each panel's span); with
+    ``samples``, exactly that many crank angles.
+
+    Returns
+    -------
+    tuple
+        ``(design's, original's or None)`` :class:`~balancer.cycle.CycleAnalysis`, both at
+        the same crank angles.
+
+    Raises
+    ------
+    SpecError
+        If the design has no operating speed; :class:`~balancer.errors.AssemblyError` if a
+        crank cannot turn a full revolution.
+    """
+    if design.operation is None:
+        raise SpecError("missing required key: a cycle analysis needs the operating speed",
+                        key="operation.speed")
+    op = design.operation
+    models = [design.mechanism, *([design.original] if design.original is not None else [])]
+    analyses = drawn_analyses(models, op.speed, samples=samples, least=op.samples,
+                              gravity=op.gravity, tolerance=tolerance)
+    return analyses[0], (analyses[1] if len(analyses) > 1 else None)
 
 
 def optimize(design: Design, *, backend: str = "nlp"):
@@ -139,14 +170,13 @@ def to_table(result):
     import numpy as np
     import pyarrow as pa
 
-    from . import report
     from .balance.pareto import Front
     from .simulation import Trajectory
 
     if isinstance(result, CycleAnalysis):
-        names, values = report.analysis_columns(result)
+        names, values = result.columns()
     elif isinstance(result, Trajectory):
-        names, values = report.simulation_columns(result, all_columns=True)
+        names, values = result.columns(all_columns=True)
     elif isinstance(result, Front):
         rows = result.as_dict()["points"]
         return pa.Table.from_pylist(rows)

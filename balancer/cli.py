@@ -82,34 +82,21 @@ def _output_path(args: argparse.Namespace, value: str | None, option: str) -> Pa
     return path
 
 
-#: Figure and animation types by extension: :data:`balancer.plots.FIGURE_TYPES` and
-#: :data:`balancer.plots.ANIMATION_TYPES`, here so that a path of another type is refused before
-#: matplotlib loads (a test keeps them equal).
-FIGURE_EXTENSIONS: tuple[str, ...] = (".png", ".svg", ".pdf")
-ANIMATION_EXTENSIONS: tuple[str, ...] = (".gif", ".mp4")
 #: Most frames per revolution of an animation: ten a degree, more than any screen shows.
 MAX_FRAMES = 3600
 
 
-def _figure_path(args: argparse.Namespace, value: str | None, option: str,
-                 extensions: tuple[str, ...] = FIGURE_EXTENSIONS) -> Path | None:
-    """An output path for a figure (or animation), checked before any work.
+def _figure_path(args: argparse.Namespace, value: str | None, option: str) -> Path | None:
+    """An output path for a figure, checked before any work.
 
-    It must be writable (:func:`_output_path`), and its extension must name a type
-    (:func:`_of_type`).
+    It must be writable (:func:`_output_path`), and its extension must name a figure type
+    (:func:`balancer.outputs.figure_type`).
     """
-    return _of_type(_output_path(args, value, option), option, extensions)
+    from .outputs import figure_type
 
-
-def _of_type(path: Path | None, option: str,
-             extensions: tuple[str, ...] = FIGURE_EXTENSIONS) -> Path | None:
-    """``path``, if its extension is one of ``extensions``; else :class:`OutputError`.
-
-    :func:`balancer.plots.figure_type`'s check and message, without loading matplotlib.
-    """
-    if path is not None and path.suffix.lower() not in extensions:
-        raise OutputError("the file type comes from the extension: use one of "
-                          + ", ".join(extensions), key=option, value=str(path))
+    path = _output_path(args, value, option)
+    if path is not None:
+        figure_type(path, option)
     return path
 
 
@@ -325,12 +312,12 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             os.path.realpath(cycle) == os.path.realpath(animation):
         raise OutputError("names the same file as --cycle", key="--animate",
                           value=args.animate)
-    _of_type(cycle, "--cycle")
-    _of_type(animation, "--animate", ANIMATION_EXTENSIONS)
-    if animation is not None:
-        from .plots import animation_type
+    from .outputs import animation_type, figure_type
 
-        animation_type(animation, "--animate")  # an MP4 needs ffmpeg
+    if cycle is not None:
+        figure_type(cycle, "--cycle")
+    if animation is not None:
+        animation_type(animation, "--animate")  # its extension, and ffmpeg for an MP4
     design = _load(args)
     from .mechanisms import mechanism_of
 
@@ -338,7 +325,8 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         "a cycle plot" if animation is None else "an animation of one revolution")
     figure = None
     if cycle is not None:
-        from .plots import cycle_analyses, cycle_figure
+        from .api import cycle_analyses
+        from .plots import cycle_figure
 
         figure = cycle_figure(*cycle_analyses(design), title=design.title)
     if animation is not None:
@@ -373,14 +361,9 @@ def _cmd_pareto(args: argparse.Namespace) -> int:
     text = (dumps_json(front_json(front, spec=args.spec)) if args.json
             else front_text(front, spec=args.spec) + "\n")
     if plot is not None:
-        from .balance.conditions import RESIDUAL_FLOOR, force_balance_residual
-        from .mechanisms import mechanism_of
         from .plots import front_figure, save_figure
 
-        balanced = force_balance_residual(mechanism_of(design.mechanism)) <= RESIDUAL_FLOOR
-        save_figure(front_figure(front, title=design.title,
-                                 force_balance=design.balance.force_balance,
-                                 original_force_balanced=balanced), plot)
+        save_figure(front_figure(front, title=design.title), plot)
         _wrote(plot)
     if csv_path is not None:
         write_atomic(csv_path, csv)
@@ -412,12 +395,12 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                        progress=progress)
     _wrote(result.out)
     if plot is not None:
-        from .plots import save_figure, sweep_figure
-        from .sweeps import spec_values
+        from .plots import save_figure
+        from .sweeps import atlas_figure, spec_values
 
         keys = [v.key for v in varies]
         original = spec_values(args.spec, keys or [p.key for p in perturbs])
-        save_figure(sweep_figure(result.out, keys or None, original=original,
+        save_figure(atlas_figure(result.out, keys or None, original=original,
                                  perturbs=perturbs), plot)
     sys.stdout.write(dumps_json(result.as_dict()) if args.json
                      else sweep_text(result, spec=args.spec) + "\n")

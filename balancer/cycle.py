@@ -23,7 +23,9 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
+from .columns import analysis_columns
 from .errors import SpecError
+from .force_balance import RESIDUAL_FLOOR, force_balance_residual
 from .linkage.kinematics import Motion
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism
@@ -213,6 +215,50 @@ class CycleAnalysis:
             return math.nan
         return float(np.max(np.abs(path - path.mean())))
 
+    @cached_property
+    def force_balance_residual(self) -> float:
+        """How far the design is from shaking-force balance: its conditions' residual.
+
+        Relative: the first moments of mass left over, over those that make them
+        (:func:`balancer.force_balance.force_balance_residual`); 0 for a balanced design.
+        """
+        return force_balance_residual(self.mechanism)
+
+    @property
+    def force_balanced(self) -> bool:
+        """Whether the design is force-balanced (its residual is rounding)."""
+        return self.force_balance_residual <= RESIDUAL_FLOOR
+
+    def harmonics(self, orders: int = 4) -> dict[str, NDArray[np.float64]]:
+        """Amplitudes of the harmonics 0…``orders`` of the shaking over the revolution.
+
+        Keys ``shaking_force_x``, ``shaking_force_y`` (N), ``shaking_moment`` (N·m),
+        ``driving_torque`` (N·m); entry ``k`` is the amplitude at ``k`` times the crank speed
+        (entry 0 the mean). From the equally spaced samples (a discrete Fourier transform);
+        samples at a singular pose carry the limits of the smooth motion.
+        """
+        r = self.reactions
+        signals = {
+            "shaking_force_x": np.real(r.shaking_force),
+            "shaking_force_y": np.imag(r.shaking_force),
+            "shaking_moment": np.asarray(r.shaking_moment, float),
+            "driving_torque": np.asarray(r.driving_torque, float),
+        }
+        out = {}
+        for name, values in signals.items():
+            spectrum = np.fft.rfft(values) / values.size
+            amp = np.abs(spectrum[: orders + 1]) * 2
+            amp[0] /= 2
+            out[name] = amp
+        return out
+
+    def columns(self) -> tuple[list[str], list]:
+        """The columns of ``analyze --csv``: names and values over the samples.
+
+        See :func:`balancer.columns.analysis_columns`.
+        """
+        return analysis_columns(self)
+
     @property
     def samples(self) -> int:
         """Number of sampled crank angles."""
@@ -324,3 +370,75 @@ def cycle_analysis(model, speed: float, samples: int = 360, *, route: str | None
     reactions = Reactions(ground=ground, slider_normal=normal, slider_couple=couple, **out)
     return CycleAnalysis(mechanism=mech, speed=speed, theta1=angles, reactions=reactions,
                          route=route, gravity=tuple(gravity), loads=loads, singular=singular)
+
+
+#: Largest distance, between two samples, of a drawn curve from the line through them,
+#: relative to the span of its panel: about a pixel of a panel 500 pixels high.
+DRAWING_TOLERANCE = 2e-3
+
+#: Fewest and most crank angles of a drawn revolution (the spec's ``samples`` if more).
+PLOT_SAMPLES = (720, 2**17)
+
+#: A curve whose span is below this fraction of its natural scale (the largest force on the
+#: ground, times the linkage's size for a moment) is drawn as rounding: not refined further.
+ROUNDING_SPAN = 1e-9
+
+
+def drawn_analyses(models, speed: float, *, samples: int | None = None, least: int = 0,
+                   gravity: tuple[float, float] = (0.0, 0.0),
+                   tolerance: float = DRAWING_TOLERANCE) -> list[CycleAnalysis]:
+    """Revolutions of mechanisms at the same crank angles, sampled finely enough to draw.
+
+    At ``speed`` (rad/s) with ``gravity`` (m/s²), from at least ``least`` and
+    :data:`PLOT_SAMPLES`' least crank angles, doubled until every drawn curve
+    (:func:`drawn_panels`: the shaking force's tip, the shaking moment, the driving torque) of
+    every model lies within ``tolerance`` of its panel's span from the straight lines between
+    its samples (checked at the midpoints), or the most; ``samples`` takes exactly that many.
+
+    Raises
+    ------
+    AssemblyError
+        If a crank cannot turn a full revolution.
+    """
+    def at(n: int) -> list[CycleAnalysis]:
+        return [cycle_analysis(m, speed, n, gravity=gravity) for m in models]
+
+    n = samples or max(least, PLOT_SAMPLES[0])
+    coarse = at(n)
+    while samples is None and 2 * n <= PLOT_SAMPLES[1]:
+        fine = at(2 * n)
+        if _drawn_within(fine, tolerance):
+            return fine
+        coarse, n = fine, 2 * n
+    return coarse
+
+
+def drawn_panels(analysis) -> dict[str, np.ndarray]:
+    """What the cycle figure draws of an analysis, by panel."""
+    r = analysis.reactions
+    return {"force": r.shaking_force, "moment": r.shaking_moment, "torque": r.driving_torque}
+
+def _drawn_within(analyses, tolerance: float) -> bool:
+    """Whether every curve at the even samples is drawn within ``tolerance`` of its panel.
+
+    The odd samples are the midpoints: their distance from the chords of the even ones,
+    relative to the panel's span over all the analyses (floored at :data:`ROUNDING_SPAN` of
+    its natural scale).
+    """
+    force_scale = max(max((float(np.nanmax(np.abs(v), initial=0.0)) for v in
+                           (*a.reactions.ground.values(), *a.reactions.slider_normal.values())),
+                          default=0.0) for a in analyses)
+    length = analyses[0].mechanism.structure.length_scale()
+    panels = [drawn_panels(a) for a in analyses]
+    for key in panels[0]:
+        curves = [p[key] for p in panels]
+        span = max(max(np.ptp(c.real), np.ptp(c.imag)) if np.iscomplexobj(c) else np.ptp(c)
+                   for c in curves)
+        natural = force_scale * (1.0 if key == "force" else length)
+        span = max(span, ROUNDING_SPAN * natural, 1e-300)
+        for c in curves:
+            even, odd = c[0::2], c[1::2]
+            chord = 0.5 * (even + np.roll(even, -1))
+            if not np.nanmax(np.abs(odd - chord), initial=0.0) <= tolerance * span:
+                return False
+    return True

@@ -96,3 +96,58 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> Path:
             fh.write(payload)
 
     return write_with(path, write)
+
+
+#: Figure formats by file extension (matplotlib's Agg, SVG and PDF backends).
+FIGURE_TYPES: dict[str, str] = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
+
+#: Animation formats by file extension (GIF by Pillow, MP4 by ffmpeg: :func:`ffmpeg`).
+ANIMATION_TYPES: dict[str, str] = {".gif": "gif", ".mp4": "mp4"}
+
+def figure_type(path: str | os.PathLike[str], option: str | None = None,
+                types: dict[str, str] = FIGURE_TYPES) -> str:
+    """The file type that ``path``'s extension names, or :class:`OutputError` (exit 2)."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in types:
+        known = ", ".join(types)
+        raise OutputError(f"the file type comes from the extension: use one of {known}",
+                          key=option, value=str(path))
+    return types[suffix]
+
+def ffmpeg() -> str | None:
+    """The ffmpeg program that writes MP4 animations, or ``None`` if there is none.
+
+    matplotlib's ``animation.ffmpeg_path`` setting (``ffmpeg`` on ``PATH`` by default), else
+    the one the ``imageio-ffmpeg`` package ships (``pip install 'balancer[video]'``).
+    """
+    import shutil
+
+    import matplotlib
+
+    found = shutil.which(matplotlib.rcParams["animation.ffmpeg_path"])
+    if found:
+        return found
+    try:
+        import imageio_ffmpeg
+    except ImportError:
+        return None
+    try:
+        return imageio_ffmpeg.get_ffmpeg_exe()
+    except RuntimeError:  # the package without its binary for this platform
+        return None
+
+def animation_type(path: str | os.PathLike[str], option: str | None = None) -> str:
+    """The animation type that ``path``'s extension names, if it can be written here.
+
+    Raises
+    ------
+    OutputError
+        (exit 2) For an extension other than :data:`ANIMATION_TYPES`', or ``.mp4`` where there
+        is no ffmpeg (:func:`ffmpeg`).
+    """
+    kind = figure_type(path, option, ANIMATION_TYPES)
+    if kind == "mp4" and ffmpeg() is None:
+        raise OutputError("an MP4 animation needs ffmpeg, which is not installed: install it "
+                          "(or pip install 'balancer[video]'), or write a .gif", key=option,
+                          value=str(path))
+    return kind

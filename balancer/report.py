@@ -12,13 +12,10 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
-from .balance.conditions import RESIDUAL_FLOOR, force_balance_residual
 from .balance.counterweights import UNCHANGED
 from .cycle import CycleAnalysis, Figure
 from .errors import SolverError
-from .mechanisms import mechanism_of
 
 UNITS = {"shaking_force": "N", "shaking_moment": "N·m", "driving_torque": "N·m"}
 
@@ -73,46 +70,16 @@ def figures_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
     return analysis.summary.as_dict()
 
 
-def harmonics(analysis: CycleAnalysis, orders: int = 4) -> dict[str, NDArray[np.float64]]:
-    """Amplitudes of the harmonics 0…``orders`` of the shaking over a revolution.
-
-    Keys ``shaking_force_x``, ``shaking_force_y`` (N), ``shaking_moment`` (N·m),
-    ``driving_torque`` (N·m); entry ``k`` is the amplitude at ``k`` times the crank speed
-    (entry 0 the mean). From equally spaced samples of one revolution (a discrete Fourier
-    transform); samples at a singular pose carry the limits of the smooth motion.
-    """
-    r = analysis.reactions
-    signals = {
-        "shaking_force_x": np.real(r.shaking_force),
-        "shaking_force_y": np.imag(r.shaking_force),
-        "shaking_moment": np.asarray(r.shaking_moment, float),
-        "driving_torque": np.asarray(r.driving_torque, float),
-    }
-    out = {}
-    for name, values in signals.items():
-        spectrum = np.fft.rfft(values) / values.size
-        amp = np.abs(spectrum[: orders + 1]) * 2
-        amp[0] /= 2
-        out[name] = amp
-    return out
-
-
 def _harmonics_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
     """Primary and secondary harmonic amplitudes of the shaking (N, N·m)."""
-    h = harmonics(analysis)
+    h = analysis.harmonics()
     return {name: {"primary": float(v[1]), "secondary": float(v[2])} for name, v in h.items()}
-
-
-def _force_balance(mech) -> tuple[bool, float]:
-    """Whether a mechanism is force-balanced, and its conditions' residual (relative)."""
-    residual = force_balance_residual(mech)
-    return residual <= RESIDUAL_FLOOR, residual
 
 
 def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str, Any]:
     """The ``analyze --json`` document."""
     mech = analysis.mechanism
-    balanced, residual = _force_balance(mech)
+    balanced, residual = analysis.force_balanced, analysis.force_balance_residual
     doc: dict[str, Any] = {}
     if spec is not None:
         doc["spec"] = spec
@@ -204,7 +171,7 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
                 for link in analysis.reactions.slider_normal]
         lines += ["", table(rows, ["slider on the frame", "normal force max (N)",
                                    "couple max (N·m)"])]
-    h = harmonics(analysis)
+    h = analysis.harmonics()
     lines += ["", table(
         [[name.replace("_", " "), _fmt(h[name][1]), _fmt(h[name][2]), unit] for name, unit in (
             ("shaking_force_x", "N"), ("shaking_force_y", "N"), ("shaking_moment", "N·m"))],
@@ -225,7 +192,7 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
 
 def _force_balance_line(analysis: CycleAnalysis) -> str:
     """Whether the design is force-balanced, in words a designer pictures."""
-    balanced, residual = _force_balance(analysis.mechanism)
+    balanced, residual = analysis.force_balanced, analysis.force_balance_residual
     if balanced:
         return ("force-balanced: yes (the total centre of mass stands still; the conditions, "
                 f"Eq. 57–58, hold to {residual:.1e} of the links' first moments)")
@@ -276,122 +243,9 @@ def _nonfinite(value: Any, path: str) -> str | None:
     return None
 
 
-#: The columns of ``simulate``'s CSV, fixed by DESIGN.md.
-SIMULATION_COLUMNS = (
-    "t",
-    "theta1",
-    "theta2",
-    "theta3",
-    "omega1",
-    "omega2",
-    "omega3",
-    "alpha1",
-    "alpha2",
-    "alpha3",
-    "RA0x",
-    "RA0y",
-    "RA3x",
-    "RA3y",
-)
-#: What the frame feels and what drives the crank, after the state and reactions.
-SHAKING_COLUMNS = ("shaking_force_x", "shaking_force_y", "shaking_moment", "driving_torque")
-#: Extra columns written after the fixed ones with ``simulate --all-columns``.
-SIMULATION_EXTRA_COLUMNS = (*SHAKING_COLUMNS, "kinetic_energy", "work")
-#: The columns of ``analyze --csv`` for a four-bar (:func:`analysis_columns`).
-ANALYSIS_COLUMNS = (*SIMULATION_COLUMNS, *SHAKING_COLUMNS)
-
-
-def analysis_columns(analysis: CycleAnalysis) -> tuple[list[str], list]:
-    """The columns of ``analyze --csv``: names and values (arrays over the samples).
-
-    ``t``; per moving link ``k`` (1, 2, … in the spec's order) ``theta{k}``, ``omega{k}``,
-    ``alpha{k}`` (rad, rad/s, rad/s²); the forces on the frame (:func:`frame_force_columns`);
-    the sliders on the frame (:func:`slider_columns`); then the shaking force's components,
-    the shaking moment and the driving torque. For every mechanism: the columns of
-    ``simulate``'s CSV (whatever its formulation), then the shaking.
-    """
-    mo, r = analysis.motion, analysis.reactions
-    n = len(mo.pose.angles)
-    names = ["t"]
-    cols: list = [analysis.time]
-    for group, values in (("theta", mo.pose.angles), ("omega", mo.rate), ("alpha", mo.accel)):
-        names += [f"{group}{k + 1}" for k in range(n)]
-        cols += [np.asarray(v, float) * np.ones(analysis.samples) for v in values]
-    frame_names, frame_cols = frame_force_columns(analysis.linkage, r.ground, r.slider_normal,
-                                                  r.slider_couple)
-    names += frame_names
-    cols += frame_cols
-    slider_names, slider_cols = slider_columns(analysis.linkage, mo.theta1, mo.omega1, mo.alpha1)
-    names += slider_names
-    cols += slider_cols
-    names += list(SHAKING_COLUMNS)
-    cols += [r.shaking_force.real, r.shaking_force.imag, r.shaking_moment, r.driving_torque]
-    return names, cols
-
-
-def frame_force_columns(model, ground, normal, couple) -> tuple[list[str], list]:
-    """Columns of the forces on the frame: names and values.
-
-    Per ground point ``P`` the force on it ``R{P}x``, ``R{P}y`` (N); per slider on the frame
-    its normal force and couple ``N_{link}`` (N), ``C_{link}`` (N·m) — or, for a guide that the
-    mechanism names as a point (the slider-crank's A3), the force as ``R{name}x``, ``R{name}y``
-    and the couple.
-    """
-    mech = mechanism_of(model)
-    names: list[str] = []
-    cols: list = []
-    for point, values in ground.items():
-        names += [f"R{point}x", f"R{point}y"]
-        cols += [values.real, values.imag]
-    normals = mech.guide_normals()
-    for link in normal:
-        if link in mech.guide_force_names:
-            point = mech.guide_force_names[link]
-            force = normal[link] * normals[link]
-            names += [f"R{point}x", f"R{point}y"]
-            cols += [force.real, force.imag]
-        else:
-            names.append(f"N_{link}")
-            cols.append(normal[link])
-        names.append(f"C_{link}")
-        cols.append(couple[link])
-    return names, cols
-
-
-def slider_columns(model, theta1, omega1, alpha1) -> tuple[list[str], list]:
-    """Columns of each slider on the frame: where its point runs along the guide.
-
-    For the sliding link ``k`` (numbered as in ``theta{k}``): ``x{k}``, ``v{k}``, ``a{k}``,
-    the position (m), velocity (m/s) and acceleration (m/s²) of the slider's point along the
-    guide's direction, the position measured from the foot of the origin on the guide's line
-    (the slider-crank's ``x3``: the pin's x). From the mechanism's kinematics at the crank's
-    states, so that every formulation and the cycle analysis give the same columns; none
-    where the crank states do not fix the pose (a crank that does not turn fully, whose free
-    motion may change branch at a dead point, or a linkage with change points).
-    """
-    mech = mechanism_of(model)
-    sliders = [s for s in mech.linkage.sliders if s.link in mech.ground_sliders]
-    if not sliders or mech.change_points() or not mech.assembly_range().full:
-        return [], []
-    with np.errstate(all="ignore"):
-        mo = mech.motion(theta1, omega1, alpha1)
-    names: list[str] = []
-    cols: list = []
-    for s in sliders:
-        k = mech.link_names.index(s.link)
-        local = mech.structure.local[(k, s.point)]
-        d = complex(*s.direction) / math.hypot(*s.direction)
-        for prefix, vector in (("x", mo.point(k, local)), ("v", mo.point_velocity(k, local)),
-                               ("a", mo.point_acceleration(k, local))):
-            names.append(f"{prefix}{k + 1}")
-            cols.append(np.asarray(vector.x * d.real + vector.y * d.imag, float)
-                        * np.ones(np.shape(theta1)))
-    return names, cols
-
-
 def analysis_csv(analysis: CycleAnalysis) -> str:
     """Per-angle values of a cycle analysis as CSV text (SI units, full precision)."""
-    return csv_text(*analysis_columns(analysis))
+    return csv_text(*analysis.columns())
 
 
 def csv_text(columns: Sequence[str], values: Sequence[np.ndarray]) -> str:
@@ -414,42 +268,9 @@ def csv_text(columns: Sequence[str], values: Sequence[np.ndarray]) -> str:
 # ----------------------------------------------------------------------------------------------
 # simulate
 
-def simulation_columns(traj, all_columns: bool = False) -> tuple[list[str], list]:
-    """The columns of ``simulate``'s CSV: names and values (arrays over the output times).
-
-    ``t``; per moving link ``k`` (1, 2, … in the mechanism's order) ``theta{k}``, ``omega{k}``,
-    ``alpha{k}``; the forces on the frame (:func:`frame_force_columns`); the sliders on the
-    frame (:func:`slider_columns`: the slider-crank's ``x3``, ``v3``, ``a3``); with
-    ``all_columns`` the shaking, the driving torque and the energy. The same columns whatever
-    the formulation; for the four-bar and the slider-crank the first are DESIGN.md's fixed
-    ones (:data:`SIMULATION_COLUMNS`).
-    """
-    names = ["t"]
-    cols: list = [traj.t]
-    for group in ("theta", "omega", "alpha"):
-        values = getattr(traj, group)
-        names += [f"{group}{k + 1}" for k in range(len(values))]
-        cols += list(values)
-    frame_names, frame_cols = frame_force_columns(traj.model, traj.ground, traj.slider_normal,
-                                                  traj.slider_couple)
-    names += frame_names
-    cols += frame_cols
-    crank = list(traj.links).index(mechanism_of(traj.model).input)
-    slider_names, slider_cols = slider_columns(traj.model, traj.theta[crank], traj.omega[crank],
-                                               traj.alpha[crank])
-    names += slider_names
-    cols += slider_cols
-    if all_columns:
-        sf = traj.shaking_force
-        cols += [sf.real, sf.imag, traj.shaking_moment, traj.driving_torque, traj.kinetic_energy,
-                 traj.work]
-        names += SIMULATION_EXTRA_COLUMNS
-    return names, cols
-
-
 def simulation_csv(traj, all_columns: bool = False) -> str:
-    """The time histories of a simulation as CSV text (:func:`simulation_columns`)."""
-    return csv_text(*simulation_columns(traj, all_columns))
+    """The time histories of a simulation as CSV text (:meth:`Trajectory.columns`)."""
+    return csv_text(*traj.columns(all_columns))
 
 
 def simulation_json(traj, spec: str | None = None) -> dict[str, Any]:
@@ -621,8 +442,8 @@ def optimization_json(result, before, after, verification=None, spec=None, out=N
                  "objective": s.objective if math.isfinite(s.objective) else None}
                 for s in result.stages
             ],
-            "force_balanced": _force_balance(mechanism_of(linkage))[0],
-            "force_balance_residual": _force_balance(mechanism_of(linkage))[1],
+            "force_balanced": after.force_balanced,
+            "force_balance_residual": after.force_balance_residual,
             "harmonics": {"before": _harmonics_dict(before), "after": _harmonics_dict(after)},
             "verification": None if verification is None else verification.as_dict(),
             "out": None if out is None else str(out),

@@ -47,6 +47,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import NDArray
 
+from .columns import simulation_columns
 from .errors import AssemblyError, LockupError, SolverError, SpecError
 from .formulations import (
     DEAD_POINT_THRESHOLD,
@@ -183,6 +184,13 @@ class Trajectory:
         values = [np.max(np.abs(v), initial=0.0) for v in (
             *self.ground.values(), *self.slider_normal.values())]
         return float(max(values, default=0.0))
+
+    def columns(self, all_columns: bool = False) -> tuple[list[str], list]:
+        """The columns of ``simulate``'s CSV: names and values over the output times.
+
+        See :func:`balancer.columns.simulation_columns`.
+        """
+        return simulation_columns(self, all_columns)
 
     def state(self, index: int) -> dict:
         """Angles, rates and accelerations of the links at output ``index``.

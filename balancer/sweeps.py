@@ -52,6 +52,7 @@ from .balance.result import InfeasibleError
 from .cycle import cycle_analysis
 from .errors import AssemblyError, LockupError, OutputError, SolverError, SpecError
 from .outputs import write_with
+from .plots import sweep_figure
 from .spec import design_from_dict
 
 #: Sampling methods of the varied keys.
@@ -147,6 +148,25 @@ def key_unit(key: str) -> str:
         return "m"
     names = [part for part in parts if not part.isdigit()]
     return KEY_UNITS.get(names[-1], "") if names else ""
+
+
+def read_table(path: str | os.PathLike[str]) -> dict[str, list]:
+    """A sweep's Parquet table, by column (Python lists; a missing value is ``None``)."""
+    import pyarrow.parquet as pq
+
+    return pq.read_table(path).to_pydict()
+
+
+def atlas_figure(path: str | os.PathLike[str], keys: Sequence[str] | None, *,
+                 original: dict[str, float] | None = None, perturbs: Sequence = ()):
+    """The figure of a sweep's table (:func:`balancer.plots.sweep_figure`), keys with units.
+
+    ``keys``: the varied keys, ``None`` for a perturbation sweep (``perturbs`` then named in
+    its title); ``original``: the spec's own values, marked.
+    """
+    named = list(keys) if keys is not None else [p.key for p in perturbs]
+    return sweep_figure(read_table(path), keys, original=original, perturbs=perturbs,
+                        units={key: key_unit(key) for key in named})
 
 
 def analyse_point(data: dict[str, Any], values: dict[str, float], index: int) -> dict:

@@ -27,13 +27,11 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 
-from balancer.balance.conditions import RESIDUAL_FLOOR, force_balance_residual
 from balancer.balance.pareto import pareto_front
-from balancer.mechanisms import mechanism_of
-from balancer.plots import front_figure, save_png, sweep_figure
+from balancer.plots import front_figure, save_png
 from balancer.report import markdown_table
 from balancer.spec import load_design
-from balancer.sweeps import Vary, spec_values, sweep
+from balancer.sweeps import Vary, atlas_figure, spec_values, sweep
 
 NAME = "atlas_and_fronts"
 ROOT = Path(__file__).resolve().parents[1]
@@ -73,7 +71,7 @@ def run(out_dir: Path, quick: bool = False) -> dict:
                 != grashof_crank_rocker(crank, r[KEYS[0]], rocker, r[KEYS[1]])]
     solved = [r for r in rows if r["shaking_moment_after"] is not None]
     best = min(solved, key=lambda r: r["shaking_moment_after"])
-    figures = [save_png(sweep_figure(table_path, list(KEYS), original=spec_values(PB1, KEYS)),
+    figures = [save_png(atlas_figure(table_path, list(KEYS), original=spec_values(PB1, KEYS)),
                         out_dir / "atlas.png")]
     designs = {"PB1 against driving torque": (design, "driving-torque"),
                "PB1 with counterweights against added mass": (
@@ -82,12 +80,7 @@ def run(out_dir: Path, quick: bool = False) -> dict:
               for title, (d, against) in designs.items()}
     for (title, front), name in zip(fronts.items(), ("front_torque.png", "front_mass.png"),
                                     strict=True):
-        spec = designs[title][0]
-        balanced = force_balance_residual(mechanism_of(spec.mechanism)) <= RESIDUAL_FLOOR
-        figures.append(save_png(front_figure(front, title=title,
-                                             force_balance=spec.balance.force_balance,
-                                             original_force_balanced=balanced),
-                                out_dir / name))
+        figures.append(save_png(front_figure(front, title=title), out_dir / name))
     results = {
         "atlas": atlas, "rows": rows, "grashof_mismatch": len(mismatch), "best": best,
         "fronts": fronts, "figures": figures, "seconds": time.perf_counter() - start,

@@ -15,7 +15,7 @@ from helpers import growth, integration_bound
 
 from balancer import spec
 from balancer.cli import main
-from balancer.report import ANALYSIS_COLUMNS
+from balancer.columns import ANALYSIS_COLUMNS
 from balancer.simulation import simulate
 
 EXAMPLE = str(Path(__file__).resolve().parent.parent / "examples" / "meijaard2020.toml")
@@ -145,7 +145,7 @@ def test_simulate_methods_agree_through_the_cli(capsys):
 
 
 def test_simulate_csv_columns(tmp_path, capsys):
-    from balancer.report import SIMULATION_COLUMNS
+    from balancer.columns import SIMULATION_COLUMNS
 
     path = tmp_path / "run.csv"
     assert main(["simulate", EXAMPLE, "--out", str(path), "--duration", "0.5",
@@ -486,7 +486,7 @@ def _csv_header(path: Path) -> list[str]:
     ("quick_return", ["crank-angle", "multibody"]),
 ])
 def test_csv_columns_are_the_mechanisms_whatever_the_route(tmp_path, capsys, name, methods):
-    from balancer.report import SHAKING_COLUMNS, SIMULATION_COLUMNS
+    from balancer.columns import SHAKING_COLUMNS, SIMULATION_COLUMNS
 
     example = str(ROOT / "examples" / f"{name}.toml")
     headers = []
@@ -511,7 +511,7 @@ def test_slider_columns_agree_with_the_slider_cranks_own_closed_form():
     # L·cos θ2) against the general kinematics' point on the guide, at the run's crank states.
     from helpers import ROUNDING
 
-    from balancer.report import simulation_columns
+    from balancer.columns import simulation_columns
 
     design = spec.load_design(ROOT / "examples" / "engine.toml")
     traj = simulate(design.mechanism, design.simulation, method="mass-matrix", duration=0.004,
@@ -533,9 +533,10 @@ def test_slider_columns_rates_are_the_positions_derivatives():
     # over the crank angle (at ω1 = 1, α1 = 0: v = dx/dθ1, a = d²x/dθ1²).
     from helpers import derivative_with_error
 
-    from balancer.report import slider_columns
+    from balancer.columns import slider_columns
+    from balancer.mechanisms import mechanism_of
 
-    model = spec.load_design(ROOT / "examples" / "quick_return.toml").mechanism
+    model = mechanism_of(spec.load_design(ROOT / "examples" / "quick_return.toml").mechanism)
 
     def column(theta, index):
         return slider_columns(model, np.atleast_1d(theta), 1.0, 0.0)[1][index]

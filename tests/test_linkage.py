@@ -100,7 +100,7 @@ def test_a_simulated_linkage_agrees_with_its_four_bar(method):
 @pytest.mark.parametrize("example", ["pb1.toml", "pb2.toml"])
 def test_a_four_bar_balanced_as_a_linkage_reaches_the_same_optimum(example):
     # The four-bar's force balance is Eq. 57–58 in closed form; the linkage's is found from
-    # the variation of its centre of mass (balance.conditions): the same row space, so the
+    # the variation of its centre of mass (balancer.force_balance): the same row space, so the
     # same certified optimum. Each RMS is within GAP_TOLERANCE of the problem's scale of its
     # certified lower bound, so the two agree within twice that.
     from balancer.balance.optimizer import optimize

@@ -14,10 +14,12 @@ import numpy as np
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from balancer import plots
+from balancer import api, cycle, drawing, outputs, plots
 from balancer.api import analyze
 from balancer.cli import main
+from balancer.plots import style
 from balancer.spec import load_design
+from balancer.sweeps import atlas_figure
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 #: One of each mechanism type: four-bar, slider-crank (gas force), general linkages.
@@ -65,11 +67,11 @@ def _check_cycle_figure(fig, after, before):
 @pytest.mark.parametrize("name", SPECS)
 def test_the_cycle_figure_draws_the_cycle_analysis_of_every_mechanism(name):
     design = load_design(EXAMPLES / f"{name}.toml")
-    after, before = plots.cycle_analyses(design)
+    after, before = api.cycle_analyses(design)
     assert before is None
     # At least the spec's samples, and the arrays are those of the design's own analysis at
     # that many angles (the same route, speed, gravity and loads as `analyze`).
-    assert after.samples >= max(design.operation.samples, plots.PLOT_SAMPLES[0])
+    assert after.samples >= max(design.operation.samples, cycle.PLOT_SAMPLES[0])
     reference = analyze(replace(design, operation=replace(design.operation,
                                                           samples=after.samples)))
     for key in ("shaking_force", "shaking_moment", "driving_torque"):
@@ -84,32 +86,32 @@ def test_the_sampling_draws_every_curve_within_a_pixel(name):
     # Checked independently of the refinement: at the midpoints between the drawn samples, the
     # curves lie within DRAWING_TOLERANCE of the panel's span from the drawn chords.
     design = load_design(EXAMPLES / f"{name}.toml")
-    after, _ = plots.cycle_analyses(design)
+    after, _ = api.cycle_analyses(design)
     n = after.samples
     mid = analyze(replace(design, operation=replace(design.operation, samples=2 * n)))
     for key in ("shaking_force", "shaking_moment", "driving_torque"):
         drawn, between = getattr(after.reactions, key), getattr(mid.reactions, key)[1::2]
         chord = 0.5 * (drawn + np.roll(drawn, -1))
         span = max(np.ptp(drawn.real), np.ptp(drawn.imag))
-        assert np.max(np.abs(between - chord)) <= plots.DRAWING_TOLERANCE * span
+        assert np.max(np.abs(between - chord)) <= cycle.DRAWING_TOLERANCE * span
 
 
 def test_a_curve_with_a_sharp_feature_is_sampled_more_finely_than_a_smooth_one():
     # The engine's gas force rises steeply after top dead centre; the paper's four-bar is smooth.
-    engine = plots.cycle_analyses(load_design(EXAMPLES / "engine.toml"))[0]
-    smooth = plots.cycle_analyses(load_design(EXAMPLES / "meijaard2020.toml"))[0]
-    coarse = plots.cycle_analyses(load_design(EXAMPLES / "engine.toml"), samples=16)[0]
+    engine = api.cycle_analyses(load_design(EXAMPLES / "engine.toml"))[0]
+    smooth = api.cycle_analyses(load_design(EXAMPLES / "meijaard2020.toml"))[0]
+    coarse = api.cycle_analyses(load_design(EXAMPLES / "engine.toml"), samples=16)[0]
     assert coarse.samples == 16
     assert engine.samples >= smooth.samples
     fine_spec = load_design(EXAMPLES / "meijaard2020.toml")
     fine_spec = replace(fine_spec, operation=replace(fine_spec.operation, samples=5000))
-    assert plots.cycle_analyses(fine_spec)[0].samples >= 5000
+    assert api.cycle_analyses(fine_spec)[0].samples >= 5000
 
 
 def test_before_and_after_are_the_original_and_the_balanced_design(pb1_balanced):
     balanced = load_design(pb1_balanced)
     original = load_design(EXAMPLES / "pb1.toml")
-    after, before = plots.cycle_analyses(balanced)
+    after, before = api.cycle_analyses(balanced)
     assert before is not None and before.samples == after.samples
     for analysis, design in ((after, balanced), (before, original)):
         reference = analyze(replace(design, operation=replace(design.operation,
@@ -191,7 +193,7 @@ def test_cycle_and_animation_in_one_call(tmp_path, capsys):
     capsys.readouterr()
 
 
-needs_ffmpeg = pytest.mark.skipif(plots.ffmpeg() is None,
+needs_ffmpeg = pytest.mark.skipif(outputs.ffmpeg() is None,
                                   reason="no ffmpeg (pip install imageio-ffmpeg)")
 
 
@@ -204,7 +206,7 @@ def test_an_mp4_animation_has_one_frame_per_crank_angle(tmp_path, capsys):
                  "--frames", "10"]) == 0
     assert out.read_bytes()[4:8] == b"ftyp"  # an ISO media file
     # ffmpeg decodes it back: 10 frames.
-    probe = subprocess.run([plots.ffmpeg(), "-i", str(out), "-map", "0:v:0", "-f", "null", "-"],
+    probe = subprocess.run([outputs.ffmpeg(), "-i", str(out), "-map", "0:v:0", "-f", "null", "-"],
                            capture_output=True, text=True, check=True)
     assert "frame=   10" in probe.stderr.replace("frame=10", "frame=   10")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.mp4"]
@@ -212,7 +214,7 @@ def test_an_mp4_animation_has_one_frame_per_crank_angle(tmp_path, capsys):
 
 
 def test_an_mp4_without_ffmpeg_is_refused_before_any_work(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(plots, "ffmpeg", lambda: None)
+    monkeypatch.setattr(outputs, "ffmpeg", lambda: None)
     out = tmp_path / "run.mp4"
     assert main(["plot", str(EXAMPLES / "pb1.toml"), "--animate", str(out)]) == 2
     err = capsys.readouterr().err
@@ -221,7 +223,7 @@ def test_an_mp4_without_ffmpeg_is_refused_before_any_work(tmp_path, capsys, monk
 
 
 def test_a_failing_ffmpeg_leaves_nothing_behind(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(plots, "ffmpeg", lambda: "/bin/false")
+    monkeypatch.setattr(outputs, "ffmpeg", lambda: "/bin/false")
     out = tmp_path / "run.mp4"
     assert main(["plot", str(EXAMPLES / "pb1.toml"), "--animate", str(out), "--frames",
                  "3"]) == 2
@@ -231,10 +233,10 @@ def test_a_failing_ffmpeg_leaves_nothing_behind(tmp_path, capsys, monkeypatch):
 
 
 def test_every_animation_extension_is_checked(tmp_path):
-    assert set(plots.ANIMATION_TYPES) == {".gif", ".mp4"}
-    assert set(plots.FIGURE_TYPES) == {".png", ".svg", ".pdf"}
+    assert set(outputs.ANIMATION_TYPES) == {".gif", ".mp4"}
+    assert set(outputs.FIGURE_TYPES) == {".png", ".svg", ".pdf"}
     for name in ("a.GIF", "a.Mp4"):
-        assert plots.figure_type(tmp_path / name, types=plots.ANIMATION_TYPES) in {"gif", "mp4"}
+        assert outputs.figure_type(tmp_path / name, types=outputs.ANIMATION_TYPES) in {"gif", "mp4"}
 
 
 # --- verify's figure: before and after on every panel, legends outside, no aliasing -------
@@ -334,7 +336,7 @@ def test_counterweights_turn_with_their_links_in_the_animation(tmp_path):
     its (e, f) in the link's frame, i.e. A0 + e^{iθ1}·(e + i·f) for the crank, whose angle the
     frames sample evenly; the animation of a balanced spec draws them."""
     import balancer
-    from balancer.plots import counterweight_paths
+    from balancer.drawing import counterweight_paths
 
     design = balancer.example("pb1_counterweights")
     result = balancer.optimize(design, backend="convex")
@@ -404,7 +406,7 @@ def test_the_atlas_names_its_axes_with_units_marks_the_original_and_tells_empty_
 
     statuses = ["bad-geometry", "infeasible", "optimal", "infeasible", "optimal", "optimal"]
     path = _atlas_table(tmp_path / "atlas.parquet", statuses)
-    fig = plots.sweep_figure(path, [COUPLER, FRAME], original={COUPLER: 3.0, FRAME: 3.2})
+    fig = atlas_figure(path, [COUPLER, FRAME], original={COUPLER: 3.0, FRAME: 3.2})
     ax = fig.axes[0]
     assert ax.get_xlabel() == f"{COUPLER} (m)" and ax.get_ylabel() == f"{FRAME} (m)"
     # The original design: a marker at the spec's values.
@@ -424,7 +426,7 @@ def test_the_atlas_names_its_axes_with_units_marks_the_original_and_tells_empty_
 
 def test_an_original_outside_the_swept_ranges_is_an_arrow_at_the_edge(tmp_path):
     path = _atlas_table(tmp_path / "atlas.parquet", ["optimal"] * 6)
-    fig = plots.sweep_figure(path, [COUPLER, FRAME], original={COUPLER: 3.0, FRAME: 4.5})
+    fig = atlas_figure(path, [COUPLER, FRAME], original={COUPLER: 3.0, FRAME: 4.5})
     ax = fig.axes[0]
     limits = ax.get_ylim()
     assert limits[1] < 4.0  # the map keeps the swept ranges
@@ -434,13 +436,13 @@ def test_an_original_outside_the_swept_ranges_is_an_arrow_at_the_edge(tmp_path):
     (mark,) = (line for line in ax.get_lines() if line.get_label().startswith("original"))
     (x0, x1) = ax.get_xlim()
     assert mark.get_xdata()[0] == pytest.approx((3.0 - x0) / (x1 - x0))
-    assert mark.get_ydata()[0] == pytest.approx(1.0 - plots.EDGE_INSET)
+    assert mark.get_ydata()[0] == pytest.approx(1.0 - style.EDGE_INSET)
 
 
 def test_one_varied_key_has_its_unit_and_the_original_and_no_design_points(tmp_path):
     path = _atlas_table(tmp_path / "line.parquet", ["bad-geometry", "infeasible", "optimal"],
                         keys=("links.crank.mass",), values=((2.0, 3.0, 4.0),))
-    fig = plots.sweep_figure(path, ["links.crank.mass"], original={"links.crank.mass": 2.1})
+    fig = atlas_figure(path, ["links.crank.mass"], original={"links.crank.mass": 2.1})
     ax = fig.axes[0]
     assert ax.get_xlabel() == "links.crank.mass (kg)"
     labels = {line.get_label(): line for line in ax.get_lines()}
@@ -460,7 +462,7 @@ def test_a_scattered_atlas_marks_the_points_without_a_design(tmp_path):
             for i, (c, f, s) in enumerate([(2.1, 3.0, "optimal"), (2.6, 3.3, "infeasible"),
                                            (3.4, 2.9, "bad-geometry"), (3.0, 3.1, "optimal")])]
     pq.write_table(pa.Table.from_pylist(rows), tmp_path / "lhs.parquet")
-    fig = plots.sweep_figure(tmp_path / "lhs.parquet", [COUPLER, FRAME],
+    fig = atlas_figure(tmp_path / "lhs.parquet", [COUPLER, FRAME],
                              original={COUPLER: 3.0, FRAME: 3.2})
     labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
     assert [label.split(":")[0] for label in labels] == ["infeasible", "bad geometry",
@@ -597,7 +599,7 @@ def test_the_animation_carries_each_centre_of_mass_and_counterweight_with_its_li
     frames = 6
     weights = counterweights(design.original, design.mechanism)
     fig, update, _ = _drawn_animation(design, frames, counterweights=weights)
-    _, coms, _ = plots.drawing_frames(design.mechanism, frames)
+    _, coms, _ = drawing.drawing_frames(design.mechanism, frames)
     reach = {}  # per link: the length of its centre of mass's arm
     for k in range(frames):
         arms = [a.get_xydata() for a in update(k) if isinstance(a, Line2D)
@@ -614,7 +616,7 @@ def test_the_animation_carries_each_centre_of_mass_and_counterweight_with_its_li
     result = balancer.optimize(cw, backend="convex")
     balanced = result.balanced_design(cw)
     fig, update, _ = _drawn_animation(balanced, frames, counterweights=result.counterweights)
-    paths = plots.counterweight_paths(balanced.mechanism, result.counterweights, frames)
+    paths = drawing.counterweight_paths(balanced.mechanism, result.counterweights, frames)
     discs = [p for p in fig.axes[0].patches if isinstance(p, Circle)]
     assert len(discs) == len(paths) == 2
     for k in (0, 3):
@@ -675,7 +677,7 @@ def test_free_motion_spikes_are_clipped_and_marked_not_squashing_the_rest(watt_b
         marks = [line for line in ax.get_lines() if line.get_label().startswith("clipped")]
         (mark,) = marks
         peak = np.max(np.abs(values))
-        assert f"{plots._number(peak)} {unit}" in mark.get_label()
+        assert f"{style.number(peak)} {unit}" in mark.get_label()
         labels = [t.get_text() for t in ax.get_legend().get_texts()]
         assert mark.get_label() in labels
     # The driven run has no spikes: its axes hold every sample.

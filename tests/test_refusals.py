@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from balancer import cli, plots, simulation
+from balancer import plots, simulation
 from balancer.cli import main
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -24,11 +24,6 @@ def _never(what: str):
     def fail(*args, **kwargs):
         raise AssertionError(f"{what} began before the input was refused")
     return fail
-
-
-def test_the_command_line_knows_the_plots_file_types():
-    assert set(cli.FIGURE_EXTENSIONS) == set(plots.FIGURE_TYPES)
-    assert set(cli.ANIMATION_EXTENSIONS) == set(plots.ANIMATION_TYPES)
 
 
 @pytest.mark.parametrize("args", [

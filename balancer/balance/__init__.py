@@ -1,1 +1,1 @@
-"""Balancing: force-balance conditions found from the mechanism, the redesign problem, solvers."""
+"""Balancing: the redesign problem, its convex and nonlinear solvers, fronts and counterweights."""

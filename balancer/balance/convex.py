@@ -3,7 +3,7 @@
 With the crank at constant speed the shaking moment, driving torque and shaking force are
 linear in the design vector ``x`` (the mechanism's layout,
 :class:`balancer.linkage.dynamics.Layout`), and force balance is linear equations
-(:mod:`balancer.balance.conditions`; Eq. 58 for the four-bar). Per link, with ``S = (m·e,
+(:mod:`balancer.force_balance`; Eq. 58 for the four-bar). Per link, with ``S = (m·e,
 m·f)`` and ``c`` the position of ``com_about`` in the link's frame:
 
 - mass bounds ``m_low ≤ m ≤ m_high``;

@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import SolverError, SpecError
+from ..force_balance import RESIDUAL_FLOOR, force_balance_residual
 from ..model import Design
 from .certificate import Constraint, lower_bound
 from .certificate import Objective as Certified
@@ -82,12 +83,16 @@ class Front:
     """A trade-off front, its points ordered by the second objective.
 
     ``original`` is the original design's ``(second objective, RMS shaking moment)``: where the
-    designer starts from (it need not meet the balancing constraints).
+    designer starts from (it need not meet the balancing constraints). ``force_balance``: whether
+    every design on the front is held to exact force balance (the spec's ``[balance]
+    force_balance``); ``original_force_balanced``: whether the original design is.
     """
 
     against: str
     points: tuple[FrontPoint, ...]
     original: tuple[float, float] = (math.nan, math.nan)
+    force_balance: bool = False
+    original_force_balanced: bool | None = None
 
     def __repr__(self) -> str:
         ends = (f"{self.points[0].value:.4g}–{self.points[-1].value:.4g} {self.unit}, "
@@ -286,7 +291,9 @@ def pareto_front(design: Design, against: str, points: int = 11) -> Front:
                               lower_bound=bound, x=x))
     out.sort(key=lambda p: p.value)
     original = (programs.other_value(data.x0), programs.moment_value(data.x0))
-    return Front(against=against, points=tuple(_mark_knee(out)), original=original)
+    return Front(against=against, points=tuple(_mark_knee(out)), original=original,
+                 force_balance=design.balance.force_balance,
+                 original_force_balanced=force_balance_residual(data.mechanism) <= RESIDUAL_FLOOR)
 
 
 def _certified(programs: _Programs, cap: Constraint, solution, x) -> float:

@@ -55,7 +55,7 @@ Two halves:
   :func:`balance_lines`;
 - the numeric side, :class:`NumericProblem` from :func:`numeric_problem`: the regressors over
   the revolution, per-link bounds (:class:`LinkBounds`), the force-balance conditions
-  (:mod:`balancer.balance.conditions`), the objective, and the feasibility checks that the
+  (:mod:`balancer.force_balance`), the objective, and the feasibility checks that the
   optimisers and the tests rely on.
 
 This module imports neither CVXPY nor CasADi.
@@ -75,11 +75,11 @@ from numpy.typing import NDArray
 from .. import tomltext as toml
 from ..cycle import sample_angles
 from ..errors import SpecError
+from ..force_balance import force_balance_conditions
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import GROUND, Design, Link
 from ..validate import LENGTH_RANGE
-from .conditions import force_balance_conditions
 from .lsq import bounded_lstsq
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -960,7 +960,7 @@ class NumericProblem:
         ``R`` above, upper triangular, N·m.
     force_balance
         ``(A, b)``: ``A·x = b`` is shaking-force balance
-        (:func:`balancer.balance.conditions.force_balance_conditions`), or ``None`` when force
+        (:func:`balancer.force_balance.force_balance_conditions`), or ``None`` when force
         balance is not imposed.
     inert
         Entries of ``x`` (inertias about the frames' origins, counter-rotors) that change
@@ -1581,7 +1581,10 @@ def _checked_problem(problem) -> BalanceProblem:
 
 
 def _force_balance(mech: Mechanism) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``(A, b)`` of shaking-force balance (:func:`.conditions.force_balance_conditions`)."""
+    """``(A, b)`` of shaking-force balance.
+
+    From :func:`~balancer.force_balance.force_balance_conditions`.
+    """
     conditions = force_balance_conditions(mech)
     return conditions.matrix, np.zeros(conditions.count)
 

@@ -363,7 +363,7 @@ class Mechanism(ABC):
     def closed_form_force_balance(self) -> NDArray[np.float64] | None:
         """Shaking-force balance in closed form, ``A`` with ``A·π = 0`` over :attr:`layout`.
 
-        ``None`` in general: :mod:`balancer.balance.conditions` finds the conditions from the
+        ``None`` in general: :mod:`balancer.force_balance` finds the conditions from the
         linkage; the four-bar and the slider-crank give the seeds' (Eq. 57–58; Wunderlich's
         Eq. 20a–b), exact where sampled ones are exact only to rounding.
         """

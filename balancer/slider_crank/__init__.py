@@ -11,8 +11,8 @@ module                   what it holds
 ``formulations``         forward dynamics: one equation in θ1 by virtual power, and truss
                          elements with the guide as a constraint (Meijaard & van der Wijk's
                          Sect. 5.1)
-``conditions``           stationary centre of mass (Eq. 20a–b) and the primary and secondary
-                         harmonics of the shaking force
+``conditions``           stationary centre of mass (Eq. 20a–b) and the classic crank
+                         counterweight
 =======================  =====================================================================
 
 Conventions (the project's DESIGN.md): A0 at the origin; crank A0→A1, connecting rod A1→A2, A2

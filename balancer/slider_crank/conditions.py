@@ -1,4 +1,4 @@
-"""Balance conditions of the slider-crank and the harmonics of its shaking.
+"""Balance conditions of the slider-crank.
 
 - Stationary total centre of mass (Wunderlich 1964, Eq. 20a–b; his Eq. 14c): ``α1 = α2 = 0``,
   i.e. ``m1·s̄1/r + m2 + m3 = 0`` (the crank's centre of mass on the far side of A0) and
@@ -6,8 +6,9 @@
   cannot accept). Linear in the inertial parameters ``(m, m·e, m·f)``.
 - The engine designer's alternative, partial balancing with a crank counterweight: at constant
   speed the counterweight's force is a pure first harmonic, so it can only act on the first
-  harmonic of the shaking force; :func:`harmonics` gives the primary (1×) and secondary (2×)
-  amplitudes, and :func:`classic_counterweight` the textbook balance of the rotating masses plus
+  harmonic of the shaking force (the cycle analysis' :meth:`~balancer.cycle.CycleAnalysis.
+  harmonics` give the primary (1×) and secondary (2×) amplitudes), and
+  :func:`classic_counterweight` the textbook balance of the rotating masses plus
   a fraction of the reciprocating ones (the rod split into two masses at its joints).
 """
 
@@ -103,26 +104,3 @@ def classic_counterweight(mech: SliderCrank, balance_factor: float) -> complex:
     c2 = mech.rod
     _, recip = equivalent_masses(mech)
     return complex(-c2.mass * (1 - c2.com / big_l) * r - balance_factor * recip * r)
-
-
-def harmonics(analysis, orders: int = 4) -> dict[str, NDArray[np.float64]]:
-    """Amplitudes of the harmonics 0…``orders`` of the shaking over a revolution.
-
-    Keys ``shaking_force_x``, ``shaking_force_y`` (N), ``shaking_moment`` (N·m),
-    ``driving_torque`` (N·m); entry ``k`` is the amplitude of the component at ``k`` times the
-    crank speed (entry 0 the mean). Needs equally spaced samples of one revolution.
-    """
-    r = analysis.reactions
-    signals = {
-        "shaking_force_x": np.real(r.shaking_force),
-        "shaking_force_y": np.imag(r.shaking_force),
-        "shaking_moment": np.asarray(r.shaking_moment, float),
-        "driving_torque": np.asarray(r.driving_torque, float),
-    }
-    out = {}
-    for name, values in signals.items():
-        spectrum = np.fft.rfft(values) / values.size
-        amp = np.abs(spectrum[: orders + 1]) * 2
-        amp[0] /= 2
-        out[name] = amp
-    return out

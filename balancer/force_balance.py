@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import SolverError
+from .errors import SolverError
 
 #: Singular values below this share of the largest are rounding (a condition that holds).
 NULL_TOLERANCE = 1e-11

@@ -1,0 +1,162 @@
+"""The per-sample columns of the CSV files: a cycle analysis' and a simulation's, by name.
+
+Names and units are fixed by DESIGN.md (``simulate``'s first columns) and documented in the
+command line's help: ``t`` s; ``theta<k>`` rad, ``omega<k>`` rad/s, ``alpha<k>`` rad/s² per
+moving link; ``R<point>x``, ``R<point>y``, ``N_<link>`` N; ``C_<link>`` N·m; ``x<k>`` m,
+``v<k>`` m/s, ``a<k>`` m/s² along a slider's guide; the shaking, the driving torque and the
+energy. A mechanism has the same columns whatever computed them (the cycle analysis, any
+formulation's simulation).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .mechanisms import mechanism_of
+from .mechanisms.base import Mechanism
+
+#: The columns of ``simulate``'s CSV, fixed by DESIGN.md.
+SIMULATION_COLUMNS = (
+    "t",
+    "theta1",
+    "theta2",
+    "theta3",
+    "omega1",
+    "omega2",
+    "omega3",
+    "alpha1",
+    "alpha2",
+    "alpha3",
+    "RA0x",
+    "RA0y",
+    "RA3x",
+    "RA3y",
+)
+#: What the frame feels and what drives the crank, after the state and reactions.
+SHAKING_COLUMNS = ("shaking_force_x", "shaking_force_y", "shaking_moment", "driving_torque")
+#: Extra columns written after the fixed ones with ``simulate --all-columns``.
+SIMULATION_EXTRA_COLUMNS = (*SHAKING_COLUMNS, "kinetic_energy", "work")
+#: The columns of ``analyze --csv`` for a four-bar (:func:`analysis_columns`).
+ANALYSIS_COLUMNS = (*SIMULATION_COLUMNS, *SHAKING_COLUMNS)
+
+
+def analysis_columns(analysis) -> tuple[list[str], list]:
+    """The columns of ``analyze --csv``: names and values (arrays over the samples).
+
+    ``t``; per moving link ``k`` (1, 2, … in the spec's order) ``theta{k}``, ``omega{k}``,
+    ``alpha{k}`` (rad, rad/s, rad/s²); the forces on the frame (:func:`frame_force_columns`);
+    the sliders on the frame (:func:`slider_columns`); then the shaking force's components,
+    the shaking moment and the driving torque. For every mechanism: the columns of
+    ``simulate``'s CSV (whatever its formulation), then the shaking.
+    """
+    mo, r = analysis.motion, analysis.reactions
+    n = len(mo.pose.angles)
+    names = ["t"]
+    cols: list = [analysis.time]
+    for group, values in (("theta", mo.pose.angles), ("omega", mo.rate), ("alpha", mo.accel)):
+        names += [f"{group}{k + 1}" for k in range(n)]
+        cols += [np.asarray(v, float) * np.ones(analysis.samples) for v in values]
+    frame_names, frame_cols = frame_force_columns(analysis.mechanism, r.ground, r.slider_normal,
+                                                  r.slider_couple)
+    names += frame_names
+    cols += frame_cols
+    slider_names, slider_cols = slider_columns(analysis.mechanism, mo.theta1, mo.omega1, mo.alpha1)
+    names += slider_names
+    cols += slider_cols
+    names += list(SHAKING_COLUMNS)
+    cols += [r.shaking_force.real, r.shaking_force.imag, r.shaking_moment, r.driving_torque]
+    return names, cols
+
+
+def frame_force_columns(mech: Mechanism, ground, normal, couple) -> tuple[list[str], list]:
+    """Columns of the forces on the frame: names and values.
+
+    Per ground point ``P`` the force on it ``R{P}x``, ``R{P}y`` (N); per slider on the frame
+    its normal force and couple ``N_{link}`` (N), ``C_{link}`` (N·m) — or, for a guide that the
+    mechanism names as a point (the slider-crank's A3), the force as ``R{name}x``, ``R{name}y``
+    and the couple.
+    """
+    names: list[str] = []
+    cols: list = []
+    for point, values in ground.items():
+        names += [f"R{point}x", f"R{point}y"]
+        cols += [values.real, values.imag]
+    normals = mech.guide_normals()
+    for link in normal:
+        if link in mech.guide_force_names:
+            point = mech.guide_force_names[link]
+            force = normal[link] * normals[link]
+            names += [f"R{point}x", f"R{point}y"]
+            cols += [force.real, force.imag]
+        else:
+            names.append(f"N_{link}")
+            cols.append(normal[link])
+        names.append(f"C_{link}")
+        cols.append(couple[link])
+    return names, cols
+
+
+def slider_columns(mech: Mechanism, theta1, omega1, alpha1) -> tuple[list[str], list]:
+    """Columns of each slider on the frame: where its point runs along the guide.
+
+    For the sliding link ``k`` (numbered as in ``theta{k}``): ``x{k}``, ``v{k}``, ``a{k}``,
+    the position (m), velocity (m/s) and acceleration (m/s²) of the slider's point along the
+    guide's direction, the position measured from the foot of the origin on the guide's line
+    (the slider-crank's ``x3``: the pin's x). From the mechanism's kinematics at the crank's
+    states, so that every formulation and the cycle analysis give the same columns; none
+    where the crank states do not fix the pose (a crank that does not turn fully, whose free
+    motion may change branch at a dead point, or a linkage with change points).
+    """
+    sliders = [s for s in mech.linkage.sliders if s.link in mech.ground_sliders]
+    if not sliders or mech.change_points() or not mech.assembly_range().full:
+        return [], []
+    with np.errstate(all="ignore"):
+        mo = mech.motion(theta1, omega1, alpha1)
+    names: list[str] = []
+    cols: list = []
+    for s in sliders:
+        k = mech.link_names.index(s.link)
+        local = mech.structure.local[(k, s.point)]
+        d = complex(*s.direction) / math.hypot(*s.direction)
+        for prefix, vector in (("x", mo.point(k, local)), ("v", mo.point_velocity(k, local)),
+                               ("a", mo.point_acceleration(k, local))):
+            names.append(f"{prefix}{k + 1}")
+            cols.append(np.asarray(vector.x * d.real + vector.y * d.imag, float)
+                        * np.ones(np.shape(theta1)))
+    return names, cols
+
+
+def simulation_columns(traj, all_columns: bool = False) -> tuple[list[str], list]:
+    """The columns of ``simulate``'s CSV: names and values (arrays over the output times).
+
+    ``t``; per moving link ``k`` (1, 2, … in the mechanism's order) ``theta{k}``, ``omega{k}``,
+    ``alpha{k}``; the forces on the frame (:func:`frame_force_columns`); the sliders on the
+    frame (:func:`slider_columns`: the slider-crank's ``x3``, ``v3``, ``a3``); with
+    ``all_columns`` the shaking, the driving torque and the energy. The same columns whatever
+    the formulation; for the four-bar and the slider-crank the first are DESIGN.md's fixed
+    ones (:data:`SIMULATION_COLUMNS`).
+    """
+    names = ["t"]
+    cols: list = [traj.t]
+    for group in ("theta", "omega", "alpha"):
+        values = getattr(traj, group)
+        names += [f"{group}{k + 1}" for k in range(len(values))]
+        cols += list(values)
+    mech = mechanism_of(traj.model)
+    frame_names, frame_cols = frame_force_columns(mech, traj.ground, traj.slider_normal,
+                                                  traj.slider_couple)
+    names += frame_names
+    cols += frame_cols
+    crank = list(traj.links).index(mech.input)
+    slider_names, slider_cols = slider_columns(mech, traj.theta[crank], traj.omega[crank],
+                                               traj.alpha[crank])
+    names += slider_names
+    cols += slider_cols
+    if all_columns:
+        sf = traj.shaking_force
+        cols += [sf.real, sf.imag, traj.shaking_moment, traj.driving_torque, traj.kinetic_energy,
+                 traj.work]
+        names += SIMULATION_EXTRA_COLUMNS
+    return names, cols

@@ -1,0 +1,92 @@
+"""What pictures draw of a mechanism: its frame, its links over a revolution, centres of mass.
+
+Positions from the mechanism's kinematics at crank angles, for the figures and animations of
+:mod:`balancer.plots` (which compute nothing themselves).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .cycle import sample_angles
+from .linkage.vectors import V
+from .mechanisms import mechanism_of
+from .model import GROUND
+
+
+def centre_of_mass_path(linkage, traj) -> np.ndarray:
+    """Total centre of mass along a simulated motion, complex, m.
+
+    ``traj`` a simulated motion (:class:`balancer.simulation.Trajectory`: its links' names,
+    angles, rates and accelerations); from the crank's angle (the pose of the smooth motion
+    there).
+    """
+    mech = mechanism_of(linkage)
+    crank = traj.links.index(mech.input)
+    mo = mech.motion(traj.theta[crank], traj.omega[crank], traj.alpha[crank])
+    return np.asarray(mech.total_centre_of_mass(mo), complex)
+
+
+def frame(linkage, samples: int = 72) -> tuple[np.ndarray, list[np.ndarray]]:
+    """What to draw of the frame: the ground points, and each ground guide's travel, m.
+
+    Returns the ground points (complex) and, per slider on a ground guide, the two ends of
+    the stretch of its line that its point covers over a revolution (or near the reference
+    pose, for a crank that does not turn fully).
+    """
+    mech = mechanism_of(linkage)
+    pivots = np.array(list(mech.ground_positions.values()), complex)
+    rng = mech.assembly_range()
+    angles = sample_angles(samples) if rng.full else np.linspace(*rng.intervals[0], samples)
+    with np.errstate(all="ignore"):
+        mo = mech.motion(angles)
+    points = mech.points(mo)
+    guides = []
+    for slider in mech.linkage.sliders:
+        if slider.guide == GROUND:
+            path = points[slider.point][np.isfinite(points[slider.point])]
+            if path.size:
+                d = complex(*slider.direction) / abs(complex(*slider.direction))
+                along = (path * np.conj(d)).real
+                base = path[0] - (path[0] * np.conj(d)).real * d
+                guides.append(base + d * np.array([along.min(), along.max()]))
+    return pivots, guides
+
+
+def drawing_frames(linkage, frames: int):
+    """What an animation draws over a revolution at equally spaced crank angles.
+
+    Returns ``(links, coms, total)``: per link (the ground's left out) a ``(frames, k)``
+    complex array of its points in drawing order (a ternary link closed into a triangle),
+    per link its centre of mass ``(frames,)``, and ``(frames,)`` the total, m.
+    """
+    mech = mechanism_of(linkage)
+    mo = mech.motion(sample_angles(frames), 1.0)
+    points = mech.points(mo)
+    links = {}
+    for name, names in mech.drawing().items():
+        if name == GROUND:
+            continue
+        ring = [*names, names[0]] if len(names) > 2 else list(names)
+        links[name] = np.column_stack([points[p] for p in ring])
+    coms = {name: np.asarray(c.complex() + 0 * mo.theta1, complex)
+            for name, c in zip(mech.link_names, mech.centres_of_mass(mo), strict=True)}
+    return links, coms, np.asarray(mech.total_centre_of_mass(mo), complex)
+
+
+def counterweight_paths(linkage, counterweights, frames: int) -> dict[str, tuple]:
+    """Where each counterweight to add is over a revolution: ``(centres, radius)`` per link.
+
+    ``centres`` a ``(frames,)`` complex array (m): the counterweight's centre ``(e, f)`` in its
+    link's frame, carried by the link; ``radius`` its steel disc's (m; 0 for a point).
+    """
+    mech = mechanism_of(linkage)
+    mo = mech.motion(sample_angles(frames), 1.0)
+    out = {}
+    for k, name in enumerate(mech.link_names):
+        w = counterweights.get(name)
+        if w is None or w.kind != "add":
+            continue
+        centre = mo.point(k, V(w.e, w.f)).complex() + 0 * mo.theta1
+        out[name] = (np.asarray(centre, complex), w.disc_radius or 0.0)
+    return out

@@ -1,0 +1,45 @@
+"""Figures for a designer's report (matplotlib, Agg; never ``show()``).
+
+Each ``plot_*`` function draws on the axes it is given (or a new figure's) and returns them;
+the ``*_figure`` functions assemble a report's figure from results (a cycle analysis, a
+simulation's verification, a front, a sweep's table), computing nothing themselves; and
+:func:`save_figure` writes one as PNG, SVG or PDF (from the extension), whole or not at all.
+matplotlib is imported by the functions that draw, not by importing this package.
+
+=================  ===========================================================================
+``revolution``     one revolution: the shaking force's polar diagram, moment and torque
+``motion``         a simulated motion: forces on the ground, shaking moment, the centre of
+                   mass' path; ``balancer verify``'s figure
+``animation``      the mechanism turning (GIF, MP4)
+``fronts``         a trade-off front
+``atlas``          a sweep's atlas and a tolerance histogram
+``style``          colours, styles, axes, numbers, writing files
+=================  ===========================================================================
+"""
+
+from __future__ import annotations
+
+from .animation import animate, animation_figure
+from .atlas import sweep_figure
+from .fronts import front_figure
+from .motion import plot_com_path, plot_reactions, plot_shaking_moment, verification_figure
+from .revolution import cycle_figure, plot_over_crank_angle, plot_shaking_force_polar
+from .style import COLOURS, SERIES, save_figure, save_png
+
+__all__ = [
+    "COLOURS",
+    "SERIES",
+    "animate",
+    "animation_figure",
+    "cycle_figure",
+    "front_figure",
+    "plot_com_path",
+    "plot_over_crank_angle",
+    "plot_reactions",
+    "plot_shaking_force_polar",
+    "plot_shaking_moment",
+    "save_figure",
+    "save_png",
+    "sweep_figure",
+    "verification_figure",
+]

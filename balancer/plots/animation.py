@@ -1,0 +1,208 @@
+"""An animation of the mechanism turning one revolution (GIF, or MP4 with ffmpeg)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .. import outputs
+from ..cycle import sample_angles
+from ..drawing import counterweight_paths, drawing_frames, frame
+from ..errors import OutputError
+from ..outputs import animation_type, write_with
+from .style import COLOURS, draw_frame
+
+
+def _arm(points: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """``(frames, 2)``: from the link's point nearest ``target`` (at the first frame) to it.
+
+    ``points`` ``(frames, k)`` a link's points, ``target`` ``(frames,)`` a point it carries:
+    the pair moves rigidly with the link.
+    """
+    near = int(np.argmin(np.abs(points[0] - target[0])))
+    return np.column_stack([points[:, near], target])
+
+
+def animation_figure(linkage, *, frames: int = 72, title: str = "", counterweights=None):
+    """The figure of an animation of one revolution, and what changes from frame to frame.
+
+    Drawn once: the frame (pivots, guides), the path of the total centre of mass, the title
+    (wrapped to the figure's width), the legend. Per frame, at the crank angle
+    θ1 = 360°·k/``frames``: the links; each link's centre of mass on a thin arm from the
+    link's nearest point (it turns with its link, wherever the balancing put it); the
+    counterweights added to the original links (``counterweights``, per link as
+    :func:`balancer.balance.counterweights.counterweights` gives them; ``kind`` ``"add"``) as
+    their steel discs (a diamond for a point mass) on arms from their links; the total centre
+    of mass with its path so far; and the crank angle's readout. Links that no single added
+    body makes (``rebuild``, ``remove``) are named in the legend.
+
+    Returns
+    -------
+    tuple
+        ``(fig, update)``: the :class:`~matplotlib.figure.Figure` (its moving artists marked
+        animated, so a plain draw leaves them out) and ``update(k)``, which sets frame ``k``'s
+        moving artists and returns them, to be drawn over the still picture.
+    """
+    import textwrap
+
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Circle
+
+    weights = counterweights or {}
+    links, coms, total = drawing_frames(linkage, frames)
+    pivots, guides = frame(linkage)
+    discs = counterweight_paths(linkage, weights, frames)
+    fig = Figure(figsize=(6, 4.5), dpi=100, layout="constrained")
+    ax = fig.add_subplot()
+    rims = [c + r * s for c, r in discs.values() for s in (1, -1, 1j, -1j)]
+    everything = np.concatenate([*(v.ravel() for v in links.values()), *coms.values(), total,
+                                 pivots, *guides, *rims])
+    everything = everything[np.isfinite(everything)]
+    extent = max(np.ptp(everything.real), np.ptp(everything.imag), 1e-300)
+    pad = 0.08 * extent
+    ax.set_xlim(everything.real.min() - pad, everything.real.max() + pad)
+    ax.set_ylim(everything.imag.min() - pad, everything.imag.max() + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(title or "linkage over one crank revolution", wrap=True)
+    ax.grid(alpha=0.3)
+    ax.plot(total.real, total.imag, color=COLOURS["before"], lw=1, ls=":",
+            label="path of the total centre of mass")
+    draw_frame(ax, linkage, label=None)
+    lines = []  # (artist, (frames, n) points joined)
+    for name, points in links.items():
+        (arm,) = ax.plot([], [], "-", color=COLOURS["com"], lw=1.0, animated=True, zorder=1.5)
+        lines.append((arm, _arm(points, coms[name])))
+    for i, points in enumerate(links.values()):
+        (bar,) = ax.plot([], [], "-o", color=COLOURS["link"], lw=3, ms=5, animated=True,
+                         label="links" if i == 0 else None)
+        lines.append((bar, points))
+    for name, (centres, _) in discs.items():
+        (arm,) = ax.plot([], [], "-", color="0.35", lw=2, animated=True)
+        lines.append((arm, _arm(links[name], centres)))
+    bodies = []
+    for i, (centres, radius) in enumerate(discs.values()):
+        if radius > 0:
+            body = Circle((centres[0].real, centres[0].imag), radius, color="0.35", alpha=0.8,
+                          animated=True, label="counterweights added" if i == 0 else None)
+            ax.add_patch(body)
+        else:
+            (body,) = ax.plot([], [], "D", color="0.35", ms=7, animated=True,
+                              label="counterweights added" if i == 0 else None)
+        bodies.append((body, centres, radius))
+    (link_coms,) = ax.plot([], [], "s", color=COLOURS["com"], ms=5, animated=True,
+                           label="link centres of mass (line: to its link)")
+    (trace,) = ax.plot([], [], color=COLOURS["after"], lw=2, animated=True)
+    (com,) = ax.plot([], [], "o", color=COLOURS["after"], ms=9, label="total centre of mass",
+                     animated=True)
+    angle = ax.text(0.02, 0.97, "", transform=ax.transAxes, ha="left", va="top",
+                    fontsize="medium", animated=True,
+                    bbox={"boxstyle": "round,pad=0.3", "fc": "white", "ec": "0.6", "alpha": 0.9})
+    handles, _ = ax.get_legend_handles_labels()
+    for kind, what in (("rebuild", "rebuilt, no single counterweight"),
+                       ("remove", "lightened, material removed")):
+        names = [name for name, w in weights.items() if w.kind == kind]
+        if names:
+            handles.append(Line2D([], [], ls="none",
+                                  label=textwrap.fill(f"{what}: {', '.join(names)}", 36)))
+    fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize="small")
+    fig.draw_without_rendering()  # the constrained layout's first pass leaves the title out
+    degrees = np.degrees(sample_angles(frames))
+    link_com_values = np.column_stack(list(coms.values()))
+
+    def update(k: int) -> list:
+        for line, values in lines:
+            line.set_data(values[k].real, values[k].imag)
+        for body, centres, radius in bodies:
+            if radius > 0:
+                body.set_center((centres[k].real, centres[k].imag))
+            else:
+                body.set_data([centres[k].real], [centres[k].imag])
+        link_coms.set_data(link_com_values[k].real, link_com_values[k].imag)
+        trace.set_data(total[: k + 1].real, total[: k + 1].imag)
+        com.set_data([total[k].real], [total[k].imag])
+        angle.set_text(f"crank angle θ1 = {degrees[k]:5.1f}°")
+        return [trace, *(line for line, _ in lines), *(b for b, _, _ in bodies), link_coms,
+                com, angle]
+
+    return fig, update
+
+
+def animate(linkage, path: str | os.PathLike[str], *, frames: int = 72, fps: int = 24,
+            title: str = "", counterweights=None) -> Path:
+    """Write an animation of the linkage turning one revolution, its centre of mass traced.
+
+    What it draws: :func:`animation_figure` (``counterweights`` per link, as
+    :attr:`BalanceResult.counterweights` gives them: the bodies added to the original links
+    are drawn as their steel discs, turning with their links).
+
+    The type comes from the extension (:func:`animation_type`): a GIF (Pillow) or an MP4
+    (H.264 by ffmpeg). Frames are equally spaced crank angles (the crank at constant speed).
+    The still parts are drawn once and each frame only blits the moving artists onto them
+    (matplotlib's animation writers would redraw the whole figure for every frame, and draw no
+    artist marked animated). Written whole or not at all.
+
+    Raises
+    ------
+    OutputError
+        For an extension other than :data:`ANIMATION_TYPES`', an MP4 without ffmpeg (both
+        before any work), or a file that cannot be written.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    kind = animation_type(path)
+    fig, update = animation_figure(linkage, frames=frames, title=title,
+                                   counterweights=counterweights)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    fig.set_layout_engine("none")
+    background = canvas.copy_from_bbox(fig.bbox)
+    ax = fig.axes[0]
+    images = []
+    for k in range(frames):
+        canvas.restore_region(background)
+        for artist in update(k):
+            ax.draw_artist(artist)
+        images.append(np.asarray(canvas.buffer_rgba())[..., :3].copy())
+    writer = _write_mp4 if kind == "mp4" else _write_gif
+    return write_with(path, lambda tmp: writer(tmp, images, fps), suffix=f".{kind}")
+
+
+def _write_gif(path: str, images: list[np.ndarray], fps: int) -> None:
+    """Write RGB frames as a looping GIF (64 colours a frame)."""
+    from PIL import Image
+
+    frames = [Image.fromarray(rgb).quantize(colors=64) for rgb in images]
+    frames[0].save(path, format="GIF", save_all=True, append_images=frames[1:],
+                   duration=round(1000 / fps), loop=0)
+
+
+def _write_mp4(path: str, images: list[np.ndarray], fps: int) -> None:
+    """Write RGB frames as an H.264 MP4 by piping them to ffmpeg.
+
+    Raises
+    ------
+    OutputError
+        If there is no ffmpeg, or it fails (its last line of error).
+    """
+    import subprocess
+
+    exe = outputs.ffmpeg()
+    if exe is None:
+        raise OutputError("an MP4 animation needs ffmpeg, which is not installed",
+                          source=path)
+    height, width = images[0].shape[:2]
+    command = [exe, "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
+               "-s", f"{width}x{height}", "-r", str(fps), "-i", "-", "-an",
+               "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264",
+               "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4", path]
+    done = subprocess.run(command, input=b"".join(rgb.tobytes() for rgb in images),
+                          capture_output=True, check=False)
+    if done.returncode != 0:
+        lines = done.stderr.decode(errors="replace").strip().splitlines() or ["no message"]
+        raise OutputError(f"ffmpeg could not write the MP4 (exit {done.returncode}: "
+                          f"{lines[-1]})", source=path)

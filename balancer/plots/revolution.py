@@ -1,0 +1,142 @@
+"""Figures of one revolution at the operating speed, before and after a redesign.
+
+The shaking force's polar diagram, the shaking moment and the driving torque over the crank
+angle.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..cycle import Figure as Figures
+from ..cycle import drawn_panels
+from .style import AFTER_STYLE, BEFORE_STYLE, axes, legend_outside, number
+
+if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+
+def _closed(values: np.ndarray) -> np.ndarray:
+    """A revolution's samples with the first repeated at the end (the curve closes)."""
+    return np.append(values, values[:1])
+
+
+def _cycle_label(role: str, values: np.ndarray, unit: str) -> str:
+    f = Figures.of(values)
+    return f"{role}: RMS {number(f.rms)} {unit}, max {number(f.max)} {unit}"
+
+
+def _roles(before) -> tuple[str, str]:
+    return ("balanced design", "original") if before is not None else ("design", "")
+
+
+def plot_shaking_force_polar(analysis, before=None, ax: Axes | None = None,
+                             legend: bool = True) -> Axes:
+    """Polar diagram of the shaking force: its vector's tip over one revolution, N.
+
+    ``analysis`` and ``before`` (the original's, optional) are
+    :class:`~balancer.cycle.CycleAnalysis`; a dot marks θ1 = 0 and an arrow the sense of
+    travel. A force-balanced design's curve is a point at the origin.
+    """
+    ax = axes(ax)
+    after_role, before_role = _roles(before)
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    ax.axvline(0.0, color="0.6", lw=0.8)
+    for a, role, style in ((before, before_role, BEFORE_STYLE),
+                           (analysis, after_role, AFTER_STYLE)):
+        if a is None:
+            continue
+        colour, lw = style["color"], style["lw"]
+        f = _closed(a.reactions.shaking_force)
+        ax.plot(f.real, f.imag, **style, label=_cycle_label(role, a.reactions.shaking_force, "N"))
+        ax.plot(f.real[:1], f.imag[:1], "o", color=colour, ms=6, mec="k", mew=0.6, zorder=4)
+        k = max(1, f.size // 8)
+        if abs(f[k + 1] - f[k]) > 0:
+            ax.annotate("", xy=(f[k + 1].real, f[k + 1].imag), xytext=(f[k].real, f[k].imag),
+                        arrowprops={"arrowstyle": "-|>", "color": colour, "lw": lw,
+                                    "mutation_scale": 14})
+    ax.plot([], [], "o", color="w", mec="k", mew=0.6, label="θ1 = 0, arrow: sense of travel")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("shaking force, x (N)")
+    ax.set_ylabel("shaking force, y (N)")
+    ax.set_title("shaking force over one revolution (polar diagram)")
+    ax.grid(alpha=0.3)
+    if legend:
+        legend_outside(ax)
+    return ax
+
+
+def plot_over_crank_angle(analysis, quantity: str, before=None, ax: Axes | None = None,
+                          legend: bool = True) -> Axes:
+    """``quantity`` (``"shaking_moment"`` or ``"driving_torque"``, N·m) over the crank angle.
+
+    Of ``analysis`` and, if given, ``before`` (the original's), over one revolution in degrees.
+    """
+    ax = axes(ax)
+    names = {"shaking_moment": ("shaking moment about the origin", "shaking moment"),
+             "driving_torque": ("driving torque on the crank", "driving torque")}
+    if quantity not in names:
+        raise ValueError(f"no such quantity: {quantity!r}")
+    after_role, before_role = _roles(before)
+    for a, role, style in ((before, before_role, BEFORE_STYLE),
+                           (analysis, after_role, AFTER_STYLE)):
+        if a is None:
+            continue
+        values = getattr(a.reactions, quantity)
+        ax.plot(np.degrees(np.append(a.theta1, 2 * np.pi)), _closed(values), **style,
+                label=_cycle_label(role, values, "N·m"))
+    ax.set_xlim(0.0, 360.0)
+    ax.set_xticks(np.arange(0, 361, 45))
+    ax.set_xlabel("crank angle θ1 (°)")
+    ax.set_ylabel(f"{names[quantity][0]} (N·m)")
+    ax.set_title(f"{names[quantity][1]} over one revolution")
+    ax.grid(alpha=0.3)
+    if legend:
+        legend_outside(ax)
+    return ax
+
+
+def cycle_figure(analysis, before=None, title: str = "") -> Figure:
+    """The picture a balancing report starts with: one revolution at the operating speed.
+
+    The shaking force's polar diagram, and the shaking moment and driving torque over the
+    crank angle; of the design, and of the original before it (``before``) if given. Each
+    panel's title gives its RMS and maximum (original → design); one legend below the panels.
+    """
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(12, 7), layout="constrained")
+    axes = fig.subplot_mosaic([["force", "moment"], ["force", "torque"]],
+                              width_ratios=[1.0, 1.3])
+    plot_shaking_force_polar(analysis, before, ax=axes["force"], legend=False)
+    plot_over_crank_angle(analysis, "shaking_moment", before, ax=axes["moment"], legend=False)
+    plot_over_crank_angle(analysis, "driving_torque", before, ax=axes["torque"], legend=False)
+    for key, unit in (("force", "N"), ("moment", "N·m"), ("torque", "N·m")):
+        ax = axes[key]
+        after = drawn_panels(analysis)[key]
+        figures = [_figure_pair(drawn_panels(before)[key] if before is not None else None,
+                                after, stat) for stat in ("rms", "max")]
+        ax.set_title(f"{ax.get_title()}\nRMS {figures[0]} {unit}, max {figures[1]} {unit}",
+                     fontsize="medium")
+    handles, labels = axes["force"].get_legend_handles_labels()
+    fig.legend(handles, [label.split(": RMS")[0] for label in labels],
+               loc="outside lower center",
+               ncols=len(handles), fontsize="small")
+    what = f"one revolution at {analysis.speed:g} rad/s"
+    if any(analysis.gravity):
+        what += f", gravity ({analysis.gravity[0]:g}, {analysis.gravity[1]:g}) m/s²"
+    if before is not None:
+        what += ", before and after balancing"
+    fig.suptitle(f"{title}: {what}" if title else what)
+    return fig
+
+
+def _figure_pair(before: np.ndarray | None, after: np.ndarray, stat: str) -> str:
+    """``"b → a"`` (or ``"a"``) of a figure of one revolution's values, to 3 digits."""
+    text = number(getattr(Figures.of(after), stat))
+    if before is None:
+        return text
+    return f"{number(getattr(Figures.of(before), stat))} → {text}"
