@@ -187,16 +187,16 @@ _SIMULATE_OPTIONS = ("method", "drive", "duration", "rtol", "atol", "outputs")
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
+    from .api import simulate
     from .outputs import write_atomic
     from .progress import Progress
     from .report import dumps_json, simulation_csv, simulation_json, simulation_text
-    from .simulation import simulate_design
 
     out = _output_path(args, args.out, "--out")
     design = _load(args)
     progress = Progress("simulating", enabled=not args.json)
     try:
-        traj = simulate_design(
+        traj = simulate(
             design,
             method=args.method,
             drive=args.drive,
@@ -226,8 +226,8 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _cmd_verify(args: argparse.Namespace) -> int:
+    from .api import verify
     from .report import dumps_json, verification_text
-    from .verification import verify
 
     plot = _figure_path(args, args.plot, "--plot")
     design = _load(args)
@@ -255,12 +255,11 @@ def _cmd_verify(args: argparse.Namespace) -> int:
 
 
 def _cmd_optimize(args: argparse.Namespace) -> int:
-    from .balance.optimizer import optimize
+    from .api import optimize, verify
     from .errors import SolverError
     from .outputs import write_atomic
     from .report import dumps_json, optimization_json, optimization_text
     from .spec import dumps_design, loads_design
-    from .verification import verify
 
     out = _output_path(args, args.out, "--out")
     design = _load(args)
@@ -349,14 +348,14 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 
 def _cmd_pareto(args: argparse.Namespace) -> int:
-    from .balance.pareto import pareto_front
+    from .api import pareto
     from .outputs import write_atomic
     from .report import dumps_json, front_csv, front_json, front_text
 
     csv_path = _output_path(args, args.csv, "--csv")
     plot = _figure_path(args, args.plot, "--plot")
     design = _load(args)
-    front = pareto_front(design, args.against, args.points)
+    front = pareto(design, against=args.against, points=args.points)
     csv = front_csv(front) if csv_path is not None else None
     text = (dumps_json(front_json(front, spec=args.spec)) if args.json
             else front_text(front, spec=args.spec) + "\n")

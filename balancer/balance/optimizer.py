@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import replace
+from typing import Literal, get_args
 
 import numpy as np
 
@@ -56,7 +57,10 @@ from .result import (
     Status,
 )
 
-BACKENDS: tuple[str, ...] = ("nlp", "convex")
+#: The optimisers: ``"nlp"`` (the convex optimum, then IPOPT on the designer's parameters) or
+#: ``"convex"`` (the certified optimum of the second-order cone program alone).
+Backend = Literal["nlp", "convex"]
+BACKENDS: tuple[str, ...] = get_args(Backend)
 #: Gap (relative to the problem's scale, :meth:`NumericProblem.gap`) within which the NLP's
 #: design does not replace the convex one (which may exceed the optimum by Clarabel's
 #: tolerance and the tie-break's, :data:`.convex.TIE_ACCEPT`).
@@ -64,6 +68,7 @@ TIE_TOLERANCE = 1e-7
 
 __all__ = [
     "BACKENDS",
+    "Backend",
     "BalanceResult",
     "ConvexSolution",
     "ConvexSolver",
@@ -256,7 +261,7 @@ def _message(result: BalanceResult, convex: ConvexSolution, notes: list[str]) ->
     return "; ".join(parts + notes)
 
 
-def optimize(design: Design, backend: str = "nlp") -> BalanceResult:
+def optimize(design: Design, backend: Backend = "nlp") -> BalanceResult:
     """Balance a design as its ``[balance]`` section asks.
 
     Parameters

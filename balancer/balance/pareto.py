@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -37,6 +38,8 @@ from .convex import Compressed, ConvexSolver
 from .problem import NumericProblem, Objective, numeric_problem
 
 #: The second objectives, and the name and unit each is reported under.
+#: The second objectives of a front (``pareto --against``).
+Against = Literal["driving-torque", "added-mass", "shaking-force"]
 AGAINST: dict[str, tuple[str, str]] = {
     "driving-torque": ("driving_torque", "N·m"),
     "added-mass": ("added_mass", "kg"),
@@ -213,7 +216,7 @@ def _scale(factor: NDArray[np.float64], data: NumericProblem) -> float:
     return value if value > 0 else 1.0
 
 
-def pareto_front(design: Design, against: str, points: int = 11) -> Front:
+def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
     """The front of least RMS shaking moment against ``against`` (see the module docstring).
 
     Parameters

@@ -1,0 +1,63 @@
+"""The Python API in a few calls, for scripts and notebooks.
+
+>>> from balancer import load_design, analyze
+>>> design = load_design("examples/meijaard2020.toml")
+>>> analysis = analyze(design)
+>>> analysis.summary.shaking_moment.rms  # doctest: +SKIP
+
+Each call takes a :class:`~balancer.model.Design` (from :func:`~balancer.spec.load_design`) and
+returns a result object; nothing here prints or writes files. The calls live in modules by
+what they need (:mod:`.analysis`, :mod:`.balancing`, :mod:`.motion`, :mod:`.results`), each
+loaded when one of its names is first used (PEP 562): a command that analyses does not load
+the optimisers.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+#: Where each name lives.
+_EXPORTS = {
+    "analyze": "analysis",
+    "cycle_analyses": "analysis",
+    "example": "analysis",
+    "optimize": "balancing",
+    "pareto": "balancing",
+    "simulate": "motion",
+    "verify": "motion",
+    "to_dict": "results",
+    "to_table": "results",
+}
+
+__all__ = [
+    "analyze",
+    "cycle_analyses",
+    "example",
+    "optimize",
+    "pareto",
+    "simulate",
+    "to_dict",
+    "to_table",
+    "verify",
+]
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'balancer.api' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_EXPORTS})
+
+
+if TYPE_CHECKING:  # for type checkers and editors: the names as they are
+    from .analysis import analyze, cycle_analyses, example
+    from .balancing import optimize, pareto
+    from .motion import simulate, verify
+    from .results import to_dict, to_table

@@ -1,0 +1,79 @@
+"""The analysis of a design: one revolution at its operating speed, and the shipped examples."""
+
+from __future__ import annotations
+
+from .. import examples
+from .. import validate as v
+from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses
+from ..errors import SpecError
+from ..model import Design, check_scales
+
+
+def analyze(design: Design, *, route: str | None = None,
+            gravity: tuple[float, float] | None = None) -> CycleAnalysis:
+    """One crank revolution at the design's operating speed (``[operation]``).
+
+    Parameters
+    ----------
+    design
+        The design.
+    route
+        Inverse-dynamics route (default the mechanism's first).
+    gravity
+        Gravitational acceleration ``(gx, gy)``, m/s², instead of the spec's
+        ``[operation] gravity`` (whose default is none); the figures then include the weights.
+
+    Raises
+    ------
+    SpecError
+        If the spec has no operating speed, the crank cannot turn a full revolution, or
+        ``gravity`` is not two finite numbers.
+    """
+    if design.operation is None:
+        raise SpecError(
+            "missing required key: a cycle analysis needs the operating speed",
+            key="operation.speed",
+        )
+    op = design.operation
+    if gravity is None:
+        gravity = op.gravity
+    else:
+        gravity = v.vector2(gravity, "gravity")
+        check_scales(design.mechanism, {"operation.speed": op.speed}, {"gravity": gravity})
+    return cycle_analysis(design.mechanism, op.speed, op.samples, route=route, gravity=gravity)
+
+
+def cycle_analyses(design: Design, *, samples: int | None = None,
+                   tolerance: float = DRAWING_TOLERANCE) -> tuple[CycleAnalysis,
+                                                                   CycleAnalysis | None]:
+    """One revolution of the design and of its original, sampled finely enough to draw.
+
+    At the operating speed with the spec's gravity, from at least the spec's ``samples``
+    (:func:`balancer.cycle.drawn_analyses`, to ``tolerance`` of each panel's span); with
+    ``samples``, exactly that many crank angles.
+
+    Returns
+    -------
+    tuple
+        ``(design's, original's or None)`` :class:`~balancer.cycle.CycleAnalysis`, both at
+        the same crank angles.
+
+    Raises
+    ------
+    SpecError
+        If the design has no operating speed; :class:`~balancer.errors.AssemblyError` if a
+        crank cannot turn a full revolution.
+    """
+    if design.operation is None:
+        raise SpecError("missing required key: a cycle analysis needs the operating speed",
+                        key="operation.speed")
+    op = design.operation
+    models = [design.mechanism, *([design.original] if design.original is not None else [])]
+    analyses = drawn_analyses(models, op.speed, samples=samples, least=op.samples,
+                              gravity=op.gravity, tolerance=tolerance)
+    return analyses[0], (analyses[1] if len(analyses) > 1 else None)
+
+
+def example(name: str) -> Design:
+    """A design spec shipped with the package, by name (``balancer example`` lists them)."""
+    return examples.load(name)
