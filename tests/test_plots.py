@@ -471,7 +471,7 @@ def test_a_scattered_atlas_marks_the_points_without_a_design(tmp_path):
 
 def test_the_sweep_command_marks_the_specs_design_on_its_atlas(tmp_path, monkeypatch, capsys):
     drawn = []
-    monkeypatch.setattr(plots, "save_figure", lambda fig, path: drawn.append(fig))
+    monkeypatch.setattr("balancer.cli.sweep.save_figure", lambda fig, path: drawn.append(fig))
     out = tmp_path / "atlas.parquet"
     assert main(["sweep", str(EXAMPLES / "pb1.toml"), "--vary", f"{COUPLER}=2.6:3.4:2",
                  "--vary", f"{FRAME}=3.0:3.4:2", "--out", str(out), "--workers", "0",
@@ -485,7 +485,7 @@ def test_the_sweep_command_marks_the_specs_design_on_its_atlas(tmp_path, monkeyp
 def test_the_tolerance_histogram_names_the_key_its_sigma_and_the_draws(tmp_path, monkeypatch,
                                                                         capsys, pb1_balanced):
     drawn = []
-    monkeypatch.setattr(plots, "save_figure", lambda fig, path: drawn.append(fig))
+    monkeypatch.setattr("balancer.cli.sweep.save_figure", lambda fig, path: drawn.append(fig))
     assert main(["sweep", str(pb1_balanced), "--perturb", "links.crank.mass=0.01",
                  "--samples", "30", "--out", str(tmp_path / "p.parquet"), "--workers", "0",
                  "--plot", str(tmp_path / "hist.png"), "--json"]) == 0
@@ -502,7 +502,7 @@ def test_the_tolerance_histogram_names_the_key_its_sigma_and_the_draws(tmp_path,
 
 def _front_figure_of(tmp_path, monkeypatch, capsys, spec, against):
     drawn = []
-    monkeypatch.setattr(plots, "save_figure", lambda fig, path: drawn.append(fig))
+    monkeypatch.setattr("balancer.cli.pareto.save_figure", lambda fig, path: drawn.append(fig))
     assert main(["pareto", str(spec), "--against", against, "--points", "5", "--plot",
                  str(tmp_path / "front.png"), "--json"]) == 0
     import json

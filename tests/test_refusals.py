@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from balancer import plots, simulation
+from balancer import simulation
 from balancer.cli import main
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -56,7 +56,7 @@ def test_a_figure_path_of_no_type_is_refused_before_any_work(tmp_path, args):
 
 def test_frames_beyond_the_limit_are_refused_naming_it(tmp_path, capsys, monkeypatch):
     """`plot --animate a.gif --frames 100000` ran past 20 s: now refused, naming the limit."""
-    monkeypatch.setattr(plots, "animate", _never("the animation"))
+    monkeypatch.setattr("balancer.cli.plot.animate", _never("the animation"))
     gif = tmp_path / "a.gif"
     assert main(["plot", PB1, "--animate", str(gif), "--frames", "100000"]) == 2
     err = capsys.readouterr().err
@@ -97,9 +97,7 @@ def test_verify_runs_first_the_run_the_step_budget_may_refuse(tmp_path, capsys, 
 def test_optimize_refuses_its_check_s_duration_before_optimizing(capsys, monkeypatch):
     """The check by simulation comes at the end of optimize: a --verify-duration it would
     refuse is refused before the optimisation."""
-    import balancer.balance.optimizer as optimizer
-
-    monkeypatch.setattr(optimizer, "optimize", _never("the optimisation"))
+    monkeypatch.setattr("balancer.cli.optimize.optimize", _never("the optimisation"))
     assert main(["optimize", PB1, "--verify-duration", "1e6"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--verify-duration" in err and "panels" in err

@@ -58,6 +58,13 @@ def _preload() -> None:
     import balancer.api  # noqa: F401
     import balancer.balance.optimizer  # noqa: F401
     import balancer.cli  # noqa: F401
+    import balancer.cli.analyze  # noqa: F401
+    import balancer.cli.optimize  # noqa: F401
+    import balancer.cli.pareto  # noqa: F401
+    import balancer.cli.plot  # noqa: F401
+    import balancer.cli.simulate  # noqa: F401
+    import balancer.cli.sweep  # noqa: F401
+    import balancer.cli.verify  # noqa: F401
     import balancer.plots  # noqa: F401
     import balancer.report  # noqa: F401
     import balancer.simulation  # noqa: F401

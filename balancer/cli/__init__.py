@@ -2,29 +2,38 @@
 
 Exit codes: 0 success; 2 bad input (spec or arguments); 1 a computation that fails; 130
 interrupted (SIGINT, Ctrl-C, at any moment: :mod:`balancer.interrupts`). Every error is one
-line on stderr naming the cause and where; never a traceback for a user error. Heavy
-libraries (SciPy's integrators, CVXPY, CasADi, matplotlib) are imported only by the commands that
-use them.
+line on stderr naming the cause and where; never a traceback for a user error. Each verb is
+a module of its own (:mod:`.analyze`, :mod:`.simulate`, …, with what they share in
+:mod:`.common`), loaded when it is asked for: ``balancer --help`` loads no numerics, and heavy
+libraries (SciPy's integrators, CVXPY, CasADi, matplotlib) come with the commands that use them.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
-from .errors import BalancerError, OutputError, SpecError
+from .. import interrupts
+from ..errors import BalancerError, OutputError, SpecError
 
 #: ``--drive`` values: :data:`balancer.model.DRIVES`, here so that ``--help`` needs no model
 #: (a test keeps the two equal).
 DRIVES: tuple[str, ...] = ("free", "constant-speed")
+
+
 #: ``--method`` values: every formulation of any mechanism (:mod:`balancer.formulations`), here
 #: so that ``--help`` needs no numerics (a test keeps them equal to the registry's).
 FORMULATION_NAMES: tuple[str, ...] = (
     "opened-loop", "complex-masses", "mass-matrix", "lie-group", "multibody", "crank-angle")
+
+
+#: Most frames per revolution of an animation: ten a degree, more than any screen shows.
+MAX_FRAMES = 3600
 
 
 class _Parser(argparse.ArgumentParser):
@@ -58,91 +67,12 @@ class _Parser(argparse.ArgumentParser):
         return ""
 
 
-def _output_path(args: argparse.Namespace, value: str | None, option: str) -> Path | None:
-    """An output path given as ``option``, checked before any work is done.
-
-    Its folder must exist and take a file; it must not name an existing file (the input spec
-    included) unless ``--force``.
-    """
-    if value is None:
-        return None
-    from .outputs import check_writable
-
-    path = check_writable(value, option)
-    if args.force:
-        return path
-    spec = Path(getattr(args, "spec", None) or os.devnull)
-    same = path.exists() and spec.exists() and os.path.samefile(path, spec)
-    if spec.name != os.devnull and (same or os.path.realpath(path) == os.path.realpath(spec)):
-        raise OutputError("would overwrite the input spec; give another path, or --force",
-                          key=option, value=value)
-    if os.path.lexists(path):
-        raise OutputError("the file exists; give another path, or --force to overwrite it",
-                          key=option, value=value)
-    return path
-
-
-#: Most frames per revolution of an animation: ten a degree, more than any screen shows.
-MAX_FRAMES = 3600
-
-
-def _figure_path(args: argparse.Namespace, value: str | None, option: str) -> Path | None:
-    """An output path for a figure, checked before any work.
-
-    It must be writable (:func:`_output_path`), and its extension must name a figure type
-    (:func:`balancer.outputs.figure_type`).
-    """
-    from .outputs import figure_type
-
-    path = _output_path(args, value, option)
-    if path is not None:
-        figure_type(path, option)
-    return path
-
-
-def _as_option(exc: SpecError, key: str, option: str, value: object) -> SpecError:
-    """``exc`` naming the command-line ``option`` that gave the spec ``key`` its ``value``."""
-    if exc.key == key and value is not None:
-        return SpecError(exc.detail, key=option, value=value)
-    return exc
-
-
-def _load(args: argparse.Namespace):
-    """The design of ``args.spec``, with a note on stderr for a unit that looks wrong.
-
-    The lengths as written are judged before the spec is validated (a linkage with a length in
-    millimetres may not assemble: the note then comes before the error), the speed of its
-    points after (:mod:`balancer.plausibility`). A note never changes the exit code.
-    """
-    import tomllib
-
-    from .plausibility import length_note, speed_note
-    from .spec import load_design
-
-    try:
-        note = length_note(tomllib.loads(Path(args.spec).read_text(encoding="utf-8-sig")))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
-        note = None  # load_design says what is wrong with the file
-    if note is not None:
-        print(f"balancer: note: {note}", file=sys.stderr)
-    design = load_design(args.spec)
-    if note is None:  # lengths in millimetres make every point fast: one note is enough
-        note = speed_note(design)
-        if note is not None:
-            print(f"balancer: note: {note}", file=sys.stderr)
-    return design
-
-
-def _wrote(path: str | os.PathLike[str]) -> None:
-    """Say on stderr that ``path`` was written: stdout is the report (or the JSON document)."""
-    print(f"wrote {path}", file=sys.stderr)
-
-
 #: The CSV files' units (their header keeps the plain names a csv reader expects).
 _CSV_UNITS = ("columns in SI units: t s; theta rad, omega rad/s, alpha rad/s² per link; "
               "R<point>x, R<point>y, N_<link> N; C_<link> N·m; x<k> m, v<k> m/s, a<k> m/s² "
               "along a slider's guide; shaking_force_x, shaking_force_y N; shaking_moment, "
               "driving_torque N·m")
+
 
 #: ``--force``: the one switch for every output path of a command.
 _FORCE_HELP = ("overwrite output files that exist (without it, an output path that names an "
@@ -154,281 +84,6 @@ def _spec_and_force(p: argparse.ArgumentParser, balance: bool = False) -> None:
     p.add_argument("spec", metavar="SPEC", help="design spec (TOML)"
                    + (" with a [balance] section" if balance else ""))
     p.add_argument("--force", action="store_true", help=_FORCE_HELP)
-
-
-def _cmd_analyze(args: argparse.Namespace) -> int:
-    from .api import analyze
-    from .outputs import write_atomic
-    from .report import analysis_csv, analysis_json, analysis_text, dumps_json
-
-    csv_path = _output_path(args, args.csv, "--csv")
-    design = _load(args)
-    try:
-        analysis = analyze(design, route=args.route, gravity=args.gravity)
-    except SpecError as exc:
-        if exc.key == "gravity":  # the option's value, not the spec's
-            raise SpecError(exc.detail, key="--gravity", value=",".join(
-                map(format, args.gravity))) from None
-        raise
-    csv = analysis_csv(analysis) if csv_path is not None else None
-    if args.json:
-        text = dumps_json(analysis_json(analysis, spec=args.spec))
-    else:
-        text = analysis_text(analysis, spec=args.spec) + "\n"
-    if csv_path is not None:
-        write_atomic(csv_path, csv)
-        _wrote(csv_path)
-    sys.stdout.write(text)
-    return 0
-
-
-#: Simulation settings that a command-line option overrides (errors then name the option).
-_SIMULATE_OPTIONS = ("method", "drive", "duration", "rtol", "atol", "outputs")
-
-
-def _cmd_simulate(args: argparse.Namespace) -> int:
-    from .api import simulate
-    from .outputs import write_atomic
-    from .progress import Progress
-    from .report import dumps_json, simulation_csv, simulation_json, simulation_text
-
-    out = _output_path(args, args.out, "--out")
-    design = _load(args)
-    progress = Progress("simulating", enabled=not args.json)
-    try:
-        traj = simulate(
-            design,
-            method=args.method,
-            drive=args.drive,
-            duration=args.duration,
-            rtol=args.rtol,
-            atol=args.atol,
-            outputs=args.outputs,
-            progress=progress,
-        )
-    except SpecError as exc:
-        name = (exc.key or "").removeprefix("simulation.")  # a setting, or the spec's key
-        if name in _SIMULATE_OPTIONS and getattr(args, name) is not None:
-            raise SpecError(exc.detail, key=f"--{name}", value=exc.value) from None
-        raise
-    finally:
-        progress.close()
-    csv = simulation_csv(traj, all_columns=args.all_columns) if out is not None else None
-    if args.json:
-        text = dumps_json(simulation_json(traj, spec=args.spec))
-    else:
-        text = simulation_text(traj, spec=args.spec) + "\n"
-    if out is not None:
-        write_atomic(out, csv)
-        _wrote(out)
-    sys.stdout.write(text)
-    return 0
-
-
-def _cmd_verify(args: argparse.Namespace) -> int:
-    from .api import verify
-    from .report import dumps_json, verification_text
-
-    plot = _figure_path(args, args.plot, "--plot")
-    design = _load(args)
-    from .progress import Progress
-
-    try:
-        with Progress("verifying by simulation", enabled=not args.json) as progress:
-            verification = verify(design, method=args.method, duration=args.duration,
-                                  progress=progress)
-    except SpecError as exc:
-        raise _as_option(exc, "simulation.duration", "--duration", args.duration) from None
-    paths = [] if plot is None else [plot]
-    if args.json:
-        doc = {"spec": args.spec, **verification.as_dict(), "plots": [str(p) for p in paths]}
-        text = dumps_json(doc)
-    else:
-        text = verification_text(verification, spec=args.spec) + "\n"
-    if plot is not None:
-        from .plots import save_figure, verification_figure
-
-        save_figure(verification_figure(design, verification), plot)
-        _wrote(plot)
-    sys.stdout.write(text)
-    return 0
-
-
-def _cmd_optimize(args: argparse.Namespace) -> int:
-    from .api import optimize, verify
-    from .errors import SolverError
-    from .outputs import write_atomic
-    from .report import dumps_json, optimization_json, optimization_text
-    from .spec import dumps_design, loads_design
-
-    out = _output_path(args, args.out, "--out")
-    design = _load(args)
-    if not args.no_verify:  # the check at the end refuses nothing after the work
-        from .verification import check_verification
-
-        try:
-            check_verification(design, duration=args.verify_duration)
-        except SpecError as exc:
-            raise _as_option(exc, "simulation.duration", "--verify-duration",
-                             args.verify_duration) from None
-    result = optimize(design, backend=args.backend)
-    if not result.success:
-        raise SolverError(f"the balancing failed: {result.message}")
-    balanced = result.balanced_design(design)
-    spec_text = dumps_design(balanced)
-    loads_design(spec_text, source=str(out or "the balanced spec"))  # it must load again
-    before, after = result.operating  # the analyze figures of both (loads and gravity)
-    verification = None
-    if not args.no_verify:
-        from .progress import Progress
-
-        try:
-            with Progress("verifying by simulation", enabled=not args.json) as progress:
-                verification = verify(balanced, duration=args.verify_duration,
-                                      progress=progress)
-        except SpecError as exc:
-            raise _as_option(exc, "simulation.duration", "--verify-duration",
-                             args.verify_duration) from None
-    if args.json:
-        text = dumps_json(optimization_json(result, before, after, verification,
-                                            spec=args.spec, out=out))
-    else:
-        text = optimization_text(result, before, after, verification,
-                                 spec=args.spec) + "\n"
-    if out is not None:
-        write_atomic(out, spec_text)
-        _wrote(out)
-    sys.stdout.write(text)
-    return 0
-
-
-def _cmd_plot(args: argparse.Namespace) -> int:
-    if args.animate is None and args.cycle is None:
-        raise SpecError("nothing to plot: give --cycle PATH or --animate PATH", key="--cycle")
-    cycle = _output_path(args, args.cycle, "--cycle")
-    animation = _output_path(args, args.animate, "--animate")
-    if cycle is not None and animation is not None and \
-            os.path.realpath(cycle) == os.path.realpath(animation):
-        raise OutputError("names the same file as --cycle", key="--animate",
-                          value=args.animate)
-    from .outputs import animation_type, figure_type
-
-    if cycle is not None:
-        figure_type(cycle, "--cycle")
-    if animation is not None:
-        animation_type(animation, "--animate")  # its extension, and ffmpeg for an MP4
-    design = _load(args)
-    from .mechanisms import mechanism_of
-
-    mechanism_of(design.mechanism).require_full_revolution(
-        "a cycle plot" if animation is None else "an animation of one revolution")
-    figure = None
-    if cycle is not None:
-        from .api import cycle_analyses
-        from .plots import cycle_figure
-
-        figure = cycle_figure(*cycle_analyses(design), title=design.title)
-    if animation is not None:
-        from .plots import animate
-
-        weights = None
-        if design.original is not None:  # a balanced spec: draw what was added to the links
-            from .balance.counterweights import counterweights
-
-            weights = counterweights(design.original, design.mechanism)
-        animate(design.mechanism, animation, frames=args.frames, title=design.title,
-                counterweights=weights)
-        _wrote(animation)
-    if figure is not None:
-        from .plots import save_figure
-
-        save_figure(figure, cycle)
-        _wrote(cycle)
-    return 0
-
-
-def _cmd_pareto(args: argparse.Namespace) -> int:
-    from .api import pareto
-    from .outputs import write_atomic
-    from .report import dumps_json, front_csv, front_json, front_text
-
-    csv_path = _output_path(args, args.csv, "--csv")
-    plot = _figure_path(args, args.plot, "--plot")
-    design = _load(args)
-    front = pareto(design, against=args.against, points=args.points)
-    csv = front_csv(front) if csv_path is not None else None
-    text = (dumps_json(front_json(front, spec=args.spec)) if args.json
-            else front_text(front, spec=args.spec) + "\n")
-    if plot is not None:
-        from .plots import front_figure, save_figure
-
-        save_figure(front_figure(front, title=design.title), plot)
-        _wrote(plot)
-    if csv_path is not None:
-        write_atomic(csv_path, csv)
-        _wrote(csv_path)
-    sys.stdout.write(text)
-    return 0
-
-
-def _cmd_sweep(args: argparse.Namespace) -> int:
-    from .progress import Progress
-    from .report import dumps_json, sweep_text
-    from .sweeps import Perturb, Vary, sweep
-
-    varies = [Vary.parse(text) for text in args.vary or ()]
-    perturbs = [Perturb.parse(text) for text in args.perturb or ()]
-    if not varies and not perturbs:
-        raise SpecError("nothing to vary: give --vary KEY=LOW:HIGH:N (or --perturb KEY=SIGMA)",
-                        key="--vary")
-    if not args.out.endswith(".parquet"):
-        raise OutputError("must name a .parquet file", key="--out", value=args.out)
-    out = _output_path(args, args.out, "--out") if not args.resume else Path(args.out)
-    plot = _figure_path(args, args.plot, "--plot")
-    _load(args)  # its own errors, and a note for a unit that looks wrong
-    with Progress("sweeping", unit="points", enabled=not args.json) as progress:
-        result = sweep(args.spec, varies, out, perturbs=perturbs, method=args.method,
-                       samples=args.samples,
-                       seed=args.seed, workers=args.workers, scheduler=args.scheduler,
-                       resume=args.resume, force=args.force, batch=args.batch,
-                       progress=progress)
-    _wrote(result.out)
-    if plot is not None:
-        from .plots import save_figure
-        from .sweeps import atlas_figure, spec_values
-
-        keys = [v.key for v in varies]
-        original = spec_values(args.spec, keys or [p.key for p in perturbs])
-        save_figure(atlas_figure(result.out, keys or None, original=original,
-                                 perturbs=perturbs), plot)
-    sys.stdout.write(dumps_json(result.as_dict()) if args.json
-                     else sweep_text(result, spec=args.spec) + "\n")
-    if plot is not None:
-        _wrote(plot)
-    return 0
-
-
-def _cmd_example(args: argparse.Namespace) -> int:
-    from . import examples
-
-    if args.name is None:
-        if args.out is not None:
-            raise SpecError("give the NAME of the example to write", key="--out",
-                            value=args.out)
-        width = max(map(len, examples.names()))
-        for name in examples.names():
-            print(f"{name:<{width}}  {examples.title(name)}")
-        return 0
-    path = _output_path(args, args.out, "--out")
-    text = examples.text(args.name)
-    if path is None:
-        sys.stdout.write(text)
-        return 0
-    from .outputs import write_atomic
-
-    write_atomic(path, text)
-    _wrote(path)
-    return 0
 
 
 def _positive_float(text: str) -> float:
@@ -532,7 +187,7 @@ def build_parser() -> argparse.ArgumentParser:
         "(default none): the frame then carries the weights too. Write a negative first "
         "value as --gravity=-1,-9.81",
     )
-    p.set_defaults(handler=_cmd_analyze)
+    p.set_defaults(verb="analyze")
 
     methods = FORMULATION_NAMES
 
@@ -563,7 +218,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--all-columns", action="store_true",
                    help="add shaking force and moment, driving torque, energy to the CSV")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
-    p.set_defaults(handler=_cmd_simulate)
+    p.set_defaults(verb="simulate")
 
     p = sub.add_parser(
         "verify",
@@ -587,7 +242,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "one that swings or passes change points, complex-masses for a "
                    "slider-crank, multibody for a general linkage)")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
-    p.set_defaults(handler=_cmd_verify)
+    p.set_defaults(verb="verify")
 
     p = sub.add_parser(
         "optimize",
@@ -611,7 +266,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the check by simulation")
     p.add_argument("--verify-duration", type=_positive_float, metavar="T",
                    help="simulated time of each check, s (default: the spec's)")
-    p.set_defaults(handler=_cmd_optimize)
+    p.set_defaults(verb="optimize")
 
     p = sub.add_parser(
         "plot",
@@ -629,7 +284,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write an animation to PATH (.gif, or .mp4 with ffmpeg)")
     p.add_argument("--frames", type=_frames, default=72, metavar="N",
                    help=f"frames per revolution (default 72, at most {MAX_FRAMES})")
-    p.set_defaults(handler=_cmd_plot)
+    p.set_defaults(verb="plot")
 
     p = sub.add_parser(
         "pareto",
@@ -649,7 +304,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", metavar="PATH", help="draw the front to PATH (.png, .svg or .pdf)")
     p.add_argument("--csv", metavar="PATH", help="write the points to a CSV file")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
-    p.set_defaults(handler=_cmd_pareto)
+    p.set_defaults(verb="pareto")
 
     p = sub.add_parser(
         "sweep",
@@ -688,7 +343,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", metavar="PATH",
                    help="draw the atlas (.png, .svg or .pdf): a heat map over two keys")
     p.add_argument("--json", action="store_true", help="print a JSON summary instead")
-    p.set_defaults(handler=_cmd_sweep)
+    p.set_defaults(verb="sweep")
 
     p = sub.add_parser(
         "example",
@@ -700,7 +355,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("name", metavar="NAME", nargs="?", help="the example (e.g. pb1)")
     p.add_argument("--out", metavar="PATH", help="write the spec to PATH instead of printing it")
     p.add_argument("--force", action="store_true", help=_FORCE_HELP)
-    p.set_defaults(handler=_cmd_example)
+    p.set_defaults(verb="example")
     return parser
 
 
@@ -711,8 +366,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     while an error was being reported — ends it with exit code 130 and the one line
     ``balancer: interrupted`` (:mod:`balancer.interrupts`).
     """
-    from . import interrupts
-
     with interrupts.handling():
         try:
             try:
@@ -743,13 +396,14 @@ def _run(argv: Sequence[str] | None) -> tuple[int, str | None]:
     args = None
     try:
         args = parser.parse_args(argv)
-        handler: Callable[[argparse.Namespace], int] = args.handler
+        # Each verb's module imports what it needs: only the one asked for is loaded.
+        verb = importlib.import_module(f".{args.verb}", __name__)
         # A user sees results or one line of error: the libraries' warnings (an overflow in an
         # intermediate, a solver's note) are not theirs to read. Results are checked finite
         # before they are written (report.dumps_json, report.csv_text).
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return handler(args), None
+            return verb.run(args), None
     except BalancerError as exc:
         spec = getattr(args, "spec", None)
         if (isinstance(exc, SpecError) and not isinstance(exc, OutputError)
@@ -797,8 +451,6 @@ def entry_point() -> None:
     A SIGINT from the moment this runs until the process ends gives exit code 130.
     """
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    from . import interrupts
-
     # main() handles SIGINT itself; one that comes just before or after it is counted (and
     # decides the exit code), never raised as a traceback.
     with interrupts.handling(), interrupts.shielded():

@@ -1,0 +1,37 @@
+"""``balancer verify``: the proof by simulation that a design is balanced, with its figure."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..api import verify
+from ..errors import SpecError
+from ..plots import save_figure, verification_figure
+from ..progress import Progress
+from ..report import dumps_json, verification_text
+from .common import as_option, figure_path, load, wrote
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``balancer verify``; the exit code."""
+    plot = figure_path(args, args.plot, "--plot")
+    design = load(args)
+
+    try:
+        with Progress("verifying by simulation", enabled=not args.json) as progress:
+            verification = verify(design, method=args.method, duration=args.duration,
+                                  progress=progress)
+    except SpecError as exc:
+        raise as_option(exc, "simulation.duration", "--duration", args.duration) from None
+    paths = [] if plot is None else [plot]
+    if args.json:
+        doc = {"spec": args.spec, **verification.as_dict(), "plots": [str(p) for p in paths]}
+        text = dumps_json(doc)
+    else:
+        text = verification_text(verification, spec=args.spec) + "\n"
+    if plot is not None:
+        save_figure(verification_figure(design, verification), plot)
+        wrote(plot)
+    sys.stdout.write(text)
+    return 0
