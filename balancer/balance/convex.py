@@ -442,6 +442,11 @@ class ConvexSolver:
                               (2 * centre.imag, sf), (-1.0, j))
                 at_least(cap, -hi_m)
                 relaxed.append(b.name)
+            if b.offset is not None:  # a counterweight's spread: J about p ≤ m·(2R² + ρ²)
+                reach2 = b.counterweight_reach**2 / l**2
+                spread = combine((1.0, j), (-2 * centre.real, se), (-2 * centre.imag, sf),
+                                 (abs(centre) ** 2 - reach2 + margin, m))
+                at_most(spread, 0.0)
         for b in data.rotor_links:
             k = b.rotor
             if k in free:

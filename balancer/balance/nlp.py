@@ -152,6 +152,12 @@ class NlpSolver:
                     ubg.append(math.inf)
                 elif b.gyration > 0:
                     lbx[-1] = max(lbx[-1], b.mass[0] * b.gyration**2 / iref)
+                if b.offset is not None:  # its spread (LinkBounds.counterweight_reach)
+                    p = b.com_centre
+                    g.append((inertia + m * ((e - p.real) ** 2 + (f - p.imag) ** 2)
+                              - m * b.counterweight_reach**2) / iref)
+                    lbg.append(-math.inf)
+                    ubg.append(0.0)
             # A counterweight's variables are its own; the link's entries add the kept link's.
             shift = (0.0,) * 4 if b.offset is None else b.offset
             parts[k : k + 4] = [p + d for p, d in zip(physical_to_inertial(m, e, f, inertia),

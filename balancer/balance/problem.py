@@ -752,6 +752,18 @@ class LinkBounds:
         return self.com_about
 
     @property
+    def counterweight_reach(self) -> float:
+        """How far a counterweight's mass may spread from :attr:`about`, m: ``√(2R² + ρ²)``.
+
+        Its second moment about that point is at most its mass times the square of this: as a
+        body with its centre within ``R`` and its own radius of gyration within ``√(R² + ρ²)``,
+        ``ρ`` its least (a bound that never binds a counterweight of the least inertia its
+        gyration allows). A body of no mass has no inertia: the optimiser cannot buy a
+        counter-rotor's work with a massless flywheel.
+        """
+        return math.sqrt(2 * self.com_radius**2 + self.gyration**2)
+
+    @property
     def entries(self) -> slice:
         """The link's four entries in the design vector."""
         return slice(self.start, self.start + 4)
@@ -1065,8 +1077,9 @@ class NumericProblem:
     def absent(self, b: LinkBounds, own: NDArray[np.float64] | list[float]) -> bool:
         """Whether link ``b``'s counterweight in ``own`` (:meth:`own`) is none at all.
 
-        Only a counterweight whose mass may be zero; its own ``m``, ``m·e``, ``m·f``, ``J``
-        all within :data:`ABSENT` of the link's scales.
+        Only a counterweight whose mass may be zero; its own ``m``, ``m·e``, ``m·f`` and
+        (unless it is :attr:`inert`, settled afterwards) ``J`` all within :data:`ABSENT` of the
+        link's scales.
         """
         if b.offset is None or b.mass[0] > 0:
             return False
@@ -1074,7 +1087,7 @@ class NumericProblem:
         m, me, mf, j = (float(v) for v in own[k : k + 4])
         return (abs(m) <= ABSENT * b.mass_ref and abs(me) <= ABSENT * b.mass_ref * b.length
                 and abs(mf) <= ABSENT * b.mass_ref * b.length
-                and abs(j) <= ABSENT * b.inertia_ref)
+                and (self.inert[k + 3] or abs(j) <= ABSENT * b.inertia_ref))
 
     def without_absent(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64],
                                                              NDArray[np.bool_]]:
@@ -1270,7 +1283,10 @@ class NumericProblem:
             if not self.inert[k + 3]:
                 continue
             m, me, mf = own[k], own[k + 1], own[k + 2]
-            if not m > 0 or self.absent(b, own):  # no counterweight: nothing to settle
+            if self.absent(b, own):  # no counterweight: none of its inertia either
+                x[k + 3] = self.offset[k + 3]
+                continue
+            if not m > 0:  # nothing to settle
                 continue
             q = (me * me + mf * mf) / m
             lo = max(b.inertia[0], m * b.gyration**2)
@@ -1464,6 +1480,12 @@ class NumericProblem:
                 out.append(
                     f"{whose}: inertia {inertia:.9g} kg·m² outside [{lo:.9g}, {b.inertia[1]:.9g}]"
                 )
+            if b.offset is not None:  # its spread (LinkBounds.counterweight_reach)
+                p = b.com_centre
+                about_p = j - 2 * (p.real * me + p.imag * mf) + m * abs(p) ** 2
+                if about_p > m * b.counterweight_reach**2 + tol * iref:
+                    out.append(f"{whose}: second moment {about_p:.9g} kg·m² about {b.about} "
+                               f"beyond m·(2R² + ρ²) = {m * b.counterweight_reach**2:.9g}")
         for b in self.rotor_links:
             value = float(x[b.rotor])
             if b.counter_rotor is None:
