@@ -1854,6 +1854,24 @@ def expected_terms(weights: dict[str, float]) -> dict[str, float]:
     return {k: v for k, v in terms.items() if v > 0}
 
 
+def magnitudes(obj: Objective, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The size of the terms either route sums at each sampled angle, N and N·m.
+
+    Each link's inertial forces (``a_F = Σ|force map|·|x|``), and for the moment and the torque
+    their moments with the links' own (about the origin; power over the crank's speed): a
+    force times a lever arm of at most ``reach`` (the lengths' sum and the farthest centre of
+    mass). What is analytically zero in one route (a crank's centripetal force about its pivot)
+    is a sum of such terms in the other.
+    """
+    maps = obj.maps
+    ax = np.abs(x)
+    a_force = np.abs(maps["force"]) @ ax
+    reach = sum(abs(v) for v in obj.lengths) + max(
+        abs(complex(x[k + 1], x[k + 2])) / x[k] for k in (0, 4, 8))
+    a_moment = reach * a_force + np.abs(maps["moment"]) @ ax + np.abs(maps["torque"]) @ ax
+    return a_force, a_moment
+
+
 def term_values(obj: Objective, kappa: np.ndarray, x: np.ndarray, x0: np.ndarray
                 ) -> dict[str, tuple[float, float]]:
     """Each term's RMS (its unit) at design ``x`` from the own maps, and its rounding.
@@ -1863,16 +1881,8 @@ def term_values(obj: Objective, kappa: np.ndarray, x: np.ndarray, x0: np.ndarray
     much); ``added_mass`` is the total mass less the original's, to the rounding of the sums.
     """
     maps = obj.maps
-    ax = np.abs(x)
     out = {}
-    # The terms either route sums: each link's inertial forces (a_F), and their moments with
-    # the links' own (moment about the origin, power over the crank's speed): a force times a
-    # lever arm of at most ``reach`` (what is analytically zero in one route, e.g. a crank's
-    # centripetal force about its pivot, is a sum of such terms in the other).
-    a_force = np.abs(maps["force"]) @ ax
-    reach = sum(abs(v) for v in obj.lengths) + max(
-        abs(complex(x[k + 1], x[k + 2])) / x[k] for k in (0, 4, 8))
-    a_moment = reach * a_force + np.abs(maps["moment"]) @ ax + np.abs(maps["torque"]) @ ax
+    a_force, a_moment = magnitudes(obj, x)
     for name, key in (("shaking_moment", "moment"), ("driving_torque", "torque")):
         q = maps[key] @ x
         out[name] = (float(np.sqrt(np.mean(q * q))), float(np.sqrt(np.mean(
@@ -2164,13 +2174,15 @@ def run_problem(case: Case, backends, keep: Path | None) -> tuple[list[Run], dic
 
     ca = cycle_analysis(design.mechanism, case.speed, case.samples, loads=False)
     agree = 0.0
+    a_force, a_moment = magnitudes(obj, x0)
+    kappa = model.conditioning(np.arange(case.samples) * (2 * np.pi / case.samples))
     for name, key in (("shaking_force", "force"), ("shaking_moment", "moment"),
                       ("driving_torque", "torque")):
         values = obj.maps[key] @ x0
         theirs = getattr(ca.reactions, name)
         # against the magnitude of the terms (a design balanced already has a shaking force
-        # of rounding, whose relative difference means nothing)
-        terms = float(np.max(np.abs(obj.maps[key]) @ np.abs(x0)))
+        # of rounding, whose relative difference means nothing), with the loop's conditioning
+        terms = float(np.max(kappa ** 2 * (a_force if key == "force" else a_moment)))
         scale = max(float(np.max(np.abs(theirs))), terms, 1e-300)
         agree = max(agree, float(np.max(np.abs(theirs - values))) / scale)
     meta["maps_vs_cycle_analysis"] = agree
