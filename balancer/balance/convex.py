@@ -107,7 +107,8 @@ class Layout:
 
     Fixed entries sit in ``c``; a fixed centre of mass makes ``m·e``, ``m·f`` multiples of
     ``m``; a fixed inertia with a fixed centre of mass makes ``J = I + m·|s̄|²``. Inert entries
-    (see :attr:`NumericProblem.inert`) are left at 0 and settled afterwards. Each variable is
+    (see :attr:`NumericProblem.inert`) are left at 0 (a kept link's under a counterweight: at
+    its own, the counterweight's at 0) and settled afterwards. Each variable is
     one entry of ``x`` divided by its scale.
 
     Attributes
@@ -165,7 +166,9 @@ def layout(data: NumericProblem) -> Layout:
                 c[i] = part * c[k]
                 rows[i] = part * rows[k]
         if data.inert[k + 3]:
-            pass
+            # Left to settle; under a counterweight at the kept link's own (the counterweight's
+            # nil): at 0 it would be an inertia of −J₀, never none (NumericProblem.absent).
+            c[k + 3] = data.offset[k + 3]
         elif b.inertia_fixed and b.com_fixed is not None:
             s2 = abs(b.com_fixed) ** 2
             c[k + 3] = b.inertia[0] + s2 * c[k]
@@ -904,7 +907,7 @@ class ConvexSolver:
         own = data.own(x)
         for b in data.links:  # inert ones too: a move of the mass or centre of mass shifts I
             k = b.start
-            if data.absent(b, own):
+            if data.absent(b, own) or not own[k] > 0:  # (no mass: no centre to clip about)
                 continue
             q = (own[k + 1] ** 2 + own[k + 2] ** 2) / own[k]
             low = max(b.inertia[0], own[k] * b.gyration**2)
@@ -936,7 +939,8 @@ class ConvexSolver:
         The tie-break moves towards the preferred design only to the interior-point solver's
         accuracy (a mass of 2.10001 kg where nothing asks it to leave 2.1); each free entry of
         ``x`` is set to its preferred value where that keeps every constraint and the objective
-        (to 1e-12 relative).
+        (to 1e-12 relative). First each counterweight that may be none is taken off whole where
+        that keeps every constraint and makes the objective no worse.
         """
         data, lay = self.data, self.layout
         u = lay.u(x)
@@ -954,8 +958,9 @@ class ConvexSolver:
             trial = self.restore_balance(lay.u(trial_x), trial_pinned)
             xt = data.settle(lay.x(trial), for_motion=False)
             jt = data.reduced_objective(xt)
-            if (data.within(jt, objective, 1e-12) and data.within(objective, jt, 1e-12)
-                    and not data.violations(xt)):
+            # (no worse: a counterweight whose removal lowers J was an artefact, e.g. the
+            # apex of its cone approached with an inertia of the solver's tolerance)
+            if data.within(jt, objective, 1e-12) and not data.violations(xt):
                 u, x, objective, pinned = trial, xt, jt, trial_pinned
         for j in range(u.size):
             if u[j] == preferred[j]:
@@ -1096,6 +1101,8 @@ class ConvexSolver:
         for b in data.links:
             k = b.start
             if data.inert[k + 3] or (k + 3) not in index or data.absent(b, own):
+                continue
+            if not own[k] > 0:  # a counterweight at its cone's apex: no centre to clip about
                 continue
             q = (own[k + 1] ** 2 + own[k + 2] ** 2) / own[k]
             inertia = own[k + 3] - q

@@ -166,7 +166,9 @@ class Optimizer:
             if nlp.status == "optimal" and nlp.feasible:
                 if not feasible or not data.within(objective, nlp.objective, TIE_TOLERANCE):
                     xb, ok = self.convex.finalize(nlp.x)  # bounds exactly, Eq. 58 to rounding
-                    if ok:
+                    # (made exactly feasible it may have lost what it gained: in a thin
+                    # feasible set the projection costs more than the tolerance)
+                    if ok and (not feasible or data.objective(xb) < objective):
                         x, objective, feasible = xb, data.objective(xb), True
             else:
                 notes.append(f"IPOPT: {nlp.stage.solver_status}")

@@ -1331,9 +1331,13 @@ class NumericProblem:
         (:meth:`clamp_distance`).
         """
         out = {}
+        own_x = self.own(x)
         for b in self.links:
             rotor = float(x[b.rotor]) if b.rotor is not None else 0.0
-            if self.absent(b, self.own(x)):  # no counterweight: the link as it is
+            if self.absent(b, own_x) or (b.offset is not None and b.mass[0] == 0
+                                         and not own_x[b.start] > 0):
+                # no counterweight (none, or no mass where none is allowed: its mass put into
+                # its bounds is 0, and a body of no mass has no centre): the link as it is
                 original = b.original
                 out[b.name] = (original.mass, original.e, original.f, original.inertia, rotor)
                 continue
@@ -1532,14 +1536,19 @@ class NumericProblem:
         mass sits on its pivot contributes nothing, exactly, and must not hide a light link's
         unbalance); it is at least :data:`ROUNDING_FACTOR`·ε/:data:`FORCE_BALANCE_TOLERANCE`
         times the raw terms ``Σ_j |A_ij·x_j|`` (their rounding, which no design can beat) and
-        :data:`SMALL_ROW` of the row at the parameters' scales.
+        :data:`SMALL_ROW` of the row at the parameters' scales. Under a counterweight an entry
+        is the sum of the kept link's and the counterweight's (:attr:`offset`), whose rounding
+        is that of both: its raw term is ``|A_ij|·(|x_j − offset_j| + |offset_j|)`` (a
+        counterweight that cancels the kept link's first moment, as a slider-crank's rod
+        must have ``m·f = 0``, leaves a sum of rounding).
         """
         if self.force_balance is None:
             return np.zeros(0)
         a, rhs = self.force_balance
         x = np.asarray(x, dtype=float)
         abs_a, by_link, floor, abs_rhs = self._force_balance_sizes
-        raw = abs_a @ np.abs(x) + abs_rhs
+        offset = self.offset
+        raw = abs_a @ (np.abs(x - offset) + np.abs(offset)) + abs_rhs
         combined = np.abs((a * x) @ by_link).sum(axis=1) + abs_rhs
         size = np.maximum(np.maximum(combined, _RAW_SHARE * raw), floor)
         residual = np.abs(a @ x - rhs)
