@@ -29,6 +29,12 @@ NULL_TOLERANCE = 1e-11
 KEPT_TOLERANCE = 1e-7
 #: A residual below this (relative to the size of its terms) is rounding: force-balanced.
 RESIDUAL_FLOOR = 1e-9
+#: Share of a condition's magnitude at the links' own scales (each link's mass, and its mass
+#: times the linkage's size for its first moments) below which its terms count as vanishing:
+#: a condition whose every term is rounding (the first moments across links whose centres of
+#: mass lie on their lines, left by the sums that made them) is judged against that, not
+#: against its rounding-sized terms.
+SMALL_ROW = 1e-6
 #: Samples per design-vector entry (and at least :data:`MIN_SAMPLES`) to find the conditions.
 SAMPLES_PER_ENTRY = 6
 MIN_SAMPLES = 64
@@ -53,6 +59,7 @@ class ForceBalance:
     scales: NDArray[np.float64]
     singular_values: NDArray[np.float64]
     links: tuple[slice, ...] = ()
+    length: float = 1.0
 
     @property
     def count(self) -> int:
@@ -65,15 +72,24 @@ class ForceBalance:
         The size is the sum over links of each link's contribution (its entries combined
         first: a heavy link whose centre of mass sits on its pivot contributes nothing and
         must not hide a light link's unbalance), at least the raw terms' rounding,
-        ``64·ε·Σ_j |A_ij·x_j|``, over :data:`RESIDUAL_FLOOR`.
+        ``64·ε·Σ_j |A_ij·x_j|``, over :data:`RESIDUAL_FLOOR`, and :data:`SMALL_ROW` of the
+        row's magnitude at the links' own scales (``m`` for a mass, ``m·`` :attr:`length` for
+        a first moment).
         """
         x = np.asarray(x, dtype=float)
         terms = self.matrix * x
         combined = sum(np.abs(terms[:, s].sum(axis=1)) for s in self.links) if self.links \
             else np.abs(terms).sum(axis=1)
         raw = np.abs(terms).sum(axis=1)
+        own = np.zeros(x.size)
+        for s in self.links:  # (m, m·e, m·f, J): a mass, two first moments, an inertia
+            mass = abs(float(x[s.start]))
+            own[s.start : s.start + 4] = (mass, mass * self.length, mass * self.length,
+                                          mass * self.length**2)
         eps = np.finfo(float).eps
-        size = np.maximum(np.maximum(combined, 64 * eps / RESIDUAL_FLOOR * raw), 1e-300)
+        size = np.maximum.reduce([combined, 64 * eps / RESIDUAL_FLOOR * raw,
+                                  SMALL_ROW * (np.abs(self.matrix) @ own),
+                                  np.full(combined.shape, 1e-300)])
         return np.abs(terms.sum(axis=1)) / size
 
     def residual(self, x: NDArray[np.float64]) -> float:
@@ -133,13 +149,13 @@ def force_balance_conditions(mech) -> ForceBalance:
         return cache["force balance"]
     layout = mech.layout
     links = tuple(layout.link_slice(name) for name in mech.structure.names)
+    length = mech.structure.length_scale()
     closed = mech.closed_form_force_balance()
     if closed is not None:  # the seeds' conditions, exact
         result = ForceBalance(matrix=closed, scales=np.ones(layout.size),
-                              singular_values=np.zeros(0), links=links)
+                              singular_values=np.zeros(0), links=links, length=length)
         cache["force balance"] = result
         return result
-    length = mech.structure.length_scale()
     scales = np.ones(layout.size)
     for name in mech.structure.names:
         scales[layout.index(name, "m")] = length
@@ -174,7 +190,8 @@ def force_balance_conditions(mech) -> ForceBalance:
     if null.size and np.max(np.abs(df @ null)) > 1e3 * NULL_TOLERANCE * top:
         raise SolverError("the force-balance conditions found at sampled angles do not hold "
                           "at others: the sampling missed a condition")
-    result = ForceBalance(matrix=rows * scales, scales=scales, singular_values=sv, links=links)
+    result = ForceBalance(matrix=rows * scales, scales=scales, singular_values=sv, links=links,
+                          length=length)
     cache["force balance"] = result
     return result
 

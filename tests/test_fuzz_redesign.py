@@ -19,18 +19,7 @@ COUNTS = {"random": 12, "complete": 8, "zero-force": 6, "borderline": 12, "infea
           "scale": 10, "counterweight": 30, "cw-none": 30, "cw-borderline": 24}
 #: Defects known and not fixed in the package, by (family, problem): the classes each shows.
 #: The test fails when one of them is no longer seen (remove it then).
-KNOWN: dict[tuple[str, int], set[str]] = {
-    # The optimum wants inertia on the coupler (the rocker) and a counterweight of no mass
-    # may carry any: the spec bounds its radius of gyration below only. The tool returns a
-    # body of ~1e-11 kg with an inertia of 0.27 kg·m² (11 kg·m²), which the report calls
-    # "rebuild" (its mass below 1e-9 of the link's) on a link that is kept.
-    ("cw-none", 7): {"report-kind"},
-    ("cw-none", 26): {"report-kind"},
-    # A thin feasible set: the design made exactly feasible by projecting onto the bounds
-    # tightened by a margin (convex.MARGIN) gets a crank counterweight of 2.5 mg at A0, which
-    # changes nothing; nothing takes it off after (status "feasible").
-    ("cw-borderline", 21): {"counterweight-not-none"},
-}
+KNOWN: dict[tuple[str, int], set[str]] = {}
 
 
 @pytest.mark.slow

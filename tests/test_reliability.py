@@ -989,15 +989,14 @@ def test_the_nlp_backend_keeps_the_convex_design_where_its_own_made_exact_is_wor
     assert nlp.objective <= convex.objective
 
 
-# -- found by the redesign campaign with counterweights and not fixed (see each reason) ----------
+# -- found by the redesign campaign with counterweights ------------------------------------------
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "a counterweight's radius of gyration is bounded below only: one of no mass may carry any "
-    "inertia, the optimum is such a body (not attained), and the tool returns 4e-10 kg with "
-    "0.27 kg·m² about its centre (a radius of gyration of 26 km), reported as 'rebuild' with "
-    "mass 0 on a link that is kept"))
 def test_a_counterweight_helping_by_its_inertia_alone_is_a_body():
+    """The optimum wants inertia on the coupler; a counterweight of no mass carried any (its
+    radius of gyration was bounded below only): a body of 4e-10 kg with 0.27 kg·m² about its
+    centre, a radius of gyration of 26 km, reported as rebuilding a kept link. Its spread is
+    bounded now (LinkBounds.counterweight_reach)."""
     result = optimize(spec.load_design(DATA / "counterweight_helping_by_its_inertia_alone.toml"),
                       "convex")
     weight = result.counterweights["coupler"]
@@ -1005,21 +1004,17 @@ def test_a_counterweight_helping_by_its_inertia_alone_is_a_body():
     assert weight.kind == "none" or weight.inertia < weight.mass * 1e3**2  # gyration < 1 km
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "finalize projects onto the bounds tightened by MARGIN, which puts a counterweight that "
-    "may be none off its cone's apex (2.5 mg at A0, changing nothing); nothing takes it off "
-    "after"))
 def test_a_counterweight_at_a_pivot_that_changes_nothing_is_none_in_a_thin_set():
+    """finalize projects onto the bounds tightened by a margin, which put a counterweight that
+    may be none off its cone\'s apex (2.5 mg at A0, changing nothing)."""
     result = optimize(spec.load_design(DATA / "thin_set_nlp_design_made_exact.toml"), "convex")
     assert result.counterweights["crank"].kind == "none"
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "a counterweight of radius 0 is a degenerate cone (a free link's radius 0 is a fixed "
-    "centre of mass in the layout, a counterweight's is not): its near-apex solution, clamped "
-    "onto the point, breaks force balance in a thin feasible set; 'no feasible design found' "
-    "on a feasible problem (and a certified lower bound of -9.7e11 against J = 4.6e11)"))
 def test_a_counterweight_at_a_pivot_beside_a_thin_set_is_found():
+    """A counterweight of radius 0 (a degenerate cone) beside a thin feasible set: its near-apex
+    solution, clamped onto the point, broke force balance (\'no feasible design found\' on a
+    feasible problem)."""
     result = optimize(spec.load_design(DATA / "counterweight_at_a_pivot_beside_a_thin_set.toml"),
                       "convex")
     assert result.success

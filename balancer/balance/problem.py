@@ -75,7 +75,7 @@ from numpy.typing import NDArray
 from .. import tomltext as toml
 from ..cycle import sample_angles
 from ..errors import SpecError
-from ..force_balance import force_balance_conditions
+from ..force_balance import SMALL_ROW, force_balance_conditions
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import GROUND, Design, Link
@@ -105,9 +105,6 @@ FEASIBILITY_TOLERANCE = 1e-9
 FORCE_BALANCE_TOLERANCE = 1e-12
 #: Rounding of the objective relative to the rounding of one sum (:meth:`NumericProblem.rounding`).
 ROUNDING_FACTOR = 64.0
-#: Share of a force-balance row's magnitude at the parameters' scales below which its terms
-#: count as vanishing (:meth:`NumericProblem.force_balance_rows`).
-SMALL_ROW = 1e-6
 #: The share of a row's raw terms that its size is at least: their rounding over the tolerance.
 _RAW_SHARE = ROUNDING_FACTOR * float(np.finfo(float).eps) / FORCE_BALANCE_TOLERANCE
 #: A bound met to this (relative, :meth:`NumericProblem.violations`) is met to rounding: the
@@ -1365,9 +1362,11 @@ class NumericProblem:
         """Physical values of one link put exactly into its bounds ``b``.
 
         Mass into its range; the centre of mass onto the disc (radially) or to its fixed
-        place; the inertia into ``[max(I_low, m·ρ²), I_high]``; the counter-rotor into its
-        range. A bound derived by arithmetic (a distance, ``m·ρ²``) is met with a margin of a
-        few units in the last place, so that it holds whichever way a reader rounds it.
+        place; the inertia into ``[max(I_low, m·ρ²), I_high]``, a counterweight's also under
+        its spread (:attr:`LinkBounds.counterweight_reach`: at most ``m·(reach² − |c̄ − p|²)``);
+        the counter-rotor into its range. A bound derived by arithmetic (a distance, ``m·ρ²``)
+        is met with a margin of a few units in the last place, so that it holds whichever way a
+        reader rounds it.
         """
         ulps = 8 * 2.0**-52
         m = min(max(m, b.mass[0]), b.mass[1])
@@ -1378,9 +1377,13 @@ class NumericProblem:
         else:
             e, f = NumericProblem._onto_disc(b.com_centre, b.com_radius, e, f)
         least = m * b.gyration**2 * (1 + ulps)
-        if least > b.inertia[1]:
-            least = b.inertia[1]
-        inertia = min(max(inertia, b.inertia[0], least), b.inertia[1])
+        most = b.inertia[1]
+        if b.offset is not None:  # a counterweight's spread
+            spread = m * (b.counterweight_reach**2 - abs(complex(e, f) - b.com_centre) ** 2)
+            most = min(most, max(spread * (1 - ulps), least))
+        if least > most:
+            least = most
+        inertia = min(max(inertia, b.inertia[0], least), most)
         if b.counter_rotor is not None:
             rotor = min(max(rotor, b.counter_rotor[0]), b.counter_rotor[1])
         return m, e, f, inertia, rotor

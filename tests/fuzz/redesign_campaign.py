@@ -308,6 +308,16 @@ class Bounds:
         """Whether the link may stay as it is with no counterweight (``mass = [0, hi]``)."""
         return self.offset is not None and self.mass[0] == 0.0
 
+    @property
+    def reach2(self) -> float:
+        """A counterweight's spread: its second moment about com_about ≤ ``m·reach2``.
+
+        The spec's rule (DESIGN, counterweights; the tool's ``counterweight_reach``): ``2R² +
+        ρ²``, ``R`` its radius, ``ρ`` its least radius of gyration (a body of no mass has no
+        inertia).
+        """
+        return 2 * (self.radius or 0.0) ** 2 + self.rho ** 2
+
 
 def resolve(case: Case) -> list[Bounds]:
     """Per link: what may change and within which bounds."""
@@ -430,6 +440,10 @@ def cw_violations(b: Bounds, dm: float, ds: complex, dj: float, tm: float = 0.0,
         out[f"{name}.gyration"] = max(-own - allow, 0.0) / b.iref
     else:  # no mass beyond rounding: only a negative inertia is certainly wrong
         out[f"{name}.gyration"] = max(-dj - tj, 0.0) / b.iref
+    # Its spread: J about p = J − 2·p·(m·e) + m·p² ≤ m·reach2 (p on the link's x-axis).
+    about_p = dj - 2 * p.real * ds.real - 2 * p.imag * ds.imag + dm * abs(p) ** 2
+    allow = tj + 2 * abs(p) * ts + (abs(p) ** 2 + b.reach2) * tm
+    out[f"{name}.spread"] = max(about_p - max(dm, 0.0) * b.reach2 - allow, 0.0) / b.iref
     return out
 
 
@@ -905,6 +919,10 @@ def own_optimum(case, bounds, model, obj: Objective, vrows, shrink: float = 0.0,
         lo, hi = b.inertia[0] / b.iref, b.inertia[1] / b.iref
         eta = shrink if hi - lo > 4 * shrink else 0.0
         rho2 = (b.rho / b.length) ** 2
+        if b.offset is not None:  # a counterweight's spread (Bounds.reach2), tightened on m
+            c = b.centre / b.length
+            reach2 = b.reach2 / b.length ** 2
+            cons.append(uj - 2 * c * ue + (c * c - reach2 + shrink) * um <= 0)
         if b.com_fixed is not None:
             inertia = uj - (abs(b.com_fixed) / b.length) ** 2 * um
             cons.append(inertia >= lo + eta)

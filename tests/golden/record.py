@@ -66,9 +66,9 @@ def difference(recorded: str, now: str, *, table: bool = False) -> str | None:
     a, b = _counters_masked(recorded), _counters_masked(now)
     if a == b:
         return None
-    if _NUMBER.split(a) != _NUMBER.split(b):
+    if _skeleton(a) != _skeleton(b):
         for line_a, line_b in zip(a.splitlines(), b.splitlines(), strict=False):
-            if _NUMBER.split(line_a) != _NUMBER.split(line_b):
+            if _skeleton(line_a) != _skeleton(line_b):
                 return f"text differs:\n  recorded: {line_a}\n  now:      {line_b}"
         return "a different number of lines"
     xs, ys = _NUMBER.findall(a), _NUMBER.findall(b)
@@ -79,6 +79,14 @@ def difference(recorded: str, now: str, *, table: bool = False) -> str | None:
         if abs(fx - fy) > max(RELATIVE * max(abs(fx), abs(fy)), OF_LARGEST * largest, printed):
             return f"a figure differs: recorded {x}, now {y}"
     return None
+
+
+def _skeleton(text: str) -> list[str]:
+    """The text between the numbers, a table's padding and rules reduced to one character.
+
+    (A figure printed one digit shorter narrows its column.)
+    """
+    return [re.sub(r"-{2,}", "-", re.sub(r"[ \t]+", " ", part)) for part in _NUMBER.split(text)]
 
 
 def _last_digit(token: str) -> float:
