@@ -84,7 +84,7 @@ def test_a_bound_wider_than_the_optimiser_can_hold_is_refused_by_name(line, wide
     # infinity (an internal error); on PB1 a bound 1e12 times the link's scale lost the proof
     # of optimality and 1e15 failed the solve. Beyond BOUND_RANGE (1e9) times the link's mass,
     # length or inertia scale a bound is bad input, named; well within it PB1 still solves.
-    from balancer.balance.problem import BOUND_RANGE
+    from balancer.balance.bounds import BOUND_RANGE
 
     crank = PB1.index("[balance.crank]")
     assert line in PB1[crank:]

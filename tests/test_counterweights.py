@@ -335,15 +335,15 @@ def test_random_counterweight_problems_end_feasible_or_say_what_is_missing(seed)
     import numpy as np
     from conftest import random_linkage
 
-    from balancer.balance.problem import (
+    from balancer.balance.result import InfeasibleError
+    from balancer.conditions import force_balance_error
+    from balancer.model import Design, Operation
+    from balancer.model.balance import (
         BalanceProblem,
         CounterweightFreedom,
         LinkFreedom,
         Objective,
     )
-    from balancer.balance.result import InfeasibleError
-    from balancer.conditions import force_balance_error
-    from balancer.model import Design, Operation
 
     rng = np.random.default_rng(seed)
     linkage = random_linkage(rng, loads=False, rotors=True, full_turn=True)

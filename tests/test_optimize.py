@@ -21,14 +21,8 @@ from conftest import random_linkage
 from balancer import spec
 from balancer.balance.convex import CLARABEL_SETTINGS, TIE_ACCEPT
 from balancer.balance.optimizer import ConvexSolver, InfeasibleError, Optimizer, Status, optimize
-from balancer.balance.problem import (
-    BalanceProblem,
-    LinkFreedom,
-    NumericProblem,
-    Objective,
-    numeric_problem,
-    physical_to_inertial,
-)
+from balancer.balance.problem import NumericProblem, numeric_problem
+from balancer.balance.regressors import physical_to_inertial
 from balancer.balance.result import GAP_TOLERANCE
 from balancer.conditions import (
     berkof_residuals,
@@ -38,6 +32,7 @@ from balancer.conditions import (
 from balancer.cycle import cycle_analysis
 from balancer.errors import SolverError, SpecError
 from balancer.model import Design, Operation
+from balancer.model.balance import BalanceProblem, LinkFreedom, Objective
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

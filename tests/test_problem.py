@@ -16,19 +16,15 @@ import pytest
 from conftest import CLASS_EXAMPLES, PAPER_LENGTHS, paper_linkage, paper_links, random_linkage
 
 from balancer import spec
-from balancer.balance.problem import (
-    BalanceProblem,
-    LinkFreedom,
-    Objective,
-    cycle_regressors,
-    numeric_problem,
-    resolve_link,
-)
+from balancer.balance.bounds import resolve_link
+from balancer.balance.problem import numeric_problem
+from balancer.balance.regressors import cycle_regressors
 from balancer.cli import main
 from balancer.cycle import cycle_analysis
 from balancer.errors import AssemblyError, SpecError
 from balancer.mechanisms import mechanism_of
 from balancer.model import Design, FourBar, Operation
+from balancer.model.balance import BalanceProblem, LinkFreedom, Objective
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

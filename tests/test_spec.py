@@ -199,7 +199,7 @@ def test_a_linkage_with_names_toml_must_quote_round_trips_through_its_balanced_s
     # [balance.a.b], a table b inside a table a, and the balanced spec did not load again. Link
     # and point names that are no bare keys (a dot, a space, a quote) are quoted wherever the
     # spec names them: links, points, [balance.<link>] and its com_about.
-    text = (Path(spec.__file__).parent / "examples" / "watt_sixbar.toml").read_text()
+    text = (Path(spec.__file__).parent.parent / "examples" / "watt_sixbar.toml").read_text()
     text = text.replace("[links.crank]", '[links."a.b"]').replace(
         "[balance.crank]", '[balance."a.b"]').replace('input = "crank"', 'input = "a.b"')
     point = 'A "0"'  # a quote and a space: a quoted key, an escaped string

@@ -1188,7 +1188,7 @@ class ConvexSolver:
         minimises their weighted sum subject to Eq. 58; its nonzero slacks name the bounds,
         and its design the values that suffice together. (Only force balance can make the
         problem infeasible: every other condition is met by some inertia, and
-        :func:`~balancer.balance.problem.check_problem` has rejected empty ranges.) Returns
+        :func:`~balancer.balance.bounds.check_problem` has rejected empty ranges.) Returns
         ``None`` when no bound needs widening (the problem is feasible), or when no value lies
         beyond the tolerance (undecided: the problem is no more than that far from feasible).
         """

@@ -9,7 +9,7 @@ afterwards.
 
 The objective is the same ``J`` as the convex problem's, written through the inertial
 parameters ``π(p) = (m, m·e, m·f, I + m·(e² + f²))``
-(:func:`balancer.balance.problem.physical_to_inertial`) and the factor ``R`` of the regressors:
+(:func:`balancer.balance.regressors.physical_to_inertial`) and the factor ``R`` of the regressors:
 ``J = ‖R·π‖² + w_m·Δm``. Constraints: force balance (bilinear equalities in these variables),
 the centre of mass in its disc ``|s̄ − c|² ≤ R²``, ``I ≥ m·ρ²``, and simple bounds — an upper
 inertia bound is exact here, which is where this formulation can beat the convex relaxation.
@@ -33,7 +33,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import interrupts
-from .problem import NumericProblem, inertial_to_physical, physical_to_inertial
+from .problem import NumericProblem
+from .regressors import inertial_to_physical, physical_to_inertial
 from .result import StageReport
 
 #: IPOPT's options, in one place: quiet and tight. The start is the convex optimum (a primal

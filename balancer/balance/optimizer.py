@@ -46,9 +46,10 @@ import numpy as np
 from ..cycle import cycle_analysis
 from ..errors import SpecError
 from ..model import Design
+from ..model.balance import BalanceProblem
 from .convex import ConvexSolution, ConvexSolver
 from .nlp import NlpSolution, NlpSolver
-from .problem import ROUNDING_TOLERANCE, BalanceProblem, NumericProblem, numeric_problem
+from .problem import ROUNDING_TOLERANCE, NumericProblem, numeric_problem
 from .result import (
     GAP_TOLERANCE,
     BalanceResult,
@@ -115,7 +116,7 @@ class Optimizer:
         It shares what does not depend on the bounds
         (:meth:`~balancer.balance.problem.NumericProblem.with_problem`): a sweep over bounds
         re-solves without rebuilding the regressors. ``problem`` is a
-        :class:`~balancer.balance.problem.BalanceProblem`, e.g. ``dataclasses.replace`` of
+        :class:`~balancer.model.balance.BalanceProblem`, e.g. ``dataclasses.replace`` of
         ``design.balance``, or another spec's.
 
         Raises

@@ -31,11 +31,12 @@ from numpy.typing import NDArray
 from ..errors import SolverError, SpecError
 from ..force_balance import RESIDUAL_FLOOR, force_balance_residual
 from ..model import Design
+from ..model.balance import Objective
 from .certificate import Constraint, lower_bound
 from .certificate import Objective as Certified
 from .conic import ConicProgram
 from .convex import Compressed, ConvexSolver
-from .problem import NumericProblem, Objective, numeric_problem
+from .problem import NumericProblem, numeric_problem
 
 #: The second objectives, and the name and unit each is reported under.
 #: The second objectives of a front (``pareto --against``).

@@ -14,11 +14,11 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
-from ..cycle import CycleAnalysis
+from ..cycle import CycleAnalysis, cycle_analysis
 from ..errors import SolverError
 from ..model import Design
+from ..model.balance import Objective, ObjectiveTerm
 from .counterweights import Counterweight, added_mass, counterweights
-from .problem import Objective, ObjectiveTerm
 
 #: Gap to the certified lower bound, relative to the problem's scale (the original design's
 #: RMS; :meth:`balancer.balance.problem.NumericProblem.gap`), within which a design is called
@@ -169,8 +169,6 @@ class BalanceResult:
         :attr:`after` are the inertial part alone, which the optimiser balances; without loads
         and gravity the two agree.
         """
-        from ..cycle import cycle_analysis
-
         speed, samples = self.before.speed, self.before.samples
         return tuple(cycle_analysis(model, speed, samples, gravity=self.gravity)
                      for model in (self.original, self.linkage))  # type: ignore[return-value]

@@ -12,6 +12,7 @@ from typing import ClassVar, Literal
 
 from .. import validate as v
 from ..errors import SpecError
+from .balance import BalanceProblem
 from .mechanisms import Mechanism
 
 Drive = Literal["free", "constant-speed"]
@@ -156,7 +157,7 @@ class Design:
     mechanism: Mechanism
     operation: Operation | None = None
     simulation: SimulationSettings = field(default_factory=SimulationSettings)
-    balance: object | None = None
+    balance: BalanceProblem | None = None
     original: Mechanism | None = None
     title: str = ""
 

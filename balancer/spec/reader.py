@@ -1,4 +1,4 @@
-"""Design specs in TOML: load and validate them into model objects, and write them back.
+"""Design specs in TOML: load and validate them into model objects.
 
 The key names are fixed (see the project's DESIGN.md)::
 
@@ -43,14 +43,13 @@ import cmath
 import math
 import os
 import tomllib
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from . import tomltext as toml
-from . import validate as v
-from .errors import SpecError
-from .model import (
+from .. import validate as v
+from ..errors import SpecError
+from ..mechanisms import mechanism_of
+from ..model import (
     GROUND,
     Body,
     Design,
@@ -64,167 +63,16 @@ from .model import (
     SliderCrank,
     Spring,
 )
-from .outputs import write_atomic
+from .balance import read_balance
+from .tables import Table
 
 MECHANISMS = {"four-bar": FourBar, "slider-crank": SliderCrank, "linkage": Linkage}
+
+
 MECHANISM_TYPES = tuple(MECHANISMS)
 
 
-class _Table:
-    """A TOML table being read.
-
-    Typed access by key, with the dotted path for messages, and a check that every key was used.
-    """
-
-    def __init__(self, data: dict[str, Any], path: str) -> None:
-        self.data = data
-        self.path = path
-        self.used: set[str] = set()
-        self.known: tuple[str, ...] | None = _KNOWN_KEYS.get(_generic(path))
-        if self.known is not None:
-            self.expect(self.known)
-
-    def expect(self, known: tuple[str, ...]) -> None:
-        """Declare the keys this table may hold, and report a typo now.
-
-        Before the missing key it causes ("mas" before "mass is missing").
-        """
-        self.known = tuple(known)
-        for name in self.data:
-            if name not in self.known:
-                self._unknown(name)
-
-    def key(self, name: str) -> str:
-        return f"{self.path}.{name}" if self.path else name
-
-    def has(self, name: str) -> bool:
-        return name in self.data
-
-    def raw(self, name: str) -> Any:
-        self.used.add(name)
-        return self.data[name]
-
-    def _missing(self, name: str) -> SpecError:
-        return SpecError("missing required key", key=self.key(name))
-
-    def table(self, name: str, *, required: bool = True) -> _Table | None:
-        if name not in self.data:
-            if required:
-                raise self._missing(name)
-            return None
-        value = self.raw(name)
-        if not isinstance(value, dict):
-            raise SpecError("must be a table", key=self.key(name), value=value)
-        return _Table(value, self.key(name))
-
-    def number(
-        self,
-        name: str,
-        *,
-        default: float | None = None,
-        check: Callable[[float], bool] | None = None,
-        requirement: str = "",
-    ) -> float:
-        if name not in self.data:
-            if default is None:
-                raise self._missing(name)
-            return default
-        value = self.raw(name)
-        return _as_number(value, self.key(name), check, requirement)
-
-    def positive(self, name: str, *, default: float | None = None) -> float:
-        return self.number(name, default=default, check=lambda x: x > 0, requirement="positive")
-
-    def nonnegative(self, name: str, *, default: float | None = None) -> float:
-        return self.number(
-            name, default=default, check=lambda x: x >= 0, requirement="zero or positive"
-        )
-
-    def value(self, name: str, default: Any) -> Any:
-        """The raw value (checked by the model object it goes into), or ``default``."""
-        return self.raw(name) if name in self.data else default
-
-    def string(self, name: str, *, choices: tuple[str, ...], default: str | None = None) -> str:
-        if name not in self.data:
-            if default is None:
-                raise self._missing(name)
-            return default
-        return v.choice(self.raw(name), self.key(name), choices)
-
-    def text(self, name: str, *, default: str) -> str:
-        if name not in self.data:
-            return default
-        value = self.raw(name)
-        if not isinstance(value, str):
-            raise SpecError("must be a string", key=self.key(name), value=value)
-        return value
-
-    def vector2(self, name: str, *, default: tuple[float, float]) -> tuple[float, float]:
-        if name not in self.data:
-            return default
-        return v.vector2(self.raw(name), self.key(name))
-
-    def finish(self) -> None:
-        """Raise on the first key that was not used (unknown, or a typo)."""
-        for name in self.data:
-            if name not in self.used:
-                self._unknown(name)
-
-    def _unknown(self, name: str) -> None:
-        import difflib  # only for a spec that is wrong
-
-        known = sorted(self.known or ())
-        close = difflib.get_close_matches(name, known, n=1)
-        hint = f"; did you mean '{close[0]}'?" if close else ""
-        raise SpecError(f"unknown key '{name}'{hint}", key=self.key(name))
-
-
-def _generic(path: str) -> str:
-    """Map a concrete table path to the pattern used for key suggestions."""
-    parts = path.split(".")
-    if len(parts) >= 2 and parts[0] in ("links", "original"):
-        parts[1] = "*"
-    return ".".join(parts)
-
-
-_KNOWN_KEYS: dict[str, tuple[str, ...]] = {
-    "": ("title", "mechanism", "links", "springs", "operation", "simulation", "balance",
-         "original"),
-    "mechanism": ("type", "branch", "lengths", "input", "points", "sliders"),
-    "links.*": ("points", "mass", "inertia", "com", "force", "moment", "counter_rotor",
-                "gas_force"),
-    "original.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor", "gas_force"),
-    "links.*.com": ("s", "sigma", "e", "f", "at"),
-    "original.*.com": ("s", "sigma", "e", "f", "at"),
-    "operation": ("speed", "samples", "gravity"),
-    "simulation": (
-        "duration",
-        "theta1",
-        "omega1",
-        "gravity",
-        "drive",
-        "method",
-        "rtol",
-        "atol",
-        "outputs",
-    ),
-}
-
-
-def _as_number(
-    value: Any, key: str, check: Callable[[float], bool] | None, requirement: str
-) -> float:
-    x = v.number(value, key)
-    if check is not None and not check(x):
-        raise SpecError(f"must be {requirement}", key=key, value=value)
-    return x
-
-
-# ----------------------------------------------------------------------------------------------
-# Reading
-
-
-def _read_link(table: _Table, name: str, mechanism_class, frame=None) -> Link:
+def _read_link(table: Table, name: str, mechanism_class, frame=None) -> Link:
     """One link; its values are checked by :class:`~balancer.model.Link` (keys prefixed).
 
     ``frame`` (a general linkage's link: its origin, complex, and its x-axis's angle at the
@@ -285,7 +133,7 @@ def _read_link(table: _Table, name: str, mechanism_class, frame=None) -> Link:
         )
 
 
-def _read_gas_force(table: _Table) -> GasForce:
+def _read_gas_force(table: Table) -> GasForce:
     """``gas_force = 1500.0`` or ``gas_force = {crank_angle = [...], force = [...], period}``."""
     key = table.key("gas_force")
     if not table.has("gas_force"):
@@ -293,7 +141,7 @@ def _read_gas_force(table: _Table) -> GasForce:
     raw = table.raw("gas_force")
     if not isinstance(raw, dict):
         return GasForce.constant(v.number(raw, key))
-    sub = _Table(raw, key)
+    sub = Table(raw, key)
     sub.expect(("crank_angle", "force", "period"))
     for name in ("crank_angle", "force"):
         if not sub.has(name):
@@ -308,7 +156,7 @@ def _read_gas_force(table: _Table) -> GasForce:
     return gas
 
 
-def _read_links(table: _Table, mechanism_class,
+def _read_links(table: Table, mechanism_class,
                 names: tuple[str, ...] | None = None) -> tuple[dict[str, Link], GasForce]:
     """The links of a mechanism, and the gas force on its slider (if it has one).
 
@@ -329,7 +177,7 @@ def _read_links(table: _Table, mechanism_class,
     return links, gas
 
 
-def _read_mechanism(root: _Table) -> FourBar | SliderCrank | Linkage:
+def _read_mechanism(root: Table) -> FourBar | SliderCrank | Linkage:
     mech = root.table("mechanism")
     assert mech is not None
     kind = mech.string("type", choices=MECHANISM_TYPES)
@@ -361,18 +209,18 @@ def _read_mechanism(root: _Table) -> FourBar | SliderCrank | Linkage:
     return FourBar(lengths=tuple(lengths), branch=branch, **links)  # type: ignore[arg-type]
 
 
-def _list_of_tables(table: _Table, name: str) -> list[_Table]:
-    """An array of tables (``[[name]]``), each as a :class:`_Table` with an indexed path."""
+def _list_of_tables(table: Table, name: str) -> list[Table]:
+    """An array of tables (``[[name]]``), each as a :class:`Table` with an indexed path."""
     if not table.has(name):
         return []
     raw = table.raw(name)
     key = table.key(name)
     if not isinstance(raw, list) or not all(isinstance(item, dict) for item in raw):
         raise SpecError(f"must be an array of tables ([[{key}]])", key=key, value=raw)
-    return [_Table(item, f"{key}[{i}]") for i, item in enumerate(raw)]
+    return [Table(item, f"{key}[{i}]") for i, item in enumerate(raw)]
 
 
-def _names(table: _Table, name: str) -> tuple[str, ...]:
+def _names(table: Table, name: str) -> tuple[str, ...]:
     """A required list of names (strings)."""
     if not table.has(name):
         raise table._missing(name)
@@ -382,7 +230,7 @@ def _names(table: _Table, name: str) -> tuple[str, ...]:
     return tuple(raw)
 
 
-def _read_linkage(root: _Table, mech: _Table) -> Linkage:
+def _read_linkage(root: Table, mech: Table) -> Linkage:
     """A general linkage (``type = "linkage"``; DESIGN.md, "General planar linkages")."""
     mech.expect(("type", "input", "points", "sliders"))
     if not mech.has("input"):
@@ -466,7 +314,7 @@ def _frame(name: str, link_points, positions, sliders) -> tuple[complex, float] 
     return origin, math.atan2(axis.imag, axis.real)
 
 
-def _read_operation(root: _Table) -> Operation | None:
+def _read_operation(root: Table) -> Operation | None:
     table = root.table("operation", required=False)
     if table is None:
         return None
@@ -479,13 +327,11 @@ def _read_operation(root: _Table) -> Operation | None:
     return operation
 
 
-def _read_simulation(root: _Table, mechanism) -> SimulationSettings:
+def _read_simulation(root: Table, mechanism) -> SimulationSettings:
     table = root.table("simulation", required=False)
     defaults = SimulationSettings()
     if table is None:
         return defaults
-    from .mechanisms import mechanism_of
-
     method = table.string("method", choices=mechanism_of(mechanism).formulation_names,
                           default="") or None
     with v.under("simulation"):
@@ -499,7 +345,7 @@ def _read_simulation(root: _Table, mechanism) -> SimulationSettings:
     return settings
 
 
-def _read_original(root: _Table, mechanism):
+def _read_original(root: Table, mechanism):
     table = root.table("original", required=False)
     if table is None:
         return None
@@ -516,15 +362,13 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
         With the key and value at fault and ``source`` as the file name.
     """
     try:
-        root = _Table(data, "")
+        root = Table(data, "")
         title = root.text("title", default="")
         mechanism = _read_mechanism(root)
         operation = _read_operation(root)
         simulation = _read_simulation(root, mechanism)
         balance = None
         if root.has("balance"):
-            from .balance.problem import read_balance  # the redesign problem's own reader
-
             balance = read_balance(root.table("balance"), mechanism)
         original = _read_original(root, mechanism)
         root.finish()
@@ -574,129 +418,3 @@ def loads_design(text: str, source: str = "<string>") -> Design:
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(f"not valid TOML: {exc}", source=source) from None
     return design_from_dict(data, source=source)
-
-
-# ----------------------------------------------------------------------------------------------
-# Writing
-#
-# A small emitter for this fixed schema rather than a general TOML writer: it writes floats
-# with ``repr`` (shortest text that reads back to the same number, so a model round-trips
-# exactly) and adds unit comments a designer can read.
-
-
-def _link_lines(link: Link, frame: str = "link") -> list[str]:
-    lines = [
-        f"mass = {toml.number(link.mass)}  # kg",
-        f"inertia = {toml.number(link.inertia)}  # kg·m² about the centre of mass",
-        f"com = {{ e = {toml.number(link.e)}, f = {toml.number(link.f)} }}  "
-        + (f"# m (s = {link.s:.6g} m, sigma = {link.sigma:.6g} rad)" if frame == "link"
-           else "# m from the pin, in global axes"),
-    ]
-    if link.force != (0.0, 0.0):
-        lines.append(f"force = [{toml.number(link.force[0])}, {toml.number(link.force[1])}]  # N")
-    if link.moment != 0.0:
-        lines.append(f"moment = {toml.number(link.moment)}  # N·m")
-    if link.counter_rotor != 0.0:
-        lines.append(f"counter_rotor = {toml.number(link.counter_rotor)}  # kg·m²")
-    return lines
-
-
-def _gas_lines(gas: GasForce) -> list[str]:
-    if gas.is_zero:
-        return []
-    if len(gas.values) == 1:
-        return [f"gas_force = {toml.number(gas.values[0])}  # N along the guide"]
-    angles = ", ".join(toml.number(a) for a in gas.angles)
-    values = ", ".join(toml.number(v) for v in gas.values)
-    return [f"gas_force = {{ crank_angle = [{angles}], force = [{values}], "
-            f"period = {toml.number(gas.period)} }}  # rad, N"]
-
-
-def _links_lines(mech, prefix: str) -> list[str]:
-    out = []
-    for name in mech.link_names:
-        frame = "global" if mech.type == "slider-crank" and name == "slider" else "link"
-        out += ["", f"[{prefix}.{toml.key(name)}]", *_link_lines(mech.link(name), frame)]
-        if prefix == "links" and frame == "global":
-            out += _gas_lines(mech.gas_force)
-    return out
-
-
-def _linkage_lines(mech: Linkage) -> list[str]:
-    """A general linkage's ``[mechanism]``, ``[links]`` and ``[[springs]]``."""
-    out = ["[mechanism]", 'type = "linkage"', f"input = {toml.string(mech.input)}", "",
-           "[mechanism.points]  # m, at the reference pose"]
-    out += [f"{toml.key(p)} = [{toml.number(x)}, {toml.number(y)}]" for p, (x, y) in mech.points]
-    for s in mech.sliders:
-        out += ["", "[[mechanism.sliders]]", f"link = {toml.string(s.link)}",
-                f"guide = {toml.string(s.guide)}", f"point = {toml.string(s.point)}",
-                f"direction = [{toml.number(s.direction[0])}, {toml.number(s.direction[1])}]"]
-    for body in mech.bodies:
-        names = ", ".join(map(toml.string, body.points))
-        out += ["", f"[links.{toml.key(body.name)}]", f"points = [{names}]"]
-        if body.props is not None:
-            out += _link_lines(body.props)
-    for spring in mech.springs:
-        out += ["", "[[springs]]", f"points = [{', '.join(map(toml.string, spring.points))}]",
-                f"stiffness = {toml.number(spring.stiffness)}  # N/m",
-                f"free_length = {toml.number(spring.free_length)}  # m"]
-    return out
-
-
-def dumps_design(design: Design) -> str:
-    """The design as TOML text that :func:`loads_design` reads back to an equal design."""
-    mech = design.mechanism
-    out: list[str] = []
-    if design.title:
-        out += [f"title = {toml.string(design.title)}", ""]
-    if isinstance(mech, Linkage):
-        out += _linkage_lines(mech)
-    else:
-        out += ["[mechanism]", f'type = "{mech.type}"', f'branch = "{mech.branch}"', ""]
-        out.append("[mechanism.lengths]  # m")
-        for name, length in zip(mech.length_names, mech.lengths, strict=True):
-            out.append(f"{name} = {toml.number(length)}")
-        out += _links_lines(mech, "links")
-    if design.operation is not None:
-        op = design.operation
-        out += [
-            "",
-            "[operation]",
-            f"speed = {toml.number(op.speed)}  # rad/s",
-            f"samples = {toml.number(op.samples)}",
-            *([f"gravity = [{toml.number(op.gravity[0])}, {toml.number(op.gravity[1])}]  # m/s²"]
-              if any(op.gravity) else []),
-        ]
-    sim = design.simulation
-    out += [
-        "",
-        "[simulation]",
-        f"duration = {toml.number(sim.duration)}  # s",
-        *([f"theta1 = {toml.number(sim.theta1)}  # rad"] if sim.theta1 is not None else []),
-        f"omega1 = {toml.number(sim.omega1)}  # rad/s",
-        f"gravity = [{toml.number(sim.gravity[0])}, {toml.number(sim.gravity[1])}]  # m/s²",
-        f'drive = "{sim.drive}"',
-        *([f'method = "{sim.method}"'] if sim.method else []),
-        f"rtol = {toml.number(sim.rtol)}",
-        f"atol = {toml.number(sim.atol)}",
-        f"outputs = {toml.number(sim.outputs)}",
-    ]
-    if design.balance is not None:
-        from .balance.problem import balance_lines
-
-        out += ["", *balance_lines(design.balance)]
-    if design.original is not None:
-        out += ["", "# The unbalanced design this one was derived from (same geometry)."]
-        out += _links_lines(design.original, "original")
-    return "\n".join(out) + "\n"
-
-
-def save_design(design: Design, path: str | os.PathLike[str]) -> None:
-    """Write the design to a TOML file, whole or not at all.
-
-    Raises
-    ------
-    OutputError
-        If the file cannot be written.
-    """
-    write_atomic(path, dumps_design(design))

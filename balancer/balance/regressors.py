@@ -1,0 +1,67 @@
+"""The inertial shaking over a revolution as linear maps of the design vector (the regressors).
+
+With the crank at constant speed every reaction, the shaking force, the shaking moment and the
+driving torque are linear in the design vector of the mechanism's layout
+(:class:`balancer.linkage.dynamics.Layout`): per link ``m``, ``m·e``, ``m·f``, ``J`` about the
+frame's origin, then the counter-rotors' inertias; and a link's physical values
+``(m, e, f, I)`` map to those entries and back.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..mechanisms.base import Mechanism
+
+
+def physical_to_inertial(m, e, f, inertia):
+    """Inertial parameters ``(m, m·e, m·f, J)`` from ``m``, ``e``, ``f``, ``I``.
+
+    ``J = I + m·(e² + f²)`` is the inertia about the link frame's origin. Works on floats,
+    numpy arrays and CasADi symbols alike (the NLP writes its objective through it).
+    """
+    return m, m * e, m * f, inertia + m * (e * e + f * f)
+
+
+def inertial_to_physical(params) -> tuple[float, float, float, float]:
+    """``(m, e, f, I)`` from inertial parameters ``(m, m·e, m·f, J)`` (inverse of the above)."""
+    m, me, mf, j = (float(p) for p in params)
+    e, f = me / m, mf / m
+    return m, e, f, j - m * (e * e + f * f)
+
+
+@dataclass(frozen=True)
+class CycleRegressors:
+    """The inertial shaking over a revolution as linear maps of the design vector.
+
+    Arrays ``(N, P)``: shaking force (complex, N), shaking moment and driving torque (N·m),
+    per unit of each entry.
+    """
+
+    shaking_force: NDArray[np.complex128]
+    shaking_moment: NDArray[np.float64]
+    driving_torque: NDArray[np.float64]
+
+
+def cycle_regressors(mech: Mechanism, angles: NDArray[np.float64], omega: float,
+                     alpha: float = 0.0) -> CycleRegressors:
+    """Regressors at crank states ``(θ1, ω, α)``, as the cycle analysis samples them.
+
+    At a sample exactly at a singular pose that the smooth motion passes (a four-bar's change
+    points) the rows are the limits of that motion (:meth:`Mechanism.limits`).
+    """
+    def evaluate(theta):
+        with np.errstate(all="ignore"):
+            f = mech.regressors(mech.motion(theta, omega, alpha))
+        return f.shaking_force.complex(), f.shaking_moment, f.driving_torque
+
+    force, moment, torque = evaluate(angles)
+    force, moment, torque = force.copy(), moment.copy(), torque.copy()
+    for limit in mech.limits(angles):
+        parts = [evaluate(angles[limit.mask] + d) for d in limit.offsets]
+        for i, target in enumerate((force, moment, torque)):
+            target[limit.mask] = sum(w * p[i] for w, p in zip(limit.weights, parts, strict=True))
+    return CycleRegressors(shaking_force=force, shaking_moment=moment, driving_torque=torque)

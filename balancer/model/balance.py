@@ -1,0 +1,236 @@
+"""The ``[balance]`` schema: which links may change, within which bounds, and what to minimise.
+
+A design spec's ``[balance]`` section describes it; any link of any mechanism may be listed::
+
+    [balance]
+    force_balance = true          # exact shaking-force balance as constraints
+    [balance.objective]           # J = w_M·mean(Msh²) + w_τ·mean(τ²) + w_F·mean(|F̄sh|²)
+    shaking_moment = 1.0          #     + w_m·(total mass − original total mass)
+    driving_torque = 0.0          # w_τ, (N·m)²/(N·m)²
+    shaking_force = 0.0           # w_F, (N·m)²/N² (useful only with force_balance = false)
+    added_mass = 0.0              # w_m, (N·m)²/kg
+    [balance.crank]               # a link listed here may change; links not listed stay fixed
+    mass = [2.1, 8.4]             # kg: a range, or one number that fixes the mass;
+                                  #     absent: fixed at the spec's value
+    com_radius = 1.0              # m: centre of mass anywhere within this distance of
+                                  #     com_about; absent: the centre of mass stays where it is
+    com_about = "A0"              # a point of this link; default its ground pivot if it has
+                                  #     one, else its first point
+    min_gyration = 0.1            # m: inertia about the centre of mass I ≥ m·ρ²
+    inertia = [0.5, 2.0]          # kg·m² about the centre of mass: a range, or one number that
+                                  #     fixes it (see below)
+    counter_rotor = [0.0, 20.0]   # kg·m²: a range or one number (links on a ground pivot);
+                                  #     absent: fixed at the spec's counter_rotor
+    [balance.rocker]
+    counterweight = { mass = [0.1, 3.0], radius = 0.5, gyration = 0.02 }
+                                  # keep the link as it is and add one counterweight: its mass
+                                  #     within [lo, hi] kg, its centre within `radius` m of
+                                  #     com_about (default: the link's first point), its own
+                                  #     radius of gyration at least `gyration` m (default 0)
+
+The inertia about the centre of mass ``I`` is free (``I ≥ m·ρ²``, ``ρ`` = ``min_gyration``,
+default 0) when the mass or the centre of mass may change or ``min_gyration`` is given; when the
+mass and the centre of mass are fixed and ``min_gyration`` is absent it stays at the spec's
+value. ``inertia`` bounds or fixes it explicitly. The objective is evaluated at ``[operation]
+speed`` over ``[operation] samples`` equally spaced crank angles ``θ1 = 2π·j/N``.
+
+**Counterweights.** A link with ``counterweight`` keeps its own body; the redesign adds one
+rigid body to it, and the bounds (mass, centre in a disc about ``com_about``, least radius of
+gyration) are those of that body: the same cone constraints as a free link's, on the design
+vector minus the original link's entries (:attr:`LinkBounds.offset`; the original link and the
+added body together are then realisable whatever the added body is). ``mass``, ``com_radius``,
+``min_gyration`` and ``inertia`` describe a free link and are refused beside it.
+
+The spec reader and writer (:mod:`balancer.spec.balance`) turn the TOML into these objects and
+back; :mod:`balancer.balance` solves the problem they describe.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+#: The keys of ``[balance.objective]``, ``[balance.<link>]`` and a counterweight's table.
+OBJECTIVE_KEYS = (
+    "shaking_moment",
+    "driving_torque",
+    "shaking_force",
+    "shaking_force_x",
+    "shaking_force_y",
+    "added_mass",
+)
+
+
+LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "counter_rotor",
+              "counterweight", "com_on_line")
+
+
+COUNTERWEIGHT_KEYS = ("mass", "radius", "gyration")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Objective:
+    """Weights of the objective ``J`` (see the module docstring).
+
+    ``J = w_M·mean(Msh²) + w_τ·mean(τ²) + w_F·mean(|F̄sh|²) + w_m·(Σm − Σm_original)``, in
+    (N·m)², over the sampled crank angles.
+
+    Attributes
+    ----------
+    shaking_moment
+        ``w_M``, dimensionless.
+    driving_torque
+        ``w_τ``, (N·m)²/(N·m)².
+    shaking_force
+        ``w_F``, (N·m)²/N² (zero at every design when force balance is imposed).
+    shaking_force_x, shaking_force_y
+        Weights of the shaking force's components along x and y (for a slider-crank: along
+        and across the guide), (N·m)²/N²; they add to ``w_F``.
+    added_mass
+        ``w_m``, (N·m)²/kg: penalises mass added to the linkage.
+    """
+
+    shaking_moment: float = 1.0
+    driving_torque: float = 0.0
+    shaking_force: float = 0.0
+    shaking_force_x: float = 0.0
+    shaking_force_y: float = 0.0
+    added_mass: float = 0.0
+
+    @property
+    def terms(self) -> tuple[ObjectiveTerm, ...]:
+        """The quantities ``J`` weighs, each once, with their weights (non-zero ones only).
+
+        The shaking force's components weighted alike are the shaking force (its mean-square
+        magnitude); weighted apart, each component is a term of its own.
+        """
+        fx = self.shaking_force + self.shaking_force_x
+        fy = self.shaking_force + self.shaking_force_y
+        forces = ([ObjectiveTerm("shaking_force", fx, "N")] if fx == fy else
+                  [ObjectiveTerm("shaking_force_x", fx, "N"),
+                   ObjectiveTerm("shaking_force_y", fy, "N")])
+        terms = [ObjectiveTerm("shaking_moment", self.shaking_moment, "N·m"),
+                 ObjectiveTerm("driving_torque", self.driving_torque, "N·m"), *forces,
+                 ObjectiveTerm("added_mass", self.added_mass, "kg")]
+        return tuple(t for t in terms if t.weight > 0)
+
+    @property
+    def single(self) -> ObjectiveTerm | None:
+        """The one mean-square quantity ``J`` weighs (``J = w·mean(q²)``), or ``None``."""
+        terms = self.terms
+        if len(terms) == 1 and terms[0].name != "added_mass":
+            return terms[0]
+        return None
+
+
+@dataclass(frozen=True)
+class ObjectiveTerm:
+    """One quantity of the objective: its JSON name, weight and unit.
+
+    ``added_mass`` enters ``J`` as ``w·Δm`` (``w`` in (N·m)²/kg); every other term as
+    ``w·mean(q²)`` over the cycle, ``q`` in ``unit`` (``w`` in (N·m)²/unit²).
+    """
+
+    name: str
+    weight: float
+    unit: str
+
+
+@dataclass(frozen=True, kw_only=True)
+class CounterweightFreedom:
+    """The one counterweight a kept link may get (``[balance.<link>] counterweight``).
+
+    Attributes
+    ----------
+    mass
+        ``(low, high)``, kg (``low ≥ 0``: with ``low = 0`` none may be the answer; equal ends
+        fix it).
+    radius
+        Its centre lies within this distance of the link's ``com_about`` point, m.
+    gyration
+        Least radius of gyration about its own centre, m.
+    """
+
+    mass: tuple[float, float]
+    radius: float
+    gyration: float = 0.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class LinkFreedom:
+    """What may change on one link, as written in ``[balance.<link>]``.
+
+    Attributes
+    ----------
+    mass
+        ``(low, high)`` mass range, kg (equal ends fix the mass); ``None``: fixed at the spec's.
+    com_radius
+        The centre of mass may lie anywhere within this distance of ``com_about``, m;
+        ``None``: the centre of mass stays where the spec has it.
+    com_about
+        Point of this link the radius is measured from (``None``: its ground pivot if it has
+        one, else its first point).
+    min_gyration
+        Least radius of gyration about the centre of mass ``ρ`` (``I ≥ m·ρ²``), m.
+    inertia
+        ``(low, high)`` range of the inertia about the centre of mass, kg·m² (equal ends fix
+        it); ``None``: the default rule of the module docstring.
+    counter_rotor
+        ``(low, high)`` range of the counter-rotor inertia, kg·m² (links on a ground pivot);
+        ``None``: fixed at the spec's ``counter_rotor``.
+    counterweight
+        The link is kept and one counterweight added (:class:`CounterweightFreedom`); then
+        ``mass``, ``com_radius``, ``min_gyration`` and ``inertia`` are ``None``.
+    com_on_line
+        The centre of mass stays on the link's line (its frame's x-axis, through its first
+        two points: ``f = 0``), within ``com_radius`` of ``com_about``.
+    """
+
+    mass: tuple[float, float] | None = None
+    com_radius: float | None = None
+    com_about: str | None = None
+    min_gyration: float | None = None
+    inertia: tuple[float, float] | None = None
+    counter_rotor: tuple[float, float] | None = None
+    counterweight: CounterweightFreedom | None = None
+    com_on_line: bool = False
+
+
+@dataclass(frozen=True, kw_only=True)
+class BalanceProblem:
+    """The redesign problem of a spec's ``[balance]`` section.
+
+    Attributes
+    ----------
+    force_balance
+        Impose exact shaking-force balance as equality constraints.
+    objective
+        Weights of the objective.
+    links
+        What may change on each listed link, by name (a dict is accepted); a link not listed
+        stays as it is.
+    """
+
+    force_balance: bool = True
+    objective: Objective = field(default_factory=Objective)
+    links: tuple[tuple[str, LinkFreedom], ...] = ()
+
+    def __post_init__(self) -> None:
+        """Store ``links`` as pairs (a dict is accepted)."""
+        links = self.links.items() if isinstance(self.links, dict) else self.links
+        object.__setattr__(self, "links", tuple((str(n), f) for n, f in links))
+
+    def link(self, name: str) -> LinkFreedom | None:
+        """The freedom of link ``name``, or ``None`` if it is not listed."""
+        return dict(self.links).get(name)
+
+    def with_link(self, name: str, freedom: LinkFreedom | None) -> BalanceProblem:
+        """The problem with link ``name``'s freedom replaced (listed anew; ``None``: fixed)."""
+        links = [(n, f) for n, f in self.links if n != name]
+        if freedom is not None:
+            links.append((name, freedom))
+        return replace(self, links=tuple(links))
+
+    @property
+    def listed(self) -> tuple[str, ...]:
+        """Names of the listed links."""
+        return tuple(n for n, _ in self.links)

@@ -1,0 +1,224 @@
+"""The ``[balance]`` table of a spec: read into the schema, checked, and written back exactly."""
+
+from __future__ import annotations
+
+import math
+
+from .. import tomltext as toml
+from ..balance.bounds import check_problem
+from ..errors import SpecError
+from ..mechanisms import mechanism_of
+from ..model.balance import (
+    COUNTERWEIGHT_KEYS,
+    LINK_KEYS,
+    OBJECTIVE_KEYS,
+    BalanceProblem,
+    CounterweightFreedom,
+    LinkFreedom,
+    Objective,
+)
+from ..validate import LENGTH_RANGE
+from .tables import Table
+
+
+def _check_keys(table: Table, known: tuple[str, ...]) -> None:
+    """Reject unknown keys first, with a suggestion for a typo."""
+    for name in table.data:
+        if name not in known:
+            import difflib  # only for a spec that is wrong
+
+            close = difflib.get_close_matches(name, known, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise SpecError(f"unknown key '{name}'{hint}", key=table.key(name))
+
+
+def _read_range(
+    table: Table, name: str, *, positive: bool, unit: str
+) -> tuple[float, float] | None:
+    """A number (fixes the value) or a list ``[low, high]``; ``None`` if absent."""
+    if not table.has(name):
+        return None
+    key = table.key(name)
+    value = table.raw(name)
+    if isinstance(value, list):
+        if len(value) != 2:
+            raise SpecError(
+                f"must be a number or a range [low, high] in {unit}", key=key, value=value
+            )
+        items = value
+    else:
+        items = [value, value]
+    bounds = []
+    for item in items:
+        if isinstance(item, bool) or not isinstance(item, int | float):
+            raise SpecError(
+                f"must be a number or a range [low, high] in {unit}", key=key, value=value
+            )
+        x = float(item)
+        if not math.isfinite(x):
+            raise SpecError("must be finite", key=key, value=value)
+        if positive and x <= 0:
+            raise SpecError("bounds must be positive", key=key, value=value)
+        if x < 0:
+            raise SpecError("bounds must be zero or positive", key=key, value=value)
+        bounds.append(x)
+    lo, hi = bounds
+    if lo > hi:
+        raise SpecError("the lower bound exceeds the upper bound", key=key, value=value)
+    return (lo, hi)
+
+
+def _read_link_freedom(table: Table, points: tuple[str, ...]) -> LinkFreedom:
+    _check_keys(table, LINK_KEYS)
+    com_about = None
+    if table.has("com_about"):
+        com_about = table.string("com_about", choices=points)
+    counterweight = None
+    sub = table.table("counterweight", required=False)
+    if sub is not None:
+        for name in ("mass", "com_radius", "min_gyration", "inertia"):
+            if table.has(name):
+                raise SpecError("a link with a counterweight is kept as it is: give the "
+                                "counterweight's bounds only (counterweight = {mass, radius, "
+                                "gyration})", key=table.key(name), value=table.raw(name))
+        _check_keys(sub, COUNTERWEIGHT_KEYS)
+        mass = _read_range(sub, "mass", positive=False, unit="kg")
+        if mass is None:
+            raise SpecError("missing required key (the counterweight's mass, [low, high] kg)",
+                            key=sub.key("mass"))
+        counterweight = CounterweightFreedom(
+            mass=mass, radius=sub.nonnegative("radius"),
+            gyration=sub.nonnegative("gyration", default=0.0))
+        if counterweight.gyration > LENGTH_RANGE[1]:
+            raise SpecError(f"must be at most {LENGTH_RANGE[1]:g} m", key=sub.key("gyration"),
+                            value=counterweight.gyration)
+        sub.finish()
+    freedom = LinkFreedom(
+        mass=_read_range(table, "mass", positive=True, unit="kg"),
+        com_radius=table.nonnegative("com_radius") if table.has("com_radius") else None,
+        com_about=com_about,
+        min_gyration=table.nonnegative("min_gyration") if table.has("min_gyration") else None,
+        inertia=_read_range(table, "inertia", positive=False, unit="kg·m²"),
+        counter_rotor=_read_range(table, "counter_rotor", positive=False, unit="kg·m²"),
+        counterweight=counterweight,
+        com_on_line=_read_flag(table, "com_on_line"),
+    )
+    table.finish()
+    return freedom
+
+
+def _read_flag(table: Table, name: str) -> bool:
+    """A ``true``/``false`` key (absent: false)."""
+    if not table.has(name):
+        return False
+    value = table.raw(name)
+    if not isinstance(value, bool):
+        raise SpecError("must be true or false", key=table.key(name), value=value)
+    return value
+
+
+def read_balance(table: Table, mechanism) -> BalanceProblem:
+    """Read and validate a spec's ``[balance]`` table (called by :mod:`balancer.spec`).
+
+    Parameters
+    ----------
+    table
+        The ``[balance]`` table being read.
+    mechanism
+        The spec's mechanism (a model or a :class:`Mechanism`), for the links' points and the
+        values of what stays fixed.
+
+    Raises
+    ------
+    SpecError
+        Naming the key and value at fault (see :func:`check_problem`).
+    """
+    mech = mechanism_of(mechanism)
+    names = mech.link_names
+    for name, value in table.data.items():  # a table for a link the mechanism does not have
+        if isinstance(value, dict) and name not in ("objective", *names):
+            import difflib  # only for a spec that is wrong
+
+            close = difflib.get_close_matches(name, names, n=1)
+            hint = f"; did you mean '{close[0]}'?" if close else ""
+            raise SpecError(f"names no moving link of the {mech.kind}{hint} (its moving links "
+                            f"are {', '.join(names)}; the frame stays as it is)",
+                            key=table.key(name))
+    _check_keys(table, ("force_balance", "objective", *names))
+    force_balance = True
+    if table.has("force_balance"):
+        value = table.raw("force_balance")
+        if not isinstance(value, bool):
+            raise SpecError("must be true or false", key=table.key("force_balance"), value=value)
+        force_balance = value
+    objective = Objective()
+    sub = table.table("objective", required=False)
+    if sub is not None:
+        _check_keys(sub, OBJECTIVE_KEYS)
+        objective = Objective(
+            **{
+                name: sub.nonnegative(name, default=getattr(objective, name))
+                for name in OBJECTIVE_KEYS
+            }
+        )
+        sub.finish()
+    points = tuple(p for p, _ in mech.linkage.points)
+    links: dict[str, LinkFreedom] = {}
+    for name in names:
+        sub = table.table(name, required=False)
+        if sub is not None:
+            links[name] = _read_link_freedom(sub, points)
+    table.finish()
+    problem = BalanceProblem(force_balance=force_balance, objective=objective, links=links)
+    check_problem(problem, mech)
+    return problem
+
+
+def _bracketed(bounds: tuple[float, float]) -> str:
+    return f"[{toml.number(bounds[0])}, {toml.number(bounds[1])}]"
+
+
+def _range_text(bounds: tuple[float, float]) -> str:
+    lo, hi = bounds
+    return toml.number(lo) if lo == hi else f"[{toml.number(lo)}, {toml.number(hi)}]"
+
+
+def balance_lines(problem: BalanceProblem) -> list[str]:
+    """The problem as TOML lines that :func:`read_balance` reads back to an equal problem."""
+    w = problem.objective
+    lines = [
+        "[balance]",
+        f"force_balance = {'true' if problem.force_balance else 'false'}",
+        "",
+        "[balance.objective]  # J = mean(Msh²) + w_tau·mean(tau²) + w_force·mean(|Fsh|²)"
+        " + w_mass·Δmass",
+        f"shaking_moment = {toml.number(w.shaking_moment)}",
+        f"driving_torque = {toml.number(w.driving_torque)}  # (N·m)²/(N·m)²",
+        f"shaking_force = {toml.number(w.shaking_force)}  # (N·m)²/N²",
+        *([f"shaking_force_x = {toml.number(w.shaking_force_x)}  # (N·m)²/N², along x",
+           f"shaking_force_y = {toml.number(w.shaking_force_y)}  # (N·m)²/N², along y"]
+          if w.shaking_force_x or w.shaking_force_y else []),
+        f"added_mass = {toml.number(w.added_mass)}  # (N·m)²/kg",
+    ]
+    for name, freedom in problem.links:
+        lines += ["", f"[balance.{toml.key(name)}]"]
+        if freedom.mass is not None:
+            lines.append(f"mass = {_range_text(freedom.mass)}  # kg")
+        if freedom.com_radius is not None:
+            lines.append(f"com_radius = {toml.number(freedom.com_radius)}  # m")
+        if freedom.com_about is not None:
+            lines.append(f"com_about = {toml.string(freedom.com_about)}")
+        if freedom.min_gyration is not None:
+            lines.append(f"min_gyration = {toml.number(freedom.min_gyration)}  # m")
+        if freedom.inertia is not None:
+            lines.append(f"inertia = {_range_text(freedom.inertia)}  # kg·m² about the COM")
+        if freedom.com_on_line:
+            lines.append("com_on_line = true")
+        if freedom.counterweight is not None:
+            cw = freedom.counterweight
+            lines.append(f"counterweight = {{ mass = {_bracketed(cw.mass)}, radius = "
+                         f"{toml.number(cw.radius)}, gyration = {toml.number(cw.gyration)} }}"
+                         "  # kg, m, m")
+        if freedom.counter_rotor is not None:
+            lines.append(f"counter_rotor = {_range_text(freedom.counter_rotor)}  # kg·m²")
+    return lines

@@ -1,0 +1,159 @@
+"""A TOML table read with the spec's rules: every key named by its path, unknown keys refused."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from .. import validate as v
+from ..errors import SpecError
+
+
+def _generic(path: str) -> str:
+    """Map a concrete table path to the pattern used for key suggestions."""
+    parts = path.split(".")
+    if len(parts) >= 2 and parts[0] in ("links", "original"):
+        parts[1] = "*"
+    return ".".join(parts)
+
+
+_KNOWN_KEYS: dict[str, tuple[str, ...]] = {
+    "": ("title", "mechanism", "links", "springs", "operation", "simulation", "balance",
+         "original"),
+    "mechanism": ("type", "branch", "lengths", "input", "points", "sliders"),
+    "links.*": ("points", "mass", "inertia", "com", "force", "moment", "counter_rotor",
+                "gas_force"),
+    "original.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor", "gas_force"),
+    "links.*.com": ("s", "sigma", "e", "f", "at"),
+    "original.*.com": ("s", "sigma", "e", "f", "at"),
+    "operation": ("speed", "samples", "gravity"),
+    "simulation": (
+        "duration",
+        "theta1",
+        "omega1",
+        "gravity",
+        "drive",
+        "method",
+        "rtol",
+        "atol",
+        "outputs",
+    ),
+}
+
+
+def _as_number(
+    value: Any, key: str, check: Callable[[float], bool] | None, requirement: str
+) -> float:
+    x = v.number(value, key)
+    if check is not None and not check(x):
+        raise SpecError(f"must be {requirement}", key=key, value=value)
+    return x
+
+
+class Table:
+    """A TOML table being read.
+
+    Typed access by key, with the dotted path for messages, and a check that every key was used.
+    """
+
+    def __init__(self, data: dict[str, Any], path: str) -> None:
+        self.data = data
+        self.path = path
+        self.used: set[str] = set()
+        self.known: tuple[str, ...] | None = _KNOWN_KEYS.get(_generic(path))
+        if self.known is not None:
+            self.expect(self.known)
+
+    def expect(self, known: tuple[str, ...]) -> None:
+        """Declare the keys this table may hold, and report a typo now.
+
+        Before the missing key it causes ("mas" before "mass is missing").
+        """
+        self.known = tuple(known)
+        for name in self.data:
+            if name not in self.known:
+                self._unknown(name)
+
+    def key(self, name: str) -> str:
+        return f"{self.path}.{name}" if self.path else name
+
+    def has(self, name: str) -> bool:
+        return name in self.data
+
+    def raw(self, name: str) -> Any:
+        self.used.add(name)
+        return self.data[name]
+
+    def _missing(self, name: str) -> SpecError:
+        return SpecError("missing required key", key=self.key(name))
+
+    def table(self, name: str, *, required: bool = True) -> Table | None:
+        if name not in self.data:
+            if required:
+                raise self._missing(name)
+            return None
+        value = self.raw(name)
+        if not isinstance(value, dict):
+            raise SpecError("must be a table", key=self.key(name), value=value)
+        return Table(value, self.key(name))
+
+    def number(
+        self,
+        name: str,
+        *,
+        default: float | None = None,
+        check: Callable[[float], bool] | None = None,
+        requirement: str = "",
+    ) -> float:
+        if name not in self.data:
+            if default is None:
+                raise self._missing(name)
+            return default
+        value = self.raw(name)
+        return _as_number(value, self.key(name), check, requirement)
+
+    def positive(self, name: str, *, default: float | None = None) -> float:
+        return self.number(name, default=default, check=lambda x: x > 0, requirement="positive")
+
+    def nonnegative(self, name: str, *, default: float | None = None) -> float:
+        return self.number(
+            name, default=default, check=lambda x: x >= 0, requirement="zero or positive"
+        )
+
+    def value(self, name: str, default: Any) -> Any:
+        """The raw value (checked by the model object it goes into), or ``default``."""
+        return self.raw(name) if name in self.data else default
+
+    def string(self, name: str, *, choices: tuple[str, ...], default: str | None = None) -> str:
+        if name not in self.data:
+            if default is None:
+                raise self._missing(name)
+            return default
+        return v.choice(self.raw(name), self.key(name), choices)
+
+    def text(self, name: str, *, default: str) -> str:
+        if name not in self.data:
+            return default
+        value = self.raw(name)
+        if not isinstance(value, str):
+            raise SpecError("must be a string", key=self.key(name), value=value)
+        return value
+
+    def vector2(self, name: str, *, default: tuple[float, float]) -> tuple[float, float]:
+        if name not in self.data:
+            return default
+        return v.vector2(self.raw(name), self.key(name))
+
+    def finish(self) -> None:
+        """Raise on the first key that was not used (unknown, or a typo)."""
+        for name in self.data:
+            if name not in self.used:
+                self._unknown(name)
+
+    def _unknown(self, name: str) -> None:
+        import difflib  # only for a spec that is wrong
+
+        known = sorted(self.known or ())
+        close = difflib.get_close_matches(name, known, n=1)
+        hint = f"; did you mean '{close[0]}'?" if close else ""
+        raise SpecError(f"unknown key '{name}'{hint}", key=self.key(name))
