@@ -13,10 +13,10 @@ from balancer import inverse
 from balancer import kinematics as kin
 from balancer.cycle import cycle_analysis
 from balancer.errors import LockupError
-from balancer.formulations import make
+from balancer.formulations import DEAD_POINT_THRESHOLD, make
 from balancer.mechanisms.fourbar import FourBarMechanism
 from balancer.model import FourBar, Link, SimulationSettings, assembly
-from balancer.simulation import DEAD_POINT_THRESHOLD, simulate
+from balancer.simulation import simulate
 
 #: The paper's four formulations of the four-bar.
 METHODS = tuple(FourBarMechanism.formulations)

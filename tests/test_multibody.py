@@ -489,12 +489,12 @@ def test_a_compiled_dop853_step_is_scipys_step(method, driven):
     from scipy.integrate import DOP853
 
     from balancer.integration import CompiledDOP853, Stages, with_extra_work
-    from balancer.simulation import _WithExtraWork
+    from balancer.simulation.stepper import WithExtraWork
 
     design = _watt()
     f = make(method, design.mechanism, gravity=design.simulation.gravity,
              speed=5.0 if driven else None)
-    own = _WithExtraWork(f)
+    own = WithExtraWork(f)
     y0 = np.append(f.initial_state(0.3, 4.0), 0.0)
     options = {"rtol": 1e-10, "atol": 1e-12, "first_step": 1e-3}
     ref = DOP853(own.rhs, 0.0, y0, 1.0, **options)

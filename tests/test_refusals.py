@@ -74,7 +74,7 @@ def test_verify_refuses_a_driven_run_too_long_before_simulating_anything(capsys,
     """`verify --duration 1e6` ran past 20 s (the Stephenson six-bar's driven run laid out
     1e8 guide times): the driven run's quadrature panels are counted before any run starts,
     the free one included, and the error names the option."""
-    monkeypatch.setattr(simulation._Stepper, "run", _never("a simulation"))
+    monkeypatch.setattr(simulation.stepper.Stepper, "run", _never("a simulation"))
     spec = str(EXAMPLES / "stephenson_sixbar.toml")
     assert main(["verify", spec, "--duration", "1e6"]) == 2
     err = capsys.readouterr().err
@@ -88,7 +88,7 @@ def test_verify_runs_first_the_run_the_step_budget_may_refuse(tmp_path, capsys, 
     spec.write_text(Path(PB1).read_text().replace(
         "[simulation]\n", "[simulation]\ngravity = [0.0, -1e10]\n"))
     assert "gravity = [0.0, -1e10]" in spec.read_text()
-    monkeypatch.setattr(simulation._Stepper, "_prescribed", _never("the driven run"))
+    monkeypatch.setattr(simulation.stepper.Stepper, "_prescribed", _never("the driven run"))
     assert main(["verify", str(spec)]) == 2
     err = capsys.readouterr().err
     assert "simulation.duration" in err and "integration steps" in err
@@ -107,7 +107,7 @@ def test_a_prescribed_motion_in_absolute_coordinates_counts_its_panels_first(cap
                                                                             monkeypatch):
     """The multibody formulation's driven motion laid out its outputs and guide times (1e8
     for 1e5 s of the Stephenson six-bar) before its quadrature's panels were counted."""
-    monkeypatch.setattr(simulation._Stepper, "_guide_times", _never("laying out the times"))
+    monkeypatch.setattr(simulation.stepper.Stepper, "_guide_times", _never("laying out the times"))
     spec = str(EXAMPLES / "stephenson_sixbar.toml")
     assert main(["simulate", spec, "--method", "multibody", "--duration", "1e5"]) == 2
     err = capsys.readouterr().err

@@ -258,7 +258,8 @@ def test_a_driven_lie_group_simulation_passes_a_change_point():
 
 def test_a_run_that_stalls_at_a_change_point_fails_naming_it():
     """At rtol 1e-11 the opened loop shrank its steps near the change point without end."""
-    from balancer.simulation import STALL_WINDOW, simulate
+    from balancer.simulation import simulate
+    from balancer.simulation.stepper import STALL_WINDOW
 
     design = spec.loads_design("""
         [mechanism]

@@ -375,9 +375,9 @@ class Formulation(ABC):
 
         Such as the links' positions, angles, velocities and rates. The integrator holds no
         component of a group to an absolute error below the rounding of the group's largest
-        (:func:`balancer.simulation.floored_atol`): a component that is zero for the motion (the
-        velocity of a frame pinned at its origin) is computed from the others to their
-        rounding, and a tolerance below that makes the steps shrink to the noise. None by
+        (:func:`balancer.simulation.stepper.floored_atol`): a component that is zero for the
+        motion (the velocity of a frame pinned at its origin) is computed from the others to
+        their rounding, and a tolerance below that makes the steps shrink to the noise. None by
         default (each component is its own kind).
         """
         return ()

@@ -1,250 +1,67 @@
-"""Forward dynamics: integrate a formulation, project, detect events, report what happened.
+"""The stepping of a simulation: DOP853 by hand, projections, events, budgets, quadrature.
 
-The integrator is the explicit Runge–Kutta method of order 8, DOP853 (:mod:`.integration`),
-stepped by hand so that after every accepted step the non-minimal formulations' states are
-projected back onto the loop closure and its derivative (the drift before projection is
-reported). Output values come from the step's dense output, all those within a step in one
-evaluation, at equally spaced times; they are projected in the same way, all together at the
-end of the run. No component is held to an
-absolute error below 100 ε of the largest of its kind (:func:`floored_atol`).
-
-Events:
-
-- a formulation whose coordinate is the crank angle (``complex-masses``, ``lie-group``) cannot
-  pass a dead point of the crank, where coupler and rocker align: the simulation stops there
-  with a :class:`~balancer.errors.LockupError` that names the time and the crank angle (the
-  ``opened-loop`` and ``mass-matrix`` formulations pass through such points);
-- the change points of a change-point linkage (all joints collinear) are passed on the smooth
-  motion by every formulation;
-- a crank driven at constant speed that would leave the range where the linkage assembles locks
-  the linkage: the simulation stops there.
-
-Energy: the kinetic energy change must equal the work of the loads, of gravity and of the motor.
-The loads are constant forces at the centres of mass and constant moments, so their work is a
-function of the configuration, ``W = Σ F̄k·(r̄k − r̄k0) + Mk·(θk − θk0)``; the motor's work and
-the work of a force that depends on the crank angle (a gas force) are integrated with the state:
-the driver appends one component ``W_extra`` with ``Ẇ_extra`` =
-:meth:`~balancer.formulations.Formulation.extra_power`. ``T − T0 − W`` is then a first integral
-of the integrated system, which the integrator keeps to its tolerance: the reported
-:attr:`Trajectory.energy_error` is a check of the integration, at no extra cost.
-
-A driven crank's motion is prescribed. A formulation whose coordinate is the crank angle
-(``complex-masses``) then has nothing to integrate but the work, a function of the time alone:
-it is found by adaptive Gauss–Kronrod quadrature of the vectorised power at the output times
-(:mod:`balancer.quadrature`, to the same tolerances), and the energy balance checks the driving
-torque of the formulation against its kinetic energy and the loads' work. Where the power is not
-vectorised, or the motion comes near a dead point, the integrator steps as for any motion.
+:class:`Stepper` integrates a formulation's equations of motion over a duration (see
+:mod:`balancer.simulation` for what it guarantees): accepted steps projected back onto the
+constraints, outputs from the dense output, a dead point or a lock as an event, the step budget
+refused from the first steps' rate, and a driven crank's prescribed motion by quadrature.
 """
 
 from __future__ import annotations
 
 import math
-import time as _time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .columns import simulation_columns
-from .errors import AssemblyError, LockupError, SolverError, SpecError
-from .formulations import (
+from ..errors import SolverError, SpecError
+from ..formulations import (
     DEAD_POINT_THRESHOLD,
     Formulation,
-    continuous_angles,
-    default_method,
     formulation_class,
     formulation_names,
-    make,
 )
-from .integration import DOP853, CompiledDOP853, Stages, TimeOnlyDOP853, with_extra_work
-from .mechanisms import mechanism_of
-from .model import RTOL_MIN, Design, SimulationSettings, check_scales
-from .quadrature import cumulative
+from ..integration import DOP853, CompiledDOP853, Stages, TimeOnlyDOP853, with_extra_work
+from ..model import RTOL_MIN
+from ..quadrature import cumulative
 
 #: Most integration steps a simulation may take (under a minute with the slowest formulation,
 #: multibody with its projections, at some 2 000 steps a second on a 2-core machine): a
 #: duration that needs more is refused, from the rate of its first steps.
 MAX_STEPS = 100_000
+
+
 #: Steps after which the rate is extrapolated to the whole duration.
 PROJECT_AFTER = 200
-#: Energy error (relative to the energy's scale, :attr:`Trajectory.energy_error`) beyond which
-#: an integration has failed, whatever its tolerances: a tenth of the energy unaccounted for.
-ENERGY_FAILURE = 0.1
+
+
 #: Distance in θ1 from a change point, rad, within which a motion is near it (passable by
 #: a dead-point event, named as the cause of a stall).
 CHANGE_POINT_NEAR = 0.05
+
+
 #: Largest angle, rad, the crank turns over one quadrature panel of a driven motion's work
-#: (:meth:`_Stepper._prescribed`): a sixteenth of a revolution, so that the panels resolve the
+#: (:meth:`Stepper._prescribed`): a sixteenth of a revolution, so that the panels resolve the
 #: power's harmonics and the Gauss and Kronrod rules cannot agree on a wrong value.
 PANEL_ANGLE = math.pi / 8
+
+
 #: Largest crank angle, rad, between two states through which a prescribed motion's angles
 #: are followed from one output time to the next (a link turns a few times that at most).
 GUIDE_ANGLE = 0.1
+
+
 #: Most output times of a run that resamples its outputs to a resolution.
 MAX_OUTPUTS = 100_000
+
+
 #: Steps over which the recent rate is judged: a run whose last ``STALL_WINDOW`` steps would
 #: need more than :data:`MAX_STEPS` more to finish has stalled (near-singular motion).
 STALL_WINDOW = 1000
 
 
-@dataclass(frozen=True)
-class Trajectory:
-    """A simulated motion at equally spaced output times.
-
-    Attributes
-    ----------
-    method
-        Formulation used.
-    drive
-        ``"free"`` or ``"constant-speed"``.
-    speed
-        The crank's constant speed of a driven run, rad/s (``None`` in free motion).
-    links
-        Names of the moving links, in the order of the rows of ``theta``, ``omega``, ``alpha``.
-    t
-        Output times, s, shape ``(n,)``.
-    theta, omega, alpha
-        Link angles (rad, continuous from their initial values), angular velocities (rad/s)
-        and accelerations (rad/s²), each of shape ``(links, n)``.
-    ground
-        Force of the mechanism on the ground at each ground point, complex, N.
-    slider_normal, slider_couple
-        For each slider on a ground guide (keyed by the sliding link): the normal force on the
-        guide (N) and its couple about the slider's point (N·m).
-    driving_torque
-        Motor torque on the crank, N·m (zero in free motion).
-    shaking_force, shaking_moment
-        Sum of the forces on the frame (N) and their moment about the origin with the motor's
-        reaction and the counter-rotors' (N·m).
-    kinetic_energy
-        Kinetic energy of the moving parts, counter-rotors included, J.
-    work
-        Work of the loads, gravity, springs and the motor since t = 0, J.
-    energy_error
-        ``max|T − T0 − W|`` relative to the largest of ``|T|``, ``|W|`` and the energy the loads,
-        gravity and springs could exchange over the linkage's size (dimensionless). A run
-        beyond :data:`ENERGY_FAILURE` raises a :class:`~balancer.errors.SolverError`.
-    drift
-        Largest constraint residual before projection: position (m) and velocity (m/s).
-    nfev
-        Right-hand-side evaluations.
-    steps
-        Accepted integration steps (of a driven crank's prescribed motion whose work is found
-        by quadrature: the quadrature's panels).
-    seconds
-        Wall-clock time of the integration and the outputs, s.
-    rtol, atol
-        Integrator tolerances used.
-    named_states
-        Whether :meth:`state` keys the links by name (a general linkage) or lists them.
-    model
-        The mechanism simulated.
-    slider
-        A formulation's own slider coordinate (the slider-crank's): position, velocity and
-        acceleration along the guide, shape ``(3, n)`` (m, m/s, m/s²).
-    """
-
-    method: str
-    drive: str
-    links: tuple[str, ...]
-    t: NDArray[np.float64]
-    theta: NDArray[np.float64]
-    omega: NDArray[np.float64]
-    alpha: NDArray[np.float64]
-    ground: dict[str, NDArray[np.complex128]]
-    slider_normal: dict[str, NDArray[np.float64]]
-    slider_couple: dict[str, NDArray[np.float64]]
-    driving_torque: NDArray[np.float64]
-    shaking_force: NDArray[np.complex128]
-    shaking_moment: NDArray[np.float64]
-    kinetic_energy: NDArray[np.float64]
-    work: NDArray[np.float64]
-    energy_error: float
-    drift: tuple[float, float]
-    nfev: int
-    steps: int
-    seconds: float
-    rtol: float
-    atol: float
-    named_states: bool = False
-    speed: float | None = None
-    model: object = field(repr=False, default=None)
-    slider: NDArray[np.float64] | None = field(repr=False, default=None)
-
-    def __repr__(self) -> str:
-        return (f"Trajectory({self.method}, {self.drive}, {self.t.size} outputs over "
-                f"{self.t[-1] - self.t[0]:g} s, {self.steps} steps; energy balance to "
-                f"{self.energy_error:.2g})")
-
-    @property
-    def largest_reaction(self) -> float:
-        """Largest magnitude of any force on the frame over the run, N (0 if none)."""
-        values = [np.max(np.abs(v), initial=0.0) for v in (
-            *self.ground.values(), *self.slider_normal.values())]
-        return float(max(values, default=0.0))
-
-    def columns(self, all_columns: bool = False) -> tuple[list[str], list]:
-        """The columns of ``simulate``'s CSV: names and values over the output times.
-
-        See :func:`balancer.columns.simulation_columns`.
-        """
-        return simulation_columns(self, all_columns)
-
-    def state(self, index: int) -> dict:
-        """Angles, rates and accelerations of the links at output ``index``.
-
-        Each a list in link order, or (``named_states``) an object keyed by link name.
-        """
-        out = {}
-        for key, values in (("theta", self.theta), ("omega", self.omega),
-                            ("alpha", self.alpha)):
-            numbers = [float(x) + 0.0 for x in values[:, index]]
-            out[key] = dict(zip(self.links, numbers, strict=True)) if self.named_states \
-                else numbers
-        return out
-
-
-#: Distance (rad) from a change point within which a motion cannot start: √ε, where the
-#: rates of the dependent links are lost to rounding (they are 0/0 at the change point).
-CHANGE_POINT_MARGIN = 1.5e-8
-
-
-def _check_start(f: Formulation, theta1: float) -> None:
-    rng = f.assembly_range()
-    if not rng.contains(theta1):
-        raise AssemblyError(
-            f"the linkage cannot be assembled at the initial crank angle; it assembles for θ1 "
-            f"in {rng.describe()}",
-            key="simulation.theta1",
-            value=theta1,
-        )
-    for point in f.change_points():
-        if abs(math.remainder(theta1 - point, 2 * math.pi)) < CHANGE_POINT_MARGIN:
-            raise SpecError(
-                f"is a change point of the linkage (θ1 = {point:.6g} rad: all joints in line), "
-                "where the rates of coupler and rocker are not determined by the crank's; "
-                f"start at least {CHANGE_POINT_MARGIN:g} rad away from it",
-                key="simulation.theta1", value=theta1)
-
-
-def _lock_time(f: Formulation, theta1: float, speed: float, duration: float) -> float | None:
-    """First time a crank driven at ``speed`` leaves the assembly range, or None."""
-    rng = f.assembly_range()
-    if rng.full or speed == 0:
-        return None
-    for a, b in rng.intervals:
-        # Bring θ1 into the interval's own 2π window.
-        w = a + math.fmod(theta1 - a, 2 * math.pi) % (2 * math.pi)
-        if a - 1e-12 <= w <= b + 1e-12:
-            end = b if speed > 0 else a
-            t_lock = (end - w) / speed
-            return t_lock if t_lock <= duration else None
-    return None
-
-
-class _Stepper:
+class Stepper:
     """One integration with projection, dense outputs and events."""
 
     def __init__(self, f: Formulation, duration: float, rtol: float, atol: float,
@@ -263,7 +80,7 @@ class _Stepper:
         self.pieces: list[tuple[float, object]] = []
         #: States between the output times (the steps' ends; a prescribed motion's at every
         #: :data:`GUIDE_ANGLE` of crank, :meth:`_guide_times`), as ``(times, states)``: the
-        #: angles are followed through them from one output to the next (:func:`_trajectory`).
+        #: angles are followed through them from one output to the next (:func:`trajectory_of`).
         self.guide: tuple[list[float], list[NDArray[np.float64]]] = ([], [])
 
     def run(self, y0: NDArray[np.float64], stop_at: float | None):
@@ -275,7 +92,7 @@ class _Stepper:
                           else self._prescribed_motion(y0))
             if prescribed is not None:
                 return prescribed
-        f = _WithExtraWork(self.f)
+        f = WithExtraWork(self.f)
         y0 = np.append(y0, 0.0)
         groups = self.f.like_components()
         atol = floored_atol(self.atol, groups, y0)
@@ -579,7 +396,7 @@ class _Stepper:
         cause = (f"near the change point θ1 = {near[0]:.6g} rad (all joints in line), where "
                  "the crank's rate does not determine the others'"
                  + ("" if f.passes_change_points else
-                    f"; the {f.name} formulation cannot pass it{_passing_change(f.f.linkage)}")
+                    f"; the {f.name} formulation cannot pass it{passing_change(f.f.linkage)}")
                  if near else
                  "where the motion is too sensitive for these tolerances (masses or loads of "
                  "very different magnitudes, or a near-singular configuration)")
@@ -594,11 +411,11 @@ class _Stepper:
 
         ``y1`` is the state at the step's end (the dense output is made only for an event).
         """
-        f = _WithExtraWork(self.f)
+        f = WithExtraWork(self.f)
 
         def gap(t: float, y=None) -> float:
             y = interp(t) if y is None else y
-            if change_points and _near_change_point(f, t, y, change_points):
+            if change_points and near_change_point(f, t, y, change_points):
                 return 1.0  # passable: the smooth motion goes through
             return abs(f.transmission(t, y)) - DEAD_POINT_THRESHOLD
 
@@ -631,7 +448,7 @@ def floored_atol(atol: float, groups, y: NDArray[np.float64]) -> float | NDArray
     return out
 
 
-class _WithExtraWork:
+class WithExtraWork:
     """A formulation whose state carries, as a last entry, the work of the extra power.
 
     ``Ẇ_extra`` = :meth:`~balancer.formulations.Formulation.extra_power` (a force that depends
@@ -675,311 +492,21 @@ class _WithExtraWork:
         return self.f.change_points()
 
 
-def _passing_change(model) -> str:
+def passing_change(model) -> str:
     """The formulations of a mechanism that pass change points, as a parenthesis."""
     names = [n for n in formulation_names(model)
              if formulation_class(n, model).passes_change_points]
     return f" ({' and '.join(names)} can)" if names else ""
 
 
-def _passing(model) -> str:
+def passing(model) -> str:
     """The formulations of a mechanism that pass dead points, as a parenthesis."""
     names = [n for n in formulation_names(model)
              if formulation_class(n, model).passes_dead_points]
     return f" ({' and '.join(names)} can)" if names else ""
 
 
-def _near_change_point(f, t: float, y, points) -> bool:
+def near_change_point(f, t: float, y, points) -> bool:
+    """Whether the state ``y`` at ``t`` is within :data:`CHANGE_POINT_NEAR` of a change point."""
     theta1 = f.theta1_of(t, y)
     return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < CHANGE_POINT_NEAR for p in points)
-
-
-@dataclass(frozen=True)
-class _Setup:
-    """A simulation's checked settings and formulation, before any integration."""
-
-    f: Formulation
-    settings: SimulationSettings
-    y0: NDArray[np.float64]
-    #: The output times' number (more for a driven crank at a resolution).
-    outputs: int
-    #: When a driven crank reaches the end of its assembly range, s (``None``: never).
-    stop_at: float | None
-    #: Where the run ends before that lock, s (``None``: at its duration).
-    end: float | None
-
-
-def _prepare(linkage, settings: SimulationSettings, *, resolution: float | None = None,
-             **overrides) -> _Setup:
-    """The settings with the overrides, checked, and the formulation at its initial state.
-
-    Raises :class:`SpecError` for what :func:`simulate` refuses before it integrates (bad
-    settings, forces beyond double precision, a start where the linkage does not assemble).
-    """
-    # The settings with the overrides, checked as a spec's would be (SimulationSettings).
-    settings = replace(settings, **{k: x for k, x in overrides.items() if x is not None})
-    method = settings.method or default_method(linkage)
-    drive, duration, outputs = settings.drive, settings.duration, settings.outputs
-    formulation_class(method, linkage)  # a SpecError naming those that apply, if none
-    theta1, omega1 = settings.theta1, settings.omega1
-    if theta1 is None:
-        theta1 = mechanism_of(linkage).start_angle
-    check_scales(linkage, {"simulation.omega1": omega1},
-                 {"simulation.gravity": settings.gravity})
-    speed = None
-    if drive == "constant-speed":
-        if omega1 == 0:
-            raise SpecError("a crank driven at constant speed needs a non-zero speed: give it "
-                            "here or as the operating speed [operation] speed",
-                            key="simulation.omega1", value=omega1)
-        speed = omega1
-    f = make(method, linkage, gravity=settings.gravity, speed=speed)
-    _check_start(f, theta1)
-    stop_at = None if speed is None else _lock_time(f, theta1, speed, duration)
-    y0 = f.initial_state(theta1, omega1)
-    if not np.all(np.isfinite(y0)):  # the pose assembles, its rates are not determined
-        raise SpecError(f"is a singular pose of the linkage (θ1 = {theta1:.9g} rad: a dead "
-                        "point, where the crank's rate does not determine the others'); start "
-                        "the motion elsewhere", key="simulation.theta1", value=theta1)
-    if resolution is not None and speed is not None:  # the crank's prescribed turning
-        need = math.ceil(abs(speed) * duration / resolution) + 1
-        outputs = min(MAX_OUTPUTS, max(outputs, need))
-    # A driven crank that locks: integrate up to just before the dead point, where the torque
-    # it would need grows without bound.
-    end = None if stop_at is None else _before_lock(f, stop_at)
-    return _Setup(f=f, settings=settings, y0=y0, outputs=outputs, stop_at=stop_at, end=end)
-
-
-def check(linkage, settings: SimulationSettings, *, resolution: float | None = None,
-          **overrides) -> None:
-    """Raise what :func:`simulate` with these arguments would refuse before it integrates.
-
-    Its settings, scales and start, and a driven crank's prescribed motion that would need more
-    than :data:`MAX_STEPS` quadrature panels; nothing is integrated. (A run whose steps exceed
-    the budget is refused from the rate of its first :data:`PROJECT_AFTER` steps, which only
-    the run finds.)
-
-    Parameters
-    ----------
-    linkage, settings, resolution, **overrides
-        As for :func:`simulate` (``method``, ``drive``, ``duration`` in s, ``rtol``, ``atol``,
-        ``outputs``).
-    """
-    run = _prepare(linkage, settings, resolution=resolution, **overrides)
-    stepper = _Stepper(run.f, run.settings.duration, run.settings.rtol, run.settings.atol,
-                       run.outputs, None, resolution)
-    stepper.check_up_front(run.y0, run.end)
-
-
-def simulate(
-    linkage,
-    settings: SimulationSettings,
-    *,
-    method: str | None = None,
-    drive: str | None = None,
-    duration: float | None = None,
-    rtol: float | None = None,
-    atol: float | None = None,
-    outputs: int | None = None,
-    progress: Callable[[float, float], None] | None = None,
-    resolution: float | None = None,
-) -> Trajectory:
-    """Simulate the linkage's motion.
-
-    Parameters
-    ----------
-    linkage
-        The mechanism (a four-bar, slider-crank or general linkage model).
-    settings
-        The spec's ``[simulation]`` settings; the keyword arguments override them.
-    method
-        Formulation (one of the mechanism's: :func:`balancer.formulations.formulation_table`).
-    drive
-        ``"free"`` or ``"constant-speed"`` (the crank held at ``settings.omega1``).
-    duration
-        Simulated time, s.
-    rtol, atol
-        Integrator tolerances.
-    outputs
-        Number of equally spaced output times.
-    progress
-        Called as ``progress(t, duration)`` after every step.
-    resolution
-        Most angle, rad, the crank may turn between two output times: more outputs than
-        ``outputs`` where it turns faster (from the steps' dense outputs, at most
-        :data:`MAX_OUTPUTS`).
-
-    Raises
-    ------
-    SpecError
-        For bad settings or an initial crank angle where the linkage does not assemble.
-    LockupError
-        If the motion reaches a position the formulation cannot pass (its ``partial``
-        attribute holds the trajectory up to there).
-    """
-    run = _prepare(linkage, settings, method=method, drive=drive, duration=duration,
-                   rtol=rtol, atol=atol, outputs=outputs, resolution=resolution)
-    f, y0, end = run.f, run.y0, run.end
-    duration, rtol, atol = run.settings.duration, run.settings.rtol, run.settings.atol
-    start = _time.perf_counter()
-    stepper = _Stepper(f, duration, rtol, atol, run.outputs, progress, resolution)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        times, states, drift, nfev, steps, stopped = stepper.run(y0, end)
-    traj = _trajectory(f, times, states, drift, nfev, steps, rtol, atol,
-                       _time.perf_counter() - start, guide=stepper.guide)
-    if not traj.energy_error <= ENERGY_FAILURE:
-        raise SolverError(
-            f"the {f.name} integration lost its own energy balance (an error of "
-            f"{traj.energy_error:.2g} of the energy's scale, at rtol = {rtol:g}): its results "
-            "cannot be trusted; tighten rtol or choose another formulation")
-    if stopped is not None:
-        t_event, y_event = stopped
-        th = f.theta1_of(t_event, y_event)
-        raise _lockup(
-            f"the motion reaches a dead point (sine of the transmission angle "
-            f"below {DEAD_POINT_THRESHOLD:g}) at t = {t_event:.6g} s, θ1 = {th:.6g} rad; the "
-            f"{f.name} formulation uses the crank angle as its coordinate and cannot pass it"
-            + _passing(linkage),
-            t_event, th, traj)
-    if run.stop_at is not None:
-        th = f.crank_angle(run.stop_at)
-        raise _lockup(
-            f"the crank, driven at {f.speed:g} rad/s, reaches the end of the range where the "
-            f"linkage assembles at t = {run.stop_at:.6g} s, θ1 = {th:.6g} rad: the linkage "
-            "locks", run.stop_at, th, traj)
-    return traj
-
-
-def _before_lock(f: Formulation, t_lock: float) -> float:
-    """The time before ``t_lock`` at which the prescribed motion's |sin(θ3 − θ2)| is small.
-
-    That is, where it falls to :data:`DEAD_POINT_THRESHOLD`; a pose that does not assemble
-    counts as below it. Where it is still above at ``t_lock`` (the end of the assembly range
-    is known to the precision of its search, and the transmission falls as the square root of
-    the distance to it), ``t_lock`` itself.
-    """
-    def gap(t: float) -> float:
-        value = f.transmission_of_crank(f.crank_angle(t)) - DEAD_POINT_THRESHOLD
-        return value if math.isfinite(value) else -1.0
-
-    if gap(0.0) <= 0:
-        return 0.0
-    if gap(t_lock) > 0:
-        return t_lock
-    from scipy.optimize import brentq  # only for a lock (its import costs 0.3–0.5 s)
-
-    return brentq(gap, 0.0, t_lock, xtol=1e-14)
-
-
-def _lockup(message: str, t: float, theta1: float, partial: Trajectory) -> LockupError:
-    err = LockupError(message, time=t, theta1=theta1)
-    err.partial = partial  # type: ignore[attr-defined]
-    return err
-
-
-def _trajectory(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
-                seconds, guide=None) -> Trajectory:
-    t = np.array(times)
-    extra = np.array([y[-1] for y in states])
-    states = [y[:-1] for y in states]
-    ev = f.evaluate_batch(times, states)
-    omega, alpha = np.asarray(ev.omega, float), np.asarray(ev.alpha, float)
-    theta = _followed_angles(f, t, np.asarray(ev.theta, float), omega, guide)
-    tau = np.asarray(ev.driving_torque, float) * np.ones(t.size)
-    motor = np.array([f.motor_work(y) for y in states])
-    slider = None if ev.slider is None else np.asarray(ev.slider, float)
-    # Energy: T − T0 = work of loads and gravity (a function of the configuration) + motor
-    # + the extra work integrated with the motion (a gas force).
-    kin, work = f.energy(theta, omega, alpha, slider, states=states)
-    work = work + motor + extra
-    scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), _exchangeable_energy(f), 1e-300)
-    energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
-    shaking_force, moment = f.shaking(ev)
-    return Trajectory(
-        method=f.name,
-        drive="constant-speed" if f.driven else "free",
-        speed=f.speed,
-        links=f.link_names,
-        t=t,
-        theta=theta,
-        omega=omega,
-        alpha=alpha,
-        ground={p: np.asarray(v, complex) * np.ones(t.size) for p, v in ev.ground.items()},
-        slider_normal={k: np.asarray(v, float) * np.ones(t.size)
-                       for k, v in ev.slider_normal.items()},
-        slider_couple={k: np.asarray(v, float) * np.ones(t.size)
-                       for k, v in ev.slider_couple.items()},
-        driving_torque=tau,
-        shaking_force=np.asarray(shaking_force, complex) * np.ones(t.size),
-        shaking_moment=np.asarray(moment, float) * np.ones(t.size),
-        kinetic_energy=kin,
-        work=work,
-        energy_error=energy_error,
-        drift=(float(drift[0]), float(drift[1])),
-        nfev=int(nfev),
-        steps=int(steps),
-        seconds=float(seconds),
-        rtol=rtol,
-        atol=atol,
-        named_states=mechanism_of(f.linkage).named_states,
-        model=f.linkage,
-        slider=slider,
-    )
-
-
-def _followed_angles(f: Formulation, t, theta, omega, guide) -> NDArray[np.float64]:
-    """The links' angles at the output times, continuous over the motion, rad.
-
-    Each step from one time to the next takes the 2π branch nearest to the trapezoidal
-    prediction from the rates (:func:`~balancer.formulations.continuous_angles`), through the
-    ``guide`` states (the integrator's steps, a prescribed motion's crank grid) that lie
-    between two output times: coarse output times (a whole turn of a link apart, or more) would
-    leave the prediction unable to count the turns.
-    """
-    if guide is not None and len(guide[0]) and t.size:
-        g_t = np.asarray(guide[0], dtype=float)
-        inside = (g_t > t[0]) & (g_t < t[-1]) & ~np.isin(g_t, t)
-        if inside.any():
-            ev = f.evaluate_batch(g_t[inside], [y[:-1] for y, keep
-                                                 in zip(guide[1], inside, strict=True) if keep])
-            merged = np.concatenate([t, g_t[inside]])
-            order = np.argsort(merged, kind="stable")
-            rank = np.empty_like(order)
-            rank[order] = np.arange(order.size)
-            both_theta = np.hstack([theta, np.asarray(ev.theta, float)])[:, order]
-            both_omega = np.hstack([omega, np.asarray(ev.omega, float)])[:, order]
-            followed = np.array([continuous_angles(row, both_omega[k], merged[order])
-                                 for k, row in enumerate(both_theta)])
-            return followed[:, rank[: t.size]]
-    return np.array([continuous_angles(row, omega[k], t) for k, row in enumerate(theta)])
-
-
-def _exchangeable_energy(f: Formulation) -> float:
-    """An energy the loads, gravity and springs could exchange over the linkage's size, J.
-
-    ``L·Σ(m·|g| + |F|) + 2π·Σ|M| + Σ k·(L + l0)²`` with ``L`` the linkage's length scale: the
-    energy balance's scale where the motion itself exchanges almost none (a linkage at rest in
-    equilibrium, whose kinetic energy and work are both rounding).
-    """
-    mech = mechanism_of(f.linkage)
-    length = mech.structure.length_scale()
-    g = abs(f.gravity)
-    total = sum((link.mass * g + math.hypot(*link.force)) * length
-                + 2 * math.pi * abs(link.moment) for link in mech.links)
-    for spring in mech.linkage.springs:
-        total += spring.stiffness * (length + abs(spring.free_length)) ** 2
-    return float(total)
-
-
-def simulate_design(design: Design, **overrides) -> Trajectory:
-    """:func:`simulate` with a design's own linkage and ``[simulation]`` settings.
-
-    A crank driven at constant speed turns at ``[simulation] omega1`` where that is given and
-    non-zero, else at the operating speed ``[operation] speed`` (a constant speed of zero is no
-    motion: ``omega1 = 0`` is a free motion's start from rest).
-    """
-    settings = design.simulation
-    drive = overrides.get("drive") or settings.drive
-    if drive == "constant-speed" and settings.omega1 == 0 and design.operation is not None:
-        settings = replace(settings, omega1=design.operation.speed)
-    return simulate(design.mechanism, settings, **overrides)

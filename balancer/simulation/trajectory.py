@@ -1,0 +1,237 @@
+"""A simulated motion (:class:`Trajectory`), assembled from a formulation's states.
+
+The links' angles made continuous through the states between the outputs, the forces on the
+frame, the shaking, the energy balance of :mod:`balancer.simulation`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..columns import simulation_columns
+from ..formulations import (
+    Formulation,
+    continuous_angles,
+)
+from ..mechanisms import mechanism_of
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A simulated motion at equally spaced output times.
+
+    Attributes
+    ----------
+    method
+        Formulation used.
+    drive
+        ``"free"`` or ``"constant-speed"``.
+    speed
+        The crank's constant speed of a driven run, rad/s (``None`` in free motion).
+    links
+        Names of the moving links, in the order of the rows of ``theta``, ``omega``, ``alpha``.
+    t
+        Output times, s, shape ``(n,)``.
+    theta, omega, alpha
+        Link angles (rad, continuous from their initial values), angular velocities (rad/s)
+        and accelerations (rad/s²), each of shape ``(links, n)``.
+    ground
+        Force of the mechanism on the ground at each ground point, complex, N.
+    slider_normal, slider_couple
+        For each slider on a ground guide (keyed by the sliding link): the normal force on the
+        guide (N) and its couple about the slider's point (N·m).
+    driving_torque
+        Motor torque on the crank, N·m (zero in free motion).
+    shaking_force, shaking_moment
+        Sum of the forces on the frame (N) and their moment about the origin with the motor's
+        reaction and the counter-rotors' (N·m).
+    kinetic_energy
+        Kinetic energy of the moving parts, counter-rotors included, J.
+    work
+        Work of the loads, gravity, springs and the motor since t = 0, J.
+    energy_error
+        ``max|T − T0 − W|`` relative to the largest of ``|T|``, ``|W|`` and the energy the loads,
+        gravity and springs could exchange over the linkage's size (dimensionless). A run
+        beyond :data:`ENERGY_FAILURE` raises a :class:`~balancer.errors.SolverError`.
+    drift
+        Largest constraint residual before projection: position (m) and velocity (m/s).
+    nfev
+        Right-hand-side evaluations.
+    steps
+        Accepted integration steps (of a driven crank's prescribed motion whose work is found
+        by quadrature: the quadrature's panels).
+    seconds
+        Wall-clock time of the integration and the outputs, s.
+    rtol, atol
+        Integrator tolerances used.
+    named_states
+        Whether :meth:`state` keys the links by name (a general linkage) or lists them.
+    model
+        The mechanism simulated.
+    slider
+        A formulation's own slider coordinate (the slider-crank's): position, velocity and
+        acceleration along the guide, shape ``(3, n)`` (m, m/s, m/s²).
+    """
+
+    method: str
+    drive: str
+    links: tuple[str, ...]
+    t: NDArray[np.float64]
+    theta: NDArray[np.float64]
+    omega: NDArray[np.float64]
+    alpha: NDArray[np.float64]
+    ground: dict[str, NDArray[np.complex128]]
+    slider_normal: dict[str, NDArray[np.float64]]
+    slider_couple: dict[str, NDArray[np.float64]]
+    driving_torque: NDArray[np.float64]
+    shaking_force: NDArray[np.complex128]
+    shaking_moment: NDArray[np.float64]
+    kinetic_energy: NDArray[np.float64]
+    work: NDArray[np.float64]
+    energy_error: float
+    drift: tuple[float, float]
+    nfev: int
+    steps: int
+    seconds: float
+    rtol: float
+    atol: float
+    named_states: bool = False
+    speed: float | None = None
+    model: object = field(repr=False, default=None)
+    slider: NDArray[np.float64] | None = field(repr=False, default=None)
+
+    def __repr__(self) -> str:
+        return (f"Trajectory({self.method}, {self.drive}, {self.t.size} outputs over "
+                f"{self.t[-1] - self.t[0]:g} s, {self.steps} steps; energy balance to "
+                f"{self.energy_error:.2g})")
+
+    @property
+    def largest_reaction(self) -> float:
+        """Largest magnitude of any force on the frame over the run, N (0 if none)."""
+        values = [np.max(np.abs(v), initial=0.0) for v in (
+            *self.ground.values(), *self.slider_normal.values())]
+        return float(max(values, default=0.0))
+
+    def columns(self, all_columns: bool = False) -> tuple[list[str], list]:
+        """The columns of ``simulate``'s CSV: names and values over the output times.
+
+        See :func:`balancer.columns.simulation_columns`.
+        """
+        return simulation_columns(self, all_columns)
+
+    def state(self, index: int) -> dict:
+        """Angles, rates and accelerations of the links at output ``index``.
+
+        Each a list in link order, or (``named_states``) an object keyed by link name.
+        """
+        out = {}
+        for key, values in (("theta", self.theta), ("omega", self.omega),
+                            ("alpha", self.alpha)):
+            numbers = [float(x) + 0.0 for x in values[:, index]]
+            out[key] = dict(zip(self.links, numbers, strict=True)) if self.named_states \
+                else numbers
+        return out
+
+
+def trajectory_of(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
+                  seconds, guide=None) -> Trajectory:
+    """The :class:`Trajectory` of formulation ``f``'s states at the output times.
+
+    Each state carries the work integrated with it as its last component; ``drift``, ``nfev``,
+    ``steps``, ``seconds``, the tolerances and ``guide`` (the states between the outputs
+    through which the angles are followed) are the stepper's.
+    """
+    t = np.array(times)
+    extra = np.array([y[-1] for y in states])
+    states = [y[:-1] for y in states]
+    ev = f.evaluate_batch(times, states)
+    omega, alpha = np.asarray(ev.omega, float), np.asarray(ev.alpha, float)
+    theta = _followed_angles(f, t, np.asarray(ev.theta, float), omega, guide)
+    tau = np.asarray(ev.driving_torque, float) * np.ones(t.size)
+    motor = np.array([f.motor_work(y) for y in states])
+    slider = None if ev.slider is None else np.asarray(ev.slider, float)
+    # Energy: T − T0 = work of loads and gravity (a function of the configuration) + motor
+    # + the extra work integrated with the motion (a gas force).
+    kin, work = f.energy(theta, omega, alpha, slider, states=states)
+    work = work + motor + extra
+    scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), _exchangeable_energy(f), 1e-300)
+    energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
+    shaking_force, moment = f.shaking(ev)
+    return Trajectory(
+        method=f.name,
+        drive="constant-speed" if f.driven else "free",
+        speed=f.speed,
+        links=f.link_names,
+        t=t,
+        theta=theta,
+        omega=omega,
+        alpha=alpha,
+        ground={p: np.asarray(v, complex) * np.ones(t.size) for p, v in ev.ground.items()},
+        slider_normal={k: np.asarray(v, float) * np.ones(t.size)
+                       for k, v in ev.slider_normal.items()},
+        slider_couple={k: np.asarray(v, float) * np.ones(t.size)
+                       for k, v in ev.slider_couple.items()},
+        driving_torque=tau,
+        shaking_force=np.asarray(shaking_force, complex) * np.ones(t.size),
+        shaking_moment=np.asarray(moment, float) * np.ones(t.size),
+        kinetic_energy=kin,
+        work=work,
+        energy_error=energy_error,
+        drift=(float(drift[0]), float(drift[1])),
+        nfev=int(nfev),
+        steps=int(steps),
+        seconds=float(seconds),
+        rtol=rtol,
+        atol=atol,
+        named_states=mechanism_of(f.linkage).named_states,
+        model=f.linkage,
+        slider=slider,
+    )
+
+
+def _followed_angles(f: Formulation, t, theta, omega, guide) -> NDArray[np.float64]:
+    """The links' angles at the output times, continuous over the motion, rad.
+
+    Each step from one time to the next takes the 2π branch nearest to the trapezoidal
+    prediction from the rates (:func:`~balancer.formulations.continuous_angles`), through the
+    ``guide`` states (the integrator's steps, a prescribed motion's crank grid) that lie
+    between two output times: coarse output times (a whole turn of a link apart, or more) would
+    leave the prediction unable to count the turns.
+    """
+    if guide is not None and len(guide[0]) and t.size:
+        g_t = np.asarray(guide[0], dtype=float)
+        inside = (g_t > t[0]) & (g_t < t[-1]) & ~np.isin(g_t, t)
+        if inside.any():
+            ev = f.evaluate_batch(g_t[inside], [y[:-1] for y, keep
+                                                 in zip(guide[1], inside, strict=True) if keep])
+            merged = np.concatenate([t, g_t[inside]])
+            order = np.argsort(merged, kind="stable")
+            rank = np.empty_like(order)
+            rank[order] = np.arange(order.size)
+            both_theta = np.hstack([theta, np.asarray(ev.theta, float)])[:, order]
+            both_omega = np.hstack([omega, np.asarray(ev.omega, float)])[:, order]
+            followed = np.array([continuous_angles(row, both_omega[k], merged[order])
+                                 for k, row in enumerate(both_theta)])
+            return followed[:, rank[: t.size]]
+    return np.array([continuous_angles(row, omega[k], t) for k, row in enumerate(theta)])
+
+
+def _exchangeable_energy(f: Formulation) -> float:
+    """An energy the loads, gravity and springs could exchange over the linkage's size, J.
+
+    ``L·Σ(m·|g| + |F|) + 2π·Σ|M| + Σ k·(L + l0)²`` with ``L`` the linkage's length scale: the
+    energy balance's scale where the motion itself exchanges almost none (a linkage at rest in
+    equilibrium, whose kinetic energy and work are both rounding).
+    """
+    mech = mechanism_of(f.linkage)
+    length = mech.structure.length_scale()
+    g = abs(f.gravity)
+    total = sum((link.mass * g + math.hypot(*link.force)) * length
+                + 2 * math.pi * abs(link.moment) for link in mech.links)
+    for spring in mech.linkage.springs:
+        total += spring.stiffness * (length + abs(spring.free_length)) ** 2
+    return float(total)
