@@ -28,7 +28,7 @@ from .errors import SpecError
 from .force_balance import RESIDUAL_FLOOR, force_balance_residual
 from .linkage.kinematics import Motion
 from .mechanisms import mechanism_of
-from .mechanisms.base import Mechanism
+from .mechanisms.base import Mechanism, Route
 
 #: Number of crank angles evaluated at once.
 CHUNK = 32768
@@ -277,7 +277,7 @@ def sample_angles(samples: int) -> NDArray[np.float64]:
     return angles
 
 
-def cycle_analysis(model, speed: float, samples: int = 360, *, route: str | None = None,
+def cycle_analysis(model, speed: float, samples: int = 360, *, route: Route | None = None,
                    loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0),
                    theta1: NDArray[np.float64] | None = None) -> CycleAnalysis:
     """Analyse one crank revolution at constant ``speed`` (rad/s) over ``samples`` angles.

@@ -6,10 +6,11 @@ from .. import examples
 from .. import validate as v
 from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses
 from ..errors import SpecError
+from ..mechanisms.base import Route
 from ..model import Design, check_scales
 
 
-def analyze(design: Design, *, route: str | None = None,
+def analyze(design: Design, *, route: Route | None = None,
             gravity: tuple[float, float] | None = None) -> CycleAnalysis:
     """One crank revolution at the design's operating speed (``[operation]``).
 

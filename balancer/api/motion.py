@@ -4,13 +4,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from ..formulations import Method
 from ..model import Design, Drive
 from ..simulation import Trajectory, simulate_design
 from ..verification import Verification
 from ..verification import verify as run_verification
 
 
-def simulate(design: Design, *, method: str | None = None, drive: Drive | None = None,
+def simulate(design: Design, *, method: Method | None = None, drive: Drive | None = None,
              duration: float | None = None, rtol: float | None = None,
              atol: float | None = None, outputs: int | None = None,
              progress: Callable[[float, float], None] | None = None) -> Trajectory:
@@ -25,7 +26,7 @@ def simulate(design: Design, *, method: str | None = None, drive: Drive | None =
                            atol=atol, outputs=outputs, progress=progress)
 
 
-def verify(design: Design, *, method: str | None = None, duration: float | None = None,
+def verify(design: Design, *, method: Method | None = None, duration: float | None = None,
            progress: Callable[[float, float], None] | None = None) -> Verification:
     """Proof by simulation (driven and free) that a design is balanced.
 

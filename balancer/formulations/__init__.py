@@ -33,6 +33,8 @@ outputs) is :mod:`balancer.simulation`.
 
 from __future__ import annotations
 
+from typing import Literal
+
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..slider_crank.formulations import SliderComplexMasses, SliderMassMatrix
@@ -52,6 +54,9 @@ from .mass_matrix import MassMatrix
 from .multibody import Multibody
 from .opened_loop import OpenedLoop
 
+#: A formulation of the equations of motion, by name (``simulate --method``).
+Method = Literal["opened-loop", "complex-masses", "mass-matrix", "lie-group", "multibody",
+                 "crank-angle"]
 #: The formulations by name: those every linkage has, and each mechanism's own by its kind
 #: (the names a mechanism offers, in its order, are its ``formulation_names``).
 GENERAL: dict[str, type[Formulation]] = {"multibody": Multibody, "crank-angle": CrankAngle}
@@ -118,6 +123,7 @@ def make(
 __all__ = [
     "DEAD_POINT_THRESHOLD",
     "GENERAL",
+    "Method",
     "OWN",
     "DrivenRates",
     "Evaluation",

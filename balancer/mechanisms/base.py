@@ -20,7 +20,7 @@ import threading
 from abc import ABC
 from dataclasses import dataclass
 from functools import cached_property
-from typing import ClassVar
+from typing import ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -36,6 +36,9 @@ from ..linkage.vectors import V
 from ..model import GROUND, Link, Linkage
 from ..model.assembly import AssemblyRange
 
+#: The inverse-dynamics routes of every mechanism (``analyze --route``): the links' equations
+#: group by group, or all at once with the mass matrices and the constraints' multipliers.
+Route = Literal["newton-euler", "mass-matrix"]
 #: The formulations of the equations of motion that apply to every linkage: in absolute
 #: coordinates with the constraints' multipliers, and in the crank angle.
 MULTIBODY = "multibody"
@@ -89,7 +92,7 @@ class Mechanism(ABC):
     #: The spec's ``mechanism.type``.
     kind: ClassVar[str]
     #: Inverse-dynamics routes (``analyze --route``), the default first.
-    routes: ClassVar[tuple[str, ...]] = ("newton-euler", "mass-matrix")
+    routes: ClassVar[tuple[Route, ...]] = ("newton-euler", "mass-matrix")
     #: The mechanism's own formulations of the equations of motion (:mod:`balancer.formulations`
     #: has them by name), the default first.
     formulations: ClassVar[tuple[str, ...]] = ()

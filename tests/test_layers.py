@@ -1,0 +1,171 @@
+"""The package's layers hold by themselves: every import runs down or sideways, none in a cycle.
+
+Read from the source with :mod:`ast`, counting imports inside functions and under
+``TYPE_CHECKING`` as much as those at the top (docs/architecture.md draws the layers). And the
+package's public names: every type a user meets is a name of ``balancer``, loaded lazily.
+"""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+import typing
+from pathlib import Path
+
+import pytest
+
+import balancer
+
+PACKAGE = Path(balancer.__file__).resolve().parent
+
+#: The layers, lowest first: a module may import its own layer and those below. A module is
+#: placed by its longest matching prefix.
+LAYERS: tuple[tuple[str, ...], ...] = (
+    ("errors", "validate", "tomltext", "progress", "interrupts", "outputs"),
+    ("model",),
+    ("linkage", "quadrature"),
+    ("kinematics", "massmodels", "inverse", "conditions", "slider_crank", "mechanisms"),
+    ("force_balance", "columns", "cycle", "drawing", "formulations", "integration",
+     "slider_crank.formulations"),
+    ("balance",),
+    ("simulation", "verification", "report", "plots", "plausibility"),
+    ("spec", "examples", "api", "sweeps", "cli", "__main__"),
+)
+
+
+def modules() -> dict[str, Path]:
+    """Every module of the package by dotted name (``balancer`` left out)."""
+    out = {}
+    for path in PACKAGE.rglob("*.py"):
+        parts = path.relative_to(PACKAGE).with_suffix("").parts
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        if parts:
+            out[".".join(parts)] = path
+    return out
+
+
+def layer(name: str) -> int:
+    """The layer of module ``name`` (by its longest prefix in :data:`LAYERS`)."""
+    best, found = -1, None
+    for level, prefixes in enumerate(LAYERS):
+        for prefix in prefixes:
+            if (name == prefix or name.startswith(prefix + ".")) and len(prefix) > best:
+                best, found = len(prefix), level
+    if found is None:
+        raise AssertionError(f"module balancer.{name} is in no layer: place it in LAYERS")
+    return found
+
+
+def imports(name: str, path: Path, known: dict[str, Path]) -> set[str]:
+    """The package's modules that module ``name`` imports, anywhere in its source."""
+    is_package = path.name == "__init__.py"
+    base = name.split(".") if name else []
+    if not is_package:
+        base = base[:-1]
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names if a.name.startswith("balancer.")]
+            out |= {t.removeprefix("balancer.") for t in targets}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                parts = base[: len(base) - (node.level - 1)]
+                module = ".".join([*parts, *([node.module] if node.module else [])])
+            elif node.module and node.module.startswith("balancer"):
+                module = node.module.removeprefix("balancer").removeprefix(".")
+            else:
+                continue
+            for alias in node.names:
+                full = f"{module}.{alias.name}" if module else alias.name
+                out.add(full if full in known else module)
+    out.discard(name)
+    out.discard("")
+    return {m for m in out if m in known}
+
+
+def graph() -> dict[str, set[str]]:
+    known = modules()
+    return {name: imports(name, path, known) for name, path in known.items()}
+
+
+def test_every_import_runs_down_or_sideways():
+    upward = [f"balancer.{a} (layer {layer(a)}) imports balancer.{b} (layer {layer(b)})"
+              for a, targets in graph().items() for b in sorted(targets) if layer(b) > layer(a)]
+    assert not upward, "\n".join(upward)
+
+
+def test_no_import_cycle():
+    edges = graph()
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    cycles: list[list[str]] = []
+
+    def visit(v: str) -> None:  # Tarjan's strongly connected components
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in edges[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                cycles.append(sorted(component))
+
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 10 * len(edges)))
+    for v in edges:
+        if v not in index:
+            visit(v)
+    assert not cycles, cycles
+
+
+def test_the_layer_table_knows_every_module():
+    for name in modules():
+        if name:
+            layer(name)
+
+
+@pytest.mark.parametrize("name", balancer.__all__)
+def test_every_public_name_resolves(name):
+    assert getattr(balancer, name) is not None
+
+
+def test_every_api_call_returns_a_public_type():
+    from balancer import api
+
+    public = {getattr(balancer, n) for n in balancer.__all__}
+    plain = (dict, list, tuple, str, float, int, type(None), typing.Any)
+
+    def classes(kind):  # the classes a (possibly nested) annotation names
+        args = typing.get_args(kind)
+        if args:
+            for arg in args:
+                yield from classes(arg)
+        if (typing.get_origin(kind) or kind) not in plain and not args:
+            yield kind
+
+    for name in api.__all__:
+        hints = typing.get_type_hints(getattr(api, name), vars(balancer) | vars(typing))
+        for kind in classes(hints["return"]):
+            assert kind in public, f"api.{name} returns {kind!r}, not a name of balancer"
+
+
+def test_import_balancer_loads_no_numerics():
+    code = "import sys, balancer; print(sorted(m for m in ('numpy', 'scipy', 'casadi') " \
+           "if m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.strip() == "[]"
