@@ -198,7 +198,10 @@ class NlpSolver:
         self._ubx = np.array(ubx)
         self._lbg = np.array(lbg)
         self._ubg = np.array(ubg)
-        self._solver = ca.nlpsol(
+        # As many equations (Eq. 58's rows) as variables leave IPOPT nothing to improve on the
+        # convex optimum, and CasADi would say on stderr that the NLP is overconstrained.
+        equations = int(np.sum(self._lbg == self._ubg))
+        self._solver = None if equations >= len(symbols) else ca.nlpsol(
             "balance", "ipopt", {"x": v, "f": value, "g": ca.vertcat(*g)}, self.options
         )
 
@@ -249,8 +252,13 @@ class NlpSolver:
         """The design vector ``x`` of a scaled decision vector (inert entries settled)."""
         return self.data.settle(np.array(self._pi(v)).ravel())
 
-    def solve(self, x_start: NDArray[np.float64]) -> NlpSolution:
-        """Run IPOPT from design vector ``x_start`` (normally the convex optimum)."""
+    def solve(self, x_start: NDArray[np.float64]) -> NlpSolution | None:
+        """Run IPOPT from design vector ``x_start`` (normally the convex optimum).
+
+        ``None`` where the problem leaves no freedom beyond its equations (nothing to solve).
+        """
+        if self._solver is None:
+            return None
         data = self.data
         v0 = self.start(np.asarray(x_start, float))
         t0 = time.perf_counter()

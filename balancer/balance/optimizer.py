@@ -162,16 +162,17 @@ class Optimizer:
         objective = data.objective(x)
         notes = []
         if backend == "nlp":
-            nlp = self.nlp.solve(convex.x)
-            stages.append(nlp.stage)
-            if nlp.status == "optimal" and nlp.feasible:
+            nlp = self.nlp.solve(convex.x)  # None: no freedom beyond Eq. 58 to improve on
+            if nlp is not None:
+                stages.append(nlp.stage)
+            if nlp is not None and nlp.status == "optimal" and nlp.feasible:
                 if not feasible or not data.within(objective, nlp.objective, TIE_TOLERANCE):
                     xb, ok = self.convex.finalize(nlp.x)  # bounds exactly, Eq. 58 to rounding
                     # (made exactly feasible it may have lost what it gained: in a thin
                     # feasible set the projection costs more than the tolerance)
                     if ok and (not feasible or data.objective(xb) < objective):
                         x, objective, feasible = xb, data.objective(xb), True
-            else:
+            elif nlp is not None:
                 notes.append(f"IPOPT: {nlp.stage.solver_status}")
         # The design as its physical values, exactly in their bounds (what the spec will say).
         x = data.vector_of(data.physical(x))
