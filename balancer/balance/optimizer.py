@@ -171,6 +171,13 @@ class Optimizer:
                     # (made exactly feasible it may have lost what it gained: in a thin
                     # feasible set the projection costs more than the tolerance)
                     if ok and (not feasible or data.objective(xb) < objective):
+                        # What IPOPT left where nothing pulls (a counterweight that may be none
+                        # at its barrier's middle) is put back as the convex stage puts it.
+                        polished, _ = self.convex.polish(xb, data.x0,
+                                                         data.reduced_objective(xb))
+                        xp, exact = self.convex.finalize(polished)
+                        if exact and data.within(data.objective(xp), data.objective(xb), 1e-12):
+                            xb = xp
                         x, objective, feasible = xb, data.objective(xb), True
             elif nlp is not None:
                 notes.append(f"IPOPT: {nlp.stage.solver_status}")
