@@ -169,3 +169,23 @@ def test_import_balancer_loads_no_numerics():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout
     assert out.strip() == "[]"
+
+
+def test_the_architecture_page_draws_every_layer_as_the_test_holds_it():
+    """Each module of LAYERS is named in docs/architecture.md's diagram, in its own layer."""
+    page = (PACKAGE.parent / "docs" / "architecture.md").read_text(encoding="utf-8")
+    diagram = page.split("```text", 1)[1].split("```", 1)[0]
+    rows: dict[int, str] = {}
+    current = -1
+    for line in diagram.splitlines():
+        head = line[:3].strip()
+        if head.isdigit():
+            current = int(head)
+        if current >= 0:
+            rows[current] = rows.get(current, "") + line
+    for level, prefixes in enumerate(LAYERS):
+        for prefix in prefixes:
+            if prefix == "__main__" or "." in prefix:  # the entry point; a module of a package
+                continue
+            name = prefix
+            assert name in rows.get(level, ""), f"{prefix} is not drawn in layer {level}"
