@@ -76,6 +76,13 @@ CLARABEL_SETTINGS: dict[str, float | int] = {
     "tol_ktratio": 1e-8,
     "max_iter": 200,
 }
+#: Settings Clarabel is run with again, in turn, where it stops for numerical trouble (its
+#: factorisation fails in a thin feasible set, as the redesign campaign found on problems at
+#: the edge of force balance): a stronger static regularisation, then no equilibration.
+NUMERICAL_FALLBACKS: tuple[dict[str, float | bool], ...] = (
+    {"static_regularization_constant": 1e-7},
+    {"equilibrate_enable": False},
+)
 #: The tie-break's design replaces the SOCP's if it is feasible and its objective is no worse
 #: by more than this, relative to the problem's scale (:meth:`NumericProblem.within`).
 TIE_ACCEPT = 1e-8
@@ -268,9 +275,12 @@ class ConvexSolver(Repairs, Diagnosis):
             k = b.start
             mref, l, iref = b.mass_ref, b.length, b.inertia_ref
             m = entry(k, mref)
+            # A counterweight that may be none keeps its cone's apex in the tightened set: its
+            # bounds are tightened in proportion to its mass (none stays none).
+            apex = b.offset is not None and b.mass[0] == 0
             if k in free:
                 lo, hi = inside(b.mass[0] / mref, b.mass[1] / mref)
-                at_least(m, lo)
+                at_least(m, 0.0 if apex else lo)
                 at_most(m, hi)
             se, sf = entry(k + 1, mref * l), entry(k + 2, mref * l)
             centre = b.com_centre / l  # complex, in the link's frame
@@ -294,11 +304,15 @@ class ConvexSolver(Repairs, Diagnosis):
                 if math.isfinite(hi):
                     at_most(inertia, hi_m)
                 continue
-            if lo > 0 or not rho2:  # ‖S‖²/m ≤ J − lo
-                quad_at_most([se, sf], m, (j[0], j[1] - lo_m))
-            if rho2:  # ‖S‖²/m ≤ J − ρ²·m − margin
-                room = combine((1.0, j), (-rho2, m))
-                quad_at_most([se, sf], m, (room[0], room[1] - margin))
+            if apex:  # ‖S‖²/m ≤ J − (ρ² + margin)·m (lo = 0)
+                room = combine((1.0, j), (-(rho2 + margin), m))
+                quad_at_most([se, sf], m, room)
+            else:
+                if lo > 0 or not rho2:  # ‖S‖²/m ≤ J − lo
+                    quad_at_most([se, sf], m, (j[0], j[1] - lo_m))
+                if rho2:  # ‖S‖²/m ≤ J − ρ²·m − margin
+                    room = combine((1.0, j), (-rho2, m))
+                    quad_at_most([se, sf], m, (room[0], room[1] - margin))
             if math.isfinite(hi):  # J − hi ≤ m·(R² − |c|²) + 2·c·S
                 radius = b.com_radius / l
                 cap = combine((radius**2 - abs(centre) ** 2, m), (2 * centre.real, se),
@@ -396,6 +410,10 @@ class ConvexSolver(Repairs, Diagnosis):
         """Solve one of the programs; its report, and Clarabel's answer."""
         start = time.perf_counter()
         solution = program.solve(self.settings, **data)
+        for fallback in NUMERICAL_FALLBACKS:  # numerical trouble (a thin feasible set): again
+            if solution.status != "solver_error":
+                break
+            solution = program.solve({**self.settings, **fallback}, **data)
         elapsed = time.perf_counter() - start
         ok = solution.u is not None
         report = StageReport(
@@ -463,6 +481,15 @@ class ConvexSolver(Repairs, Diagnosis):
             x, objective = self.polish(x, target, objective)
         x = data.settle(x)  # the inert entries, for a crank whose speed changes
         x, feasible = self.finalize(x)
+        if feasible and tie_break and lay.size:
+            # Made exact in a thin feasible set, a counterweight that may be none can come off
+            # its cone's apex again (the projection's margin): tried at none once more.
+            before = data.reduced_objective(x)
+            again, _ = self._without_small_counterweights(x, x, u1, target, before, stages)
+            if again is not x:
+                exact, ok = self.finalize(data.settle(again))
+                if ok and data.within(data.reduced_objective(exact), before, TIE_ACCEPT):
+                    x = exact
         lower = self._lower_bound(u1, multipliers, norm_dual, x if feasible else None)
         return ConvexSolution(
             x=x,

@@ -345,12 +345,17 @@ class Repairs:
         Interior-point solvers meet the force balance to their tolerance (Clarabel's 1e-10,
         IPOPT's 1e-12 in scaled units); this puts the shaking force at rounding level. Where
         the unpinned entries cannot restore a row, the least-squares correction is made and the
-        feasibility check that follows decides.
+        feasibility check that follows decides. A counterweight that is none
+        (:meth:`NumericProblem.absent`) stays none: its entries are kept too.
         """
         u = np.array(u, dtype=float)
         if self._fb is None:
             return u
         at, rhs, pinv = self._fb
+        _, none = self.data.without_absent(self.layout.x(u))
+        if none.any():
+            kept = none[list(self.layout.primary)]
+            pinned = kept if pinned is None else (pinned | kept)
         free = None if pinned is None or not pinned.any() else ~pinned
         if free is not None and not free.any():
             return u
