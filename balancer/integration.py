@@ -309,7 +309,7 @@ class DOP853:
         self.status = "running"
         self.max_step = max_step
         self.rtol = max(rtol, 100 * np.finfo(float).eps)
-        self.atol = np.asarray(atol)
+        self.atol: float | NDArray[np.float64] = np.asarray(atol)
         self.f = self.fun(self.t, self.y)
         if first_step is None:
             self.h_abs = self._initial_step()
