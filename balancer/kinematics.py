@@ -504,9 +504,9 @@ def motion_from_angles(
         singular=np.abs(s_mu) < SINGULAR_TOLERANCE,
     )
     big = transfer_functions(pos)
-    om = tuple(np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in omega)
-    al = tuple(np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in alpha)
-    return Motion(pos=pos, omega=om, alpha=al, transfer=big)  # type: ignore[arg-type]
+    w1, w2, w3 = (np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in omega)
+    a1, a2, a3 = (np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in alpha)
+    return Motion(pos=pos, omega=(w1, w2, w3), alpha=(a1, a2, a3), transfer=big)
 
 
 # ----------------------------------------------------------------------------------------------

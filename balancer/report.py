@@ -681,7 +681,7 @@ class SweepSummary(Protocol):
     def rate(self) -> float | None:
         """Points per second of this run, or ``None``."""
     @property
-    def residual_force(self) -> Mapping[str, float] | None:
+    def residual_force(self) -> Mapping[str, float | str] | None:
         """The perturbed designs' residual RMS shaking force (``mean``, ``p95``, ``max``), N."""
 
 
