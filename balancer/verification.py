@@ -95,7 +95,7 @@ class RunCheck:
         """Largest shaking moment relative to the original's."""
         return _ratio(self.max_shaking_moment, self.original_max_shaking_moment)
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """Plain dictionary for JSON."""
         return {
             "max_shaking_force": self.max_shaking_force,
