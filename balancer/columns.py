@@ -11,11 +11,91 @@ formulation's simulation).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from typing import Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
+from .linkage.kinematics import Motion
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism
+from .model import Mechanism as Model
+
+#: Columns of a CSV file: real arrays over its rows.
+Columns = list[NDArray[np.floating]]
+
+
+class FrameForces(Protocol):
+    """What a cycle analysis' reactions and a trajectory tell of the forces on the frame."""
+
+    @property
+    def ground(self) -> Mapping[str, NDArray[np.complex128]]:
+        """Force on the ground at each ground point, complex, N."""
+    @property
+    def slider_normal(self) -> Mapping[str, NDArray[np.float64]]:
+        """Normal force of each slider on a ground guide, by link, N."""
+    @property
+    def slider_couple(self) -> Mapping[str, NDArray[np.float64]]:
+        """Couple of each slider on a ground guide, by link, N·m."""
+    @property
+    def shaking_force(self) -> NDArray[np.complex128]:
+        """Sum of the forces on the frame, complex, N."""
+    @property
+    def shaking_moment(self) -> NDArray[np.float64]:
+        """Their moment about the origin, N·m."""
+    @property
+    def driving_torque(self) -> NDArray[np.float64]:
+        """Torque of the motor on the input, N·m."""
+
+
+class AnalysisLike(Protocol):
+    """What the columns read of a cycle analysis (:class:`balancer.cycle.CycleAnalysis`)."""
+
+    @property
+    def mechanism(self) -> Mechanism:
+        """The analysed mechanism."""
+    @property
+    def motion(self) -> Motion:
+        """Kinematics at the samples."""
+    @property
+    def reactions(self) -> FrameForces:
+        """The forces on the frame at the samples."""
+    @property
+    def time(self) -> NDArray[np.float64]:
+        """Time at each sample, s."""
+    @property
+    def samples(self) -> int:
+        """Number of samples."""
+
+
+class TrajectoryLike(FrameForces, Protocol):
+    """What the columns read of a simulation (:class:`balancer.simulation.Trajectory`)."""
+
+    @property
+    def model(self) -> Model | None:
+        """The simulated mechanism's model."""
+    @property
+    def links(self) -> tuple[str, ...]:
+        """Names of the moving links, in the rows' order of :attr:`theta`."""
+    @property
+    def t(self) -> NDArray[np.float64]:
+        """Output times, s."""
+    @property
+    def theta(self) -> NDArray[np.float64]:
+        """Each link's angle, rad, shape ``(links, times)``."""
+    @property
+    def omega(self) -> NDArray[np.float64]:
+        """Each link's angular velocity, rad/s."""
+    @property
+    def alpha(self) -> NDArray[np.float64]:
+        """Each link's angular acceleration, rad/s²."""
+    @property
+    def kinetic_energy(self) -> NDArray[np.float64]:
+        """Kinetic energy, J."""
+    @property
+    def work(self) -> NDArray[np.float64]:
+        """Work done on the mechanism, J."""
 
 #: The columns of ``simulate``'s CSV, fixed by DESIGN.md.
 SIMULATION_COLUMNS = (
@@ -42,7 +122,7 @@ SIMULATION_EXTRA_COLUMNS = (*SHAKING_COLUMNS, "kinetic_energy", "work")
 ANALYSIS_COLUMNS = (*SIMULATION_COLUMNS, *SHAKING_COLUMNS)
 
 
-def analysis_columns(analysis) -> tuple[list[str], list]:
+def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     """The columns of ``analyze --csv``: names and values (arrays over the samples).
 
     ``t``; per moving link ``k`` (1, 2, … in the spec's order) ``theta{k}``, ``omega{k}``,
@@ -54,7 +134,7 @@ def analysis_columns(analysis) -> tuple[list[str], list]:
     mo, r = analysis.motion, analysis.reactions
     n = len(mo.pose.angles)
     names = ["t"]
-    cols: list = [analysis.time]
+    cols: Columns = [analysis.time]
     for group, values in (("theta", mo.pose.angles), ("omega", mo.rate), ("alpha", mo.accel)):
         names += [f"{group}{k + 1}" for k in range(n)]
         cols += [np.asarray(v, float) * np.ones(analysis.samples) for v in values]
@@ -70,7 +150,10 @@ def analysis_columns(analysis) -> tuple[list[str], list]:
     return names, cols
 
 
-def frame_force_columns(mech: Mechanism, ground, normal, couple) -> tuple[list[str], list]:
+def frame_force_columns(mech: Mechanism, ground: Mapping[str, NDArray[np.complex128]],
+                        normal: Mapping[str, NDArray[np.float64]],
+                        couple: Mapping[str, NDArray[np.float64]]
+                        ) -> tuple[list[str], Columns]:
     """Columns of the forces on the frame: names and values.
 
     Per ground point ``P`` the force on it ``R{P}x``, ``R{P}y`` (N); per slider on the frame
@@ -79,7 +162,7 @@ def frame_force_columns(mech: Mechanism, ground, normal, couple) -> tuple[list[s
     and the couple.
     """
     names: list[str] = []
-    cols: list = []
+    cols: Columns = []
     for point, values in ground.items():
         names += [f"R{point}x", f"R{point}y"]
         cols += [values.real, values.imag]
@@ -98,7 +181,8 @@ def frame_force_columns(mech: Mechanism, ground, normal, couple) -> tuple[list[s
     return names, cols
 
 
-def slider_columns(mech: Mechanism, theta1, omega1, alpha1) -> tuple[list[str], list]:
+def slider_columns(mech: Mechanism, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike
+                   ) -> tuple[list[str], Columns]:
     """Columns of each slider on the frame: where its point runs along the guide.
 
     For the sliding link ``k`` (numbered as in ``theta{k}``): ``x{k}``, ``v{k}``, ``a{k}``,
@@ -115,7 +199,7 @@ def slider_columns(mech: Mechanism, theta1, omega1, alpha1) -> tuple[list[str], 
     with np.errstate(all="ignore"):
         mo = mech.motion(theta1, omega1, alpha1)
     names: list[str] = []
-    cols: list = []
+    cols: Columns = []
     for s in sliders:
         k = mech.link_names.index(s.link)
         local = mech.structure.local[(k, s.point)]
@@ -128,7 +212,8 @@ def slider_columns(mech: Mechanism, theta1, omega1, alpha1) -> tuple[list[str], 
     return names, cols
 
 
-def simulation_columns(traj, all_columns: bool = False) -> tuple[list[str], list]:
+def simulation_columns(traj: TrajectoryLike, all_columns: bool = False
+                       ) -> tuple[list[str], Columns]:
     """The columns of ``simulate``'s CSV: names and values (arrays over the output times).
 
     ``t``; per moving link ``k`` (1, 2, … in the mechanism's order) ``theta{k}``, ``omega{k}``,
@@ -139,11 +224,12 @@ def simulation_columns(traj, all_columns: bool = False) -> tuple[list[str], list
     ones (:data:`SIMULATION_COLUMNS`).
     """
     names = ["t"]
-    cols: list = [traj.t]
+    cols: Columns = [traj.t]
     for group in ("theta", "omega", "alpha"):
         values = getattr(traj, group)
         names += [f"{group}{k + 1}" for k in range(len(values))]
         cols += list(values)
+    assert traj.model is not None  # a simulation's trajectory names its model
     mech = mechanism_of(traj.model)
     frame_names, frame_cols = frame_force_columns(mech, traj.ground, traj.slider_normal,
                                                   traj.slider_couple)

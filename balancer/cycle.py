@@ -17,18 +17,21 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from .columns import analysis_columns
+from .columns import Columns, analysis_columns
 from .errors import SpecError
 from .force_balance import RESIDUAL_FLOOR, force_balance_residual
+from .linkage.dynamics import Forces
 from .linkage.kinematics import Motion
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism, Route
+from .model import Mechanism as Model
 
 #: Number of crank angles evaluated at once.
 CHUNK = 32768
@@ -44,7 +47,7 @@ class Figure:
     max: float
 
     @classmethod
-    def of(cls, values: NDArray) -> Figure:
+    def of(cls, values: ArrayLike) -> Figure:
         """Figures of an array of real or complex values (complex: vector magnitudes).
 
         Values that do not exist (NaN, at a change point) are left out; computed without
@@ -164,7 +167,7 @@ class CycleAnalysis:
     speed: float
     theta1: NDArray[np.float64]
     reactions: Reactions
-    route: str
+    route: Route
     gravity: tuple[float, float] = (0.0, 0.0)
     loads: bool = True
     singular: NDArray[np.bool_] | None = None
@@ -189,7 +192,7 @@ class CycleAnalysis:
                 f"{s.driving_torque.rms:.4g} N·m)")
 
     @property
-    def linkage(self):
+    def linkage(self) -> Model:
         """The mechanism's model (a FourBar, SliderCrank or Linkage)."""
         return self.mechanism.model
 
@@ -208,8 +211,8 @@ class CycleAnalysis:
         of an unbalance. Samples at a singular pose are left out.
         """
         with np.errstate(all="ignore"):
-            path = self.mechanism.total_centre_of_mass(self.motion)
-        path = np.asarray(path, dtype=complex) * np.ones(self.samples)
+            centre = self.mechanism.total_centre_of_mass(self.motion)
+        path = np.asarray(centre, dtype=complex) * np.ones(self.samples)
         path = path[np.isfinite(path)]
         if not path.size:
             return math.nan
@@ -252,7 +255,7 @@ class CycleAnalysis:
             out[name] = amp
         return out
 
-    def columns(self) -> tuple[list[str], list]:
+    def columns(self) -> tuple[list[str], Columns]:
         """The columns of ``analyze --csv``: names and values over the samples.
 
         See :func:`balancer.columns.analysis_columns`.
@@ -277,8 +280,9 @@ def sample_angles(samples: int) -> NDArray[np.float64]:
     return angles
 
 
-def cycle_analysis(model, speed: float, samples: int = 360, *, route: Route | None = None,
-                   loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0),
+def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *,
+                   route: Route | None = None, loads: bool = True,
+                   gravity: tuple[float, float] = (0.0, 0.0),
                    theta1: NDArray[np.float64] | None = None) -> CycleAnalysis:
     """Analyse one crank revolution at constant ``speed`` (rad/s) over ``samples`` angles.
 
@@ -322,7 +326,7 @@ def cycle_analysis(model, speed: float, samples: int = 360, *, route: Route | No
     normal = {k: np.empty(n) for k in sliders}
     couple = {k: np.empty(n) for k in sliders}
 
-    def evaluate(theta):
+    def evaluate(theta: NDArray[np.float64]) -> Forces:
         with np.errstate(all="ignore"):
             return mech.crank_forces(theta, speed, 0.0, route=route, loads=loads,
                                      gravity=gravity)
@@ -369,7 +373,8 @@ def cycle_analysis(model, speed: float, samples: int = 360, *, route: Route | No
         singular |= hit
     reactions = Reactions(ground=ground, slider_normal=normal, slider_couple=couple, **out)
     return CycleAnalysis(mechanism=mech, speed=speed, theta1=angles, reactions=reactions,
-                         route=route, gravity=tuple(gravity), loads=loads, singular=singular)
+                         route=route, gravity=(gravity[0], gravity[1]), loads=loads,
+                         singular=singular)
 
 
 #: Largest distance, between two samples, of a drawn curve from the line through them,
@@ -384,7 +389,8 @@ PLOT_SAMPLES = (720, 2**17)
 ROUNDING_SPAN = 1e-9
 
 
-def drawn_analyses(models, speed: float, *, samples: int | None = None, least: int = 0,
+def drawn_analyses(models: Sequence[Model | Mechanism], speed: float, *,
+                   samples: int | None = None, least: int = 0,
                    gravity: tuple[float, float] = (0.0, 0.0),
                    tolerance: float = DRAWING_TOLERANCE) -> list[CycleAnalysis]:
     """Revolutions of mechanisms at the same crank angles, sampled finely enough to draw.
@@ -413,12 +419,12 @@ def drawn_analyses(models, speed: float, *, samples: int | None = None, least: i
     return coarse
 
 
-def drawn_panels(analysis) -> dict[str, np.ndarray]:
+def drawn_panels(analysis: CycleAnalysis) -> dict[str, NDArray[np.number]]:
     """What the cycle figure draws of an analysis, by panel."""
     r = analysis.reactions
     return {"force": r.shaking_force, "moment": r.shaking_moment, "torque": r.driving_torque}
 
-def _drawn_within(analyses, tolerance: float) -> bool:
+def _drawn_within(analyses: Sequence[CycleAnalysis], tolerance: float) -> bool:
     """Whether every curve at the even samples is drawn within ``tolerance`` of its panel.
 
     The odd samples are the midpoints: their distance from the chords of the even ones,

@@ -6,15 +6,40 @@ Positions from the mechanism's kinematics at crank angles, for the figures and a
 
 from __future__ import annotations
 
-import numpy as np
+from collections.abc import Mapping
+from typing import Protocol
 
+import numpy as np
+from numpy.typing import NDArray
+
+from .columns import TrajectoryLike
 from .cycle import sample_angles
 from .linkage.vectors import V
 from .mechanisms import mechanism_of
+from .mechanisms.base import Mechanism
 from .model import GROUND
+from .model import Mechanism as Model
 
 
-def centre_of_mass_path(linkage, traj) -> np.ndarray:
+class CounterweightLike(Protocol):
+    """What a drawing reads of a counterweight (:class:`balancer.balance.Counterweight`)."""
+
+    @property
+    def kind(self) -> str:
+        """``"add"`` for a body added to the link (the others are not drawn)."""
+    @property
+    def e(self) -> float:
+        """Its centre along the link, m."""
+    @property
+    def f(self) -> float:
+        """Its centre across the link, m."""
+    @property
+    def disc_radius(self) -> float | None:
+        """Its steel disc's radius, m (``None``: a point)."""
+
+
+def centre_of_mass_path(linkage: Model | Mechanism, traj: TrajectoryLike
+                        ) -> NDArray[np.complex128]:
     """Total centre of mass along a simulated motion, complex, m.
 
     ``traj`` a simulated motion (:class:`balancer.simulation.Trajectory`: its links' names,
@@ -27,7 +52,8 @@ def centre_of_mass_path(linkage, traj) -> np.ndarray:
     return np.asarray(mech.total_centre_of_mass(mo), complex)
 
 
-def frame(linkage, samples: int = 72) -> tuple[np.ndarray, list[np.ndarray]]:
+def frame(linkage: Model | Mechanism, samples: int = 72
+          ) -> tuple[NDArray[np.complex128], list[NDArray[np.complex128]]]:
     """What to draw of the frame: the ground points, and each ground guide's travel, m.
 
     Returns the ground points (complex) and, per slider on a ground guide, the two ends of
@@ -41,7 +67,7 @@ def frame(linkage, samples: int = 72) -> tuple[np.ndarray, list[np.ndarray]]:
     with np.errstate(all="ignore"):
         mo = mech.motion(angles)
     points = mech.points(mo)
-    guides = []
+    guides: list[NDArray[np.complex128]] = []
     for slider in mech.linkage.sliders:
         if slider.guide == GROUND:
             path = points[slider.point][np.isfinite(points[slider.point])]
@@ -53,7 +79,9 @@ def frame(linkage, samples: int = 72) -> tuple[np.ndarray, list[np.ndarray]]:
     return pivots, guides
 
 
-def drawing_frames(linkage, frames: int):
+def drawing_frames(linkage: Model | Mechanism, frames: int
+                   ) -> tuple[dict[str, NDArray[np.complex128]], dict[str, NDArray[np.complex128]],
+                              NDArray[np.complex128]]:
     """What an animation draws over a revolution at equally spaced crank angles.
 
     Returns ``(links, coms, total)``: per link (the ground's left out) a ``(frames, k)``
@@ -63,7 +91,7 @@ def drawing_frames(linkage, frames: int):
     mech = mechanism_of(linkage)
     mo = mech.motion(sample_angles(frames), 1.0)
     points = mech.points(mo)
-    links = {}
+    links: dict[str, NDArray[np.complex128]] = {}
     for name, names in mech.drawing().items():
         if name == GROUND:
             continue
@@ -74,7 +102,9 @@ def drawing_frames(linkage, frames: int):
     return links, coms, np.asarray(mech.total_centre_of_mass(mo), complex)
 
 
-def counterweight_paths(linkage, counterweights, frames: int) -> dict[str, tuple]:
+def counterweight_paths(linkage: Model | Mechanism,
+                        counterweights: Mapping[str, CounterweightLike], frames: int
+                        ) -> dict[str, tuple[NDArray[np.complex128], float]]:
     """Where each counterweight to add is over a revolution: ``(centres, radius)`` per link.
 
     ``centres`` a ``(frames,)`` complex array (m): the counterweight's centre ``(e, f)`` in its
@@ -82,7 +112,7 @@ def counterweight_paths(linkage, counterweights, frames: int) -> dict[str, tuple
     """
     mech = mechanism_of(linkage)
     mo = mech.motion(sample_angles(frames), 1.0)
-    out = {}
+    out: dict[str, tuple[NDArray[np.complex128], float]] = {}
     for k, name in enumerate(mech.link_names):
         w = counterweights.get(name)
         if w is None or w.kind != "add":

@@ -8,6 +8,8 @@ on the class, never on a message string alone.
 
 from __future__ import annotations
 
+from typing import Any
+
 
 class BalancerError(Exception):
     """Base class of every error the package raises on purpose."""
@@ -105,6 +107,9 @@ class LockupError(BalancerError):
     """
 
     exit_code = 1
+    #: The trajectory up to the event (a :class:`balancer.simulation.Trajectory`, a layer
+    #: above: so typed no closer), set by :func:`balancer.simulation.simulate`.
+    partial: Any
 
     def __init__(self, message: str, *, time: float, theta1: float) -> None:
         self.time = time

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .errors import SolverError
+from .mechanisms.base import Mechanism
 
 #: Singular values below this share of the largest are rounding (a condition that holds).
 NULL_TOLERANCE = 1e-11
@@ -101,7 +102,7 @@ class ForceBalance:
         return float(np.max(self.rows(x), initial=0.0))
 
 
-def first_moment_map(mech, theta1: NDArray[np.float64]) -> NDArray[np.complex128]:
+def first_moment_map(mech: Mechanism, theta1: NDArray[np.float64]) -> NDArray[np.complex128]:
     """``G(θ1)``: the moving links' total first moment of mass per unit design entry.
 
     Shape ``(N, P)``, complex (x + i·y), kg·m per kg (mass entries) or per kg·m (first
@@ -120,7 +121,7 @@ def first_moment_map(mech, theta1: NDArray[np.float64]) -> NDArray[np.complex128
     return g
 
 
-def _angles(mech, count: int, rng: np.random.Generator) -> NDArray[np.float64]:
+def _angles(mech: Mechanism, count: int, rng: np.random.Generator) -> NDArray[np.float64]:
     """Crank angles where the mechanism assembles, spread over its range (seeded)."""
     r = mech.assembly_range()
     if r.full:
@@ -133,7 +134,7 @@ def _angles(mech, count: int, rng: np.random.Generator) -> NDArray[np.float64]:
     return base + (hi - lo) / count * 0.4 * rng.uniform(-1, 1, count)
 
 
-def force_balance_conditions(mech) -> ForceBalance:
+def force_balance_conditions(mech: Mechanism) -> ForceBalance:
     """The conditions of shaking-force balance of a mechanism (see the module docstring).
 
     Cached on the mechanism's structure (they depend on its geometry only).
@@ -196,6 +197,6 @@ def force_balance_conditions(mech) -> ForceBalance:
     return result
 
 
-def force_balance_residual(mech) -> float:
+def force_balance_residual(mech: Mechanism) -> float:
     """How far a mechanism's own design is from shaking-force balance (0: balanced)."""
     return force_balance_conditions(mech).residual(mech.parameters())

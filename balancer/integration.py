@@ -23,10 +23,11 @@ Everything else is :class:`DOP853`'s.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .errors import SolverError
 from .formulations.compiled import Compiled
@@ -285,14 +286,15 @@ class DOP853:
     D = D
     TOO_SMALL_STEP = "Required step size is less than spacing between numbers."
 
-    def __init__(self, fun, t0: float, y0, t_bound: float, *, rtol: float, atol,
+    def __init__(self, fun: Callable[[float, NDArray[np.float64]], ArrayLike], t0: float,
+                 y0: ArrayLike, t_bound: float, *, rtol: float, atol: ArrayLike,
                  max_step: float = np.inf, first_step: float | None = None) -> None:
         y0 = np.asarray(y0, dtype=float)
         if y0.ndim != 1 or not np.isfinite(y0).all():
             raise ValueError("the initial state must be a 1-D array of finite numbers")
         self.nfev = 0
 
-        def counted(t, y):
+        def counted(t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
             self.nfev += 1
             return np.asarray(fun(t, y), dtype=float)
 
@@ -307,7 +309,7 @@ class DOP853:
         self.status = "running"
         self.max_step = max_step
         self.rtol = max(rtol, 100 * np.finfo(float).eps)
-        self.atol = np.asarray(atol)
+        self.atol: float | NDArray[np.float64] = np.asarray(atol)
         self.f = self.fun(self.t, self.y)
         if first_step is None:
             self.h_abs = self._initial_step()
@@ -363,7 +365,7 @@ class DOP853:
                 self.status = "finished"
         return message
 
-    def _stages(self, t: float, y, h: float) -> NDArray[np.float64]:
+    def _stages(self, t: float, y: NDArray[np.float64], h: float) -> NDArray[np.float64]:
         """The stages into ``K`` (``K[0]`` is ``f``, ``K[12]`` f at the end); the end's ``y``."""
         K, A, C = self.K, self.A, self.C
         K[0] = self.f
@@ -374,7 +376,7 @@ class DOP853:
         K[-1] = self.fun(t + h, y_new)
         return y_new
 
-    def _error_norm(self, h: float, scale) -> float:
+    def _error_norm(self, h: float, scale: NDArray[np.float64]) -> float:
         K = self.K
         err5 = np.dot(K.T, self.E5) / scale
         err3 = np.dot(K.T, self.E3) / scale
@@ -428,6 +430,7 @@ class DOP853:
 
     def _extra_stages(self, h: float) -> None:
         """The dense output's stages 13–15 into ``K_extended``."""
+        assert self.t_old is not None and self.y_old is not None  # after a step
         K = self.K_extended
         for s, (a, c) in enumerate(zip(self.A_EXTRA, self.C_EXTRA, strict=True),
                                    start=self.n_stages + 1):
@@ -436,6 +439,7 @@ class DOP853:
 
     def _dense_output_impl(self) -> DenseOutput:
         h = self.h_previous
+        assert h is not None and self.t_old is not None and self.y_old is not None  # a step
         self._extra_stages(h)
         K = self.K_extended
         F = np.empty((INTERPOLATOR_POWER, self.n))
@@ -456,13 +460,14 @@ class DenseOutput:
     no rows: the constant ``y_old``.)
     """
 
-    def __init__(self, t_old: float, t: float, y_old, F) -> None:
+    def __init__(self, t_old: float, t: float, y_old: NDArray[np.float64],
+                 F: NDArray[np.float64]) -> None:
         self.t_old, self.t = t_old, t
         self.h = t - t_old
         self.y_old = y_old
         self.F = F
 
-    def __call__(self, t) -> NDArray[np.float64]:
+    def __call__(self, t: ArrayLike) -> NDArray[np.float64]:
         t = np.asarray(t, dtype=float)
         if not len(self.F):
             return self.y_old.copy() if t.ndim == 0 else np.repeat(
@@ -493,7 +498,7 @@ class TimeOnlyDOP853(DOP853):
     :class:`DOP853`'s, bit for bit.
     """
 
-    def _stages(self, t: float, y, h: float) -> NDArray[np.float64]:
+    def _stages(self, t: float, y: NDArray[np.float64], h: float) -> NDArray[np.float64]:
         K, fun = self.K, self.fun
         K[0] = self.f
         for s, c in enumerate(self.C[1:], start=1):
@@ -503,6 +508,7 @@ class TimeOnlyDOP853(DOP853):
         return y_new
 
     def _extra_stages(self, h: float) -> None:
+        assert self.t_old is not None and self.y_old is not None  # after a step
         K = self.K_extended
         for s, c in enumerate(self.C_EXTRA, start=self.n_stages + 1):
             K[s] = self.fun(self.t_old + c * h, self.y_old)
@@ -520,7 +526,8 @@ def with_extra_work(rhs: ca.Function) -> ca.Function:
     return ca.Function("rhs_with_work", [t, y], [ca.vertcat(rhs(t, y[:-1]), 0)])
 
 
-def _stages(rhs: ca.Function, n: int, a, c, first: int, count: int):
+def _stages(rhs: ca.Function, n: int, a: NDArray[np.float64], c: NDArray[np.float64],
+            first: int, count: int) -> tuple[ca.MX, ca.MX, ca.MX, ca.MX, list[ca.MX]]:
     """Stages ``first … first+count−1`` of an explicit Runge–Kutta method.
 
     As MX of ``(t, y, h, K[:first])``.
@@ -577,11 +584,12 @@ class CompiledDOP853(DOP853):
         The same right-hand side's compiled stages (:class:`Stages`).
     """
 
-    def __init__(self, fun, t0, y0, t_bound, *, stages: Stages, **options) -> None:
+    def __init__(self, fun: Callable[[float, NDArray[np.float64]], ArrayLike], t0: float,
+                 y0: ArrayLike, t_bound: float, *, stages: Stages, **options: Any) -> None:
         super().__init__(fun, t0, y0, t_bound, **options)
         self._step, self._extra = stages.step, stages.extra
 
-    def _stages(self, t: float, y, h: float) -> NDArray[np.float64]:
+    def _stages(self, t: float, y: NDArray[np.float64], h: float) -> NDArray[np.float64]:
         n, stages = self.n, self.n_stages
         out = self._step(np.concatenate([[t, h], y, self.f]))
         self.nfev += stages
@@ -590,6 +598,7 @@ class CompiledDOP853(DOP853):
         return out[stages * n :]
 
     def _extra_stages(self, h: float) -> None:
+        assert self.t_old is not None and self.y_old is not None  # after a step
         k, stages = self.K_extended, self.n_stages
         extra = self._extra(np.concatenate([[self.t_old, h], self.y_old,
                                             k[: stages + 1].reshape(-1)]))

@@ -27,6 +27,7 @@ Everything is vectorised over the states of a :class:`~balancer.kinematics.Motio
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -40,6 +41,7 @@ from .massmodels import (
     inertial_parameters,
 )
 from .model import FourBar, Link
+from .model.assembly import Lengths
 
 Route = Literal["newton-euler", "mass-matrix"]
 ROUTES: tuple[Route, ...] = ("newton-euler", "mass-matrix")
@@ -69,7 +71,8 @@ class Reactions:
     RA3: NDArray[np.complex128]
     driving_torque: NDArray[np.float64]
     shaking_moment: NDArray[np.float64]
-    shaking_force: NDArray[np.complex128] = None  # type: ignore[assignment]
+    # None (only as an argument) is replaced by RA0 + RA3 in __post_init__: never None after.
+    shaking_force: NDArray[np.complex128] = None  # type: ignore[assignment]  # see above
     guide_couple: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
@@ -180,7 +183,8 @@ def newton_euler(
     return Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
 
 
-def _combine_nodal_forces(mo: Motion, nodes, l4: float) -> Reactions:
+def _combine_nodal_forces(mo: Motion, nodes: Sequence[NDArray[np.complex128]],
+                          l4: float) -> Reactions:
     """Reactions from nodal forces ``G_n`` at A0…A3 by length-keeping virtual displacements.
 
     The counter-rotors' gear reaction on the ground is not included.
@@ -199,7 +203,8 @@ def _combine_nodal_forces(mo: Motion, nodes, l4: float) -> Reactions:
     )
 
 
-def _inertial_nodal_forces(params, lengths, mo: Motion, k: int):
+def _inertial_nodal_forces(params: Sequence[float], lengths: Sequence[float], mo: Motion,
+                           k: int) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
     """Nodal inertia forces ``−(Me·r̈)`` of link ``k`` (0-based) at its two joints (Eq. 45)."""
     acc_a1, acc_a2 = mo.joint_accelerations
     node_acc = (0.0, acc_a1, acc_a2, 0.0)
@@ -228,7 +233,7 @@ def mass_matrix(
     g = complex(*gravity)
     forces = _applied_forces(linkage, g, loads)
     lengths = linkage.lengths[:3]
-    nodes: list = [0j, 0j, 0j, 0j]
+    nodes = [np.zeros(mo.size, dtype=complex) for _ in range(4)]
     for k, link in enumerate(linkage.links):
         loaded = Link(
             mass=link.mass,
@@ -285,7 +290,7 @@ def angular_momentum(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
     vel_a1, vel_a2 = mo.joint_velocities
     joint_pos = (0.0, mo.pos.A1, mo.pos.A2)
     joint_vel = (0.0, vel_a1, vel_a2)
-    total = 0.0
+    total = np.zeros(mo.size)
     for k, (link, length) in enumerate(zip(linkage.links, (l1, l2, l3), strict=True)):
         zeta = link.com / length
         r = joint_pos[k] + zeta * mo.vectors[k]
@@ -299,7 +304,7 @@ def kinetic_energy(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
     l1, l2, l3, _ = linkage.lengths
     vel_a1, vel_a2 = mo.joint_velocities
     joint_vel = (0.0, vel_a1, vel_a2)
-    total = 0.0
+    total = np.zeros(mo.size)
     for k, (link, length) in enumerate(zip(linkage.links, (l1, l2, l3), strict=True)):
         v = joint_vel[k] + link.com / length * mo.vector_rate(k)
         total = total + 0.5 * (
@@ -308,7 +313,8 @@ def kinetic_energy(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
     return total
 
 
-def change_point_limits(lengths, angles: NDArray[np.float64]):
+def change_point_limits(lengths: Lengths, angles: NDArray[np.float64]
+                        ) -> list[tuple[NDArray[np.bool_], tuple[float, ...], tuple[float, ...]]]:
     """How to evaluate a revolution's samples that fall exactly on a change point.
 
     There all joints are collinear and the transfer functions are 0/0; the shaking force, the
@@ -324,11 +330,12 @@ def change_point_limits(lengths, angles: NDArray[np.float64]):
         at which to evaluate, and the weights of those evaluations.
     """
     delta = 1e-4
-    out = []
+    out: list[tuple[NDArray[np.bool_], tuple[float, ...], tuple[float, ...]]] = []
     for theta_star in change_point_angles(lengths):
         hit = np.abs(np.angle(np.exp(1j * (angles - theta_star)))) < 1e-9
         if not hit.any():
             continue
+        weights: tuple[float, ...]
         if theta_star == 0.0:
             steps, weights = (1, 2, 3, 4), (4.0, -6.0, 4.0, -1.0)
         else:

@@ -300,14 +300,15 @@ def dependent_accelerations(
     """
     _, l2, l3, _ = pos.lengths
     w1, w2, w3 = (np.asarray(w) for w in omega)
+    alpha = np.asarray(alpha1)
     v1, v2, v3 = pos.l1, pos.l2, pos.l3
     big2, big3 = transfer
     w1s, w2s, w3s = w1 * w1, w2 * w2, w3 * w3
     with np.errstate(divide="ignore", invalid="ignore"):
-        a2 = big2 * alpha1 + (inner(v3, v1) * w1s + inner(v3, v2) * w2s + l3 * l3 * w3s) / (
+        a2 = big2 * alpha + (inner(v3, v1) * w1s + inner(v3, v2) * w2s + l3 * l3 * w3s) / (
             -cross(v3, v2)
         )
-        a3 = big3 * alpha1 + (inner(v2, v1) * w1s + l2 * l2 * w2s + inner(v2, v3) * w3s) / (
+        a3 = big3 * alpha + (inner(v2, v1) * w1s + l2 * l2 * w2s + inner(v2, v3) * w3s) / (
             -cross(v2, v3)
         )
     return a2, a3
@@ -503,9 +504,9 @@ def motion_from_angles(
         singular=np.abs(s_mu) < SINGULAR_TOLERANCE,
     )
     big = transfer_functions(pos)
-    om = tuple(np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in omega)
-    al = tuple(np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in alpha)
-    return Motion(pos=pos, omega=om, alpha=al, transfer=big)  # type: ignore[arg-type]
+    w1, w2, w3 = (np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in omega)
+    a1, a2, a3 = (np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in alpha)
+    return Motion(pos=pos, omega=(w1, w2, w3), alpha=(a1, a2, a3), transfer=big)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -17,13 +17,30 @@ symbols alike.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .kinematics import Position
+from .linkage.vectors import Num
 from .model import FourBar, Link
+
+
+class LinkVectors(Protocol):
+    """The moving links' vectors ``l̄1``, ``l̄2``, ``l̄3`` (complex, m).
+
+    A :class:`Position`'s arrays, or one state's numbers.
+    """
+
+    @property
+    def l1(self) -> Num: ...
+    @property
+    def l2(self) -> Num: ...
+    @property
+    def l3(self) -> Num: ...
 
 
 def inertial_parameters(link: Link) -> tuple[float, float, float, float]:
@@ -260,7 +277,8 @@ def wunderlich_linkage(linkage: FourBar) -> WunderlichLinkage:
 # Equivalent mass matrix (Eq. 45–46) and the assembled four-bar matrices (Eq. 48–49, 53–54)
 
 
-def mass_matrix_coefficients(params, length: float):
+def mass_matrix_coefficients(params: Sequence[Num], length: float
+                             ) -> tuple[Num, Num, Num, Num]:
     """Entries ``(Ip, Iq, Ired, m·f·l)`` of the equivalent mass matrix from inertial parameters.
 
     ``Ip = I + m(e² + f²)``, ``Iq = I + m((l − e)² + f²)``, ``Ired = I − m·e(l − e) + m·f²``
@@ -274,7 +292,7 @@ def mass_matrix_coefficients(params, length: float):
     return ip, iq, ired, mf * length
 
 
-def equivalent_mass_matrix(params, length: float) -> NDArray[np.float64]:
+def equivalent_mass_matrix(params: Sequence[float], length: float) -> NDArray[np.float64]:
     """Constant 4×4 mass matrix of a link over ``(r_px, r_py, r_qx, r_qy)`` (Eq. 45), kg.
 
     Parameters
@@ -298,7 +316,8 @@ def equivalent_mass_matrix(params, length: float) -> NDArray[np.float64]:
     )
 
 
-def equivalent_inertia_forces(params, length: float, acc_p, acc_q):
+def equivalent_inertia_forces(params: Sequence[Num], length: float, acc_p: Num, acc_q: Num
+                              ) -> tuple[Num, Num]:
     """``Me·ẍ`` of Eq. 45 at the two joints, as complex numbers (N).
 
     ``(Iq·r̈p − (Ired − i·m·f·l)·r̈q)/l²`` at p and ``(Ip·r̈q − (Ired + i·m·f·l)·r̈p)/l²`` at q:
@@ -311,7 +330,8 @@ def equivalent_inertia_forces(params, length: float, acc_p, acc_q):
     return at_p, at_q
 
 
-def equivalent_joint_forces(link: Link, length: float, vector, moment=None):
+def equivalent_joint_forces(link: Link, length: float, vector: Num, moment: Num | None = None
+                            ) -> tuple[Num, Num]:
     """Applied force and moment of a link reduced to its two joints (Eq. 46), complex, N.
 
     ``conj(1 − ζ)·F̄ − i·M·l̄/l²`` at the first joint and ``conj(ζ)·F̄ + i·M·l̄/l²`` at the second,
@@ -341,7 +361,8 @@ NODES = ("A0", "A1", "A2", "A3")
 LINK_NODES = ((0, 1), (1, 2), (2, 3))
 
 
-def global_mass_matrix(linkage: FourBar, inertias=None) -> NDArray[np.float64]:
+def global_mass_matrix(linkage: FourBar, inertias: Sequence[float] | None = None
+                       ) -> NDArray[np.float64]:
     """Assembled 8×8 mass matrix over the joint coordinates of A0, A1, A2, A3 (Eq. 45), kg.
 
     Parameters
@@ -362,18 +383,21 @@ def global_mass_matrix(linkage: FourBar, inertias=None) -> NDArray[np.float64]:
     return big
 
 
-def fourbar_mass_matrix(linkage: FourBar, inertias=None) -> NDArray[np.float64]:
+def fourbar_mass_matrix(linkage: FourBar, inertias: Sequence[float] | None = None
+                        ) -> NDArray[np.float64]:
     """The 4×4 mass matrix ``M`` of Eq. 48 over ``(r_A1x, r_A1y, r_A2x, r_A2y)``, kg."""
     return global_mass_matrix(linkage, inertias)[2:6, 2:6]
 
 
-def reaction_mass_matrix(linkage: FourBar, inertias=None) -> NDArray[np.float64]:
+def reaction_mass_matrix(linkage: FourBar, inertias: Sequence[float] | None = None
+                         ) -> NDArray[np.float64]:
     """The 4×4 matrix ``M_r`` of Eq. 53: rows A0x, A0y, A3x, A3y; columns A1x, A1y, A2x, A2y."""
     g = global_mass_matrix(linkage, inertias)
     return g[np.ix_([0, 1, 6, 7], [2, 3, 4, 5])]
 
 
-def fourbar_force_vector(linkage: FourBar, pos: Position, moments=None):
+def fourbar_force_vector(linkage: FourBar, pos: LinkVectors,
+                         moments: Sequence[Num] | None = None) -> tuple[Num, ...]:
     """Force vectors of Eq. 49 (at A1, A2) and Eq. 54 without the reactions (at A0, A3).
 
     Returns the equivalent applied forces at the four nodes as complex arrays
@@ -386,7 +410,7 @@ def fourbar_force_vector(linkage: FourBar, pos: Position, moments=None):
         Applied moments on the three links to use instead of the links' own, N·m.
     """
     vectors = (pos.l1, pos.l2, pos.l3)
-    nodes = [0j, 0j, 0j, 0j]
+    nodes: list[Num] = [0j, 0j, 0j, 0j]
     for k, (link, (p, q)) in enumerate(zip(linkage.links, LINK_NODES, strict=True)):
         mom = None if moments is None else moments[k]
         fp, fq = equivalent_joint_forces(link, linkage.lengths[k], vectors[k], mom)

@@ -13,11 +13,14 @@ the spec then fails to load (a linkage with one length in millimetres does not a
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, TypeGuard
 
 from .cycle import sample_angles
 from .errors import BalancerError
 from .mechanisms import mechanism_of
+from .mechanisms.base import Mechanism
+from .model import Design
+from .model import Mechanism as Model
 
 #: Longest length that is plausibly meant, m: no planar linkage this tool balances is longer.
 MAX_LENGTH = 100.0
@@ -27,7 +30,7 @@ MAX_TIP_SPEED = 340.0
 NAMED = 3
 
 
-def _number(x: Any) -> bool:
+def _number(x: Any) -> TypeGuard[float]:
     return isinstance(x, int | float) and not isinstance(x, bool) and math.isfinite(x)
 
 
@@ -60,7 +63,7 @@ def _lengths(data: dict[str, Any]) -> list[tuple[str, float, str]]:
             size = math.hypot(*com["at"])
             out.append((key, size, f"{key}.at ({size:.4g} m from the origin)"))
             continue
-        parts = [com.get(k) for k in ("e", "f") if k in com] or [com.get("s")]
+        parts: list[Any] = [com.get(k) for k in ("e", "f") if k in com] or [com.get("s")]
         if all(map(_number, parts)):
             size = math.hypot(*parts)
             out.append((key, size, f"{key} ({size:.4g} m from its link's first point)"))
@@ -92,7 +95,7 @@ def length_note(data: dict[str, Any]) -> str | None:
             "as m?)")
 
 
-def tip_radius(mechanism, samples: int = 72) -> float | None:
+def tip_radius(mechanism: Model | Mechanism, samples: int = 72) -> float | None:
     """The largest distance of a point or centre of mass from the crank's pivot, m.
 
     Over ``samples`` crank angles of a revolution (those where the linkage assembles);
@@ -117,7 +120,7 @@ def tip_radius(mechanism, samples: int = 72) -> float | None:
     return radius if math.isfinite(radius) else None
 
 
-def speed_note(design) -> str | None:
+def speed_note(design: Design) -> str | None:
     """A note if a point would move faster than :data:`MAX_TIP_SPEED`, or ``None``.
 
     The tip speed is ``ω·R``: ω the operating speed ``[operation] speed`` (rad/s), R the

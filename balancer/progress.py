@@ -12,7 +12,10 @@ nothing. tqdm is imported only when a bar is first drawn.
 from __future__ import annotations
 
 import sys
-from typing import IO
+from typing import IO, TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from tqdm import tqdm
 
 #: Seconds of work before a bar appears.
 DELAY = 1.0
@@ -57,7 +60,7 @@ class Progress:
         self.delay = DELAY if delay is None else delay
         self.refresh = refresh
         self.active = enabled and is_terminal(self.stream)
-        self._bar = None
+        self._bar: tqdm | None = None
 
     def __call__(self, done: float, total: float) -> None:
         """Report ``done`` of ``total`` (in :attr:`unit`)."""

@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
@@ -108,11 +109,17 @@ def _partial_basis() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     lagrange = np.linalg.inv(np.polynomial.legendre.legvander(NODES, 14))  # row n: c_n's weights
     tail = lagrange.copy()
     tail[:13] = 0.0  # the terms of degree 13 and 14 only
-    return (np.polynomial.legendre.legint(lagrange, lbnd=-1.0),
-            np.polynomial.legendre.legint(tail, lbnd=-1.0))
+    return (np.asarray(np.polynomial.legendre.legint(lagrange, lbnd=-1.0), dtype=float),
+            np.asarray(np.polynomial.legendre.legint(tail, lbnd=-1.0), dtype=float))
 
 
 _PARTIAL, _TAIL = _partial_basis()
+
+#: Accepted panels: their left and right ends and their Kronrod sums ``(panels, components)``.
+Panels: TypeAlias = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+#: Times inside accepted panels: their indices, their panels' left ends and the integrals
+#: from those to them.
+Inside: TypeAlias = tuple[NDArray[np.intp], NDArray[np.float64], NDArray[np.float64]]
 
 
 def partial_weights(u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -171,8 +178,9 @@ def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
     edges[-1] = end
     left, right = edges[:-1], edges[1:]
     refined = 0  # panels made by halving
-    accepted = []  # (left, right, kronrod sum) of the accepted panels
-    interior = []  # (time index, its panel's left end, integral from it) of the times inside
+    accepted: list[Panels] = []  # (left, right, kronrod sum) of the accepted panels
+    # (time index, its panel's left end, integral from it) of the times inside
+    interior: list[Inside] = []
     evaluations = 0
     for _ in range(MAX_ROUNDS + 1):
         values, kronrod, gauss = _rules(integrand, left, right)
@@ -231,7 +239,8 @@ def _times_inside(times: NDArray[np.float64], left: NDArray[np.float64],
     return inside, owner
 
 
-def _assemble(times: NDArray[np.float64], accepted, interior, evaluations: int) -> Cumulative:
+def _assemble(times: NDArray[np.float64], accepted: list[Panels], interior: list[Inside],
+              evaluations: int) -> Cumulative:
     """The integral at every time from the accepted panels (they tile the span).
 
     A time at a panel's end takes the sum of the panels up to it; a time inside one, the sum
@@ -255,7 +264,9 @@ def _assemble(times: NDArray[np.float64], accepted, interior, evaluations: int) 
     return Cumulative(values=out, panels=left.size, evaluations=evaluations)
 
 
-def _rules(integrand, left: NDArray[np.float64], right: NDArray[np.float64]):
+def _rules(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+           left: NDArray[np.float64], right: NDArray[np.float64]
+           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The integrand at the panels' nodes, and the Kronrod and Gauss sums on each panel.
 
     Shapes ``(panels, 15, components)`` and ``(panels, components)``.

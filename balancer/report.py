@@ -8,14 +8,22 @@ from __future__ import annotations
 
 import io
 import math
-from collections.abc import Sequence
-from typing import Any
+import os
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
-from .balance.counterweights import UNCHANGED
+from .balance.counterweights import UNCHANGED, Counterweight
 from .cycle import CycleAnalysis, Figure
 from .errors import SolverError
+
+if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these load them
+    from .balance.pareto import Front
+    from .balance.result import BalanceResult
+    from .model import Link
+    from .simulation import Trajectory
+    from .verification import Verification
 
 UNITS = {"shaking_force": "N", "shaking_moment": "N·m", "driving_torque": "N·m"}
 
@@ -268,12 +276,12 @@ def csv_text(columns: Sequence[str], values: Sequence[np.ndarray]) -> str:
 # ----------------------------------------------------------------------------------------------
 # simulate
 
-def simulation_csv(traj, all_columns: bool = False) -> str:
+def simulation_csv(traj: Trajectory, all_columns: bool = False) -> str:
     """The time histories of a simulation as CSV text (:meth:`Trajectory.columns`)."""
     return csv_text(*traj.columns(all_columns))
 
 
-def simulation_json(traj, spec: str | None = None) -> dict[str, Any]:
+def simulation_json(traj: Trajectory, spec: str | None = None) -> dict[str, Any]:
     """The ``simulate --json`` document."""
     doc: dict[str, Any] = {}
     if spec is not None:
@@ -313,7 +321,7 @@ def simulation_json(traj, spec: str | None = None) -> dict[str, Any]:
     return doc
 
 
-def simulation_text(traj, spec: str | None = None) -> str:
+def simulation_text(traj: Trajectory, spec: str | None = None) -> str:
     """The readable ``simulate`` report: the paper's Table 1 quantities and the checks."""
     head = f"balancer simulate — {spec}" if spec else "balancer simulate"
     lines = [
@@ -356,7 +364,7 @@ def _opt(x: float | None, fmt: str = ".4g") -> str:
     return "—" if x is None else format(x, fmt)
 
 
-def verification_text(verification, spec: str | None = None) -> str:
+def verification_text(verification: Verification, spec: str | None = None) -> str:
     """The readable ``verify`` report."""
     head = f"balancer verify — {spec}" if spec else "balancer verify"
     lines = [head, f"simulated with the {verification.method} formulation", ""]
@@ -386,7 +394,7 @@ def verification_text(verification, spec: str | None = None) -> str:
 # optimize
 
 
-def link_parameters(link) -> dict[str, float]:
+def link_parameters(link: Link) -> dict[str, float]:
     """A link's physical parameters for a report (SI units)."""
     return {
         "mass": link.mass,
@@ -399,7 +407,9 @@ def link_parameters(link) -> dict[str, float]:
     }
 
 
-def optimization_json(result, before, after, verification=None, spec=None, out=None) -> dict:
+def optimization_json(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis,
+                      verification: Verification | None = None, spec: str | None = None,
+                      out: str | os.PathLike[str] | None = None) -> dict[str, Any]:
     """The ``optimize --json`` document.
 
     ``before``, ``after``, ``links``, ``status`` and ``verification`` are fixed names.
@@ -497,7 +507,7 @@ def worse_figures(before: CycleAnalysis, after: CycleAnalysis) -> list[str]:
     return out
 
 
-def _objective_terms(result) -> dict[str, dict[str, float | str]]:
+def _objective_terms(result: BalanceResult) -> dict[str, dict[str, float | str]]:
     """Each term of the objective: its weight and unit, its RMS before and after (inertial)."""
     before, after = result.term_rms(result.before), result.term_rms(result.after)
     return {t.name: {"weight": t.weight, "unit": t.unit, "before": before[t.name],
@@ -513,7 +523,7 @@ _COUNTERWEIGHT_KINDS = {
 }
 
 
-def counterweight_text(weights) -> str:
+def counterweight_text(weights: Mapping[str, Counterweight]) -> str:
     """The counterweights as a table a workshop can build from (mm, kg, kg·m²).
 
     A body to add: its mass, centre and inertia about its centre; material to remove: the
@@ -523,7 +533,7 @@ def counterweight_text(weights) -> str:
     rows = []
     for name, w in weights.items():
         disc = (f"Ø {2e3 * w.disc_radius:.4g} × {1e3 * w.disc_thickness:.4g}"
-                if w.disc_radius is not None else "")
+                if w.disc_radius is not None and w.disc_thickness is not None else "")
         if w.kind == "none":
             values: tuple[str, ...] = ("", "", "", "")
         else:
@@ -551,7 +561,9 @@ def counterweight_text(weights) -> str:
             + "\n" + "\n".join(notes))
 
 
-def optimization_text(result, before, after, verification=None, spec=None) -> str:
+def optimization_text(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis,
+                      verification: Verification | None = None,
+                      spec: str | None = None) -> str:
     """The readable ``optimize`` report."""
     head = f"balancer optimize — {spec}" if spec else "balancer optimize"
     lines = [
@@ -611,14 +623,14 @@ def optimization_text(result, before, after, verification=None, spec=None) -> st
 # Trade-off fronts
 
 
-def front_json(front, spec=None) -> dict:
+def front_json(front: Front, spec: str | None = None) -> dict[str, Any]:
     """The ``pareto --json`` document: ``against`` and ``points`` are fixed names."""
     doc: dict[str, Any] = {} if spec is None else {"spec": spec}
     doc.update(front.as_dict())
     return doc
 
 
-def front_text(front, spec=None) -> str:
+def front_text(front: Front, spec: str | None = None) -> str:
     """The readable front: one row per point, the knee marked."""
     head = f"balancer pareto — {spec}" if spec else "balancer pareto"
     name = front.name.replace("_", " ")
@@ -634,7 +646,7 @@ def front_text(front, spec=None) -> str:
     return "\n".join(lines)
 
 
-def front_csv(front) -> str:
+def front_csv(front: Front) -> str:
     """The front as CSV: one row per point (knee: 1 at the knee, else 0)."""
     points = front.points
     return csv_text(
@@ -644,7 +656,36 @@ def front_csv(front) -> str:
          np.array([1.0 if p.knee else 0.0 for p in points])])
 
 
-def sweep_text(result, spec=None) -> str:
+class SweepSummary(Protocol):
+    """What the summary reads of a sweep (:class:`balancer.sweeps.SweepResult`, a layer above)."""
+
+    @property
+    def statuses(self) -> Mapping[str, int]:
+        """Points by status."""
+    @property
+    def points(self) -> int:
+        """Points in all."""
+    @property
+    def computed(self) -> int:
+        """Points this run computed."""
+    @property
+    def resumed(self) -> int:
+        """Batches kept from an interrupted run."""
+    @property
+    def workers(self) -> int:
+        """Dask workers (0: this process)."""
+    @property
+    def seconds(self) -> float:
+        """Wall-clock time, s."""
+    @property
+    def rate(self) -> float | None:
+        """Points per second of this run, or ``None``."""
+    @property
+    def residual_force(self) -> Mapping[str, float | str] | None:
+        """The perturbed designs' residual RMS shaking force (``mean``, ``p95``, ``max``), N."""
+
+
+def sweep_text(result: SweepSummary, spec: str | None = None) -> str:
     """The readable summary of a sweep."""
     head = f"balancer sweep — {spec}" if spec else "balancer sweep"
     rows = [[status, str(count)] for status, count in sorted(result.statuses.items())]

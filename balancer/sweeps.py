@@ -41,19 +41,25 @@ import math
 import os
 import shutil
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from . import interrupts
 from .balance.optimizer import optimize
 from .balance.result import InfeasibleError
 from .cycle import cycle_analysis
 from .errors import AssemblyError, LockupError, OutputError, SolverError, SpecError
+from .model import Design
 from .outputs import write_with
 from .plots import sweep_figure
 from .spec import design_from_dict
+
+if TYPE_CHECKING:
+    import pyarrow as pa
+    from distributed import Client, LocalCluster
+    from matplotlib.figure import Figure
 
 #: Sampling methods of the varied keys.
 METHODS = ("grid", "lhs", "sobol")
@@ -89,12 +95,13 @@ class Perturb:
         return cls(key=key.strip(), sigma=sigma)
 
 
-def perturbed_points(data: dict[str, Any], perturbs: Sequence[Perturb], samples: int,
+def perturbed_points(data: dict[str, Any], perturbs: Sequence[Perturb], samples: int | None,
                      seed: int = 0) -> list[dict[str, float]]:
     """``samples`` draws of the perturbed keys around the spec's values (seeded)."""
     import numpy as np
 
     _check_samples(samples, "--perturb")
+    assert samples is not None  # (checked)
     keys = [p.key for p in perturbs]
     if len(set(keys)) != len(keys):
         raise SpecError("a key is perturbed twice", key="--perturb", value=", ".join(keys))
@@ -150,7 +157,7 @@ def key_unit(key: str) -> str:
     return KEY_UNITS.get(names[-1], "") if names else ""
 
 
-def read_table(path: str | os.PathLike[str]) -> dict[str, list]:
+def read_table(path: str | os.PathLike[str]) -> dict[str, list[Any]]:
     """A sweep's Parquet table, by column (Python lists; a missing value is ``None``)."""
     import pyarrow.parquet as pq
 
@@ -158,7 +165,8 @@ def read_table(path: str | os.PathLike[str]) -> dict[str, list]:
 
 
 def atlas_figure(path: str | os.PathLike[str], keys: Sequence[str] | None, *,
-                 original: dict[str, float] | None = None, perturbs: Sequence = ()):
+                 original: dict[str, float] | None = None,
+                 perturbs: Sequence[Perturb] = ()) -> Figure:
     """The figure of a sweep's table (:func:`balancer.plots.sweep_figure`), keys with units.
 
     ``keys``: the varied keys, ``None`` for a perturbation sweep (``perturbs`` then named in
@@ -169,7 +177,8 @@ def atlas_figure(path: str | os.PathLike[str], keys: Sequence[str] | None, *,
                         units={key: key_unit(key) for key in named})
 
 
-def analyse_point(data: dict[str, Any], values: dict[str, float], index: int) -> dict:
+def analyse_point(data: dict[str, Any], values: dict[str, float], index: int
+                  ) -> dict[str, Any]:
     """One row of a perturbation sweep: the perturbed design's own figures (no redesign)."""
     row = _empty_row(values, index)
     try:
@@ -275,6 +284,7 @@ def _locate(data: dict[str, Any], key: str) -> tuple[Any, Any]:
 
 def number_keys(data: Any, prefix: str = "") -> list[str]:
     """Every dotted key that names a number in a parsed spec (a list's entries by index)."""
+    items: Iterable[tuple[str, Any]]
     if isinstance(data, dict):
         items = data.items()
     elif isinstance(data, list):
@@ -321,15 +331,17 @@ def _empty_row(values: dict[str, float], index: int) -> dict[str, Any]:
             **{name: None for name in COLUMNS[2:-1]}}
 
 
-def _own_figures(design) -> dict[str, float]:
+def _own_figures(design: Design) -> dict[str, float]:
     """The design's own inertial figures at the operating speed (the ``before`` columns)."""
+    assert design.operation is not None  # (the sweep has checked the spec's)
     summary = cycle_analysis(design.mechanism, design.operation.speed,
                              design.operation.samples, loads=False).summary
     return {"shaking_moment_before": summary.shaking_moment.rms,
             "shaking_force_before": summary.shaking_force.rms}
 
 
-def evaluate_point(data: dict[str, Any], values: dict[str, float], index: int) -> dict:
+def evaluate_point(data: dict[str, Any], values: dict[str, float], index: int
+                   ) -> dict[str, Any]:
     """One row of the table: the design at ``values``, analysed and balanced."""
     row = _empty_row(values, index)
     try:
@@ -360,7 +372,7 @@ def evaluate_point(data: dict[str, Any], values: dict[str, float], index: int) -
 
 
 def run_batch(data: dict[str, Any], batch: list[tuple[int, dict[str, float]]],
-              analyse_only: bool = False) -> list[dict]:
+              analyse_only: bool = False) -> list[dict[str, Any]]:
     """Evaluate a batch of points (a Dask task): their rows, in order.
 
     ``analyse_only``: the designs' own figures (a perturbation sweep), no redesign.
@@ -377,14 +389,15 @@ def _parts_dir(out: Path) -> Path:
     return out.with_name(out.name + ".parts")
 
 
-def _manifest(data: dict[str, Any], points: list[dict[str, float]], batch: int) -> dict:
+def _manifest(data: dict[str, Any], points: list[dict[str, float]], batch: int
+              ) -> dict[str, Any]:
     text = json.dumps({"spec": data, "points": points, "batch": batch}, sort_keys=True,
                       default=str)
     return {"version": 1, "points": len(points), "batch": batch,
             "digest": hashlib.sha256(text.encode()).hexdigest()}
 
 
-def _schema(keys: Sequence[str]):
+def _schema(keys: Sequence[str]) -> pa.Schema:
     import pyarrow as pa
 
     fields = [pa.field(k, pa.float64()) for k in keys]
@@ -394,7 +407,7 @@ def _schema(keys: Sequence[str]):
     return pa.schema(fields)
 
 
-def _write_part(path: Path, rows: list[dict], keys: Sequence[str]) -> None:
+def _write_part(path: Path, rows: list[dict[str, Any]], keys: Sequence[str]) -> None:
     """A batch's rows as a Parquet file, written whole or not at all."""
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -465,7 +478,7 @@ class SweepResult:
     workers: int
     resumed: int
     computed: int
-    residual_force: dict[str, float] | None = None
+    residual_force: dict[str, float | str] | None = None
 
     @property
     def rate(self) -> float | None:
@@ -589,7 +602,7 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
     used = 0
     finished = len(done)
 
-    def record(i: int, rows: list[dict], client) -> None:
+    def record(i: int, rows: list[dict[str, Any]], client: Client | None) -> None:
         nonlocal count, finished
         _write_part(parts / f"batch-{i:06d}.parquet", rows, keys)
         count += len(rows)
@@ -621,15 +634,16 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
 
     for status in pq.read_table(out, columns=["status"]).column("status").to_pylist():
         statuses[status] = statuses.get(status, 0) + 1
-    residual = None
+    residual: dict[str, float | str] | None = None
     if perturbs:
         import numpy as np
 
-        force = np.array([v for v in pq.read_table(out, columns=["shaking_force_before"])
-                          .column(0).to_pylist() if v is not None])
-        if force.size:
-            residual = {"mean": float(force.mean()), "p95": float(np.percentile(force, 95)),
-                        "max": float(force.max()), "unit": "N (RMS over a revolution)"}
+        shaking = np.array([v for v in pq.read_table(out, columns=["shaking_force_before"])
+                            .column(0).to_pylist() if v is not None])
+        if shaking.size:
+            residual = {"mean": float(shaking.mean()),
+                        "p95": float(np.percentile(shaking, 95)),
+                        "max": float(shaking.max()), "unit": "N (RMS over a revolution)"}
     return SweepResult(out=out, points=len(points), statuses=statuses,
                        seconds=time.perf_counter() - start, workers=used, resumed=len(done),
                        computed=len(points) - sum(len(batches[i]) for i in done),
@@ -641,7 +655,10 @@ def _finished(parts: Path) -> set[int]:
     return {int(p.stem.split("-")[1]) for p in parts.glob("batch-*.parquet")}
 
 
-def _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only) -> int:
+def _run_on_dask(data: dict[str, Any], batches: list[list[tuple[int, dict[str, float]]]],
+                 todo: list[int],
+                 record: Callable[[int, list[dict[str, Any]], Client | None], None],
+                 workers: int | None, scheduler: str | None, analyse_only: bool) -> int:
     """Run the batches ``todo`` on a cluster; ``record`` each as it finishes. Its workers.
 
     Interrupted, it cancels the tasks and closes the client and its local cluster before the
@@ -652,8 +669,9 @@ def _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only) 
 
     from distributed import Client, LocalCluster, as_completed
 
-    cluster = client = None
-    futures: dict = {}
+    cluster: LocalCluster | None = None
+    client: Client | None = None
+    futures: dict[Any, int] = {}
     try:
         if scheduler is None:
             n = workers or os.cpu_count() or 1
@@ -691,7 +709,7 @@ def _run_on_dask(data, batches, todo, record, workers, scheduler, analyse_only) 
             _close(client, cluster, [])
 
 
-def _close(client, cluster, futures: list) -> None:
+def _close(client: Client | None, cluster: LocalCluster | None, futures: list[Any]) -> None:
     """Cancel ``futures`` and close the client and the cluster (each once)."""
     if client is not None and client.status not in ("closed", "closing"):
         if futures:
@@ -702,7 +720,7 @@ def _close(client, cluster, futures: list) -> None:
 
 
 @contextlib.contextmanager
-def _silenced(*names: str):
+def _silenced(*names: str) -> Iterator[None]:
     """The loggers ``names`` silent (above CRITICAL) for the block."""
     import logging
 

@@ -21,12 +21,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
 from .errors import LockupError, SpecError
 from .mechanisms import mechanism_of
-from .model import Design
+from .model import Design, SimulationSettings
+from .model import Mechanism as Model
 from .simulation import MAX_OUTPUTS, Trajectory, check, simulate
 
 #: Output times per crank revolution at least: 2°, some fifteen across the engine example's
@@ -93,7 +95,7 @@ class RunCheck:
         """Largest shaking moment relative to the original's."""
         return _ratio(self.max_shaking_moment, self.original_max_shaking_moment)
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """Plain dictionary for JSON."""
         return {
             "max_shaking_force": self.max_shaking_force,
@@ -133,7 +135,7 @@ class Verification:
     free: RunCheck
 
     def __repr__(self) -> str:
-        def fmt(x):
+        def fmt(x: float | None) -> str:
             return "none" if x is None else f"{x:.4g}"
 
         return (f"Verification({self.method}: largest shaking force "
@@ -151,7 +153,7 @@ class Verification:
         return max((x for x in (self.driven.max_shaking_moment, self.free.max_shaking_moment)
                     if x is not None), default=None)
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """Plain dictionary for JSON (``max_shaking_force``, ``max_shaking_moment`` fixed)."""
         return {
             "method": self.method,
@@ -176,14 +178,17 @@ class _Tally:
         self.total = total
         self.done = 0.0
 
-    def simulate(self, linkage, settings, method: str, **kw) -> Trajectory:
+    def simulate(self, linkage: Model, settings: SimulationSettings, method: str,
+                 **kw: Any) -> Trajectory:
         """:func:`~balancer.simulation.simulate`, reporting its progress within the whole."""
-        report = None
+        report: Callable[[float, float], None] | None = None
         if self.progress is not None:
             progress, done, total = self.progress, self.done, self.total
 
-            def report(t: float, duration: float) -> None:
+            def report_total(t: float, duration: float) -> None:
                 progress(done + t, total)
+
+            report = report_total
 
         try:
             return simulate(linkage, settings, method=method, progress=report, **kw)
@@ -191,14 +196,16 @@ class _Tally:
             self.done += settings.duration
 
 
-def _simulate_span(tally: _Tally, linkage, settings, method: str, resolution: float | None,
-                   **kw) -> tuple[Trajectory | None, str, object]:
+def _simulate_span(tally: _Tally, linkage: Model, settings: SimulationSettings, method: str,
+                   resolution: float | None, **kw: Any
+                   ) -> tuple[Trajectory | None, str, SimulationSettings]:
     """The run (or its part before the motion stopped), why it stopped, its settings.
 
     The reason is "" for a run that did not stop. With a ``resolution`` (rad), the crank
     turns at most that far between two output times (:func:`~balancer.simulation.simulate`
     resamples the outputs of a crank that turned faster).
     """
+    traj: Trajectory | None
     try:
         traj, note = tally.simulate(linkage, settings, method, resolution=resolution, **kw), ""
     except LockupError as exc:
@@ -208,7 +215,8 @@ def _simulate_span(tally: _Tally, linkage, settings, method: str, resolution: fl
     return traj, note, settings
 
 
-def _resolved(settings, speed: float, resolution: float | None):
+def _resolved(settings: SimulationSettings, speed: float, resolution: float | None
+              ) -> SimulationSettings:
     """``settings`` with output times enough for a crank at ``speed`` (rad/s)."""
     if resolution is None:
         return settings
@@ -216,8 +224,8 @@ def _resolved(settings, speed: float, resolution: float | None):
     return replace(settings, outputs=min(MAX_OUTPUTS, max(settings.outputs, need)))
 
 
-def _run(tally: _Tally, linkage, original, settings, method: str,
-         resolution: float | None = None, **kw) -> RunCheck:
+def _run(tally: _Tally, linkage: Model, original: Model | None, settings: SimulationSettings,
+         method: str, resolution: float | None = None, **kw: Any) -> RunCheck:
     """Simulate the design and the original over the same span.
 
     A run that stops early (a lock-up, a dead point its formulation cannot pass) is judged over
@@ -228,6 +236,7 @@ def _run(tally: _Tally, linkage, original, settings, method: str,
     orig = None
     o_force = o_moment = None
     if original is not None and force is not None:
+        assert traj is not None  # (it has figures)
         span = settings if not note else replace(settings, duration=float(traj.t[-1]))
         orig, o_note, _ = _simulate_span(tally, original, span, method, resolution, **kw) \
             if span.duration > 0 else (None, "", span)
@@ -294,11 +303,12 @@ def verify(
 class _Planned:
     """One run of a verification: its settings and :func:`simulate`'s keywords."""
 
-    settings: object
-    kw: dict
+    settings: SimulationSettings
+    kw: dict[str, Any]
 
 
-def _plan(design: Design, method, duration, rtol, atol, outputs) -> tuple[str, list[_Planned]]:
+def _plan(design: Design, method: str | None, duration: float | None, rtol: float, atol: float,
+          outputs: int | None) -> tuple[str, list[_Planned]]:
     """The method and the runs (free, then driven) of :func:`verify`, checked.
 
     Everything :func:`~balancer.simulation.simulate` refuses before it integrates is refused

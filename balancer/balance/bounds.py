@@ -10,11 +10,13 @@ from __future__ import annotations
 import math
 import sys
 from dataclasses import dataclass
+from typing import Any
 
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Link
+from ..model import Mechanism as Model
 from ..model.balance import OBJECTIVE_KEYS, BalanceProblem, LinkFreedom
 from ..validate import LENGTH_RANGE
 from .regressors import physical_to_inertial
@@ -40,7 +42,7 @@ def _link_is_free(b: LinkBounds) -> bool:
     )
 
 
-def check_problem(problem: BalanceProblem, mechanism) -> None:
+def check_problem(problem: BalanceProblem, mechanism: Model | Mechanism) -> None:
     """Raise :class:`SpecError` on a contradictory or impossible redesign problem.
 
     Checks what one key alone cannot: a point that is not on the link, a counter-rotor on a
@@ -251,7 +253,7 @@ class LinkBounds:
 
         With 8 units in the last place of the radius to spare, as :meth:`_onto_disc` keeps.
         """
-        c, r = self.com_centre, self.com_radius * (1 - 8 * 2.0**-52)
+        c, r = self.com_centre, self.radius * (1 - 8 * 2.0**-52)
         half = math.sqrt(max(r * r - c.imag * c.imag, 0.0))
         return c.real - half, c.real + half
 
@@ -261,6 +263,21 @@ class LinkBounds:
             return f"{self.key}.{bound}"
         word = {"mass": "mass", "com_radius": "radius", "min_gyration": "gyration"}[bound]
         return f"{self.key}.counterweight.{word}"
+
+    @property
+    def radius(self) -> float:
+        """:attr:`com_radius` of a link whose centre of mass may move (no :attr:`com_fixed`), m.
+
+        Every such link has one (a disc; :func:`resolve_link`).
+        """
+        assert self.com_radius is not None, "a fixed centre of mass has no disc"
+        return self.com_radius
+
+    @property
+    def rotor_entry(self) -> int:
+        """:attr:`rotor` of a link that has a counter-rotor entry (``rotor_links``)."""
+        assert self.rotor is not None, "a link with a counter-rotor entry"
+        return self.rotor
 
     @property
     def about(self) -> str:
@@ -277,7 +294,7 @@ class LinkBounds:
         gyration allows). A body of no mass has no inertia: the optimiser cannot buy a
         counter-rotor's work with a massless flywheel.
         """
-        return math.sqrt(2 * self.com_radius**2 + self.gyration**2)
+        return math.sqrt(2 * self.radius**2 + self.gyration**2)
 
     @property
     def entries(self) -> slice:
@@ -332,9 +349,10 @@ def resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> Lin
     rotor_entry = layout.rotor(name)
     rotor = (link.counter_rotor, link.counter_rotor) if rotor_entry is not None else None
     about_default = default_about(mech, name)
-    common = {"name": name, "index": k, "start": layout.index(name, "m"), "rotor": rotor_entry,
-              "length": link_length(mech, name), "original": link, "points": points,
-              "default_about": about_default}
+    common: dict[str, Any] = {
+        "name": name, "index": k, "start": layout.index(name, "m"), "rotor": rotor_entry,
+        "length": link_length(mech, name), "original": link, "points": points,
+        "default_about": about_default}
     if freedom is None:
         return LinkBounds(
             **common, listed=False, mass=(link.mass, link.mass), com_fixed=link.com,
@@ -347,12 +365,13 @@ def resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> Lin
     if freedom.counterweight is not None:
         cw = freedom.counterweight
         about = freedom.com_about or points[0]
+        m, me, mf, j = (float(v) for v in physical_to_inertial(
+            link.mass, link.com.real, link.com.imag, link.inertia))
         return LinkBounds(
             **common, listed=True, mass=cw.mass, com_fixed=None, com_about=about,
             com_centre=mech.structure.local[(k, about)].complex(), com_radius=cw.radius,
             inertia=(0.0, math.inf), gyration=cw.gyration, counter_rotor=rotor,
-            offset=tuple(float(v) for v in physical_to_inertial(
-                link.mass, link.com.real, link.com.imag, link.inertia)),
+            offset=(m, me, mf, j),
         )  # fmt: skip
     mass = freedom.mass if freedom.mass is not None else (link.mass, link.mass)
     about = freedom.com_about or about_default

@@ -37,13 +37,17 @@ rounding is bounded too: sums are exactly rounded (``math.fsum``) and the bound 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .lsq import bounded_lstsq
+
+#: Equality constraints ``E·u = r``: ``(E, r)``.
+Equality: TypeAlias = tuple[NDArray[np.float64], NDArray[np.float64]]
 
 _EPS = float(np.finfo(float).eps)
 #: Multiplier (relative to the largest) above which a bound counts as active when the
@@ -131,7 +135,8 @@ class Bound:
     residual: float
 
 
-def _sublevel_box(objective: Objective, lo, hi, upper: float) -> NDArray[np.float64] | None:
+def _sublevel_box(objective: Objective, lo: NDArray[np.float64], hi: NDArray[np.float64],
+                  upper: float) -> NDArray[np.float64] | None:
     """``hi`` with the entries at ``∞`` bounded on ``{u in the box: f(u) ≤ upper}``.
 
     ``‖P_J·u_J‖ ≤ ‖P·u + q‖ + max over the rest of the box of ‖P_o·u_o + q‖``; with ``P_J``
@@ -167,7 +172,7 @@ def _sublevel_box(objective: Objective, lo, hi, upper: float) -> NDArray[np.floa
     return out
 
 
-def lower_bound(objective: Objective, constraints: list[Constraint], equality,
+def lower_bound(objective: Objective, constraints: list[Constraint], equality: Equality | None,
                 u: NDArray[np.float64], duals: list[NDArray[np.float64]],
                 v: NDArray[np.float64] | None, lo: NDArray[np.float64],
                 hi: NDArray[np.float64], upper: float | None) -> Bound | None:
@@ -242,8 +247,9 @@ class _Refit:
     objective's sublevel set (:func:`_sublevel_box`).
     """
 
-    def __init__(self, objective: Objective, constraints: list[Constraint], equality, active,
-                 u, lo, hi, upper: float | None) -> None:
+    def __init__(self, objective: Objective, constraints: list[Constraint],
+                 equality: Equality | None, active: Sequence[bool], u: NDArray[np.float64],
+                 lo: NDArray[np.float64], hi: NDArray[np.float64], upper: float | None) -> None:
         self.objective, self.u, self.lo, self.upper = objective, u, lo, upper
         self.hi = np.array(hi, dtype=float)
         finite = np.isfinite(self.hi)
@@ -254,7 +260,8 @@ class _Refit:
         # terms vanish at û, so they cost the bound nothing there), to cancel what they can of
         # ρ. (The scalar part of an active cone's multiplier may grow too, keeping it in the
         # cone, but at the cost of its term at û: it did not pay.)
-        columns, offsets = [], []
+        columns: list[NDArray[np.float64]] = []
+        offsets: list[float] = []
         for c, on in zip(constraints, active, strict=True):
             if c.kind == "nonneg" and on:
                 columns.append(-c.M[0])
@@ -282,7 +289,8 @@ class _Refit:
             self._box.append(_sublevel_box(self.objective, self.lo, self.hi, upper))
         return self._box[0]
 
-    def __call__(self, a_terms, r_terms) -> Bound | None:
+    def __call__(self, a_terms: list[NDArray[np.float64]], r_terms: list[NDArray[np.float64]]
+                 ) -> Bound | None:
         """The bound for the products ``a_terms`` (of ``α``) and rows ``r_terms`` (of ``ρ``)."""
         extra_a: list[NDArray[np.float64]] = []
         extra_r: list[NDArray[np.float64]] = []
@@ -311,7 +319,8 @@ def _column_sums(rows: list[NDArray[np.float64]], n: int
     return sums, np.abs(stack).sum(axis=0)
 
 
-def _finish(a_terms, r_terms, u, lo, hi,
+def _finish(a_terms: list[NDArray[np.float64]], r_terms: list[NDArray[np.float64]],
+            u: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64],
             sublevel_box: Callable[[], NDArray[np.float64] | None]) -> Bound | None:
     """``α + Σ_j min(ρ_j·lo_j, ρ_j·hi_j)`` less the rounding of its evaluation.
 

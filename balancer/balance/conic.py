@@ -21,6 +21,7 @@ infeasibility diagnosis.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -138,7 +139,7 @@ class ConicProgram:
         if epigraph and (P is None or q is None):
             raise ValueError("the norm objective needs P and q")
         total = e.shape[0] + sum(constraints[i].M.shape[0] for i in order) + (
-            P.shape[0] + 1 if epigraph else 0)
+            P.shape[0] + 1 if epigraph and P is not None else 0)
         a_matrix = np.zeros((total, width))
         b_vector = np.zeros(total)
         a_matrix[: e.shape[0], :n] = e
@@ -161,6 +162,7 @@ class ConicProgram:
         hessian = np.zeros((width, width))
         linear = np.zeros(width)
         if epigraph:
+            assert P is not None and q is not None  # (checked above)
             k = P.shape[0]
             a_matrix[start, n] = -1.0  # t
             a_matrix[start + 1 : start + 1 + k, :n] = -P
@@ -191,7 +193,7 @@ class ConicProgram:
         # Clarabel's forms of what every solve shares
         self._csc = (CscMatrix.of(self._H), CscMatrix.of(self._A))
 
-    def solve(self, settings: dict, *, target: NDArray[np.float64] | None = None,
+    def solve(self, settings: dict[str, Any], *, target: NDArray[np.float64] | None = None,
               equality_rhs: NDArray[np.float64] | None = None) -> ConicSolution:
         """Solve with Clarabel (``settings``: names of its ``DefaultSettings``).
 

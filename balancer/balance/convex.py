@@ -49,7 +49,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
@@ -89,6 +89,8 @@ TIE_ACCEPT = 1e-8
 #: A counterweight whose mass may be zero and that the optimum gives less than this share of
 #: its link's mass is tried at none (:meth:`ConvexSolver._without_small_counterweights`).
 SMALL_COUNTERWEIGHT = 1e-3
+#: An affine function ``a·u + a0`` of the solver's variables: ``(a, a0)``.
+Affine: TypeAlias = tuple[NDArray[np.float64], float]
 
 
 
@@ -137,7 +139,7 @@ class ConvexSolver(Repairs, Diagnosis):
         whose work this one may share where the free variables are the same.
     """
 
-    def __init__(self, data: NumericProblem, *, settings: dict | None = None,
+    def __init__(self, data: NumericProblem, *, settings: dict[str, Any] | None = None,
                  like: ConvexSolver | None = None) -> None:
         self.data = data
         self.settings = {**CLARABEL_SETTINGS, **(settings or {})}
@@ -146,7 +148,8 @@ class ConvexSolver(Repairs, Diagnosis):
         self._scale = data.objective_scale
         lay = self.layout
         self._cones, self._relaxed = self._constraints()
-        self._fb: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._fb: tuple[NDArray[np.float64], NDArray[np.float64],
+                        NDArray[np.float64]] | None = None
         self._failed_row = -1  # a row of Eq. 58 with nothing free that fails
         # restore_balance's least-squares inverse of Eq. 58's rows per set of pinned entries
         # (they depend on the free variables alone: shared with a solver `like` this one)
@@ -249,22 +252,24 @@ class ConvexSolver(Repairs, Diagnosis):
             """
             return lay.T[i] / scale, float((lay.c[i] - data.offset[i]) / scale)
 
-        def at_least(a, lo: float) -> None:  # a ≥ lo
+        def at_least(a: Affine, lo: float) -> None:  # a ≥ lo
             out.append(Constraint("nonneg", a[0][None, :], np.array([a[1] - lo])))
 
-        def at_most(a, hi: float) -> None:  # a ≤ hi
+        def at_most(a: Affine, hi: float) -> None:  # a ≤ hi
             out.append(Constraint("nonneg", -a[0][None, :], np.array([hi - a[1]])))
 
-        def norm_at_most(rows, rhs) -> None:  # ‖rows‖ ≤ rhs, each an affine (a, a0)
+        def norm_at_most(rows: list[Affine], rhs: Affine) -> None:  # ‖rows‖ ≤ rhs
             out.append(Constraint("soc", np.array([rhs[0]] + [a for a, _ in rows]),
                                   np.array([rhs[1]] + [a0 for _, a0 in rows])))
 
-        def quad_at_most(rows, den, rhs) -> None:  # ‖rows‖²/den ≤ rhs: ‖(2·w, s − t)‖ ≤ s + t
+        # ‖rows‖²/den ≤ rhs: ‖(2·w, s − t)‖ ≤ s + t
+        def quad_at_most(rows: list[Affine], den: Affine, rhs: Affine) -> None:
             norm_at_most([combine((2.0, a)) for a in rows] + [combine((1.0, den), (-1.0, rhs))],
                          combine((1.0, den), (1.0, rhs)))
 
-        def combine(*terms) -> tuple[NDArray[np.float64], float]:
+        def combine(*terms: tuple[float, Affine]) -> Affine:
             """``Σ w·a`` of ``(w, a)`` pairs."""
+            # (a sum of arrays, never of none: not the 0 that sum() starts from)
             return (sum(w * a[0] for w, a in terms),  # type: ignore[return-value]
                     float(sum(w * a[1] for w, a in terms)))
 
@@ -285,7 +290,7 @@ class ConvexSolver(Repairs, Diagnosis):
             se, sf = entry(k + 1, mref * l), entry(k + 2, mref * l)
             centre = b.com_centre / l  # complex, in the link's frame
             if b.com_fixed is None:
-                radius = b.com_radius / l
+                radius = b.radius / l
                 radius = radius - margin if radius > 2 * margin else radius
                 norm_at_most([combine((1.0, se), (-centre.real, m)),
                               combine((1.0, sf), (-centre.imag, m))], combine((radius, m)))
@@ -314,7 +319,7 @@ class ConvexSolver(Repairs, Diagnosis):
                     room = combine((1.0, j), (-rho2, m))
                     quad_at_most([se, sf], m, (room[0], room[1] - margin))
             if math.isfinite(hi):  # J − hi ≤ m·(R² − |c|²) + 2·c·S
-                radius = b.com_radius / l
+                radius = b.radius / l
                 cap = combine((radius**2 - abs(centre) ** 2, m), (2 * centre.real, se),
                               (2 * centre.imag, sf), (-1.0, j))
                 at_least(cap, -hi_m)
@@ -325,7 +330,7 @@ class ConvexSolver(Repairs, Diagnosis):
                                  (abs(centre) ** 2 - reach2 + margin, m))
                 at_most(spread, 0.0)
         for b in data.rotor_links:
-            k = b.rotor
+            k = b.rotor_entry
             if k in free:
                 assert b.counter_rotor is not None
                 scale = data.scales[k]
@@ -353,7 +358,7 @@ class ConvexSolver(Repairs, Diagnosis):
             ranges = {k: (m_lo, m_hi)}
             if b.com_fixed is None:
                 for i, c in ((k + 1, b.com_centre.real), (k + 2, b.com_centre.imag)):
-                    low, high = c - b.com_radius, c + b.com_radius
+                    low, high = c - b.radius, c + b.radius
                     ranges[i] = (min(m_lo * low, m_hi * low), max(m_lo * high, m_hi * high))
             shift = data.offset
             for i, (low, high) in ranges.items():
@@ -363,17 +368,17 @@ class ConvexSolver(Repairs, Diagnosis):
             if k + 3 in index:
                 base = max(b.inertia[0], m_lo * b.gyration**2)
                 reach = abs(b.com_fixed) if b.com_fixed is not None else (
-                    abs(b.com_centre) + b.com_radius)
+                    abs(b.com_centre) + b.radius)
                 if b.com_fixed is not None:
                     base += m_lo * reach**2
                 scale = data.scales[k + 3]
                 lo[index[k + 3]] = (base + shift[k + 3]) / scale
                 hi[index[k + 3]] = (b.inertia[1] + m_hi * reach**2 + shift[k + 3]) / scale
         for b in data.rotor_links:
-            if b.rotor in index:
+            if b.rotor_entry in index:
                 assert b.counter_rotor is not None
-                j = index[b.rotor]
-                lo[j], hi[j] = (v / data.scales[b.rotor] for v in b.counter_rotor)
+                j = index[b.rotor_entry]
+                lo[j], hi[j] = (v / data.scales[b.rotor_entry] for v in b.counter_rotor)
         return lo, hi
 
     def _force_balance(self) -> bool:
@@ -422,7 +427,8 @@ class ConvexSolver(Repairs, Diagnosis):
             solver_status=solution.status,
             iterations=solution.iterations,
             time=elapsed,
-            objective=self.data.reduced_objective(self.layout.x(solution.u)) if ok else math.nan,
+            objective=(self.data.reduced_objective(self.layout.x(solution.u))
+                       if solution.u is not None else math.nan),
         )
         return report, solution
 

@@ -21,6 +21,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ..model import Link
+from ..model import Mechanism as Model
+
 #: Density of steel, kg/m³ (the disc that realises a counterweight).
 STEEL_DENSITY = 7850.0
 #: A disc thicker than this many diameters is no disc (the body is as good as a point mass,
@@ -102,7 +105,7 @@ class Counterweight:
                 "kind": self.kind, "exact": self.exact, "disc": disc}
 
 
-def counterweight(name: str, original, balanced) -> Counterweight:
+def counterweight(name: str, original: Link, balanced: Link) -> Counterweight:
     """The counterweight that makes link ``original`` into ``balanced``.
 
     Both are links with ``mass`` (kg), ``e``, ``f`` (m, the centre of mass in the link's frame)
@@ -143,7 +146,7 @@ def counterweight(name: str, original, balanced) -> Counterweight:
                          rebuilt=rebuilt)
 
 
-def counterweights(original, balanced) -> dict[str, Counterweight]:
+def counterweights(original: Model, balanced: Model) -> dict[str, Counterweight]:
     """Each moving link's counterweight, from the original mechanism model to the balanced one.
 
     The models are any mechanism's (``link_names`` and ``link(name)``), with the same links.

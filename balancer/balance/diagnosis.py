@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import SolverError
+from .bounds import LinkBounds
 from .conic import SOLVED
 from .problem import NumericProblem
 from .result import InfeasibleError
@@ -37,13 +39,14 @@ class Diagnosis:
 
     data: NumericProblem
     layout: Layout
-    settings: dict
+    settings: dict[str, Any]
     _failed_row: int
 
     def _fixed_row_error(self) -> InfeasibleError:
         """A condition of Eq. 58 that nothing free enters, and fails: name its links."""
         data = self.data
         rows = data.force_balance_rows(self.layout.c)
+        assert data.force_balance is not None  # a row of it failed
         a, _ = data.force_balance
         i = self._failed_row
         names = [b.name for b in data.links if np.any(a[i, b.start : b.start + 3])]
@@ -65,7 +68,9 @@ class Diagnosis:
         return SolverError(f"the convex balancing problem could not be solved ({why}), though "
                            "a design within the bounds meets force balance: numerical trouble")
 
-    def _bound_constraints(self, m, s, tau, slack=None, skip=None) -> list:
+    def _bound_constraints(self, m: cp.Variable, s: cp.Variable, tau: float | cp.Variable,
+                           slack: Callable[[tuple[int, str]], cp.Variable] | None = None,
+                           skip: tuple[int, str] | None = None) -> list[cp.Constraint]:
         """Eq. 58 and the bounds on masses and centres of mass (what force balance meets).
 
         In scaled variables ``m[i] = m_i/m_ref``, ``s[i] = S_i/(m_ref·l)``. ``tau`` multiplies
@@ -78,11 +83,12 @@ class Diagnosis:
 
         data = self.data
 
-        def relax(group):
+        def relax(group: tuple[int, str]) -> float | cp.Variable:
             return 0.0 if slack is None else slack(group)
 
-        cons: list = []
-        parts: list = [0.0] * data.size  # the design vector, in the layout's order
+        cons: list[cp.Constraint] = []
+        # the design vector, in the layout's order
+        parts: list[float | cp.Expression] = [0.0] * data.size
         for b in data.links:
             i, mref, l = b.index, b.mass_ref, b.length
             if skip != (i, "mass-low"):
@@ -94,7 +100,7 @@ class Diagnosis:
                 group = (i, "com")
                 c = b.com_centre / l
                 lhs = cp.norm(s[i] - cp.hstack([c.real * m[i], c.imag * m[i]]))
-                rhs = b.com_radius / l * m[i]
+                rhs = b.radius / l * m[i]
             else:
                 group = (i, "com-fixed")
                 lhs = cp.norm(
@@ -143,11 +149,11 @@ class Diagnosis:
         beyond the tolerance (undecided: the problem is no more than that far from feasible).
         """
         data = self.data
-        groups = []
+        groups: list[tuple[int, str]] = []
         for b in data.links:
             groups += [(b.index, "mass-low"), (b.index, "mass-high")]
             groups.append((b.index, "com" if b.com_fixed is None else "com-fixed"))
-        ranked = []
+        ranked: list[tuple[bool, float, tuple[int, str], float]] = []
         infeasible = solved = False
         for group in groups:
             value = self._needed(group)
@@ -168,7 +174,7 @@ class Diagnosis:
             elif kind == "mass-low":
                 ranked.append((lo == hi, 1 - value / lo, group, value))
             elif kind == "com":
-                ranked.append((False, (value - b.com_radius) / b.length, group, value))
+                ranked.append((False, (value - b.radius) / b.length, group, value))
             else:
                 ranked.append((True, value / b.length, group, value))
         if not solved:
@@ -218,10 +224,14 @@ class Diagnosis:
                 "force balance cannot be met within the bounds (the elastic problem failed: "
                 f"{problem.status})"
             )
-        support = [g for g, (t, _) in slacks.items() if t.value > SLACK_TOLERANCE]
+        # (solved: CVXPY has given every variable its value)
+        support = [g for g, (t, _) in slacks.items()
+                   if t.value is not None and t.value > SLACK_TOLERANCE]
         if not support:
             return None  # a design within the bounds meets force balance
-        items, parts = [], []
+        items: list[tuple[str, float, float | None, str]] = []
+        parts: list[str] = []
+        assert m.value is not None and s.value is not None  # solved
         for i, kind in support:
             b = data.links[i]
             mi = float(m.value[i]) * b.mass_ref
@@ -235,7 +245,7 @@ class Diagnosis:
         return InfeasibleError(message + " (together)", needed=tuple(items), jointly=True)
 
     @staticmethod
-    def _excess(b, kind: str, value: float) -> float:
+    def _excess(b: LinkBounds, kind: str, value: float) -> float:
         """How far the value a bound group needs (:meth:`_needed`) lies beyond its bound.
 
         Relative to the bound's scale (the link's mass or length); ``≤ 0``: within it.
@@ -245,10 +255,10 @@ class Diagnosis:
         if kind == "mass-low":
             return (b.mass[0] - value) / b.mass_ref
         if kind == "com":
-            return (value - b.com_radius) / b.length
+            return (value - b.radius) / b.length
         return value / b.length  # a fixed centre of mass: how far it must move
 
-    def _centre(self, b, kind: str) -> complex:
+    def _centre(self, b: LinkBounds, kind: str) -> complex:
         """Where a centre-of-mass group's value is measured from (local, m).
 
         A radius's ``com_about``; for a fixed centre of mass, the fixed centre itself: the
@@ -257,9 +267,10 @@ class Diagnosis:
         """
         if kind == "com":
             return b.com_centre
+        assert b.com_fixed is not None  # the group of a fixed centre of mass
         return b.com_fixed
 
-    def _about(self, b) -> complex:
+    def _about(self, b: LinkBounds) -> complex:
         """The link's default ``com_about`` point (local, m)."""
         return self.data.mechanism.structure.local[(b.index, b.default_about)].complex()
 
@@ -305,7 +316,10 @@ class Diagnosis:
         """
         b = self.data.links[group[0]]
         value = self._needed(group, centre=self._about(b))
-        return value if value is not None else abs(b.com_fixed - self._about(b)) + move
+        if value is not None:
+            return value
+        assert b.com_fixed is not None  # the group of a fixed centre of mass
+        return abs(b.com_fixed - self._about(b)) + move
 
     def _describe(
         self, group: tuple[int, str], value: float
@@ -342,7 +356,7 @@ class Diagnosis:
         )
 
 
-def _solve(problem: cp.Problem, settings: dict) -> None:
+def _solve(problem: cp.Problem, settings: dict[str, Any]) -> None:
     """Solve with Clarabel; an inaccurate solution is judged by its status, not a warning.
 
     (A run stopped at its iteration limit can leave iterates of 1e155, whose objective CVXPY

@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 
 @dataclass(frozen=True)
@@ -55,7 +55,8 @@ def _kkt_violation(g: NDArray[np.float64], on_bound: NDArray[np.float64]) -> flo
     return float(np.max(g_kkt))
 
 
-def bounded_lstsq(A, b, lower, upper, *, tol: float = 1e-10,
+def bounded_lstsq(A: ArrayLike, b: ArrayLike, lower: ArrayLike, upper: ArrayLike, *,
+                  tol: float = 1e-10,
                   max_iter: int | None = None) -> BoundedFit:
     """``x`` minimising ``‖A·x − b‖`` with ``lower ≤ x ≤ upper`` (see the module docstring).
 
@@ -86,7 +87,9 @@ def bounded_lstsq(A, b, lower, upper, *, tol: float = 1e-10,
     return _bvls(A, b, x_lsq, lb, ub, tol, max_iter)
 
 
-def _bvls(A, b, x_lsq, lb, ub, tol: float, max_iter: int | None) -> BoundedFit:
+def _bvls(A: NDArray[np.float64], b: NDArray[np.float64], x_lsq: NDArray[np.float64],
+          lb: NDArray[np.float64], ub: NDArray[np.float64], tol: float,
+          max_iter: int | None) -> BoundedFit:
     """BVLS from the unconstrained solution ``x_lsq`` (SciPy's ``_lsq/bvls.py``, as it is)."""
     n = A.shape[1]
     x = x_lsq.copy()

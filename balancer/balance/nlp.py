@@ -28,6 +28,7 @@ import math
 import sys
 import time
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,6 +37,9 @@ from .. import interrupts
 from .problem import NumericProblem
 from .regressors import inertial_to_physical, physical_to_inertial
 from .result import StageReport
+
+if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
+    import casadi as ca
 
 #: IPOPT's options, in one place: quiet and tight. The start is the convex optimum (a primal
 #: warm start); IPOPT's own warm-start mode, which also wants multipliers that the convex
@@ -92,22 +96,26 @@ class NlpSolver:
         IPOPT/CasADi options to override :data:`IPOPT_OPTIONS`.
     """
 
-    def __init__(self, data: NumericProblem, *, options: dict | None = None) -> None:
+    def __init__(self, data: NumericProblem, *, options: dict[str, Any] | None = None) -> None:
         import casadi as ca  # heavy: only where symbols are built
         self.data = data
         self.options = {**IPOPT_OPTIONS, **(options or {})}
         self._names: list[tuple[int, str]] = []  # (link index or entry, kind) per variable
         lbx: list[float] = []
         ubx: list[float] = []
-        parts = []
-        symbols = []
-        g: list = []
+        symbols: list[ca.SX] = []
+        g: list[ca.SX] = []
         lbg: list[float] = []
         ubg: list[float] = []
         varying: set[int] = set()  # entries of x that can change
-        parts: list = [0.0] * data.size  # the design vector, in the layout's order
+        # the design vector, in the layout's order
+        parts: list[ca.SX | float] = [0.0] * data.size
+        m: ca.SX | float  # a link's physical values: variables, or fixed
+        e: ca.SX | float
+        f: ca.SX | float
+        inertia: ca.SX | float
 
-        def variable(name: str, lo: float, hi: float, tag: tuple[int, str]):
+        def variable(name: str, lo: float, hi: float, tag: tuple[int, str]) -> ca.SX:
             s = ca.SX.sym(name)
             symbols.append(s)
             lbx.append(lo)
@@ -130,7 +138,7 @@ class NlpSolver:
                 f = 0.0
                 varying.add(k + 1)
             elif b.com_fixed is None:
-                c, r = b.com_centre / l, b.com_radius / l
+                c, r = b.com_centre / l, b.radius / l
                 e = l * variable(f"e{b.index}", c.real - r, c.real + r, (b.index, "e"))
                 f = l * variable(f"f{b.index}", c.imag - r, c.imag + r, (b.index, "f"))
                 g.append((e / l - c.real) ** 2 + (f / l - c.imag) ** 2)
@@ -164,7 +172,7 @@ class NlpSolver:
             parts[k : k + 4] = [p + d for p, d in zip(physical_to_inertial(m, e, f, inertia),
                                                        shift, strict=True)]
         for b in data.rotor_links:
-            entry = b.rotor
+            entry = b.rotor_entry
             assert b.counter_rotor is not None
             lo, hi = b.counter_rotor
             scale = data.scales[entry]
@@ -184,10 +192,10 @@ class NlpSolver:
                     lbg.append(0.0)
                     ubg.append(0.0)
         scale = data.objective_scale
-        value = 0
+        value: ca.SX | float = 0
         if data.factor.shape[0]:
-            r = ca.mtimes(ca.DM(data.factor / scale), pi)
-            value = ca.sumsqr(r)
+            weighted = ca.mtimes(ca.DM(data.factor / scale), pi)
+            value = ca.sumsqr(weighted)
         if data.weights.added_mass:
             value = value + data.weights.added_mass / scale**2 * (
                 sum(pi[i] for i in data.mass_entries) - data.original_mass
@@ -241,7 +249,7 @@ class NlpSolver:
         for i, (index, kind) in enumerate(self._names):  # pull the centre of mass into its disc
             if kind == "e" and not data.links[index].on_line:
                 b = data.links[index]
-                c, r = b.com_centre / b.length, b.com_radius / b.length
+                c, r = b.com_centre / b.length, b.radius / b.length
                 d = math.hypot(v[i] - c.real, v[i + 1] - c.imag)
                 if d > r:
                     v[i] = c.real + (v[i] - c.real) * r / d

@@ -43,7 +43,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
-from ..cycle import cycle_analysis
+from ..cycle import CycleAnalysis, cycle_analysis
 from ..errors import SpecError
 from ..model import Design
 from ..model.balance import BalanceProblem
@@ -95,11 +95,11 @@ class Optimizer:
     def __init__(self, data: NumericProblem, *, like: Optimizer | None = None,
                  gravity: tuple[float, float] = (0.0, 0.0)) -> None:
         self.data = data
-        self.gravity = gravity if like is None else like.gravity
-        self.convex = ConvexSolver(data, like=None if like is None else like.convex)
+        self.gravity: tuple[float, float] = gravity if like is None else like.gravity
+        self.convex: ConvexSolver = ConvexSolver(data, like=None if like is None else like.convex)
         self._nlp: NlpSolver | None = None
         # The original design's cycle analysis: the same under any bounds.
-        self._before = None if like is None else like._before
+        self._before: CycleAnalysis | None = None if like is None else like._before
 
     @classmethod
     def of(cls, design: Design) -> Optimizer:
@@ -108,7 +108,8 @@ class Optimizer:
         Raises as :func:`~balancer.balance.problem.numeric_problem`.
         """
         data = numeric_problem(design)  # it has checked that [operation] is there
-        return cls(data, gravity=tuple(design.operation.gravity))
+        assert design.operation is not None
+        return cls(data, gravity=design.operation.gravity)
 
     def with_problem(self, problem: BalanceProblem) -> Optimizer:
         """The optimiser of the same design under another redesign problem (new bounds).
@@ -133,7 +134,7 @@ class Optimizer:
             self._nlp = NlpSolver(self.data)
         return self._nlp
 
-    def run(self, backend: str = "nlp") -> BalanceResult:
+    def run(self, backend: Backend = "nlp") -> BalanceResult:
         """Solve with ``backend`` and assemble the result.
 
         Parameters
@@ -160,7 +161,7 @@ class Optimizer:
         stages: list[StageReport] = list(convex.stages)
         x, feasible = convex.x, convex.converged
         objective = data.objective(x)
-        notes = []
+        notes: list[str] = []
         if backend == "nlp":
             nlp = self.nlp.solve(convex.x)  # None: no freedom beyond Eq. 58 to improve on
             if nlp is not None:

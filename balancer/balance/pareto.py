@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,7 +34,7 @@ from ..model import Design
 from ..model.balance import Objective
 from .certificate import Constraint, lower_bound
 from .certificate import Objective as Certified
-from .conic import ConicProgram
+from .conic import ConicProgram, ConicSolution
 from .convex import Compressed, ConvexSolver
 from .problem import NumericProblem, numeric_problem
 
@@ -129,7 +129,7 @@ class Front:
 class _Programs:
     """The ε-constraint programs of one redesign problem, in the convex solver's variables."""
 
-    def __init__(self, data: NumericProblem, against: str) -> None:
+    def __init__(self, data: NumericProblem, against: Against) -> None:
         self.data = data
         self.solver = solver = ConvexSolver(data)
         lay = solver.layout
@@ -137,7 +137,9 @@ class _Programs:
         self.equality = solver.equality
         n_samples = data.samples
         reg = data.regressors
-        moment = np.linalg.qr(reg.shaking_moment / math.sqrt(n_samples), mode="r")
+        # (R alone: numpy's stubs say qr gives a QRResult whatever its mode.)
+        moment = cast("NDArray[np.float64]",
+                      np.linalg.qr(reg.shaking_moment / math.sqrt(n_samples), mode="r"))
         self.moment_scale = _scale(moment, data)
         self.moment = Compressed.of(moment @ lay.T / self.moment_scale,
                                     moment @ lay.c / self.moment_scale)
@@ -155,7 +157,8 @@ class _Programs:
                 rows = reg.driving_torque
             else:
                 rows = np.vstack([reg.shaking_force.real, reg.shaking_force.imag])
-            factor = np.linalg.qr(rows / math.sqrt(n_samples), mode="r")
+            factor = cast("NDArray[np.float64]",
+                          np.linalg.qr(rows / math.sqrt(n_samples), mode="r"))  # (as above)
             self.other_scale = _scale(factor, data)
             self.other = Compressed.of(factor @ lay.T / self.other_scale,
                                        factor @ lay.c / self.other_scale)
@@ -190,7 +193,7 @@ class _Programs:
         return Constraint("soc", np.vstack([np.zeros((1, self.n)), c.P]),
                           np.concatenate([[value / self.moment_scale], c.q]))
 
-    def least_other(self, extra: list[Constraint]):
+    def least_other(self, extra: list[Constraint]) -> ConicSolution:
         """The program ``min g`` within the bounds and ``extra``; its solution."""
         cones = [*self.solver.constraints, *extra]
         if self.against == "added-mass":
@@ -201,7 +204,7 @@ class _Programs:
                                    P=self.other.P, q=self.other.q)
         return program.solve(self.solver.settings)
 
-    def least_moment(self, extra: list[Constraint]):
+    def least_moment(self, extra: list[Constraint]) -> ConicSolution:
         """The program ``min ‖R_M·x‖`` within the bounds and ``extra``; its solution."""
         program = ConicProgram(self.n, [*self.solver.constraints, *extra], equality=self.equality,
                                objective="norm", P=self.moment.P, q=self.moment.q)
@@ -279,7 +282,7 @@ def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
         grid = [high + slack]
     else:
         grid = list(np.linspace(low + slack, high + slack, points))
-    out = []
+    out: list[FrontPoint] = []
     for epsilon in grid:
         cap = programs.cap(epsilon)
         solution = programs.least_moment([cap])
@@ -300,9 +303,11 @@ def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
                  original_force_balanced=force_balance_residual(data.mechanism) <= RESIDUAL_FLOOR)
 
 
-def _certified(programs: _Programs, cap: Constraint, solution, x) -> float:
+def _certified(programs: _Programs, cap: Constraint, solution: ConicSolution,
+               x: NDArray[np.float64]) -> float:
     """The certified least RMS shaking moment under ``cap``, N·m (0 where none is made)."""
     solver = programs.solver
+    assert solution.u is not None  # solved: the caller has checked
     lo, hi = solver.box()
     upper = programs.moment_full.value(solver.layout.u(x))
     norm_dual = None

@@ -19,11 +19,13 @@ This module imports neither CVXPY nor CasADi.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from functools import cached_property
+from typing import cast
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..cycle import sample_angles
 from ..errors import SpecError
@@ -31,6 +33,7 @@ from ..force_balance import SMALL_ROW, force_balance_conditions
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Design
+from ..model import Mechanism as Model
 from ..model.balance import BalanceProblem, Objective
 from .bounds import LinkBounds, check_problem, resolve_link
 from .lsq import bounded_lstsq
@@ -78,30 +81,32 @@ ABSENT = 1e-9
 BALANCED_SHARE = 1e-3
 
 
-def _bounded_least_squares(a, x, entries, lower, upper, original) -> NDArray[np.float64]:
+def _bounded_least_squares(a: NDArray[np.float64], x: NDArray[np.float64],
+                           entries: Sequence[int], lower: ArrayLike, upper: ArrayLike,
+                           original: ArrayLike) -> NDArray[np.float64]:
     """Values of ``x[entries]`` within bounds minimising ``‖a·x‖²``, nearest ``original``.
 
     A light pull towards the original (1e-6 of the problem's scale) picks one among equally
     good choices.
     """
-    lower, upper = np.asarray(lower, float), np.asarray(upper, float)
-    original = np.asarray(original, float)
-    free = lower < upper
-    out = original.copy()
+    lows, highs = np.asarray(lower, float), np.asarray(upper, float)
+    values = np.asarray(original, float)
+    free = lows < highs
+    out = values.copy()
     if not free.any():
         return out
     x = np.array(x, dtype=float)
-    x[list(entries)] = original  # the fixed ones at their value, the free ones solved for
-    entries = [e for e, f in zip(entries, free, strict=True) if f]
-    lower, upper, original = lower[free], upper[free], original[free]
-    cols = a[:, entries]
-    rest = a @ x - cols @ x[entries]
-    scale = np.maximum(np.abs(original), 1.0)
+    x[list(entries)] = values  # the fixed ones at their value, the free ones solved for
+    solved = [e for e, f in zip(entries, free, strict=True) if f]
+    lows, highs, values = lows[free], highs[free], values[free]
+    cols = a[:, solved]
+    rest = a @ x - cols @ x[solved]
+    scale = np.maximum(np.abs(values), 1.0)
     weight = 1e-6 * max(float(np.linalg.norm(cols)), 1e-300)
-    lhs = np.vstack([cols * scale, weight * np.eye(len(entries))])
-    rhs = np.concatenate([-rest, weight * original / scale])
-    sol = bounded_lstsq(lhs, rhs, lower / scale, upper / scale, tol=1e-14)
-    out[free] = np.clip(sol.x * scale, lower, upper)
+    lhs = np.vstack([cols * scale, weight * np.eye(len(solved))])
+    rhs = np.concatenate([-rest, weight * values / scale])
+    sol = bounded_lstsq(lhs, rhs, lows / scale, highs / scale, tol=1e-14)
+    out[free] = np.clip(sol.x * scale, lows, highs)
     return out
 
 
@@ -197,7 +202,7 @@ class NumericProblem:
         return new
 
     @property
-    def linkage(self):
+    def linkage(self) -> Model:
         """The original design's model."""
         return self.mechanism.model
 
@@ -421,7 +426,8 @@ class NumericProblem:
         """
         reg = cycle_regressors(self.mechanism, self.theta1, 0.0, 1.0)
         rows = reg.shaking_moment / math.sqrt(self.theta1.size)
-        return np.linalg.qr(rows, mode="r")
+        # (R alone: numpy's stubs say qr gives a QRResult whatever its mode.)
+        return cast("NDArray[np.float64]", np.linalg.qr(rows, mode="r"))
 
     def settle(self, x: NDArray[np.float64], *, for_motion: bool = True) -> NDArray[np.float64]:
         """Give the :attr:`inert` entries their values.
@@ -462,9 +468,9 @@ class NumericProblem:
             upper.append(b.inertia[1] + q + shift)
             original.append(kept + q + shift)
         for b in self.rotor_links:
-            if self.inert[b.rotor] and b.counter_rotor is not None:
+            if self.inert[b.rotor_entry] and b.counter_rotor is not None:
                 lo, hi = b.counter_rotor
-                entries.append(b.rotor)
+                entries.append(b.rotor_entry)
                 lower.append(lo)
                 upper.append(hi)
                 original.append(min(max(b.original.counter_rotor, lo), hi))
@@ -542,7 +548,7 @@ class NumericProblem:
         elif b.on_line:
             e, f = min(max(e, b.line_span[0]), b.line_span[1]), 0.0
         else:
-            e, f = NumericProblem._onto_disc(b.com_centre, b.com_radius, e, f)
+            e, f = NumericProblem._onto_disc(b.com_centre, b.radius, e, f)
         least = m * b.gyration**2 * (1 + ulps)
         most = b.inertia[1]
         if b.offset is not None:  # a counterweight's spread
@@ -590,7 +596,8 @@ class NumericProblem:
         """
         return float(np.max(np.abs(self.vector_of(self.physical(x)) - x) / self.scales))
 
-    def vector_of(self, physical) -> NDArray[np.float64]:
+    def vector_of(self, physical: Mapping[str, tuple[float, float, float, float, float]]
+                  ) -> NDArray[np.float64]:
         """The design vector of physical values (as from :meth:`physical`)."""
         x = np.zeros(self.size)
         for b in self.links:
@@ -600,7 +607,7 @@ class NumericProblem:
                 x[b.rotor] = rotor
         return x
 
-    def linkage_of(self, x: NDArray[np.float64]):
+    def linkage_of(self, x: NDArray[np.float64]) -> Model:
         """The mechanism's model with design vector ``x`` (loads kept from the original links).
 
         Physical values from :meth:`physical`, in their bounds exactly.
@@ -642,7 +649,7 @@ class NumericProblem:
             if b.com_fixed is not None:
                 if abs(com - b.com_fixed) > tol * l:
                     out.append(f"{b.name}: centre of mass moved by {abs(com - b.com_fixed):.3g} m")
-            elif abs(com - b.com_centre) > b.com_radius + tol * l:
+            elif abs(com - b.com_centre) > b.radius + tol * l:
                 out.append(
                     f"{b.bound_key('com_radius')}: centre of {whose} "
                     f"{abs(com - b.com_centre):.9g} m from {b.about} (at most "
@@ -661,7 +668,7 @@ class NumericProblem:
                     out.append(f"{whose}: second moment {about_p:.9g} kg·m² about {b.about} "
                                f"beyond m·(2R² + ρ²) = {m * b.counterweight_reach**2:.9g}")
         for b in self.rotor_links:
-            value = float(x[b.rotor])
+            value = float(x[b.rotor_entry])
             if b.counter_rotor is None:
                 if abs(value) > tol * b.inertia_ref:
                     out.append(f"{b.name}: has no counter-rotor, got {value:.6g} kg·m²")
@@ -692,6 +699,7 @@ class NumericProblem:
         combined before their magnitude is taken), each row's :data:`SMALL_ROW` floor, and
         ``|b|``.
         """
+        assert self.force_balance is not None, "where force balance is imposed"
         a, rhs = self.force_balance
         by_link = np.zeros((self.size, len(self.links)))
         for j, b in enumerate(self.links):
@@ -771,7 +779,7 @@ def numeric_problem(design: Design) -> NumericProblem:
     )
 
 
-def _checked_problem(problem) -> BalanceProblem:
+def _checked_problem(problem: object) -> BalanceProblem:
     """``problem`` if it is a redesign problem; :class:`SpecError` if there is none."""
     if problem is None:
         raise SpecError("missing required table: the redesign problem ([balance])",
@@ -809,7 +817,8 @@ def _reduced(reg: CycleRegressors, w: Objective, links: tuple[LinkBounds, ...], 
     if wy:
         blocks.append(math.sqrt(wy) * reg.shaking_force.imag)
     rows = np.vstack(blocks) / math.sqrt(n) if blocks else np.zeros((0, p))
-    factor = np.linalg.qr(rows, mode="r") if blocks else np.zeros((0, p))
+    factor = (cast("NDArray[np.float64]", np.linalg.qr(rows, mode="r"))  # R alone (as above)
+              if blocks else np.zeros((0, p)))
     norms = np.linalg.norm(factor, axis=0) if blocks else np.zeros(p)
     threshold = 1e-12 * max(float(norms.max(initial=0.0)), 1e-300)
     candidates = {b.start + 3 for b in links} | {b.rotor for b in links if b.rotor is not None}

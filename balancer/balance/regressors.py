@@ -9,15 +9,17 @@ frame's origin, then the counter-rotors' inertias; and a link's physical values
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ..linkage.vectors import Num
 from ..mechanisms.base import Mechanism
 
 
-def physical_to_inertial(m, e, f, inertia):
+def physical_to_inertial(m: Num, e: Num, f: Num, inertia: Num) -> tuple[Num, Num, Num, Num]:
     """Inertial parameters ``(m, m·e, m·f, J)`` from ``m``, ``e``, ``f``, ``I``.
 
     ``J = I + m·(e² + f²)`` is the inertia about the link frame's origin. Works on floats,
@@ -26,7 +28,7 @@ def physical_to_inertial(m, e, f, inertia):
     return m, m * e, m * f, inertia + m * (e * e + f * f)
 
 
-def inertial_to_physical(params) -> tuple[float, float, float, float]:
+def inertial_to_physical(params: Iterable[float]) -> tuple[float, float, float, float]:
     """``(m, e, f, I)`` from inertial parameters ``(m, m·e, m·f, J)`` (inverse of the above)."""
     m, me, mf, j = (float(p) for p in params)
     e, f = me / m, mf / m
@@ -53,7 +55,8 @@ def cycle_regressors(mech: Mechanism, angles: NDArray[np.float64], omega: float,
     At a sample exactly at a singular pose that the smooth motion passes (a four-bar's change
     points) the rows are the limits of that motion (:meth:`Mechanism.limits`).
     """
-    def evaluate(theta):
+    def evaluate(theta: NDArray[np.float64]
+                 ) -> tuple[NDArray[np.complex128], NDArray[np.float64], NDArray[np.float64]]:
         with np.errstate(all="ignore"):
             f = mech.regressors(mech.motion(theta, omega, alpha))
         return f.shaking_force.complex(), f.shaking_moment, f.driving_torque

@@ -10,11 +10,12 @@ counterweights that the optimum does not need.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from .certificate import Constraint
 from .conic import ConicProgram
 from .problem import FORCE_BALANCE_TOLERANCE, ROUNDING_TOLERANCE, NumericProblem
 
@@ -43,10 +44,14 @@ class Repairs:
 
     data: NumericProblem
     layout: Layout
-    settings: dict
-    _fb: tuple[np.ndarray, np.ndarray, np.ndarray] | None
+    settings: dict[str, Any]
+    _fb: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]] | None
     _pinned_inverses: dict[bytes, NDArray[np.float64]]
     _projections: dict[float, ConicProgram]
+
+    def _constraints(self, margin: float = 0.0) -> tuple[list[Constraint], list[str]]:
+        """The bounds as cone constraints tightened by ``margin`` (the solver's)."""
+        raise NotImplementedError
 
     def finalize(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64], bool]:
         """The design ``x`` made exactly feasible: bounds met exactly, Eq. 58 to rounding.
@@ -129,14 +134,14 @@ class Repairs:
                         values.append((target - m) / mref)
                 if b.com_fixed is None and m > 0:
                     d = complex(x[k + 1], x[k + 2]) - m * b.com_centre
-                    g = abs(d) - b.com_radius * m  # ≤ 0 inside, kg·m
-                    inside = min(ACTIVE_INSIDE * l, b.com_radius / 4) * m
+                    g = abs(d) - b.radius * m  # ≤ 0 inside, kg·m
+                    inside = min(ACTIVE_INSIDE * l, b.radius / 4) * m
                     broken = broken or g > 0
                     if (g > -inside / 2 or (k, "com") in taken) and abs(d) > 0:
                         taken.add((k, "com"))
                         n = d / abs(d)
                         grad = (-(n.real * b.com_centre.real + n.imag * b.com_centre.imag)
-                                - b.com_radius, n.real, n.imag)
+                                - b.radius, n.real, n.imag)
                         rows.append(np.asarray(grad) @ lay.T[k:k + 3] / (mref * l))
                         values.append((-inside - g) / (mref * l))
             residual = 0.0
@@ -220,8 +225,8 @@ class Repairs:
             elif b.com_fixed is None:
                 x = data.own(lay.x(u))
                 m, d = x[k], complex(x[k + 1], x[k + 2]) - x[k] * b.com_centre
-                if abs(d) > m * b.com_radius:
-                    d *= m * b.com_radius / abs(d) * (1 - 4 * 2.0**-52)
+                if abs(d) > m * b.radius:
+                    d *= m * b.radius / abs(d) * (1 - 4 * 2.0**-52)
                     s_ = m * b.com_centre + d
                     u[index[k + 1]] = (s_.real + shift[k + 1]) / data.scales[k + 1]
                     u[index[k + 2]] = (s_.imag + shift[k + 2]) / data.scales[k + 2]
@@ -234,7 +239,8 @@ class Repairs:
         x = np.array(x, dtype=float)
         for b in data.rotor_links:
             if b.counter_rotor is not None:
-                x[b.rotor] = min(max(x[b.rotor], b.counter_rotor[0]), b.counter_rotor[1])
+                x[b.rotor_entry] = min(max(x[b.rotor_entry], b.counter_rotor[0]),
+                                       b.counter_rotor[1])
         own = data.own(x)
         for b in data.links:  # inert ones too: a move of the mass or centre of mass shifts I
             k = b.start
@@ -362,7 +368,8 @@ class Repairs:
         if free is not None:
             key = free.tobytes()
             if key not in self._pinned_inverses:  # the same few patterns recur: keep them
-                self._pinned_inverses[key] = np.linalg.pinv(at[:, free])
+                self._pinned_inverses[key] = np.asarray(np.linalg.pinv(at[:, free]),
+                                                        dtype=float)
             pinv = self._pinned_inverses[key]
         residual = at @ u - rhs
         size = np.linalg.norm(residual)
@@ -419,13 +426,13 @@ class Repairs:
                 elif b.com_fixed is None:
                     x = data.own(lay.x(u))
                     m, d = x[k], complex(x[k + 1], x[k + 2]) - x[k] * b.com_centre
-                    if abs(d) > m * b.com_radius:
-                        d *= m * b.com_radius / abs(d)
+                    if abs(d) > m * b.radius:
+                        d *= m * b.radius / abs(d)
                         s = m * b.com_centre + d
                         u[index[k + 1]] = (s.real + shift[k + 1]) / data.scales[k + 1]
                         u[index[k + 2]] = (s.imag + shift[k + 2]) / data.scales[k + 2]
             for b in data.rotor_links:
-                entry = b.rotor
+                entry = b.rotor_entry
                 if entry in index:
                     assert b.counter_rotor is not None
                     lo, hi = (v / data.scales[entry] for v in b.counter_rotor)

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from ..cycle import CycleAnalysis, cycle_analysis
 from ..errors import SolverError
 from ..model import Design
+from ..model import Mechanism as Model
 from ..model.balance import Objective, ObjectiveTerm
 from .counterweights import Counterweight, added_mass, counterweights
 
@@ -138,8 +139,8 @@ class BalanceResult:
     status: Status
     message: str
     backend: str
-    linkage: object
-    original: object
+    linkage: Model
+    original: Model
     x: NDArray[np.float64]
     objective: float
     original_objective: float
@@ -170,8 +171,9 @@ class BalanceResult:
         and gravity the two agree.
         """
         speed, samples = self.before.speed, self.before.samples
-        return tuple(cycle_analysis(model, speed, samples, gravity=self.gravity)
-                     for model in (self.original, self.linkage))  # type: ignore[return-value]
+        original, balanced = (cycle_analysis(model, speed, samples, gravity=self.gravity)
+                              for model in (self.original, self.linkage))
+        return original, balanced
 
     @property
     def counterweights(self) -> dict[str, Counterweight]:

@@ -89,7 +89,7 @@ def layout(data: NumericProblem) -> Layout:
         else:
             new_variable(k + 3)
     for b in data.rotor_links:
-        entry = b.rotor
+        entry = b.rotor_entry
         assert b.counter_rotor is not None
         lo, hi = b.counter_rotor
         if data.inert[entry]:

@@ -17,6 +17,7 @@ import sys
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any, NoReturn
 
 from .. import interrupts
 from ..errors import BalancerError, OutputError, SpecError
@@ -44,11 +45,14 @@ class _Parser(argparse.ArgumentParser):
     shows the ``=`` form that takes it (``--gravity=-1,-9.81``).
     """
 
-    def parse_known_args(self, args=None, namespace=None):  # type: ignore[override]
+    # (one body for typeshed's overloads, which tell the namespace's type from the argument)
+    def parse_known_args(  # type: ignore[override]
+            self, args: Sequence[str] | None = None, namespace: Any = None
+    ) -> tuple[Any, list[str]]:
         self._given = list(sys.argv[1:] if args is None else args)
         return super().parse_known_args(args, namespace)
 
-    def error(self, message: str) -> None:  # type: ignore[override]
+    def error(self, message: str) -> NoReturn:
         raise SpecError(f"{message}{self._dash_hint(message)} (see '{self.prog} --help')")
 
     def _dash_hint(self, message: str) -> str:
@@ -140,11 +144,13 @@ def _version() -> str:
 class _VersionAction(argparse.Action):
     """``--version``: the installed version, looked up only when asked for."""
 
-    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS,
-                 help="show the version and exit"):  # noqa: A002 - argparse's keyword
+    def __init__(self, option_strings: Sequence[str], dest: str = argparse.SUPPRESS,
+                 default: Any = argparse.SUPPRESS,
+                 help: str = "show the version and exit") -> None:  # noqa: A002 - argparse's
         super().__init__(option_strings, dest, nargs=0, default=default, help=help)
 
-    def __call__(self, parser, namespace, values, option_string=None):
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: str | Sequence[Any] | None, option_string: str | None = None) -> None:
         parser._print_message(f"balancer {_version()}\n", sys.stdout)
         parser.exit()
 

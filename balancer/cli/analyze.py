@@ -29,6 +29,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         text = analysis_text(analysis, spec=args.spec) + "\n"
     if csv_path is not None:
+        assert csv is not None  # (made above for that path)
         write_atomic(csv_path, csv)
         wrote(csv_path)
     sys.stdout.write(text)

@@ -7,11 +7,19 @@ import os
 import sys
 import tomllib
 from pathlib import Path
+from typing import overload
 
 from ..errors import OutputError, SpecError
+from ..model import Design
 from ..outputs import check_writable, figure_type
 from ..plausibility import length_note, speed_note
 from ..spec import load_design
+
+
+@overload
+def output_path(args: argparse.Namespace, value: str, option: str) -> Path: ...
+@overload
+def output_path(args: argparse.Namespace, value: str | None, option: str) -> Path | None: ...
 
 
 def output_path(args: argparse.Namespace, value: str | None, option: str) -> Path | None:
@@ -56,7 +64,7 @@ def as_option(exc: SpecError, key: str, option: str, value: object) -> SpecError
     return exc
 
 
-def load(args: argparse.Namespace):
+def load(args: argparse.Namespace) -> Design:
     """The design of ``args.spec``, with a note on stderr for a unit that looks wrong.
 
     The lengths as written are judged before the spec is validated (a linkage with a length in

@@ -25,6 +25,7 @@ def run(args: argparse.Namespace) -> int:
         save_figure(front_figure(front, title=design.title), plot)
         wrote(plot)
     if csv_path is not None:
+        assert csv is not None  # (made above for that path)
         write_atomic(csv_path, csv)
         wrote(csv_path)
     sys.stdout.write(text)

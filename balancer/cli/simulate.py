@@ -42,6 +42,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         text = simulation_text(traj, spec=args.spec) + "\n"
     if out is not None:
+        assert csv is not None  # (made above for that path)
         write_atomic(out, csv)
         wrote(out)
     sys.stdout.write(text)

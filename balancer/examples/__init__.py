@@ -14,8 +14,10 @@ from __future__ import annotations
 
 import tomllib
 from importlib import resources
+from importlib.resources.abc import Traversable
 
 from ..errors import SpecError
+from ..model import Design
 from ..spec import loads_design
 
 
@@ -25,7 +27,7 @@ def names() -> tuple[str, ...]:
     return tuple(sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml")))
 
 
-def _resource(name: str):
+def _resource(name: str) -> Traversable:
     stem = name[:-5] if name.endswith(".toml") else name
     if stem not in names():
         raise SpecError(f"no such example; choose from {', '.join(names())}", key="example",
@@ -56,6 +58,6 @@ def title(name: str) -> str:
     return ""
 
 
-def load(name: str):
+def load(name: str) -> Design:
     """The example's :class:`~balancer.model.Design` (its errors name the example's file)."""
     return loads_design(text(name), source=f"example {name}")

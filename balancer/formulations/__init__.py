@@ -37,6 +37,8 @@ from typing import Literal
 
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
+from ..mechanisms.base import Mechanism
+from ..model import Mechanism as Model
 from ..slider_crank.formulations import SliderComplexMasses, SliderMassMatrix
 from .base import (
     DEAD_POINT_THRESHOLD,
@@ -67,7 +69,7 @@ OWN: dict[str, dict[str, type[Formulation]]] = {
 }
 
 
-def formulation_names(model) -> tuple[str, ...]:
+def formulation_names(model: Model | Mechanism) -> tuple[str, ...]:
     """The formulations that apply to a mechanism, the default first.
 
     The mechanism's own (:attr:`balancer.mechanisms.base.Mechanism.formulation_names`), and the
@@ -76,12 +78,12 @@ def formulation_names(model) -> tuple[str, ...]:
     return mechanism_of(model).formulation_names
 
 
-def default_method(model) -> str:
+def default_method(model: Model | Mechanism) -> str:
     """The formulation used when none is asked for."""
     return formulation_names(model)[0]
 
 
-def formulation_class(name: str, model) -> type[Formulation]:
+def formulation_class(name: str, model: Model | Mechanism) -> type[Formulation]:
     """The formulation called ``name`` for a mechanism.
 
     Raises
@@ -99,7 +101,7 @@ def formulation_class(name: str, model) -> type[Formulation]:
 
 def make(
     name: str,
-    linkage,
+    linkage: Model,
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     speed: float | None = None,

@@ -10,13 +10,20 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, overload
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..mechanisms import mechanism_of
+from ..mechanisms.base import Mechanism
+from ..model import Mechanism as Model
+from ..model.assembly import AssemblyRange
+
+if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
+    import casadi as ca
 
 #: The transmission (|sin(θ3 − θ2)|, or the square root of a group's assembly gap) at which a
 #: formulation that cannot pass a dead point stops before it (:mod:`balancer.simulation`).
@@ -46,7 +53,7 @@ def least_norm(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np
     try:
         return jac.T @ np.linalg.solve(jac @ jac.T, res)
     except np.linalg.LinAlgError:
-        return np.linalg.lstsq(jac, res, rcond=None)[0]
+        return np.asarray(np.linalg.lstsq(jac, res, rcond=None)[0], dtype=float)
 
 
 def least_norm_many(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -122,7 +129,7 @@ class Evaluation:
 
     def at(self, index: int) -> Evaluation:
         """The state ``index`` of an evaluation of arrays (from ``evaluate_batch``)."""
-        def pick(x, kind):
+        def pick(x: Any, kind: type[complex] | type[float]) -> complex | float | None:
             return None if x is None else kind(np.asarray(x)[index])
 
         return Evaluation(
@@ -143,11 +150,11 @@ class Evaluation:
         """Evaluations at single states as one of arrays (the inverse of :meth:`at`)."""
         first = evaluations[0]
 
-        def arrays(name):
+        def arrays(name: str) -> NDArray[Any] | None:
             values = [getattr(e, name) for e in evaluations]
             return None if values[0] is None else np.array(values)
 
-        def keyed(name, dtype):
+        def keyed(name: str, dtype: type[complex] | type[float]) -> dict[str, NDArray[Any]]:
             return {k: np.array([getattr(e, name)[k] for e in evaluations], dtype)
                     for k in getattr(first, name)}
 
@@ -193,7 +200,7 @@ class Formulation(ABC):
 
     def __init__(
         self,
-        linkage,
+        linkage: Model,
         *,
         gravity: tuple[float, float] = (0.0, 0.0),
         speed: float | None = None,
@@ -210,10 +217,21 @@ class Formulation(ABC):
         """Whether a motor holds the crank at constant speed."""
         return self.speed is not None
 
-    def crank_angle(self, t):
+    @overload
+    def crank_angle(self, t: float) -> float: ...
+    @overload
+    def crank_angle(self, t: NDArray[np.float64]) -> NDArray[np.float64]: ...
+
+    def crank_angle(self, t: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
         """Prescribed crank angle at time ``t`` (s, a number or an array; driven motion), rad."""
         assert self.speed is not None
         return self.theta1_start + self.speed * t
+
+    @property
+    def _motor_speed(self) -> float:
+        """The speed at which the motor holds the crank, rad/s (driven motion only)."""
+        assert self.speed is not None, "a driven motion's"
+        return float(self.speed)
 
     @staticmethod
     def continuous_crank(wrapped: float, carried: float) -> float:
@@ -237,7 +255,8 @@ class Formulation(ABC):
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         """Angles, rates, accelerations and reactions at a state."""
 
-    def evaluate_batch(self, times, states) -> Evaluation:
+    def evaluate_batch(self, times: Sequence[float] | NDArray[np.float64],
+                       states: Sequence[NDArray[np.float64]]) -> Evaluation:
         """:meth:`evaluate` at many states, as an :class:`Evaluation` of arrays.
 
         ``theta``, ``omega``, ``alpha`` have shape ``(n, count)``. Formulations override it
@@ -277,7 +296,7 @@ class Formulation(ABC):
         """
         return None
 
-    def symbolic_rhs(self):
+    def symbolic_rhs(self) -> ca.Function | None:
         """:meth:`rhs` as a CasADi function ``(t, y) → ẏ``, or ``None``.
 
         Offered only where :meth:`extra_power` is zero: the integrator then evaluates a step's
@@ -291,7 +310,7 @@ class Formulation(ABC):
 
     # -- what the simulation driver needs to know of the mechanism --------------------------
 
-    def assembly_range(self):
+    def assembly_range(self) -> AssemblyRange:
         """Crank angles at which the mechanism assembles."""
         return self.mechanism.assembly_range()
 
@@ -304,14 +323,17 @@ class Formulation(ABC):
         """How far from a dead point the motion's pose at crank angle ``theta1`` is (0 there)."""
 
     @abstractmethod
-    def energy(self, theta, omega, alpha, slider=None, states=None):
+    def energy(self, theta: NDArray[np.float64], omega: NDArray[np.float64],
+               alpha: NDArray[np.float64], slider: NDArray[np.float64] | None = None,
+               states: Sequence[NDArray[np.float64]] | None = None
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Kinetic energy and the work of loads, gravity and springs since the first state, J.
 
         At output states: arrays over time of the angles (continuous), rates and
         accelerations, the formulation's own slider coordinate, and the states themselves.
         """
 
-    def shaking(self, ev: Evaluation) -> tuple:
+    def shaking(self, ev: Evaluation) -> tuple[Any, Any]:
         """Shaking force (N) and moment about the origin (N·m) from a (batch) evaluation.
 
         From the forces at the ground points, the motor's reaction and the counter-rotors'
@@ -319,7 +341,7 @@ class Formulation(ABC):
         """
         if ev.shaking_force is not None and ev.shaking_moment is not None:
             return ev.shaking_force, ev.shaking_moment
-        force = 0.0
+        force: Any = 0.0
         moment = -np.asarray(ev.driving_torque, float)
         positions = self.mechanism.ground_positions
         for point, value in ev.ground.items():
@@ -332,7 +354,7 @@ class Formulation(ABC):
         return force, moment
 
     @property
-    def mechanism(self):
+    def mechanism(self) -> Mechanism:
         """The mechanism (:func:`balancer.mechanisms.mechanism_of`) of the linkage."""
         return mechanism_of(self.linkage)
 
@@ -351,7 +373,8 @@ class Formulation(ABC):
         """Put a state back on the constraint manifold (identity for minimal formulations)."""
         return y
 
-    def project_many(self, times, states) -> list[NDArray[np.float64]]:
+    def project_many(self, times: Sequence[float] | NDArray[np.float64],
+                     states: Sequence[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
         """:meth:`project` at many states (a step's output times), as a list.
 
         One by one, unless a formulation projects them together.
@@ -362,7 +385,8 @@ class Formulation(ABC):
         """Loop-closure residuals of a state: position (m) and velocity (m/s)."""
         return 0.0, 0.0
 
-    def constraint_residuals(self, times, states) -> tuple[float, float]:
+    def constraint_residuals(self, times: Sequence[float] | NDArray[np.float64],
+                             states: Sequence[NDArray[np.float64]]) -> tuple[float, float]:
         """The largest :meth:`constraint_residual` over many states: position and velocity."""
         pos = vel = 0.0
         for t, y in zip(times, states, strict=True):

@@ -11,9 +11,11 @@ smooth motion's branch through a change point, and the energy from the link angl
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import ClassVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..inverse import dynamic_link, kinetic_energy, link_com_kinematics
 from ..kinematics import (
@@ -23,7 +25,8 @@ from ..kinematics import (
     position_scalar,
     rates_scalar,
 )
-from ..model.assembly import assembly_range
+from ..model import FourBar, SliderCrank
+from ..model.assembly import AssemblyRange, assembly_range
 from .base import Formulation
 
 
@@ -39,13 +42,15 @@ class ClosedForm(Formulation):
         As for :class:`~balancer.formulations.Formulation`.
     """
 
+    linkage: FourBar | SliderCrank
+
     #: Number of links that turn (a slider does not).
     rotating_links: ClassVar[int] = 3
 
-    def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
+    def __init__(self, linkage: FourBar | SliderCrank, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
         super().__init__(linkage, gravity=gravity, speed=speed)
-        self.lengths = linkage.lengths
+        self.lengths: tuple[float, ...] = linkage.lengths
         #: Links as the dynamics see them (counter-rotor inertia added).
         self.links = tuple(dynamic_link(link) for link in linkage.links)
         #: Applied force on each link at its centre of mass, weight included, N.
@@ -66,7 +71,10 @@ class ClosedForm(Formulation):
 class FourBarFormulation(ClosedForm):
     """The four-bar's formulations: its closed-form kinematics for the simulation driver."""
 
-    def assembly_range(self):
+    linkage: FourBar
+    lengths: tuple[float, float, float, float]
+
+    def assembly_range(self) -> AssemblyRange:
         """Crank angles at which the mechanism assembles."""
         return assembly_range(self.lengths)
 
@@ -80,7 +88,10 @@ class FourBarFormulation(ClosedForm):
         _, v2, v3 = position_scalar(self.lengths, theta1, float(sign))
         return abs(v2.real * v3.imag - v2.imag * v3.real) / (self.lengths[1] * self.lengths[2])
 
-    def energy(self, theta, omega, alpha, slider=None, states=None):
+    def energy(self, theta: NDArray[np.float64], omega: NDArray[np.float64],
+               alpha: NDArray[np.float64], slider: NDArray[np.float64] | None = None,
+               states: Sequence[NDArray[np.float64]] | None = None
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Kinetic energy and the work of loads and gravity since the first state, J.
 
         At output states (arrays over time; angles continuous).
@@ -105,7 +116,8 @@ class FourBarFormulation(ClosedForm):
         points = change_point_angles(self.lengths)
         return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < width for p in points)
 
-    def branch_vectors(self, theta1: float, omega1: float):
+    def branch_vectors(self, theta1: float, omega1: float
+                       ) -> tuple[tuple[complex, complex, complex], float, float]:
         """Link vectors and dependent rates ``(l̄1, l̄2, l̄3), θ̇2, θ̇3`` of the smooth motion.
 
         On the assembly the motion is on at crank angle ``theta1`` (unwrapped, rad) (Eq. 2–7).

@@ -10,16 +10,19 @@ through its buffers; :func:`link_equations` and
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..linkage.constraints import GROUND_INDEX, Pose
 from ..linkage.structure import Structure
 from ..linkage.symbols import CasadiOps
-from ..linkage.vectors import NUMPY, V
+from ..linkage.vectors import NUMPY, Num, OpsLike, V
 from ..mechanisms import mechanism_of
+from ..model import Link, Spring
+from ..model import Mechanism as Model
 from .base import Formulation
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
@@ -41,9 +44,14 @@ class Compiled:
         self.arg = np.zeros(fn.size1_in(0))
         self.res = np.zeros(fn.size1_out(0))
         self._buffer, self._eval = fn.buffer()
-        self._buffer.set_arg(0, memoryview(self.arg))
-        self._buffer.set_res(0, memoryview(self.res))
-        self._block = None  # the function mapped over BLOCK columns, when first needed
+        # (CasADi's stubs ask a size its binding takes from the buffer; numpy's arrays are
+        # buffers, typed so from Python 3.12.)
+        self._buffer.set_arg(0, memoryview(self.arg))  # type: ignore[call-arg, arg-type]
+        self._buffer.set_res(0, memoryview(self.res))  # type: ignore[call-arg, arg-type]
+        #: The function mapped over BLOCK columns, when first needed: its buffer, its
+        #: evaluation and its argument and result arrays.
+        self._block: tuple[ca.FunctionBuffer, Callable[[], None], NDArray[np.float64],
+                           NDArray[np.float64]] | None = None
 
     def __call__(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         self.arg[:] = x
@@ -64,8 +72,8 @@ class Compiled:
             arg = np.zeros((BLOCK, self.arg.size))  # row j: column j's inputs, as CasADi stores
             res = np.zeros((BLOCK, self.res.size))
             buffer, evaluate = mapped.buffer()
-            buffer.set_arg(0, memoryview(arg.reshape(-1)))
-            buffer.set_res(0, memoryview(res.reshape(-1)))
+            buffer.set_arg(0, memoryview(arg.reshape(-1)))  # type: ignore[call-arg, arg-type]
+            buffer.set_res(0, memoryview(res.reshape(-1)))  # type: ignore[call-arg, arg-type]
             self._block = (buffer, evaluate, arg, res)
         _, evaluate, arg, res = self._block
         count = x.shape[1]
@@ -81,9 +89,10 @@ class Compiled:
         return out
 
 
-def spring_forces(structure: Structure, spring, pose: Pose, ops):
+def spring_forces(structure: Structure, spring: Spring, pose: Pose, ops: OpsLike
+                  ) -> list[tuple[int, V, V]]:
     """The spring's forces on its two carriers: ``(link, force, point)`` twice (N, m)."""
-    ends = []
+    ends: list[tuple[int, V]] = []
     for p in spring.points:
         links = structure.point_links[p]
         k = GROUND_INDEX if GROUND_INDEX in links else links[0]
@@ -96,7 +105,8 @@ def spring_forces(structure: Structure, spring, pose: Pose, ops):
     return [(ka, unit * tension, a), (kb, unit * (-tension), b)]
 
 
-def link_equations(structure: Structure, links, pose: Pose, rate, gravity: V, gas):
+def link_equations(structure: Structure, links: Sequence[Link], pose: Pose, rate: Sequence[Num],
+                   gravity: V, gas: ca.SX) -> tuple[ca.SX, ca.SX]:
     """Mass matrix ``M`` and applied forces ``Q`` of the moving links (SX, 3n×3n and 3n).
 
     Per link ``k``, in its coordinates ``(x, y, θ)``, with ``S̄ = R(θ)·(m·s̄)`` its first
@@ -155,7 +165,7 @@ class LinkageFormulation(Formulation):
 
     reusable = True
 
-    def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
+    def __init__(self, linkage: Model, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
         super().__init__(linkage, gravity=gravity, speed=speed)
         self.mech = mechanism_of(linkage)
@@ -179,7 +189,7 @@ class LinkageFormulation(Formulation):
         values = [float(sliders[c.slider].force.at(theta1)) for c in self.structure.prisms]
         return np.array(values if values else [0.0])
 
-    def configuration_work(self, pose: Pose, angles) -> NDArray[np.float64]:
+    def configuration_work(self, pose: Pose, angles: ArrayLike) -> NDArray[np.float64]:
         """Work of the loads and gravity less the springs' energy gained since the first state.
 
         ``pose`` holds the links' frames at the states (arrays over them) and ``angles`` their
@@ -187,16 +197,16 @@ class LinkageFormulation(Formulation):
         mass' and the angles' displacements, the springs' from their potential energy, J.
         """
         g = V(self.gravity.real, self.gravity.imag)
-        angles = np.asarray(angles, dtype=float)
-        count = angles.shape[1]
+        theta = np.asarray(angles, dtype=float)
+        count = theta.shape[1]
         work = np.zeros(count)
         for k, link in enumerate(self.links):
             com = pose.point(k, V(link.e, link.f))
             work += (g * link.mass + V(*link.force)).dot(com - V(com.x[0], com.y[0]))
-            work += link.moment * (angles[k] - angles[k, 0])
-        spring = 0.0
+            work += link.moment * (theta[k] - theta[k, 0])
+        energy: Num = 0.0
         for s in self.structure.linkage.springs:
             (_, _, a), (_, _, b) = spring_forces(self.structure, s, pose, NUMPY)
-            spring = spring + 0.5 * s.stiffness * (np.sqrt((b - a).norm2()) - s.free_length) ** 2
-        spring = np.asarray(spring, dtype=float) * np.ones(count)
+            energy = energy + 0.5 * s.stiffness * (np.sqrt((b - a).norm2()) - s.free_length) ** 2
+        spring = np.asarray(energy, dtype=float) * np.ones(count)
         return work - (spring - spring[0])

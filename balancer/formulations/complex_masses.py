@@ -22,12 +22,20 @@ there and says so.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any, TypeAlias
+
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..kinematics import branch_sign_along, cross_scalar, motion, position_scalar, rates_scalar
+from ..linkage.vectors import Num
 from .base import DrivenRates, Evaluation
 from .closed_form import FourBarFormulation
+
+#: The kinematics the reduced equation needs, at one state (numbers) or many (arrays):
+#: ``((l̄1, l̄2, l̄3), Θ2, Θ3, θ̇2, θ̇3, b2, b3)`` with ``θ̈k = Θk·θ̈1 + bk``.
+Kinematics: TypeAlias = tuple[tuple[Num, Num, Num], Num, Num, Num, Num, Num, Num]
 
 
 def _ip(x: complex, y: complex) -> float:
@@ -41,7 +49,7 @@ class ComplexMasses(FourBarFormulation):
     name = "complex-masses"
     minimal = True
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         (l1, _, l3, _), (c1, c2, c3) = self.lengths, self.links
         m2 = c2.mass
@@ -62,19 +70,19 @@ class ComplexMasses(FourBarFormulation):
 
     def _crank(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
         if self.driven:
-            return self.crank_angle(t), float(self.speed)  # type: ignore[arg-type]
+            return self.crank_angle(t), self._motor_speed
         return float(y[0]), float(y[1])
 
     # -- Eq. 36–39 -----------------------------------------------------------------------------
 
-    def _reduced(self, theta1: float, omega1: float):
+    def _reduced(self, theta1: float, omega1: float) -> tuple[float, float, Kinematics]:
         """Terms of the reduced equation at one state: ``(ΘᵀMΘ, ΘᵀQ − ΘᵀMb − ΘᵀCθ̇², kin)``."""
         vectors = self._vectors(theta1)
-        kin = (vectors, *rates_scalar(self.lengths, vectors, omega1))
+        kin: Kinematics = (vectors, *rates_scalar(self.lengths, vectors, omega1))
         inertia, force = self._dynamics(kin, omega1)
         return inertia, force, kin
 
-    def _dynamics(self, kin, omega1):
+    def _dynamics(self, kin: Kinematics, omega1: Num) -> tuple[Num, Num]:
         """Eq. 36–39 reduced to θ1, for scalars or arrays of states.
 
         ``kin = ((l̄1, l̄2, l̄3), Θ2, Θ3, θ̇2, θ̇3, b2, b3)`` with ``θ̈k = Θk·θ̈1 + bk``.
@@ -113,13 +121,16 @@ class ComplexMasses(FourBarFormulation):
         inertia, force, kin = self._reduced(theta1, omega1)
         return self._evaluation(theta1, omega1, inertia, force, kin)
 
-    def _kinematics_batch(self, theta1, omega1):
+    def _kinematics_batch(self, theta1: NDArray[np.float64], omega1: NDArray[np.float64]
+                          ) -> Kinematics:
         """``kin`` of :meth:`_dynamics` at arrays of crank states (Eq. 2–10, vectorised)."""
         signs = branch_sign_along(self.lengths, self.sign0, self.theta1_start, theta1)
         mo = motion(self.lengths, theta1, omega1, 0.0, signs * np.ones_like(theta1), check=False)
-        return (mo.vectors, *mo.transfer, mo.omega[1], mo.omega[2], mo.alpha[1], mo.alpha[2])
+        v1, v2, v3 = mo.vectors
+        return ((v1, v2, v3), *mo.transfer, mo.omega[1], mo.omega[2], mo.alpha[1], mo.alpha[2])
 
-    def evaluate_batch(self, times, states) -> Evaluation:
+    def evaluate_batch(self, times: Sequence[float] | NDArray[np.float64],
+                       states: Sequence[NDArray[np.float64]]) -> Evaluation:
         """The same equations on arrays of states, with the vectorised kinematics (Eq. 2–10)."""
         cranks = [self._crank(t, y) for t, y in zip(times, states, strict=True)]
         theta1 = np.array([c[0] for c in cranks])
@@ -128,12 +139,12 @@ class ComplexMasses(FourBarFormulation):
         inertia, force = self._dynamics(kin, omega1)
         return self._evaluation(theta1, omega1, inertia, force, kin)
 
-    def driven_rates(self, times) -> DrivenRates | None:
+    def driven_rates(self, times: ArrayLike) -> DrivenRates | None:
         """The motor's power ``τ·θ̇1`` (``τ = −force``, as :meth:`rhs`) at many times."""
         if not self.time_only:
             return None
         theta1 = self.crank_angle(np.asarray(times, dtype=float))
-        omega1 = np.full(theta1.shape, float(self.speed))  # type: ignore[arg-type]
+        omega1 = np.full(theta1.shape, self._motor_speed)
         kin = self._kinematics_batch(theta1, omega1)
         _, force = self._dynamics(kin, omega1)
         _, v2, v3 = kin[0]
@@ -142,7 +153,8 @@ class ComplexMasses(FourBarFormulation):
         return DrivenRates(rates=(-force * omega1)[:, None], extra_power=np.zeros(theta1.shape),
                            transmission=transmission)
 
-    def _evaluation(self, theta1, omega1, inertia, force, kin) -> Evaluation:
+    def _evaluation(self, theta1: Num, omega1: Num, inertia: Num, force: Num,
+                    kin: Kinematics) -> Evaluation:
         vectors, big2, big3, w2, w3, b2, b3 = kin
         if self.driven:
             alpha1, tau = 0.0 * force, -force
@@ -155,7 +167,8 @@ class ComplexMasses(FourBarFormulation):
         return Evaluation(theta=theta, omega=omega, alpha=alpha, ground={"A0": ra0, "A3": ra3},
                           driving_torque=tau)
 
-    def _reactions(self, vectors, omega, alpha):
+    def _reactions(self, vectors: tuple[Num, Num, Num], omega: NDArray[Any],
+                   alpha: NDArray[Any]) -> tuple[Num, Num]:
         """R̄A0, R̄A3 by virtual displacements with the complex masses (Eq. 35, 40).
 
         For scalars or arrays of states.

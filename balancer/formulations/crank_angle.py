@@ -29,6 +29,7 @@ integrated states, vectorised (numpy, an independent solve of the same positions
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -38,8 +39,9 @@ from ..errors import AssemblyError, SolverError
 from ..linkage.kinematics import numeric_table, positions, rates
 from ..linkage.numeric import TABLE_STEPS
 from ..linkage.symbols import CasadiOps
-from ..linkage.vectors import V
+from ..linkage.vectors import Num, V
 from ..mechanisms.base import _gaps
+from ..model import Mechanism as Model
 from .base import DEAD_POINT_THRESHOLD, DrivenRates, Evaluation
 from .compiled import Compiled, LinkageFormulation, link_equations
 
@@ -59,7 +61,7 @@ class CrankAngle(LinkageFormulation):
     passes_dead_points = False
     passes_change_points = False
 
-    def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
+    def __init__(self, linkage: Model, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
         super().__init__(linkage, gravity=gravity, speed=speed)
         #: Each link's angle at the start less its principal value there (whole turns).
@@ -77,8 +79,8 @@ class CrankAngle(LinkageFormulation):
         starts = np.cumsum([0, *sizes])
         guesses = {i: [guess[j] for j in range(a, b)]
                    for i, a, b in zip(numeric, starts[:-1], starts[1:], strict=True)}
-        gaps: list = []
-        residuals: list = []
+        gaps: list[Num] = []
+        residuals: list[Num] = []
         pose = positions(s, theta1, CasadiOps, gaps=gaps, guesses=guesses, residuals=residuals)
         u_vel, u_rate, b_acc, b_accel = rates(s, pose, 1.0, 0.0, theta1, CasadiOps)
         u = ca.vertcat(*[x for k in range(self.n)
@@ -110,7 +112,7 @@ class CrankAngle(LinkageFormulation):
         self._prisms = len(s.prisms)
         self._numeric = bool(numeric)
 
-    def _table_guess(self, index: int, theta1):
+    def _table_guess(self, index: int, theta1: ca.MX) -> ca.MX:
         """A numeric group's coordinates at ``theta1`` (MX) from its continuation table.
 
         A cubic spline through the table's rows (:func:`balancer.linkage.numeric.table`),
@@ -160,7 +162,7 @@ class CrankAngle(LinkageFormulation):
         t = ca.MX.sym("t")
         gas = ca.MX.zeros(max(1, len(s.prisms)))
         if self.driven:
-            speed = float(self.speed)  # type: ignore[arg-type]
+            speed = self._motor_speed
             y = ca.MX.sym("y", 3)  # θ1 integrated at the constant speed
             _, general = self._sym(y[0], speed, gas)
             dy = ca.vertcat(speed, 0, -general * speed)
@@ -179,7 +181,7 @@ class CrankAngle(LinkageFormulation):
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         self.theta1_start = float(theta1)
         if self.driven:
-            omega1 = float(self.speed)  # type: ignore[arg-type]
+            omega1 = self._motor_speed
         continued = self.mech.continued_angles(theta1)
         with np.errstate(all="ignore"):
             principal = self.mech.motion(theta1).pose.angles
@@ -197,7 +199,7 @@ class CrankAngle(LinkageFormulation):
 
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         if self.driven:  # the prescribed angle (the state's, integrated, is the same)
-            speed = float(self.speed)  # type: ignore[arg-type]
+            speed = self._motor_speed
             general = self._at(self.crank_angle(t), speed)[1]
             return np.array([speed, 0.0, -general * speed])  # the motor's power: τ = −F
         out = self._at(y[0], y[1])
@@ -213,7 +215,7 @@ class CrankAngle(LinkageFormulation):
         """
         if not self.driven:
             return None
-        speed = float(self.speed)  # type: ignore[arg-type]
+        speed = self._motor_speed
         theta1 = self.crank_angle(np.asarray(times, dtype=float))
         gas = np.array([self._gas(x) for x in theta1]).reshape(theta1.size, -1)
         out = self._equation.columns(np.vstack([theta1, np.full(theta1.size, speed), gas.T]))
@@ -254,16 +256,17 @@ class CrankAngle(LinkageFormulation):
         gas = self._gas(theta1)
         if not np.any(gas):
             return 0.0
-        omega1 = float(self.speed) if self.driven else float(y[1])  # type: ignore[arg-type]
+        omega1 = self._motor_speed if self.driven else float(y[1])
         per = self._at(theta1, 0.0)[4:]
         return float(omega1 * np.dot(gas, per))
 
     @staticmethod
-    def _crank_states(states) -> NDArray[np.float64]:
+    def _crank_states(states: Sequence[NDArray[np.float64]]) -> NDArray[np.float64]:
         """Crank angle and rate at states, ``(count, 2)`` (the driven state's θ1 integrated)."""
         return np.array(states, dtype=float).reshape(len(states), -1)[:, :2]
 
-    def _crank_accelerations(self, states) -> NDArray[np.float64]:
+    def _crank_accelerations(self, states: Sequence[NDArray[np.float64]]
+                             ) -> NDArray[np.float64]:
         """The crank's angular acceleration at states, rad/s² (zero when driven)."""
         if self.driven:
             return np.zeros(len(states))
@@ -272,7 +275,8 @@ class CrankAngle(LinkageFormulation):
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         return self.evaluate_batch([t], [y]).at(0)
 
-    def evaluate_batch(self, times, states) -> Evaluation:
+    def evaluate_batch(self, times: Sequence[float] | NDArray[np.float64],
+                       states: Sequence[NDArray[np.float64]]) -> Evaluation:
         """The linkage core's motion and inverse dynamics at the states, vectorised."""
         theta1, omega1 = self._crank_states(states).T
         alpha1 = self._crank_accelerations(states)
@@ -299,13 +303,17 @@ class CrankAngle(LinkageFormulation):
             slider_normal={k: v[:, 0] for k, v in forces.slider_normal.items()},
             slider_couple={k: v[:, 0] for k, v in forces.slider_couple.items()})
 
-    def energy(self, theta, omega, alpha, slider=None, states=None):
+    def energy(self, theta: NDArray[np.float64], omega: NDArray[np.float64],
+               alpha: NDArray[np.float64], slider: NDArray[np.float64] | None = None,
+               states: Sequence[NDArray[np.float64]] | None = None
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Kinetic energy and the work of loads, gravity and springs since the first state, J.
 
         The kinetic energy from each link's own motion at the output states (the linkage
         core's velocities, ``Σ m·|v_G|²/2 + J_G·ω²/2`` with the counter-rotors' ``J_c·ω²/2``),
         a route apart from the compiled ``m(θ1)·θ̇1²/2`` the motion was integrated with.
         """
+        assert states is not None  # the simulation passes them
         theta1, omega1 = self._crank_states(states).T
         with np.errstate(all="ignore"):
             mo = self.mech.motion(theta1, omega1, 0.0)

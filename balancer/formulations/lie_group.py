@@ -32,6 +32,8 @@ and rocker align (``q_Dᵀ·S1·q_B = 0``): the simulation stops at such a dead 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -69,7 +71,7 @@ class LieGroup(FourBarFormulation):
     name = "lie-group"
     minimal = False
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         (l1, _, l3, _), (c1, c2, c3) = self.lengths, self.links
         # Centre-of-mass offsets in each body frame: the rocker's frame starts at A3 along q_D.
@@ -113,7 +115,9 @@ class LieGroup(FourBarFormulation):
 
     # -- Eq. 82–85 ---------------------------------------------------------------------------
 
-    def terms(self, q: NDArray[np.float64]):
+    def terms(self, q: NDArray[np.float64]
+              ) -> tuple[float, float, float, NDArray[np.float64], NDArray[np.float64],
+                         NDArray[np.float64]]:
         """``(Σ, P, Q_loads, K, δK, velocity map)`` at attitudes ``q`` (Eq. 83–84)."""
         k = self.k_matrix(q)
         dk = self.k_variation(q, k)
@@ -133,7 +137,7 @@ class LieGroup(FourBarFormulation):
         return sigma, p, q_loads, k, dk, z2
 
     def _omega1(self, t: float, y: NDArray[np.float64], sigma: float) -> float:
-        return float(self.speed) if self.driven else float(y[0]) / sigma  # type: ignore[arg-type]
+        return self._motor_speed if self.driven else float(y[0]) / sigma
 
     @staticmethod
     def _q(y: NDArray[np.float64], driven: bool) -> NDArray[np.float64]:
@@ -160,7 +164,9 @@ class LieGroup(FourBarFormulation):
         pi_dot = p * w1 * w1 + q_loads  # Eq. 84
         return np.concatenate([[pi_dot], q_dot, [w1]])
 
-    def _kinematic_state(self, t: float, y: NDArray[np.float64]):
+    def _kinematic_state(self, t: float, y: NDArray[np.float64]
+                         ) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                    NDArray[np.float64], float]:
         """Angles, rates, accelerations and motor torque at a state (Eq. 82–85)."""
         q = self._q(y, self.driven)
         sigma, p, q_loads, k, dk, _ = self.terms(q)
@@ -181,7 +187,8 @@ class LieGroup(FourBarFormulation):
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         return self.evaluate_batch([t], [y]).at(0)
 
-    def evaluate_batch(self, times, states) -> Evaluation:
+    def evaluate_batch(self, times: Sequence[float] | NDArray[np.float64],
+                       states: Sequence[NDArray[np.float64]]) -> Evaluation:
         """Accelerations per state, then reactions from Newton–Euler in one vectorised call."""
         parts = [self._kinematic_state(t, y) for t, y in zip(times, states, strict=True)]
         theta = np.array([p[0] for p in parts]).T

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from abc import abstractmethod
 from types import SimpleNamespace
+from typing import Any, TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,6 +36,13 @@ from ..massmodels import fourbar_force_vector, global_mass_matrix
 from ..model import Link
 from .base import Evaluation
 from .closed_form import FourBarFormulation
+
+#: Node accelerations ẍ (m/s²), the constraints' multipliers λ and the motor torque (N·m) at a
+#: state.
+NodeAccelerations: TypeAlias = tuple[NDArray[np.float64], NDArray[np.float64], float]
+#: The same, and the link vectors there (m).
+NodalSolution: TypeAlias = tuple[NDArray[np.float64], NDArray[np.float64], float,
+                                 tuple[complex, complex, complex]]
 
 
 class NodalTruss(FourBarFormulation):
@@ -57,7 +65,7 @@ class NodalTruss(FourBarFormulation):
         """``Φ(x)`` (3) and ``∂Φ/∂x`` (3×4)."""
 
     @abstractmethod
-    def solve(self, t: float, y: NDArray[np.float64]) -> tuple:
+    def solve(self, t: float, y: NDArray[np.float64]) -> NodeAccelerations | NodalSolution:
         """``(ẍ, λ, τ, …)``: node accelerations, multipliers and the motor torque at a state."""
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
@@ -83,7 +91,7 @@ class NodalTruss(FourBarFormulation):
         gamma: NDArray[np.float64],
         f_free: NDArray[np.float64],
         a1: complex,
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+    ) -> NodeAccelerations:
         """``(ẍ, λ, τ)`` from ``M·ẍ + Φxᵀ·λ = F``, ``Φx·ẍ = γ`` (Eq. 48–50).
 
         Free motion: one linear solve for ẍ and λ (τ = 0). Driven: r̈A1 is the prescribed
@@ -98,7 +106,7 @@ class NodalTruss(FourBarFormulation):
             a[4:7, 0:4] = jac
             z = np.linalg.solve(a, np.concatenate([f_free, gamma]))
             return z[0:4], z[4:7], 0.0
-        omega = float(self.speed)  # type: ignore[arg-type]
+        omega = self._motor_speed
         acc_a1 = -omega * omega * a1
         x1 = np.array([acc_a1.real, acc_a1.imag])
         couple = 1j * a1 / self.lengths[0] ** 2
@@ -115,7 +123,7 @@ class NodalTruss(FourBarFormulation):
         acc, _, tau = self.solve(t, y)[:3]
         dy = np.concatenate([y[4:8], acc])
         if self.driven:
-            return np.append(dy, tau * float(self.speed))  # type: ignore[arg-type]
+            return np.append(dy, tau * self._motor_speed)
         a1, v_a1 = complex(y[0], y[1]), complex(y[4], y[5])
         return np.append(dy, cross_scalar(a1, v_a1) / abs(a1) ** 2)  # θ̇1
 
@@ -129,7 +137,7 @@ class NodalTruss(FourBarFormulation):
         if self.driven:
             th = self.crank_angle(t)
             a1 = self.lengths[0] * complex(math.cos(th), math.sin(th))
-            v1 = 1j * float(self.speed) * a1  # type: ignore[arg-type]
+            v1 = 1j * self._motor_speed * a1
             y[0:2] = a1.real, a1.imag
             y[4:6] = v1.real, v1.imag
             rows, free = slice(1, 3), slice(2, 4)
@@ -154,7 +162,7 @@ class MassMatrix(NodalTruss):
     minimal = False
     passes_dead_points = True
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         # Eq. 45 assembled over the nodes A0, A1, A2, A3 (8×8), counter-rotors in the inertia.
         self.m_global = global_mass_matrix(
@@ -200,7 +208,8 @@ class MassMatrix(NodalTruss):
             ]
         )
 
-    def _forces(self, vectors, tau: float = 0.0) -> tuple[complex, ...]:
+    def _forces(self, vectors: tuple[complex, complex, complex], tau: float = 0.0
+                ) -> tuple[complex, ...]:
         """Nodal applied forces at A0…A3 (Eq. 46, 49, 54), with a motor torque on the crank."""
         pos = SimpleNamespace(l1=vectors[0], l2=vectors[1], l3=vectors[2])
         moments = (self.moments[0] + tau, self.moments[1], self.moments[2])
@@ -208,7 +217,7 @@ class MassMatrix(NodalTruss):
 
     # -- the formulation ---------------------------------------------------------------------
 
-    def solve(self, t: float, y: NDArray[np.float64]):
+    def solve(self, t: float, y: NDArray[np.float64]) -> NodalSolution:
         """Accelerations ẍ, multipliers λ and the motor torque at a state.
 
         Near a change point the constrained system is singular (the length constraints become
@@ -227,10 +236,11 @@ class MassMatrix(NodalTruss):
         acc, lam, tau = self.node_accelerations(jac, gamma, f_free, a1)
         return acc, lam, tau, vectors
 
-    def _solve_reduced(self, t: float, y: NDArray[np.float64], theta1: float):
+    def _solve_reduced(self, t: float, y: NDArray[np.float64], theta1: float
+                       ) -> NodalSolution:
         a1 = complex(y[0], y[1])
         v_a1 = complex(y[4], y[5])
-        omega1 = float(self.speed) if self.driven else cross_scalar(a1, v_a1) / abs(a1) ** 2
+        omega1 = self._motor_speed if self.driven else cross_scalar(a1, v_a1) / abs(a1) ** 2
         vectors, w2, w3 = self.branch_vectors(theta1, omega1)
         v1, v2, v3 = vectors
         _, big3, _, _, _, b3 = rates_scalar(self.lengths, vectors, omega1)
@@ -257,7 +267,7 @@ class MassMatrix(NodalTruss):
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         self.theta1_start = float(theta1)
         if self.driven:
-            omega1 = float(self.speed)  # type: ignore[arg-type]
+            omega1 = self._motor_speed
         mo = motion_of(self.linkage, theta1, omega1, 0.0)
         return self.node_state(mo.pos.A1[0], mo.pos.A2[0], mo.joint_velocities[0][0],
                                mo.joint_velocities[1][0], theta1)
@@ -321,7 +331,7 @@ class MassMatrix(NodalTruss):
         y = np.array(y, dtype=float)
         a1 = complex(y[0], y[1])
         v_a1 = complex(y[4], y[5])
-        omega1 = self.speed if self.driven else cross_scalar(a1, v_a1) / abs(a1) ** 2
+        omega1 = self._motor_speed if self.driven else cross_scalar(a1, v_a1) / abs(a1) ** 2
         (v1, v2, v3), w2, w3 = self.branch_vectors(theta1, float(omega1))
         a2 = v1 + v2
         v_a1 = 1j * omega1 * v1

@@ -29,6 +29,8 @@ symbols) and compiled into one function; the linear system is solved with numpy.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from types import ModuleType
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -37,6 +39,7 @@ from numpy.typing import NDArray
 from ..errors import AssemblyError, SolverError
 from ..linkage.constraints import (
     GROUND_INDEX,
+    Constraint,
     Driver,
     Pin,
     Pose,
@@ -46,8 +49,9 @@ from ..linkage.constraints import (
 )
 from ..linkage.kinematics import _gamma
 from ..linkage.symbols import CasadiOps
-from ..linkage.vectors import V
+from ..linkage.vectors import Num, OpsLike, V
 from ..mechanisms.base import _gaps
+from ..model import Mechanism as Model
 from .base import Evaluation, continuous_angles, least_norm, least_norm_many
 from .compiled import Compiled, LinkageFormulation, link_equations, spring_forces
 
@@ -64,21 +68,22 @@ class Multibody(LinkageFormulation):
     #: At a change point its constraints are dependent and the saddle-point system singular.
     passes_change_points = False
 
-    def __init__(self, linkage, *, gravity: tuple[float, float] = (0.0, 0.0),
+    def __init__(self, linkage: Model, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
         super().__init__(linkage, gravity=gravity, speed=speed)
         #: The mechanism as a general linkage (springs, sliders, ground points).
         self.general = self.mech.linkage
         s = self.structure
         self.theta1_start = s.ref_angle[s.input]
-        self.constraints = [*s.constraints, *([s.driver] if self.driven else [])]
+        self.constraints: list[Constraint] = [*s.constraints,
+                                              *([s.driver] if self.driven else [])]
         self.rows = sum(c.rows for c in self.constraints)
         self.scale = s.length_scale()
         self._build()
 
     # -- the compiled equations ---------------------------------------------------------------
 
-    def _pose(self, q, ops) -> Pose:
+    def _pose(self, q: Num, ops: OpsLike | ModuleType) -> Pose:
         n = self.n
         angles = [q[3 * k + 2] for k in range(n)]
         return Pose([V(q[3 * k], q[3 * k + 1]) for k in range(n)], angles,
@@ -116,7 +121,7 @@ class Multibody(LinkageFormulation):
         self._build_dynamics()
         self._build_constraints(q, pose)
 
-    def _build_frame(self, q, qd, gas, pose: Pose) -> None:
+    def _build_frame(self, q: ca.SX, qd: ca.SX, gas: ca.SX, pose: Pose) -> None:
         """The forces on the frame from a state, its accelerations and multipliers (SX).
 
         A constraint's generalized force on the ground (the ground as a link at rest) is
@@ -126,13 +131,14 @@ class Multibody(LinkageFormulation):
         n, s = self.n, self.structure
         lam = ca.SX.sym("lam", self.rows)
         acc = ca.SX.sym("acc", 3 * n)
-        ground = {p: [0, 0] for p in self.general.ground.points}
-        normal, couple = [], []
+        ground: dict[str, list[Num]] = {p: [0, 0] for p in self.general.ground.points}
+        normal: list[ca.SX] = []
+        couple: list[ca.SX] = []
         fx = fy = mz = ca.SX(0)
         row = 0
         for c in self.constraints:
-            for link, coeffs in constraint_jacobian(c, pose):
-                if link != GROUND_INDEX:
+            for carrier, coeffs in constraint_jacobian(c, pose):
+                if carrier != GROUND_INDEX:
                     continue
                 gen = [-sum(coeffs[r][col] * lam[row + r] for r in range(c.rows))
                        for col in range(3)]
@@ -211,7 +217,7 @@ class Multibody(LinkageFormulation):
         r = np.where(norms > 0, 1.0 / np.where(norms > 0, norms, 1.0), 1.0)
         return d, r
 
-    def _build_constraints(self, q, pose: Pose) -> None:
+    def _build_constraints(self, q: ca.SX, pose: Pose) -> None:
         """The constraints' residual and Jacobian at a pose and a prescribed crank angle (SX)."""
         import casadi as ca  # heavy: only where symbols are built
         angle = ca.SX.sym("angle")
@@ -244,10 +250,10 @@ class Multibody(LinkageFormulation):
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         self.theta1_start = float(theta1)
         if self.driven:
-            omega1 = float(self.speed)  # type: ignore[arg-type]
+            omega1 = self._motor_speed
         mo = self.mech.motion(theta1, omega1, 0.0)
 
-        def first(x) -> float:
+        def first(x: Num) -> float:
             return float(np.ravel(x)[0])
 
         q, qd = np.empty(3 * self.n), np.empty(3 * self.n)
@@ -263,7 +269,8 @@ class Multibody(LinkageFormulation):
         y = np.concatenate([q, qd])
         return np.append(y, 0.0) if self.driven else y
 
-    def driven_motion(self, times, start) -> NDArray[np.float64] | None:
+    def driven_motion(self, times: NDArray[np.float64],
+                      start: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """The frames' coordinates and rates from the mechanism's motion at the crank angles.
 
         The crank angle ``θ1(t)`` exactly; the other links' angles continuous from ``start``'s
@@ -273,7 +280,7 @@ class Multibody(LinkageFormulation):
         times = np.asarray(times, dtype=float)
         theta1 = self.crank_angle(times)
         with np.errstate(all="ignore"):
-            mo = self.mech.motion(theta1, float(self.speed), 0.0)  # type: ignore[arg-type]
+            mo = self.mech.motion(theta1, self._motor_speed, 0.0)
         count, n = times.size, self.n
         q, qd = np.empty((count, 3 * n)), np.empty((count, 3 * n))
         for k in range(n):
@@ -303,7 +310,7 @@ class Multibody(LinkageFormulation):
         acc, frame = out[0], out[-1]
         dy = [y[k : 2 * k], acc]
         if self.driven:
-            dy.append(frame[3] * float(self.speed))  # type: ignore[arg-type]
+            dy.append(frame[3] * self._motor_speed)
         return ca.Function("multibody_rhs", [t, y], [ca.vertcat(*dy)])
 
     def rhs(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -311,10 +318,11 @@ class Multibody(LinkageFormulation):
         acc, _, _, _, _, frame = self._call(t, y)
         dy = np.concatenate([y[k : 2 * k], acc])
         if self.driven:
-            return np.append(dy, frame[3] * float(self.speed))  # type: ignore[arg-type]
+            return np.append(dy, frame[3] * self._motor_speed)
         return dy
 
-    def _constraint_values(self, t: float, q: NDArray[np.float64]):
+    def _constraint_values(self, t: float, q: NDArray[np.float64]
+                           ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Residual and Jacobian of the constraints (the driver's at time ``t``)."""
         angle = self.crank_angle(t) if self.driven else 0.0
         out = self._constraints(np.append(q, angle))
@@ -324,7 +332,7 @@ class Multibody(LinkageFormulation):
     def _velocity_rhs(self) -> NDArray[np.float64]:
         out = np.zeros(self.rows)
         if self.driven:
-            out[-1] = float(self.speed)  # type: ignore[arg-type]
+            out[-1] = self._motor_speed
         return out
 
     def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -344,7 +352,9 @@ class Multibody(LinkageFormulation):
         y[:n], y[n : 2 * n] = q, qd
         return y
 
-    def _constraint_values_many(self, times, q: NDArray[np.float64]):
+    def _constraint_values_many(self, times: Sequence[float] | NDArray[np.float64],
+                                q: NDArray[np.float64]
+                                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """:meth:`_constraint_values` at many states in one call.
 
         Residuals ``(k, rows)`` and Jacobians ``(k, rows, n)``.
@@ -356,7 +366,8 @@ class Multibody(LinkageFormulation):
         rows = self.rows
         return out[:rows].T, out[rows:].T.reshape(count, n, rows).transpose(0, 2, 1)
 
-    def project_many(self, times, states) -> list[NDArray[np.float64]]:
+    def project_many(self, times: Sequence[float] | NDArray[np.float64],
+                     states: Sequence[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
         """:meth:`project` at many states, the Newton steps of all of them taken together.
 
         The same steps, state by state, with the constraints of all the states evaluated in one
@@ -382,7 +393,8 @@ class Multibody(LinkageFormulation):
         qd -= least_norm_many(jacs, np.einsum("kri,ki->kr", jacs, qd) - self._velocity_rhs())
         return list(ys)
 
-    def constraint_residuals(self, times, states) -> tuple[float, float]:
+    def constraint_residuals(self, times: Sequence[float] | NDArray[np.float64],
+                             states: Sequence[NDArray[np.float64]]) -> tuple[float, float]:
         """:meth:`constraint_residual` at many states, the constraints in one call."""
         n = 3 * self.n
         ys = np.array(states, dtype=float).reshape(len(states), -1)
@@ -425,7 +437,7 @@ class Multibody(LinkageFormulation):
         return float(total)
 
     @staticmethod
-    def _point_velocity(pose: Pose, qd, k: int, at: V) -> V:
+    def _point_velocity(pose: Pose, qd: NDArray[np.float64], k: int, at: V) -> V:
         if k == GROUND_INDEX:
             return V(0.0, 0.0)
         arm = at - pose.origin(k)
@@ -434,7 +446,8 @@ class Multibody(LinkageFormulation):
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         return self.evaluate_batch([t], [y]).at(0)
 
-    def evaluate_batch(self, times, states) -> Evaluation:
+    def evaluate_batch(self, times: Sequence[float] | NDArray[np.float64],
+                       states: Sequence[NDArray[np.float64]]) -> Evaluation:
         """The compiled dynamics mapped over the states (one call)."""
         n = 3 * self.n
         count = len(times)
@@ -459,7 +472,10 @@ class Multibody(LinkageFormulation):
             slider_normal={name: normal[i] for i, name in enumerate(self._slider_names)},
             slider_couple={name: couple[i] for i, name in enumerate(self._slider_names)})
 
-    def energy(self, theta, omega, alpha, slider=None, states=None):
+    def energy(self, theta: NDArray[np.float64], omega: NDArray[np.float64],
+               alpha: NDArray[np.float64], slider: NDArray[np.float64] | None = None,
+               states: Sequence[NDArray[np.float64]] | None = None
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Kinetic energy and the work of loads, gravity and springs since the first state, J.
 
         From the states themselves (``states``), all at once: ``T = q̇ᵀ·M·q̇/2`` (compiled);
@@ -467,6 +483,7 @@ class Multibody(LinkageFormulation):
         displacements; the springs' from their potential energy.
         """
         import casadi as ca  # heavy: only where symbols are built
+        assert states is not None  # the simulation passes them
         n = 3 * self.n
         ys = np.array(states, dtype=float).reshape(len(states), -1)
         q, qd = ys[:, :n].T, ys[:, n : 2 * n].T  # (3n, count)

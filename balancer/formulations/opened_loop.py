@@ -21,13 +21,25 @@ from __future__ import annotations
 
 import cmath
 import math
+from collections.abc import Sequence
+from typing import Any, TypeAlias
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..kinematics import cross_scalar, motion_of, rates_scalar
+from ..linkage.vectors import Num
 from .base import Evaluation, least_norm_many
 from .closed_form import FourBarFormulation
+
+#: Three values of the links (complex numbers, or complex arrays over many states).
+Three: TypeAlias = tuple[Num, Num, Num]
+#: Eq. 22 and 27 at a state (or many): ``M``, ``C``, ``G``, ``Q``, ``b``, the principal vectors
+#: and the link vectors (:meth:`OpenedLoop.system`).
+System: TypeAlias = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                          NDArray[np.float64], NDArray[np.float64], tuple[Num, ...], Three]
+#: The accelerations, R̄A3, the motor torque, the principal and the link vectors at a state.
+Solution: TypeAlias = tuple[NDArray[np.floating], complex, float, tuple[Num, ...], Three]
 
 
 def _ip(x: complex, y: complex) -> float:
@@ -43,7 +55,7 @@ class OpenedLoop(FourBarFormulation):
     minimal = False
     passes_dead_points = True
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         (l1, l2, _, _), (c1, c2, c3) = self.lengths, self.links
         m1, m2, m3 = self.mass
@@ -57,7 +69,7 @@ class OpenedLoop(FourBarFormulation):
 
     # -- principal vectors -------------------------------------------------------------------
 
-    def principal_vectors(self, vectors: tuple[complex, complex, complex]):
+    def principal_vectors(self, vectors: Three) -> tuple[Num, Num, Num, Num, Num]:
         """``(ā12, ā21, ā23, ā32, ā'14)`` at link vectors ``l̄1, l̄2, l̄3`` (Eq. 12–13), m."""
         v1, v2, v3 = vectors
         m1, m2, m3 = self.mass
@@ -70,7 +82,7 @@ class OpenedLoop(FourBarFormulation):
         a14p = a12 - v1
         return a12, a21, a23, a32, a14p
 
-    def _terms(self, vectors):
+    def _terms(self, vectors: Three) -> tuple[Three, Three, Three, tuple[Num, ...]]:
         """The entries of Eq. 22–25 that depend on the pose, from the link vectors.
 
         ``vectors`` are ``l̄1, l̄2, l̄3`` as complex numbers or complex arrays (many states);
@@ -96,7 +108,7 @@ class OpenedLoop(FourBarFormulation):
         )  # Eq. 25
         return inertia, convective, forces, pv
 
-    def system(self, theta: NDArray[np.float64], omega: NDArray[np.float64]):
+    def system(self, theta: NDArray[np.float64], omega: NDArray[np.float64]) -> System:
         """Matrices of Eq. 22 and 27 at a state.
 
         Returns ``(M, C, G, Q, b, pv, vectors)``: mass matrix, convective coefficients, the
@@ -105,8 +117,9 @@ class OpenedLoop(FourBarFormulation):
         principal vectors and the link vectors.
         """
         l1, l2, l3, _ = self.lengths
-        vectors = tuple(length * cmath.exp(1j * th) for length, th in zip(
+        v1, v2, v3 = (length * cmath.exp(1j * th) for length, th in zip(
             (l1, l2, l3), theta, strict=True))
+        vectors = (v1, v2, v3)
         (m12, m13, m23), (c12, c13, c23), q, pv = self._terms(vectors)
         big_m = np.array(
             [
@@ -120,14 +133,15 @@ class OpenedLoop(FourBarFormulation):
         rhs = sum(v * w * w for v, w in zip(vectors, omega, strict=True))
         return big_m, big_c, g, np.array(q), np.array([rhs.real, rhs.imag]), pv, vectors
 
-    def _system_batch(self, theta: NDArray[np.float64], omega: NDArray[np.float64]):
+    def _system_batch(self, theta: NDArray[np.float64], omega: NDArray[np.float64]) -> System:
         """:meth:`system` at many states, ``theta`` and ``omega`` of shape ``(3, N)``.
 
         ``M``, ``C`` and ``G`` come as ``(N, 3, 3)``, ``(N, 3, 3)``, ``(N, 2, 3)``, ``Q`` and
         ``b`` as ``(N, 3)``, ``(N, 2)``; the principal and link vectors as complex arrays.
         """
-        vectors = tuple(length * np.exp(1j * th) for length, th in zip(
+        v1, v2, v3 = (length * np.exp(1j * th) for length, th in zip(
             self.lengths[:3], theta, strict=True))
+        vectors = (v1, v2, v3)
         (m12, m13, m23), (c12, c13, c23), q, pv = self._terms(vectors)
         count = theta.shape[1]
         big_m = np.empty((count, 3, 3))
@@ -146,7 +160,7 @@ class OpenedLoop(FourBarFormulation):
 
     # -- the formulation ---------------------------------------------------------------------
 
-    def solve(self, t: float, y: NDArray[np.float64]):
+    def solve(self, t: float, y: NDArray[np.float64]) -> Solution:
         """Accelerations, R̄A3 and the motor torque at a state: the five equations of Eq. 22, 27.
 
         Near a change point the five equations are singular (the loop-closure Jacobian loses
@@ -161,7 +175,10 @@ class OpenedLoop(FourBarFormulation):
         alpha, ra3, tau = self._kkt(big_m, big_c, g, q, b, omega)
         return alpha, complex(ra3), float(tau), pv, vectors
 
-    def _kkt(self, big_m, big_c, g, q, b, omega):
+    def _kkt(self, big_m: NDArray[np.float64], big_c: NDArray[np.float64],
+             g: NDArray[np.float64], q: NDArray[np.float64], b: NDArray[np.float64],
+             omega: NDArray[np.float64]
+             ) -> tuple[NDArray[np.floating], NDArray[np.complexfloating], NDArray[np.floating]]:
         """Eq. 22 and 27 solved: ``θ̈`` (…, 3), ``R̄A3`` and the motor torque (…).
 
         For one state (``M`` of shape ``(3, 3)``, ``omega`` ``(3,)``) or many (``(N, 3, 3)``,
@@ -190,7 +207,7 @@ class OpenedLoop(FourBarFormulation):
         alpha[..., 1:3] = z[..., 0:2]
         return alpha, z[..., 2] + 1j * z[..., 3], z[..., 4]
 
-    def _solve_reduced(self, theta1: float, omega1: float):
+    def _solve_reduced(self, theta1: float, omega1: float) -> Solution:
         """The single equation in θ1 with ``θ̈k = Θk·θ̈1 + bk`` (Eq. 7, 9–10).
 
         Then R̄A3 from Eq. 22 by least squares.
@@ -215,7 +232,7 @@ class OpenedLoop(FourBarFormulation):
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         self.theta1_start = float(theta1)
         if self.driven:
-            omega1 = float(self.speed)  # type: ignore[arg-type]
+            omega1 = self._motor_speed
         mo = motion_of(self.linkage, theta1, omega1, 0.0)
         y = [mo.theta[0][0], mo.theta[1][0], mo.theta[2][0]]
         y += [mo.omega[0][0], mo.omega[1][0], mo.omega[2][0]]
@@ -239,7 +256,8 @@ class OpenedLoop(FourBarFormulation):
             return np.zeros(theta1.shape, bool)
         return np.array([self.near_change_point(float(x)) for x in theta1], bool)
 
-    def evaluate_batch(self, times, states) -> Evaluation:
+    def evaluate_batch(self, times: Sequence[float] | NDArray[np.float64],
+                       states: Sequence[NDArray[np.float64]]) -> Evaluation:
         """:meth:`evaluate` at every state at once.
 
         Eq. 22 and 27 (the reduced equation near a change point); R̄A0 from the motion of the
@@ -280,7 +298,7 @@ class OpenedLoop(FourBarFormulation):
 
     # -- constraints -------------------------------------------------------------------------
 
-    def _closure(self, theta) -> tuple:
+    def _closure(self, theta: ArrayLike) -> tuple[Num, NDArray[np.float64]]:
         """Loop closure ``Σ l̄k − l4`` (Eq. 26) and its Jacobian ``G`` at angles ``(…, 3)``.
 
         Complex residuals ``(…)`` and Jacobians ``(…, 2, 3)``.
@@ -296,7 +314,8 @@ class OpenedLoop(FourBarFormulation):
     def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         return self.project_many([t], [y])[0]
 
-    def project_many(self, times, states) -> list[NDArray[np.float64]]:
+    def project_many(self, times: Sequence[float] | NDArray[np.float64],
+                     states: Sequence[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
         """Least-norm Gauss–Newton corrections onto the loop closure, at every state at once.
 
         The closure is Eq. 26, its rate Eq. 5. With the crank driven, θ1 and θ̇1 are
@@ -304,11 +323,11 @@ class OpenedLoop(FourBarFormulation):
         is put on the smooth motion's assembly.
         """
         ys = np.array(states, dtype=float).reshape(len(states), -1)
-        times = np.asarray(times, dtype=float)
+        at = np.asarray(times, dtype=float)
         free = np.arange(3) if not self.driven else np.arange(1, 3)
         if self.driven:
-            ys[:, 0] = self.crank_angle(times)
-            ys[:, 3] = float(self.speed)  # type: ignore[arg-type]
+            ys[:, 0] = self.crank_angle(at)
+            ys[:, 3] = self._motor_speed
         near = self._near(ys[:, 0])
         for i in np.flatnonzero(near):
             self._onto_smooth_motion(ys[i])

@@ -8,12 +8,12 @@ residuals and Jacobians at a :class:`Pose`, and an Assur group (:class:`Group`) 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .vectors import V
+from .vectors import Num, OpsLike, V
 
 #: Index of the ground among the links.
 GROUND_INDEX = -1
@@ -108,15 +108,13 @@ class Pose:
     is the spec's.
     """
 
-    def __init__(self, origins: list[V], angles: list, cos: list | None = None,
-                 sin: list | None = None, ops=None) -> None:
+    def __init__(self, origins: list[V], angles: list[Num], cos: list[Num] | None = None,
+                 sin: list[Num] | None = None, ops: OpsLike | None = None) -> None:
         self.origins = origins
         self.angles = angles
-        if cos is None:
-            cos = [(np if ops is None else ops).cos(t) for t in angles]
-            sin = [(np if ops is None else ops).sin(t) for t in angles]
-        self.cos = cos
-        self.sin = sin
+        functions = np if ops is None else ops
+        self.cos: list[Num] = [functions.cos(t) for t in angles] if cos is None else cos
+        self.sin: list[Num] = [functions.sin(t) for t in angles] if sin is None else sin
 
     def origin(self, k: int) -> V:
         return V(0.0, 0.0) if k == GROUND_INDEX else self.origins[k]
@@ -138,7 +136,7 @@ def pose_of(q: NDArray[np.float64]) -> Pose:
     return Pose([V(q[3 * k], q[3 * k + 1]) for k in range(n)], [q[3 * k + 2] for k in range(n)])
 
 
-def constraint_residual(c: Constraint, pose: Pose, angle: Any = 0.0) -> list:
+def constraint_residual(c: Constraint, pose: Pose, angle: Num = 0.0) -> list[Num]:
     """The residual of one constraint at a pose: ``c.rows`` values (m or rad).
 
     ``angle`` is the crank angle a driver prescribes.
@@ -154,7 +152,12 @@ def constraint_residual(c: Constraint, pose: Pose, angle: Any = 0.0) -> list:
     return [pose.angles[c.link] - angle]
 
 
-def constraint_jacobian(c: Constraint, pose: Pose):
+#: A constraint's Jacobian by link: ``(link, rows)``, each row three coefficients (for ``x``,
+#: ``y``, ``θ``).
+Blocks: TypeAlias = list[tuple[int, list[list[Num]]]]
+
+
+def constraint_jacobian(c: Constraint, pose: Pose) -> Blocks:
     """The Jacobian of one constraint at a pose.
 
     ``(link, rows)`` pairs: per link, ``c.rows`` rows of three coefficients (for ``x``, ``y``,
@@ -174,7 +177,8 @@ def constraint_jacobian(c: Constraint, pose: Pose):
     return [(c.link, [[0.0, 0.0, 1.0]]), (GROUND_INDEX, [[0.0, 0.0, -1.0]])]
 
 
-def group_jacobian(g: Group, pose: Pose):
+def group_jacobian(g: Group, pose: Pose
+                   ) -> tuple[list[list[Num]], list[list[tuple[int, list[Num]]]]]:
     """The Jacobian of a group's constraints at a pose, split by links.
 
     Returns ``(rows, known)``: ``Φ_S``, the k×k block in the group's own links' coordinates
@@ -183,12 +187,12 @@ def group_jacobian(g: Group, pose: Pose):
     """
     index = {link: i for i, link in enumerate(g.links)}
     k = 3 * len(g.links)
-    rows: list[list] = []
-    known: list[list[tuple[int, list]]] = []
+    rows: list[list[Num]] = []
+    known: list[list[tuple[int, list[Num]]]] = []
     for c in g.constraints:
         blocks = constraint_jacobian(c, pose)
         for r in range(c.rows):
-            row = [0.0] * k
+            row: list[Num] = [0.0] * k
             row_known = []
             for link, coeffs in blocks:
                 if link in index:

@@ -8,12 +8,21 @@ solutions, is read off the reference pose (:func:`dyad_branch`) and followed fro
 from __future__ import annotations
 
 import math
+from typing import TypeAlias, overload
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .constraints import GROUND_INDEX, Group, Pin, Pose
-from .vectors import NUMPY, Ops, V
+from .constraints import GROUND_INDEX, Group, Pin, Pose, Prism
+from .vectors import NUMPY, Num, OpsLike, V
+
+#: A link's frame: its angle (rad), and its cosine and sine (``None``: from the angle).
+Frame: TypeAlias = tuple[Num, Num | None, Num | None]
+#: How a dyad places one of its links: its frame, a point to place it by (global), and that
+#: point's local position in the link (``None``: the point is the link's origin).
+Placement: TypeAlias = tuple[Frame, V, V | None]
+#: A dyad's two links placed, and its gap (≥ 0 where it assembles).
+Solution: TypeAlias = tuple[Placement, Placement, Num]
 
 
 def known_point(pose: Pose, c: Pin, k: int) -> tuple[V, V]:
@@ -27,12 +36,12 @@ def _local(c: Pin, k: int) -> V:
     return c.pa if c.a == k else c.pb
 
 
-def _angle_of(ops: Ops, w: V, local: V):
+def _angle_of(ops: OpsLike, w: V, local: V) -> Num:
     """The angle of a link whose local vector ``local`` lies along global ``w``."""
     return ops.atan2(w.y, w.x) - math.atan2(local.y, local.x)
 
 
-def _frame_of(ops: Ops, w: V, local: V) -> tuple:
+def _frame_of(ops: OpsLike, w: V, local: V) -> Frame:
     """Angle, cosine and sine of a link that turns ``local`` into global ``w`` (``|w| = |local|``).
 
     ``w = R(θ)·local`` gives ``cos θ = w·local/|local|²`` and ``sin θ = (local × w)/|local|²``:
@@ -52,9 +61,17 @@ class Dyads:
     the branch at the given (reference) pose instead.
     """
 
+    @overload
     @staticmethod
-    def rrr(ops: Ops, pose: Pose, g: Group, sign=None):
+    def rrr(ops: OpsLike, pose: Pose, g: Group, sign: None = None) -> float: ...
+    @overload
+    @staticmethod
+    def rrr(ops: OpsLike, pose: Pose, g: Group, sign: Num) -> Solution: ...
+
+    @staticmethod
+    def rrr(ops: OpsLike, pose: Pose, g: Group, sign: Num | None = None) -> float | Solution:
         (a, b), (j1, j2, j3) = g.links, g.constraints
+        assert isinstance(j1, Pin) and isinstance(j2, Pin) and isinstance(j3, Pin)  # RRR
         p1, pa1 = known_point(pose, j1, a)
         p3, pb3 = known_point(pose, j3, b)
         pa2, pb2 = _local(j2, a), _local(j2, b)
@@ -75,9 +92,10 @@ class Dyads:
         return (frame_a, p1, pa1), (frame_b, p3, pb3), gap / ra2
 
     @staticmethod
-    def _rrp_line(ops: Ops, pose: Pose, g: Group):
-        """The line ``Q + t·d̄`` that ``P2`` runs on, and ``b``'s angle."""
+    def _rrp_line(ops: OpsLike, pose: Pose, g: Group) -> tuple[V, V, Num, Num, Num]:
+        """The line ``Q + t·d̄`` that ``P2`` runs on, and ``b``'s angle, cosine and sine."""
         b, (_, j2, j3) = g.links[1], g.constraints
+        assert isinstance(j2, Pin) and isinstance(j3, Prism)  # RRP
         other = j3.g if j3.s == b else j3.s
         theta_k = 0.0 if other == GROUND_INDEX else pose.angles[other]
         theta_b = theta_k + j3.delta if j3.s == b else theta_k - j3.delta
@@ -91,9 +109,18 @@ class Dyads:
             q = pose.point(other, j3.ps) + (pb2 - j3.pg).rotated(cb, sb)
         return q, d, theta_b, cb, sb
 
+    @overload
     @classmethod
-    def rrp(cls, ops: Ops, pose: Pose, g: Group, sign=None):
+    def rrp(cls, ops: OpsLike, pose: Pose, g: Group, sign: None = None) -> float: ...
+    @overload
+    @classmethod
+    def rrp(cls, ops: OpsLike, pose: Pose, g: Group, sign: Num) -> Solution: ...
+
+    @classmethod
+    def rrp(cls, ops: OpsLike, pose: Pose, g: Group, sign: Num | None = None
+            ) -> float | Solution:
         (a, b), (j1, j2, _) = g.links, g.constraints
+        assert isinstance(j1, Pin) and isinstance(j2, Pin)  # RRP
         p1, pa1 = known_point(pose, j1, a)
         pa2, pb2 = _local(j2, a), _local(j2, b)
         ra2 = (pa2 - pa1).norm2()
@@ -111,9 +138,17 @@ class Dyads:
         origin_b = p2 - pb2.rotated(cb, sb)
         return (frame_a, p1, pa1), ((theta_b, cb, sb), origin_b, None), gap / ra2
 
+    @overload
     @staticmethod
-    def rpr(ops: Ops, pose: Pose, g: Group, sign=None):
+    def rpr(ops: OpsLike, pose: Pose, g: Group, sign: None = None) -> float: ...
+    @overload
+    @staticmethod
+    def rpr(ops: OpsLike, pose: Pose, g: Group, sign: Num) -> Solution: ...
+
+    @staticmethod
+    def rpr(ops: OpsLike, pose: Pose, g: Group, sign: Num | None = None) -> float | Solution:
         (a, b), (j1, j2, j3) = g.links, g.constraints
+        assert isinstance(j1, Pin) and isinstance(j2, Prism) and isinstance(j3, Pin)  # RPR
         pivots = {a: known_point(pose, j1, a), b: known_point(pose, j3, b)}
         s_link, g_link = j2.s, j2.g
         p_s, ps_piv = pivots[s_link]
@@ -132,7 +167,8 @@ class Dyads:
         phi = ops.atan2(dp.y, dp.x) - ops.atan2(sin_b, cos_b)
         theta_g = phi - math.atan2(j2.dg.y, j2.dg.x)
         theta_s = theta_g + j2.delta
-        frames = {g_link: (theta_g, None, None), s_link: (theta_s, None, None)}
+        frames: dict[int, Frame] = {g_link: (theta_g, None, None),
+                                    s_link: (theta_s, None, None)}
         return ((frames[a], pivots[a][0], pivots[a][1]), (frames[b], pivots[b][0],
                                                           pivots[b][1]), gap)
 

@@ -26,17 +26,18 @@ per inertial parameter (and one for the constant part) for the regressors.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Literal, TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..model import GROUND
-from .constraints import GROUND_INDEX, Driver, Pin, Prism, constraint_jacobian
+from ..model import GROUND, Linkage
+from .constraints import GROUND_INDEX, Blocks, Constraint, Driver, Pin, Prism, constraint_jacobian
 from .kinematics import Motion
 from .structure import Structure
-from .vectors import NUMPY, Ops, V, _plus, _times
+from .vectors import NUMPY, Num, OpsLike, V, _plus, _times
 
 #: Parameters of a link in the design vector, in order: kg, kg·m, kg·m, kg·m² (about the frame's
 #: origin).
@@ -82,7 +83,7 @@ class Layout:
         except ValueError:
             return None
 
-    def vector(self, linkage) -> NDArray[np.float64]:
+    def vector(self, linkage: Linkage) -> NDArray[np.float64]:
         """The design vector of a model's links (its mass properties)."""
         x = np.zeros(self.size)
         for name, link in zip(linkage.link_names, linkage.links, strict=True):
@@ -99,7 +100,8 @@ class Layout:
 class Forces:
     """Inverse dynamics at arrays of crank states, for ``C`` columns (designs or parameters).
 
-    Every array has shape ``(N, C)``.
+    Every array has shape ``(N, C)`` (a scalar CasADi symbol each in the program of
+    :mod:`.program`).
 
     Attributes
     ----------
@@ -120,13 +122,13 @@ class Forces:
     """
 
     reactions: dict[str, V]
-    slider_normal: dict[str, NDArray[np.float64]]
-    slider_couple: dict[str, NDArray[np.float64]]
-    driving_torque: NDArray[np.float64]
+    slider_normal: dict[str, Num]
+    slider_couple: dict[str, Num]
+    driving_torque: Num
     shaking_force: V
-    shaking_moment: NDArray[np.float64]
+    shaking_moment: Num
 
-    def arrays(self) -> list:
+    def arrays(self) -> list[Num]:
         """Every figure in one fixed order (what :meth:`with_arrays` reads back).
 
         Driving torque, shaking force ``x`` and ``y``, shaking moment; each ground point's
@@ -141,7 +143,7 @@ class Forces:
             out += [self.slider_normal[k], self.slider_couple[k]]
         return out
 
-    def with_arrays(self, values: list) -> Forces:
+    def with_arrays(self, values: Sequence[Num]) -> Forces:
         """Forces with the same names holding ``values`` in :meth:`arrays`' order."""
         points, sliders = sorted(self.reactions), sorted(self.slider_normal)
         at = 4 + 2 * len(points)
@@ -153,7 +155,7 @@ class Forces:
             shaking_moment=values[3])
 
 
-def _col(x, n: int, c: int) -> NDArray[np.float64]:
+def _col(x: Num, n: int, c: int) -> NDArray[np.float64]:
     """``x`` (a scalar, ``(N,)`` or ``(N, C)``) as an ``(N, C)`` array."""
     a = np.asarray(x, dtype=float)
     if a.ndim == 1:
@@ -161,20 +163,25 @@ def _col(x, n: int, c: int) -> NDArray[np.float64]:
     return np.broadcast_to(a, (n, c))
 
 
-def inertial_columns(structure: Structure, mo: Motion, gravity: V):
+#: A link's generalized force: force ``x``, ``y`` and moment about its frame's origin.
+Generalized: TypeAlias = tuple[Num, Num, Num]
+
+
+def inertial_columns(structure: Structure, mo: Motion, gravity: V
+                     ) -> dict[str, list[tuple[str, Generalized]]]:
     """``−(I_k − gravity_k)`` per unit inertial parameter: the regressors' ``E_k`` columns.
 
     Returns ``{link: [(param, (Ex, Ey, Eθ))]}`` with each component an ``(N,)`` array; params
     ``m``, ``me``, ``mf``, ``J`` and, for a grounded link, ``Jc``.
     """
-    out = {}
+    out: dict[str, list[tuple[str, Generalized]]] = {}
     grounded = set(structure.linkage.grounded_links)
     for k, name in enumerate(structure.names):
         c, s = mo.pose.cos[k], mo.pose.sin[k]
         w, a = mo.rate[k], mo.accel[k]
         acc = mo.acceleration[k] - gravity  # r̈ − ḡ
         ex, ey = V(c, s), V(-s, c)  # the frame's axes
-        cols = [("m", (-acc.x, -acc.y, 0.0 * w))]
+        cols: list[tuple[str, Generalized]] = [("m", (-acc.x, -acc.y, 0.0 * w))]
         for p, axis in (("me", ex), ("mf", ey)):
             lin = axis.perp() * a - axis * (w * w)  # (α·J − ω²)·R·ê
             cols.append((p, (-lin.x, -lin.y, -axis.cross(acc))))
@@ -186,7 +193,8 @@ def inertial_columns(structure: Structure, mo: Motion, gravity: V):
 
 
 def applied_column(structure: Structure, mo: Motion, gravity: V, loads: bool = True,
-                   ops: Ops = NUMPY, gas: list | None = None):
+                   ops: OpsLike = NUMPY, gas: list[Num] | None = None
+                   ) -> tuple[list[tuple[Num, ...]], tuple[Num, ...]]:
     """The part of ``E`` that is not linear in the inertial parameters, and its share on the ground.
 
     Applied forces at the centres of mass and moments, springs, slider forces.
@@ -195,6 +203,9 @@ def applied_column(structure: Structure, mo: Motion, gravity: V, loads: bool = T
     (arrays ``(N,)``; ``Mz`` about the origin). On symbols (``ops`` CasADi's), ``gas`` gives
     each prismatic pair's slider force along its guide (N), instead of its table.
     """
+    zero: Num
+    per: list[list[Num]]
+    ground: list[Num]
     if ops is NUMPY:
         zero = np.zeros(mo.theta1.size)
         per = [[zero.copy(), zero.copy(), zero.copy()] for _ in structure.names]
@@ -253,8 +264,9 @@ def _carrier(structure: Structure, point: str) -> tuple[V, int]:
     return structure.local[(k, point)], k
 
 
-def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor_moment=None,
-                  ground_extra=None, ops: Ops = NUMPY) -> Forces:
+def kinetostatics(structure: Structure, mo: Motion, effective: list[list[Num]],
+                  rotor_moment: Num | None = None,
+                  ground_extra: tuple[Num, ...] | None = None, ops: OpsLike = NUMPY) -> Forces:
     """Solve the groups in reverse order for given ``E`` columns (see the module docstring).
 
     Parameters
@@ -277,18 +289,18 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor
     if numeric:
         n, c_count = effective[0][0].shape if effective else (mo.theta1.size, 1)
         applied = [[np.array(e, dtype=float, copy=True) for e in row] for row in effective]
-        zero: Any = np.zeros((n, c_count))
+        zero: Num = np.zeros((n, c_count))
     else:
         applied = [list(row) for row in effective]
         zero = 0.0
-    lam: dict[int, list] = {}
-    ground_of: dict[int, list] = {}
+    lam: dict[int, list[Num]] = {}
+    ground_of: dict[int, list[Num]] = {}
     for g in reversed(structure.groups):
         index = {link: i for i, link in enumerate(g.links)}
         k = 3 * len(g.links)
-        mat: list[list] = [[0.0] * k for _ in range(k)]  # Φ_SSᵀ, entries floats or (N,)
+        mat: list[list[Num]] = [[0.0] * k for _ in range(k)]  # Φ_SSᵀ, entries floats or (N,)
         rhs = [[applied[link][j]] for link in g.links for j in range(3)]
-        blocks_of = []
+        blocks_of: list[tuple[Constraint, int, Blocks]] = []
         row = 0
         for c in g.constraints:
             blocks = constraint_jacobian(c, mo.pose)
@@ -319,16 +331,17 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list], rotor
     return _collect(structure, constraints, lam, ground_of, zero, rotor_moment, ground_extra)
 
 
-def _sum(terms) -> Any:
+def _sum(terms: Iterable[Num]) -> Num:
     """The sum of ``terms``, structural zeros (the float 0.0) skipped."""
-    total: Any = 0.0
+    total: Num = 0.0
     for t in terms:
         total = _plus(total, t)
     return total
 
 
-def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list],
-                         rotor_moment=None, ground_extra=None) -> Forces:
+def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list[Num]],
+                         rotor_moment: Num | None = None,
+                         ground_extra: tuple[Num, ...] | None = None) -> Forces:
     """The same forces from all the links' equations at once: ``Φ_qᵀ·λ = E``.
 
     One ``3n × 3n`` solve per crank state over every constraint and the driver (the pairs of
@@ -337,14 +350,14 @@ def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list]
     """
     n, c_count = effective[0][0].shape
     size = 3 * structure.size
-    constraints = [*structure.constraints, structure.driver]
+    constraints: list[Constraint] = [*structure.constraints, structure.driver]
     mat = np.zeros((n, size, size))
     rhs = np.zeros((n, size, c_count))
     for k in range(structure.size):
         for j in range(3):
             rhs[:, 3 * k + j, :] = effective[k][j]
     row = 0
-    blocks_of = []
+    blocks_of: list[tuple[Constraint, int, Blocks]] = []
     for c in constraints:
         blocks = constraint_jacobian(c, mo.pose)
         blocks_of.append((c, row, blocks))
@@ -363,7 +376,8 @@ def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list]
             ok = np.abs(np.linalg.det(mat)) > 0
             if ok.any():
                 sol[ok] = np.linalg.solve(mat[ok], rhs[ok])
-    lam, ground_of = {}, {}
+    lam: dict[int, list[Num]] = {}
+    ground_of: dict[int, list[Num]] = {}
     for c, row, blocks in blocks_of:
         values = [sol[:, row + r, :] for r in range(c.rows)]
         lam[id(c)] = values
@@ -375,20 +389,21 @@ def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list]
                     rotor_moment, ground_extra)
 
 
-def _collect(structure: Structure, constraints, lam, ground_of, zero, rotor_moment,
-             ground_extra) -> Forces:
+def _collect(structure: Structure, constraints: Sequence[Constraint],
+             lam: dict[int, list[Num]], ground_of: dict[int, list[Num]], zero: Num,
+             rotor_moment: Num | None, ground_extra: tuple[Num, ...] | None) -> Forces:
     """The forces on the ground from the constraints' multipliers.
 
     ``zero`` fills what no constraint puts there: an ``(N, C)`` array, or the float 0.0 on
     symbols.
     """
     reactions: dict[str, V] = {}
-    fx: Any = zero
-    fy: Any = zero
-    mz: Any = zero
-    driving: Any = zero
-    normal: dict[str, Any] = {}
-    couple: dict[str, Any] = {}
+    fx: Num = zero
+    fy: Num = zero
+    mz: Num = zero
+    driving: Num = zero
+    normal: dict[str, Num] = {}
+    couple: dict[str, Num] = {}
     for c in constraints:
         if isinstance(c, Driver):
             driving = -lam[id(c)][0]  # τ = −λ_driver
@@ -414,7 +429,8 @@ def _collect(structure: Structure, constraints, lam, ground_of, zero, rotor_mome
                   driving_torque=driving, shaking_force=V(fx, fy), shaking_moment=mz)
 
 
-def regressors(structure: Structure, mo: Motion, gravity=(0.0, 0.0)) -> tuple[Forces, Layout]:
+def regressors(structure: Structure, mo: Motion, gravity: tuple[float, float] = (0.0, 0.0)
+               ) -> tuple[Forces, Layout]:
     """Every result of :func:`inverse_dynamics` as a linear map of the design vector.
 
     Columns follow :class:`Layout`; applied loads, springs and slider forces are left out (the
@@ -437,9 +453,10 @@ def regressors(structure: Structure, mo: Motion, gravity=(0.0, 0.0)) -> tuple[Fo
     return kinetostatics(structure, mo, effective, rotor_moment=rotor), layout
 
 
-def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.0, 0.0),
-                     loads: bool = True, route: str = "groups", ops: Ops = NUMPY,
-                     gas: list | None = None) -> Forces:
+def inverse_dynamics(structure: Structure, mo: Motion, linkage: Linkage | None = None,
+                     gravity: tuple[float, float] = (0.0, 0.0), loads: bool = True,
+                     route: Literal["groups", "global"] = "groups", ops: OpsLike = NUMPY,
+                     gas: list[Num] | None = None) -> Forces:
     """Joint forces on the ground, driving torque and shaking sums of a design (one column).
 
     Parameters
@@ -468,13 +485,13 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.
     per, ground = applied_column(structure_now, mo, g, loads, ops, gas)
     numeric = ops is NUMPY
 
-    def column(v):
+    def column(v: Num) -> Num:
         return v[:, None] if numeric else v
 
     # E_k = applied − (I_k − gravity_k) of the design: inertial_columns summed with the
     # design's parameters, in closed form (S̄ = R·(m·s̄), the first moment about the origin).
-    effective = []
-    rotor: Any = np.zeros(n) if numeric else 0.0
+    effective: list[list[Num]] = []
+    rotor: Num = np.zeros(n) if numeric else 0.0
     for k, name in enumerate(structure.names):
         m, me, mf, j_origin = x[layout.link_slice(name)]
         r = layout.rotor(name)
@@ -498,7 +515,7 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage=None, gravity=(0.
     return solver(structure, mo, effective, rotor_moment=rotor, ground_extra=extra)
 
 
-def _with(structure: Structure, linkage) -> Structure:
+def _with(structure: Structure, linkage: Linkage) -> Structure:
     from dataclasses import replace
 
     return replace(structure, linkage=linkage)

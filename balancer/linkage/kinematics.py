@@ -32,13 +32,23 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import numeric
-from .constraints import GROUND_INDEX, Driver, Group, Pin, Pose, Prism, group_jacobian
-from .dyads import Dyads, known_point
+from .constraints import (
+    GROUND_INDEX,
+    Constraint,
+    Driver,
+    Group,
+    Pin,
+    Pose,
+    Prism,
+    group_jacobian,
+)
+from .dyads import Dyads, Frame, known_point
 from .structure import Structure
-from .vectors import NUMPY, Ops, V
+from .vectors import NUMPY, Num, OpsLike, V
 
 
-def _place(pose: Pose, k: int, frame, origin_or_pivot: V, local: V | None, ops: Ops) -> None:
+def _place(pose: Pose, k: int, frame: Frame | Num, origin_or_pivot: V, local: V | None,
+           ops: OpsLike) -> None:
     """Set link ``k``'s frame from its angle and a point to place it by.
 
     ``frame`` is the angle or ``(angle, cos, sin)`` (``None`` cosine and sine computed from the
@@ -55,9 +65,9 @@ def _place(pose: Pose, k: int, frame, origin_or_pivot: V, local: V | None, ops: 
         pose.origins[k] = origin_or_pivot - local.rotated(c, s)
 
 
-def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
-              gaps: list | None = None, guesses: dict | None = None,
-              residuals: list | None = None, steps: list | None = None) -> Pose:
+def positions(structure: Structure, theta1: Num, ops: OpsLike = NUMPY,
+              gaps: list[Num] | None = None, guesses: dict[int, list[Num]] | None = None,
+              residuals: list[Num] | None = None, steps: list[Num] | None = None) -> Pose:
     """Every link's frame at crank angles ``theta1`` (rad), on the reference pose's branch.
 
     Parameters
@@ -92,6 +102,7 @@ def positions(structure: Structure, theta1: ArrayLike, ops: Ops = NUMPY,
     for index, g in enumerate(structure.groups):
         if g.kind == "crank":
             pin = g.constraints[0]
+            assert isinstance(pin, Pin)  # the crank's pivot
             pivot, local = known_point(pose, pin, g.links[0])
             _place(pose, g.links[0], theta1, pivot, local, ops)
             continue
@@ -135,7 +146,8 @@ class Motion:
     Attributes
     ----------
     theta1, omega1, alpha1
-        The input's angle (rad), rate (rad/s) and acceleration (rad/s²), shape ``(N,)``.
+        The input's angle (rad), rate (rad/s) and acceleration (rad/s²), shape ``(N,)`` (or
+        CasADi symbols, in the program of :mod:`.program`).
     pose
         Origins (m) and angles (rad) of the links' frames.
     velocity, rate
@@ -146,14 +158,14 @@ class Motion:
         The motion as a mechanism's closed form computed it (the four-bar's), or ``None``.
     """
 
-    theta1: NDArray[np.float64]
-    omega1: NDArray[np.float64]
-    alpha1: NDArray[np.float64]
+    theta1: Num
+    omega1: Num
+    alpha1: Num
     pose: Pose
     velocity: tuple[V, ...]
-    rate: tuple[NDArray[np.float64], ...]
+    rate: tuple[Num, ...]
     acceleration: tuple[V, ...]
-    accel: tuple[NDArray[np.float64], ...]
+    accel: tuple[Num, ...]
     #: The same motion in a mechanism's own closed form, when it made it (reused by its routes).
     closed_form: Any = field(default=None, repr=False, compare=False)
 
@@ -175,12 +187,13 @@ class Motion:
         return self.acceleration[k] + r.perp() * self.accel[k] - r * (self.rate[k] ** 2)
 
 
-def _gamma(c, pose: Pose, vel: list[V], rate: list, ops: Ops = NUMPY) -> list:
+def _gamma(c: Constraint, pose: Pose, vel: list[V], rate: list[Num],
+           ops: OpsLike = NUMPY) -> list[Num]:
     """``γ`` of one constraint (``Φ_q·q̈ = γ``): the velocity terms of its second derivative."""
-    def w(k):
+    def w(k: int) -> Num:
         return 0.0 if k == GROUND_INDEX else rate[k]
 
-    def v(k):
+    def v(k: int) -> V:
         return V(0.0, 0.0) if k == GROUND_INDEX else vel[k]
 
     if isinstance(c, Pin):
@@ -199,8 +212,9 @@ def _gamma(c, pose: Pose, vel: list[V], rate: list, ops: Ops = NUMPY) -> list:
     return [0.0]
 
 
-def rates(structure: Structure, pose: Pose, omega1, alpha1, theta1=None,
-          ops: Ops = NUMPY) -> tuple[list[V], list, list[V], list]:
+def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
+          theta1: Num | None = None, ops: OpsLike = NUMPY
+          ) -> tuple[list[V], list[Num], list[V], list[Num]]:
     """Velocities and accelerations of every link's frame (see the module docstring).
 
     Returns ``(velocity, rate, acceleration, accel)``, each a list over the links.
@@ -208,15 +222,15 @@ def rates(structure: Structure, pose: Pose, omega1, alpha1, theta1=None,
     n = structure.size
     zero = 0.0 * (pose.angles[structure.input] if theta1 is None else theta1)
     vel: list[V] = [V(zero, zero)] * n
-    rate: list = [zero] * n
+    rate: list[Num] = [zero] * n
     acc: list[V] = [V(zero, zero)] * n
-    accel: list = [zero] * n
+    accel: list[Num] = [zero] * n
     for g in structure.groups:
         rows, known = group_jacobian(g, pose)
         drivers = [isinstance(c, Driver) for c in g.constraints for _ in range(c.rows)]
         rhs_v = []
         for r, row_known in enumerate(known):
-            v_term = 0.0
+            v_term: Num = 0.0
             for link, coeffs in row_known:
                 v_term = v_term + coeffs[0] * vel[link].x + coeffs[1] * vel[link].y \
                     + coeffs[2] * rate[link]
@@ -232,7 +246,7 @@ def rates(structure: Structure, pose: Pose, omega1, alpha1, theta1=None,
                                                      if not isinstance(c, Driver) else [0.0])]
         rhs_a = []
         for r, row_known in enumerate(known):
-            a_term = 0.0
+            a_term: Num = 0.0
             for link, coeffs in row_known:
                 a_term = a_term + coeffs[0] * acc[link].x + coeffs[1] * acc[link].y \
                     + coeffs[2] * accel[link]

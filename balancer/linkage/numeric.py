@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from .constraints import Group, Pose, Prism, constraint_residual, group_jacobian
 from .structure import Structure
-from .vectors import NUMPY, Factor, V
+from .vectors import NUMPY, Factor, Num, OpsLike, V
 
 #: How the links found before a group are placed at crank angles: the general kinematics'
 #: positions (:func:`balancer.linkage.kinematics.positions`), which solves the groups in order
@@ -40,7 +40,7 @@ NEWTON_TOLERANCE = 1e-13
 FEW_ANGLES = 128
 
 
-def _residual(g: Group, pose: Pose) -> list:
+def _residual(g: Group, pose: Pose) -> list[Num]:
     return [r for c in g.constraints for r in constraint_residual(c, pose)]
 
 
@@ -49,7 +49,7 @@ def _set(pose: Pose, g: Group, q: NDArray[np.float64]) -> None:
     _place(pose, g, list(q.T), NUMPY)
 
 
-def _place(pose: Pose, g: Group, q: list, ops) -> None:
+def _place(pose: Pose, g: Group, q: list[Num], ops: OpsLike) -> None:
     """Place the group's links from their coordinates, ``3·|g|`` arrays or symbols."""
     for i, k in enumerate(g.links):
         pose.origins[k] = V(q[3 * i], q[3 * i + 1])
@@ -63,7 +63,8 @@ def _place(pose: Pose, g: Group, q: list, ops) -> None:
 TAYLOR_STEP = 1e-6
 
 
-def _moved(pose: Pose, g: Group, q: list, step: list, ops=NUMPY) -> list:
+def _moved(pose: Pose, g: Group, q: list[Num], step: list[Num], ops: OpsLike = NUMPY
+           ) -> list[Num]:
     """Place the group's links at ``q − step`` (lists of ``3·|g|`` arrays); return those.
 
     A link whose angle moves by at most :data:`TAYLOR_STEP` everywhere has its cosine and
@@ -97,7 +98,7 @@ def _jacobian(g: Group, pose: Pose, n: int) -> NDArray[np.float64]:
 def _dense_step(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArray[np.float64]:
     """Newton's step ``J⁻¹·r`` per system by LAPACK (NaN where ``J`` is singular)."""
     try:
-        return np.linalg.solve(jac, res[:, :, None])[:, :, 0]
+        return np.asarray(np.linalg.solve(jac, res[:, :, None])[:, :, 0], dtype=float)
     except np.linalg.LinAlgError:
         step = np.full(res.shape, np.nan)
         ok = np.abs(np.linalg.det(jac)) > 0
@@ -168,7 +169,7 @@ def table(structure: Structure, g: Group, place: Positions
     partial = replace(structure, groups=tuple(before), cache={})  # places the known links
     q_ref = _coordinates(structure, g)
     out = np.full((2 * TABLE_STEPS + 1, q_ref.size), np.nan)
-    angles = start + step * np.arange(-TABLE_STEPS, TABLE_STEPS + 1)
+    angles = start + step * np.arange(-TABLE_STEPS, TABLE_STEPS + 1, dtype=float)
     out[TABLE_STEPS] = q_ref
     _continue(structure, partial, g, angles, out, 1, place)
     turn = _turn(structure, out[-1] - q_ref)
@@ -185,8 +186,8 @@ def table(structure: Structure, g: Group, place: Positions
 STRIDE = 32
 
 
-def _continue(structure: Structure, partial: Structure, g: Group, angles, out, direction: int,
-              place: Positions) -> None:
+def _continue(structure: Structure, partial: Structure, g: Group, angles: NDArray[np.float64],
+              out: NDArray[np.float64], direction: int, place: Positions) -> None:
     """Fill ``out``'s rows from the reference's (the middle row) towards ``direction``.
 
     The continuation steps by a stride of table rows that adapts: each step solves the next
@@ -202,7 +203,8 @@ def _continue(structure: Structure, partial: Structure, g: Group, angles, out, d
     middle = TABLE_STEPS
     done = [middle]  # rows found, in order away from the middle
 
-    def solve_at(rows, guess):
+    def solve_at(rows: NDArray[np.intp], guess: NDArray[np.float64]
+                 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
         pose = place(partial, angles[rows])
         with np.errstate(all="ignore"):
             return newton(g, pose, guess, scale)
@@ -292,8 +294,8 @@ def start(structure: Structure, g: Group, theta1: NDArray[np.float64],
     return guess, inside
 
 
-def solve_group(structure: Structure, g: Group, pose: Pose, theta1, place: Positions,
-                gaps: list | None = None) -> None:
+def solve_group(structure: Structure, g: Group, pose: Pose, theta1: NDArray[np.float64],
+                place: Positions, gaps: list[Num] | None = None) -> None:
     """Place the links of numeric group ``g`` in ``pose`` at crank angles ``theta1``.
 
     ``place`` places links found before it (:data:`Positions`); ``gaps``, if a list,
@@ -309,8 +311,8 @@ def solve_group(structure: Structure, g: Group, pose: Pose, theta1, place: Posit
         gaps.append(assembly_gap(structure, g, pose, q.shape[0]))
 
 
-def solve_group_symbolic(g: Group, pose: Pose, guess: list, ops,
-                         iterations: int = 2, steps: list | None = None) -> list:
+def solve_group_symbolic(g: Group, pose: Pose, guess: list[Num], ops: OpsLike,
+                         iterations: int = 2, steps: list[Num] | None = None) -> list[Num]:
     """Place numeric group ``g``'s links in ``pose`` by Newton's method on symbols.
 
     ``iterations`` steps from ``guess`` (the group's coordinates, ``3·|g|`` symbols: a good

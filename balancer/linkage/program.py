@@ -19,18 +19,19 @@ reports its residual: a state where it did not converge is left to the numpy rou
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import cache
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import numeric
 from .dynamics import Forces, inverse_dynamics
 from .kinematics import Motion, numeric_start, positions, rates
 from .structure import Structure
 from .symbols import CasadiOps
-from .vectors import Factor, _is_zero, _minus, _times
+from .vectors import Factor, Num, _is_zero, _minus, _times
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
     import casadi as ca
@@ -78,9 +79,10 @@ class Tape:
         self.sizes_out = [fn.nnz_out(i) for i in range(fn.n_out())]
         self.registers = fn.sz_w()
         self.source = _generate(fn)
-        scope = {"np": np}
+        scope: dict[str, Any] = {"np": np}
         exec(compile(self.source, f"<tape {fn.name()}>", "exec"), scope)  # noqa: S102
-        self._run = scope["run"]
+        self._run: Callable[[list[NDArray[np.float64]], list[NDArray[np.float64]],
+                             list[NDArray[np.float64]]], None] = scope["run"]
 
     def __call__(self, inputs: list[NDArray[np.float64]], n: int,
                  outs: list[NDArray[np.float64]] | None = None) -> list[NDArray[np.float64]]:
@@ -226,22 +228,24 @@ class _FixedPivotOps(CasadiOps):
     order is a valid threshold pivoting.
     """
 
-    def __init__(self, reference) -> None:
+    def __init__(self, reference: Callable[[list[Num]], list[float]]) -> None:
         #: ``reference(entries)``: the symbols' values at the reference state, as floats.
         self.reference = reference
-        self.health: list = []
+        self.health: list[Num] = []
 
-    def factor(self, a):
+    # An instance's factor (it needs the reference), where the other Ops' are static: this
+    # class is only ever used through its instances.
+    def factor(self, a: list[list[Num]]) -> Factor:  # type: ignore[override]
         return Factor(a, dense=self._solve)
 
-    def _solve(self, block: list[list], columns: list[list]) -> list[list]:
+    def _solve(self, block: list[list[Num]], columns: list[list[Num]]) -> list[list[Num]]:
         import casadi as ca  # heavy: only where symbols are built
         k = len(block)
         a = [list(row) for row in block]
         b = [list(row) for row in columns]
         values = self.reference([v for row in a for v in row])
         num = [list(values[i * k:(i + 1) * k]) for i in range(k)]
-        inverse = []
+        inverse: list[Num] = []
         for p in range(k):
             best = max(range(p, k), key=lambda i: abs(num[i][p]))
             for rows in (a, b, num):
@@ -257,7 +261,7 @@ class _FixedPivotOps(CasadiOps):
                     num[i][j] -= num[i][p] / num[p][p] * num[p][j]
                 for j in range(len(b[i])):
                     b[i][j] = _minus(b[i][j], _times(m, b[p][j]))
-        x: list[list] = [[0.0] * len(b[0]) for _ in range(k)]
+        x: list[list[Num]] = [[0.0] * len(b[0]) for _ in range(k)]
         for p in reversed(range(k)):
             for j in range(len(b[p])):
                 acc = b[p][j]
@@ -288,19 +292,18 @@ class CrankForcesProgram:
         gas = ca.SX.sym("gas", len(s.prisms))
         inputs = [theta1, omega1, alpha1, guess, gas]
         q_ref = s.reference_coordinates()
+        guess_ref: list[ArrayLike] = [[q_ref[3 * k + j] for k in s.groups[i].links
+                                       for j in range(3)] for i in self.numeric]
         at_reference = [s.ref_angle[s.input], 1.0, 0.0,
-                        np.concatenate([[q_ref[3 * k + j] for k in s.groups[i].links
-                                         for j in range(3)] for i in self.numeric]
-                                       or [np.zeros(0)]),
-                        np.zeros(len(s.prisms))]
+                        np.concatenate(guess_ref or [np.zeros(0)]), np.zeros(len(s.prisms))]
 
-        def reference(entries: list) -> list[float]:
+        def reference(entries: list[Num]) -> list[float]:
             probe = ca.Function("probe", inputs, [ca.vertcat(*[ca.SX(e) for e in entries])])
             return [float(v) for v in np.asarray(probe(*at_reference)).ravel()]
 
         ops = _FixedPivotOps(reference)
-        residuals: list = []
-        steps: list = []
+        residuals: list[Num] = []
+        steps: list[Num] = []
         pose = positions(s, theta1, ops, guesses=guesses, residuals=residuals, steps=steps)
         vel, rate, acc, accel = rates(s, pose, omega1, alpha1, theta1, ops)
         mo = Motion(theta1=theta1, omega1=omega1, alpha1=alpha1, pose=pose,
@@ -356,7 +359,7 @@ class CrankForcesProgram:
 __all__ = ["CrankForcesProgram", "Tape"]
 
 
-def _largest(values: list):
+def _largest(values: list[Num]) -> ca.SX:
     """The largest of ``values`` (symbols), or −1 for none."""
     import casadi as ca  # heavy: only where symbols are built
     out = ca.SX(-1.0)

@@ -31,6 +31,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,7 +40,6 @@ from ..errors import SpecError
 from ..model import GROUND, Linkage
 from .constraints import (
     GROUND_INDEX,
-    Constraint,
     Driver,
     Group,
     Pin,
@@ -93,7 +93,7 @@ class Structure:
     groups: tuple[Group, ...]
     point_links: dict[str, tuple[int, ...]] = field(repr=False)
     #: Tables and other results computed once per structure (numeric groups' continuation).
-    cache: dict = field(default_factory=dict, repr=False, compare=False)
+    cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def size(self) -> int:
@@ -106,7 +106,7 @@ class Structure:
         return self.driver.link
 
     @property
-    def constraints(self) -> tuple[Constraint, ...]:
+    def constraints(self) -> tuple[Pin | Prism, ...]:
         """All constraints but the driver (``3·n − 1`` rows)."""
         return (*self.pins, *self.prisms)
 
@@ -139,7 +139,8 @@ class Structure:
         index[GROUND] = GROUND_INDEX
         positions = linkage.point_positions
         sliders_of = {s.link: s for s in linkage.sliders}
-        ref_angle, ref_origin = [], []
+        ref_angle: list[float] = []
+        ref_origin: list[V] = []
         local: dict[tuple[int, str], V] = {}
         for body in linkage.moving:
             k = index[body.name]
@@ -242,7 +243,7 @@ class Structure:
 
     # -- groups -------------------------------------------------------------------------------
 
-    def _closing(self, group: set[int], known: set[int]) -> list[Constraint] | None:
+    def _closing(self, group: set[int], known: set[int]) -> list[Pin | Prism] | None:
         """The constraints that close ``group`` given ``known`` links, if it is a group.
 
         Attachments of a group link at a point to a known link there (the ground first), pairs
@@ -250,7 +251,7 @@ class Structure:
         links. ``None`` unless their rows equal the group's coordinates and every link takes
         part.
         """
-        out: list[Constraint] = []
+        out: list[Pin | Prism] = []
         for p, links in self.point_links.items():
             inside = [k for k in links if k in group]
             if not inside:
@@ -267,9 +268,9 @@ class Structure:
             if (c.s in group or c.g in group) and {c.s, c.g} <= group | known:
                 out.append(c)
         rows = sum(c.rows for c in out)
-        touched = set()
-        for c in out:
-            touched |= {c.a, c.b} if isinstance(c, Pin) else {c.s, c.g}
+        touched: set[int] = set()
+        for joint in out:
+            touched |= {joint.a, joint.b} if isinstance(joint, Pin) else {joint.s, joint.g}
         if rows != 3 * len(group) or not group <= touched:
             return None
         return out
@@ -285,7 +286,7 @@ class Structure:
         unknown = set(range(self.size)) - known
         q_ref = self.reference_coordinates()
         while unknown:
-            found = None
+            found: tuple[tuple[int, ...], list[Pin | Prism]] | None = None
             for size in range(2, len(unknown) + 1):
                 for combo in itertools.combinations(sorted(unknown), size):
                     closing = self._closing(set(combo), known)
@@ -305,14 +306,14 @@ class Structure:
             unknown -= set(combo)
         return tuple(groups)
 
-    def _classify(self, links: tuple[int, ...], closing: list[Constraint],
+    def _classify(self, links: tuple[int, ...], closing: list[Pin | Prism],
                   q_ref: NDArray[np.float64]) -> Group:
         """A dyad of a kind solved in closed form, with its branch; else a numeric group."""
         if len(links) != 2 or len(closing) != 3:
             return Group(links, tuple(closing), "numeric")
         a, b = links
 
-        def between(c, x, y):
+        def between(c: Pin | Prism, x: int, y: int) -> bool:
             pair = {c.a, c.b} if isinstance(c, Pin) else {c.s, c.g}
             return pair == {x, y}
 
@@ -363,11 +364,11 @@ class Structure:
         return np.vstack(rows) if rows else np.zeros((0, 3 * self.size))
 
 
-def _touches(c: Constraint, k: int) -> bool:
+def _touches(c: Pin | Prism, k: int) -> bool:
     return k in ((c.a, c.b) if isinstance(c, Pin) else (c.s, c.g))
 
 
-def _pin_offset(c: Constraint, k: int) -> tuple[float, float] | None:
+def _pin_offset(c: Pin | Prism, k: int) -> tuple[float, float] | None:
     """The local point by which pin ``c`` holds link ``k`` (``None`` for a prism)."""
     if not isinstance(c, Pin):
         return None

@@ -8,9 +8,7 @@ programs of :mod:`.program`.
 
 from __future__ import annotations
 
-from typing import Any
-
-from .vectors import Factor, Ops
+from .vectors import Factor, Num, Ops
 
 
 class CasadiOps(Ops):
@@ -21,42 +19,42 @@ class CasadiOps(Ops):
     """
 
     @staticmethod
-    def sqrt(x: Any) -> Any:
+    def sqrt(x: Num) -> Num:
         import casadi as ca
 
         return ca.sqrt(x)
 
     @staticmethod
-    def sin(x: Any) -> Any:
+    def sin(x: Num) -> Num:
         import casadi as ca
 
         return ca.sin(x)
 
     @staticmethod
-    def cos(x: Any) -> Any:
+    def cos(x: Num) -> Num:
         import casadi as ca
 
         return ca.cos(x)
 
     @staticmethod
-    def atan2(y: Any, x: Any) -> Any:
+    def atan2(y: Num, x: Num) -> Num:
         import casadi as ca
 
         return ca.atan2(y, x)
 
     @staticmethod
-    def where(condition: Any, a: Any, b: Any) -> Any:
+    def where(condition: Num, a: Num, b: Num) -> Num:
         import casadi as ca
 
         return ca.if_else(condition, a, b)
 
     @staticmethod
-    def factor(a):
+    def factor(a: list[list[Num]]) -> Factor:
         """``A`` factored for its solves; a dense remainder by CasADi's symbolic QR."""
         return Factor(a, dense=_dense_solve)
 
 
-def _dense_solve(block, columns):
+def _dense_solve(block: list[list[Num]], columns: list[list[Num]]) -> list[list[Num]]:
     """``X`` with ``A·X = B`` for symbols: ``A`` k×k and ``B`` k×m as lists of rows."""
     import casadi as ca
 

@@ -11,19 +11,28 @@ exploiting their structure.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeAlias
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
+
+#: A value of the linkage's equations: a float, a numpy array (one entry per crank angle, or
+#: ``(N, C)``) or a CasADi symbol — whatever arithmetic and :class:`Ops` accept. The equations
+#: are written once against all three, so their values are typed no closer than this.
+Num: TypeAlias = Any
+#: A dense solve of symbols ``dense(block, columns)``: ``X`` with ``A·X = B``, ``A`` ``k×k`` and
+#: ``B`` ``k×m`` as lists of rows (:meth:`balancer.linkage.symbols.CasadiOps.factor`).
+DenseSolve: TypeAlias = Callable[[list[list[Num]], list[list[Num]]], list[list[Num]]]
 
 
 @dataclass(frozen=True, slots=True)
 class V:
     """A plane vector ``(x, y)``; the components may be floats, arrays or symbols."""
 
-    x: Any
-    y: Any
+    x: Num
+    y: Num
 
     def __add__(self, other: V) -> V:
         return V(self.x + other.x, self.y + other.y)
@@ -34,19 +43,19 @@ class V:
     def __neg__(self) -> V:
         return V(-self.x, -self.y)
 
-    def __mul__(self, k: Any) -> V:
+    def __mul__(self, k: Num) -> V:
         return V(self.x * k, self.y * k)
 
     __rmul__ = __mul__
 
-    def __truediv__(self, k: Any) -> V:
+    def __truediv__(self, k: Num) -> V:
         return V(self.x / k, self.y / k)
 
-    def dot(self, other: V) -> Any:
+    def dot(self, other: V) -> Num:
         """Scalar product."""
         return self.x * other.x + self.y * other.y
 
-    def cross(self, other: V) -> Any:
+    def cross(self, other: V) -> Num:
         """Z-component of ``self × other``."""
         return self.x * other.y - self.y * other.x
 
@@ -54,7 +63,7 @@ class V:
         """The vector turned by +90° (``J·v``, ``i·v`` for a complex number)."""
         return V(-self.y, self.x)
 
-    def rotated(self, c: Any, s: Any) -> V:
+    def rotated(self, c: Num, s: Num) -> V:
         """The vector turned by the angle whose cosine and sine are ``c`` and ``s``.
 
         A component that is the float 0.0 (a point on a link's axis) costs nothing.
@@ -66,7 +75,7 @@ class V:
             return V(-(s * y), c * y)
         return V(c * x - s * y, s * x + c * y)
 
-    def norm2(self) -> Any:
+    def norm2(self) -> Num:
         """Squared length."""
         return self.x * self.x + self.y * self.y
 
@@ -76,12 +85,12 @@ class V:
         return V(z.real, z.imag)
 
     @staticmethod
-    def of_array(z) -> V:
+    def of_array(z: ArrayLike) -> V:
         """From a complex array (real and imaginary parts as arrays)."""
-        z = np.asarray(z)
-        return V(z.real.astype(float), z.imag.astype(float))
+        a = np.asarray(z)
+        return V(a.real.astype(float), a.imag.astype(float))
 
-    def complex(self):
+    def complex(self) -> Num:
         """As a complex number (numpy: a complex array)."""
         return self.x + 1j * self.y
 
@@ -89,30 +98,49 @@ class V:
 class Ops:
     """Elementary functions of numpy arrays (the default) or, in :class:`CasadiOps`, symbols."""
 
-    sqrt = staticmethod(np.sqrt)
-    sin = staticmethod(np.sin)
-    cos = staticmethod(np.cos)
-    atan2 = staticmethod(np.arctan2)
+    @staticmethod
+    def sqrt(x: Num) -> Num:
+        """Square root."""
+        return np.sqrt(x)
 
     @staticmethod
-    def where(condition: Any, a: Any, b: Any) -> Any:
+    def sin(x: Num) -> Num:
+        """Sine."""
+        return np.sin(x)
+
+    @staticmethod
+    def cos(x: Num) -> Num:
+        """Cosine."""
+        return np.cos(x)
+
+    @staticmethod
+    def atan2(y: Num, x: Num) -> Num:
+        """The angle of ``(x, y)``, rad."""
+        return np.arctan2(y, x)
+
+    @staticmethod
+    def where(condition: Num, a: Num, b: Num) -> Num:
         """``a`` where ``condition`` holds, else ``b``."""
         return np.where(condition, a, b)
 
     @staticmethod
-    def factor(a: list[list[Any]]) -> Factor:
+    def factor(a: list[list[Num]]) -> Factor:
         """``A`` (k×k, entries floats or arrays over the systems) factored for its solves."""
         return Factor(a)
 
 
 NUMPY = Ops()
+#: Where the equations take their elementary functions: an :class:`Ops` (:data:`NUMPY`, or a
+#: program's own) or an :class:`Ops` class itself (:class:`~.symbols.CasadiOps`, whose
+#: functions are static).
+OpsLike: TypeAlias = Ops | type[Ops]
 
 
-def _is_zero(v: Any) -> bool:
+def _is_zero(v: Num) -> bool:
     return isinstance(v, float) and v == 0.0
 
 
-def _times(m: Any, x: Any) -> Any:
+def _times(m: Num, x: Num) -> Num:
     """``m·x``, structural zeros kept as the float 0.0 (an ``(N,)`` ``m`` spans ``(N, C)``)."""
     if _is_zero(m) or _is_zero(x):
         return 0.0
@@ -121,7 +149,7 @@ def _times(m: Any, x: Any) -> Any:
     return m * x
 
 
-def _plus(a: Any, b: Any) -> Any:
+def _plus(a: Num, b: Num) -> Num:
     """``a + b`` with structural zeros kept."""
     if _is_zero(b):
         return a
@@ -130,7 +158,7 @@ def _plus(a: Any, b: Any) -> Any:
     return a + b
 
 
-def _minus(a: Any, b: Any) -> Any:
+def _minus(a: Num, b: Num) -> Num:
     """``a − b`` with structural zeros kept."""
     if _is_zero(b):
         return a
@@ -139,7 +167,7 @@ def _minus(a: Any, b: Any) -> Any:
     return a - b
 
 
-def _reciprocal(v: Any) -> Any:
+def _reciprocal(v: Num) -> Num:
     """``1/v``: NaN where a float or an array is zero; a symbol's as it is."""
     if isinstance(v, float | np.ndarray):
         v = np.asarray(v, dtype=float)
@@ -157,7 +185,7 @@ class _BatchLU:
     """
 
     @np.errstate(divide="ignore", invalid="ignore")
-    def __init__(self, block: list[list[Any]], n: int) -> None:
+    def __init__(self, block: list[list[Num]], n: int) -> None:
         k = len(block)
         a = [[np.broadcast_to(np.asarray(v, dtype=float), (n,)).copy() for v in row]
              for row in block]
@@ -185,7 +213,7 @@ class _BatchLU:
         self.diagonal = [1.0 / a[p][p] for p in range(k)]
 
     @np.errstate(divide="ignore", invalid="ignore")
-    def solve(self, b: list[Any]) -> list[Any]:
+    def solve(self, b: list[Num]) -> list[Num]:
         """``x`` with ``A·x = b``; ``b`` a list of ``k`` entries (``(N,)`` or ``(N, C)``)."""
         k = len(b)
         y = list(b)
@@ -195,7 +223,7 @@ class _BatchLU:
                 y[p], y[i] = np.where(mask, y[i], y[p]), np.where(mask, y[p], y[i])
             for i, m in self.lower[p]:
                 y[i] = _minus(y[i], _times(m, y[p]))
-        x: list[Any] = [0.0] * k
+        x: list[Num] = [0.0] * k
         for p in reversed(range(k)):
             acc = y[p]
             for j in range(p + 1, k):
@@ -223,11 +251,11 @@ class Factor:
     """
 
     @np.errstate(divide="ignore", invalid="ignore")
-    def __init__(self, a: list[list[Any]], dense=None) -> None:
+    def __init__(self, a: list[list[Num]], dense: DenseSolve | None = None) -> None:
         k = len(a)
         rows = [list(row) for row in a]
         live_rows, live_cols = list(range(k)), list(range(k))
-        self.steps: list[tuple[int, int, Any, list[tuple[int, Any]]]] = []
+        self.steps: list[tuple[int, int, Num, list[tuple[int, Num]]]] = []
         while True:
             best, size = None, 0.0
             for i in live_rows:
@@ -255,9 +283,9 @@ class Factor:
         self.rows = rows
         self.rest_rows, self.rest_cols = live_rows, live_cols
         block = [[rows[i][j] for j in live_cols] for i in live_rows]
-        self.inverse: list[list[Any]] | None = None
+        self.inverse: list[list[Num]] | None = None
         self.dense: _BatchLU | None = None
-        self.symbolic: tuple | None = None
+        self.symbolic: tuple[DenseSolve, list[list[Num]]] | None = None
         if len(block) == 1:
             (a11,), = block
             self.inverse = [[_reciprocal(a11)]]
@@ -276,7 +304,7 @@ class Factor:
                 self.dense = _BatchLU(block, n)
 
     @np.errstate(divide="ignore", invalid="ignore")
-    def solve(self, b: list[list[Any]]) -> list[list[Any]]:
+    def solve(self, b: list[list[Num]]) -> list[list[Num]]:
         """``X`` with ``A·X = B``.
 
         ``B`` is ``k`` rows of ``m`` entries (floats, ``(N,)`` or ``(N, C)`` arrays); ``X``
@@ -288,11 +316,11 @@ class Factor:
             for r, m in updates:
                 for c in range(width):
                     rhs[r][c] = _minus(rhs[r][c], _times(m, rhs[i][c]))
-        x: list[list[Any]] = [[0.0] * width for _ in self.rows]
+        x: list[list[Num]] = [[0.0] * width for _ in self.rows]
         if self.inverse is not None:
             for jj, j in enumerate(self.rest_cols):
                 for c in range(width):
-                    acc: Any = 0.0
+                    acc: Num = 0.0
                     for ii, i in enumerate(self.rest_rows):
                         acc = _plus(acc, _times(self.inverse[jj][ii], rhs[i][c]))
                     x[j][c] = acc

@@ -9,6 +9,7 @@ from __future__ import annotations
 from functools import lru_cache
 
 from ..errors import SpecError
+from ..model import Mechanism as Model
 from .base import Mechanism
 from .fourbar import FourBarMechanism
 from .general import LinkageMechanism
@@ -22,7 +23,7 @@ REGISTRY: dict[str, type[Mechanism]] = {
 }
 
 
-def mechanism_of(model) -> Mechanism:
+def mechanism_of(model: Model | Mechanism) -> Mechanism:
     """The :class:`~.base.Mechanism` of a model (a FourBar, SliderCrank or Linkage).
 
     Built once per model (models are frozen and hashable); a mechanism is returned as it is.
@@ -42,11 +43,11 @@ def mechanism_of(model) -> Mechanism:
 
 
 @lru_cache(maxsize=64)
-def _cached(model) -> Mechanism:
+def _cached(model: Model) -> Mechanism:
     return _build(model)
 
 
-def _build(model) -> Mechanism:
+def _build(model: Model) -> Mechanism:
     kind = getattr(model, "type", None)
     if kind not in REGISTRY:
         raise SpecError("must be a mechanism (a FourBar, SliderCrank or Linkage)",

@@ -33,7 +33,7 @@ from ..linkage.kinematics import Motion
 from ..linkage.program import CrankForcesProgram
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
-from ..model import GROUND, Link, Linkage
+from ..model import GROUND, Branch, FourBar, Link, Linkage, SliderCrank
 from ..model.assembly import AssemblyRange
 
 #: The inverse-dynamics routes of every mechanism (``analyze --route``): the links' equations
@@ -55,6 +55,10 @@ ZOOM_ROUNDS = 5
 #: as a straight-line program (:mod:`balancer.linkage.program`): the same arithmetic in
 #: fewer operations, whose one-time build (about 0.1 s) then pays off.
 PROGRAM_STATES = 8192
+#: The general core's routes (:func:`balancer.linkage.dynamics.inverse_dynamics`) by the
+#: mechanism's.
+_GENERAL_ROUTES: dict[Route, Literal["groups", "global"]] = {
+    "newton-euler": "groups", "mass-matrix": "global"}
 
 
 #: One build of a program at a time (a cycle analysis runs its chunks on threads).
@@ -107,7 +111,7 @@ class Mechanism(ABC):
     #: (``R{name}x``, ``R{name}y``) rather than by its normal force ``N_{link}``.
     guide_force_names: ClassVar[dict[str, str]] = {}
 
-    def __init__(self, model) -> None:
+    def __init__(self, model: FourBar | SliderCrank | Linkage) -> None:
         self.model = model
 
     # -- identity -----------------------------------------------------------------------------
@@ -115,6 +119,7 @@ class Mechanism(ABC):
     @cached_property
     def linkage(self) -> Linkage:
         """The mechanism as a general linkage."""
+        assert isinstance(self.model, Linkage), "a seed's mechanism builds its general linkage"
         return self.model
 
     @cached_property
@@ -162,7 +167,7 @@ class Mechanism(ABC):
 
         The direction in which a positive normal force acts.
         """
-        out = {}
+        out: dict[str, complex] = {}
         for s in self.linkage.sliders:
             if s.guide == GROUND:
                 d = complex(*s.direction)
@@ -209,7 +214,7 @@ class Mechanism(ABC):
         return "full turn" if self.assembly_range().full else "swinging crank"
 
     @property
-    def branch(self) -> str | None:
+    def branch(self) -> Branch | None:
         """The assembly branch its spec names (``"+"`` or ``"-"``), or ``None``.
 
         ``None`` in general: the reference pose fixes the branch.
@@ -304,7 +309,7 @@ class Mechanism(ABC):
 
     # -- dynamics -----------------------------------------------------------------------------
 
-    def inverse_dynamics(self, mo: Motion, *, route: str | None = None, loads: bool = True,
+    def inverse_dynamics(self, mo: Motion, *, route: Route | None = None, loads: bool = True,
                          gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         """Forces on the ground and driving torque of the mechanism's own design (one column).
 
@@ -313,12 +318,12 @@ class Mechanism(ABC):
         with the links' mass matrices and the constraints' multipliers.
         """
         route = route or self.routes[0]
-        general = {"newton-euler": "groups", "mass-matrix": "global"}[route]
+        general = _GENERAL_ROUTES[route]
         return dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
                                          loads=loads, route=general)
 
     def crank_forces(self, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0,
-                     *, route: str | None = None, loads: bool = True,
+                     *, route: Route | None = None, loads: bool = True,
                      gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         """:meth:`inverse_dynamics` of :meth:`motion` at crank states (arrays broadcast).
 
@@ -331,7 +336,7 @@ class Mechanism(ABC):
         states = np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))
                                        for x in (theta1, omega1, alpha1)))
         if route == "newton-euler" and states[0].size >= PROGRAM_STATES:
-            program = self._program(loads, tuple(gravity))
+            program = self._program(loads, (gravity[0], gravity[1]))
             if program is not None:
                 forces, ok = program.evaluate(*(np.ascontiguousarray(x) for x in states))
                 if not ok.all():
@@ -342,11 +347,13 @@ class Mechanism(ABC):
         return self.inverse_dynamics(self.motion(theta1, omega1, alpha1), route=route,
                                      loads=loads, gravity=gravity)
 
-    def _program(self, loads: bool, gravity: tuple[float, float]):
+    def _program(self, loads: bool, gravity: tuple[float, float]
+                 ) -> CrankForcesProgram | None:
         """The mechanism's crank-forces program for these loads and gravity (built once)."""
         key = (loads, gravity)
         with _PROGRAM_LOCK:
-            cache = self.__dict__.setdefault("_programs", {})  # of this design only
+            cache: dict[tuple[bool, tuple[float, float]], CrankForcesProgram | None] = (
+                self.__dict__.setdefault("_programs", {}))  # of this design only
             if key not in cache:
                 try:
                     cache[key] = CrankForcesProgram(self.structure, loads=loads,
@@ -386,7 +393,7 @@ class Mechanism(ABC):
 
     def points(self, mo: Motion) -> dict[str, NDArray[np.complex128]]:
         """Every point's position, complex, m (a point of the frame: its fixed place)."""
-        out = {}
+        out: dict[str, NDArray[np.complex128]] = {}
         for p, links in self.structure.point_links.items():
             k = GROUND_INDEX if GROUND_INDEX in links else links[0]
             out[p] = mo.point(k, self.structure.local[(k, p)]).complex() + 0 * mo.theta1
@@ -398,7 +405,7 @@ class Mechanism(ABC):
 
     def guides(self, mo: Motion) -> list[tuple[NDArray[np.complex128], NDArray[np.complex128]]]:
         """Each slider's guide as a point on the line and the line's unit direction, complex."""
-        out = []
+        out: list[tuple[NDArray[np.complex128], NDArray[np.complex128]]] = []
         for c in self.structure.prisms:
             base = mo.point(c.g, c.pg).complex() + 0 * mo.theta1
             d = mo.pose.rotate(c.g, c.dg)
@@ -411,7 +418,7 @@ def _gaps(structure: Structure, theta1: NDArray[np.float64]) -> NDArray[np.float
 
     Where a link cannot be placed (a numeric group's Newton fails) the gap is −1.
     """
-    gaps: list = []
+    gaps: list[NDArray[np.float64]] = []
     with np.errstate(all="ignore"):
         pose = kinematics.positions(structure, theta1, gaps=gaps)
     least = np.ones_like(theta1)
@@ -453,7 +460,7 @@ def _assembly_range(structure: Structure) -> AssemblyRange:
     """
     start = structure.ref_angle[structure.input]
     step = 2 * math.pi / RANGE_SAMPLES
-    theta = start + step * np.arange(RANGE_SAMPLES + 1)
+    theta = start + step * np.arange(RANGE_SAMPLES + 1, dtype=float)
     gap = _gaps(structure, theta)
 
     def at(t: float) -> float:
@@ -470,7 +477,7 @@ def _assembly_range(structure: Structure) -> AssemblyRange:
     from scipy.optimize import brentq
 
     # The range around the reference: walk out each way to the first bad sample, then bisect.
-    ends = []
+    ends: list[float] = []
     for direction in (1, -1):
         t = start
         while True:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -23,9 +24,9 @@ from ..linkage.dynamics import Forces
 from ..linkage.kinematics import Motion
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
-from ..model import Body, FourBar, Linkage
+from ..model import Body, Branch, FourBar, Linkage
 from ..model.assembly import AssemblyRange, assembly_range, classify
-from .base import Limit, Mechanism
+from .base import Limit, Mechanism, Route
 
 
 def fourbar_linkage(model: FourBar) -> Linkage:
@@ -60,6 +61,8 @@ def fourbar_linkage(model: FourBar) -> Linkage:
 class FourBarMechanism(Mechanism):
     """The 4R four-bar (``type = "four-bar"``)."""
 
+    model: FourBar
+
     kind = "four-bar"
     formulations = ("opened-loop", "complex-masses", "mass-matrix", "lie-group")
     geometry_key = "mechanism.lengths"
@@ -68,7 +71,7 @@ class FourBarMechanism(Mechanism):
     start_angle = 0.0
 
     @property
-    def verify_method(self) -> str:  # type: ignore[override]
+    def verify_method(self) -> str:  # type: ignore[override]  # per design: a property here
         """The formulation :func:`balancer.verification.verify` uses by default.
 
         The paper's complex joint masses (Eq. 36–40) where the crank turns fully without change
@@ -94,7 +97,7 @@ class FourBarMechanism(Mechanism):
         return str(classify(self.model.lengths))
 
     @property
-    def branch(self) -> str:
+    def branch(self) -> Branch:
         return self.model.branch
 
     def assembly_range(self) -> AssemblyRange:
@@ -127,7 +130,7 @@ class FourBarMechanism(Mechanism):
         return [Limit(mask, offsets, weights) for mask, offsets, weights
                 in change_point_limits(self.model.lengths, theta1)]
 
-    def inverse_dynamics(self, mo: Motion, *, route: str | None = None, loads: bool = True,
+    def inverse_dynamics(self, mo: Motion, *, route: Route | None = None, loads: bool = True,
                          gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         """The paper's routes in closed form (the general core checks them in the tests).
 
@@ -137,16 +140,17 @@ class FourBarMechanism(Mechanism):
         return self._closed_form_forces(fourbar_motion(self.model, mo), route, loads, gravity)
 
     def crank_forces(self, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0,
-                     *, route: str | None = None, loads: bool = True,
+                     *, route: Route | None = None, loads: bool = True,
                      gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         """:meth:`inverse_dynamics` at crank states from the closed-form motion alone."""
         return self._closed_form_forces(self._closed_form_motion(theta1, omega1, alpha1),
                                         route, loads, gravity)
 
-    def _closed_form_forces(self, mo: fourbar.Motion, route, loads, gravity) -> Forces:
+    def _closed_form_forces(self, mo: fourbar.Motion, route: Route | None, loads: bool,
+                            gravity: tuple[float, float]) -> Forces:
         route_fn = mass_matrix if (route or self.routes[0]) == "mass-matrix" else newton_euler
         r = route_fn(self.model, mo, gravity=gravity, loads=loads)
-        def col(z):
+        def col(z: ArrayLike) -> NDArray[Any]:
             return np.asarray(z)[:, None]
 
         return Forces(

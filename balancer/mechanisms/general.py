@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from ..model import Linkage
 from .base import Mechanism
 
 
 class LinkageMechanism(Mechanism):
     """Any planar linkage with one degree of freedom (``type = "linkage"``)."""
+
+    model: Linkage
 
     kind = "linkage"
     formulations = ()  # the general formulations only (Mechanism.formulation_names)

@@ -10,19 +10,21 @@ from __future__ import annotations
 
 import math
 from functools import cached_property
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..linkage.dynamics import Forces
 from ..linkage.kinematics import Motion
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
-from ..model import Body, Linkage, Slider, SliderCrank
+from ..model import Body, Branch, Linkage, Slider, SliderCrank
 from ..model.assembly import AssemblyRange
 from ..slider_crank import kinematics as closed
 from ..slider_crank.conditions import force_balance_matrix
 from ..slider_crank.dynamics import mass_matrix
-from .base import Mechanism
+from .base import Mechanism, Route
 
 
 def slider_crank_linkage(model: SliderCrank) -> Linkage:
@@ -54,6 +56,8 @@ def slider_crank_linkage(model: SliderCrank) -> Linkage:
 class SliderCrankMechanism(Mechanism):
     """The slider-crank (``type = "slider-crank"``)."""
 
+    model: SliderCrank
+
     kind = "slider-crank"
     formulations = ("mass-matrix", "complex-masses")
     verify_method = "complex-masses"
@@ -77,13 +81,13 @@ class SliderCrankMechanism(Mechanism):
         return closed.classify(self.model.lengths)
 
     @property
-    def branch(self) -> str:
+    def branch(self) -> Branch:
         return self.model.branch
 
     def assembly_range(self) -> AssemblyRange:
         return closed.assembly_range(self.model.lengths)
 
-    def closed_form_force_balance(self) -> np.ndarray:
+    def closed_form_force_balance(self) -> NDArray[np.float64]:
         """Wunderlich's Eq. 20a–b over the layout (crank, rod, slider, then a counter-rotor)."""
         ab = force_balance_matrix(self.model.lengths)
         assert not np.any(ab[:, 12]), "Eq. 20 is homogeneous"
@@ -92,13 +96,14 @@ class SliderCrankMechanism(Mechanism):
     def _full_turn_rule(self) -> str:
         return " (crank + |offset| < rod)"
 
-    def inverse_dynamics(self, mo: Motion, *, route: str | None = None, loads: bool = True,
+    def inverse_dynamics(self, mo: Motion, *, route: Route | None = None, loads: bool = True,
                          gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         if (route or self.routes[0]) != "mass-matrix":
             return super().inverse_dynamics(mo, route=route, loads=loads, gravity=gravity)
         smo = closed.motion_of(self.model, mo.theta1, mo.omega1, mo.alpha1)
         r = mass_matrix(self.model, smo, gravity=gravity, loads=loads)
-        def col(z):
+        assert r.guide_couple is not None  # a slider-crank's reactions carry it
+        def col(z: ArrayLike) -> NDArray[Any]:
             return np.asarray(z)[:, None] * np.ones((mo.theta1.size, 1))
 
         return Forces(

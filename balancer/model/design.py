@@ -189,7 +189,7 @@ class Design:
                 check_scales(mech, speeds, gravity)
 
 
-def check_scales(mechanism, speeds: dict[str, float],
+def check_scales(mechanism: Mechanism, speeds: dict[str, float],
                  gravity: dict[str, tuple[float, float]] | None = None) -> None:
     """Raise :class:`SpecError` if a force, moment or energy of the motion leaves double precision.
 
@@ -223,9 +223,9 @@ def check_scales(mechanism, speeds: dict[str, float],
         moments += [mass + r + r + w2, mass + g_abs + r, force + r, inertia + w2, rotor + w2,
                     [(f"links.{name}.moment", link.moment)]]
         energies += [inertia + w2, rotor + w2, mass + r + r + w2]
-    for key, g in mechanism.gas_forces:
-        if not g.is_zero:
-            gas = [(key, max(abs(x) for x in g.values))]
+    for key, gas_force in mechanism.gas_forces:
+        if not gas_force.is_zero:
+            gas = [(key, max(abs(x) for x in gas_force.values))]
             forces.append(gas)
             moments.append(gas + r)
     for i, spring in enumerate(mechanism.springs):

@@ -10,11 +10,18 @@ from __future__ import annotations
 
 import cmath
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
+from types import ModuleType
+from typing import TYPE_CHECKING, overload
 
 from .. import validate as v
 from ..errors import SpecError
+
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import ArrayLike, NDArray
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -147,10 +154,15 @@ class GasForce:
         return all(v == 0.0 for v in self.values)
 
     @cached_property
-    def _spline(self):
+    def _spline(self) -> _PeriodicCubic:
         return _PeriodicCubic(self.angles, self.values, self.period)
 
-    def at(self, theta1):
+    @overload
+    def at(self, theta1: float) -> float: ...
+    @overload
+    def at(self, theta1: NDArray[np.float64]) -> NDArray[np.float64]: ...
+
+    def at(self, theta1: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
         """The force (N) at crank angle(s) ``theta1`` (rad): a float for a float."""
         if len(self.values) == 1:
             return self.values[0] + 0.0 * theta1
@@ -174,31 +186,31 @@ class _PeriodicCubic:
     tests compare them), without importing ``scipy.interpolate`` (0.6 s) for a short table.
     """
 
-    def __init__(self, x, y, period: float) -> None:
+    def __init__(self, x: Sequence[float], y: Sequence[float], period: float) -> None:
         import numpy as np
 
-        x = np.asarray(x, dtype=float)
-        y = np.asarray(y, dtype=float)
-        n = x.size
-        self.knots = np.append(x, x[0] + period)
+        xs = np.asarray(x, dtype=float)
+        ys = np.asarray(y, dtype=float)
+        n = xs.size
+        self.knots = np.append(xs, xs[0] + period)
         h = np.diff(self.knots)
-        slope = (np.roll(y, -1) - y) / h
+        slope = (np.roll(ys, -1) - ys) / h
         i = np.arange(n)
         a = np.zeros((n, n))
         a[i, i] = 2 * (np.roll(h, 1) + h)
         a[i, (i - 1) % n] += np.roll(h, 1)
         a[i, (i + 1) % n] += h
         m = np.linalg.solve(a, 6 * (slope - np.roll(slope, 1)))
-        self.h, self.y, self.m = h, np.append(y, y[0]), np.append(m, m[0])
+        self.h, self.y, self.m = h, np.append(ys, ys[0]), np.append(m, m[0])
         self._knots = self.knots.tolist()
 
-    def __call__(self, t):
+    def __call__(self, t: ArrayLike) -> NDArray[np.float64]:
         """The spline at ``t`` (within one period from the first knot)."""
         import numpy as np
 
-        t = np.asarray(t, dtype=float)
-        i = np.clip(np.searchsorted(self.knots, t, side="right") - 1, 0, self.h.size - 1)
-        return self._piece(i, t, np)
+        ts = np.asarray(t, dtype=float)
+        i = np.clip(np.searchsorted(self.knots, ts, side="right") - 1, 0, self.h.size - 1)
+        return self._piece(i, ts, np)
 
     def at(self, t: float) -> float:
         """:meth:`__call__` at one time, in plain floats (an integrator's single state)."""
@@ -207,7 +219,14 @@ class _PeriodicCubic:
         i = min(max(bisect.bisect_right(self._knots, t) - 1, 0), len(self._knots) - 2)
         return float(self._piece(i, t, None))
 
-    def _piece(self, i, t, np):
+    @overload
+    def _piece(self, i: int, t: float, np: None) -> np.float64: ...
+    @overload
+    def _piece(self, i: NDArray[np.intp], t: NDArray[np.float64],
+               np: ModuleType) -> NDArray[np.float64]: ...
+
+    def _piece(self, i: int | NDArray[np.intp], t: float | NDArray[np.float64],
+               np: ModuleType | None) -> np.float64 | NDArray[np.float64]:
         """The cubic of interval ``i`` at ``t`` (indices and times arrays, or numbers)."""
         h = self.h[i]
         a = (self.knots[i + 1] - t) / h

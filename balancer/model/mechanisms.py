@@ -10,8 +10,9 @@ assembly branch.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 from .. import validate as v
 from ..errors import AssemblyError, SpecError
@@ -56,7 +57,8 @@ class FourBar:
 
         Keys are the spec's, from its root (``mechanism.lengths.crank``).
         """
-        lengths = _check_mechanism(self)
+        _check_mechanism(self)
+        lengths = self.lengths  # as _check_mechanism stored them
         if assembly_range(lengths).empty:
             l1, l2, l3, l4 = lengths
             raise AssemblyError(
@@ -94,7 +96,7 @@ class FourBar:
         return ()
 
     @property
-    def springs(self) -> tuple:
+    def springs(self) -> tuple[Spring, ...]:
         """Linear springs: none on a four-bar."""
         return ()
 
@@ -108,15 +110,18 @@ class FourBar:
         """Return a copy with link ``name`` replaced."""
         if name not in self.link_names:
             raise KeyError(name)
-        return replace(self, **{name: link})
+        changes: dict[str, Any] = {name: link}
+        return replace(self, **changes)
 
     def with_links(self, links: dict[str, Link]) -> FourBar:
         """Return a copy with several links replaced."""
-        return replace(self, **links)
+        changes: dict[str, Any] = dict(links)
+        return replace(self, **changes)
 
     def without_loads(self) -> FourBar:
         """Return a copy with every applied force and moment removed."""
-        return replace(self, **{n: self.link(n).without_loads() for n in self.link_names})
+        changes: dict[str, Any] = {n: self.link(n).without_loads() for n in self.link_names}
+        return replace(self, **changes)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -200,7 +205,7 @@ class SliderCrank:
         return (("links.slider.gas_force", self.gas_force),)
 
     @property
-    def springs(self) -> tuple:
+    def springs(self) -> tuple[Spring, ...]:
         """Linear springs: none on a slider-crank."""
         return ()
 
@@ -214,16 +219,18 @@ class SliderCrank:
         """Return a copy with link ``name`` replaced."""
         if name not in self.link_names:
             raise KeyError(name)
-        return replace(self, **{name: link})
+        changes: dict[str, Any] = {name: link}
+        return replace(self, **changes)
 
     def with_links(self, links: dict[str, Link]) -> SliderCrank:
         """Return a copy with several links replaced."""
-        return replace(self, **links)
+        changes: dict[str, Any] = dict(links)
+        return replace(self, **changes)
 
     def without_loads(self) -> SliderCrank:
         """Return a copy with every applied force, moment and gas force removed."""
-        return replace(self, gas_force=GasForce(),
-                       **{n: self.link(n).without_loads() for n in self.link_names})
+        changes: dict[str, Any] = {n: self.link(n).without_loads() for n in self.link_names}
+        return replace(self, gas_force=GasForce(), **changes)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -262,7 +269,7 @@ class Linkage:
 
     def __post_init__(self) -> None:
         """Check names and references (keys are the spec's, from its root)."""
-        points = {}
+        points: dict[str, tuple[float, float]] = {}
         for item in self.points:
             if not (isinstance(item, tuple | list) and len(item) == 2
                     and isinstance(item[0], str)):
@@ -348,7 +355,8 @@ class Linkage:
                             "a ground point: the crank turns about it", key=key,
                             value=self.input)
         for name, body in names.items():
-            if name != GROUND and body.props.counter_rotor and not ground & set(body.points):
+            if (name != GROUND and body.props is not None and body.props.counter_rotor
+                    and not ground & set(body.points)):
                 raise SpecError("a counter-rotor sits on a ground pivot: this link has none",
                                 key=f"links.{name}.counter_rotor",
                                 value=body.props.counter_rotor)
@@ -357,7 +365,8 @@ class Linkage:
         v.store(self, "springs", tuple(self.springs))
 
     @staticmethod
-    def _check_slider(i: int, slider, names, points) -> None:
+    def _check_slider(i: int, slider: Slider, names: dict[str, Body],
+                      points: dict[str, tuple[float, float]]) -> None:
         key = f"mechanism.sliders[{i}]"
         if not isinstance(slider, Slider):
             raise SpecError("must be a Slider", key=key, value=slider)
@@ -384,7 +393,7 @@ class Linkage:
         object.__setattr__(slider, "direction", (dx, dy))
 
     @staticmethod
-    def _check_frames(names, points) -> None:
+    def _check_frames(names: dict[str, Body], points: dict[str, tuple[float, float]]) -> None:
         """A link's first two points must be apart: they fix its frame."""
         scale = max(math.hypot(*xy) for xy in points.values()) or 1.0
         for name, body in names.items():
@@ -422,7 +431,7 @@ class Linkage:
     @property
     def links(self) -> tuple[Link, ...]:
         """Mass properties of the moving links."""
-        return tuple(b.props for b in self.moving)  # type: ignore[misc]
+        return tuple(b.props for b in self.moving if b.props is not None)  # all of them
 
     @property
     def grounded_links(self) -> tuple[str, ...]:
@@ -454,8 +463,8 @@ class Linkage:
     def link(self, name: str) -> Link:
         """The mass properties of the moving link called ``name``."""
         for b in self.moving:
-            if b.name == name:
-                return b.props  # type: ignore[return-value]
+            if b.name == name and b.props is not None:  # a moving link's always is
+                return b.props
         raise KeyError(name)
 
     def with_link(self, name: str, link: Link) -> Linkage:
@@ -483,13 +492,13 @@ class Linkage:
 Mechanism = FourBar | SliderCrank | Linkage
 
 
-def _length_sizes(mech) -> dict[str, float]:
+def _length_sizes(mech: FourBar | SliderCrank) -> dict[str, float]:
     """A four-bar's or slider-crank's lengths by spec key (magnitudes), m."""
     return {f"mechanism.lengths.{n}": abs(x)
             for n, x in zip(mech.length_names, mech.lengths, strict=True)}
 
 
-def _check_mechanism(mech) -> tuple[float, ...]:
+def _check_mechanism(mech: FourBar | SliderCrank) -> tuple[float, ...]:
     """Lengths, links and branch of a mechanism; store the lengths as floats and return them.
 
     A slider-crank's offset (its last length) is signed; every other length is positive. Link
@@ -500,7 +509,7 @@ def _check_mechanism(mech) -> tuple[float, ...]:
     if isinstance(raw, str) or not hasattr(raw, "__len__") or len(raw) != len(names):
         raise SpecError(f"must be {len(names)} lengths ({', '.join(names)})",
                         key="mechanism.lengths", value=raw)
-    lengths = []
+    lengths: list[float] = []
     for name, value in zip(names, raw, strict=True):
         key = f"mechanism.lengths.{name}"
         if name == "offset":
@@ -526,7 +535,7 @@ def _check_mechanism(mech) -> tuple[float, ...]:
     return tuple(lengths)
 
 
-def _link_list(names) -> str:
+def _link_list(names: Iterable[str]) -> str:
     """The links of a spec by name, for a message: the moving ones, and the frame's name."""
     moving = [n for n in names if n != GROUND]
     return f"the moving links are {', '.join(moving)}; the frame is called {GROUND}"

@@ -3,16 +3,27 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .. import outputs
 from ..cycle import sample_angles
-from ..drawing import counterweight_paths, drawing_frames, frame
+from ..drawing import CounterweightLike, counterweight_paths, drawing_frames, frame
 from ..errors import OutputError
+from ..mechanisms.base import Mechanism
+from ..model import Mechanism as Model
 from ..outputs import animation_type, write_with
 from .style import COLOURS, draw_frame
+
+if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
+    from matplotlib.artist import Artist
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Circle
 
 
 def _arm(points: np.ndarray, target: np.ndarray) -> np.ndarray:
@@ -25,7 +36,9 @@ def _arm(points: np.ndarray, target: np.ndarray) -> np.ndarray:
     return np.column_stack([points[:, near], target])
 
 
-def animation_figure(linkage, *, frames: int = 72, title: str = "", counterweights=None):
+def animation_figure(linkage: Model | Mechanism, *, frames: int = 72, title: str = "",
+                     counterweights: Mapping[str, CounterweightLike] | None = None
+                     ) -> tuple[Figure, Callable[[int], list[Artist]]]:
     """The figure of an animation of one revolution, and what changes from frame to frame.
 
     Drawn once: the frame (pivots, guides), the path of the total centre of mass, the title
@@ -51,7 +64,7 @@ def animation_figure(linkage, *, frames: int = 72, title: str = "", counterweigh
     from matplotlib.lines import Line2D
     from matplotlib.patches import Circle
 
-    weights = counterweights or {}
+    weights: Mapping[str, CounterweightLike] = counterweights or {}
     links, coms, total = drawing_frames(linkage, frames)
     pivots, guides = frame(linkage)
     discs = counterweight_paths(linkage, weights, frames)
@@ -73,7 +86,7 @@ def animation_figure(linkage, *, frames: int = 72, title: str = "", counterweigh
     ax.plot(total.real, total.imag, color=COLOURS["before"], lw=1, ls=":",
             label="path of the total centre of mass")
     draw_frame(ax, linkage, label=None)
-    lines = []  # (artist, (frames, n) points joined)
+    lines: list[tuple[Line2D, NDArray[np.complex128]]] = []  # (artist, (frames, n) joined)
     for name, points in links.items():
         (arm,) = ax.plot([], [], "-", color=COLOURS["com"], lw=1.0, animated=True, zorder=1.5)
         lines.append((arm, _arm(points, coms[name])))
@@ -84,8 +97,9 @@ def animation_figure(linkage, *, frames: int = 72, title: str = "", counterweigh
     for name, (centres, _) in discs.items():
         (arm,) = ax.plot([], [], "-", color="0.35", lw=2, animated=True)
         lines.append((arm, _arm(links[name], centres)))
-    bodies = []
+    bodies: list[tuple[Circle | Line2D, NDArray[np.complex128], float]] = []
     for i, (centres, radius) in enumerate(discs.values()):
+        body: Circle | Line2D
         if radius > 0:
             body = Circle((centres[0].real, centres[0].imag), radius, color="0.35", alpha=0.8,
                           animated=True, label="counterweights added" if i == 0 else None)
@@ -114,11 +128,11 @@ def animation_figure(linkage, *, frames: int = 72, title: str = "", counterweigh
     degrees = np.degrees(sample_angles(frames))
     link_com_values = np.column_stack(list(coms.values()))
 
-    def update(k: int) -> list:
+    def update(k: int) -> list[Artist]:
         for line, values in lines:
             line.set_data(values[k].real, values[k].imag)
-        for body, centres, radius in bodies:
-            if radius > 0:
+        for body, centres, _ in bodies:
+            if isinstance(body, Circle):  # (a disc: its radius is positive)
                 body.set_center((centres[k].real, centres[k].imag))
             else:
                 body.set_data([centres[k].real], [centres[k].imag])
@@ -132,8 +146,9 @@ def animation_figure(linkage, *, frames: int = 72, title: str = "", counterweigh
     return fig, update
 
 
-def animate(linkage, path: str | os.PathLike[str], *, frames: int = 72, fps: int = 24,
-            title: str = "", counterweights=None) -> Path:
+def animate(linkage: Model | Mechanism, path: str | os.PathLike[str], *, frames: int = 72,
+            fps: int = 24, title: str = "",
+            counterweights: Mapping[str, CounterweightLike] | None = None) -> Path:
     """Write an animation of the linkage turning one revolution, its centre of mass traced.
 
     What it draws: :func:`animation_figure` (``counterweights`` per link, as

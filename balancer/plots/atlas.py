@@ -2,15 +2,29 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
 from .style import ORIGINAL_STYLE, legend_outside, mark_point, number
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
+    from matplotlib.artist import Artist
     from matplotlib.axes import Axes
+    from matplotlib.collections import PathCollection, QuadMesh
     from matplotlib.figure import Figure
+
+
+class PerturbLike(Protocol):
+    """A perturbed key of a sweep (:class:`balancer.sweeps.Perturb`, a layer above)."""
+
+    @property
+    def key(self) -> str:
+        """The spec key drawn."""
+    @property
+    def sigma(self) -> float:
+        """The standard deviation of its normal draws, in its unit."""
 
 
 def _key_label(key: str, units: dict[str, str]) -> str:
@@ -44,8 +58,10 @@ def _no_design(status: str) -> dict[str, str]:
                                   "hatch": "--", "edgecolor": "0.5", "marker": "o"})
 
 
-def sweep_figure(table: dict[str, list], keys, *, original: dict[str, float] | None = None,
-                 perturbs=(), units: dict[str, str] | None = None) -> Figure:
+def sweep_figure(table: Mapping[str, Sequence[Any]], keys: Sequence[str] | None, *,
+                 original: dict[str, float] | None = None,
+                 perturbs: Sequence[PerturbLike] = (),
+                 units: dict[str, str] | None = None) -> Figure:
     """The atlas of a sweep's table: the balanced RMS shaking moment over the varied keys.
 
     Parameters
@@ -130,7 +146,7 @@ def _atlas_line(ax: Axes, x: np.ndarray, key: str, before: np.ndarray, after: np
     ax.figure.legend(loc="outside lower center", ncols=2, fontsize="small")
 
 
-def _atlas_map(fig: Figure, ax: Axes, values: list[np.ndarray], keys: list[str],
+def _atlas_map(fig: Figure, ax: Axes, values: list[np.ndarray], keys: Sequence[str],
                after: np.ndarray, status: np.ndarray,
                original: dict[str, float] | None, units: dict[str, str]) -> None:
     """Two varied keys: a heat map (a grid) or a scatter of the balanced RMS shaking moment."""
@@ -141,8 +157,8 @@ def _atlas_map(fig: Figure, ax: Axes, values: list[np.ndarray], keys: list[str],
     xs, ys = np.unique(x), np.unique(y)
     solved = np.isfinite(after)
     masks = _no_design_masks(after, status)
-    handles = []
-    mesh = None
+    handles: list[Artist] = []
+    mesh: QuadMesh | PathCollection | None = None
     if xs.size * ys.size == x.size:  # a grid: a cell per point
         cell = np.searchsorted(ys, y), np.searchsorted(xs, x)
 
@@ -183,7 +199,8 @@ def _atlas_map(fig: Figure, ax: Axes, values: list[np.ndarray], keys: list[str],
         fig.legend(handles=handles, loc="outside lower center", ncols=1, fontsize="small")
 
 
-def _perturbation_figure(table: dict, perturbs, original: dict[str, float],
+def _perturbation_figure(table: Mapping[str, Sequence[Any]], perturbs: Sequence[PerturbLike],
+                         original: dict[str, float],
                          units: dict[str, str]) -> Figure:
     """A perturbation sweep's histogram of the perturbed designs' RMS shaking force, N.
 

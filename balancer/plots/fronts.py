@@ -11,13 +11,15 @@ from .style import mark_point, number
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
     from matplotlib.figure import Figure
 
+    from ..balance.pareto import Front  # (no cycle: loaded by the command that makes it)
+
 
 #: How far beyond a front's own extent (a fraction of it) the axes reach to take the original
 #: design in; one farther away is an arrow at the edge (the front is not squashed into a corner).
 FRONT_REACH = 0.3
 
 
-def front_figure(front, title: str | None = None) -> Figure:
+def front_figure(front: Front, title: str | None = None) -> Figure:
     """A trade-off front as a designer puts it in a report.
 
     The least RMS shaking moment against the second objective, each point's certified lower
@@ -76,7 +78,8 @@ def front_figure(front, title: str | None = None) -> Figure:
     return fig
 
 
-def _front_limits(xs: np.ndarray, ys: np.ndarray, original: tuple[float, float]):
+def _front_limits(xs: np.ndarray, ys: np.ndarray, original: tuple[float, float]
+                  ) -> tuple[tuple[float, float], tuple[float, float]]:
     """The axes' limits of a front (its points ``xs``, ``ys``), and the original's if near.
 
     The moment axis starts at zero (less a margin, for the points at zero). The original is

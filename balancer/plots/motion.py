@@ -12,7 +12,11 @@ import numpy as np
 
 from ..drawing import centre_of_mass_path
 from ..mechanisms import mechanism_of
+from ..mechanisms.base import Mechanism
+from ..model import Design
+from ..model import Mechanism as Model
 from ..simulation import Trajectory
+from ..verification import Verification
 from .style import (
     AFTER_STYLE,
     BEFORE_STYLE,
@@ -27,6 +31,7 @@ from .style import (
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
 
 
 #: Quantiles of a time panel's samples (all its curves together) that bound its bulk.
@@ -43,9 +48,9 @@ SPIKE_ROOM = 0.25
 COINCIDENT = 2e-3
 
 
-def _curves(ax: Axes) -> list:
+def _curves(ax: Axes) -> list[Line2D]:
     """The axes' data curves (lines with more than two samples)."""
-    return [line for line in ax.get_lines() if len(line.get_xdata()) > 2]
+    return [line for line in ax.get_lines() if np.size(line.get_xdata()) > 2]
 
 
 def _clip_spikes(ax: Axes, unit: str) -> None:
@@ -77,7 +82,7 @@ def _clip_spikes(ax: Axes, unit: str) -> None:
     top, bottom = top + (0.0 if clip_top else margin), bottom - (0.0 if clip_bottom else margin)
     ax.set_ylim(bottom, top)
     edge = ax.get_xaxis_transform()  # x in data, y in axes fractions
-    clipped = []
+    clipped: list[float] = []
     for line in curves:
         t, y = np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
         for beyond, at, marker, sign in ((y > top, 1.0, "^", 1.0),
@@ -139,8 +144,8 @@ def plot_reactions(traj: Trajectory, ax: Axes | None = None, title: str = "",
             colour = next(colours)
             ax.plot(t, values.real, color=colour, lw=1.2, label=f"$R_{{{point}x}}$")
             ax.plot(t, values.imag, color=colour, lw=1.2, ls="--", label=f"$R_{{{point}y}}$")
-        for link, values in traj.slider_normal.items():
-            ax.plot(t, values, color=next(colours), lw=1.2, ls=":", label=f"normal force, {link}")
+        for link, normal in traj.slider_normal.items():
+            ax.plot(t, normal, color=next(colours), lw=1.2, ls=":", label=f"normal force, {link}")
         total = traj.shaking_force
         ax.plot(t, total.real, color=COLOURS["sum"], lw=1.8, label="sum, x")
         ax.plot(t, total.imag, color=COLOURS["sum"], lw=1.8, ls="--", label="sum, y")
@@ -163,8 +168,8 @@ def _plot_reaction_magnitudes(ax: Axes, traj: Trajectory, original: Trajectory) 
         for point, values in run.ground.items():
             ax.plot(run.t, np.abs(values), color=colours[point], lw=lw, alpha=alpha,
                     label=f"$|R_{{{point}}}|$, {role}")
-        for link, values in run.slider_normal.items():
-            ax.plot(run.t, np.abs(values), color=colours[link], lw=lw, alpha=alpha, ls=":",
+        for link, normal in run.slider_normal.items():
+            ax.plot(run.t, np.abs(normal), color=colours[link], lw=lw, alpha=alpha, ls=":",
                     label=f"normal force, {link}, {role}")
         ax.plot(run.t, np.abs(run.shaking_force), color=COLOURS["sum"], lw=lw + 0.4,
                 alpha=alpha, ls="--" if role == "before" else "-",
@@ -198,7 +203,7 @@ def plot_shaking_moment(
 
 
 def plot_com_path(
-    linkage, traj: Trajectory, original=None,
+    linkage: Model | Mechanism, traj: Trajectory, original: Model | Mechanism | None = None,
     original_traj: Trajectory | None = None, ax: Axes | None = None,
 ) -> Axes:
     """Path of the total centre of mass, with the frame (a point when balanced)."""
@@ -224,7 +229,7 @@ def plot_com_path(
     return ax
 
 
-def verification_figure(design, verification) -> Figure:
+def verification_figure(design: Design, verification: Verification) -> Figure:
     """The report figure of ``balancer verify``.
 
     Columns: the crank driven at the operating speed, free motion; rows: the forces on the

@@ -10,8 +10,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..cycle import CycleAnalysis, drawn_panels
 from ..cycle import Figure as Figures
-from ..cycle import drawn_panels
 from .style import AFTER_STYLE, BEFORE_STYLE, axes, legend_outside, number
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
@@ -29,11 +29,12 @@ def _cycle_label(role: str, values: np.ndarray, unit: str) -> str:
     return f"{role}: RMS {number(f.rms)} {unit}, max {number(f.max)} {unit}"
 
 
-def _roles(before) -> tuple[str, str]:
+def _roles(before: CycleAnalysis | None) -> tuple[str, str]:
     return ("balanced design", "original") if before is not None else ("design", "")
 
 
-def plot_shaking_force_polar(analysis, before=None, ax: Axes | None = None,
+def plot_shaking_force_polar(analysis: CycleAnalysis, before: CycleAnalysis | None = None,
+                             ax: Axes | None = None,
                              legend: bool = True) -> Axes:
     """Polar diagram of the shaking force: its vector's tip over one revolution, N.
 
@@ -69,7 +70,8 @@ def plot_shaking_force_polar(analysis, before=None, ax: Axes | None = None,
     return ax
 
 
-def plot_over_crank_angle(analysis, quantity: str, before=None, ax: Axes | None = None,
+def plot_over_crank_angle(analysis: CycleAnalysis, quantity: str,
+                          before: CycleAnalysis | None = None, ax: Axes | None = None,
                           legend: bool = True) -> Axes:
     """``quantity`` (``"shaking_moment"`` or ``"driving_torque"``, N·m) over the crank angle.
 
@@ -99,7 +101,8 @@ def plot_over_crank_angle(analysis, quantity: str, before=None, ax: Axes | None 
     return ax
 
 
-def cycle_figure(analysis, before=None, title: str = "") -> Figure:
+def cycle_figure(analysis: CycleAnalysis, before: CycleAnalysis | None = None,
+                 title: str = "") -> Figure:
     """The picture a balancing report starts with: one revolution at the operating speed.
 
     The shaking force's polar diagram, and the shaking moment and driving torque over the

@@ -4,16 +4,19 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..drawing import frame
+from ..mechanisms.base import Mechanism
+from ..model import Mechanism as Model
 from ..outputs import figure_type, write_with
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
 
 
 #: Colours for the sum, before and after (colour-blind safe, Okabe & Ito).
@@ -23,9 +26,10 @@ COLOURS = {"sum": "#000000", "before": "#999999", "after": "#009E73", "link": "#
 
 #: How a curve of the original (before) and of the design (after) is drawn where both are: the
 #: original dashed on top, so that it shows where the two coincide.
-BEFORE_STYLE = {"color": COLOURS["before"], "lw": 1.4, "ls": (0, (5, 2)), "zorder": 3}
+BEFORE_STYLE: dict[str, Any] = {"color": COLOURS["before"], "lw": 1.4, "ls": (0, (5, 2)),
+                                 "zorder": 3}
 
-AFTER_STYLE = {"color": COLOURS["after"], "lw": 2.2, "zorder": 2}
+AFTER_STYLE: dict[str, Any] = {"color": COLOURS["after"], "lw": 2.2, "zorder": 2}
 
 #: Colours for the forces at the ground points and guides, in order (A0, A3, … ).
 SERIES = ("#0072B2", "#D55E00", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#009E73")
@@ -40,7 +44,7 @@ def axes(ax: Axes | None) -> Axes:
     return Figure(figsize=(7, 4), layout="constrained").add_subplot()
 
 
-def legend_outside(ax: Axes, **kw) -> None:
+def legend_outside(ax: Axes, **kw: Any) -> None:
     """The axes' legend to the right of its frame, clear of the data."""
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0,
               fontsize="small", **kw)
@@ -53,7 +57,8 @@ def number(x: float) -> str:
     return f"{x:.3g}"
 
 
-def draw_frame(ax: Axes, linkage, label: str | None = "frame (pivots, guides)") -> None:
+def draw_frame(ax: Axes, linkage: Model | Mechanism,
+               label: str | None = "frame (pivots, guides)") -> None:
     """The frame: the ground pivots as triangles, the ground guides' travel as thick lines."""
     pivots, guides = frame(linkage)
     ax.plot(pivots.real, pivots.imag, "k^", ms=8, label=label, zorder=5)
@@ -65,7 +70,7 @@ def draw_frame(ax: Axes, linkage, label: str | None = "frame (pivots, guides)") 
 EDGE_INSET = 0.08
 
 
-def mark_point(ax: Axes, x: float, y: float, label: str, where: str, **style):
+def mark_point(ax: Axes, x: float, y: float, label: str, where: str, **style: Any) -> Line2D:
     """Mark the point ``(x, y)`` (data) on ``ax`` labelled ``label``, keeping its limits.
 
     Inside the limits: a marker of ``style`` there. Outside: the marker where the point would
@@ -88,10 +93,13 @@ def mark_point(ax: Axes, x: float, y: float, label: str, where: str, **style):
         (marker,) = ax.plot([inside[0]], [inside[1]], linestyle="none", transform=ax.transAxes,
                             label=f"{label} (off the axes: arrow)", zorder=6, clip_on=False,
                             **style)
-        ax.annotate("", xy=inside + reach * d, xytext=inside, xycoords="axes fraction",
+        tip = inside + reach * d
+        ax.annotate("", xy=(tip[0], tip[1]), xytext=(inside[0], inside[1]),
+                    xycoords="axes fraction",
                     arrowprops={"arrowstyle": "-|>", "color": style.get("mec", "k"),
                                 "lw": 1.2, "shrinkA": 7, "shrinkB": 0})
-        ax.annotate(where, xy=inside, xycoords="axes fraction", xytext=-12 * d,
+        ax.annotate(where, xy=(inside[0], inside[1]), xycoords="axes fraction",
+                    xytext=(-12 * d[0], -12 * d[1]),
                     textcoords="offset points", fontsize="small",
                     bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
                           "alpha": 0.8},
@@ -131,4 +139,5 @@ def save_png(fig: Figure, path: str | os.PathLike[str], dpi: float = 100) -> Pat
 
 
 #: How the spec's own design is marked on an atlas.
-ORIGINAL_STYLE = {"marker": "*", "ms": 16, "mfc": "white", "mec": "k", "mew": 1.2}
+ORIGINAL_STYLE: dict[str, Any] = {"marker": "*", "ms": 16, "mfc": "white", "mec": "k",
+                                   "mew": 1.2}

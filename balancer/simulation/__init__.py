@@ -42,6 +42,7 @@ import math
 import time as _time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -55,7 +56,8 @@ from ..formulations import (
     make,
 )
 from ..mechanisms import mechanism_of
-from ..model import Design, SimulationSettings, check_scales
+from ..model import Design, Drive, SimulationSettings, check_scales
+from ..model import Mechanism as Model
 from .stepper import MAX_OUTPUTS, MAX_STEPS, Stepper, passing
 from .trajectory import Trajectory, trajectory_of
 
@@ -115,8 +117,8 @@ class _Setup:
     end: float | None
 
 
-def _prepare(linkage, settings: SimulationSettings, *, resolution: float | None = None,
-             **overrides) -> _Setup:
+def _prepare(linkage: Model, settings: SimulationSettings, *,
+             resolution: float | None = None, **overrides: Any) -> _Setup:
     """The settings with the overrides, checked, and the formulation at its initial state.
 
     Raises :class:`SpecError` for what :func:`simulate` refuses before it integrates (bad
@@ -156,8 +158,8 @@ def _prepare(linkage, settings: SimulationSettings, *, resolution: float | None 
     return _Setup(f=f, settings=settings, y0=y0, outputs=outputs, stop_at=stop_at, end=end)
 
 
-def check(linkage, settings: SimulationSettings, *, resolution: float | None = None,
-          **overrides) -> None:
+def check(linkage: Model, settings: SimulationSettings, *, resolution: float | None = None,
+          **overrides: Any) -> None:
     """Raise what :func:`simulate` with these arguments would refuse before it integrates.
 
     Its settings, scales and start, and a driven crank's prescribed motion that would need more
@@ -178,11 +180,11 @@ def check(linkage, settings: SimulationSettings, *, resolution: float | None = N
 
 
 def simulate(
-    linkage,
+    linkage: Model,
     settings: SimulationSettings,
     *,
     method: str | None = None,
-    drive: str | None = None,
+    drive: Drive | None = None,
     duration: float | None = None,
     rtol: float | None = None,
     atol: float | None = None,
@@ -279,11 +281,11 @@ def _before_lock(f: Formulation, t_lock: float) -> float:
 
 def _lockup(message: str, t: float, theta1: float, partial: Trajectory) -> LockupError:
     err = LockupError(message, time=t, theta1=theta1)
-    err.partial = partial  # type: ignore[attr-defined]
+    err.partial = partial
     return err
 
 
-def simulate_design(design: Design, **overrides) -> Trajectory:
+def simulate_design(design: Design, **overrides: Any) -> Trajectory:
     """:func:`simulate` with a design's own linkage and ``[simulation]`` settings.
 
     A crank driven at constant speed turns at ``[simulation] omega1`` where that is given and

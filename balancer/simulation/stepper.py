@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from typing import TypeAlias
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..errors import SolverError, SpecError
 from ..formulations import (
@@ -22,8 +23,17 @@ from ..formulations import (
     formulation_class,
     formulation_names,
 )
-from ..integration import DOP853, CompiledDOP853, Stages, TimeOnlyDOP853, with_extra_work
+from ..integration import (
+    DOP853,
+    CompiledDOP853,
+    DenseOutput,
+    Stages,
+    TimeOnlyDOP853,
+    with_extra_work,
+)
+from ..mechanisms.base import Mechanism
 from ..model import RTOL_MIN
+from ..model import Mechanism as Model
 from ..quadrature import cumulative
 
 #: Most integration steps a simulation may take (under a minute with the slowest formulation,
@@ -60,6 +70,13 @@ MAX_OUTPUTS = 100_000
 #: need more than :data:`MAX_STEPS` more to finish has stalled (near-singular motion).
 STALL_WINDOW = 1000
 
+#: A run's outputs (:meth:`Stepper.run`): the output times (s), the states there (each with
+#: the extra work as its last entry), the largest constraint drift of position and velocity,
+#: the right-hand sides evaluated, the steps taken, and where a dead point stopped it (its
+#: time and state) or ``None``.
+Run: TypeAlias = tuple[list[float], list[NDArray[np.float64]], list[float], int, int,
+                       tuple[float, NDArray[np.float64]] | None]
+
 
 class Stepper:
     """One integration with projection, dense outputs and events."""
@@ -77,13 +94,13 @@ class Stepper:
         self.t_end = duration
         self.resolution = resolution
         #: Each step's end and dense output, kept where the outputs may be resampled.
-        self.pieces: list[tuple[float, object]] = []
+        self.pieces: list[tuple[float, DenseOutput | None]] = []
         #: States between the output times (the steps' ends; a prescribed motion's at every
         #: :data:`GUIDE_ANGLE` of crank, :meth:`_guide_times`), as ``(times, states)``: the
         #: angles are followed through them from one output to the next (:func:`trajectory_of`).
         self.guide: tuple[list[float], list[NDArray[np.float64]]] = ([], [])
 
-    def run(self, y0: NDArray[np.float64], stop_at: float | None):
+    def run(self, y0: NDArray[np.float64], stop_at: float | None) -> Run:
         """Integrate from ``y0``; the states returned carry the extra work as a last entry."""
         t_end = self.duration if stop_at is None else min(stop_at, self.duration)
         self.t_end = t_end
@@ -97,6 +114,7 @@ class Stepper:
         groups = self.f.like_components()
         atol = floored_atol(self.atol, groups, y0)
         stages = self._stages()
+        solver: DOP853
         if stages is None and f.time_only:
             solver = TimeOnlyDOP853(f.rhs, 0.0, y0, t_end, rtol=self.rtol, atol=atol)
         elif stages is None:
@@ -131,9 +149,9 @@ class Stepper:
             self._check_stall(recent, f, solver.t, solver.y, change_points)
             # The step's dense output (three more evaluations for DOP853) is made only for a
             # step that holds an output time or an event, and before a projection moves y.
-            dense = None
+            dense: DenseOutput | None = None
 
-            def interp(t, _solver=solver):
+            def interp(t: ArrayLike, _solver: DOP853 = solver) -> NDArray[np.float64]:
                 nonlocal dense
                 if dense is None:
                     dense = _solver.dense_output()
@@ -157,6 +175,7 @@ class Stepper:
             self.guide[0].append(float(solver.t))
             self.guide[1].append(np.array(solver.y))
             if not passes_dead_points:
+                assert solver.t_old is not None  # a step was taken
                 event = self._dead_point(interp, solver.t_old, solver.t, solver.y,
                                          change_points)
                 if event is not None:
@@ -179,13 +198,16 @@ class Stepper:
             states[initial:] = f.project_many(times[initial:], states[initial:])
         return times, states, drift, solver.nfev + self.extra_fev, steps, stopped
 
-    def _resampled(self, f, times: list[float], states: list, initial: int):
+    def _resampled(self, f: WithExtraWork, times: list[float],
+                   states: list[NDArray[np.float64]], initial: int
+                   ) -> tuple[list[float], list[NDArray[np.float64]]]:
         """The outputs, more of them where the crank turned farther than the resolution.
 
         From the steps' dense outputs (:attr:`pieces`), without integrating again: output times
         at least twice as many each round, until the crank turns at most :attr:`resolution`
         between two (or :data:`MAX_OUTPUTS`).
         """
+        assert self.resolution is not None  # a run that resamples
         last = times[-1]
         ends = np.array([end for end, _ in self.pieces])
         outputs = self.t_out.size
@@ -203,12 +225,14 @@ class Stepper:
             fresh = [states[0]] * head
             for index in np.unique(where):
                 at = grid[head:][where == index]
-                fresh += list(self.pieces[index][1](np.minimum(at, ends[index])).T)
+                piece = self.pieces[index][1]
+                assert piece is not None  # made for every step of a run that resamples
+                fresh += list(piece(np.minimum(at, ends[index])).T)
             times, states = grid.tolist(), fresh
             self.t_out = np.linspace(0.0, self.duration, outputs)
         return times, states
 
-    def _prescribed(self, y0: NDArray[np.float64]):
+    def _prescribed(self, y0: NDArray[np.float64]) -> Run | None:
         """A driven crank's prescribed motion, its work by quadrature instead of steps.
 
         The state of a :attr:`~balancer.formulations.Formulation.time_only` formulation is a
@@ -222,6 +246,7 @@ class Stepper:
         f = self.f
         if not self.prescribes(y0):
             return None
+        assert f.speed is not None  # driven
         self._check_panels(self.t_end)
         outs = self._outputs()
         near_dead_point = False
@@ -230,6 +255,7 @@ class Stepper:
         def integrand(t: NDArray[np.float64]) -> NDArray[np.float64]:
             nonlocal near_dead_point
             rates = f.driven_rates(t)
+            assert rates is not None  # (prescribes() has checked)
             if not f.passes_dead_points:
                 low = np.abs(rates.transmission) <= DEAD_POINT_THRESHOLD
                 if np.any(low):
@@ -282,7 +308,8 @@ class Stepper:
         a run of as many steps would be, before the panels' nodes are laid out (a 1e5 s run:
         1e8 nodes).
         """
-        panels = abs(float(self.f.speed)) * t_end / PANEL_ANGLE  # type: ignore[arg-type]
+        assert self.f.speed is not None  # driven
+        panels = abs(float(self.f.speed)) * t_end / PANEL_ANGLE
         if panels > MAX_STEPS:
             raise SpecError(
                 f"would take about {panels:.2g} quadrature panels of the crank's prescribed "
@@ -300,13 +327,14 @@ class Stepper:
         Every :data:`GUIDE_ANGLE` of crank; none where the (equally spaced) output times
         ``outs`` are that close already.
         """
-        turn = abs(float(self.f.speed))  # type: ignore[arg-type]
+        assert self.f.speed is not None  # driven
+        turn = abs(float(self.f.speed))
         if outs.size < 2 or turn * (outs[1] - outs[0]) <= GUIDE_ANGLE:
             return np.zeros(0)
         grid = np.linspace(0.0, outs[-1], math.ceil(turn * outs[-1] / GUIDE_ANGLE) + 1)
         return grid[(grid > 0) & (grid < outs[-1]) & ~np.isin(grid, outs)]
 
-    def _prescribed_motion(self, y0: NDArray[np.float64]):
+    def _prescribed_motion(self, y0: NDArray[np.float64]) -> Run | None:
         """A driven crank's prescribed motion in a formulation that is not minimal.
 
         The states at the output times are the motion itself
@@ -328,14 +356,15 @@ class Stepper:
         motion = f.driven_motion(times, y0)
         if motion is None:
             return None
-        speed = float(f.speed)  # type: ignore[arg-type]
+        assert f.speed is not None  # driven
+        speed = float(f.speed)
 
         def integrand(t: NDArray[np.float64]) -> NDArray[np.float64]:
-            states = f.driven_motion(t, y0)
-            if states is None:
+            moving = f.driven_motion(t, y0)
+            if moving is None:
                 raise SolverError("the prescribed motion does not exist at a quadrature node "
                                   f"within 0 ≤ t ≤ {self.t_end:.6g} s")
-            states = [np.append(y, 0.0) for y in states]  # the motor's work: not used
+            states = [np.append(y, 0.0) for y in moving]  # the motor's work: not used
             torque = np.asarray(f.evaluate_batch(t, states).driving_torque, float)
             extra = [f.extra_power(ti, y) for ti, y in zip(t, states, strict=True)]
             return np.column_stack([torque * speed, extra])
@@ -350,7 +379,7 @@ class Stepper:
             self.progress(self.duration, self.duration)
         return outs.tolist(), states, list(drift), work.evaluations, work.panels, None
 
-    def _stages(self):
+    def _stages(self) -> Stages | None:
         """The formulation's compiled DOP853 stages (built once per formulation), or None."""
         cache = self.f.compiled
         if "dop853" not in cache:
@@ -376,7 +405,8 @@ class Stepper:
                 f"{t:.3g} s ({steps} steps), more than the {MAX_STEPS:.0e} allowed: shorten "
                 "it, or loosen rtol", key="simulation.duration", value=self.duration)
 
-    def _check_stall(self, recent: deque[float], f, t: float, y, change_points) -> None:
+    def _check_stall(self, recent: deque[float], f: WithExtraWork, t: float,
+                     y: NDArray[np.float64], change_points: tuple[float, ...]) -> None:
         """Fail a run whose last :data:`STALL_WINDOW` steps project past :data:`MAX_STEPS`.
 
         The integrator keeps its error within rtol and atol by shrinking its steps; near a
@@ -406,14 +436,16 @@ class Stepper:
             f"{MAX_STEPS:.0e} steps at rtol = {self.rtol:g}, atol = {self.atol:g}; loosen "
             f"the tolerances or end the run before t = {t:.6g} s")
 
-    def _dead_point(self, interp, t0: float, t1: float, y1, change_points):
+    def _dead_point(self, interp: Callable[[ArrayLike], NDArray[np.float64]], t0: float,
+                    t1: float, y1: NDArray[np.float64], change_points: tuple[float, ...]
+                    ) -> tuple[float, NDArray[np.float64]] | None:
         """The time at which |sin(θ3 − θ2)| falls to the threshold within a step, or None.
 
         ``y1`` is the state at the step's end (the dense output is made only for an event).
         """
         f = WithExtraWork(self.f)
 
-        def gap(t: float, y=None) -> float:
+        def gap(t: float, y: NDArray[np.float64] | None = None) -> float:
             y = interp(t) if y is None else y
             if change_points and near_change_point(f, t, y, change_points):
                 return 1.0  # passable: the smooth motion goes through
@@ -427,7 +459,8 @@ class Stepper:
         return t_event, interp(t_event)
 
 
-def floored_atol(atol: float, groups, y: NDArray[np.float64]) -> float | NDArray[np.float64]:
+def floored_atol(atol: float, groups: Sequence[NDArray[np.intp]], y: NDArray[np.float64]
+                 ) -> float | NDArray[np.float64]:
     """The absolute tolerance of each component of the state ``y``.
 
     ``atol``, but for a component of one of the ``groups``
@@ -475,7 +508,8 @@ class WithExtraWork:
     def project(self, t: float, y: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.append(self.f.project(t, y[:-1]), y[-1])
 
-    def project_many(self, times, states) -> list[NDArray[np.float64]]:
+    def project_many(self, times: Sequence[float] | NDArray[np.float64],
+                     states: Sequence[NDArray[np.float64]]) -> list[NDArray[np.float64]]:
         own = self.f.project_many(times, [y[:-1] for y in states])
         return [np.append(p, y[-1]) for p, y in zip(own, states, strict=True)]
 
@@ -492,21 +526,22 @@ class WithExtraWork:
         return self.f.change_points()
 
 
-def passing_change(model) -> str:
+def passing_change(model: Model | Mechanism) -> str:
     """The formulations of a mechanism that pass change points, as a parenthesis."""
     names = [n for n in formulation_names(model)
              if formulation_class(n, model).passes_change_points]
     return f" ({' and '.join(names)} can)" if names else ""
 
 
-def passing(model) -> str:
+def passing(model: Model | Mechanism) -> str:
     """The formulations of a mechanism that pass dead points, as a parenthesis."""
     names = [n for n in formulation_names(model)
              if formulation_class(n, model).passes_dead_points]
     return f" ({' and '.join(names)} can)" if names else ""
 
 
-def near_change_point(f, t: float, y, points) -> bool:
+def near_change_point(f: WithExtraWork, t: float, y: NDArray[np.float64],
+                      points: Sequence[float]) -> bool:
     """Whether the state ``y`` at ``t`` is within :data:`CHANGE_POINT_NEAR` of a change point."""
     theta1 = f.theta1_of(t, y)
     return any(abs(math.remainder(theta1 - p, 2 * math.pi)) < CHANGE_POINT_NEAR for p in points)

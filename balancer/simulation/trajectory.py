@@ -7,17 +7,21 @@ frame, the shaking, the energy balance of :mod:`balancer.simulation`.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..columns import simulation_columns
+from ..columns import Columns, simulation_columns
 from ..formulations import (
     Formulation,
     continuous_angles,
 )
 from ..mechanisms import mechanism_of
+from ..model import Drive
+from ..model import Mechanism as Model
 
 
 @dataclass(frozen=True)
@@ -78,7 +82,7 @@ class Trajectory:
     """
 
     method: str
-    drive: str
+    drive: Drive
     links: tuple[str, ...]
     t: NDArray[np.float64]
     theta: NDArray[np.float64]
@@ -101,7 +105,7 @@ class Trajectory:
     atol: float
     named_states: bool = False
     speed: float | None = None
-    model: object = field(repr=False, default=None)
+    model: Model | None = field(repr=False, default=None)
     slider: NDArray[np.float64] | None = field(repr=False, default=None)
 
     def __repr__(self) -> str:
@@ -116,19 +120,19 @@ class Trajectory:
             *self.ground.values(), *self.slider_normal.values())]
         return float(max(values, default=0.0))
 
-    def columns(self, all_columns: bool = False) -> tuple[list[str], list]:
+    def columns(self, all_columns: bool = False) -> tuple[list[str], Columns]:
         """The columns of ``simulate``'s CSV: names and values over the output times.
 
         See :func:`balancer.columns.simulation_columns`.
         """
         return simulation_columns(self, all_columns)
 
-    def state(self, index: int) -> dict:
+    def state(self, index: int) -> dict[str, list[float] | dict[str, float]]:
         """Angles, rates and accelerations of the links at output ``index``.
 
         Each a list in link order, or (``named_states``) an object keyed by link name.
         """
-        out = {}
+        out: dict[str, list[float] | dict[str, float]] = {}
         for key, values in (("theta", self.theta), ("omega", self.omega),
                             ("alpha", self.alpha)):
             numbers = [float(x) + 0.0 for x in values[:, index]]
@@ -137,8 +141,13 @@ class Trajectory:
         return out
 
 
-def trajectory_of(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
-                  seconds, guide=None) -> Trajectory:
+#: States between the output times: ``(times, states)``.
+Guide = tuple[Sequence[float], Sequence[NDArray[np.float64]]]
+
+
+def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArray[np.float64]],
+                  drift: Sequence[float], nfev: int, steps: int, rtol: float, atol: float,
+                  seconds: float, guide: Guide | None = None) -> Trajectory:
     """The :class:`Trajectory` of formulation ``f``'s states at the output times.
 
     Each state carries the work integrated with it as its last component; ``drift``, ``nfev``,
@@ -147,16 +156,16 @@ def trajectory_of(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
     """
     t = np.array(times)
     extra = np.array([y[-1] for y in states])
-    states = [y[:-1] for y in states]
-    ev = f.evaluate_batch(times, states)
+    own = [y[:-1] for y in states]
+    ev = f.evaluate_batch(times, own)
     omega, alpha = np.asarray(ev.omega, float), np.asarray(ev.alpha, float)
     theta = _followed_angles(f, t, np.asarray(ev.theta, float), omega, guide)
     tau = np.asarray(ev.driving_torque, float) * np.ones(t.size)
-    motor = np.array([f.motor_work(y) for y in states])
+    motor = np.array([f.motor_work(y) for y in own])
     slider = None if ev.slider is None else np.asarray(ev.slider, float)
     # Energy: T − T0 = work of loads and gravity (a function of the configuration) + motor
     # + the extra work integrated with the motion (a gas force).
-    kin, work = f.energy(theta, omega, alpha, slider, states=states)
+    kin, work = f.energy(theta, omega, alpha, slider, states=own)
     work = work + motor + extra
     scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), _exchangeable_energy(f), 1e-300)
     energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
@@ -170,13 +179,16 @@ def trajectory_of(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
         theta=theta,
         omega=omega,
         alpha=alpha,
-        ground={p: np.asarray(v, complex) * np.ones(t.size) for p, v in ev.ground.items()},
+        # (numpy's stubs type a complex array times a real one as real)
+        ground={p: cast("NDArray[np.complex128]", np.asarray(v, complex) * np.ones(t.size))
+                for p, v in ev.ground.items()},
         slider_normal={k: np.asarray(v, float) * np.ones(t.size)
                        for k, v in ev.slider_normal.items()},
         slider_couple={k: np.asarray(v, float) * np.ones(t.size)
                        for k, v in ev.slider_couple.items()},
         driving_torque=tau,
-        shaking_force=np.asarray(shaking_force, complex) * np.ones(t.size),
+        shaking_force=cast("NDArray[np.complex128]",
+                           np.asarray(shaking_force, complex) * np.ones(t.size)),
         shaking_moment=np.asarray(moment, float) * np.ones(t.size),
         kinetic_energy=kin,
         work=work,
@@ -193,7 +205,8 @@ def trajectory_of(f: Formulation, times, states, drift, nfev, steps, rtol, atol,
     )
 
 
-def _followed_angles(f: Formulation, t, theta, omega, guide) -> NDArray[np.float64]:
+def _followed_angles(f: Formulation, t: NDArray[np.float64], theta: NDArray[np.float64],
+                     omega: NDArray[np.float64], guide: Guide | None) -> NDArray[np.float64]:
     """The links' angles at the output times, continuous over the motion, rad.
 
     Each step from one time to the next takes the 2π branch nearest to the trapezoidal

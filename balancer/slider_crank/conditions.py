@@ -47,7 +47,7 @@ def is_force_balanced(mech: SliderCrank, tol: float = FORCE_BALANCE_TOLERANCE) -
     return force_balance_error(mech) <= tol
 
 
-def force_balance_matrix(lengths) -> NDArray[np.float64]:
+def force_balance_matrix(lengths: tuple[float, float, float]) -> NDArray[np.float64]:
     """Eq. 20a–b as a 4×13 matrix ``A`` with ``A·x = 0`` for a force-balanced design.
 
     Columns of ``x``: crank, rod and slider, each ``(m, m·e, m·f, J)`` (kg, kg·m, kg·m,

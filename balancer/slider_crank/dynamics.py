@@ -21,6 +21,8 @@ Routes:
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -28,10 +30,11 @@ from ..inverse import Reactions, dynamic_link
 from ..kinematics import cross
 from ..massmodels import equivalent_inertia_forces, equivalent_joint_forces, inertial_parameters
 from ..model import Link, SliderCrank
-from .kinematics import SliderMotion
+from .kinematics import Lengths, SliderMotion
 
 
-def _loads(mech: SliderCrank, mo: SliderMotion, gravity: complex, loads: bool):
+def _loads(mech: SliderCrank, mo: SliderMotion, gravity: complex, loads: bool
+           ) -> tuple[list[complex], list[float], NDArray[np.float64]]:
     """Forces at the centres of mass (weight included), moments and the gas force."""
     forces = [(link.force_complex if loads else 0j) + link.mass * gravity for link in mech.links]
     moments = [link.moment if loads else 0.0 for link in mech.links]
@@ -39,13 +42,16 @@ def _loads(mech: SliderCrank, mo: SliderMotion, gravity: complex, loads: bool):
     return forces, moments, np.asarray(gas, dtype=float)
 
 
-def _finish(mech, mo, ra0, n_guide, m_guide, tau, gas, shaking, alpha1) -> Reactions:
+def _finish(mech: SliderCrank, mo: SliderMotion, ra0: NDArray[np.complex128],
+            n_guide: NDArray[np.float64], m_guide: NDArray[np.float64],
+            tau: NDArray[np.float64], gas: NDArray[np.float64],
+            shaking: NDArray[np.complex128], alpha1: NDArray[np.float64]) -> Reactions:
     """Frame loads from the pin and guide forces, the motor torque and the gas force.
 
     The guide's normal force and couple are those on the slider.
     """
     h = mech.lengths[2]
-    ra3 = -1j * n_guide  # the slider on its guide
+    ra3 = np.asarray(-1j * n_guide, dtype=complex)  # the slider on its guide
     moment = -mo.x * n_guide - m_guide + h * gas - tau
     if mech.crank.counter_rotor:
         moment = moment + 2 * mech.crank.counter_rotor * alpha1
@@ -88,11 +94,13 @@ def newton_euler(
     p1 = need2 + p2
     p0 = need1 + p1
     tau = dyn[0].inertia * mo.alpha[0] + cross(z1 * v1, need1) + cross(v1, p1) - moments[0]
-    shaking = -p0 - 1j * n_guide - gas
+    shaking = np.asarray(-p0 - 1j * n_guide - gas, dtype=complex)
     return _finish(mech, mo, -p0, n_guide, m_guide, tau, gas, shaking, mo.alpha[0])
 
 
-def _nodal(params_crank, params_rod, m3, mo: SliderMotion, lengths):
+def _nodal(params_crank: Sequence[float], params_rod: Sequence[float], m3: float,
+           mo: SliderMotion, lengths: Lengths
+           ) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]]:
     """Nodal inertia forces ``−M·r̈`` at A0, A1, A2 (Eq. 45 for crank and rod, a mass at A2)."""
     r, big_l, _ = lengths
     acc_a1 = mo.vector_acceleration(0)
@@ -102,7 +110,13 @@ def _nodal(params_crank, params_rod, m3, mo: SliderMotion, lengths):
     return -c0, -c1 - r1, -r2 - m3 * acc_a2
 
 
-def _combine(mech_lengths, mo: SliderMotion, nodes, gas, slider_moment, rotor_alpha) -> tuple:
+def _combine(mech_lengths: Lengths, mo: SliderMotion,
+             nodes: tuple[NDArray[np.complex128], NDArray[np.complex128],
+                          NDArray[np.complex128]],
+             gas: NDArray[np.float64], slider_moment: NDArray[np.float64],
+             rotor_alpha: NDArray[np.float64] | float
+             ) -> tuple[NDArray[np.float64], NDArray[np.complex128], NDArray[np.float64],
+                        NDArray[np.complex128], NDArray[np.float64]]:
     """Torque, shaking force, guide force, crank-pivot force and shaking moment.
 
     From the nodal forces ``G`` at A0, A1, A2 (gas excluded) by virtual displacements that keep

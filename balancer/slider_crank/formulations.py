@@ -22,32 +22,39 @@ Both take the gas force as acting between slider and frame along the guide.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import Any, overload
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..formulations.base import DrivenRates, Evaluation
 from ..formulations.closed_form import ClosedForm
-from ..formulations.mass_matrix import NodalTruss
+from ..formulations.mass_matrix import NodalTruss, NodeAccelerations
 from ..kinematics import cross_scalar
+from ..linkage.vectors import Num
 from ..massmodels import equivalent_joint_forces, equivalent_mass_matrix, inertial_parameters
-from ..model import Link
+from ..model import Link, SliderCrank
+from ..model.assembly import AssemblyRange
 from .dynamics import kinetic_energy, newton_euler
-from .kinematics import assembly_range, motion
+from .kinematics import Lengths, SliderMotion, assembly_range, motion
 
 
 class _SliderFormulation(ClosedForm):
     """What both slider-crank formulations share: the mechanism's geometry for the driver."""
 
+    linkage: SliderCrank
+    lengths: Lengths
+
     rotating_links = 2
     passes_dead_points = False
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.sign0 = 1.0 if self.linkage.branch == "+" else -1.0
         self.offset = self.lengths[2]
 
-    def assembly_range(self):
+    def assembly_range(self) -> AssemblyRange:
         return assembly_range(self.lengths)
 
     def change_points(self) -> tuple[float, ...]:
@@ -58,13 +65,22 @@ class _SliderFormulation(ClosedForm):
         s2 = (e - r * math.sin(theta1)) / big_l
         return math.sqrt(max(1 - s2 * s2, 0.0))
 
-    def gas(self, theta1):
+    @overload
+    def gas(self, theta1: float) -> float: ...
+    @overload
+    def gas(self, theta1: NDArray[np.float64]) -> NDArray[np.float64]: ...
+
+    def gas(self, theta1: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
         return self.linkage.gas_force.at(theta1)
 
-    def motion_of(self, theta1, omega1=0.0, alpha1=0.0):
+    def motion_of(self, theta1: ArrayLike, omega1: ArrayLike = 0.0,
+                  alpha1: ArrayLike = 0.0) -> SliderMotion:
         return motion(self.lengths, theta1, omega1, alpha1, self.sign0, check=False)
 
-    def energy(self, theta, omega, alpha, slider=None, states=None):
+    def energy(self, theta: NDArray[np.float64], omega: NDArray[np.float64],
+               alpha: NDArray[np.float64], slider: NDArray[np.float64] | None = None,
+               states: Sequence[NDArray[np.float64]] | None = None
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Kinetic energy and the work of the loads and gravity since the start, J."""
         mo = self.motion_of(theta[0], omega[0], alpha[0])
         kin = kinetic_energy(self.linkage, mo)
@@ -79,10 +95,12 @@ class _SliderFormulation(ClosedForm):
         # The gas force's work is integrated with the motion (extra_power).
         return kin, work
 
-    def shaking(self, ev: Evaluation) -> tuple:
+    def shaking(self, ev: Evaluation) -> tuple[Any, Any]:
         return ev.shaking_force, ev.shaking_moment
 
-    def _evaluation(self, theta1, omega1, alpha1, driving_torque) -> Evaluation:
+    def _evaluation(self, theta1: NDArray[np.float64], omega1: NDArray[np.float64],
+                    alpha1: NDArray[np.float64], driving_torque: NDArray[np.float64]
+                    ) -> Evaluation:
         """Reactions and everything else from the crank's state and acceleration."""
         mo = self.motion_of(theta1, omega1, alpha1)
         ne = newton_euler(self.linkage, mo, gravity=(self.gravity.real, self.gravity.imag))
@@ -107,19 +125,20 @@ class SliderComplexMasses(_SliderFormulation):
     name = "complex-masses"
     minimal = True
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         c1, c2, c3 = self.links
         self.m2p = c2.mass * (1 - self.zeta[1])
         self.m2q = c2.mass * self.zeta[1]
         self.crank_inertia = c1.inertia + c1.mass * abs(c1.com) ** 2  # about A0, rotor included
 
-    def _crank(self, t: float, y) -> tuple[float, float]:
+    def _crank(self, t: float, y: NDArray[np.float64]) -> tuple[float, float]:
         if self.driven:
-            return self.crank_angle(t), float(self.speed)  # type: ignore[arg-type]
+            return self.crank_angle(t), self._motor_speed
         return float(y[0]), float(y[1])
 
-    def reduced(self, theta1: float, omega1: float, torque: float = 0.0):
+    def reduced(self, theta1: float, omega1: float, torque: float = 0.0
+                ) -> tuple[float, float, float]:
         """``(Σ, Σ'/2, Q)`` at a state.
 
         The generalised inertia, half its derivative, and the generalised force of loads,
@@ -141,7 +160,8 @@ class SliderComplexMasses(_SliderFormulation):
         d_big_x = -r * c1 - big_l * (s2 * d_big2 + c2 * big2 * big2)  # dX/dθ1
         return complex(r * c1, r * s1), big2, big_x, d_big2, d_big_x
 
-    def _combine(self, v1, big2, big_x, d_big2, d_big_x, gas, torque=0.0):
+    def _combine(self, v1: Num, big2: Num, big_x: Num, d_big2: Num, d_big_x: Num, gas: Num,
+                 torque: Num = 0.0) -> tuple[Num, Num, Num]:
         """``(Σ, Σ'/2, Q)`` from the kinematics' transfer functions, for numbers or arrays."""
         c1, c2, c3 = self.links
         m2 = c2.mass
@@ -158,7 +178,9 @@ class SliderComplexMasses(_SliderFormulation):
              + (f3.real + gas) * big_x)
         return sigma, half_dsigma, q
 
-    def _terms(self, theta1: NDArray[np.float64]):
+    def _terms(self, theta1: NDArray[np.float64]
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                          NDArray[np.float64]]:
         """``(Σ, Σ'/2, Q, X)`` at an array of crank angles (``Q`` without the motor's torque).
 
         ``X = dx/dθ1``, the slider's velocity per unit crank rate.
@@ -186,7 +208,8 @@ class SliderComplexMasses(_SliderFormulation):
     def evaluate(self, t: float, y: NDArray[np.float64]) -> Evaluation:
         return self.evaluate_batch([t], [y]).at(0)
 
-    def evaluate_batch(self, times, states) -> Evaluation:
+    def evaluate_batch(self, times: Sequence[float] | NDArray[np.float64],
+                       states: Sequence[NDArray[np.float64]]) -> Evaluation:
         cranks = np.array([self._crank(t, y) for t, y in zip(times, states, strict=True)],
                           dtype=float).reshape(-1, 2)
         theta1, omega1 = cranks[:, 0], cranks[:, 1]
@@ -197,12 +220,12 @@ class SliderComplexMasses(_SliderFormulation):
             alphas, torques = (q - half_dsigma * omega1 * omega1) / sigma, 0.0 * theta1
         return self._evaluation(theta1, omega1, alphas, torques)
 
-    def driven_rates(self, times) -> DrivenRates | None:
+    def driven_rates(self, times: ArrayLike) -> DrivenRates | None:
         """The motor's power ``τ·θ̇1`` and the gas force's ``G·X·θ̇1`` at many times."""
         if not self.time_only:
             return None
         theta1 = self.crank_angle(np.asarray(times, dtype=float))
-        omega1 = float(self.speed)  # type: ignore[arg-type]
+        omega1 = self._motor_speed
         _, half_dsigma, q, big_x = self._terms(theta1)
         tau = half_dsigma * omega1 * omega1 - q  # as rhs
         extra = (0.0 * theta1 if self.linkage.gas_force.is_zero
@@ -226,13 +249,15 @@ class SliderComplexMasses(_SliderFormulation):
         return self.transmission_of_crank(self._crank(t, y)[0])
 
 
-class SliderMassMatrix(_SliderFormulation, NodalTruss):
+# The four-bar's nodal truss (a FourBarFormulation) with the slider-crank's linkage and lengths,
+# which come first: their types are the slider-crank's.
+class SliderMassMatrix(_SliderFormulation, NodalTruss):  # type: ignore[misc]  # see above
     """Truss elements for crank and rod, the slider a mass at its pin, the guide a constraint."""
 
     name = "mass-matrix"
     minimal = False
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         c1, c2, c3 = self.links
         r, big_l, _ = self.lengths
@@ -249,7 +274,8 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):
 
     # -- geometry ----------------------------------------------------------------------------
 
-    def constraints(self, x):
+    def constraints(self, x: NDArray[np.float64]
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``Φ`` and ``∂Φ/∂x`` for x = (A1x, A1y, A2x, A2y).
 
         Crank and rod ``(|l̄|² − l²)/2`` (m²), the guide ``y_A2 − e`` (m).
@@ -264,11 +290,11 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):
                         [0.0, 0.0, 0.0, 1.0]])
         return phi, jac
 
-    def _forces(self, x, tau: float, gas: float):
+    def _forces(self, x: NDArray[np.float64], tau: float, gas: float) -> list[complex]:
         """Nodal applied forces at A0, A1, A2 (Eq. 46), the gas force and the motor torque in."""
         r, big_l, _ = self.lengths
         a1, a2 = complex(x[0], x[1]), complex(x[2], x[3])
-        out = [0j, 0j, 0j]
+        out: list[complex] = [0j, 0j, 0j]
         for k, (vec, length, (p, q)) in enumerate(((a1, r, (0, 1)), (a2 - a1, big_l, (1, 2)))):
             link = self.links[k]
             loaded = Link(mass=link.mass, inertia=link.inertia, e=link.e, f=link.f,
@@ -280,7 +306,7 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):
         out[2] += self.forces[2] + gas
         return out
 
-    def solve(self, t: float, y: NDArray[np.float64]):
+    def solve(self, t: float, y: NDArray[np.float64]) -> NodeAccelerations:
         """Accelerations, multipliers (crank, rod, guide) and the motor torque at a state."""
         x, xd = y[0:4], y[4:8]
         a1d, a2d = complex(xd[0], xd[1]), complex(xd[2], xd[3])
@@ -293,7 +319,7 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         self.theta1_start = float(theta1)
         if self.driven:
-            omega1 = float(self.speed)  # type: ignore[arg-type]
+            omega1 = self._motor_speed
         mo = motion(self.lengths, theta1, omega1, 0.0, self.sign0)
         return self.node_state(mo.A1[0], mo.A2[0], mo.vector_rate(0)[0], complex(mo.v[0]), theta1)
 
@@ -353,5 +379,5 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):
         return float(pos), float(np.max(np.abs(jac @ y[4:8])))
 
 
-def _element(link, length: float) -> NDArray[np.float64]:
+def _element(link: Link, length: float) -> NDArray[np.float64]:
     return equivalent_mass_matrix(inertial_parameters(link), length)

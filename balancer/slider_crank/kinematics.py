@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import AssemblyError
 from ..kinematics import SINGULAR_TOLERANCE, _as_1d
+from ..model import SliderCrank
 from ..model.assembly import AssemblyRange
 
 Lengths = tuple[float, float, float]
@@ -57,7 +58,7 @@ def assembly_range(lengths: Lengths) -> AssemblyRange:
     return AssemblyRange(intervals=((a, b), (math.pi - b, math.pi - a)), full=False)
 
 
-def _sign(branch) -> float | NDArray[np.float64]:
+def _sign(branch: str | ArrayLike) -> float | NDArray[np.float64]:
     if isinstance(branch, str):
         if branch not in ("+", "-"):
             raise ValueError(f"branch must be '+' or '-', got {branch!r}")
@@ -112,7 +113,7 @@ class SliderMotion:
     @cached_property
     def A2(self) -> NDArray[np.complex128]:
         """Slider pin ``x + i·e``, m."""
-        return self.x + 1j * self.lengths[2]
+        return np.asarray(self.x + 1j * self.lengths[2], dtype=complex)
 
     @cached_property
     def theta2(self) -> NDArray[np.float64]:
@@ -199,8 +200,8 @@ def motion(
     )
 
 
-def motion_of(mechanism, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0,
-              *, check: bool = True) -> SliderMotion:
+def motion_of(mechanism: SliderCrank, theta1: ArrayLike, omega1: ArrayLike = 0.0,
+              alpha1: ArrayLike = 0.0, *, check: bool = True) -> SliderMotion:
     """:func:`motion` for a :class:`~balancer.model.SliderCrank` on its own branch."""
     return motion(mechanism.lengths, theta1, omega1, alpha1, mechanism.branch, check=check)
 

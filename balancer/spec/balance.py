@@ -8,6 +8,8 @@ from .. import tomltext as toml
 from ..balance.bounds import check_problem
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
+from ..mechanisms.base import Mechanism
+from ..model import Mechanism as Model
 from ..model.balance import (
     COUNTERWEIGHT_KEYS,
     LINK_KEYS,
@@ -117,7 +119,7 @@ def _read_flag(table: Table, name: str) -> bool:
     return value
 
 
-def read_balance(table: Table, mechanism) -> BalanceProblem:
+def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
     """Read and validate a spec's ``[balance]`` table (called by :mod:`balancer.spec`).
 
     Parameters
@@ -169,7 +171,8 @@ def read_balance(table: Table, mechanism) -> BalanceProblem:
         if sub is not None:
             links[name] = _read_link_freedom(sub, points)
     table.finish()
-    problem = BalanceProblem(force_balance=force_balance, objective=objective, links=links)
+    problem = BalanceProblem(force_balance=force_balance, objective=objective,
+                             links=tuple(links.items()))
     check_problem(problem, mech)
     return problem
 

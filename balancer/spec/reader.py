@@ -63,16 +63,20 @@ from ..model import (
     SliderCrank,
     Spring,
 )
+from ..model import Mechanism as Model
 from .balance import read_balance
 from .tables import Table
 
-MECHANISMS = {"four-bar": FourBar, "slider-crank": SliderCrank, "linkage": Linkage}
+MECHANISMS: dict[str, type[FourBar] | type[SliderCrank] | type[Linkage]] = {
+    "four-bar": FourBar, "slider-crank": SliderCrank, "linkage": Linkage}
 
 
 MECHANISM_TYPES = tuple(MECHANISMS)
 
 
-def _read_link(table: Table, name: str, mechanism_class, frame=None) -> Link:
+def _read_link(table: Table, name: str,
+               mechanism_class: type[FourBar] | type[SliderCrank] | type[Linkage],
+               frame: tuple[complex, float] | None = None) -> Link:
     """One link; its values are checked by :class:`~balancer.model.Link` (keys prefixed).
 
     ``frame`` (a general linkage's link: its origin, complex, and its x-axis's angle at the
@@ -156,13 +160,15 @@ def _read_gas_force(table: Table) -> GasForce:
     return gas
 
 
-def _read_links(table: Table, mechanism_class,
+def _read_links(table: Table, mechanism_class: type[FourBar] | type[SliderCrank] | type[Linkage],
                 names: tuple[str, ...] | None = None) -> tuple[dict[str, Link], GasForce]:
     """The links of a mechanism, and the gas force on its slider (if it has one).
 
     ``names``: the links to read (by default the mechanism class's own).
     """
-    names = mechanism_class.link_names if names is None else names
+    if names is None:
+        assert not issubclass(mechanism_class, Linkage)  # (a general linkage's are named)
+        names = mechanism_class.link_names
     table.expect(names)
     links = {}
     gas = GasForce()
@@ -182,14 +188,14 @@ def _read_mechanism(root: Table) -> FourBar | SliderCrank | Linkage:
     assert mech is not None
     kind = mech.string("type", choices=MECHANISM_TYPES)
     cls = MECHANISMS[kind]
-    if cls is Linkage:
+    if issubclass(cls, Linkage):  # (it is Linkage)
         return _read_linkage(root, mech)
     mech.expect(("type", "branch", "lengths"))
     branch = mech.string("branch", choices=("+", "-"), default="+")
     lengths_table = mech.table("lengths")
     assert lengths_table is not None
     lengths_table.expect(cls.length_names)
-    lengths = []
+    lengths: list[Any] = []  # as written: the mechanism checks them
     for name in cls.length_names:
         if name == "offset":
             lengths.append(lengths_table.value(name, 0.0))
@@ -204,9 +210,10 @@ def _read_mechanism(root: Table) -> FourBar | SliderCrank | Linkage:
     links, gas = _read_links(links_table, cls)
     # The mechanism checks its lengths (keys from the root: mechanism.lengths.crank), that it
     # assembles, and its links.
+    fields: dict[str, Any] = {"lengths": tuple(lengths), "branch": branch, **links}
     if cls is SliderCrank:
-        return SliderCrank(lengths=tuple(lengths), branch=branch, gas_force=gas, **links)  # type: ignore[arg-type]
-    return FourBar(lengths=tuple(lengths), branch=branch, **links)  # type: ignore[arg-type]
+        return SliderCrank(gas_force=gas, **fields)
+    return FourBar(**fields)
 
 
 def _list_of_tables(table: Table, name: str) -> list[Table]:
@@ -243,10 +250,10 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
     points_table.known = tuple(points_table.data)
     points = {p: points_table.vector2(p, default=(0.0, 0.0)) for p in points_table.data}
     points_table.finish()
-    sliders = []
+    sliders: list[dict[str, Any]] = []  # each a Slider's fields
     for sub in _list_of_tables(mech, "sliders"):
         sub.expect(("link", "guide", "point", "direction"))
-        fields = {}
+        fields: dict[str, Any] = {}
         for attr in ("link", "guide", "point"):
             if not sub.has(attr):
                 raise sub._missing(attr)
@@ -266,18 +273,17 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
     positions = {p: complex(*xy) for p, xy in points.items()}
     bodies = []
     for name in links_table.data:
-        sub = links_table.table(name)
-        assert sub is not None
+        link = links_table.table(name)
         if name == GROUND:
-            sub.expect(("points",))
-            bodies.append(Body(name=name, points=_names(sub, "points")))
-            sub.finish()
+            link.expect(("points",))
+            bodies.append(Body(name=name, points=_names(link, "points")))
+            link.finish()
             continue
-        sub.expect(("points", "mass", "inertia", "com", "force", "moment", "counter_rotor"))
-        link_points = _names(sub, "points")
+        link.expect(("points", "mass", "inertia", "com", "force", "moment", "counter_rotor"))
+        link_points = _names(link, "points")
         frame = _frame(name, link_points, positions, sliders)
-        props = _read_link(sub, name, Linkage, frame)
-        sub.finish()
+        props = _read_link(link, name, Linkage, frame)
+        link.finish()
         bodies.append(Body(name=name, points=link_points, props=props))
     links_table.finish()
     springs = []
@@ -286,15 +292,17 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
         for k in ("stiffness", "free_length"):
             if not sub.has(k):
                 raise sub._missing(k)
+        ends: Any = _names(sub, "points")  # names as written: the spring checks there are two
         with v.under(sub.path):
-            springs.append(Spring(points=_names(sub, "points"), stiffness=sub.raw("stiffness"),
+            springs.append(Spring(points=ends, stiffness=sub.raw("stiffness"),
                                   free_length=sub.raw("free_length")))
         sub.finish()
     return Linkage(points=tuple(points.items()), bodies=tuple(bodies), input=input_name,
                    sliders=tuple(Slider(**f) for f in sliders), springs=tuple(springs))
 
 
-def _frame(name: str, link_points, positions, sliders) -> tuple[complex, float] | None:
+def _frame(name: str, link_points: tuple[str, ...], positions: dict[str, complex],
+           sliders: list[dict[str, Any]]) -> tuple[complex, float] | None:
     """A general linkage's link frame at the reference pose: origin and x-axis angle.
 
     ``None`` if its points are not all known yet (the model then reports what is wrong).
@@ -327,7 +335,7 @@ def _read_operation(root: Table) -> Operation | None:
     return operation
 
 
-def _read_simulation(root: Table, mechanism) -> SimulationSettings:
+def _read_simulation(root: Table, mechanism: Model) -> SimulationSettings:
     table = root.table("simulation", required=False)
     defaults = SimulationSettings()
     if table is None:
@@ -345,7 +353,7 @@ def _read_simulation(root: Table, mechanism) -> SimulationSettings:
     return settings
 
 
-def _read_original(root: Table, mechanism):
+def _read_original(root: Table, mechanism: Model) -> Model | None:
     table = root.table("original", required=False)
     if table is None:
         return None

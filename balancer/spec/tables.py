@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Literal, overload
 
 from .. import validate as v
 from ..errors import SpecError
@@ -86,6 +86,11 @@ class Table:
 
     def _missing(self, name: str) -> SpecError:
         return SpecError("missing required key", key=self.key(name))
+
+    @overload
+    def table(self, name: str, *, required: Literal[True] = True) -> Table: ...
+    @overload
+    def table(self, name: str, *, required: bool) -> Table | None: ...
 
     def table(self, name: str, *, required: bool = True) -> Table | None:
         if name not in self.data:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 
 from .. import tomltext as toml
-from ..model import Design, GasForce, Link, Linkage
+from ..model import Design, FourBar, GasForce, Link, Linkage, SliderCrank
 from ..outputs import write_atomic
 from .balance import balance_lines
 
@@ -38,12 +38,12 @@ def _gas_lines(gas: GasForce) -> list[str]:
             f"period = {toml.number(gas.period)} }}  # rad, N"]
 
 
-def _links_lines(mech, prefix: str) -> list[str]:
-    out = []
+def _links_lines(mech: FourBar | SliderCrank | Linkage, prefix: str) -> list[str]:
+    out: list[str] = []
     for name in mech.link_names:
         frame = "global" if mech.type == "slider-crank" and name == "slider" else "link"
         out += ["", f"[{prefix}.{toml.key(name)}]", *_link_lines(mech.link(name), frame)]
-        if prefix == "links" and frame == "global":
+        if prefix == "links" and frame == "global" and isinstance(mech, SliderCrank):
             out += _gas_lines(mech.gas_force)
     return out
 
