@@ -100,12 +100,15 @@ def _last_digit(token: str) -> float:
 
 
 def mask(text: str, folder: Path | None = None) -> str:
-    """``text`` with wall-clock times and the temporary ``folder`` replaced by markers."""
+    """``text`` with wall-clock times, the temporary ``folder`` and the checkout replaced.
+
+    (A clone elsewhere names the examples by another path.)
+    """
     for pattern, replacement in _MASKS:
         text = pattern.sub(replacement, text)
     if folder is not None:
         text = text.replace(str(folder), "<tmp>")
-    return text
+    return text.replace(str(ROOT), "<root>")
 
 
 def examples() -> list[str]:
