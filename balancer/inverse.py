@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .kinematics import Motion, change_point_angles, cross
+from .linkage import rotors
 from .massmodels import (
     equivalent_inertia_forces,
     equivalent_joint_forces,
@@ -86,7 +87,7 @@ def dynamic_link(link: Link) -> Link:
         return link
     return Link(
         mass=link.mass,
-        inertia=link.inertia + link.counter_rotor,
+        inertia=link.inertia + rotors.link_inertia(link.counter_rotor),
         e=link.e,
         f=link.f,
         force=link.force,
@@ -123,7 +124,7 @@ def _counter_rotor_moment(linkage: FourBar, mo: Motion) -> NDArray[np.float64] |
     total: NDArray[np.float64] | float = 0.0
     for k, link in enumerate(linkage.links):
         if link.counter_rotor:
-            total = total + 2.0 * link.counter_rotor * mo.alpha[k]
+            total = total + rotors.ground_couple(link.counter_rotor, mo.alpha[k])
     return total
 
 
@@ -295,7 +296,8 @@ def angular_momentum(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
         zeta = link.com / length
         r = joint_pos[k] + zeta * mo.vectors[k]
         v = joint_vel[k] + zeta * mo.vector_rate(k)
-        total = total + (link.inertia - link.counter_rotor) * mo.omega[k] + link.mass * cross(r, v)
+        total = (total + link.inertia * mo.omega[k]
+                 + rotors.momentum(link.counter_rotor, mo.omega[k]) + link.mass * cross(r, v))
     return total
 
 
@@ -307,9 +309,8 @@ def kinetic_energy(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
     total = np.zeros(mo.size)
     for k, (link, length) in enumerate(zip(linkage.links, (l1, l2, l3), strict=True)):
         v = joint_vel[k] + link.com / length * mo.vector_rate(k)
-        total = total + 0.5 * (
-            link.mass * np.abs(v) ** 2 + (link.inertia + link.counter_rotor) * mo.omega[k] ** 2
-        )
+        total = total + 0.5 * (link.mass * np.abs(v) ** 2 + link.inertia * mo.omega[k] ** 2) \
+            + rotors.energy(link.counter_rotor, mo.omega[k])
     return total
 
 

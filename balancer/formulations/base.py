@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, overload
 import numpy as np
 from numpy.typing import NDArray
 
+from ..linkage import rotors
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Mechanism as Model
@@ -350,7 +351,8 @@ class Formulation(ABC):
             moment = moment + (np.conj(positions[point]) * value).imag
         for k, link in enumerate(self.mechanism.links):
             if link.counter_rotor:
-                moment = moment + 2 * link.counter_rotor * np.asarray(ev.alpha)[k]
+                moment = moment + rotors.ground_couple(link.counter_rotor,
+                                                        np.asarray(ev.alpha)[k])
         return force, moment
 
     @property

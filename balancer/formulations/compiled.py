@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..linkage import rotors
 from ..linkage.constraints import GROUND_INDEX, Pose
 from ..linkage.structure import Structure
 from ..linkage.symbols import CasadiOps
@@ -125,7 +126,8 @@ def link_equations(structure: Structure, links: Sequence[Link], pose: Pose, rate
     force = ca.SX.zeros(3 * n)
     for k, link in enumerate(links):
         first = V(link.mass * link.e, link.mass * link.f).rotated(pose.cos[k], pose.sin[k])
-        j_origin = link.inertia + link.mass * (link.e**2 + link.f**2) + link.counter_rotor
+        j_origin = (link.inertia + link.mass * (link.e**2 + link.f**2)
+                    + rotors.link_inertia(link.counter_rotor))
         i = 3 * k
         mass[i, i] = mass[i + 1, i + 1] = link.mass
         mass[i, i + 2] = mass[i + 2, i] = -first.y

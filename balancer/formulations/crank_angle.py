@@ -36,6 +36,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import AssemblyError, SolverError
+from ..linkage import rotors
 from ..linkage.kinematics import numeric_table, positions, rates
 from ..linkage.numeric import TABLE_STEPS
 from ..linkage.symbols import CasadiOps
@@ -321,7 +322,8 @@ class CrankAngle(LinkageFormulation):
         for k, link in enumerate(self.links):
             v = mo.point_velocity(k, V(link.e, link.f))
             w = np.asarray(mo.rate[k], float)
-            kin += 0.5 * link.mass * v.norm2() + 0.5 * (link.inertia + link.counter_rotor) * w**2
+            kin += (0.5 * link.mass * v.norm2() + 0.5 * link.inertia * w**2
+                    + rotors.energy(link.counter_rotor, w))
         return kin, self.configuration_work(mo.pose, theta)
 
 

@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import AssemblyError, SolverError
+from ..linkage import rotors
 from ..linkage.constraints import (
     GROUND_INDEX,
     Constraint,
@@ -160,7 +161,7 @@ class Multibody(LinkageFormulation):
                 fx, fy, mz = fx + f_vec.x, fy + f_vec.y, mz + at.cross(f_vec)
         for k, link in enumerate(self.links):
             if link.counter_rotor:
-                mz = mz + 2 * link.counter_rotor * acc[3 * k + 2]
+                mz = mz + rotors.ground_couple(link.counter_rotor, acc[3 * k + 2])
         torque = -lam[-1] if self.driven else ca.SX(0)  # the driver's multiplier
         #: Names of the outputs of :attr:`_frame` and of the dynamics after ``q̈`` and ``λ``.
         self._ground_names = tuple(ground)

@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model import GROUND, Linkage
+from . import rotors
 from .constraints import GROUND_INDEX, Blocks, Constraint, Driver, Pin, Prism, constraint_jacobian
 from .kinematics import Motion
 from .structure import Structure
@@ -503,9 +504,10 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage: Linkage | None =
         lin = first.perp() * a - first * (w * w)
         effective.append([column(per[k][0] - m * acc.x - lin.x),
                           column(per[k][1] - m * acc.y - lin.y),
-                          column(per[k][2] - first.cross(acc) - (j_origin + rotor_j) * a)])
+                          column(per[k][2] - first.cross(acc)
+                                 - (j_origin + rotors.link_inertia(rotor_j)) * a)])
         if rotor_j:
-            rotor = rotor + 2 * rotor_j * a
+            rotor = rotor + rotors.ground_couple(rotor_j, a)
     if not numeric:
         return kinetostatics(structure, mo, effective, rotor_moment=rotor,
                              ground_extra=tuple(ground), ops=ops)

@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from ..inverse import Reactions, dynamic_link
 from ..kinematics import cross
+from ..linkage import rotors
 from ..massmodels import equivalent_inertia_forces, equivalent_joint_forces, inertial_parameters
 from ..model import Link, SliderCrank
 from .kinematics import Lengths, SliderMotion
@@ -54,7 +55,7 @@ def _finish(mech: SliderCrank, mo: SliderMotion, ra0: NDArray[np.complex128],
     ra3 = np.asarray(-1j * n_guide, dtype=complex)  # the slider on its guide
     moment = -mo.x * n_guide - m_guide + h * gas - tau
     if mech.crank.counter_rotor:
-        moment = moment + 2 * mech.crank.counter_rotor * alpha1
+        moment = moment + rotors.ground_couple(mech.crank.counter_rotor, alpha1)
     return Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment,
                      shaking_force=shaking, guide_couple=-m_guide + 0 * mo.x)
 
@@ -163,7 +164,8 @@ def mass_matrix(
     g2 = n2 + f[1][1] + forces[2]
     # The slider's own moment about its pin (loads and inertia), resisted by the guide.
     slider_moment = moments[2] + cross(slider.com, forces[2] - slider.mass * mo.a)
-    rotor = 2 * mech.crank.counter_rotor * mo.alpha[0] if mech.crank.counter_rotor else 0.0
+    rotor = (rotors.ground_couple(mech.crank.counter_rotor, mo.alpha[0])
+             if mech.crank.counter_rotor else 0.0)
     tau, shaking, n_guide, ra0, moment = _combine(mech.lengths, mo, (g0, g1, g2), gas,
                                                   slider_moment, rotor)
     m_guide = -slider_moment
@@ -193,7 +195,8 @@ def angular_momentum(mech: SliderCrank, mo: SliderMotion) -> NDArray[np.float64]
     z1, z2 = c1.com / r, c2.com / big_l
     pos = (z1 * mo.l1, mo.l1 + z2 * mo.l2, mo.A2 + c3.com)
     vel = (z1 * mo.vector_rate(0), mo.vector_rate(0) + z2 * mo.vector_rate(1), mo.v + 0j)
-    spin = (c1.inertia - c1.counter_rotor) * mo.omega[0] + c2.inertia * mo.omega[1]
+    spin = (c1.inertia * mo.omega[0] + rotors.momentum(c1.counter_rotor, mo.omega[0])
+            + c2.inertia * mo.omega[1])
     return spin + sum(link.mass * cross(p, v) for link, p, v in zip(mech.links, pos, vel,
                                                                       strict=True))
 
@@ -206,5 +209,5 @@ def kinetic_energy(mech: SliderCrank, mo: SliderMotion) -> NDArray[np.float64]:
     v1 = z1 * mo.vector_rate(0)
     v2 = mo.vector_rate(0) + z2 * mo.vector_rate(1)
     return 0.5 * (c1.mass * np.abs(v1) ** 2 + c2.mass * np.abs(v2) ** 2 + c3.mass * mo.v**2
-                  + (c1.inertia + c1.counter_rotor) * mo.omega[0] ** 2
-                  + c2.inertia * mo.omega[1] ** 2)
+                  + c1.inertia * mo.omega[0] ** 2 + c2.inertia * mo.omega[1] ** 2) \
+        + rotors.energy(c1.counter_rotor, mo.omega[0])

@@ -32,6 +32,7 @@ from ..formulations.base import DrivenRates, Evaluation
 from ..formulations.closed_form import ClosedForm
 from ..formulations.mass_matrix import NodalTruss, NodeAccelerations
 from ..kinematics import cross_scalar
+from ..linkage import rotors
 from ..linkage.vectors import Num
 from ..massmodels import equivalent_joint_forces, equivalent_mass_matrix, inertial_parameters
 from ..model import Link, SliderCrank
@@ -348,7 +349,7 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):  # type: ignore[misc]  #
         h = self.offset
         moment = -a2.real * n_guide - m_guide + h * gas - tau
         if self.linkage.crank.counter_rotor:
-            moment += 2 * self.linkage.crank.counter_rotor * alpha[0]
+            moment += rotors.ground_couple(self.linkage.crank.counter_rotor, alpha[0])
         return Evaluation(
             theta=np.array([theta1, math.atan2(v2.imag, v2.real), 0.0]),
             omega=np.array([omega[0], omega[1], 0.0]),
