@@ -63,6 +63,7 @@ from ..model import (
     SliderCrank,
     Spring,
 )
+from . import schema
 from .balance import read_balance
 from .tables import Table
 
@@ -142,7 +143,7 @@ def _read_gas_force(table: Table) -> GasForce:
     if not isinstance(raw, dict):
         return GasForce.constant(v.number(raw, key))
     sub = Table(raw, key)
-    sub.expect(("crank_angle", "force", "period"))
+    sub.expect(schema.known("links.<link>.gas_force", schema.SLIDER_CRANK))
     for name in ("crank_angle", "force"):
         if not sub.has(name):
             raise sub._missing(name)
@@ -163,7 +164,7 @@ def _read_links(table: Table, mechanism_class,
     ``names``: the links to read (by default the mechanism class's own).
     """
     names = mechanism_class.link_names if names is None else names
-    table.expect(names)
+    table.expect(schema.known(table.path, mechanism_class.type) or names)
     links = {}
     gas = GasForce()
     for name in names:
@@ -184,11 +185,11 @@ def _read_mechanism(root: Table) -> FourBar | SliderCrank | Linkage:
     cls = MECHANISMS[kind]
     if cls is Linkage:
         return _read_linkage(root, mech)
-    mech.expect(("type", "branch", "lengths"))
+    mech.expect(schema.known("mechanism", kind))
     branch = mech.string("branch", choices=("+", "-"), default="+")
     lengths_table = mech.table("lengths")
     assert lengths_table is not None
-    lengths_table.expect(cls.length_names)
+    lengths_table.expect(schema.known("mechanism.lengths", kind))
     lengths = []
     for name in cls.length_names:
         if name == "offset":
@@ -232,7 +233,7 @@ def _names(table: Table, name: str) -> tuple[str, ...]:
 
 def _read_linkage(root: Table, mech: Table) -> Linkage:
     """A general linkage (``type = "linkage"``; DESIGN.md, "General planar linkages")."""
-    mech.expect(("type", "input", "points", "sliders"))
+    mech.expect(schema.known("mechanism", schema.LINKAGE))
     if not mech.has("input"):
         raise mech._missing("input")
     input_name = mech.raw("input")
@@ -245,7 +246,7 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
     points_table.finish()
     sliders = []
     for sub in _list_of_tables(mech, "sliders"):
-        sub.expect(("link", "guide", "point", "direction"))
+        sub.expect(schema.known("mechanism.sliders[]", schema.LINKAGE))
         fields = {}
         for attr in ("link", "guide", "point"):
             if not sub.has(attr):
@@ -269,11 +270,11 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
         sub = links_table.table(name)
         assert sub is not None
         if name == GROUND:
-            sub.expect(("points",))
+            sub.expect(schema.known("links.ground", schema.LINKAGE))
             bodies.append(Body(name=name, points=_names(sub, "points")))
             sub.finish()
             continue
-        sub.expect(("points", "mass", "inertia", "com", "force", "moment", "counter_rotor"))
+        sub.expect(schema.known("links.<link>", schema.LINKAGE))
         link_points = _names(sub, "points")
         frame = _frame(name, link_points, positions, sliders)
         props = _read_link(sub, name, Linkage, frame)
@@ -282,7 +283,7 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
     links_table.finish()
     springs = []
     for sub in _list_of_tables(root, "springs"):
-        sub.expect(("points", "stiffness", "free_length"))
+        sub.expect(schema.known("springs[]", schema.LINKAGE))
         for k in ("stiffness", "free_length"):
             if not sub.has(k):
                 raise sub._missing(k)
