@@ -29,12 +29,14 @@ STORE = Path(__file__).resolve().parent / "outputs"
 
 #: Examples without a ``[balance]`` section (no optimize, pareto).
 UNBALANCED = ("meijaard2020",)
-#: Fields and phrases that measure wall-clock time or name a temporary folder.
+#: Fields and phrases that measure wall-clock time or name a temporary or the checkout's folder.
 _MASKS = (
     (re.compile(r'("(?:time|seconds)": )[-+0-9.eE]+'), r"\1<t>"),
     (re.compile(r"\b[0-9.]+(?:e[-+]?\d+)? ms\b"), "<t> ms"),
     (re.compile(r"(right-hand sides, )[0-9.eE+-]+ s"), r"\1<t> s"),
     (re.compile(r"(\d+ points in )[0-9.]+ s \([0-9.]+ points/s"), r"\1<t> s (<r> points/s"),
+    # The checkout's folder, in the spec paths the reports name: the same outputs in any clone.
+    (re.compile(r"(?:/[^\s\"'/]+)+/examples/"), "<examples>/"),
 )
 
 
