@@ -175,7 +175,8 @@ SECTIONS: tuple[Section, ...] = (
         Key("sliders", "table", "none",
             "Prismatic pairs (`[[mechanism.sliders]]`, below).", (LINKAGE,)),
     )),
-    Section("mechanism.lengths", "The lengths, m, each between 1e-50 and 1e50 m.", (
+    Section("mechanism.lengths", "The lengths, m, each between 1e-50 and 1e50 m (a slider-crank's "
+            "offset is signed, and may be 0).", (
         Key("crank", "m", "required", "A0→A1, the crank (l1).", (FOUR_BAR,), example="1.0"),
         Key("coupler", "m", "required", "A1→A2, the coupler (l2).", (FOUR_BAR,),
             example="3.0"),
