@@ -57,7 +57,7 @@ class RunCheck:
     trajectory, original
         The simulated motion of the design and of the unbalanced original (or ``None``).
     max_shaking_force, max_shaking_moment
-        Largest shaking force (N) and |shaking moment| (N·m) over the run (over the part
+        Largest shaking force (N) and absolute shaking moment (N·m) over the run (over the part
         before it stopped, if it stopped; ``None`` if it could not start).
     original_max_shaking_force, original_max_shaking_moment
         The same for the original, or ``None``.

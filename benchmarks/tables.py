@@ -1,4 +1,4 @@
-"""The benchmarks' one table printer: aligned text, or Markdown for the README."""
+"""The benchmarks' one table printer: aligned text, or Markdown for docs/benchmarks.md."""
 
 from __future__ import annotations
 

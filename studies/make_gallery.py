@@ -2,7 +2,7 @@
 
 Runs every study (``studies/*.py`` with a ``run``) in full mode into ``studies/out/<name>/``,
 copies the figures listed in :data:`CHOSEN` into ``docs/gallery/`` under stable names, runs the
-``balancer`` commands of :data:`COMMANDS` (the README's, word for word: the report pictures of
+``balancer`` commands of :data:`COMMANDS` (docs/gallery.md's, word for word: the report pictures of
 ``plot --cycle`` and ``verify --plot``, from designs balanced by ``optimize`` into
 ``studies/out/gallery/``), and writes an animation of the example of Meijaard & van der Wijk
 (2020), Eq. 56 (``examples/meijaard2020.toml``) with :func:`balancer.plots.animate`. The
@@ -10,8 +10,8 @@ gallery is committed,
 so each file must stay small (:data:`MAX_BYTES`); the script says which one does not and exits
 with status 1.
 
-Run ``python studies/make_gallery.py`` from anywhere; ``README_SECTION.md`` beside the figures
-holds the README text that shows them.
+Run ``python studies/make_gallery.py`` from anywhere; ``docs/gallery.md`` shows the figures with
+the commands and studies that make them.
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ CHOSEN = (
     ("atlas_and_fronts", "front_torque.png", "pb1_front_torque.png"),
     ("atlas_and_fronts", "front_mass.png", "pb1_front_mass.png"),
 )
-#: Report pictures by the command line, as the README shows them: (gallery name, commands run
+#: Report pictures by the command line, as docs/gallery.md shows them: (gallery name, commands run
 #: from the repository's root; ``OUT`` is ``studies/out/gallery``). Each command overwrites.
 COMMANDS = (
     ("pb1_cycle.png", (

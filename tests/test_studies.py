@@ -320,19 +320,23 @@ def test_gallery_shows_figures_the_studies_make(quick):
     assert animation.stat().st_size <= gallery.MAX_BYTES[".gif"]
 
 
-def test_gallery_report_pictures_come_from_the_readmes_commands():
+def test_gallery_report_pictures_come_from_the_gallery_pages_commands():
     # docs/gallery's pictures of `plot --cycle` and `verify --plot` are made by make_gallery
-    # running these commands; the README shows each picture and its commands.
+    # running these commands; docs/gallery.md shows each picture and its commands (and
+    # tests/test_docs.py runs them), every picture of the gallery and every study that makes one.
     from balancer.cli import build_parser
 
     gallery = load("make_gallery")
-    readme = (STUDIES.parent / "README.md").read_text(encoding="utf-8")
+    page = (STUDIES.parent / "docs" / "gallery.md").read_text(encoding="utf-8")
     parser = build_parser()
     for target, commands in gallery.COMMANDS:
         picture = gallery.GALLERY / target
         assert picture.stat().st_size <= gallery.MAX_BYTES[picture.suffix]
-        assert f"](docs/gallery/{target})" in readme
+        assert f"](gallery/{target})" in page
         for command in commands:
             parser.parse_args(gallery.command_argv(command))  # a valid command line
             shown = command.replace("OUT/", "").replace("docs/gallery/", "")
-            assert shown in readme, shown
+            assert shown in page, shown
+    for study, _, target in gallery.CHOSEN:
+        assert f"](gallery/{target})" in page and f"python studies/{study}.py" in page
+    assert f"](gallery/{gallery.ANIMATION})" in page

@@ -34,6 +34,8 @@ def front_figure(front: Front, title: str | None = None) -> Figure:
     title
         The figure's title (default: what is traded against what).
 
+    Notes
+    -----
     The legend says whether the front's designs are held to exact force balance
     (:attr:`Front.force_balance`) and, where the original design is not force-balanced and the
     front is, why it is not on the front.

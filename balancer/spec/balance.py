@@ -11,8 +11,6 @@ from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Mechanism as Model
 from ..model.balance import (
-    COUNTERWEIGHT_KEYS,
-    LINK_KEYS,
     OBJECTIVE_KEYS,
     BalanceProblem,
     CounterweightFreedom,
@@ -20,6 +18,7 @@ from ..model.balance import (
     Objective,
 )
 from ..validate import LENGTH_RANGE
+from . import schema
 from .tables import Table
 
 
@@ -71,7 +70,7 @@ def _read_range(
 
 
 def _read_link_freedom(table: Table, points: tuple[str, ...]) -> LinkFreedom:
-    _check_keys(table, LINK_KEYS)
+    _check_keys(table, schema.known("balance.<link>"))
     com_about = None
     if table.has("com_about"):
         com_about = table.string("com_about", choices=points)
@@ -83,7 +82,7 @@ def _read_link_freedom(table: Table, points: tuple[str, ...]) -> LinkFreedom:
                 raise SpecError("a link with a counterweight is kept as it is: give the "
                                 "counterweight's bounds only (counterweight = {mass, radius, "
                                 "gyration})", key=table.key(name), value=table.raw(name))
-        _check_keys(sub, COUNTERWEIGHT_KEYS)
+        _check_keys(sub, schema.known("balance.<link>.counterweight"))
         mass = _read_range(sub, "mass", positive=False, unit="kg")
         if mass is None:
             raise SpecError("missing required key (the counterweight's mass, [low, high] kg)",
@@ -146,7 +145,7 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
             raise SpecError(f"names no moving link of the {mech.kind}{hint} (its moving links "
                             f"are {', '.join(names)}; the frame stays as it is)",
                             key=table.key(name))
-    _check_keys(table, ("force_balance", "objective", *names))
+    _check_keys(table, (*schema.known("balance"), *names))
     force_balance = True
     if table.has("force_balance"):
         value = table.raw("force_balance")
@@ -156,7 +155,7 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
     objective = Objective()
     sub = table.table("objective", required=False)
     if sub is not None:
-        _check_keys(sub, OBJECTIVE_KEYS)
+        _check_keys(sub, schema.known("balance.objective"))
         objective = Objective(
             **{
                 name: sub.nonnegative(name, default=getattr(objective, name))

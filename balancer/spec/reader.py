@@ -64,6 +64,7 @@ from ..model import (
     Spring,
 )
 from ..model import Mechanism as Model
+from . import schema
 from .balance import read_balance
 from .tables import Table
 
@@ -146,7 +147,7 @@ def _read_gas_force(table: Table) -> GasForce:
     if not isinstance(raw, dict):
         return GasForce.constant(v.number(raw, key))
     sub = Table(raw, key)
-    sub.expect(("crank_angle", "force", "period"))
+    sub.expect(schema.known("links.<link>.gas_force", schema.SLIDER_CRANK))
     for name in ("crank_angle", "force"):
         if not sub.has(name):
             raise sub._missing(name)
@@ -169,7 +170,7 @@ def _read_links(table: Table, mechanism_class: type[FourBar] | type[SliderCrank]
     if names is None:
         assert not issubclass(mechanism_class, Linkage)  # (a general linkage's are named)
         names = mechanism_class.link_names
-    table.expect(names)
+    table.expect(schema.known(table.path, mechanism_class.type) or names)
     links = {}
     gas = GasForce()
     for name in names:
@@ -190,11 +191,11 @@ def _read_mechanism(root: Table) -> FourBar | SliderCrank | Linkage:
     cls = MECHANISMS[kind]
     if issubclass(cls, Linkage):  # (it is Linkage)
         return _read_linkage(root, mech)
-    mech.expect(("type", "branch", "lengths"))
+    mech.expect(schema.known("mechanism", kind))
     branch = mech.string("branch", choices=("+", "-"), default="+")
     lengths_table = mech.table("lengths")
     assert lengths_table is not None
-    lengths_table.expect(cls.length_names)
+    lengths_table.expect(schema.known("mechanism.lengths", kind))
     lengths: list[Any] = []  # as written: the mechanism checks them
     for name in cls.length_names:
         if name == "offset":
@@ -239,7 +240,7 @@ def _names(table: Table, name: str) -> tuple[str, ...]:
 
 def _read_linkage(root: Table, mech: Table) -> Linkage:
     """A general linkage (``type = "linkage"``; DESIGN.md, "General planar linkages")."""
-    mech.expect(("type", "input", "points", "sliders"))
+    mech.expect(schema.known("mechanism", schema.LINKAGE))
     if not mech.has("input"):
         raise mech._missing("input")
     input_name = mech.raw("input")
@@ -252,7 +253,7 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
     points_table.finish()
     sliders: list[dict[str, Any]] = []  # each a Slider's fields
     for sub in _list_of_tables(mech, "sliders"):
-        sub.expect(("link", "guide", "point", "direction"))
+        sub.expect(schema.known("mechanism.sliders[]", schema.LINKAGE))
         fields: dict[str, Any] = {}
         for attr in ("link", "guide", "point"):
             if not sub.has(attr):
@@ -275,11 +276,11 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
     for name in links_table.data:
         link = links_table.table(name)
         if name == GROUND:
-            link.expect(("points",))
+            link.expect(schema.known("links.ground", schema.LINKAGE))
             bodies.append(Body(name=name, points=_names(link, "points")))
             link.finish()
             continue
-        link.expect(("points", "mass", "inertia", "com", "force", "moment", "counter_rotor"))
+        link.expect(schema.known("links.<link>", schema.LINKAGE))
         link_points = _names(link, "points")
         frame = _frame(name, link_points, positions, sliders)
         props = _read_link(link, name, Linkage, frame)
@@ -288,7 +289,7 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
     links_table.finish()
     springs = []
     for sub in _list_of_tables(root, "springs"):
-        sub.expect(("points", "stiffness", "free_length"))
+        sub.expect(schema.known("springs[]", schema.LINKAGE))
         for k in ("stiffness", "free_length"):
             if not sub.has(k):
                 raise sub._missing(k)

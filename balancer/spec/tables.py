@@ -7,38 +7,7 @@ from typing import Any, Literal, overload
 
 from .. import validate as v
 from ..errors import SpecError
-
-
-def _generic(path: str) -> str:
-    """Map a concrete table path to the pattern used for key suggestions."""
-    parts = path.split(".")
-    if len(parts) >= 2 and parts[0] in ("links", "original"):
-        parts[1] = "*"
-    return ".".join(parts)
-
-
-_KNOWN_KEYS: dict[str, tuple[str, ...]] = {
-    "": ("title", "mechanism", "links", "springs", "operation", "simulation", "balance",
-         "original"),
-    "mechanism": ("type", "branch", "lengths", "input", "points", "sliders"),
-    "links.*": ("points", "mass", "inertia", "com", "force", "moment", "counter_rotor",
-                "gas_force"),
-    "original.*": ("mass", "inertia", "com", "force", "moment", "counter_rotor", "gas_force"),
-    "links.*.com": ("s", "sigma", "e", "f", "at"),
-    "original.*.com": ("s", "sigma", "e", "f", "at"),
-    "operation": ("speed", "samples", "gravity"),
-    "simulation": (
-        "duration",
-        "theta1",
-        "omega1",
-        "gravity",
-        "drive",
-        "method",
-        "rtol",
-        "atol",
-        "outputs",
-    ),
-}
+from . import schema
 
 
 def _as_number(
@@ -60,7 +29,7 @@ class Table:
         self.data = data
         self.path = path
         self.used: set[str] = set()
-        self.known: tuple[str, ...] | None = _KNOWN_KEYS.get(_generic(path))
+        self.known: tuple[str, ...] | None = schema.screen(path)
         if self.known is not None:
             self.expect(self.known)
 

@@ -1,0 +1,453 @@
+"""Every key a design spec may hold: its unit, default, meaning and the mechanisms it applies to.
+
+The one list of the spec's keys. The reader takes the keys it knows from here — a table is
+screened when it is opened (:func:`screen`) and declares its keys for the spec's mechanism
+(:func:`known`) — so that it cannot accept a key that has no entry; the documentation's
+reference of the spec format (``docs/spec.md``) is generated from these entries when the site is
+built, and the tests hold the three together (``tests/test_schema.py``: every entry is accepted
+where it says, refused elsewhere, and nothing else is accepted).
+
+Tables are named by their pattern: the dotted path of the table with a link's name written
+``<link>`` and an array of tables ``[]`` (``links.<link>.com``, ``mechanism.sliders[]``); the top
+level is ``""``. A table whose keys are names the spec chooses (the points of a general
+linkage, its links, the links listed in ``[balance]``) describes them by one entry in angle
+brackets (:attr:`Section.names`).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+FOUR_BAR = "four-bar"
+SLIDER_CRANK = "slider-crank"
+LINKAGE = "linkage"
+#: The values of ``[mechanism] type``.
+MECHANISMS = (FOUR_BAR, SLIDER_CRANK, LINKAGE)
+_CLOSED = (FOUR_BAR, SLIDER_CRANK)
+
+
+@dataclass(frozen=True)
+class Key:
+    """One key of a table.
+
+    Attributes
+    ----------
+    name
+        The key as written in the spec (an entry for names the spec chooses: ``<point>``).
+    unit
+        Its unit (SI), ``—`` for none (a name, a flag, a weight without dimension), or
+        ``table`` for a table of its own.
+    default
+        What an absent key means (``required`` where it must be given).
+    meaning
+        What it is, its bounds and where it applies.
+    mechanisms
+        The mechanism types whose specs accept it.
+    example
+        A TOML value for it (empty for a table described by a section of its own).
+    """
+
+    name: str
+    unit: str
+    default: str
+    meaning: str
+    mechanisms: tuple[str, ...] = MECHANISMS
+    example: str = ""
+
+
+@dataclass(frozen=True)
+class Section:
+    """A table of the spec (by its pattern) and its keys.
+
+    Attributes
+    ----------
+    pattern
+        The table's dotted path, ``<link>`` for a link's name, ``[]`` for an array of tables.
+    summary
+        What the table is.
+    keys
+        Its fixed keys (a name may have one entry per set of mechanisms).
+    mechanisms
+        The mechanism types whose specs may have the table.
+    names
+        For a table whose keys are names the spec chooses: the entry that describes them.
+    """
+
+    pattern: str
+    summary: str
+    keys: tuple[Key, ...]
+    mechanisms: tuple[str, ...] = MECHANISMS
+    names: Key | None = None
+
+    def keys_for(self, mechanism: str | None = None) -> tuple[Key, ...]:
+        """The entries of the fixed keys that apply to ``mechanism`` (``None``: any)."""
+        return tuple(k for k in self.keys if mechanism is None or mechanism in k.mechanisms)
+
+    @property
+    def header(self) -> str:
+        """The table as TOML writes it (``[links.<link>]``, ``[[springs]]``, top level)."""
+        if not self.pattern:
+            return "top level"
+        if self.pattern.endswith("[]"):
+            return f"[[{self.pattern[:-2]}]]"
+        return f"[{self.pattern}]"
+
+
+_LINK_BODY = ("A link's frame: origin at its first joint (a general linkage: its first point), "
+              "x-axis towards its second (a slider-crank's slider: global axes, from its pin).")
+
+#: The centre of mass: one of three forms (the same keys in ``[links]`` and ``[original]``).
+_COM = (
+    Key("s", "m", "required with sigma",
+        "Distance of the centre of mass from the link's first joint (s̄ = s·exp(iσ)); "
+        "at least 0. Give `s` and `sigma`, or `e` and `f`, or `at`.", example="0.6"),
+    Key("sigma", "rad", "required with s",
+        "Angle of the centre of mass from the link's line (from its first joint towards its "
+        "second), counter-clockwise positive.", example="0.3"),
+    Key("e", "m", "required with f",
+        "Centre of mass along the link's line from its first joint (s̄ = e + i·f). A "
+        "slider-crank's slider: along x from its pin, in global axes.", example="0.4"),
+    Key("f", "m", "required with e",
+        "Centre of mass across the link's line, positive to its left. A slider-crank's slider: "
+        "along y from its pin, in global axes.", example="0.0"),
+)
+
+def _link_keys(com_forms: str) -> tuple[Key, ...]:
+    """A link's mass properties and loads (``[links.<link>]``, ``[original.<link>]``)."""
+    return (
+        Key("mass", "kg", "required", "Mass of the link; positive.", example="2.1"),
+        Key("inertia", "kg·m²", "required (a slider-crank's slider: 0)",
+            "Moment of inertia about the centre of mass; at least 0. A slider-crank's slider "
+            "does not turn: its inertia may be left out.", example="1.1"),
+        Key("com", "table", "required",
+            f"The centre of mass in the link's frame (the table `com` below): {com_forms}.",
+            example="{ e = 0.4, f = 0.0 }"),
+        Key("force", "N", "[0, 0]",
+            "A constant force `[Fx, Fy]` in global axes at the centre of mass, from outside the "
+            "machine (no reaction on the frame).", example="[1.1, 1.2]"),
+        Key("moment", "N·m", "0",
+            "A constant moment on the link, counter-clockwise positive, from outside the "
+            "machine.", example="0.37"),
+        Key("counter_rotor", "kg·m²", "0",
+            "Inertia of a counter-rotor: a disc coaxial with the link's ground pivot, geared to "
+            "turn at −1 times the link's angular velocity (only its inertia counts). Only on a "
+            "link pivoted to the ground: a four-bar's crank and rocker, a slider-crank's crank, "
+            "a general linkage's links with a ground point. At least 0.", example="0.5"),
+    )
+
+
+SECTIONS: tuple[Section, ...] = (
+    Section("", "The spec file itself: a title and the tables below.", (
+        Key("title", "—", '""', "Free text naming the design in reports.",
+            example='"PB1: partial balancing"'),
+        Key("mechanism", "table", "required", "The linkage's type and geometry."),
+        Key("links", "table", "required", "Each moving link's mass properties and loads."),
+        Key("springs", "table", "none", "Linear springs between two points (`[[springs]]`).",
+            (LINKAGE,)),
+        Key("operation", "table", "none",
+            "The operating condition that `analyze`, `optimize`, `pareto`, `sweep` and `plot` "
+            "refer to; they refuse a spec without it."),
+        Key("simulation", "table", "the defaults below",
+            "How `simulate` and `verify` run the equations of motion."),
+        Key("balance", "table", "none",
+            "The redesign problem that `optimize`, `pareto` and `sweep` solve."),
+        Key("original", "table", "none",
+            "The unbalanced design a balanced one was derived from (same geometry), as "
+            "`optimize --out` writes it: `verify` and `plot` show both."),
+    )),
+    Section("mechanism", "The type of linkage and its geometry.", (
+        Key("type", "—", "required",
+            '`"four-bar"` (Meijaard & van der Wijk 2020), `"slider-crank"` (Wunderlich 1964) '
+            'or `"linkage"` (any planar linkage with one degree of freedom).',
+            example='"four-bar"'),
+        Key("branch", "—", '"+"',
+            'The assembly: a four-bar\'s `"+"` puts A2 to the left of the directed line A1→A3 '
+            '(the paper\'s Fig. 1); a slider-crank\'s `"+"` puts the slider on the +x side of '
+            'the crank pin; `"-"` the other assembly (a general linkage\'s is fixed by its '
+            "reference pose).", _CLOSED, example='"+"'),
+        Key("lengths", "table", "required", "The link lengths (the table below).", _CLOSED),
+        Key("input", "—", "required",
+            "The name of the driven link (the crank); its first point is its ground pivot.",
+            (LINKAGE,), example='"crank"'),
+        Key("points", "table", "required",
+            "Every point at the reference pose (the table below).", (LINKAGE,)),
+        Key("sliders", "table", "none",
+            "Prismatic pairs (`[[mechanism.sliders]]`, below).", (LINKAGE,)),
+    )),
+    Section("mechanism.lengths", "The lengths, m, each between 1e-50 and 1e50 m (a slider-crank's "
+            "offset is signed, and may be 0).", (
+        Key("crank", "m", "required", "A0→A1, the crank (l1).", (FOUR_BAR,), example="1.0"),
+        Key("coupler", "m", "required", "A1→A2, the coupler (l2).", (FOUR_BAR,),
+            example="3.0"),
+        Key("rocker", "m", "required", "A2→A3, the rocker (l3).", (FOUR_BAR,), example="2.0"),
+        Key("frame", "m", "required",
+            "A0→A3, the frame (l4): A0 at the origin, A3 at (l4, 0).", (FOUR_BAR,),
+            example="3.2"),
+        Key("crank", "m", "required", "A0→A1, the crank radius (half the stroke).",
+            (SLIDER_CRANK,), example="0.0196"),
+        Key("rod", "m", "required", "A1→A2, the connecting rod; A2 is the slider's pin.",
+            (SLIDER_CRANK,), example="0.085"),
+        Key("offset", "m", "0",
+            "Signed distance of the guide line (along +x) from A0: the guide is y = offset.",
+            (SLIDER_CRANK,), example="0.0"),
+    ), _CLOSED),
+    Section("mechanism.points", "A general linkage's points at the reference pose, which fixes "
+            "the assembly branch: every other pose is reached from it continuously as the crank "
+            "turns.", (), (LINKAGE,),
+            names=Key("<point>", "m", "—",
+                      "A point's position `[x, y]` at the reference pose, within 1e50 m of the "
+                      "origin. A point named by two links is a revolute joint between them (by "
+                      "k links, a compound hinge); one named by one link only is a marker (a "
+                      "coupler point, a spring's anchor).", (LINKAGE,), example="[0.0, 1.0]")),
+    Section("mechanism.sliders[]", "A prismatic pair of a general linkage: a point of `link` "
+            "runs on a line fixed in `guide`, which also keeps the two links' relative angle. "
+            "Frictionless: the guide carries a normal force and a couple.", (
+                Key("link", "—", "required",
+                    "The sliding link (it may have a single point: its frame's x-axis is then "
+                    "`direction`).", (LINKAGE,), example='"ram"'),
+                Key("guide", "—", "required",
+                    'The link that carries the guide line (`"ground"` for the frame).',
+                    (LINKAGE,), example='"ground"'),
+                Key("point", "—", "required",
+                    "The point of `link` that runs on the line; the line passes through its "
+                    "reference position.", (LINKAGE,), example='"D"'),
+                Key("direction", "—", "required",
+                    "The line's direction `[dx, dy]` at the reference pose (any length but "
+                    "zero).", (LINKAGE,), example="[1.0, 0.0]"),
+            ), (LINKAGE,)),
+    Section("links", "The moving links by name. A four-bar's and a slider-crank's names are "
+            "fixed; a general linkage names its own.", (
+                Key("crank", "table", "required", "Link 1, A0→A1.", (FOUR_BAR,)),
+                Key("coupler", "table", "required", "Link 2, A1→A2.", (FOUR_BAR,)),
+                Key("rocker", "table", "required", "Link 3, A2→A3.", (FOUR_BAR,)),
+                Key("crank", "table", "required", "The crank, A0→A1.", (SLIDER_CRANK,)),
+                Key("rod", "table", "required", "The connecting rod, A1→A2.", (SLIDER_CRANK,)),
+                Key("slider", "table", "required",
+                    "The slider (piston) on the pin A2; it does not turn.", (SLIDER_CRANK,)),
+                Key("ground", "table", "required",
+                    "The frame: a link without mass whose points do not move.", (LINKAGE,)),
+            ),
+            names=Key("<link>", "table", "—",
+                      "A moving link of a general linkage, by the name the spec gives it "
+                      '(not `ground`, `objective` nor `force_balance`).', (LINKAGE,))),
+    Section("links.<link>", f"A moving link's mass properties and the loads on it. "
+            f"{_LINK_BODY}", (
+                Key("points", "—", "required",
+                    "The names of the link's points, first its frame's origin, second the "
+                    "direction of its x-axis (ternary and quaternary links too).", (LINKAGE,),
+                    example='["A0", "A1"]'),
+                *_link_keys("`{ s, sigma }`, `{ e, f }` or, in a general linkage, "
+                            "`{ at = [x, y] }`"),
+                Key("gas_force", "N", "none",
+                    "A force on the slider along the guide (+x), from the frame: a number, or "
+                    "a table of it over the crank angle (below). It acts between piston and "
+                    "cylinder head, so it drives the crank without shaking the frame except "
+                    "through the torque reaction. The slider only.", (SLIDER_CRANK,),
+                    example="-1500.0"),
+            )),
+    Section("links.ground", "A general linkage's frame.", (
+        Key("points", "—", "required",
+            "Its points: the ground pivots, and the anchors of springs and guides on the frame.",
+            (LINKAGE,), example='["A0", "B0"]'),
+    ), (LINKAGE,)),
+    Section("links.<link>.com", "A link's centre of mass, in one of three forms: `{ s, sigma }`, "
+            "`{ e, f }` or `{ at }`.", (
+                *_COM,
+                Key("at", "m", "—",
+                    "The centre of mass's global position `[x, y]` at the reference pose (a "
+                    "general linkage's links).", (LINKAGE,), example="[0.4, 0.0]"),
+            )),
+    Section("links.<link>.gas_force", "A slider-crank's gas force as a table over the crank "
+            "angle, interpolated by a periodic cubic spline.", (
+                Key("crank_angle", "rad", "required",
+                    "Crank angles, increasing within one period from 0.", (SLIDER_CRANK,),
+                    example="[0.0, 3.14159]"),
+                Key("force", "N", "required",
+                    "The force along +x at those angles (as many values).", (SLIDER_CRANK,),
+                    example="[-3500.0, -30.0]"),
+                Key("period", "rad", "2π",
+                    "The period in crank angle (4π for a four-stroke cycle); positive.",
+                    (SLIDER_CRANK,), example="6.283185307179586"),
+            ), (SLIDER_CRANK,)),
+    Section("springs[]", "A linear spring between two points of a general linkage (of one or two "
+            "links, or the ground). One anchored to the frame counts in the shaking sums, not "
+            "in the pin reactions.", (
+                Key("points", "—", "required", "The two anchor points (different).", (LINKAGE,),
+                    example='["B", "A3"]'),
+                Key("stiffness", "N/m", "required", "Its stiffness; at least 0.", (LINKAGE,),
+                    example="4530.0"),
+                Key("free_length", "m", "required",
+                    "The length at which it carries no force; at least 0.", (LINKAGE,),
+                    example="0.07785"),
+            ), (LINKAGE,)),
+    Section("operation", "The operating condition of a cycle analysis and of a balancing: the "
+            "crank at constant speed over one revolution, sampled at θ1 = 2πk/samples.", (
+                Key("speed", "rad/s", "required",
+                    "The constant crank speed, counter-clockwise positive; not 0.",
+                    example="10.0"),
+                Key("samples", "—", "360",
+                    "Equally spaced crank angles over one revolution, from θ1 = 0; a whole "
+                    "number, at least 8.", example="360"),
+                Key("gravity", "m/s²", "[0, 0] (none)",
+                    "Gravitational acceleration `[gx, gy]` the cycle analysis includes: the "
+                    "frame then carries the links' weights (`analyze --gravity` overrides it).",
+                    example="[0.0, -9.81]"),
+            )),
+    Section("simulation", "Forward dynamics (`simulate`, `verify`).", (
+        Key("duration", "s", "5", "Simulated time; positive.", example="5.0"),
+        Key("theta1", "rad", "the reference pose (0 for a four-bar and a slider-crank)",
+            "Initial crank angle, within ±1e5 rad.", example="1.0"),
+        Key("omega1", "rad/s", "0",
+            'Initial crank speed; with `drive = "constant-speed"` the speed held (where it is '
+            "0, the operating speed `[operation] speed`).", example="0.0"),
+        Key("gravity", "m/s²", "[0, 0] (none)", "Gravitational acceleration `[gx, gy]`.",
+            example="[0.0, -9.81]"),
+        Key("drive", "—", '"free"',
+            '`"free"`: the crank moves under the loads alone; `"constant-speed"`: a motor on '
+            "the ground holds it at constant speed.", example='"free"'),
+        Key("method", "—", "the mechanism's first",
+            "The formulation of the equations of motion: a four-bar's `opened-loop` (the "
+            "default), `complex-masses`, `mass-matrix`, `lie-group`; a slider-crank's "
+            "`mass-matrix` (the default), `complex-masses`; and for every mechanism "
+            "`multibody` and `crank-angle` (a general linkage's default where its crank turns "
+            "fully, else `multibody`).", example='"complex-masses"'),
+        Key("rtol", "—", "1e-10",
+            "Relative tolerance of the integrator; at least 100 ε (2.2e-14), below 1.",
+            example="1e-10"),
+        Key("atol", "—", "1e-12",
+            "Absolute tolerance of the integrator (in the states' units); at least 1e-150.",
+            example="1e-12"),
+        Key("outputs", "—", "501",
+            "Equally spaced output times, both ends included; a whole number, at least 2.",
+            example="501"),
+    )),
+    Section("balance", "The redesign problem: exact shaking-force balance as constraints, the "
+            "objective minimised over one revolution at `[operation] speed`, within each listed "
+            "link's bounds. A link not listed stays as it is.", (
+                Key("force_balance", "—", "true",
+                    "Impose exact shaking-force balance (Eq. 57–58; Wunderlich's Eq. 10d, "
+                    "20a–b; for a general linkage, the conditions found from the linkage "
+                    "itself) as equality constraints.", example="true"),
+                Key("objective", "table", "the defaults below",
+                    "The weights of the objective (the table below).",
+                    example="{ shaking_moment = 1.0 }"),
+            ),
+            names=Key("<link>", "table", "—",
+                      "A moving link that may change, by its name: its bounds (the table "
+                      "below).")),
+    Section("balance.objective", "The weights of the objective J = w_M·mean(Msh²) + "
+            "w_τ·mean(τ²) + w_F·mean(|F̄sh|²) + w_m·Δm, in (N·m)², over the sampled crank "
+            "angles; the inertial shaking only (applied loads are left out). Each weight is at "
+            "least 0.", (
+                Key("shaking_moment", "—", "1", "w_M, of the mean-square shaking moment.",
+                    example="1.0"),
+                Key("driving_torque", "—", "0",
+                    "w_τ, of the mean-square driving torque ((N·m)²/(N·m)²).", example="0.0"),
+                Key("shaking_force", "m²", "0",
+                    "w_F, of the mean-square shaking force ((N·m)²/N²; useful with "
+                    "`force_balance = false`).", example="0.0"),
+                Key("shaking_force_x", "m²", "0",
+                    "Weight of the shaking force's x component (a slider-crank's: along the "
+                    "guide), added to `shaking_force`'s.", example="1.0"),
+                Key("shaking_force_y", "m²", "0",
+                    "Weight of the shaking force's y component (across the guide), added to "
+                    "`shaking_force`'s.", example="1.0"),
+                Key("added_mass", "(N·m)²/kg", "0",
+                    "w_m, of the mass added to the linkage (total minus the original's).",
+                    example="0.0"),
+            )),
+    Section("balance.<link>", "What may change on one link, within which bounds. Either its own "
+            "bounds (mass, centre of mass, inertia) or one `counterweight` added to the link "
+            "as it is. The inertia about the centre of mass is free (at least m·ρ²) when the "
+            "mass or the centre of mass may change or `min_gyration` is given; otherwise it "
+            "stays.", (
+                Key("mass", "kg", "the spec's mass, fixed",
+                    "A range `[low, high]`, or one number that fixes it; positive.",
+                    example="[2.1, 8.4]"),
+                Key("com_radius", "m", "the spec's centre of mass, fixed",
+                    "The centre of mass may lie anywhere within this distance of `com_about`; "
+                    "at least 0.", example="1.0"),
+                Key("com_about", "—", "the link's ground pivot, else its first point",
+                    "A point of the link (a four-bar's A0 … A3, a slider-crank's A0 … A2) that "
+                    "`com_radius` is measured from; with a `counterweight`, the point its "
+                    "`radius` is measured from (default then: the link's first point). Needs "
+                    "`com_radius` or `counterweight`.", example='"A0"'),
+                Key("min_gyration", "m", "0",
+                    "Least radius of gyration ρ about the centre of mass: inertia ≥ m·ρ²; at "
+                    "least 0.", example="0.1"),
+                Key("inertia", "kg·m²", "see above",
+                    "A range `[low, high]` of the inertia about the centre of mass, or one "
+                    "number that fixes it; at least 0.", example="[0.5, 2.0]"),
+                Key("counter_rotor", "kg·m²", "the spec's counter_rotor, fixed",
+                    "A range `[low, high]` of the counter-rotor's inertia, or one number; at "
+                    "least 0. Only on a link pivoted to the ground.", example="[0.0, 20.0]"),
+                Key("com_on_line", "—", "false",
+                    "`true`: the centre of mass stays on the link's line (f = 0), within "
+                    "`com_radius` of `com_about`.", example="true"),
+                Key("counterweight", "table", "none",
+                    "Keep the link as it is and add one counterweight: "
+                    "`{ mass = [low, high], radius = r, gyration = ρ }` (below). Not with "
+                    "`mass`, `com_radius`, `min_gyration` or `inertia`.",
+                    example="{ mass = [0.01, 6.6], radius = 2.0, gyration = 0.05 }"),
+            )),
+    Section("balance.<link>.counterweight", "The one rigid body a kept link may get.", (
+        Key("mass", "kg", "required",
+            "Its mass: a range `[low, high]` (low = 0: none may be the answer) or one number; "
+            "at least 0.", example="[0.01, 6.6]"),
+        Key("radius", "m", "required",
+            "Its centre lies within this distance of the link's `com_about` point; at least 0.",
+            example="2.0"),
+        Key("gyration", "m", "0",
+            "Its own least radius of gyration about its centre; at least 0.", example="0.05"),
+    )),
+    Section("original", "The unbalanced design, as `optimize --out` writes it: the same links "
+            "by name (a general linkage's moving links), each with its own mass properties.", (
+                Key("crank", "table", "required", "The original crank.", _CLOSED),
+                Key("coupler", "table", "required", "The original coupler.", (FOUR_BAR,)),
+                Key("rocker", "table", "required", "The original rocker.", (FOUR_BAR,)),
+                Key("rod", "table", "required", "The original connecting rod.", (SLIDER_CRANK,)),
+                Key("slider", "table", "required", "The original slider.", (SLIDER_CRANK,)),
+            ),
+            names=Key("<link>", "table", "—",
+                      "A general linkage's original moving link, by its name; every one.",
+                      (LINKAGE,))),
+    Section("original.<link>", "An original link's mass properties and loads (its points are "
+            "the design's).", _link_keys("`{ s, sigma }` or `{ e, f }`")),
+    Section("original.<link>.com", "An original link's centre of mass: `{ s, sigma }` or "
+            "`{ e, f }`.", _COM),
+)
+
+_BY_PATTERN = {s.pattern: s for s in SECTIONS}
+_INDEX = re.compile(r"\[\d+\]$")
+
+
+def pattern(path: str) -> str:
+    """The pattern of a table's dotted path (``links.crank.com`` → ``links.<link>.com``)."""
+    parts = [_INDEX.sub("[]", part) for part in path.split(".")] if path else []
+    if len(parts) >= 2 and parts[0] in ("links", "original", "balance"):
+        kept = {"links": "ground", "balance": "objective"}.get(parts[0])
+        if parts[1] != kept:
+            parts[1] = "<link>"
+    return ".".join(parts)
+
+
+def section(path: str) -> Section | None:
+    """The section of a table by its dotted path (or pattern), ``None`` if it has none."""
+    return _BY_PATTERN.get(pattern(path))
+
+
+def screen(path: str) -> tuple[str, ...] | None:
+    """The keys a table may hold whatever the mechanism (``None``: names the spec chooses)."""
+    found = section(path)
+    if found is None or found.names is not None:
+        return None
+    return tuple(dict.fromkeys(k.name for k in found.keys))
+
+
+def known(path: str, mechanism: str | None = None) -> tuple[str, ...]:
+    """The fixed keys of a table in a spec of ``mechanism`` (``None``: of any), in order."""
+    found = section(path)
+    if found is None:
+        raise KeyError(f"the spec schema has no table {pattern(path)!r}")
+    return tuple(dict.fromkeys(k.name for k in found.keys_for(mechanism)))
