@@ -39,7 +39,6 @@ from .linkage import rotors
 from .massmodels import (
     equivalent_inertia_forces,
     equivalent_joint_forces,
-    inertial_parameters,
 )
 from .model import FourBar, Link
 from .model.assembly import Lengths
@@ -246,7 +245,7 @@ def mass_matrix(
         )
         fp, fq = equivalent_joint_forces(loaded, lengths[k], mo.vectors[k])
         ip, iq = _inertial_nodal_forces(
-            inertial_parameters(dynamic_link(link)), lengths, mo, k
+            dynamic_link(link).inertial_parameters, lengths, mo, k
         )
         nodes[k] = nodes[k] + fp + ip
         nodes[k + 1] = nodes[k + 1] + fq + iq

@@ -43,12 +43,6 @@ class LinkVectors(Protocol):
     def l3(self) -> Num: ...
 
 
-def inertial_parameters(link: Link) -> tuple[float, float, float, float]:
-    """Inertial parameters ``(m, m·e, m·f, J)``; ``J = I + m·s²`` is about the first joint."""
-    m = link.mass
-    return (m, m * link.e, m * link.f, link.inertia_about_joint())
-
-
 # ----------------------------------------------------------------------------------------------
 # Complex joint masses (Eq. 29)
 
@@ -298,7 +292,7 @@ def equivalent_mass_matrix(params: Sequence[float], length: float) -> NDArray[np
     Parameters
     ----------
     params
-        Inertial parameters ``(m, m·e, m·f, J)`` (see :func:`inertial_parameters`).
+        Inertial parameters ``(m, m·e, m·f, J)`` (:attr:`balancer.model.Link.inertial_parameters`).
     length
         Distance between the joints ``l``, m.
     """
@@ -377,7 +371,7 @@ def global_mass_matrix(linkage: FourBar, inertias: Sequence[float] | None = None
     for k, (link, (p, q)) in enumerate(zip(linkage.links, LINK_NODES, strict=True)):
         if inertias is not None:
             link = Link(mass=link.mass, inertia=inertias[k], e=link.e, f=link.f)
-        me = equivalent_mass_matrix(inertial_parameters(link), linkage.lengths[k])
+        me = equivalent_mass_matrix(link.inertial_parameters, linkage.lengths[k])
         idx = [2 * p, 2 * p + 1, 2 * q, 2 * q + 1]
         big[np.ix_(idx, idx)] += me
     return big

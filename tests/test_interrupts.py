@@ -127,7 +127,9 @@ def test_ipopt_does_not_swallow_a_sigint(tmp_path):
     Thrown), after a warning on stderr: the balancing would go on with the convex design.
     The NLP stage raises KeyboardInterrupt instead, without the warning. IPOPT is made to
     iterate without end (tolerances it cannot meet) and printing, so that the signal comes
-    while it runs."""
+    while it runs; for a minute of CPU at most (``max_cpu_time``), so that a signal CasADi
+    loses in a race ends the run after all (``interrupts.checked`` then raises) instead of
+    hanging the test."""
     script = tmp_path / "nlp.py"
     script.write_text(f"""
 import sys
@@ -140,7 +142,8 @@ x = optimizer.convex.solve().x
 endless = {{"ipopt.print_level": 5, "ipopt.tol": 1e-300, "ipopt.max_iter": 10**8,
            "ipopt.dual_inf_tol": 1e-300, "ipopt.constr_viol_tol": 1e-300,
            "ipopt.compl_inf_tol": 1e-300, "ipopt.acceptable_iter": 10**8,
-           "ipopt.acceptable_tol": 1e-300, "ipopt.acceptable_obj_change_tol": 0.0}}
+           "ipopt.acceptable_tol": 1e-300, "ipopt.acceptable_obj_change_tol": 0.0,
+           "ipopt.max_cpu_time": 60.0}}
 try:
     solution = NlpSolver(optimizer.data, options=endless).solve(x)
 except KeyboardInterrupt:
@@ -154,7 +157,7 @@ print("returned", solution.stage.solver_status, file=sys.stderr)
         if line.startswith("iter"):
             break
     proc.send_signal(signal.SIGINT)
-    out, err = proc.communicate(timeout=900)
+    out, err = proc.communicate(timeout=300)
     assert proc.returncode == 130, err
     assert err.strip() == "interrupted"
 

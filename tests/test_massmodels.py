@@ -149,7 +149,7 @@ def test_equivalent_mass_matrix_gives_the_rigid_kinetic_energy(seed):
     length = rng.uniform(0.5, 3)
     link = Link(mass=rng.uniform(0.5, 5), inertia=rng.uniform(0.1, 3),
                 e=rng.uniform(-1, 2), f=rng.uniform(-1, 1))
-    me = mm.equivalent_mass_matrix(mm.inertial_parameters(link), length)
+    me = mm.equivalent_mass_matrix(link.inertial_parameters, length)
     assert np.allclose(me, me.T, rtol=0, atol=1e-15)  # symmetric by construction: exactly
     # Positive semidefinite: eigenvalues to rounding, ~ROUNDING·|Me| ≲ 1e-12 here.
     assert np.min(np.linalg.eigvalsh(me)) > -ROUNDING * np.max(np.abs(me))
@@ -162,7 +162,7 @@ def test_equivalent_mass_matrix_gives_the_rigid_kinetic_energy(seed):
     assert abs(0.5 * x @ me @ x - t_rigid) < ROUNDING * max(terms, t_rigid)
     # The complex application is the same matrix.
     ap, aq = complex(*rng.normal(size=2)), complex(*rng.normal(size=2))
-    fp, fq = mm.equivalent_inertia_forces(mm.inertial_parameters(link), length, ap, aq)
+    fp, fq = mm.equivalent_inertia_forces(link.inertial_parameters, length, ap, aq)
     acc = np.array([ap.real, ap.imag, aq.real, aq.imag])
     y = me @ acc
     # The same products in another order: ROUNDING times the terms, |Me|·|ẍ|.

@@ -22,7 +22,6 @@ from balancer import spec
 from balancer.balance.convex import CLARABEL_SETTINGS, TIE_ACCEPT
 from balancer.balance.optimizer import ConvexSolver, InfeasibleError, Optimizer, Status, optimize
 from balancer.balance.problem import NumericProblem, numeric_problem
-from balancer.balance.regressors import physical_to_inertial
 from balancer.balance.result import GAP_TOLERANCE
 from balancer.conditions import (
     berkof_residuals,
@@ -33,6 +32,7 @@ from balancer.cycle import cycle_analysis
 from balancer.errors import SolverError, SpecError
 from balancer.model import Design, Operation
 from balancer.model.balance import BalanceProblem, LinkFreedom, Objective
+from balancer.model.links import inertial_parameters
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
@@ -129,7 +129,7 @@ def _feasible_samples(data: NumericProblem, rng, n: int, around=None, spread: fl
             com[2] = l3 * (1 + (m[1] / m[2]) * com[1] / l2)
         x = np.zeros(14)
         for i in range(3):
-            x[4 * i : 4 * i + 4] = physical_to_inertial(m[i], com[i].real, com[i].imag, inertia[i])
+            x[4 * i : 4 * i + 4] = inertial_parameters(m[i], com[i].real, com[i].imag, inertia[i])
         for entry, b in ((12, data.links[0]), (13, data.links[2])):
             x[entry] = rng.uniform(*b.counter_rotor)
         if not data.violations(x):

@@ -18,8 +18,8 @@ from ..mechanisms.base import Mechanism
 from ..model import Link
 from ..model import Mechanism as Model
 from ..model.balance import OBJECTIVE_KEYS, BalanceProblem, LinkFreedom
+from ..model.links import inertial_parameters
 from ..validate import LENGTH_RANGE
-from .regressors import physical_to_inertial
 
 
 def default_about(mech: Mechanism, name: str) -> str:
@@ -365,7 +365,7 @@ def resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> Lin
     if freedom.counterweight is not None:
         cw = freedom.counterweight
         about = freedom.com_about or points[0]
-        m, me, mf, j = (float(v) for v in physical_to_inertial(
+        m, me, mf, j = (float(v) for v in inertial_parameters(
             link.mass, link.com.real, link.com.imag, link.inertia))
         return LinkBounds(
             **common, listed=True, mass=cw.mass, com_fixed=None, com_about=about,

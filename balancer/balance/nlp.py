@@ -9,7 +9,7 @@ afterwards.
 
 The objective is the same ``J`` as the convex problem's, written through the inertial
 parameters ``π(p) = (m, m·e, m·f, I + m·(e² + f²))``
-(:func:`balancer.balance.regressors.physical_to_inertial`) and the factor ``R`` of the regressors:
+(:func:`balancer.model.links.inertial_parameters`) and the factor ``R`` of the regressors:
 ``J = ‖R·π‖² + w_m·Δm``. Constraints: force balance (bilinear equalities in these variables),
 the centre of mass in its disc ``|s̄ − c|² ≤ R²``, ``I ≥ m·ρ²``, and simple bounds — an upper
 inertia bound is exact here, which is where this formulation can beat the convex relaxation.
@@ -34,8 +34,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import interrupts
+from ..model.links import inertial_parameters, physical_parameters
 from .problem import NumericProblem
-from .regressors import inertial_to_physical, physical_to_inertial
 from .result import StageReport
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
@@ -169,7 +169,7 @@ class NlpSolver:
                     ubg.append(0.0)
             # A counterweight's variables are its own; the link's entries add the kept link's.
             shift = (0.0,) * 4 if b.offset is None else b.offset
-            parts[k : k + 4] = [p + d for p, d in zip(physical_to_inertial(m, e, f, inertia),
+            parts[k : k + 4] = [p + d for p, d in zip(inertial_parameters(m, e, f, inertia),
                                                        shift, strict=True)]
         for b in data.rotor_links:
             entry = b.rotor_entry
@@ -229,7 +229,7 @@ class NlpSolver:
         own = data.own(x)
         # A counterweight of no mass has no centre: it starts at its disc's centre.
         physical = [(0.0, b.com_centre.real, b.com_centre.imag, 0.0) if data.absent(b, own)
-                    else inertial_to_physical(own[b.entries]) for b in data.links]
+                    else physical_parameters(own[b.entries]) for b in data.links]
         out = []
         for index, kind in self._names:
             if kind == "Jc":

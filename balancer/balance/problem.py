@@ -35,14 +35,10 @@ from ..mechanisms.base import Mechanism
 from ..model import Design
 from ..model import Mechanism as Model
 from ..model.balance import BalanceProblem, Objective
+from ..model.links import inertial_parameters, physical_parameters
 from .bounds import LinkBounds, check_problem, resolve_link
 from .lsq import bounded_lstsq
-from .regressors import (
-    CycleRegressors,
-    cycle_regressors,
-    inertial_to_physical,
-    physical_to_inertial,
-)
+from .regressors import CycleRegressors, cycle_regressors
 
 #: Relative tolerance of :meth:`NumericProblem.violations` for a solver's design (bounds and
 #: force balance): ten times Clarabel's tolerance.
@@ -512,18 +508,18 @@ class NumericProblem:
                 out[b.name] = (original.mass, original.e, original.f, original.inertia, rotor)
                 continue
             if b.offset is not None:  # the counterweight in its bounds, added to the link
-                own = inertial_to_physical(x[b.entries] - self.offset[b.entries])
+                own = physical_parameters(x[b.entries] - self.offset[b.entries])
                 m, e, f, inertia, rotor = self.clamp(b, *own, rotor)
                 if (m, e, f, inertia) == own:  # in its bounds: the link's values as they are
-                    out[b.name] = (*inertial_to_physical(x[b.entries]), rotor)
+                    out[b.name] = (*physical_parameters(x[b.entries]), rotor)
                     continue
                 # (Through the counterweight's own values only when a bound moved it: a
                 # counterweight that nearly cancels the link's first moment loses digits of
                 # the sum on the way.)
-                total = np.add(physical_to_inertial(m, e, f, inertia), b.offset)
-                out[b.name] = (*inertial_to_physical(total), rotor)
+                total = np.add(inertial_parameters(m, e, f, inertia), b.offset)
+                out[b.name] = (*physical_parameters(total), rotor)
                 continue
-            m, e, f, inertia = inertial_to_physical(x[b.entries])
+            m, e, f, inertia = physical_parameters(x[b.entries])
             if abs(inertia - b.original.inertia) <= 1e-12 * b.inertia_ref:
                 inertia = b.original.inertia  # only roundoff from J − m·s²
             out[b.name] = self.clamp(b, m, e, f, inertia, rotor)
@@ -602,7 +598,7 @@ class NumericProblem:
         x = np.zeros(self.size)
         for b in self.links:
             m, e, f, inertia, rotor = physical[b.name]
-            x[b.entries] = physical_to_inertial(m, e, f, inertia)
+            x[b.entries] = inertial_parameters(m, e, f, inertia)
             if b.rotor is not None:
                 x[b.rotor] = rotor
         return x

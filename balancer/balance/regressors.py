@@ -9,30 +9,12 @@ frame's origin, then the counter-rotors' inertias; and a link's physical values
 
 from __future__ import annotations
 
-from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..linkage.vectors import Num
 from ..mechanisms.base import Mechanism
-
-
-def physical_to_inertial(m: Num, e: Num, f: Num, inertia: Num) -> tuple[Num, Num, Num, Num]:
-    """Inertial parameters ``(m, m·e, m·f, J)`` from ``m``, ``e``, ``f``, ``I``.
-
-    ``J = I + m·(e² + f²)`` is the inertia about the link frame's origin. Works on floats,
-    numpy arrays and CasADi symbols alike (the NLP writes its objective through it).
-    """
-    return m, m * e, m * f, inertia + m * (e * e + f * f)
-
-
-def inertial_to_physical(params: Iterable[float]) -> tuple[float, float, float, float]:
-    """``(m, e, f, I)`` from inertial parameters ``(m, m·e, m·f, J)`` (inverse of the above)."""
-    m, me, mf, j = (float(p) for p in params)
-    e, f = me / m, mf / m
-    return m, e, f, j - m * (e * e + f * f)
 
 
 @dataclass(frozen=True)

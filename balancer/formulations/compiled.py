@@ -125,9 +125,9 @@ def link_equations(structure: Structure, links: Sequence[Link], pose: Pose, rate
     mass = ca.SX.zeros(3 * n, 3 * n)
     force = ca.SX.zeros(3 * n)
     for k, link in enumerate(links):
-        first = V(link.mass * link.e, link.mass * link.f).rotated(pose.cos[k], pose.sin[k])
-        j_origin = (link.inertia + link.mass * (link.e**2 + link.f**2)
-                    + rotors.link_inertia(link.counter_rotor))
+        _, me, mf, j = link.inertial_parameters
+        first = V(me, mf).rotated(pose.cos[k], pose.sin[k])
+        j_origin = j + rotors.link_inertia(link.counter_rotor)
         i = 3 * k
         mass[i, i] = mass[i + 1, i + 1] = link.mass
         mass[i, i + 2] = mass[i + 2, i] = -first.y

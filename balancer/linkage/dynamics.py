@@ -89,8 +89,7 @@ class Layout:
         x = np.zeros(self.size)
         for name, link in zip(linkage.link_names, linkage.links, strict=True):
             s = self.link_slice(name)
-            x[s] = (link.mass, link.mass * link.e, link.mass * link.f,
-                    link.inertia + link.mass * (link.e**2 + link.f**2))
+            x[s] = link.inertial_parameters
             r = self.rotor(name)
             if r is not None:
                 x[r] = link.counter_rotor

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import cmath
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from types import ModuleType
-from typing import TYPE_CHECKING, overload
+from typing import TYPE_CHECKING, Any, TypeVar, overload
 
 from .. import validate as v
 from ..errors import SpecError
@@ -22,6 +22,31 @@ from ..errors import SpecError
 if TYPE_CHECKING:
     import numpy as np
     from numpy.typing import ArrayLike, NDArray
+
+
+#: A number, a numpy array or a CasADi symbol: what the inertial-parameter map works on.
+N = TypeVar("N", bound=Any)
+
+
+def inertial_parameters(mass: N, e: N, f: N, inertia: N) -> tuple[N, N, N, N]:
+    """A link's inertial parameters ``(m, m·e, m·f, J)`` from ``m``, ``e``, ``f``, ``I``.
+
+    ``J = I + m·(e² + f²)`` is the inertia about the link frame's origin (its first joint); the
+    shaking force, moment and driving torque are linear in these four (Meijaard & van der Wijk
+    2020, Eq. 55–56). Works on floats, numpy arrays and CasADi symbols alike. The one map from
+    a link's mass properties to its inertial parameters; :func:`physical_parameters` inverts it.
+    """
+    return mass, mass * e, mass * f, inertia + mass * (e * e + f * f)
+
+
+def physical_parameters(params: Iterable[float]) -> tuple[float, float, float, float]:
+    """``(m, e, f, I)`` from inertial parameters ``(m, m·e, m·f, J)`` (:func:`inertial_parameters`).
+
+    ``m`` must not be zero.
+    """
+    m, me, mf, j = (float(p) for p in params)
+    e, f = me / m, mf / m
+    return m, e, f, j - m * (e * e + f * f)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -89,9 +114,17 @@ class Link:
         """Whether any applied force or moment acts on the link."""
         return self.force != (0.0, 0.0) or self.moment != 0.0
 
+    @property
+    def inertial_parameters(self) -> tuple[float, float, float, float]:
+        """Inertial parameters ``(m, m·e, m·f, J)``, ``J = I + m·s²`` about the first joint.
+
+        See :func:`inertial_parameters`.
+        """
+        return inertial_parameters(self.mass, self.e, self.f, self.inertia)
+
     def inertia_about_joint(self) -> float:
         """Moment of inertia about the first joint ``I + m·s²``, kg·m²."""
-        return self.inertia + self.mass * (self.e**2 + self.f**2)
+        return self.inertial_parameters[3]
 
     def with_com_polar(self, s: float, sigma: float) -> Link:
         """Return a copy with the centre of mass at distance ``s`` (m) and angle ``sigma`` (rad)."""

@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 from ..inverse import Reactions, dynamic_link
 from ..kinematics import cross
 from ..linkage import rotors
-from ..massmodels import equivalent_inertia_forces, equivalent_joint_forces, inertial_parameters
+from ..massmodels import equivalent_inertia_forces, equivalent_joint_forces
 from ..model import Link, SliderCrank
 from .kinematics import Lengths, SliderMotion
 
@@ -152,7 +152,7 @@ def mass_matrix(
     g = complex(*gravity)
     forces, moments, gas = _loads(mech, mo, g, loads)
     crank, rod, slider = (dynamic_link(link) for link in mech.links)
-    n0, n1, n2 = _nodal(inertial_parameters(crank), inertial_parameters(rod), slider.mass, mo,
+    n0, n1, n2 = _nodal(crank.inertial_parameters, rod.inertial_parameters, slider.mass, mo,
                         mech.lengths)
     f = []
     for k, (link, length, vec) in enumerate(((crank, r, mo.l1), (rod, big_l, mo.l2))):

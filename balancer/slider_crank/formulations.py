@@ -34,7 +34,7 @@ from ..formulations.mass_matrix import NodalTruss, NodeAccelerations
 from ..kinematics import cross_scalar
 from ..linkage import rotors
 from ..linkage.vectors import Num
-from ..massmodels import equivalent_joint_forces, equivalent_mass_matrix, inertial_parameters
+from ..massmodels import equivalent_joint_forces, equivalent_mass_matrix
 from ..model import Link, SliderCrank
 from ..model.assembly import AssemblyRange
 from .dynamics import kinetic_energy, newton_euler
@@ -381,4 +381,4 @@ class SliderMassMatrix(_SliderFormulation, NodalTruss):  # type: ignore[misc]  #
 
 
 def _element(link: Link, length: float) -> NDArray[np.float64]:
-    return equivalent_mass_matrix(inertial_parameters(link), length)
+    return equivalent_mass_matrix(link.inertial_parameters, length)
