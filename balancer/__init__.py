@@ -54,8 +54,8 @@ _EXPORTS = {
     "Operation": "model",
     "SimulationSettings": "model",
     "Drive": "model",
-    "FourBar": "model",
-    "SliderCrank": "model",
+    "FourBar": "mechanisms.fourbar.model",
+    "SliderCrank": "mechanisms.slidercrank.model",
     "Linkage": "model",
     "Branch": "model",
     "Link": "model",
@@ -64,7 +64,7 @@ _EXPORTS = {
     "Slider": "model",
     "Spring": "model",
     "AssemblyRange": "model",
-    "LinkageClass": "model",
+    "LinkageClass": "mechanisms.fourbar.assembly",
     "BalanceProblem": "model.balance",
     "Objective": "model.balance",
     "ObjectiveTerm": "model.balance",
@@ -214,21 +214,21 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .formulations import Method
     from .mechanisms import mechanism_of
     from .mechanisms.base import Mechanism, Route
+    from .mechanisms.fourbar.assembly import LinkageClass
+    from .mechanisms.fourbar.model import FourBar
+    from .mechanisms.slidercrank.model import SliderCrank
     from .model import (
         AssemblyRange,
         Body,
         Branch,
         Design,
         Drive,
-        FourBar,
         GasForce,
         Link,
         Linkage,
-        LinkageClass,
         Operation,
         SimulationSettings,
         Slider,
-        SliderCrank,
         Spring,
     )
     from .model.balance import (

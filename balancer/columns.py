@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from .linkage.kinematics import Motion
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism
-from .model import Mechanism as Model
+from .model import MechanismModel as Model
 
 #: Columns of a CSV file: real arrays over its rows.
 Columns = list[NDArray[np.floating]]

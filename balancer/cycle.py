@@ -31,7 +31,7 @@ from .linkage.dynamics import Forces
 from .linkage.kinematics import Motion
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism, Route
-from .model import Mechanism as Model
+from .model import MechanismModel as Model
 
 #: Number of crank angles evaluated at once.
 CHUNK = 32768

@@ -18,7 +18,7 @@ from .linkage.vectors import V
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism
 from .model import GROUND
-from .model import Mechanism as Model
+from .model import MechanismModel as Model
 
 
 class CounterweightLike(Protocol):

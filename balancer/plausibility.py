@@ -20,7 +20,7 @@ from .errors import BalancerError
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism
 from .model import Design
-from .model import Mechanism as Model
+from .model import MechanismModel as Model
 
 #: Longest length that is plausibly meant, m: no planar linkage this tool balances is longer.
 MAX_LENGTH = 100.0

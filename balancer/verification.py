@@ -28,7 +28,7 @@ import numpy as np
 from .errors import LockupError, SpecError
 from .mechanisms import mechanism_of
 from .model import Design, SimulationSettings
-from .model import Mechanism as Model
+from .model import MechanismModel as Model
 from .simulation import MAX_OUTPUTS, Trajectory, check, simulate
 
 #: Output times per crank revolution at least: 2°, some fifteen across the engine example's

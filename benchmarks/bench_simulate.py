@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from balancer.mechanisms.fourbar import FourBarMechanism
+from balancer.mechanisms.fourbar.mechanism import FourBarMechanism
 from balancer.simulation import simulate_design
 from balancer.spec import load_design
 

@@ -36,9 +36,10 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from balancer.formulations import make
-from balancer.mechanisms.fourbar import FourBarMechanism
-from balancer.model import FourBar, Link, SimulationSettings
-from balancer.model.assembly import classify
+from balancer.mechanisms.fourbar.assembly import classify
+from balancer.mechanisms.fourbar.mechanism import FourBarMechanism
+from balancer.mechanisms.fourbar.model import FourBar
+from balancer.model import Link, SimulationSettings
 from balancer.plots import SERIES, save_png
 from balancer.report import markdown_table
 from balancer.simulation import simulate

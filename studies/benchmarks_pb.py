@@ -30,7 +30,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from balancer.balance.optimizer import BACKENDS, optimize
-from balancer.conditions import berkof_residuals, force_balance_error
+from balancer.mechanisms.fourbar.conditions import berkof_residuals, force_balance_error
 from balancer.plots import COLOURS, save_png, verification_figure
 from balancer.report import markdown_table
 from balancer.spec import load_design

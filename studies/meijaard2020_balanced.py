@@ -32,13 +32,13 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from balancer.balance.optimizer import optimize
-from balancer.conditions import (
+from balancer.cycle import cycle_analysis
+from balancer.mechanisms.fourbar.conditions import (
     berkof_residuals,
     force_balance_error,
     force_balanced_by_crank_and_rocker,
 )
-from balancer.cycle import cycle_analysis
-from balancer.mechanisms.fourbar import FourBarMechanism
+from balancer.mechanisms.fourbar.mechanism import FourBarMechanism
 from balancer.model import SimulationSettings
 from balancer.plots import COLOURS, SERIES, plot_reactions, save_png
 from balancer.report import markdown_table
@@ -217,8 +217,9 @@ Sect. 5.2 and Fig. 9.
 ## Fig. 9: the force-balanced linkage in free motion
 
 The linkage of Eq. 56 without loads; the centres of mass of crank and rocker are moved so that
-Eq. 57 holds (`balancer.conditions.force_balanced_by_crank_and_rocker`; the paper does not print
-the values it used, these are the ones Eq. 57 gives with the masses and the coupler kept):
+Eq. 57 holds
+(`balancer.mechanisms.fourbar.conditions.force_balanced_by_crank_and_rocker`; the paper does not
+print the values it used, these are the ones Eq. 57 gives with the masses and the coupler kept):
 s1 = {fb.crank.s:.6g} m, σ1 = {fb.crank.sigma:.6g} rad, s3 = {fb.rocker.s:.6g} m,
 σ3 = {fb.rocker.sigma:.6g} rad (Eq. 57 residual {results['force_balance_error']:.1e} of the
 total mass). Free motion from θ1 = {settings.theta1:g} rad, θ̇1 = {settings.omega1:g} rad/s over

@@ -30,7 +30,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from balancer.formulations import make
-from balancer.mechanisms.fourbar import FourBarMechanism
+from balancer.mechanisms.fourbar.mechanism import FourBarMechanism
 from balancer.plots import COLOURS, SERIES, save_png
 from balancer.report import markdown_table
 from balancer.simulation import simulate

@@ -13,7 +13,7 @@ What it reproduces:
   of mass lie off the link lines (complex σk, the general case). Checked numerically: the
   mass-weighted centre of mass equals the similarity transform of the coupler curve to
   rounding (~1e-16 of the link lengths), B0, B3 and β from his Eq. 8–9 written out here agree
-  with :func:`balancer.massmodels.wunderlich_linkage`, and B0B1B2B3 closes.
+  with :func:`balancer.mechanisms.fourbar.massmodels.wunderlich_linkage`, and B0B1B2B3 closes.
 - Theorem 2 and Fig. 2: with the centres of mass on the link lines chosen by his Eq. 10d the
   total centre of mass is a fixed point, ``m3·σ3·a`` (masses summing to one). Also checked:
   the force-balance conditions of Meijaard & van der Wijk (Eq. 57) hold, and, as Wunderlich
@@ -35,17 +35,23 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from balancer.conditions import force_balance_error
 from balancer.cycle import sample_angles
-from balancer.kinematics import position_of
-from balancer.massmodels import link_centres_of_mass, total_com_direct, wunderlich_linkage
-from balancer.model import FourBar, Link, SimulationSettings, SliderCrank
+from balancer.mechanisms.fourbar.conditions import force_balance_error
+from balancer.mechanisms.fourbar.kinematics import position_of
+from balancer.mechanisms.fourbar.massmodels import (
+    link_centres_of_mass,
+    total_com_direct,
+    wunderlich_linkage,
+)
+from balancer.mechanisms.fourbar.model import FourBar
+from balancer.mechanisms.slidercrank import conditions as sc_cond
+from balancer.mechanisms.slidercrank import kinematics as sk
+from balancer.mechanisms.slidercrank import massmodels as sm
+from balancer.mechanisms.slidercrank.model import SliderCrank
+from balancer.model import Link, SimulationSettings
 from balancer.plots import COLOURS, SERIES, save_png
 from balancer.report import markdown_table
 from balancer.simulation import simulate
-from balancer.slider_crank import conditions as sc_cond
-from balancer.slider_crank import kinematics as sk
-from balancer.slider_crank import massmodels as sm
 from balancer.spec import load_design
 
 NAME = "wunderlich1964"
@@ -368,7 +374,7 @@ def _c(x: complex, digits: int = 6) -> str:
 def write_report(path: Path, linkage, still, paper, samples, results) -> None:
     w = results
     table1 = markdown_table(
-        ["quantity", "Wunderlich's formula (Eq. 7–9)", "balancer.massmodels"],
+        ["quantity", "Wunderlich's formula (Eq. 7–9)", "balancer.mechanisms.fourbar.massmodels"],
         [["B0 = m3·σ3·a (m)", _c(paper["B0"]), _c(w["B0"])],
          ["B3 = [1 + m1(σ1 − 1)]·a (m)", _c(paper["B3"]), _c(w["B3"])],
          ["γ = α1 − α3", _c(paper["alpha1"] - paper["alpha3"]), _c(w["gamma"])],

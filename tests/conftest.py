@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
-from balancer.model import FourBar, Link
-from balancer.model.assembly import assembly_range
+from balancer.mechanisms.fourbar.assembly import assembly_range
+from balancer.mechanisms.fourbar.model import FourBar
+from balancer.model import Link
 
 # Property tests draw the same examples on every machine and run (reproducible, like the seeded
 # random tests); HYPOTHESIS_PROFILE=explore draws new ones and keeps what fails (a fuzz campaign),

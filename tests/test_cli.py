@@ -192,11 +192,11 @@ def test_simulate_initial_angle_outside_the_assembly_range(tmp_path, capsys):
 def test_the_command_line_lists_every_formulation_and_drive():
     # The names the parser offers without importing the mechanisms (for a fast --help), against
     # the mechanisms' own tables and the model's drives.
-    from balancer import cli, formulations, model
+    from balancer import cli, formulations, mechanisms, model
 
     names = set(formulations.GENERAL)
-    for own in formulations.OWN.values():
-        names |= set(own)
+    for mechanism in mechanisms.REGISTRY.values():
+        names |= set(mechanism.own_formulations)
     assert set(cli.FORMULATION_NAMES) == names
     assert cli.DRIVES == model.DRIVES
 
@@ -326,8 +326,8 @@ def test_help_names_each_mechanisms_default_formulations(capsys):
     # applies (formulations.default_method), verify's the mechanism's verify_method.
     from balancer.formulations import default_method
     from balancer.mechanisms import mechanism_of
-    from balancer.mechanisms.fourbar import fourbar_linkage
-    from balancer.model import FourBar
+    from balancer.mechanisms.fourbar.mechanism import fourbar_linkage
+    from balancer.mechanisms.fourbar.model import FourBar
 
     with pytest.raises(SystemExit):
         main(["simulate", "--help"])

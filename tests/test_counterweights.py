@@ -336,7 +336,7 @@ def test_random_counterweight_problems_end_feasible_or_say_what_is_missing(seed)
     from conftest import random_linkage
 
     from balancer.balance.result import InfeasibleError
-    from balancer.conditions import force_balance_error
+    from balancer.mechanisms.fourbar.conditions import force_balance_error
     from balancer.model import Design, Operation
     from balancer.model.balance import (
         BalanceProblem,

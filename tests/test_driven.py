@@ -21,9 +21,9 @@ from test_slider_crank import random_slider_crank
 from balancer import simulation
 from balancer.errors import LockupError
 from balancer.formulations import make
-from balancer.formulations.complex_masses import ComplexMasses
+from balancer.mechanisms.fourbar.complex_masses import ComplexMasses
+from balancer.mechanisms.slidercrank.formulations import SliderComplexMasses
 from balancer.model import SimulationSettings
-from balancer.slider_crank.formulations import SliderComplexMasses
 
 
 def _cases():

@@ -9,13 +9,14 @@ import pytest
 from conftest import CLASS_EXAMPLES, paper_linkage, random_angles, random_link, random_linkage
 from helpers import drift_bound, growth, integration_bound, rel_err
 
-from balancer import inverse
-from balancer import kinematics as kin
 from balancer.cycle import cycle_analysis
 from balancer.errors import LockupError
 from balancer.formulations import DEAD_POINT_THRESHOLD, make
-from balancer.mechanisms.fourbar import FourBarMechanism
-from balancer.model import FourBar, Link, SimulationSettings, assembly
+from balancer.mechanisms.fourbar import assembly, inverse
+from balancer.mechanisms.fourbar import kinematics as kin
+from balancer.mechanisms.fourbar.mechanism import FourBarMechanism
+from balancer.mechanisms.fourbar.model import FourBar
+from balancer.model import Link, SimulationSettings
 from balancer.simulation import simulate
 
 #: The paper's four formulations of the four-bar.
@@ -291,7 +292,8 @@ def test_driven_motion_matches_the_cycle_analysis(method):
     settings = SimulationSettings(duration=2 * np.pi / speed, theta1=0.0, omega1=speed,
                                   drive="constant-speed", outputs=73)
     tr = simulate(linkage, settings, method=method, **TIGHT)
-    # The paper's Newton–Euler route in closed form (balancer.inverse.newton_euler).
+    # The paper's Newton–Euler route in closed form
+    # (balancer.mechanisms.fourbar.inverse.newton_euler).
     ca = cycle_analysis(linkage, speed, theta1=tr.theta[0], route="newton-euler")
     # The motion is prescribed (every state is put on θ1 = θ0 + ω·t and its loop closure), so
     # no integration error enters the reactions: the formulations' algebraic 1e-9 (DESIGN.md)
@@ -368,7 +370,7 @@ def test_the_opened_loops_outputs_at_many_states_are_its_single_state_equations(
     lengths = CLASS_EXAMPLES[cls]
     linkage = FourBar(lengths=lengths, branch="+", **{
         name: random_link(rng, length, loads=True, rotor=name != "coupler")
-        for name, length in zip(FourBar.link_names, lengths, strict=False)})
+        for name, length in zip(FourBar.chain_links, lengths, strict=False)})
     f = make("opened-loop", linkage, gravity=(0.3, -9.81), speed=3.0 if driven else None)
     times, states = [], []
     for theta1 in np.linspace(0.05, 2 * np.pi - 0.05, 40):

@@ -13,12 +13,16 @@ from helpers import ROUNDING, derivative_with_error, rel_err
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from balancer import cycle, inverse
-from balancer import kinematics as kin
-from balancer import massmodels as mm
-from balancer.conditions import berkof_counter_rotors, force_balanced_by_crank_and_rocker
+from balancer import cycle
 from balancer.errors import AssemblyError
-from balancer.model import FourBar
+from balancer.mechanisms.fourbar import inverse
+from balancer.mechanisms.fourbar import kinematics as kin
+from balancer.mechanisms.fourbar import massmodels as mm
+from balancer.mechanisms.fourbar.conditions import (
+    berkof_counter_rotors,
+    force_balanced_by_crank_and_rocker,
+)
+from balancer.mechanisms.fourbar.model import FourBar
 
 #: Least |sin(θ3 − θ2)| of the states of the finite-difference tests.
 FD_MARGIN = 0.3

@@ -9,9 +9,9 @@ import pytest
 from conftest import CLASS_EXAMPLES, PAPER_LENGTHS, random_angles, random_linkage
 from helpers import ROUNDING, derivative_with_error, rel_err
 
-from balancer import kinematics as kin
 from balancer.errors import AssemblyError
-from balancer.model import assembly
+from balancer.mechanisms.fourbar import assembly
+from balancer.mechanisms.fourbar import kinematics as kin
 
 
 def test_class_examples_are_what_they_claim():

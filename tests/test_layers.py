@@ -25,9 +25,14 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("errors", "validate", "tomltext", "progress", "interrupts", "outputs"),
     ("model",),
     ("linkage", "quadrature"),
-    ("kinematics", "massmodels", "inverse", "conditions", "slider_crank", "mechanisms"),
-    ("force_balance", "columns", "cycle", "drawing", "formulations", "integration",
-     "slider_crank.formulations"),
+    # The mechanism interface, and what every mechanism's formulations share.
+    ("mechanisms.base", "mechanisms.formulation", "mechanisms.chains"),
+    # Each mechanism in its own folder; the general formulations (any mechanism).
+    ("mechanisms.fourbar", "mechanisms.slidercrank", "mechanisms.general",
+     "formulations.compiled", "formulations.crank_angle", "formulations.multibody"),
+    # The registry of mechanisms and of formulations, and what runs over any mechanism.
+    ("mechanisms", "formulations", "force_balance", "columns", "cycle", "drawing",
+     "integration"),
     ("balance",),
     ("simulation", "verification", "report", "plots", "plausibility"),
     ("spec", "examples", "api", "sweeps", "cli", "__main__"),

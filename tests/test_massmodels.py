@@ -9,9 +9,10 @@ import pytest
 from conftest import paper_linkage, random_angles, random_linkage
 from helpers import ROUNDING, rel_err
 
-from balancer import kinematics as kin
-from balancer import massmodels as mm
-from balancer.conditions import force_balanced_by_crank_and_rocker
+from balancer.linkage import massmodels as link_mm
+from balancer.mechanisms.fourbar import kinematics as kin
+from balancer.mechanisms.fourbar import massmodels as mm
+from balancer.mechanisms.fourbar.conditions import force_balanced_by_crank_and_rocker
 from balancer.model import Link
 
 
@@ -68,9 +69,9 @@ def test_complex_joint_masses_reproduce_the_centre_of_mass(linkage, angles):
         # Joint masses of magnitude ≤ m·(1 + |s̄|/l) ≤ 2.6·m, from a few operations each:
         # rounding ≲ 8ε·m ≈ 2e-15·m, within 1e-14·m; the two forms to ROUNDING·m (a mass, not
         # an absolute number).
-        mp, mq = mm.complex_joint_masses(link, linkage.lengths[k])
+        mp, mq = link_mm.complex_joint_masses(link, linkage.lengths[k])
         assert abs(mp + mq - link.mass) < 1e-14 * link.mass
-        ma, mb, mc = mm.equivalent_masses(link, linkage.lengths[k])
+        ma, mb, mc = link_mm.equivalent_masses(link, linkage.lengths[k])
         tol = ROUNDING * link.mass
         assert abs(mp - (ma - 1j * mc)) < tol and abs(mq - (mb + 1j * mc)) < tol
         rp, rq = joints[k]
@@ -149,7 +150,7 @@ def test_equivalent_mass_matrix_gives_the_rigid_kinetic_energy(seed):
     length = rng.uniform(0.5, 3)
     link = Link(mass=rng.uniform(0.5, 5), inertia=rng.uniform(0.1, 3),
                 e=rng.uniform(-1, 2), f=rng.uniform(-1, 1))
-    me = mm.equivalent_mass_matrix(link.inertial_parameters, length)
+    me = link_mm.equivalent_mass_matrix(link.inertial_parameters, length)
     assert np.allclose(me, me.T, rtol=0, atol=1e-15)  # symmetric by construction: exactly
     # Positive semidefinite: eigenvalues to rounding, ~ROUNDING·|Me| ≲ 1e-12 here.
     assert np.min(np.linalg.eigvalsh(me)) > -ROUNDING * np.max(np.abs(me))
@@ -162,7 +163,7 @@ def test_equivalent_mass_matrix_gives_the_rigid_kinetic_energy(seed):
     assert abs(0.5 * x @ me @ x - t_rigid) < ROUNDING * max(terms, t_rigid)
     # The complex application is the same matrix.
     ap, aq = complex(*rng.normal(size=2)), complex(*rng.normal(size=2))
-    fp, fq = mm.equivalent_inertia_forces(link.inertial_parameters, length, ap, aq)
+    fp, fq = link_mm.equivalent_inertia_forces(link.inertial_parameters, length, ap, aq)
     acc = np.array([ap.real, ap.imag, aq.real, aq.imag])
     y = me @ acc
     # The same products in another order: ROUNDING times the terms, |Me|·|ẍ|.
@@ -177,7 +178,7 @@ def test_equivalent_joint_forces_do_the_same_virtual_work(seed):
     link = Link(mass=1.0, inertia=1.0, e=rng.uniform(-1, 2), f=rng.uniform(-1, 1),
                 force=tuple(rng.normal(size=2)), moment=rng.normal())
     p, q, dp, dq, dth = _rigid_motion(rng, length)  # a rigid virtual displacement
-    fp, fq = mm.equivalent_joint_forces(link, length, q - p)
+    fp, fq = link_mm.equivalent_joint_forces(link, length, q - p)
     work_nodes = kin.inner(dp, fp) + kin.inner(dq, fq)
     d_com = dp + 1j * dth * link.com / length * (q - p)
     work = kin.inner(d_com, link.force_complex) + link.moment * dth

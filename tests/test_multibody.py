@@ -268,7 +268,8 @@ def test_the_multibody_formulation_names_a_change_point_it_cannot_pass():
     # constraints are dependent: the saddle-point system is singular, so the run stalls and
     # says where, why, and which formulations follow the smooth motion through it.
     from balancer.errors import SolverError
-    from balancer.model import FourBar, Link
+    from balancer.mechanisms.fourbar.model import FourBar
+    from balancer.model import Link
 
     links = [Link(mass=m, inertia=0.01, e=length / 2, f=0.0)
              for m, length in ((1.0, 0.1), (2.0, 0.25), (1.5, 0.1))]

@@ -1,7 +1,8 @@
 """The balancing optimisers: optimality, feasibility, agreement of the backends, PB1 and PB2.
 
 Checks that do not re-run the optimiser's own code: force balance by
-:func:`balancer.conditions.force_balance_error` on the rebuilt links; the objective by the
+:func:`balancer.mechanisms.fourbar.conditions.force_balance_error` on the rebuilt links; the
+objective by the
 Newton–Euler cycle analysis (the optimisers use the general core's regressors); optimality by a
 random search over feasible designs built in closed form (Eq. 57 solved for the crank's and
 rocker's centres of mass); complete balance by Berkof's conditions; infeasibility diagnoses by
@@ -23,13 +24,13 @@ from balancer.balance.convex import CLARABEL_SETTINGS, TIE_ACCEPT
 from balancer.balance.optimizer import ConvexSolver, InfeasibleError, Optimizer, Status, optimize
 from balancer.balance.problem import NumericProblem, numeric_problem
 from balancer.balance.result import GAP_TOLERANCE
-from balancer.conditions import (
+from balancer.cycle import cycle_analysis
+from balancer.errors import SolverError, SpecError
+from balancer.mechanisms.fourbar.conditions import (
     berkof_residuals,
     force_balance_error,
     force_balanced_by_crank_and_rocker,
 )
-from balancer.cycle import cycle_analysis
-from balancer.errors import SolverError, SpecError
 from balancer.model import Design, Operation
 from balancer.model.balance import BalanceProblem, LinkFreedom, Objective
 from balancer.model.links import inertial_parameters

@@ -23,7 +23,8 @@ from balancer.cli import main
 from balancer.cycle import cycle_analysis
 from balancer.errors import AssemblyError, SpecError
 from balancer.mechanisms import mechanism_of
-from balancer.model import Design, FourBar, Operation
+from balancer.mechanisms.fourbar.model import FourBar
+from balancer.model import Design, Operation
 from balancer.model.balance import BalanceProblem, LinkFreedom, Objective
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -258,7 +259,8 @@ def _objective_by_newton_euler(data, linkage: FourBar) -> float:
     """The objective from the Newton–Euler cycle analysis (no loads), not the regressors.
 
     A four-bar's route "newton-euler" is the paper's free-body equations in closed form
-    (:func:`balancer.inverse.newton_euler`), independent of the general core's regressors.
+    (:func:`balancer.mechanisms.fourbar.inverse.newton_euler`), independent of the general
+    core's regressors.
     """
     w = data.weights
     s = cycle_analysis(linkage, data.speed, data.samples, route="newton-euler", loads=False)

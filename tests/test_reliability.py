@@ -22,7 +22,9 @@ from balancer.balance.problem import FORCE_BALANCE_TOLERANCE, NumericProblem, nu
 from balancer.balance.result import GAP_TOLERANCE, InfeasibleError
 from balancer.cli import main
 from balancer.errors import AssemblyError, OutputError, SolverError, SpecError
-from balancer.model import Design, FourBar, Link, Operation, SimulationSettings, SliderCrank
+from balancer.mechanisms.fourbar.model import FourBar
+from balancer.mechanisms.slidercrank.model import SliderCrank
+from balancer.model import Design, Link, Operation, SimulationSettings
 from balancer.report import csv_text, dumps_json
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"

@@ -16,8 +16,11 @@ from pathlib import Path
 import pytest
 
 from balancer.errors import SpecError
-from balancer.formulations import GENERAL, OWN
-from balancer.model import FourBar, Linkage, Operation, SimulationSettings, SliderCrank
+from balancer.formulations import GENERAL
+from balancer.mechanisms import REGISTRY
+from balancer.mechanisms.fourbar.model import FourBar
+from balancer.mechanisms.slidercrank.model import SliderCrank
+from balancer.model import Linkage, Operation, SimulationSettings
 from balancer.model.balance import COUNTERWEIGHT_KEYS, LINK_KEYS, OBJECTIVE_KEYS
 from balancer.spec import MECHANISM_TYPES, design_from_dict, schema
 from balancer.spec.tables import Table
@@ -211,8 +214,8 @@ def test_the_schema_names_what_the_model_names():
     for kind in (schema.FOUR_BAR, schema.SLIDER_CRANK):
         cls = CLASSES[kind]
         assert schema.known("mechanism.lengths", kind) == cls.length_names
-        assert schema.known("links", kind) == cls.link_names
-        assert schema.known("original", kind) == cls.link_names
+        assert schema.known("links", kind) == cls.chain_links
+        assert schema.known("original", kind) == cls.chain_links
     assert schema.known("balance.objective") == OBJECTIVE_KEYS
     assert set(schema.known("balance.<link>")) == set(LINK_KEYS)
     assert schema.known("balance.<link>.counterweight") == COUNTERWEIGHT_KEYS
@@ -220,7 +223,7 @@ def test_the_schema_names_what_the_model_names():
     assert set(schema.known("simulation")) == {
         f.name for f in dataclasses.fields(SimulationSettings)}
     method = next(k for k in schema.section("simulation").keys if k.name == "method")
-    for name in (*GENERAL, *(n for own in OWN.values() for n in own)):
+    for name in (*GENERAL, *(n for m in REGISTRY.values() for n in m.own_formulations)):
         assert f"`{name}`" in method.meaning, name
     kind = next(k for k in schema.section("mechanism").keys if k.name == "type")
     assert all(f'`"{t}"`' in kind.meaning for t in MECHANISM_TYPES)

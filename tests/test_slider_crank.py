@@ -18,13 +18,14 @@ from balancer.cli import main
 from balancer.cycle import cycle_analysis
 from balancer.errors import AssemblyError, SpecError
 from balancer.formulations import make
-from balancer.kinematics import cross
-from balancer.model import GasForce, Link, SimulationSettings, SliderCrank
+from balancer.linkage.vectors import cross
+from balancer.mechanisms.slidercrank import conditions as sc_cond
+from balancer.mechanisms.slidercrank import dynamics as sd
+from balancer.mechanisms.slidercrank import kinematics as sk
+from balancer.mechanisms.slidercrank import massmodels as sm
+from balancer.mechanisms.slidercrank.model import SliderCrank
+from balancer.model import GasForce, Link, SimulationSettings
 from balancer.simulation import simulate
-from balancer.slider_crank import conditions as sc_cond
-from balancer.slider_crank import dynamics as sd
-from balancer.slider_crank import kinematics as sk
-from balancer.slider_crank import massmodels as sm
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 GAS = GasForce(angles=(0.0, 1.0, 2.5, 4.0), values=(-300.0, -120.0, 10.0, -40.0))

@@ -18,8 +18,8 @@ import pytest
 from conftest import PAPER_LENGTHS
 from helpers import drift_bound, growth, integration_bound
 
-from balancer import kinematics as kin
 from balancer.balance.result import GAP_TOLERANCE
+from balancer.mechanisms.fourbar import kinematics as kin
 from balancer.model import SimulationSettings
 from balancer.simulation import simulate
 

@@ -12,7 +12,7 @@ from helpers import integration_bound
 from balancer import spec
 from balancer.balance.result import GAP_TOLERANCE
 from balancer.cli import main
-from balancer.conditions import berkof_residuals, force_balance_error
+from balancer.mechanisms.fourbar.conditions import berkof_residuals, force_balance_error
 from balancer.verification import verify
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"

@@ -16,7 +16,7 @@ from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Link
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from ..model.balance import OBJECTIVE_KEYS, BalanceProblem, LinkFreedom
 from ..model.links import inertial_parameters
 from ..validate import LENGTH_RANGE

@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass
 
 from ..model import Link
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 
 #: Density of steel, kg/m³ (the disc that realises a counterweight).
 STEEL_DENSITY = 7850.0

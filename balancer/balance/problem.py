@@ -33,7 +33,7 @@ from ..force_balance import SMALL_ROW, force_balance_conditions
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Design
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from ..model.balance import BalanceProblem, Objective
 from ..model.links import inertial_parameters, physical_parameters
 from .bounds import LinkBounds, check_problem, resolve_link

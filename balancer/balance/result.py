@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 from ..cycle import CycleAnalysis, cycle_analysis
 from ..errors import SolverError
 from ..model import Design
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from ..model.balance import Objective, ObjectiveTerm
 from .counterweights import Counterweight, added_mass, counterweights
 

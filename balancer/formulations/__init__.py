@@ -2,7 +2,8 @@
 
 Every mechanism has the general ``multibody`` formulation (:mod:`.multibody`: absolute
 coordinates of every link with the constraints' multipliers, any linkage); the four-bar has the
-paper's four (below), the slider-crank two of its own (:mod:`balancer.slider_crank.formulations`);
+paper's four (below), the slider-crank two of its own
+(:mod:`balancer.mechanisms.slidercrank.formulations`);
 each mechanism names its own (:attr:`balancer.mechanisms.base.Mechanism.formulation_table`).
 The four-bar's:
 
@@ -38,9 +39,7 @@ from typing import Literal
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
-from ..model import Mechanism as Model
-from ..slider_crank.formulations import SliderComplexMasses, SliderMassMatrix
-from .base import (
+from ..mechanisms.formulation import (
     DEAD_POINT_THRESHOLD,
     DrivenRates,
     Evaluation,
@@ -49,24 +48,17 @@ from .base import (
     least_norm,
     least_norm_many,
 )
-from .complex_masses import ComplexMasses
+from ..model import MechanismModel as Model
 from .crank_angle import CrankAngle
-from .lie_group import LieGroup
-from .mass_matrix import MassMatrix
 from .multibody import Multibody
-from .opened_loop import OpenedLoop
 
 #: A formulation of the equations of motion, by name (``simulate --method``).
 Method = Literal["opened-loop", "complex-masses", "mass-matrix", "lie-group", "multibody",
                  "crank-angle"]
-#: The formulations by name: those every linkage has, and each mechanism's own by its kind
-#: (the names a mechanism offers, in its order, are its ``formulation_names``).
+#: The formulations every linkage has, by name; each mechanism adds its own
+#: (:attr:`~balancer.mechanisms.base.Mechanism.own_formulations`; the names a mechanism offers,
+#: in its order, are its ``formulation_names``).
 GENERAL: dict[str, type[Formulation]] = {"multibody": Multibody, "crank-angle": CrankAngle}
-OWN: dict[str, dict[str, type[Formulation]]] = {
-    "four-bar": {"opened-loop": OpenedLoop, "complex-masses": ComplexMasses,
-                 "mass-matrix": MassMatrix, "lie-group": LieGroup},
-    "slider-crank": {"mass-matrix": SliderMassMatrix, "complex-masses": SliderComplexMasses},
-}
 
 
 def formulation_names(model: Model | Mechanism) -> tuple[str, ...]:
@@ -96,12 +88,13 @@ def formulation_class(name: str, model: Model | Mechanism) -> type[Formulation]:
     if name not in names:
         raise SpecError(f"the {mech.kind} has no such formulation; choose from "
                         f"{', '.join(names)}", key="method", value=name)
-    return OWN.get(mech.kind, {}).get(name) or GENERAL[name]
+    own: type[Formulation] | None = mech.own_formulations.get(name)
+    return own or GENERAL[name]
 
 
 def make(
     name: str,
-    linkage: Model,
+    linkage: Model | Mechanism,
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     speed: float | None = None,
@@ -112,13 +105,14 @@ def make(
     mechanism, gravity and speed and kept with the mechanism; its state is set again by each
     :meth:`~Formulation.initial_state`.
     """
-    cls = formulation_class(name, linkage)
+    mech = mechanism_of(linkage)
+    cls = formulation_class(name, mech)
     if not cls.reusable:
-        return cls(linkage, gravity=gravity, speed=speed)
-    cache = mechanism_of(linkage).structure.cache.setdefault("formulations", {})
+        return cls(mech, gravity=gravity, speed=speed)
+    cache = mech.structure.cache.setdefault("formulations", {})
     key = (name, complex(*gravity), speed)
     if key not in cache:
-        cache[key] = cls(linkage, gravity=gravity, speed=speed)
+        cache[key] = cls(mech, gravity=gravity, speed=speed)
     return cache[key]
 
 
@@ -126,7 +120,6 @@ __all__ = [
     "DEAD_POINT_THRESHOLD",
     "GENERAL",
     "Method",
-    "OWN",
     "DrivenRates",
     "Evaluation",
     "Formulation",

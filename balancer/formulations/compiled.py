@@ -21,10 +21,9 @@ from ..linkage.constraints import GROUND_INDEX, Pose
 from ..linkage.structure import Structure
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import NUMPY, Num, OpsLike, V
-from ..mechanisms import mechanism_of
+from ..mechanisms.base import Mechanism
+from ..mechanisms.formulation import Formulation
 from ..model import Link, Spring
-from ..model import Mechanism as Model
-from .base import Formulation
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
     import casadi as ca
@@ -167,10 +166,10 @@ class LinkageFormulation(Formulation):
 
     reusable = True
 
-    def __init__(self, linkage: Model, *, gravity: tuple[float, float] = (0.0, 0.0),
+    def __init__(self, mechanism: Mechanism, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
-        super().__init__(linkage, gravity=gravity, speed=speed)
-        self.mech = mechanism_of(linkage)
+        super().__init__(mechanism, gravity=gravity, speed=speed)
+        self.mech = mechanism
         self.structure = self.mech.structure
         self.n = self.structure.size
         self.links = self.mech.links

@@ -41,9 +41,8 @@ from ..linkage.kinematics import numeric_table, positions, rates
 from ..linkage.numeric import TABLE_STEPS
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import Num, V
-from ..mechanisms.base import _gaps
-from ..model import Mechanism as Model
-from .base import DEAD_POINT_THRESHOLD, DrivenRates, Evaluation
+from ..mechanisms.base import Mechanism, _gaps
+from ..mechanisms.formulation import DEAD_POINT_THRESHOLD, DrivenRates, Evaluation
 from .compiled import Compiled, LinkageFormulation, link_equations
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
@@ -62,9 +61,9 @@ class CrankAngle(LinkageFormulation):
     passes_dead_points = False
     passes_change_points = False
 
-    def __init__(self, linkage: Model, *, gravity: tuple[float, float] = (0.0, 0.0),
+    def __init__(self, mechanism: Mechanism, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
-        super().__init__(linkage, gravity=gravity, speed=speed)
+        super().__init__(mechanism, gravity=gravity, speed=speed)
         #: Each link's angle at the start less its principal value there (whole turns).
         self.turns = np.zeros(self.n)
         self._build()

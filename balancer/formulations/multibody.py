@@ -51,9 +51,8 @@ from ..linkage.constraints import (
 from ..linkage.kinematics import _gamma
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import Num, OpsLike, V
-from ..mechanisms.base import _gaps
-from ..model import Mechanism as Model
-from .base import Evaluation, continuous_angles, least_norm, least_norm_many
+from ..mechanisms.base import Mechanism, _gaps
+from ..mechanisms.formulation import Evaluation, continuous_angles, least_norm, least_norm_many
 from .compiled import Compiled, LinkageFormulation, link_equations, spring_forces
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
@@ -69,9 +68,9 @@ class Multibody(LinkageFormulation):
     #: At a change point its constraints are dependent and the saddle-point system singular.
     passes_change_points = False
 
-    def __init__(self, linkage: Model, *, gravity: tuple[float, float] = (0.0, 0.0),
+    def __init__(self, mechanism: Mechanism, *, gravity: tuple[float, float] = (0.0, 0.0),
                  speed: float | None = None) -> None:
-        super().__init__(linkage, gravity=gravity, speed=speed)
+        super().__init__(mechanism, gravity=gravity, speed=speed)
         #: The mechanism as a general linkage (springs, sliders, ground points).
         self.general = self.mech.linkage
         s = self.structure

@@ -16,6 +16,7 @@ The functions take numbers, arrays or CasADi symbols alike (the inertia may be a
 
 from __future__ import annotations
 
+from ..model.links import Link
 from .vectors import Num
 
 #: The ratio of a counter-rotor: against its link, at its speed.
@@ -50,3 +51,20 @@ def ground_couple(inertia: Num, alpha: Num, ratio: float = COUNTER) -> Num:
 def moment(inertia: Num, alpha: Num, ratio: float = COUNTER) -> Num:
     """What the rotor adds to the shaking moment through its link and the frame, ``−J·k·α``."""
     return -inertia * ratio * alpha
+
+
+def dynamic_link(link: Link) -> Link:
+    """The link as the equations of motion see it: its counter-rotor's inertia added to ``I``.
+
+    (:func:`link_inertia`: a counter-rotor's ``J·k²`` is ``J``.)
+    """
+    if link.counter_rotor == 0.0:
+        return link
+    return Link(
+        mass=link.mass,
+        inertia=link.inertia + link_inertia(link.counter_rotor),
+        e=link.e,
+        f=link.f,
+        force=link.force,
+        moment=link.moment,
+    )

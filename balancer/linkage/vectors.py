@@ -7,6 +7,9 @@ with numpy (vectorised) or CasADi (compiled).
 
 :class:`Factor` solves ``A·X = B`` for many small systems at once (one per crank angle),
 exploiting their structure.
+
+The seeds' closed forms write plane vectors as complex numbers ``x + i·y``: their scalar and
+cross products are :func:`inner` and :func:`cross` (:func:`cross_scalar` for single numbers).
 """
 
 from __future__ import annotations
@@ -343,3 +346,34 @@ class Factor:
                         acc = _minus(acc, _times(v, x[col][c]))
                 x[j][c] = acc / pivot if not _is_zero(acc) else 0.0
         return x
+
+
+# -- plane vectors as complex numbers (the seeds' closed forms) --------------------------------
+
+
+def inner(x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
+    """Scalar product ``⟨x̄, ȳ⟩ = Re(x*·y)`` of plane vectors given as complex numbers."""
+    x = np.asarray(x)
+    y = np.asarray(y)
+    return x.real * y.real + x.imag * y.imag
+
+
+def cross(x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
+    """Z-component of ``x × y`` for plane vectors given as complex numbers (``Im(x*·y)``)."""
+    x = np.asarray(x)
+    y = np.asarray(y)
+    return x.real * y.imag - x.imag * y.real
+
+
+def cross_scalar(x: complex, y: complex) -> float:
+    """:func:`cross` of two Python complex numbers, without numpy's per-call cost.
+
+    The formulations' right-hand sides call it thousands of times per simulation.
+    """
+    return x.real * y.imag - x.imag * y.real
+
+
+def as_1d(x: ArrayLike) -> NDArray[np.float64]:
+    """``x`` as a one-dimensional float array (a number as an array of one)."""
+    a = np.asarray(x, dtype=float)
+    return a.reshape(-1) if a.ndim else a.reshape(1)

@@ -9,11 +9,11 @@ from __future__ import annotations
 from functools import lru_cache
 
 from ..errors import SpecError
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from .base import Mechanism
-from .fourbar import FourBarMechanism
-from .general import LinkageMechanism
-from .slidercrank import SliderCrankMechanism
+from .fourbar.mechanism import FourBarMechanism
+from .general.mechanism import LinkageMechanism
+from .slidercrank.mechanism import SliderCrankMechanism
 
 #: The mechanism classes by the spec's ``mechanism.type``.
 REGISTRY: dict[str, type[Mechanism]] = {

@@ -1,7 +1,7 @@
 """The one mechanism interface that everything downstream uses.
 
-A :class:`Mechanism` wraps a model (:class:`~balancer.model.FourBar`,
-:class:`~balancer.model.SliderCrank` or :class:`~balancer.model.Linkage`) and tells the rest of
+A :class:`Mechanism` wraps a model (:class:`~balancer.FourBar`,
+:class:`~balancer.SliderCrank` or :class:`~balancer.model.Linkage`) and tells the rest of
 the package what it needs: the links and the ground points, the named layout of the design
 vector, the range of crank angles where it assembles, the motion at arrays of crank angles, the
 forces on the ground and the driving torque (and the same as linear maps of the design vector),
@@ -18,9 +18,10 @@ from __future__ import annotations
 import math
 import threading
 from abc import ABC
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -33,7 +34,7 @@ from ..linkage.kinematics import Motion
 from ..linkage.program import CrankForcesProgram
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
-from ..model import GROUND, Branch, FourBar, Link, Linkage, SliderCrank
+from ..model import GROUND, Branch, Link, Linkage, MechanismModel
 from ..model.assembly import AssemblyRange
 
 #: The inverse-dynamics routes of every mechanism (``analyze --route``): the links' equations
@@ -97,6 +98,10 @@ class Mechanism(ABC):
     kind: ClassVar[str]
     #: Inverse-dynamics routes (``analyze --route``), the default first.
     routes: ClassVar[tuple[Route, ...]] = ("newton-euler", "mass-matrix")
+    #: The mechanism's own formulations of the equations of motion by name, the default first
+    #: (classes of :class:`~balancer.mechanisms.formulation.Formulation`, in its folder): the
+    #: general ones (:mod:`balancer.formulations`) apply to every mechanism besides.
+    own_formulations: ClassVar[Mapping[str, Any]] = {}
     #: The mechanism's own formulations of the equations of motion (:mod:`balancer.formulations`
     #: has them by name), the default first.
     formulations: ClassVar[tuple[str, ...]] = ()
@@ -111,7 +116,7 @@ class Mechanism(ABC):
     #: (``R{name}x``, ``R{name}y``) rather than by its normal force ``N_{link}``.
     guide_force_names: ClassVar[dict[str, str]] = {}
 
-    def __init__(self, model: FourBar | SliderCrank | Linkage) -> None:
+    def __init__(self, model: MechanismModel) -> None:
         self.model = model
 
     # -- identity -----------------------------------------------------------------------------

@@ -1,4 +1,8 @@
-"""Immutable model objects: links, mechanisms, operating conditions and a whole design.
+"""Immutable model objects: links, the general linkage, operating conditions and a whole design.
+
+The four-bar's and the slider-crank's data are their mechanisms' own
+(:mod:`balancer.mechanisms.fourbar.model`, :mod:`balancer.mechanisms.slidercrank.model`); all
+share :class:`MechanismModel`.
 
 Notation (Meijaard & van der Wijk 2020, Sect. 2–3, Fig. 1): link ``k`` runs from its first joint
 to its second; its centre of mass relative to the first joint, in the frame along the link, is
@@ -14,7 +18,7 @@ made (:mod:`balancer.validate`, the same checks as the spec loader's) and raises
 notebook is as safe as one read from a spec.
 """
 
-from .assembly import AssemblyRange, LinkageClass
+from .assembly import AssemblyRange
 from .design import (
     ATOL_MIN,
     DRIVES,
@@ -27,7 +31,7 @@ from .design import (
     check_scales,
 )
 from .links import GROUND, RESERVED_LINK_NAMES, Body, GasForce, Link, Slider, Spring
-from .mechanisms import Branch, FourBar, Linkage, Mechanism, SliderCrank
+from .mechanisms import Branch, ChainModel, Linkage, MechanismModel
 
 __all__ = [
     "ATOL_MIN",
@@ -41,15 +45,13 @@ __all__ = [
     "Branch",
     "Design",
     "Drive",
-    "FourBar",
     "GasForce",
     "Link",
-    "LinkageClass",
     "Linkage",
-    "Mechanism",
+    "ChainModel",
+    "MechanismModel",
     "Operation",
     "SimulationSettings",
-    "SliderCrank",
     "Slider",
     "Spring",
     "check_scales",

@@ -13,7 +13,7 @@ from typing import ClassVar, Literal
 from .. import validate as v
 from ..errors import SpecError
 from .balance import BalanceProblem
-from .mechanisms import Mechanism
+from .mechanisms import MechanismModel
 
 Drive = Literal["free", "constant-speed"]
 
@@ -154,11 +154,11 @@ class Design:
         A free-text name for reports.
     """
 
-    mechanism: Mechanism
+    mechanism: MechanismModel
     operation: Operation | None = None
     simulation: SimulationSettings = field(default_factory=SimulationSettings)
     balance: BalanceProblem | None = None
-    original: Mechanism | None = None
+    original: MechanismModel | None = None
     title: str = ""
 
     def __post_init__(self) -> None:
@@ -166,7 +166,7 @@ class Design:
 
         Keys are the spec's, from its root.
         """
-        if not isinstance(self.mechanism, Mechanism):
+        if not isinstance(self.mechanism, MechanismModel):
             raise SpecError("must be a FourBar, a SliderCrank or a Linkage", key="mechanism",
                             value=type(self.mechanism).__name__)
         for name, cls in (("operation", Operation), ("simulation", SimulationSettings)):
@@ -189,7 +189,7 @@ class Design:
                 check_scales(mech, speeds, gravity)
 
 
-def check_scales(mechanism: Mechanism, speeds: dict[str, float],
+def check_scales(mechanism: MechanismModel, speeds: dict[str, float],
                  gravity: dict[str, tuple[float, float]] | None = None) -> None:
     """Raise :class:`SpecError` if a force, moment or energy of the motion leaves double precision.
 

@@ -1,240 +1,195 @@
-"""The mechanisms a spec describes: the four-bar, the slider-crank and the general linkage.
+"""What every mechanism's data offers (:class:`MechanismModel`), and the general linkage.
 
-Each is frozen data that checks itself when made (:mod:`balancer.validate`, the same checks as
-the spec loader's). Conventions (DESIGN.md): the four-bar's ground pivots A0 at the origin and
-A3 at ``(l4, 0)``, links crank A0→A1, coupler A1→A2, rocker A2→A3; the slider-crank's guide
-along +x at ``offset`` from A0; a general linkage's points at a reference pose that fixes its
-assembly branch.
+A mechanism's data is frozen and checks itself when made (:mod:`balancer.validate`, the same
+checks as the spec loader's). The general linkage (:class:`Linkage`) is the core's: a general
+linkage's points at a reference pose that fix its assembly branch (DESIGN.md, "General planar
+linkages"). A mechanism given by its lengths and named links in a chain, with an assembly
+branch (the four-bar, the slider-crank: :mod:`balancer.mechanisms`), shares
+:class:`ChainModel`.
 """
 
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from collections.abc import Iterable
-from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar, Literal
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar, Literal, Self
 
 from .. import validate as v
-from ..errors import AssemblyError, SpecError
-from .assembly import assembly_range
+from ..errors import SpecError
 from .links import GROUND, RESERVED_LINK_NAMES, Body, GasForce, Link, Slider, Spring
 
+#: An assembly branch of a mechanism given by its lengths.
 Branch = Literal["+", "-"]
 
 
-@dataclass(frozen=True, kw_only=True)
-class FourBar:
-    """A planar 4R four-bar linkage A0 A1 A2 A3 (Meijaard & van der Wijk 2020, Fig. 1).
+class MechanismModel(ABC):
+    """What every mechanism's data offers the rest of the package: its links and loads.
 
-    Ground pivots A0 at the origin and A3 at ``(l4, 0)``. Link 1 (crank) A0→A1, link 2 (coupler)
-    A1→A2, link 3 (rocker) A2→A3, link 4 the frame A3→A0 (θ4 = π).
-
-    Attributes
-    ----------
-    lengths
-        ``(l1, l2, l3, l4)``: crank, coupler, rocker and frame lengths, m.
-    crank, coupler, rocker
-        The three moving links.
-    branch
-        ``"+"``: A2 to the left of the directed line A1→A3 (the paper's Fig. 1); ``"-"``: the
-        other assembly.
+    The spec's ``mechanism.type`` is :attr:`type`; the mechanisms' registry
+    (:func:`balancer.mechanisms.mechanism_of`) turns the data into the mechanism that moves.
     """
 
-    type: ClassVar[str] = "four-bar"
-    link_names: ClassVar[tuple[str, str, str]] = ("crank", "coupler", "rocker")
-    length_names: ClassVar[tuple[str, ...]] = ("crank", "coupler", "rocker", "frame")
-    #: Links whose pivot is on the ground, where a counter-rotor can sit.
-    grounded_links: ClassVar[tuple[str, ...]] = ("crank", "rocker")
-
-    lengths: tuple[float, float, float, float]
-    crank: Link
-    coupler: Link
-    rocker: Link
-    branch: Branch = "+"
-
-    def __post_init__(self) -> None:
-        """Check lengths, links and branch; raise :class:`AssemblyError` if it never assembles.
-
-        Keys are the spec's, from its root (``mechanism.lengths.crank``).
-        """
-        _check_mechanism(self)
-        lengths = self.lengths  # as _check_mechanism stored them
-        if assembly_range(lengths).empty:
-            l1, l2, l3, l4 = lengths
-            raise AssemblyError(
-                "the linkage cannot be assembled at any crank angle: the coupler and rocker "
-                f"(|l2 − l3| = {abs(l2 - l3):.6g} m to l2 + l3 = {l2 + l3:.6g} m) cannot "
-                f"bridge A1 to A3 (|l4 − l1| = {abs(l4 - l1):.6g} m to l1 + l4 = "
-                f"{l1 + l4:.6g} m)",
-                key="mechanism.lengths",
-                value=dict(zip(self.length_names, lengths, strict=True)),
-            )
+    #: The spec's ``mechanism.type``.
+    type: ClassVar[str]
 
     @property
-    def links(self) -> tuple[Link, Link, Link]:
-        """The moving links in order (crank, coupler, rocker)."""
-        return (self.crank, self.coupler, self.rocker)
+    @abstractmethod
+    def link_names(self) -> tuple[str, ...]:
+        """Names of the moving links, in order."""
 
     @property
-    def total_mass(self) -> float:
-        """Mass of the moving links ``m_tot = m1 + m2 + m3``, kg."""
-        return self.crank.mass + self.coupler.mass + self.rocker.mass
+    @abstractmethod
+    def links(self) -> tuple[Link, ...]:
+        """Mass properties of the moving links, in order."""
 
     @property
-    def has_loads(self) -> bool:
-        """Whether any link carries an applied force or moment."""
-        return any(link.has_loads for link in self.links)
+    @abstractmethod
+    def grounded_links(self) -> tuple[str, ...]:
+        """Links pivoted to the frame (where a counter-rotor can sit)."""
 
     @property
+    @abstractmethod
     def sizes(self) -> dict[str, float]:
-        """The geometry's sizes by spec key, m: the lengths (see :func:`check_scales`)."""
-        return _length_sizes(self)
+        """The geometry's sizes by spec key, m (see :func:`balancer.model.check_scales`)."""
 
     @property
     def gas_forces(self) -> tuple[tuple[str, GasForce], ...]:
-        """Forces on sliders along their guides, by spec key: none on a four-bar."""
+        """Forces on sliders along their guides, by spec key (none unless it has sliders)."""
         return ()
 
     @property
     def springs(self) -> tuple[Spring, ...]:
-        """Linear springs: none on a four-bar."""
+        """Linear springs (none unless it has some)."""
         return ()
-
-    def link(self, name: str) -> Link:
-        """Return the link called ``name`` (``"crank"``, ``"coupler"`` or ``"rocker"``)."""
-        if name not in self.link_names:
-            raise KeyError(name)
-        return getattr(self, name)
-
-    def with_link(self, name: str, link: Link) -> FourBar:
-        """Return a copy with link ``name`` replaced."""
-        if name not in self.link_names:
-            raise KeyError(name)
-        changes: dict[str, Any] = {name: link}
-        return replace(self, **changes)
-
-    def with_links(self, links: dict[str, Link]) -> FourBar:
-        """Return a copy with several links replaced."""
-        changes: dict[str, Any] = dict(links)
-        return replace(self, **changes)
-
-    def without_loads(self) -> FourBar:
-        """Return a copy with every applied force and moment removed."""
-        changes: dict[str, Any] = {n: self.link(n).without_loads() for n in self.link_names}
-        return replace(self, **changes)
-
-
-@dataclass(frozen=True, kw_only=True)
-class SliderCrank:
-    """A slider-crank A0 A1 A2 with the slider's pin A2 on a straight guide.
-
-    Wunderlich (1964), Sect. 3.
-
-    A0 at the origin; link 1 (crank) A0→A1, link 2 (connecting rod) A1→A2; the slider's pin A2
-    moves on the guide line ``y = offset`` along x. θ1, θ2 are the angles of A0→A1 and A1→A2.
-
-    Attributes
-    ----------
-    lengths
-        ``(r, L, e)``: crank and rod lengths (m, positive) and the signed offset of the guide
-        from A0 (m).
-    crank, rod
-        The rotating links (centre of mass in the link frame, as for the four-bar).
-    slider
-        The slider: its centre of mass relative to the pin is in global axes; its inertia does
-        not matter (it does not turn).
-    branch
-        ``"+"``: the slider on the +x side of the crank pin; ``"-"``: the other assembly.
-    gas_force
-        Force on the slider along the guide, from the frame (see :class:`GasForce`).
-    """
-
-    type: ClassVar[str] = "slider-crank"
-    link_names: ClassVar[tuple[str, str, str]] = ("crank", "rod", "slider")
-    length_names: ClassVar[tuple[str, ...]] = ("crank", "rod", "offset")
-    grounded_links: ClassVar[tuple[str, ...]] = ("crank",)
-
-    lengths: tuple[float, float, float]
-    crank: Link
-    rod: Link
-    slider: Link
-    branch: Branch = "+"
-    gas_force: GasForce = field(default_factory=GasForce)
-
-    def __post_init__(self) -> None:
-        """Check lengths, links and branch; raise :class:`AssemblyError` if it never assembles.
-
-        Keys are the spec's, from its root (``mechanism.lengths.offset``).
-        """
-        if not isinstance(self.gas_force, GasForce):
-            raise SpecError("must be a GasForce", key="links.slider.gas_force",
-                            value=self.gas_force)
-        r, big_l, e = _check_mechanism(self)
-        if abs(e) > r + big_l:
-            raise AssemblyError(
-                f"the slider-crank cannot be assembled at any crank angle: the guide is "
-                f"{abs(e):.6g} m from A0, beyond the reach of crank and rod "
-                f"({r + big_l:.6g} m)",
-                key="mechanism.lengths.offset",
-                value=e,
-            )
-
-    @property
-    def links(self) -> tuple[Link, Link, Link]:
-        """The moving links in order (crank, rod, slider)."""
-        return (self.crank, self.rod, self.slider)
 
     @property
     def total_mass(self) -> float:
-        """Mass of the moving parts, kg."""
-        return self.crank.mass + self.rod.mass + self.slider.mass
+        """Mass of the moving links, kg."""
+        return math.fsum(link.mass for link in self.links)
 
     @property
     def has_loads(self) -> bool:
-        """Whether any link carries an applied force or moment, or a gas force acts."""
-        return any(link.has_loads for link in self.links) or not self.gas_force.is_zero
+        """Whether any link carries an applied force or moment, or a slider a force."""
+        return (any(link.has_loads for link in self.links)
+                or any(not gas.is_zero for _, gas in self.gas_forces))
+
+    def link(self, name: str) -> Link:
+        """The mass properties of the moving link called ``name``."""
+        try:
+            return self.links[self.link_names.index(name)]
+        except ValueError:
+            raise KeyError(name) from None
+
+    def with_link(self, name: str, link: Link) -> Self:
+        """Return a copy with link ``name``'s mass properties replaced."""
+        return self.with_links({name: link})
+
+    @abstractmethod
+    def with_links(self, links: dict[str, Link]) -> Self:
+        """Return a copy with several links' mass properties replaced."""
+
+    @abstractmethod
+    def without_loads(self) -> Self:
+        """Return a copy with every applied force, moment and slider force removed."""
+
+
+class ChainModel(MechanismModel):
+    """A mechanism given by its lengths, its links by name (fields of its own) and a branch.
+
+    Subclasses are frozen dataclasses with the fields ``lengths``, ``branch`` and one
+    :class:`Link` per name of :attr:`link_names`; :meth:`check_chain` checks them.
+    """
+
+    #: The spec's names of the lengths (``mechanism.lengths.<name>``), in order; a length
+    #: called ``offset`` is signed and may be zero.
+    length_names: ClassVar[tuple[str, ...]]
+    #: The moving links' names (fields of the dataclass), in order.
+    chain_links: ClassVar[tuple[str, ...]]
+    #: Links pivoted to the frame.
+    ground_pivoted: ClassVar[tuple[str, ...]]
+
+    lengths: tuple[float, ...]
+    branch: Branch
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        return self.chain_links
+
+    @property
+    def links(self) -> tuple[Link, ...]:
+        return tuple(getattr(self, name) for name in self.chain_links)
+
+    @property
+    def grounded_links(self) -> tuple[str, ...]:
+        return self.ground_pivoted
 
     @property
     def sizes(self) -> dict[str, float]:
-        """The geometry's sizes by spec key, m: the lengths, the offset's magnitude."""
-        return _length_sizes(self)
+        """The geometry's sizes by spec key, m: the lengths (an offset's magnitude)."""
+        return {f"mechanism.lengths.{n}": abs(x)
+                for n, x in zip(self.length_names, self.lengths, strict=True)}
 
-    @property
-    def gas_forces(self) -> tuple[tuple[str, GasForce], ...]:
-        """Forces on sliders along their guides, by spec key: the gas force."""
-        return (("links.slider.gas_force", self.gas_force),)
-
-    @property
-    def springs(self) -> tuple[Spring, ...]:
-        """Linear springs: none on a slider-crank."""
-        return ()
-
-    def link(self, name: str) -> Link:
-        """Return the link called ``name`` (``"crank"``, ``"rod"`` or ``"slider"``)."""
-        if name not in self.link_names:
-            raise KeyError(name)
-        return getattr(self, name)
-
-    def with_link(self, name: str, link: Link) -> SliderCrank:
-        """Return a copy with link ``name`` replaced."""
-        if name not in self.link_names:
-            raise KeyError(name)
-        changes: dict[str, Any] = {name: link}
-        return replace(self, **changes)
-
-    def with_links(self, links: dict[str, Link]) -> SliderCrank:
-        """Return a copy with several links replaced."""
+    def with_links(self, links: dict[str, Link]) -> Self:
+        unknown = set(links) - set(self.chain_links)
+        if unknown:
+            raise KeyError(sorted(unknown)[0])
         changes: dict[str, Any] = dict(links)
-        return replace(self, **changes)
+        return replace(self, **changes)  # type: ignore[type-var]  # a dataclass (see above)
 
-    def without_loads(self) -> SliderCrank:
-        """Return a copy with every applied force, moment and gas force removed."""
-        changes: dict[str, Any] = {n: self.link(n).without_loads() for n in self.link_names}
-        return replace(self, gas_force=GasForce(), **changes)
+    def without_loads(self) -> Self:
+        changes: dict[str, Any] = {n: self.link(n).without_loads() for n in self.chain_links}
+        changes.update(self.unloaded_fields())
+        return replace(self, **changes)  # type: ignore[type-var]  # a dataclass (see above)
+
+    def unloaded_fields(self) -> dict[str, Any]:
+        """The fields other than the links that :meth:`without_loads` sets (a gas force)."""
+        return {}
+
+    def check_chain(self) -> tuple[float, ...]:
+        """Check lengths, links and branch; store the lengths as floats and return them.
+
+        An ``offset`` (a slider-crank's last length) is signed; every other length is
+        positive. Link keys are ``links.<name>``, lengths ``mechanism.lengths.<name>``.
+        """
+        names = self.length_names
+        raw = self.lengths
+        if isinstance(raw, str) or not hasattr(raw, "__len__") or len(raw) != len(names):
+            raise SpecError(f"must be {len(names)} lengths ({', '.join(names)})",
+                            key="mechanism.lengths", value=raw)
+        lengths: list[float] = []
+        for name, value in zip(names, raw, strict=True):
+            key = f"mechanism.lengths.{name}"
+            if name == "offset":
+                x = v.number(value, key)
+                if x != 0:
+                    v.length(abs(x), key)
+                lengths.append(x)
+            else:
+                lengths.append(v.length(value, key))
+        v.relative_lengths(dict(zip(names, lengths, strict=True)), "mechanism.lengths")
+        v.store(self, "lengths", tuple(lengths))
+        v.store(self, "branch", v.choice(self.branch, "mechanism.branch", ("+", "-")))
+        for name in self.chain_links:
+            link = getattr(self, name)
+            if not isinstance(link, Link):
+                raise SpecError("must be a Link", key=f"links.{name}", value=link)
+            if link.counter_rotor and name not in self.ground_pivoted:
+                where = " and ".join(self.ground_pivoted)
+                raise SpecError(
+                    f"a counter-rotor sits on a ground pivot: only the {where} can have one",
+                    key=f"links.{name}.counter_rotor", value=link.counter_rotor,
+                )
+        return tuple(lengths)
+
+
+
+
 
 
 @dataclass(frozen=True, kw_only=True)
-class Linkage:
+class Linkage(MechanismModel):
     """A planar linkage with one degree of freedom, driven by a crank on a ground pivot.
 
     See DESIGN.md, "General planar linkages". A point named by two or more links is a revolute
@@ -440,17 +395,6 @@ class Linkage:
         return tuple(b.name for b in self.moving if ground & set(b.points))
 
     @property
-    def total_mass(self) -> float:
-        """Mass of the moving links, kg."""
-        return math.fsum(link.mass for link in self.links)
-
-    @property
-    def has_loads(self) -> bool:
-        """Whether any link carries an applied force or moment, or a slider a force."""
-        return (any(link.has_loads for link in self.links)
-                or any(not s.force.is_zero for s in self.sliders))
-
-    @property
     def sizes(self) -> dict[str, float]:
         """The geometry's sizes by spec key, m: each point's distance from the origin."""
         return {f"mechanism.points.{p}": math.hypot(*xy) for p, xy in self.points}
@@ -467,10 +411,6 @@ class Linkage:
                 return b.props
         raise KeyError(name)
 
-    def with_link(self, name: str, link: Link) -> Linkage:
-        """Return a copy with link ``name``'s mass properties replaced."""
-        return self.with_links({name: link})
-
     def with_links(self, links: dict[str, Link]) -> Linkage:
         """Return a copy with several links' mass properties replaced."""
         unknown = set(links) - set(self.link_names)
@@ -486,53 +426,6 @@ class Linkage:
                        for b in self.bodies)
         sliders = tuple(replace(s, force=GasForce()) for s in self.sliders)
         return replace(self, bodies=bodies, sliders=sliders)
-
-
-#: A mechanism the package knows.
-Mechanism = FourBar | SliderCrank | Linkage
-
-
-def _length_sizes(mech: FourBar | SliderCrank) -> dict[str, float]:
-    """A four-bar's or slider-crank's lengths by spec key (magnitudes), m."""
-    return {f"mechanism.lengths.{n}": abs(x)
-            for n, x in zip(mech.length_names, mech.lengths, strict=True)}
-
-
-def _check_mechanism(mech: FourBar | SliderCrank) -> tuple[float, ...]:
-    """Lengths, links and branch of a mechanism; store the lengths as floats and return them.
-
-    A slider-crank's offset (its last length) is signed; every other length is positive. Link
-    keys are ``links.<name>``, lengths ``mechanism.lengths.<name>``.
-    """
-    names = mech.length_names
-    raw = mech.lengths
-    if isinstance(raw, str) or not hasattr(raw, "__len__") or len(raw) != len(names):
-        raise SpecError(f"must be {len(names)} lengths ({', '.join(names)})",
-                        key="mechanism.lengths", value=raw)
-    lengths: list[float] = []
-    for name, value in zip(names, raw, strict=True):
-        key = f"mechanism.lengths.{name}"
-        if name == "offset":
-            x = v.number(value, key)
-            if x != 0:
-                v.length(abs(x), key)
-            lengths.append(x)
-        else:
-            lengths.append(v.length(value, key))
-    v.relative_lengths(dict(zip(names, lengths, strict=True)), "mechanism.lengths")
-    v.store(mech, "lengths", tuple(lengths))
-    v.store(mech, "branch", v.choice(mech.branch, "mechanism.branch", ("+", "-")))
-    for name in mech.link_names:
-        link = getattr(mech, name)
-        if not isinstance(link, Link):
-            raise SpecError("must be a Link", key=f"links.{name}", value=link)
-        if link.counter_rotor and name not in mech.grounded_links:
-            where = " and ".join(mech.grounded_links)
-            raise SpecError(
-                f"a counter-rotor sits on a ground pivot: only the {where} can have one",
-                key=f"links.{name}.counter_rotor", value=link.counter_rotor,
-            )
-    return tuple(lengths)
 
 
 def _link_list(names: Iterable[str]) -> str:

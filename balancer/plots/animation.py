@@ -15,7 +15,7 @@ from ..cycle import sample_angles
 from ..drawing import CounterweightLike, counterweight_paths, drawing_frames, frame
 from ..errors import OutputError
 from ..mechanisms.base import Mechanism
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from ..outputs import animation_type, write_with
 from .style import COLOURS, draw_frame
 

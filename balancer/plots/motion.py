@@ -14,7 +14,7 @@ from ..drawing import centre_of_mass_path
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Design
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from ..simulation import Trajectory
 from ..verification import Verification
 from .style import (

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..drawing import frame
 from ..mechanisms.base import Mechanism
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from ..outputs import figure_type, write_with
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw

@@ -57,7 +57,7 @@ from ..formulations import (
 )
 from ..mechanisms import mechanism_of
 from ..model import Design, Drive, SimulationSettings, check_scales
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from .stepper import MAX_OUTPUTS, MAX_STEPS, Stepper, passing
 from .trajectory import Trajectory, trajectory_of
 

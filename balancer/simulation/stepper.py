@@ -33,7 +33,7 @@ from ..integration import (
 )
 from ..mechanisms.base import Mechanism
 from ..model import RTOL_MIN
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from ..quadrature import cumulative
 
 #: Most integration steps a simulation may take (under a minute with the slowest formulation,

@@ -21,7 +21,7 @@ from ..formulations import (
 )
 from ..mechanisms import mechanism_of
 from ..model import Drive
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ from ..balance.bounds import check_problem
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from ..model.balance import (
     OBJECTIVE_KEYS,
     BalanceProblem,

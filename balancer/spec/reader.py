@@ -49,26 +49,27 @@ from typing import Any
 from .. import validate as v
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
+from ..mechanisms.fourbar.model import FourBar
+from ..mechanisms.slidercrank.model import SliderCrank
 from ..model import (
     GROUND,
     Body,
+    ChainModel,
     Design,
-    FourBar,
     GasForce,
     Link,
     Linkage,
     Operation,
     SimulationSettings,
     Slider,
-    SliderCrank,
     Spring,
 )
-from ..model import Mechanism as Model
+from ..model import MechanismModel as Model
 from . import schema
 from .balance import read_balance
 from .tables import Table
 
-MECHANISMS: dict[str, type[FourBar] | type[SliderCrank] | type[Linkage]] = {
+MECHANISMS: dict[str, type[Model]] = {
     "four-bar": FourBar, "slider-crank": SliderCrank, "linkage": Linkage}
 
 
@@ -76,7 +77,7 @@ MECHANISM_TYPES = tuple(MECHANISMS)
 
 
 def _read_link(table: Table, name: str,
-               mechanism_class: type[FourBar] | type[SliderCrank] | type[Linkage],
+               mechanism_class: type[Model],
                frame: tuple[complex, float] | None = None) -> Link:
     """One link; its values are checked by :class:`~balancer.model.Link` (keys prefixed).
 
@@ -161,15 +162,15 @@ def _read_gas_force(table: Table) -> GasForce:
     return gas
 
 
-def _read_links(table: Table, mechanism_class: type[FourBar] | type[SliderCrank] | type[Linkage],
+def _read_links(table: Table, mechanism_class: type[Model],
                 names: tuple[str, ...] | None = None) -> tuple[dict[str, Link], GasForce]:
     """The links of a mechanism, and the gas force on its slider (if it has one).
 
     ``names``: the links to read (by default the mechanism class's own).
     """
     if names is None:
-        assert not issubclass(mechanism_class, Linkage)  # (a general linkage's are named)
-        names = mechanism_class.link_names
+        assert issubclass(mechanism_class, ChainModel)  # (a general linkage's are named)
+        names = mechanism_class.chain_links
     table.expect(schema.known(table.path, mechanism_class.type) or names)
     links = {}
     gas = GasForce()
@@ -184,13 +185,14 @@ def _read_links(table: Table, mechanism_class: type[FourBar] | type[SliderCrank]
     return links, gas
 
 
-def _read_mechanism(root: Table) -> FourBar | SliderCrank | Linkage:
+def _read_mechanism(root: Table) -> Model:
     mech = root.table("mechanism")
     assert mech is not None
     kind = mech.string("type", choices=MECHANISM_TYPES)
     cls = MECHANISMS[kind]
     if issubclass(cls, Linkage):  # (it is Linkage)
         return _read_linkage(root, mech)
+    assert issubclass(cls, ChainModel)
     mech.expect(schema.known("mechanism", kind))
     branch = mech.string("branch", choices=("+", "-"), default="+")
     lengths_table = mech.table("lengths")

@@ -5,7 +5,8 @@ from __future__ import annotations
 import os
 
 from .. import tomltext as toml
-from ..model import Design, FourBar, GasForce, Link, Linkage, SliderCrank
+from ..mechanisms.slidercrank.model import SliderCrank
+from ..model import ChainModel, Design, GasForce, Link, Linkage, MechanismModel
 from ..outputs import write_atomic
 from .balance import balance_lines
 
@@ -38,7 +39,7 @@ def _gas_lines(gas: GasForce) -> list[str]:
             f"period = {toml.number(gas.period)} }}  # rad, N"]
 
 
-def _links_lines(mech: FourBar | SliderCrank | Linkage, prefix: str) -> list[str]:
+def _links_lines(mech: MechanismModel, prefix: str) -> list[str]:
     out: list[str] = []
     for name in mech.link_names:
         frame = "global" if mech.type == "slider-crank" and name == "slider" else "link"
@@ -78,6 +79,7 @@ def dumps_design(design: Design) -> str:
     if isinstance(mech, Linkage):
         out += _linkage_lines(mech)
     else:
+        assert isinstance(mech, ChainModel)
         out += ["[mechanism]", f'type = "{mech.type}"', f'branch = "{mech.branch}"', ""]
         out.append("[mechanism.lengths]  # m")
         for name, length in zip(mech.length_names, mech.lengths, strict=True):

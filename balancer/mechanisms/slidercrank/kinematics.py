@@ -19,10 +19,11 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import AssemblyError
-from ..kinematics import SINGULAR_TOLERANCE, _as_1d
-from ..model import SliderCrank
-from ..model.assembly import AssemblyRange
+from ...errors import AssemblyError
+from ...linkage.vectors import as_1d
+from ...model.assembly import AssemblyRange
+from ..chains import SINGULAR_TOLERANCE
+from .model import SliderCrank
 
 Lengths = tuple[float, float, float]
 
@@ -85,7 +86,7 @@ class SliderMotion:
     transfer
         ``Θ2 = dθ2/dθ1`` and ``X = dx/dθ1`` (m/rad).
     singular
-        At or near a dead point (|cos θ2| < :data:`~balancer.kinematics.SINGULAR_TOLERANCE`).
+        At or near a dead point (|cos θ2| < :data:`~balancer.mechanisms.chains.SINGULAR_TOLERANCE`).
     """
 
     lengths: Lengths
@@ -157,7 +158,7 @@ def motion(
         Raise :class:`~balancer.errors.AssemblyError` for an angle where it cannot assemble.
     """
     r, big_l, e = lengths
-    t, w1, a1 = np.broadcast_arrays(_as_1d(theta1), _as_1d(omega1), _as_1d(alpha1))
+    t, w1, a1 = np.broadcast_arrays(as_1d(theta1), as_1d(omega1), as_1d(alpha1))
     sign = _sign(branch)
     c1, s1 = np.cos(t), np.sin(t)
     s2 = (e - r * s1) / big_l
@@ -202,7 +203,7 @@ def motion(
 
 def motion_of(mechanism: SliderCrank, theta1: ArrayLike, omega1: ArrayLike = 0.0,
               alpha1: ArrayLike = 0.0, *, check: bool = True) -> SliderMotion:
-    """:func:`motion` for a :class:`~balancer.model.SliderCrank` on its own branch."""
+    """:func:`motion` for a :class:`~balancer.SliderCrank` on its own branch."""
     return motion(mechanism.lengths, theta1, omega1, alpha1, mechanism.branch, check=check)
 
 

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..model import SliderCrank
 from .kinematics import SliderMotion
+from .model import SliderCrank
 
 
 def link_centres_of_mass(

@@ -18,10 +18,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..linkage import rotors
-from ..mechanisms import mechanism_of
-from ..mechanisms.base import Mechanism
-from ..model import Mechanism as Model
 from ..model.assembly import AssemblyRange
+from .base import Mechanism
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
     import casadi as ca
@@ -179,8 +177,8 @@ class Formulation(ABC):
 
     Parameters
     ----------
-    linkage
-        The mechanism's model (a four-bar, slider-crank or general linkage).
+    mechanism
+        The mechanism (its data is :attr:`linkage`).
     gravity
         Gravitational acceleration ``(gx, gy)``, m/s².
     speed
@@ -201,12 +199,14 @@ class Formulation(ABC):
 
     def __init__(
         self,
-        linkage: Model,
+        mechanism: Mechanism,
         *,
         gravity: tuple[float, float] = (0.0, 0.0),
         speed: float | None = None,
     ) -> None:
-        self.linkage = linkage
+        #: The mechanism (:func:`balancer.mechanisms.mechanism_of`) and its data.
+        self.mechanism = mechanism
+        self.linkage = mechanism.model
         self.gravity = complex(*gravity)
         self.speed = speed
         self.theta1_start = 0.0
@@ -354,11 +354,6 @@ class Formulation(ABC):
                 moment = moment + rotors.ground_couple(link.counter_rotor,
                                                         np.asarray(ev.alpha)[k])
         return force, moment
-
-    @property
-    def mechanism(self) -> Mechanism:
-        """The mechanism (:func:`balancer.mechanisms.mechanism_of`) of the linkage."""
-        return mechanism_of(self.linkage)
 
     @property
     def link_names(self) -> tuple[str, ...]:

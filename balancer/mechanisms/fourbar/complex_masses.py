@@ -28,10 +28,10 @@ from typing import Any, TypeAlias
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..kinematics import branch_sign_along, cross_scalar, motion, position_scalar, rates_scalar
-from ..linkage.vectors import Num
-from .base import DrivenRates, Evaluation
+from ...linkage.vectors import Num, cross_scalar
+from ..formulation import DrivenRates, Evaluation
 from .closed_form import FourBarFormulation
+from .kinematics import branch_sign_along, motion, position_scalar, rates_scalar
 
 #: The kinematics the reduced equation needs, at one state (numbers) or many (arrays):
 #: ``((l̄1, l̄2, l̄3), Θ2, Θ3, θ̇2, θ̇3, b2, b3)`` with ``θ̈k = Θk·θ̈1 + bk``.

@@ -28,17 +28,16 @@ from typing import Any, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..formulations.base import DrivenRates, Evaluation
-from ..formulations.closed_form import ClosedForm
-from ..formulations.mass_matrix import NodalTruss, NodeAccelerations
-from ..kinematics import cross_scalar
-from ..linkage import rotors
-from ..linkage.vectors import Num
-from ..massmodels import equivalent_joint_forces, equivalent_mass_matrix
-from ..model import Link, SliderCrank
-from ..model.assembly import AssemblyRange
+from ...linkage import rotors
+from ...linkage.massmodels import equivalent_joint_forces, equivalent_mass_matrix
+from ...linkage.vectors import Num, cross_scalar
+from ...model import Link
+from ...model.assembly import AssemblyRange
+from ..chains import ClosedForm, NodalTruss, NodeAccelerations
+from ..formulation import DrivenRates, Evaluation
 from .dynamics import kinetic_energy, newton_euler
 from .kinematics import Lengths, SliderMotion, assembly_range, motion
+from .model import SliderCrank
 
 
 class _SliderFormulation(ClosedForm):
@@ -144,8 +143,8 @@ class SliderComplexMasses(_SliderFormulation):
 
         The generalised inertia, half its derivative, and the generalised force of loads,
         gravity, gas force and motor torque. The kinematics of one state in plain floats
-        (:func:`~balancer.slider_crank.kinematics.motion`'s equations, which :meth:`_terms`
-        uses on arrays: a free motion's integrator calls this thousands of times).
+        (:func:`~balancer.mechanisms.slidercrank.kinematics.motion`'s equations, which
+        :meth:`_terms` uses on arrays: a free motion's integrator calls this thousands of times).
         """
         return self._combine(*self._transfer(theta1), float(self.gas(theta1)), torque)
 
@@ -252,7 +251,7 @@ class SliderComplexMasses(_SliderFormulation):
 
 # The four-bar's nodal truss (a FourBarFormulation) with the slider-crank's linkage and lengths,
 # which come first: their types are the slider-crank's.
-class SliderMassMatrix(_SliderFormulation, NodalTruss):  # type: ignore[misc]  # see above
+class SliderMassMatrix(_SliderFormulation, NodalTruss):
     """Truss elements for crank and rod, the slider a mass at its pin, the guide a constraint."""
 
     name = "mass-matrix"

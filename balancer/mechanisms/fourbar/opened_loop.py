@@ -27,10 +27,10 @@ from typing import Any, TypeAlias
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..kinematics import cross_scalar, motion_of, rates_scalar
-from ..linkage.vectors import Num
-from .base import Evaluation, least_norm_many
+from ...linkage.vectors import Num, cross_scalar
+from ..formulation import Evaluation, least_norm_many
 from .closed_form import FourBarFormulation
+from .kinematics import motion_of, rates_scalar
 
 #: Three values of the links (complex numbers, or complex arrays over many states).
 Three: TypeAlias = tuple[Num, Num, Num]

@@ -16,17 +16,23 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import kinematics as fourbar
-from ..conditions import force_balance_matrix
-from ..inverse import change_point_limits, mass_matrix, newton_euler
-from ..linkage.constraints import Pose
-from ..linkage.dynamics import Forces
-from ..linkage.kinematics import Motion
-from ..linkage.structure import Structure
-from ..linkage.vectors import V
-from ..model import Body, Branch, FourBar, Linkage
-from ..model.assembly import AssemblyRange, assembly_range, classify
-from .base import Limit, Mechanism, Route
+from ...linkage.constraints import Pose
+from ...linkage.dynamics import Forces
+from ...linkage.kinematics import Motion
+from ...linkage.structure import Structure
+from ...linkage.vectors import V
+from ...model import Body, Branch, Linkage
+from ...model.assembly import AssemblyRange
+from ..base import Limit, Mechanism, Route
+from . import kinematics as fourbar
+from .assembly import assembly_range, classify
+from .complex_masses import ComplexMasses
+from .conditions import force_balance_matrix
+from .inverse import change_point_limits, mass_matrix, newton_euler
+from .lie_group import LieGroup
+from .mass_matrix import MassMatrix
+from .model import FourBar
+from .opened_loop import OpenedLoop
 
 
 def fourbar_linkage(model: FourBar) -> Linkage:
@@ -64,7 +70,9 @@ class FourBarMechanism(Mechanism):
     model: FourBar
 
     kind = "four-bar"
-    formulations = ("opened-loop", "complex-masses", "mass-matrix", "lie-group")
+    own_formulations = {"opened-loop": OpenedLoop, "complex-masses": ComplexMasses,
+                        "mass-matrix": MassMatrix, "lie-group": LieGroup}
+    formulations = tuple(own_formulations)
     geometry_key = "mechanism.lengths"
     named_states = False
     #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ..model import Linkage
-from .base import Mechanism
+from ...model import Linkage
+from ..base import Mechanism
 
 
 class LinkageMechanism(Mechanism):

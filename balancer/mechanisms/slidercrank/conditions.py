@@ -19,7 +19,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from ..model import SliderCrank
+from .model import SliderCrank
 
 #: Relative residual of Eq. 20a–b below which the centre of mass counts as stationary.
 FORCE_BALANCE_TOLERANCE = 1e-9

@@ -12,60 +12,22 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..inverse import dynamic_link, kinetic_energy, link_com_kinematics
-from ..kinematics import (
+from ...model.assembly import AssemblyRange
+from ..chains import ClosedForm
+from .assembly import assembly_range
+from .inverse import kinetic_energy, link_com_kinematics
+from .kinematics import (
     branch_sign_along,
     change_point_angles,
     motion_from_angles,
     position_scalar,
     rates_scalar,
 )
-from ..model import FourBar, SliderCrank
-from ..model.assembly import AssemblyRange, assembly_range
-from .base import Formulation
-
-
-class ClosedForm(Formulation):
-    """A formulation of a mechanism given by its lengths and its links in a chain.
-
-    Parameters
-    ----------
-    linkage
-        A :class:`~balancer.model.FourBar` or :class:`~balancer.model.SliderCrank` (its
-        counter-rotors add to the inertia of their links).
-    gravity, speed
-        As for :class:`~balancer.formulations.Formulation`.
-    """
-
-    linkage: FourBar | SliderCrank
-
-    #: Number of links that turn (a slider does not).
-    rotating_links: ClassVar[int] = 3
-
-    def __init__(self, linkage: FourBar | SliderCrank, *, gravity: tuple[float, float] = (0.0, 0.0),
-                 speed: float | None = None) -> None:
-        super().__init__(linkage, gravity=gravity, speed=speed)
-        self.lengths: tuple[float, ...] = linkage.lengths
-        #: Links as the dynamics see them (counter-rotor inertia added).
-        self.links = tuple(dynamic_link(link) for link in linkage.links)
-        #: Applied force on each link at its centre of mass, weight included, N.
-        self.forces = tuple(link.force_complex + link.mass * self.gravity for link in linkage.links)
-        #: Applied moment on each link, N·m.
-        self.moments = tuple(link.moment for link in linkage.links)
-        self.mass = tuple(link.mass for link in linkage.links)
-        self.total_mass = sum(self.mass)
-        #: Centres of mass as fractions of the link vectors, ``ζk = s̄k/lk`` (rotating links).
-        self.zeta = tuple(
-            link.com / length
-            for link, length in zip(linkage.links[: self.rotating_links], self.lengths,
-                                    strict=False)
-        )
-        self.sign0 = 1.0 if linkage.branch == "+" else -1.0
+from .model import FourBar
 
 
 class FourBarFormulation(ClosedForm):

@@ -38,10 +38,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..inverse import newton_euler
-from ..kinematics import motion_from_angles, motion_of
-from .base import Evaluation
+from ..formulation import Evaluation
 from .closed_form import FourBarFormulation
+from .inverse import newton_euler
+from .kinematics import motion_from_angles, motion_of
 
 S1 = np.array([[0.0, -1.0], [1.0, 0.0]])  # the generator of planar rotations (Eq. 1)
 E1 = np.array([1.0, 0.0])

@@ -26,12 +26,14 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ..inverse import Reactions, dynamic_link
-from ..kinematics import cross
-from ..linkage import rotors
-from ..massmodels import equivalent_inertia_forces, equivalent_joint_forces
-from ..model import Link, SliderCrank
+from ...linkage import rotors
+from ...linkage.massmodels import equivalent_inertia_forces, equivalent_joint_forces
+from ...linkage.rotors import dynamic_link
+from ...linkage.vectors import cross
+from ...model import Link
+from ..chains import Reactions
 from .kinematics import Lengths, SliderMotion
+from .model import SliderCrank
 
 
 def _loads(mech: SliderCrank, mo: SliderMotion, gravity: complex, loads: bool

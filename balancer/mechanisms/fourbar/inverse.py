@@ -22,76 +22,34 @@ Counter-rotors: a counter-rotor of inertia J on link k's ground pivot, geared th
 whose housing is the ground, acts on the link as extra inertia (``(Ik + J)·αk``) and puts a
 reaction moment ``2·J·αk`` on the ground; its angular momentum is ``−J·ωk``.
 
-Everything is vectorised over the states of a :class:`~balancer.kinematics.Motion`.
+Everything is vectorised over the states of a
+:class:`~balancer.mechanisms.fourbar.kinematics.Motion`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .kinematics import Motion, change_point_angles, cross
-from .linkage import rotors
-from .massmodels import (
-    equivalent_inertia_forces,
-    equivalent_joint_forces,
-)
-from .model import FourBar, Link
-from .model.assembly import Lengths
+from ...linkage import rotors
+from ...linkage.massmodels import equivalent_inertia_forces, equivalent_joint_forces
+from ...linkage.rotors import dynamic_link
+from ...linkage.vectors import cross
+from ...model import Link
+from ..chains import Reactions
+from .assembly import Lengths
+from .kinematics import Motion, change_point_angles
+from .model import FourBar
 
 Route = Literal["newton-euler", "mass-matrix"]
 ROUTES: tuple[Route, ...] = ("newton-euler", "mass-matrix")
 
 
-@dataclass(frozen=True)
-class Reactions:
-    """What the linkage exerts on its frame at each state.
-
-    Attributes
-    ----------
-    RA0, RA3
-        Forces of the mechanism on the ground at A0 and A3, complex ``x + i·y``, N.
-    driving_torque
-        Torque of the motor on the crank, N·m (its reaction on the ground is the opposite).
-    shaking_moment
-        Moment about A0 of everything the mechanism exerts on the ground, N·m.
-    shaking_force
-        The sum of the forces on the frame, N: ``R̄A0 + R̄A3`` for a four-bar (computed from
-        them when not given).
-    guide_couple
-        For a slider-crank, whose R̄A3 is the slider's normal force on its guide: the couple
-        of the slider on its guide about the slider's pin, N·m (``None`` for a four-bar).
-    """
-
-    RA0: NDArray[np.complex128]
-    RA3: NDArray[np.complex128]
-    driving_torque: NDArray[np.float64]
-    shaking_moment: NDArray[np.float64]
-    # None (only as an argument) is replaced by RA0 + RA3 in __post_init__: never None after.
-    shaking_force: NDArray[np.complex128] = None  # type: ignore[assignment]  # see above
-    guide_couple: NDArray[np.float64] | None = None
-
-    def __post_init__(self) -> None:
-        if self.shaking_force is None:
-            object.__setattr__(self, "shaking_force", self.RA0 + self.RA3)
 
 
-def dynamic_link(link: Link) -> Link:
-    """The link as the equations of motion see it: counter-rotor inertia added to ``I``."""
-    if link.counter_rotor == 0.0:
-        return link
-    return Link(
-        mass=link.mass,
-        inertia=link.inertia + rotors.link_inertia(link.counter_rotor),
-        e=link.e,
-        f=link.f,
-        force=link.force,
-        moment=link.moment,
-    )
 
 
 def link_com_kinematics(

@@ -21,34 +21,11 @@ from functools import cached_property, lru_cache
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import AssemblyError
+from ...errors import AssemblyError
+from ...linkage.vectors import as_1d, cross, inner
+from ..chains import SINGULAR_TOLERANCE
+from .assembly import BOUND_TOLERANCE, Lengths, assembly_range, cosine_bounds
 from .model import FourBar
-from .model.assembly import BOUND_TOLERANCE, Lengths, assembly_range, cosine_bounds
-
-#: |sin(θ3 − θ2)| below which a position is flagged as (near) a dead or change point.
-SINGULAR_TOLERANCE = 1e-6
-
-
-def inner(x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
-    """Scalar product ``⟨x̄, ȳ⟩ = Re(x*·y)`` of plane vectors given as complex numbers."""
-    x = np.asarray(x)
-    y = np.asarray(y)
-    return x.real * y.real + x.imag * y.imag
-
-
-def cross(x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
-    """Z-component of ``x × y`` for plane vectors given as complex numbers (``Im(x*·y)``)."""
-    x = np.asarray(x)
-    y = np.asarray(y)
-    return x.real * y.imag - x.imag * y.real
-
-
-def cross_scalar(x: complex, y: complex) -> float:
-    """:func:`cross` of two Python complex numbers, without numpy's per-call cost.
-
-    The formulations' right-hand sides call it thousands of times per simulation.
-    """
-    return x.real * y.imag - x.imag * y.real
 
 
 def _sign(branch: str) -> float:
@@ -114,9 +91,6 @@ class Position:
         return cross(self.l2, self.l3) / (self.lengths[1] * self.lengths[2])
 
 
-def _as_1d(x: ArrayLike) -> NDArray[np.float64]:
-    a = np.asarray(x, dtype=float)
-    return a.reshape(-1) if a.ndim else a.reshape(1)
 
 
 @lru_cache(maxsize=256)
@@ -150,7 +124,7 @@ def position(
     theta1
         Crank angle(s), rad.
     branch
-        ``"+"`` or ``"-"`` (see :class:`balancer.model.FourBar`), or an array of ±1 per angle.
+        ``"+"`` or ``"-"`` (see :class:`balancer.FourBar`), or an array of ±1 per angle.
     check
         Raise :class:`AssemblyError` for an angle outside the assembly range; otherwise such
         positions come back as NaN and flagged singular.
@@ -162,7 +136,7 @@ def position(
         bound are put on it exactly and flagged.
     """
     l1, l2, l3, l4 = lengths
-    t = _as_1d(theta1)
+    t = as_1d(theta1)
     sign = _sign(branch) if isinstance(branch, str) else np.asarray(branch, dtype=float)
     c_half = np.cos(0.5 * t)
     s_half = np.sin(0.5 * t)
@@ -206,7 +180,7 @@ def position(
 
 
 def position_of(linkage: FourBar, theta1: ArrayLike, *, check: bool = True) -> Position:
-    """:func:`position` for a :class:`~balancer.model.FourBar` on its own branch."""
+    """:func:`position` for a :class:`~balancer.FourBar` on its own branch."""
     return position(linkage.lengths, theta1, linkage.branch, check=check)
 
 
@@ -337,7 +311,7 @@ def motion(
     check
         See :func:`position`.
     """
-    t, w1, a1 = np.broadcast_arrays(_as_1d(theta1), _as_1d(omega1), _as_1d(alpha1))
+    t, w1, a1 = np.broadcast_arrays(as_1d(theta1), as_1d(omega1), as_1d(alpha1))
     pos = position(lengths, t, branch, check=check)
     big = transfer_functions(pos)
     w2 = big[0] * w1  # Eq. 6
@@ -359,7 +333,7 @@ def motion_of(
     *,
     check: bool = True,
 ) -> Motion:
-    """:func:`motion` for a :class:`~balancer.model.FourBar` on its own branch."""
+    """:func:`motion` for a :class:`~balancer.FourBar` on its own branch."""
     return motion(linkage.lengths, theta1, omega1, alpha1, linkage.branch, check=check)
 
 
@@ -472,7 +446,7 @@ def cycle_branch_signs(
     """
     if not change_point_angles(lengths):
         return branch
-    t = np.mod(_as_1d(theta1), 2 * math.pi)
+    t = np.mod(as_1d(theta1), 2 * math.pi)
     return np.asarray(branch_sign_along(lengths, _sign(branch), 1e-9, t), dtype=float) * np.ones(
         t.shape
     )
@@ -490,7 +464,7 @@ def motion_from_angles(
     whatever the state satisfies.
     """
     l1, l2, l3, _ = lengths
-    th = [_as_1d(x) for x in theta]
+    th = [as_1d(x) for x in theta]
     n = max(x.size for x in th)
     th = [np.broadcast_to(x, (n,)) for x in th]
     vectors = [length * np.exp(1j * x) for length, x in zip((l1, l2, l3), th, strict=True)]
@@ -504,8 +478,8 @@ def motion_from_angles(
         singular=np.abs(s_mu) < SINGULAR_TOLERANCE,
     )
     big = transfer_functions(pos)
-    w1, w2, w3 = (np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in omega)
-    a1, a2, a3 = (np.broadcast_to(_as_1d(x), (n,)).astype(float) for x in alpha)
+    w1, w2, w3 = (np.broadcast_to(as_1d(x), (n,)).astype(float) for x in omega)
+    a1, a2, a3 = (np.broadcast_to(as_1d(x), (n,)).astype(float) for x in alpha)
     return Motion(pos=pos, omega=(w1, w2, w3), alpha=(a1, a2, a3), transfer=big)
 
 

@@ -3,7 +3,7 @@
 Wunderlich (1964), Sect. 3: crank A0→A1, connecting rod A1→A2, the slider's pin A2 on a guide
 along +x at the signed offset ``e`` from A0. The slider is a one-point link on a ground guide; a
 gas force acts between it and the cylinder (internal to the machine). The mass-matrix route
-of its inverse dynamics is the slider-crank's own (:mod:`balancer.slider_crank.dynamics`).
+of its inverse dynamics is the slider-crank's own (:mod:`balancer.mechanisms.slidercrank.dynamics`).
 """
 
 from __future__ import annotations
@@ -15,16 +15,18 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..linkage.dynamics import Forces
-from ..linkage.kinematics import Motion
-from ..linkage.structure import Structure
-from ..linkage.vectors import V
-from ..model import Body, Branch, Linkage, Slider, SliderCrank
-from ..model.assembly import AssemblyRange
-from ..slider_crank import kinematics as closed
-from ..slider_crank.conditions import force_balance_matrix
-from ..slider_crank.dynamics import mass_matrix
-from .base import Mechanism, Route
+from ...linkage.dynamics import Forces
+from ...linkage.kinematics import Motion
+from ...linkage.structure import Structure
+from ...linkage.vectors import V
+from ...model import Body, Branch, Linkage, Slider
+from ...model.assembly import AssemblyRange
+from ..base import Mechanism, Route
+from . import kinematics as closed
+from .conditions import force_balance_matrix
+from .dynamics import mass_matrix
+from .formulations import SliderComplexMasses, SliderMassMatrix
+from .model import SliderCrank
 
 
 def slider_crank_linkage(model: SliderCrank) -> Linkage:
@@ -59,7 +61,8 @@ class SliderCrankMechanism(Mechanism):
     model: SliderCrank
 
     kind = "slider-crank"
-    formulations = ("mass-matrix", "complex-masses")
+    own_formulations = {"mass-matrix": SliderMassMatrix, "complex-masses": SliderComplexMasses}
+    formulations = tuple(own_formulations)
     verify_method = "complex-masses"
     geometry_key = "mechanism.lengths"
     named_states = False

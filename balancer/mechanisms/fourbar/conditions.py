@@ -38,7 +38,7 @@ def force_balance_residuals(linkage: FourBar) -> tuple[complex, complex]:
 def force_balance_error(linkage: FourBar) -> float:
     """Largest force-balance residual of Eq. 57 relative to the total mass (dimensionless).
 
-    (A slider-crank's, Wunderlich's Eq. 20a–b: :func:`balancer.slider_crank.conditions.
+    (A slider-crank's, Wunderlich's Eq. 20a–b: :func:`balancer.mechanisms.slidercrank.conditions.
     force_balance_error`; any mechanism's: :mod:`balancer.balance.conditions`.)
     """
     c14, c34 = force_balance_residuals(linkage)
