@@ -47,6 +47,9 @@ class FrameForces(Protocol):
     @property
     def driving_torque(self) -> NDArray[np.float64]:
         """Torque of the motor on the input, N·m."""
+    @property
+    def rocking_couple(self) -> NDArray[np.complex128]:
+        """The couple about x and y from links in several planes, complex, N·m."""
 
 
 class AnalysisLike(Protocol):
@@ -115,7 +118,8 @@ SIMULATION_COLUMNS = (
     "RA3y",
 )
 #: What the frame feels and what drives the crank, after the state and reactions.
-SHAKING_COLUMNS = ("shaking_force_x", "shaking_force_y", "shaking_moment", "driving_torque")
+SHAKING_COLUMNS = ("shaking_force_x", "shaking_force_y", "shaking_moment", "rocking_couple_x",
+                   "rocking_couple_y", "driving_torque")
 #: Extra columns written after the fixed ones with ``simulate --all-columns``.
 SIMULATION_EXTRA_COLUMNS = (*SHAKING_COLUMNS, "kinetic_energy", "work")
 #: The columns of ``analyze --csv`` for a four-bar (:func:`analysis_columns`).
@@ -128,8 +132,8 @@ def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     ``t``; per moving link ``k`` (1, 2, … in the spec's order) ``theta{k}``, ``omega{k}``,
     ``alpha{k}`` (rad, rad/s, rad/s²); the forces on the frame (:func:`frame_force_columns`);
     the sliders on the frame (:func:`slider_columns`); then the shaking force's components,
-    the shaking moment and the driving torque. For every mechanism: the columns of
-    ``simulate``'s CSV (whatever its formulation), then the shaking.
+    the shaking moment, the rocking couple's components and the driving torque. For every
+    mechanism: the columns of ``simulate``'s CSV (whatever its formulation), then the shaking.
     """
     mo, r = analysis.motion, analysis.reactions
     n = len(mo.pose.angles)
@@ -146,7 +150,8 @@ def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     names += slider_names
     cols += slider_cols
     names += list(SHAKING_COLUMNS)
-    cols += [r.shaking_force.real, r.shaking_force.imag, r.shaking_moment, r.driving_torque]
+    cols += [r.shaking_force.real, r.shaking_force.imag, r.shaking_moment,
+             r.rocking_couple.real, r.rocking_couple.imag, r.driving_torque]
     return names, cols
 
 
@@ -242,7 +247,8 @@ def simulation_columns(traj: TrajectoryLike, all_columns: bool = False
     cols += slider_cols
     if all_columns:
         sf = traj.shaking_force
-        cols += [sf.real, sf.imag, traj.shaking_moment, traj.driving_torque, traj.kinetic_energy,
-                 traj.work]
+        rc = traj.rocking_couple
+        cols += [sf.real, sf.imag, traj.shaking_moment, rc.real, rc.imag, traj.driving_torque,
+                 traj.kinetic_energy, traj.work]
         names += SIMULATION_EXTRA_COLUMNS
     return names, cols

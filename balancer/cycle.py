@@ -32,6 +32,7 @@ from .linkage.kinematics import Motion
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism, Route
 from .model import MechanismModel as Model
+from .orders import Order, order_table
 
 #: Number of crank angles evaluated at once.
 CHUNK = 32768
@@ -97,6 +98,9 @@ class Reactions:
         Their moment about the origin, with the motor's reaction and counter-rotors, N·m.
     driving_torque
         Torque of the motor on the input, N·m.
+    rocking_couple
+        The couple about ``x`` and ``y`` from links in planes along the crank's axis, complex
+        ``Mx + i·My``, N·m (zero for a mechanism in one plane).
     """
 
     ground: dict[str, NDArray[np.complex128]]
@@ -105,6 +109,7 @@ class Reactions:
     shaking_force: NDArray[np.complex128]
     shaking_moment: NDArray[np.float64]
     driving_torque: NDArray[np.float64]
+    rocking_couple: NDArray[np.complex128]
 
 
 @dataclass(frozen=True)
@@ -114,6 +119,7 @@ class CycleSummary:
     shaking_force: Figure
     shaking_moment: Figure
     driving_torque: Figure
+    rocking_couple: Figure
     ground: dict[str, Figure]
     slider_normal: dict[str, Figure]
     slider_couple: dict[str, Figure]
@@ -131,11 +137,12 @@ class CycleSummary:
         return max(values, default=0.0)
 
     def as_dict(self) -> dict[str, dict[str, float]]:
-        """The three fixed figures with their JSON names."""
+        """The fixed figures with their JSON names (the rocking couple's: its magnitude)."""
         return {
             "shaking_force": self.shaking_force.as_dict(),
             "shaking_moment": self.shaking_moment.as_dict(),
             "driving_torque": self.driving_torque.as_dict(),
+            "rocking_couple": self.rocking_couple.as_dict(),
         }
 
 
@@ -179,6 +186,7 @@ class CycleAnalysis:
             shaking_force=Figure.of(r.shaking_force),
             shaking_moment=Figure.of(r.shaking_moment),
             driving_torque=Figure.of(r.driving_torque),
+            rocking_couple=Figure.of(r.rocking_couple),
             ground={p: Figure.of(v) for p, v in r.ground.items()},
             slider_normal={k: Figure.of(v) for k, v in r.slider_normal.items()},
             slider_couple={k: Figure.of(v) for k, v in r.slider_couple.items()},
@@ -232,28 +240,16 @@ class CycleAnalysis:
         """Whether the design is force-balanced (its residual is rounding)."""
         return self.force_balance_residual <= RESIDUAL_FLOOR
 
-    def harmonics(self, orders: int = 4) -> dict[str, NDArray[np.float64]]:
-        """Amplitudes of the harmonics 0…``orders`` of the shaking over the revolution.
+    @cached_property
+    def orders(self) -> tuple[Order, ...]:
+        """The frame's loads by order of the crank speed (:mod:`balancer.orders`).
 
-        Keys ``shaking_force_x``, ``shaking_force_y`` (N), ``shaking_moment`` (N·m),
-        ``driving_torque`` (N·m); entry ``k`` is the amplitude at ``k`` times the crank speed
-        (entry 0 the mean). From the equally spaced samples (a discrete Fourier transform);
-        samples at a singular pose carry the limits of the smooth motion.
+        From the equally spaced samples of the cycle; samples at a singular pose carry the
+        limits of the smooth motion.
         """
         r = self.reactions
-        signals = {
-            "shaking_force_x": np.real(r.shaking_force),
-            "shaking_force_y": np.imag(r.shaking_force),
-            "shaking_moment": np.asarray(r.shaking_moment, float),
-            "driving_torque": np.asarray(r.driving_torque, float),
-        }
-        out = {}
-        for name, values in signals.items():
-            spectrum = np.fft.rfft(values) / values.size
-            amp = np.abs(spectrum[: orders + 1]) * 2
-            amp[0] /= 2
-            out[name] = amp
-        return out
+        return order_table(r.shaking_force, r.rocking_couple, r.shaking_moment,
+                           r.driving_torque)
 
     def columns(self) -> tuple[list[str], Columns]:
         """The columns of ``analyze --csv``: names and values over the samples.
@@ -321,7 +317,7 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     grounds = mech.ground_points
     sliders = mech.ground_sliders
     out = {"shaking_force": np.empty(n, complex), "shaking_moment": np.empty(n),
-           "driving_torque": np.empty(n)}
+           "driving_torque": np.empty(n), "rocking_couple": np.empty(n, complex)}
     ground = {p: np.empty(n, complex) for p in grounds}
     normal = {k: np.empty(n) for k in sliders}
     couple = {k: np.empty(n) for k in sliders}
@@ -337,6 +333,7 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
         out["shaking_force"][sl] = f.shaking_force.complex()[:, 0]
         out["shaking_moment"][sl] = f.shaking_moment[:, 0]
         out["driving_torque"][sl] = f.driving_torque[:, 0]
+        out["rocking_couple"][sl] = f.rocking_couple.complex()[:, 0]
         for p in grounds:
             ground[p][sl] = f.reactions[p].complex()[:, 0]
         for k in sliders:
@@ -364,6 +361,8 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
         out["shaking_moment"][hit] = sum(w * p.shaking_moment[:, 0]
                                          for w, p in zip(limit.weights, parts, strict=True))
         out["driving_torque"][hit] = sum(w * p.driving_torque[:, 0]
+                                         for w, p in zip(limit.weights, parts, strict=True))
+        out["rocking_couple"][hit] = sum(w * p.rocking_couple.complex()[:, 0]
                                          for w, p in zip(limit.weights, parts, strict=True))
         for p in grounds:
             ground[p][hit] = np.nan

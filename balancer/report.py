@@ -25,7 +25,8 @@ if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these l
     from .simulation import Trajectory
     from .verification import Verification
 
-UNITS = {"shaking_force": "N", "shaking_moment": "N·m", "driving_torque": "N·m"}
+UNITS = {"shaking_force": "N", "shaking_moment": "N·m", "driving_torque": "N·m",
+         "rocking_couple": "N·m"}
 
 
 def _fmt(x: float, width: int = 12) -> str:
@@ -78,10 +79,34 @@ def figures_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
     return analysis.summary.as_dict()
 
 
-def _harmonics_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
-    """Primary and secondary harmonic amplitudes of the shaking (N, N·m)."""
-    h = analysis.harmonics()
-    return {name: {"primary": float(v[1]), "secondary": float(v[2])} for name, v in h.items()}
+def _orders_list(analysis: CycleAnalysis) -> list[dict[str, Any]]:
+    """The ``orders`` table (DESIGN.md's names; :mod:`balancer.orders`)."""
+    return [order.as_dict() for order in analysis.orders]
+
+
+def _order_name(order: float) -> str:
+    """An order as a designer writes it: 1, 2, ½, 1½."""
+    whole, half = divmod(round(2 * order), 2)
+    return (f"{whole}" if not half else "½" if not whole else f"{whole}½")
+
+
+def orders_text(analysis: CycleAnalysis) -> str:
+    """The order table of ``analyze``: amplitudes by multiple of the crank speed."""
+    planes = any(o.rocking_couple.forward or o.rocking_couple.backward for o in analysis.orders)
+    rows = []
+    for o in analysis.orders:
+        f = o.shaking_force
+        row = [_order_name(o.order), _fmt(f.x), _fmt(f.y), _fmt(f.forward), _fmt(f.backward),
+               _fmt(o.shaking_moment), _fmt(o.driving_torque)]
+        if planes:
+            row += [_fmt(o.rocking_couple.forward), _fmt(o.rocking_couple.backward)]
+        rows.append(row)
+    head = ["order", "force x (N)", "force y (N)", "forward (N)", "backward (N)",
+            "moment (N·m)", "torque (N·m)"]
+    if planes:
+        head += ["couple fwd (N·m)", "couple bwd (N·m)"]
+    return ("orders (peak amplitudes; order 0 the mean; forward turns with the crank, backward "
+            "against it):\n" + table(rows, head))
 
 
 def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str, Any]:
@@ -107,7 +132,7 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
             "centre_of_mass_excursion": analysis.centre_of_mass_excursion,
             "reactions": _reactions_dict(analysis),
             "change_points": _change_points(analysis),
-            "harmonics": _harmonics_dict(analysis),
+            "orders": _orders_list(analysis),
             "units": {
                 "force": "N",
                 "moment": "N·m",
@@ -160,6 +185,8 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
                     ("shaking_force", s.shaking_force),
                     ("shaking_moment", s.shaking_moment),
                     ("driving_torque", s.driving_torque),
+                    *((("rocking_couple", s.rocking_couple),)
+                      if not analysis.mechanism.in_one_plane() else ()),
                 )
             ],
             ["quantity", "RMS", "max", "unit"],
@@ -179,11 +206,7 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
                 for link in analysis.reactions.slider_normal]
         lines += ["", table(rows, ["slider on the frame", "normal force max (N)",
                                    "couple max (N·m)"])]
-    h = analysis.harmonics()
-    lines += ["", table(
-        [[name.replace("_", " "), _fmt(h[name][1]), _fmt(h[name][2]), unit] for name, unit in (
-            ("shaking_force_x", "N"), ("shaking_force_y", "N"), ("shaking_moment", "N·m"))],
-        ["harmonic amplitude", "primary (1×)", "secondary (2×)", "unit"])]
+    lines += ["", orders_text(analysis)]
     lines.append("")
     points = _change_points(analysis)
     if points:
@@ -454,7 +477,7 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis, after: Cycle
             ],
             "force_balanced": after.force_balanced,
             "force_balance_residual": after.force_balance_residual,
-            "harmonics": {"before": _harmonics_dict(before), "after": _harmonics_dict(after)},
+            "orders": {"before": _orders_list(before), "after": _orders_list(after)},
             "verification": None if verification is None else verification.as_dict(),
             "out": None if out is None else str(out),
             "units": {"objective, lower_bound": "(N·m)², the weighted mean squares of the "
@@ -575,7 +598,8 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
         "",
     ]
     rows = []
-    for name in ("shaking_force", "shaking_moment", "driving_torque"):
+    planes = () if after.mechanism.in_one_plane() else ("rocking_couple",)
+    for name in ("shaking_force", "shaking_moment", "driving_torque", *planes):
         b, a = getattr(before.summary, name), getattr(after.summary, name)
         ratio = f"{a.rms / b.rms:.3g}" if b.rms > 0 else "—"  # nothing to compare with
         rows.append([name.replace("_", " "), _fmt(b.rms), _fmt(a.rms), ratio,
@@ -595,11 +619,16 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
         lines += ["objective J = Σ weight × mean square (added mass: weight × kg added), "
                   "inertial shaking at the operating speed:",
                   table(rows, ["term", "weight", "RMS before", "RMS after", "unit"]), ""]
-    hb, ha = _harmonics_dict(before), _harmonics_dict(after)
-    rows = [[name.replace("_", " "), _fmt(hb[name][order]), _fmt(ha[name][order]), order]
-            for name in ("shaking_force_x", "shaking_force_y", "shaking_moment")
-            for order in ("primary", "secondary")]
-    lines += [table(rows, ["harmonic amplitude", "before", "after", "order"]), ""]
+    rows = []
+    for ob, oa in zip(before.orders, after.orders, strict=True):
+        if ob.order not in (1.0, 2.0):
+            continue
+        for label, b, a, unit in (
+                ("force forward", ob.shaking_force.forward, oa.shaking_force.forward, "N"),
+                ("force backward", ob.shaking_force.backward, oa.shaking_force.backward, "N"),
+                ("shaking moment", ob.shaking_moment, oa.shaking_moment, "N·m")):
+            rows.append([f"{_order_name(ob.order)}: {label}", _fmt(b), _fmt(a), unit])
+    lines += [table(rows, ["order amplitude", "before", "after", "unit"]), ""]
     rows = []
     for name in result.linkage.link_names:
         old, new = result.original.link(name), result.linkage.link(name)

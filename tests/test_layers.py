@@ -24,7 +24,7 @@ PACKAGE = Path(balancer.__file__).resolve().parent
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("errors", "validate", "tomltext", "progress", "interrupts", "outputs"),
     ("model",),
-    ("linkage", "quadrature"),
+    ("linkage", "quadrature", "orders"),
     # The mechanism interface, and what every mechanism's formulations share.
     ("mechanisms.base", "mechanisms.formulation", "mechanisms.chains"),
     # Each mechanism in its own folder; the general formulations (any mechanism).

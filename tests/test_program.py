@@ -31,7 +31,8 @@ RTOL = 1e-10
 
 def _fields(forces):
     out = {"driving_torque": forces.driving_torque, "shaking_moment": forces.shaking_moment,
-           "shaking_force.x": forces.shaking_force.x, "shaking_force.y": forces.shaking_force.y}
+           "shaking_force.x": forces.shaking_force.x, "shaking_force.y": forces.shaking_force.y,
+           "rocking_couple.x": forces.rocking_couple.x, "rocking_couple.y": forces.rocking_couple.y}
     for p, r in forces.reactions.items():
         out[f"{p}.x"], out[f"{p}.y"] = r.x, r.y
     for k in forces.slider_normal:
@@ -58,7 +59,8 @@ def _assert_same(got, want, where: str, length: float, slack=1.0) -> None:
     a, b = _fields(got), _fields(want)
     assert a.keys() == b.keys(), where
     size = {k: float(np.max(np.abs(v[np.isfinite(v)]), initial=0.0)) for k, v in b.items()}
-    moments = ("driving_torque", "shaking_moment", ".couple")
+    moments = ("driving_torque", "shaking_moment", ".couple", "rocking_couple.x",
+               "rocking_couple.y")
     force = max(v for k, v in size.items() if not k.endswith(moments))
     moment = max(max(v for k, v in size.items() if k.endswith(moments)), force * length)
     for key in b:
@@ -95,7 +97,8 @@ def _take(value, rows):
     if hasattr(value, "driving_torque"):
         return type(value)(**{f: _take(getattr(value, f), rows) for f in
                               ("reactions", "slider_normal", "slider_couple",
-                               "driving_torque", "shaking_force", "shaking_moment")})
+                               "driving_torque", "shaking_force", "shaking_moment",
+                               "rocking_couple")})
     if isinstance(value, dict):
         return {k: _take(v, rows) for k, v in value.items()}
     if hasattr(value, "x"):
@@ -111,6 +114,9 @@ def test_the_program_agrees_on_random_linkages(family, seed):
     topo, cls, _, _ = build_topology(rng, want="valid", family=family)
     assert cls == "valid"
     doc, _ = spec_from_topology(rng, topo, _random_transform(rng))
+    for name, link in doc["links"].items():  # in planes along the crank's axis: rocking
+        if name != "ground":
+            link["z"] = float(rng.uniform(-0.3, 0.3))
     mech = mechanism_of(design_from_dict(doc).mechanism)
     theta, omega, alpha = _states(2000, seed=seed)
     want = _numpy_route(mech, theta, omega, alpha)

@@ -119,6 +119,9 @@ class Forces:
     shaking_moment
         Their moment about the spec's origin with the motor's reaction and the counter-rotors,
         N·m.
+    rocking_couple
+        The couple about ``x`` and ``y`` on the frame from links in planes along the crank's
+        axis (:func:`rocking_couple`), N·m; zero for a mechanism in one plane.
     """
 
     reactions: dict[str, V]
@@ -127,16 +130,17 @@ class Forces:
     driving_torque: Num
     shaking_force: V
     shaking_moment: Num
+    rocking_couple: V
 
     def arrays(self) -> list[Num]:
         """Every figure in one fixed order (what :meth:`with_arrays` reads back).
 
-        Driving torque, shaking force ``x`` and ``y``, shaking moment; each ground point's
-        reaction ``x`` and ``y``, by name; each ground slider's normal force and couple, by
-        name.
+        Driving torque, shaking force ``x`` and ``y``, shaking moment, rocking couple ``x`` and
+        ``y``; each ground point's reaction ``x`` and ``y``, by name; each ground slider's normal
+        force and couple, by name.
         """
         out = [self.driving_torque, self.shaking_force.x, self.shaking_force.y,
-               self.shaking_moment]
+               self.shaking_moment, self.rocking_couple.x, self.rocking_couple.y]
         for p in sorted(self.reactions):
             out += [self.reactions[p].x, self.reactions[p].y]
         for k in sorted(self.slider_normal):
@@ -146,13 +150,13 @@ class Forces:
     def with_arrays(self, values: Sequence[Num]) -> Forces:
         """Forces with the same names holding ``values`` in :meth:`arrays`' order."""
         points, sliders = sorted(self.reactions), sorted(self.slider_normal)
-        at = 4 + 2 * len(points)
+        at = 6 + 2 * len(points)
         return Forces(
-            reactions={p: V(values[4 + 2 * i], values[5 + 2 * i]) for i, p in enumerate(points)},
+            reactions={p: V(values[6 + 2 * i], values[7 + 2 * i]) for i, p in enumerate(points)},
             slider_normal={k: values[at + 2 * i] for i, k in enumerate(sliders)},
             slider_couple={k: values[at + 2 * i + 1] for i, k in enumerate(sliders)},
             driving_torque=values[0], shaking_force=V(values[1], values[2]),
-            shaking_moment=values[3])
+            shaking_moment=values[3], rocking_couple=V(values[4], values[5]))
 
 
 def _col(x: Num, n: int, c: int) -> NDArray[np.float64]:
@@ -266,7 +270,8 @@ def _carrier(structure: Structure, point: str) -> tuple[V, int]:
 
 def kinetostatics(structure: Structure, mo: Motion, effective: list[list[Num]],
                   rotor_moment: Num | None = None,
-                  ground_extra: tuple[Num, ...] | None = None, ops: OpsLike = NUMPY) -> Forces:
+                  ground_extra: tuple[Num, ...] | None = None, ops: OpsLike = NUMPY,
+                  rocking: V | None = None) -> Forces:
     """Solve the groups in reverse order for given ``E`` columns (see the module docstring).
 
     Parameters
@@ -284,6 +289,9 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list[Num]],
     ops
         Elementary functions: numpy (the default), or CasADi's for one design on symbols
         (every entry then a scalar symbol, :mod:`balancer.linkage.program`).
+    rocking
+        The rocking couple (:func:`rocking_couple`), as the columns of ``effective``; none:
+        zero.
     """
     numeric = ops is NUMPY
     if numeric:
@@ -328,7 +336,8 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list[Num]],
                     for j in range(3):
                         applied[link][j] = applied[link][j] - force[j]
     constraints = [c for g in structure.groups for c in g.constraints]
-    return _collect(structure, constraints, lam, ground_of, zero, rotor_moment, ground_extra)
+    return _collect(structure, constraints, lam, ground_of, zero, rotor_moment, ground_extra,
+                    rocking)
 
 
 def _sum(terms: Iterable[Num]) -> Num:
@@ -341,7 +350,8 @@ def _sum(terms: Iterable[Num]) -> Num:
 
 def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list[Num]],
                          rotor_moment: Num | None = None,
-                         ground_extra: tuple[Num, ...] | None = None) -> Forces:
+                         ground_extra: tuple[Num, ...] | None = None,
+                         rocking: V | None = None) -> Forces:
     """The same forces from all the links' equations at once: ``Φ_qᵀ·λ = E``.
 
     One ``3n × 3n`` solve per crank state over every constraint and the driver (the pairs of
@@ -386,12 +396,13 @@ def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list[
                 ground_of[id(c)] = [-_sum(_times(coeffs[r][j], values[r])
                                           for r in range(c.rows)) for j in range(3)]
     return _collect(structure, constraints, lam, ground_of, np.zeros((n, c_count)),
-                    rotor_moment, ground_extra)
+                    rotor_moment, ground_extra, rocking)
 
 
 def _collect(structure: Structure, constraints: Sequence[Constraint],
              lam: dict[int, list[Num]], ground_of: dict[int, list[Num]], zero: Num,
-             rotor_moment: Num | None, ground_extra: tuple[Num, ...] | None) -> Forces:
+             rotor_moment: Num | None, ground_extra: tuple[Num, ...] | None,
+             rocking: V | None = None) -> Forces:
     """The forces on the ground from the constraints' multipliers.
 
     ``zero`` fills what no constraint puts there: an ``(N, C)`` array, or the float 0.0 on
@@ -426,7 +437,8 @@ def _collect(structure: Structure, constraints: Sequence[Constraint],
     for p in structure.linkage.ground.points:
         reactions.setdefault(p, V(zero, zero))
     return Forces(reactions=reactions, slider_normal=normal, slider_couple=couple,
-                  driving_torque=driving, shaking_force=V(fx, fy), shaking_moment=mz)
+                  driving_torque=driving, shaking_force=V(fx, fy), shaking_moment=mz,
+                  rocking_couple=V(zero, zero) if rocking is None else rocking)
 
 
 def regressors(structure: Structure, mo: Motion, gravity: tuple[float, float] = (0.0, 0.0)
@@ -450,7 +462,9 @@ def regressors(structure: Structure, mo: Motion, gravity: tuple[float, float] = 
                 effective[k][r][:, j] = values[r]
             if param == "Jc":
                 rotor[:, j] = 2 * mo.accel[k]
-    return kinetostatics(structure, mo, effective, rotor_moment=rotor), layout
+    rocking = rocking_couple(structure.linkage,
+                             [V(e[0], e[1]) for e in effective], np.zeros((n, p)))
+    return kinetostatics(structure, mo, effective, rotor_moment=rotor, rocking=rocking), layout
 
 
 def inverse_dynamics(structure: Structure, mo: Motion, linkage: Linkage | None = None,
@@ -491,6 +505,7 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage: Linkage | None =
     # E_k = applied − (I_k − gravity_k) of the design: inertial_columns summed with the
     # design's parameters, in closed form (S̄ = R·(m·s̄), the first moment about the origin).
     effective: list[list[Num]] = []
+    shares: list[V] = []  # each link's m·(ḡ − a_G) + F̄: its share of the shaking force
     rotor: Num = np.zeros(n) if numeric else 0.0
     for k, name in enumerate(structure.names):
         m, me, mf, j_origin = x[layout.link_slice(name)]
@@ -501,19 +516,48 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage: Linkage | None =
         acc = mo.acceleration[k] - g
         first = V(c * me - sn * mf, sn * me + c * mf)
         lin = first.perp() * a - first * (w * w)
+        link = linkage.link(name)
+        applied = V(*link.force) if loads and link.has_loads else V(0.0, 0.0)
+        shares.append(V(column(applied.x - m * acc.x - lin.x),
+                        column(applied.y - m * acc.y - lin.y)))
         effective.append([column(per[k][0] - m * acc.x - lin.x),
                           column(per[k][1] - m * acc.y - lin.y),
                           column(per[k][2] - first.cross(acc)
                                  - (j_origin + rotors.link_inertia(rotor_j)) * a)])
         if rotor_j:
             rotor = rotor + rotors.ground_couple(rotor_j, a)
+    rocking = rocking_couple(linkage, shares, np.zeros((n, 1)) if numeric else 0.0)
     if not numeric:
         return kinetostatics(structure, mo, effective, rotor_moment=rotor,
-                             ground_extra=tuple(ground), ops=ops)
+                             ground_extra=tuple(ground), ops=ops, rocking=rocking)
     rotor = np.broadcast_to(rotor, (n,))[:, None]
     extra = tuple(np.asarray(v)[:, None] * np.ones((n, 1)) for v in ground)
     solver = kinetostatics if route == "groups" else global_kinetostatics
-    return solver(structure, mo, effective, rotor_moment=rotor, ground_extra=extra)
+    return solver(structure, mo, effective, rotor_moment=rotor, ground_extra=extra,
+                  rocking=rocking)
+
+
+def rocking_couple(linkage: Linkage, shares: Sequence[V], zero: Num) -> V:
+    """The rocking couple on the frame from each link's share of the shaking force, N·m.
+
+    ``shares[k] = m_k·(ḡ − a_k) + F̄_k``, link ``k``'s centre-of-mass acceleration ``a_k``
+    and the force from outside the machine on it ``F̄_k`` (its ``force``; springs, slider and
+    gas forces are the machine's own). From momentum (DESIGN.md, "Planes and the rocking
+    couple"), the link a lamina in its plane ``z_k``:
+
+    ``Mx = Σ_k z_k·(m_k·a_k,y − F_k,y) = −Σ_k z_k·share_k,y``,
+    ``My = Σ_k z_k·(F_k,x − m_k·a_k,x) = Σ_k z_k·share_k,x``
+
+    — the moment about the origin of each share applied in its plane. ``zero`` (an array of the
+    shares' shape, or 0.0 on symbols) for a mechanism in one plane.
+    """
+    mx: Num = zero
+    my: Num = zero
+    for link, share in zip(linkage.links, shares, strict=True):
+        if link.z:
+            mx = mx - link.z * share.y
+            my = my + link.z * share.x
+    return V(mx, my)
 
 
 def _with(structure: Structure, linkage: Linkage) -> Structure:

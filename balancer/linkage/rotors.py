@@ -67,4 +67,5 @@ def dynamic_link(link: Link) -> Link:
         f=link.f,
         force=link.force,
         moment=link.moment,
+        z=link.z,
     )

@@ -327,6 +327,37 @@ class Mechanism(ABC):
         return dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
                                          loads=loads, route=general)
 
+    def in_one_plane(self) -> bool:
+        """Whether every link moves in the crank's plane (no rocking couple)."""
+        return not any(link.z for link in self.links)
+
+    def rocking_couple(self, mo: Motion, *, loads: bool = True,
+                       gravity: tuple[float, float] = (0.0, 0.0)) -> V:
+        """The rocking couple on the frame (:func:`balancer.linkage.dynamics.rocking_couple`).
+
+        Arrays ``(N, 1)``, N·m: what a closed-form route, which works in the plane, adds to its
+        forces; zeros for a mechanism in one plane.
+        """
+        if self.in_one_plane():
+            zero = np.zeros((np.size(mo.theta1), 1))
+            return V(zero, zero.copy())
+        return dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
+                                         loads=loads).rocking_couple
+
+    def crank_rocking_couple(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike, *,
+                             loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)
+                             ) -> NDArray[np.complex128]:
+        """:meth:`rocking_couple` at crank states (arrays ``(N,)``), complex ``Mx + i·My``, N·m.
+
+        The pose is the crank's on the mechanism's branch (:meth:`motion`).
+        """
+        theta1 = np.atleast_1d(np.asarray(theta1, dtype=float))
+        if self.in_one_plane():
+            return np.zeros(theta1.size, complex)
+        with np.errstate(all="ignore"):
+            mo = self.motion(theta1, omega1, alpha1)
+        return self.rocking_couple(mo, loads=loads, gravity=gravity).complex()[:, 0]
+
     def crank_forces(self, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0,
                      *, route: Route | None = None, loads: bool = True,
                      gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:

@@ -69,6 +69,9 @@ class Link:
         Constant applied moment ``M``, N·m (counter-clockwise positive).
     counter_rotor
         Inertia of a counter-rotor coaxial with the link's ground pivot, kg·m² (0: none).
+    z
+        The plane the link moves in, along the crank's axis, m (0: the crank's plane): a
+        lamina there. Links in several planes rock the frame (the rocking couple).
     """
 
     mass: float
@@ -78,6 +81,7 @@ class Link:
     force: tuple[float, float] = (0.0, 0.0)
     moment: float = 0.0
     counter_rotor: float = 0.0
+    z: float = 0.0
 
     def __post_init__(self) -> None:
         """Check the values (keys are the spec's names within the link's table)."""
@@ -88,6 +92,7 @@ class Link:
         v.store(self, "force", v.vector2(self.force, "force"))
         v.store(self, "moment", v.number(self.moment, "moment"))
         v.store(self, "counter_rotor", v.nonnegative(self.counter_rotor, "counter_rotor"))
+        v.store(self, "z", v.number(self.z, "z"))
 
     @property
     def com(self) -> complex:

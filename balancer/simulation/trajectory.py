@@ -53,6 +53,9 @@ class Trajectory:
     shaking_force, shaking_moment
         Sum of the forces on the frame (N) and their moment about the origin with the motor's
         reaction and the counter-rotors' (N·m).
+    rocking_couple
+        The couple about ``x`` and ``y`` on the frame from links in planes along the crank's
+        axis, complex ``Mx + i·My``, N·m (zero for a mechanism in one plane).
     kinetic_energy
         Kinetic energy of the moving parts, counter-rotors included, J.
     work
@@ -94,6 +97,7 @@ class Trajectory:
     driving_torque: NDArray[np.float64]
     shaking_force: NDArray[np.complex128]
     shaking_moment: NDArray[np.float64]
+    rocking_couple: NDArray[np.complex128]
     kinetic_energy: NDArray[np.float64]
     work: NDArray[np.float64]
     energy_error: float
@@ -170,6 +174,9 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
     scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), _exchangeable_energy(f), 1e-300)
     energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
     shaking_force, moment = f.shaking(ev)
+    crank = list(f.link_names).index(f.mechanism.input)
+    rocking = f.mechanism.crank_rocking_couple(theta[crank], omega[crank], alpha[crank],
+                                               gravity=(f.gravity.real, f.gravity.imag))
     return Trajectory(
         method=f.name,
         drive="constant-speed" if f.driven else "free",
@@ -190,6 +197,7 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
         shaking_force=cast("NDArray[np.complex128]",
                            np.asarray(shaking_force, complex) * np.ones(t.size)),
         shaking_moment=np.asarray(moment, float) * np.ones(t.size),
+        rocking_couple=rocking,
         kinetic_energy=kin,
         work=work,
         energy_error=energy_error,

@@ -136,6 +136,7 @@ def _read_link(table: Table, name: str,
             force=table.value("force", (0.0, 0.0)),
             moment=table.value("moment", 0.0),
             counter_rotor=table.value("counter_rotor", 0.0),
+            z=table.value("z", 0.0),
         )
 
 

@@ -134,6 +134,10 @@ def _link_keys(com_forms: str) -> tuple[Key, ...]:
             "turn at −1 times the link's angular velocity (only its inertia counts). Only on a "
             "link pivoted to the ground: a four-bar's crank and rocker, a slider-crank's crank, "
             "a general linkage's links with a ground point. At least 0.", example="0.5"),
+        Key("z", "m", "0",
+            "The plane the link moves in, along the crank's axis (z = 0: the crank's plane). "
+            "Links in different planes rock the frame about x and y (the rocking couple); the "
+            "link is a lamina in its plane.", example="0.1"),
     )
 
 

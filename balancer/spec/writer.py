@@ -25,6 +25,8 @@ def _link_lines(link: Link, frame: str = "link") -> list[str]:
         lines.append(f"moment = {toml.number(link.moment)}  # N·m")
     if link.counter_rotor != 0.0:
         lines.append(f"counter_rotor = {toml.number(link.counter_rotor)}  # kg·m²")
+    if link.z != 0.0:
+        lines.append(f"z = {toml.number(link.z)}  # m: the link's plane along the crank's axis")
     return lines
 
 

@@ -167,7 +167,16 @@ class FourBarMechanism(Mechanism):
             slider_normal={}, slider_couple={},
             driving_torque=col(r.driving_torque),
             shaking_force=V(col(r.shaking_force.real), col(r.shaking_force.imag)),
-            shaking_moment=col(r.shaking_moment))
+            shaking_moment=col(r.shaking_moment),
+            rocking_couple=self._rocking_couple(mo, loads, gravity))
+
+    def _rocking_couple(self, mo: fourbar.Motion, loads: bool,
+                        gravity: tuple[float, float]) -> V:
+        """The rocking couple at the closed-form motion (the general core's, from its motion)."""
+        if self.in_one_plane():
+            zero = np.zeros((mo.size, 1))
+            return V(zero, zero.copy())
+        return self.rocking_couple(general_motion(mo), loads=loads, gravity=gravity)
 
 
 def general_motion(mo: fourbar.Motion) -> Motion:

@@ -115,4 +115,5 @@ class SliderCrankMechanism(Mechanism):
             slider_couple={"slider": col(r.guide_couple)},
             driving_torque=col(r.driving_torque),
             shaking_force=V(col(np.real(r.shaking_force)), col(np.imag(r.shaking_force))),
-            shaking_moment=col(r.shaking_moment))
+            shaking_moment=col(r.shaking_moment),
+            rocking_couple=self.rocking_couple(mo, loads=loads, gravity=gravity))
