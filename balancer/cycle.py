@@ -419,9 +419,14 @@ def drawn_analyses(models: Sequence[Model | Mechanism], speed: float, *,
 
 
 def drawn_panels(analysis: CycleAnalysis) -> dict[str, NDArray[np.number]]:
-    """What the cycle figure draws of an analysis, by panel."""
+    """What the cycle figure draws of an analysis, by panel (the rocking couple's: in planes)."""
     r = analysis.reactions
-    return {"force": r.shaking_force, "moment": r.shaking_moment, "torque": r.driving_torque}
+    panels: dict[str, NDArray[np.number]] = {
+        "force": r.shaking_force, "moment": r.shaking_moment, "torque": r.driving_torque}
+    if not analysis.mechanism.in_one_plane():
+        panels["couple"] = r.rocking_couple
+    return panels
+
 
 def _drawn_within(analyses: Sequence[CycleAnalysis], tolerance: float) -> bool:
     """Whether every curve at the even samples is drawn within ``tolerance`` of its panel.

@@ -92,7 +92,7 @@ def _order_name(order: float) -> str:
 
 def orders_text(analysis: CycleAnalysis) -> str:
     """The order table of ``analyze``: amplitudes by multiple of the crank speed."""
-    planes = any(o.rocking_couple.forward or o.rocking_couple.backward for o in analysis.orders)
+    planes = not analysis.mechanism.in_one_plane()
     rows = []
     for o in analysis.orders:
         f = o.shaking_force
@@ -225,8 +225,9 @@ def _force_balance_line(analysis: CycleAnalysis) -> str:
     """Whether the design is force-balanced, in words a designer pictures."""
     balanced, residual = analysis.force_balanced, analysis.force_balance_residual
     if balanced:
-        return ("force-balanced: yes (the total centre of mass stands still; the conditions, "
-                f"Eq. 57–58, hold to {residual:.1e} of the links' first moments)")
+        return ("force-balanced: yes (the total centre of mass stands still; "
+                f"{analysis.mechanism.force_balance_source} hold to {residual:.1e} of the "
+                "links' first moments)")
     excursion = analysis.centre_of_mass_excursion
     return ("force-balanced: no (the total centre of mass moves up to "
             f"{_length(excursion)} from its mean place over a revolution)")
@@ -387,6 +388,10 @@ def _opt(x: float | None, fmt: str = ".4g") -> str:
     return "—" if x is None else format(x, fmt)
 
 
+def _ratio_of(a: float | None, b: float | None) -> float | None:
+    return None if a is None or b is None or b == 0 else a / b
+
+
 def verification_text(verification: Verification, spec: str | None = None) -> str:
     """The readable ``verify`` report."""
     head = f"balancer verify — {spec}" if spec else "balancer verify"
@@ -400,6 +405,12 @@ def verification_text(verification: Verification, spec: str | None = None) -> st
                      _opt(run.moment_ratio, ".2e")])
     lines.append(table(rows, ["motion", "max |ΣR| (N)", "original", "ratio", "of |R|",
                               "max |Msh| (N·m)", "original", "ratio"]))
+    if any(r.max_rocking_couple for r in (verification.driven, verification.free)):
+        rows = [[name, _opt(run.max_rocking_couple), _opt(run.original_max_rocking_couple),
+                 _opt(_ratio_of(run.max_rocking_couple, run.original_max_rocking_couple), ".2e")]
+                for name, run in (("driven at the operating speed", verification.driven),
+                                  ("free from the initial state", verification.free))]
+        lines += ["", table(rows, ["motion", "max |Mrock| (N·m)", "original", "ratio"])]
     for name, run in (("driven", verification.driven), ("free", verification.free)):
         if run.note:
             lines.append(f"{name}: {run.note}")

@@ -61,6 +61,9 @@ class RunCheck:
         before it stopped, if it stopped; ``None`` if it could not start).
     original_max_shaking_force, original_max_shaking_moment
         The same for the original, or ``None``.
+    max_rocking_couple, original_max_rocking_couple
+        Largest rocking couple's magnitude (N·m) of the design and of the original (0 for a
+        mechanism in one plane; ``None`` as above).
     note
         Why a run stopped early or could not be made (for example a lock-up), and the span
         its figures cover.
@@ -72,6 +75,8 @@ class RunCheck:
     max_shaking_moment: float | None
     original_max_shaking_force: float | None = None
     original_max_shaking_moment: float | None = None
+    max_rocking_couple: float | None = None
+    original_max_rocking_couple: float | None = None
     note: str = ""
 
     @property
@@ -102,6 +107,8 @@ class RunCheck:
             "max_shaking_moment": self.max_shaking_moment,
             "original_max_shaking_force": self.original_max_shaking_force,
             "original_max_shaking_moment": self.original_max_shaking_moment,
+            "max_rocking_couple": self.max_rocking_couple,
+            "original_max_rocking_couple": self.original_max_rocking_couple,
             "force_ratio": self.force_ratio,
             "force_level": self.force_level,
             "moment_ratio": self.moment_ratio,
@@ -153,21 +160,31 @@ class Verification:
         return max((x for x in (self.driven.max_shaking_moment, self.free.max_shaking_moment)
                     if x is not None), default=None)
 
+    @property
+    def max_rocking_couple(self) -> float | None:
+        """Largest rocking couple over the runs, N·m (``None``: neither could start)."""
+        return max((x for x in (self.driven.max_rocking_couple, self.free.max_rocking_couple)
+                    if x is not None), default=None)
+
     def as_dict(self) -> dict[str, Any]:
         """Plain dictionary for JSON (``max_shaking_force``, ``max_shaking_moment`` fixed)."""
         return {
             "method": self.method,
             "max_shaking_force": self.max_shaking_force,
             "max_shaking_moment": self.max_shaking_moment,
+            "max_rocking_couple": self.max_rocking_couple,
             "driven": self.driven.as_dict(),
             "free": self.free.as_dict(),
         }
 
 
-def _figures(traj: Trajectory | None) -> tuple[float | None, float | None]:
+def _figures(traj: Trajectory | None) -> tuple[float | None, float | None, float | None]:
+    """Largest shaking force, shaking moment and rocking couple of a run (``None``: no run)."""
     if traj is None or traj.t.size == 0:
-        return None, None
-    return float(np.max(np.abs(traj.shaking_force))), float(np.max(np.abs(traj.shaking_moment)))
+        return None, None, None
+    return (float(np.max(np.abs(traj.shaking_force))),
+            float(np.max(np.abs(traj.shaking_moment))),
+            float(np.max(np.abs(traj.rocking_couple))))
 
 
 class _Tally:
@@ -232,23 +249,24 @@ def _run(tally: _Tally, linkage: Model, original: Model | None, settings: Simula
     the part before it stopped, the note says where; the original is then run over that span.
     """
     traj, note, settings = _simulate_span(tally, linkage, settings, method, resolution, **kw)
-    force, moment = _figures(traj)
+    force, moment, couple = _figures(traj)
     orig = None
-    o_force = o_moment = None
+    o_force = o_moment = o_couple = None
     if original is not None and force is not None:
         assert traj is not None  # (it has figures)
         span = settings if not note else replace(settings, duration=float(traj.t[-1]))
         orig, o_note, _ = _simulate_span(tally, original, span, method, resolution, **kw) \
             if span.duration > 0 else (None, "", span)
-        o_force, o_moment = _figures(orig)
+        o_force, o_moment, o_couple = _figures(orig)
         if o_note:
             note = "; ".join(x for x in (note, f"original: {o_note}") if x)
-            o_force = o_moment = None  # over a shorter span: not comparable
+            o_force = o_moment = o_couple = None  # over a shorter span: not comparable
     if note and traj is not None and traj.t.size:
         note += f" (figures over 0 ≤ t ≤ {float(traj.t[-1]):.6g} s)"
     return RunCheck(trajectory=traj, original=orig, max_shaking_force=force,
                     max_shaking_moment=moment, original_max_shaking_force=o_force,
-                    original_max_shaking_moment=o_moment, note=note)
+                    original_max_shaking_moment=o_moment, max_rocking_couple=couple,
+                    original_max_rocking_couple=o_couple, note=note)
 
 
 def verify(

@@ -2,11 +2,11 @@
 
 Runs every study (``studies/*.py`` with a ``run``) in full mode into ``studies/out/<name>/``,
 copies the figures listed in :data:`CHOSEN` into ``docs/gallery/`` under stable names, runs the
-``balancer`` commands of :data:`COMMANDS` (docs/gallery.md's, word for word: the report pictures of
-``plot --cycle`` and ``verify --plot``, from designs balanced by ``optimize`` into
-``studies/out/gallery/``), and writes an animation of the example of Meijaard & van der Wijk
-(2020), Eq. 56 (``examples/meijaard2020.toml``) with :func:`balancer.plots.animate`. The
-gallery is committed,
+``balancer`` commands of :data:`COMMANDS` (docs/gallery.md's, word for word: the report pictures
+of ``plot --cycle``, ``plot --orders`` and ``verify --plot``, from designs balanced by
+``optimize`` into ``studies/out/gallery/``), and writes an animation of the example of
+Meijaard & van der Wijk (2020), Eq. 56 (``examples/meijaard2020.toml``) with
+:func:`balancer.plots.animate`. The gallery is committed,
 so each file must stay small (:data:`MAX_BYTES`); the script says which one does not and exits
 with status 1.
 
@@ -56,6 +56,12 @@ COMMANDS = (
     ("engine_cycle.png", (
         "balancer optimize examples/engine.toml --out OUT/engine_balanced.toml",
         "balancer plot OUT/engine_balanced.toml --cycle docs/gallery/engine_cycle.png")),
+    ("two_plane_cycle.png", (
+        "balancer optimize examples/two_plane_drive.toml --out OUT/two_plane_balanced.toml",
+        "balancer plot OUT/two_plane_balanced.toml --cycle docs/gallery/two_plane_cycle.png")),
+    ("two_plane_orders.png", (
+        "balancer plot OUT/two_plane_balanced.toml --orders docs/gallery/two_plane_orders.png",
+    )),
 )
 ANIMATION = "meijaard2020.gif"
 FRAMES = 48

@@ -188,15 +188,16 @@ def rank_rows(rows: np.ndarray) -> np.ndarray:
     return sv[keep, None] * vt[keep]
 
 
-def least_rms_moment_by_cvxpy(design, extra=None) -> float:
+def least_rms_moment_by_cvxpy(design, extra=None, rows=None) -> float:
     """The least RMS shaking moment of a redesign problem, formulated apart from the optimiser.
 
     A CVXPY program written from the spec's bounds in the links' inertial parameters (scaled
     per entry): each listed link's mass range, its centre of mass in its disc
     (``‖S − m·c‖ ≤ R·m``), its inertia about the centre of mass at least ``m·ρ²``
     (``‖S‖²/m ≤ J − ρ²·m``), unlisted links fixed, counter-rotor ranges, force balance
-    ``A·x = b``; ``extra(x, data)`` adds constraints. The product instead assembles Clarabel's
-    standard form in its own scaled variables from its own constraint builder.
+    ``A·x = b``; ``extra(x, data)`` adds constraints; ``rows(data)`` gives the rows whose mean
+    square is minimised instead of the shaking moment's. The product instead assembles
+    Clarabel's standard form in its own scaled variables from its own constraint builder.
     """
     import math
 
@@ -224,7 +225,7 @@ def least_rms_moment_by_cvxpy(design, extra=None) -> float:
     cons.append(a @ x == rhs)
     if extra is not None:
         cons += extra(x, data)
-    moment = rank_rows(data.regressors.shaking_moment)
+    moment = rank_rows(data.regressors.shaking_moment if rows is None else rows(data))
     scale = float(np.linalg.norm(moment @ data.x0))
     problem = cp.Problem(cp.Minimize(cp.norm(moment @ x) / scale), cons)
     # Tolerances 1e-9: far below the comparisons' 1e-6, and met where 1e-10 stalls.

@@ -167,11 +167,37 @@ def test_plot_cycle_with_another_extension_is_refused_before_any_work(tmp_path, 
 def test_plot_needs_something_to_draw_and_distinct_paths(tmp_path, capsys):
     spec = str(EXAMPLES / "pb1.toml")
     assert main(["plot", spec]) == 2
-    assert "--cycle PATH or --animate PATH" in capsys.readouterr().err
+    assert "--cycle PATH, --orders PATH or --animate PATH" in capsys.readouterr().err
     assert main(["plot", spec, "--cycle", str(tmp_path / "a.png"), "--animate",
                  str(tmp_path / "a.png")]) == 2
     assert "same file" in capsys.readouterr().err
+    assert main(["plot", spec, "--cycle", str(tmp_path / "a.png"), "--orders",
+                 str(tmp_path / "a.png")]) == 2
+    assert "--orders: names the same file as --cycle" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("name", "panels"), [("pb1_counterweights", 3), ("two_plane_drive", 4)])
+def test_plot_orders_draws_the_order_table(tmp_path, capsys, name, panels):
+    """Bars of `analyze`'s orders: force, (rocking couple in planes,) moment, torque; the
+    heights are the order table's, before and after for a spec with [original]."""
+    from balancer.api import cycle_analyses
+    from balancer.plots import orders_figure
+    from balancer.spec import load_design
+
+    out = tmp_path / "orders.png"
+    spec = EXAMPLES / f"{name}.toml"
+    assert main(["plot", str(spec), "--orders", str(out)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    design = load_design(spec)
+    after, before = cycle_analyses(design, samples=design.operation.samples)
+    fig = orders_figure(after, before)
+    assert len(fig.axes) == panels
+    force = fig.axes[0]
+    heights = sorted(round(p.get_height(), 9) for p in force.patches)
+    want = sorted(round(v, 9) for a in ([after] if before is None else [before, after])
+                  for o in a.orders for v in (o.shaking_force.forward, o.shaking_force.backward))
+    assert heights == want
 
 
 def test_plot_cycle_of_a_crank_that_cannot_turn_is_bad_input(tmp_path, capsys):

@@ -318,6 +318,9 @@ class NumericProblem:
             wx = w.shaking_force + w.shaking_force_x
             wy = w.shaking_force + w.shaking_force_y
             total += wx * float(np.mean(force.real**2)) + wy * float(np.mean(force.imag**2))
+        if w.rocking_couple:
+            couple = reg.rocking_couple @ x
+            total += w.rocking_couple * float(np.mean(couple.real**2 + couple.imag**2))
         if w.added_mass:
             total += w.added_mass * (self.total_mass(x) - self.original_mass)
         return total
@@ -812,6 +815,9 @@ def _reduced(reg: CycleRegressors, w: Objective, links: tuple[LinkBounds, ...], 
         blocks.append(math.sqrt(wx) * reg.shaking_force.real)
     if wy:
         blocks.append(math.sqrt(wy) * reg.shaking_force.imag)
+    if w.rocking_couple:
+        blocks += [math.sqrt(w.rocking_couple) * reg.rocking_couple.real,
+                   math.sqrt(w.rocking_couple) * reg.rocking_couple.imag]
     rows = np.vstack(blocks) / math.sqrt(n) if blocks else np.zeros((0, p))
     factor = (cast("NDArray[np.float64]", np.linalg.qr(rows, mode="r"))  # R alone (as above)
               if blocks else np.zeros((0, p)))

@@ -10,6 +10,7 @@ frame's origin, then the counter-rotors' inertias; and a link's physical values
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -22,12 +23,13 @@ class CycleRegressors:
     """The inertial shaking over a revolution as linear maps of the design vector.
 
     Arrays ``(N, P)``: shaking force (complex, N), shaking moment and driving torque (N·m),
-    per unit of each entry.
+    rocking couple (complex ``Mx + i·My``, N·m), per unit of each entry.
     """
 
     shaking_force: NDArray[np.complex128]
     shaking_moment: NDArray[np.float64]
     driving_torque: NDArray[np.float64]
+    rocking_couple: NDArray[np.complex128]
 
 
 def cycle_regressors(mech: Mechanism, angles: NDArray[np.float64], omega: float,
@@ -37,16 +39,17 @@ def cycle_regressors(mech: Mechanism, angles: NDArray[np.float64], omega: float,
     At a sample exactly at a singular pose that the smooth motion passes (a four-bar's change
     points) the rows are the limits of that motion (:meth:`Mechanism.limits`).
     """
-    def evaluate(theta: NDArray[np.float64]
-                 ) -> tuple[NDArray[np.complex128], NDArray[np.float64], NDArray[np.float64]]:
+    def evaluate(theta: NDArray[np.float64]) -> tuple[NDArray[Any], ...]:
         with np.errstate(all="ignore"):
             f = mech.regressors(mech.motion(theta, omega, alpha))
-        return f.shaking_force.complex(), f.shaking_moment, f.driving_torque
+        return (f.shaking_force.complex(), np.asarray(f.shaking_moment),
+                np.asarray(f.driving_torque), f.rocking_couple.complex())
 
-    force, moment, torque = evaluate(angles)
-    force, moment, torque = force.copy(), moment.copy(), torque.copy()
+    values = [np.array(v) for v in evaluate(angles)]  # (copies: the limits are written in)
     for limit in mech.limits(angles):
         parts = [evaluate(angles[limit.mask] + d) for d in limit.offsets]
-        for i, target in enumerate((force, moment, torque)):
+        for i, target in enumerate(values):
             target[limit.mask] = sum(w * p[i] for w, p in zip(limit.weights, parts, strict=True))
-    return CycleRegressors(shaking_force=force, shaking_moment=moment, driving_torque=torque)
+    force, moment, torque, rocking = values
+    return CycleRegressors(shaking_force=force, shaking_moment=moment, driving_torque=torque,
+                           rocking_couple=rocking)

@@ -229,6 +229,7 @@ class BalanceResult:
                   "shaking_force": analysis.summary.shaking_force.rms,
                   "shaking_force_x": float(np.sqrt(np.mean(force.real**2))),
                   "shaking_force_y": float(np.sqrt(np.mean(force.imag**2))),
+                  "rocking_couple": analysis.summary.rocking_couple.rms,
                   "added_mass": analysis.linkage.total_mass - self.original.total_mass}
         return {t.name: values[t.name] for t in self.weights.terms}
 

@@ -276,16 +276,20 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "plot",
-        help="pictures for a report: one revolution's shaking, an animation",
+        help="pictures for a report: one revolution's shaking, its orders, an animation",
         description="Pictures of one crank revolution at the operating speed. --cycle: the "
-        "shaking force's polar diagram, and the shaking moment and driving torque over the "
-        "crank angle, of the design and (for a balanced spec that names its [original]) of "
-        "the original before it. --animate: the linkage turning, its total centre of mass "
-        "traced. The file type comes from the extension.",
+        "shaking force's polar diagram (and the rocking couple's, for links in several "
+        "planes), and the shaking moment and driving torque over the crank angle, of the "
+        "design and (for a balanced spec that names its [original]) of the original before "
+        "it. --orders: the order table as bars, forward and backward whirl, before and after. "
+        "--animate: the linkage turning, its total centre of mass traced. The file type "
+        "comes from the extension.",
     )
     _spec_and_force(p)
     p.add_argument("--cycle", metavar="PATH",
                    help="write the figure of one revolution to PATH (.png, .svg or .pdf)")
+    p.add_argument("--orders", metavar="PATH",
+                   help="write the order table's bars to PATH (.png, .svg or .pdf)")
     p.add_argument("--animate", metavar="PATH",
                    help="write an animation to PATH (.gif, or .mp4 with ffmpeg)")
     p.add_argument("--frames", type=_frames, default=72, metavar="N",

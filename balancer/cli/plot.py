@@ -10,32 +10,44 @@ from ..balance.counterweights import counterweights
 from ..errors import OutputError, SpecError
 from ..mechanisms import mechanism_of
 from ..outputs import animation_type, figure_type
-from ..plots import animate, cycle_figure, save_figure
+from ..plots import animate, cycle_figure, orders_figure, save_figure
 from .common import load, output_path, wrote
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``balancer plot``; the exit code."""
-    if args.animate is None and args.cycle is None:
-        raise SpecError("nothing to plot: give --cycle PATH or --animate PATH", key="--cycle")
+    if args.animate is None and args.cycle is None and args.orders is None:
+        raise SpecError("nothing to plot: give --cycle PATH, --orders PATH or --animate PATH",
+                        key="--cycle")
     cycle = output_path(args, args.cycle, "--cycle")
+    orders = output_path(args, args.orders, "--orders")
     animation = output_path(args, args.animate, "--animate")
-    if cycle is not None and animation is not None and \
-            os.path.realpath(cycle) == os.path.realpath(animation):
-        raise OutputError("names the same file as --cycle", key="--animate",
-                          value=args.animate)
-
-    if cycle is not None:
-        figure_type(cycle, "--cycle")
+    named: dict[str, str] = {}
+    for option, path in (("--cycle", cycle), ("--orders", orders), ("--animate", animation)):
+        if path is None:
+            continue
+        same = named.get(os.path.realpath(path))
+        if same is not None:
+            raise OutputError(f"names the same file as {same}", key=option, value=path)
+        named[os.path.realpath(path)] = option
+    for option, path in (("--cycle", cycle), ("--orders", orders)):
+        if path is not None:
+            figure_type(path, option)
     if animation is not None:
         animation_type(animation, "--animate")  # its extension, and ffmpeg for an MP4
     design = load(args)
 
     mechanism_of(design.mechanism).require_full_revolution(
-        "a cycle plot" if animation is None else "an animation of one revolution")
-    figure = None
+        "an animation of one revolution" if animation is not None else "a cycle plot")
+    figures = []
     if cycle is not None:
-        figure = cycle_figure(*cycle_analyses(design), title=design.title)
+        figures.append((cycle_figure(*cycle_analyses(design), title=design.title), cycle))
+    if orders is not None:
+        # At the spec's samples: the orders `analyze` gives (a spec without an operating
+        # speed is refused by cycle_analyses, as for --cycle).
+        analyses = cycle_analyses(design, samples=None if design.operation is None
+                                  else design.operation.samples)
+        figures.append((orders_figure(*analyses, title=design.title), orders))
     if animation is not None:
         weights = None
         if design.original is not None:  # a balanced spec: draw what was added to the links
@@ -44,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
         animate(design.mechanism, animation, frames=args.frames, title=design.title,
                 counterweights=weights)
         wrote(animation)
-    if figure is not None:
-        save_figure(figure, cycle)
-        wrote(cycle)
+    for figure, path in figures:
+        save_figure(figure, path)
+        wrote(path)
     return 0

@@ -96,6 +96,9 @@ class Mechanism(ABC):
 
     #: The spec's ``mechanism.type``.
     kind: ClassVar[str]
+    #: Where the force-balance conditions come from, as a report's sentence names them
+    #: ("… hold to 1e-16 of the links' first moments").
+    force_balance_source: ClassVar[str] = "the conditions found from the linkage"
     #: Inverse-dynamics routes (``analyze --route``), the default first.
     routes: ClassVar[tuple[Route, ...]] = ("newton-euler", "mass-matrix")
     #: The mechanism's own formulations of the equations of motion by name, the default first

@@ -8,6 +8,7 @@ A design spec's ``[balance]`` section describes it; any link of any mechanism ma
     shaking_moment = 1.0          #     + w_m·(total mass − original total mass)
     driving_torque = 0.0          # w_τ, (N·m)²/(N·m)²
     shaking_force = 0.0           # w_F, (N·m)²/N² (useful only with force_balance = false)
+    rocking_couple = 0.0          # w_R, of mean(|M̄rock|²) (links in several planes)
     added_mass = 0.0              # w_m, (N·m)²/kg
     [balance.crank]               # a link listed here may change; links not listed stay fixed
     mass = [2.1, 8.4]             # kg: a range, or one number that fixes the mass;
@@ -56,6 +57,7 @@ OBJECTIVE_KEYS = (
     "shaking_force",
     "shaking_force_x",
     "shaking_force_y",
+    "rocking_couple",
     "added_mass",
 )
 
@@ -71,8 +73,8 @@ COUNTERWEIGHT_KEYS = ("mass", "radius", "gyration")
 class Objective:
     """Weights of the objective ``J`` (see the module docstring).
 
-    ``J = w_M·mean(Msh²) + w_τ·mean(τ²) + w_F·mean(|F̄sh|²) + w_m·(Σm − Σm_original)``, in
-    (N·m)², over the sampled crank angles.
+    ``J = w_M·mean(Msh²) + w_τ·mean(τ²) + w_F·mean(|F̄sh|²) + w_R·mean(|M̄rock|²)
+    + w_m·(Σm − Σm_original)``, in (N·m)², over the sampled crank angles.
 
     Attributes
     ----------
@@ -85,6 +87,9 @@ class Objective:
     shaking_force_x, shaking_force_y
         Weights of the shaking force's components along x and y (for a slider-crank: along
         and across the guide), (N·m)²/N²; they add to ``w_F``.
+    rocking_couple
+        ``w_R``, dimensionless: of the rocking couple's mean-square magnitude (links in several
+        planes along the crank's axis; zero at every design of a mechanism in one plane).
     added_mass
         ``w_m``, (N·m)²/kg: penalises mass added to the linkage.
     """
@@ -94,6 +99,7 @@ class Objective:
     shaking_force: float = 0.0
     shaking_force_x: float = 0.0
     shaking_force_y: float = 0.0
+    rocking_couple: float = 0.0
     added_mass: float = 0.0
 
     @property
@@ -110,6 +116,7 @@ class Objective:
                    ObjectiveTerm("shaking_force_y", fy, "N")])
         terms = [ObjectiveTerm("shaking_moment", self.shaking_moment, "N·m"),
                  ObjectiveTerm("driving_torque", self.driving_torque, "N·m"), *forces,
+                 ObjectiveTerm("rocking_couple", self.rocking_couple, "N·m"),
                  ObjectiveTerm("added_mass", self.added_mass, "kg")]
         return tuple(t for t in terms if t.weight > 0)
 

@@ -8,6 +8,7 @@ matplotlib is imported by the functions that draw, not by importing this package
 
 =================  ===========================================================================
 ``revolution``     one revolution: the shaking force's polar diagram, moment and torque
+``orders``         the order table as bars: forward and backward whirl, before and after
 ``motion``         a simulated motion: forces on the ground, shaking moment, the centre of
                    mass' path; ``balancer verify``'s figure
 ``animation``      the mechanism turning (GIF, MP4)
@@ -23,7 +24,13 @@ from .animation import animate, animation_figure
 from .atlas import sweep_figure
 from .fronts import front_figure
 from .motion import plot_com_path, plot_reactions, plot_shaking_moment, verification_figure
-from .revolution import cycle_figure, plot_over_crank_angle, plot_shaking_force_polar
+from .orders import orders_figure, plot_orders
+from .revolution import (
+    cycle_figure,
+    plot_over_crank_angle,
+    plot_rocking_couple_polar,
+    plot_shaking_force_polar,
+)
 from .style import COLOURS, SERIES, save_figure, save_png
 
 __all__ = [
@@ -33,9 +40,12 @@ __all__ = [
     "animation_figure",
     "cycle_figure",
     "front_figure",
+    "orders_figure",
     "plot_com_path",
+    "plot_orders",
     "plot_over_crank_angle",
     "plot_reactions",
+    "plot_rocking_couple_polar",
     "plot_shaking_force_polar",
     "plot_shaking_moment",
     "save_figure",

@@ -1,7 +1,7 @@
 """Figures of one revolution at the operating speed, before and after a redesign.
 
-The shaking force's polar diagram, the shaking moment and the driving torque over the crank
-angle.
+The shaking force's polar diagram (and the rocking couple's, for links in several planes), the
+shaking moment and the driving torque over the crank angle.
 """
 
 from __future__ import annotations
@@ -42,6 +42,29 @@ def plot_shaking_force_polar(analysis: CycleAnalysis, before: CycleAnalysis | No
     :class:`~balancer.cycle.CycleAnalysis`; a dot marks θ1 = 0 and an arrow the sense of
     travel. A force-balanced design's curve is a point at the origin.
     """
+    return _polar(analysis, before, ax, legend, "shaking_force")
+
+
+def plot_rocking_couple_polar(analysis: CycleAnalysis, before: CycleAnalysis | None = None,
+                              ax: Axes | None = None,
+                              legend: bool = True) -> Axes:
+    """Polar diagram of the rocking couple ``(Mx, My)`` over one revolution, N·m.
+
+    As :func:`plot_shaking_force_polar`: for links in several planes along the crank's axis.
+    """
+    return _polar(analysis, before, ax, legend, "rocking_couple")
+
+
+#: A polar diagram's quantity: its axis name, unit and title.
+_POLAR = {"shaking_force": ("shaking force", "N", "shaking force over one revolution "
+                                                  "(polar diagram)"),
+          "rocking_couple": ("rocking couple", "N·m", "rocking couple over one revolution "
+                                                      "(polar diagram)")}
+
+
+def _polar(analysis: CycleAnalysis, before: CycleAnalysis | None, ax: Axes | None,
+           legend: bool, quantity: str) -> Axes:
+    name, unit, title = _POLAR[quantity]
     ax = axes(ax)
     after_role, before_role = _roles(before)
     ax.axhline(0.0, color="0.6", lw=0.8)
@@ -51,8 +74,9 @@ def plot_shaking_force_polar(analysis: CycleAnalysis, before: CycleAnalysis | No
         if a is None:
             continue
         colour, lw = style["color"], style["lw"]
-        f = _closed(a.reactions.shaking_force)
-        ax.plot(f.real, f.imag, **style, label=_cycle_label(role, a.reactions.shaking_force, "N"))
+        values = getattr(a.reactions, quantity)
+        f = _closed(values)
+        ax.plot(f.real, f.imag, **style, label=_cycle_label(role, values, unit))
         ax.plot(f.real[:1], f.imag[:1], "o", color=colour, ms=6, mec="k", mew=0.6, zorder=4)
         k = max(1, f.size // 8)
         if abs(f[k + 1] - f[k]) > 0:
@@ -61,9 +85,9 @@ def plot_shaking_force_polar(analysis: CycleAnalysis, before: CycleAnalysis | No
                                     "mutation_scale": 14})
     ax.plot([], [], "o", color="w", mec="k", mew=0.6, label="θ1 = 0, arrow: sense of travel")
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("shaking force, x (N)")
-    ax.set_ylabel("shaking force, y (N)")
-    ax.set_title("shaking force over one revolution (polar diagram)")
+    ax.set_xlabel(f"{name}, x ({unit})")
+    ax.set_ylabel(f"{name}, y ({unit})")
+    ax.set_title(title)
     ax.grid(alpha=0.3)
     if legend:
         legend_outside(ax)
@@ -105,19 +129,29 @@ def cycle_figure(analysis: CycleAnalysis, before: CycleAnalysis | None = None,
                  title: str = "") -> Figure:
     """The picture a balancing report starts with: one revolution at the operating speed.
 
-    The shaking force's polar diagram, and the shaking moment and driving torque over the
-    crank angle; of the design, and of the original before it (``before``) if given. Each
-    panel's title gives its RMS and maximum (original → design); one legend below the panels.
+    The shaking force's polar diagram (beside it the rocking couple's, for links in several
+    planes), and the shaking moment and driving torque over the crank angle; of the design,
+    and of the original before it (``before``) if given. Each panel's title gives its RMS and
+    maximum (original → design); one legend below the panels.
     """
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(12, 7), layout="constrained")
-    axes = fig.subplot_mosaic([["force", "moment"], ["force", "torque"]],
-                              width_ratios=[1.0, 1.3])
+    planes = "couple" in drawn_panels(analysis)
+    if planes:
+        fig = Figure(figsize=(17, 7), layout="constrained")
+        axes = fig.subplot_mosaic([["force", "couple", "moment"], ["force", "couple", "torque"]],
+                                  width_ratios=[1.0, 1.0, 1.3])
+        plot_rocking_couple_polar(analysis, before, ax=axes["couple"], legend=False)
+    else:
+        fig = Figure(figsize=(12, 7), layout="constrained")
+        axes = fig.subplot_mosaic([["force", "moment"], ["force", "torque"]],
+                                  width_ratios=[1.0, 1.3])
     plot_shaking_force_polar(analysis, before, ax=axes["force"], legend=False)
     plot_over_crank_angle(analysis, "shaking_moment", before, ax=axes["moment"], legend=False)
     plot_over_crank_angle(analysis, "driving_torque", before, ax=axes["torque"], legend=False)
-    for key, unit in (("force", "N"), ("moment", "N·m"), ("torque", "N·m")):
+    units = {"force": "N", "moment": "N·m", "torque": "N·m", "couple": "N·m"}
+    for key in drawn_panels(analysis):
+        unit = units[key]
         ax = axes[key]
         after = drawn_panels(analysis)[key]
         figures = [_figure_pair(drawn_panels(before)[key] if before is not None else None,

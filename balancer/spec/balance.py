@@ -200,6 +200,8 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
         *([f"shaking_force_x = {toml.number(w.shaking_force_x)}  # (N·m)²/N², along x",
            f"shaking_force_y = {toml.number(w.shaking_force_y)}  # (N·m)²/N², along y"]
           if w.shaking_force_x or w.shaking_force_y else []),
+        *([f"rocking_couple = {toml.number(w.rocking_couple)}  # (N·m)²/(N·m)²"]
+          if w.rocking_couple else []),
         f"added_mass = {toml.number(w.added_mass)}  # (N·m)²/kg",
     ]
     for name, freedom in problem.links:

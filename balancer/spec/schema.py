@@ -341,9 +341,9 @@ SECTIONS: tuple[Section, ...] = (
                       "A moving link that may change, by its name: its bounds (the table "
                       "below).")),
     Section("balance.objective", "The weights of the objective J = w_M·mean(Msh²) + "
-            "w_τ·mean(τ²) + w_F·mean(|F̄sh|²) + w_m·Δm, in (N·m)², over the sampled crank "
-            "angles; the inertial shaking only (applied loads are left out). Each weight is at "
-            "least 0.", (
+            "w_τ·mean(τ²) + w_F·mean(|F̄sh|²) + w_R·mean(|M̄rock|²) + w_m·Δm, in (N·m)², over "
+            "the sampled crank angles; the inertial shaking only (applied loads are left "
+            "out). Each weight is at least 0.", (
                 Key("shaking_moment", "—", "1", "w_M, of the mean-square shaking moment.",
                     example="1.0"),
                 Key("driving_torque", "—", "0",
@@ -357,6 +357,10 @@ SECTIONS: tuple[Section, ...] = (
                 Key("shaking_force_y", "m²", "0",
                     "Weight of the shaking force's y component (across the guide), added to "
                     "`shaking_force`'s.", example="1.0"),
+                Key("rocking_couple", "—", "0",
+                    "w_R, of the rocking couple's mean-square magnitude ((N·m)²/(N·m)²): for "
+                    "links in several planes along the crank's axis (`[links.<name>] z`).",
+                    example="1.0"),
                 Key("added_mass", "(N·m)²/kg", "0",
                     "w_m, of the mass added to the linkage (total minus the original's).",
                     example="0.0"),

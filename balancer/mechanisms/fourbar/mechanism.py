@@ -70,6 +70,7 @@ class FourBarMechanism(Mechanism):
     model: FourBar
 
     kind = "four-bar"
+    force_balance_source = "the conditions, Eq. 57–58,"
     own_formulations = {"opened-loop": OpenedLoop, "complex-masses": ComplexMasses,
                         "mass-matrix": MassMatrix, "lie-group": LieGroup}
     formulations = tuple(own_formulations)
