@@ -168,6 +168,9 @@ class CycleAnalysis:
         Whether applied loads are included.
     singular
         Samples at a singular pose of the smooth motion (individual reactions NaN).
+    revolutions
+        Crank revolutions the samples span: 2 for loads that repeat every two (a four-stroke
+        engine's gas force, period 4π), else 1.
     """
 
     mechanism: Mechanism
@@ -178,6 +181,7 @@ class CycleAnalysis:
     gravity: tuple[float, float] = (0.0, 0.0)
     loads: bool = True
     singular: NDArray[np.bool_] | None = None
+    revolutions: int = 1
     summary: CycleSummary = field(init=False)
 
     def __post_init__(self) -> None:
@@ -249,7 +253,7 @@ class CycleAnalysis:
         """
         r = self.reactions
         return order_table(r.shaking_force, r.rocking_couple, r.shaking_moment,
-                           r.driving_torque)
+                           r.driving_torque, revolutions=self.revolutions)
 
     def columns(self) -> tuple[list[str], Columns]:
         """The columns of ``analyze --csv``: names and values over the samples.
@@ -260,8 +264,13 @@ class CycleAnalysis:
 
     @property
     def samples(self) -> int:
-        """Number of sampled crank angles."""
+        """Number of sampled crank angles (over all the cycle's revolutions)."""
         return self.theta1.size
+
+    @property
+    def samples_per_revolution(self) -> int:
+        """Sampled crank angles per revolution (the spec's ``samples``)."""
+        return self.theta1.size // self.revolutions
 
     @property
     def time(self) -> NDArray[np.float64]:
@@ -269,9 +278,9 @@ class CycleAnalysis:
         return self.theta1 / self.speed
 
 
-def sample_angles(samples: int) -> NDArray[np.float64]:
-    """``samples`` equally spaced crank angles over one revolution from 0, rad."""
-    angles = np.arange(samples, dtype=float)
+def sample_angles(samples: int, revolutions: int = 1) -> NDArray[np.float64]:
+    """``θ1 = 2π·k/samples``, ``k = 0 … revolutions·samples − 1``: the cycle's angles, rad."""
+    angles = np.arange(samples * revolutions, dtype=float)
     angles *= 2 * np.pi / samples  # in place: no second array of a long cycle's size
     return angles
 
@@ -280,7 +289,10 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
                    route: Route | None = None, loads: bool = True,
                    gravity: tuple[float, float] = (0.0, 0.0),
                    theta1: NDArray[np.float64] | None = None) -> CycleAnalysis:
-    """Analyse one crank revolution at constant ``speed`` (rad/s) over ``samples`` angles.
+    """Analyse one cycle at constant ``speed`` (rad/s), ``samples`` angles per revolution.
+
+    The cycle is one revolution, or two where the loads repeat every two
+    (:attr:`Mechanism.cycle_revolutions`: a four-stroke engine's gas force).
 
     Parameters
     ----------
@@ -289,7 +301,7 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     speed
         Crank speed, rad/s.
     samples
-        Number of equally spaced angles from θ1 = 0.
+        Number of equally spaced angles per revolution from θ1 = 0.
     route
         Inverse-dynamics route (the mechanism's :attr:`~Mechanism.routes`; default its first).
     loads
@@ -312,7 +324,9 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
         raise SpecError(f"the {mech.kind} has no such route; choose from "
                         f"{', '.join(mech.routes)}", key="route", value=route)
     mech.require_full_revolution("a cycle analysis")
-    angles = sample_angles(samples) if theta1 is None else np.asarray(theta1, dtype=float)
+    revolutions = mech.cycle_revolutions if theta1 is None else 1
+    angles = (sample_angles(samples, revolutions) if theta1 is None
+              else np.asarray(theta1, dtype=float))
     n = angles.size
     grounds = mech.ground_points
     sliders = mech.ground_sliders
@@ -373,7 +387,7 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     reactions = Reactions(ground=ground, slider_normal=normal, slider_couple=couple, **out)
     return CycleAnalysis(mechanism=mech, speed=speed, theta1=angles, reactions=reactions,
                          route=route, gravity=(gravity[0], gravity[1]), loads=loads,
-                         singular=singular)
+                         singular=singular, revolutions=revolutions)
 
 
 #: Largest distance, between two samples, of a drawn curve from the line through them,

@@ -122,7 +122,7 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
             "class": mech.describe(),
             **({"branch": mech.branch} if mech.branch is not None else {}),
             "speed": analysis.speed,
-            "samples": int(analysis.samples),
+            "samples": int(analysis.samples_per_revolution),
             "route": analysis.route,
             # Always [gx, gy] (one type for a reader): [0, 0] when the figures include none.
             "gravity": [float(g) for g in analysis.gravity],
@@ -172,7 +172,8 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
     head = f"balancer analyze — {spec}" if spec else "balancer analyze"
     lines = [
         head,
-        f"{mech.kind} ({mech.describe()}), {analysis.samples} crank angles per revolution at "
+        f"{mech.kind} ({mech.describe()}), {analysis.samples_per_revolution} crank angles per "
+        f"revolution{' over a cycle of 720°' if analysis.revolutions == 2 else ''} at "
         f"{analysis.speed:g} rad/s ({rpm:.4g} rpm), {analysis.route} route"
         + (f"; gravity ({analysis.gravity[0]:g}, {analysis.gravity[1]:g}) m/s² included"
            if any(analysis.gravity) else "; gravity not included")

@@ -130,3 +130,54 @@ def test_a_cycle_of_two_revolutions_has_half_orders_and_no_order_above_half_the_
     assert last.shaking_moment == pytest.approx(1.0)
     assert last.shaking_force.forward == pytest.approx(0.5)
     assert last.shaking_force.backward == pytest.approx(0.5)
+
+
+def _four_stroke():
+    """The shipped engine with a four-stroke gas table (period 4π): firing near top dead
+    centre, nothing over the exhaust and intake revolution."""
+    from dataclasses import replace
+
+    from balancer.model import GasForce
+
+    design = load_design(EXAMPLES / "engine.toml")
+    engine = design.mechanism
+    angles = (0.0, 0.3, 0.8, 1.6, 2.6, 3.4, 6.0, 9.0, 11.5, 12.3)
+    force = (-4000.0, -5000.0, -3000.0, -1200.0, -300.0, -50.0, 0.0, -20.0, -400.0, -2500.0)
+    gas = GasForce(angles=angles, values=force, period=4 * math.pi)
+    return replace(engine, gas_force=gas), design.operation.speed
+
+
+def test_a_four_stroke_is_analysed_over_720_degrees_with_half_orders():
+    engine, speed = _four_stroke()
+    analysis = cycle_analysis(engine, speed, 360)
+    assert analysis.revolutions == 2 and analysis.samples == 720
+    assert analysis.theta1[-1] == pytest.approx(4 * math.pi * 719 / 720)
+    assert [o.order for o in analysis.orders] == [j / 2 for j in range(17)]
+    assert analysis.orders[1].driving_torque > 0  # order ½: the firing every other turn
+    # The same engine with the table read as one revolution's: whole orders only.
+    from dataclasses import replace
+    two = replace(engine, gas_force=replace(engine.gas_force, period=2 * math.pi * 1.999))
+    assert cycle_analysis(two, speed, 360).revolutions == 1
+
+
+def test_a_four_strokes_mean_torque_is_its_gas_work_over_the_cycle():
+    """Energy: at constant speed the drive's mean torque over 720° is −(gas work)/(4π), the work
+    ∮ F·dx on the piston from the closed-form stroke x(θ) by quadrature (inertia and the
+    shaking do no net work over a cycle)."""
+    engine, speed = _four_stroke()
+    r, big_l, e = engine.lengths
+
+    def work(n: int) -> float:
+        theta = np.linspace(0.0, 4 * np.pi, n + 1)
+        s = r * np.sin(theta) - e
+        dx = -r * np.sin(theta) - s * r * np.cos(theta) / np.sqrt(big_l**2 - s**2)
+        f = np.asarray(engine.gas_force.at(theta), float)
+        values = f * dx
+        return float(np.sum(values[:-1]) * (4 * np.pi / n))  # periodic: the rectangle rule
+
+    w1, w2 = work(40_000), work(80_000)
+    means = [cycle_analysis(engine, speed, n).orders[0].driving_torque for n in (360, 720)]
+    want = -w2 / (4 * np.pi)
+    tol = 10 * (abs(w1 - w2) / (4 * np.pi) + abs(means[0] - means[1])) + 1e-12 * abs(want)
+    assert means[1] == pytest.approx(want, abs=tol)
+    assert tol < 1e-6 * abs(want)  # a bound worth the name

@@ -330,6 +330,18 @@ class Mechanism(ABC):
         return dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
                                          loads=loads, route=general)
 
+    @property
+    def cycle_revolutions(self) -> int:
+        """Crank revolutions of the mechanism's cycle: 2 where a load repeats every two.
+
+        A slider force given as a table of period 4π (a four-stroke engine's gas force); else
+        1 (the motion and every other load repeat every revolution).
+        """
+        for _, gas in self.model.gas_forces:
+            if not gas.is_zero and math.isclose(gas.period, 4 * math.pi, rel_tol=1e-12):
+                return 2
+        return 1
+
     def in_one_plane(self) -> bool:
         """Whether every link moves in the crank's plane (no rocking couple)."""
         return not any(link.z for link in self.links)

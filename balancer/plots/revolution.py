@@ -56,15 +56,18 @@ def plot_rocking_couple_polar(analysis: CycleAnalysis, before: CycleAnalysis | N
 
 
 #: A polar diagram's quantity: its axis name, unit and title.
-_POLAR = {"shaking_force": ("shaking force", "N", "shaking force over one revolution "
-                                                  "(polar diagram)"),
-          "rocking_couple": ("rocking couple", "N·m", "rocking couple over one revolution "
-                                                      "(polar diagram)")}
+_POLAR = {"shaking_force": ("shaking force", "N"), "rocking_couple": ("rocking couple", "N·m")}
+
+
+def _span(analysis: CycleAnalysis) -> str:
+    """What the samples span, for a title: one revolution, or a four-stroke's 720°."""
+    return "one revolution" if analysis.revolutions == 1 else "a cycle of 720°"
 
 
 def _polar(analysis: CycleAnalysis, before: CycleAnalysis | None, ax: Axes | None,
            legend: bool, quantity: str) -> Axes:
-    name, unit, title = _POLAR[quantity]
+    name, unit = _POLAR[quantity]
+    title = f"{name} over {_span(analysis)} (polar diagram)"
     ax = axes(ax)
     after_role, before_role = _roles(before)
     ax.axhline(0.0, color="0.6", lw=0.8)
@@ -112,13 +115,14 @@ def plot_over_crank_angle(analysis: CycleAnalysis, quantity: str,
         if a is None:
             continue
         values = getattr(a.reactions, quantity)
-        ax.plot(np.degrees(np.append(a.theta1, 2 * np.pi)), _closed(values), **style,
-                label=_cycle_label(role, values, "N·m"))
-    ax.set_xlim(0.0, 360.0)
-    ax.set_xticks(np.arange(0, 361, 45))
+        ax.plot(np.degrees(np.append(a.theta1, 2 * np.pi * a.revolutions)), _closed(values),
+                **style, label=_cycle_label(role, values, "N·m"))
+    span = 360.0 * analysis.revolutions
+    ax.set_xlim(0.0, span)
+    ax.set_xticks(np.arange(0, span + 1, 45 * analysis.revolutions))
     ax.set_xlabel("crank angle θ1 (°)")
     ax.set_ylabel(f"{names[quantity][0]} (N·m)")
-    ax.set_title(f"{names[quantity][1]} over one revolution")
+    ax.set_title(f"{names[quantity][1]} over {_span(analysis)}")
     ax.grid(alpha=0.3)
     if legend:
         legend_outside(ax)
@@ -162,7 +166,7 @@ def cycle_figure(analysis: CycleAnalysis, before: CycleAnalysis | None = None,
     fig.legend(handles, [label.split(": RMS")[0] for label in labels],
                loc="outside lower center",
                ncols=len(handles), fontsize="small")
-    what = f"one revolution at {analysis.speed:g} rad/s"
+    what = f"{_span(analysis)} at {analysis.speed:g} rad/s"
     if any(analysis.gravity):
         what += f", gravity ({analysis.gravity[0]:g}, {analysis.gravity[1]:g}) m/s²"
     if before is not None:
