@@ -12,12 +12,25 @@ From the rotor's kinetic energy ``½·J·k²·ω²`` and angular momentum ``J·k
   (:func:`ground_couple`; ``+2·J·α`` for a counter-rotor, whose link takes ``−J·α``).
 
 The functions take numbers, arrays or CasADi symbols alike (the inertia may be a design entry).
+
+:class:`Rotor` is the general one: at any ratio, its axis anywhere in the frame, with eccentric
+masses (mass·radius at an angle, each in its plane along the crank's axis) — a balance shaft.
+Its loads on the frame follow from its momentum (DESIGN.md, "Planes and the rocking couple"):
+each eccentric's first moment ``ū = m·ρ·e^{iψ}``, ``ψ = k·θ + angle``, gives the force
+``−d²ū/dt² = ū·(ψ̇² − i·ψ̈)``; its angular momentum about the origin is ``J·ψ̇ + ā × dū/dt``
+(``ā`` the axis, ``J`` about the axis with the eccentrics); the counter-rotor is
+``Rotor(ratio=−1, inertia=J, axis=its pivot)``.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
 from ..model.links import Link
-from .vectors import Num
+from .vectors import Num, cross
 
 #: The ratio of a counter-rotor: against its link, at its speed.
 COUNTER = -1.0
@@ -69,3 +82,137 @@ def dynamic_link(link: Link) -> Link:
         moment=link.moment,
         z=link.z,
     )
+
+
+@dataclass(frozen=True)
+class Eccentric:
+    """A mass off a rotor's axis: its mass·radius, angle and plane.
+
+    Attributes
+    ----------
+    mr
+        Mass times the distance of its centre from the axis, kg·m (at least 0).
+    angle
+        Its direction from the axis when the rotor's angle is 0, rad (from +x towards +y).
+    z
+        Its plane along the crank's axis, m.
+    mass
+        Its mass, kg, for its weight under gravity (0: its weight left out; the inertia forces
+        need only ``mr``).
+    """
+
+    mr: float
+    angle: float = 0.0
+    z: float = 0.0
+    mass: float = 0.0
+
+
+@dataclass(frozen=True)
+class Rotor:
+    """A rotor geared to a link at ratio ``k``: the rotor's angle is ``k·θ`` of the link's ``θ``.
+
+    Attributes
+    ----------
+    ratio
+        ``k``, non-zero (−1: a counter-rotor; ±2: a Lanchester shaft on an engine's crank).
+    inertia
+        ``J`` about its axis, kg·m², its eccentrics included.
+    axis
+        Where its axis meets the plane, complex ``x + i·y``, m (fixed in the frame).
+    eccentrics
+        Its masses off the axis (none: a disc).
+
+    Each method takes the link's angle, angular velocity and acceleration (arrays broadcast)
+    and, where it matters, ``gravity`` ``(gx, gy)`` m/s²; each is what the rotor adds to the
+    frame's loads (force and moments of the mechanism on the frame) or takes from its link.
+    """
+
+    ratio: float
+    inertia: float
+    axis: complex = 0j
+    eccentrics: tuple[Eccentric, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.ratio == 0:
+            raise ValueError("a rotor's ratio must not be zero")
+
+    def _moments(self, theta: ArrayLike) -> list[NDArray[np.complex128]]:
+        """Each eccentric's first moment about the axis ``ū = mr·e^{i(kθ + angle)}``, kg·m."""
+        psi = self.ratio * np.asarray(theta, dtype=float)
+        return [e.mr * np.exp(1j * (psi + e.angle)) for e in self.eccentrics]
+
+    def _forces(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
+                gravity: tuple[float, float]) -> list[NDArray[np.complex128]]:
+        """Each eccentric's share of the shaking force, ``ū·(ψ̇² − i·ψ̈) + m·ḡ``, N."""
+        rate = self.ratio * np.asarray(omega, dtype=float)
+        accel = self.ratio * np.asarray(alpha, dtype=float)
+        g = complex(*gravity)
+        return [u * (rate * rate - 1j * accel) + e.mass * g
+                for u, e in zip(self._moments(theta), self.eccentrics, strict=True)]
+
+    def shaking_force(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
+                      gravity: tuple[float, float] = (0.0, 0.0)) -> NDArray[np.complex128]:
+        """What the rotor adds to the shaking force, complex, N (zero without eccentrics)."""
+        shape = np.broadcast(np.asarray(theta), np.asarray(omega), np.asarray(alpha)).shape
+        return sum(self._forces(theta, omega, alpha, gravity), np.zeros(shape, complex))
+
+    def shaking_moment(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
+                       gravity: tuple[float, float] = (0.0, 0.0)) -> NDArray[np.float64]:
+        """What the rotor adds to the shaking moment about the origin, N·m.
+
+        ``−dH/dt`` of its angular momentum about the origin plus the moment of its weights:
+        ``−J·k·α + ā × F̄ + Σ ū × ḡ`` with ``F̄`` its :meth:`shaking_force`.
+        """
+        shape = np.broadcast(np.asarray(theta), np.asarray(omega), np.asarray(alpha)).shape
+        g = complex(*gravity)
+        force = self.shaking_force(theta, omega, alpha, gravity)
+        spin = moment(self.inertia, np.asarray(alpha, dtype=float), self.ratio)
+        weights = sum((cross(u, g) for u in self._moments(theta)), np.zeros(shape))
+        return np.asarray(spin + cross(self.axis, force) + weights, dtype=float) * np.ones(shape)
+
+    def rocking_couple(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
+                       gravity: tuple[float, float] = (0.0, 0.0)) -> NDArray[np.complex128]:
+        """What the rotor adds to the rocking couple, complex ``Mx + i·My``, N·m.
+
+        Each eccentric's force share in its plane ``z``: ``Mx = −z·F_y``, ``My = z·F_x``.
+        """
+        shape = np.broadcast(np.asarray(theta), np.asarray(omega), np.asarray(alpha)).shape
+        total = np.zeros(shape, complex)
+        for f, e in zip(self._forces(theta, omega, alpha, gravity), self.eccentrics,
+                        strict=True):
+            total = total + e.z * (-f.imag + 1j * f.real)
+        return total
+
+    def link_couple(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
+                    gravity: tuple[float, float] = (0.0, 0.0)) -> NDArray[np.float64]:
+        """Couple of the rotor's gearing on its link, N·m: ``k·(−J·k·α + Σ ū × ḡ)``.
+
+        The rotor's own equation about its axis, its gearing's couple carried to the link at
+        the ratio (by power, ``τ_link·ω = τ_rotor·k·ω``).
+        """
+        shape = np.broadcast(np.asarray(theta), np.asarray(omega), np.asarray(alpha)).shape
+        g = complex(*gravity)
+        weights = sum((cross(u, g) for u in self._moments(theta)), np.zeros(shape))
+        own = link_couple(self.inertia, np.asarray(alpha, dtype=float), self.ratio)
+        return np.asarray(own + self.ratio * weights, dtype=float) * np.ones(shape)
+
+    def kinetic_energy(self, omega: ArrayLike) -> NDArray[np.float64]:
+        """``½·J·k²·ω²``, J."""
+        return np.asarray(energy(self.inertia, np.asarray(omega, dtype=float), self.ratio))
+
+    def angular_momentum(self, theta: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]:
+        """About the origin: ``J·k·ω + ā × dū/dt`` summed, kg·m²/s."""
+        rate = self.ratio * np.asarray(omega, dtype=float)
+        velocity = sum((1j * rate * u for u in self._moments(theta)),
+                       np.zeros(np.broadcast(np.asarray(theta), rate).shape, complex))
+        return np.asarray(momentum(self.inertia, np.asarray(omega, dtype=float), self.ratio)
+                          + cross(self.axis, velocity))
+
+    @staticmethod
+    def counter(inertia: float, axis: complex = 0j) -> Rotor:
+        """A counter-rotor (DESIGN.md): ratio −1, coaxial with its link's pivot, no eccentric."""
+        return Rotor(ratio=COUNTER, inertia=inertia, axis=axis)
+
+
+__all__ = ["COUNTER", "Eccentric", "Rotor", "dynamic_link", "energy", "ground_couple",
+           "link_couple", "link_inertia", "moment", "momentum"]
