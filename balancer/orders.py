@@ -82,6 +82,12 @@ class Order:
                 "shaking_moment": self.shaking_moment, "driving_torque": self.driving_torque}
 
 
+def order_name(order: float) -> str:
+    """An order as a designer writes it: 0, 1, 2, ½, 1½."""
+    whole, half = divmod(round(2 * order), 2)
+    return f"{whole}" if not half else "½" if not whole else f"{whole}½"
+
+
 def order_bins(samples: int, revolutions: int = 1,
                highest: int = HIGHEST_ORDER) -> list[tuple[Fraction, int]]:
     """The table's orders and their DFT bins: ``(q, j)`` with ``q = j/revolutions``.
@@ -110,21 +116,29 @@ def scalar_amplitudes(values: ArrayLike, bins: list[int]) -> NDArray[np.float64]
 
 
 def whirls(values: ArrayLike, bins: list[int]) -> list[Whirl]:
-    """Each bin's :class:`Whirl` of a load in the plane given as complex ``x + i·y``."""
+    """Each bin's :class:`Whirl` of a load in the plane given as complex ``x + i·y``.
+
+    From the one spectrum ``C`` of ``x + i·y``: ``x`` and ``y`` have ``(C_j + C̄_{N−j})/2``
+    and ``(C_j − C̄_{N−j})/(2i)``, so their peak amplitudes are ``|C_j + C̄_{N−j}|`` and
+    ``|C_j − C̄_{N−j}|`` (at ``j = N/2``, where both signals' coefficients are real: ``|Re C_j|``
+    and ``|Im C_j|``; at ``j = 0`` the means ``Re C_0`` and ``Im C_0``).
+    """
     z = np.asarray(values, dtype=complex)
     n = z.size
     spectrum = np.fft.fft(z) / n
-    xs = scalar_amplitudes(z.real, bins)
-    ys = scalar_amplitudes(z.imag, bins)
     out = []
-    for i, j in enumerate(bins):
+    for j in bins:
+        c = complex(spectrum[j])
         if j == 0:
-            forward, backward = abs(spectrum[0]), 0.0
+            x, y, forward, backward = c.real, c.imag, abs(c), 0.0
         elif 2 * j == n:
-            forward = backward = abs(spectrum[j]) / 2
+            x, y = abs(c.real), abs(c.imag)
+            forward = backward = abs(c) / 2
         else:
-            forward, backward = abs(spectrum[j]), abs(spectrum[n - j])
-        out.append(Whirl(x=float(xs[i]), y=float(ys[i]), forward=float(forward),
+            mirror = complex(spectrum[n - j]).conjugate()
+            x, y = abs(c + mirror), abs(c - mirror)
+            forward, backward = abs(c), abs(complex(spectrum[n - j]))
+        out.append(Whirl(x=float(x), y=float(y), forward=float(forward),
                          backward=float(backward)))
     return out
 

@@ -17,6 +17,7 @@ import numpy as np
 from .balance.counterweights import UNCHANGED, Counterweight
 from .cycle import CycleAnalysis, Figure
 from .errors import SolverError
+from .orders import order_name
 
 if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these load them
     from .balance.pareto import Front
@@ -84,19 +85,13 @@ def _orders_list(analysis: CycleAnalysis) -> list[dict[str, Any]]:
     return [order.as_dict() for order in analysis.orders]
 
 
-def _order_name(order: float) -> str:
-    """An order as a designer writes it: 1, 2, ½, 1½."""
-    whole, half = divmod(round(2 * order), 2)
-    return (f"{whole}" if not half else "½" if not whole else f"{whole}½")
-
-
 def orders_text(analysis: CycleAnalysis) -> str:
     """The order table of ``analyze``: amplitudes by multiple of the crank speed."""
     planes = not analysis.mechanism.in_one_plane()
     rows = []
     for o in analysis.orders:
         f = o.shaking_force
-        row = [_order_name(o.order), _fmt(f.x), _fmt(f.y), _fmt(f.forward), _fmt(f.backward),
+        row = [order_name(o.order), _fmt(f.x), _fmt(f.y), _fmt(f.forward), _fmt(f.backward),
                _fmt(o.shaking_moment), _fmt(o.driving_torque)]
         if planes:
             row += [_fmt(o.rocking_couple.forward), _fmt(o.rocking_couple.backward)]
@@ -389,9 +384,6 @@ def _opt(x: float | None, fmt: str = ".4g") -> str:
     return "—" if x is None else format(x, fmt)
 
 
-def _ratio_of(a: float | None, b: float | None) -> float | None:
-    return None if a is None or b is None or b == 0 else a / b
-
 
 def verification_text(verification: Verification, spec: str | None = None) -> str:
     """The readable ``verify`` report."""
@@ -408,7 +400,7 @@ def verification_text(verification: Verification, spec: str | None = None) -> st
                               "max |Msh| (N·m)", "original", "ratio"]))
     if any(r.max_rocking_couple for r in (verification.driven, verification.free)):
         rows = [[name, _opt(run.max_rocking_couple), _opt(run.original_max_rocking_couple),
-                 _opt(_ratio_of(run.max_rocking_couple, run.original_max_rocking_couple), ".2e")]
+                 _opt(run.couple_ratio, ".2e")]
                 for name, run in (("driven at the operating speed", verification.driven),
                                   ("free from the initial state", verification.free))]
         lines += ["", table(rows, ["motion", "max |Mrock| (N·m)", "original", "ratio"])]
@@ -639,7 +631,7 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
                 ("force forward", ob.shaking_force.forward, oa.shaking_force.forward, "N"),
                 ("force backward", ob.shaking_force.backward, oa.shaking_force.backward, "N"),
                 ("shaking moment", ob.shaking_moment, oa.shaking_moment, "N·m")):
-            rows.append([f"{_order_name(ob.order)}: {label}", _fmt(b), _fmt(a), unit])
+            rows.append([f"{order_name(ob.order)}: {label}", _fmt(b), _fmt(a), unit])
     lines += [table(rows, ["order amplitude", "before", "after", "unit"]), ""]
     rows = []
     for name in result.linkage.link_names:

@@ -100,6 +100,11 @@ class RunCheck:
         """Largest shaking moment relative to the original's."""
         return _ratio(self.max_shaking_moment, self.original_max_shaking_moment)
 
+    @property
+    def couple_ratio(self) -> float | None:
+        """Largest rocking couple relative to the original's."""
+        return _ratio(self.max_rocking_couple, self.original_max_rocking_couple)
+
     def as_dict(self) -> dict[str, Any]:
         """Plain dictionary for JSON."""
         return {

@@ -46,7 +46,7 @@ from balancer.simulation import simulate
 from balancer.spec import dumps_design, load_design, loads_design
 
 #: The paper's four formulations of the four-bar.
-METHODS = tuple(FourBarMechanism.formulations)
+METHODS = tuple(FourBarMechanism.own_formulations)
 
 NAME = "meijaard2020_balanced"
 ROOT = Path(__file__).resolve().parents[1]

@@ -37,7 +37,7 @@ from balancer.simulation import simulate
 from balancer.spec import load_design
 
 #: The paper's four formulations of the four-bar.
-METHODS = tuple(FourBarMechanism.formulations)
+METHODS = tuple(FourBarMechanism.own_formulations)
 
 NAME = "meijaard2020_example"
 ROOT = Path(__file__).resolve().parents[1]

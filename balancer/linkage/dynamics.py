@@ -505,27 +505,21 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage: Linkage | None =
     # E_k = applied − (I_k − gravity_k) of the design: inertial_columns summed with the
     # design's parameters, in closed form (S̄ = R·(m·s̄), the first moment about the origin).
     effective: list[list[Num]] = []
-    shares: list[V] = []  # each link's m·(ḡ − a_G) + F̄: its share of the shaking force
     rotor: Num = np.zeros(n) if numeric else 0.0
-    for k, name in enumerate(structure.names):
-        m, me, mf, j_origin = x[layout.link_slice(name)]
+    inertial = _inertial_forces(structure, mo, layout, x, g)
+    for k, (name, (force, first, acc)) in enumerate(zip(structure.names, inertial,
+                                                         strict=True)):
+        j_origin = x[layout.link_slice(name)][3]
         r = layout.rotor(name)
         rotor_j = 0.0 if r is None else x[r]
-        c, sn = mo.pose.cos[k], mo.pose.sin[k]
-        w, a = mo.rate[k], mo.accel[k]
-        acc = mo.acceleration[k] - g
-        first = V(c * me - sn * mf, sn * me + c * mf)
-        lin = first.perp() * a - first * (w * w)
-        link = linkage.link(name)
-        applied = V(*link.force) if loads and link.has_loads else V(0.0, 0.0)
-        shares.append(V(column(applied.x - m * acc.x - lin.x),
-                        column(applied.y - m * acc.y - lin.y)))
-        effective.append([column(per[k][0] - m * acc.x - lin.x),
-                          column(per[k][1] - m * acc.y - lin.y),
+        a = mo.accel[k]
+        effective.append([column(per[k][0] - force.x),
+                          column(per[k][1] - force.y),
                           column(per[k][2] - first.cross(acc)
                                  - (j_origin + rotors.link_inertia(rotor_j)) * a)])
         if rotor_j:
             rotor = rotor + rotors.ground_couple(rotor_j, a)
+    shares = [V(column(s.x), column(s.y)) for s in _shares(structure, linkage, inertial, loads)]
     rocking = rocking_couple(linkage, shares, np.zeros((n, 1)) if numeric else 0.0)
     if not numeric:
         return kinetostatics(structure, mo, effective, rotor_moment=rotor,
@@ -535,6 +529,52 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage: Linkage | None =
     solver = kinetostatics if route == "groups" else global_kinetostatics
     return solver(structure, mo, effective, rotor_moment=rotor, ground_extra=extra,
                   rocking=rocking)
+
+
+def _inertial_forces(structure: Structure, mo: Motion, layout: Layout, x: NDArray[np.float64],
+                     gravity: V) -> list[tuple[V, V, V]]:
+    """Per link of design ``x``: ``m·(r̈ − ḡ) + (α·J − ω²)·S̄``, ``S̄`` and ``r̈ − ḡ``.
+
+    The link's inertia force less its weight (``m·(a_G − ḡ)``, N), its first moment about its
+    frame's origin in global axes (``S̄ = R·(m·s̄)``, kg·m) and its origin's acceleration less
+    gravity (m/s²).
+    """
+    out = []
+    for k, name in enumerate(structure.names):
+        m, me, mf, _ = x[layout.link_slice(name)]
+        c, sn = mo.pose.cos[k], mo.pose.sin[k]
+        w, a = mo.rate[k], mo.accel[k]
+        acc = mo.acceleration[k] - gravity
+        first = V(c * me - sn * mf, sn * me + c * mf)
+        lin = first.perp() * a - first * (w * w)
+        out.append((acc * m + lin, first, acc))
+    return out
+
+
+def _shares(structure: Structure, linkage: Linkage, inertial: list[tuple[V, V, V]],
+            loads: bool) -> list[V]:
+    """Each link's share of the shaking force, ``m·(ḡ − a_G) + F̄`` (its ``force``), N."""
+    out = []
+    for name, (force, _, _) in zip(structure.names, inertial, strict=True):
+        link = linkage.link(name)
+        applied = V(*link.force) if loads and link.has_loads else V(0.0, 0.0)
+        out.append(applied - force)
+    return out
+
+
+def rocking_couple_of(structure: Structure, mo: Motion, linkage: Linkage | None = None,
+                      gravity: tuple[float, float] = (0.0, 0.0), loads: bool = True) -> V:
+    """The rocking couple of a design (:func:`rocking_couple`) without its joint forces.
+
+    Arrays ``(N, 1)``, N·m; ``linkage`` the design (default: the structure's own).
+    """
+    linkage = structure.linkage if linkage is None else linkage
+    layout = Layout.of(structure)
+    inertial = _inertial_forces(structure, mo, layout, layout.vector(linkage), V(*gravity))
+    n = mo.theta1.size
+    shares = [V(np.asarray(s.x * np.ones(n))[:, None], np.asarray(s.y * np.ones(n))[:, None])
+              for s in _shares(structure, linkage, inertial, loads)]
+    return rocking_couple(linkage, shares, np.zeros((n, 1)))
 
 
 def rocking_couple(linkage: Linkage, shares: Sequence[V], zero: Num) -> V:

@@ -9,17 +9,20 @@ from __future__ import annotations
 from functools import lru_cache
 
 from ..errors import SpecError
+from ..model import Linkage
 from ..model import MechanismModel as Model
 from .base import Mechanism
 from .fourbar.mechanism import FourBarMechanism
+from .fourbar.model import FourBar
 from .general.mechanism import LinkageMechanism
 from .slidercrank.mechanism import SliderCrankMechanism
+from .slidercrank.model import SliderCrank
 
 #: The mechanism classes by the spec's ``mechanism.type``.
 REGISTRY: dict[str, type[Mechanism]] = {
-    "four-bar": FourBarMechanism,
-    "slider-crank": SliderCrankMechanism,
-    "linkage": LinkageMechanism,
+    FourBar.type: FourBarMechanism,
+    SliderCrank.type: SliderCrankMechanism,
+    Linkage.type: LinkageMechanism,
 }
 
 

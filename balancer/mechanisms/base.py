@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import math
 import threading
-from abc import ABC
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
@@ -85,7 +84,7 @@ class Limit:
     weights: tuple[float, ...]
 
 
-class Mechanism(ABC):
+class Mechanism:
     """What a mechanism tells the rest of the package (see the module docstring).
 
     Parameters
@@ -94,8 +93,6 @@ class Mechanism(ABC):
         The mechanism's data.
     """
 
-    #: The spec's ``mechanism.type``.
-    kind: ClassVar[str]
     #: Where the force-balance conditions come from, as a report's sentence names them
     #: ("… hold to 1e-16 of the links' first moments").
     force_balance_source: ClassVar[str] = "the conditions found from the linkage"
@@ -105,9 +102,6 @@ class Mechanism(ABC):
     #: (classes of :class:`~balancer.mechanisms.formulation.Formulation`, in its folder): the
     #: general ones (:mod:`balancer.formulations`) apply to every mechanism besides.
     own_formulations: ClassVar[Mapping[str, Any]] = {}
-    #: The mechanism's own formulations of the equations of motion (:mod:`balancer.formulations`
-    #: has them by name), the default first.
-    formulations: ClassVar[tuple[str, ...]] = ()
     #: The formulation a check by simulation uses: one the optimiser's route does not share.
     verify_method: ClassVar[str] = "multibody"
     #: The spec key that holds the geometry (named by errors about it).
@@ -121,6 +115,11 @@ class Mechanism(ABC):
 
     def __init__(self, model: MechanismModel) -> None:
         self.model = model
+
+    @property
+    def kind(self) -> str:
+        """The spec's ``mechanism.type`` (the model's)."""
+        return self.model.type
 
     # -- identity -----------------------------------------------------------------------------
 
@@ -205,9 +204,10 @@ class Mechanism(ABC):
         (:mod:`balancer.formulations.crank_angle`), the latter first where the crank turns fully
         (no dead point of the crank to stop it).
         """
+        own = tuple(self.own_formulations)
         if self.assembly_range().full:
-            return (*self.formulations, CRANK_ANGLE, MULTIBODY)
-        return (*self.formulations, MULTIBODY, CRANK_ANGLE)
+            return (*own, CRANK_ANGLE, MULTIBODY)
+        return (*own, MULTIBODY, CRANK_ANGLE)
 
     def parameters(self) -> NDArray[np.float64]:
         """The design vector of the mechanism's own links (:attr:`layout`)."""
@@ -356,8 +356,8 @@ class Mechanism(ABC):
         if self.in_one_plane():
             zero = np.zeros((np.size(mo.theta1), 1))
             return V(zero, zero.copy())
-        return dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
-                                         loads=loads).rocking_couple
+        return dynamics.rocking_couple_of(self.structure, mo, self.linkage, gravity=gravity,
+                                          loads=loads)
 
     def crank_rocking_couple(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike, *,
                              loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)

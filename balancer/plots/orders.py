@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..cycle import CycleAnalysis
-from ..orders import Order
+from ..orders import Order, order_name
 from .style import COLOURS
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
@@ -37,11 +37,6 @@ def _bars(order: Order, panel: str) -> list[tuple[str, float]]:
                 ("backward", order.rocking_couple.backward)]
     value = order.shaking_moment if panel == "moment" else order.driving_torque
     return [("amplitude", abs(value))]
-
-
-def _order_label(order: float) -> str:
-    whole, half = divmod(round(2 * order), 2)
-    return f"{whole}" if not half else "½" if not whole else f"{whole}½"
 
 
 def plot_orders(analysis: CycleAnalysis, panel: str, before: CycleAnalysis | None = None,
@@ -73,7 +68,7 @@ def plot_orders(analysis: CycleAnalysis, panel: str, before: CycleAnalysis | Non
         ax.bar(x - 0.4 + width * (i + 0.5), values, width, color=colour,
                hatch="//" if kind == "backward" else None, edgecolor="k", linewidth=0.4,
                label=f"{who}, {kind}" if kind != "amplitude" else who)
-    ax.set_xticks(x, [_order_label(o.order) for o in orders])
+    ax.set_xticks(x, [order_name(o.order) for o in orders])
     ax.set_xlabel("order (multiple of the crank speed)")
     ax.set_ylabel(f"{title} ({unit})")
     ax.set_title(f"{title} by order")

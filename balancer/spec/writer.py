@@ -44,9 +44,11 @@ def _gas_lines(gas: GasForce) -> list[str]:
 def _links_lines(mech: MechanismModel, prefix: str) -> list[str]:
     out: list[str] = []
     for name in mech.link_names:
-        frame = "global" if mech.type == "slider-crank" and name == "slider" else "link"
-        out += ["", f"[{prefix}.{toml.key(name)}]", *_link_lines(mech.link(name), frame)]
-        if prefix == "links" and frame == "global" and isinstance(mech, SliderCrank):
+        slider = isinstance(mech, SliderCrank) and name == "slider"  # (in global axes)
+        out += ["", f"[{prefix}.{toml.key(name)}]",
+                *_link_lines(mech.link(name), "global" if slider else "link")]
+        if prefix == "links" and slider:
+            assert isinstance(mech, SliderCrank)
             out += _gas_lines(mech.gas_force)
     return out
 

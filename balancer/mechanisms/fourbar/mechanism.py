@@ -69,11 +69,9 @@ class FourBarMechanism(Mechanism):
 
     model: FourBar
 
-    kind = "four-bar"
     force_balance_source = "the conditions, Eq. 57–58,"
     own_formulations = {"opened-loop": OpenedLoop, "complex-masses": ComplexMasses,
                         "mass-matrix": MassMatrix, "lie-group": LieGroup}
-    formulations = tuple(own_formulations)
     geometry_key = "mechanism.lengths"
     named_states = False
     #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.

@@ -11,5 +11,3 @@ class LinkageMechanism(Mechanism):
 
     model: Linkage
 
-    kind = "linkage"
-    formulations = ()  # the general formulations only (Mechanism.formulation_names)

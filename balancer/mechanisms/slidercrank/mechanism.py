@@ -60,10 +60,8 @@ class SliderCrankMechanism(Mechanism):
 
     model: SliderCrank
 
-    kind = "slider-crank"
     force_balance_source = "Wunderlich's conditions, Eq. 20a–b,"
     own_formulations = {"mass-matrix": SliderMassMatrix, "complex-masses": SliderComplexMasses}
-    formulations = tuple(own_formulations)
     verify_method = "complex-masses"
     geometry_key = "mechanism.lengths"
     named_states = False
