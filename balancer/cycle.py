@@ -123,6 +123,7 @@ class CycleSummary:
     ground: dict[str, Figure]
     slider_normal: dict[str, Figure]
     slider_couple: dict[str, Figure]
+    mount_torque: Figure | None = None
 
     @property
     def max_ground_reaction(self) -> float:
@@ -137,13 +138,19 @@ class CycleSummary:
         return max(values, default=0.0)
 
     def as_dict(self) -> dict[str, dict[str, float]]:
-        """The fixed figures with their JSON names (the rocking couple's: its magnitude)."""
-        return {
+        """The fixed figures with their JSON names (the rocking couple's: its magnitude).
+
+        An engine's ``mount_torque`` too.
+        """
+        out = {
             "shaking_force": self.shaking_force.as_dict(),
             "shaking_moment": self.shaking_moment.as_dict(),
             "driving_torque": self.driving_torque.as_dict(),
             "rocking_couple": self.rocking_couple.as_dict(),
         }
+        if self.mount_torque is not None:
+            out["mount_torque"] = self.mount_torque.as_dict()
+        return out
 
 
 @dataclass(frozen=True)
@@ -194,6 +201,7 @@ class CycleAnalysis:
             ground={p: Figure.of(v) for p, v in r.ground.items()},
             slider_normal={k: Figure.of(v) for k, v in r.slider_normal.items()},
             slider_couple={k: Figure.of(v) for k, v in r.slider_couple.items()},
+            mount_torque=None if self.mount_torque is None else Figure.of(self.mount_torque),
         ))
 
     def __repr__(self) -> str:
@@ -207,6 +215,17 @@ class CycleAnalysis:
     def linkage(self) -> Model:
         """The mechanism's model (a FourBar, SliderCrank or Linkage)."""
         return self.mechanism.model
+
+    @property
+    def mount_torque(self) -> NDArray[np.float64] | None:
+        """An engine's torque about z on its mounts, N·m: shaking moment + driving torque.
+
+        With the load (what the engine drives) off the frame, the mounts carry ``−dH_z/dt``
+        less the output torque (DESIGN.md); ``None`` for a mechanism that is not an engine.
+        """
+        if not self.mechanism.reports_mount_torque:
+            return None
+        return self.reactions.shaking_moment + self.reactions.driving_torque
 
     @cached_property
     def motion(self) -> Motion:
@@ -253,7 +272,8 @@ class CycleAnalysis:
         """
         r = self.reactions
         return order_table(r.shaking_force, r.rocking_couple, r.shaking_moment,
-                           r.driving_torque, revolutions=self.revolutions)
+                           r.driving_torque, revolutions=self.revolutions,
+                           mount_torque=self.mount_torque)
 
     def columns(self) -> tuple[list[str], Columns]:
         """The columns of ``analyze --csv``: names and values over the samples.

@@ -197,6 +197,26 @@ def force_balance_conditions(mech: Mechanism) -> ForceBalance:
     return result
 
 
+#: Crank angles over a revolution at which a mechanism with rotors is judged.
+ROTOR_SAMPLES = 1024
+
+
 def force_balance_residual(mech: Mechanism) -> float:
-    """How far a mechanism's own design is from shaking-force balance (0: balanced)."""
-    return force_balance_conditions(mech).residual(mech.parameters())
+    """How far a mechanism's own design is from shaking-force balance (0: balanced).
+
+    A mechanism with rotors besides its links (an engine's crankshaft masses and balance
+    shafts, whose first moments are not in the design vector): the largest swing of the total
+    first moment of mass over :data:`ROTOR_SAMPLES` crank angles of a revolution, over the sum
+    of each body's own largest swing (:meth:`~balancer.mechanisms.base.Mechanism.first_moments`).
+    """
+    if not mech.rotors:
+        return force_balance_conditions(mech).residual(mech.parameters())
+    theta = 2 * np.pi * np.arange(ROTOR_SAMPLES) / ROTOR_SAMPLES
+    with np.errstate(all="ignore"):
+        moments = mech.first_moments(mech.motion(theta))
+    swings = [np.asarray(m, dtype=complex) * np.ones(theta.size) for m in moments]
+    swings = [m - m.mean() for m in swings]
+    total = float(np.max(np.abs(sum(swings))))
+    size = sum(float(np.max(np.abs(m))) for m in swings)
+    eps = np.finfo(float).eps
+    return total / max(size, 1e-300) if total > 64 * eps * size else 0.0

@@ -67,6 +67,8 @@ class Order:
         The couple about ``x`` and ``y`` from planes along the crank's axis, N·m.
     shaking_moment, driving_torque
         Peak amplitudes (order 0: signed means), N·m.
+    mount_torque
+        An engine's: the torque about z on its mounts, the same way (``None``: not an engine).
     """
 
     order: float
@@ -74,12 +76,17 @@ class Order:
     rocking_couple: Whirl
     shaking_moment: float
     driving_torque: float
+    mount_torque: float | None = None
 
     def as_dict(self) -> dict[str, object]:
         """The entry of ``orders`` in ``analyze --json`` (DESIGN.md's names)."""
-        return {"order": self.order, "shaking_force": self.shaking_force.as_dict(),
-                "rocking_couple": self.rocking_couple.as_dict(),
-                "shaking_moment": self.shaking_moment, "driving_torque": self.driving_torque}
+        out: dict[str, object] = {
+            "order": self.order, "shaking_force": self.shaking_force.as_dict(),
+            "rocking_couple": self.rocking_couple.as_dict(),
+            "shaking_moment": self.shaking_moment, "driving_torque": self.driving_torque}
+        if self.mount_torque is not None:
+            out["mount_torque"] = self.mount_torque
+        return out
 
 
 def order_name(order: float) -> str:
@@ -145,11 +152,13 @@ def whirls(values: ArrayLike, bins: list[int]) -> list[Whirl]:
 
 def order_table(shaking_force: ArrayLike, rocking_couple: ArrayLike, shaking_moment: ArrayLike,
                 driving_torque: ArrayLike, revolutions: int = 1,
-                highest: int = HIGHEST_ORDER) -> tuple[Order, ...]:
+                highest: int = HIGHEST_ORDER, mount_torque: ArrayLike | None = None
+                ) -> tuple[Order, ...]:
     """The orders of a cycle's samples (each an array over the cycle's equally spaced angles).
 
     ``shaking_force`` and ``rocking_couple`` complex ``x + i·y`` (N, N·m); ``shaking_moment``
-    and ``driving_torque`` real (N·m); ``revolutions`` the revolutions the samples span.
+    and ``driving_torque`` real (N·m); ``revolutions`` the revolutions the samples span; an
+    engine's ``mount_torque`` real (N·m), or ``None``.
     """
     force = np.asarray(shaking_force, dtype=complex)
     pairs = order_bins(force.size, revolutions, highest)
@@ -158,7 +167,9 @@ def order_table(shaking_force: ArrayLike, rocking_couple: ArrayLike, shaking_mom
     couples = whirls(rocking_couple, bins)
     moments = scalar_amplitudes(shaking_moment, bins)
     torques = scalar_amplitudes(driving_torque, bins)
+    mounts = None if mount_torque is None else scalar_amplitudes(mount_torque, bins)
     return tuple(
         Order(order=float(q), shaking_force=forces[i], rocking_couple=couples[i],
-              shaking_moment=float(moments[i]), driving_torque=float(torques[i]))
+              shaking_moment=float(moments[i]), driving_torque=float(torques[i]),
+              mount_torque=None if mounts is None else float(mounts[i]))
         for i, (q, _) in enumerate(pairs))

@@ -27,7 +27,7 @@ if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these l
     from .verification import Verification
 
 UNITS = {"shaking_force": "N", "shaking_moment": "N·m", "driving_torque": "N·m",
-         "rocking_couple": "N·m"}
+         "rocking_couple": "N·m", "mount_torque": "N·m"}
 
 
 def _fmt(x: float, width: int = 12) -> str:
@@ -93,11 +93,15 @@ def orders_text(analysis: CycleAnalysis) -> str:
         f = o.shaking_force
         row = [order_name(o.order), _fmt(f.x), _fmt(f.y), _fmt(f.forward), _fmt(f.backward),
                _fmt(o.shaking_moment), _fmt(o.driving_torque)]
+        if o.mount_torque is not None:
+            row.append(_fmt(o.mount_torque))
         if planes:
             row += [_fmt(o.rocking_couple.forward), _fmt(o.rocking_couple.backward)]
         rows.append(row)
     head = ["order", "force x (N)", "force y (N)", "forward (N)", "backward (N)",
             "moment (N·m)", "torque (N·m)"]
+    if analysis.mount_torque is not None:
+        head.append("mount (N·m)")
     if planes:
         head += ["couple fwd (N·m)", "couple bwd (N·m)"]
     return ("orders (peak amplitudes; order 0 the mean; forward turns with the crank, backward "
@@ -183,6 +187,8 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
                     ("driving_torque", s.driving_torque),
                     *((("rocking_couple", s.rocking_couple),)
                       if not analysis.mechanism.in_one_plane() else ()),
+                    *((("mount_torque", s.mount_torque),) if s.mount_torque is not None
+                      else ()),
                 )
             ],
             ["quantity", "RMS", "max", "unit"],

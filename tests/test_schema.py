@@ -18,6 +18,7 @@ import pytest
 from balancer.errors import SpecError
 from balancer.formulations import GENERAL
 from balancer.mechanisms import REGISTRY
+from balancer.mechanisms.engine.model import Engine
 from balancer.mechanisms.fourbar.model import FourBar
 from balancer.mechanisms.slidercrank.model import SliderCrank
 from balancer.model import Linkage, Operation, SimulationSettings
@@ -27,16 +28,18 @@ from balancer.spec.tables import Table
 
 ROOT = Path(__file__).resolve().parent.parent
 SPEC = ROOT / "balancer" / "spec"
-CLASSES = {schema.FOUR_BAR: FourBar, schema.SLIDER_CRANK: SliderCrank, schema.LINKAGE: Linkage}
+CLASSES = {schema.FOUR_BAR: FourBar, schema.SLIDER_CRANK: SliderCrank, schema.LINKAGE: Linkage,
+           schema.ENGINE: Engine}
 
 #: A shipped example of each mechanism: the spec each key is written into.
-BASES = {schema.FOUR_BAR: "pb1", schema.SLIDER_CRANK: "engine", schema.LINKAGE: "quick_return"}
+BASES = {schema.FOUR_BAR: "pb1", schema.SLIDER_CRANK: "engine", schema.LINKAGE: "quick_return",
+         schema.ENGINE: "inline_four"}
 #: The link a pattern's ``<link>`` is in each base: the crank, but where a gas force goes.
 SLIDER = ("links.<link>.gas_force", ("links.<link>", "gas_force"))
 #: Values that depend on the base's names (points, links) or must come whole.
 SPRING = {"points": ["D", "A0"], "stiffness": 100.0, "free_length": 0.3}
 METHOD = {schema.FOUR_BAR: "complex-masses", schema.SLIDER_CRANK: "complex-masses",
-          schema.LINKAGE: "multibody"}
+          schema.LINKAGE: "multibody", schema.ENGINE: "multibody"}
 #: The centre of mass's partner keys (``s`` with ``sigma``, ``e`` with ``f``).
 PARTNER = {"s": ("sigma", 0.3), "sigma": ("s", 0.6), "e": ("f", 0.0), "f": ("e", 0.4)}
 
@@ -56,6 +59,11 @@ def path_of(data: dict, pattern: str, key: str) -> list:
     """The concrete path of a pattern's table in a base, for writing ``key`` into it."""
     slider = "slider" in data["links"] and (pattern in SLIDER or (pattern, key) in SLIDER)
     link = "slider" if slider else "crank"
+    if "crankshaft" in data["links"]:  # an engine: the link that takes the key
+        link = next((name for name, keys in schema.ENGINE_LINKS.items()
+                     if key in keys and pattern == "links.<link>"), "rod")
+        if pattern.startswith("links.<link>.masses"):
+            link = "crankshaft"
     out: list = []
     for part in pattern.split(".") if pattern else []:
         if part == "<link>":

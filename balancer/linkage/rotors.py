@@ -141,6 +141,15 @@ class Rotor:
         psi = self.ratio * np.asarray(theta, dtype=float)
         return [e.mr * np.exp(1j * (psi + e.angle)) for e in self.eccentrics]
 
+    def first_moment(self, theta: ArrayLike) -> NDArray[np.complex128]:
+        """Its masses' first moment about the origin, ``Σ ū + ā·Σ m``, complex, kg·m.
+
+        (The eccentrics' masses where given: an eccentric's ``mr`` alone moves.)
+        """
+        mass = sum(e.mass for e in self.eccentrics)
+        shape = np.shape(np.asarray(theta))
+        return sum(self._moments(theta), np.full(shape, self.axis * mass, complex))
+
     def _forces(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
                 gravity: tuple[float, float]) -> list[NDArray[np.complex128]]:
         """Each eccentric's share of the shaking force, ``ū·(ψ̇² − i·ψ̈) + m·ḡ``, N."""

@@ -12,6 +12,8 @@ from ..errors import SpecError
 from ..model import Linkage
 from ..model import MechanismModel as Model
 from .base import Mechanism
+from .engine.mechanism import EngineMechanism
+from .engine.model import Engine
 from .fourbar.mechanism import FourBarMechanism
 from .fourbar.model import FourBar
 from .general.mechanism import LinkageMechanism
@@ -23,6 +25,7 @@ REGISTRY: dict[str, type[Mechanism]] = {
     FourBar.type: FourBarMechanism,
     SliderCrank.type: SliderCrankMechanism,
     Linkage.type: LinkageMechanism,
+    Engine.type: EngineMechanism,
 }
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Any, ClassVar, Literal
 
@@ -31,6 +31,7 @@ from ..linkage.constraints import GROUND_INDEX
 from ..linkage.dynamics import Forces, Layout
 from ..linkage.kinematics import Motion
 from ..linkage.program import CrankForcesProgram
+from ..linkage.rotors import Rotor, ground_couple
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
 from ..model import GROUND, Branch, Link, Linkage, MechanismModel
@@ -63,6 +64,28 @@ _GENERAL_ROUTES: dict[Route, Literal["groups", "global"]] = {
 
 #: One build of a program at a time (a cycle analysis runs its chunks on threads).
 _PROGRAM_LOCK = threading.Lock()
+
+
+@dataclass
+class RotorLoads:
+    """What a mechanism's rotors add to the frame's loads at crank states (arrays ``(N,)``).
+
+    Attributes
+    ----------
+    bearings
+        Force on the frame at each rotor's bearing point, complex, N.
+    force, moment, couple
+        The shaking force (complex, N), moment about the origin (N·m) and rocking couple
+        (complex ``Mx + i·My``, N·m) they add.
+    torque
+        What they add to the driving torque, N·m.
+    """
+
+    bearings: dict[str, NDArray[np.complex128]]
+    force: NDArray[np.complex128]
+    moment: NDArray[np.float64]
+    couple: NDArray[np.complex128]
+    torque: NDArray[np.float64]
 
 
 def _put(forces: Forces, part: Forces, where: NDArray[np.bool_]) -> None:
@@ -109,6 +132,9 @@ class Mechanism:
     #: Whether ``simulate --json`` gives the link states keyed by link name (a general
     #: linkage) or as lists of links 1–3 (the four-bar and slider-crank, fixed by DESIGN.md).
     named_states: ClassVar[bool] = True
+    #: Whether the cycle analysis gives the torque about z on the mounts (an engine's
+    #: ``mount_torque``: the shaking moment plus the driving torque).
+    reports_mount_torque: ClassVar[bool] = False
     #: Sliders on ground guides whose force on the guide tables name as a force at a point
     #: (``R{name}x``, ``R{name}y``) rather than by its normal force ``N_{link}``.
     guide_force_names: ClassVar[dict[str, str]] = {}
@@ -150,9 +176,22 @@ class Mechanism:
         return self.linkage.links
 
     @property
+    def rotors(self) -> tuple[tuple[str, Rotor], ...]:
+        """Rotors geared to the input besides the links' counter-rotors (none in general).
+
+        Each with the name of the frame's point that carries its bearing (a ground point of
+        the linkage where its axis is one: an engine's crankshaft masses on the main bearings
+        ``O``; else a point of its own: a balance shaft's). Their loads are added to the
+        linkage's in :meth:`inverse_dynamics` and :meth:`crank_forces`
+        (:class:`~balancer.linkage.rotors.Rotor`).
+        """
+        return ()
+
+    @property
     def ground_points(self) -> tuple[str, ...]:
-        """Points of the frame (where reactions act)."""
-        return self.linkage.ground.points
+        """Points of the frame (where reactions act): the linkage's, and rotors' bearings."""
+        own = self.linkage.ground.points
+        return (*own, *dict.fromkeys(p for p, _ in self.rotors if p not in own))
 
     @property
     def ground_sliders(self) -> tuple[str, ...]:
@@ -184,8 +223,9 @@ class Mechanism:
     @cached_property
     def ground_positions(self) -> dict[str, complex]:
         """Place of each ground point, complex ``x + i·y``, m."""
-        places = dict(self.linkage.points)
-        return {p: complex(*places[p]) for p in self.ground_points}
+        places = {p: complex(*xy) for p, xy in self.linkage.points}
+        places.update({p: rotor.axis for p, rotor in self.rotors if p not in places})
+        return {p: places[p] for p in self.ground_points}
 
     @property
     def start_angle(self) -> float:
@@ -327,8 +367,60 @@ class Mechanism:
         """
         route = route or self.routes[0]
         general = _GENERAL_ROUTES[route]
-        return dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
-                                         loads=loads, route=general)
+        forces = dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
+                                           loads=loads, route=general)
+        return self._with_rotors(forces, mo.theta1, mo.omega1, mo.alpha1, gravity)
+
+    def rotor_loads(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike,
+                    gravity: tuple[float, float] = (0.0, 0.0)) -> RotorLoads | None:
+        """What the :attr:`rotors` add to the frame's loads at crank states (arrays ``(N,)``).
+
+        The linkage carries each rotor's inertia seen by the crank (``k²·J``, in its input
+        link's, as a counter-rotor's: :meth:`linkage`); a rotor adds its force on its bearing,
+        the force's moment about the origin, its weights' moment, its gear train's couple on the
+        frame ``J·k·(k − 1)·α`` and its rocking couple; the driving torque gains what its
+        weights take from the crank. ``None`` without rotors.
+        """
+        if not self.rotors:
+            return None
+        state = tuple(np.atleast_1d(np.asarray(x, dtype=float)) for x in
+                      (theta1, omega1, alpha1))
+        shape = np.broadcast(*state).shape
+        zero = np.zeros(shape)
+        out = RotorLoads(bearings={}, force=zero.astype(complex), moment=zero.copy(),
+                         couple=zero.astype(complex), torque=zero.copy())
+        for point, rotor in self.rotors:
+            bare = replace(rotor, inertia=0.0)  # (its inertia is the linkage's)
+            f = bare.shaking_force(*state, gravity)
+            out.bearings[point] = out.bearings.get(point, 0.0) + f
+            out.force = out.force + f
+            out.moment = (out.moment + bare.shaking_moment(*state, gravity)
+                          + ground_couple(rotor.inertia, state[2], rotor.ratio))
+            out.couple = out.couple + bare.rocking_couple(*state, gravity)
+            out.torque = out.torque - bare.link_couple(*state, gravity)
+        return out
+
+    def _with_rotors(self, forces: Forces, theta1: ArrayLike, omega1: ArrayLike,
+                     alpha1: ArrayLike, gravity: tuple[float, float]) -> Forces:
+        """``forces`` (one column) with the :attr:`rotors`' loads added (:meth:`rotor_loads`)."""
+        extra = self.rotor_loads(theta1, omega1, alpha1, gravity)
+        if extra is None:
+            return forces
+
+        def column(x: ArrayLike) -> NDArray[Any]:
+            return np.reshape(np.asarray(x), (-1, 1))
+
+        reactions = dict(forces.reactions)
+        for point, f in extra.bearings.items():
+            reactions[point] = V.of_array(
+                (reactions[point].complex() if point in reactions else 0.0) + column(f))
+        return Forces(
+            reactions=reactions, slider_normal=forces.slider_normal,
+            slider_couple=forces.slider_couple,
+            driving_torque=np.asarray(forces.driving_torque, dtype=float) + column(extra.torque),
+            shaking_force=V.of_array(forces.shaking_force.complex() + column(extra.force)),
+            shaking_moment=np.asarray(forces.shaking_moment, dtype=float) + column(extra.moment),
+            rocking_couple=V.of_array(forces.rocking_couple.complex() + column(extra.couple)))
 
     @property
     def cycle_revolutions(self) -> int:
@@ -343,8 +435,9 @@ class Mechanism:
         return 1
 
     def in_one_plane(self) -> bool:
-        """Whether every link moves in the crank's plane (no rocking couple)."""
-        return not any(link.z for link in self.links)
+        """Whether every link and rotor's mass moves in the crank's plane (no rocking couple)."""
+        return not (any(link.z for link in self.links)
+                    or any(e.z for _, r in self.rotors for e in r.eccentrics))
 
     def rocking_couple(self, mo: Motion, *, loads: bool = True,
                        gravity: tuple[float, float] = (0.0, 0.0)) -> V:
@@ -356,8 +449,13 @@ class Mechanism:
         if self.in_one_plane():
             zero = np.zeros((np.size(mo.theta1), 1))
             return V(zero, zero.copy())
-        return dynamics.rocking_couple_of(self.structure, mo, self.linkage, gravity=gravity,
-                                          loads=loads)
+        couple = dynamics.rocking_couple_of(self.structure, mo, self.linkage, gravity=gravity,
+                                            loads=loads)
+        for _, rotor in self.rotors:
+            extra = np.reshape(rotor.rocking_couple(mo.theta1, mo.omega1, mo.alpha1, gravity),
+                               (-1, 1))
+            couple = V.of_array(couple.complex() + extra)
+        return couple
 
     def crank_rocking_couple(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike, *,
                              loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)
@@ -390,6 +488,7 @@ class Mechanism:
             program = self._program(loads, (gravity[0], gravity[1]))
             if program is not None:
                 forces, ok = program.evaluate(*(np.ascontiguousarray(x) for x in states))
+                forces = self._with_rotors(forces, states[0], states[1], states[2], gravity)
                 if not ok.all():
                     rest = self.inverse_dynamics(self.motion(*(x[~ok] for x in states)),
                                                  route=route, loads=loads, gravity=gravity)
@@ -436,11 +535,22 @@ class Mechanism:
         """Each moving link's centre of mass, m."""
         return [mo.point(k, V(link.e, link.f)) for k, link in enumerate(self.links)]
 
+    def first_moments(self, mo: Motion) -> list[NDArray[np.complex128]]:
+        """Each moving link's first moment of mass about the origin, then each rotor's, kg·m.
+
+        Complex ``x + i·y``; the shaking force is minus the second time derivative of their
+        sum.
+        """
+        links = [c.complex() * link.mass
+                 for c, link in zip(self.centres_of_mass(mo), self.links, strict=True)]
+        return [*links, *(rotor.first_moment(mo.theta1) for _, rotor in self.rotors)]
+
     def total_centre_of_mass(self, mo: Motion) -> NDArray[np.complex128]:
-        """The moving links' total centre of mass, complex, m."""
-        total = sum(c.complex() * link.mass
-                    for c, link in zip(self.centres_of_mass(mo), self.links, strict=True))
-        return total / self.linkage.total_mass
+        """The moving links' total centre of mass, complex, m (rotors' moving masses in)."""
+        mass = self.linkage.total_mass + sum(e.mass for _, r in self.rotors for e in r.eccentrics)
+        total: NDArray[np.complex128] = np.sum(np.broadcast_arrays(*self.first_moments(mo)),
+                                               axis=0)
+        return total / mass
 
     def points(self, mo: Motion) -> dict[str, NDArray[np.complex128]]:
         """Every point's position, complex, m (a point of the frame: its fixed place)."""

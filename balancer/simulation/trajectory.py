@@ -175,8 +175,17 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
     energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
     shaking_force, moment = f.shaking(ev)
     crank = list(f.link_names).index(f.mechanism.input)
+    gravity = (f.gravity.real, f.gravity.imag)
     rocking = f.mechanism.crank_rocking_couple(theta[crank], omega[crank], alpha[crank],
-                                               gravity=(f.gravity.real, f.gravity.imag))
+                                               gravity=gravity)
+    ground = {p: np.asarray(v, complex) * np.ones(t.size) for p, v in ev.ground.items()}
+    extra = f.mechanism.rotor_loads(theta[crank], omega[crank], alpha[crank], gravity)
+    if extra is not None:  # rotors geared to the crank: their bearings and what they shake
+        for point, value in extra.bearings.items():
+            ground[point] = ground.get(point, 0.0) + value
+        shaking_force = shaking_force + extra.force
+        moment = moment + extra.moment
+        tau = tau + extra.torque
     return Trajectory(
         method=f.name,
         drive="constant-speed" if f.driven else "free",
@@ -187,8 +196,7 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
         omega=omega,
         alpha=alpha,
         # (numpy's stubs type a complex array times a real one as real)
-        ground={p: cast("NDArray[np.complex128]", np.asarray(v, complex) * np.ones(t.size))
-                for p, v in ev.ground.items()},
+        ground={p: cast("NDArray[np.complex128]", v) for p, v in ground.items()},
         slider_normal={k: np.asarray(v, float) * np.ones(t.size)
                        for k, v in ev.slider_normal.items()},
         slider_couple={k: np.asarray(v, float) * np.ones(t.size)

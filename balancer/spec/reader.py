@@ -49,6 +49,7 @@ from typing import Any
 from .. import validate as v
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
+from ..mechanisms.engine.model import Engine
 from ..mechanisms.fourbar.model import FourBar
 from ..mechanisms.slidercrank.model import SliderCrank
 from ..model import (
@@ -67,10 +68,11 @@ from ..model import (
 from ..model import MechanismModel as Model
 from . import schema
 from .balance import read_balance
+from .engine import read_engine
 from .tables import Table
 
 MECHANISMS: dict[str, type[Model]] = {
-    "four-bar": FourBar, "slider-crank": SliderCrank, "linkage": Linkage}
+    "four-bar": FourBar, "slider-crank": SliderCrank, "linkage": Linkage, "engine": Engine}
 
 
 MECHANISM_TYPES = tuple(MECHANISMS)
@@ -193,6 +195,8 @@ def _read_mechanism(root: Table) -> Model:
     cls = MECHANISMS[kind]
     if issubclass(cls, Linkage):  # (it is Linkage)
         return _read_linkage(root, mech)
+    if issubclass(cls, Engine):
+        return read_engine(root, mech)
     assert issubclass(cls, ChainModel)
     mech.expect(schema.known("mechanism", kind))
     branch = mech.string("branch", choices=("+", "-"), default="+")
@@ -220,17 +224,6 @@ def _read_mechanism(root: Table) -> Model:
     return FourBar(**fields)
 
 
-def _list_of_tables(table: Table, name: str) -> list[Table]:
-    """An array of tables (``[[name]]``), each as a :class:`Table` with an indexed path."""
-    if not table.has(name):
-        return []
-    raw = table.raw(name)
-    key = table.key(name)
-    if not isinstance(raw, list) or not all(isinstance(item, dict) for item in raw):
-        raise SpecError(f"must be an array of tables ([[{key}]])", key=key, value=raw)
-    return [Table(item, f"{key}[{i}]") for i, item in enumerate(raw)]
-
-
 def _names(table: Table, name: str) -> tuple[str, ...]:
     """A required list of names (strings)."""
     if not table.has(name):
@@ -255,7 +248,7 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
     points = {p: points_table.vector2(p, default=(0.0, 0.0)) for p in points_table.data}
     points_table.finish()
     sliders: list[dict[str, Any]] = []  # each a Slider's fields
-    for sub in _list_of_tables(mech, "sliders"):
+    for sub in mech.tables("sliders"):
         sub.expect(schema.known("mechanism.sliders[]", schema.LINKAGE))
         fields: dict[str, Any] = {}
         for attr in ("link", "guide", "point"):
@@ -291,7 +284,7 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
         bodies.append(Body(name=name, points=link_points, props=props))
     links_table.finish()
     springs = []
-    for sub in _list_of_tables(root, "springs"):
+    for sub in root.tables("springs"):
         sub.expect(schema.known("springs[]", schema.LINKAGE))
         for k in ("stiffness", "free_length"):
             if not sub.has(k):
@@ -377,6 +370,7 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
         root = Table(data, "")
         title = root.text("title", default="")
         mechanism = _read_mechanism(root)
+        root.expect(schema.known("", mechanism.type))  # the top-level tables of its type
         operation = _read_operation(root)
         simulation = _read_simulation(root, mechanism)
         balance = None

@@ -17,14 +17,17 @@ brackets (:attr:`Section.names`).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 FOUR_BAR = "four-bar"
 SLIDER_CRANK = "slider-crank"
 LINKAGE = "linkage"
+ENGINE = "engine"
 #: The values of ``[mechanism] type``.
-MECHANISMS = (FOUR_BAR, SLIDER_CRANK, LINKAGE)
+MECHANISMS = (FOUR_BAR, SLIDER_CRANK, LINKAGE, ENGINE)
 _CLOSED = (FOUR_BAR, SLIDER_CRANK)
+#: The linkages (every mechanism but the engine): their links are the design's.
+_LINKAGES = (FOUR_BAR, SLIDER_CRANK, LINKAGE)
 
 
 @dataclass(frozen=True)
@@ -113,32 +116,76 @@ _COM = (
         "along y from its pin, in global axes.", example="0.0"),
 )
 
-def _link_keys(com_forms: str) -> tuple[Key, ...]:
-    """A link's mass properties and loads (``[links.<link>]``, ``[original.<link>]``)."""
+def _link_keys(com_forms: str, engine: bool = False) -> tuple[Key, ...]:
+    """A link's mass properties and loads (``[links.<link>]``, ``[original.<link>]``).
+
+    ``engine``: the engine's links take their mass, inertia and centre of mass too (as
+    :data:`_ENGINE_LINKS` says which link takes which).
+    """
+    linkages = _LINKAGES
+    both = (*_LINKAGES, ENGINE) if engine else _LINKAGES
     return (
-        Key("mass", "kg", "required", "Mass of the link; positive.", example="2.1"),
+        Key("mass", "kg", "required",
+            "Mass of the link; positive. An engine's `crankshaft`: optional (its weight under "
+            "gravity).", both, example="2.1"),
         Key("inertia", "kg·m²", "required (a slider-crank's slider: 0)",
             "Moment of inertia about the centre of mass; at least 0. A slider-crank's slider "
-            "does not turn: its inertia may be left out.", example="1.1"),
+            "does not turn: its inertia may be left out. An engine's `crankshaft`: about its "
+            "axis (its masses included); its `rod`: about the rod's centre of mass; its "
+            "`piston` has none.", both, example="1.1"),
         Key("com", "table", "required",
-            f"The centre of mass in the link's frame (the table `com` below): {com_forms}.",
-            example="{ e = 0.4, f = 0.0 }"),
+            f"The centre of mass in the link's frame (the table `com` below): {com_forms}. An "
+            "engine's `rod` only (its frame: big end, x towards the small end).",
+            both, example="{ e = 0.4, f = 0.0 }"),
         Key("force", "N", "[0, 0]",
             "A constant force `[Fx, Fy]` in global axes at the centre of mass, from outside the "
-            "machine (no reaction on the frame).", example="[1.1, 1.2]"),
+            "machine (no reaction on the frame).", linkages, example="[1.1, 1.2]"),
         Key("moment", "N·m", "0",
             "A constant moment on the link, counter-clockwise positive, from outside the "
-            "machine.", example="0.37"),
+            "machine.", linkages, example="0.37"),
         Key("counter_rotor", "kg·m²", "0",
             "Inertia of a counter-rotor: a disc coaxial with the link's ground pivot, geared to "
             "turn at −1 times the link's angular velocity (only its inertia counts). Only on a "
             "link pivoted to the ground: a four-bar's crank and rocker, a slider-crank's crank, "
-            "a general linkage's links with a ground point. At least 0.", example="0.5"),
+            "a general linkage's links with a ground point. At least 0.", linkages,
+            example="0.5"),
         Key("z", "m", "0",
             "The plane the link moves in, along the crank's axis (z = 0: the crank's plane). "
             "Links in different planes rock the frame about x and y (the rocking couple); the "
-            "link is a lamina in its plane.", example="0.1"),
+            "link is a lamina in its plane. An engine's rods and pistons move in their "
+            "cylinders' planes.", linkages, example="0.1"),
     )
+
+
+#: An engine's links and the keys each takes (of ``[links.<link>]``'s).
+ENGINE_LINKS = {"crankshaft": ("inertia", "mass", "masses"),
+                    "rod": ("mass", "inertia", "com"), "piston": ("mass",)}
+
+#: A mass·radius at an angle in a plane: the crankshaft's masses, a shaft's eccentrics.
+_ECCENTRIC = (
+    Key("mr", "kg·m", "required",
+        "Its mass times the distance of its centre from the axis; at least 0.", (ENGINE,),
+        example="0.015"),
+    Key("phase_deg", "°", "0",
+        "Its direction from the axis at θ1 = 0, from +x towards +y.", (ENGINE,),
+        example="180.0"),
+    Key("z", "m", "0", "Its plane along the crankshaft.", (ENGINE,), example="-0.132"),
+)
+
+#: The lengths of an engine's cylinders (``[mechanism.lengths]``, each cylinder's override).
+_CYLINDER_LENGTHS = (
+    Key("crank", "m", "required", "Crank radius: half the stroke; positive.", (ENGINE,),
+        example="0.040"),
+    Key("rod", "m", "required",
+        "Connecting rod between its pin centres; longer than crank + |offset|.", (ENGINE,),
+        example="0.135"),
+    Key("offset", "m", "0",
+        "Désaxé: the piston pin's line from the crank's axis, along the cylinder's axis turned "
+        "+90° (signed).", (ENGINE,), example="0.0"),
+    Key("bore", "m", "none (required with [gas])",
+        "The cylinder's bore: the gas force is (p − crankcase)·π·bore²/4; positive.",
+        (ENGINE,), example="0.080"),
+)
 
 
 SECTIONS: tuple[Section, ...] = (
@@ -149,28 +196,47 @@ SECTIONS: tuple[Section, ...] = (
         Key("links", "table", "required", "Each moving link's mass properties and loads."),
         Key("springs", "table", "none", "Linear springs between two points (`[[springs]]`).",
             (LINKAGE,)),
+        Key("balance_shafts", "table", "none",
+            "An engine's balance shafts, geared to the crank (`[[balance_shafts]]`, below).",
+            (ENGINE,)),
+        Key("gas", "table", "none",
+            "An engine's gas pressure over the working cycle (`[gas]`, below).", (ENGINE,)),
         Key("operation", "table", "none",
             "The operating condition that `analyze`, `optimize`, `pareto`, `sweep` and `plot` "
             "refer to; they refuse a spec without it."),
         Key("simulation", "table", "the defaults below",
             "How `simulate` and `verify` run the equations of motion."),
         Key("balance", "table", "none",
-            "The redesign problem that `optimize`, `pareto` and `sweep` solve."),
+            "The redesign problem that `optimize`, `pareto` and `sweep` solve.", _LINKAGES),
         Key("original", "table", "none",
             "The unbalanced design a balanced one was derived from (same geometry), as "
-            "`optimize --out` writes it: `verify` and `plot` show both."),
+            "`optimize --out` writes it: `verify` and `plot` show both.", _LINKAGES),
     )),
     Section("mechanism", "The type of linkage and its geometry.", (
         Key("type", "—", "required",
-            '`"four-bar"` (Meijaard & van der Wijk 2020), `"slider-crank"` (Wunderlich 1964) '
-            'or `"linkage"` (any planar linkage with one degree of freedom).',
+            '`"four-bar"` (Meijaard & van der Wijk 2020), `"slider-crank"` (Wunderlich 1964), '
+            '`"linkage"` (any planar linkage with one degree of freedom) or `"engine"` '
+            "(cylinders on one crankshaft).",
             example='"four-bar"'),
         Key("branch", "—", '"+"',
             'The assembly: a four-bar\'s `"+"` puts A2 to the left of the directed line A1→A3 '
             '(the paper\'s Fig. 1); a slider-crank\'s `"+"` puts the slider on the +x side of '
             'the crank pin; `"-"` the other assembly (a general linkage\'s is fixed by its '
             "reference pose).", _CLOSED, example='"+"'),
-        Key("lengths", "table", "required", "The link lengths (the table below).", _CLOSED),
+        Key("lengths", "table", "required",
+            "The link lengths (the table below); an engine's: every cylinder's.",
+            (*_CLOSED, ENGINE)),
+        Key("strokes", "—", "4",
+            "An engine's working cycle: 4 (720° of crank angle) or 2 (360°).", (ENGINE,),
+            example="4"),
+        Key("firing_order", "—", "none (required with [gas])",
+            "The cylinders (numbered from 1, in the order of `[[mechanism.cylinders]]`) in the "
+            "order they fire: the first at its first top dead centre at or after θ1 = 0, each "
+            "next at its own first top dead centre after the previous firing, all within one "
+            "working cycle.", (ENGINE,), example="[1, 3, 4, 2]"),
+        Key("cylinders", "table", "required",
+            "An engine's cylinders, cylinder 1 first (`[[mechanism.cylinders]]`, below).",
+            (ENGINE,)),
         Key("input", "—", "required",
             "The name of the driven link (the crank); its first point is its ground pivot.",
             (LINKAGE,), example='"crank"'),
@@ -195,7 +261,24 @@ SECTIONS: tuple[Section, ...] = (
         Key("offset", "m", "0",
             "Signed distance of the guide line (along +x) from A0: the guide is y = offset.",
             (SLIDER_CRANK,), example="0.0"),
-    ), _CLOSED),
+        *_CYLINDER_LENGTHS,
+    ), (*_CLOSED, ENGINE)),
+    Section("mechanism.cylinders[]", "An engine's cylinder: its plane along the crankshaft, its "
+            "crank pin's angle and its axis' angle (in-line, V, W, boxer, radial: cylinders "
+            "with their own angles; cylinders on one crank pin share its phase). Its top dead "
+            "centre is where its crank pin points along its axis (θ1 + phase = bank).", (
+                Key("z", "m", "0", "Its plane along the crankshaft (z).", (ENGINE,),
+                    example="-0.132"),
+                Key("phase_deg", "°", "0",
+                    "Its crank pin's angle at θ1 = 0, from +x towards +y.", (ENGINE,),
+                    example="180.0"),
+                Key("bank_deg", "°", "0",
+                    "Its axis' angle, from the crank towards the head, from +x towards +y.",
+                    (ENGINE,), example="90.0"),
+                *(Key(k.name, k.unit, "`[mechanism.lengths]`'s",
+                      f"{k.meaning[:-1]} — this cylinder's, where it differs.", (ENGINE,),
+                      k.example) for k in _CYLINDER_LENGTHS),
+            ), (ENGINE,)),
     Section("mechanism.points", "A general linkage's points at the reference pose, which fixes "
             "the assembly branch: every other pose is reached from it continuously as the crank "
             "turns.", (), (LINKAGE,),
@@ -231,6 +314,15 @@ SECTIONS: tuple[Section, ...] = (
                     "The slider (piston) on the pin A2; it does not turn.", (SLIDER_CRANK,)),
                 Key("ground", "table", "required",
                     "The frame: a link without mass whose points do not move.", (LINKAGE,)),
+                Key("crankshaft", "table", "required",
+                    "An engine's crankshaft: its inertia, mass and the mass·radius it carries.",
+                    (ENGINE,)),
+                Key("rod", "table", "required",
+                    "Every cylinder's connecting rod (`rod1`, `rod2`, … in the outputs).",
+                    (ENGINE,)),
+                Key("piston", "table", "required",
+                    "Every cylinder's reciprocating group: piston, rings, pin, a point mass at "
+                    "the piston pin (`piston1`, … in the outputs).", (ENGINE,)),
             ),
             names=Key("<link>", "table", "—",
                       "A moving link of a general linkage, by the name the spec gives it "
@@ -242,7 +334,11 @@ SECTIONS: tuple[Section, ...] = (
                     "direction of its x-axis (ternary and quaternary links too).", (LINKAGE,),
                     example='["A0", "A1"]'),
                 *_link_keys("`{ s, sigma }`, `{ e, f }` or, in a general linkage, "
-                            "`{ at = [x, y] }`"),
+                            "`{ at = [x, y] }`", engine=True),
+                Key("masses", "table", "none",
+                    "An engine's crankshaft: every mass·radius it carries (pins, webs, "
+                    "counterweights), a list of `{ mr, phase_deg, z, label }` (below).",
+                    (ENGINE,), example="[{ mr = 0.015, phase_deg = 0.0, z = -0.132 }]"),
                 Key("gas_force", "N", "none",
                     "A force on the slider along the guide (+x), from the frame: a number, or "
                     "a table of it over the crank angle (below). It acts between piston and "
@@ -250,6 +346,12 @@ SECTIONS: tuple[Section, ...] = (
                     "through the torque reaction. The slider only.", (SLIDER_CRANK,),
                     example="-1500.0"),
             )),
+    Section("links.<link>.masses[]", "A mass·radius the crankshaft carries.", (
+        *_ECCENTRIC,
+        Key("label", "—", '""',
+            'What it is (`"counterweight"`: one that `optimize` may replace).', (ENGINE,),
+            example='"counterweight"'),
+    ), (ENGINE,)),
     Section("links.ground", "A general linkage's frame.", (
         Key("points", "—", "required",
             "Its points: the ground pivots, and the anchors of springs and guides on the frame.",
@@ -285,6 +387,38 @@ SECTIONS: tuple[Section, ...] = (
                     "The length at which it carries no force; at least 0.", (LINKAGE,),
                     example="0.07785"),
             ), (LINKAGE,)),
+    Section("balance_shafts[]", "An engine's balance shaft: a shaft on an axis parallel to the "
+            "crankshaft's, geared to the crank, with eccentrics in several planes.", (
+                Key("ratio", "—", "required",
+                    "Its speed over the crank's: a non-zero whole number (negative: it turns "
+                    "the other way; ±2: a Lanchester shaft).", (ENGINE,), example="2"),
+                Key("at", "m", "[0, 0]", "Its axis in the x–y plane `[x, y]`.", (ENGINE,),
+                    example="[-0.10, 0.07]"),
+                Key("inertia", "kg·m²", "0",
+                    "About its axis, its eccentrics included (the free simulation); at least 0.",
+                    (ENGINE,), example="0.0005"),
+                Key("eccentrics", "table", "none",
+                    "Its masses off the axis, a list of `{ mr, phase_deg, z }` (below; their "
+                    "angles at θ1 = 0).", (ENGINE,),
+                    example="[{ mr = 0.0037, phase_deg = 180.0, z = 0.0 }]"),
+            ), (ENGINE,)),
+    Section("balance_shafts[].eccentrics[]", "A mass·radius on a balance shaft.", _ECCENTRIC,
+            (ENGINE,)),
+    Section("gas", "An engine's gas pressure: cylinder 1's absolute pressure over its working "
+            "cycle from its firing top dead centre, a periodic cubic spline through the points; "
+            "every cylinder follows it from its own firing (`mechanism.firing_order`). The gas "
+            "force acts between piston and head: it drives the crank without shaking the frame "
+            "except through the torque's reaction.", (
+                Key("crank_angle_deg", "°", "required",
+                    "Crank angles from the firing top dead centre, increasing within one "
+                    "working cycle from 0.", (ENGINE,), example="[0.0, 360.0]"),
+                Key("pressure", "Pa", "required",
+                    "The absolute pressure at those angles (as many values); at least 0.",
+                    (ENGINE,), example="[5.8e6, 1.0e5]"),
+                Key("crankcase", "Pa", "1e5",
+                    "The pressure under the piston; at least 0.", (ENGINE,),
+                    example="1.0e5"),
+            ), (ENGINE,)),
     Section("operation", "The operating condition of a cycle analysis and of a balancing: the "
             "crank at constant speed over one revolution, sampled at θ1 = 2πk/samples.", (
                 Key("speed", "rad/s", "required",
@@ -425,6 +559,22 @@ SECTIONS: tuple[Section, ...] = (
     Section("original.<link>.com", "An original link's centre of mass: `{ s, sigma }` or "
             "`{ e, f }`.", _COM),
 )
+
+
+
+def _for_linkages(section: Section) -> Section:
+    """A section of the linkages' only: its keys (and chosen names) for them alone."""
+    def only(key: Key) -> Key:
+        return replace(key, mechanisms=tuple(m for m in key.mechanisms if m in _LINKAGES))
+
+    return replace(section, keys=tuple(only(k) for k in section.keys), mechanisms=_LINKAGES,
+                   names=None if section.names is None else only(section.names))
+
+
+#: The redesign of linkages' links (``[balance]``) and their originals (``[original]``) are the
+#: linkages': an engine is balanced by counterweights and shafts of its own.
+SECTIONS = tuple(_for_linkages(s) if s.pattern.split(".")[0] in ("balance", "original") else s
+                 for s in SECTIONS)
 
 _BY_PATTERN = {s.pattern: s for s in SECTIONS}
 _INDEX = re.compile(r"\[\d+\]$")

@@ -118,6 +118,19 @@ class Table:
             return default
         return v.vector2(self.raw(name), self.key(name))
 
+    def tables(self, name: str) -> list[Table]:
+        """An array of tables (``[[name]]``, or a list of inline tables), each as a table.
+
+        Their paths are indexed (``springs[0]``); absent: none.
+        """
+        if not self.has(name):
+            return []
+        raw = self.raw(name)
+        key = self.key(name)
+        if not isinstance(raw, list) or not all(isinstance(item, dict) for item in raw):
+            raise SpecError(f"must be an array of tables ([[{key}]])", key=key, value=raw)
+        return [Table(item, f"{key}[{i}]") for i, item in enumerate(raw)]
+
     def finish(self) -> None:
         """Raise on the first key that was not used (unknown, or a typo)."""
         for name in self.data:

@@ -5,10 +5,12 @@ from __future__ import annotations
 import os
 
 from .. import tomltext as toml
+from ..mechanisms.engine.model import Engine
 from ..mechanisms.slidercrank.model import SliderCrank
 from ..model import ChainModel, Design, GasForce, Link, Linkage, MechanismModel
 from ..outputs import write_atomic
 from .balance import balance_lines
+from .engine import engine_lines
 
 
 def _link_lines(link: Link, frame: str = "link") -> list[str]:
@@ -82,6 +84,8 @@ def dumps_design(design: Design) -> str:
         out += [f"title = {toml.string(design.title)}", ""]
     if isinstance(mech, Linkage):
         out += _linkage_lines(mech)
+    elif isinstance(mech, Engine):
+        out += engine_lines(mech)
     else:
         assert isinstance(mech, ChainModel)
         out += ["[mechanism]", f'type = "{mech.type}"', f'branch = "{mech.branch}"', ""]

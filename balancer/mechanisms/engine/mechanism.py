@@ -1,0 +1,116 @@
+"""An engine as a mechanism: a general linkage of slider-cranks on one crankshaft, and rotors.
+
+The crankshaft is the input link, pivoted at the main bearings ``O`` at the origin, with a pin
+for each cylinder; each cylinder's rod joins its pin to its piston, a one-point link on a guide
+of the frame along the cylinder's axis, in the cylinder's plane. The general core (positions,
+rates, accelerations, inverse dynamics by Newton–Euler or the mass matrix, the rocking couple
+from momentum) computes the linkage exactly — not the two-term series. The crankshaft's masses
+(a rotor at ratio 1 on ``O``) and the balance shafts (rotors at their ratios, on their own
+bearings ``shaft<j>``) add their loads in closed form
+(:class:`~balancer.linkage.rotors.Rotor`). Gas forces act along each cylinder's axis between
+piston and head: internal to the machine.
+"""
+
+from __future__ import annotations
+
+import cmath
+import math
+from dataclasses import replace
+from functools import cached_property
+
+from ...linkage.rotors import Rotor, link_inertia
+from ...linkage.structure import Structure
+from ...model import Body, Linkage, Slider
+from ..base import Mechanism
+from .model import Engine
+
+#: The main bearings' point (the crankshaft's axis at the origin).
+MAIN_BEARINGS = "O"
+
+
+def crank_pin(k: int) -> str:
+    """The name of cylinder ``k``'s crank pin (a point of the crankshaft)."""
+    return f"crankpin{k}"
+
+
+def piston_pin(k: int) -> str:
+    """The name of cylinder ``k``'s piston pin (the rod's small end, the piston's point)."""
+    return f"pistonpin{k}"
+
+
+def engine_linkage(model: Engine) -> Linkage:
+    """The engine as a general linkage at θ1 = 0.
+
+    The crankshaft's frame has its x-axis along θ1 (a marker point ``X`` on it at the first
+    cylinder's crank radius on +x), so that its angle is θ1; its pins at ``r·e^{i·phase}``; its
+    inertia the crankshaft's with each balance shaft's as the crank feels it (``k²·J``, as a
+    counter-rotor's is carried: :meth:`~balancer.mechanisms.base.Mechanism.rotor_loads`).
+    Each piston pin on its line ``offset·i·u + s·u`` (``u`` the axis) at the root of
+    ``|W − P| = rod`` farther from the crank (the piston on the head's side of its pin).
+    """
+    points: list[tuple[str, tuple[float, float]]] = [
+        (MAIN_BEARINGS, (0.0, 0.0)), ("X", (model.cylinders[0].crank, 0.0))]
+    bodies: list[Body] = [Body(name="ground", points=(MAIN_BEARINGS,))]
+    shaft_points = [MAIN_BEARINGS, "X"]
+    rods: list[Body] = []
+    pistons: list[Body] = []
+    sliders: list[Slider] = []
+    links = model.links
+    n = len(model.cylinders)
+    for k, c in enumerate(model.cylinders, start=1):
+        pin = cmath.rect(c.crank, c.phase)
+        u = c.axis
+        along = (pin * u.conjugate()).real
+        across = (pin * (1j * u).conjugate()).real
+        s = along + math.sqrt(c.rod * c.rod - (c.offset - across) ** 2)
+        wrist = c.offset * 1j * u + s * u
+        points += [(crank_pin(k), (pin.real, pin.imag)), (piston_pin(k), (wrist.real, wrist.imag))]
+        shaft_points.append(crank_pin(k))
+        rods.append(Body(name=f"rod{k}", points=(crank_pin(k), piston_pin(k)), props=links[k]))
+        pistons.append(Body(name=f"piston{k}", points=(piston_pin(k),), props=links[n + k]))
+        sliders.append(Slider(link=f"piston{k}", guide="ground", point=piston_pin(k),
+                              direction=(u.real, u.imag), force=model.gas_force(k)))
+    geared = sum(link_inertia(s.inertia, s.ratio) for s in model.balance_shafts)
+    crankshaft = replace(links[0], inertia=links[0].inertia + geared)
+    bodies.append(Body(name="crankshaft", points=tuple(shaft_points), props=crankshaft))
+    return Linkage(points=tuple(points), bodies=(*bodies, *rods, *pistons), input="crankshaft",
+                   sliders=tuple(sliders))
+
+
+class EngineMechanism(Mechanism):
+    """A piston engine (``type = "engine"``)."""
+
+    model: Engine
+
+    geometry_key = "mechanism.cylinders"
+    #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.
+    start_angle = 0.0
+    reports_mount_torque = True
+
+    @cached_property
+    def linkage(self) -> Linkage:
+        return engine_linkage(self.model)
+
+    @cached_property
+    def structure(self) -> Structure:
+        exact = {"crankshaft": self.model.cylinders[0].crank}
+        exact.update({f"rod{k}": c.rod for k, c in enumerate(self.model.cylinders, start=1)})
+        return Structure.of(self.linkage, exact)
+
+    @cached_property
+    def rotors(self) -> tuple[tuple[str, Rotor], ...]:
+        """The crankshaft's masses on the main bearings, then each balance shaft's rotor."""
+        out: list[tuple[str, Rotor]] = []
+        if self.model.crankshaft.masses:
+            out.append((MAIN_BEARINGS, self.model.crankshaft.rotor))
+        out += [(f"shaft{j}", s.rotor)
+                for j, s in enumerate(self.model.balance_shafts, start=1)]
+        return tuple(out)
+
+    def describe(self) -> str:
+        n = len(self.model.cylinders)
+        cylinders = "one cylinder" if n == 1 else f"{n} cylinders"
+        return f"{cylinders}, {self.model.strokes}-stroke"
+
+    def _full_turn_rule(self) -> str:
+        return " (each rod longer than its crank + |offset|)"

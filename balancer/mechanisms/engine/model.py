@@ -1,0 +1,466 @@
+"""An engine's data: cylinders on one crankshaft, rods, pistons, balance shafts and gas.
+
+DESIGN.md, "Engines and multi-plane machines". z is the crankshaft's axis, the origin O on it;
+the crank turns about +z and every angle is from +x towards +y, in degrees as engine data sheets
+give them (fields that end in ``_deg``; a spec reads back exactly). Cylinder ``k`` (from 1) has
+its crank pin at ``θ1 + phase`` at radius ``crank``; its axis points at ``bank`` from the crank
+towards the head, its piston pin's line shifted by ``offset`` along the axis turned +90°; its
+rod (big end at the crank pin, x to the small end) and piston move in its plane ``z``. The
+crankshaft carries mass·radius at angles and planes; balance shafts turn at integer ratios of
+the crank's speed about axes parallel to it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from typing import ClassVar
+
+from ... import validate as v
+from ...errors import AssemblyError, SpecError
+from ...linkage.rotors import Eccentric, Rotor
+from ...model.links import GasForce, Link
+from ...model.mechanisms import MechanismModel
+
+#: A four-stroke cycle's crank angle, rad; a two-stroke's is half of it.
+TWO_TURNS = 4 * math.pi
+#: The crankcase's pressure when the spec gives none, Pa (DESIGN.md).
+ATMOSPHERE = 1.0e5
+#: Tolerance of two firings at the same crank angle, rad (cylinders with the same dead centre).
+SAME_ANGLE = 1e-9
+
+
+@dataclass(frozen=True, kw_only=True)
+class Cylinder:
+    """One cylinder: its plane, its crank pin's phase, its axis and its lengths.
+
+    Attributes
+    ----------
+    z
+        Its plane along the crankshaft, m.
+    phase_deg
+        Its crank pin's angle at θ1 = 0, degrees.
+    bank_deg
+        Its axis' angle, from the crank towards the head, degrees.
+    crank
+        Crank radius (half the stroke), m; positive.
+    rod
+        Rod length between the pin centres, m; longer than ``crank + |offset|``.
+    offset
+        The piston pin's line from the crank's axis, along the axis turned +90°, m (signed).
+    bore
+        The bore, m (needed with gas; 0: none given).
+    """
+
+    z: float = 0.0
+    phase_deg: float = 0.0
+    bank_deg: float = 0.0
+    crank: float
+    rod: float
+    offset: float = 0.0
+    bore: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("z", "phase_deg", "bank_deg", "offset"):
+            v.store(self, name, v.number(getattr(self, name), name))
+        v.store(self, "crank", v.length(self.crank, "crank"))
+        v.store(self, "rod", v.length(self.rod, "rod"))
+        v.store(self, "bore", v.nonnegative(self.bore, "bore"))
+        if not self.rod > self.crank + abs(self.offset):
+            raise AssemblyError(
+                f"the crank cannot turn: the rod ({self.rod:.6g} m) must be longer than the "
+                f"crank and the offset's size together ({self.crank + abs(self.offset):.6g} m)",
+                key="rod", value=self.rod)
+
+    @property
+    def phase(self) -> float:
+        """Its crank pin's angle at θ1 = 0, rad."""
+        return math.radians(self.phase_deg)
+
+    @property
+    def bank(self) -> float:
+        """Its axis' angle, rad."""
+        return math.radians(self.bank_deg)
+
+    @property
+    def axis(self) -> complex:
+        """The unit vector of its axis, towards the head."""
+        return complex(math.cos(self.bank), math.sin(self.bank))
+
+    @property
+    def piston_area(self) -> float:
+        """``π·bore²/4``, m²."""
+        return math.pi * self.bore * self.bore / 4
+
+    @property
+    def top_dead_centre(self) -> float:
+        """The crank angle θ1 in [0, 2π) where its crank pin points along its axis, rad."""
+        return (self.bank - self.phase) % (2 * math.pi)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Mass:
+    """A mass·radius on a shaft: the crankshaft's (pin, web, counterweight), a shaft's eccentric.
+
+    Attributes
+    ----------
+    mr
+        Its mass times the distance of its centre from the axis, kg·m; at least 0.
+    phase_deg
+        Its direction from the axis at θ1 = 0, degrees from +x towards +y.
+    z
+        Its plane along the crankshaft, m.
+    label
+        What it is (``"counterweight"``: one that balancing may replace).
+    """
+
+    mr: float
+    phase_deg: float = 0.0
+    z: float = 0.0
+    label: str = ""
+
+    def __post_init__(self) -> None:
+        v.store(self, "mr", v.nonnegative(self.mr, "mr"))
+        v.store(self, "phase_deg", v.number(self.phase_deg, "phase_deg"))
+        v.store(self, "z", v.number(self.z, "z"))
+        if not isinstance(self.label, str):
+            raise SpecError("must be a string", key="label", value=self.label)
+
+    @property
+    def eccentric(self) -> Eccentric:
+        """As a rotor's eccentric (angle in radians)."""
+        return Eccentric(mr=self.mr, angle=math.radians(self.phase_deg), z=self.z)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ShaftLink(Link):
+    """The crankshaft as a link of the engine's linkage: on its axis, its mass maybe not given.
+
+    Its centre of mass on its axis (``e = f = 0``: the mass·radius it carries is its rotor's);
+    its mass 0 where the spec gives none (then only its inertia counts, and its weight is left
+    out).
+    """
+
+    def __post_init__(self) -> None:
+        mass = self.mass
+        object.__setattr__(self, "mass", 1.0)  # (checked here: it may be 0)
+        super().__post_init__()
+        v.store(self, "mass", v.nonnegative(mass, "mass"))
+
+
+@dataclass(frozen=True, kw_only=True)
+class Crankshaft:
+    """The crankshaft: its inertia, its mass and the mass·radius it carries.
+
+    Attributes
+    ----------
+    inertia
+        About its axis, kg·m² (its masses' included).
+    mass
+        Its mass, kg, for its weight under gravity (0: not given).
+    masses
+        Every mass·radius it carries (pins, webs, counterweights): each at its angle at θ1 = 0
+        and in its plane; a counterweight labelled ``"counterweight"``.
+    """
+
+    inertia: float = 0.0
+    mass: float = 0.0
+    masses: tuple[Mass, ...] = ()
+
+    def __post_init__(self) -> None:
+        v.store(self, "inertia", v.nonnegative(self.inertia, "inertia"))
+        v.store(self, "mass", v.nonnegative(self.mass, "mass"))
+        v.store(self, "masses", _masses(self.masses, "masses"))
+
+    @property
+    def rotor(self) -> Rotor:
+        """Its masses as a rotor at ratio 1 on its axis (its inertia is the link's)."""
+        return Rotor(ratio=1.0, inertia=0.0, eccentrics=tuple(m.eccentric for m in self.masses))
+
+
+@dataclass(frozen=True, kw_only=True)
+class BalanceShaft:
+    """A shaft geared to the crank at an integer ratio, with eccentrics.
+
+    Attributes
+    ----------
+    ratio
+        Its speed over the crank's, a non-zero integer (negative: the other way).
+    at
+        Its axis in the x–y plane, m.
+    inertia
+        About its axis, kg·m².
+    eccentrics
+        Its masses off the axis, at their angles at θ1 = 0.
+    """
+
+    ratio: int
+    at: tuple[float, float] = (0.0, 0.0)
+    inertia: float = 0.0
+    eccentrics: tuple[Mass, ...] = ()
+
+    def __post_init__(self) -> None:
+        ratio = v.number(self.ratio, "ratio")
+        if ratio == 0 or ratio != round(ratio):
+            raise SpecError("must be a non-zero whole number", key="ratio", value=self.ratio)
+        v.store(self, "ratio", int(ratio))
+        v.store(self, "at", v.vector2(self.at, "at"))
+        v.store(self, "inertia", v.nonnegative(self.inertia, "inertia"))
+        v.store(self, "eccentrics", _masses(self.eccentrics, "eccentrics"))
+
+    @property
+    def rotor(self) -> Rotor:
+        """The shaft as a rotor geared to the crank."""
+        return Rotor(ratio=float(self.ratio), inertia=self.inertia, axis=complex(*self.at),
+                     eccentrics=tuple(m.eccentric for m in self.eccentrics))
+
+
+@dataclass(frozen=True, kw_only=True)
+class GasCycle:
+    """Cylinder 1's absolute pressure over its working cycle, from its firing top dead centre.
+
+    Attributes
+    ----------
+    crank_angle_deg
+        Crank angles from the firing top dead centre, degrees, increasing within the working
+        cycle from 0.
+    pressure
+        Absolute pressure there, Pa (a periodic cubic spline through the points).
+    crankcase
+        The pressure under the piston, Pa.
+    """
+
+    crank_angle_deg: tuple[float, ...]
+    pressure: tuple[float, ...]
+    crankcase: float = ATMOSPHERE
+
+    def __post_init__(self) -> None:
+        v.store(self, "crank_angle_deg", v.numbers(self.crank_angle_deg, "crank_angle_deg"))
+        v.store(self, "pressure", v.numbers(self.pressure, "pressure"))
+        v.store(self, "crankcase", v.nonnegative(self.crankcase, "crankcase"))
+        if len(self.crank_angle_deg) != len(self.pressure):
+            raise SpecError(f"crank_angle_deg and pressure must have the same length "
+                            f"({len(self.crank_angle_deg)} and {len(self.pressure)})",
+                            key="pressure")
+        if any(p < 0 for p in self.pressure):
+            raise SpecError("absolute pressures must be zero or positive", key="pressure",
+                            value=list(self.pressure))
+
+    def force(self, cylinder: Cylinder, firing: float, period: float) -> GasForce:
+        """The gas force on a cylinder's piston along its axis (+: towards the head), N.
+
+        ``−(p − crankcase)·π·bore²/4`` over the crank angle θ1, the pressure curve started at
+        the cylinder's ``firing`` angle (rad) and repeating every ``period``. The spline through
+        the shifted points is the shifted spline (a periodic spline is the same curve whatever
+        its start).
+        """
+        area = cylinder.piston_area
+        pairs = sorted(((math.radians(a) + firing) % period, -(p - self.crankcase) * area)
+                       for a, p in zip(self.crank_angle_deg, self.pressure, strict=True))
+        with v.under("gas"):
+            return GasForce(angles=tuple(a for a, _ in pairs),
+                            values=tuple(f for _, f in pairs), period=period)
+
+
+def _masses(items: Sequence[Mass], key: str) -> tuple[Mass, ...]:
+    out = tuple(items)
+    for i, m in enumerate(out):
+        if not isinstance(m, Mass):
+            raise SpecError("must be a Mass", key=f"{key}[{i}]", value=m)
+    return out
+
+
+@dataclass(frozen=True, kw_only=True)
+class Engine(MechanismModel):
+    """A piston engine: cylinders on one crankshaft (DESIGN.md, "Engines").
+
+    Attributes
+    ----------
+    cylinders
+        Cylinder 1 first.
+    crankshaft
+        Its inertia, mass and mass·radius.
+    rod
+        Every cylinder's connecting rod: mass, inertia about its centre of mass, centre of mass
+        ``(e, f)`` in its frame (big end, x to the small end); it moves in its cylinder's plane.
+    piston
+        Every cylinder's reciprocating group, a point mass at the piston pin, kg.
+    balance_shafts
+        Shafts geared to the crank.
+    strokes
+        4 (a working cycle of 720°) or 2 (360°).
+    firing_order
+        The cylinders (numbered from 1) in the order they fire; needed with ``gas``.
+    gas
+        Cylinder 1's pressure over its working cycle (``None``: no gas forces).
+    """
+
+    type: ClassVar[str] = "engine"
+
+    cylinders: tuple[Cylinder, ...]
+    crankshaft: Crankshaft = field(default_factory=Crankshaft)
+    rod: Link
+    piston: float
+    balance_shafts: tuple[BalanceShaft, ...] = ()
+    strokes: int = 4
+    firing_order: tuple[int, ...] | None = None
+    gas: GasCycle | None = None
+
+    def __post_init__(self) -> None:
+        """Check the fields (keys are the spec's, from its root)."""
+        cylinders = tuple(self.cylinders) if isinstance(self.cylinders, Sequence) else ()
+        if not cylinders:
+            raise SpecError("an engine needs at least one cylinder",
+                            key="mechanism.cylinders", value=self.cylinders)
+        for i, c in enumerate(cylinders):
+            if not isinstance(c, Cylinder):
+                raise SpecError("must be a Cylinder", key=f"mechanism.cylinders[{i}]", value=c)
+        v.store(self, "cylinders", cylinders)
+        if not isinstance(self.crankshaft, Crankshaft):
+            raise SpecError("must be a Crankshaft", key="links.crankshaft",
+                            value=self.crankshaft)
+        if not isinstance(self.rod, Link):
+            raise SpecError("must be a Link", key="links.rod", value=self.rod)
+        v.store(self, "piston", v.positive(self.piston, "links.piston.mass"))
+        shafts = tuple(self.balance_shafts)
+        for j, s in enumerate(shafts):
+            if not isinstance(s, BalanceShaft):
+                raise SpecError("must be a BalanceShaft", key=f"balance_shafts[{j}]", value=s)
+        v.store(self, "balance_shafts", shafts)
+        strokes = v.number(self.strokes, "mechanism.strokes")
+        if strokes not in (2, 4):
+            raise SpecError("must be 4 or 2", key="mechanism.strokes", value=self.strokes)
+        v.store(self, "strokes", int(strokes))
+        n = len(cylinders)
+        if self.firing_order is not None:
+            order = tuple(self.firing_order)
+            if (sorted(x for x in order if isinstance(x, int) and not isinstance(x, bool))
+                    != list(range(1, n + 1))):
+                raise SpecError(f"must be a permutation of the cylinders 1 … {n}",
+                                key="mechanism.firing_order", value=list(order))
+            v.store(self, "firing_order", order)
+        if self.gas is not None:
+            if not isinstance(self.gas, GasCycle):
+                raise SpecError("must be a GasCycle", key="gas", value=self.gas)
+            if self.firing_order is None:
+                raise SpecError("an engine with gas needs its firing order",
+                                key="mechanism.firing_order")
+            for i, c in enumerate(cylinders):
+                if c.bore <= 0:
+                    raise SpecError("an engine with gas needs each cylinder's bore",
+                                    key=f"mechanism.cylinders[{i}].bore", value=c.bore)
+            angles = self.gas.crank_angle_deg
+            if angles[0] < 0 or angles[-1] >= 180 * self.strokes or any(
+                    b <= a for a, b in zip(angles, angles[1:], strict=False)):
+                raise SpecError(
+                    f"crank angles must increase within one working cycle "
+                    f"({180 * self.strokes}°), from 0", key="gas.crank_angle_deg",
+                    value=list(angles))
+            self.firing_angles()  # (checks that the order fits in the cycle)
+
+    # -- the working cycle -------------------------------------------------------------------
+
+    @property
+    def cycle_angle(self) -> float:
+        """The working cycle's crank angle: 4π for a four-stroke, 2π for a two-stroke, rad."""
+        return TWO_TURNS if self.strokes == 4 else TWO_TURNS / 2
+
+    def firing_angles(self) -> tuple[float, ...]:
+        """Each cylinder's firing crank angle, rad, by cylinder (DESIGN.md).
+
+        The first of ``firing_order`` at its first top dead centre at or after θ1 = 0, each next
+        one at its own first top dead centre after the previous firing; all within one working
+        cycle of the first.
+
+        Raises
+        ------
+        SpecError
+            Without a firing order, or one that does not fit in the working cycle.
+        """
+        if self.firing_order is None:
+            raise SpecError("needed to place the firings", key="mechanism.firing_order")
+        out = [0.0] * len(self.cylinders)
+        turn = 2 * math.pi
+        previous: float | None = None
+        for k in self.firing_order:
+            tdc = self.cylinders[k - 1].top_dead_centre
+            if previous is None:
+                angle = tdc
+            else:
+                angle = tdc + turn * math.floor((previous - tdc) / turn)
+                while angle <= previous + SAME_ANGLE:
+                    angle += turn
+            out[k - 1] = angle
+            previous = angle
+        first = out[self.firing_order[0] - 1]
+        if previous is not None and previous - first >= self.cycle_angle - SAME_ANGLE:
+            raise SpecError(
+                f"the firings do not fit in one working cycle of "
+                f"{math.degrees(self.cycle_angle):g}° (each cylinder fires at its own next top "
+                f"dead centre: cylinder {self.firing_order[-1]} would fire "
+                f"{math.degrees(previous - first):.6g}° after cylinder {self.firing_order[0]})",
+                key="mechanism.firing_order", value=list(self.firing_order))
+        return tuple(out)
+
+    def gas_force(self, k: int) -> GasForce:
+        """The gas force on cylinder ``k``'s piston (from 1) along its axis (zero without gas)."""
+        if self.gas is None:
+            return GasForce()
+        return self.gas.force(self.cylinders[k - 1], self.firing_angles()[k - 1],
+                              self.cycle_angle)
+
+    # -- what every mechanism model offers ---------------------------------------------------
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        n = len(self.cylinders)
+        return ("crankshaft", *(f"rod{k}" for k in range(1, n + 1)),
+                *(f"piston{k}" for k in range(1, n + 1)))
+
+    @property
+    def links(self) -> tuple[Link, ...]:
+        """The crankshaft (its mass on its axis, its inertia), each rod, each piston."""
+        shaft = ShaftLink(mass=self.crankshaft.mass, inertia=self.crankshaft.inertia, e=0.0,
+                          f=0.0)
+        rods = tuple(replace(self.rod, z=c.z) for c in self.cylinders)
+        pistons = tuple(Link(mass=self.piston, inertia=0.0, e=0.0, f=0.0, z=c.z)
+                        for c in self.cylinders)
+        return (shaft, *rods, *pistons)
+
+    @property
+    def grounded_links(self) -> tuple[str, ...]:
+        return ("crankshaft",)
+
+    @property
+    def sizes(self) -> dict[str, float]:
+        """Each cylinder's crank, rod and offset, and each shaft's distance from the axis, m."""
+        out: dict[str, float] = {}
+        for i, c in enumerate(self.cylinders):
+            key = f"mechanism.cylinders[{i}]"
+            out.update({f"{key}.crank": c.crank, f"{key}.rod": c.rod,
+                        f"{key}.offset": abs(c.offset)})
+        for j, s in enumerate(self.balance_shafts):
+            out[f"balance_shafts[{j}].at"] = math.hypot(*s.at)
+        return out
+
+    @property
+    def gas_forces(self) -> tuple[tuple[str, GasForce], ...]:
+        return tuple(("gas", self.gas_force(k)) for k in range(1, len(self.cylinders) + 1))
+
+    def with_links(self, links: dict[str, Link]) -> Engine:
+        """A copy with the crankshaft's mass and inertia replaced (``"crankshaft"``).
+
+        An engine's rods and pistons are one spec for every cylinder: they are replaced through
+        the fields ``rod`` and ``piston`` (``dataclasses.replace``).
+        """
+        unknown = set(links) - {"crankshaft"}
+        if unknown:
+            raise KeyError(sorted(unknown)[0])
+        shaft = links["crankshaft"]
+        return replace(self, crankshaft=replace(self.crankshaft, mass=shaft.mass,
+                                                inertia=shaft.inertia))
+
+    def without_loads(self) -> Engine:
+        """A copy without gas."""
+        return replace(self, gas=None)

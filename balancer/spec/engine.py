@@ -1,0 +1,229 @@
+"""An engine's tables of a spec (``type = "engine"``; DESIGN.md, "Engines"): read and written.
+
+``[mechanism]`` (strokes, firing order, every cylinder's lengths and ``[[mechanism.cylinders]]``),
+``[links.crankshaft]``, ``[links.rod]``, ``[links.piston]``, ``[[balance_shafts]]`` and ``[gas]``.
+Angles are in degrees, as the spec writes them: what is written reads back exactly.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .. import tomltext as toml
+from .. import validate as v
+from ..errors import SpecError
+from ..mechanisms.engine.model import BalanceShaft, Crankshaft, Cylinder, Engine, GasCycle, Mass
+from ..model import Link
+from . import schema
+from .tables import Table
+
+#: The cylinder's lengths, in ``[mechanism.lengths]`` and each ``[[mechanism.cylinders]]``.
+LENGTHS = ("crank", "rod", "offset", "bore")
+
+
+def _masses(table: Table, name: str) -> tuple[Mass, ...]:
+    out = []
+    for sub in table.tables(name):
+        sub.expect(schema.known(sub.path, schema.ENGINE))
+        if not sub.has("mr"):
+            raise sub._missing("mr")
+        with v.under(sub.path):
+            out.append(Mass(mr=sub.raw("mr"), phase_deg=sub.value("phase_deg", 0.0),
+                            z=sub.value("z", 0.0), label=sub.value("label", "")))
+        sub.finish()
+    return tuple(out)
+
+
+def _cylinders(mech: Table) -> tuple[Cylinder, ...]:
+    lengths = mech.table("lengths")
+    lengths.expect(schema.known(lengths.path, schema.ENGINE))
+    common = {k: lengths.raw(k) for k in LENGTHS if lengths.has(k)}
+    lengths.finish()
+    tables = mech.tables("cylinders")
+    if not tables:
+        raise SpecError("an engine needs at least one cylinder ([[mechanism.cylinders]])",
+                        key=mech.key("cylinders"))
+    out = []
+    for sub in tables:
+        sub.expect(schema.known(sub.path, schema.ENGINE))
+        own = {k: sub.raw(k) for k in LENGTHS if sub.has(k)}
+        fields: dict[str, Any] = {**common, **own}
+        for k in ("crank", "rod"):
+            if k not in fields:
+                raise SpecError("missing required key (here or in [mechanism.lengths])",
+                                key=sub.key(k))
+        # Keys of the cylinder's own table, else of [mechanism.lengths].
+        where = {k: sub.path if k in own else lengths.path for k in fields}
+        for k, value in fields.items():
+            checked = v.number(value, f"{where[k]}.{k}")
+            if k == "bore" and not checked > 0:
+                raise SpecError("must be positive", key=f"{where[k]}.{k}", value=value)
+        try:
+            cylinder = Cylinder(z=sub.value("z", 0.0), phase_deg=sub.value("phase_deg", 0.0),
+                                bank_deg=sub.value("bank_deg", 0.0), **fields)
+        except SpecError as exc:
+            name = (exc.key or "").split(".")[-1]
+            raise exc.under(lengths.path if name in where and where[name] != sub.path
+                            else sub.path) from None
+        out.append(cylinder)
+        sub.finish()
+    return tuple(out)
+
+
+def _link(links: Table, name: str) -> Table:
+    """``[links.<name>]`` of an engine, with only the keys that link takes."""
+    table = links.table(name)
+    table.expect(schema.known("links.<link>", schema.ENGINE))
+    for key in table.data:
+        if key not in schema.ENGINE_LINKS[name]:
+            raise SpecError(f"is not a key of an engine's {name} (it takes "
+                            f"{', '.join(schema.ENGINE_LINKS[name])})", key=table.key(key))
+    return table
+
+
+def _rod(links: Table) -> Link:
+    table = _link(links, "rod")
+    for key in ("mass", "inertia", "com"):
+        if not table.has(key):
+            raise table._missing(key)
+    com = table.table("com")
+    com.expect(schema.known(com.path, schema.ENGINE))
+    polar = com.has("s") or com.has("sigma")
+    if polar and (com.has("e") or com.has("f")):
+        raise SpecError("give the centre of mass either as {s, sigma} or {e, f}, not both",
+                        key=com.path)
+    if polar:
+        s, sigma = com.nonnegative("s"), com.number("sigma")
+        e, f = s * math.cos(sigma), s * math.sin(sigma)
+    else:
+        e, f = com.number("e"), com.number("f")
+    com.finish()
+    mass = v.positive(table.raw("mass"), table.key("mass"))
+    with v.under(table.path):
+        rod = Link(mass=mass, inertia=table.raw("inertia"), e=e, f=f)
+    table.finish()
+    return rod
+
+
+def _crankshaft(links: Table) -> Crankshaft:
+    table = _link(links, "crankshaft")
+    with v.under(table.path):
+        shaft = Crankshaft(inertia=table.value("inertia", 0.0), mass=table.value("mass", 0.0),
+                           masses=_masses(table, "masses"))
+    table.finish()
+    return shaft
+
+
+def _piston(links: Table) -> float:
+    table = _link(links, "piston")
+    if not table.has("mass"):
+        raise table._missing("mass")
+    mass = v.positive(table.raw("mass"), table.key("mass"))
+    table.finish()
+    return mass
+
+
+def _shafts(root: Table) -> tuple[BalanceShaft, ...]:
+    out = []
+    for sub in root.tables("balance_shafts"):
+        sub.expect(schema.known(sub.path, schema.ENGINE))
+        if not sub.has("ratio"):
+            raise sub._missing("ratio")
+        with v.under(sub.path):
+            out.append(BalanceShaft(ratio=sub.raw("ratio"), at=sub.value("at", (0.0, 0.0)),
+                                    inertia=sub.value("inertia", 0.0),
+                                    eccentrics=_masses(sub, "eccentrics")))
+        sub.finish()
+    return tuple(out)
+
+
+def _gas(root: Table) -> GasCycle | None:
+    table = root.table("gas", required=False)
+    if table is None:
+        return None
+    table.expect(schema.known("gas", schema.ENGINE))
+    for name in ("crank_angle_deg", "pressure"):
+        if not table.has(name):
+            raise table._missing(name)
+        if not isinstance(table.data[name], list) or not table.data[name]:
+            raise SpecError("must be a non-empty list of numbers", key=table.key(name),
+                            value=table.data[name])
+    with v.under("gas"):
+        gas = GasCycle(crank_angle_deg=table.raw("crank_angle_deg"),
+                       pressure=table.raw("pressure"),
+                       crankcase=table.value("crankcase", 1.0e5))
+    table.finish()
+    return gas
+
+
+def read_engine(root: Table, mech: Table) -> Engine:
+    """An engine from a spec's root table and its ``[mechanism]`` (its ``type`` read)."""
+    mech.expect(schema.known("mechanism", schema.ENGINE))
+    strokes = mech.value("strokes", 4)
+    order = mech.value("firing_order", None)
+    if order is not None and not isinstance(order, list):
+        raise SpecError("must be a list of cylinder numbers", key=mech.key("firing_order"),
+                        value=order)
+    cylinders = _cylinders(mech)
+    mech.finish()
+    links = root.table("links")
+    links.expect(schema.known("links", schema.ENGINE))
+    crankshaft, rod, piston = _crankshaft(links), _rod(links), _piston(links)
+    links.finish()
+    return Engine(cylinders=cylinders, crankshaft=crankshaft, rod=rod, piston=piston,
+                  balance_shafts=_shafts(root), strokes=strokes,
+                  firing_order=None if order is None else tuple(order), gas=_gas(root))
+
+
+def _mass_text(m: Mass) -> str:
+    label = f", label = {toml.string(m.label)}" if m.label else ""
+    return (f"{{ mr = {toml.number(m.mr)}, phase_deg = {toml.number(m.phase_deg)}, "
+            f"z = {toml.number(m.z)}{label} }}")
+
+
+def _masses_lines(key: str, masses: tuple[Mass, ...]) -> list[str]:
+    if not masses:
+        return []
+    return [f"{key} = [", *(f"  {_mass_text(m)}," for m in masses), "]  # kg·m, °, m"]
+
+
+def engine_lines(model: Engine) -> list[str]:
+    """The engine's ``[mechanism]``, ``[links]``, ``[[balance_shafts]]`` and ``[gas]``."""
+    out = ["[mechanism]", 'type = "engine"', f"strokes = {model.strokes}"]
+    if model.firing_order is not None:
+        out.append(f"firing_order = [{', '.join(str(k) for k in model.firing_order)}]")
+    first = model.cylinders[0]
+    out += ["", "[mechanism.lengths]  # m, every cylinder's",
+            f"crank = {toml.number(first.crank)}", f"rod = {toml.number(first.rod)}",
+            f"offset = {toml.number(first.offset)}"]
+    if first.bore:
+        out.append(f"bore = {toml.number(first.bore)}")
+    for c in model.cylinders:
+        out += ["", "[[mechanism.cylinders]]", f"z = {toml.number(c.z)}  # m",
+                f"phase_deg = {toml.number(c.phase_deg)}",
+                f"bank_deg = {toml.number(c.bank_deg)}"]
+        out += [f"{k} = {toml.number(getattr(c, k))}  # m" for k in LENGTHS
+                if getattr(c, k) != getattr(first, k)]
+    shaft, rod = model.crankshaft, model.rod
+    out += ["", "[links.crankshaft]", f"inertia = {toml.number(shaft.inertia)}  # kg·m²"]
+    if shaft.mass:
+        out.append(f"mass = {toml.number(shaft.mass)}  # kg")
+    out += _masses_lines("masses", shaft.masses)
+    out += ["", "[links.rod]", f"mass = {toml.number(rod.mass)}  # kg",
+            f"inertia = {toml.number(rod.inertia)}  # kg·m² about its centre of mass",
+            f"com = {{ e = {toml.number(rod.e)}, f = {toml.number(rod.f)} }}  # m from the big "
+            "end",
+            "", "[links.piston]", f"mass = {toml.number(model.piston)}  # kg"]
+    for s in model.balance_shafts:
+        out += ["", "[[balance_shafts]]", f"ratio = {s.ratio}",
+                f"at = [{toml.number(s.at[0])}, {toml.number(s.at[1])}]  # m",
+                f"inertia = {toml.number(s.inertia)}  # kg·m²",
+                *_masses_lines("eccentrics", s.eccentrics)]
+    if model.gas is not None:
+        g = model.gas
+        out += ["", "[gas]",
+                f"crank_angle_deg = [{', '.join(toml.number(a) for a in g.crank_angle_deg)}]",
+                f"pressure = [{', '.join(toml.number(p) for p in g.pressure)}]  # Pa",
+                f"crankcase = {toml.number(g.crankcase)}  # Pa"]
+    return out
