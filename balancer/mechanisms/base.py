@@ -383,21 +383,21 @@ class Mechanism:
         """
         if not self.rotors:
             return None
-        state = tuple(np.atleast_1d(np.asarray(x, dtype=float)) for x in
-                      (theta1, omega1, alpha1))
-        shape = np.broadcast(*state).shape
+        theta, omega, alpha = np.broadcast_arrays(
+            *(np.atleast_1d(np.asarray(x, dtype=float)) for x in (theta1, omega1, alpha1)))
+        shape = theta.shape
         zero = np.zeros(shape)
         out = RotorLoads(bearings={}, force=zero.astype(complex), moment=zero.copy(),
                          couple=zero.astype(complex), torque=zero.copy())
         for point, rotor in self.rotors:
             bare = replace(rotor, inertia=0.0)  # (its inertia is the linkage's)
-            f = bare.shaking_force(*state, gravity)
+            f = bare.shaking_force(theta, omega, alpha, gravity)
             out.bearings[point] = out.bearings.get(point, 0.0) + f
             out.force = out.force + f
-            out.moment = (out.moment + bare.shaking_moment(*state, gravity)
-                          + ground_couple(rotor.inertia, state[2], rotor.ratio))
-            out.couple = out.couple + bare.rocking_couple(*state, gravity)
-            out.torque = out.torque - bare.link_couple(*state, gravity)
+            out.moment = (out.moment + bare.shaking_moment(theta, omega, alpha, gravity)
+                          + ground_couple(rotor.inertia, alpha, rotor.ratio))
+            out.couple = out.couple + bare.rocking_couple(theta, omega, alpha, gravity)
+            out.torque = out.torque - bare.link_couple(theta, omega, alpha, gravity)
         return out
 
     def _with_rotors(self, forces: Forces, theta1: ArrayLike, omega1: ArrayLike,

@@ -178,14 +178,15 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
     gravity = (f.gravity.real, f.gravity.imag)
     rocking = f.mechanism.crank_rocking_couple(theta[crank], omega[crank], alpha[crank],
                                                gravity=gravity)
-    ground = {p: np.asarray(v, complex) * np.ones(t.size) for p, v in ev.ground.items()}
-    extra = f.mechanism.rotor_loads(theta[crank], omega[crank], alpha[crank], gravity)
-    if extra is not None:  # rotors geared to the crank: their bearings and what they shake
-        for point, value in extra.bearings.items():
+    ground: dict[str, NDArray[np.complex128]] = {
+        p: np.asarray(v, complex) * np.ones(t.size, complex) for p, v in ev.ground.items()}
+    geared = f.mechanism.rotor_loads(theta[crank], omega[crank], alpha[crank], gravity)
+    if geared is not None:  # rotors geared to the crank: their bearings and what they shake
+        for point, value in geared.bearings.items():
             ground[point] = ground.get(point, 0.0) + value
-        shaking_force = shaking_force + extra.force
-        moment = moment + extra.moment
-        tau = tau + extra.torque
+        shaking_force = shaking_force + geared.force
+        moment = moment + geared.moment
+        tau = tau + geared.torque
     return Trajectory(
         method=f.name,
         drive="constant-speed" if f.driven else "free",
