@@ -197,7 +197,7 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
         omega=omega,
         alpha=alpha,
         # (numpy's stubs type a complex array times a real one as real)
-        ground={p: cast("NDArray[np.complex128]", v) for p, v in ground.items()},
+        ground=ground,
         slider_normal={k: np.asarray(v, float) * np.ones(t.size)
                        for k, v in ev.slider_normal.items()},
         slider_couple={k: np.asarray(v, float) * np.ones(t.size)
