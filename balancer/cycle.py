@@ -462,6 +462,20 @@ def drawn_panels(analysis: CycleAnalysis) -> dict[str, NDArray[np.number]]:
     return panels
 
 
+def natural_scales(analysis: CycleAnalysis) -> dict[str, float]:
+    """The scale of each drawn panel (:func:`drawn_panels`) from the loads that make it.
+
+    The largest force on the frame at one ground point or guide (N) for the shaking force,
+    times the mechanism's size (m) for a moment (N·m): a panel whose values are below
+    :data:`ROUNDING_SPAN` of its scale is rounding, zero for a reader.
+    """
+    force = max((float(np.nanmax(np.abs(v), initial=0.0)) for v in
+                 (*analysis.reactions.ground.values(),
+                  *analysis.reactions.slider_normal.values())), default=0.0)
+    moment = force * analysis.mechanism.structure.length_scale()
+    return {"force": force, "couple": moment, "moment": moment, "torque": moment}
+
+
 def _drawn_within(analyses: Sequence[CycleAnalysis], tolerance: float) -> bool:
     """Whether every curve at the even samples is drawn within ``tolerance`` of its panel.
 

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..cycle import CycleAnalysis
+from ..cycle import ROUNDING_SPAN, CycleAnalysis, natural_scales
 from ..orders import Order, order_name
 from .style import COLOURS
 
@@ -61,7 +61,9 @@ def plot_orders(analysis: CycleAnalysis, panel: str, before: CycleAnalysis | Non
     for i, (role, kind) in enumerate(groups):
         a = before if role is None else analysis
         assert a is not None
-        values = [dict(_bars(o, panel))[kind] for o in a.orders]
+        floor = ROUNDING_SPAN * natural_scales(a)[panel]  # rounding: drawn as the zero it is
+        values = [v if v > floor else 0.0 for v in
+                  (dict(_bars(o, panel))[kind] for o in a.orders)]
         colour = COLOURS["before"] if role is None else COLOURS["after"]
         who = "original" if role is None else ("balanced design" if before is not None
                                                else "design")

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..cycle import CycleAnalysis, drawn_panels
+from ..cycle import ROUNDING_SPAN, CycleAnalysis, drawn_panels, natural_scales
 from ..cycle import Figure as Figures
 from .style import AFTER_STYLE, BEFORE_STYLE, axes, legend_outside, number
 
@@ -59,6 +59,24 @@ def plot_rocking_couple_polar(analysis: CycleAnalysis, before: CycleAnalysis | N
 _POLAR = {"shaking_force": ("shaking force", "N"), "rocking_couple": ("rocking couple", "N·m")}
 
 
+#: Each drawn quantity's panel (:func:`balancer.cycle.natural_scales`).
+_PANEL = {"shaking_force": "force", "rocking_couple": "couple", "shaking_moment": "moment",
+          "driving_torque": "torque"}
+
+
+def _zero_below_rounding(analysis: CycleAnalysis, quantity: str) -> np.ndarray:
+    """A quantity's samples, all zero where every one is below rounding of its natural scale.
+
+    (A balanced design's shaking moment of 1e-12 N·m is drawn as the zero it is, not as noise
+    blown up to fill its panel; the label still gives its RMS and maximum.)
+    """
+    values = np.asarray(getattr(analysis.reactions, quantity))
+    floor = ROUNDING_SPAN * natural_scales(analysis)[_PANEL[quantity]]
+    if np.nanmax(np.abs(values), initial=0.0) <= floor:
+        return np.zeros_like(values)
+    return values
+
+
 def _span(analysis: CycleAnalysis) -> str:
     """What the samples span, for a title: one revolution, or a four-stroke's 720°."""
     return "one revolution" if analysis.revolutions == 1 else "a cycle of 720°"
@@ -77,9 +95,9 @@ def _polar(analysis: CycleAnalysis, before: CycleAnalysis | None, ax: Axes | Non
         if a is None:
             continue
         colour, lw = style["color"], style["lw"]
-        values = getattr(a.reactions, quantity)
-        f = _closed(values)
-        ax.plot(f.real, f.imag, **style, label=_cycle_label(role, values, unit))
+        f = _closed(_zero_below_rounding(a, quantity))
+        ax.plot(f.real, f.imag, **style,
+                label=_cycle_label(role, getattr(a.reactions, quantity), unit))
         ax.plot(f.real[:1], f.imag[:1], "o", color=colour, ms=6, mec="k", mew=0.6, zorder=4)
         k = max(1, f.size // 8)
         if abs(f[k + 1] - f[k]) > 0:
@@ -114,9 +132,9 @@ def plot_over_crank_angle(analysis: CycleAnalysis, quantity: str,
                            (analysis, after_role, AFTER_STYLE)):
         if a is None:
             continue
-        values = getattr(a.reactions, quantity)
-        ax.plot(np.degrees(np.append(a.theta1, 2 * np.pi * a.revolutions)), _closed(values),
-                **style, label=_cycle_label(role, values, "N·m"))
+        ax.plot(np.degrees(np.append(a.theta1, 2 * np.pi * a.revolutions)),
+                _closed(_zero_below_rounding(a, quantity)), **style,
+                label=_cycle_label(role, getattr(a.reactions, quantity), "N·m"))
     span = 360.0 * analysis.revolutions
     ax.set_xlim(0.0, span)
     ax.set_xticks(np.arange(0, span + 1, 45 * analysis.revolutions))
