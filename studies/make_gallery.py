@@ -62,6 +62,12 @@ COMMANDS = (
     ("two_plane_orders.png", (
         "balancer plot OUT/two_plane_balanced.toml --orders docs/gallery/two_plane_orders.png",
     )),
+    ("inline_four_cycle.png", (
+        "balancer plot examples/inline_four.toml --cycle docs/gallery/inline_four_cycle.png",
+    )),
+    ("inline_four_orders.png", (
+        "balancer plot examples/inline_four.toml --orders docs/gallery/inline_four_orders.png",
+    )),
 )
 ANIMATION = "meijaard2020.gif"
 FRAMES = 48
