@@ -216,7 +216,7 @@ class CycleAnalysis:
         """The mechanism's model (a FourBar, SliderCrank or Linkage)."""
         return self.mechanism.model
 
-    @property
+    @cached_property
     def mount_torque(self) -> NDArray[np.float64] | None:
         """An engine's torque about z on its mounts, N·m: shaking moment + driving torque.
 

@@ -753,3 +753,21 @@ def test_an_engine_with_its_own_lengths_shafts_and_gas_round_trips(strokes):
     assert again.mechanism == engine
     assert again == design
     assert dumps_design(again) == text
+
+
+def test_a_spec_with_bores_that_differ_or_are_missing_reads_back_exactly():
+    """The writer puts a bore in [mechanism.lengths] only when every cylinder shares it."""
+    from dataclasses import replace
+
+    from balancer import examples
+    from balancer.spec import dumps_design, loads_design
+
+    design = examples.load("inline_four")
+    engine = design.mechanism
+    mixed = list(engine.cylinders)
+    mixed[2] = replace(mixed[2], bore=0.09)
+    unbored = [replace(c, bore=None) if i == 0 else c for i, c in enumerate(engine.cylinders)]
+    for cylinders, gas in ((mixed, engine.gas), (unbored, None)):
+        changed = replace(engine, cylinders=tuple(cylinders), gas=gas)
+        again = loads_design(dumps_design(replace(design, mechanism=changed)))
+        assert again.mechanism == changed

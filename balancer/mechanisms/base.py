@@ -451,11 +451,10 @@ class Mechanism:
             return V(zero, zero.copy())
         couple = dynamics.rocking_couple_of(self.structure, mo, self.linkage, gravity=gravity,
                                             loads=loads)
-        for _, rotor in self.rotors:
-            extra = np.reshape(rotor.rocking_couple(mo.theta1, mo.omega1, mo.alpha1, gravity),
-                               (-1, 1))
-            couple = V.of_array(couple.complex() + extra)
-        return couple
+        geared = self.rotor_loads(mo.theta1, mo.omega1, mo.alpha1, gravity)
+        if geared is None:
+            return couple
+        return V.of_array(couple.complex() + np.reshape(geared.couple, (-1, 1)))
 
     def crank_rocking_couple(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike, *,
                              loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)

@@ -7,7 +7,6 @@ Angles are in degrees, as the spec writes them: what is written reads back exact
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from .. import tomltext as toml
@@ -16,6 +15,7 @@ from ..errors import SpecError
 from ..mechanisms.engine.model import BalanceShaft, Crankshaft, Cylinder, Engine, GasCycle, Mass
 from ..model import Link
 from . import schema
+from .links import read_link
 from .tables import Table
 
 #: The cylinder's lengths, in ``[mechanism.lengths]`` and each ``[[mechanism.cylinders]]``.
@@ -53,18 +53,12 @@ def _cylinders(mech: Table) -> tuple[Cylinder, ...]:
             if k not in fields:
                 raise SpecError("missing required key (here or in [mechanism.lengths])",
                                 key=sub.key(k))
-        # Keys of the cylinder's own table, else of [mechanism.lengths].
-        where = {k: sub.path if k in own else lengths.path for k in fields}
-        for k, value in fields.items():
-            checked = v.number(value, f"{where[k]}.{k}")
-            if k == "bore" and not checked > 0:
-                raise SpecError("must be positive", key=f"{where[k]}.{k}", value=value)
         try:
             cylinder = Cylinder(z=sub.value("z", 0.0), phase_deg=sub.value("phase_deg", 0.0),
                                 bank_deg=sub.value("bank_deg", 0.0), **fields)
-        except SpecError as exc:
+        except SpecError as exc:  # named where the value was given: here, or for every cylinder
             name = (exc.key or "").split(".")[-1]
-            raise exc.under(lengths.path if name in where and where[name] != sub.path
+            raise exc.under(lengths.path if name in common and name not in own
                             else sub.path) from None
         out.append(cylinder)
         sub.finish()
@@ -84,24 +78,7 @@ def _link(links: Table, name: str) -> Table:
 
 def _rod(links: Table) -> Link:
     table = _link(links, "rod")
-    for key in ("mass", "inertia", "com"):
-        if not table.has(key):
-            raise table._missing(key)
-    com = table.table("com")
-    com.expect(schema.known(com.path, schema.ENGINE))
-    polar = com.has("s") or com.has("sigma")
-    if polar and (com.has("e") or com.has("f")):
-        raise SpecError("give the centre of mass either as {s, sigma} or {e, f}, not both",
-                        key=com.path)
-    if polar:
-        s, sigma = com.nonnegative("s"), com.number("sigma")
-        e, f = s * math.cos(sigma), s * math.sin(sigma)
-    else:
-        e, f = com.number("e"), com.number("f")
-    com.finish()
-    mass = v.positive(table.raw("mass"), table.key("mass"))
-    with v.under(table.path):
-        rod = Link(mass=mass, inertia=table.raw("inertia"), e=e, f=f)
+    rod = read_link(table, "rod", Engine)
     table.finish()
     return rod
 
@@ -115,11 +92,12 @@ def _crankshaft(links: Table) -> Crankshaft:
     return shaft
 
 
-def _piston(links: Table) -> float:
+def _piston(links: Table) -> Any:
+    """The piston's mass as written (the engine checks it)."""
     table = _link(links, "piston")
     if not table.has("mass"):
         raise table._missing("mass")
-    mass = v.positive(table.raw("mass"), table.key("mass"))
+    mass = table.raw("mass")
     table.finish()
     return mass
 
@@ -197,14 +175,16 @@ def engine_lines(model: Engine) -> list[str]:
     out += ["", "[mechanism.lengths]  # m, every cylinder's",
             f"crank = {toml.number(first.crank)}", f"rod = {toml.number(first.rod)}",
             f"offset = {toml.number(first.offset)}"]
-    if first.bore:
+    shared_bore = all(c.bore == first.bore for c in model.cylinders)
+    if shared_bore and first.bore is not None:
         out.append(f"bore = {toml.number(first.bore)}")
     for c in model.cylinders:
         out += ["", "[[mechanism.cylinders]]", f"z = {toml.number(c.z)}  # m",
                 f"phase_deg = {toml.number(c.phase_deg)}",
                 f"bank_deg = {toml.number(c.bank_deg)}"]
         out += [f"{k} = {toml.number(getattr(c, k))}  # m" for k in LENGTHS
-                if getattr(c, k) != getattr(first, k)]
+                if getattr(c, k) is not None
+                and (getattr(c, k) != getattr(first, k) or (k == "bore" and not shared_bore))]
     shaft, rod = model.crankshaft, model.rod
     out += ["", "[links.crankshaft]", f"inertia = {toml.number(shaft.inertia)}  # kg·m²"]
     if shaft.mass:

@@ -39,7 +39,6 @@ Every error names the file, the key and the value; unknown keys are errors (a ty
 
 from __future__ import annotations
 
-import cmath
 import math
 import os
 import tomllib
@@ -69,6 +68,7 @@ from ..model import MechanismModel as Model
 from . import schema
 from .balance import read_balance
 from .engine import read_engine
+from .links import read_link
 from .tables import Table
 
 MECHANISMS: dict[str, type[Model]] = {
@@ -76,70 +76,6 @@ MECHANISMS: dict[str, type[Model]] = {
 
 
 MECHANISM_TYPES = tuple(MECHANISMS)
-
-
-def _read_link(table: Table, name: str,
-               mechanism_class: type[Model],
-               frame: tuple[complex, float] | None = None) -> Link:
-    """One link; its values are checked by :class:`~balancer.model.Link` (keys prefixed).
-
-    ``frame`` (a general linkage's link: its origin, complex, and its x-axis's angle at the
-    reference pose) allows ``com = { at = [x, y] }``, the centre of mass's global position.
-    """
-    slider = mechanism_class is SliderCrank and name == "slider"
-    if not table.has("mass"):
-        raise table._missing("mass")
-    mass = table.raw("mass")
-    # A slider does not turn: its inertia does not matter and may be left out.
-    if not slider and not table.has("inertia"):
-        raise table._missing("inertia")
-    inertia = table.value("inertia", 0.0)
-    com = table.table("com")
-    assert com is not None
-    polar = com.has("s") or com.has("sigma")
-    cartesian = com.has("e") or com.has("f")
-    at = com.has("at")
-    if polar + cartesian + at > 1:
-        raise SpecError(
-            "give the centre of mass either as {s, sigma}, {e, f} or {at = [x, y]}, not two",
-            key=com.path,
-        )
-    if at:
-        if mechanism_class is not Linkage:
-            raise SpecError("at = [x, y] is for the links of a general linkage (type = "
-                            '"linkage"); give {e, f} or {s, sigma}', key=com.key("at"))
-        # Without a frame (unknown or coincident points, a one-point link without its one
-        # slider or with a zero direction) the linkage itself names the cause when it is
-        # built; until then the centre of mass stays at the origin of the link.
-        origin, angle = frame if frame is not None else (complex(*com.vector2(
-            "at", default=(0.0, 0.0))), 0.0)
-        x, y = com.vector2("at", default=(0.0, 0.0))
-        local = (complex(x, y) - origin) * cmath.exp(-1j * angle)
-        e, f = local.real, local.imag
-    elif polar:
-        s = com.nonnegative("s")
-        sigma = com.number("sigma")
-        e, f = s * math.cos(sigma), s * math.sin(sigma)
-    elif cartesian:
-        e = com.number("e")
-        f = com.number("f")
-    else:
-        raise SpecError("missing required key: give {s, sigma}, {e, f} or {at = [x, y]}",
-                        key=com.path)
-    com.finish()
-    if table.has("gas_force") and not slider:
-        raise SpecError("only a slider carries a gas force", key=table.key("gas_force"))
-    with v.under(table.path):
-        return Link(
-            mass=mass,
-            inertia=inertia,
-            e=e,
-            f=f,
-            force=table.value("force", (0.0, 0.0)),
-            moment=table.value("moment", 0.0),
-            counter_rotor=table.value("counter_rotor", 0.0),
-            z=table.value("z", 0.0),
-        )
 
 
 def _read_gas_force(table: Table) -> GasForce:
@@ -180,7 +116,7 @@ def _read_links(table: Table, mechanism_class: type[Model],
     for name in names:
         sub = table.table(name)
         assert sub is not None
-        links[name] = _read_link(sub, name, mechanism_class)
+        links[name] = read_link(sub, name, mechanism_class)
         if mechanism_class is SliderCrank and name == "slider":
             gas = _read_gas_force(sub)
         sub.finish()
@@ -279,7 +215,7 @@ def _read_linkage(root: Table, mech: Table) -> Linkage:
         link.expect(schema.known("links.<link>", schema.LINKAGE))
         link_points = _names(link, "points")
         frame = _frame(name, link_points, positions, sliders)
-        props = _read_link(link, name, Linkage, frame)
+        props = read_link(link, name, Linkage, frame)
         link.finish()
         bodies.append(Body(name=name, points=link_points, props=props))
     links_table.finish()

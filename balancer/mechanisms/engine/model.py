@@ -50,7 +50,7 @@ class Cylinder:
     offset
         The piston pin's line from the crank's axis, along the axis turned +90°, m (signed).
     bore
-        The bore, m (needed with gas; 0: none given).
+        The bore, m, positive (needed with gas; ``None``: not given).
     """
 
     z: float = 0.0
@@ -59,14 +59,15 @@ class Cylinder:
     crank: float
     rod: float
     offset: float = 0.0
-    bore: float = 0.0
+    bore: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("z", "phase_deg", "bank_deg", "offset"):
             v.store(self, name, v.number(getattr(self, name), name))
         v.store(self, "crank", v.length(self.crank, "crank"))
         v.store(self, "rod", v.length(self.rod, "rod"))
-        v.store(self, "bore", v.nonnegative(self.bore, "bore"))
+        if self.bore is not None:
+            v.store(self, "bore", v.positive(self.bore, "bore"))
         if not self.rod > self.crank + abs(self.offset):
             raise AssemblyError(
                 f"the crank cannot turn: the rod ({self.rod:.6g} m) must be longer than the "
@@ -90,8 +91,8 @@ class Cylinder:
 
     @property
     def piston_area(self) -> float:
-        """``π·bore²/4``, m²."""
-        return math.pi * self.bore * self.bore / 4
+        """``π·bore²/4``, m² (0 without a bore)."""
+        return 0.0 if self.bore is None else math.pi * self.bore * self.bore / 4
 
     @property
     def top_dead_centre(self) -> float:
@@ -347,7 +348,7 @@ class Engine(MechanismModel):
                 raise SpecError("an engine with gas needs its firing order",
                                 key="mechanism.firing_order")
             for i, c in enumerate(cylinders):
-                if c.bore <= 0:
+                if c.bore is None:
                     raise SpecError("an engine with gas needs each cylinder's bore",
                                     key=f"mechanism.cylinders[{i}].bore", value=c.bore)
             angles = self.gas.crank_angle_deg
