@@ -1,4 +1,4 @@
-"""The shipped example specs (package data): the paper's four-bar, PB1 and PB2, an engine, six-bars.
+"""The shipped example specs (package data): the paper's four-bar, PB1 and PB2, engines, six-bars.
 
 They are the TOML files beside this module (``examples/`` at the repository's root is a link
 to this folder, so that the README's paths work in a checkout); ``balancer example NAME`` writes

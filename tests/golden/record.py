@@ -29,7 +29,7 @@ STORE = Path(__file__).resolve().parent / "outputs"
 
 #: Examples without a ``[balance]`` section (no optimize, pareto): engines are balanced by
 #: counterweights and shafts of their own (issue 31).
-UNBALANCED = ("meijaard2020", "inline_four")
+UNBALANCED = ("meijaard2020", "single_cylinder", "inline_three", "inline_four", "v6", "v8")
 #: Fields and phrases that measure wall-clock time or name a temporary folder.
 _MASKS = (
     (re.compile(r'("(?:time|seconds)": )[-+0-9.eE]+'), r"\1<t>"),
