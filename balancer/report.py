@@ -21,7 +21,7 @@ from .orders import order_name
 
 if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these load them
     from .balance.pareto import Front
-    from .balance.result import BalanceResult
+    from .balance.result import BalanceResult, RotorMasses
     from .model import Link
     from .simulation import Trajectory
     from .verification import Verification
@@ -468,6 +468,7 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis, after: Cycle
                                for name in linkage.link_names},
             "counterweights": {name: w.as_dict() for name, w in result.counterweights.items()},
             "added_mass": result.added_mass,
+            **({} if result.rotor_masses is None else result.rotor_masses.as_dict()),
             "objective": result.objective,
             "objective_terms": _objective_terms(result),
             "original_objective": result.original_objective,
@@ -498,6 +499,9 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis, after: Cycle
                       "gap": "relative to scale (of √J when rms is given, else of J)",
                       "scale, rms, rms_lower_bound, rms_gap": "N·m", "time": "s",
                       "mass, added_mass": "kg", "inertia": "kg·m²", "e, f, s": "m",
+                      **({} if result.rotor_masses is None else {
+                          "mr": "kg·m", "phase_deg": "degrees at θ1 = 0", "z, at": "m",
+                          "max_bearing_load": "N"}),
                       "sigma": "rad", "disc radius, thickness": "m"},
         }
     )
@@ -594,6 +598,38 @@ def counterweight_text(weights: Mapping[str, Counterweight]) -> str:
             + "\n" + "\n".join(notes))
 
 
+def rotor_masses_text(masses: RotorMasses, speed: float) -> str:
+    """What an engine's balancing builds: per plane the counterweight, per shaft its eccentrics.
+
+    Each mass·radius (kg·m) at its angle at θ1 = 0 (degrees), its plane (mm), its mass at the
+    given radius (kg); then what they cost: their centrifugal loads (N).
+    """
+    rows = []
+    for c in masses.counterweights:
+        mass = masses.mass(c)
+        rows.append(["crankshaft", f"{1e3 * c.z:.6g}", f"{c.mr:.6g}",
+                     f"{c.phase_deg:.6g}" if c.mr > 0 else "—",
+                     "" if mass is None else f"{mass:.6g}"])
+    for j, s in enumerate(masses.shafts, start=1):
+        where = (f"new shaft {j} (×{s.ratio} at {1e3 * s.at[0]:.6g}, "
+                 f"{1e3 * s.at[1]:.6g} mm)")
+        for e in s.eccentrics:
+            rows.append([where, f"{1e3 * e.z:.6g}", f"{e.mr:.6g}",
+                         f"{e.phase_deg:.6g}" if e.mr > 0 else "—", ""])
+    header = ["to build", "plane z mm", "mr kg·m", "angle °", "mass kg"]
+    notes = ["angle: the mass's direction at θ1 = 0 from +x towards +y; mr 0: none in that "
+             "plane" + ("" if not masses.replaced else
+                        "; the new counterweights replace those labelled \"counterweight\" in "
+                        "their planes")]
+    if masses.radius is not None:
+        notes[0] += f"; mass at radius {1e3 * masses.radius:.6g} mm"
+    notes.append(f"their centrifugal load √Σ(mr·ω²)²: {masses.unbalance_before:.6g} N before, "
+                 f"{masses.unbalance_after:.6g} N after (ω = {speed:.6g} rad/s)")
+    for j, load in enumerate(masses.bearing_loads, start=1):
+        notes.append(f"new shaft {j}: largest bearing load {load:.6g} N")
+    return table(rows, header) + "\n" + "\n".join(notes)
+
+
 def optimization_text(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis,
                       verification: Verification | None = None,
                       spec: str | None = None) -> str:
@@ -638,7 +674,18 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
                 ("force backward", ob.shaking_force.backward, oa.shaking_force.backward, "N"),
                 ("shaking moment", ob.shaking_moment, oa.shaking_moment, "N·m")):
             rows.append([f"{order_name(ob.order)}: {label}", _fmt(b), _fmt(a), unit])
+        if planes:
+            for label, b, a in (
+                    ("couple forward", ob.rocking_couple.forward, oa.rocking_couple.forward),
+                    ("couple backward", ob.rocking_couple.backward, oa.rocking_couple.backward)):
+                rows.append([f"{order_name(ob.order)}: {label}", _fmt(b), _fmt(a), "N·m"])
     lines += [table(rows, ["order amplitude", "before", "after", "unit"]), ""]
+    if result.rotor_masses is not None:  # an engine: what to build, not changed links
+        lines += [rotor_masses_text(result.rotor_masses, before.speed), ""]
+        lines.append(_force_balance_line(after))
+        if verification is not None:
+            lines += ["", verification_text(verification).split("\n", 1)[1].strip("\n")]
+        return "\n".join(lines)
     rows = []
     for name in result.linkage.link_names:
         old, new = result.original.link(name), result.linkage.link(name)

@@ -93,6 +93,14 @@ def nonzero(value: Any, key: str, why: str = "") -> float:
     return x
 
 
+def ratio(value: Any, key: str) -> int:
+    """A gear ratio: a non-zero whole number (given as an integer or a whole float)."""
+    x = number(value, key)
+    if x == 0 or x != round(x):
+        raise SpecError("must be a non-zero whole number", key=key, value=value)
+    return int(x)
+
+
 def integer(value: Any, key: str, *, minimum: int, maximum: int | None = None) -> int:
     """A whole number (not a bool) within ``[minimum, maximum]``."""
     if isinstance(value, bool) or not isinstance(value, int):

@@ -22,7 +22,15 @@ from balancer.mechanisms.engine.model import Engine
 from balancer.mechanisms.fourbar.model import FourBar
 from balancer.mechanisms.slidercrank.model import SliderCrank
 from balancer.model import Linkage, Operation, SimulationSettings
-from balancer.model.balance import COUNTERWEIGHT_KEYS, LINK_KEYS, OBJECTIVE_KEYS
+from balancer.model.balance import (
+    COUNTERWEIGHT_KEYS,
+    ENGINE_OBJECTIVE_KEYS,
+    LINK_KEYS,
+    OBJECTIVE_KEYS,
+    CounterweightPlanes,
+    Objective,
+    ShaftFreedom,
+)
 from balancer.spec import MECHANISM_TYPES, design_from_dict, schema
 from balancer.spec.tables import Table
 
@@ -40,6 +48,9 @@ SLIDER = ("links.<link>.gas_force", ("links.<link>", "gas_force"))
 SPRING = {"points": ["D", "A0"], "stiffness": 100.0, "free_length": 0.3}
 METHOD = {schema.FOUR_BAR: "complex-masses", schema.SLIDER_CRANK: "complex-masses",
           schema.LINKAGE: "multibody", schema.ENGINE: "multibody"}
+#: An engine's ``[balance]`` for its keys to stand in: its required keys only.
+ENGINE_BALANCE = {"objective": {}, "counterweights": {"max_mr": 0.03},
+                  "shafts": [{"ratio": -1, "planes": [0.1], "max_mr": 0.01}]}
 #: The centre of mass's partner keys (``s`` with ``sigma``, ``e`` with ``f``).
 PARTNER = {"s": ("sigma", 0.3), "sigma": ("s", 0.6), "e": ("f", 0.0), "f": ("e", 0.4)}
 
@@ -92,6 +103,9 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
         data["balance"]["crank"] = {"counterweight": {"mass": [0.0, 1.0], "radius": 0.1}}
     if pattern == "balance.<link>" and name == "counterweight":
         data["balance"]["crank"] = {}
+    if mechanism == schema.ENGINE and "balance" not in data and (
+            pattern.startswith("balance") or (pattern == "" and name == "balance")):
+        data["balance"] = copy.deepcopy(ENGINE_BALANCE)
     if pattern == "links.<link>.gas_force":
         data["links"]["slider"]["gas_force"] = {"crank_angle": [0.0, 3.0], "force": [-1.0, 0.0]}
     table = data
@@ -224,7 +238,14 @@ def test_the_schema_names_what_the_model_names():
         assert schema.known("mechanism.lengths", kind) == cls.length_names
         assert schema.known("links", kind) == cls.chain_links
         assert schema.known("original", kind) == cls.chain_links
-    assert schema.known("balance.objective") == OBJECTIVE_KEYS
+    for kind in (schema.FOUR_BAR, schema.SLIDER_CRANK, schema.LINKAGE):
+        assert schema.known("balance.objective", kind) == OBJECTIVE_KEYS
+    assert schema.known("balance.objective", schema.ENGINE) == ENGINE_OBJECTIVE_KEYS
+    objective = {f.name for f in dataclasses.fields(Objective)}
+    assert set(OBJECTIVE_KEYS) | set(ENGINE_OBJECTIVE_KEYS) == objective
+    for section, cls in (("balance.counterweights", CounterweightPlanes),
+                         ("balance.shafts[]", ShaftFreedom)):
+        assert set(schema.known(section)) == {f.name for f in dataclasses.fields(cls)}
     assert set(schema.known("balance.<link>")) == set(LINK_KEYS)
     assert schema.known("balance.<link>.counterweight") == COUNTERWEIGHT_KEYS
     assert schema.known("operation") == tuple(f.name for f in dataclasses.fields(Operation))

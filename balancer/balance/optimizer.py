@@ -46,7 +46,8 @@ import numpy as np
 from ..cycle import CycleAnalysis, cycle_analysis
 from ..errors import SpecError
 from ..model import Design
-from ..model.balance import BalanceProblem
+from ..model.balance import BalanceProblem, RotorBalanceProblem
+from . import rotors
 from .convex import ConvexSolution, ConvexSolver
 from .nlp import NlpSolution, NlpSolver
 from .problem import ROUNDING_TOLERANCE, NumericProblem, numeric_problem
@@ -107,6 +108,9 @@ class Optimizer:
 
         Raises as :func:`~balancer.balance.problem.numeric_problem`.
         """
+        if isinstance(design.balance, RotorBalanceProblem):
+            raise SpecError("not yet for an engine: its counterweights and shafts are chosen by "
+                            "`balancer optimize`", key="balance")
         data = numeric_problem(design)  # it has checked that [operation] is there
         assert design.operation is not None
         return cls(data, gravity=design.operation.gravity)
@@ -304,4 +308,6 @@ def optimize(design: Design, backend: Backend = "nlp") -> BalanceResult:
         raise SpecError(
             f"unknown backend; choose from {', '.join(BACKENDS)}", key="backend", value=backend
         )
+    if isinstance(design.balance, RotorBalanceProblem):  # an engine's counterweights, shafts
+        return rotors.optimize(design, backend)
     return Optimizer.of(design).run(backend)

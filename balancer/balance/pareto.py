@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from ..errors import SolverError, SpecError
 from ..force_balance import RESIDUAL_FLOOR, force_balance_residual
 from ..model import Design
-from ..model.balance import Objective
+from ..model.balance import Objective, RotorBalanceProblem
 from .certificate import Constraint, lower_bound
 from .certificate import Objective as Certified
 from .conic import ConicProgram, ConicSolution
@@ -245,6 +245,9 @@ def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
     if design.balance is None:
         raise SpecError("missing required table: the redesign problem ([balance])",
                         key="balance")
+    if isinstance(design.balance, RotorBalanceProblem):
+        raise SpecError("not yet for an engine: its counterweights and shafts are chosen by "
+                        "`balancer optimize`", key="balance")
     if against == "shaking-force" and design.balance.force_balance:
         raise SpecError("with force balance imposed the shaking force is zero at every point: "
                         "there is no front against it; set [balance] force_balance = false to "

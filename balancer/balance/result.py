@@ -18,7 +18,7 @@ from ..cycle import CycleAnalysis, cycle_analysis
 from ..errors import SolverError
 from ..model import Design
 from ..model import MechanismModel as Model
-from ..model.balance import Objective, ObjectiveTerm
+from ..model.balance import Objective, ObjectiveTerm, PlacedMass, ShaftDesign
 from .counterweights import Counterweight, added_mass, counterweights
 
 #: Gap to the certified lower bound, relative to the problem's scale (the original design's
@@ -72,6 +72,57 @@ class StageReport:
     time: float
     objective: float
     gap: float = float("nan")
+
+
+@dataclass(frozen=True)
+class RotorMasses:
+    """What a balancing builds: counterweights on the crankshaft and new shafts.
+
+    Attributes
+    ----------
+    counterweights
+        Per chosen plane, its counterweight (``mr`` 0: none there).
+    shafts
+        Each new shaft with an eccentric per plane (``mr`` 0: none there).
+    radius
+        The counterweights' radius, m (``None``: not given), for their masses.
+    replaced
+        The planes whose labelled counterweights the new ones replace, m.
+    unbalance_before, unbalance_after
+        ``√Σ (mr·ω²)²`` over the chosen planes' counterweights and the new shafts' eccentrics
+        of the original (its replaced counterweights) and of the balanced design, N.
+    bearing_loads
+        Each new shaft's largest bearing force, N (its eccentrics' centrifugal forces summed).
+    """
+
+    counterweights: tuple[PlacedMass, ...]
+    shafts: tuple[ShaftDesign, ...]
+    radius: float | None
+    replaced: tuple[float, ...]
+    unbalance_before: float
+    unbalance_after: float
+    bearing_loads: tuple[float, ...]
+
+    def mass(self, c: PlacedMass) -> float | None:
+        """A counterweight's mass at :attr:`radius`, kg (``None`` without a radius)."""
+        return None if self.radius is None else c.mr / self.radius
+
+    def as_dict(self) -> dict[str, object]:
+        """``crankshaft_counterweights`` and ``balance_shafts`` as ``optimize --json`` gives."""
+        cws = []
+        for c in self.counterweights:
+            item: dict[str, object] = {"z": c.z, "mr": c.mr, "phase_deg": c.phase_deg}
+            mass = self.mass(c)
+            if mass is not None:
+                item["mass"] = mass
+            cws.append(item)
+        shafts = [{"ratio": s.ratio, "at": list(s.at),
+                   "eccentrics": [{"z": e.z, "mr": e.mr, "phase_deg": e.phase_deg}
+                                  for e in s.eccentrics],
+                   "max_bearing_load": load}
+                  for s, load in zip(self.shafts, self.bearing_loads, strict=True)]
+        return {"crankshaft_counterweights": cws, "balance_shafts": shafts}
+
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -133,6 +184,9 @@ class BalanceResult:
         The spec's ``[operation] gravity`` (m/s²), for :attr:`operating`.
     weights
         The objective's weights (``[balance.objective]``).
+    rotor_masses
+        An engine's balancing: the counterweights and shafts it builds (``None`` for a
+        linkage's, whose links change).
     """
 
     success: bool
@@ -156,6 +210,7 @@ class BalanceResult:
     after: CycleAnalysis
     gravity: tuple[float, float] = (0.0, 0.0)
     weights: Objective = Objective()
+    rotor_masses: RotorMasses | None = None
 
     def __repr__(self) -> str:
         return (f"BalanceResult({self.status}, {self.backend}: {self.message}; added mass "
@@ -177,7 +232,13 @@ class BalanceResult:
 
     @property
     def counterweights(self) -> dict[str, Counterweight]:
-        """Per link, the body to add to the original link to build the balanced one."""
+        """Per link, the body to add to the original link to build the balanced one.
+
+        (None for an engine's balancing: its links stay; :attr:`rotor_masses` says what it
+        adds.)
+        """
+        if self.rotor_masses is not None:
+            return {}
         return counterweights(self.original, self.linkage)
 
     @property
@@ -231,6 +292,10 @@ class BalanceResult:
                   "shaking_force_y": float(np.sqrt(np.mean(force.imag**2))),
                   "rocking_couple": analysis.summary.rocking_couple.rms,
                   "added_mass": analysis.linkage.total_mass - self.original.total_mass}
+        if self.rotor_masses is not None:  # (of the chosen masses, not of the analysis)
+            rm = self.rotor_masses
+            values["unbalance"] = (rm.unbalance_after if analysis is self.after
+                                   else rm.unbalance_before)
         return {t.name: values[t.name] for t in self.weights.terms}
 
     @property
@@ -239,7 +304,12 @@ class BalanceResult:
         return self.status is Status.OPTIMAL
 
     def balanced_design(self, design: Design) -> Design:
-        """The spec ``design`` with the balanced linkage, and the original kept as ``original``."""
+        """The spec ``design`` with the balanced linkage, and the original kept as ``original``.
+
+        (An engine's balancing keeps no original: what it added is labelled in its spec.)
+        """
+        if self.rotor_masses is not None:
+            return replace(design, mechanism=self.linkage)
         return replace(
             design,
             mechanism=self.linkage,

@@ -48,7 +48,13 @@ back; :mod:`balancer.balance` solves the problem they describe.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from typing import Protocol
+
+from .. import validate as v
+from ..errors import SpecError
+from .mechanisms import MechanismModel
 
 #: The keys of ``[balance.objective]``, ``[balance.<link>]`` and a counterweight's table.
 OBJECTIVE_KEYS = (
@@ -60,6 +66,9 @@ OBJECTIVE_KEYS = (
     "rocking_couple",
     "added_mass",
 )
+
+#: The keys of an engine's ``[balance.objective]`` (DESIGN.md, "Balancing an engine").
+ENGINE_OBJECTIVE_KEYS = ("rocking_couple", "shaking_force", "shaking_moment", "unbalance")
 
 
 LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "counter_rotor",
@@ -92,6 +101,9 @@ class Objective:
         planes along the crank's axis; zero at every design of a mechanism in one plane).
     added_mass
         ``w_m``, (N·m)²/kg: penalises mass added to the linkage.
+    unbalance
+        ``w_U``, m²: of ``Σ (mr·ω²)²`` over an engine's chosen counterweights and eccentrics
+        (``ω`` the crank's speed), the centrifugal load they put on their bearings.
     """
 
     shaking_moment: float = 1.0
@@ -101,6 +113,7 @@ class Objective:
     shaking_force_y: float = 0.0
     rocking_couple: float = 0.0
     added_mass: float = 0.0
+    unbalance: float = 0.0
 
     @property
     def terms(self) -> tuple[ObjectiveTerm, ...]:
@@ -117,14 +130,15 @@ class Objective:
         terms = [ObjectiveTerm("shaking_moment", self.shaking_moment, "N·m"),
                  ObjectiveTerm("driving_torque", self.driving_torque, "N·m"), *forces,
                  ObjectiveTerm("rocking_couple", self.rocking_couple, "N·m"),
-                 ObjectiveTerm("added_mass", self.added_mass, "kg")]
+                 ObjectiveTerm("added_mass", self.added_mass, "kg"),
+                 ObjectiveTerm("unbalance", self.unbalance, "N")]
         return tuple(t for t in terms if t.weight > 0)
 
     @property
     def single(self) -> ObjectiveTerm | None:
         """The one mean-square quantity ``J`` weighs (``J = w·mean(q²)``), or ``None``."""
         terms = self.terms
-        if len(terms) == 1 and terms[0].name != "added_mass":
+        if len(terms) == 1 and terms[0].name not in ("added_mass", "unbalance"):
             return terms[0]
         return None
 
@@ -241,3 +255,165 @@ class BalanceProblem:
     def listed(self) -> tuple[str, ...]:
         """Names of the listed links."""
         return tuple(n for n, _ in self.links)
+
+
+# -- an engine's: counterweights on its crankshaft and eccentrics of new shafts ----------------
+
+
+def _planes(planes: object) -> tuple[float, ...]:
+    """A non-empty list of planes (z, m), each once."""
+    out = v.numbers(planes, "planes")
+    if len(set(out)) != len(out):
+        raise SpecError("must name each plane once", key="planes", value=list(out))
+    return out
+
+
+def _bounds(max_mr: object, count: int) -> tuple[float, ...]:
+    """``max_mr``: one positive number for every plane, or one per plane (kg·m)."""
+    if isinstance(max_mr, list | tuple):
+        out = tuple(v.positive(x, "max_mr") for x in max_mr)
+        if len(out) != count:
+            raise SpecError(f"must be one number or one per plane ({count})", key="max_mr",
+                            value=list(max_mr))
+        return out
+    return (v.positive(max_mr, "max_mr"),) * count
+
+
+@dataclass(frozen=True)
+class CounterweightPlanes:
+    """Where ``optimize`` may put counterweights on the crankshaft (``[balance.counterweights]``).
+
+    Attributes
+    ----------
+    planes
+        Each plane's z, m (in the order given).
+    max_mr
+        Each plane's bound on the counterweight's mass·radius, kg·m (positive).
+    radius
+        The counterweights' radius, m, for their masses in the report (``None``: not given).
+    """
+
+    planes: tuple[float, ...]
+    max_mr: tuple[float, ...]
+    radius: float | None = None
+
+    def __post_init__(self) -> None:
+        v.store(self, "planes", _planes(self.planes))
+        v.store(self, "max_mr", _bounds(self.max_mr, len(self.planes)))
+        if self.radius is not None:
+            v.store(self, "radius", v.positive(self.radius, "radius"))
+
+
+@dataclass(frozen=True)
+class ShaftFreedom:
+    """A new balance shaft sized by ``optimize`` (``[[balance.shafts]]``).
+
+    Attributes
+    ----------
+    ratio
+        Its speed over the crank's, a non-zero integer (negative: the other way).
+    at
+        Its axis in the x–y plane, m.
+    planes
+        The z of each of its eccentrics, m.
+    max_mr
+        Each eccentric's bound on its mass·radius, kg·m (positive).
+    """
+
+    ratio: int
+    at: tuple[float, float]
+    planes: tuple[float, ...]
+    max_mr: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        v.store(self, "ratio", v.ratio(self.ratio, "ratio"))
+        v.store(self, "at", v.vector2(self.at, "at"))
+        v.store(self, "planes", _planes(self.planes))
+        v.store(self, "max_mr", _bounds(self.max_mr, len(self.planes)))
+
+
+@dataclass(frozen=True, kw_only=True)
+class RotorBalanceProblem:
+    """An engine's redesign problem: counterweights and new shafts, each mass·radius bounded.
+
+    The loads are linear in each counterweight's and eccentric's mass·radius vector and each
+    bound is a cone, so the problem is convex (:mod:`balancer.balance.rotors`).
+
+    Attributes
+    ----------
+    objective
+        Weights of the objective (``rocking_couple``, ``shaking_force``, ``shaking_moment``,
+        ``unbalance``).
+    counterweights
+        The crankshaft's planes, or ``None``.
+    shafts
+        The new shafts.
+    """
+
+    objective: Objective = field(default_factory=lambda: Objective(shaking_moment=0.0,
+                                                                  rocking_couple=1.0))
+    counterweights: CounterweightPlanes | None = None
+    shafts: tuple[ShaftFreedom, ...] = ()
+
+
+@dataclass(frozen=True)
+class PlacedMass:
+    """A mass·radius on a rotor: its plane, size and angle at θ1 = 0 (a design's answer).
+
+    Attributes
+    ----------
+    z
+        Its plane, m.
+    mr
+        Mass times radius, kg·m (at least 0).
+    phase_deg
+        Its angle at θ1 = 0 from +x towards +y, degrees.
+    """
+
+    z: float
+    mr: float
+    phase_deg: float
+
+
+@dataclass(frozen=True)
+class ShaftDesign:
+    """A new balance shaft as ``optimize`` sizes it: ratio, axis and eccentrics."""
+
+    ratio: int
+    at: tuple[float, float]
+    eccentrics: tuple[PlacedMass, ...]
+
+
+class RotorBalanced(Protocol):
+    """A mechanism model that counterweights on its crank's rotor and new shafts can balance.
+
+    (An engine: :class:`balancer.mechanisms.engine.model.Engine`.)
+    """
+
+    @property
+    def counterweight_planes(self) -> tuple[float, ...]:
+        """The planes counterweights go in where the spec names none, m."""
+
+    def counterweights_in(self, planes: Sequence[float]) -> tuple[PlacedMassLike, ...]:
+        """The counterweights that balancing replaces in ``planes``."""
+
+    def with_rotor_masses(self, counterweights: Sequence[PlacedMass],
+                          shafts: Sequence[ShaftDesign],
+                          replacing: Sequence[float]) -> MechanismModel:
+        """The model with the counterweights in ``replacing`` replaced and the shafts added."""
+
+
+class PlacedMassLike(Protocol):
+    """A mass·radius at an angle in a plane (``mr`` kg·m, ``phase_deg``, ``z`` m)."""
+
+    @property
+    def mr(self) -> float:
+        """Mass times radius, kg·m."""
+
+    @property
+    def phase_deg(self) -> float:
+        """Angle at θ1 = 0, degrees."""
+
+    @property
+    def z(self) -> float:
+        """Plane, m."""

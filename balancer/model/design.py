@@ -12,7 +12,7 @@ from typing import ClassVar, Literal
 
 from .. import validate as v
 from ..errors import SpecError
-from .balance import BalanceProblem
+from .balance import BalanceProblem, RotorBalanceProblem
 from .mechanisms import MechanismModel
 
 Drive = Literal["free", "constant-speed"]
@@ -157,7 +157,7 @@ class Design:
     mechanism: MechanismModel
     operation: Operation | None = None
     simulation: SimulationSettings = field(default_factory=SimulationSettings)
-    balance: BalanceProblem | None = None
+    balance: BalanceProblem | RotorBalanceProblem | None = None
     original: MechanismModel | None = None
     title: str = ""
 

@@ -7,6 +7,7 @@ Angles are in degrees, as the spec writes them: what is written reads back exact
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 from .. import tomltext as toml
@@ -14,6 +15,12 @@ from .. import validate as v
 from ..errors import SpecError
 from ..mechanisms.engine.model import BalanceShaft, Crankshaft, Cylinder, Engine, GasCycle, Mass
 from ..model import Link
+from ..model.balance import (
+    ENGINE_OBJECTIVE_KEYS,
+    CounterweightPlanes,
+    RotorBalanceProblem,
+    ShaftFreedom,
+)
 from . import schema
 from .links import read_link
 from .tables import Table
@@ -206,4 +213,71 @@ def engine_lines(model: Engine) -> list[str]:
                 f"crank_angle_deg = [{', '.join(toml.number(a) for a in g.crank_angle_deg)}]",
                 f"pressure = [{', '.join(toml.number(p) for p in g.pressure)}]  # Pa",
                 f"crankcase = {toml.number(g.crankcase)}  # Pa"]
+    return out
+
+
+# -- [balance]: counterweights and new shafts (DESIGN.md, "Balancing an engine") -------------
+
+
+def read_engine_balance(table: Table, engine: Engine) -> RotorBalanceProblem:
+    """An engine's ``[balance]``: the objective, the counterweights' planes, the new shafts."""
+    if table.has("force_balance"):
+        raise SpecError("does not apply to an engine: its balancing chooses counterweights and "
+                        "shafts ([balance.counterweights], [[balance.shafts]])",
+                        key=table.key("force_balance"), value=table.raw("force_balance"))
+    table.expect(schema.known("balance", schema.ENGINE))
+    defaults = RotorBalanceProblem().objective
+    objective = defaults
+    sub = table.table("objective", required=False)
+    if sub is not None:
+        sub.expect(schema.known("balance.objective", schema.ENGINE))
+        objective = replace(defaults, **{name: sub.nonnegative(name, default=getattr(
+            defaults, name)) for name in ENGINE_OBJECTIVE_KEYS})
+        sub.finish()
+    counterweights = None
+    sub = table.table("counterweights", required=False)
+    if sub is not None:
+        sub.expect(schema.known("balance.counterweights", schema.ENGINE))
+        if not sub.has("max_mr"):
+            raise sub._missing("max_mr")
+        with v.under(sub.path):
+            counterweights = CounterweightPlanes(
+                planes=sub.value("planes", list(engine.counterweight_planes)),
+                max_mr=sub.raw("max_mr"), radius=sub.value("radius", None))
+        sub.finish()
+    shafts = []
+    for sub in table.tables("shafts"):
+        sub.expect(schema.known(sub.path, schema.ENGINE))
+        for name in ("ratio", "planes", "max_mr"):
+            if not sub.has(name):
+                raise sub._missing(name)
+        with v.under(sub.path):
+            shafts.append(ShaftFreedom(ratio=sub.raw("ratio"), at=sub.value("at", (0.0, 0.0)),
+                                       planes=sub.raw("planes"), max_mr=sub.raw("max_mr")))
+        sub.finish()
+    table.finish()
+    return RotorBalanceProblem(objective=objective, counterweights=counterweights,
+                               shafts=tuple(shafts))
+
+
+def _numbers(values: tuple[float, ...]) -> str:
+    return f"[{', '.join(toml.number(x) for x in values)}]"
+
+
+def engine_balance_lines(problem: RotorBalanceProblem) -> list[str]:
+    """The problem as TOML lines that :func:`read_engine_balance` reads back equal."""
+    w = problem.objective
+    out = ["[balance.objective]  # weights of the mean squares over the cycle",
+           *(f"{name} = {toml.number(getattr(w, name))}" for name in ENGINE_OBJECTIVE_KEYS)]
+    cws = problem.counterweights
+    if cws is not None:
+        out += ["", "[balance.counterweights]  # on the crankshaft",
+                f"planes = {_numbers(cws.planes)}  # m",
+                f"max_mr = {_numbers(cws.max_mr)}  # kg·m"]
+        if cws.radius is not None:
+            out.append(f"radius = {toml.number(cws.radius)}  # m")
+    for s in problem.shafts:
+        out += ["", "[[balance.shafts]]  # a new shaft, sized by the optimiser",
+                f"ratio = {s.ratio}", f"at = {_numbers(s.at)}  # m",
+                f"planes = {_numbers(s.planes)}  # m", f"max_mr = {_numbers(s.max_mr)}  # kg·m"]
     return out

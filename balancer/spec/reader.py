@@ -67,7 +67,7 @@ from ..model import (
 from ..model import MechanismModel as Model
 from . import schema
 from .balance import read_balance
-from .engine import read_engine
+from .engine import read_engine, read_engine_balance
 from .links import read_link
 from .tables import Table
 
@@ -311,7 +311,9 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
         simulation = _read_simulation(root, mechanism)
         balance = None
         if root.has("balance"):
-            balance = read_balance(root.table("balance"), mechanism)
+            table = root.table("balance")
+            balance = (read_engine_balance(table, mechanism) if isinstance(mechanism, Engine)
+                       else read_balance(table, mechanism))
         original = _read_original(root, mechanism)
         root.finish()
         return Design(

@@ -207,7 +207,8 @@ SECTIONS: tuple[Section, ...] = (
         Key("simulation", "table", "the defaults below",
             "How `simulate` and `verify` run the equations of motion."),
         Key("balance", "table", "none",
-            "The redesign problem that `optimize`, `pareto` and `sweep` solve.", _LINKAGES),
+            "The redesign problem that `optimize`, `pareto` and `sweep` solve (an engine's: "
+            "its counterweights and new shafts, which `optimize` sizes)."),
         Key("original", "table", "none",
             "The unbalanced design a balanced one was derived from (same geometry), as "
             "`optimize --out` writes it: `verify` and `plot` show both.", _LINKAGES),
@@ -576,6 +577,67 @@ def _for_linkages(section: Section) -> Section:
 SECTIONS = tuple(_for_linkages(s) if s.pattern.split(".")[0] in ("balance", "original") else s
                  for s in SECTIONS)
 
+#: An engine's ``[balance]`` (DESIGN.md, "Balancing an engine"): the objective's weights, the
+#: crankshaft's planes for counterweights, the new shafts.
+_ENGINE_BALANCE: dict[str, tuple[Key, ...]] = {
+    "balance": (
+        Key("objective", "table", "the defaults below",
+            "The weights of the objective (the table below).", (ENGINE,),
+            example="{ rocking_couple = 1.0 }"),
+        Key("counterweights", "table", "none",
+            "Where counterweights may go on the crankshaft (`[balance.counterweights]`, "
+            "below).", (ENGINE,)),
+        Key("shafts", "table", "none",
+            "New balance shafts, sized by the optimiser (`[[balance.shafts]]`, below); those "
+            "of `[[balance_shafts]]` stay as given.", (ENGINE,)),
+    ),
+    "balance.objective": (
+        Key("rocking_couple", "—", "1",
+            "An engine's: w_R, of the rocking couple's mean-square magnitude.", (ENGINE,),
+            example="1.0"),
+        Key("shaking_force", "m²", "0",
+            "An engine's: w_F, of the shaking force's mean-square magnitude ((N·m)²/N²).",
+            (ENGINE,), example="0.04"),
+        Key("shaking_moment", "—", "0",
+            "An engine's: w_M, of the mean-square shaking moment about z.", (ENGINE,),
+            example="0.0"),
+        Key("unbalance", "m²", "0",
+            "An engine's: w_U, of Σ (mr·ω²)² over the chosen counterweights and eccentrics (ω "
+            "the crank's speed): the load they put on their bearings.", (ENGINE,),
+            example="0.0004"),
+    ),
+}
+SECTIONS = tuple(
+    replace(s, keys=s.keys + _ENGINE_BALANCE[s.pattern], mechanisms=(*s.mechanisms, ENGINE))
+    if s.pattern in _ENGINE_BALANCE else s for s in SECTIONS) + (
+    Section("balance.counterweights", "An engine's counterweights on the crankshaft: the "
+            "optimiser chooses each one's mass·radius (within `max_mr`) and angle (any); they "
+            "replace the counterweights labelled `\"counterweight\"` in these planes.", (
+                Key("planes", "m", "each cylinder's plane",
+                    "The z of each plane, each once.", (ENGINE,),
+                    example="[-0.088, 0.0, 0.088]"),
+                Key("max_mr", "kg·m", "required",
+                    "The largest mass·radius in each plane: one number, or one per plane; "
+                    "positive.", (ENGINE,), example="0.035"),
+                Key("radius", "m", "none",
+                    "The counterweights' radius: the report then gives each one's mass; "
+                    "positive.", (ENGINE,), example="0.05"),
+            ), (ENGINE,)),
+    Section("balance.shafts[]", "A new balance shaft, geared to the crank, with an eccentric "
+            "in each of its planes sized by the optimiser.", (
+                Key("ratio", "—", "required",
+                    "Its speed over the crank's, a non-zero whole number; negative turns the "
+                    "other way.", (ENGINE,), example="-1"),
+                Key("at", "m", "[0, 0]", "Its axis in the x–y plane `[x, y]`.", (ENGINE,),
+                    example="[-0.06, 0.09]"),
+                Key("planes", "m", "required", "The z of each eccentric, each once.",
+                    (ENGINE,), example="[0.11, -0.11]"),
+                Key("max_mr", "kg·m", "required",
+                    "The largest mass·radius of each eccentric: one number, or one per plane; "
+                    "positive.", (ENGINE,), example="0.006"),
+            ), (ENGINE,)),
+)
+
 _BY_PATTERN = {s.pattern: s for s in SECTIONS}
 _INDEX = re.compile(r"\[\d+\]$")
 
@@ -584,8 +646,10 @@ def pattern(path: str) -> str:
     """The pattern of a table's dotted path (``links.crank.com`` → ``links.<link>.com``)."""
     parts = [_INDEX.sub("[]", part) for part in path.split(".")] if path else []
     if len(parts) >= 2 and parts[0] in ("links", "original", "balance"):
-        kept = {"links": "ground", "balance": "objective"}.get(parts[0])
-        if parts[1] != kept:
+        kept = {"links": ("ground",),
+                "balance": ("objective", "counterweights", "shafts", "shafts[]")}.get(
+            parts[0], ())
+        if parts[1] not in kept:
             parts[1] = "<link>"
     return ".".join(parts)
 

@@ -8,9 +8,10 @@ from .. import tomltext as toml
 from ..mechanisms.engine.model import Engine
 from ..mechanisms.slidercrank.model import SliderCrank
 from ..model import ChainModel, Design, GasForce, Link, Linkage, MechanismModel
+from ..model.balance import RotorBalanceProblem
 from ..outputs import write_atomic
 from .balance import balance_lines
-from .engine import engine_lines
+from .engine import engine_balance_lines, engine_lines
 
 
 def _link_lines(link: Link, frame: str = "link") -> list[str]:
@@ -118,7 +119,9 @@ def dumps_design(design: Design) -> str:
         f"outputs = {toml.number(sim.outputs)}",
     ]
     if design.balance is not None:
-        out += ["", *balance_lines(design.balance)]
+        out += ["", *(engine_balance_lines(design.balance)
+                      if isinstance(design.balance, RotorBalanceProblem)
+                      else balance_lines(design.balance))]
     if design.original is not None:
         out += ["", "# The unbalanced design this one was derived from (same geometry)."]
         out += _links_lines(design.original, "original")

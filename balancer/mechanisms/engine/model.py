@@ -20,6 +20,7 @@ from typing import ClassVar
 from ... import validate as v
 from ...errors import AssemblyError, SpecError
 from ...linkage.rotors import Eccentric, Rotor
+from ...model.balance import PlacedMass, ShaftDesign
 from ...model.links import GasForce, Link
 from ...model.mechanisms import MechanismModel
 
@@ -98,6 +99,10 @@ class Cylinder:
     def top_dead_centre(self) -> float:
         """The crank angle θ1 in [0, 2π) where its crank pin points along its axis, rad."""
         return (self.bank - self.phase) % (2 * math.pi)
+
+
+#: The label of a counterweight that balancing may replace.
+COUNTERWEIGHT = "counterweight"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -202,10 +207,7 @@ class BalanceShaft:
     eccentrics: tuple[Mass, ...] = ()
 
     def __post_init__(self) -> None:
-        ratio = v.number(self.ratio, "ratio")
-        if ratio == 0 or ratio != round(ratio):
-            raise SpecError("must be a non-zero whole number", key="ratio", value=self.ratio)
-        v.store(self, "ratio", int(ratio))
+        v.store(self, "ratio", v.ratio(self.ratio, "ratio"))
         v.store(self, "at", v.vector2(self.at, "at"))
         v.store(self, "inertia", v.nonnegative(self.inertia, "inertia"))
         v.store(self, "eccentrics", _masses(self.eccentrics, "eccentrics"))
@@ -465,3 +467,34 @@ class Engine(MechanismModel):
     def without_loads(self) -> Engine:
         """A copy without gas."""
         return replace(self, gas=None)
+
+    # -- balancing by counterweights and shafts (model.balance.RotorBalanced) ---------------
+
+    @property
+    def counterweight_planes(self) -> tuple[float, ...]:
+        """The cylinders' planes, each once, in the cylinders' order, m."""
+        return tuple(dict.fromkeys(c.z for c in self.cylinders))
+
+    def counterweights_in(self, planes: Sequence[float]) -> tuple[Mass, ...]:
+        """The crankshaft's masses labelled ``"counterweight"`` in ``planes``."""
+        return tuple(m for m in self.crankshaft.masses
+                     if m.label == COUNTERWEIGHT and any(m.z == z for z in planes))
+
+    def with_rotor_masses(self, counterweights: Sequence[PlacedMass],
+                          shafts: Sequence[ShaftDesign], replacing: Sequence[float]) -> Engine:
+        """The engine with new counterweights and shafts (DESIGN.md, "Balancing an engine").
+
+        The labelled counterweights in the planes ``replacing`` go; each of ``counterweights``
+        with a mass·radius is added, labelled ``"counterweight"``; each of ``shafts`` is added
+        after the engine's own (no inertia), with its eccentrics that have a mass·radius.
+        """
+        gone = set(self.counterweights_in(replacing))
+        kept = tuple(m for m in self.crankshaft.masses if m not in gone)
+        added = tuple(Mass(mr=c.mr, phase_deg=c.phase_deg, z=c.z, label=COUNTERWEIGHT)
+                      for c in counterweights if c.mr > 0)
+        new_shafts = tuple(
+            BalanceShaft(ratio=s.ratio, at=s.at, eccentrics=tuple(
+                Mass(mr=e.mr, phase_deg=e.phase_deg, z=e.z) for e in s.eccentrics if e.mr > 0))
+            for s in shafts)
+        return replace(self, crankshaft=replace(self.crankshaft, masses=kept + added),
+                       balance_shafts=self.balance_shafts + new_shafts)
