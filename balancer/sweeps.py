@@ -52,6 +52,7 @@ from .balance.result import InfeasibleError
 from .cycle import cycle_analysis
 from .errors import AssemblyError, LockupError, OutputError, SolverError, SpecError
 from .model import Design
+from .model.balance import RotorBalanceProblem
 from .outputs import write_with
 from .plots import sweep_figure
 from .spec import design_from_dict
@@ -556,6 +557,9 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
         raise SpecError("missing required table: a sweep balances each point as the spec's "
                         "[balance] asks (or give --perturb to analyse perturbed designs)",
                         key="balance", source=str(spec))
+    if not perturbs and isinstance(design.balance, RotorBalanceProblem):
+        raise SpecError("not yet for an engine: its counterweights and shafts are chosen by "
+                        "`balancer optimize`", key="balance", source=str(spec))
     if design.operation is None:
         raise SpecError("missing required key: the figures are taken at the operating speed",
                         key="operation.speed", source=str(spec))

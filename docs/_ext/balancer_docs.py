@@ -25,8 +25,11 @@ def _cell(text: str) -> str:
 
 
 def label(pattern: str) -> str:
-    """The page's anchor of a table: ``spec-links-link-com`` for ``links.<link>.com``."""
-    slug = "".join(c if c.isalnum() else "-" for c in pattern.lower())
+    """The page's anchor of a table: ``spec-links-link-com`` for ``links.<link>.com``.
+
+    (An underscore stays: ``balance_shafts[]`` and ``balance.shafts[]`` are two tables.)
+    """
+    slug = "".join(c if c.isalnum() or c == "_" else "-" for c in pattern.lower())
     return "spec-" + "-".join(part for part in slug.split("-") if part) if pattern else "spec-top"
 
 
