@@ -630,6 +630,21 @@ def rotor_masses_text(masses: RotorMasses, speed: float) -> str:
     return table(rows, header) + "\n" + "\n".join(notes)
 
 
+def _parameters_text(result: BalanceResult) -> str:
+    """Each link's parameters before and after, the changed ones marked."""
+    rows = []
+    for name in result.linkage.link_names:
+        old, new = result.original.link(name), result.linkage.link(name)
+        for key, unit in (("mass", "kg"), ("e", "m"), ("f", "m"), ("inertia", "kg·m²"),
+                          ("counter_rotor", "kg·m²")):
+            a, b = getattr(old, key), getattr(new, key)
+            if key == "counter_rotor" and name not in result.linkage.grounded_links:
+                continue
+            changed = "" if abs(a - b) <= 1e-12 * max(1.0, abs(a)) else "changed"
+            rows.append([f"{name} {key}", f"{a:.6g}", f"{b:.6g}", unit, changed])
+    return table(rows, ["parameter", "before", "after", "unit", ""])
+
+
 def optimization_text(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis,
                       verification: Verification | None = None,
                       spec: str | None = None) -> str:
@@ -682,22 +697,8 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
     lines += [table(rows, ["order amplitude", "before", "after", "unit"]), ""]
     if result.rotor_masses is not None:  # an engine: what to build, not changed links
         lines += [rotor_masses_text(result.rotor_masses, before.speed), ""]
-        lines.append(_force_balance_line(after))
-        if verification is not None:
-            lines += ["", verification_text(verification).split("\n", 1)[1].strip("\n")]
-        return "\n".join(lines)
-    rows = []
-    for name in result.linkage.link_names:
-        old, new = result.original.link(name), result.linkage.link(name)
-        for key, unit in (("mass", "kg"), ("e", "m"), ("f", "m"), ("inertia", "kg·m²"),
-                          ("counter_rotor", "kg·m²")):
-            a, b = getattr(old, key), getattr(new, key)
-            if key == "counter_rotor" and name not in result.linkage.grounded_links:
-                continue
-            changed = "" if abs(a - b) <= 1e-12 * max(1.0, abs(a)) else "changed"
-            rows.append([f"{name} {key}", f"{a:.6g}", f"{b:.6g}", unit, changed])
-    lines.append(table(rows, ["parameter", "before", "after", "unit", ""]))
-    lines += ["", counterweight_text(result.counterweights), ""]
+    else:
+        lines += [_parameters_text(result), "", counterweight_text(result.counterweights), ""]
     lines.append(_force_balance_line(after))
     if verification is not None:
         lines.append("")

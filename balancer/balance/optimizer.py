@@ -241,40 +241,7 @@ class Optimizer:
             gravity=self.gravity,
             weights=data.weights,
         )
-        return replace(result, message=_message(result, convex, notes))
-
-
-def _message(result: BalanceResult, convex: ConvexSolution, notes: list[str]) -> str:
-    """One line: the status, the figure, the certified bound and the gap.
-
-    With one quantity in the objective, as its RMS in its own unit (N for a force, N·m for a
-    moment or torque); otherwise the weighted sum ``J`` in (N·m)².
-    """
-    text = {
-        Status.OPTIMAL: "globally optimal",
-        Status.FEASIBLE: "feasible, not proven optimal",
-        Status.FAILED: "no feasible design found",
-    }[result.status]
-    term = result.single_term
-    if result.rms_form and term is not None:
-        unit, name = term.unit, term.name.replace("_", " ")
-        tolerance = (f"tolerance {GAP_TOLERANCE:g} of the problem's scale "
-                     f"{result.in_unit(result.scale):.4g} {unit}")
-        value = f"RMS {name} {result.in_unit(result.rms):.6g} {unit}"
-        if result.original_objective > 0:
-            ratio = result.rms / math.sqrt(result.original_objective)
-            value += f" ({ratio:.3g} of the original's)"
-        parts = [text, value,
-                 f"certified lower bound {result.in_unit(result.rms_lower_bound):.6g} {unit}",
-                 f"gap {result.in_unit(result.rms_gap):.2g} {unit} ({tolerance})"]
-    else:
-        tolerance = f"tolerance {GAP_TOLERANCE:g} of the problem's scale {result.scale:.4g} N·m"
-        parts = [text, f"J = {result.objective:.6g} (N·m)²",
-                 f"certified lower bound {result.lower_bound:.6g} (N·m)²",
-                 f"gap {result.gap * result.scale**2:.2g} (N·m)² ({tolerance}, squared)"]
-    if not convex.relaxation_tight:
-        parts.append("convex relaxation not tight")
-    return "; ".join(parts + notes)
+        return replace(result, message=result.summary(notes))
 
 
 def optimize(design: Design, backend: Backend = "nlp") -> BalanceResult:

@@ -7,6 +7,7 @@ A result says whether it succeeded in its own terms (:attr:`BalanceResult.succes
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from enum import StrEnum
 from functools import cached_property
@@ -297,6 +298,38 @@ class BalanceResult:
             values["unbalance"] = (rm.unbalance_after if analysis is self.after
                                    else rm.unbalance_before)
         return {t.name: values[t.name] for t in self.weights.terms}
+
+    def summary(self, notes: list[str] | None = None) -> str:
+        """One line: the status, the figure, the certified bound and the gap (and ``notes``).
+
+        With one quantity in the objective, as its RMS in its own unit (N for a force, N·m for a
+        moment or torque); otherwise the weighted sum ``J`` in (N·m)².
+        """
+        text = {
+            Status.OPTIMAL: "globally optimal",
+            Status.FEASIBLE: "feasible, not proven optimal",
+            Status.FAILED: "no feasible design found",
+        }[self.status]
+        term = self.single_term
+        if self.rms_form and term is not None:
+            unit, name = term.unit, term.name.replace("_", " ")
+            tolerance = (f"tolerance {GAP_TOLERANCE:g} of the problem's scale "
+                         f"{self.in_unit(self.scale):.4g} {unit}")
+            value = f"RMS {name} {self.in_unit(self.rms):.6g} {unit}"
+            if self.original_objective > 0:
+                ratio = self.rms / math.sqrt(self.original_objective)
+                value += f" ({ratio:.3g} of the original's)"
+            parts = [text, value,
+                     f"certified lower bound {self.in_unit(self.rms_lower_bound):.6g} {unit}",
+                     f"gap {self.in_unit(self.rms_gap):.2g} {unit} ({tolerance})"]
+        else:
+            tolerance = f"tolerance {GAP_TOLERANCE:g} of the problem's scale {self.scale:.4g} N·m"
+            parts = [text, f"J = {self.objective:.6g} (N·m)²",
+                     f"certified lower bound {self.lower_bound:.6g} (N·m)²",
+                     f"gap {self.gap * self.scale**2:.2g} (N·m)² ({tolerance}, squared)"]
+        if not self.relaxation_tight:
+            parts.append("convex relaxation not tight")
+        return "; ".join(parts + (notes or []))
 
     @property
     def optimal(self) -> bool:

@@ -44,6 +44,7 @@ import math
 import sys
 import time
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Any, cast
 
 import numpy as np
@@ -176,6 +177,8 @@ class RotorProblem:
                 force[:, col] = rotor.shaking_force(theta, self.speed, zero)
                 couple[:, col] = rotor.rocking_couple(theta, self.speed, zero)
                 moment[:, col] = rotor.shaking_moment(theta, self.speed, zero)
+        #: Each mass·radius entry's force on its bearing per kg·m, ``(N, P)`` complex, N.
+        self.force_columns = force
         r = base.reactions
         w = self.weights
         blocks: list[tuple[float, NDArray[np.float64], NDArray[np.float64]]] = [
@@ -221,27 +224,29 @@ class RotorProblem:
         """``J`` of the original design, (N·m)²."""
         return self.objective(self.x0)
 
+    @cached_property
     def inertial_scale(self) -> float:
         """The largest RMS a change of every mass·radius by its bound makes, N·m."""
         return float(np.linalg.norm(self.factor[:, :-1] * self.bounds, 2))
 
+    @cached_property
     def objective_scale(self) -> float:
         """The problem's scale of ``√J``: the original's, or a share of the inertial scale."""
         value = max(math.sqrt(self.original_objective),
-                    BALANCED_SHARE * self.inertial_scale())
+                    BALANCED_SHARE * self.inertial_scale)
         return value if value > 0 else 1.0
 
     def gap(self, objective: float, lower: float) -> float:
         """``(√J − √J_low)/scale``, dimensionless."""
         return (math.sqrt(max(objective, 0.0)) - math.sqrt(max(lower, 0.0))) \
-            / self.objective_scale()
+            / self.objective_scale
 
     def rounding(self, x: NDArray[np.float64]) -> float:
         """How much rounding can blur ``√J`` at ``x``, in the units of :meth:`gap`."""
         eps = float(np.finfo(float).eps)
         blur = ROUNDING_FACTOR * eps * float(
             np.linalg.norm(np.abs(self.factor) @ np.abs(np.append(x, 1.0))))
-        return blur / self.objective_scale()
+        return blur / self.objective_scale
 
     def violations(self, x: NDArray[np.float64], tol: float = 1e-9) -> list[str]:
         """The bounds ``x`` breaks by more than ``tol`` of the bound, as text."""
@@ -286,14 +291,15 @@ class RotorProblem:
         """``√Σ (|x_i|·ω²)²``, N."""
         return float(np.linalg.norm(x)) * self.speed**2
 
-    def bearing_loads(self, shafts: tuple[ShaftDesign, ...]) -> tuple[float, ...]:
-        """Each new shaft's largest bearing force over the cycle, N."""
+    def bearing_loads(self, x: NDArray[np.float64]) -> tuple[float, ...]:
+        """Each new shaft's largest bearing force over the cycle, N.
+
+        Its eccentrics' columns of :attr:`force_columns` times their entries of ``x``.
+        """
         out = []
-        for s in shafts:
-            rotor = Rotor(ratio=float(s.ratio), inertia=0.0, axis=complex(*s.at),
-                          eccentrics=tuple(Eccentric(mr=e.mr, angle=math.radians(e.phase_deg),
-                                                     z=e.z) for e in s.eccentrics))
-            force = rotor.shaking_force(self.theta1, self.speed, np.zeros(self.theta1.size))
+        for j in range(len(self.problem.shafts)):
+            cols = np.repeat([s.shaft == j for s in self.sites], 2)
+            force = self.force_columns[:, cols] @ x[cols]
             out.append(float(np.max(np.abs(force), initial=0.0)))
         return tuple(out)
 
@@ -304,7 +310,7 @@ class RotorSolver:
     def __init__(self, data: RotorProblem) -> None:
         self.data = data
         n = data.size
-        scale = data.objective_scale()
+        scale = data.objective_scale
         full = data.factor[:, :-1] * data.bounds / scale  # in u = x / max_mr
         offset = data.factor[:, -1] / scale
         u_svd, sing, vt = np.linalg.svd(full, full_matrices=False)
@@ -346,7 +352,7 @@ class RotorSolver:
     def convex(self) -> tuple[NDArray[np.float64], float, list[StageReport]]:
         """The certified optimum: ``x``, the lower bound on ``J`` ((N·m)²) and the stages."""
         data = self.data
-        scale = data.objective_scale()
+        scale = data.objective_scale
         t0 = time.perf_counter()
         first = self._solve(self._norm)
         stages = [StageReport(name="convex", converged=first.u is not None,
@@ -409,21 +415,26 @@ class RotorSolver:
         y = candidate * bounds
         return y if data.objective(y) <= data.objective(x) else x
 
-    def nlp(self, x_start: NDArray[np.float64]) -> tuple[NDArray[np.float64] | None,
-                                                         StageReport]:
-        """IPOPT on ``x`` (kg·m) from ``x_start``: its design (``None`` if it failed)."""
+    @cached_property
+    def _ipopt(self) -> Any:
+        """IPOPT's solver of the problem in ``x``, kg·m (built when first asked for)."""
         import casadi as ca
 
         data = self.data
-        n = data.size
-        xs = ca.SX.sym("x", n)
-        scale = data.objective_scale()
-        residual = ca.mtimes(ca.DM(data.factor / scale), ca.vertcat(xs, 1.0))
+        xs = ca.SX.sym("x", data.size)
+        residual = ca.mtimes(ca.DM(data.factor / data.objective_scale), ca.vertcat(xs, 1.0))
         bounds = data.bounds
-        g = [xs[2 * i] ** 2 / bounds[2 * i] ** 2 + xs[2 * i + 1] ** 2 / bounds[2 * i] ** 2
+        g = [(xs[2 * i] ** 2 + xs[2 * i + 1] ** 2) / bounds[2 * i] ** 2
              for i in range(len(data.sites))]
-        solver = ca.nlpsol("rotors", "ipopt", {"x": xs, "f": ca.dot(residual, residual),
-                                               "g": ca.vertcat(*g)}, cast("Any", IPOPT_OPTIONS))
+        return ca.nlpsol("rotors", "ipopt", {"x": xs, "f": ca.dot(residual, residual),
+                                             "g": ca.vertcat(*g)}, cast("Any", IPOPT_OPTIONS))
+
+    def nlp(self, x_start: NDArray[np.float64]) -> tuple[NDArray[np.float64] | None,
+                                                         StageReport]:
+        """IPOPT on ``x`` (kg·m) from ``x_start``: its design (``None`` if it failed)."""
+        data = self.data
+        solver = self._ipopt
+        bounds = data.bounds
         t0 = time.perf_counter()
         said = io.StringIO()
         with interrupts.checked(), contextlib.redirect_stderr(said):
@@ -481,40 +492,17 @@ def optimize(design: Design, backend: str = "nlp") -> BalanceResult:
         counterweights=counterweights, shafts=shafts,
         radius=None if data.problem.counterweights is None else data.problem.counterweights.radius,
         replaced=data.replaced, unbalance_before=data.unbalance(data.x0),
-        unbalance_after=data.unbalance(x), bearing_loads=data.bearing_loads(shafts))
+        unbalance_after=data.unbalance(x), bearing_loads=data.bearing_loads(x))
     result = BalanceResult(
         success=True, status=status, message="", backend=backend, linkage=balanced,
         original=data.original, x=x, objective=objective,
         original_objective=data.original_objective, lower_bound=lower, gap=g,
-        scale=data.objective_scale(), rms_form=True, relaxation_tight=True,
+        scale=data.objective_scale, rms_form=True, relaxation_tight=True,
         iterations=sum(s.iterations for s in stages), time=elapsed, stages=tuple(stages),
         before=data.before, after=after,
         gravity=design.operation.gravity if design.operation is not None else (0.0, 0.0),
         weights=data.weights, rotor_masses=masses)
-    return replace(result, message=_message(result, notes))
-
-
-def _message(result: BalanceResult, notes: list[str]) -> str:
-    """One line: the status, J, its certified lower bound and the gap."""
-    text = {Status.OPTIMAL: "globally optimal", Status.FEASIBLE: "feasible, not proven optimal",
-            Status.FAILED: "no feasible design found"}[result.status]
-    term = result.single_term
-    if term is not None:
-        unit, name = term.unit, term.name.replace("_", " ")
-        value = f"RMS {name} {result.in_unit(result.rms):.6g} {unit}"
-        if result.original_objective > 0:
-            value += f" ({result.rms / math.sqrt(result.original_objective):.3g} of the original's)"
-        parts = [text, value,
-                 f"certified lower bound {result.in_unit(result.rms_lower_bound):.6g} {unit}",
-                 f"gap {result.in_unit(result.rms_gap):.2g} {unit} (tolerance "
-                 f"{GAP_TOLERANCE:g} of the problem's scale "
-                 f"{result.in_unit(result.scale):.4g} {unit})"]
-    else:
-        parts = [text, f"J = {result.objective:.6g} (N·m)²",
-                 f"certified lower bound {result.lower_bound:.6g} (N·m)²",
-                 f"gap {result.rms_gap:.2g} N·m in √J (tolerance {GAP_TOLERANCE:g} of the "
-                 f"problem's scale {result.scale:.4g} N·m)"]
-    return "; ".join(parts + notes)
+    return replace(result, message=result.summary(notes))
 
 
 __all__ = ["RotorProblem", "RotorSolver", "Site", "optimize"]
