@@ -82,9 +82,9 @@ _EXPORTS = {
     "Status": "balance.result",
     "StageReport": "balance.result",
     "InfeasibleError": "balance.result",
-    "Front": "balance.pareto",
-    "FrontPoint": "balance.pareto",
-    "Against": "balance.pareto",
+    "Front": "balance.front",
+    "FrontPoint": "balance.front",
+    "Against": "balance.front",
     "Counterweight": "balance.counterweights",
     "Mechanism": "mechanisms.base",
     "Route": "mechanisms.base",
@@ -190,8 +190,8 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         verify,
     )
     from .balance.counterweights import Counterweight
+    from .balance.front import Against, Front, FrontPoint
     from .balance.optimizer import Backend, Optimizer
-    from .balance.pareto import Against, Front, FrontPoint
     from .balance.result import BalanceResult, InfeasibleError, StageReport, Status
     from .cycle import CycleAnalysis, CycleSummary, Figure, Reactions
     from .errors import (

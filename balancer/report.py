@@ -15,12 +15,12 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 
 from .balance.counterweights import UNCHANGED, Counterweight
+from .balance.front import FIGURES, Front
 from .cycle import CycleAnalysis, Figure
 from .errors import SolverError
 from .orders import order_name
 
 if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these load them
-    from .balance.pareto import Front
     from .balance.result import BalanceResult, RotorMasses
     from .model import Link
     from .simulation import Trajectory
@@ -721,26 +721,34 @@ def front_text(front: Front, spec: str | None = None) -> str:
     """The readable front: one row per point, the knee marked."""
     head = f"balancer pareto — {spec}" if spec else "balancer pareto"
     name = front.name.replace("_", " ")
-    rows = [[f"{i + 1}", _fmt(p.value), _fmt(p.shaking_moment), _fmt(p.lower_bound),
-             "knee" if p.knee else ""] for i, p in enumerate(front.points)]
+    others = front.figure_names
+    rows = [[f"{i + 1}", _fmt(p.value), _fmt(p.least), *(_fmt(p.figures[n]) for n in others),
+             _fmt(p.lower_bound), "knee" if p.knee else ""] for i, p in enumerate(front.points)]
+    unit = FIGURES[front.minimised][1]
+    held = ("the balancing constraints of [balance] hold at every point"
+            if front.minimised == "shaking_moment"
+            else "each mass·radius within its bound; the unbalance term's place taken by the "
+                 "bound on the mass")
     lines = [head,
-             f"least RMS shaking moment against {name} ({len(front.points)} "
+             f"least {front.words} against {name} ({len(front.points)} "
              f"point{'s' if len(front.points) != 1 else ''}, each a "
-             "global optimum with its certified lower bound; the balancing constraints of "
-             "[balance] hold at every point)", "",
-             table(rows, ["point", f"{name} {front.unit}", "RMS shaking moment N·m",
-                          "certified bound N·m", ""])]
+             f"global optimum with its certified lower bound; {held})", "",
+             table(rows, ["point", f"{name} {front.unit}", f"{front.words} {unit}",
+                          *(f"{FIGURES[n][0]} {FIGURES[n][1]}" for n in others),
+                          f"certified bound {unit}", ""])]
     return "\n".join(lines)
 
 
 def front_csv(front: Front) -> str:
     """The front as CSV: one row per point (knee: 1 at the knee, else 0)."""
     points = front.points
+    others = front.figure_names
     return csv_text(
-        ["shaking_moment", front.name, "epsilon", "lower_bound", "knee"],
-        [np.array([p.shaking_moment for p in points]), np.array([p.value for p in points]),
+        [front.minimised, front.name, "epsilon", "lower_bound", "knee", *others],
+        [np.array([p.least for p in points]), np.array([p.value for p in points]),
          np.array([p.epsilon for p in points]), np.array([p.lower_bound for p in points]),
-         np.array([1.0 if p.knee else 0.0 for p in points])])
+         np.array([1.0 if p.knee else 0.0 for p in points]),
+         *(np.array([p.figures[n] for p in points]) for n in others)])
 
 
 class SweepSummary(Protocol):

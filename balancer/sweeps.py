@@ -11,9 +11,16 @@ single ``balancer optimize --backend convex`` run gives). Each point becomes one
   the bounds meets force balance), ``bad-geometry`` (the design does not assemble, or its crank
   does not turn fully), ``failed`` (the solver failed);
 - ``shaking_moment_before``, ``shaking_moment_after`` (RMS, N·m), ``shaking_force_before``,
-  ``shaking_force_after`` (RMS, N): the inertial figures of the design and of its optimum at the
-  operating speed (``after`` empty unless solved); ``lower_bound`` (N·m, the certificate),
-  ``added_mass`` (kg), ``message``.
+  ``shaking_force_after`` (RMS, N), ``rocking_couple_before``, ``rocking_couple_after`` (RMS,
+  N·m; zero for a mechanism in one plane): the inertial figures of the design and of its
+  optimum at the operating speed (``after`` empty unless solved); ``lower_bound`` (N·m, the
+  certificate: ``√J`` of the objective), ``added_mass`` (kg; an engine's chosen masses at its
+  counterweights' radius, empty where none is given), ``message``.
+
+An engine's spec (``[balance.counterweights]``, ``[[balance.shafts]]``) is balanced at each point
+as ``optimize`` balances it (:mod:`balancer.balance.rotors`); its keys — a crank radius
+``mechanism.lengths.crank``, a bank angle ``mechanism.cylinders.1.bank_deg``, a plane
+``balance.counterweights.planes.0`` — vary like any other.
 
 **On Dask.** The points are cut into batches (each task solves many points, and imports and
 builds once per worker); the batches run on ``dask.distributed`` — a ``LocalCluster`` on this
@@ -52,7 +59,6 @@ from .balance.result import InfeasibleError
 from .cycle import cycle_analysis
 from .errors import AssemblyError, LockupError, OutputError, SolverError, SpecError
 from .model import Design
-from .model.balance import RotorBalanceProblem
 from .outputs import write_with
 from .plots import sweep_figure
 from .spec import design_from_dict
@@ -71,8 +77,8 @@ BATCH = 25
 MAX_POINTS = 1_000_000
 #: The table's fixed columns after the varied keys, in order.
 COLUMNS = ("point", "status", "shaking_moment_before", "shaking_moment_after",
-           "shaking_force_before", "shaking_force_after", "lower_bound", "added_mass",
-           "message")
+           "shaking_force_before", "shaking_force_after", "rocking_couple_before",
+           "rocking_couple_after", "lower_bound", "added_mass", "message")
 
 
 @dataclass(frozen=True)
@@ -141,7 +147,9 @@ KEY_UNITS = {"mass": "kg", "inertia": "kg·m²", "counter_rotor": "kg·m²",
              "e": "m", "f": "m", "s": "m", "at": "m", "com_radius": "m", "min_gyration": "m",
              "radius": "m", "gyration": "m", "free_length": "m", "sigma": "rad",
              "theta1": "rad", "speed": "rad/s", "omega1": "rad/s", "force": "N",
-             "moment": "N·m", "stiffness": "N/m", "gravity": "m/s²", "duration": "s"}
+             "moment": "N·m", "stiffness": "N/m", "gravity": "m/s²", "duration": "s",
+             "z": "m", "planes": "m", "mr": "kg·m", "max_mr": "kg·m", "bank_deg": "°",
+             "phase_deg": "°", "crankcase": "Pa"}
 
 
 def key_unit(key: str) -> str:
@@ -167,15 +175,16 @@ def read_table(path: str | os.PathLike[str]) -> dict[str, list[Any]]:
 
 def atlas_figure(path: str | os.PathLike[str], keys: Sequence[str] | None, *,
                  original: dict[str, float] | None = None,
-                 perturbs: Sequence[Perturb] = ()) -> Figure:
+                 perturbs: Sequence[Perturb] = (), headline: str = "shaking_moment") -> Figure:
     """The figure of a sweep's table (:func:`balancer.plots.sweep_figure`), keys with units.
 
     ``keys``: the varied keys, ``None`` for a perturbation sweep (``perturbs`` then named in
-    its title); ``original``: the spec's own values, marked.
+    its title); ``original``: the spec's own values, marked; ``headline``: the figure shown
+    (:attr:`SweepResult.headline`).
     """
     named = list(keys) if keys is not None else [p.key for p in perturbs]
     return sweep_figure(read_table(path), keys, original=original, perturbs=perturbs,
-                        units={key: key_unit(key) for key in named})
+                        units={key: key_unit(key) for key in named}, headline=headline)
 
 
 def analyse_point(data: dict[str, Any], values: dict[str, float], index: int
@@ -338,7 +347,8 @@ def _own_figures(design: Design) -> dict[str, float]:
     summary = cycle_analysis(design.mechanism, design.operation.speed,
                              design.operation.samples, loads=False).summary
     return {"shaking_moment_before": summary.shaking_moment.rms,
-            "shaking_force_before": summary.shaking_force.rms}
+            "shaking_force_before": summary.shaking_force.rms,
+            "rocking_couple_before": summary.rocking_couple.rms}
 
 
 def evaluate_point(data: dict[str, Any], values: dict[str, float], index: int
@@ -367,8 +377,10 @@ def evaluate_point(data: dict[str, Any], values: dict[str, float], index: int
                shaking_moment_after=after.shaking_moment.rms,
                shaking_force_before=before.shaking_force.rms,
                shaking_force_after=after.shaking_force.rms,
+               rocking_couple_before=before.rocking_couple.rms,
+               rocking_couple_after=after.rocking_couple.rms,
                lower_bound=result.rms_lower_bound if result.rms_form else None,
-               added_mass=result.linkage.total_mass - result.original.total_mass)
+               added_mass=result.added_mass)
     return row
 
 
@@ -470,6 +482,9 @@ class SweepResult:
         Points computed by this run: ``points`` less those of the ``resumed`` batches.
     residual_force
         A perturbation sweep's residual RMS shaking force (``mean``, ``p95``, ``max``, N).
+    headline
+        The figure its balancing is about (``shaking_moment``, an engine's ``rocking_couple``:
+        the atlas shows it).
     """
 
     out: Path
@@ -480,6 +495,7 @@ class SweepResult:
     resumed: int
     computed: int
     residual_force: dict[str, float | str] | None = None
+    headline: str = "shaking_moment"
 
     @property
     def rate(self) -> float | None:
@@ -557,9 +573,6 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
         raise SpecError("missing required table: a sweep balances each point as the spec's "
                         "[balance] asks (or give --perturb to analyse perturbed designs)",
                         key="balance", source=str(spec))
-    if not perturbs and isinstance(design.balance, RotorBalanceProblem):
-        raise SpecError("not yet for an engine: its counterweights and shafts are chosen by "
-                        "`balancer optimize`", key="balance", source=str(spec))
     if design.operation is None:
         raise SpecError("missing required key: the figures are taken at the operating speed",
                         key="operation.speed", source=str(spec))
@@ -651,7 +664,9 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
     return SweepResult(out=out, points=len(points), statuses=statuses,
                        seconds=time.perf_counter() - start, workers=used, resumed=len(done),
                        computed=len(points) - sum(len(batches[i]) for i in done),
-                       residual_force=residual)
+                       residual_force=residual,
+                       headline=(design.balance.headline if design.balance is not None
+                                 else "shaking_moment"))
 
 
 def _finished(parts: Path) -> set[int]:

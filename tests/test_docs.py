@@ -331,9 +331,12 @@ def test_the_outputs_page_names_the_fronts_and_sweeps_keys(tmp_path, monkeypatch
     _, front = run_balancer(f"balancer pareto {spec} --against driving-torque --points 3 --json")
     _, sweep = run_balancer(f"balancer sweep {spec} --vary mechanism.lengths.coupler=2.9:3.1:2 "
                             "--workers 0 --out s.parquet --json")
+    engine = str(ROOT / "examples" / "v8_to_balance.toml")
+    _, engine_front = run_balancer(f"balancer pareto {engine} --against added-mass --points 2 "
+                                   "--json")
     front_doc, sweep_doc = json.loads(front), json.loads(sweep.split("wrote")[0])
     documented = _documented_keys("`pareto --json` and `sweep --json`")
-    assert documented == set(front_doc) | set(sweep_doc)
+    assert documented == set(front_doc) | set(sweep_doc) | set(json.loads(engine_front))
     assert {"shaking_moment", "driving_torque", "epsilon", "lower_bound",
             "knee"} == set(front_doc["points"][0])
 

@@ -21,6 +21,7 @@ analysis; here every check is built apart from it:
 from __future__ import annotations
 
 import math
+import tomllib
 from dataclasses import replace
 
 import cvxpy as cp
@@ -29,6 +30,8 @@ import pytest
 from test_engines import EXAMPLES, flat_four, harmonic_coefficients, momentum_loads
 
 from balancer.balance.optimizer import optimize
+from balancer.balance.pareto import pareto_front
+from balancer.balance.rotor_front import END_ROOM
 from balancer.cli import main
 from balancer.mechanisms.engine.model import BalanceShaft, Cylinder, Engine, Mass
 from balancer.model import Design, Link, Operation
@@ -38,7 +41,8 @@ from balancer.model.balance import (
     RotorBalanceProblem,
     ShaftFreedom,
 )
-from balancer.spec import load_design
+from balancer.spec import design_from_dict, load_design
+from balancer.sweeps import Vary, read_table, sweep, with_values
 
 #: What two solvers' optima of the same program agree to: Clarabel's tolerances (1e-10 on the
 #: scaled program) leave the objective within about 1e-8 of its optimum; CVXPY's default run
@@ -325,11 +329,216 @@ def test_a_wrong_engine_balance_is_refused_naming_its_key(tmp_path, capsys, tabl
     assert message in err and "Traceback" not in err
 
 
-@pytest.mark.parametrize("verb", [["pareto", "--against", "added-mass"],
-                                  ["sweep", "--vary", "mechanism.lengths.crank=0.04:0.05:2",
-                                   "--out", "x.parquet"]])
-def test_pareto_and_sweep_refuse_an_engine_for_now(tmp_path, capsys, verb, monkeypatch):
+# -- fronts: the least shaking against the mass·radius added -------------------------------------
+
+
+def without_unbalance(design: Design, **weights: float) -> Design:
+    """The design whose objective is its own without the unbalance term (or ``weights``)."""
+    w = replace(design.balance.objective, unbalance=0.0, **weights)
+    return replace(design, balance=replace(design.balance, objective=w))
+
+
+def capped_oracle(design: Design, theta: np.ndarray, per_mr: float, epsilon: float) -> float:
+    """min J' subject to each bound and Σ |X_i|·per_mr ≤ ε, by CVXPY."""
+    a, b = quadratic(design, theta)
+    bounds = [bound for _, _, _, bound in sites(design.balance)]
+    x = cp.Variable(a.shape[1])
+    sizes = [cp.norm(x[2 * i : 2 * i + 2]) for i in range(len(bounds))]
+    cons = [size <= bound for size, bound in zip(sizes, bounds, strict=True)]
+    cons.append(per_mr * cp.sum(cp.hstack(sizes)) <= epsilon)
+    prob = cp.Problem(cp.Minimize(cp.sum_squares(a @ x + b)), cons)
+    prob.solve(solver=cp.CLARABEL)
+    assert prob.status == cp.OPTIMAL
+    return float(prob.value)
+
+
+def masses_of(design: Design, x: np.ndarray) -> Engine:
+    """The base engine with ``x``'s masses (in :func:`sites`' order) added by hand."""
+    engine, problem = design.mechanism, design.balance
+    placed = [(k, at, z, complex(x[2 * i], x[2 * i + 1]))
+              for i, (k, at, z, _) in enumerate(sites(problem))]
+    cws = tuple(Mass(mr=abs(c), phase_deg=math.degrees(np.angle(c)), z=z)
+                for k, at, z, c in placed if k == 1 and at == 0)
+    shafts = tuple(BalanceShaft(ratio=s.ratio, at=s.at, eccentrics=tuple(
+        Mass(mr=abs(c), phase_deg=math.degrees(np.angle(c)), z=z)
+        for k, at, z, c in placed if (k, at) == (s.ratio, complex(*s.at))))
+        for s in problem.shafts)
+    base = base_engine(engine, problem)
+    return replace(base, crankshaft=replace(base.crankshaft,
+                                            masses=base.crankshaft.masses + cws),
+                   balance_shafts=base.balance_shafts + shafts)
+
+
+@pytest.fixture(scope="module", params=EXAMPLES_TO_BALANCE)
+def front(request):
+    design = load_design(EXAMPLES / f"{request.param}.toml")
+    return design, pareto_front(design, "added-mass", 5)
+
+
+def test_each_point_of_an_engines_front_is_the_independent_programs_optimum(front):
+    """At each point's ε: CVXPY's least J' (the spec's weights, no unbalance term) under the
+    bounds and Σ|mr|/radius ≤ ε is the point's (√J')², and the certified bound below it."""
+    design, result = front
+    theta = optimize(design, "convex").before.theta1
+    plain = without_unbalance(design)
+    per_mr = 1.0 / design.balance.counterweights.radius
+    assert result.minimised == "rms"  # (both examples weigh the couple and the force)
+    for p in result.points:
+        best = capped_oracle(plain, theta, per_mr, p.epsilon)
+        assert p.least**2 == pytest.approx(best, rel=SOLVERS, abs=SOLVERS * result.points[0]
+                                           .least**2)
+        assert p.lower_bound**2 <= best * (1 + SOLVERS)
+        assert p.value <= p.epsilon * (1 + SOLVERS)
+
+
+def test_an_engines_front_runs_from_nothing_added_to_the_optimum_without_unbalance(front):
+    """The first point adds nothing (the base engine's J'); the last is ``optimize``'s optimum
+    of the same objective; the least falls and the mass grows along the front."""
+    design, result = front
+    theta = optimize(design, "convex").before.theta1
+    plain = without_unbalance(design)
+    a, b = quadratic(plain, theta)
+    assert result.points[0].least == pytest.approx(float(np.linalg.norm(b)), rel=1e-7)
+    # (the end's ε is the least mass within END_ROOM of the problem's scale — the original's
+    # √J' — of the optimum: the program stays feasible)
+    best = math.sqrt(optimize(plain, "convex").objective)
+    room = 2 * END_ROOM * result.original[1] + SOLVERS * best
+    assert abs(result.points[-1].least - best) <= room
+    least = [p.least for p in result.points]
+    assert all(x >= y * (1 - SOLVERS) for x, y in zip(least, least[1:], strict=False))
+
+
+def test_an_engines_front_points_figures_are_its_masses_added_by_hand(front):
+    """Each point's design built by hand: its RMS couple, force and moment by the momentum sums,
+    √J' from them, and its mass Σ|mr|/radius."""
+    design, result = front
+    speed = design.operation.speed
+    theta = optimize(design, "convex").before.theta1
+    w = design.balance.objective
+    radius = design.balance.counterweights.radius
+    for p in result.points:
+        x = p.x
+        loads = momentum_loads(masses_of(design, x), theta, speed)
+        want = {"rocking_couple": float(np.sqrt(np.mean(np.abs(loads.couple) ** 2))),
+                "shaking_force": float(np.sqrt(np.mean(np.abs(loads.force) ** 2))),
+                "shaking_moment": float(np.sqrt(np.mean(loads.moment**2)))}
+        for name, value in want.items():
+            assert p.figures[name] == pytest.approx(value, rel=EXACT,
+                                                    abs=EXACT * loads.scale_moment)
+        j = sum(getattr(w, n) * v**2 for n, v in want.items())
+        assert p.least == pytest.approx(math.sqrt(j), rel=EXACT)
+        mass = sum(math.hypot(x[2 * i], x[2 * i + 1]) for i in range(x.size // 2)) / radius
+        assert p.value == pytest.approx(mass, rel=EXACT)
+
+
+def test_an_engines_front_of_the_couple_alone_is_of_its_rms():
+    """With the rocking couple the only term, the front is of its RMS (N·m), and without a
+    radius of Σ|mr| (kg·m). In-line three: at its optimum end the couple left is what neither
+    counterweights nor a −1× shaft reach, every order n ≥ 2 not a multiple of three, each
+    √3/2·s·m_rec·r·ω²·A_n turning either way (mean square 2·a_n² per order)."""
+    design = without_unbalance(load_design(EXAMPLES / "inline_three_to_balance.toml"),
+                               shaking_force=0.0)
+    design = replace(design, balance=replace(design.balance, counterweights=replace(
+        design.balance.counterweights, radius=None)))
+    result = pareto_front(design, "added-mass", 3)
+    assert result.minimised == "rocking_couple" and result.unit == "kg·m"
+    for p in result.points:
+        assert p.least == pytest.approx(p.figures["rocking_couple"], rel=EXACT)
+        assert p.value == pytest.approx(sum(np.hypot(p.x[0::2], p.x[1::2])), rel=EXACT)
+    engine = design.mechanism
+    c = engine.cylinders
+    m_rec = engine.piston + engine.rod.mass * engine.rod.e / c[0].rod
+    speed = design.operation.speed
+    coefficients = harmonic_coefficients(c[0].crank / c[0].rod, orders=tuple(range(2, 41)))
+    # What no counterweight or −1× shaft reaches: every order from the second, each of the
+    # in-line three's orders 2 and 4 (mod 3: ±1) turning both ways, √3/2·s·m_rec·r·ω²·A_n.
+    s = c[2].z
+    left = [math.sqrt(3) / 2 * s * m_rec * c[0].crank * speed**2 * coefficients[n]
+            for n in coefficients if n % 3]
+    rms = math.sqrt(sum(2 * a**2 for a in left))
+    assert result.points[-1].least == pytest.approx(rms, rel=1e-6)
+
+
+def test_pareto_of_an_engine_on_the_command_line(tmp_path, capsys, monkeypatch):
+    """``--json`` names each point's figures and the units; a plot and a CSV are written."""
     monkeypatch.chdir(tmp_path)
     spec = str(EXAMPLES / "v8_to_balance.toml")
-    assert main([verb[0], spec, *verb[1:]]) == 2
-    assert "balance" in capsys.readouterr().err
+    assert main(["pareto", spec, "--against", "added-mass", "--points", "4", "--json",
+                 "--plot", "front.png", "--csv", "front.csv"]) == 0
+    import json
+
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["against"] == "added-mass" and doc["minimised"] == "rms"
+    for p in doc["points"]:
+        assert {"rms", "shaking_moment", "rocking_couple", "shaking_force", "added_mass",
+                "epsilon", "lower_bound", "knee"} <= set(p)
+    assert doc["units"]["added_mass, epsilon"] == "kg"
+    assert (tmp_path / "front.png").stat().st_size > 0
+    header = (tmp_path / "front.csv").read_text().splitlines()[0].split(",")
+    assert header[:5] == ["rms", "added_mass", "epsilon", "lower_bound", "knee"]
+
+
+@pytest.mark.parametrize(("args", "key"), [
+    (["--against", "driving-torque"], "--against"),
+    (["--against", "shaking-force"], "--against"),
+])
+def test_pareto_of_an_engine_refuses_another_second_objective(tmp_path, capsys, args, key):
+    assert main(["pareto", str(EXAMPLES / "v8_to_balance.toml"), *args]) == 2
+    err = capsys.readouterr().err
+    assert key in err and "added-mass" in err and "Traceback" not in err
+
+
+def test_pareto_of_an_engine_weighing_only_the_unbalance_is_refused(tmp_path, capsys):
+    text = (EXAMPLES / "v8_to_balance.toml").read_text()
+    text = text.replace("rocking_couple = 1.0", "rocking_couple = 0.0").replace(
+        "shaking_force = 0.04", "shaking_force = 0.0")
+    spec = tmp_path / "only.toml"
+    spec.write_text(text)
+    assert main(["pareto", str(spec), "--against", "added-mass"]) == 2
+    assert "balance.objective" in capsys.readouterr().err
+
+
+# -- sweeps of engines -------------------------------------------------------------------------
+
+
+def test_a_sweep_of_an_engine_balances_each_point_as_the_independent_program_does(tmp_path):
+    """In-line three over its crank radius and a shaft's plane: each row's couple before by
+    the momentum sums, its optimum (J from the row's after figures: no unbalance term, no
+    moment weight) CVXPY's, the certified bound below it, the added mass the masses at the
+    radius."""
+    spec = EXAMPLES / "inline_three_to_balance.toml"
+    out = tmp_path / "three.parquet"
+    varies = [Vary.parse("mechanism.lengths.crank=0.035:0.045:2"),
+              Vary.parse("balance.shafts.0.planes.0=0.10:0.12:2")]
+    result = sweep(spec, varies, out, workers=0)
+    assert result.statuses == {"optimal": 4} and result.headline == "rocking_couple"
+    rows = read_table(out)
+    data = tomllib.loads(spec.read_text())
+    for i in range(4):
+        values = {v.key: rows[v.key][i] for v in varies}
+        design = design_from_dict(with_values(data, values))
+        w = design.balance.objective
+        assert w.unbalance == 0 and w.shaking_moment == 0
+        theta = optimize(design, "convex").before.theta1
+        loads = momentum_loads(design.mechanism, theta, design.operation.speed)
+        couple = float(np.sqrt(np.mean(np.abs(loads.couple) ** 2)))
+        assert rows["rocking_couple_before"][i] == pytest.approx(couple, rel=EXACT)
+        best = oracle(design, theta)
+        j = (w.rocking_couple * rows["rocking_couple_after"][i] ** 2
+             + w.shaking_force * rows["shaking_force_after"][i] ** 2)
+        assert j == pytest.approx(best, rel=SOLVERS)
+        assert rows["lower_bound"][i] ** 2 <= best * (1 + SOLVERS)
+        assert rows["added_mass"][i] > 0
+
+
+def test_a_sweep_of_an_engine_draws_its_rocking_couple(tmp_path, capsys, monkeypatch):
+    """``sweep --plot`` of an engine: the atlas of the balanced rocking couple."""
+    monkeypatch.chdir(tmp_path)
+    spec = str(EXAMPLES / "v8_to_balance.toml")
+    assert main(["sweep", spec, "--vary", "mechanism.cylinders.1.bank_deg=44:46:2",
+                 "--out", "v8.parquet", "--workers", "0", "--plot", "atlas.png"]) == 0
+    rows = read_table(tmp_path / "v8.parquet")
+    assert rows["status"] == ["optimal", "optimal"]
+    assert all(a < b for a, b in zip(rows["rocking_couple_after"],
+                                     rows["rocking_couple_before"], strict=True))
+    assert (tmp_path / "atlas.png").stat().st_size > 0

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+from ..balance.front import Against, Front
 from ..balance.optimizer import Backend
 from ..balance.optimizer import optimize as run_optimizer
-from ..balance.pareto import Against, Front, pareto_front
+from ..balance.pareto import pareto_front
 from ..balance.result import BalanceResult
 from ..model import Design
 
@@ -21,7 +22,9 @@ def optimize(design: Design, *, backend: Backend = "nlp") -> BalanceResult:
 def pareto(design: Design, *, against: Against, points: int = 11) -> Front:
     """The exact front of least RMS shaking moment against ``against``.
 
-    ``against``: ``"driving-torque"``, ``"added-mass"`` or ``"shaking-force"``. See
-    :func:`balancer.balance.pareto.pareto_front`.
+    ``against``: ``"driving-torque"``, ``"added-mass"`` or ``"shaking-force"``. An engine's
+    front (``[balance.counterweights]``, ``[[balance.shafts]]``) is of its weighted shaking
+    against the mass·radius it adds (``"added-mass"``; :mod:`balancer.balance.rotor_front`).
+    See :func:`balancer.balance.pareto.pareto_front`.
     """
     return pareto_front(design, against, points)

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from .. import report
-from ..balance.pareto import Front
+from ..balance.front import Front
 from ..balance.result import BalanceResult
 from ..cycle import CycleAnalysis
 from ..simulation import Trajectory

@@ -22,8 +22,8 @@ measured over its range.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
-from typing import Literal, cast
+from dataclasses import replace
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,94 +36,15 @@ from .certificate import Constraint, lower_bound
 from .certificate import Objective as Certified
 from .conic import ConicProgram, ConicSolution
 from .convex import Compressed, ConvexSolver
+from .front import AGAINST, Against, Front, FrontPoint, mark_knee
 from .problem import NumericProblem, numeric_problem
+from .rotor_front import rotor_front
 
-#: The second objectives, and the name and unit each is reported under.
-#: The second objectives of a front (``pareto --against``).
-Against = Literal["driving-torque", "added-mass", "shaking-force"]
-AGAINST: dict[str, tuple[str, str]] = {
-    "driving-torque": ("driving_torque", "N·m"),
-    "added-mass": ("added_mass", "kg"),
-    "shaking-force": ("shaking_force", "N"),
-}
 #: Most points of one front (each a conic program: ~10 ms).
 MAX_POINTS = 1000
 #: Room given to an end of the front when it becomes a constraint (relative to the objective's
 #: scale): a hundred times Clarabel's tolerance, so that the constrained program stays feasible.
 END_ROOM = 1e-8
-
-
-@dataclass(frozen=True)
-class FrontPoint:
-    """One point of a front: a design and its two objectives.
-
-    Attributes
-    ----------
-    shaking_moment
-        RMS shaking moment of the design (inertial, at the operating speed), N·m.
-    value
-        Its second objective (RMS driving torque N·m, added mass kg, or RMS shaking force N).
-    epsilon
-        The bound on the second objective this point was solved under (same unit).
-    lower_bound
-        No design within the bounds with the second objective at most ``epsilon`` has a
-        smaller RMS shaking moment, N·m (certified).
-    x
-        The design vector.
-    knee
-        Whether this is the front's knee.
-    """
-
-    shaking_moment: float
-    value: float
-    epsilon: float
-    lower_bound: float
-    x: NDArray[np.float64] = field(repr=False)
-    knee: bool = False
-
-
-@dataclass(frozen=True)
-class Front:
-    """A trade-off front, its points ordered by the second objective.
-
-    ``original`` is the original design's ``(second objective, RMS shaking moment)``: where the
-    designer starts from (it need not meet the balancing constraints). ``force_balance``: whether
-    every design on the front is held to exact force balance (the spec's ``[balance]
-    force_balance``); ``original_force_balanced``: whether the original design is.
-    """
-
-    against: str
-    points: tuple[FrontPoint, ...]
-    original: tuple[float, float] = (math.nan, math.nan)
-    force_balance: bool = False
-    original_force_balanced: bool | None = None
-
-    def __repr__(self) -> str:
-        ends = (f"{self.points[0].value:.4g}–{self.points[-1].value:.4g} {self.unit}, "
-                f"{self.points[0].shaking_moment:.4g}–{self.points[-1].shaking_moment:.4g} N·m")
-        return f"Front(against {self.against}, {len(self.points)} points: {ends})"
-
-    @property
-    def name(self) -> str:
-        """The second objective's report name (``driving_torque``, …)."""
-        return AGAINST[self.against][0]
-
-    @property
-    def unit(self) -> str:
-        """The second objective's unit."""
-        return AGAINST[self.against][1]
-
-    def as_dict(self) -> dict[str, object]:
-        """The ``pareto --json`` document's ``against`` and ``points``."""
-        return {
-            "against": self.against,
-            "points": [{"shaking_moment": p.shaking_moment, self.name: p.value,
-                        "epsilon": p.epsilon, "lower_bound": p.lower_bound, "knee": p.knee}
-                       for p in self.points],
-            "original": {"shaking_moment": self.original[1], self.name: self.original[0]},
-            "units": {"shaking_moment, lower_bound": "N·m",
-                      f"{self.name}, epsilon": self.unit},
-        }
 
 
 class _Programs:
@@ -223,6 +144,9 @@ def _scale(factor: NDArray[np.float64], data: NumericProblem) -> float:
 def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
     """The front of least RMS shaking moment against ``against`` (see the module docstring).
 
+    An engine's balancing (a :class:`~balancer.model.balance.RotorBalanceProblem`) has its
+    own front: :func:`.rotor_front.rotor_front`.
+
     Parameters
     ----------
     design
@@ -245,17 +169,16 @@ def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
     if design.balance is None:
         raise SpecError("missing required table: the redesign problem ([balance])",
                         key="balance")
+    if not 2 <= points <= MAX_POINTS:
+        raise SpecError(f"a front has from 2 to {MAX_POINTS} points", key="--points",
+                        value=points)
     if isinstance(design.balance, RotorBalanceProblem):
-        raise SpecError("not yet for an engine: its counterweights and shafts are chosen by "
-                        "`balancer optimize`", key="balance")
+        return rotor_front(design, against, points)
     if against == "shaking-force" and design.balance.force_balance:
         raise SpecError("with force balance imposed the shaking force is zero at every point: "
                         "there is no front against it; set [balance] force_balance = false to "
                         "trade the shaking force against the shaking moment",
                         key="--against", value=against)
-    if not 2 <= points <= MAX_POINTS:
-        raise SpecError(f"a front has from 2 to {MAX_POINTS} points", key="--points",
-                        value=points)
     # The problem with both objectives weighted, so that the entries it leaves out as inert
     # (:attr:`NumericProblem.inert`) are those that neither sees.
     weights = Objective(shaking_moment=1.0,
@@ -296,12 +219,12 @@ def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
         x = data.settle(x)
         x, _ = solver.finalize(x)
         bound = _certified(programs, cap, solution, x)
-        out.append(FrontPoint(shaking_moment=programs.moment_value(x),
+        out.append(FrontPoint(least=programs.moment_value(x),
                               value=programs.other_value(x), epsilon=float(epsilon),
                               lower_bound=bound, x=x))
     out.sort(key=lambda p: p.value)
     original = (programs.other_value(data.x0), programs.moment_value(data.x0))
-    return Front(against=against, points=tuple(_mark_knee(out)), original=original,
+    return Front(against=against, points=tuple(mark_knee(out)), original=original,
                  force_balance=design.balance.force_balance,
                  original_force_balanced=force_balance_residual(data.mechanism) <= RESIDUAL_FLOOR)
 
@@ -322,18 +245,3 @@ def _certified(programs: _Programs, cap: Constraint, solution: ConicSolution,
     if bound is None:
         return 0.0
     return max(bound.value, 0.0) * programs.moment_scale
-
-
-def _mark_knee(points: list[FrontPoint]) -> list[FrontPoint]:
-    """The points, the one farthest from the chord between the ends marked as the knee."""
-    if len(points) < 3:
-        return points
-    xs = np.array([p.value for p in points])
-    ys = np.array([p.shaking_moment for p in points])
-    span_x, span_y = xs[-1] - xs[0], ys[0] - ys[-1]
-    if not (span_x > 0 and span_y > 0):
-        return points
-    u, v = (xs - xs[0]) / span_x, (ys - ys[-1]) / span_y  # the ends at (0, 1) and (1, 0)
-    distance = 1.0 - u - v  # below the chord u + v = 1 (a convex front lies below it)
-    k = int(np.argmax(distance))
-    return [FrontPoint(**{**p.__dict__, "knee": i == k}) for i, p in enumerate(points)]

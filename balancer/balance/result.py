@@ -108,6 +108,21 @@ class RotorMasses:
         """A counterweight's mass at :attr:`radius`, kg (``None`` without a radius)."""
         return None if self.radius is None else c.mr / self.radius
 
+    @property
+    def mr_sum(self) -> float:
+        """``Σ |mr|`` of the chosen counterweights and the new shafts' eccentrics, kg·m."""
+        return math.fsum([c.mr for c in self.counterweights]
+                         + [e.mr for s in self.shafts for e in s.eccentrics])
+
+    @property
+    def added_mass(self) -> float | None:
+        """:attr:`mr_sum` as masses at :attr:`radius` (the eccentrics' too), kg; else ``None``.
+
+        What ``pareto --against added-mass`` bounds and a sweep's ``added_mass`` column holds
+        for an engine (DESIGN.md, "Balancing an engine").
+        """
+        return None if self.radius is None else self.mr_sum / self.radius
+
     def as_dict(self) -> dict[str, object]:
         """``crankshaft_counterweights`` and ``balance_shafts`` as ``optimize --json`` gives."""
         cws = []
@@ -214,8 +229,9 @@ class BalanceResult:
     rotor_masses: RotorMasses | None = None
 
     def __repr__(self) -> str:
-        return (f"BalanceResult({self.status}, {self.backend}: {self.message}; added mass "
-                f"{self.added_mass:.4g} kg)")
+        mass = self.added_mass
+        added = "" if mass is None else f"; added mass {mass:.4g} kg"
+        return f"BalanceResult({self.status}, {self.backend}: {self.message}{added})"
 
     @cached_property
     def operating(self) -> tuple[CycleAnalysis, CycleAnalysis]:
@@ -243,8 +259,14 @@ class BalanceResult:
         return counterweights(self.original, self.linkage)
 
     @property
-    def added_mass(self) -> float:
-        """Total mass of the counterweights, kg (material removed counts negative)."""
+    def added_mass(self) -> float | None:
+        """Total mass of the counterweights, kg (material removed counts negative).
+
+        An engine's: its chosen masses at the counterweights' radius
+        (:attr:`RotorMasses.added_mass`; ``None`` where no radius is given).
+        """
+        if self.rotor_masses is not None:
+            return self.rotor_masses.added_mass
         return added_mass(self.counterweights)
 
     @property

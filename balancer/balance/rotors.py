@@ -180,6 +180,12 @@ class RotorProblem:
         #: Each mass·radius entry's force on its bearing per kg·m, ``(N, P)`` complex, N.
         self.force_columns = force
         r = base.reactions
+        #: Per load on the frame: each entry's columns per kg·m and the base engine's samples
+        #: (the shaking force and rocking couple complex, N and N·m; the moment about z, N·m).
+        self.loads: dict[str, tuple[NDArray[Any], NDArray[Any]]] = {
+            "shaking_force": (force, r.shaking_force),
+            "rocking_couple": (couple, r.rocking_couple),
+            "shaking_moment": (moment, r.shaking_moment)}
         w = self.weights
         blocks: list[tuple[float, NDArray[np.float64], NDArray[np.float64]]] = [
             (w.shaking_force, force.real, r.shaking_force.real),
@@ -286,6 +292,11 @@ class RotorProblem:
                  shafts: tuple[ShaftDesign, ...]) -> Model:
         """The balanced model."""
         return self._model.with_rotor_masses(counterweights, shafts, self.replaced)
+
+    def figures(self, x: NDArray[np.float64]) -> dict[str, float]:
+        """The RMS of each load of :attr:`loads` with the masses ``x`` (N, N·m)."""
+        return {name: float(np.sqrt(np.mean(np.abs(columns @ x + base) ** 2)))
+                for name, (columns, base) in self.loads.items()}
 
     def unbalance(self, x: NDArray[np.float64]) -> float:
         """``√Σ (|x_i|·ω²)²``, N."""

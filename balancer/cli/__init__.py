@@ -303,7 +303,9 @@ def build_parser() -> argparse.ArgumentParser:
         "balancing constraints of the spec's [balance] section (force balance and every "
         "link's bounds): an even grid of bounds on the second objective between its two "
         "ends, each point the global optimum of a convex program with its certified lower "
-        "bound; the knee marked.",
+        "bound; the knee marked. An engine's front (its [balance.counterweights] and "
+        "[[balance.shafts]]) is of its weighted shaking against the mass it adds "
+        "(--against added-mass).",
     )
     _spec_and_force(p, balance=True)
     p.add_argument("--against", required=True,

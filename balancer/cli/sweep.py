@@ -37,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
         keys = [v.key for v in varies]
         original = spec_values(args.spec, keys or [p.key for p in perturbs])
         save_figure(atlas_figure(result.out, keys or None, original=original,
-                                 perturbs=perturbs), plot)
+                                 perturbs=perturbs, headline=result.headline), plot)
     sys.stdout.write(dumps_json(result.as_dict()) if args.json
                      else sweep_text(result, spec=args.spec) + "\n")
     if plot is not None:

@@ -50,7 +50,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from typing import Protocol
+from typing import ClassVar, Protocol
 
 from .. import validate as v
 from ..errors import SpecError
@@ -234,6 +234,8 @@ class BalanceProblem:
     force_balance: bool = True
     objective: Objective = field(default_factory=Objective)
     links: tuple[tuple[str, LinkFreedom], ...] = ()
+    #: The figure a balancing of this kind is about, as a sweep's atlas shows it.
+    headline: ClassVar[str] = "shaking_moment"
 
     def __post_init__(self) -> None:
         """Store ``links`` as pairs (a dict is accepted)."""
@@ -354,6 +356,8 @@ class RotorBalanceProblem:
                                                                   rocking_couple=1.0))
     counterweights: CounterweightPlanes | None = None
     shafts: tuple[ShaftFreedom, ...] = ()
+    #: The figure a balancing of this kind is about, as a sweep's atlas shows it.
+    headline: ClassVar[str] = "rocking_couple"
 
 
 @dataclass(frozen=True)

@@ -52,6 +52,10 @@ NO_DESIGN: dict[str, dict[str, str]] = {
 }
 
 
+#: The figure an atlas shows, by its column's stem in the sweep's table: its words.
+HEADLINES = {"shaking_moment": "RMS shaking moment", "rocking_couple": "RMS rocking couple"}
+
+
 def _no_design(status: str) -> dict[str, str]:
     """:data:`NO_DESIGN`'s entry for ``status`` (a generic one for any other status)."""
     return NO_DESIGN.get(status, {"label": f"no design ({status})", "facecolor": "white",
@@ -61,7 +65,8 @@ def _no_design(status: str) -> dict[str, str]:
 def sweep_figure(table: Mapping[str, Sequence[Any]], keys: Sequence[str] | None, *,
                  original: dict[str, float] | None = None,
                  perturbs: Sequence[PerturbLike] = (),
-                 units: dict[str, str] | None = None) -> Figure:
+                 units: dict[str, str] | None = None,
+                 headline: str = "shaking_moment") -> Figure:
     """The atlas of a sweep's table: the balanced RMS shaking moment over the varied keys.
 
     Parameters
@@ -77,6 +82,9 @@ def sweep_figure(table: Mapping[str, Sequence[Any]], keys: Sequence[str] | None,
         in its histogram's title.
     units
         Each key's unit (:func:`balancer.sweeps.key_unit`), for the axes and titles.
+    headline
+        The figure shown (a key of :data:`HEADLINES`): the RMS shaking moment, or an engine's
+        RMS rocking couple; its ``_before`` and ``_after`` columns.
 
     Returns
     -------
@@ -95,17 +103,18 @@ def sweep_figure(table: Mapping[str, Sequence[Any]], keys: Sequence[str] | None,
     units = units or {}
     if keys is None:
         return _perturbation_figure(table, perturbs, original or {}, units)
-    after = np.array([np.nan if v is None else v for v in table["shaking_moment_after"]])
+    words = HEADLINES[headline]
+    after = np.array([np.nan if v is None else v for v in table[f"{headline}_after"]])
     status = np.array(table["status"], dtype=object)
     fig = Figure(figsize=(7.5, 5.0), layout="constrained")
     ax = fig.add_subplot()
     if len(keys) == 1:
-        before = np.array([np.nan if v is None else v for v in table["shaking_moment_before"]])
+        before = np.array([np.nan if v is None else v for v in table[f"{headline}_before"]])
         _atlas_line(ax, np.array(table[keys[0]], float), keys[0], before, after, status,
-                    original, units)
+                    original, units, words)
     else:
         _atlas_map(fig, ax, [np.array(table[k], float) for k in keys[:2]], keys[:2], after,
-                   status, original, units)
+                   status, original, units, words)
     return fig
 
 
@@ -118,8 +127,8 @@ def _no_design_masks(after: np.ndarray, status: np.ndarray) -> dict[str, np.ndar
 
 def _atlas_line(ax: Axes, x: np.ndarray, key: str, before: np.ndarray, after: np.ndarray,
                 status: np.ndarray, original: dict[str, float] | None,
-                units: dict[str, str]) -> None:
-    """One varied key: the RMS shaking moment before and after balancing against it."""
+                units: dict[str, str], words: str) -> None:
+    """One varied key: the RMS shaking moment (``words``) before and after balancing."""
     ax.plot(x, before, "o-", color="0.5", label="before balancing (each point's own design)")
     ax.plot(x, after, "o-", color="C0", label="balanced (certified optimum)")
     ax.set_ylim(bottom=0)
@@ -140,16 +149,16 @@ def _atlas_line(ax: Axes, x: np.ndarray, key: str, before: np.ndarray, after: np
             mark_point(ax, value, 0.5 * (ylim[0] + ylim[1]), "original design",
                         _key_value(key, value, units), **ORIGINAL_STYLE)
     ax.set_xlabel(_key_label(key, units))
-    ax.set_ylabel("RMS shaking moment (N·m)")
-    ax.set_title("RMS shaking moment before and after balancing")
+    ax.set_ylabel(f"{words} (N·m)")
+    ax.set_title(f"{words} before and after balancing")
     ax.grid(True, alpha=0.3)
     ax.figure.legend(loc="outside lower center", ncols=2, fontsize="small")
 
 
 def _atlas_map(fig: Figure, ax: Axes, values: list[np.ndarray], keys: Sequence[str],
                after: np.ndarray, status: np.ndarray,
-               original: dict[str, float] | None, units: dict[str, str]) -> None:
-    """Two varied keys: a heat map (a grid) or a scatter of the balanced RMS shaking moment."""
+               original: dict[str, float] | None, units: dict[str, str], words: str) -> None:
+    """Two varied keys: a heat map (a grid) or a scatter of the balanced figure (``words``)."""
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
@@ -184,7 +193,7 @@ def _atlas_map(fig: Figure, ax: Axes, values: list[np.ndarray], keys: Sequence[s
             handles.append(ax.scatter(x[mask], y[mask], marker=style["marker"], s=24,
                                       color=style["edgecolor"], label=style["label"]))
     if mesh is not None:
-        fig.colorbar(mesh, ax=ax, label="balanced RMS shaking moment (N·m)")
+        fig.colorbar(mesh, ax=ax, label=f"balanced {words} (N·m)")
     if original is not None and all(k in original for k in keys):
         ox, oy = (original[k] for k in keys)
         handles.append(mark_point(ax, ox, oy, "original design: the spec",
@@ -193,7 +202,7 @@ def _atlas_map(fig: Figure, ax: Axes, values: list[np.ndarray], keys: Sequence[s
                                    **ORIGINAL_STYLE))
     ax.set_xlabel(_key_label(keys[0], units))
     ax.set_ylabel(_key_label(keys[1], units))
-    ax.set_title("RMS shaking moment of the balanced design at each point"
+    ax.set_title(f"{words} of the balanced design at each point"
                  if mesh is not None else "No point has a balanced design")
     if handles:
         fig.legend(handles=handles, loc="outside lower center", ncols=1, fontsize="small")

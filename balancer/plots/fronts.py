@@ -1,4 +1,4 @@
-"""A trade-off front of least shaking moment against a second objective, as a report shows it."""
+"""A trade-off front of least shaking against a second objective, as a report shows it."""
 
 from __future__ import annotations
 
@@ -6,12 +6,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..balance.front import FIGURES
 from .style import mark_point, number
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
     from matplotlib.figure import Figure
 
-    from ..balance.pareto import Front  # (no cycle: loaded by the command that makes it)
+    from ..balance.front import Front  # (no cycle: loaded by the command that makes it)
 
 
 #: How far beyond a front's own extent (a fraction of it) the axes reach to take the original
@@ -22,15 +23,15 @@ FRONT_REACH = 0.3
 def front_figure(front: Front, title: str | None = None) -> Figure:
     """A trade-off front as a designer puts it in a report.
 
-    The least RMS shaking moment against the second objective, each point's certified lower
-    bound beside it, the knee marked. The axes are the front's: the original design is drawn
-    where it lies within :data:`FRONT_REACH` of the front's extent, else as an arrow at the edge
-    pointing its way, with its coordinates.
+    The least RMS shaking moment (an engine's: :attr:`Front.minimised`) against the second
+    objective, each point's certified lower bound beside it, the knee marked. The axes are the
+    front's: the original design is drawn where it lies within :data:`FRONT_REACH` of the
+    front's extent, else as an arrow at the edge pointing its way, with its coordinates.
 
     Parameters
     ----------
     front
-        A :class:`~balancer.balance.pareto.Front`.
+        A :class:`~balancer.balance.front.Front`.
     title
         The figure's title (default: what is traded against what).
 
@@ -46,22 +47,22 @@ def front_figure(front: Front, title: str | None = None) -> Figure:
     fig = Figure(figsize=(7.5, 4.5), layout="constrained")
     ax = fig.add_subplot()
     xs = np.array([p.value for p in front.points])
-    ys = np.array([p.shaking_moment for p in front.points])
+    ys = np.array([p.least for p in front.points])
     bounds = np.array([p.lower_bound for p in front.points])
     what = front.name.replace("_", " ")
-    label = "least RMS shaking moment" + (", every design force-balanced" if force_balance
-                                          else "")
+    words, least_unit = FIGURES[front.minimised]
+    label = f"least {words}" + (", every design force-balanced" if force_balance else "")
     if len(front.points) == 1:
         label += f" (one point: nothing to trade against {what})"
     ax.plot(xs, ys, "o-", color="C0", label=label)
     ax.plot(xs, bounds, "_", color="k", markersize=12, label="certified lower bound")
     knee = [p for p in front.points if p.knee]
     if knee:
-        ax.plot([knee[0].value], [knee[0].shaking_moment], "*", color="C3", markersize=14,
+        ax.plot([knee[0].value], [knee[0].least], "*", color="C3", markersize=14,
                 label="knee")
-    unit = f"{'RMS, ' if front.unit != 'kg' else ''}{front.unit}"
+    unit = f"{'RMS, ' if front.unit not in ('kg', 'kg·m') else ''}{front.unit}"
     ax.set_xlabel(f"{what} ({unit})")
-    ax.set_ylabel("RMS shaking moment (N·m)")
+    ax.set_ylabel(f"{words} ({least_unit})")
     ox, oy = front.original
     if np.isfinite(ox) and np.isfinite(oy):
         (x0, x1), (y0, y1) = _front_limits(xs, np.maximum(ys, bounds), (ox, oy))
@@ -71,11 +72,12 @@ def front_figure(front: Front, title: str | None = None) -> Figure:
         if force_balance and original_force_balanced is False:
             name += ": not force-balanced, so not on the front"
         mark_point(ax, ox, oy, name, f"original design\n{number(ox)} {front.unit}, "
-                    f"{number(oy)} N·m", marker="s", color="0.5", mec="0.2", ms=7)
+                    f"{number(oy)} {least_unit}", marker="s", color="0.5", mec="0.2", ms=7)
     else:
         ax.set_ylim(bottom=0)
     ax.grid(True, alpha=0.3)
-    ax.set_title(title or f"Shaking moment against {what}")
+    short = words.removeprefix("RMS ")
+    ax.set_title(title or f"{short[0].upper()}{short[1:]} against {what}")
     fig.legend(loc="outside lower center", ncols=1, fontsize="small")
     return fig
 

@@ -1,0 +1,172 @@
+"""An engine's trade-off front: the least shaking against the mass·radius its balancing adds.
+
+DESIGN.md, "Balancing an engine": ``pareto --against added-mass`` for an engine bounds the sum of
+the chosen ``|mr|`` (kg·m; their masses, kg, where ``[balance.counterweights] radius`` is given —
+the new shafts' eccentrics then counted at the same radius). What it minimises is the spec's
+objective without its unbalance term, ``J'`` (:mod:`.rotors`; the bound on the masses takes the
+unbalance term's place): where ``J'`` weighs one quantity alone the front is of that quantity's
+RMS (the RMS rocking couple by default), else of ``√J'``, the weighted RMS (N·m).
+
+Each point is the convex program of :mod:`.rotors` (in its scaled variables ``u = x/max_mr``,
+``‖u_i‖ ≤ 1``) with one more variable per mass·radius, ``t_i ≥ ‖u_i‖``, and the cap
+
+    Σ c_i·t_i ≤ ε,   c_i = max_mr_i (kg·m) or max_mr_i/radius (kg),
+
+so that ``Σ c_i·t_i`` bounds ``Σ |mr_i|`` (or the masses): a second-order cone program, solved
+by Clarabel, with its certified lower bound (:func:`.certificate.lower_bound`, over the box
+``|u| ≤ 1``, ``0 ≤ t ≤ 1``, which holds a minimiser: ``t_i = ‖u_i‖`` is feasible whenever any
+``t`` is). ``ε`` runs on an even grid from nothing added to the least sum among the designs of
+least ``J'`` (the front's two ends).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import SolverError, SpecError
+from ..model import Design
+from ..model.balance import RotorBalanceProblem
+from .certificate import Constraint, lower_bound
+from .certificate import Objective as Norm
+from .conic import ConicProgram, ConicSolution
+from .front import Front, FrontPoint, mark_knee
+from .rotors import RotorProblem, RotorSolver
+
+#: Room given to an end of the front when it becomes a constraint (relative to its scale): a
+#: hundred times Clarabel's tolerance, so that the constrained program stays feasible.
+END_ROOM = 1e-8
+#: The quantities ``J'`` may weigh alone, whose RMS the front then shows in its own unit.
+SINGLE = ("rocking_couple", "shaking_force", "shaking_moment")
+
+
+class _RotorFront:
+    """The ε-constraint programs of an engine's balancing, in ``(u, t)``."""
+
+    def __init__(self, data: RotorProblem) -> None:
+        self.data = data
+        self.solver = solver = RotorSolver(data)
+        n, s = data.size, len(data.sites)
+        self.n, self.s = n, s
+        width = n + s
+        radius = (None if data.problem.counterweights is None
+                  else data.problem.counterweights.radius)
+        self.per_mr = 1.0 if radius is None else 1.0 / radius
+        self.unit = "kg·m" if radius is None else "kg"
+        weights = np.array([site.max_mr for site in data.sites]) * self.per_mr
+        self.value_scale = float(weights.sum())
+        self.cap_row = np.r_[np.zeros(n), weights / self.value_scale]
+        cones = [Constraint("soc", np.hstack([c.M, np.zeros((3, s))]), c.m)
+                 for c in solver.constraints]
+        for i in range(s):
+            m = np.zeros((3, width))
+            m[0, n + i] = 1.0
+            m[1, 2 * i] = m[2, 2 * i + 1] = 1.0
+            cones.append(Constraint("soc", m, np.zeros(3)))
+        self.cones = cones
+        self.P = np.hstack([solver.P, np.zeros((solver.P.shape[0], s))])
+        self.q = solver.q
+        self.norm = Norm(P=self.P, q=self.q, norm=True, g=np.zeros(width), g0=0.0)
+        self.lo = np.r_[-np.ones(n), np.zeros(s)]
+        self.hi = np.ones(width)
+        self.width = width
+
+    def value(self, x: NDArray[np.float64]) -> float:
+        """``Σ |mr_i|`` of ``x`` (kg·m), or the masses at the radius (kg)."""
+        return math.fsum(np.hypot(x[0::2], x[1::2])) * self.per_mr
+
+    def cap(self, epsilon: float) -> Constraint:
+        """``Σ c_i·t_i ≤ ε`` (``ε`` in :attr:`unit`) as a cone constraint."""
+        return Constraint("nonneg", -self.cap_row[None, :],
+                          np.array([epsilon / self.value_scale]))
+
+    def least_objective(self, extra: list[Constraint]) -> ConicSolution:
+        """``min ‖P·u + q‖`` within the bounds and ``extra``."""
+        program = ConicProgram(self.width, [*self.cones, *extra], objective="norm", P=self.P,
+                               q=self.q)
+        return program.solve(self.solver.settings)
+
+    def least_value(self, root: float) -> ConicSolution:
+        """``min Σ c_i·t_i`` among the designs with ``‖P·u + q‖ ≤ root``."""
+        cap = Constraint("soc", np.vstack([np.zeros((1, self.width)), self.P]),
+                         np.r_[root, self.q])
+        program = ConicProgram(self.width, [*self.cones, cap], objective="squares",
+                               P=np.zeros((0, self.width)), q=np.zeros(0), g=self.cap_row)
+        return program.solve(self.solver.settings)
+
+    def certified(self, solution: ConicSolution, cap: Constraint) -> float:
+        """The certified least ``√J'`` under ``cap``, N·m (0 where none is made)."""
+        assert solution.u is not None  # solved: the caller has checked
+        y = np.asarray(solution.u, float)
+        v = (None if solution.epigraph_dual is None
+             else -np.asarray(solution.epigraph_dual[1:]))
+        bound = lower_bound(self.norm, [*self.cones, cap], None, y, list(solution.duals), v,
+                            self.lo, self.hi, self.norm.value(y))
+        return 0.0 if bound is None else max(bound.value, 0.0) * self.data.objective_scale
+
+
+def rotor_front(design: Design, against: str, points: int) -> Front:
+    """The front of an engine's balancing (see the module docstring).
+
+    Raises
+    ------
+    SpecError
+        For a second objective other than ``added-mass``, or an objective that weighs only
+        the unbalance (nothing to trade it against).
+    SolverError
+        If Clarabel fails.
+    """
+    problem = design.balance
+    if not isinstance(problem, RotorBalanceProblem):
+        raise TypeError("design.balance must be a RotorBalanceProblem")
+    if against != "added-mass":
+        raise SpecError("an engine's balancing trades its shaking against the mass it adds: "
+                        "give --against added-mass", key="--against", value=against)
+    weights = replace(problem.objective, unbalance=0.0)
+    if not weights.terms:
+        raise SpecError("weighs only the unbalance: nothing to trade against the added mass; "
+                        "weigh the rocking couple, the shaking force or the shaking moment",
+                        key="balance.objective")
+    data = RotorProblem(replace(design, balance=replace(problem, objective=weights)))
+    single = weights.single
+    minimised = single.name if single is not None and single.name in SINGLE else "rms"
+    per_weight = 1.0 / math.sqrt(single.weight) if minimised != "rms" and single else 1.0
+    programs = _RotorFront(data)
+    solver = programs.solver
+    scale = data.objective_scale
+
+    def least(x: NDArray[np.float64]) -> float:
+        return math.sqrt(data.objective(x)) * per_weight
+
+    def solved(solution: ConicSolution, what: str) -> NDArray[np.float64]:
+        if solution.u is None:
+            raise SolverError(f"{what} could not be solved (Clarabel: {solution.status})")
+        return solver.x(solution.u[: programs.n])
+
+    best = solved(programs.least_objective([]), "the least shaking")
+    top = programs.least_value(math.sqrt(data.objective(best)) / scale + END_ROOM)
+    high = programs.value(solved(top, "the least mass of the least shaking")
+                          if top.u is not None else best)
+    slack = END_ROOM * programs.value_scale
+    grid = [slack] if high <= slack else list(np.linspace(slack, high + slack, points))
+    out: list[FrontPoint] = []
+    for epsilon in grid:
+        cap = programs.cap(float(epsilon))
+        solution = programs.least_objective([cap])
+        x = solved(solution, f"a point of the front (ε = {epsilon:.6g} {programs.unit})")
+        counterweights, shafts = data.masses(x)
+        x = data.vector_of(counterweights, shafts)  # as the spec would say it
+        out.append(FrontPoint(least=least(x), value=programs.value(x), epsilon=float(epsilon),
+                              lower_bound=programs.certified(solution, cap) * per_weight,
+                              x=x, figures=data.figures(x)))
+    out.sort(key=lambda p: p.value)
+    return Front(against=against, points=tuple(mark_knee(out)),
+                 original=(programs.value(data.x0), least(data.x0)),
+                 minimised=minimised, value_unit=None if programs.unit == "kg" else "kg·m",
+                 original_figures=data.figures(data.x0))
+
+
+__all__ = ["rotor_front"]
