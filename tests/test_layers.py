@@ -8,6 +8,7 @@ package's public names: every type a user meets is a name of ``balancer``, loade
 from __future__ import annotations
 
 import ast
+import re
 import subprocess
 import sys
 import typing
@@ -51,8 +52,16 @@ def modules() -> dict[str, Path]:
     return out
 
 
+#: A mechanism's reader and writer of its tables of a spec (``mechanisms/<name>/spec.py``): it
+#: reads TOML tables, so it sits in the spec's layer, and the spec reader finds it by name
+#: through the registry (``Mechanism.spec_module``).
+SPEC_MODULE = re.compile(r"^mechanisms\.\w+\.spec$")
+
+
 def layer(name: str) -> int:
     """The layer of module ``name`` (by its longest prefix in :data:`LAYERS`)."""
+    if SPEC_MODULE.match(name):
+        name = "spec"
     best, found = -1, None
     for level, prefixes in enumerate(LAYERS):
         for prefix in prefixes:
@@ -194,3 +203,29 @@ def test_the_architecture_page_draws_every_layer_as_the_test_holds_it():
                 continue
             name = prefix
             assert name in rows.get(level, ""), f"{prefix} is not drawn in layer {level}"
+
+
+def test_every_registered_mechanism_reads_and_writes_its_spec_tables_in_its_folder():
+    """``spec`` in each mechanism's folder gives the reader and writer of its tables."""
+    import importlib
+
+    from balancer.mechanisms import REGISTRY
+
+    for kind, mechanism in REGISTRY.items():
+        name = mechanism.spec_module()
+        folder = mechanism.__module__.rpartition(".")[0]
+        assert name == f"{folder}.spec" and folder.startswith("balancer.mechanisms.")
+        module = importlib.import_module(name)
+        for function in ("read", "lines", "read_original", "original_lines", "read_balance",
+                         "balance_lines"):
+            assert callable(getattr(module, function)), f"{kind}: {name}.{function}"
+
+
+def test_the_spec_reader_and_writer_ask_no_mechanism_what_it_is():
+    """``balancer/spec`` imports no mechanism's folder: each is reached through the registry."""
+    edges = graph()
+    for name, targets in edges.items():
+        if name.startswith("spec"):
+            folders = {t for t in targets if t.startswith("mechanisms.")
+                       and t.count(".") >= 1 and not t.startswith("mechanisms.base")}
+            assert not folders, f"balancer.{name} imports {sorted(folders)}"

@@ -135,6 +135,17 @@ class Mechanism:
     #: Whether the cycle analysis gives the torque about z on the mounts (an engine's
     #: ``mount_torque``: the shaking moment plus the driving torque).
     reports_mount_torque: ClassVar[bool] = False
+
+    @classmethod
+    def spec_module(cls) -> str:
+        """The module that reads and writes the mechanism's tables of a spec, dotted.
+
+        ``spec`` in the mechanism's folder (``balancer.mechanisms.fourbar.spec``): its
+        ``read``, ``lines``, ``read_original``, ``original_lines``, ``read_balance`` and
+        ``balance_lines`` (:class:`balancer.spec.codecs.MechanismSpec`). It sits above this
+        layer (it reads TOML tables), so the spec reader imports it by this name.
+        """
+        return f"{cls.__module__.rpartition('.')[0]}.spec"
     #: Sliders on ground guides whose force on the guide tables name as a force at a point
     #: (``R{name}x``, ``R{name}y``) rather than by its normal force ``N_{link}``.
     guide_force_names: ClassVar[dict[str, str]] = {}

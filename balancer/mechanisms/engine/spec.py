@@ -2,28 +2,31 @@
 
 ``[mechanism]`` (strokes, firing order, every cylinder's lengths and ``[[mechanism.cylinders]]``),
 ``[links.crankshaft]``, ``[links.rod]``, ``[links.piston]``, ``[[balance_shafts]]`` and ``[gas]``.
-Angles are in degrees, as the spec writes them: what is written reads back exactly.
+Angles are in degrees, as the spec writes them: what is written reads back exactly. Reached
+through the registry (:meth:`balancer.mechanisms.base.Mechanism.spec_module`) by the spec
+reader and writer (:mod:`balancer.spec`).
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import Any, cast
 
-from .. import tomltext as toml
-from .. import validate as v
-from ..errors import SpecError
-from ..mechanisms.engine.model import BalanceShaft, Crankshaft, Cylinder, Engine, GasCycle, Mass
-from ..model import Link
-from ..model.balance import (
+from ... import tomltext as toml
+from ... import validate as v
+from ...errors import SpecError
+from ...model import Link
+from ...model import MechanismModel as Model
+from ...model.balance import (
     ENGINE_OBJECTIVE_KEYS,
     CounterweightPlanes,
     RotorBalanceProblem,
     ShaftFreedom,
 )
-from . import schema
-from .links import read_link
-from .tables import Table
+from ...spec import schema
+from ...spec.links import read_link
+from ...spec.tables import Table
+from .model import BalanceShaft, Crankshaft, Cylinder, Engine, GasCycle, Mass
 
 #: The cylinder's lengths, in ``[mechanism.lengths]`` and each ``[[mechanism.cylinders]]``.
 LENGTHS = ("crank", "rod", "offset", "bore")
@@ -85,7 +88,7 @@ def _link(links: Table, name: str) -> Table:
 
 def _rod(links: Table) -> Link:
     table = _link(links, "rod")
-    rod = read_link(table, "rod", Engine)
+    rod = read_link(table)
     table.finish()
     return rod
 
@@ -142,7 +145,7 @@ def _gas(root: Table) -> GasCycle | None:
     return gas
 
 
-def read_engine(root: Table, mech: Table) -> Engine:
+def read(root: Table, mech: Table) -> Engine:
     """An engine from a spec's root table and its ``[mechanism]`` (its ``type`` read)."""
     mech.expect(schema.known("mechanism", schema.ENGINE))
     strokes = mech.value("strokes", 4)
@@ -173,8 +176,9 @@ def _masses_lines(key: str, masses: tuple[Mass, ...]) -> list[str]:
     return [f"{key} = [", *(f"  {_mass_text(m)}," for m in masses), "]  # kg·m, °, m"]
 
 
-def engine_lines(model: Engine) -> list[str]:
+def lines(model: Model) -> list[str]:
     """The engine's ``[mechanism]``, ``[links]``, ``[[balance_shafts]]`` and ``[gas]``."""
+    assert isinstance(model, Engine)
     out = ["[mechanism]", 'type = "engine"', f"strokes = {model.strokes}"]
     if model.firing_order is not None:
         out.append(f"firing_order = [{', '.join(str(k) for k in model.firing_order)}]")
@@ -219,7 +223,7 @@ def engine_lines(model: Engine) -> list[str]:
 # -- [balance]: counterweights and new shafts (DESIGN.md, "Balancing an engine") -------------
 
 
-def read_engine_balance(table: Table, engine: Engine) -> RotorBalanceProblem:
+def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
     """An engine's ``[balance]``: the objective, the counterweights' planes, the new shafts."""
     if table.has("force_balance"):
         raise SpecError("does not apply to an engine: its balancing chooses counterweights and "
@@ -242,7 +246,7 @@ def read_engine_balance(table: Table, engine: Engine) -> RotorBalanceProblem:
             raise sub._missing("max_mr")
         with v.under(sub.path):
             counterweights = CounterweightPlanes(
-                planes=sub.value("planes", list(engine.counterweight_planes)),
+                planes=sub.value("planes", list(cast("Engine", engine).counterweight_planes)),
                 max_mr=sub.raw("max_mr"), radius=sub.value("radius", None))
         sub.finish()
     shafts = []
@@ -264,8 +268,9 @@ def _numbers(values: tuple[float, ...]) -> str:
     return f"[{', '.join(toml.number(x) for x in values)}]"
 
 
-def engine_balance_lines(problem: RotorBalanceProblem) -> list[str]:
-    """The problem as TOML lines that :func:`read_engine_balance` reads back equal."""
+def balance_lines(problem: object) -> list[str]:
+    """The problem as TOML lines that :func:`read_balance` reads back equal."""
+    assert isinstance(problem, RotorBalanceProblem)
     w = problem.objective
     out = ["[balance.objective]  # weights of the mean squares over the cycle",
            *(f"{name} = {toml.number(getattr(w, name))}" for name in ENGINE_OBJECTIVE_KEYS)]
@@ -281,3 +286,17 @@ def engine_balance_lines(problem: RotorBalanceProblem) -> list[str]:
                 f"ratio = {s.ratio}", f"at = {_numbers(s.at)}  # m",
                 f"planes = {_numbers(s.planes)}  # m", f"max_mr = {_numbers(s.max_mr)}  # kg·m"]
     return out
+
+
+def read_original(table: Table, model: Model) -> Model:
+    """An engine has no ``[original]`` (its balancing replaces labelled counterweights)."""
+    raise SpecError("an engine's spec has no [original]: its balancing replaces the "
+                    "crankshaft's labelled counterweights", key=table.path)
+
+
+def original_lines(model: Model) -> list[str]:
+    """None: an engine's spec has no ``[original]``."""
+    return []
+
+
+__all__ = ["balance_lines", "lines", "original_lines", "read", "read_balance", "read_original"]
