@@ -29,8 +29,9 @@ from .errors import SpecError
 from .force_balance import RESIDUAL_FLOOR, force_balance_residual
 from .linkage.dynamics import Forces
 from .linkage.kinematics import Motion
+from .linkage.vectors import V
 from .mechanisms import mechanism_of
-from .mechanisms.base import Mechanism, Route
+from .mechanisms.base import KERNEL_STATES, Mechanism, Route
 from .model import MechanismModel as Model
 from .orders import Order, order_table
 
@@ -356,20 +357,28 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     normal = {k: np.empty(n) for k in sliders}
     couple = {k: np.empty(n) for k in sliders}
 
+    compiled = n >= KERNEL_STATES  # a long cycle: its chunks by the compiled program
+
     def evaluate(theta: NDArray[np.float64]) -> Forces:
         with np.errstate(all="ignore"):
             return mech.crank_forces(theta, speed, 0.0, route=route, loads=loads,
-                                     gravity=gravity)
+                                     gravity=gravity, compiled=compiled)
+
+    def put(target: NDArray[np.complex128], sl: slice, vector: V) -> None:
+        """A planar vector's column into a complex array (no complex temporary)."""
+        part = target[sl]
+        part.real = np.asarray(vector.x)[:, 0]
+        part.imag = np.asarray(vector.y)[:, 0]
 
     def fill(start: int) -> None:
         sl = slice(start, start + CHUNK)
         f = evaluate(angles[sl])
-        out["shaking_force"][sl] = f.shaking_force.complex()[:, 0]
+        put(out["shaking_force"], sl, f.shaking_force)
         out["shaking_moment"][sl] = f.shaking_moment[:, 0]
         out["driving_torque"][sl] = f.driving_torque[:, 0]
-        out["rocking_couple"][sl] = f.rocking_couple.complex()[:, 0]
+        put(out["rocking_couple"], sl, f.rocking_couple)
         for p in grounds:
-            ground[p][sl] = f.reactions[p].complex()[:, 0]
+            put(ground[p], sl, f.reactions[p])
         for k in sliders:
             normal[k][sl] = f.slider_normal[k][:, 0]
             couple[k][sl] = f.slider_couple[k][:, 0]

@@ -388,7 +388,8 @@ def test_each_point_of_an_engines_front_is_the_independent_programs_optimum(fron
         assert p.least**2 == pytest.approx(best, rel=SOLVERS, abs=SOLVERS * result.points[0]
                                            .least**2)
         assert p.lower_bound**2 <= best * (1 + SOLVERS)
-        assert p.value <= p.epsilon * (1 + SOLVERS)
+        # (within the solver's feasibility on the cap, in units of the front's span)
+        assert p.value <= p.epsilon + SOLVERS * result.points[-1].value
 
 
 def test_an_engines_front_runs_from_nothing_added_to_the_optimum_without_unbalance(front):

@@ -19,8 +19,8 @@ reports its residual: a state where it did not converge is left to the numpy rou
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable
-from functools import cache
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import numeric
 from .dynamics import Forces, inverse_dynamics
+from .kernel import Kernel, compile_kernel, op_names
 from .kinematics import Motion, numeric_start, positions, rates
 from .structure import Structure
 from .symbols import CasadiOps
@@ -35,14 +36,6 @@ from .vectors import Factor, Num, _is_zero, _minus, _times
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
     import casadi as ca
-
-
-@cache
-def _op_names() -> dict[int, str]:
-    """CasADi's operation codes by name without the ``OP_`` prefix (``OP_SIN`` → ``SIN``)."""
-    import casadi
-
-    return {getattr(casadi, name): name[3:] for name in dir(casadi) if name.startswith("OP_")}
 
 
 _UNARY = {"SIN": "sin", "COS": "cos", "TAN": "tan", "SQRT": "sqrt", "NEG": "negative",
@@ -116,7 +109,7 @@ def _generate(fn: ca.Function) -> str:
                  if fn.sz_w() else "    pass")
     regs = _Registers()
     for k in range(fn.n_instructions()):
-        op = _op_names()[fn.instruction_id(k)]
+        op = op_names()[fn.instruction_id(k)]
         ins, outs = fn.instruction_input(k), fn.instruction_output(k)
         if op == "INPUT":
             regs.alias(outs[0], f"inputs[{ins[0]}][{ins[1]}]")
@@ -317,13 +310,28 @@ class CrankForcesProgram:
         # (≤ TAYLOR_STEP), the pivots' health (≤ 0).
         entries += [_largest([ca.fabs(r) for r in residuals]),
                     _largest([ca.fabs(d) for d in steps]), _largest(ops.health)]
-        self.tape = Tape(ca.Function("crank_forces", inputs,
-                                     [ca.cse(ca.vertcat(*[ca.SX(e) for e in entries]))]))
+        #: The program as CasADi's function (its algorithm: :class:`Tape`, a compiled kernel).
+        self.function = ca.Function("crank_forces", inputs,
+                                    [ca.cse(ca.vertcat(*[ca.SX(e) for e in entries]))])
+        self.tape = Tape(self.function)
         self.loads = loads
+        self._kernel: list[Kernel | None] = []  # compiled when a long evaluation first asks
+
+    @property
+    def kernel(self) -> Kernel | None:
+        """The program compiled (:mod:`.kernel`), or ``None`` where it cannot be (built once)."""
+        with _KERNEL_LOCK:
+            if not self._kernel:
+                self._kernel.append(compile_kernel(self.function))
+            return self._kernel[0]
 
     def evaluate(self, theta1: NDArray[np.float64], omega1: NDArray[np.float64],
-                 alpha1: NDArray[np.float64]) -> tuple[Forces, NDArray[np.bool_]]:
+                 alpha1: NDArray[np.float64], *, compiled: bool = False
+                 ) -> tuple[Forces, NDArray[np.bool_]]:
         """The forces at crank states (arrays ``(N,)``) and where they are the numpy route's.
+
+        ``compiled``: by the compiled :attr:`kernel` where there is one (the same figures as
+        the tape's, to rounding), else by the numpy :class:`Tape`.
 
         A state is left out (``False``) where a numeric group's Newton step did not converge
         to the numpy route's tolerance or the group cannot be placed there, and where any
@@ -336,8 +344,12 @@ class CrankForcesProgram:
         n = theta1.size
         ok = np.ones(n, dtype=bool)
         out = np.empty((self.tape.sizes_out[0], n))
-        for a in range(0, n, Tape.block):  # a block at a time: the starts stay in the cache
-            b = min(a + Tape.block, n)
+        run: Tape | Kernel = self.tape
+        block = Tape.block  # a block at a time: the tape's work arrays stay in the cache
+        if compiled and self.kernel is not None:
+            run, block = self.kernel, max(n, 1)  # (its work is in registers: all at once)
+        for a in range(0, n, block):
+            b = min(a + block, n)
             theta = theta1[a:b]
             guesses = []
             for i in self.numeric:
@@ -348,13 +360,16 @@ class CrankForcesProgram:
             gas = [np.asarray(s.linkage.sliders[c.slider].force.at(theta), dtype=float)
                    * np.ones(b - a) if self.loads else np.zeros(b - a) for c in s.prisms]
             gas_in = np.array(gas) if gas else np.zeros((0, 1))
-            self.tape([theta[None, :], omega1[None, a:b], alpha1[None, a:b], guess, gas_in],
-                      b - a, [out[:, a:b]])
+            run([theta[None, :], omega1[None, a:b], alpha1[None, a:b], guess, gas_in],
+                b - a, [out[:, a:b]])
         closure, step, health = out[-3], out[-2], out[-1]
         ok &= ((closure <= numeric.NEWTON_TOLERANCE * s.length_scale())
                & (step <= numeric.TAYLOR_STEP) & (health <= 0) & np.isfinite(out).all(axis=0))
         return self.forces.with_arrays([row[:, None] for row in out[:-3]]), ok
 
+
+#: One compilation of a program's kernel at a time (a cycle analysis runs chunks on threads).
+_KERNEL_LOCK = threading.Lock()
 
 __all__ = ["CrankForcesProgram", "Tape"]
 

@@ -24,7 +24,9 @@ each eccentric's first moment ``ū = m·ρ·e^{iψ}``, ``ψ = k·θ + angle``, g
 
 from __future__ import annotations
 
+import cmath
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -85,6 +87,21 @@ def dynamic_link(link: Link) -> Link:
 
 
 @dataclass(frozen=True)
+class FrameLoads:
+    """What a rotor puts on the frame and takes from its link at crank states (arrays).
+
+    ``force`` (complex, N) and ``moment`` about the origin (N·m) it adds to the shaking,
+    ``couple`` to the rocking couple (complex ``Mx + i·My``, N·m), and ``link_couple``, its
+    gearing's couple on its link (N·m).
+    """
+
+    force: NDArray[np.complex128]
+    moment: NDArray[np.float64]
+    couple: NDArray[np.complex128]
+    link_couple: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
 class Eccentric:
     """A mass off a rotor's axis: its mass·radius, angle and plane.
 
@@ -136,74 +153,91 @@ class Rotor:
         if self.ratio == 0:
             raise ValueError("a rotor's ratio must not be zero")
 
-    def _moments(self, theta: ArrayLike) -> list[NDArray[np.complex128]]:
-        """Each eccentric's first moment about the axis ``ū = mr·e^{i(kθ + angle)}``, kg·m."""
-        psi = self.ratio * np.asarray(theta, dtype=float)
-        return [e.mr * np.exp(1j * (psi + e.angle)) for e in self.eccentrics]
+    @cached_property
+    def _sums(self) -> tuple[complex, complex, float, float]:
+        """``Σ mr·e^{i·angle}``, ``Σ z·mr·e^{i·angle}`` (kg·m, kg·m²), ``Σ m``, ``Σ z·m``.
+
+        Every eccentric turns with the rotor, ``ū = mr·e^{i·angle}·e^{iψ}``: each load is
+        these sums times ``e^{iψ}`` (one complex exponential per state, not one per eccentric).
+        """
+        ecc = self.eccentrics
+        return (complex(sum(e.mr * cmath.exp(1j * e.angle) for e in ecc)),
+                complex(sum(e.z * e.mr * cmath.exp(1j * e.angle) for e in ecc)),
+                float(sum(e.mass for e in ecc)), float(sum(e.z * e.mass for e in ecc)))
+
+    def _turn(self, theta: ArrayLike) -> NDArray[np.complex128]:
+        """``e^{iψ}``, ``ψ = k·θ``."""
+        return np.exp(1j * (self.ratio * np.asarray(theta, dtype=float)))
 
     def first_moment(self, theta: ArrayLike) -> NDArray[np.complex128]:
         """Its masses' first moment about the origin, ``Σ ū + ā·Σ m``, complex, kg·m.
 
         (The eccentrics' masses where given: an eccentric's ``mr`` alone moves.)
         """
-        mass = sum(e.mass for e in self.eccentrics)
-        shape = np.shape(np.asarray(theta))
-        return sum(self._moments(theta), np.full(shape, self.axis * mass, complex))
+        u, _, mass, _ = self._sums
+        return np.asarray(u * self._turn(theta) + self.axis * mass, dtype=complex)
 
-    def _forces(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
-                gravity: tuple[float, float]) -> list[NDArray[np.complex128]]:
-        """Each eccentric's share of the shaking force, ``ū·(ψ̇² − i·ψ̈) + m·ḡ``, N."""
-        rate = self.ratio * np.asarray(omega, dtype=float)
-        accel = self.ratio * np.asarray(alpha, dtype=float)
+    def loads(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
+              gravity: tuple[float, float] = (0.0, 0.0)) -> FrameLoads:
+        """Everything the rotor puts on the frame and takes from its link, at once.
+
+        With ``ū = Σ mr·e^{i·angle}·e^{iψ}`` (``ψ = k·θ``) and ``s = ψ̇² − i·ψ̈``:
+
+        - shaking force ``ū·s + m·ḡ`` (zero without eccentrics);
+        - shaking moment about the origin, ``−dH/dt`` of its angular momentum plus the moment
+          of its weights: ``−J·k·α + ā × F̄ + ū × ḡ``;
+        - rocking couple, each eccentric's force share in its plane ``z`` (``Mx = −z·F_y``,
+          ``My = z·F_x``, that is ``i·z·F``): ``i·(Σ z·ū·s + Σ z·m·ḡ)``;
+        - couple of its gearing on its link, ``k·(−J·k·α + ū × ḡ)``: the rotor's own equation
+          about its axis carried to the link at the ratio (by power,
+          ``τ_link·ω = τ_rotor·k·ω``).
+        """
+        shape = np.broadcast(np.asarray(theta), np.asarray(omega), np.asarray(alpha)).shape
+        ones = np.ones(shape)
+        alpha_ = np.asarray(alpha, dtype=float)
+        moment_ = np.asarray(moment(self.inertia, alpha_, self.ratio), dtype=float) * ones
+        couple_on_link = np.asarray(link_couple(self.inertia, alpha_, self.ratio),
+                                    dtype=float) * ones
+        if not self.eccentrics:
+            zero = np.zeros(shape, complex)
+            return FrameLoads(force=zero, moment=moment_, couple=zero.copy(),
+                              link_couple=couple_on_link)
+        u_sum, uz_sum, mass, mass_z = self._sums
         g = complex(*gravity)
-        return [u * (rate * rate - 1j * accel) + e.mass * g
-                for u, e in zip(self._moments(theta), self.eccentrics, strict=True)]
+        turn = np.exp(1j * (self.ratio * np.asarray(theta, dtype=float)))
+        rate = self.ratio * np.asarray(omega, dtype=float)
+        spin = rate * rate - 1j * (self.ratio * alpha_)
+        u = u_sum * turn
+        force = np.broadcast_to(u * spin + mass * g, shape).astype(complex)
+        couple = np.broadcast_to(1j * (uz_sum * turn * spin + mass_z * g),
+                                 shape).astype(complex)
+        weights = cross(u, g) if g else 0.0
+        return FrameLoads(force=force,
+                          moment=np.asarray(moment_ + cross(self.axis, force) + weights,
+                                            dtype=float) * ones,
+                          couple=couple,
+                          link_couple=np.asarray(couple_on_link + self.ratio * weights,
+                                                 dtype=float) * ones)
 
     def shaking_force(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
                       gravity: tuple[float, float] = (0.0, 0.0)) -> NDArray[np.complex128]:
-        """What the rotor adds to the shaking force, complex, N (zero without eccentrics)."""
-        shape = np.broadcast(np.asarray(theta), np.asarray(omega), np.asarray(alpha)).shape
-        return sum(self._forces(theta, omega, alpha, gravity), np.zeros(shape, complex))
+        """What the rotor adds to the shaking force, complex, N (:meth:`loads`)."""
+        return self.loads(theta, omega, alpha, gravity).force
 
     def shaking_moment(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
                        gravity: tuple[float, float] = (0.0, 0.0)) -> NDArray[np.float64]:
-        """What the rotor adds to the shaking moment about the origin, N·m.
-
-        ``−dH/dt`` of its angular momentum about the origin plus the moment of its weights:
-        ``−J·k·α + ā × F̄ + Σ ū × ḡ`` with ``F̄`` its :meth:`shaking_force`.
-        """
-        shape = np.broadcast(np.asarray(theta), np.asarray(omega), np.asarray(alpha)).shape
-        g = complex(*gravity)
-        force = self.shaking_force(theta, omega, alpha, gravity)
-        spin = moment(self.inertia, np.asarray(alpha, dtype=float), self.ratio)
-        weights = sum((cross(u, g) for u in self._moments(theta)), np.zeros(shape))
-        return np.asarray(spin + cross(self.axis, force) + weights, dtype=float) * np.ones(shape)
+        """What the rotor adds to the shaking moment about the origin, N·m (:meth:`loads`)."""
+        return self.loads(theta, omega, alpha, gravity).moment
 
     def rocking_couple(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
                        gravity: tuple[float, float] = (0.0, 0.0)) -> NDArray[np.complex128]:
-        """What the rotor adds to the rocking couple, complex ``Mx + i·My``, N·m.
-
-        Each eccentric's force share in its plane ``z``: ``Mx = −z·F_y``, ``My = z·F_x``.
-        """
-        shape = np.broadcast(np.asarray(theta), np.asarray(omega), np.asarray(alpha)).shape
-        total = np.zeros(shape, complex)
-        for f, e in zip(self._forces(theta, omega, alpha, gravity), self.eccentrics,
-                        strict=True):
-            total = total + e.z * (-f.imag + 1j * f.real)
-        return total
+        """What the rotor adds to the rocking couple, ``Mx + i·My``, N·m (:meth:`loads`)."""
+        return self.loads(theta, omega, alpha, gravity).couple
 
     def link_couple(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
                     gravity: tuple[float, float] = (0.0, 0.0)) -> NDArray[np.float64]:
-        """Couple of the rotor's gearing on its link, N·m: ``k·(−J·k·α + Σ ū × ḡ)``.
-
-        The rotor's own equation about its axis, its gearing's couple carried to the link at
-        the ratio (by power, ``τ_link·ω = τ_rotor·k·ω``).
-        """
-        shape = np.broadcast(np.asarray(theta), np.asarray(omega), np.asarray(alpha)).shape
-        g = complex(*gravity)
-        weights = sum((cross(u, g) for u in self._moments(theta)), np.zeros(shape))
-        own = link_couple(self.inertia, np.asarray(alpha, dtype=float), self.ratio)
-        return np.asarray(own + self.ratio * weights, dtype=float) * np.ones(shape)
+        """Couple of the rotor's gearing on its link, N·m (:meth:`loads`)."""
+        return self.loads(theta, omega, alpha, gravity).link_couple
 
     def kinetic_energy(self, omega: ArrayLike) -> NDArray[np.float64]:
         """``½·J·k²·ω²``, J."""
@@ -212,10 +246,10 @@ class Rotor:
     def angular_momentum(self, theta: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]:
         """About the origin: ``J·k·ω + ā × dū/dt`` summed, kg·m²/s."""
         rate = self.ratio * np.asarray(omega, dtype=float)
-        velocity = sum((1j * rate * u for u in self._moments(theta)),
-                       np.zeros(np.broadcast(np.asarray(theta), rate).shape, complex))
+        velocity = 1j * rate * self._sums[0] * self._turn(theta)
+        shape = np.broadcast(np.asarray(theta), rate).shape
         return np.asarray(momentum(self.inertia, np.asarray(omega, dtype=float), self.ratio)
-                          + cross(self.axis, velocity))
+                          + cross(self.axis, np.broadcast_to(velocity, shape)))
 
     @staticmethod
     def counter(inertia: float, axis: complex = 0j) -> Rotor:
@@ -223,5 +257,5 @@ class Rotor:
         return Rotor(ratio=COUNTER, inertia=inertia, axis=axis)
 
 
-__all__ = ["COUNTER", "Eccentric", "Rotor", "dynamic_link", "energy", "ground_couple",
+__all__ = ["COUNTER", "Eccentric", "FrameLoads", "Rotor", "dynamic_link", "energy", "ground_couple",
            "link_couple", "link_inertia", "moment", "momentum"]

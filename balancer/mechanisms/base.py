@@ -56,6 +56,10 @@ ZOOM_ROUNDS = 5
 #: as a straight-line program (:mod:`balancer.linkage.program`): the same arithmetic in
 #: fewer operations, whose one-time build (about 0.1 s) then pays off.
 PROGRAM_STATES = 8192
+#: From this many crank states on, the program runs compiled (:mod:`balancer.linkage.kernel`,
+#: where numba is there): its compilation (about a second, then milliseconds from the disk
+#: cache) and numba's import (0.3 s) pay off only over a long cycle.
+KERNEL_STATES = 2**18
 #: The general core's routes (:func:`balancer.linkage.dynamics.inverse_dynamics`) by the
 #: mechanism's.
 _GENERAL_ROUTES: dict[Route, Literal["groups", "global"]] = {
@@ -402,13 +406,13 @@ class Mechanism:
                          couple=zero.astype(complex), torque=zero.copy())
         for point, rotor in self.rotors:
             bare = replace(rotor, inertia=0.0)  # (its inertia is the linkage's)
-            f = bare.shaking_force(theta, omega, alpha, gravity)
-            out.bearings[point] = out.bearings.get(point, 0.0) + f
-            out.force = out.force + f
-            out.moment = (out.moment + bare.shaking_moment(theta, omega, alpha, gravity)
+            loads = bare.loads(theta, omega, alpha, gravity)
+            out.bearings[point] = out.bearings.get(point, 0.0) + loads.force
+            out.force = out.force + loads.force
+            out.moment = (out.moment + loads.moment
                           + ground_couple(rotor.inertia, alpha, rotor.ratio))
-            out.couple = out.couple + bare.rocking_couple(theta, omega, alpha, gravity)
-            out.torque = out.torque - bare.link_couple(theta, omega, alpha, gravity)
+            out.couple = out.couple + loads.couple
+            out.torque = out.torque - loads.link_couple
         return out
 
     def _with_rotors(self, forces: Forces, theta1: ArrayLike, omega1: ArrayLike,
@@ -483,29 +487,47 @@ class Mechanism:
 
     def crank_forces(self, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0,
                      *, route: Route | None = None, loads: bool = True,
-                     gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
+                     gravity: tuple[float, float] = (0.0, 0.0),
+                     compiled: bool | None = None) -> Forces:
         """:meth:`inverse_dynamics` of :meth:`motion` at crank states (arrays broadcast).
 
         A mechanism with a closed form may compute it without the general motion. At
         :data:`PROGRAM_STATES` states or more, the groups' route runs as a straight-line
         program (:class:`~balancer.linkage.program.CrankForcesProgram`, the same figures to
-        rounding); the states it leaves out, the numpy route computes.
+        rounding); the states it leaves out, the numpy route computes. ``compiled``: run the
+        program compiled where it can be (``None``: at :data:`KERNEL_STATES` states or more;
+        a long cycle analysis asks for it for each of its chunks).
         """
         route = route or self.routes[0]
-        states = np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))
-                                       for x in (theta1, omega1, alpha1)))
-        if route == "newton-euler" and states[0].size >= PROGRAM_STATES:
-            program = self._program(loads, (gravity[0], gravity[1]))
-            if program is not None:
-                forces, ok = program.evaluate(*(np.ascontiguousarray(x) for x in states))
-                forces = self._with_rotors(forces, states[0], states[1], states[2], gravity)
-                if not ok.all():
-                    rest = self.inverse_dynamics(self.motion(*(x[~ok] for x in states)),
-                                                 route=route, loads=loads, gravity=gravity)
-                    _put(forces, rest, ~ok)
+        states = list(np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))
+                                            for x in (theta1, omega1, alpha1))))
+        if compiled is None:
+            compiled = states[0].size >= KERNEL_STATES
+        if route == "newton-euler" and (compiled or states[0].size >= PROGRAM_STATES):
+            forces = self._program_forces(states, loads, gravity, compiled=compiled)
+            if forces is not None:
                 return forces
         return self.inverse_dynamics(self.motion(theta1, omega1, alpha1), route=route,
                                      loads=loads, gravity=gravity)
+
+    def _program_forces(self, states: list[NDArray[np.float64]], loads: bool,
+                        gravity: tuple[float, float], *, compiled: bool) -> Forces | None:
+        """The groups' route by the straight-line program (compiled, where asked and possible).
+
+        ``None`` where the mechanism has no program; the states the program leaves out, the
+        numpy route computes.
+        """
+        program = self._program(loads, (gravity[0], gravity[1]))
+        if program is None:
+            return None
+        forces, ok = program.evaluate(*(np.ascontiguousarray(x) for x in states),
+                                      compiled=compiled)
+        forces = self._with_rotors(forces, states[0], states[1], states[2], gravity)
+        if not ok.all():
+            rest = self.inverse_dynamics(self.motion(*(x[~ok] for x in states)),
+                                         route="newton-euler", loads=loads, gravity=gravity)
+            _put(forces, rest, ~ok)
+        return forces
 
     def _program(self, loads: bool, gravity: tuple[float, float]
                  ) -> CrankForcesProgram | None:
