@@ -414,7 +414,8 @@ current, peak = tracemalloc.get_traced_memory()
 tracemalloc.stop()
 hwm = status("VmHWM")
 r = ca.reactions
-arrays = [ca.theta1, r.shaking_force, r.shaking_moment, r.driving_torque, *r.ground.values(),
+arrays = [ca.theta1, r.shaking_force, r.shaking_moment, r.driving_torque, r.rocking_couple,
+          *r.ground.values(),
           *r.slider_normal.values(), *r.slider_couple.values()]
 if ca.singular is not None:
     arrays.append(ca.singular)
