@@ -725,10 +725,9 @@ def front_text(front: Front, spec: str | None = None) -> str:
     rows = [[f"{i + 1}", _fmt(p.value), _fmt(p.least), *(_fmt(p.figures[n]) for n in others),
              _fmt(p.lower_bound), "knee" if p.knee else ""] for i, p in enumerate(front.points)]
     unit = FIGURES[front.minimised][1]
-    held = ("the balancing constraints of [balance] hold at every point"
-            if front.minimised == "shaking_moment"
-            else "each mass·radius within its bound; the unbalance term's place taken by the "
-                 "bound on the mass")
+    held = ("each mass·radius within its bound; the unbalance term's place taken by the "
+            "bound on the mass" if front.masses
+            else "the balancing constraints of [balance] hold at every point")
     lines = [head,
              f"least {front.words} against {name} ({len(front.points)} "
              f"point{'s' if len(front.points) != 1 else ''}, each a "

@@ -82,7 +82,8 @@ class Front:
     spec's ``[balance] force_balance``); ``original_force_balanced``: whether the original
     design is. ``minimised``: what the front minimises (a key of :data:`FIGURES`);
     ``value_unit``: the second objective's unit where it is not :data:`AGAINST`'s (an
-    engine's mass·radius, kg·m).
+    engine's mass·radius, kg·m). ``masses``: the front of an engine's balancing, each point
+    bounded masses on rotors (:mod:`.rotor_front`), not a linkage's redesign.
     """
 
     against: str
@@ -93,6 +94,7 @@ class Front:
     minimised: str = "shaking_moment"
     value_unit: str | None = None
     original_figures: Mapping[str, float] = field(default_factory=dict)
+    masses: bool = False
 
     def __repr__(self) -> str:
         ends = (f"{self.points[0].value:.4g}–{self.points[-1].value:.4g} {self.unit}, "
@@ -128,7 +130,7 @@ class Front:
             units[n] = FIGURES[n][1]
         return {
             "against": self.against,
-            **({} if self.minimised == "shaking_moment" else {"minimised": self.minimised}),
+            **({"minimised": self.minimised} if self.masses else {}),
             "points": [{self.minimised: p.least, **{n: p.figures[n] for n in self.figure_names},
                         self.name: p.value, "epsilon": p.epsilon,
                         "lower_bound": p.lower_bound, "knee": p.knee}

@@ -56,9 +56,8 @@ class _RotorFront:
                   else data.problem.counterweights.radius)
         self.per_mr = 1.0 if radius is None else 1.0 / radius
         self.unit = "kg·m" if radius is None else "kg"
-        weights = np.array([site.max_mr for site in data.sites]) * self.per_mr
-        self.value_scale = float(weights.sum())
-        self.cap_row = np.r_[np.zeros(n), weights / self.value_scale]
+        self.weights = np.array([site.max_mr for site in data.sites]) * self.per_mr
+        self.rescale(float(self.weights.sum()))
         cones = [Constraint("soc", np.hstack([c.M, np.zeros((3, s))]), c.m)
                  for c in solver.constraints]
         for i in range(s):
@@ -74,6 +73,15 @@ class _RotorFront:
         self.hi = np.ones(width)
         self.width = width
 
+    def rescale(self, scale: float) -> None:
+        """Measure the cap in units of ``scale`` (its unit).
+
+        The front's own extent, once known: the sum of the bounds may be far larger than any
+        mass the front uses.
+        """
+        self.value_scale = scale if scale > 0 else float(self.weights.sum())
+        self.cap_row = np.r_[np.zeros(self.n), self.weights / self.value_scale]
+
     def value(self, x: NDArray[np.float64]) -> float:
         """``Σ |mr_i|`` of ``x`` (kg·m), or the masses at the radius (kg)."""
         return math.fsum(np.hypot(x[0::2], x[1::2])) * self.per_mr
@@ -87,7 +95,7 @@ class _RotorFront:
         """``min ‖P·u + q‖`` within the bounds and ``extra``."""
         program = ConicProgram(self.width, [*self.cones, *extra], objective="norm", P=self.P,
                                q=self.q)
-        return program.solve(self.solver.settings)
+        return self.solver.solve_program(program)
 
     def least_value(self, root: float) -> ConicSolution:
         """``min Σ c_i·t_i`` among the designs with ``‖P·u + q‖ ≤ root``."""
@@ -95,7 +103,7 @@ class _RotorFront:
                          np.r_[root, self.q])
         program = ConicProgram(self.width, [*self.cones, cap], objective="squares",
                                P=np.zeros((0, self.width)), q=np.zeros(0), g=self.cap_row)
-        return program.solve(self.solver.settings)
+        return self.solver.solve_program(program)
 
     def certified(self, solution: ConicSolution, cap: Constraint) -> float:
         """The certified least ``√J'`` under ``cap``, N·m (0 where none is made)."""
@@ -127,8 +135,9 @@ def rotor_front(design: Design, against: str, points: int) -> Front:
                         "give --against added-mass", key="--against", value=against)
     weights = replace(problem.objective, unbalance=0.0)
     if not weights.terms:
-        raise SpecError("weighs only the unbalance: nothing to trade against the added mass; "
-                        "weigh the rocking couple, the shaking force or the shaking moment",
+        what = "only the unbalance" if problem.objective.unbalance else "nothing"
+        raise SpecError(f"weighs {what}: nothing to trade against the added mass; weigh the "
+                        "rocking couple, the shaking force or the shaking moment",
                         key="balance.objective")
     data = RotorProblem(replace(design, balance=replace(problem, objective=weights)))
     single = weights.single
@@ -147,6 +156,9 @@ def rotor_front(design: Design, against: str, points: int) -> Front:
         return solver.x(solution.u[: programs.n])
 
     best = solved(programs.least_objective([]), "the least shaking")
+    # The front's extent is at most the mass of that optimum: the cap's unit from here on
+    # (not below a millionth of the bounds' sum: an optimum that adds nothing is one point).
+    programs.rescale(max(programs.value(best), 1e-6 * float(programs.weights.sum())))
     top = programs.least_value(math.sqrt(data.objective(best)) / scale + END_ROOM)
     high = programs.value(solved(top, "the least mass of the least shaking")
                           if top.u is not None else best)
@@ -166,7 +178,7 @@ def rotor_front(design: Design, against: str, points: int) -> Front:
     return Front(against=against, points=tuple(mark_knee(out)),
                  original=(programs.value(data.x0), least(data.x0)),
                  minimised=minimised, value_unit=None if programs.unit == "kg" else "kg·m",
-                 original_figures=data.figures(data.x0))
+                 original_figures=data.figures(data.x0), masses=True)
 
 
 __all__ = ["rotor_front"]

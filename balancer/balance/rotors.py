@@ -65,7 +65,7 @@ from ..model.balance import (
 )
 from .certificate import Constraint, lower_bound
 from .certificate import Objective as Norm
-from .conic import ConicProgram
+from .conic import ConicProgram, ConicSolution
 from .convex import CLARABEL_SETTINGS, NUMERICAL_FALLBACKS, TIE_ACCEPT
 from .nlp import IPOPT_OPTIONS
 from .problem import BALANCED_SHARE, ROUNDING_FACTOR
@@ -343,7 +343,9 @@ class RotorSolver:
                          if self.rank < n else None)
         self.settings = dict(CLARABEL_SETTINGS)
 
-    def _solve(self, program: ConicProgram, **data: NDArray[np.float64]):  # type: ignore[no-untyped-def]
+    def solve_program(self, program: ConicProgram,
+                      **data: NDArray[np.float64]) -> ConicSolution:
+        """``program`` by Clarabel, again with looser settings where it fails numerically."""
         solution = program.solve(self.settings, **data)
         for fallback in NUMERICAL_FALLBACKS:
             if solution.status != "solver_error":
@@ -365,7 +367,7 @@ class RotorSolver:
         data = self.data
         scale = data.objective_scale
         t0 = time.perf_counter()
-        first = self._solve(self._norm)
+        first = self.solve_program(self._norm)
         stages = [StageReport(name="convex", converged=first.u is not None,
                               solver_status=first.status, iterations=first.iterations,
                               time=time.perf_counter() - t0,
@@ -384,7 +386,7 @@ class RotorSolver:
         lower = 0.0 if bound is None else (max(bound.value, 0.0) * scale) ** 2
         if self._nearest is not None:
             t1 = time.perf_counter()
-            second = self._solve(self._nearest, target=np.zeros(data.size),
+            second = self.solve_program(self._nearest, target=np.zeros(data.size),
                                  equality_rhs=self._seen @ u)
             objective2 = (data.objective(self.x(second.u)) if second.u is not None
                           else math.nan)

@@ -258,9 +258,20 @@ def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
     return vel, rate, acc, accel
 
 
+#: Motions at up to this many crank states are kept with the geometry (a cycle's samples: the
+#: cycle analysis, the regressors and the force-balance conditions of a design and of its
+#: redesign ask for the same motion), the last :data:`MOTIONS_KEPT` of them.
+MOTION_CACHE_STATES = 4096
+MOTIONS_KEPT = 4
+
+
 def motion(structure: Structure, theta1: ArrayLike, omega1: ArrayLike = 0.0,
            alpha1: ArrayLike = 0.0) -> Motion:
     """Positions, velocities and accelerations at crank states (arrays broadcast together).
+
+    The motion depends on the geometry alone: one at a few states is kept with it
+    (:attr:`Structure.kinematic`) and given again for the same states. (Its arrays are
+    shared: not to be written into.)
 
     Parameters
     ----------
@@ -272,8 +283,20 @@ def motion(structure: Structure, theta1: ArrayLike, omega1: ArrayLike = 0.0,
     theta1, omega1, alpha1 = (np.asarray(x, dtype=float) for x in
                               np.broadcast_arrays(theta1, omega1, alpha1))
     theta1, omega1, alpha1 = (np.atleast_1d(x) for x in (theta1, omega1, alpha1))
+    key = None
+    if theta1.size <= MOTION_CACHE_STATES:  # a cycle's samples: the same ones, asked again
+        key = ("motion", theta1.shape, theta1.tobytes(), omega1.tobytes(), alpha1.tobytes())
+        known = structure.kinematic.get(key)
+        if known is not None:
+            return known
     pose = positions(structure, theta1)
     vel, rate, acc, accel = rates(structure, pose, omega1, alpha1, theta1)
-    return Motion(theta1=theta1, omega1=omega1, alpha1=alpha1, pose=pose,
-                  velocity=tuple(vel), rate=tuple(rate), acceleration=tuple(acc),
-                  accel=tuple(accel))
+    mo = Motion(theta1=theta1, omega1=omega1, alpha1=alpha1, pose=pose,
+                velocity=tuple(vel), rate=tuple(rate), acceleration=tuple(acc),
+                accel=tuple(accel))
+    if key is not None:
+        kept = [k for k in structure.kinematic if isinstance(k, tuple) and k[0] == "motion"]
+        for old in kept[: max(len(kept) - MOTIONS_KEPT + 1, 0)]:
+            structure.kinematic.pop(old, None)
+        structure.kinematic[key] = mo
+    return mo

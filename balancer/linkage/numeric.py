@@ -159,14 +159,15 @@ def table(structure: Structure, g: Group, place: Positions
     pose, the turn downwards is the same poses, each link's angle less what it turns in a
     revolution; otherwise it is continued too.
     """
-    cache = structure.cache.setdefault("numeric tables", {})
+    cache = structure.kinematic.setdefault("numeric tables", {})
     key = structure.groups.index(g)
     if key in cache:
         return cache[key]
     start = structure.ref_angle[structure.input]
     step = 2 * math.pi / TABLE_STEPS
     before = structure.groups[: structure.groups.index(g)]
-    partial = replace(structure, groups=tuple(before), cache={})  # places the known links
+    partial = replace(structure, groups=tuple(before), cache={},
+                      kinematic={})  # places the known links
     q_ref = _coordinates(structure, g)
     out = np.full((2 * TABLE_STEPS + 1, q_ref.size), np.nan)
     angles = start + step * np.arange(-TABLE_STEPS, TABLE_STEPS + 1, dtype=float)
@@ -281,7 +282,7 @@ def start(structure: Structure, g: Group, theta1: NDArray[np.float64],
         t = theta1 - 2 * math.pi * np.floor((theta1 - valid.min()) / (2 * math.pi))
     else:  # within the range found, in the window nearest the reference
         t = begin + np.remainder(theta1 - begin + math.pi, 2 * math.pi) - math.pi
-    cubics = structure.cache.setdefault("numeric cubics", {})
+    cubics = structure.kinematic.setdefault("numeric cubics", {})
     key = structure.groups.index(g)
     if key not in cubics:
         cubics[key] = _cubic_coefficients(tab)

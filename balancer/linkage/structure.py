@@ -30,7 +30,9 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, field
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -54,6 +56,11 @@ from .vectors import V
 #: Singular values below this share of the largest (columns in common units) make the
 #: reference pose's Jacobian singular.
 RANK_TOLERANCE = 1e-10
+#: Geometries whose structures are kept (:meth:`Structure.of`): a sweep's point and its
+#: redesign share one; the least recently used goes.
+SKELETONS = 64
+_SKELETONS: OrderedDict[Any, Structure] = OrderedDict()
+_SKELETON_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -92,8 +99,12 @@ class Structure:
     driver: Driver
     groups: tuple[Group, ...]
     point_links: dict[str, tuple[int, ...]] = field(repr=False)
-    #: Tables and other results computed once per structure (numeric groups' continuation).
+    #: Results computed once per structure.
     cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+    #: What depends on the geometry alone — the assembly range, the numeric groups'
+    #: continuation tables, motions at a few crank states — shared by every structure of the
+    #: same geometry (a design and its redesign, which changes masses only: :meth:`of`).
+    kinematic: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def size(self) -> int:
@@ -134,6 +145,24 @@ class Structure:
             singular or the input does not drive the linkage there, or no order of groups
             finds every link.
         """
+        key = (linkage.points, tuple((b.name, b.points) for b in linkage.bodies),
+               linkage.sliders, linkage.input, tuple(sorted((lengths or {}).items())))
+        with _SKELETON_LOCK:
+            known = _SKELETONS.get(key)
+            if known is not None:
+                _SKELETONS.move_to_end(key)
+        if known is not None:  # the same geometry: its equations, with this design's links
+            return replace(known, linkage=linkage, cache={})
+        structure = cls._build(linkage, lengths)
+        with _SKELETON_LOCK:
+            _SKELETONS[key] = structure
+            while len(_SKELETONS) > SKELETONS:
+                _SKELETONS.popitem(last=False)
+        return structure
+
+    @classmethod
+    def _build(cls, linkage: Linkage, lengths: dict[str, float] | None) -> Structure:
+        """:meth:`of` from the linkage's points, bodies and sliders."""
         names = linkage.link_names
         index = {name: k for k, name in enumerate(names)}
         index[GROUND] = GROUND_INDEX

@@ -288,9 +288,10 @@ class Mechanism:
 
     def assembly_range(self) -> AssemblyRange:
         """Crank angles at which the linkage assembles, on the reference pose's branch."""
-        if "assembly" not in self.structure.cache:
-            self.structure.cache["assembly"] = _assembly_range(self.structure)
-        return self.structure.cache["assembly"]
+        shared = self.structure.kinematic  # (the same for every design of this geometry)
+        if "assembly" not in shared:
+            shared["assembly"] = _assembly_range(self.structure)
+        return shared["assembly"]
 
     def least_gap(self) -> float | None:
         """The groups' least assembly gap over a revolution, or ``None``.
@@ -299,7 +300,7 @@ class Mechanism:
         does not turn fully.
         """
         self.assembly_range()
-        return self.structure.cache.get("least gap")
+        return self.structure.kinematic.get("least gap")
 
     def change_points(self) -> tuple[float, ...]:
         """Crank angles where the assemblies meet and the smooth motion passes (none in general).
@@ -665,7 +666,7 @@ def _assembly_range(structure: Structure) -> AssemblyRange:
     least = min(float(np.min(gap)), _refined_minimum(structure, theta[dips - 1],
                                                       theta[dips + 1]))
     if least > GAP_TOLERANCE:
-        structure.cache["least gap"] = least
+        structure.kinematic["least gap"] = least
         return AssemblyRange(intervals=((-math.pi, math.pi),), full=True)
     from scipy.optimize import brentq
 

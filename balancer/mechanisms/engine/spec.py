@@ -95,9 +95,10 @@ def _rod(links: Table) -> Link:
 
 def _crankshaft(links: Table) -> Crankshaft:
     table = _link(links, "crankshaft")
+    masses = _masses(table, "masses")  # (each under its own path, not under the shaft's too)
     with v.under(table.path):
         shaft = Crankshaft(inertia=table.value("inertia", 0.0), mass=table.value("mass", 0.0),
-                           masses=_masses(table, "masses"))
+                           masses=masses)
     table.finish()
     return shaft
 
@@ -118,10 +119,10 @@ def _shafts(root: Table) -> tuple[BalanceShaft, ...]:
         sub.expect(schema.known(sub.path, schema.ENGINE))
         if not sub.has("ratio"):
             raise sub._missing("ratio")
+        eccentrics = _masses(sub, "eccentrics")  # (each under its own path)
         with v.under(sub.path):
             out.append(BalanceShaft(ratio=sub.raw("ratio"), at=sub.value("at", (0.0, 0.0)),
-                                    inertia=sub.value("inertia", 0.0),
-                                    eccentrics=_masses(sub, "eccentrics")))
+                                    inertia=sub.value("inertia", 0.0), eccentrics=eccentrics))
         sub.finish()
     return tuple(out)
 
