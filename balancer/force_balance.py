@@ -137,7 +137,8 @@ def _angles(mech: Mechanism, count: int, rng: np.random.Generator) -> NDArray[np
 def force_balance_conditions(mech: Mechanism) -> ForceBalance:
     """The conditions of shaking-force balance of a mechanism (see the module docstring).
 
-    Cached on the mechanism's structure (they depend on its geometry only).
+    Cached with the mechanism's geometry (:attr:`~balancer.linkage.structure.Structure.
+    kinematic`: they depend on it and on the layout alone, which a redesign keeps).
 
     Raises
     ------
@@ -145,7 +146,7 @@ def force_balance_conditions(mech: Mechanism) -> ForceBalance:
         If the sampled singular values show no clear gap, or the conditions do not hold at
         fresh angles (the rank cannot be trusted).
     """
-    cache = mech.structure.cache
+    cache = mech.structure.kinematic
     if "force balance" in cache:
         return cache["force balance"]
     layout = mech.layout
@@ -166,7 +167,9 @@ def force_balance_conditions(mech: Mechanism) -> ForceBalance:
     g = first_moment_map(mech, theta)
     d = g - g.mean(axis=0)
     d = np.vstack([d.real, d.imag]) / scales  # columns in units of a first moment
-    _, sv, vt = np.linalg.svd(d, full_matrices=True)
+    # (Rows ≥ columns: the reduced factorisation has every right singular vector, without
+    # the square left factor of the samples' size.)
+    _, sv, vt = np.linalg.svd(d, full_matrices=False)
     top = sv[0] if sv.size else 0.0
     if top == 0:
         result = ForceBalance(matrix=np.zeros((0, layout.size)), scales=scales,
