@@ -25,6 +25,7 @@ Where a group cannot be assembled the positions are NaN (see :func:`assembly_gap
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -263,6 +264,7 @@ def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
 #: redesign ask for the same motion), the last :data:`MOTIONS_KEPT` of them.
 MOTION_CACHE_STATES = 4096
 MOTIONS_KEPT = 4
+_MOTIONS_LOCK = threading.Lock()
 
 
 def motion(structure: Structure, theta1: ArrayLike, omega1: ArrayLike = 0.0,
@@ -286,7 +288,8 @@ def motion(structure: Structure, theta1: ArrayLike, omega1: ArrayLike = 0.0,
     key = None
     if theta1.size <= MOTION_CACHE_STATES:  # a cycle's samples: the same ones, asked again
         key = ("motion", theta1.shape, theta1.tobytes(), omega1.tobytes(), alpha1.tobytes())
-        known = structure.kinematic.get(key)
+        with _MOTIONS_LOCK:
+            known = structure.kinematic.get(key)
         if known is not None:
             return known
     pose = positions(structure, theta1)
@@ -295,8 +298,10 @@ def motion(structure: Structure, theta1: ArrayLike, omega1: ArrayLike = 0.0,
                 velocity=tuple(vel), rate=tuple(rate), acceleration=tuple(acc),
                 accel=tuple(accel))
     if key is not None:
-        kept = [k for k in structure.kinematic if isinstance(k, tuple) and k[0] == "motion"]
-        for old in kept[: max(len(kept) - MOTIONS_KEPT + 1, 0)]:
-            structure.kinematic.pop(old, None)
-        structure.kinematic[key] = mo
+        with _MOTIONS_LOCK:  # (threads may share a geometry)
+            kept = [k for k in structure.kinematic
+                    if isinstance(k, tuple) and k[0] == "motion"]
+            for old in kept[: max(len(kept) - MOTIONS_KEPT + 1, 0)]:
+                structure.kinematic.pop(old, None)
+            structure.kinematic[key] = mo
     return mo
