@@ -363,8 +363,10 @@ class CrankForcesProgram:
             run([theta[None, :], omega1[None, a:b], alpha1[None, a:b], guess, gas_in],
                 b - a, [out[:, a:b]])
         closure, step, health = out[-3], out[-2], out[-1]
+        # (Every figure finite: their sum is, the figures being far below overflow.)
         ok &= ((closure <= numeric.NEWTON_TOLERANCE * s.length_scale())
-               & (step <= numeric.TAYLOR_STEP) & (health <= 0) & np.isfinite(out).all(axis=0))
+               & (step <= numeric.TAYLOR_STEP) & (health <= 0)
+               & np.isfinite(out.sum(axis=0)))
         return self.forces.with_arrays([row[:, None] for row in out[:-3]]), ok
 
 
