@@ -204,7 +204,7 @@ class Rotor:
                               link_couple=couple_on_link)
         u_sum, uz_sum, mass, mass_z = self._sums
         g = complex(*gravity)
-        turn = np.exp(1j * (self.ratio * np.asarray(theta, dtype=float)))
+        turn = self._turn(theta)
         rate = self.ratio * np.asarray(omega, dtype=float)
         spin = rate * rate - 1j * (self.ratio * alpha_)
         u = u_sum * turn
