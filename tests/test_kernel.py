@@ -188,3 +188,20 @@ def test_a_short_analysis_and_help_never_import_numba():
             f"main(['analyze', {str(EXAMPLES / 'pb1.toml')!r}, '--json'])\n"
             "print(json.dumps({'numba': 'numba' in sys.modules}))")
     assert _child(code, {}) == {"numba": False}
+
+
+def test_the_cache_keeps_the_most_recently_used_kernels(cache, monkeypatch):
+    """Beyond KEPT kernels the least recently used goes, its numba code with it."""
+    import balancer.linkage.kernel as kernel_module
+
+    monkeypatch.setattr(kernel_module, "KEPT", 2)
+    x = ca.SX.sym("x")
+    names = []
+    for k in range(4):
+        names.append(Kernel(ca.Function(f"f{k}", [x], [x * (k + 2.5)])).name)
+    folder = cache / "kernels"
+    kept = {p.stem for p in folder.glob("kernel_*.py")}
+    assert names[-1] in kept and names[0] not in kept and len(kept) <= 3
+    assert not list((folder / "__pycache__").glob(f"{names[0]}.*"))
+    again = Kernel(ca.Function("f3", [x], [x * 5.5]))  # the newest, loaded: still there
+    assert again.cached and again([np.array([[2.0]])], 1)[0][0, 0] == 11.0

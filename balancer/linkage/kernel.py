@@ -22,6 +22,7 @@ import it. Where numba is missing or cannot compile a program, :func:`compile_ke
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.util
 import math
@@ -42,6 +43,9 @@ if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are buil
 
 #: The generated source's format: part of the cache key (a change here makes new kernels).
 KERNEL_FORMAT = 4
+#: Kernels kept in the cache folder (the least recently used go first): a design analysed at
+#: length keeps its kernel (about 150 KB) until this many others are.
+KEPT = 256
 #: Environment variables: the cache folder, and ``0`` to turn kernels off.
 CACHE_ENV = "BALANCER_CACHE_DIR"
 SWITCH_ENV = "BALANCER_KERNELS"
@@ -150,6 +154,26 @@ def cache_dir() -> Path:
     return Path(base) / "balancer" / "kernels"
 
 
+def prune(folder: Path, keep: str, most: int | None = None) -> None:
+    """Remove the least recently used kernels beyond :data:`KEPT` (``most``) from ``folder``.
+
+    Each kernel's source and numba's cached code of it go together; ``keep`` (a kernel's
+    name) stays. Another process pruning, loading or writing at the same time is not an
+    error: what cannot be removed stays.
+    """
+    most = KEPT if most is None else most
+    try:
+        sources = sorted(folder.glob("kernel_*.py"), key=lambda p: p.stat().st_mtime)
+    except OSError:
+        return
+    for path in sources[: max(len(sources) - most, 0)]:
+        if path.stem == keep:
+            continue
+        for old in (path, *(folder / "__pycache__").glob(f"{path.stem}.*")):
+            with contextlib.suppress(OSError):
+                old.unlink()
+
+
 def enabled() -> bool:
     """Whether kernels may be used (``BALANCER_KERNELS`` is not ``0``) and numba is there."""
     if os.environ.get(SWITCH_ENV, "1").strip() == "0":
@@ -195,7 +219,8 @@ class Kernel:
         The module is registered under its name (numba finds it again so when it loads the
         cached code).
         """
-        if self.name in sys.modules:
+        if self.name in sys.modules:  # (loaded in this process already)
+            self.cached = True
             return sys.modules[self.name].run
         folder = cache_dir()
         folder.mkdir(parents=True, exist_ok=True)
@@ -206,6 +231,10 @@ class Kernel:
             with os.fdopen(fd, "w", encoding="utf-8") as f:
                 f.write(self._text(True))
             os.replace(tmp, path)
+            prune(folder, keep=self.name)
+        else:
+            with contextlib.suppress(OSError):
+                os.utime(path)  # (used: the last to go when the folder is pruned)
         spec = importlib.util.spec_from_file_location(self.name, path)
         assert spec is not None and spec.loader is not None
         module = importlib.util.module_from_spec(spec)
@@ -269,5 +298,5 @@ def compile_kernel(fn: ca.Function) -> Kernel | None:
         return None
 
 
-__all__ = ["CACHE_ENV", "SWITCH_ENV", "Kernel", "cache_dir", "compile_kernel", "enabled",
-           "kernel_source", "op_names"]
+__all__ = ["CACHE_ENV", "KEPT", "SWITCH_ENV", "Kernel", "cache_dir", "compile_kernel",
+           "enabled", "kernel_source", "op_names", "prune"]
