@@ -173,15 +173,13 @@ class RotorProblem:
         moment = np.zeros((theta.size, n))
         for i, site in enumerate(self.sites):
             for col, angle in ((2 * i, 0.0), (2 * i + 1, math.pi / 2)):
-                rotor = site.rotor(angle)
-                force[:, col] = rotor.shaking_force(theta, self.speed, zero)
-                couple[:, col] = rotor.rocking_couple(theta, self.speed, zero)
-                moment[:, col] = rotor.shaking_moment(theta, self.speed, zero)
-        #: Each mass·radius entry's force on its bearing per kg·m, ``(N, P)`` complex, N.
-        self.force_columns = force
+                loads = site.rotor(angle).loads(theta, self.speed, zero)
+                force[:, col], couple[:, col], moment[:, col] = (loads.force, loads.couple,
+                                                                 loads.moment)
         r = base.reactions
         #: Per load on the frame: each entry's columns per kg·m and the base engine's samples
         #: (the shaking force and rocking couple complex, N and N·m; the moment about z, N·m).
+        #: A shaft's bearing force is its eccentrics' columns of the shaking force.
         self.loads: dict[str, tuple[NDArray[Any], NDArray[Any]]] = {
             "shaking_force": (force, r.shaking_force),
             "rocking_couple": (couple, r.rocking_couple),
@@ -305,12 +303,14 @@ class RotorProblem:
     def bearing_loads(self, x: NDArray[np.float64]) -> tuple[float, ...]:
         """Each new shaft's largest bearing force over the cycle, N.
 
-        Its eccentrics' columns of :attr:`force_columns` times their entries of ``x``.
+        Its eccentrics' columns of the shaking force (:attr:`loads`) times their entries of
+        ``x``.
         """
+        columns = self.loads["shaking_force"][0]
         out = []
         for j in range(len(self.problem.shafts)):
             cols = np.repeat([s.shaft == j for s in self.sites], 2)
-            force = self.force_columns[:, cols] @ x[cols]
+            force = columns[:, cols] @ x[cols]
             out.append(float(np.max(np.abs(force), initial=0.0)))
         return tuple(out)
 

@@ -26,6 +26,7 @@ Where a group cannot be assembled the positions are NaN (see :func:`assembly_gap
 from __future__ import annotations
 
 import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -287,9 +288,10 @@ def motion(structure: Structure, theta1: ArrayLike, omega1: ArrayLike = 0.0,
     theta1, omega1, alpha1 = (np.atleast_1d(x) for x in (theta1, omega1, alpha1))
     key = None
     if theta1.size <= MOTION_CACHE_STATES:  # a cycle's samples: the same ones, asked again
-        key = ("motion", theta1.shape, theta1.tobytes(), omega1.tobytes(), alpha1.tobytes())
+        key = (theta1.shape, theta1.tobytes(), omega1.tobytes(), alpha1.tobytes())
         with _MOTIONS_LOCK:
-            known = structure.kinematic.get(key)
+            motions = structure.kinematic.setdefault("motions", OrderedDict())
+            known = motions.get(key)
         if known is not None:
             return known
     pose = positions(structure, theta1)
@@ -299,9 +301,7 @@ def motion(structure: Structure, theta1: ArrayLike, omega1: ArrayLike = 0.0,
                 accel=tuple(accel))
     if key is not None:
         with _MOTIONS_LOCK:  # (threads may share a geometry)
-            kept = [k for k in structure.kinematic
-                    if isinstance(k, tuple) and k[0] == "motion"]
-            for old in kept[: max(len(kept) - MOTIONS_KEPT + 1, 0)]:
-                structure.kinematic.pop(old, None)
-            structure.kinematic[key] = mo
+            motions[key] = mo
+            while len(motions) > MOTIONS_KEPT:
+                motions.popitem(last=False)
     return mo

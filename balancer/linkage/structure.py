@@ -104,7 +104,7 @@ class Structure:
     #: What depends on the geometry alone — the assembly range, the numeric groups'
     #: continuation tables, motions at a few crank states — shared by every structure of the
     #: same geometry (a design and its redesign, which changes masses only: :meth:`of`).
-    kinematic: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
+    kinematic: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def size(self) -> int:

@@ -504,23 +504,32 @@ class Mechanism:
                                             for x in (theta1, omega1, alpha1))))
         if compiled is None:
             compiled = states[0].size >= KERNEL_STATES
-        if route == "newton-euler" and (compiled or states[0].size >= PROGRAM_STATES):
-            forces = self._program_forces(states, loads, gravity, compiled=compiled)
-            if forces is not None:
-                return forces
-        return self.inverse_dynamics(self.motion(theta1, omega1, alpha1), route=route,
-                                     loads=loads, gravity=gravity)
+        if compiled and route == "newton-euler":
+            program = self._program(loads, (gravity[0], gravity[1]))
+            if program is not None and program.kernel is not None:
+                return self._program_forces(program, states, loads, gravity, compiled=True)
+        return self.uncompiled_forces(states, route=route, loads=loads, gravity=gravity)
 
-    def _program_forces(self, states: list[NDArray[np.float64]], loads: bool,
-                        gravity: tuple[float, float], *, compiled: bool) -> Forces | None:
-        """The groups' route by the straight-line program (compiled, where asked and possible).
+    def uncompiled_forces(self, states: list[NDArray[np.float64]], *, route: Route,
+                          loads: bool, gravity: tuple[float, float]) -> Forces:
+        """:meth:`crank_forces` without a compiled kernel, at states ``(θ1, ω1, α1)``.
 
-        ``None`` where the mechanism has no program; the states the program leaves out, the
-        numpy route computes.
+        The straight-line program by numpy over :data:`PROGRAM_STATES` states or more, else
+        the numpy route; a mechanism with closed forms gives its own.
         """
-        program = self._program(loads, (gravity[0], gravity[1]))
-        if program is None:
-            return None
+        if route == "newton-euler" and states[0].size >= PROGRAM_STATES:
+            program = self._program(loads, (gravity[0], gravity[1]))
+            if program is not None:
+                return self._program_forces(program, states, loads, gravity, compiled=False)
+        return self.inverse_dynamics(self.motion(*states), route=route, loads=loads,
+                                     gravity=gravity)
+
+    def _program_forces(self, program: CrankForcesProgram, states: list[NDArray[np.float64]],
+                        loads: bool, gravity: tuple[float, float], *, compiled: bool) -> Forces:
+        """The groups' route by the straight-line ``program`` (compiled, where asked).
+
+        The states the program leaves out, the numpy route computes.
+        """
         forces, ok = program.evaluate(*(np.ascontiguousarray(x) for x in states),
                                       compiled=compiled)
         forces = self._with_rotors(forces, states[0], states[1], states[2], gravity)

@@ -23,7 +23,7 @@ from ...linkage.structure import Structure
 from ...linkage.vectors import V
 from ...model import Body, Branch, Linkage
 from ...model.assembly import AssemblyRange
-from ..base import KERNEL_STATES, Limit, Mechanism, Route
+from ..base import Limit, Mechanism, Route
 from . import kinematics as fourbar
 from .assembly import assembly_range, classify
 from .complex_masses import ComplexMasses
@@ -146,28 +146,15 @@ class FourBarMechanism(Mechanism):
         """
         return self._closed_form_forces(fourbar_motion(self.model, mo), route, loads, gravity)
 
-    def crank_forces(self, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0,
-                     *, route: Route | None = None, loads: bool = True,
-                     gravity: tuple[float, float] = (0.0, 0.0),
-                     compiled: bool | None = None) -> Forces:
-        """:meth:`inverse_dynamics` at crank states from the closed-form motion alone.
+    def uncompiled_forces(self, states: list[NDArray[np.float64]], *, route: Route,
+                          loads: bool, gravity: tuple[float, float]) -> Forces:
+        """The crank forces from the closed-form motion alone (Eq. 2–10, 12–28, 45–54).
 
-        Compiled (``compiled``, or ``None`` and :data:`~balancer.mechanisms.base.KERNEL_STATES`
-        states or more), the general core's groups' route runs as machine code where it can
-        (the same figures to rounding: the closed forms check it in the tests).
+        (Compiled, :meth:`crank_forces` runs the general core's groups' route instead: the
+        same figures to rounding, which the closed forms check in the tests.)
         """
-        states = list(np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))
-                                            for x in (theta1, omega1, alpha1))))
-        if compiled is None:
-            compiled = states[0].size >= KERNEL_STATES
-        if (route or self.routes[0]) == "newton-euler" and compiled:
-            program = self._program(loads, (gravity[0], gravity[1]))
-            if program is not None and program.kernel is not None:
-                forces = self._program_forces(states, loads, gravity, compiled=True)
-                assert forces is not None  # (it has a program)
-                return forces
-        return self._closed_form_forces(self._closed_form_motion(theta1, omega1, alpha1),
-                                        route, loads, gravity)
+        return self._closed_form_forces(self._closed_form_motion(*states), route, loads,
+                                        gravity)
 
     def _closed_form_forces(self, mo: fourbar.Motion, route: Route | None, loads: bool,
                             gravity: tuple[float, float]) -> Forces:
