@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
@@ -190,11 +190,12 @@ class CycleAnalysis:
     loads: bool = True
     singular: NDArray[np.bool_] | None = None
     revolutions: int = 1
-    summary: CycleSummary = field(init=False)
 
-    def __post_init__(self) -> None:
+    @cached_property
+    def summary(self) -> CycleSummary:
+        """Each column's RMS and largest magnitude (computed when first asked)."""
         r = self.reactions
-        object.__setattr__(self, "summary", CycleSummary(
+        return CycleSummary(
             shaking_force=Figure.of(r.shaking_force),
             shaking_moment=Figure.of(r.shaking_moment),
             driving_torque=Figure.of(r.driving_torque),
@@ -203,7 +204,7 @@ class CycleAnalysis:
             slider_normal={k: Figure.of(v) for k, v in r.slider_normal.items()},
             slider_couple={k: Figure.of(v) for k, v in r.slider_couple.items()},
             mount_torque=None if self.mount_torque is None else Figure.of(self.mount_torque),
-        ))
+        )
 
     def __repr__(self) -> str:
         s = self.summary
@@ -359,29 +360,30 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
 
     compiled = n >= KERNEL_STATES  # a long cycle: its chunks by the compiled program
 
-    def evaluate(theta: NDArray[np.float64]) -> Forces:
+    def evaluate(theta: NDArray[np.float64], into: Forces | None = None) -> Forces:
         with np.errstate(all="ignore"):
             return mech.crank_forces(theta, speed, 0.0, route=route, loads=loads,
-                                     gravity=gravity, compiled=compiled)
+                                     gravity=gravity, compiled=compiled, into=into)
 
-    def put(target: NDArray[np.complex128], sl: slice, vector: V) -> None:
-        """A planar vector's column into a complex array (no complex temporary)."""
-        part = target[sl]
-        part.real = np.asarray(vector.x)[:, 0]
-        part.imag = np.asarray(vector.y)[:, 0]
+    def columns(sl: slice) -> Forces:
+        """The cycle's columns at ``sl`` as forces (views: what is written there is theirs)."""
+        def real(a: NDArray[np.float64]) -> NDArray[np.float64]:
+            return a[sl, None]
+
+        def vector(a: NDArray[np.complex128]) -> V:
+            return V(a.real[sl, None], a.imag[sl, None])
+
+        return Forces(reactions={p: vector(ground[p]) for p in grounds},
+                      slider_normal={k: real(normal[k]) for k in sliders},
+                      slider_couple={k: real(couple[k]) for k in sliders},
+                      driving_torque=real(out["driving_torque"]),
+                      shaking_force=vector(out["shaking_force"]),
+                      shaking_moment=real(out["shaking_moment"]),
+                      rocking_couple=vector(out["rocking_couple"]))
 
     def fill(start: int) -> None:
         sl = slice(start, start + CHUNK)
-        f = evaluate(angles[sl])
-        put(out["shaking_force"], sl, f.shaking_force)
-        out["shaking_moment"][sl] = f.shaking_moment[:, 0]
-        out["driving_torque"][sl] = f.driving_torque[:, 0]
-        put(out["rocking_couple"], sl, f.rocking_couple)
-        for p in grounds:
-            put(ground[p], sl, f.reactions[p])
-        for k in sliders:
-            normal[k][sl] = f.slider_normal[k][:, 0]
-            couple[k][sl] = f.slider_couple[k][:, 0]
+        evaluate(angles[sl], into=columns(sl))
 
     starts = range(0, n, CHUNK)
     if len(starts) > 1 and WORKERS > 1:

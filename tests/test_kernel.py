@@ -118,7 +118,7 @@ def test_the_kernel_source_covers_every_operation_of_the_tape():
     xs, ys = (a.ravel() for a in np.meshgrid(values, values))
     with np.errstate(all="ignore"):
         tape = Tape(fn)([xs[None, :], ys[None, :]], xs.size)[0]
-    kernel = Kernel(fn)([xs[None, :], ys[None, :]], xs.size)[0]
+    kernel = np.array(Kernel(fn)([xs[None, :], ys[None, :]], xs.size)[0])
     np.testing.assert_array_equal(np.isnan(kernel), np.isnan(tape))
     finite = np.isfinite(tape)
     np.testing.assert_array_equal(kernel[~finite & ~np.isnan(tape)],
@@ -197,11 +197,66 @@ def test_the_cache_keeps_the_most_recently_used_kernels(cache, monkeypatch):
     monkeypatch.setattr(kernel_module, "KEPT", 2)
     x = ca.SX.sym("x")
     names = []
-    for k in range(4):
-        names.append(Kernel(ca.Function(f"f{k}", [x], [x * (k + 2.5)])).name)
+    for k in range(4):  # (each of its own form: a kernel takes its constants as inputs)
+        names.append(Kernel(ca.Function(f"f{k}", [x], [ca.sin(x) ** (k + 2.5)])).name)
     folder = cache / "kernels"
     kept = {p.stem for p in folder.glob("kernel_*.py")}
     assert names[-1] in kept and names[0] not in kept and len(kept) <= 3
     assert not list((folder / "__pycache__").glob(f"{names[0]}.*"))
-    again = Kernel(ca.Function("f3", [x], [x * 5.5]))  # the newest, loaded: still there
-    assert again.cached and again([np.array([[2.0]])], 1)[0][0, 0] == 11.0
+    again = Kernel(ca.Function("f3", [x], [ca.sin(x) ** 5.5]))  # the newest: still there
+    assert again.cached and again([np.array([[2.0]])], 1)[0][0][0] == math.sin(2.0) ** 5.5
+
+
+def test_designs_of_one_topology_share_one_kernel():
+    """A kernel takes its design's numbers as inputs: PB1 and PB1 with another coupler and
+    frame (a sweep's point) compile one kernel; each still gives its own tape's figures."""
+    import tomllib
+
+    from balancer.spec import design_from_dict
+    from balancer.sweeps import with_values
+
+    data = tomllib.loads((EXAMPLES / "pb1.toml").read_text())
+    other = with_values(data, {"mechanism.lengths.coupler": 3.37,
+                               "mechanism.lengths.frame": 2.81})
+    programs = [mechanism_of(design_from_dict(d).mechanism)._program(True, (0.0, 0.0))
+                for d in (data, other)]
+    assert programs[0].kernel.name == programs[1].kernel.name
+    assert not np.array_equal(programs[0].kernel.constants, programs[1].kernel.constants)
+    theta, omega, alpha = states(2000, seed=11)
+    for program in programs:
+        by_tape, _ = program.evaluate(theta, omega, alpha)
+        by_kernel, _ = program.evaluate(theta, omega, alpha, compiled=True)
+        for a, b in zip(by_kernel.arrays(), by_tape.arrays(), strict=True):
+            close(np.asarray(a)[:, 0], np.asarray(b)[:, 0])
+
+
+@pytest.mark.parametrize("name", ("inline_four", "stephenson_sixbar", "quick_return"))
+@pytest.mark.parametrize("compiled", (True, False))
+def test_forces_written_into_a_cycles_columns_are_the_forces_returned(name, compiled):
+    """``crank_forces(into=…)`` into strided views of complex columns (a cycle's), rotors'
+    bearings of their own and sliders included: the same figures as returned, bit for bit."""
+    from balancer.linkage.dynamics import Forces
+    from balancer.linkage.vectors import V
+
+    mech = mechanism_of(load_design(EXAMPLES / f"{name}.toml").mechanism)
+    theta, omega, alpha = states(1500, seed=3)
+    returned = mech.crank_forces(theta, omega, alpha, compiled=compiled)
+    n = theta.size
+    columns = {key: np.full(n, np.nan, complex) for key in
+               ("force", "couple", *(f"R{p}" for p in mech.ground_points))}
+    reals = {key: np.full(n, np.nan) for key in
+             ("torque", "moment", *(f"N{k}" for k in mech.ground_sliders),
+              *(f"C{k}" for k in mech.ground_sliders))}
+
+    def vector(a):
+        return V(a.real[:, None], a.imag[:, None])
+
+    into = Forces(reactions={p: vector(columns[f"R{p}"]) for p in mech.ground_points},
+                  slider_normal={k: reals[f"N{k}"][:, None] for k in mech.ground_sliders},
+                  slider_couple={k: reals[f"C{k}"][:, None] for k in mech.ground_sliders},
+                  driving_torque=reals["torque"][:, None], shaking_force=vector(columns["force"]),
+                  shaking_moment=reals["moment"][:, None], rocking_couple=vector(columns["couple"]))
+    written = mech.crank_forces(theta, omega, alpha, compiled=compiled, into=into)
+    assert written is into
+    for a, b in zip(into.arrays(), returned.matching(into).arrays(), strict=True):
+        np.testing.assert_array_equal(np.asarray(a)[:, 0], np.broadcast_to(b, (n, 1))[:, 0])

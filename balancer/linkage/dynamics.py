@@ -147,6 +147,20 @@ class Forces:
             out += [self.slider_normal[k], self.slider_couple[k]]
         return out
 
+    def matching(self, names: Forces) -> Forces:
+        """These forces' figures at ``names``' ground points and sliders (the same arrays).
+
+        Raises
+        ------
+        KeyError
+            If ``names`` has a ground point or slider these forces have not.
+        """
+        return Forces(reactions={p: self.reactions[p] for p in names.reactions},
+                      slider_normal={k: self.slider_normal[k] for k in names.slider_normal},
+                      slider_couple={k: self.slider_couple[k] for k in names.slider_couple},
+                      driving_torque=self.driving_torque, shaking_force=self.shaking_force,
+                      shaking_moment=self.shaking_moment, rocking_couple=self.rocking_couple)
+
     def with_arrays(self, values: Sequence[Num]) -> Forces:
         """Forces with the same names holding ``values`` in :meth:`arrays`' order."""
         points, sliders = sorted(self.reactions), sorted(self.slider_normal)

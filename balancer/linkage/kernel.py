@@ -36,13 +36,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
     import casadi as ca
 
 #: The generated source's format: part of the cache key (a change here makes new kernels).
-KERNEL_FORMAT = 4
+KERNEL_FORMAT = 5
 #: Kernels kept in the cache folder (the least recently used go first): a design analysed at
 #: length keeps its kernel (about 150 KB) until this many others are.
 KEPT = 256
@@ -99,47 +99,120 @@ def _literal(value: float) -> str:
     return "math.nan" if math.isnan(value) else ("math.inf" if value > 0 else "-math.inf")
 
 
-def kernel_source(fn: ca.Function) -> str:
-    """Python source of a module whose ``run(in_0, …, out_0, …)`` is ``fn``'s algorithm.
+#: Operations that are calls of the C library (no vector form without fast, inexact maths):
+#: each runs in a scalar loop of its own, between the loops of arithmetic.
+_CALLS = frozenset({"SIN", "COS", "TAN", "EXP", "LOG", "ATAN", "ASIN", "ACOS", "TANH", "ATAN2",
+                    "POW", "CONSTPOW", "HYPOT", "FMOD"})
 
-    Each input ``in_k`` is ``(nnz_k, N)`` (it may broadcast: stride 0), each output ``out_j``
-    ``(nnz_j, N)``; ``run`` loops over the ``N`` states. Constants are written where they are
-    used (numba folds what they make constant).
+#: States per block: the values one loop hands the next stay in the processor's cache.
+BLOCK = 1024
+
+
+def kernel_source(fn: ca.Function, checked: int = 0) -> str:
+    """Python source of a module whose ``run`` is ``fn``'s algorithm over ``n`` states.
+
+    ``run(constants, in_0, …, outs, limits, ok, n)``: each input ``in_k`` is ``(nnz_k, n)``;
+    ``outs`` holds one array ``(n,)`` (any stride) per scalar output, in order, but the last
+    ``checked``; ``ok[i]`` says that every output is finite at state ``i`` and each checked one
+    is at most its entry of ``limits``.
+
+    The algorithm's constants are the entries of ``constants``, in their order (a design's
+    numbers: designs of one topology share the source, hence one compiled kernel), but a
+    constant power's exponent, written where it is used. The states run in blocks of
+    :data:`BLOCK`; within a block, the algorithm's operations run in loops over the block's
+    states, one loop per stage: arithmetic, ``sqrt``, ``abs``, comparisons — operations the
+    compiler turns into vector instructions — up to the next call of the C library
+    (:data:`_CALLS`), then a scalar loop of the calls whose arguments are ready, and so on. A
+    value that one loop hands another waits in a work array of the block; the rest stay in
+    registers.
     """
-    n_in, n_out = fn.n_in(), fn.n_out()
-    arguments = ", ".join([f"in_{k}" for k in range(n_in)] + [f"out_{j}" for j in range(n_out)])
-    body: list[str] = []
-    names: dict[int, str] = {}
     ops = op_names()
+    n_in = fn.n_in()
+    flat_out = [sum(fn.nnz_out(j) for j in range(o)) for o in range(fn.n_out())]
+    n_flat = sum(fn.nnz_out(j) for j in range(fn.n_out()))
+    if checked > n_flat or n_flat - checked < 1:
+        raise NotImplementedError("a kernel writes at least one output")
+    register: dict[int, tuple[str, Any]] = {}  # what a work register holds now
+    stage: dict[int, int] = {}  # each operation's loop (even: arithmetic, odd: calls)
+    operations: list[tuple[int, str, list[tuple[str, Any]]]] = []
+    outputs: dict[int, tuple[str, Any]] = {}
+    constants = 0
     for k in range(fn.n_instructions()):
         op = ops[fn.instruction_id(k)]
         ins, outs = fn.instruction_input(k), fn.instruction_output(k)
         if op == "INPUT":
-            names[outs[0]] = f"in_{ins[0]}[{ins[1]}, i]"
-            continue
-        if op == "OUTPUT":
-            body.append(f"out_{outs[0]}[{outs[1]}, i] = {names.get(ins[0], f'w{ins[0]}')}")
-            continue
-        if op == "CONST":
-            names[outs[0]] = _literal(float(fn.instruction_constant(k)))
-            continue
-        a = names.get(ins[0], f"w{ins[0]}")
-        if op == "ASSIGN":
-            expression = a
-        elif op in _UNARY:
-            expression = _UNARY[op].format(a=a)
-        elif op in _BINARY:
-            expression = _BINARY[op].format(a=a, b=names.get(ins[1], f"w{ins[1]}"))
+            register[outs[0]] = ("input", f"in_{ins[0]}[{ins[1]}, i]")
+        elif op == "CONST":
+            register[outs[0]] = ("constant", (constants, float(fn.instruction_constant(k))))
+            constants += 1
+        elif op == "OUTPUT":
+            outputs[flat_out[outs[0]] + outs[1]] = register[ins[0]]
+        elif op == "ASSIGN":
+            register[outs[0]] = register[ins[0]]
+        elif op in _UNARY or op in _BINARY:
+            args = [register[ins[0]]] + ([register[ins[1]]] if op in _BINARY else [])
+            after = max([stage[a[1]] for a in args if a[0] == "value"], default=0)
+            call = op in _CALLS
+            stage[k] = after + (after % 2 == 0 if call else after % 2)
+            operations.append((k, op, args))
+            register[outs[0]] = ("value", k)
         else:
             raise NotImplementedError(f"CasADi operation {op} in a kernel")
-        names.pop(outs[0], None)  # the register holds its own value from here on
-        body.append(f"w{outs[0]} = {expression}")
+    # The values a later loop (or the outputs) reads: a row of the work array each.
+    handed = {a[1] for k, _, args in operations for a in args
+              if a[0] == "value" and stage[a[1]] != stage[k]}
+    handed |= {a[1] for a in outputs.values() if a[0] == "value"}
+    row = {k: r for r, k in enumerate(sorted(handed))}
+
+    def name(arg: tuple[str, Any], where: int | None) -> str:
+        kind, what = arg
+        if kind == "input":
+            return str(what)
+        if kind == "constant":
+            return f"c{what[0]}"
+        return f"v{what}" if stage[what] == where else f"w[{row[what] * BLOCK} + j]"
+
     lines = ["import math", "", "import numba", "import numpy as np", "", _HELPERS, "",
              "@numba.njit(cache=CACHE, nogil=True, error_model='numpy')",
-             f"def run({arguments}):",
-             "    for i in range(out_0.shape[1]):" if n_out else "    pass"]
-    lines += [f"        {line}" for line in body] if n_out else []
+             "def run(constants, " + "".join(f"in_{k}, " for k in range(n_in))
+             + "outs, limits, ok, n):"]
+    lines += [f"    c{c} = constants[{c}]" for c in range(constants)]
+    lines += [f"    w = np.empty({max(len(row), 1) * BLOCK})",
+              f"    for start in range(0, n, {BLOCK}):",
+              f"        size = min({BLOCK}, n - start)"]
+    for loop in range(max(stage.values(), default=0) + 1):
+        body = [(k, op, args) for k, op, args in operations if stage[k] == loop]
+        if not body:
+            continue
+        lines += ["        for j in range(size):", "            i = start + j"]
+        for k, op, args in body:
+            a = name(args[0], loop)
+            if op == "CONSTPOW" and args[1][0] == "constant":  # (an exponent of the form)
+                b = _literal(args[1][1][1])
+            else:
+                b = name(args[1], loop) if len(args) > 1 else ""
+            expression = (_UNARY[op].format(a=a) if op in _UNARY
+                          else _BINARY[op].format(a=a, b=b))
+            lines.append(f"            v{k} = {expression}")
+            if k in row:
+                lines.append(f"            w[{row[k] * BLOCK} + j] = v{k}")
+    lines += ["        for j in range(size):", "            i = start + j"]
+    for o in range(n_flat):
+        lines.append(f"            o{o} = {name(outputs[o], None)}")
+    for o in range(n_flat - checked):
+        lines.append(f"            outs[{o}][i] = o{o}")
+    total = " + ".join(f"o{o}" for o in range(n_flat))
+    within = "".join(f" and o{n_flat - checked + q} <= limits[{q}]" for q in range(checked))
+    lines += [f"            total = {total}",
+              f"            ok[i] = total - total == 0.0{within}"]
     return "\n".join(lines) + "\n"
+
+
+def kernel_constants(fn: ca.Function) -> NDArray[np.float64]:
+    """``fn``'s constants in the order :func:`kernel_source`'s ``run`` takes them."""
+    ops = op_names()
+    return np.array([float(fn.instruction_constant(k)) for k in range(fn.n_instructions())
+                     if ops[fn.instruction_id(k)] == "CONST"], dtype=float)
 
 
 def cache_dir() -> Path:
@@ -182,7 +255,10 @@ def enabled() -> bool:
 
 
 class Kernel:
-    """``fn``'s algorithm compiled: called like :class:`~.program.Tape` (see the module).
+    """``fn``'s algorithm compiled (see the module and :func:`kernel_source`).
+
+    ``checked``: its last outputs that are checks, each to be at most a limit (see
+    :meth:`__call__`).
 
     Raises
     ------
@@ -192,10 +268,13 @@ class Kernel:
         If numba is not installed.
     """
 
-    def __init__(self, fn: ca.Function) -> None:
+    def __init__(self, fn: ca.Function, checked: int = 0) -> None:
         self.sizes_in = [fn.nnz_in(i) for i in range(fn.n_in())]
-        self.sizes_out = [fn.nnz_out(i) for i in range(fn.n_out())]
-        self.source = kernel_source(fn)
+        self.size_out = sum(fn.nnz_out(j) for j in range(fn.n_out())) - checked
+        self.checked = checked
+        self.source = kernel_source(fn, checked)
+        #: The design's numbers, the kernel's first argument.
+        self.constants = kernel_constants(fn)
         digest = hashlib.sha256(f"{KERNEL_FORMAT}\n{self.source}".encode()).hexdigest()[:24]
         self.name = f"kernel_{digest}"
         self.cached = False
@@ -206,7 +285,6 @@ class Kernel:
             self.cached = False
             self._run = self._in_memory()
             self._compile()
-
     def _in_memory(self) -> Callable[..., None]:
         """The module's ``run`` compiled for this process alone (no disk cache)."""
         scope: dict[str, Any] = {}
@@ -251,39 +329,53 @@ class Kernel:
         return f"CACHE = {cache}\n" + self.source
 
     def _compile(self) -> None:
-        """Compile for 2-D float arrays of any layout now (or load the cached code)."""
+        """Compile for its arguments' types now (or load the cached code)."""
         import numba
 
-        array = numba.types.Array(numba.float64, 2, "C")
-        signature = numba.void(*([array] * (len(self.sizes_in) + len(self.sizes_out))))
+        floats = numba.types.Array(numba.float64, 1, "C")
+        table = numba.types.Array(numba.float64, 2, "C")
+        outs = numba.types.UniTuple(numba.types.Array(numba.float64, 1, "A"), self.size_out)
+        signature = numba.void(floats, *([table] * len(self.sizes_in)), outs, floats,
+                               numba.types.Array(numba.boolean, 1, "C"), numba.intp)
         with _COMPILE_LOCK:
             self._run.compile(signature)  # type: ignore[attr-defined]
 
     def __call__(self, inputs: list[NDArray[np.float64]], n: int,
-                 outs: list[NDArray[np.float64]] | None = None) -> list[NDArray[np.float64]]:
-        """The outputs at ``n`` states: ``inputs[i]`` is ``(nnz_i, n)`` (or broadcasts to it).
+                 into: list[NDArray[np.float64]] | None = None,
+                 limits: ArrayLike = ()) -> tuple[list[NDArray[np.float64]], NDArray[np.bool_]]:
+        """The outputs at ``n`` states, and where they are valid.
 
-        ``outs``, if given, receives them (arrays ``(nnz_j, n)``).
+        ``inputs[i]`` is ``(nnz_i, n)`` (or broadcasts to it). Returns one array ``(n,)`` per
+        scalar output but the checked ones — ``into``'s, if given (writable, any stride) —
+        and ``ok``: where every output is finite and each checked one at most its entry of
+        ``limits``.
         """
-        if outs is None:
-            outs = [np.empty((m, n)) for m in self.sizes_out]
-        # Its compiled signature takes C-ordered, writable arrays: a broadcast input (a constant
-        # row) is made whole, an output that is a strided view is written through a copy.
-        arrays = [np.require(np.broadcast_to(np.asarray(a, dtype=float), (a.shape[0], n)),
-                             requirements=("C", "W")) for a in inputs]
-        written = [np.require(o, requirements=("C", "W")) for o in outs]
-        self._run(*arrays, *written)
-        for o, w in zip(outs, written, strict=True):
-            if w is not o:
-                o[...] = w
-        return outs
+        if into is None:
+            into = list(np.empty((self.size_out, n)))
+        if len(into) != self.size_out:
+            raise ValueError(f"the kernel writes {self.size_out} outputs, not {len(into)}")
+        # Its compiled signature takes C-ordered inputs: a broadcast one (a constant row) is
+        # made whole.
+        arrays = [np.require(_whole(np.asarray(a, dtype=float), n), requirements=("C", "W"))
+                  for a in inputs]
+        ok = np.empty(n, dtype=bool)
+        bounds = np.ascontiguousarray(limits, dtype=float).reshape(-1)
+        if bounds.size != self.checked:
+            raise ValueError(f"the kernel checks {self.checked} outputs, not {bounds.size}")
+        self._run(self.constants, *arrays, tuple(into), bounds, ok, n)
+        return into, ok
+
+
+def _whole(a: NDArray[np.float64], n: int) -> NDArray[np.float64]:
+    """``a`` ``(rows, n)``: broadcast where it is not (a view: made whole by the caller)."""
+    return a if a.shape[1:] == (n,) else np.broadcast_to(a, (a.shape[0], n))
 
 
 #: One compilation at a time in this process (numba's compiler is not reentrant).
 _COMPILE_LOCK = threading.RLock()
 
 
-def compile_kernel(fn: ca.Function) -> Kernel | None:
+def compile_kernel(fn: ca.Function, checked: int = 0) -> Kernel | None:
     """``fn`` as a :class:`Kernel`, or ``None`` where it cannot be one.
 
     Where kernels are off, numba is missing, or it cannot compile the algorithm (an operation
@@ -293,10 +385,10 @@ def compile_kernel(fn: ca.Function) -> Kernel | None:
     if not enabled():
         return None
     try:
-        return Kernel(fn)
+        return Kernel(fn, checked)
     except Exception:  # noqa: BLE001 - any failure to compile leaves the numpy route
         return None
 
 
-__all__ = ["CACHE_ENV", "KEPT", "SWITCH_ENV", "Kernel", "cache_dir", "compile_kernel",
-           "enabled", "kernel_source", "op_names", "prune"]
+__all__ = ["BLOCK", "CACHE_ENV", "KEPT", "SWITCH_ENV", "Kernel", "cache_dir", "compile_kernel",
+           "enabled", "kernel_constants", "kernel_source", "op_names", "prune"]

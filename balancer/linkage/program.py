@@ -319,19 +319,25 @@ class CrankForcesProgram:
 
     @property
     def kernel(self) -> Kernel | None:
-        """The program compiled (:mod:`.kernel`), or ``None`` where it cannot be (built once)."""
+        """The program compiled (:mod:`.kernel`), or ``None`` where it cannot be (built once).
+
+        The kernel compares the :data:`CHECKS` with their limits itself.
+        """
         with _KERNEL_LOCK:
             if not self._kernel:
-                self._kernel.append(compile_kernel(self.function))
+                self._kernel.append(compile_kernel(self.function, checked=len(CHECKS)))
             return self._kernel[0]
 
     def evaluate(self, theta1: NDArray[np.float64], omega1: NDArray[np.float64],
-                 alpha1: NDArray[np.float64], *, compiled: bool = False
-                 ) -> tuple[Forces, NDArray[np.bool_]]:
+                 alpha1: NDArray[np.float64], *, compiled: bool = False,
+                 into: Forces | None = None) -> tuple[Forces, NDArray[np.bool_]]:
         """The forces at crank states (arrays ``(N,)``) and where they are the numpy route's.
 
         ``compiled``: by the compiled :attr:`kernel` where there is one (the same figures as
-        the tape's, to rounding), else by the numpy :class:`Tape`.
+        the tape's, to rounding), else by the numpy :class:`Tape`. ``into``: forces whose
+        arrays ``(N, 1)`` (writable views, any stride) receive the figures of the program's
+        names (:meth:`Forces.matching`), and are returned; the kernel writes them there
+        directly.
 
         A state is left out (``False``) where a numeric group's Newton step did not converge
         to the numpy route's tolerance or the group cannot be placed there, and where any
@@ -343,12 +349,13 @@ class CrankForcesProgram:
         s = self.structure
         n = theta1.size
         ok = np.ones(n, dtype=bool)
-        out = np.empty((self.tape.sizes_out[0], n))
-        run: Tape | Kernel = self.tape
-        block = Tape.block  # a block at a time: the tape's work arrays stay in the cache
-        if compiled and self.kernel is not None:
-            run, block = self.kernel, max(n, 1)  # (its work is in registers: all at once)
-        for a in range(0, n, block):
+        target = None if into is None else into.matching(self.forces)
+        limits = (numeric.NEWTON_TOLERANCE * s.length_scale(), numeric.TAYLOR_STEP, 0.0)
+        kernel = self.kernel if compiled else None
+        block = n if kernel is not None else Tape.block  # (the tape: its work arrays cached)
+        rows = (list(np.empty((self.tape.sizes_out[0] - len(CHECKS), n))) if target is None
+                else [a[:, 0] for a in target.arrays()])
+        for a in range(0, n, max(block, 1)):
             b = min(a + block, n)
             theta = theta1[a:b]
             guesses = []
@@ -360,15 +367,26 @@ class CrankForcesProgram:
             gas = [np.asarray(s.linkage.sliders[c.slider].force.at(theta), dtype=float)
                    * np.ones(b - a) if self.loads else np.zeros(b - a) for c in s.prisms]
             gas_in = np.array(gas) if gas else np.zeros((0, 1))
-            run([theta[None, :], omega1[None, a:b], alpha1[None, a:b], guess, gas_in],
-                b - a, [out[:, a:b]])
-        closure, step, health = out[-3], out[-2], out[-1]
-        # (Every figure finite: their sum is, the figures being far below overflow.)
-        ok &= ((closure <= numeric.NEWTON_TOLERANCE * s.length_scale())
-               & (step <= numeric.TAYLOR_STEP) & (health <= 0)
-               & np.isfinite(out.sum(axis=0)))
-        return self.forces.with_arrays([row[:, None] for row in out[:-3]]), ok
+            inputs = [theta[None, :], omega1[None, a:b], alpha1[None, a:b], guess, gas_in]
+            if kernel is not None:
+                _, valid = kernel(inputs, b - a, [r[a:b] for r in rows], limits)
+                ok[a:b] &= valid
+                continue
+            out = self.tape(inputs, b - a)[0]
+            for r, figure in zip(rows, out, strict=False):
+                r[a:b] = figure
+            checks = out[-len(CHECKS):]
+            # (Every figure finite: their sum is, the figures being far below overflow.)
+            ok[a:b] &= (np.all(checks <= np.array(limits)[:, None], axis=0)
+                        & np.isfinite(out.sum(axis=0)))
+        forces = self.forces.with_arrays([r[:, None] for r in rows]) if into is None else into
+        return forces, ok
 
+
+#: The program's last outputs, checks each at most its limit: the groups' largest residual
+#: (≤ the numpy route's Newton tolerance), their largest angle step (≤ ``TAYLOR_STEP``), the
+#: pivots' health (≤ 0).
+CHECKS = ("closure", "step", "health")
 
 #: One compilation of a program's kernel at a time (a cycle analysis runs chunks on threads).
 _KERNEL_LOCK = threading.Lock()

@@ -92,7 +92,7 @@ class RotorLoads:
     torque: NDArray[np.float64]
 
 
-def _put(forces: Forces, part: Forces, where: NDArray[np.bool_]) -> None:
+def _put(forces: Forces, part: Forces, where: NDArray[np.bool_] | slice) -> None:
     """Write ``part``'s rows into ``forces`` at the states ``where`` (in place)."""
     for mine, theirs in zip(forces.arrays(), part.arrays(), strict=True):
         mine[where] = theirs
@@ -417,26 +417,43 @@ class Mechanism:
         return out
 
     def _with_rotors(self, forces: Forces, theta1: ArrayLike, omega1: ArrayLike,
-                     alpha1: ArrayLike, gravity: tuple[float, float]) -> Forces:
-        """``forces`` (one column) with the :attr:`rotors`' loads added (:meth:`rotor_loads`)."""
+                     alpha1: ArrayLike, gravity: tuple[float, float], *,
+                     in_place: bool = False) -> Forces:
+        """``forces`` (one column) with the :attr:`rotors`' loads added (:meth:`rotor_loads`).
+
+        ``in_place``: added into ``forces``' own arrays (writable, every ground point there),
+        else into copies.
+        """
         extra = self.rotor_loads(theta1, omega1, alpha1, gravity)
         if extra is None:
             return forces
+        if not in_place:
+            n = np.shape(extra.torque)[0]
+            zero = V(np.zeros((n, 1)), np.zeros((n, 1)))
+            reactions = {p: forces.reactions.get(p, zero) for p in self.ground_points}
+            forces = Forces(reactions=reactions, slider_normal=forces.slider_normal,
+                            slider_couple=forces.slider_couple,
+                            driving_torque=forces.driving_torque,
+                            shaking_force=forces.shaking_force,
+                            shaking_moment=forces.shaking_moment,
+                            rocking_couple=forces.rocking_couple)
+            forces = forces.with_arrays([np.array(np.broadcast_to(a, (n, 1)), dtype=float)
+                                         for a in forces.arrays()])
 
-        def column(x: ArrayLike) -> NDArray[Any]:
-            return np.reshape(np.asarray(x), (-1, 1))
+        def add(target: ArrayLike, value: ArrayLike) -> None:
+            np.asarray(target)[:, 0] += np.asarray(value)
 
-        reactions = dict(forces.reactions)
+        def add_vector(target: V, value: ArrayLike) -> None:
+            add(target.x, np.real(value))
+            add(target.y, np.imag(value))
+
         for point, f in extra.bearings.items():
-            reactions[point] = V.of_array(
-                (reactions[point].complex() if point in reactions else 0.0) + column(f))
-        return Forces(
-            reactions=reactions, slider_normal=forces.slider_normal,
-            slider_couple=forces.slider_couple,
-            driving_torque=np.asarray(forces.driving_torque, dtype=float) + column(extra.torque),
-            shaking_force=V.of_array(forces.shaking_force.complex() + column(extra.force)),
-            shaking_moment=np.asarray(forces.shaking_moment, dtype=float) + column(extra.moment),
-            rocking_couple=V.of_array(forces.rocking_couple.complex() + column(extra.couple)))
+            add_vector(forces.reactions[point], f)
+        add(forces.driving_torque, extra.torque)
+        add_vector(forces.shaking_force, extra.force)
+        add(forces.shaking_moment, extra.moment)
+        add_vector(forces.rocking_couple, extra.couple)
+        return forces
 
     @property
     def cycle_revolutions(self) -> int:
@@ -489,7 +506,7 @@ class Mechanism:
     def crank_forces(self, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0,
                      *, route: Route | None = None, loads: bool = True,
                      gravity: tuple[float, float] = (0.0, 0.0),
-                     compiled: bool | None = None) -> Forces:
+                     compiled: bool | None = None, into: Forces | None = None) -> Forces:
         """:meth:`inverse_dynamics` of :meth:`motion` at crank states (arrays broadcast).
 
         A mechanism with a closed form may compute it without the general motion. At
@@ -497,7 +514,10 @@ class Mechanism:
         program (:class:`~balancer.linkage.program.CrankForcesProgram`, the same figures to
         rounding); the states it leaves out, the numpy route computes. ``compiled``: run the
         program compiled where it can be (``None``: at :data:`KERNEL_STATES` states or more;
-        a long cycle analysis asks for it for each of its chunks).
+        a long cycle analysis asks for it for each of its chunks). ``into``: forces at
+        :attr:`ground_points` and :attr:`ground_sliders` whose arrays ``(N, 1)`` (writable,
+        any stride: views of a cycle's columns) receive the figures, and are returned — the
+        compiled program writes there directly.
         """
         route = route or self.routes[0]
         states = list(np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))
@@ -507,8 +527,13 @@ class Mechanism:
         if compiled and route == "newton-euler":
             program = self._program(loads, (gravity[0], gravity[1]))
             if program is not None and program.kernel is not None:
-                return self._program_forces(program, states, loads, gravity, compiled=True)
-        return self.uncompiled_forces(states, route=route, loads=loads, gravity=gravity)
+                return self._program_forces(program, states, loads, gravity, compiled=True,
+                                            into=into)
+        forces = self.uncompiled_forces(states, route=route, loads=loads, gravity=gravity)
+        if into is None:
+            return forces
+        _put(into, forces.matching(into), slice(None))
+        return into
 
     def uncompiled_forces(self, states: list[NDArray[np.float64]], *, route: Route,
                           loads: bool, gravity: tuple[float, float]) -> Forces:
@@ -525,18 +550,25 @@ class Mechanism:
                                      gravity=gravity)
 
     def _program_forces(self, program: CrankForcesProgram, states: list[NDArray[np.float64]],
-                        loads: bool, gravity: tuple[float, float], *, compiled: bool) -> Forces:
+                        loads: bool, gravity: tuple[float, float], *, compiled: bool,
+                        into: Forces | None = None) -> Forces:
         """The groups' route by the straight-line ``program`` (compiled, where asked).
 
-        The states the program leaves out, the numpy route computes.
+        The states the program leaves out, the numpy route computes. ``into``: as
+        :meth:`crank_forces`'.
         """
         forces, ok = program.evaluate(*(np.ascontiguousarray(x) for x in states),
-                                      compiled=compiled)
-        forces = self._with_rotors(forces, states[0], states[1], states[2], gravity)
+                                      compiled=compiled, into=into)
+        if into is not None:
+            for point in set(into.reactions) - set(program.forces.reactions):
+                for a in (into.reactions[point].x, into.reactions[point].y):
+                    np.asarray(a)[...] = 0.0  # (a rotor's bearing alone: its loads below)
+        forces = self._with_rotors(forces, states[0], states[1], states[2], gravity,
+                                   in_place=into is not None)
         if not ok.all():
             rest = self.inverse_dynamics(self.motion(*(x[~ok] for x in states)),
                                          route="newton-euler", loads=loads, gravity=gravity)
-            _put(forces, rest, ~ok)
+            _put(forces, rest.matching(forces), ~ok)
         return forces
 
     def _program(self, loads: bool, gravity: tuple[float, float]
