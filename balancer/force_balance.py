@@ -110,12 +110,12 @@ def first_moment_map(mech: Mechanism, theta1: NDArray[np.float64]) -> NDArray[np
     """
     layout, structure = mech.layout, mech.structure
     with np.errstate(all="ignore"):
-        mo = mech.motion(theta1)
+        pose = mech.pose(theta1)  # (positions alone: no rates)
     g = np.zeros((theta1.size, layout.size), dtype=complex)
     for k, name in enumerate(structure.names):
         s = layout.link_slice(name)
-        c, sn = mo.pose.cos[k], mo.pose.sin[k]
-        g[:, s.start] = mo.pose.origins[k].complex()
+        c, sn = pose.cos[k], pose.sin[k]
+        g[:, s.start] = pose.origins[k].complex()
         g[:, s.start + 1] = c + 1j * sn
         g[:, s.start + 2] = -sn + 1j * c
     return g

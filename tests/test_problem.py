@@ -427,3 +427,28 @@ def test_violations_name_what_is_broken():
     assert any("balance.crank.mass" in v for v in data.violations(x))
     x[13] = 25.0
     assert any("balance.rocker.counter_rotor" in v for v in data.violations(x))
+
+
+@pytest.mark.parametrize("name", ["pb1", "watt_sixbar", "quick_return", "stephenson_sixbar"])
+def test_regressors_at_two_rates_in_one_pass_are_each_alone(name):
+    """The operating speed's regressors and unit crank acceleration's, computed together
+    (``numeric_problem``), are each what ``cycle_regressors`` gives alone, bit for bit; the
+    four-bar's change points (limits) included where sampled."""
+    design = spec.load_design(EXAMPLES / f"{name}.toml")
+    data = numeric_problem(design)
+    alone = [cycle_regressors(data.mechanism, data.theta1, data.speed),
+             cycle_regressors(data.mechanism, data.theta1, 0.0, 1.0)]
+    for together, single in zip([data.regressors, data.unit_acceleration], alone, strict=True):
+        for key in ("shaking_force", "shaking_moment", "driving_torque", "rocking_couple"):
+            np.testing.assert_array_equal(getattr(together, key), getattr(single, key))
+
+
+@pytest.mark.parametrize("name", ["pb1", "watt_sixbar", "stephenson_sixbar", "quick_return"])
+def test_a_mechanisms_pose_is_its_motions(name):
+    mech = mechanism_of(spec.load_design(EXAMPLES / f"{name}.toml").mechanism)
+    theta = np.linspace(0.1, 6.0, 37)
+    pose, motion = mech.pose(theta), mech.motion(theta, 3.0, 2.0).pose
+    for a, b in zip([*pose.cos, *pose.sin], [*motion.cos, *motion.sin], strict=True):
+        np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
+    for a, b in zip(pose.origins, motion.origins, strict=True):
+        np.testing.assert_array_equal(a.complex(), b.complex())

@@ -38,7 +38,7 @@ from ..model.balance import BalanceProblem, Objective
 from ..model.links import inertial_parameters, physical_parameters
 from .bounds import LinkBounds, check_problem, resolve_link
 from .lsq import bounded_lstsq
-from .regressors import CycleRegressors, cycle_regressors
+from .regressors import CycleRegressors, cycle_regressors, cycle_regressors_at
 
 #: Relative tolerance of :meth:`NumericProblem.violations` for a solver's design (bounds and
 #: force balance): ten times Clarabel's tolerance.
@@ -157,6 +157,10 @@ class NumericProblem:
     factor: NDArray[np.float64]
     force_balance: tuple[NDArray[np.float64], NDArray[np.float64]] | None
     inert: tuple[bool, ...]
+    #: The regressors at rest under unit crank acceleration (``θ̇1 = 0``, ``θ̈1 = 1``) on the
+    #: same angles, where they were computed with :attr:`regressors`
+    #: (:attr:`acceleration_factor` computes them otherwise).
+    unit_acceleration: CycleRegressors | None = None
 
     def with_problem(self, problem: BalanceProblem) -> NumericProblem:
         """The same design at the same operating point under another redesign problem.
@@ -423,7 +427,7 @@ class NumericProblem:
         objective, at constant speed, does not see what the crank's rotary inertia does when
         the speed changes; this does.
         """
-        reg = cycle_regressors(self.mechanism, self.theta1, 0.0, 1.0)
+        reg = self.unit_acceleration or cycle_regressors(self.mechanism, self.theta1, 0.0, 1.0)
         rows = reg.shaking_moment / math.sqrt(self.theta1.size)
         # (R alone: numpy's stubs say qr gives a QRResult whatever its mode.)
         return cast("NDArray[np.float64]", np.linalg.qr(rows, mode="r"))
@@ -760,7 +764,8 @@ def numeric_problem(design: Design) -> NumericProblem:
     mech.require_full_revolution("balancing")
     speed = design.operation.speed
     angles = sample_angles(design.operation.samples)
-    reg = cycle_regressors(mech, angles, speed)
+    # (At unit crank acceleration too, for the counter-rotors' settling: in the same pass.)
+    reg, unit = cycle_regressors_at(mech, angles, [(speed, 0.0), (0.0, 1.0)])
     links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
     rows, factor, inert = _reduced(reg, problem.objective, links, mech.layout.size)
     return NumericProblem(
@@ -775,6 +780,7 @@ def numeric_problem(design: Design) -> NumericProblem:
         factor=factor,
         force_balance=_force_balance(mech) if problem.force_balance else None,
         inert=inert,
+        unit_acceleration=unit,
     )
 
 

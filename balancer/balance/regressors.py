@@ -9,6 +9,7 @@ frame's origin, then the counter-rotors' inertias; and a link's physical values
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -39,17 +40,32 @@ def cycle_regressors(mech: Mechanism, angles: NDArray[np.float64], omega: float,
     At a sample exactly at a singular pose that the smooth motion passes (a four-bar's change
     points) the rows are the limits of that motion (:meth:`Mechanism.limits`).
     """
+    return cycle_regressors_at(mech, angles, [(omega, alpha)])[0]
+
+
+def cycle_regressors_at(mech: Mechanism, angles: NDArray[np.float64],
+                        rates: Sequence[tuple[float, float]]) -> list[CycleRegressors]:
+    """:func:`cycle_regressors` at each crank rate and acceleration ``(ω, α)`` of ``rates``.
+
+    Computed in one pass over the angles repeated for each (the numpy route's cost is mostly
+    per operation, not per state): each is what :func:`cycle_regressors` gives alone, bit
+    for bit.
+    """
+    count, n = len(rates), angles.size
+    omegas, alphas = (np.array([r[i] for r in rates], dtype=float) for i in (0, 1))
+
     def evaluate(theta: NDArray[np.float64]) -> tuple[NDArray[Any], ...]:
+        m = theta.size
         with np.errstate(all="ignore"):
-            f = mech.regressors(mech.motion(theta, omega, alpha))
+            f = mech.regressors(mech.motion(np.tile(theta, count), np.repeat(omegas, m),
+                                            np.repeat(alphas, m)))
         return (f.shaking_force.complex(), np.asarray(f.shaking_moment),
                 np.asarray(f.driving_torque), f.rocking_couple.complex())
 
     values = [np.array(v) for v in evaluate(angles)]  # (copies: the limits are written in)
     for limit in mech.limits(angles):
         parts = [evaluate(angles[limit.mask] + d) for d in limit.offsets]
+        mask = np.tile(limit.mask, count)
         for i, target in enumerate(values):
-            target[limit.mask] = sum(w * p[i] for w, p in zip(limit.weights, parts, strict=True))
-    force, moment, torque, rocking = values
-    return CycleRegressors(shaking_force=force, shaking_moment=moment, driving_torque=torque,
-                           rocking_couple=rocking)
+            target[mask] = sum(w * p[i] for w, p in zip(limit.weights, parts, strict=True))
+    return [CycleRegressors(*(v[k * n:(k + 1) * n] for v in values)) for k in range(count)]

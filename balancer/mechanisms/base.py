@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import AssemblyError
 from ..linkage import dynamics, kinematics
-from ..linkage.constraints import GROUND_INDEX
+from ..linkage.constraints import GROUND_INDEX, Pose
 from ..linkage.dynamics import Forces, Layout
 from ..linkage.kinematics import Motion
 from ..linkage.program import CrankForcesProgram
@@ -334,6 +334,10 @@ class Mechanism:
                alpha1: ArrayLike = 0.0) -> Motion:
         """Frames, rates and accelerations at crank states (arrays broadcast together)."""
         return kinematics.motion(self.structure, theta1, omega1, alpha1)
+
+    def pose(self, theta1: ArrayLike) -> Pose:
+        """The links' frames at crank angles (:attr:`Motion.pose` without the rates)."""
+        return kinematics.positions(self.structure, np.atleast_1d(np.asarray(theta1, float)))
 
     def continued_angles(self, theta1: float) -> NDArray[np.float64]:
         """The links' angles at crank angle ``theta1``, continuous from the reference pose.

@@ -118,6 +118,10 @@ class FourBarMechanism(Mechanism):
         """The closed form (Eq. 2–10) on the smooth motion's branch, as a general motion."""
         return general_motion(self._closed_form_motion(theta1, omega1, alpha1))
 
+    def pose(self, theta1: ArrayLike) -> Pose:
+        """The closed form's frames (Eq. 2–4)."""
+        return self.motion(theta1).pose
+
     def _closed_form_motion(self, theta1: ArrayLike, omega1: ArrayLike,
                             alpha1: ArrayLike) -> fourbar.Motion:
         """The closed form (Eq. 2–10) on the smooth motion's branch (arrays broadcast)."""
