@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -39,6 +41,22 @@ from .orders import Order, order_table
 CHUNK = 32768
 #: Threads evaluating the chunks of a long cycle.
 WORKERS = min(2, os.cpu_count() or 1)
+#: Whether the cycle analyses of this thread run their chunks on it alone
+#: (:func:`one_thread`).
+_ONE_THREAD: ContextVar[bool] = ContextVar("balancer_cycle_one_thread", default=False)
+
+
+@contextmanager
+def one_thread() -> Iterator[None]:
+    """Within it, this thread's cycle analyses evaluate their chunks on it alone.
+
+    A sweep's worker runs its points so: its cores are the other workers'.
+    """
+    token = _ONE_THREAD.set(True)
+    try:
+        yield
+    finally:
+        _ONE_THREAD.reset(token)
 
 
 @dataclass(frozen=True)
@@ -386,7 +404,7 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
         evaluate(angles[sl], into=columns(sl))
 
     starts = range(0, n, CHUNK)
-    if len(starts) > 1 and WORKERS > 1:
+    if len(starts) > 1 and WORKERS > 1 and not _ONE_THREAD.get():
         from concurrent.futures import ThreadPoolExecutor  # a long cycle only: 3 ms to import
 
         pool = ThreadPoolExecutor(WORKERS)

@@ -140,12 +140,18 @@ def test_a_resumed_sweep_rates_only_the_points_it_computed(tmp_path):
 def test_on_a_dask_cluster_a_killed_worker_loses_no_point(tmp_path):
     """Two local worker processes; after the first batch one of them is killed (os._exit).
     The scheduler reruns what it held, its nanny starts it again, and the table has every
-    point exactly once, equal to the same sweep run in process."""
+    point exactly once, equal to the same sweep run in process. The workers' environment
+    keeps Dask's one BLAS thread each, without its memory trimming (which makes a point cost
+    1.3–1.5 times as much)."""
     varies = [Vary.parse(f"{COUPLER}=2.4:3.6:4"), Vary.parse(f"{FRAME}=2.8:3.4:4")]
-    killed = []
+    killed, environments = [], []
+
+    def environment():
+        return {k: os.environ.get(k) for k in ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS")}
 
     def kill(done, client):
         if done == 1 and not killed:
+            environments.extend(client.run(environment).values())
             victim = sorted(client.scheduler_info()["workers"])[0]
             killed.append(victim)
             try:
@@ -156,6 +162,7 @@ def test_on_a_dask_cluster_a_killed_worker_loses_no_point(tmp_path):
     out = tmp_path / "dask.parquet"
     result = sweep(PB1, varies, out, workers=2, batch=1, on_batch=kill)
     assert killed and result.workers == 2
+    assert environments == [{"MALLOC_TRIM_THRESHOLD_": None, "OMP_NUM_THREADS": "1"}] * 2
     rows = _rows(out)
     assert [r["point"] for r in rows] == list(range(16))
     reference = tmp_path / "local.parquet"
@@ -271,3 +278,31 @@ def test_an_unknown_key_suggests_the_closest_naming_the_option(tmp_path, capsys,
     assert err.count("\n") == 1 and err.startswith(f"balancer: error: {option}: ")
     assert f"'{close}'" in err and f"(got '{key}')" in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_sweep_task_runs_its_cycles_on_its_own_thread(monkeypatch):
+    """A long cycle's chunks go to a pool of threads — but not within a sweep's task, whose
+    worker shares the machine's cores with the others (cycles cut into chunks of 100 here)."""
+    import concurrent.futures
+
+    import balancer.cycle as cycle_module
+    from balancer.sweeps import run_batch
+
+    pools = []
+
+    class Counting(concurrent.futures.ThreadPoolExecutor):
+        def __init__(self, *args, **kwargs):
+            pools.append(self)
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(concurrent.futures, "ThreadPoolExecutor", Counting)
+    monkeypatch.setattr(cycle_module, "CHUNK", 100)
+    monkeypatch.setattr(cycle_module, "WORKERS", 2)
+    data = tomllib.loads((ROOT / "examples" / "pb1.toml").read_text())
+    design = design_from_dict(data)
+    cycle_module.cycle_analysis(design.mechanism, design.operation.speed, 360)
+    assert len(pools) == 1  # (outside a task: a pool)
+    rows = run_batch(data, [(0, {})], analyse_only=True)
+    assert rows[0]["status"] == "analysed" and len(pools) == 1
+    cycle_module.cycle_analysis(design.mechanism, design.operation.speed, 360)
+    assert len(pools) == 2  # (and again after it)
