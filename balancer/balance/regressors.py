@@ -57,8 +57,8 @@ def cycle_regressors_at(mech: Mechanism, angles: NDArray[np.float64],
     def evaluate(theta: NDArray[np.float64]) -> tuple[NDArray[Any], ...]:
         m = theta.size
         with np.errstate(all="ignore"):
-            f = mech.regressors(mech.motion(np.tile(theta, count), np.repeat(omegas, m),
-                                            np.repeat(alphas, m)))
+            f = mech.shaking_regressors(mech.motion(np.tile(theta, count),
+                                                    np.repeat(omegas, m), np.repeat(alphas, m)))
         return (f.shaking_force.complex(), np.asarray(f.shaking_moment),
                 np.asarray(f.driving_torque), f.rocking_couple.complex())
 

@@ -86,12 +86,19 @@ class Repairs:
         exact = exact_of(self.onto_active(lay.u(x)))
         if exact is not None:
             return exact, True
+        # A counterweight that is none stays none: the projection's margin would put it off
+        # its cone's apex (a few milligrams at its pivot that change nothing).
+        _, was_none = data.without_absent(x)
         for margin in (MARGIN, 1e-2 * MARGIN, 0.0):  # a thin feasible set takes a smaller one
             u = self._project(lay.u(x), margin)
             if u is None:
                 continue
-            for candidate in (self._clip_and_pin(self.restore_balance(u)),
-                              self.onto_active(u)):
+            candidates = [self._clip_and_pin(self.restore_balance(u)), self.onto_active(u)]
+            if was_none.any():
+                kept = lay.x(u)
+                kept[was_none] = x[was_none]
+                candidates.insert(0, self._clip_and_pin(self.restore_balance(lay.u(kept))))
+            for candidate in candidates:
                 exact = exact_of(candidate)
                 if exact is not None:
                     return exact, True

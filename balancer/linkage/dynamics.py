@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 from ..model import GROUND, Linkage
 from . import rotors
 from .constraints import GROUND_INDEX, Blocks, Constraint, Driver, Pin, Prism, constraint_jacobian
-from .kinematics import Motion
+from .kinematics import Motion, rates
 from .structure import Structure
 from .vectors import NUMPY, Num, OpsLike, V, _plus, _times
 
@@ -479,6 +479,71 @@ def regressors(structure: Structure, mo: Motion, gravity: tuple[float, float] = 
     rocking = rocking_couple(structure.linkage,
                              [V(e[0], e[1]) for e in effective], np.zeros((n, p)))
     return kinetostatics(structure, mo, effective, rotor_moment=rotor, rocking=rocking), layout
+
+
+@dataclass(frozen=True)
+class Shaking:
+    """What the frame feels from a linkage as linear maps of the design vector.
+
+    Arrays ``(N, P)`` over :class:`Layout`'s entries: the shaking force (N), the shaking moment
+    about the spec's origin with the motor's reaction and the counter-rotors (N·m), the
+    driving torque (N·m) and the rocking couple (N·m) — per unit entry.
+    """
+
+    shaking_force: V
+    shaking_moment: NDArray[np.float64]
+    driving_torque: NDArray[np.float64]
+    rocking_couple: V
+
+
+def shaking_regressors(structure: Structure, mo: Motion,
+                       gravity: tuple[float, float] = (0.0, 0.0)) -> Shaking:
+    """:func:`regressors`' shaking, moment, torque and couple without the joint forces.
+
+    The whole linkage in equilibrium with the frame (the pins and the motor): what the frame
+    receives is the sum of the links' ``E_k`` (the columns of :func:`inertial_columns`),
+
+    ``F̄sh = Σ_k Ē_k``,  ``Msh = Σ_k (r̄_k × Ē_k + E_k,θ) + 2·J_c·α`` (the counter-rotors),
+
+    and the constraints do no work, so the motor's power balances theirs (virtual power):
+    ``τ·θ̇1 = −Σ_k (Ē_k·ṙ_k + E_k,θ·θ̇_k)`` with the links' rates per unit crank rate
+    (the motion's own rates over ``θ̇1`` where it turns, else those of a unit crank rate). The
+    rocking couple is :func:`rocking_couple` of the same columns. Equal to :func:`regressors`'
+    figures (the groups' joint forces, solved state by state) to rounding, at a fraction of the
+    work: the regressors of a design's balancing are these.
+    """
+    layout = Layout.of(structure)
+    n, p = mo.theta1.size, layout.size
+    g = V(*gravity)
+    omega = np.asarray(mo.omega1, dtype=float) * np.ones(n)
+    turning = omega != 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        unit = [(mo.velocity[k] / omega, mo.rate[k] / omega) for k in range(structure.size)]
+    if not turning.all():  # (at rest there: the links' rates at a unit crank rate; each
+        # state's figures its own, whatever else is computed with it)
+        vel, rate, _, _ = rates(structure, mo.pose, np.ones(n), np.zeros(n), mo.theta1)
+        unit = [(V(np.where(turning, v.x, u.x), np.where(turning, v.y, u.y)),
+                 np.where(turning, w, r))
+                for (v, w), u, r in zip(unit, vel, rate, strict=True)]
+    force_x, force_y, moment, power = (np.zeros((n, p)) for _ in range(4))
+    shares = [V(np.zeros((n, p)), np.zeros((n, p))) for _ in structure.names]
+    for name, cols in inertial_columns(structure, mo, g).items():
+        k = structure.index(name)
+        origin = mo.pose.origins[k]
+        velocity, rate = unit[k]
+        for param, (ex, ey, et) in cols:
+            j = layout.index(name, param)
+            force_x[:, j] += ex
+            force_y[:, j] += ey
+            moment[:, j] += origin.x * ey - origin.y * ex + et
+            power[:, j] += ex * velocity.x + ey * velocity.y + et * rate
+            shares[k].x[:, j] = ex
+            shares[k].y[:, j] = ey
+            if param == "Jc":
+                moment[:, j] += 2 * mo.accel[k]
+    rocking = rocking_couple(structure.linkage, shares, np.zeros((n, p)))
+    return Shaking(shaking_force=V(force_x, force_y), shaking_moment=moment,
+                   driving_torque=-power, rocking_couple=rocking)
 
 
 def inverse_dynamics(structure: Structure, mo: Motion, linkage: Linkage | None = None,
