@@ -260,3 +260,20 @@ def test_forces_written_into_a_cycles_columns_are_the_forces_returned(name, comp
     assert written is into
     for a, b in zip(into.arrays(), returned.matching(into).arrays(), strict=True):
         np.testing.assert_array_equal(np.asarray(a)[:, 0], np.broadcast_to(b, (n, 1))[:, 0])
+
+
+def test_no_states_and_wrong_sizes():
+    """No states: empty outputs from both routes; arrays of the wrong size: refused (the
+    compiled loop does not check its indices)."""
+    x, y = ca.SX.sym("x"), ca.SX.sym("y")
+    fn = ca.Function("g", [x, y], [ca.vertcat(ca.sin(x) * y, x + 2.0)])
+    tape = Tape(fn)([np.zeros((1, 0)), np.zeros((1, 0))], 0)[0]
+    rows, ok = Kernel(fn)([np.zeros((1, 0)), np.zeros((1, 0))], 0)
+    assert tape.shape == (2, 0) and [r.shape for r in rows] == [(0,), (0,)] and ok.size == 0
+    kernel = Kernel(fn)
+    with pytest.raises(ValueError, match="outputs"):
+        kernel([np.ones((1, 5)), np.ones((1, 5))], 5, [np.empty(5), np.empty(4)])
+    with pytest.raises(ValueError, match="inputs"):
+        kernel([np.ones((1, 5)), np.ones((2, 5))], 5)
+    with pytest.raises(ValueError, match="inputs"):
+        kernel([np.ones((1, 5)), np.ones((1, 3))], 5)

@@ -469,7 +469,8 @@ def test_shaking_regressors_from_momentum_are_the_joint_forces(name):
     (virtual power then takes the rates of a unit crank rate), with gravity."""
     mech = mechanism_of(spec.load_design(EXAMPLES / f"{name}.toml").mechanism)
     theta = np.linspace(0.05, 2 * math.pi - 0.05, 60)
-    omega = np.where(np.arange(60) % 3 == 0, 0.0, 35.0)  # (a third at rest)
+    omega = np.where(np.arange(60) % 3 == 0, 0.0, 35.0)  # (a third at rest,
+    omega[1] = 1e-320  # one barely turning: a subnormal rate, the rates of a unit one)
     alpha = np.where(np.arange(60) % 2 == 0, 4.0, -120.0)
     mo = mech.motion(theta, omega, alpha)
     joints = mech.regressors(mo, (0.3, -9.81))

@@ -481,6 +481,12 @@ def regressors(structure: Structure, mo: Motion, gravity: tuple[float, float] = 
     return kinetostatics(structure, mo, effective, rotor_moment=rotor, rocking=rocking), layout
 
 
+#: A crank rate (rad/s) below which :func:`shaking_regressors` takes the links' rates of a
+#: unit crank rate instead of dividing the motion's own by it (which, at a subnormal rate,
+#: would have lost their digits).
+TURNING = 1e-100
+
+
 @dataclass(frozen=True)
 class Shaking:
     """What the frame feels from a linkage as linear maps of the design vector.
@@ -516,7 +522,7 @@ def shaking_regressors(structure: Structure, mo: Motion,
     n, p = mo.theta1.size, layout.size
     g = V(*gravity)
     omega = np.asarray(mo.omega1, dtype=float) * np.ones(n)
-    turning = omega != 0
+    turning = np.abs(omega) > TURNING
     with np.errstate(divide="ignore", invalid="ignore"):
         unit = [(mo.velocity[k] / omega, mo.rate[k] / omega) for k in range(structure.size)]
     if not turning.all():  # (at rest there: the links' rates at a unit crank rate; each

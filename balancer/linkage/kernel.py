@@ -279,8 +279,9 @@ class Kernel:
         self.name = f"kernel_{digest}"
         self.cached = False
         try:
-            self._run = self._load()
-            self._compile()
+            with _COMPILE_LOCK:  # (a module half loaded by another thread is not used)
+                self._run = self._load()
+                self._compile()
         except Exception:  # noqa: BLE001 - a cache that cannot be read or written: in memory
             self.cached = False
             self._run = self._in_memory()
@@ -352,8 +353,13 @@ class Kernel:
         """
         if into is None:
             into = list(np.empty((self.size_out, n)))
-        if len(into) != self.size_out:
-            raise ValueError(f"the kernel writes {self.size_out} outputs, not {len(into)}")
+        # (Its compiled loop does not check its indices: the sizes are checked here.)
+        if len(into) != self.size_out or any(np.shape(o) != (n,) for o in into):
+            raise ValueError(f"the kernel writes {self.size_out} outputs of {n} states")
+        if len(inputs) != len(self.sizes_in) or any(
+                np.shape(a)[0] != rows or np.shape(a)[1] not in (1, n)
+                for a, rows in zip(inputs, self.sizes_in, strict=False)):
+            raise ValueError(f"the kernel takes inputs of {self.sizes_in} rows by {n} states")
         # Its compiled signature takes C-ordered inputs: a broadcast one (a constant row) is
         # made whole.
         arrays = [np.require(_whole(np.asarray(a, dtype=float), n), requirements=("C", "W"))

@@ -85,7 +85,7 @@ class Tape:
         """
         if outs is None:
             outs = [np.empty((m, n)) for m in self.sizes_out]
-        size = min(self.block, n)
+        size = max(min(self.block, n), 1)  # (no states: no block, nothing to do)
         work = [np.empty(size) for _ in range(self.registers)]
         with np.errstate(all="ignore"):
             for start in range(0, n, size):
