@@ -70,8 +70,23 @@ if TYPE_CHECKING:
 
 #: Sampling methods of the varied keys.
 METHODS = ("grid", "lhs", "sobol")
-#: Points per task (a task's fixed costs — transfer, scheduling — spread over this many solves).
+#: Most points per task (a task's fixed costs — transfer, scheduling — spread over this many
+#: solves).
 BATCH = 25
+#: Fewest tasks per worker a sweep is cut into where it has few points: each worker busy to the
+#: end (the last tasks of a worker are not left to it alone).
+TASKS_PER_WORKER = 8
+
+
+def batch_size(points: int, workers: int) -> int:
+    """Points per task of a sweep of ``points`` on ``workers`` (0: in this process).
+
+    :data:`BATCH`, or fewer where that would give a worker fewer than
+    :data:`TASKS_PER_WORKER` tasks.
+    """
+    if workers <= 0:
+        return BATCH
+    return max(1, min(BATCH, math.ceil(points / (workers * TASKS_PER_WORKER))))
 #: Most points one sweep takes (a million certified optima: hours on a laptop, and the table's
 #: points are held in memory while it runs); a larger design space is several sweeps.
 MAX_POINTS = 1_000_000
@@ -519,7 +534,7 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
           *, perturbs: Sequence[Perturb] = (), method: str = "grid",
           samples: int | None = None, seed: int = 0,
           workers: int | None = None, scheduler: str | None = None, resume: bool = False,
-          force: bool = False, batch: int = BATCH,
+          force: bool = False, batch: int | None = None,
           progress: Callable[[int, int], None] | None = None,
           on_batch: Callable[[int, Any], None] | None = None) -> SweepResult:
     """Run a sweep and write its table (see the module docstring).
@@ -547,7 +562,8 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
     force
         Overwrite an existing table (never an interrupted sweep's parts: resume or remove).
     batch
-        Points per task.
+        Points per task (default: :func:`batch_size` for the workers; resumed, the
+        interrupted sweep's).
     progress
         Called as ``progress(points done, points)``.
     on_batch
@@ -587,6 +603,10 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
               else design_points(varies, method, samples, seed))
     for key in points[0]:
         with_values(data, {key: points[0][key]})  # every key names a number of the spec
+    if batch is None:
+        in_process = workers == 0 and scheduler is None
+        batch = (_recorded_batch(parts) if resume else None) or batch_size(
+            len(points), 0 if in_process else (workers or os.cpu_count() or 1))
     if batch < 1:
         raise SpecError("must be at least 1", key="--batch", value=batch)
     manifest = _manifest(data, points, batch)
@@ -670,6 +690,15 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
                        residual_force=residual,
                        headline=(design.balance.headline if design.balance is not None
                                  else "shaking_moment"))
+
+
+def _recorded_batch(parts: Path) -> int | None:
+    """The points per task of the interrupted sweep in ``parts``, if it says."""
+    try:
+        value = json.loads((parts / "manifest.json").read_text()).get("batch")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return value if isinstance(value, int) and value >= 1 else None
 
 
 def _finished(parts: Path) -> set[int]:

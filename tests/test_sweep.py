@@ -108,9 +108,19 @@ def test_an_interrupted_sweep_resumes_and_equals_an_uninterrupted_one(tmp_path):
         sweep(PB1, varies, out, workers=0, batch=1)
     with pytest.raises(OutputError):  # nor resumed with other points
         sweep(PB1, [Vary.parse(f"{COUPLER}=2.6:3.4:6")], out, workers=0, batch=1, resume=True)
-    result = sweep(PB1, varies, out, workers=0, batch=1, resume=True)
+    # (Resumed without --batch: the interrupted sweep's batches, not ones sized anew.)
+    result = sweep(PB1, varies, out, workers=0, resume=True)
     assert result.resumed == 2 and not parts.exists()
     assert _rows(out) == _rows(whole)
+
+
+def test_batches_are_sized_to_the_workers():
+    """25 points a task, fewer where a worker would get fewer than 8 tasks; in process 25."""
+    from balancer.sweeps import batch_size
+
+    assert batch_size(10_000, 2) == 25 and batch_size(10_000, 64) == 20
+    assert batch_size(100, 2) == 7 and batch_size(5, 2) == 1 and batch_size(0, 2) == 1
+    assert batch_size(100, 0) == 25
 
 
 def test_a_resumed_sweep_rates_only_the_points_it_computed(tmp_path):

@@ -350,8 +350,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786")
     p.add_argument("--resume", action="store_true",
                    help="continue the interrupted sweep whose parts lie beside --out")
-    p.add_argument("--batch", type=int, default=25, metavar="N",
-                   help="points per task (default 25)")
+    p.add_argument("--batch", type=int, default=None, metavar="N",
+                   help="points per task (default: 25, fewer where a worker would get fewer "
+                        "than 8 tasks; resumed: the interrupted sweep's)")
     p.add_argument("--plot", metavar="PATH",
                    help="draw the atlas (.png, .svg or .pdf): a heat map over two keys")
     p.add_argument("--json", action="store_true", help="print a JSON summary instead")
