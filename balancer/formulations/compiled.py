@@ -106,7 +106,8 @@ def spring_forces(structure: Structure, spring: Spring, pose: Pose, ops: OpsLike
 
 
 def link_equations(structure: Structure, links: Sequence[Link], pose: Pose, rate: Sequence[Num],
-                   gravity: V, gas: ca.SX) -> tuple[ca.SX, ca.SX]:
+                   gravity: V, gas: ca.SX, geared: Sequence[rotors.Rotor] = ()
+                   ) -> tuple[ca.SX, ca.SX]:
     """Mass matrix ``M`` and applied forces ``Q`` of the moving links (SX, 3n×3n and 3n).
 
     Per link ``k``, in its coordinates ``(x, y, θ)``, with ``S̄ = R(θ)·(m·s̄)`` its first
@@ -118,6 +119,9 @@ def link_equations(structure: Structure, links: Sequence[Link], pose: Pose, rate
 
     (``ω²·S̄`` is what is left of the inertia force's velocity terms; ``rate`` the links'
     angular velocities, ``gas`` the slider forces along their guides, N, per prismatic pair).
+    ``geared``: rotors geared to the input link (an engine's crankshaft masses and balance
+    shafts; their inertia is in the link's already): their eccentrics' weights' couple on it,
+    ``k·(ū × ḡ)`` (:meth:`~balancer.linkage.rotors.Rotor.weight_couple`).
     """
     import casadi as ca  # heavy: only where symbols are built
     n = structure.size
@@ -137,6 +141,11 @@ def link_equations(structure: Structure, links: Sequence[Link], pose: Pose, rate
         force[i] += link.mass * gravity.x + link.force[0] + w2 * first.x
         force[i + 1] += link.mass * gravity.y + link.force[1] + w2 * first.y
         force[i + 2] += first.cross(gravity) + arm.cross(V(*link.force)) + link.moment
+
+    g = complex(gravity.x, gravity.y)
+    for rotor in geared:
+        force[3 * structure.input + 2] += rotor.weight_couple(pose.angles[structure.input], g,
+                                                              CasadiOps)
 
     def put(k: int, f_vec: V, at: V) -> None:
         if k != GROUND_INDEX:
@@ -195,7 +204,8 @@ class LinkageFormulation(Formulation):
 
         ``pose`` holds the links' frames at the states (arrays over them) and ``angles`` their
         continuous angles, ``(n, count)``: the loads' and gravity's work from the centres of
-        mass' and the angles' displacements, the springs' from their potential energy, J.
+        mass' and the angles' displacements (the rotors' eccentrics' from their first
+        moments, turned with the input), the springs' from their potential energy, J.
         """
         g = V(self.gravity.real, self.gravity.imag)
         theta = np.asarray(angles, dtype=float)
@@ -205,6 +215,9 @@ class LinkageFormulation(Formulation):
             com = pose.point(k, V(link.e, link.f))
             work += (g * link.mass + V(*link.force)).dot(com - V(com.x[0], com.y[0]))
             work += link.moment * (theta[k] - theta[k, 0])
+        for _, rotor in self.mech.rotors:  # its eccentrics' weights (a crank geared rotor's)
+            turned = rotor.first_moment(theta[self.structure.input])
+            work += (np.conj(self.gravity) * (turned - turned[0])).real
         energy: Num = 0.0
         for s in self.structure.linkage.springs:
             (_, _, a), (_, _, b) = spring_forces(self.structure, s, pose, NUMPY)

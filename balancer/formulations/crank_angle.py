@@ -89,7 +89,8 @@ class CrankAngle(LinkageFormulation):
                          for x in (b_acc[k].x, b_acc[k].y, b_accel[k])])
         rate = [u_rate[k] * omega1 for k in range(self.n)]
         g = V(self.gravity.real, self.gravity.imag)
-        mass, force = link_equations(s, self.links, pose, rate, g, gas)
+        mass, force = link_equations(s, self.links, pose, rate, g, gas,
+                                     [r for _, r in self.mech.rotors])
         inertia = ca.dot(u, ca.mtimes(mass, u))  # m(θ1)
         general = ca.dot(u, force - ca.mtimes(mass, b) * omega1**2)
         # The slider forces' generalized forces per newton (their power is θ̇1 times these).

@@ -99,7 +99,8 @@ class Multibody(LinkageFormulation):
         vel = [V(qd[3 * k], qd[3 * k + 1]) for k in range(n)]
         rate = [qd[3 * k + 2] for k in range(n)]
         g = V(self.gravity.real, self.gravity.imag)
-        mass, force = link_equations(self.structure, self.links, pose, rate, g, gas)
+        mass, force = link_equations(self.structure, self.links, pose, rate, g, gas,
+                                     [r for _, r in self.mech.rotors])
         jac = ca.SX.zeros(self.rows, 3 * n)
         gamma = ca.SX.zeros(self.rows)
         row = 0

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..model.links import Link
-from .vectors import Num, cross
+from .vectors import NUMPY, Num, OpsLike, cross
 
 #: The ratio of a counter-rotor: against its link, at its speed.
 COUNTER = -1.0
@@ -218,6 +218,22 @@ class Rotor:
                           couple=couple,
                           link_couple=np.asarray(couple_on_link + self.ratio * weights,
                                                  dtype=float) * ones)
+
+    def weight_couple(self, angle: Num, gravity: complex, ops: OpsLike = NUMPY) -> Num:
+        """Its eccentrics' weights' couple carried to its link, ``k·(ū × ḡ)``, N·m.
+
+        ``angle`` the link's ``θ`` (a number, an array, or a CasADi symbol with ``ops``
+        CasADi's functions): the generalized force the weights put on the link's coordinate,
+        ``−dV/dθ`` of their potential ``V = −ḡ·ū`` (:meth:`loads`' ``link_couple`` under
+        gravity less its inertia's part).
+        """
+        if not self.eccentrics or not gravity:
+            return 0.0
+        u = self._sums[0]
+        psi = self.ratio * angle
+        c, s = ops.cos(psi), ops.sin(psi)
+        ux, uy = u.real * c - u.imag * s, u.real * s + u.imag * c
+        return self.ratio * (ux * gravity.imag - uy * gravity.real)
 
     def shaking_force(self, theta: ArrayLike, omega: ArrayLike, alpha: ArrayLike,
                       gravity: tuple[float, float] = (0.0, 0.0)) -> NDArray[np.complex128]:

@@ -392,7 +392,8 @@ class Mechanism:
         return self._with_rotors(forces, mo.theta1, mo.omega1, mo.alpha1, gravity)
 
     def rotor_loads(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike,
-                    gravity: tuple[float, float] = (0.0, 0.0)) -> RotorLoads | None:
+                    gravity: tuple[float, float] = (0.0, 0.0), *,
+                    weights_on_crank: bool = False) -> RotorLoads | None:
         """What the :attr:`rotors` add to the frame's loads at crank states (arrays ``(N,)``).
 
         The linkage carries each rotor's inertia seen by the crank (``k²·J``, in its input
@@ -400,6 +401,12 @@ class Mechanism:
         the force's moment about the origin, its weights' moment, its gear train's couple on the
         frame ``J·k·(k − 1)·α`` and its rocking couple; the driving torque gains what its
         weights take from the crank. ``None`` without rotors.
+
+        ``weights_on_crank``: the linkage's own equations carry the weights' couple on the
+        crank (a simulation's: :meth:`~balancer.linkage.rotors.Rotor.weight_couple` applied to
+        it), so that its motor's torque has it already, and its loads on the frame count it as
+        applied from outside: the driving torque then leaves it out and the moment takes it
+        back.
         """
         if not self.rotors:
             return None
@@ -418,6 +425,10 @@ class Mechanism:
                           + ground_couple(rotor.inertia, alpha, rotor.ratio))
             out.couple = out.couple + loads.couple
             out.torque = out.torque - loads.link_couple
+            if weights_on_crank:
+                carried = rotor.weight_couple(theta, complex(*gravity))
+                out.torque = out.torque + carried
+                out.moment = out.moment - carried
         return out
 
     def _with_rotors(self, forces: Forces, theta1: ArrayLike, omega1: ArrayLike,

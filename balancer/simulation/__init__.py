@@ -134,11 +134,6 @@ def _prepare(linkage: Model, settings: SimulationSettings, *,
         theta1 = mechanism_of(linkage).start_angle
     check_scales(linkage, {"simulation.omega1": omega1},
                  {"simulation.gravity": settings.gravity})
-    if any(settings.gravity) and any(r.eccentrics for _, r in mechanism_of(linkage).rotors):
-        raise SpecError("the weights of masses on rotors geared to the crank (an engine's "
-                        "crankshaft masses, its balance shafts' eccentrics) are not in the "
-                        "equations of motion: simulate without gravity (the cycle analysis "
-                        "takes them)", key="simulation.gravity", value=list(settings.gravity))
     speed = None
     if drive == "constant-speed":
         if omega1 == 0:

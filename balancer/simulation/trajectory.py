@@ -180,7 +180,9 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
                                                gravity=gravity)
     ground: dict[str, NDArray[np.complex128]] = {
         p: np.asarray(v, complex) * np.ones(t.size, complex) for p, v in ev.ground.items()}
-    geared = f.mechanism.rotor_loads(theta[crank], omega[crank], alpha[crank], gravity)
+    # (The formulations' equations carry the rotors' weights' couple on the crank.)
+    geared = f.mechanism.rotor_loads(theta[crank], omega[crank], alpha[crank], gravity,
+                                     weights_on_crank=True)
     if geared is not None:  # rotors geared to the crank: their bearings and what they shake
         for point, value in geared.bearings.items():
             ground[point] = ground.get(point, 0.0) + value
