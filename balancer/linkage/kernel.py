@@ -1,17 +1,21 @@
-"""A straight-line program compiled to machine code: one loop over crank states, with numba.
+"""A straight-line program compiled to machine code with numba: one kernel per topology.
 
 :class:`~.program.Tape` evaluates CasADi's algorithm of a program as numpy calls over arrays of
 states, one array operation after another. :class:`Kernel` writes the same algorithm as scalar
-Python — each of CasADi's operations one assignment, in its order, inside one loop over the
-states — and compiles it with numba (LLVM; no system compiler needed): every intermediate stays
-in a register, each state costs its arithmetic alone. The operations are those of
-:class:`~.program.Tape`, each IEEE-rounded as numpy rounds it (``fastmath`` off; ``math``'s
-functions are the C library's, as numpy's are), so the two agree to rounding — in practice bit
-for bit.
+Python over the states of a block and compiles it with numba (LLVM; no system compiler
+needed): the arithmetic between two calls of the C library (sines, cosines, arc tangents) runs
+as one loop over the block that the compiler turns into vector instructions, the calls as a
+scalar loop of their own, and what one loop hands the next waits in a work array of the block
+(:func:`kernel_source`). The design's numbers are the kernel's inputs, not constants of its
+source: the designs of one topology — a sweep over dimensions — share one compiled kernel. The
+operations are those of :class:`~.program.Tape`, each IEEE-rounded as numpy rounds it
+(``fastmath`` off, no contraction into fused multiply-adds), so the two agree to rounding: bit
+for bit where numpy calls the C library too, within an ulp where numpy has vector functions of
+its own (``exp``, ``log``, ``pow``, ``atan2``, ``tan``, ``asin`` on some machines).
 
 Compiled code is cached on disk (numba's cache, beside the generated source), keyed by the
 source's hash: a design analysed again, in this process or the next, loads its kernel in
-milliseconds instead of compiling it again (about a second). The folder is
+milliseconds instead of compiling it again (a few seconds). The folder is
 :func:`cache_dir` (``BALANCER_CACHE_DIR`` overrides it); two processes compiling the same
 kernel at once, or a folder that cannot be written, are not errors — the kernel is then
 compiled in memory for this process alone. numba is imported only here, only when a kernel is
