@@ -378,10 +378,11 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
 
     compiled = n >= KERNEL_STATES  # a long cycle: its chunks by the compiled program
 
-    def evaluate(theta: NDArray[np.float64], into: Forces | None = None) -> Forces:
+    def evaluate(theta: NDArray[np.float64], into: Forces | None = None, *,
+                 fast: bool = True) -> Forces:
         with np.errstate(all="ignore"):
             return mech.crank_forces(theta, speed, 0.0, route=route, loads=loads,
-                                     gravity=gravity, compiled=compiled, into=into)
+                                     gravity=gravity, compiled=compiled and fast, into=into)
 
     def columns(sl: slice) -> Forces:
         """The cycle's columns at ``sl`` as forces (views: what is written there is theirs)."""
@@ -418,7 +419,9 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     singular = np.zeros(n, bool)
     for limit in mech.limits(angles):
         hit = limit.mask
-        parts = [evaluate(angles[hit] + d) for d in limit.offsets]
+        # (A few states beside a change point: by the mechanism's own route, which takes the
+        # limit best — a four-bar's closed forms, not the compiled general core.)
+        parts = [evaluate(angles[hit] + d, fast=False) for d in limit.offsets]
         out["shaking_force"][hit] = sum(w * p.shaking_force.complex()[:, 0]
                                         for w, p in zip(limit.weights, parts, strict=True))
         out["shaking_moment"][hit] = sum(w * p.shaking_moment[:, 0]

@@ -277,3 +277,30 @@ def test_no_states_and_wrong_sizes():
         kernel([np.ones((1, 5)), np.ones((2, 5))], 5)
     with pytest.raises(ValueError, match="inputs"):
         kernel([np.ones((1, 5)), np.ones((1, 3))], 5)
+
+
+def test_a_change_point_four_bar_compiled_is_its_closed_forms(monkeypatch):
+    """PB1 with a 2 m frame (a change point at θ1 = 0, sampled): the compiled cycle — the
+    states near the toggle and the change point's limit by the closed forms, the rest by the
+    kernel — equals the numpy route's to 1e-10 of each column's largest value. (The general
+    core loses digits as a toggle nears: 2e-6 of the closed forms' at a gap of 1e-6.)"""
+    import tomllib
+
+    import balancer.cycle as cycle_module
+    from balancer.spec import design_from_dict
+    from balancer.sweeps import with_values
+
+    data = tomllib.loads((EXAMPLES / "pb1.toml").read_text())
+    mech = mechanism_of(design_from_dict(
+        with_values(data, {"mechanism.lengths.frame": 2.0})).mechanism)
+    assert mech.change_points()
+    numpy_route = cycle_analysis(mech, 10.0, 600)
+    monkeypatch.setattr(cycle_module, "KERNEL_STATES", 512)
+    monkeypatch.setattr(cycle_module, "CHUNK", 300)
+    compiled = cycle_analysis(mech, 10.0, 600)
+    assert numpy_route.singular.any()
+    a, b = compiled.reactions, numpy_route.reactions
+    for got, want in ((a.shaking_force, b.shaking_force), (a.shaking_moment, b.shaking_moment),
+                      (a.driving_torque, b.driving_torque), (a.ground["A0"], b.ground["A0"])):
+        np.testing.assert_array_equal(np.isnan(got), np.isnan(want))
+        assert np.nanmax(np.abs(got - want)) <= 1e-10 * np.nanmax(np.abs(want))

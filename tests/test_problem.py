@@ -485,3 +485,26 @@ def test_shaking_regressors_from_momentum_are_the_joint_forces(name):
         want = np.asarray(want) * np.ones_like(got)
         scale = np.max(np.abs(want))
         assert np.max(np.abs(got - want)) <= FORMULATIONS * max(scale, 1e-300)
+
+
+def test_shaking_regressors_where_the_linkage_does_not_assemble_are_nan_as_the_joints():
+    """A rocking crank (PB1 with a 5 m frame: it turns within ±1.47 rad): outside its range
+    every column is NaN by both routes, inside both are finite and agree."""
+    import tomllib
+
+    from balancer.sweeps import with_values
+
+    data = tomllib.loads((EXAMPLES / "pb1.toml").read_text())
+    design = spec.design_from_dict(with_values(data, {"mechanism.lengths.frame": 5.0}))
+    mech = mechanism_of(design.mechanism)
+    (lo, hi), = mech.assembly_range().intervals
+    theta = np.array([lo + 0.1, 0.0, hi - 0.1, hi + 0.3, math.pi])
+    mo = mech.motion(theta, 12.0, -3.0)
+    momentum, joints = mech.shaking_regressors(mo, (0.0, -9.81)), mech.regressors(mo, (0, -9.81))
+    for got, want in ((momentum.shaking_force.x, joints.shaking_force.x),
+                      (momentum.shaking_moment, joints.shaking_moment),
+                      (momentum.driving_torque, joints.driving_torque)):
+        want = np.asarray(want) * np.ones_like(got)
+        np.testing.assert_array_equal(np.isnan(got), np.isnan(want))
+        assert np.isnan(got[3:]).all() and np.isfinite(got[:3]).all()
+        assert np.max(np.abs(got[:3] - want[:3])) <= FORMULATIONS * np.max(np.abs(want[:3]))

@@ -548,6 +548,13 @@ def shaking_regressors(structure: Structure, mo: Motion,
             if param == "Jc":
                 moment[:, j] += 2 * mo.accel[k]
     rocking = rocking_couple(structure.linkage, shares, np.zeros((n, p)))
+    # A state where a link is not placed (the linkage does not assemble there): NaN in every
+    # column, as the joint forces give it (a link that is placed there keeps finite columns).
+    lost = ~(np.isfinite(force_x) & np.isfinite(force_y) & np.isfinite(moment)
+             & np.isfinite(power)).all(axis=1)
+    if lost.any():
+        for figure in (force_x, force_y, moment, power, rocking.x, rocking.y):
+            np.asarray(figure)[lost] = np.nan
     return Shaking(shaking_force=V(force_x, force_y), shaking_moment=moment,
                    driving_torque=-power, rocking_couple=rocking)
 

@@ -297,7 +297,9 @@ class CrankForcesProgram:
         ops = _FixedPivotOps(reference)
         residuals: list[Num] = []
         steps: list[Num] = []
-        pose = positions(s, theta1, ops, guesses=guesses, residuals=residuals, steps=steps)
+        gaps: list[Num] = []
+        pose = positions(s, theta1, ops, gaps=gaps, guesses=guesses, residuals=residuals,
+                         steps=steps)
         vel, rate, acc, accel = rates(s, pose, omega1, alpha1, theta1, ops)
         mo = Motion(theta1=theta1, omega1=omega1, alpha1=alpha1, pose=pose,
                     velocity=tuple(vel), rate=tuple(rate), acceleration=tuple(acc),
@@ -306,10 +308,11 @@ class CrankForcesProgram:
                                   gas=[gas[j] for j in range(len(s.prisms))])
         self.forces = forces  # the names, in :meth:`Forces.arrays`' order
         entries = forces.arrays()
-        # Checks: the groups' residuals (≤ the numpy route's tolerance), their angle steps
-        # (≤ TAYLOR_STEP), the pivots' health (≤ 0).
+        # Checks (CHECKS): the groups' residuals (≤ the numpy route's tolerance), their angle
+        # steps (≤ TAYLOR_STEP), the pivots' health (≤ 0), the dyads' gaps (≥ TOGGLE_GAP).
         entries += [_largest([ca.fabs(r) for r in residuals]),
-                    _largest([ca.fabs(d) for d in steps]), _largest(ops.health)]
+                    _largest([ca.fabs(d) for d in steps]), _largest(ops.health),
+                    _largest([-g for g in gaps])]
         #: The program as CasADi's function (its algorithm: :class:`Tape`, a compiled kernel).
         self.function = ca.Function("crank_forces", inputs,
                                     [ca.cse(ca.vertcat(*[ca.SX(e) for e in entries]))])
@@ -340,17 +343,19 @@ class CrankForcesProgram:
         directly.
 
         A state is left out (``False``) where a numeric group's Newton step did not converge
-        to the numpy route's tolerance or the group cannot be placed there, and where any
-        figure is not finite: its forces are then to be computed by the numpy route. (CasADi
-        folds ``0·x`` to 0, so a figure that is structurally zero, such as the couple of a
-        piston whose centre of mass is on its guide, stays 0 where the numpy route's
-        ``0·NaN`` is NaN: outside the assembly range, or at a non-finite input.)
+        to the numpy route's tolerance or the group cannot be placed there, where a dyad is
+        within :data:`TOGGLE_GAP` of a toggle, and where any figure is not finite: its forces
+        are then to be computed by the numpy route. (CasADi folds ``0·x`` to 0, so a figure
+        that is structurally zero, such as the couple of a piston whose centre of mass is on
+        its guide, stays 0 where the numpy route's ``0·NaN`` is NaN: outside the assembly
+        range, or at a non-finite input.)
         """
         s = self.structure
         n = theta1.size
         ok = np.ones(n, dtype=bool)
         target = None if into is None else into.matching(self.forces)
-        limits = (numeric.NEWTON_TOLERANCE * s.length_scale(), numeric.TAYLOR_STEP, 0.0)
+        limits = (numeric.NEWTON_TOLERANCE * s.length_scale(), numeric.TAYLOR_STEP, 0.0,
+                  -TOGGLE_GAP)
         kernel = self.kernel if compiled else None
         block = n if kernel is not None else Tape.block  # (the tape: its work arrays cached)
         rows = (list(np.empty((self.tape.sizes_out[0] - len(CHECKS), n))) if target is None
@@ -385,8 +390,15 @@ class CrankForcesProgram:
 
 #: The program's last outputs, checks each at most its limit: the groups' largest residual
 #: (≤ the numpy route's Newton tolerance), their largest angle step (≤ ``TAYLOR_STEP``), the
-#: pivots' health (≤ 0).
-CHECKS = ("closure", "step", "health")
+#: pivots' health (≤ 0), the dyads' least gap, negated (≤ −:data:`TOGGLE_GAP`).
+CHECKS = ("closure", "step", "health", "toggle")
+#: Least assembly gap of the dyads (a squared sine of a transmission angle,
+#: :meth:`~.dyads.Dyads.rrr`) at which the program's figures are taken: nearer a toggle the
+#: general core's solves lose digits as about ε/gap^1.65 (measured on a four-bar at its change
+#: point: 1e-12 of the closed forms' at a gap of 1e-2, 2e-9 at 1e-4, 2e-6 at 1e-6), so that a
+#: state there is left to the numpy route — a four-bar's closed forms, which take the toggle's
+#: limit exactly. (A transmission angle of 1.8°: never in a working mechanism.)
+TOGGLE_GAP = 1e-3
 
 #: One compilation of a program's kernel at a time (a cycle analysis runs chunks on threads).
 _KERNEL_LOCK = threading.Lock()
