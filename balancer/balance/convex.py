@@ -487,15 +487,6 @@ class ConvexSolver(Repairs, Diagnosis):
             x, objective = self.polish(x, target, objective)
         x = data.settle(x)  # the inert entries, for a crank whose speed changes
         x, feasible = self.finalize(x)
-        if feasible and tie_break and lay.size:
-            # Made exact in a thin feasible set, a counterweight that may be none can come off
-            # its cone's apex again (the projection's margin): tried at none once more.
-            before = data.reduced_objective(x)
-            again, _ = self._without_small_counterweights(x, x, u1, target, before, stages)
-            if again is not x:
-                exact, ok = self.finalize(data.settle(again))
-                if ok and data.within(data.reduced_objective(exact), before, TIE_ACCEPT):
-                    x = exact
         lower = self._lower_bound(u1, multipliers, norm_dual, x if feasible else None)
         return ConvexSolution(
             x=x,

@@ -531,7 +531,8 @@ def shaking_regressors(structure: Structure, mo: Motion,
         unit = [(V(np.where(turning, v.x, u.x), np.where(turning, v.y, u.y)),
                  np.where(turning, w, r))
                 for (v, w), u, r in zip(unit, vel, rate, strict=True)]
-    force_x, force_y, moment, power = (np.zeros((n, p)) for _ in range(4))
+    moment, power = np.zeros((n, p)), np.zeros((n, p))
+    # Each link's share of the shaking force (its own columns): their sum is the force.
     shares = [V(np.zeros((n, p)), np.zeros((n, p))) for _ in structure.names]
     for name, cols in inertial_columns(structure, mo, g).items():
         k = structure.index(name)
@@ -539,14 +540,13 @@ def shaking_regressors(structure: Structure, mo: Motion,
         velocity, rate = unit[k]
         for param, (ex, ey, et) in cols:
             j = layout.index(name, param)
-            force_x[:, j] += ex
-            force_y[:, j] += ey
-            moment[:, j] += origin.x * ey - origin.y * ex + et
-            power[:, j] += ex * velocity.x + ey * velocity.y + et * rate
             shares[k].x[:, j] = ex
             shares[k].y[:, j] = ey
+            moment[:, j] = origin.x * ey - origin.y * ex + et
+            power[:, j] = ex * velocity.x + ey * velocity.y + et * rate
             if param == "Jc":
                 moment[:, j] += 2 * mo.accel[k]
+    force_x, force_y = (np.sum([getattr(v, c) for v in shares], axis=0) for c in "xy")
     rocking = rocking_couple(structure.linkage, shares, np.zeros((n, p)))
     # A state where a link is not placed (the linkage does not assemble there): NaN in every
     # column, as the joint forces give it (a link that is placed there keeps finite columns).

@@ -112,8 +112,8 @@ _CALLS = frozenset({"SIN", "COS", "TAN", "EXP", "LOG", "ATAN", "ASIN", "ACOS", "
 BLOCK = 1024
 
 
-def kernel_source(fn: ca.Function, checked: int = 0) -> str:
-    """Python source of a module whose ``run`` is ``fn``'s algorithm over ``n`` states.
+def kernel_source(fn: ca.Function, checked: int = 0) -> tuple[str, NDArray[np.float64]]:
+    """The source of a module whose ``run`` is ``fn``'s algorithm, and the constants it takes.
 
     ``run(constants, in_0, …, outs, limits, ok, n)``: each input ``in_k`` is ``(nnz_k, n)``;
     ``outs`` holds one array ``(n,)`` (any stride) per scalar output, in order, but the last
@@ -140,15 +140,15 @@ def kernel_source(fn: ca.Function, checked: int = 0) -> str:
     stage: dict[int, int] = {}  # each operation's loop (even: arithmetic, odd: calls)
     operations: list[tuple[int, str, list[tuple[str, Any]]]] = []
     outputs: dict[int, tuple[str, Any]] = {}
-    constants = 0
+    values: list[float] = []  # the constants, in their order
     for k in range(fn.n_instructions()):
         op = ops[fn.instruction_id(k)]
         ins, outs = fn.instruction_input(k), fn.instruction_output(k)
         if op == "INPUT":
             register[outs[0]] = ("input", f"in_{ins[0]}[{ins[1]}, i]")
         elif op == "CONST":
-            register[outs[0]] = ("constant", (constants, float(fn.instruction_constant(k))))
-            constants += 1
+            values.append(float(fn.instruction_constant(k)))
+            register[outs[0]] = ("constant", (len(values) - 1, values[-1]))
         elif op == "OUTPUT":
             outputs[flat_out[outs[0]] + outs[1]] = register[ins[0]]
         elif op == "ASSIGN":
@@ -180,7 +180,7 @@ def kernel_source(fn: ca.Function, checked: int = 0) -> str:
              "@numba.njit(cache=CACHE, nogil=True, error_model='numpy')",
              "def run(constants, " + "".join(f"in_{k}, " for k in range(n_in))
              + "outs, limits, ok, n):"]
-    lines += [f"    c{c} = constants[{c}]" for c in range(constants)]
+    lines += [f"    c{c} = constants[{c}]" for c in range(len(values))]
     lines += [f"    w = np.empty({max(len(row), 1) * BLOCK})",
               f"    for start in range(0, n, {BLOCK}):",
               f"        size = min({BLOCK}, n - start)"]
@@ -209,14 +209,7 @@ def kernel_source(fn: ca.Function, checked: int = 0) -> str:
     within = "".join(f" and o{n_flat - checked + q} <= limits[{q}]" for q in range(checked))
     lines += [f"            total = {total}",
               f"            ok[i] = total - total == 0.0{within}"]
-    return "\n".join(lines) + "\n"
-
-
-def kernel_constants(fn: ca.Function) -> NDArray[np.float64]:
-    """``fn``'s constants in the order :func:`kernel_source`'s ``run`` takes them."""
-    ops = op_names()
-    return np.array([float(fn.instruction_constant(k)) for k in range(fn.n_instructions())
-                     if ops[fn.instruction_id(k)] == "CONST"], dtype=float)
+    return "\n".join(lines) + "\n", np.array(values, dtype=float)
 
 
 def cache_dir() -> Path:
@@ -276,9 +269,8 @@ class Kernel:
         self.sizes_in = [fn.nnz_in(i) for i in range(fn.n_in())]
         self.size_out = sum(fn.nnz_out(j) for j in range(fn.n_out())) - checked
         self.checked = checked
-        self.source = kernel_source(fn, checked)
-        #: The design's numbers, the kernel's first argument.
-        self.constants = kernel_constants(fn)
+        #: The source, and the design's numbers: the kernel's first argument.
+        self.source, self.constants = kernel_source(fn, checked)
         digest = hashlib.sha256(f"{KERNEL_FORMAT}\n{self.source}".encode()).hexdigest()[:24]
         self.name = f"kernel_{digest}"
         self.cached = False
@@ -401,4 +393,4 @@ def compile_kernel(fn: ca.Function, checked: int = 0) -> Kernel | None:
 
 
 __all__ = ["BLOCK", "CACHE_ENV", "KEPT", "SWITCH_ENV", "Kernel", "cache_dir", "compile_kernel",
-           "enabled", "kernel_constants", "kernel_source", "op_names", "prune"]
+           "enabled", "kernel_source", "op_names", "prune"]

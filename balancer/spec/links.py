@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from .. import tomltext as toml
 from .. import validate as v
 from ..errors import SpecError
-from ..model import Link
+from ..model import Link, Linkage
 from ..model import MechanismModel as Model
 from . import schema
 from .tables import Table
@@ -50,7 +50,8 @@ def read_link(table: Table, *, slider: bool = False, positions: bool = False,
     if at:
         if not positions:
             raise SpecError("at = [x, y] is for the links of a general linkage (type = "
-                            '"linkage"); give {e, f} or {s, sigma}', key=com.key("at"))
+                            f'"{Linkage.type}"); give {{e, f}} or {{s, sigma}}',
+                            key=com.key("at"))
         # Without a frame (unknown or coincident points, a one-point link without its one
         # slider or with a zero direction) the linkage itself names the cause when it is
         # built; until then the centre of mass stays at the origin of the link.
