@@ -635,14 +635,42 @@ def _parameters_text(result: BalanceResult) -> str:
     rows = []
     for name in result.linkage.link_names:
         old, new = result.original.link(name), result.linkage.link(name)
+        scales = _parameter_scales(old, new)
         for key, unit in (("mass", "kg"), ("e", "m"), ("f", "m"), ("inertia", "kg·m²"),
                           ("counter_rotor", "kg·m²")):
             a, b = getattr(old, key), getattr(new, key)
             if key == "counter_rotor" and name not in result.linkage.grounded_links:
                 continue
-            changed = "" if abs(a - b) <= 1e-12 * max(1.0, abs(a)) else "changed"
+            # A change within MARKED_CHANGE of its kind's scale in the link is the optimiser's
+            # resolution (a parameter nothing pulls, or held off its bound by the interior-point
+            # solver): not marked.
+            changed = "" if abs(a - b) <= MARKED_CHANGE * scales[key] else "changed"
             rows.append([f"{name} {key}", f"{a:.6g}", f"{b:.6g}", unit, changed])
     return table(rows, ["parameter", "before", "after", "unit", ""])
+
+
+#: The share of its kind's scale in the link (:func:`_parameter_scales`) by which a parameter
+#: must move to be marked ``changed``: the certified tolerance of the optimum
+#: (:data:`balancer.balance.result.GAP_TOLERANCE`). An interior-point solver leaves a parameter
+#: at its bound, or where nothing pulls it, to ~1e-10 on one machine and ~1e-6 on another
+#: ("almost solved"); no workshop builds such a change.
+MARKED_CHANGE = 1e-6
+
+
+def _parameter_scales(old: Any, new: Any) -> dict[str, float]:
+    """Each parameter kind's scale in a link before and after (as :func:`.counterweight` uses).
+
+    Mass: the larger mass, kg; ``e``, ``f``: the link's reach (its centre's distance or radius
+    of gyration about its frame's origin), m; inertia and counter-rotor: the larger inertia
+    about the frame's origin (or counter-rotor), kg·m².
+    """
+    m = max(old.mass, new.mass)
+    j = max(old.inertia + old.mass * (old.e**2 + old.f**2),
+            new.inertia + new.mass * (new.e**2 + new.f**2))
+    reach = max(math.hypot(old.e, old.f), math.hypot(new.e, new.f),
+                math.sqrt(j / m) if m > 0 else 0.0)
+    rotor = max(j, abs(old.counter_rotor), abs(new.counter_rotor))
+    return {"mass": m, "e": reach, "f": reach, "inertia": j, "counter_rotor": rotor}
 
 
 def optimization_text(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis,

@@ -119,7 +119,25 @@ class RunCheck:
             "moment_ratio": self.moment_ratio,
             "energy_error": None if self.trajectory is None else self.trajectory.energy_error,
             "note": self.note,
+            "steps": None if self.trajectory is None else self.trajectory.steps,
+            "rtol": None if self.trajectory is None else self.trajectory.rtol,
+            "duration": None if self.trajectory is None else self.duration,
+            "revolutions": self.revolutions,
         }
+
+    @property
+    def duration(self) -> float:
+        """Simulated time of the run, s (0 if it could not start)."""
+        t = self.trajectory.t if self.trajectory is not None else None
+        return 0.0 if t is None or t.size == 0 else float(t[-1] - t[0])
+
+    @property
+    def revolutions(self) -> float | None:
+        """Revolutions of the input link (link 1) over the run, ``|Δθ1|/2π`` (``None``: none)."""
+        if self.trajectory is None or self.trajectory.theta.size == 0:
+            return None
+        theta = self.trajectory.theta[0]
+        return float(abs(theta[-1] - theta[0]) / (2 * np.pi))
 
 
 def _ratio(a: float | None, b: float | None) -> float | None:

@@ -1,7 +1,7 @@
 """The conic program handed to Clarabel directly (balance/conic.py) against CVXPY's.
 
 CVXPY canonicalises the same program by its own route (its cone ordering, variables and
-duals); both end in Clarabel, so the optimum must agree to Clarabel's tolerance (1e-10 on the
+duals); both end in Clarabel, so the optimum must agree to Clarabel's tolerance (1e-9 on the
 gap and feasibility, here on problems of unit scale: a value to ~1e-8). The multipliers are
 checked by what defines them: stationarity of the Lagrangian f − Σ zᵀ·(M·u + m) − νᵀ·(E·u − r)
 in the convention the certificate uses, and membership of the (self-dual) cones.
@@ -19,10 +19,18 @@ import pytest
 
 from balancer.balance.certificate import Constraint
 from balancer.balance.conic import ConicProgram, CscMatrix
-from balancer.balance.convex import CLARABEL_SETTINGS
+from balancer.balance.convex import CLARABEL_SETTINGS as PRODUCT_SETTINGS
 
-#: Agreement of two solves to Clarabel's tolerances (1e-10) on problems of unit scale, with
-#: room for the conditioning of a random problem (a hundredfold).
+#: The product's Clarabel settings at tolerances of 1e-9 (gap, feasibility): at the product's
+#: 1e-10, a random program of this file stalls "almost solved" on some machines' arithmetic
+#: (seed 2 without AVX2), in CVXPY's canonical form and in ours alike. (The product meets that
+#: status by repair and certificate; here the two routes are compared.)
+TOLERANCE = 1e-9
+CLARABEL_SETTINGS = {**PRODUCT_SETTINGS, "tol_gap_abs": TOLERANCE, "tol_gap_rel": TOLERANCE,
+                     "tol_feas": TOLERANCE, "tol_infeas_abs": TOLERANCE,
+                     "tol_infeas_rel": TOLERANCE}
+#: Agreement of two solves to Clarabel's tolerances (1e-9) on problems of unit scale, with
+#: room for the conditioning of a random problem (tenfold).
 AGREE = 1e-8
 
 
@@ -74,7 +82,8 @@ def test_norm_objective_agrees_with_cvxpy(seed):
     u_ref, value_ref = _cvxpy(constraints, equality, lambda u: cp.norm(p @ u + q))
     value = float(np.linalg.norm(p @ solution.u + q))
     assert value == pytest.approx(value_ref, rel=AGREE, abs=AGREE)
-    assert np.max(np.abs(solution.u - u_ref)) < 1e-6  # a unique optimum, to √tolerance
+    # a unique optimum, to √tolerance (the objective is flat to first order at its minimum)
+    assert np.max(np.abs(solution.u - u_ref)) < math.sqrt(TOLERANCE)
     # The epigraph's multiplier (μ, w): μ = 1 at the optimum and ∇‖P·u + q‖ = −Pᵀ·w... in
     # the Lagrangian t − μ·t − wᵀ(P·u + q), so stationarity in u reads Σ Mᵀz + Eᵀν = −Pᵀw.
     mu, w = solution.epigraph_dual[0], solution.epigraph_dual[1:]

@@ -131,8 +131,11 @@ def test_optimized_examples_report_counterweights_that_rebuild_the_balanced_link
         assert w.exact or w.kind == "rebuild", name
         if w.exact:
             assert_reproduces(result.original.link(name), result.linkage.link(name), w)
+    # A link whose mass moves by less than UNCHANGED of itself (a bound met to the solver's
+    # rounding) has no counterweight: the sum may miss that much of the links' masses.
     assert result.added_mass == pytest.approx(
-        result.linkage.total_mass - result.original.total_mass, rel=1e-12, abs=1e-12)
+        result.linkage.total_mass - result.original.total_mass, rel=1e-12,
+        abs=UNCHANGED * (result.linkage.total_mass + result.original.total_mass))
     doc = optimization_json(result, result.before, result.after)
     assert set(doc["counterweights"]) == set(weights)
     assert {"mass", "e", "f", "inertia"} <= set(doc["counterweights"][name])
@@ -303,9 +306,13 @@ def test_optimize_reports_the_analyze_figures_and_the_inertial_ones_apart(tmp_pa
     result = balancer.optimize(balancer.load_design("examples/engine.toml"), backend="convex")
     assert doc["inertial"]["before"] == result.before.summary.as_dict()
     assert doc["inertial"]["after"] == result.after.summary.as_dict()
-    # The gas force makes the two differ: the inertial view leaves it out.
-    assert doc["before"]["shaking_force"]["rms"] != doc["inertial"]["before"]["shaking_force"][
-        "rms"]
+    # The gas force makes the two differ: the inertial view leaves it out. (It pushes the
+    # piston and the head apart, so the frame's shaking force is the same to rounding; the
+    # crank's torque is not.)
+    assert doc["before"]["shaking_force"]["rms"] == pytest.approx(
+        doc["inertial"]["before"]["shaking_force"]["rms"], rel=1e-12)
+    assert doc["before"]["driving_torque"]["rms"] > 1.4 * doc["inertial"]["before"][
+        "driving_torque"]["rms"]
     api = balancer.to_dict(result)
     assert api["before"] == doc["before"] and api["after"] == doc["after"]
 

@@ -61,19 +61,37 @@ def test_a_difference_above_the_threshold_is_a_body():
     assert UNCHANGED <= 1e-8  # far below any change a designer builds
 
 
-def test_a_first_moment_moved_at_constant_mass_has_no_centre_but_keeps_the_difference():
+def test_a_first_moment_moved_at_constant_mass_is_a_link_to_rebuild_with_the_difference_beside():
     original, balanced = Body(2.0, 0.4, 0.0, 0.5), Body(2.0, 0.6, 0.1, 0.5)
     w = counterweight("rocker", original, balanced)
     doc = w.as_dict()
-    assert w.kind == "rebuild" and doc["e"] is None and doc["f"] is None
-    # The difference is kept: original + counterweight = balanced, first moment and inertia
-    # about the link frame's origin (a few rounding units of the terms).
-    moment = complex(*doc["first_moment"])
+    # What JSON gives to build is the new link itself, as the text does: every figure physical.
+    assert w.kind == "rebuild" and w.rebuilt == (2.0, 0.6, 0.1, 0.5)
+    assert (doc["mass"], doc["e"], doc["f"], doc["inertia"]) == w.rebuilt
+    # The difference beside it: original + change = balanced, first moment and inertia about
+    # the link frame's origin (a few rounding units of the terms).
+    change = doc["change"]
+    assert change["mass"] == 0.0
+    moment = complex(*change["first_moment"])
     assert moment == pytest.approx(2.0 * complex(0.6, 0.1) - 2.0 * 0.4, rel=1e-14)
+    assert complex(*doc["first_moment"]) == moment
     j0 = 0.5 + 2.0 * 0.4**2
     j1 = 0.5 + 2.0 * abs(complex(0.6, 0.1)) ** 2
-    assert doc["inertia"] == pytest.approx(j1 - j0, rel=1e-14)
-    assert w.rebuilt == (2.0, 0.6, 0.1, 0.5)
+    assert change["inertia"] == pytest.approx(j1 - j0, rel=1e-14)
+
+
+def test_a_link_to_rebuild_whose_mass_barely_moves_is_given_as_the_new_link():
+    """The Jansen leg's j, held 5e-7 off its mass bound while its centre moves: the difference
+    body would be 2.7e-7 kg at half a kilometre with a negative inertia; JSON gives the new
+    link (0.54 kg, its centre, its inertia), the change beside it."""
+    original = Body(0.54, 0.25, 0.0, 0.01125)
+    balanced = Body(0.54 * (1 + 5e-7), 0.4962, 0.0615, 0.0054)
+    w = counterweight("j", original, balanced)
+    doc = w.as_dict()
+    assert w.kind == "rebuild"
+    assert doc["mass"] == balanced.mass and doc["inertia"] == 0.0054 > 0
+    assert (doc["e"], doc["f"]) == (0.4962, 0.0615)
+    assert doc["change"]["mass"] == pytest.approx(0.54 * 5e-7, rel=1e-6)
 
 
 def _rows(text: str) -> dict[str, list[str]]:
@@ -119,13 +137,21 @@ def test_the_json_keeps_the_difference_of_every_row():
         doc = optimization_json(result, *result.operating)
         for name, w in doc["counterweights"].items():
             a, b = doc["original_links"][name], doc["links"][name]
+            change = w["change"]
             scale_m = max(a["mass"], b["mass"])
-            assert a["mass"] + w["mass"] == pytest.approx(b["mass"], abs=1e-9 * scale_m)
+            assert a["mass"] + change["mass"] == pytest.approx(b["mass"], abs=1e-9 * scale_m)
             s0, s1 = complex(a["e"], a["f"]), complex(b["e"], b["f"])
             reach = max(abs(s0), abs(s1), math.sqrt((a["inertia"] + b["inertia"]) / scale_m))
-            moment = complex(*w["first_moment"])
+            moment = complex(*change["first_moment"])
             assert abs(a["mass"] * s0 + moment - b["mass"] * s1) <= 1e-9 * scale_m * reach
-            if w["e"] is not None:
+            j0 = a["inertia"] + a["mass"] * abs(s0) ** 2
+            j1 = b["inertia"] + b["mass"] * abs(s1) ** 2
+            assert abs(j0 + change["inertia"] - j1) <= 1e-9 * max(j0, j1)
+            if w["kind"] == "rebuild":  # the new link itself
+                assert (w["mass"], w["e"], w["f"], w["inertia"]) == (
+                    b["mass"], b["e"], b["f"], b["inertia"])
+            elif w["e"] is not None:  # the body added or removed
+                assert w["mass"] == change["mass"]
                 assert moment == pytest.approx(w["mass"] * complex(w["e"], w["f"]), rel=1e-12)
             else:
                 assert w["mass"] == 0

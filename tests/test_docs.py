@@ -31,7 +31,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from golden.record import STORE, _counters_masked, _last_digit, _skeleton, mask
+from golden import compare
+from golden.record import STORE, mask
 
 import balancer
 from balancer.spec import loads_design, schema
@@ -46,9 +47,6 @@ SETUP = ('python3 -m venv .venv && .venv/bin/pip install -e ".[dev]" && '
          ".venv/bin/balancer analyze examples/meijaard2020.toml",
          ".venv/bin/python -m pytest")
 MAX_README_BYTES = 12_000
-#: A figure below this share of the largest figure a command prints is rounding (a balanced
-#: design's 1e-13 N, an optimality gap): another machine prints another one.
-NOISE = 1e-9
 ELISION = ("…", "...")
 FILE_LINE = re.compile(r"#\s*(\S+\.toml)(, continued)?\s*$")
 EXIT_CODE = re.compile(r"#\s*exit code (\d+)\s*$")
@@ -171,38 +169,27 @@ def run_balancer(command: str) -> tuple[int, str]:
     return code, out.getvalue() + err.getvalue()
 
 
-def _numbers_agree(expected: str, actual: str, largest: float) -> bool:
-    from golden.record import _NUMBER
+def check_output(expected: list[str], printed: str, verb: str = "analyze") -> None:
+    """Each line shown is printed, in order; ``…`` stands for lines left out.
 
-    xs, ys = _NUMBER.findall(expected), _NUMBER.findall(actual)
-    if len(xs) != len(ys):
-        return False
-    for x, y in zip(xs, ys, strict=True):
-        fx, fy = float(x), float(y)
-        printed = 1.000001 * max(_last_digit(x), _last_digit(y))
-        if abs(fx - fy) > max(1e-9 * max(abs(fx), abs(fy)), printed, NOISE * largest):
-            return False
-    return True
-
-
-def check_output(expected: list[str], printed: str) -> None:
-    """Each line shown is printed, in order; ``…`` stands for lines left out."""
-    from golden.record import _NUMBER
-
-    actual = [_counters_masked(mask(line)).rstrip() for line in printed.splitlines()]
-    largest = max((abs(float(x)) for x in _NUMBER.findall(printed)), default=0.0)
+    A line's figures agree by ``verb``'s rule for text (:func:`golden.compare.text_rule`: an
+    analysis to rounding, a simulation to its integrator, an optimum to its certificate).
+    """
+    actual = [compare.masked(mask(line)).rstrip() for line in printed.splitlines()]
+    largest = compare.largest_figure(printed)
+    tolerance = compare.text_rule(verb, printed)
     at = 0
     for line in expected:
         if not line.strip() or line.strip() in ELISION:
             continue
-        shown = _counters_masked(mask(line)).rstrip()
+        shown = compare.masked(mask(line)).rstrip()
         for i in range(at, len(actual)):
-            if (_skeleton(actual[i]) == _skeleton(shown)
-                    and _numbers_agree(shown, actual[i], largest)):
+            if (compare.skeleton(actual[i]) == compare.skeleton(shown)
+                    and compare.line_difference(shown, actual[i], tolerance, largest) is None):
                 at = i + 1
                 break
         else:
-            near = [a for a in actual if _skeleton(a) == _skeleton(shown)]
+            near = [a for a in actual if compare.skeleton(a) == compare.skeleton(shown)]
             raise AssertionError(f"not printed (or not in this order): {line!r}"
                                  + (f"\n  printed: {near[0]!r}" if near else "")
                                  + "\n--- printed:\n" + printed)
@@ -215,7 +202,7 @@ def run_command(command: str, expected: list[str]) -> None:
     code, printed = run_balancer(command)
     assert code == (int(wanted.group(1)) if wanted else 0), f"{command}: exit {code}\n{printed}"
     if expected:
-        check_output(expected, printed)
+        check_output(expected, printed, shlex.split(command, comments=True)[1])
 
 
 def check_toml(block: Block, folder: Path) -> None:

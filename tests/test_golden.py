@@ -2,14 +2,20 @@
 
 A guard, not a check of correctness (see ``tests/golden/record.py``): a change meant to move
 code without changing results must leave the outputs as they were — the same text, every figure
-the same to another machine's rounding (:func:`golden.record.difference`), wall-clock times
-masked. A change meant to alter outputs records them again (``python -m tests.golden.record``)
-in the same commit, which then shows what moved.
+the same to what it is certified to (:mod:`golden.compare`: a closed form's to rounding, an
+integrator's to its tolerance and steps, an optimum's objective to its certified gap and its
+design to what that gap allows), on any machine's arithmetic; wall-clock times masked. A change
+meant to alter outputs records them again (``python -m tests.golden.record``) in the same
+commit, which then shows what moved. Never record again to make a machine pass.
 """
 
 from __future__ import annotations
 
+import json
+import math
+
 import pytest
+from golden import compare
 from golden.record import STORE, commands, difference, examples, output
 
 CASES = [(name, key) for name in examples() for key in commands(name)]
@@ -17,21 +23,117 @@ CASES = [(name, key) for name in examples() for key in commands(name)]
 
 @pytest.mark.parametrize(("name", "key"), CASES, ids=[f"{n}-{k}" for n, k in CASES])
 def test_outputs_are_as_recorded(name, key):
-    problem = difference((STORE / name / key).read_text(), output(name, key),
-                         table=key.endswith(".txt"))
+    sibling = STORE / name / f"{key.split('.')[0]}.json"
+    problem = difference((STORE / name / key).read_text(), output(name, key), key,
+                         sibling.read_text() if sibling.is_file() else None)
     if problem is not None:
         pytest.fail(f"{name} {key}: {problem}")
 
 
-def test_the_comparison_sees_a_change_and_forgives_rounding():
-    text = '{"rms": 101.59012345678901, "max": 4.3e-14, "iterations": 48}\nRMS 101.59 N·m'
-    assert difference(text, text) is None
-    assert difference(text, text.replace("101.59012345678901", "101.59012345678912")) is None
-    assert difference(text, text.replace("4.3e-14", "9.1e-14")) is None  # rounding-level
-    assert difference(text, text.replace('"iterations": 48', '"iterations": 47')) is None
-    assert difference(text, text.replace("101.59012345678901", "101.5902")) is not None
-    assert difference(text, text.replace("RMS 101.59", "RMS 101.58")) is not None
-    table = "quantity  RMS\nshaking moment  101.59  N·m"
-    assert difference(table, table.replace("101.59", "101.58"), table=True) is None
-    assert difference(table, table.replace("101.59", "101.57"), table=True) is not None
-    assert difference(text, text.replace("N·m", "N")) is not None
+def _json(doc: dict) -> str:
+    return "exit 0\n--- stdout\n" + json.dumps(doc, indent=2) + "\n--- stderr\n"
+
+
+def _with(doc: dict, path: str, value: object) -> dict:
+    out = json.loads(json.dumps(doc))
+    *head, last = path.split(".")
+    node = out
+    for k in head:
+        node = node[k]
+    node[last] = value
+    return out
+
+
+def test_an_analysis_is_compared_to_rounding():
+    doc = {"shaking_force": {"rms": 430.27201234567, "max": 697.254}, "samples": 360,
+           "shaking_moment": {"rms": 214.892, "max": 4.3e-14}}
+    text = _json(doc)
+    assert difference(text, text, "analyze.json") is None
+    ulps = _with(doc, "shaking_force.rms", 430.27201234567 * (1 + 4e-16))
+    assert difference(text, _json(ulps), "analyze.json") is None
+    noise = _with(doc, "shaking_moment.max", 9.1e-14)  # rounding of its quantity's 214.9 N·m
+    assert difference(text, _json(noise), "analyze.json") is None
+    moved = _with(doc, "shaking_force.rms", 430.27201234567 * (1 + 1e-7))
+    assert "shaking_force.rms" in difference(text, _json(moved), "analyze.json")
+    renamed = {"shaking_forces": doc["shaking_force"], **{k: v for k, v in doc.items()
+                                                          if k != "shaking_force"}}
+    assert difference(text, _json(renamed), "analyze.json") is not None
+
+
+def _optimum() -> dict:
+    return {"status": "optimal", "before": {"shaking_moment": {"rms": 214.892}},
+            "after": {"shaking_moment": {"rms": 101.59041472450815},
+                      "driving_torque": {"rms": 478.382}},
+            "links": {"crank": {"mass": 4.97462, "sigma": -math.pi, "inertia": 4.11681},
+                      "rocker": {"mass": 5.45968, "sigma": 1.0, "inertia": 8.18888}},
+            "objective": 10320.612363905664, "lower_bound": 10320.612363, "gap": 4e-10,
+            "scale": 214.89219637241663, "rms": 101.59041472450815,
+            "stages": [{"name": "convex", "solver_status": "optimal", "iterations": 18}]}
+
+
+def test_an_optimum_is_compared_to_its_certificate():
+    doc = _optimum()
+    text = _json(doc)
+    assert difference(text, text, "optimize.json") is None
+    # the design: within √(2·1e-6) of its quantity's scale; its angles on the circle
+    for path, value in (("links.crank.mass", 4.97462 * (1 + 1e-4)),
+                        ("links.crank.sigma", math.pi),
+                        ("after.driving_torque.rms", 478.382 * (1 + 5e-4)),
+                        ("gap", 9e-7),  # an error measure: within the certified 1e-6
+                        ("stages", [{"name": "convex", "solver_status": "optimal_inaccurate",
+                                     "iterations": 19}])):
+        assert difference(text, _json(_with(doc, path, value)), "optimize.json") is None, path
+    for path, value in (("links.crank.mass", 4.97462 * 1.01),
+                        ("links.rocker.sigma", 1.01),
+                        ("before.shaking_moment.rms", 214.892 * (1 + 1e-7)),  # exact
+                        ("rms", 101.59041472450815 + 1e-3),  # beyond 1e-6 of 214.9 N·m
+                        ("objective", 10320.612363905664 * (1 + 1e-6)),
+                        ("gap", 2e-6),
+                        ("status", "optimal_inaccurate")):
+        assert difference(text, _json(_with(doc, path, value)), "optimize.json") is not None, \
+            path
+
+
+def test_a_simulation_is_compared_to_its_integrator():
+    doc = {"rtol": 1e-10, "steps": 29, "final": {"theta": {"crank": 5.660960598248986}},
+           "energy_error": 6.4e-11}
+    text = _json(doc)
+    # 29 steps at 1e-10, angles up to 5.66 rad: known to 29·1e-10·5.66 = 1.6e-8
+    near = _with(doc, "final.theta.crank", 5.660960598248986 * (1 + 1e-8))
+    assert difference(text, _json(near), "simulate.json") is None
+    assert difference(text, _json(_with(doc, "energy_error", 2e-9)), "simulate.json") is None
+    far = _with(doc, "final.theta.crank", 5.660960598248986 * (1 + 1e-7))
+    assert difference(text, _json(far), "simulate.json") is not None
+    assert difference(text, _json(_with(doc, "energy_error", 1e-8)), "simulate.json") \
+        is not None
+
+
+def test_a_csv_is_compared_figure_by_figure():
+    head = "exit 0\n--- stdout\nwrote out.csv\n--- out.csv\n"
+    table = head + "t,RA0x,RA0y\n0,2.4314407662977566,4.0566090225290754\n1,nan,-0.5\n"
+    assert difference(table, table, "analyze.csv") is None
+    ulp = table.replace("2.4314407662977566", "2.4314407662977570")
+    assert difference(table, ulp, "analyze.csv") is None
+    moved = table.replace("2.4314407662977566", "2.43144077")
+    assert "row 1, RA0x" in difference(table, moved, "analyze.csv")
+    assert difference(table, table.replace("nan", "0.5"), "analyze.csv") is not None
+    assert difference(table, table.replace("RA0y", "RA0z"), "analyze.csv") is not None
+
+
+def test_a_text_is_compared_by_its_wording_and_its_verbs_tolerance():
+    text = ("exit 0\n--- stdout\nRMS 101.59 N·m, gap 4.3e-14 N·m in 48 solver iterations\n"
+            "quantity  RMS\nshaking moment  101.59  N·m\n")
+    assert difference(text, text.replace("48 solver", "47 solver"), "analyze.txt") is None
+    assert difference(text, text.replace("4.3e-14", "9.1e-14"), "analyze.txt") is None
+    assert difference(text, text.replace("101.59  N", "101.58  N"), "analyze.txt") is None
+    assert difference(text, text.replace("101.59  N", "101.57  N"), "analyze.txt") is not None
+    assert difference(text, text.replace("N·m\n", "N\n"), "analyze.txt") is not None
+    assert difference(text, text.replace("101.59  N", "101.5  N"), "optimize.txt") is None
+    assert difference(text, text.replace("101.59  N", "100.5  N"), "optimize.txt") is not None
+
+
+def test_the_rules_name_each_figure_by_its_quantity():
+    assert compare.quantity("after.shaking_force.rms") == compare.quantity(
+        "before.shaking_force.max") == compare.quantity("reactions.A0.x_min") == "force"
+    assert compare.quantity("links.crank.sigma") == "angle"
+    assert compare.quantity("original_links.rocker.inertia") == "inertia"

@@ -70,6 +70,8 @@ class Counterweight:
     rebuilt
         For ``kind = "rebuild"``: the balanced link's own ``(mass, e, f, inertia)`` (kg, m, m,
         kg·m² about its centre of mass), what the workshop builds instead.
+    inertia_change
+        The change of the link's inertia about its frame's origin, kg·m².
     """
 
     link: str
@@ -83,6 +85,7 @@ class Counterweight:
     disc_thickness: float | None = None
     exact: bool = True
     rebuilt: tuple[float, float, float, float] | None = None
+    inertia_change: float = 0.0
 
     @property
     def has_centre(self) -> bool:
@@ -92,17 +95,28 @@ class Counterweight:
     def as_dict(self) -> dict[str, object]:
         """The JSON form (``mass``, ``e``, ``f``, ``inertia`` are fixed names).
 
-        ``e`` and ``f`` are ``null`` where the mass is 0 (nothing has a centre there).
+        What to build, as the text report gives it: the body to add or remove (``e`` and
+        ``f`` ``null`` where the mass is 0: nothing has a centre there), or for ``"rebuild"``
+        the new link itself (its mass, centre of mass and inertia about it: a body, every
+        figure physical). ``change``: the link's change of mass (kg), of first moment in its
+        frame (kg·m) and of inertia about its frame's origin (kg·m²), for every kind.
         """
         disc = None
         if self.disc_radius is not None:
             disc = {"radius": self.disc_radius, "thickness": self.disc_thickness,
                     "material": "steel", "density": STEEL_DENSITY}
-        centre = self.has_centre
-        return {"mass": self.mass, "e": self.e if centre else None,
-                "f": self.f if centre else None, "inertia": self.inertia,
-                "first_moment": [self.first_moment.real, self.first_moment.imag],
-                "kind": self.kind, "exact": self.exact, "disc": disc}
+        if self.rebuilt is not None:
+            mass, e, f, inertia = self.rebuilt
+            body: dict[str, object] = {"mass": mass, "e": e, "f": f, "inertia": inertia}
+        else:
+            centre = self.has_centre
+            body = {"mass": self.mass, "e": self.e if centre else None,
+                    "f": self.f if centre else None, "inertia": self.inertia}
+        return {**body, "first_moment": [self.first_moment.real, self.first_moment.imag],
+                "kind": self.kind, "exact": self.exact, "disc": disc,
+                "change": {"mass": self.mass,
+                           "first_moment": [self.first_moment.real, self.first_moment.imag],
+                           "inertia": self.inertia_change}}
 
 
 def counterweight(name: str, original: Link, balanced: Link) -> Counterweight:
@@ -127,7 +141,7 @@ def counterweight(name: str, original: Link, balanced: Link) -> Counterweight:
     if mass_same:  # a first moment or an inertia moved with no mass to carry it
         # (With the first moment kept, a massless "body" of inertia dj still adds up.)
         return Counterweight(name, 0.0, 0.0, 0.0, dj, "rebuild", first_moment=ds,
-                             exact=moment_same, rebuilt=rebuilt)
+                             exact=moment_same, rebuilt=rebuilt, inertia_change=dj)
     centre = ds / dm
     inertia = dj - dm * abs(centre) ** 2
     if dm > 0 and inertia >= -UNCHANGED * max(j0, j1):
@@ -139,11 +153,12 @@ def counterweight(name: str, original: Link, balanced: Link) -> Counterweight:
             if thickness > MAX_ASPECT * 2 * radius:  # a point mass, not a disc
                 radius = thickness = None
         return Counterweight(name, dm, centre.real, centre.imag, inertia, "add", ds, radius,
-                             thickness)
+                             thickness, inertia_change=dj)
     if dm < 0 and inertia <= UNCHANGED * max(j0, j1):
-        return Counterweight(name, dm, centre.real, centre.imag, min(inertia, 0.0), "remove", ds)
+        return Counterweight(name, dm, centre.real, centre.imag, min(inertia, 0.0), "remove", ds,
+                             inertia_change=dj)
     return Counterweight(name, dm, centre.real, centre.imag, inertia, "rebuild", ds,
-                         rebuilt=rebuilt)
+                         rebuilt=rebuilt, inertia_change=dj)
 
 
 def counterweights(original: Model, balanced: Model) -> dict[str, Counterweight]:

@@ -106,8 +106,12 @@ class Link:
 
     @property
     def sigma(self) -> float:
-        """Angle of the centre of mass from the link line, rad."""
-        return math.atan2(self.f, self.e)
+        """Angle of the centre of mass from the link line, rad, in (−π, π].
+
+        (A centre on the link line behind its first joint is at π whatever the sign of its
+        zero ``f``: ``+ 0.0`` turns −0.0 into 0.0.)
+        """
+        return math.atan2(self.f + 0.0, self.e)
 
     @property
     def force_complex(self) -> complex:

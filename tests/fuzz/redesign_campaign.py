@@ -2013,10 +2013,11 @@ def check_report(case: Case, result, bounds: list[Bounds], model: Model, obj: Ob
     """``optimize --json`` (``optimization_json(result, *result.operating)``) against the design.
 
     - ``original_links`` are the spec's links, ``links`` the written balanced spec's;
-    - per link, ``original_links`` + ``counterweights`` = ``links``: mass, first moment and
-      inertia about the frame's origin, to :data:`REPORT_UNCHANGED` of the link's scales plus
-      the rounding of the sums; ``e``, ``f`` null exactly when the mass is 0, the first moment
-      their product with the mass otherwise;
+    - per link, ``original_links`` + the counterweight's ``change`` = ``links``: mass, first
+      moment and inertia about the frame's origin, to :data:`REPORT_UNCHANGED` of the link's
+      scales plus the rounding of the sums; a ``rebuild`` row is the new link itself, another
+      row the body of that change: ``e``, ``f`` null exactly when the mass is 0, the first
+      moment their product with the mass otherwise;
     - ``kind``: ``none`` only when nothing changed beyond that share of the link's scales (and
       then no body), ``add`` a body of positive mass and inertia ≥ 0, ``remove`` the opposite;
       a link kept with a counterweight is ``none`` or ``add``, a link not listed ``none``;
@@ -2060,9 +2061,14 @@ def check_report(case: Case, result, bounds: list[Bounds], model: Model, obj: Ob
         m0, s0 = o["mass"], complex(o["e"], o["f"])
         m1, s1 = n["mass"], complex(n["e"], n["f"])
         j0, j1 = o["inertia"] + m0 * abs(s0) ** 2, n["inertia"] + m1 * abs(s1) ** 2
-        wm, wi = w["mass"], w["inertia"]
-        fm = complex(*w["first_moment"])
-        wj = wi + abs(fm) ** 2 / wm if wm != 0 else wi  # about the frame's origin
+        # The link's change (mass, first moment, inertia about the frame's origin), beside
+        # what to build: the body added or removed, or for "rebuild" the new link itself.
+        delta = w["change"]
+        wm, wj = delta["mass"], delta["inertia"]
+        fm = complex(*delta["first_moment"])
+        # a body's inertia about its own centre (its row's; a link to rebuild: the change's)
+        wi = w["inertia"] if w["kind"] != "rebuild" else (
+            wj - abs(fm) ** 2 / wm if wm != 0 else wj)
         big_m = max(m0, m1)
         reach = max(b.length, abs(s0), abs(s1), math.sqrt(max(j0, j1) / big_m))
         big_i = max(j0, j1, big_m * b.length ** 2)
@@ -2078,7 +2084,17 @@ def check_report(case: Case, result, bounds: list[Bounds], model: Model, obj: Ob
             if not abs(lhs - rhs) <= REPORT_UNCHANGED * sc + rd:
                 sums.append(f"{name}: original + counterweight {what} {lhs!r} != links' "
                             f"{rhs!r} ({abs(lhs - rhs) / sc:.3g} of the link's scale)")
-        if wm == 0:
+        if complex(*w["first_moment"]) != fm:
+            kinds.append(f"{name}: first_moment {w['first_moment']!r} is not the change's "
+                         f"{delta['first_moment']!r}")
+        if w["kind"] == "rebuild":
+            if (w["mass"], w["e"], w["f"], w["inertia"]) != (n["mass"], n["e"], n["f"],
+                                                             n["inertia"]):
+                kinds.append(f"{name}: a link to rebuild given as ({w['mass']!r}, {w['e']!r}, "
+                             f"{w['f']!r}, {w['inertia']!r}), not the new link's")
+        elif w["mass"] != wm:
+            kinds.append(f"{name}: a body of mass {w['mass']!r} kg for a change of {wm!r}")
+        elif wm == 0:
             if w["e"] is not None or w["f"] is not None:
                 kinds.append(f"{name}: a counterweight of no mass with a centre "
                              f"({w['e']!r}, {w['f']!r})")

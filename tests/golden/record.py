@@ -15,13 +15,15 @@ Record (after a change that is meant to alter outputs, and only then)::
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import io
+import json
 import re
 import shutil
 import sys
 import tempfile
 from pathlib import Path
+
+from . import compare
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
@@ -32,72 +34,55 @@ STORE = Path(__file__).resolve().parent / "outputs"
 UNBALANCED = ("meijaard2020", "single_cylinder", "inline_three", "inline_four", "v6", "v8")
 #: Fields and phrases that measure wall-clock time or name a temporary folder.
 _MASKS = (
-    (re.compile(r'("(?:time|seconds)": )[-+0-9.eE]+'), r"\1<t>"),
+    (re.compile(r'("(?:time|seconds)": )[-+0-9.eE]+'), r'\1"<t>"'),
     (re.compile(r"\b[0-9.]+(?:e[-+]?\d+)? ms\b"), "<t> ms"),
     (re.compile(r"(right-hand sides, )[0-9.eE+-]+ s"), r"\1<t> s"),
     (re.compile(r"(\d+ points in )[0-9.]+ s \([0-9.]+ points/s"), r"\1<t> s (<r> points/s"),
 )
+#: A recorded output's parts: ``exit N``, then ``--- stdout``, ``--- stderr`` and each file
+#: written (``--- out.csv``).
+_PART = re.compile(r"^--- (stdout|stderr|\S+\.\w+)$", re.MULTILINE)
+#: A CSV longer than this many rows is kept as its header and every :data:`CSV_EVERY`-th row
+#: (each figure of those compared; a cycle's 360 or 720 angles, every 5th).
+CSV_ROWS = 100
+CSV_EVERY = 5
 
 
-#: A number as the outputs print it (JSON, tables, CSV).
-_NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.])")
-#: Counters of a solver's or an integrator's path, which rounding on another machine's
-#: arithmetic (another BLAS kernel) may lengthen or shorten by a step: not compared.
-_COUNTERS = re.compile(r'("(?:iterations|steps|nfev|evaluations)": )\d+'
-                       r"|\b\d+( solver iterations| steps| right-hand sides)")
-#: Agreement of two figures: relative, and as a share of the largest figure of the same
-#: output (a rounding-level figure, such as a balanced design's 4e-14 N, is noise on another
-#: machine's arithmetic).
-RELATIVE = 1e-9
-OF_LARGEST = 1e-12
+def difference(recorded: str, now: str, key: str, sibling: str | None = None) -> str | None:
+    """Where the output ``now`` of command ``key`` differs from ``recorded``, or ``None``.
 
-
-def _counters_masked(text: str) -> str:
-    return _COUNTERS.sub(lambda m: (m.group(1) or "") + "<n>" + (m.group(2) or ""), text)
-
-
-def difference(recorded: str, now: str, *, table: bool = False) -> str | None:
-    """Where ``now`` differs from ``recorded`` beyond another machine's rounding, or ``None``.
-
-    The text between the numbers must be the same; each number the same to :data:`RELATIVE`,
-    or to :data:`OF_LARGEST` of the output's largest number; in a readable ``table`` (figures
-    printed to a few significant digits), or to the last digit it is printed with. (JSON, CSV
-    and TOML print the shortest text that reads back as the same double: every digit counts.)
+    Part by part (:data:`_PART`): a JSON document and a CSV table figure by figure, each by
+    what it is (:mod:`golden.compare`), a text (a table, a written spec) by its verb's
+    tolerance with its wording exact. ``sibling``: the recorded JSON output of the same verb
+    (an integrator's steps, ``rtol`` and travel, for its text and CSV).
     """
-    a, b = _counters_masked(recorded), _counters_masked(now)
-    if a == b:
-        return None
-    if _skeleton(a) != _skeleton(b):
-        for line_a, line_b in zip(a.splitlines(), b.splitlines(), strict=False):
-            if _skeleton(line_a) != _skeleton(line_b):
-                return f"text differs:\n  recorded: {line_a}\n  now:      {line_b}"
-        return "a different number of lines"
-    xs, ys = _NUMBER.findall(a), _NUMBER.findall(b)
-    largest = max((abs(float(x)) for x in xs), default=0.0)
-    for x, y in zip(xs, ys, strict=True):
-        fx, fy = float(x), float(y)
-        printed = 1.000001 * max(_last_digit(x), _last_digit(y)) if table else 0.0
-        if abs(fx - fy) > max(RELATIVE * max(abs(fx), abs(fy)), OF_LARGEST * largest, printed):
-            return f"a figure differs: recorded {x}, now {y}"
+    verb, kind = key.split(".")[0].split("-")[0], key.rsplit(".", 1)[1]
+    parts_a, parts_b = _parts(recorded), _parts(now)
+    if list(parts_a) != list(parts_b):
+        return f"other parts: recorded {list(parts_a)}, now {list(parts_b)}"
+    document = _parts(sibling).get("stdout") if sibling else None
+    if kind == "json":
+        document = parts_a["stdout"]
+    text = compare.text_rule(verb, recorded, json.loads(document) if document else None)
+    for part, a in parts_a.items():
+        b = parts_b[part]
+        if part == "stdout" and kind == "json":
+            problem = compare.compare_document(a, b, "json", compare.json_rules(verb), text)
+        elif part.endswith(".csv"):
+            problem = compare.compare_csv(a, b, text)
+        else:
+            problem = compare.compare_text(a, b, text)
+        if problem is not None:
+            return f"{part}: {problem}"
     return None
 
 
-def _skeleton(text: str) -> list[str]:
-    """The text between the numbers, a table's padding and rules reduced to one character.
-
-    (A figure printed one digit shorter narrows its column.)
-    """
-    return [re.sub(r"-{2,}", "-", re.sub(r"[ \t]+", " ", part)) for part in _NUMBER.split(text)]
-
-
-def _last_digit(token: str) -> float:
-    """The value of one unit in the last printed digit of a number of fewer than 15 digits."""
-    mantissa, _, exponent = token.lower().lstrip("+-").partition("e")
-    digits = mantissa.replace(".", "").lstrip("0")
-    if len(digits) >= 15:  # a full repr: compared relatively
-        return 0.0
-    decimals = len(mantissa.partition(".")[2])
-    return 10.0 ** (int(exponent or 0) - decimals)
+def _parts(text: str) -> dict[str, str]:
+    pieces = _PART.split(text)
+    parts = {"exit": pieces[0].strip()}
+    for name, body in zip(pieces[1::2], pieces[2::2], strict=True):
+        parts[name] = body.strip("\n")
+    return parts
 
 
 def mask(text: str, folder: Path | None = None) -> str:
@@ -171,10 +156,11 @@ def output(name: str, key: str) -> str:
 
 
 def _abridged(csv: str) -> str:
-    """A long CSV as its digest, its header and every 30th row (the digest holds the rest)."""
+    """A long CSV as its header and every :data:`CSV_EVERY`-th row (:data:`CSV_ROWS`)."""
     lines = csv.splitlines()
-    digest = hashlib.sha256(csv.encode()).hexdigest()
-    return "\n".join([f"sha256 {digest}", *lines[:1], *lines[1::30]])
+    if len(lines) <= CSV_ROWS + 1:
+        return "\n".join(lines)
+    return "\n".join([*lines[:1], *lines[1::CSV_EVERY]])
 
 
 def record(names: list[str] | None = None) -> None:
