@@ -503,6 +503,8 @@ class SweepResult:
     headline
         The figure its balancing is about (``shaking_moment``, an engine's ``rocking_couple``:
         the atlas shows it).
+    notes
+        What the person who ran it should know (``--resume`` with nothing to resume).
     """
 
     out: Path
@@ -514,6 +516,7 @@ class SweepResult:
     computed: int
     residual_force: dict[str, float | str] | None = None
     headline: str = "shaking_moment"
+    notes: tuple[str, ...] = ()
 
     @property
     def rate(self) -> float | None:
@@ -558,7 +561,9 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
     scheduler
         Address of a running Dask scheduler (``tcp://host:8786``) instead of a local cluster.
     resume
-        Continue the interrupted sweep whose parts are beside ``out``.
+        Continue the interrupted sweep whose parts are beside ``out``; where there is none (it
+        was interrupted before any point finished, or never ran), run it from the start with a
+        note (:attr:`SweepResult.notes`): the same command line always completes a sweep.
     force
         Overwrite an existing table (never an interrupted sweep's parts: resume or remove).
     batch
@@ -615,6 +620,7 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
     if out.exists() and not force:
         raise OutputError("exists; give --force to overwrite it", key="--out", value=str(out))
     done: set[int] = set()
+    notes: list[str] = []
     if parts.exists():
         if not resume:
             raise OutputError(f"an interrupted sweep's results are in {parts}: --resume to "
@@ -629,9 +635,9 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
                               key="--resume")
         done = _finished(parts)
     else:
-        if resume:
-            raise OutputError(f"no interrupted sweep to resume ({parts} does not exist)",
-                              key="--resume")
+        if resume:  # (a job restarted by its scheduler runs the same command line)
+            notes.append(f"no interrupted sweep to resume ({parts} does not exist): ran it "
+                         "from the start")
         parts.mkdir()
         (parts / "manifest.json").write_text(json.dumps(manifest))
     batches = [list(enumerate(points))[i:i + batch] for i in range(0, len(points), batch)]
@@ -689,7 +695,7 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
                        computed=len(points) - sum(len(batches[i]) for i in done),
                        residual_force=residual,
                        headline=(design.balance.headline if design.balance is not None
-                                 else "shaking_moment"))
+                                 else "shaking_moment"), notes=tuple(notes))
 
 
 def _recorded_batch(parts: Path) -> int | None:

@@ -45,6 +45,15 @@ FREE_MARGIN = 1.5
 #: as the formulations agree with each other (1e-9 relative, DESIGN.md) at 0.6 times the steps
 #: of 1e-11.
 RTOL = 1e-9
+#: Revolutions of the crank at the operating speed that each run of a check lasts where the
+#: spec gives no ``[simulation] duration`` (an engine at 9000 rpm would otherwise run its
+#: default 5 s: 750 revolutions; the peaks of a steady cycle repeat every revolution, or every
+#: second one for a four-stroke engine).
+CHECK_REVOLUTIONS = 4
+#: Most wall-clock time each simulation of a check may take, s: a run that would take longer
+#: at the rate of its first steps is refused up front (its motion much faster than its
+#: duration: gravity of 1e10 m/s², say) rather than left to run for minutes.
+CHECK_SECONDS = 20.0
 ATOL = 1e-11
 
 
@@ -231,7 +240,8 @@ class _Tally:
             report = report_total
 
         try:
-            return simulate(linkage, settings, method=method, progress=report, **kw)
+            return simulate(linkage, settings, method=method, progress=report,
+                            max_seconds=CHECK_SECONDS, **kw)
         finally:
             self.done += settings.duration
 
@@ -313,7 +323,9 @@ def verify(
         Formulation for the simulations (by default one the optimiser did not use: the
         mechanism's :attr:`~balancer.mechanisms.base.Mechanism.verify_method`).
     duration
-        Simulated time of each run, s (default: the spec's ``[simulation] duration``).
+        Simulated time of each run, s (default: the spec's ``[simulation] duration``, or
+        where it gives none, :data:`CHECK_REVOLUTIONS` revolutions at the operating speed; the
+        free run then starts at the operating speed unless the spec gives ``omega1``).
     rtol, atol
         Integrator tolerances (see :data:`RTOL`).
     outputs
@@ -363,8 +375,15 @@ def _plan(design: Design, method: str | None, duration: float | None, rtol: floa
     mech = mechanism_of(linkage)
     method = method or mech.verify_method
     settings = design.simulation
+    speed = design.operation.speed
     if duration is not None:
         settings = replace(settings, duration=duration)
+    elif "duration" not in settings.given:  # sized to the machine's speed
+        settings = replace(settings, duration=CHECK_REVOLUTIONS * 2 * math.pi / abs(speed))
+    if "omega1" not in settings.given:
+        # No initial state: the free run coasts from the operating speed (from rest, a machine
+        # with no gravity and no loads would not move: its check would say nothing).
+        settings = replace(settings, omega1=speed)
     resolution = None
     if outputs is not None:
         settings = replace(settings, outputs=outputs)
@@ -372,7 +391,6 @@ def _plan(design: Design, method: str | None, duration: float | None, rtol: floa
         resolution = 2 * math.pi / PER_REVOLUTION
     start = settings.theta1
     mech.require_full_revolution("a driven check")
-    speed = design.operation.speed
     driven_settings = _resolved(replace(settings, drive="constant-speed", omega1=speed,
                                         theta1=start), speed, resolution)
     free_settings = _resolved(replace(settings, drive="free"), FREE_MARGIN * settings.omega1,

@@ -147,6 +147,32 @@ def test_a_resumed_sweep_rates_only_the_points_it_computed(tmp_path):
     assert rate == pytest.approx(3 / result.seconds, rel=5e-3)
 
 
+def test_resume_with_nothing_to_resume_runs_the_sweep_from_the_start(tmp_path, capsys,
+                                                                      monkeypatch):
+    """A sweep interrupted before any point finished keeps nothing; a scheduler that restarts
+    the job runs the same command line, --resume included: it runs the sweep whole, with a
+    note, and its table is the uninterrupted sweep's."""
+    import balancer.sweeps
+
+    varies = [Vary.parse(f"{COUPLER}=2.6:3.4:3")]
+    out, reference = tmp_path / "sweep.parquet", tmp_path / "reference.parquet"
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    with monkeypatch.context() as patch:
+        patch.setattr(balancer.sweeps, "run_batch", interrupted)
+        with pytest.raises(KeyboardInterrupt, match="nothing kept"):
+            sweep(PB1, varies, out, workers=0, batch=3)
+    args = ["sweep", str(PB1), "--vary", f"{COUPLER}=2.6:3.4:3", "--out", str(out),
+            "--workers", "0", "--resume"]
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    assert "note: no interrupted sweep to resume" in err and "ran it from the start" in err
+    sweep(PB1, varies, reference, workers=0)
+    assert _rows(out) == _rows(reference)
+
+
 def test_on_a_dask_cluster_a_killed_worker_loses_no_point(tmp_path):
     """Two local worker processes; after the first batch one of them is killed (os._exit).
     The scheduler reruns what it held, its nanny starts it again, and the table has every

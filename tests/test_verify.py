@@ -200,3 +200,54 @@ def test_balanced_design_round_trips(pb2_balanced):
     design = spec.load_design(pb2_balanced)
     assert spec.loads_design(spec.dumps_design(design)) == design
     assert np.isfinite(design.mechanism.crank.counter_rotor)
+
+
+def _without_simulation(example: str, folder: Path) -> Path:
+    """The example's spec without its ``[simulation]`` table."""
+    import re
+
+    text = (EXAMPLES / f"{example}.toml").read_text()
+    text = re.sub(r"\n\[simulation\]\n(?:[^\[\n][^\n]*\n|\n)*?(?=\n*(?:\[|#|$))", "\n", text)
+    assert "[simulation]" not in text
+    path = folder / f"{example}_no_simulation.toml"
+    path.write_text(text)
+    return path
+
+
+def test_a_check_without_a_simulation_table_is_sized_to_the_machine(tmp_path, capsys):
+    """An engine at 9000 rpm with no [simulation]: each run lasts CHECK_REVOLUTIONS
+    revolutions at the operating speed (not the 5 s default: 750 revolutions), the free run
+    coasting from that speed (from rest nothing would move); the balanced spec written back
+    leaves the defaults unsaid, so that verifying it is sized the same way."""
+    from balancer.verification import CHECK_REVOLUTIONS
+
+    path = _without_simulation("engine", tmp_path)
+    design = spec.load_design(path)
+    speed = design.operation.speed
+    check = verify(design)
+    for run in (check.driven, check.free):
+        doc = run.as_dict()
+        assert doc["duration"] == pytest.approx(CHECK_REVOLUTIONS * 2 * np.pi / speed,
+                                                rel=1e-12)
+        assert run.trajectory.omega[0][0] == pytest.approx(speed, rel=1e-12)
+    # driven at constant speed: exactly that many revolutions
+    assert check.driven.as_dict()["revolutions"] == pytest.approx(CHECK_REVOLUTIONS, rel=1e-9)
+    out = tmp_path / "balanced.toml"
+    assert main(["optimize", str(path), "--no-verify", "--out", str(out)]) == 0
+    assert "[simulation]" not in out.read_text()
+    # a spec that gives its duration keeps it
+    given = verify(spec.load_design(EXAMPLES / "engine.toml"))
+    assert given.driven.as_dict()["duration"] == pytest.approx(0.02, rel=1e-9)
+
+
+def test_a_run_that_would_take_too_long_is_refused_up_front():
+    """From the rate of its first steps, a run projected beyond its wall-clock budget is
+    refused with the figures, naming the key (verify gives each run CHECK_SECONDS: gravity of
+    1e10 m/s² made the single cylinder's free run take half a minute)."""
+    from balancer.errors import SpecError
+    from balancer.simulation import simulate
+
+    design = spec.load_design(EXAMPLES / "meijaard2020.toml")
+    with pytest.raises(SpecError, match=r"^simulation\.duration: would take about .* s on this "
+                                        r"machine .* more than the 1e-06 s a check may take"):
+        simulate(design.mechanism, design.simulation, duration=300.0, max_seconds=1e-6)

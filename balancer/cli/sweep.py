@@ -32,6 +32,8 @@ def run(args: argparse.Namespace) -> int:
                        seed=args.seed, workers=args.workers, scheduler=args.scheduler,
                        resume=args.resume, force=args.force, batch=args.batch,
                        progress=progress)
+    for note in result.notes:
+        print(f"balancer: note: {note}", file=sys.stderr)
     wrote(result.out)
     if plot is not None:
         keys = [v.key for v in varies]

@@ -87,6 +87,10 @@ class SimulationSettings:
         Relative and absolute tolerances of the integrator.
     outputs
         Number of equally spaced output times, including both ends.
+    given
+        The keys the spec gave (the others are these defaults): ``verify`` sizes its runs to
+        the operating speed where the spec gives no ``duration`` and no initial speed, and the
+        spec written back states what was given (or differs from its default).
     """
 
     duration: float = 5.0
@@ -98,6 +102,7 @@ class SimulationSettings:
     rtol: float = 1e-10
     atol: float = 1e-12
     outputs: int = 501
+    given: frozenset[str] = field(default=frozenset(), compare=False, repr=False)
 
     #: Memory a simulation takes per output time, bytes (state, evaluation, CSV text).
     BYTES_PER_OUTPUT: ClassVar[int] = 4096

@@ -191,6 +191,7 @@ def simulate(
     outputs: int | None = None,
     progress: Callable[[float, float], None] | None = None,
     resolution: float | None = None,
+    max_seconds: float | None = None,
 ) -> Trajectory:
     """Simulate the linkage's motion.
 
@@ -216,11 +217,15 @@ def simulate(
         Most angle, rad, the crank may turn between two output times: more outputs than
         ``outputs`` where it turns faster (from the steps' dense outputs, at most
         :data:`MAX_OUTPUTS`).
+    max_seconds
+        Most wall-clock time the integration may take, s: a run that would take longer at
+        the rate of its first steps is refused (``None``: only :data:`MAX_STEPS` steps).
 
     Raises
     ------
     SpecError
-        For bad settings or an initial crank angle where the linkage does not assemble.
+        For bad settings or an initial crank angle where the linkage does not assemble; for a
+        run that would take more than :data:`MAX_STEPS` steps or ``max_seconds``.
     LockupError
         If the motion reaches a position the formulation cannot pass (its ``partial``
         attribute holds the trajectory up to there).
@@ -230,7 +235,7 @@ def simulate(
     f, y0, end = run.f, run.y0, run.end
     duration, rtol, atol = run.settings.duration, run.settings.rtol, run.settings.atol
     start = _time.perf_counter()
-    stepper = Stepper(f, duration, rtol, atol, run.outputs, progress, resolution)
+    stepper = Stepper(f, duration, rtol, atol, run.outputs, progress, resolution, max_seconds)
     with np.errstate(divide="ignore", invalid="ignore"):
         times, states, drift, nfev, steps, stopped = stepper.run(y0, end)
     traj = trajectory_of(f, times, states, drift, nfev, steps, rtol, atol,

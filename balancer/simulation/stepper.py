@@ -9,6 +9,7 @@ refused from the first steps' rate, and a driven crank's prescribed motion by qu
 from __future__ import annotations
 
 import math
+import time
 from collections import deque
 from collections.abc import Callable, Sequence
 from typing import TypeAlias
@@ -83,8 +84,10 @@ class Stepper:
 
     def __init__(self, f: Formulation, duration: float, rtol: float, atol: float,
                  outputs: int, progress: Callable[[float, float], None] | None,
-                 resolution: float | None = None) -> None:
+                 resolution: float | None = None, max_seconds: float | None = None) -> None:
         self.f = f
+        self.max_seconds = max_seconds
+        self.started = time.perf_counter()
         self.duration = duration
         self.rtol = rtol
         self.atol = atol
@@ -104,6 +107,7 @@ class Stepper:
         """Integrate from ``y0``; the states returned carry the extra work as a last entry."""
         t_end = self.duration if stop_at is None else min(stop_at, self.duration)
         self.t_end = t_end
+        self.started = time.perf_counter()
         if self.f.driven:  # up to t_end: before the lock of a crank driven into one
             prescribed = (self._prescribed(y0) if self.f.time_only
                           else self._prescribed_motion(y0))
@@ -391,7 +395,8 @@ class Stepper:
         return cache["dop853"]
 
     def _check_budget(self, steps: int, t: float) -> None:
-        """Refuse a duration that would take more than :data:`MAX_STEPS` steps.
+        """Refuse a duration that would take more than :data:`MAX_STEPS` steps (or, with
+        ``max_seconds``, more than that wall-clock time at the rate so far).
 
         After :data:`PROJECT_AFTER` steps, from the rate so far; at any time, the limit itself.
         (A motion whose steps come ever faster is caught by :meth:`_check_stall`.)
@@ -404,6 +409,15 @@ class Stepper:
                 f"would take about {projected:.2g} integration steps at the rate of the first "
                 f"{t:.3g} s ({steps} steps), more than the {MAX_STEPS:.0e} allowed: shorten "
                 "it, or loosen rtol", key="simulation.duration", value=self.duration)
+        if self.max_seconds is not None:
+            seconds = (time.perf_counter() - self.started) * self.t_end / t
+            if seconds > self.max_seconds:
+                raise SpecError(
+                    f"would take about {seconds:.2g} s on this machine ({projected:.2g} "
+                    f"integration steps at the rate of the first {t:.3g} s, {steps} steps), "
+                    f"more than the {self.max_seconds:g} s a check may take: the motion is "
+                    "much faster than the duration (its loads, gravity or speed): shorten it, "
+                    "or loosen rtol", key="simulation.duration", value=self.duration)
 
     def _check_stall(self, recent: deque[float], f: WithExtraWork, t: float,
                      y: NDArray[np.float64], change_points: tuple[float, ...]) -> None:

@@ -82,12 +82,12 @@ def _read_simulation(root: Table, mechanism: Model) -> SimulationSettings:
         return defaults
     method = table.string("method", choices=mechanism_of(mechanism).formulation_names,
                           default="") or None
+    names = ("duration", "theta1", "omega1", "gravity", "drive", "rtol", "atol", "outputs")
     with v.under("simulation"):
         settings = SimulationSettings(
-            **{name: table.value(name, getattr(defaults, name))
-               for name in ("duration", "theta1", "omega1", "gravity", "drive", "rtol", "atol",
-                            "outputs")},
+            **{name: table.value(name, getattr(defaults, name)) for name in names},
             method=method,
+            given=frozenset(name for name in (*names, "method") if table.has(name)),
         )
     table.finish()
     return settings

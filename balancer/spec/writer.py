@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 
 from .. import tomltext as toml
-from ..model import Design
+from ..model import Design, SimulationSettings
 from ..outputs import write_atomic
 from .codecs import spec_of
 
@@ -27,20 +27,26 @@ def dumps_design(design: Design) -> str:
             *([f"gravity = [{toml.number(op.gravity[0])}, {toml.number(op.gravity[1])}]  # m/s²"]
               if any(op.gravity) else []),
         ]
-    sim = design.simulation
-    out += [
-        "",
-        "[simulation]",
-        f"duration = {toml.number(sim.duration)}  # s",
-        *([f"theta1 = {toml.number(sim.theta1)}  # rad"] if sim.theta1 is not None else []),
-        f"omega1 = {toml.number(sim.omega1)}  # rad/s",
-        f"gravity = [{toml.number(sim.gravity[0])}, {toml.number(sim.gravity[1])}]  # m/s²",
-        f'drive = "{sim.drive}"',
-        *([f'method = "{sim.method}"'] if sim.method else []),
-        f"rtol = {toml.number(sim.rtol)}",
-        f"atol = {toml.number(sim.atol)}",
-        f"outputs = {toml.number(sim.outputs)}",
-    ]
+    sim, default = design.simulation, SimulationSettings()
+    lines = {
+        "duration": f"duration = {toml.number(sim.duration)}  # s",
+        "theta1": f"theta1 = {toml.number(sim.theta1)}  # rad" if sim.theta1 is not None
+        else None,
+        "omega1": f"omega1 = {toml.number(sim.omega1)}  # rad/s",
+        "gravity": f"gravity = [{toml.number(sim.gravity[0])}, {toml.number(sim.gravity[1])}]"
+                   "  # m/s²",
+        "drive": f'drive = "{sim.drive}"',
+        "method": f'method = "{sim.method}"' if sim.method else None,
+        "rtol": f"rtol = {toml.number(sim.rtol)}",
+        "atol": f"atol = {toml.number(sim.atol)}",
+        "outputs": f"outputs = {toml.number(sim.outputs)}",
+    }
+    # What the spec gave, or what differs from its default (a default left unsaid stays one:
+    # verify sizes its runs where no duration is given).
+    stated = [line for key, line in lines.items() if line is not None
+              and (key in sim.given or getattr(sim, key) != getattr(default, key))]
+    if stated:
+        out += ["", "[simulation]", *stated]
     if design.balance is not None:
         out += ["", *codec.balance_lines(design.balance)]
     if design.original is not None:
