@@ -397,8 +397,9 @@ class Stepper:
     def _check_budget(self, steps: int, t: float) -> None:
         """Refuse a duration that would take more than :data:`MAX_STEPS` steps.
 
-        Or, with ``max_seconds``, more than that wall-clock time at the rate so far. After :data:`PROJECT_AFTER` steps, from the rate so far; at any time, the limit itself.
-        (A motion whose steps come ever faster is caught by :meth:`_check_stall`.)
+        Or, with ``max_seconds``, more than that wall-clock time at the rate so far. After
+        :data:`PROJECT_AFTER` steps, from the rate so far; at any time, the limit itself. (A
+        motion whose steps come ever faster is caught by :meth:`_check_stall`.)
         """
         if steps < PROJECT_AFTER or t <= 0:
             return
