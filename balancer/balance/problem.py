@@ -258,6 +258,12 @@ class NumericProblem:
                 and abs(mf) <= ABSENT * b.mass_ref * b.length
                 and (self.inert[k + 3] or abs(j) <= ABSENT * b.inertia_ref))
 
+    @cached_property
+    def nullable(self) -> tuple[LinkBounds, ...]:
+        """The links whose counterweight may be none (its mass may be zero): those that
+        :meth:`absent` can find without a counterweight. Most problems have none."""
+        return tuple(b for b in self.links if b.offset is not None and not b.mass[0] > 0)
+
     def without_absent(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64],
                                                              NDArray[np.bool_]]:
         """``x`` with every counterweight that is none (:meth:`absent`) exactly none.
@@ -266,6 +272,8 @@ class NumericProblem:
         restores Eq. 58 afterwards).
         """
         x = np.array(x, dtype=float)
+        if not self.nullable:
+            return x, np.zeros(self.size, dtype=bool)
         own = self.own(x)
         mask = np.zeros(self.size, dtype=bool)
         for b in self.links:

@@ -344,6 +344,8 @@ class Repairs:
         Eq. 58 restored by the other free variables.
         """
         data, lay = self.data, self.layout
+        if not data.nullable:
+            return u
         x, mask = data.without_absent(lay.x(u))
         if not mask.any():
             return u
@@ -365,10 +367,11 @@ class Repairs:
         if self._fb is None:
             return u
         at, rhs, pinv = self._fb
-        _, none = self.data.without_absent(self.layout.x(u))
-        if none.any():
-            kept = none[list(self.layout.primary)]
-            pinned = kept if pinned is None else (pinned | kept)
+        if self.data.nullable:  # (without a counterweight that may be none: nothing to keep)
+            _, none = self.data.without_absent(self.layout.x(u))
+            if none.any():
+                kept = none[list(self.layout.primary)]
+                pinned = kept if pinned is None else (pinned | kept)
         free = None if pinned is None or not pinned.any() else ~pinned
         if free is not None and not free.any():
             return u
