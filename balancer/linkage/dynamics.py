@@ -35,7 +35,16 @@ from numpy.typing import NDArray
 
 from ..model import GROUND, Linkage
 from . import rotors
-from .constraints import GROUND_INDEX, Blocks, Constraint, Driver, Pin, Prism, constraint_jacobian
+from .constraints import (
+    GROUND_INDEX,
+    Blocks,
+    Constraint,
+    Driver,
+    Pin,
+    Pose,
+    Prism,
+    constraint_jacobian,
+)
 from .kinematics import Motion, rates
 from .structure import Structure
 from .vectors import NUMPY, Num, OpsLike, V, _plus, _times
@@ -502,6 +511,22 @@ class Shaking:
     rocking_couple: V
 
 
+def _pose_at(pose: Pose, mask: NDArray[np.bool_]) -> Pose:
+    """The frames of ``pose`` at the states ``mask`` picks (arrays ``(N,)``; scalars kept)."""
+    def take(a: Num) -> Num:
+        return np.asarray(a)[mask] if np.ndim(a) else a
+
+    return Pose([V(take(o.x), take(o.y)) for o in pose.origins], [take(t) for t in pose.angles],
+                [take(c) for c in pose.cos], [take(s) for s in pose.sin])
+
+
+def _put_at(values: Num, mask: NDArray[np.bool_], part: Num, n: int) -> NDArray[np.float64]:
+    """``values`` (``(N,)``) with the states ``mask`` picks taken from ``part``."""
+    out = np.array(np.broadcast_to(values, (n,)), dtype=float)
+    out[mask] = part
+    return out
+
+
 def shaking_regressors(structure: Structure, mo: Motion,
                        gravity: tuple[float, float] = (0.0, 0.0)) -> Shaking:
     """:func:`regressors`' shaking, moment, torque and couple without the joint forces.
@@ -526,10 +551,13 @@ def shaking_regressors(structure: Structure, mo: Motion,
     with np.errstate(divide="ignore", invalid="ignore"):
         unit = [(mo.velocity[k] / omega, mo.rate[k] / omega) for k in range(structure.size)]
     if not turning.all():  # (at rest there: the links' rates at a unit crank rate; each
-        # state's figures its own, whatever else is computed with it)
-        vel, rate, _, _ = rates(structure, mo.pose, np.ones(n), np.zeros(n), mo.theta1)
-        unit = [(V(np.where(turning, v.x, u.x), np.where(turning, v.y, u.y)),
-                 np.where(turning, w, r))
+        # state's figures its own, whatever else is computed with it: at those states alone)
+        idle = ~turning
+        m = int(idle.sum())
+        vel, rate, _, _ = rates(structure, _pose_at(mo.pose, idle), np.ones(m), np.zeros(m),
+                                mo.theta1[idle])
+        unit = [(V(_put_at(v.x, idle, u.x, n), _put_at(v.y, idle, u.y, n)),
+                 _put_at(w, idle, r, n))
                 for (v, w), u, r in zip(unit, vel, rate, strict=True)]
     moment, power = np.zeros((n, p)), np.zeros((n, p))
     # Each link's share of the shaking force (its own columns): their sum is the force.
