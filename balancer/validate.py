@@ -51,6 +51,8 @@ def number(value: Any, key: str) -> float:
     SpecError
         If it is not a number, or is NaN or infinite.
     """
+    if type(value) is float and math.isfinite(value):  # (the common case, at once)
+        return value
     if isinstance(value, bool) or not isinstance(value, int | float):
         try:
             import numpy as np  # numpy scalars from a notebook are numbers too
