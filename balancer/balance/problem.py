@@ -260,8 +260,10 @@ class NumericProblem:
 
     @cached_property
     def nullable(self) -> tuple[LinkBounds, ...]:
-        """The links whose counterweight may be none (its mass may be zero): those that
-        :meth:`absent` can find without a counterweight. Most problems have none."""
+        """The links whose counterweight may be none (its mass may be zero).
+
+        Those that :meth:`absent` can find without a counterweight; most problems have none.
+        """
         return tuple(b for b in self.links if b.offset is not None and not b.mass[0] > 0)
 
     def without_absent(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64],

@@ -10,6 +10,7 @@ counterweights that the optimum does not need.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -33,6 +34,11 @@ ACTIVE_INSIDE = 1e-12
 #: which a design meets it to rounding: a few ε for the few products in each row.
 EQ58_ROUNDING = 16 * float(np.finfo(float).eps)
 _EPS = float(np.finfo(float).eps)
+
+
+def _norm(v: NDArray[np.float64]) -> float:
+    """The 2-norm of a real vector, as ``numpy.linalg.norm`` computes it: ``√(v·v)``."""
+    return math.sqrt(float(v.dot(v)))
 
 
 class Repairs:
@@ -382,7 +388,7 @@ class Repairs:
                                                         dtype=float)
             pinv = self._pinned_inverses[key]
         residual = at @ u - rhs
-        size = np.linalg.norm(residual)
+        size = _norm(residual)
         # The correction's own rounding (the rows' conditioning times ε) leaves a residual
         # above rounding of the terms: refine while it shrinks (one or two more steps).
         for _ in range(4):
@@ -392,7 +398,7 @@ class Repairs:
                 trial = u.copy()
                 trial[free] -= pinv @ residual
             trial_residual = at @ trial - rhs
-            trial_size = np.linalg.norm(trial_residual)
+            trial_size = _norm(trial_residual)
             if not trial_size < size:
                 break
             u, residual, size = trial, trial_residual, trial_size

@@ -566,12 +566,18 @@ def shaking_regressors(structure: Structure, mo: Motion,
         k = structure.index(name)
         origin = mo.pose.origins[k]
         velocity, rate = unit[k]
-        for param, (ex, ey, et) in cols:
-            j = layout.index(name, param)
-            shares[k].x[:, j] = ex
-            shares[k].y[:, j] = ey
-            moment[:, j] = origin.x * ey - origin.y * ex + et
-            power[:, j] = ex * velocity.x + ey * velocity.y + et * rate
+        # A link's columns side by side: each entry's arithmetic as one column at a time
+        # would do it (the same figures), in a few operations on the block.
+        js = [layout.index(name, param) for param, _ in cols]
+        ex, ey, et = (np.column_stack([np.broadcast_to(c[i], (n,)) for _, c in cols])
+                      for i in range(3))
+        shares[k].x[:, js] = ex
+        shares[k].y[:, js] = ey
+        ox, oy, vx, vy, w = (np.reshape(np.broadcast_to(a, (n,)), (n, 1))
+                             for a in (origin.x, origin.y, velocity.x, velocity.y, rate))
+        moment[:, js] = ox * ey - oy * ex + et
+        power[:, js] = ex * vx + ey * vy + et * w
+        for j, (param, _) in zip(js, cols, strict=True):
             if param == "Jc":
                 moment[:, j] += 2 * mo.accel[k]
     force_x, force_y = (np.sum([getattr(v, c) for v in shares], axis=0) for c in "xy")
