@@ -99,7 +99,7 @@ STARTUP_ANCHOR = [sys.executable, "-c", "import numpy"]
 #: ``python -c "import numpy"`` (median of 5 after a warm-up, bytecode cached) on the machine
 #: where the absolute goals of the whole-command rows were turned into ratios: the 2-core
 #: Intel Xeon (AVX-512, numpy X86_V4, OpenBLAS SkylakeX) of 2026-11-29, s.
-STARTUP_REFERENCE = 0.085
+STARTUP_REFERENCE = 0.10
 #: Measured by :func:`main` before the rows: the start-up anchor in this run, s (``None``: it
 #: could not run).
 STARTUP: float | None = None

@@ -44,7 +44,7 @@ from typing import TypeAlias
 import numpy as np
 from numpy.typing import NDArray
 
-from .lsq import bounded_lstsq
+from .lsq import bounded_lstsq, pinv
 
 #: Equality constraints ``E·u = r``: ``(E, r)``.
 Equality: TypeAlias = tuple[NDArray[np.float64], NDArray[np.float64]]
@@ -279,7 +279,7 @@ class _Refit:
         # The unconstrained least-squares solution of every choice, as LAPACK's lstsq gives it
         # (singular values below ε of the largest dropped); where it keeps the active bounds'
         # additions ≥ 0 it is BVLS's answer too.
-        self.inverse = np.linalg.pinv(self.matrix, rcond=_EPS) if columns else None
+        self.inverse = pinv(self.matrix, rcond=_EPS) if columns else None
         self._box: list[NDArray[np.float64] | None] = []
 
     def box(self) -> NDArray[np.float64] | None:

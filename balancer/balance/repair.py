@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from .certificate import Constraint
 from .conic import ConicProgram
+from .lsq import pinv as pseudo_inverse
 from .problem import FORCE_BALANCE_TOLERANCE, ROUNDING_TOLERANCE, NumericProblem
 
 if TYPE_CHECKING:
@@ -384,8 +385,7 @@ class Repairs:
         if free is not None:
             key = free.tobytes()
             if key not in self._pinned_inverses:  # the same few patterns recur: keep them
-                self._pinned_inverses[key] = np.asarray(np.linalg.pinv(at[:, free]),
-                                                        dtype=float)
+                self._pinned_inverses[key] = pseudo_inverse(at[:, free])
             pinv = self._pinned_inverses[key]
         residual = at @ u - rhs
         size = _norm(residual)

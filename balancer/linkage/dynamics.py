@@ -555,7 +555,7 @@ def shaking_regressors(structure: Structure, mo: Motion,
         idle = ~turning
         m = int(idle.sum())
         vel, rate, _, _ = rates(structure, _pose_at(mo.pose, idle), np.ones(m), np.zeros(m),
-                                mo.theta1[idle])
+                                mo.theta1[idle], accelerations=False)
         unit = [(V(_put_at(v.x, idle, u.x, n), _put_at(v.y, idle, u.y, n)),
                  _put_at(w, idle, r, n))
                 for (v, w), u, r in zip(unit, vel, rate, strict=True)]
