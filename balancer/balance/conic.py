@@ -57,9 +57,9 @@ def _settings(settings: dict[str, Any]) -> Any:
     """Clarabel's ``DefaultSettings`` with ``settings`` (names of its fields), quiet."""
     import clarabel
 
-    key = tuple(sorted(settings.items()))
+    key: tuple[tuple[str, Any], ...] | None = tuple(sorted(settings.items()))
     try:
-        options = _SETTINGS.get(key)
+        options = _SETTINGS.get(key)  # type: ignore[arg-type]  # (a tuple here)
     except TypeError:  # a value that cannot be a key: made for this solve alone
         key, options = None, None
     if options is None:

@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..cycle import sample_angles
 from ..errors import SpecError
 from ..force_balance import SMALL_ROW, force_balance_conditions
+from ..linkage.dynamics import TURNING
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Design
@@ -159,7 +160,9 @@ class NumericProblem:
     inert: tuple[bool, ...]
     #: The regressors at rest under unit crank acceleration (``θ̇1 = 0``, ``θ̈1 = 1``) on the
     #: same angles, where they were computed with :attr:`regressors`
-    #: (:attr:`acceleration_factor` computes them otherwise).
+    #: (:attr:`acceleration_factor` computes them otherwise); what :attr:`acceleration_factor`
+    #: uses, their shaking moment (their driving torque is NaN where the crank turns at the
+    #: operating speed: not computed).
     unit_acceleration: CycleRegressors | None = None
 
     def with_problem(self, problem: BalanceProblem) -> NumericProblem:
@@ -774,8 +777,10 @@ def numeric_problem(design: Design) -> NumericProblem:
     mech.require_full_revolution("balancing")
     speed = design.operation.speed
     angles = sample_angles(design.operation.samples)
-    # (At unit crank acceleration too, for the counter-rotors' settling: in the same pass.)
-    reg, unit = cycle_regressors_at(mech, angles, [(speed, 0.0), (0.0, 1.0)])
+    # (At unit crank acceleration too, for the counter-rotors' settling: in the same pass;
+    # its shaking moment alone is used, so its driving torque at rest is not computed.)
+    reg, unit = cycle_regressors_at(mech, angles, [(speed, 0.0), (0.0, 1.0)],
+                                    torque_at_rest=not abs(speed) > TURNING)
     links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
     rows, factor, inert = _reduced(reg, problem.objective, links, mech.layout.size)
     return NumericProblem(

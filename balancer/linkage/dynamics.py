@@ -528,7 +528,8 @@ def _put_at(values: Num, mask: NDArray[np.bool_], part: Num, n: int) -> NDArray[
 
 
 def shaking_regressors(structure: Structure, mo: Motion,
-                       gravity: tuple[float, float] = (0.0, 0.0)) -> Shaking:
+                       gravity: tuple[float, float] = (0.0, 0.0), *,
+                       torque_at_rest: bool = True) -> Shaking:
     """:func:`regressors`' shaking, moment, torque and couple without the joint forces.
 
     The whole linkage in equilibrium with the frame (the pins and the motor): what the frame
@@ -541,7 +542,10 @@ def shaking_regressors(structure: Structure, mo: Motion,
     (the motion's own rates over ``θ̇1`` where it turns, else those of a unit crank rate). The
     rocking couple is :func:`rocking_couple` of the same columns. Equal to :func:`regressors`'
     figures (the groups' joint forces, solved state by state) to rounding, at a fraction of the
-    work: the regressors of a design's balancing are these.
+    work: the regressors of a design's balancing are these. With ``torque_at_rest`` false the
+    driving torque at the states at rest is not computed (NaN there: the links' rates of a
+    unit crank rate are not solved for them), for a caller that asks only what the frame
+    feels there; every other figure is the same.
     """
     layout = Layout.of(structure)
     n, p = mo.theta1.size, layout.size
@@ -550,8 +554,9 @@ def shaking_regressors(structure: Structure, mo: Motion,
     turning = np.abs(omega) > TURNING
     with np.errstate(divide="ignore", invalid="ignore"):
         unit = [(mo.velocity[k] / omega, mo.rate[k] / omega) for k in range(structure.size)]
-    if not turning.all():  # (at rest there: the links' rates at a unit crank rate; each
-        # state's figures its own, whatever else is computed with it: at those states alone)
+    if not turning.all() and torque_at_rest:  # (at rest there: the links' rates at a unit
+        # crank rate; each state's figures its own, whatever else is computed with it: at
+        # those states alone)
         idle = ~turning
         m = int(idle.sum())
         vel, rate, _, _ = rates(structure, _pose_at(mo.pose, idle), np.ones(m), np.zeros(m),
@@ -584,8 +589,11 @@ def shaking_regressors(structure: Structure, mo: Motion,
     rocking = rocking_couple(structure.linkage, shares, np.zeros((n, p)))
     # A state where a link is not placed (the linkage does not assemble there): NaN in every
     # column, as the joint forces give it (a link that is placed there keeps finite columns).
+    measured = turning | torque_at_rest  # (the states whose driving torque is computed)
     lost = ~(np.isfinite(force_x) & np.isfinite(force_y) & np.isfinite(moment)
-             & np.isfinite(power)).all(axis=1)
+             & (np.isfinite(power) | ~measured[:, None])).all(axis=1)
+    if not measured.all():
+        power[~measured] = np.nan
     if lost.any():
         for figure in (force_x, force_y, moment, power, rocking.x, rocking.y):
             np.asarray(figure)[lost] = np.nan
