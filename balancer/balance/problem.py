@@ -242,6 +242,11 @@ class NumericProblem:
                 out[b.entries] = b.offset
         return out
 
+    @cached_property
+    def _offset_values(self) -> list[float] | None:
+        """:attr:`offset` as Python floats, or ``None`` where it is all zero (no counterweight)."""
+        return self.offset.tolist() if self.offset.any() else None
+
     def own(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The entries the bounds concern: ``x`` less :attr:`offset` (a counterweight's own)."""
         return np.asarray(x, dtype=float) - self.offset
@@ -462,7 +467,7 @@ class NumericProblem:
         """
         x = np.array(x, dtype=float)
         own = self.own(x).tolist()
-        offset = self.offset.tolist()
+        offset = self._offset_values or [0.0] * self.size
         entries, lower, upper, original = [], [], [], []
         for b in self.links:
             k = b.start
@@ -741,8 +746,11 @@ class NumericProblem:
         a, rhs = self.force_balance
         x = np.asarray(x, dtype=float)
         abs_a, by_link, floor, abs_rhs = self._force_balance_sizes
-        offset = self.offset
-        raw = abs_a @ (np.abs(x - offset) + np.abs(offset)) + abs_rhs
+        if self._offset_values is None:  # no counterweight: |x − 0| + |0| is |x|, exactly
+            raw = abs_a @ np.abs(x) + abs_rhs
+        else:
+            offset = self.offset
+            raw = abs_a @ (np.abs(x - offset) + np.abs(offset)) + abs_rhs
         combined = np.abs((a * x) @ by_link).sum(axis=1) + abs_rhs
         size = np.maximum(np.maximum(combined, _RAW_SHARE * raw), floor)
         residual = np.abs(a @ x - rhs)
