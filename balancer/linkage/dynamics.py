@@ -565,8 +565,12 @@ def shaking_regressors(structure: Structure, mo: Motion,
                  _put_at(w, idle, r, n))
                 for (v, w), u, r in zip(unit, vel, rate, strict=True)]
     moment, power = np.zeros((n, p)), np.zeros((n, p))
-    # Each link's share of the shaking force (its own columns): their sum is the force.
-    shares = [V(np.zeros((n, p)), np.zeros((n, p))) for _ in structure.names]
+    # Each link's share of the shaking force is its own columns (an entry is one link's):
+    # their sum, the force, is each share in its columns. Kept per link only where a link
+    # lies out of the plane (the rocking couple weighs each by its plane).
+    force_x, force_y = np.zeros((n, p)), np.zeros((n, p))
+    planar = not any(link.z for link in structure.linkage.links)
+    shares = [] if planar else [V(np.zeros((n, p)), np.zeros((n, p))) for _ in structure.names]
     for name, cols in inertial_columns(structure, mo, g).items():
         k = structure.index(name)
         origin = mo.pose.origins[k]
@@ -574,10 +578,14 @@ def shaking_regressors(structure: Structure, mo: Motion,
         # A link's columns side by side: each entry's arithmetic as one column at a time
         # would do it (the same figures), in a few operations on the block.
         js = [layout.index(name, param) for param, _ in cols]
-        ex, ey, et = (np.column_stack([np.broadcast_to(c[i], (n,)) for _, c in cols])
-                      for i in range(3))
-        shares[k].x[:, js] = ex
-        shares[k].y[:, js] = ey
+        ex, ey, et = (np.empty((n, len(cols))) for _ in range(3))
+        for i, (_, column) in enumerate(cols):
+            ex[:, i], ey[:, i], et[:, i] = column
+        force_x[:, js] = ex
+        force_y[:, js] = ey
+        if shares:
+            shares[k].x[:, js] = ex
+            shares[k].y[:, js] = ey
         ox, oy, vx, vy, w = (np.reshape(np.broadcast_to(a, (n,)), (n, 1))
                              for a in (origin.x, origin.y, velocity.x, velocity.y, rate))
         moment[:, js] = ox * ey - oy * ex + et
@@ -585,8 +593,11 @@ def shaking_regressors(structure: Structure, mo: Motion,
         for j, (param, _) in zip(js, cols, strict=True):
             if param == "Jc":
                 moment[:, j] += 2 * mo.accel[k]
-    force_x, force_y = (np.sum([getattr(v, c) for v in shares], axis=0) for c in "xy")
-    rocking = rocking_couple(structure.linkage, shares, np.zeros((n, p)))
+    # (as the sum of the shares: the other links' zeros make a −0 entry +0, and nothing else)
+    force_x += 0.0
+    force_y += 0.0
+    rocking = (V(np.zeros((n, p)), np.zeros((n, p))) if planar
+               else rocking_couple(structure.linkage, shares, np.zeros((n, p))))
     # A state where a link is not placed (the linkage does not assemble there): NaN in every
     # column, as the joint forces give it (a link that is placed there keeps finite columns).
     measured = turning | torque_at_rest  # (the states whose driving torque is computed)
