@@ -57,17 +57,33 @@ def _reference_points(lengths: tuple[float, float, float, float], branch: Branch
                       ) -> tuple[tuple[str, tuple[float, float]], ...]:
     """:func:`fourbar_linkage`'s points A0…A3 at its reference pose, m."""
     rng = assembly_range(lengths)
-    if rng.full:
+    if rng.full:  # θ1 = 0 first: taken if it is regular (as the candidates' first would be)
+        at_zero = _pose_points(lengths, branch, np.zeros(1), 0, least=0.3)
+        if at_zero is not None:
+            return at_zero
         candidates = np.linspace(0.0, 2 * math.pi, 73)[:-1]
     else:
         lo, hi = rng.intervals[0]
         candidates = np.linspace(lo, hi, 74)[1:-1]
+    best = _pose_points(lengths, branch, candidates, None)
+    assert best is not None  # (the most regular of the candidates)
+    return best
+
+
+def _pose_points(lengths: tuple[float, float, float, float], branch: Branch,
+                 candidates: NDArray[np.float64], index: int | None, least: float = 0.0
+                 ) -> tuple[tuple[str, tuple[float, float]], ...] | None:
+    """The points A0…A3 at the candidate ``index``, or ``None`` if it is not regular.
+
+    ``index`` ``None``: the candidate farthest from a dead or change point. Not regular: its
+    ``|sin(θ3 − θ2)|`` below ``least``.
+    """
     signs = fourbar.cycle_branch_signs(lengths, branch, candidates)
     pos = fourbar.position(lengths, candidates, signs, check=False)
     transmission = np.abs(pos.sin_transmission)
-    best = int(np.nanargmax(transmission))
-    if rng.full and transmission[0] >= 0.3:  # θ1 = 0 if it is regular: A1 = (l1, 0) exactly
-        best = 0
+    best = int(np.nanargmax(transmission)) if index is None else index
+    if not transmission[best] >= least:  # (NaN: not regular either)
+        return None
     a1, a2 = complex(pos.A1[best]), complex(pos.A2[best])
     return (("A0", (0.0, 0.0)), ("A1", (a1.real, a1.imag)), ("A2", (a2.real, a2.imag)),
             ("A3", (lengths[3], 0.0)))
