@@ -95,7 +95,10 @@ class Constraint:
             w = w * (t / nw)
             nw = float(np.linalg.norm(w))
         # inside the cone despite the rounding of the norm computed here
-        return np.r_[max(t, nw * (1 + 4 * (w.size + 2) * _EPS)), w]
+        out = np.empty(z.size)
+        out[0] = max(t, nw * (1 + 4 * (w.size + 2) * _EPS))
+        out[1:] = w
+        return out
 
 
 @dataclass(frozen=True)
