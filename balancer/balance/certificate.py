@@ -44,7 +44,7 @@ from typing import TypeAlias
 import numpy as np
 from numpy.typing import NDArray
 
-from .lsq import bounded_lstsq
+from .lsq import bounded_lstsq, pinv
 
 #: Equality constraints ``E·u = r``: ``(E, r)``.
 Equality: TypeAlias = tuple[NDArray[np.float64], NDArray[np.float64]]
@@ -95,7 +95,10 @@ class Constraint:
             w = w * (t / nw)
             nw = float(np.linalg.norm(w))
         # inside the cone despite the rounding of the norm computed here
-        return np.r_[max(t, nw * (1 + 4 * (w.size + 2) * _EPS)), w]
+        out = np.empty(z.size)
+        out[0] = max(t, nw * (1 + 4 * (w.size + 2) * _EPS))
+        out[1:] = w
+        return out
 
 
 @dataclass(frozen=True)
@@ -279,7 +282,7 @@ class _Refit:
         # The unconstrained least-squares solution of every choice, as LAPACK's lstsq gives it
         # (singular values below ε of the largest dropped); where it keeps the active bounds'
         # additions ≥ 0 it is BVLS's answer too.
-        self.inverse = np.linalg.pinv(self.matrix, rcond=_EPS) if columns else None
+        self.inverse = pinv(self.matrix, rcond=_EPS) if columns else None
         self._box: list[NDArray[np.float64] | None] = []
 
     def box(self) -> NDArray[np.float64] | None:

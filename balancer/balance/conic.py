@@ -48,6 +48,30 @@ SOLVED = ("optimal", "optimal_inaccurate")
 COST_SCALE_LIMIT = 1e6
 
 
+#: Clarabel's settings objects by the settings they hold (made once: the same few are asked
+#: for at every solve; Clarabel copies them into each solver).
+_SETTINGS: dict[tuple[tuple[str, Any], ...], Any] = {}
+
+
+def _settings(settings: dict[str, Any]) -> Any:
+    """Clarabel's ``DefaultSettings`` with ``settings`` (names of its fields), quiet."""
+    import clarabel
+
+    key: tuple[tuple[str, Any], ...] | None = tuple(sorted(settings.items()))
+    try:
+        options = _SETTINGS.get(key)  # type: ignore[arg-type]  # (a tuple here)
+    except TypeError:  # a value that cannot be a key: made for this solve alone
+        key, options = None, None
+    if options is None:
+        options = clarabel.DefaultSettings()
+        options.verbose = False
+        for name, value in settings.items():
+            setattr(options, name, value)
+        if key is not None:
+            _SETTINGS[key] = options
+    return options
+
+
 @dataclass(frozen=True)
 class CscMatrix:
     """A dense matrix's nonzeros in compressed sparse columns, as Clarabel reads a matrix.
@@ -192,6 +216,7 @@ class ConicProgram:
         self._cones = cones
         # Clarabel's forms of what every solve shares
         self._csc = (CscMatrix.of(self._H), CscMatrix.of(self._A))
+        self._clarabel_cones: list[Any] | None = None
 
     def solve(self, settings: dict[str, Any], *, target: NDArray[np.float64] | None = None,
               equality_rhs: NDArray[np.float64] | None = None) -> ConicSolution:
@@ -210,14 +235,12 @@ class ConicProgram:
             assert target is not None
             h = np.zeros(self.width)
             h[: self.n] = -2.0 * np.asarray(target, float) / self._cost_scale
-        kinds = {"zero": clarabel.ZeroConeT, "nonneg": clarabel.NonnegativeConeT,
-                 "soc": clarabel.SecondOrderConeT}
-        cones = [kinds[kind](k) for kind, k in self._cones]
-        options = clarabel.DefaultSettings()
-        options.verbose = False
-        for key, value in settings.items():
-            setattr(options, key, value)
-        solver = clarabel.DefaultSolver(self._csc[0], h, self._csc[1], b, cones, options)
+        if self._clarabel_cones is None:  # (the same cones at every solve)
+            kinds = {"zero": clarabel.ZeroConeT, "nonneg": clarabel.NonnegativeConeT,
+                     "soc": clarabel.SecondOrderConeT}
+            self._clarabel_cones = [kinds[kind](k) for kind, k in self._cones]
+        solver = clarabel.DefaultSolver(self._csc[0], h, self._csc[1], b, self._clarabel_cones,
+                                        _settings(settings))
         with np.errstate(over="ignore", invalid="ignore"):
             result = solver.solve()
         status = STATUS.get(str(result.status), "solver_error")

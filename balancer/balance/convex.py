@@ -57,6 +57,7 @@ from numpy.typing import NDArray
 from .certificate import Constraint, Objective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .diagnosis import Diagnosis
+from .lsq import pinv as pseudo_inverse
 from .problem import FORCE_BALANCE_TOLERANCE, NumericProblem
 from .repair import Repairs
 from .result import StageReport
@@ -417,7 +418,7 @@ class ConvexSolver(Repairs, Diagnosis):
                 inconsistent = True
                 self._failed_row = i
         if keep:
-            self._fb = (at[keep], rhs[keep], np.linalg.pinv(at[keep]))
+            self._fb = (at[keep], rhs[keep], pseudo_inverse(at[keep]))
         return inconsistent
 
     # -- solving -------------------------------------------------------------------------------

@@ -174,3 +174,20 @@ def _bvls(A: NDArray[np.float64], b: NDArray[np.float64], x_lsq: NDArray[np.floa
             break
     return BoundedFit(x=np.clip(x, lb, ub), optimality=optimality, active=on_bound,
                       status=status)
+
+
+def pinv(a: NDArray[np.float64], rcond: float = 1e-15) -> NDArray[np.float64]:
+    """The pseudo-inverse of a real matrix, as ``numpy.linalg.pinv(a, rcond)`` computes it.
+
+    The same SVD and the same arithmetic (singular values at most ``rcond`` times the largest
+    dropped), bit for bit, without its generic dispatch: the repairs take one per set of
+    pinned entries, a dozen per design.
+    """
+    a = np.asarray(a, dtype=float)
+    if a.ndim != 2 or not a.size:
+        return np.asarray(np.linalg.pinv(a, rcond=rcond), dtype=float)
+    u, s, vt = np.linalg.svd(a, full_matrices=False)
+    large = s > rcond * s.max()
+    s = np.divide(1, s, where=large, out=s)
+    s[~large] = 0
+    return np.asarray(vt.T @ (s[:, None] * u.T), dtype=float)

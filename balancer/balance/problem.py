@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..cycle import sample_angles
 from ..errors import SpecError
 from ..force_balance import SMALL_ROW, force_balance_conditions
+from ..linkage.dynamics import TURNING
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Design
@@ -159,7 +160,9 @@ class NumericProblem:
     inert: tuple[bool, ...]
     #: The regressors at rest under unit crank acceleration (``θ̇1 = 0``, ``θ̈1 = 1``) on the
     #: same angles, where they were computed with :attr:`regressors`
-    #: (:attr:`acceleration_factor` computes them otherwise).
+    #: (:attr:`acceleration_factor` computes them otherwise); what :attr:`acceleration_factor`
+    #: uses, their shaking moment (their driving torque is NaN where the crank turns at the
+    #: operating speed: not computed).
     unit_acceleration: CycleRegressors | None = None
 
     def with_problem(self, problem: BalanceProblem) -> NumericProblem:
@@ -239,6 +242,11 @@ class NumericProblem:
                 out[b.entries] = b.offset
         return out
 
+    @cached_property
+    def _offset_values(self) -> list[float] | None:
+        """:attr:`offset` as Python floats, or ``None`` where it is all zero (no counterweight)."""
+        return self.offset.tolist() if self.offset.any() else None
+
     def own(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The entries the bounds concern: ``x`` less :attr:`offset` (a counterweight's own)."""
         return np.asarray(x, dtype=float) - self.offset
@@ -258,6 +266,14 @@ class NumericProblem:
                 and abs(mf) <= ABSENT * b.mass_ref * b.length
                 and (self.inert[k + 3] or abs(j) <= ABSENT * b.inertia_ref))
 
+    @cached_property
+    def nullable(self) -> tuple[LinkBounds, ...]:
+        """The links whose counterweight may be none (its mass may be zero).
+
+        Those that :meth:`absent` can find without a counterweight; most problems have none.
+        """
+        return tuple(b for b in self.links if b.offset is not None and not b.mass[0] > 0)
+
     def without_absent(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64],
                                                              NDArray[np.bool_]]:
         """``x`` with every counterweight that is none (:meth:`absent`) exactly none.
@@ -266,6 +282,8 @@ class NumericProblem:
         restores Eq. 58 afterwards).
         """
         x = np.array(x, dtype=float)
+        if not self.nullable:
+            return x, np.zeros(self.size, dtype=bool)
         own = self.own(x)
         mask = np.zeros(self.size, dtype=bool)
         for b in self.links:
@@ -449,7 +467,7 @@ class NumericProblem:
         """
         x = np.array(x, dtype=float)
         own = self.own(x).tolist()
-        offset = self.offset.tolist()
+        offset = self._offset_values or [0.0] * self.size
         entries, lower, upper, original = [], [], [], []
         for b in self.links:
             k = b.start
@@ -728,8 +746,11 @@ class NumericProblem:
         a, rhs = self.force_balance
         x = np.asarray(x, dtype=float)
         abs_a, by_link, floor, abs_rhs = self._force_balance_sizes
-        offset = self.offset
-        raw = abs_a @ (np.abs(x - offset) + np.abs(offset)) + abs_rhs
+        if self._offset_values is None:  # no counterweight: |x − 0| + |0| is |x|, exactly
+            raw = abs_a @ np.abs(x) + abs_rhs
+        else:
+            offset = self.offset
+            raw = abs_a @ (np.abs(x - offset) + np.abs(offset)) + abs_rhs
         combined = np.abs((a * x) @ by_link).sum(axis=1) + abs_rhs
         size = np.maximum(np.maximum(combined, _RAW_SHARE * raw), floor)
         residual = np.abs(a @ x - rhs)
@@ -764,8 +785,10 @@ def numeric_problem(design: Design) -> NumericProblem:
     mech.require_full_revolution("balancing")
     speed = design.operation.speed
     angles = sample_angles(design.operation.samples)
-    # (At unit crank acceleration too, for the counter-rotors' settling: in the same pass.)
-    reg, unit = cycle_regressors_at(mech, angles, [(speed, 0.0), (0.0, 1.0)])
+    # (At unit crank acceleration too, for the counter-rotors' settling: in the same pass;
+    # its shaking moment alone is used, so its driving torque at rest is not computed.)
+    reg, unit = cycle_regressors_at(mech, angles, [(speed, 0.0), (0.0, 1.0)],
+                                    torque_at_rest=not abs(speed) > TURNING)
     links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
     rows, factor, inert = _reduced(reg, problem.objective, links, mech.layout.size)
     return NumericProblem(

@@ -44,12 +44,14 @@ def cycle_regressors(mech: Mechanism, angles: NDArray[np.float64], omega: float,
 
 
 def cycle_regressors_at(mech: Mechanism, angles: NDArray[np.float64],
-                        rates: Sequence[tuple[float, float]]) -> list[CycleRegressors]:
+                        rates: Sequence[tuple[float, float]], *,
+                        torque_at_rest: bool = True) -> list[CycleRegressors]:
     """:func:`cycle_regressors` at each crank rate and acceleration ``(ω, α)`` of ``rates``.
 
     Computed in one pass over the angles repeated for each (the numpy route's cost is mostly
     per operation, not per state): each is what :func:`cycle_regressors` gives alone, bit
-    for bit.
+    for bit. With ``torque_at_rest`` false the driving torque of a set at rest (``ω = 0``)
+    is not computed (NaN; see :func:`balancer.linkage.dynamics.shaking_regressors`).
     """
     count, n = len(rates), angles.size
     omegas, alphas = (np.array([r[i] for r in rates], dtype=float) for i in (0, 1))
@@ -58,7 +60,8 @@ def cycle_regressors_at(mech: Mechanism, angles: NDArray[np.float64],
         m = theta.size
         with np.errstate(all="ignore"):
             f = mech.shaking_regressors(mech.motion(np.tile(theta, count),
-                                                    np.repeat(omegas, m), np.repeat(alphas, m)))
+                                                    np.repeat(omegas, m), np.repeat(alphas, m)),
+                                        torque_at_rest=torque_at_rest)
         return (f.shaking_force.complex(), np.asarray(f.shaking_moment),
                 np.asarray(f.driving_torque), f.rocking_couple.complex())
 

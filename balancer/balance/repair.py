@@ -10,6 +10,7 @@ counterweights that the optimum does not need.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -17,6 +18,7 @@ from numpy.typing import NDArray
 
 from .certificate import Constraint
 from .conic import ConicProgram
+from .lsq import pinv as pseudo_inverse
 from .problem import FORCE_BALANCE_TOLERANCE, ROUNDING_TOLERANCE, NumericProblem
 
 #: :meth:`Repairs.polish` puts a parameter back at its preferred value where the objective
@@ -39,6 +41,11 @@ ACTIVE_INSIDE = 1e-12
 #: which a design meets it to rounding: a few ε for the few products in each row.
 EQ58_ROUNDING = 16 * float(np.finfo(float).eps)
 _EPS = float(np.finfo(float).eps)
+
+
+def _norm(v: NDArray[np.float64]) -> float:
+    """The 2-norm of a real vector, as ``numpy.linalg.norm`` computes it: ``√(v·v)``."""
+    return math.sqrt(float(v.dot(v)))
 
 
 class Repairs:
@@ -355,6 +362,8 @@ class Repairs:
         Eq. 58 restored by the other free variables.
         """
         data, lay = self.data, self.layout
+        if not data.nullable:
+            return u
         x, mask = data.without_absent(lay.x(u))
         if not mask.any():
             return u
@@ -376,21 +385,21 @@ class Repairs:
         if self._fb is None:
             return u
         at, rhs, pinv = self._fb
-        _, none = self.data.without_absent(self.layout.x(u))
-        if none.any():
-            kept = none[list(self.layout.primary)]
-            pinned = kept if pinned is None else (pinned | kept)
+        if self.data.nullable:  # (without a counterweight that may be none: nothing to keep)
+            _, none = self.data.without_absent(self.layout.x(u))
+            if none.any():
+                kept = none[list(self.layout.primary)]
+                pinned = kept if pinned is None else (pinned | kept)
         free = None if pinned is None or not pinned.any() else ~pinned
         if free is not None and not free.any():
             return u
         if free is not None:
             key = free.tobytes()
             if key not in self._pinned_inverses:  # the same few patterns recur: keep them
-                self._pinned_inverses[key] = np.asarray(np.linalg.pinv(at[:, free]),
-                                                        dtype=float)
+                self._pinned_inverses[key] = pseudo_inverse(at[:, free])
             pinv = self._pinned_inverses[key]
         residual = at @ u - rhs
-        size = np.linalg.norm(residual)
+        size = _norm(residual)
         # The correction's own rounding (the rows' conditioning times ε) leaves a residual
         # above rounding of the terms: refine while it shrinks (one or two more steps).
         for _ in range(4):
@@ -400,7 +409,7 @@ class Repairs:
                 trial = u.copy()
                 trial[free] -= pinv @ residual
             trial_residual = at @ trial - rhs
-            trial_size = np.linalg.norm(trial_residual)
+            trial_size = _norm(trial_residual)
             if not trial_size < size:
                 break
             u, residual, size = trial, trial_residual, trial_size

@@ -35,7 +35,16 @@ from numpy.typing import NDArray
 
 from ..model import GROUND, Linkage
 from . import rotors
-from .constraints import GROUND_INDEX, Blocks, Constraint, Driver, Pin, Prism, constraint_jacobian
+from .constraints import (
+    GROUND_INDEX,
+    Blocks,
+    Constraint,
+    Driver,
+    Pin,
+    Pose,
+    Prism,
+    constraint_jacobian,
+)
 from .kinematics import Motion, rates
 from .structure import Structure
 from .vectors import NUMPY, Num, OpsLike, V, _plus, _times
@@ -502,8 +511,25 @@ class Shaking:
     rocking_couple: V
 
 
+def _pose_at(pose: Pose, mask: NDArray[np.bool_]) -> Pose:
+    """The frames of ``pose`` at the states ``mask`` picks (arrays ``(N,)``; scalars kept)."""
+    def take(a: Num) -> Num:
+        return np.asarray(a)[mask] if np.ndim(a) else a
+
+    return Pose([V(take(o.x), take(o.y)) for o in pose.origins], [take(t) for t in pose.angles],
+                [take(c) for c in pose.cos], [take(s) for s in pose.sin])
+
+
+def _put_at(values: Num, mask: NDArray[np.bool_], part: Num, n: int) -> NDArray[np.float64]:
+    """``values`` (``(N,)``) with the states ``mask`` picks taken from ``part``."""
+    out = np.array(np.broadcast_to(values, (n,)), dtype=float)
+    out[mask] = part
+    return out
+
+
 def shaking_regressors(structure: Structure, mo: Motion,
-                       gravity: tuple[float, float] = (0.0, 0.0)) -> Shaking:
+                       gravity: tuple[float, float] = (0.0, 0.0), *,
+                       torque_at_rest: bool = True) -> Shaking:
     """:func:`regressors`' shaking, moment, torque and couple without the joint forces.
 
     The whole linkage in equilibrium with the frame (the pins and the motor): what the frame
@@ -516,7 +542,10 @@ def shaking_regressors(structure: Structure, mo: Motion,
     (the motion's own rates over ``θ̇1`` where it turns, else those of a unit crank rate). The
     rocking couple is :func:`rocking_couple` of the same columns. Equal to :func:`regressors`'
     figures (the groups' joint forces, solved state by state) to rounding, at a fraction of the
-    work: the regressors of a design's balancing are these.
+    work: the regressors of a design's balancing are these. With ``torque_at_rest`` false the
+    driving torque at the states at rest is not computed (NaN there: the links' rates of a
+    unit crank rate are not solved for them), for a caller that asks only what the frame
+    feels there; every other figure is the same.
     """
     layout = Layout.of(structure)
     n, p = mo.theta1.size, layout.size
@@ -525,33 +554,57 @@ def shaking_regressors(structure: Structure, mo: Motion,
     turning = np.abs(omega) > TURNING
     with np.errstate(divide="ignore", invalid="ignore"):
         unit = [(mo.velocity[k] / omega, mo.rate[k] / omega) for k in range(structure.size)]
-    if not turning.all():  # (at rest there: the links' rates at a unit crank rate; each
-        # state's figures its own, whatever else is computed with it)
-        vel, rate, _, _ = rates(structure, mo.pose, np.ones(n), np.zeros(n), mo.theta1)
-        unit = [(V(np.where(turning, v.x, u.x), np.where(turning, v.y, u.y)),
-                 np.where(turning, w, r))
+    if not turning.all() and torque_at_rest:  # (at rest there: the links' rates at a unit
+        # crank rate; each state's figures its own, whatever else is computed with it: at
+        # those states alone)
+        idle = ~turning
+        m = int(idle.sum())
+        vel, rate, _, _ = rates(structure, _pose_at(mo.pose, idle), np.ones(m), np.zeros(m),
+                                mo.theta1[idle], accelerations=False)
+        unit = [(V(_put_at(v.x, idle, u.x, n), _put_at(v.y, idle, u.y, n)),
+                 _put_at(w, idle, r, n))
                 for (v, w), u, r in zip(unit, vel, rate, strict=True)]
     moment, power = np.zeros((n, p)), np.zeros((n, p))
-    # Each link's share of the shaking force (its own columns): their sum is the force.
-    shares = [V(np.zeros((n, p)), np.zeros((n, p))) for _ in structure.names]
+    # Each link's share of the shaking force is its own columns (an entry is one link's):
+    # their sum, the force, is each share in its columns. Kept per link only where a link
+    # lies out of the plane (the rocking couple weighs each by its plane).
+    force_x, force_y = np.zeros((n, p)), np.zeros((n, p))
+    planar = not any(link.z for link in structure.linkage.links)
+    shares = [] if planar else [V(np.zeros((n, p)), np.zeros((n, p))) for _ in structure.names]
     for name, cols in inertial_columns(structure, mo, g).items():
         k = structure.index(name)
         origin = mo.pose.origins[k]
         velocity, rate = unit[k]
-        for param, (ex, ey, et) in cols:
-            j = layout.index(name, param)
-            shares[k].x[:, j] = ex
-            shares[k].y[:, j] = ey
-            moment[:, j] = origin.x * ey - origin.y * ex + et
-            power[:, j] = ex * velocity.x + ey * velocity.y + et * rate
+        # A link's columns side by side: each entry's arithmetic as one column at a time
+        # would do it (the same figures), in a few operations on the block.
+        js = [layout.index(name, param) for param, _ in cols]
+        ex, ey, et = (np.empty((n, len(cols))) for _ in range(3))
+        for i, (_, column) in enumerate(cols):
+            ex[:, i], ey[:, i], et[:, i] = column
+        force_x[:, js] = ex
+        force_y[:, js] = ey
+        if shares:
+            shares[k].x[:, js] = ex
+            shares[k].y[:, js] = ey
+        ox, oy, vx, vy, w = (np.reshape(np.broadcast_to(a, (n,)), (n, 1))
+                             for a in (origin.x, origin.y, velocity.x, velocity.y, rate))
+        moment[:, js] = ox * ey - oy * ex + et
+        power[:, js] = ex * vx + ey * vy + et * w
+        for j, (param, _) in zip(js, cols, strict=True):
             if param == "Jc":
                 moment[:, j] += 2 * mo.accel[k]
-    force_x, force_y = (np.sum([getattr(v, c) for v in shares], axis=0) for c in "xy")
-    rocking = rocking_couple(structure.linkage, shares, np.zeros((n, p)))
+    # (as the sum of the shares: the other links' zeros make a −0 entry +0, and nothing else)
+    force_x += 0.0
+    force_y += 0.0
+    rocking = (V(np.zeros((n, p)), np.zeros((n, p))) if planar
+               else rocking_couple(structure.linkage, shares, np.zeros((n, p))))
     # A state where a link is not placed (the linkage does not assemble there): NaN in every
     # column, as the joint forces give it (a link that is placed there keeps finite columns).
+    measured = turning | torque_at_rest  # (the states whose driving torque is computed)
     lost = ~(np.isfinite(force_x) & np.isfinite(force_y) & np.isfinite(moment)
-             & np.isfinite(power)).all(axis=1)
+             & (np.isfinite(power) | ~measured[:, None])).all(axis=1)
+    if not measured.all():
+        power[~measured] = np.nan
     if lost.any():
         for figure in (force_x, force_y, moment, power, rocking.x, rocking.y):
             np.asarray(figure)[lost] = np.nan

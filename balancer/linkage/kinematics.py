@@ -215,11 +215,13 @@ def _gamma(c: Constraint, pose: Pose, vel: list[V], rate: list[Num],
 
 
 def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
-          theta1: Num | None = None, ops: OpsLike = NUMPY
+          theta1: Num | None = None, ops: OpsLike = NUMPY, *, accelerations: bool = True
           ) -> tuple[list[V], list[Num], list[V], list[Num]]:
     """Velocities and accelerations of every link's frame (see the module docstring).
 
-    Returns ``(velocity, rate, acceleration, accel)``, each a list over the links.
+    Returns ``(velocity, rate, acceleration, accel)``, each a list over the links; with
+    ``accelerations`` false the last two are zeros (the velocities alone are solved, the same
+    figures).
     """
     n = structure.size
     zero = 0.0 * (pose.angles[structure.input] if theta1 is None else theta1)
@@ -244,6 +246,8 @@ def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
         for i, link in enumerate(g.links):
             vel[link] = V(zero + sol_v[3 * i][0], zero + sol_v[3 * i + 1][0])
             rate[link] = zero + sol_v[3 * i + 2][0]
+        if not accelerations:
+            continue
         gammas = [x for c in g.constraints for x in (_gamma(c, pose, vel, rate, ops)
                                                      if not isinstance(c, Driver) else [0.0])]
         rhs_a = []

@@ -383,9 +383,10 @@ class Structure:
     def jacobian(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
         """The constraints' Jacobian at one pose ``q``, shape ``(3n − 1, 3n)``."""
         rows = []
+        pose = pose_of(q)
         for c in self.constraints:
             block = np.zeros((c.rows, 3 * self.size))
-            for link, coeffs in constraint_jacobian(c, pose_of(q)):
+            for link, coeffs in constraint_jacobian(c, pose):
                 if link != GROUND_INDEX:
                     block[:, 3 * link : 3 * link + 3] += np.array(
                         [[float(x) for x in row] for row in coeffs])

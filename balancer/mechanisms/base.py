@@ -609,13 +609,15 @@ class Mechanism:
         forces, _ = dynamics.regressors(self.structure, mo, gravity)
         return forces
 
-    def shaking_regressors(self, mo: Motion, gravity: tuple[float, float] = (0.0, 0.0)
-                           ) -> dynamics.Shaking:
+    def shaking_regressors(self, mo: Motion, gravity: tuple[float, float] = (0.0, 0.0), *,
+                           torque_at_rest: bool = True) -> dynamics.Shaking:
         """:meth:`regressors`' shaking force and moment, driving torque and rocking couple.
 
-        From momentum and power (:func:`~balancer.linkage.dynamics.shaking_regressors`).
+        From momentum and power (:func:`~balancer.linkage.dynamics.shaking_regressors`;
+        ``torque_at_rest`` as there).
         """
-        return dynamics.shaking_regressors(self.structure, mo, gravity)
+        return dynamics.shaking_regressors(self.structure, mo, gravity,
+                                           torque_at_rest=torque_at_rest)
 
     def closed_form_force_balance(self) -> NDArray[np.float64] | None:
         """Shaking-force balance in closed form, ``A`` with ``A·π = 0`` over :attr:`layout`.

@@ -14,6 +14,7 @@ import math
 from abc import ABC, abstractmethod
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Any, ClassVar, Literal, Self
 
 from .. import validate as v
@@ -368,27 +369,27 @@ class Linkage(MechanismModel):
         """Each point's position at the reference pose, m."""
         return {name: complex(*xy) for name, xy in self.points}
 
-    @property
+    @cached_property
     def ground(self) -> Body:
         """The ground link."""
         return next(b for b in self.bodies if b.name == GROUND)
 
-    @property
+    @cached_property
     def moving(self) -> tuple[Body, ...]:
         """The moving links, in the spec's order."""
         return tuple(b for b in self.bodies if b.name != GROUND)
 
-    @property
+    @cached_property
     def link_names(self) -> tuple[str, ...]:
         """Names of the moving links."""
         return tuple(b.name for b in self.moving)
 
-    @property
+    @cached_property
     def links(self) -> tuple[Link, ...]:
         """Mass properties of the moving links."""
         return tuple(b.props for b in self.moving if b.props is not None)  # all of them
 
-    @property
+    @cached_property
     def grounded_links(self) -> tuple[str, ...]:
         """Moving links that share a point with the ground (where a counter-rotor can sit)."""
         ground = set(self.ground.points)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, replace
+from functools import lru_cache
 
 FOUR_BAR = "four-bar"
 SLIDER_CRANK = "slider-crank"
@@ -642,6 +643,7 @@ _BY_PATTERN = {s.pattern: s for s in SECTIONS}
 _INDEX = re.compile(r"\[\d+\]$")
 
 
+@lru_cache(maxsize=1024)  # (a spec's tables are read by the thousand in a sweep)
 def pattern(path: str) -> str:
     """The pattern of a table's dotted path (``links.crank.com`` → ``links.<link>.com``)."""
     parts = [_INDEX.sub("[]", part) for part in path.split(".")] if path else []
@@ -654,11 +656,13 @@ def pattern(path: str) -> str:
     return ".".join(parts)
 
 
+@lru_cache(maxsize=1024)  # (a spec's tables are read by the thousand in a sweep)
 def section(path: str) -> Section | None:
     """The section of a table by its dotted path (or pattern), ``None`` if it has none."""
     return _BY_PATTERN.get(pattern(path))
 
 
+@lru_cache(maxsize=1024)  # (a spec's tables are read by the thousand in a sweep)
 def screen(path: str) -> tuple[str, ...] | None:
     """The keys a table may hold whatever the mechanism (``None``: names the spec chooses)."""
     found = section(path)
@@ -667,6 +671,7 @@ def screen(path: str) -> tuple[str, ...] | None:
     return tuple(dict.fromkeys(k.name for k in found.keys))
 
 
+@lru_cache(maxsize=1024)  # (a spec's tables are read by the thousand in a sweep)
 def known(path: str, mechanism: str | None = None) -> tuple[str, ...]:
     """The fixed keys of a table in a spec of ``mechanism`` (``None``: of any), in order."""
     found = section(path)

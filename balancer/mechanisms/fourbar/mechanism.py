@@ -10,7 +10,8 @@ A2→A3 (rocker) with the ground pivots A0 at the origin and A3 at ``(l4, 0)``.
 from __future__ import annotations
 
 import math
-from functools import cached_property
+from collections import OrderedDict
+from functools import cached_property, lru_cache
 from typing import Any
 
 import numpy as np
@@ -18,7 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...linkage.constraints import Pose
 from ...linkage.dynamics import Forces
-from ...linkage.kinematics import Motion
+from ...linkage.kinematics import _MOTIONS_LOCK, MOTION_CACHE_STATES, MOTIONS_KEPT, Motion
 from ...linkage.structure import Structure
 from ...linkage.vectors import V
 from ...model import Body, Branch, Linkage
@@ -40,28 +41,52 @@ def fourbar_linkage(model: FourBar) -> Linkage:
 
     The reference crank angle is 0 when the crank turns fully and the pose there is regular
     (``|sin(θ3 − θ2)| ≥ 0.3``), else the one of its range's samples farthest from a dead or
-    change point (largest ``|sin(θ3 − θ2)|``).
+    change point (largest ``|sin(θ3 − θ2)|``). The pose depends on the geometry alone
+    (:func:`_reference_points`: a design and its redesign share it).
     """
-    rng = assembly_range(model.lengths)
-    if rng.full:
-        candidates = np.linspace(0.0, 2 * math.pi, 73)[:-1]
-    else:
-        lo, hi = rng.intervals[0]
-        candidates = np.linspace(lo, hi, 74)[1:-1]
-    signs = fourbar.cycle_branch_signs(model.lengths, model.branch, candidates)
-    pos = fourbar.position(model.lengths, candidates, signs, check=False)
-    transmission = np.abs(pos.sin_transmission)
-    best = int(np.nanargmax(transmission))
-    if rng.full and transmission[0] >= 0.3:  # θ1 = 0 if it is regular: A1 = (l1, 0) exactly
-        best = 0
-    a1, a2 = complex(pos.A1[best]), complex(pos.A2[best])
-    points = (("A0", (0.0, 0.0)), ("A1", (a1.real, a1.imag)), ("A2", (a2.real, a2.imag)),
-              ("A3", (model.lengths[3], 0.0)))
+    points = _reference_points(model.lengths, model.branch)
     bodies = (Body(name="ground", points=("A0", "A3")),
               Body(name="crank", points=("A0", "A1"), props=model.crank),
               Body(name="coupler", points=("A1", "A2"), props=model.coupler),
               Body(name="rocker", points=("A2", "A3"), props=model.rocker))
     return Linkage(points=points, bodies=bodies, input="crank")
+
+
+@lru_cache(maxsize=64)
+def _reference_points(lengths: tuple[float, float, float, float], branch: Branch
+                      ) -> tuple[tuple[str, tuple[float, float]], ...]:
+    """:func:`fourbar_linkage`'s points A0…A3 at its reference pose, m."""
+    rng = assembly_range(lengths)
+    if rng.full:  # θ1 = 0 first: taken if it is regular (as the candidates' first would be)
+        at_zero = _pose_points(lengths, branch, np.zeros(1), 0, least=0.3)
+        if at_zero is not None:
+            return at_zero
+        candidates = np.linspace(0.0, 2 * math.pi, 73)[:-1]
+    else:
+        lo, hi = rng.intervals[0]
+        candidates = np.linspace(lo, hi, 74)[1:-1]
+    best = _pose_points(lengths, branch, candidates, None)
+    assert best is not None  # (the most regular of the candidates)
+    return best
+
+
+def _pose_points(lengths: tuple[float, float, float, float], branch: Branch,
+                 candidates: NDArray[np.float64], index: int | None, least: float = 0.0
+                 ) -> tuple[tuple[str, tuple[float, float]], ...] | None:
+    """The points A0…A3 at the candidate ``index``, or ``None`` if it is not regular.
+
+    ``index`` ``None``: the candidate farthest from a dead or change point. Not regular: its
+    ``|sin(θ3 − θ2)|`` below ``least``.
+    """
+    signs = fourbar.cycle_branch_signs(lengths, branch, candidates)
+    pos = fourbar.position(lengths, candidates, signs, check=False)
+    transmission = np.abs(pos.sin_transmission)
+    best = int(np.nanargmax(transmission)) if index is None else index
+    if not transmission[best] >= least:  # (NaN: not regular either)
+        return None
+    a1, a2 = complex(pos.A1[best]), complex(pos.A2[best])
+    return (("A0", (0.0, 0.0)), ("A1", (a1.real, a1.imag)), ("A2", (a2.real, a2.imag)),
+            ("A3", (lengths[3], 0.0)))
 
 
 class FourBarMechanism(Mechanism):
@@ -127,9 +152,25 @@ class FourBarMechanism(Mechanism):
         """The closed form (Eq. 2–10) on the smooth motion's branch (arrays broadcast)."""
         t, w, a = (np.atleast_1d(np.asarray(x, dtype=float))
                    for x in np.broadcast_arrays(theta1, omega1, alpha1))
+        key = None
+        if t.size <= MOTION_CACHE_STATES:  # a cycle's samples, asked again (a design and
+            # its redesign: the geometry's structure keeps them, as the general core does)
+            key = ("closed form", t.shape, t.tobytes(), w.tobytes(), a.tobytes())
+            with _MOTIONS_LOCK:
+                motions = self.structure.kinematic.setdefault("closed-form motions",
+                                                              OrderedDict())
+                known = motions.get(key)
+            if known is not None:
+                return known
         signs = fourbar.cycle_branch_signs(self.model.lengths, self.model.branch, t)
         with np.errstate(divide="ignore", invalid="ignore"):
-            return fourbar.motion(self.model.lengths, t, w, a, signs, check=False)
+            mo = fourbar.motion(self.model.lengths, t, w, a, signs, check=False)
+        if key is not None:
+            with _MOTIONS_LOCK:
+                motions[key] = mo
+                while len(motions) > MOTIONS_KEPT:
+                    motions.popitem(last=False)
+        return mo
 
     def closed_form_force_balance(self) -> NDArray[np.float64]:
         """Eq. 57–58 over the layout (crank, coupler, rocker, then two counter-rotors)."""
