@@ -17,6 +17,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from balancer import api, cycle, drawing, outputs, plots
 from balancer.api import analyze
 from balancer.cli import main
+from balancer.mechanisms import mechanism_of
 from balancer.plots import style
 from balancer.spec import load_design
 from balancer.sweeps import atlas_figure
@@ -737,3 +738,114 @@ def test_free_motion_spikes_are_clipped_and_marked_not_squashing_the_rest(watt_b
         low, high = ax.get_ylim()
         assert low <= np.min(values) and np.max(values) <= high
         assert not [line for line in ax.get_lines() if line.get_label().startswith("clipped")]
+
+
+# --- engines' figures: planes, mount torque, speeds in rpm (issue 40) -------------------------
+
+
+#: Counterweights for the single cylinder in two planes off its own: the balanced design has
+#: links out of the plane, its original none.
+TWO_PLANES = """
+[balance.objective]
+rocking_couple = 1.0
+shaking_force = 0.04
+shaking_moment = 0.0
+unbalance = 0.0
+
+[balance.counterweights]
+planes = [-0.024, 0.03]
+max_mr = 0.03
+"""
+
+
+@pytest.fixture(scope="module")
+def flat_single():
+    """The single cylinder without its counterweights (all in the cylinder's plane), to
+    balance in two planes off it; and the balanced design (``optimize``'s)."""
+    import balancer
+
+    text = (EXAMPLES / "single_cylinder.toml").read_text(encoding="utf-8")
+    text = "\n".join(line for line in text.splitlines()
+                     if 'label = "counterweight"' not in line) + TWO_PLANES
+    design = balancer.loads_design(text)
+    balanced = balancer.optimize(design).balanced_design(design)
+    assert mechanism_of(design.mechanism).in_one_plane()
+    assert not mechanism_of(balanced.mechanism).in_one_plane()
+    return design, balanced
+
+
+def _panel(fig, words):
+    """The axes whose title starts with ``words``."""
+    (ax,) = (ax for ax in fig.axes if ax.get_title().startswith(words))
+    return ax
+
+
+@pytest.mark.parametrize("order", ["balanced after an original in one plane",
+                                   "in one plane after one in planes"])
+def test_the_cycle_figure_of_designs_in_one_and_several_planes(flat_single, order):
+    """The tutorial's call, ``cycle_figure(analyze(balanced), before=analyze(design))``, where
+    one of the two has links out of the plane (it raised KeyError 'couple'): the rocking
+    couple's panel draws both, the one in a plane as the zero it is."""
+    import balancer
+
+    design, balanced = flat_single
+    after, before = balancer.analyze(balanced), balancer.analyze(design)
+    if order.startswith("in one plane"):
+        after, before = before, after
+    fig = balancer.cycle_figure(after, before=before)
+    couple = _panel(fig, "rocking couple")
+    lines = _lines(couple)
+    assert len(lines) == 2
+    for line, a in zip(lines, (before, after), strict=True):
+        drawn = complex(1, 0) * line.get_xdata() + 1j * line.get_ydata()
+        values = _closed(a.reactions.rocking_couple)
+        scale = cycle.natural_scales(a)["couple"]
+        expected = values if np.max(np.abs(values)) > 1e-9 * scale else 0 * values
+        np.testing.assert_array_equal(drawn, expected)
+    # The figures of the drawing's own sampling (``plot --cycle``) at the same angles.
+    drawn = cycle.drawn_analyses([balanced.mechanism, design.mechanism],
+                                 balanced.operation.speed)
+    assert drawn[0].samples == drawn[1].samples >= 720
+    assert cycle.panel_keys(*drawn) == ("force", "couple", "moment", "torque", "mount")
+
+
+def test_an_engines_cycle_figure_draws_the_torque_on_its_mounts():
+    """The mount torque (``analyze``'s table and JSON) over the crank angle: the shaking moment
+    plus the driving torque, sample by sample, its RMS and maximum in the panel's title; a
+    mechanism that is not an engine has no such panel."""
+    design = load_design(EXAMPLES / "single_cylinder.toml")
+    a = analyze(design)
+    fig = plots.cycle_figure(a)
+    mount = _panel(fig, "mount torque")
+    (line,) = _lines(mount)
+    np.testing.assert_array_equal(line.get_ydata(), _closed(a.mount_torque))
+    np.testing.assert_allclose(a.mount_torque, a.reactions.shaking_moment
+                               + a.reactions.driving_torque, rtol=0, atol=1e-12 * np.max(
+                                   np.abs(a.reactions.driving_torque)))
+    assert mount.get_ylabel() == "torque about z on the mounts (N·m)"
+    summary = a.summary.mount_torque
+    assert (f"RMS {style.number(summary.rms)} N·m, max {style.number(summary.max)} N·m"
+            in mount.get_title())
+    assert not any(ax.get_title().startswith("mount")
+                   for ax in plots.cycle_figure(analyze(load_design(
+                       EXAMPLES / "pb1.toml"))).axes)
+    with pytest.raises(ValueError, match="'shaking_moment', 'driving_torque'"):
+        plots.plot_over_crank_angle(analyze(load_design(EXAMPLES / "pb1.toml")),
+                                    "mount_torque")
+
+
+def test_figures_give_speeds_in_rpm_beside_rad_per_s(tmp_path):
+    design = load_design(EXAMPLES / "single_cylinder.toml")  # 680.678 rad/s, 6500 rpm
+    a = analyze(design)
+    assert "680.678 rad/s (6500 rpm)" in plots.cycle_figure(a).get_suptitle()
+    assert style.speed_text(10.0) == "10 rad/s (95.49 rpm)"
+    # A sweep over the speed: a second axis in rpm, the original's speed in both.
+    path = _atlas_table(tmp_path / "speed.parquet", ["optimal"] * 3,
+                        keys=("operation.speed",), values=((500.0, 600.0, 700.0),))
+    fig = atlas_figure(path, ["operation.speed"], original={"operation.speed": 680.678})
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "operation.speed (rad/s)"
+    (rpm,) = ax.child_axes
+    assert rpm.get_xlabel() == "operation.speed (rpm)"
+    labels = [line.get_label() for line in ax.get_lines()]
+    assert "original design: operation.speed = 680.7 rad/s (6500 rpm)" in labels
