@@ -838,6 +838,7 @@ def test_figures_give_speeds_in_rpm_beside_rad_per_s(tmp_path):
     design = load_design(EXAMPLES / "single_cylinder.toml")  # 680.678 rad/s, 6500 rpm
     a = analyze(design)
     assert "680.678 rad/s (6500 rpm)" in plots.cycle_figure(a).get_suptitle()
+    assert "680.678 rad/s (6500 rpm)" in plots.orders_figure(a).get_suptitle()
     assert style.speed_text(10.0) == "10 rad/s (95.49 rpm)"
     # A sweep over the speed: a second axis in rpm, the original's speed in both.
     path = _atlas_table(tmp_path / "speed.parquet", ["optimal"] * 3,
@@ -849,3 +850,91 @@ def test_figures_give_speeds_in_rpm_beside_rad_per_s(tmp_path):
     assert rpm.get_xlabel() == "operation.speed (rpm)"
     labels = [line.get_label() for line in ax.get_lines()]
     assert "original design: operation.speed = 680.7 rad/s (6500 rpm)" in labels
+
+
+def _bars(ax, label):
+    """The heights of the bars of one legend entry, by order."""
+    (bars,) = (c for c in ax.containers if c.get_label() == label)
+    return np.array([p.get_height() for p in bars.patches])
+
+
+def test_order_zero_of_a_moment_or_torque_is_drawn_as_its_signed_mean():
+    """A firing engine's driving torque has a negative mean (the load's torque on the crank):
+    order 0's bar is that mean with its sign (it was drawn as its magnitude), as the JSON's
+    order table gives it; every other bar a peak amplitude."""
+    from balancer.api import to_dict
+
+    design = load_design(EXAMPLES / "single_cylinder.toml")
+    a = analyze(design)
+    fig = plots.orders_figure(a)
+    means = {"driving torque": a.reactions.driving_torque, "mount torque": a.mount_torque,
+             "shaking moment": a.reactions.shaking_moment}
+    for words, values in means.items():
+        heights = _bars(_panel(fig, words), "design")
+        mean = float(np.mean(values))
+        floor = 1e-9 * cycle.natural_scales(a)["moment"]
+        assert heights[0] == (mean if abs(mean) > floor else 0.0)
+        assert np.all(heights[1:] >= 0)
+    torque = _bars(_panel(fig, "driving torque"), "design")
+    assert torque[0] == pytest.approx(-49.4, abs=0.05)  # docs/engines.md's −49.4 N·m
+    orders = to_dict(a)["orders"]
+    assert orders[0]["driving_torque"] == torque[0]
+    assert orders[0]["mount_torque"] == _bars(_panel(fig, "mount torque"), "design")[0]
+    # A force's order 0: the mean's magnitude, never negative.
+    force = _panel(fig, "shaking force")
+    assert _bars(force, "design, forward")[0] == pytest.approx(abs(np.mean(
+        a.reactions.shaking_force)), rel=1e-12)
+
+
+def test_order_bars_on_a_log_axis(monkeypatch):
+    """``log=True``: each panel with a bar above zero on a logarithmic axis in whole decades,
+    every bar shown within them; a negative mean drawn by its magnitude and labelled with its
+    sign; bars at rounding of the largest (≤ 1e-12 of it) left out even where the rounding
+    floor of the load's natural scale would keep them, so that they cannot stretch the axis
+    over decades of noise; a panel of zeros (a V8's shaking moment) stays linear."""
+    from balancer.plots import orders as order_bars
+
+    single = analyze(load_design(EXAMPLES / "single_cylinder.toml"))
+    fig = plots.orders_figure(single, log=True)
+    torque = _panel(fig, "driving torque")
+    assert torque.get_yscale() == "log" and torque.get_ylabel().endswith(", log scale")
+    heights = _bars(torque, "design")
+    mean = single.orders[0].driving_torque
+    assert mean < 0 and heights[0] == -mean
+    assert [t.get_text() for t in torque.texts] == [style.number(mean).replace("-", "−")]
+    low, high = torque.get_ylim()
+    shown = heights[heights > 0]
+    assert low <= shown.min() / 2 and shown.max() * 2 <= high
+    assert np.log10(low) == round(np.log10(low)) and np.log10(high) == round(np.log10(high))
+
+    v8 = analyze(load_design(EXAMPLES / "v8.toml"))
+    monkeypatch.setattr(order_bars, "ROUNDING_SPAN", 0.0)  # only the log floor left
+    fig = plots.orders_figure(v8, log=True)
+    force = _panel(fig, "shaking force")
+    forward = _bars(force, "design, forward")
+    largest = max(o.shaking_force.forward for o in v8.orders)
+    rounding = [o.shaking_force.forward <= 1e-12 * largest for o in v8.orders]
+    assert any(rounding) and not np.any(forward[rounding])
+    kept = [v for o in v8.orders for v in (o.shaking_force.forward, o.shaking_force.backward)
+            if v > 1e-12 * largest]
+    assert min(kept) == pytest.approx(0.174, rel=1e-2)  # the 8th order, the least real one
+    assert force.get_yscale() == "log" and min(kept) / 20 <= force.get_ylim()[0]
+    monkeypatch.undo()
+    moment = _panel(plots.orders_figure(v8, log=True), "shaking moment")
+    assert moment.get_yscale() == "linear" and not np.any(_bars(moment, "design"))
+
+
+def test_plot_orders_log_flag(tmp_path, capsys, monkeypatch):
+    drawn = []
+    monkeypatch.setattr("balancer.cli.plot.save_figure", lambda fig, path: drawn.append(fig))
+    spec = str(EXAMPLES / "single_cylinder.toml")
+    assert main(["plot", spec, "--orders", str(tmp_path / "o.png"), "--log"]) == 0
+    (fig,) = drawn
+    assert _panel(fig, "driving torque").get_yscale() == "log"
+    assert main(["plot", spec, "--orders", str(tmp_path / "o.png")]) == 0
+    assert _panel(drawn[1], "driving torque").get_yscale() == "linear"
+    capsys.readouterr()
+    assert main(["plot", spec, "--cycle", str(tmp_path / "c.png"), "--log"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--log" in err and "--orders PATH" in err
+    assert len(drawn) == 2 and list(tmp_path.iterdir()) == []

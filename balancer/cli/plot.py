@@ -19,6 +19,9 @@ def run(args: argparse.Namespace) -> int:
     if args.animate is None and args.cycle is None and args.orders is None:
         raise SpecError("nothing to plot: give --cycle PATH, --orders PATH or --animate PATH",
                         key="--cycle")
+    if args.log and args.orders is None:
+        raise SpecError("draws the order bars on a logarithmic axis: give --orders PATH too",
+                        key="--log")
     cycle = output_path(args, args.cycle, "--cycle")
     orders = output_path(args, args.orders, "--orders")
     animation = output_path(args, args.animate, "--animate")
@@ -47,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
         # speed is refused by cycle_analyses, as for --cycle).
         analyses = cycle_analyses(design, samples=None if design.operation is None
                                   else design.operation.samples)
-        figures.append((orders_figure(*analyses, title=design.title), orders))
+        figures.append((orders_figure(*analyses, title=design.title, log=args.log), orders))
     if animation is not None:
         weights = None
         if design.original is not None:  # a balanced spec: draw what was added to the links
