@@ -617,12 +617,22 @@ def _drawn_animation(design, frames, **kw):
     return fig, update, canvas.get_renderer()
 
 
-def test_the_animations_title_lies_inside_the_picture(pb1_balanced):
-    design = load_design(pb1_balanced)  # PB1's title is long for a 6-inch animation
+@pytest.mark.parametrize("name", ["pb1_balanced", "v8_to_balance"])
+def test_the_animations_title_and_labels_lie_inside_the_picture(pb1_balanced, name):
+    # PB1's title is long for a 6-inch animation; the V8's, as wide as the picture, once
+    # pushed the axes left until the y label was cut off by the picture's edge.
+    design = load_design(pb1_balanced if name == "pb1_balanced" else
+                         EXAMPLES / f"{name}.toml")
     fig, _, renderer = _drawn_animation(design, 4)
-    box, page = fig.axes[0].title.get_window_extent(renderer), fig.bbox
-    assert fig.axes[0].title.get_text().replace("\n", " ") == design.title
-    assert page.x0 <= box.x0 and box.x1 <= page.x1 and page.y0 <= box.y0 and box.y1 <= page.y1
+    assert fig.get_suptitle().replace("\n", " ") == design.title
+    page = fig.bbox
+    ax = fig.axes[0]
+    for box in (fig.get_tightbbox(renderer).transformed(fig.dpi_scale_trans),
+                ax.yaxis.label.get_window_extent(renderer),
+                ax.xaxis.label.get_window_extent(renderer)):
+        assert page.x0 <= box.x0 and box.x1 <= page.x1 and page.y0 <= box.y0
+        assert box.y1 <= page.y1
+    assert ax.get_ylabel() == "y (m)" and ax.get_xlabel() == "x (m)"
 
 
 def test_the_animation_reads_the_crank_angle_of_every_frame():
@@ -938,3 +948,152 @@ def test_plot_orders_log_flag(tmp_path, capsys, monkeypatch):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--log" in err and "--orders PATH" in err
     assert len(drawn) == 2 and list(tmp_path.iterdir()) == []
+
+
+# --- the animation: a design, pistons, engines' counterweights (issue 40) ------------------
+
+
+def test_animate_takes_a_design_as_every_other_call_does(tmp_path):
+    """``animate(design, path)``: its mechanism, its title and (a balanced spec) the bodies
+    added to its original's links, as ``plot --animate`` draws them; a model or a mechanism
+    as before; anything else refused by a message that names what is accepted."""
+    from matplotlib.patches import Circle
+
+    import balancer
+
+    engine = balancer.example("single_cylinder")
+    out = balancer.animate(engine, tmp_path / "engine.gif", frames=4)
+    assert out.read_bytes()[:6] == b"GIF89a"
+    assert balancer.animate(engine.mechanism, tmp_path / "model.gif", frames=4).exists()
+    fig, _ = plots.animation_figure(engine, frames=4)
+    assert fig.get_suptitle() == engine.title
+    design = balancer.example("pb1_counterweights")
+    result = balancer.optimize(design, backend="convex")
+    balanced = result.balanced_design(design)
+    fig, _ = plots.animation_figure(balanced, frames=4)  # no counterweights given: its own
+    discs = [p for p in fig.axes[0].patches if isinstance(p, Circle)]
+    assert len(discs) == len([w for w in result.counterweights.values() if w.kind == "add"])
+    assert len(discs) == 2
+    for wrong in ("examples/v8.toml", None, result):
+        with pytest.raises(balancer.SpecError) as caught:
+            balancer.animate(wrong, tmp_path / "x.gif", frames=4)
+        message = str(caught.value)
+        assert message.count("\n") == 0 and type(wrong).__name__ in message
+        for accepted in ("Design", "FourBar", "SliderCrank", "Linkage", "Engine", "Mechanism"):
+            assert accepted in message
+    assert not (tmp_path / "x.gif").exists()
+    # Where a mechanism's model is asked for and a Design given, the message says so.
+    with pytest.raises(balancer.SpecError, match=r"Engine: a Design's is its \.mechanism"):
+        mechanism_of(engine)
+    with pytest.raises(balancer.SpecError, match="or an Engine"):
+        balancer.Design(mechanism=engine)
+
+
+def _block_frame(polygon):
+    """A rectangle's centre, its side along its first edge and across it (m), and the first
+    edge's direction (complex unit)."""
+    xy = polygon.get_xy()[:4]
+    z = xy[:, 0] + 1j * xy[:, 1]
+    along, across = z[1] - z[0], z[3] - z[0]
+    return z.mean(), abs(along), abs(across), along / abs(along)
+
+
+@pytest.mark.parametrize(("name", "size"), [
+    ("single_cylinder", (0.7 * 0.092, 0.092)),        # the bore
+    ("v8", (0.7 * 0.0995, 0.0995)),
+    ("engine", (0.7 * 2 * 0.0196, 2 * 0.0196)),       # a slider-crank: the stroke
+    ("quick_return", (0.6 * 0.1, 0.35 * 0.1)),        # blocks: of the crank's reach
+])
+def test_pistons_and_blocks_are_rectangles_along_their_sliders(name, size):
+    """Each sliding block (an engine's piston) is a rectangle centred on its point, its length
+    along its slider's line and its width across, carried with it frame by frame; an
+    engine's piston as wide as its bore (the stroke where there is none)."""
+    from matplotlib.patches import Polygon
+
+    design = load_design(EXAMPLES / f"{name}.toml")
+    mech = mechanism_of(design.mechanism)
+    frames = 6
+    fig, update = plots.animation_figure(design, frames=frames)
+    blocks = [p for p in fig.axes[0].patches if isinstance(p, Polygon)]
+    sliders = [s for s in mech.linkage.sliders
+               if len(dict((b.name, b.points) for b in mech.linkage.bodies)[s.link]) == 1]
+    assert len(blocks) == len(sliders) > 0
+    length, width = size
+    mo = mech.motion(cycle.sample_angles(frames), 1.0)
+    points = mech.points(mo)
+    guides = dict(zip((s.link for s in mech.linkage.sliders), mech.guides(mo), strict=True))
+    for k in (0, 2, 5):
+        update(k)
+        for block, slider in zip(blocks, sliders, strict=True):
+            centre, along, across, direction = _block_frame(block)
+            assert abs(centre - points[slider.point][k]) <= 1e-12
+            assert along == pytest.approx(length, rel=1e-12)
+            assert across == pytest.approx(width, rel=1e-12)
+            line = guides[slider.link][1][k]  # the slider's line's direction at this frame
+            assert abs((direction * np.conj(line)).imag) <= 1e-12
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert ("sliding blocks" if name == "quick_return" else "pistons") in labels
+
+
+@pytest.mark.parametrize("name", ["single_cylinder", "inline_four"])
+def test_an_engines_counterweights_and_eccentrics_turn_with_their_shafts(name):
+    """The crankshaft's masses labelled ``counterweight`` and each balance shaft's eccentrics
+    are sectors on their axes pointing at ``ratio·θ1 + phase`` in every frame; sectors of one
+    thickness, radius as the cube root of mass·radius, the largest the crank radius."""
+    from matplotlib.patches import Wedge
+
+    design = load_design(EXAMPLES / f"{name}.toml")
+    engine = design.mechanism
+    expected = [(0j, 1, m.phase_deg, m.mr) for m in engine.crankshaft.masses
+                if m.label == "counterweight"]
+    expected += [(complex(*s.at), s.ratio, m.phase_deg, m.mr) for s in engine.balance_shafts
+                 for m in s.eccentrics]
+    frames = 8
+    fig, update = plots.animation_figure(design, frames=frames)
+    wedges = [p for p in fig.axes[0].patches if isinstance(p, Wedge)]
+    assert len(wedges) == len(expected) > 0
+    largest = max(mr for *_, mr in expected)
+    crank = engine.cylinders[0].crank
+    for k in (0, 3):
+        update(k)
+        theta1 = 360.0 * k / frames
+        for wedge, (axis, ratio, phase, mr) in zip(wedges, expected, strict=True):
+            assert complex(*wedge.center) == axis
+            assert wedge.r == pytest.approx(crank * np.cbrt(mr / largest), rel=1e-12)
+            middle = 0.5 * (wedge.theta1 + wedge.theta2)
+            assert (middle - (ratio * theta1 + phase) + 180) % 360 - 180 == pytest.approx(
+                0.0, abs=1e-9)
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert "crankshaft counterweights" in labels
+    assert ("balance shafts' eccentrics" in labels) == bool(engine.balance_shafts)
+
+
+def test_an_optimised_engines_animation_draws_the_counterweights_it_chose(flat_single,
+                                                                          tmp_path):
+    """``optimize`` writes an engine's counterweights into its crankshaft's masses: the
+    animation of the balanced spec draws them where the optimiser put them."""
+    from matplotlib.patches import Wedge
+
+    import balancer
+
+    design, balanced = flat_single
+    chosen = [m for m in balanced.mechanism.crankshaft.masses if m.label == "counterweight"]
+    assert chosen and all(m.z in (-0.024, 0.03) for m in chosen)
+    spec = tmp_path / "balanced.toml"
+    balancer.save_design(balanced, spec)
+    fig, update = plots.animation_figure(load_design(spec), frames=4)
+    update(0)
+    wedges = [p for p in fig.axes[0].patches if isinstance(p, Wedge)]
+    assert sorted(0.5 * (w.theta1 + w.theta2) % 360 for w in wedges) == pytest.approx(
+        sorted(m.phase_deg % 360 for m in chosen), abs=1e-9)
+    # With its original named beside it ([original]), the same: an engine's balancing adds
+    # masses on its shafts, not bodies to its links (no link-by-link counterweights asked).
+    from balancer.plots import animation
+
+    def asked(*_):
+        raise AssertionError("an engine's links are not rebuilt by its balancing")
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(animation, "link_counterweights", asked)
+        fig, _ = plots.animation_figure(replace(balanced, original=design.mechanism), frames=4)
+    assert len([p for p in fig.axes[0].patches if isinstance(p, Wedge)]) == len(chosen)

@@ -6,7 +6,6 @@ import argparse
 import os
 
 from ..api import cycle_analyses
-from ..balance.counterweights import counterweights
 from ..errors import OutputError, SpecError
 from ..mechanisms import mechanism_of
 from ..outputs import animation_type, figure_type
@@ -51,13 +50,8 @@ def run(args: argparse.Namespace) -> int:
         analyses = cycle_analyses(design, samples=None if design.operation is None
                                   else design.operation.samples)
         figures.append((orders_figure(*analyses, title=design.title, log=args.log), orders))
-    if animation is not None:
-        weights = None
-        if design.original is not None:  # a balanced spec: draw what was added to the links
-
-            weights = counterweights(design.original, design.mechanism)
-        animate(design.mechanism, animation, frames=args.frames, title=design.title,
-                counterweights=weights)
+    if animation is not None:  # (a balanced spec: what was added to the links drawn too)
+        animate(design, animation, frames=args.frames)
         wrote(animation)
     for figure, path in figures:
         save_figure(figure, path)

@@ -19,9 +19,10 @@ if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions t
     from matplotlib.lines import Line2D
 
 
-#: Colours for the sum, before and after (colour-blind safe, Okabe & Ito).
+#: Colours for the sum, before and after, links, centres of mass and balance shafts'
+#: eccentrics (colour-blind safe, Okabe & Ito).
 COLOURS = {"sum": "#000000", "before": "#999999", "after": "#009E73", "link": "#0072B2",
-           "com": "#D55E00"}
+           "com": "#D55E00", "eccentric": "#E69F00"}
 
 
 #: How a curve of the original (before) and of the design (after) is drawn where both are: the
