@@ -58,6 +58,7 @@ _EXPORTS = {
     "Drive": "model",
     "FourBar": "mechanisms.fourbar.model",
     "SliderCrank": "mechanisms.slidercrank.model",
+    "Engine": "mechanisms.engine.model",
     "Linkage": "model",
     "Branch": "model",
     "Link": "model",
@@ -120,6 +121,7 @@ __all__ = [
     "Design",
     "Drive",
     "dumps_design",
+    "Engine",
     "example",
     "Figure",
     "FourBar",
@@ -207,6 +209,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .formulations import Method
     from .mechanisms import mechanism_of
     from .mechanisms.base import Mechanism, Route
+    from .mechanisms.engine.model import Engine
     from .mechanisms.fourbar.assembly import LinkageClass
     from .mechanisms.fourbar.model import FourBar
     from .mechanisms.slidercrank.model import SliderCrank

@@ -962,6 +962,7 @@ def test_animate_takes_a_design_as_every_other_call_does(tmp_path):
     import balancer
 
     engine = balancer.example("single_cylinder")
+    assert isinstance(engine.mechanism, balancer.Engine)  # the name the refusals give
     out = balancer.animate(engine, tmp_path / "engine.gif", frames=4)
     assert out.read_bytes()[:6] == b"GIF89a"
     assert balancer.animate(engine.mechanism, tmp_path / "model.gif", frames=4).exists()
