@@ -47,6 +47,7 @@ _EXPORTS = {
     "save_design": "spec",
     "animate": "plots",
     "cycle_figure": "plots",
+    "orders_figure": "plots",
     "front_figure": "plots",
     "save_figure": "plots",
     "sweep_figure": "plots",
@@ -57,6 +58,7 @@ _EXPORTS = {
     "Drive": "model",
     "FourBar": "mechanisms.fourbar.model",
     "SliderCrank": "mechanisms.slidercrank.model",
+    "Engine": "mechanisms.engine.model",
     "Linkage": "model",
     "Branch": "model",
     "Link": "model",
@@ -119,6 +121,7 @@ __all__ = [
     "Design",
     "Drive",
     "dumps_design",
+    "Engine",
     "example",
     "Figure",
     "FourBar",
@@ -142,6 +145,7 @@ __all__ = [
     "Operation",
     "optimize",
     "Optimizer",
+    "orders_figure",
     "OutputError",
     "pareto",
     "Perturb",
@@ -205,6 +209,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .formulations import Method
     from .mechanisms import mechanism_of
     from .mechanisms.base import Mechanism, Route
+    from .mechanisms.engine.model import Engine
     from .mechanisms.fourbar.assembly import LinkageClass
     from .mechanisms.fourbar.model import FourBar
     from .mechanisms.slidercrank.model import SliderCrank
@@ -233,6 +238,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         animate,
         cycle_figure,
         front_figure,
+        orders_figure,
         save_figure,
         sweep_figure,
         verification_figure,

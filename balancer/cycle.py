@@ -233,7 +233,7 @@ class CycleAnalysis:
 
     @property
     def linkage(self) -> Model:
-        """The mechanism's model (a FourBar, SliderCrank or Linkage)."""
+        """The mechanism's model (a FourBar, SliderCrank, Linkage or Engine)."""
         return self.mechanism.model
 
     @cached_property
@@ -337,7 +337,7 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     Parameters
     ----------
     model
-        A mechanism's model (FourBar, SliderCrank, Linkage) or a :class:`Mechanism`.
+        A mechanism's model (FourBar, SliderCrank, Linkage, Engine) or a :class:`Mechanism`.
     speed
         Crank speed, rad/s.
     samples
@@ -462,9 +462,10 @@ def drawn_analyses(models: Sequence[Model | Mechanism], speed: float, *,
 
     At ``speed`` (rad/s) with ``gravity`` (m/s²), from at least ``least`` and
     :data:`PLOT_SAMPLES`' least crank angles, doubled until every drawn curve
-    (:func:`drawn_panels`: the shaking force's tip, the shaking moment, the driving torque) of
-    every model lies within ``tolerance`` of its panel's span from the straight lines between
-    its samples (checked at the midpoints), or the most; ``samples`` takes exactly that many.
+    (:func:`drawn_panels`: the shaking force's tip, the rocking couple's, the shaking moment,
+    the driving torque, an engine's mount torque) of every model lies within ``tolerance`` of
+    its panel's span from the straight lines between its samples (checked at the midpoints),
+    or the most; ``samples`` takes exactly that many.
 
     Raises
     ------
@@ -484,14 +485,36 @@ def drawn_analyses(models: Sequence[Model | Mechanism], speed: float, *,
     return coarse
 
 
-def drawn_panels(analysis: CycleAnalysis) -> dict[str, NDArray[np.number]]:
-    """What the cycle figure draws of an analysis, by panel (the rocking couple's: in planes)."""
+def panel_keys(*analyses: CycleAnalysis | None) -> tuple[str, ...]:
+    """The panels a figure of these analyses draws (``None`` left out), in the figure's order.
+
+    ``"force"``; ``"couple"`` (the rocking couple) where any of them has links out of the
+    crank's plane (a design balanced in several planes beside an original in one: the
+    original's couple is the zero it is); ``"moment"``, ``"torque"``; ``"mount"`` (an engine's
+    torque on its mounts) where every one of them reports it.
+    """
+    given = [a for a in analyses if a is not None]
+    planes = any(not a.mechanism.in_one_plane() for a in given)
+    mounts = bool(given) and all(a.mount_torque is not None for a in given)
+    return ("force", *(("couple",) if planes else ()), "moment", "torque",
+            *(("mount",) if mounts else ()))
+
+
+def drawn_panels(analysis: CycleAnalysis, keys: Sequence[str] | None = None
+                 ) -> dict[str, NDArray[np.number]]:
+    """What the cycle figure draws of an analysis, by panel, over its samples.
+
+    ``keys`` the panels (default :func:`panel_keys` of this analysis alone): the shaking force
+    (complex, N), the rocking couple (complex, N·m), the shaking moment, the driving torque and
+    an engine's mount torque (N·m).
+    """
     r = analysis.reactions
-    panels: dict[str, NDArray[np.number]] = {
-        "force": r.shaking_force, "moment": r.shaking_moment, "torque": r.driving_torque}
-    if not analysis.mechanism.in_one_plane():
-        panels["couple"] = r.rocking_couple
-    return panels
+    values: dict[str, NDArray[np.number]] = {
+        "force": r.shaking_force, "couple": r.rocking_couple, "moment": r.shaking_moment,
+        "torque": r.driving_torque}
+    if analysis.mount_torque is not None:
+        values["mount"] = analysis.mount_torque
+    return {key: values[key] for key in (panel_keys(analysis) if keys is None else keys)}
 
 
 def natural_scales(analysis: CycleAnalysis) -> dict[str, float]:
@@ -505,7 +528,8 @@ def natural_scales(analysis: CycleAnalysis) -> dict[str, float]:
                  (*analysis.reactions.ground.values(),
                   *analysis.reactions.slider_normal.values())), default=0.0)
     moment = force * analysis.mechanism.structure.length_scale()
-    return {"force": force, "couple": moment, "moment": moment, "torque": moment}
+    return {"force": force, "couple": moment, "moment": moment, "torque": moment,
+            "mount": moment}
 
 
 def _drawn_within(analyses: Sequence[CycleAnalysis], tolerance: float) -> bool:
@@ -519,8 +543,9 @@ def _drawn_within(analyses: Sequence[CycleAnalysis], tolerance: float) -> bool:
                            (*a.reactions.ground.values(), *a.reactions.slider_normal.values())),
                           default=0.0) for a in analyses)
     length = analyses[0].mechanism.structure.length_scale()
-    panels = [drawn_panels(a) for a in analyses]
-    for key in panels[0]:
+    keys = panel_keys(*analyses)
+    panels = [drawn_panels(a, keys) for a in analyses]
+    for key in keys:
         curves = [p[key] for p in panels]
         span = max(max(np.ptp(c.real), np.ptp(c.imag)) if np.iscomplexobj(c) else np.ptp(c)
                    for c in curves)

@@ -16,7 +16,7 @@ from .columns import TrajectoryLike
 from .cycle import sample_angles
 from .linkage.vectors import V
 from .mechanisms import mechanism_of
-from .mechanisms.base import Mechanism
+from .mechanisms.base import DrawnMass, Mechanism
 from .model import GROUND
 from .model import MechanismModel as Model
 
@@ -120,3 +120,42 @@ def counterweight_paths(linkage: Model | Mechanism,
         centre = mo.point(k, V(w.e, w.f)).complex() + 0 * mo.theta1
         out[name] = (np.asarray(centre, complex), w.disc_radius or 0.0)
     return out
+
+
+def slider_block_outlines(linkage: Model | Mechanism, frames: int
+                          ) -> dict[str, NDArray[np.complex128]]:
+    """Each sliding block's outline over a revolution: per link a ``(frames, 5)`` array, m.
+
+    The rectangle of :meth:`~balancer.mechanisms.base.Mechanism.slider_blocks` (an engine's
+    pistons, sized by their bore), centred on the link's point and along its slider, its four
+    corners and the first again (complex), carried by the link at equally spaced crank angles.
+    """
+    mech = mechanism_of(linkage)
+    mo = mech.motion(sample_angles(frames), 1.0)
+    out: dict[str, NDArray[np.complex128]] = {}
+    for name, (length, width) in mech.slider_blocks().items():
+        k = mech.link_names.index(name)
+        corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5), (-0.5, -0.5)]
+        out[name] = np.column_stack([
+            mo.point(k, V(u * length, v * width)).complex() + 0 * mo.theta1
+            for u, v in corners])
+    return out
+
+
+def drawn_mass_sectors(linkage: Model | Mechanism, frames: int
+                       ) -> list[tuple[DrawnMass, NDArray[np.float64], float]]:
+    """The shafts' counterweights and eccentrics as sectors over a revolution.
+
+    Per mass (:meth:`~balancer.mechanisms.base.Mechanism.drawn_masses`): the mass, its
+    direction from its axis at equally spaced crank angles ``(frames,)`` (rad, ``ratio·θ1 +
+    angle``), and the radius of the sector that shows it (m): sectors of one thickness and
+    angle, so their radius goes as the cube root of their mass·radius, the largest reaching
+    the crank's reach.
+    """
+    mech = mechanism_of(linkage)
+    masses = mech.drawn_masses()
+    largest = max((m.mr for m in masses), default=0.0)
+    theta1 = sample_angles(frames)
+    reach = mech.crank_reach()
+    return [(m, m.ratio * theta1 + m.angle, reach * float(np.cbrt(m.mr / largest)))
+            for m in masses if m.mr > 0]

@@ -4,8 +4,9 @@ Runs every study (``studies/*.py`` with a ``run``) in full mode into ``studies/o
 copies the figures listed in :data:`CHOSEN` into ``docs/gallery/`` under stable names, runs the
 ``balancer`` commands of :data:`COMMANDS` (docs/gallery.md's, word for word: the report pictures
 of ``plot --cycle``, ``plot --orders`` and ``verify --plot``, from designs balanced by
-``optimize`` into ``studies/out/gallery/``), and writes an animation of the example of
-Meijaard & van der Wijk (2020), Eq. 56 (``examples/meijaard2020.toml``) with
+``optimize`` into ``studies/out/gallery/``), and writes animations (:data:`ANIMATIONS`) of the
+example of Meijaard & van der Wijk (2020), Eq. 56 (``examples/meijaard2020.toml``) and of the
+single-cylinder engine (``examples/single_cylinder.toml``: its piston and counterweights) with
 :func:`balancer.plots.animate`. The gallery is committed,
 so each file must stay small (:data:`MAX_BYTES`); the script says which one does not and exits
 with status 1.
@@ -68,9 +69,14 @@ COMMANDS = (
     ("inline_four_orders.png", (
         "balancer plot examples/inline_four.toml --orders docs/gallery/inline_four_orders.png",
     )),
+    ("single_cylinder_orders.png", (
+        "balancer plot examples/single_cylinder.toml --orders "
+        "docs/gallery/single_cylinder_orders.png --log",
+    )),
 )
-ANIMATION = "meijaard2020.gif"
-FRAMES = 48
+#: Animations: (gallery name, example spec, frames per revolution).
+ANIMATIONS = (("meijaard2020.gif", "meijaard2020", 48),
+              ("single_cylinder.gif", "single_cylinder", 36))
 #: Size budget per gallery file, bytes.
 MAX_BYTES = {".png": 250_000, ".gif": 600_000}
 
@@ -105,6 +111,12 @@ def run_commands() -> list[Path]:
     return [palette_png(GALLERY / target) for target, _ in COMMANDS]
 
 
+def write_animations() -> list[Path]:
+    """Write :data:`ANIMATIONS` (the gallery files)."""
+    return [animate(load_design(ROOT / "examples" / f"{spec}.toml"), GALLERY / name,
+                    frames=frames) for name, spec, frames in ANIMATIONS]
+
+
 def palette_png(path: Path) -> Path:
     """Rewrite a PNG with a palette of 256 colours (a plot has few): a third of the bytes."""
     from PIL import Image
@@ -126,9 +138,7 @@ def main() -> int:
     for study, figure, target in CHOSEN:
         written.append(Path(shutil.copyfile(HERE / "out" / study / figure, GALLERY / target)))
     written.extend(run_commands())
-    design = load_design(ROOT / "examples" / "meijaard2020.toml")
-    written.append(animate(design.mechanism, GALLERY / ANIMATION, frames=FRAMES,
-                           title=design.title))
+    written.extend(write_animations())
     status = 0
     for path in written:
         size = path.stat().st_size

@@ -17,6 +17,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from balancer import api, cycle, drawing, outputs, plots
 from balancer.api import analyze
 from balancer.cli import main
+from balancer.mechanisms import mechanism_of
 from balancer.plots import style
 from balancer.spec import load_design
 from balancer.sweeps import atlas_figure
@@ -616,12 +617,22 @@ def _drawn_animation(design, frames, **kw):
     return fig, update, canvas.get_renderer()
 
 
-def test_the_animations_title_lies_inside_the_picture(pb1_balanced):
-    design = load_design(pb1_balanced)  # PB1's title is long for a 6-inch animation
+@pytest.mark.parametrize("name", ["pb1_balanced", "v8_to_balance"])
+def test_the_animations_title_and_labels_lie_inside_the_picture(pb1_balanced, name):
+    # PB1's title is long for a 6-inch animation; the V8's, as wide as the picture, once
+    # pushed the axes left until the y label was cut off by the picture's edge.
+    design = load_design(pb1_balanced if name == "pb1_balanced" else
+                         EXAMPLES / f"{name}.toml")
     fig, _, renderer = _drawn_animation(design, 4)
-    box, page = fig.axes[0].title.get_window_extent(renderer), fig.bbox
-    assert fig.axes[0].title.get_text().replace("\n", " ") == design.title
-    assert page.x0 <= box.x0 and box.x1 <= page.x1 and page.y0 <= box.y0 and box.y1 <= page.y1
+    assert fig.get_suptitle().replace("\n", " ") == design.title
+    page = fig.bbox
+    ax = fig.axes[0]
+    for box in (fig.get_tightbbox(renderer).transformed(fig.dpi_scale_trans),
+                ax.yaxis.label.get_window_extent(renderer),
+                ax.xaxis.label.get_window_extent(renderer)):
+        assert page.x0 <= box.x0 and box.x1 <= page.x1 and page.y0 <= box.y0
+        assert box.y1 <= page.y1
+    assert ax.get_ylabel() == "y (m)" and ax.get_xlabel() == "x (m)"
 
 
 def test_the_animation_reads_the_crank_angle_of_every_frame():
@@ -737,3 +748,353 @@ def test_free_motion_spikes_are_clipped_and_marked_not_squashing_the_rest(watt_b
         low, high = ax.get_ylim()
         assert low <= np.min(values) and np.max(values) <= high
         assert not [line for line in ax.get_lines() if line.get_label().startswith("clipped")]
+
+
+# --- engines' figures: planes, mount torque, speeds in rpm (issue 40) -------------------------
+
+
+#: Counterweights for the single cylinder in two planes off its own: the balanced design has
+#: links out of the plane, its original none.
+TWO_PLANES = """
+[balance.objective]
+rocking_couple = 1.0
+shaking_force = 0.04
+shaking_moment = 0.0
+unbalance = 0.0
+
+[balance.counterweights]
+planes = [-0.024, 0.03]
+max_mr = 0.03
+"""
+
+
+@pytest.fixture(scope="module")
+def flat_single():
+    """The single cylinder without its counterweights (all in the cylinder's plane), to
+    balance in two planes off it; and the balanced design (``optimize``'s)."""
+    import balancer
+
+    text = (EXAMPLES / "single_cylinder.toml").read_text(encoding="utf-8")
+    text = "\n".join(line for line in text.splitlines()
+                     if 'label = "counterweight"' not in line) + TWO_PLANES
+    design = balancer.loads_design(text)
+    balanced = balancer.optimize(design).balanced_design(design)
+    assert mechanism_of(design.mechanism).in_one_plane()
+    assert not mechanism_of(balanced.mechanism).in_one_plane()
+    return design, balanced
+
+
+def _panel(fig, words):
+    """The axes whose title starts with ``words``."""
+    (ax,) = (ax for ax in fig.axes if ax.get_title().startswith(words))
+    return ax
+
+
+@pytest.mark.parametrize("order", ["balanced after an original in one plane",
+                                   "in one plane after one in planes"])
+def test_the_cycle_figure_of_designs_in_one_and_several_planes(flat_single, order):
+    """The tutorial's call, ``cycle_figure(analyze(balanced), before=analyze(design))``, where
+    one of the two has links out of the plane (it raised KeyError 'couple'): the rocking
+    couple's panel draws both, the one in a plane as the zero it is."""
+    import balancer
+
+    design, balanced = flat_single
+    after, before = balancer.analyze(balanced), balancer.analyze(design)
+    if order.startswith("in one plane"):
+        after, before = before, after
+    fig = balancer.cycle_figure(after, before=before)
+    couple = _panel(fig, "rocking couple")
+    lines = _lines(couple)
+    assert len(lines) == 2
+    for line, a in zip(lines, (before, after), strict=True):
+        drawn = complex(1, 0) * line.get_xdata() + 1j * line.get_ydata()
+        values = _closed(a.reactions.rocking_couple)
+        scale = cycle.natural_scales(a)["couple"]
+        expected = values if np.max(np.abs(values)) > 1e-9 * scale else 0 * values
+        np.testing.assert_array_equal(drawn, expected)
+    # The figures of the drawing's own sampling (``plot --cycle``) at the same angles.
+    drawn = cycle.drawn_analyses([balanced.mechanism, design.mechanism],
+                                 balanced.operation.speed)
+    assert drawn[0].samples == drawn[1].samples >= 720
+    assert cycle.panel_keys(*drawn) == ("force", "couple", "moment", "torque", "mount")
+
+
+def test_an_engines_cycle_figure_draws_the_torque_on_its_mounts():
+    """The mount torque (``analyze``'s table and JSON) over the crank angle: the shaking moment
+    plus the driving torque, sample by sample, its RMS and maximum in the panel's title; a
+    mechanism that is not an engine has no such panel."""
+    design = load_design(EXAMPLES / "single_cylinder.toml")
+    a = analyze(design)
+    fig = plots.cycle_figure(a)
+    mount = _panel(fig, "mount torque")
+    (line,) = _lines(mount)
+    np.testing.assert_array_equal(line.get_ydata(), _closed(a.mount_torque))
+    np.testing.assert_allclose(a.mount_torque, a.reactions.shaking_moment
+                               + a.reactions.driving_torque, rtol=0, atol=1e-12 * np.max(
+                                   np.abs(a.reactions.driving_torque)))
+    assert mount.get_ylabel() == "torque about z on the mounts (N·m)"
+    summary = a.summary.mount_torque
+    assert (f"RMS {style.number(summary.rms)} N·m, max {style.number(summary.max)} N·m"
+            in mount.get_title())
+    assert not any(ax.get_title().startswith("mount")
+                   for ax in plots.cycle_figure(analyze(load_design(
+                       EXAMPLES / "pb1.toml"))).axes)
+    with pytest.raises(ValueError, match="'shaking_moment', 'driving_torque'"):
+        plots.plot_over_crank_angle(analyze(load_design(EXAMPLES / "pb1.toml")),
+                                    "mount_torque")
+
+
+def test_figures_give_speeds_in_rpm_beside_rad_per_s(tmp_path):
+    design = load_design(EXAMPLES / "single_cylinder.toml")  # 680.678 rad/s, 6500 rpm
+    a = analyze(design)
+    assert "680.678 rad/s (6500 rpm)" in plots.cycle_figure(a).get_suptitle()
+    assert "680.678 rad/s (6500 rpm)" in plots.orders_figure(a).get_suptitle()
+    assert style.speed_text(10.0) == "10 rad/s (95.49 rpm)"
+    # A sweep over the speed: a second axis in rpm, the original's speed in both.
+    path = _atlas_table(tmp_path / "speed.parquet", ["optimal"] * 3,
+                        keys=("operation.speed",), values=((500.0, 600.0, 700.0),))
+    fig = atlas_figure(path, ["operation.speed"], original={"operation.speed": 680.678})
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "operation.speed (rad/s)"
+    (rpm,) = ax.child_axes
+    assert rpm.get_xlabel() == "operation.speed (rpm)"
+    labels = [line.get_label() for line in ax.get_lines()]
+    assert "original design: operation.speed = 680.7 rad/s (6500 rpm)" in labels
+
+
+def _bars(ax, label):
+    """The heights of the bars of one legend entry, by order."""
+    (bars,) = (c for c in ax.containers if c.get_label() == label)
+    return np.array([p.get_height() for p in bars.patches])
+
+
+def test_order_zero_of_a_moment_or_torque_is_drawn_as_its_signed_mean():
+    """A firing engine's driving torque has a negative mean (the load's torque on the crank):
+    order 0's bar is that mean with its sign (it was drawn as its magnitude), as the JSON's
+    order table gives it; every other bar a peak amplitude."""
+    from balancer.api import to_dict
+
+    design = load_design(EXAMPLES / "single_cylinder.toml")
+    a = analyze(design)
+    fig = plots.orders_figure(a)
+    means = {"driving torque": a.reactions.driving_torque, "mount torque": a.mount_torque,
+             "shaking moment": a.reactions.shaking_moment}
+    for words, values in means.items():
+        heights = _bars(_panel(fig, words), "design")
+        mean = float(np.mean(values))
+        floor = 1e-9 * cycle.natural_scales(a)["moment"]
+        assert heights[0] == (mean if abs(mean) > floor else 0.0)
+        assert np.all(heights[1:] >= 0)
+    torque = _bars(_panel(fig, "driving torque"), "design")
+    assert torque[0] == pytest.approx(-49.4, abs=0.05)  # docs/engines.md's −49.4 N·m
+    orders = to_dict(a)["orders"]
+    assert orders[0]["driving_torque"] == torque[0]
+    assert orders[0]["mount_torque"] == _bars(_panel(fig, "mount torque"), "design")[0]
+    # A force's order 0: the mean's magnitude, never negative.
+    force = _panel(fig, "shaking force")
+    assert _bars(force, "design, forward")[0] == pytest.approx(abs(np.mean(
+        a.reactions.shaking_force)), rel=1e-12)
+
+
+def test_order_bars_on_a_log_axis(monkeypatch):
+    """``log=True``: each panel with a bar above zero on a logarithmic axis in whole decades,
+    every bar shown within them; a negative mean drawn by its magnitude and labelled with its
+    sign; bars at rounding of the largest (≤ 1e-12 of it) left out even where the rounding
+    floor of the load's natural scale would keep them, so that they cannot stretch the axis
+    over decades of noise; a panel of zeros (a V8's shaking moment) stays linear."""
+    from balancer.plots import orders as order_bars
+
+    single = analyze(load_design(EXAMPLES / "single_cylinder.toml"))
+    fig = plots.orders_figure(single, log=True)
+    torque = _panel(fig, "driving torque")
+    assert torque.get_yscale() == "log" and torque.get_ylabel().endswith(", log scale")
+    heights = _bars(torque, "design")
+    mean = single.orders[0].driving_torque
+    assert mean < 0 and heights[0] == -mean
+    assert [t.get_text() for t in torque.texts] == [style.number(mean).replace("-", "−")]
+    low, high = torque.get_ylim()
+    shown = heights[heights > 0]
+    assert low <= shown.min() / 2 and shown.max() * 2 <= high
+    assert np.log10(low) == round(np.log10(low)) and np.log10(high) == round(np.log10(high))
+
+    v8 = analyze(load_design(EXAMPLES / "v8.toml"))
+    monkeypatch.setattr(order_bars, "ROUNDING_SPAN", 0.0)  # only the log floor left
+    fig = plots.orders_figure(v8, log=True)
+    force = _panel(fig, "shaking force")
+    forward = _bars(force, "design, forward")
+    largest = max(o.shaking_force.forward for o in v8.orders)
+    rounding = [o.shaking_force.forward <= 1e-12 * largest for o in v8.orders]
+    assert any(rounding) and not np.any(forward[rounding])
+    kept = [v for o in v8.orders for v in (o.shaking_force.forward, o.shaking_force.backward)
+            if v > 1e-12 * largest]
+    assert min(kept) == pytest.approx(0.174, rel=1e-2)  # the 8th order, the least real one
+    assert force.get_yscale() == "log" and min(kept) / 20 <= force.get_ylim()[0]
+    monkeypatch.undo()
+    moment = _panel(plots.orders_figure(v8, log=True), "shaking moment")
+    assert moment.get_yscale() == "linear" and not np.any(_bars(moment, "design"))
+
+
+def test_plot_orders_log_flag(tmp_path, capsys, monkeypatch):
+    drawn = []
+    monkeypatch.setattr("balancer.cli.plot.save_figure", lambda fig, path: drawn.append(fig))
+    spec = str(EXAMPLES / "single_cylinder.toml")
+    assert main(["plot", spec, "--orders", str(tmp_path / "o.png"), "--log"]) == 0
+    (fig,) = drawn
+    assert _panel(fig, "driving torque").get_yscale() == "log"
+    assert main(["plot", spec, "--orders", str(tmp_path / "o.png")]) == 0
+    assert _panel(drawn[1], "driving torque").get_yscale() == "linear"
+    capsys.readouterr()
+    assert main(["plot", spec, "--cycle", str(tmp_path / "c.png"), "--log"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--log" in err and "--orders PATH" in err
+    assert len(drawn) == 2 and list(tmp_path.iterdir()) == []
+
+
+# --- the animation: a design, pistons, engines' counterweights (issue 40) ------------------
+
+
+def test_animate_takes_a_design_as_every_other_call_does(tmp_path):
+    """``animate(design, path)``: its mechanism, its title and (a balanced spec) the bodies
+    added to its original's links, as ``plot --animate`` draws them; a model or a mechanism
+    as before; anything else refused by a message that names what is accepted."""
+    from matplotlib.patches import Circle
+
+    import balancer
+
+    engine = balancer.example("single_cylinder")
+    assert isinstance(engine.mechanism, balancer.Engine)  # the name the refusals give
+    out = balancer.animate(engine, tmp_path / "engine.gif", frames=4)
+    assert out.read_bytes()[:6] == b"GIF89a"
+    assert balancer.animate(engine.mechanism, tmp_path / "model.gif", frames=4).exists()
+    fig, _ = plots.animation_figure(engine, frames=4)
+    assert fig.get_suptitle() == engine.title
+    design = balancer.example("pb1_counterweights")
+    result = balancer.optimize(design, backend="convex")
+    balanced = result.balanced_design(design)
+    fig, _ = plots.animation_figure(balanced, frames=4)  # no counterweights given: its own
+    discs = [p for p in fig.axes[0].patches if isinstance(p, Circle)]
+    assert len(discs) == len([w for w in result.counterweights.values() if w.kind == "add"])
+    assert len(discs) == 2
+    for wrong in ("examples/v8.toml", None, result):
+        with pytest.raises(balancer.SpecError) as caught:
+            balancer.animate(wrong, tmp_path / "x.gif", frames=4)
+        message = str(caught.value)
+        assert message.count("\n") == 0 and type(wrong).__name__ in message
+        for accepted in ("Design", "FourBar", "SliderCrank", "Linkage", "Engine", "Mechanism"):
+            assert accepted in message
+    assert not (tmp_path / "x.gif").exists()
+    # Where a mechanism's model is asked for and a Design given, the message says so.
+    with pytest.raises(balancer.SpecError, match=r"Engine: a Design's is its \.mechanism"):
+        mechanism_of(engine)
+    with pytest.raises(balancer.SpecError, match="or an Engine"):
+        balancer.Design(mechanism=engine)
+
+
+def _block_frame(polygon):
+    """A rectangle's centre, its side along its first edge and across it (m), and the first
+    edge's direction (complex unit)."""
+    xy = polygon.get_xy()[:4]
+    z = xy[:, 0] + 1j * xy[:, 1]
+    along, across = z[1] - z[0], z[3] - z[0]
+    return z.mean(), abs(along), abs(across), along / abs(along)
+
+
+@pytest.mark.parametrize(("name", "size"), [
+    ("single_cylinder", (0.7 * 0.092, 0.092)),        # the bore
+    ("v8", (0.7 * 0.0995, 0.0995)),
+    ("engine", (0.7 * 2 * 0.0196, 2 * 0.0196)),       # a slider-crank: the stroke
+    ("quick_return", (0.6 * 0.1, 0.35 * 0.1)),        # blocks: of the crank's reach
+])
+def test_pistons_and_blocks_are_rectangles_along_their_sliders(name, size):
+    """Each sliding block (an engine's piston) is a rectangle centred on its point, its length
+    along its slider's line and its width across, carried with it frame by frame; an
+    engine's piston as wide as its bore (the stroke where there is none)."""
+    from matplotlib.patches import Polygon
+
+    design = load_design(EXAMPLES / f"{name}.toml")
+    mech = mechanism_of(design.mechanism)
+    frames = 6
+    fig, update = plots.animation_figure(design, frames=frames)
+    blocks = [p for p in fig.axes[0].patches if isinstance(p, Polygon)]
+    sliders = [s for s in mech.linkage.sliders
+               if len(dict((b.name, b.points) for b in mech.linkage.bodies)[s.link]) == 1]
+    assert len(blocks) == len(sliders) > 0
+    length, width = size
+    mo = mech.motion(cycle.sample_angles(frames), 1.0)
+    points = mech.points(mo)
+    guides = dict(zip((s.link for s in mech.linkage.sliders), mech.guides(mo), strict=True))
+    for k in (0, 2, 5):
+        update(k)
+        for block, slider in zip(blocks, sliders, strict=True):
+            centre, along, across, direction = _block_frame(block)
+            assert abs(centre - points[slider.point][k]) <= 1e-12
+            assert along == pytest.approx(length, rel=1e-12)
+            assert across == pytest.approx(width, rel=1e-12)
+            line = guides[slider.link][1][k]  # the slider's line's direction at this frame
+            assert abs((direction * np.conj(line)).imag) <= 1e-12
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert ("sliding blocks" if name == "quick_return" else "pistons") in labels
+
+
+@pytest.mark.parametrize("name", ["single_cylinder", "inline_four"])
+def test_an_engines_counterweights_and_eccentrics_turn_with_their_shafts(name):
+    """The crankshaft's masses labelled ``counterweight`` and each balance shaft's eccentrics
+    are sectors on their axes pointing at ``ratio·θ1 + phase`` in every frame; sectors of one
+    thickness, radius as the cube root of mass·radius, the largest the crank radius."""
+    from matplotlib.patches import Wedge
+
+    design = load_design(EXAMPLES / f"{name}.toml")
+    engine = design.mechanism
+    expected = [(0j, 1, m.phase_deg, m.mr) for m in engine.crankshaft.masses
+                if m.label == "counterweight"]
+    expected += [(complex(*s.at), s.ratio, m.phase_deg, m.mr) for s in engine.balance_shafts
+                 for m in s.eccentrics]
+    frames = 8
+    fig, update = plots.animation_figure(design, frames=frames)
+    wedges = [p for p in fig.axes[0].patches if isinstance(p, Wedge)]
+    assert len(wedges) == len(expected) > 0
+    largest = max(mr for *_, mr in expected)
+    crank = engine.cylinders[0].crank
+    for k in (0, 3):
+        update(k)
+        theta1 = 360.0 * k / frames
+        for wedge, (axis, ratio, phase, mr) in zip(wedges, expected, strict=True):
+            assert complex(*wedge.center) == axis
+            assert wedge.r == pytest.approx(crank * np.cbrt(mr / largest), rel=1e-12)
+            middle = 0.5 * (wedge.theta1 + wedge.theta2)
+            assert (middle - (ratio * theta1 + phase) + 180) % 360 - 180 == pytest.approx(
+                0.0, abs=1e-9)
+    labels = [t.get_text() for legend in fig.legends for t in legend.get_texts()]
+    assert "crankshaft counterweights" in labels
+    assert ("balance shafts' eccentrics" in labels) == bool(engine.balance_shafts)
+
+
+def test_an_optimised_engines_animation_draws_the_counterweights_it_chose(flat_single,
+                                                                          tmp_path):
+    """``optimize`` writes an engine's counterweights into its crankshaft's masses: the
+    animation of the balanced spec draws them where the optimiser put them."""
+    from matplotlib.patches import Wedge
+
+    import balancer
+
+    design, balanced = flat_single
+    chosen = [m for m in balanced.mechanism.crankshaft.masses if m.label == "counterweight"]
+    assert chosen and all(m.z in (-0.024, 0.03) for m in chosen)
+    spec = tmp_path / "balanced.toml"
+    balancer.save_design(balanced, spec)
+    fig, update = plots.animation_figure(load_design(spec), frames=4)
+    update(0)
+    wedges = [p for p in fig.axes[0].patches if isinstance(p, Wedge)]
+    assert sorted(0.5 * (w.theta1 + w.theta2) % 360 for w in wedges) == pytest.approx(
+        sorted(m.phase_deg % 360 for m in chosen), abs=1e-9)
+    # With its original named beside it ([original]), the same: an engine's balancing adds
+    # masses on its shafts, not bodies to its links (no link-by-link counterweights asked).
+    from balancer.plots import animation
+
+    def asked(*_):
+        raise AssertionError("an engine's links are not rebuilt by its balancing")
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(animation, "link_counterweights", asked)
+        fig, _ = plots.animation_figure(replace(balanced, original=design.mechanism), frames=4)
+    assert len([p for p in fig.axes[0].patches if isinstance(p, Wedge)]) == len(chosen)

@@ -316,8 +316,9 @@ def test_gallery_shows_figures_the_studies_make(quick):
         assert figure in {p.name for p in quick(study)["figures"]}
         committed = gallery.GALLERY / target
         assert committed.stat().st_size <= gallery.MAX_BYTES[committed.suffix]
-    animation = gallery.GALLERY / gallery.ANIMATION
-    assert animation.stat().st_size <= gallery.MAX_BYTES[".gif"]
+    for name, _, _ in gallery.ANIMATIONS:
+        animation = gallery.GALLERY / name
+        assert animation.stat().st_size <= gallery.MAX_BYTES[".gif"]
 
 
 def test_gallery_report_pictures_come_from_the_gallery_pages_commands():
@@ -339,7 +340,9 @@ def test_gallery_report_pictures_come_from_the_gallery_pages_commands():
             assert shown in page, shown
     for study, _, target in gallery.CHOSEN:
         assert f"](gallery/{target})" in page and f"python studies/{study}.py" in page
-    assert f"](gallery/{gallery.ANIMATION})" in page
+    for name, spec, frames in gallery.ANIMATIONS:
+        assert f"](gallery/{name})" in page
+        assert f"balancer plot examples/{spec}.toml --animate {name} --frames {frames}" in page
 
 
 def test_engine_orders_gives_the_classic_verdicts_and_the_series_shortfall(tmp_path):

@@ -15,7 +15,8 @@ def test_tutorial_runs_as_written(tmp_path, monkeypatch, capsys):
     namespace: dict = {}
     for block in blocks:
         exec(compile(block, str(TUTORIAL), "exec"), namespace)  # noqa: S102 - our own docs
-    for picture in ("pb1_cycle.png", "pb1_verify.pdf", "front.png"):
+    for picture in ("pb1_cycle.png", "pb1_verify.pdf", "pb1_orders.png", "pb1.gif",
+                    "front.png"):
         assert (tmp_path / picture).stat().st_size > 1000
     printed = capsys.readouterr().out
     assert "CycleAnalysis(four-bar" in printed and "BalanceResult(optimal" in printed

@@ -294,6 +294,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write an animation to PATH (.gif, or .mp4 with ffmpeg)")
     p.add_argument("--frames", type=_frames, default=72, metavar="N",
                    help=f"frames per revolution (default 72, at most {MAX_FRAMES})")
+    p.add_argument("--log", action="store_true",
+                   help="with --orders: the bars on a logarithmic axis (magnitudes; bars at "
+                   "rounding of the largest left out)")
     p.set_defaults(verb="plot")
 
     p = sub.add_parser(

@@ -6,7 +6,6 @@ import argparse
 import os
 
 from ..api import cycle_analyses
-from ..balance.counterweights import counterweights
 from ..errors import OutputError, SpecError
 from ..mechanisms import mechanism_of
 from ..outputs import animation_type, figure_type
@@ -19,6 +18,9 @@ def run(args: argparse.Namespace) -> int:
     if args.animate is None and args.cycle is None and args.orders is None:
         raise SpecError("nothing to plot: give --cycle PATH, --orders PATH or --animate PATH",
                         key="--cycle")
+    if args.log and args.orders is None:
+        raise SpecError("draws the order bars on a logarithmic axis: give --orders PATH too",
+                        key="--log")
     cycle = output_path(args, args.cycle, "--cycle")
     orders = output_path(args, args.orders, "--orders")
     animation = output_path(args, args.animate, "--animate")
@@ -47,14 +49,9 @@ def run(args: argparse.Namespace) -> int:
         # speed is refused by cycle_analyses, as for --cycle).
         analyses = cycle_analyses(design, samples=None if design.operation is None
                                   else design.operation.samples)
-        figures.append((orders_figure(*analyses, title=design.title), orders))
-    if animation is not None:
-        weights = None
-        if design.original is not None:  # a balanced spec: draw what was added to the links
-
-            weights = counterweights(design.original, design.mechanism)
-        animate(design.mechanism, animation, frames=args.frames, title=design.title,
-                counterweights=weights)
+        figures.append((orders_figure(*analyses, title=design.title, log=args.log), orders))
+    if animation is not None:  # (a balanced spec: what was added to the links drawn too)
+        animate(design, animation, frames=args.frames)
         wrote(animation)
     for figure, path in figures:
         save_figure(figure, path)

@@ -30,7 +30,7 @@ REGISTRY: dict[str, type[Mechanism]] = {
 
 
 def mechanism_of(model: Model | Mechanism) -> Mechanism:
-    """The :class:`~.base.Mechanism` of a model (a FourBar, SliderCrank or Linkage).
+    """The :class:`~.base.Mechanism` of a model (a FourBar, SliderCrank, Linkage or Engine).
 
     Built once per model (models are frozen and hashable); a mechanism is returned as it is.
 
@@ -56,8 +56,9 @@ def _cached(model: Model) -> Mechanism:
 def _build(model: Model) -> Mechanism:
     kind = getattr(model, "type", None)
     if kind not in REGISTRY:
-        raise SpecError("must be a mechanism (a FourBar, SliderCrank or Linkage)",
-                        key="mechanism", value=type(model).__name__)
+        hint = ": a Design's is its .mechanism" if hasattr(model, "mechanism") else ""
+        raise SpecError(f"must be a mechanism model (a FourBar, SliderCrank, Linkage or "
+                        f"Engine{hint})", key="mechanism", value=type(model).__name__)
     mech = REGISTRY[kind](model)
     mech.structure  # noqa: B018 - build (and so check) the equations now
     return mech

@@ -172,8 +172,8 @@ class Design:
         Keys are the spec's, from its root.
         """
         if not isinstance(self.mechanism, MechanismModel):
-            raise SpecError("must be a FourBar, a SliderCrank or a Linkage", key="mechanism",
-                            value=type(self.mechanism).__name__)
+            raise SpecError("must be a FourBar, a SliderCrank, a Linkage or an Engine",
+                            key="mechanism", value=type(self.mechanism).__name__)
         for name, cls in (("operation", Operation), ("simulation", SimulationSettings)):
             value = getattr(self, name)
             if value is not None and not isinstance(value, cls):

@@ -11,10 +11,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .. import outputs
+from ..balance.counterweights import counterweights as link_counterweights
 from ..cycle import sample_angles
-from ..drawing import CounterweightLike, counterweight_paths, drawing_frames, frame
-from ..errors import OutputError
+from ..drawing import (
+    CounterweightLike,
+    counterweight_paths,
+    drawing_frames,
+    drawn_mass_sectors,
+    frame,
+    slider_block_outlines,
+)
+from ..errors import OutputError, SpecError
+from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
+from ..model import Design
 from ..model import MechanismModel as Model
 from ..outputs import animation_type, write_with
 from .style import COLOURS, draw_frame
@@ -23,7 +33,14 @@ if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions t
     from matplotlib.artist import Artist
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
-    from matplotlib.patches import Circle
+    from matplotlib.patches import Circle, Polygon, Wedge
+
+#: What :func:`animate` and :func:`animation_figure` take, as their refusal names it.
+ACCEPTED = ("a Design (balancer.load_design, balancer.example), a mechanism model (a FourBar, "
+            "SliderCrank, Linkage or Engine: a Design's .mechanism) or a Mechanism")
+
+#: Half the angle of a sector that shows a shaft's counterweight or eccentric, degrees.
+SECTOR_HALF_ANGLE = 60.0
 
 
 def _arm(points: np.ndarray, target: np.ndarray) -> np.ndarray:
@@ -36,20 +53,57 @@ def _arm(points: np.ndarray, target: np.ndarray) -> np.ndarray:
     return np.column_stack([points[:, near], target])
 
 
-def animation_figure(linkage: Model | Mechanism, *, frames: int = 72, title: str = "",
+def _drawn(design: Design | Model | Mechanism, title: str,
+           counterweights: Mapping[str, CounterweightLike] | None
+           ) -> tuple[Model | Mechanism, str, Mapping[str, CounterweightLike]]:
+    """What an animation draws of what it is given: the mechanism, its title, the bodies added.
+
+    A :class:`~balancer.model.Design` gives its mechanism, its title (where ``title`` is
+    empty) and, where it names its original, the counterweights added to the original's links
+    (where ``counterweights`` is ``None``; an engine's are masses on its shafts, which its
+    mechanism draws).
+
+    Raises
+    ------
+    SpecError
+        For anything else than :data:`ACCEPTED`, naming what is accepted.
+    """
+    if isinstance(design, Design):
+        weights = counterweights
+        if (weights is None and design.original is not None
+                and not mechanism_of(design.mechanism).balanced_on_shafts):
+            weights = link_counterweights(design.original, design.mechanism)
+        return design.mechanism, title or design.title, weights or {}
+    if not isinstance(design, Model | Mechanism):
+        raise SpecError(f"must be {ACCEPTED}", key="design", value=type(design).__name__)
+    return design, title, counterweights or {}
+
+
+def animation_figure(design: Design | Model | Mechanism, *, frames: int = 72,
+                     title: str = "",
                      counterweights: Mapping[str, CounterweightLike] | None = None
                      ) -> tuple[Figure, Callable[[int], list[Artist]]]:
     """The figure of an animation of one revolution, and what changes from frame to frame.
 
+    ``design`` a :class:`~balancer.model.Design` (its mechanism, its title where ``title`` is
+    empty, and for a balanced spec that names its original the counterweights added to its
+    links), a mechanism's model or a :class:`~balancer.mechanisms.base.Mechanism`.
+
     Drawn once: the frame (pivots, guides), the path of the total centre of mass, the title
-    (wrapped to the figure's width), the legend. Per frame, at the crank angle
-    θ1 = 360°·k/``frames``: the links; each link's centre of mass on a thin arm from the
+    (wrapped to the figure's width, above the axes), the legend. Per frame, at the crank angle
+    θ1 = 360°·k/``frames``: the links; each sliding block as a rectangle along its slider (an
+    engine's pistons as wide as their bore, or their stroke where the spec gives no bore, and
+    0.7 of it long; a slider-crank's slider as a piston as wide as the stroke; other blocks
+    0.6 × 0.35 of the crank's reach); each link's centre of mass on a thin arm from the
     link's nearest point (it turns with its link, wherever the balancing put it); the
     counterweights added to the original links (``counterweights``, per link as
     :func:`balancer.balance.counterweights.counterweights` gives them; ``kind`` ``"add"``) as
-    their steel discs (a diamond for a point mass) on arms from their links; the total centre
-    of mass with its path so far; and the crank angle's readout. Links that no single added
-    body makes (``rebuild``, ``remove``) are named in the legend.
+    their steel discs (a diamond for a point mass) on arms from their links; an engine's
+    crankshaft counterweights (its masses labelled ``counterweight``) and balance shafts'
+    eccentrics as sectors on their axes, turning with their shafts (sectors of one thickness:
+    radius as the cube root of their mass·radius, the largest the crank's reach); the total
+    centre of mass with its path so far; and the crank angle's readout. Links that no single
+    added body makes (``rebuild``, ``remove``) are named in the legend.
 
     Returns
     -------
@@ -57,22 +111,32 @@ def animation_figure(linkage: Model | Mechanism, *, frames: int = 72, title: str
         ``(fig, update)``: the :class:`~matplotlib.figure.Figure` (its moving artists marked
         animated, so a plain draw leaves them out) and ``update(k)``, which sets frame ``k``'s
         moving artists and returns them, to be drawn over the still picture.
+
+    Raises
+    ------
+    SpecError
+        If ``design`` is none of those (the message names what is accepted).
     """
     import textwrap
 
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
-    from matplotlib.patches import Circle
+    from matplotlib.patches import Circle, Polygon, Wedge
 
-    weights: Mapping[str, CounterweightLike] = counterweights or {}
+    linkage, title, weights = _drawn(design, title, counterweights)
     links, coms, total = drawing_frames(linkage, frames)
     pivots, guides = frame(linkage)
     discs = counterweight_paths(linkage, weights, frames)
+    blocks = slider_block_outlines(linkage, frames)
+    sectors = drawn_mass_sectors(linkage, frames)
     fig = Figure(figsize=(6, 4.5), dpi=100, layout="constrained")
     ax = fig.add_subplot()
     rims = [c + r * s for c, r in discs.values() for s in (1, -1, 1j, -1j)]
+    rims += [m.axis + r * np.exp(1j * (angles + a))
+             for m, angles, r in sectors for a in np.radians((-SECTOR_HALF_ANGLE, 0.0,
+                                                               SECTOR_HALF_ANGLE))]
     everything = np.concatenate([*(v.ravel() for v in links.values()), *coms.values(), total,
-                                 pivots, *guides, *rims])
+                                 pivots, *guides, *rims, *(v.ravel() for v in blocks.values())])
     everything = everything[np.isfinite(everything)]
     extent = max(np.ptp(everything.real), np.ptp(everything.imag), 1e-300)
     pad = 0.08 * extent
@@ -81,7 +145,9 @@ def animation_figure(linkage: Model | Mechanism, *, frames: int = 72, title: str
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(title or "linkage over one crank revolution", wrap=True)
+    # The title above the whole figure (wrapped to its width): an axes' title wider than the
+    # axes pushes the constrained layout's axes off the figure's edge, the y label clipped.
+    fig.suptitle(title or "linkage over one crank revolution", wrap=True)
     ax.grid(alpha=0.3)
     ax.plot(total.real, total.imag, color=COLOURS["before"], lw=1, ls=":",
             label="path of the total centre of mass")
@@ -90,10 +156,28 @@ def animation_figure(linkage: Model | Mechanism, *, frames: int = 72, title: str
     for name, points in links.items():
         (arm,) = ax.plot([], [], "-", color=COLOURS["com"], lw=1.0, animated=True, zorder=1.5)
         lines.append((arm, _arm(points, coms[name])))
-    for i, points in enumerate(links.values()):
+    for i, points in enumerate(v for name, v in links.items() if name not in blocks):
         (bar,) = ax.plot([], [], "-o", color=COLOURS["link"], lw=3, ms=5, animated=True,
                          label="links" if i == 0 else None)
         lines.append((bar, points))
+    outlines: list[tuple[Polygon, NDArray[np.complex128]]] = []
+    for i, outline in enumerate(blocks.values()):
+        block = Polygon(np.column_stack([outline[0].real, outline[0].imag]), closed=True,
+                        fc=COLOURS["link"], ec="k", lw=0.8, alpha=0.55, animated=True,
+                        zorder=1.8, label=mechanism_of(linkage).block_name if i == 0 else None)
+        ax.add_patch(block)
+        outlines.append((block, outline))
+    wedges: list[tuple[Wedge, NDArray[np.float64]]] = []
+    for i, (mass, angles, radius) in enumerate(sectors):
+        first = not any(m.what == mass.what for m, _, _ in sectors[:i])
+        wedge = Wedge((mass.axis.real, mass.axis.imag), radius, 0.0, 1.0,
+                      fc="0.35" if mass.what == "counterweight" else COLOURS["eccentric"],
+                      ec="k", lw=0.5, alpha=0.5, animated=True, zorder=1.6,
+                      label={"counterweight": "crankshaft counterweights",
+                             "eccentric": "balance shafts' eccentrics"}[mass.what]
+                      if first else None)
+        ax.add_patch(wedge)
+        wedges.append((wedge, np.degrees(angles)))
     for name, (centres, _) in discs.items():
         (arm,) = ax.plot([], [], "-", color="0.35", lw=2, animated=True)
         lines.append((arm, _arm(links[name], centres)))
@@ -131,6 +215,11 @@ def animation_figure(linkage: Model | Mechanism, *, frames: int = 72, title: str
     def update(k: int) -> list[Artist]:
         for line, values in lines:
             line.set_data(values[k].real, values[k].imag)
+        for block, outline in outlines:
+            block.set_xy(np.column_stack([outline[k].real, outline[k].imag]))
+        for wedge, degrees_of in wedges:
+            wedge.set_theta1(degrees_of[k] - SECTOR_HALF_ANGLE)
+            wedge.set_theta2(degrees_of[k] + SECTOR_HALF_ANGLE)
         for body, centres, _ in bodies:
             if isinstance(body, Circle):  # (a disc: its radius is positive)
                 body.set_center((centres[k].real, centres[k].imag))
@@ -140,20 +229,24 @@ def animation_figure(linkage: Model | Mechanism, *, frames: int = 72, title: str
         trace.set_data(total[: k + 1].real, total[: k + 1].imag)
         com.set_data([total[k].real], [total[k].imag])
         angle.set_text(f"crank angle θ1 = {degrees[k]:5.1f}°")
-        return [trace, *(line for line, _ in lines), *(b for b, _, _ in bodies), link_coms,
-                com, angle]
+        return [trace, *(w for w, _ in wedges), *(b for b, _ in outlines),
+                *(line for line, _ in lines), *(b for b, _, _ in bodies), link_coms, com, angle]
 
     return fig, update
 
 
-def animate(linkage: Model | Mechanism, path: str | os.PathLike[str], *, frames: int = 72,
-            fps: int = 24, title: str = "",
+def animate(design: Design | Model | Mechanism, path: str | os.PathLike[str], *,
+            frames: int = 72, fps: int = 24, title: str = "",
             counterweights: Mapping[str, CounterweightLike] | None = None) -> Path:
-    """Write an animation of the linkage turning one revolution, its centre of mass traced.
+    """Write an animation of the mechanism turning one revolution, its centre of mass traced.
 
-    What it draws: :func:`animation_figure` (``counterweights`` per link, as
-    :attr:`BalanceResult.counterweights` gives them: the bodies added to the original links
-    are drawn as their steel discs, turning with their links).
+    ``design`` a :class:`~balancer.model.Design` (as every other call takes: its title where
+    ``title`` is empty, and for a balanced spec the bodies added to its original's links), a
+    mechanism's model (a FourBar, SliderCrank, Linkage or Engine) or a
+    :class:`~balancer.mechanisms.base.Mechanism`. What it draws: :func:`animation_figure`
+    (``counterweights`` per link, as :attr:`BalanceResult.counterweights` gives them: the
+    bodies added to the original links are drawn as their steel discs, turning with their
+    links; an engine's counterweights and eccentrics as sectors on their shafts).
 
     The type comes from the extension (:func:`animation_type`): a GIF (Pillow) or an MP4
     (H.264 by ffmpeg). Frames are equally spaced crank angles (the crank at constant speed).
@@ -166,11 +259,13 @@ def animate(linkage: Model | Mechanism, path: str | os.PathLike[str], *, frames:
     OutputError
         For an extension other than :data:`ANIMATION_TYPES`', an MP4 without ffmpeg (both
         before any work), or a file that cannot be written.
+    SpecError
+        If ``design`` is none of those (the message names what is accepted).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     kind = animation_type(path)
-    fig, update = animation_figure(linkage, frames=frames, title=title,
+    fig, update = animation_figure(design, frames=frames, title=title,
                                    counterweights=counterweights)
     canvas = FigureCanvasAgg(fig)
     canvas.draw()

@@ -27,6 +27,10 @@ class PerturbLike(Protocol):
         """The standard deviation of its normal draws, in its unit."""
 
 
+#: rpm per rad/s.
+RPM = 30.0 / np.pi
+
+
 def _key_label(key: str, units: dict[str, str]) -> str:
     """A spec key as an axis label, with its unit (``units``, by key; none if not given)."""
     unit = units.get(key, "")
@@ -34,8 +38,20 @@ def _key_label(key: str, units: dict[str, str]) -> str:
 
 
 def _key_value(key: str, value: float, units: dict[str, str]) -> str:
-    """``key = value unit``, the value to 4 significant digits."""
-    return f"{key} = {value:.4g} {units.get(key, '')}".rstrip()
+    """``key = value unit``, the value to 4 significant digits (a speed's in rpm beside it)."""
+    text = f"{key} = {value:.4g} {units.get(key, '')}".rstrip()
+    return f"{text} ({value * RPM:.4g} rpm)" if units.get(key) == "rad/s" else text
+
+
+def _rpm_axis(ax: Axes, key: str, units: dict[str, str], which: str) -> None:
+    """Beside an axis of a speed (a key in rad/s), a second scale in rpm (top or right)."""
+    if units.get(key) != "rad/s":
+        return
+    functions = (lambda w: w * RPM, lambda n: n / RPM)
+    if which == "x":
+        ax.secondary_xaxis("top", functions=functions).set_xlabel(f"{key} (rpm)")
+    else:
+        ax.secondary_yaxis("right", functions=functions).set_ylabel(f"{key} (rpm)")
 
 
 #: How an atlas shows a point without a balanced design, by its row's ``status``
@@ -149,6 +165,7 @@ def _atlas_line(ax: Axes, x: np.ndarray, key: str, before: np.ndarray, after: np
             mark_point(ax, value, 0.5 * (ylim[0] + ylim[1]), "original design",
                         _key_value(key, value, units), **ORIGINAL_STYLE)
     ax.set_xlabel(_key_label(key, units))
+    _rpm_axis(ax, key, units, "x")
     ax.set_ylabel(f"{words} (N·m)")
     ax.set_title(f"{words} before and after balancing")
     ax.grid(True, alpha=0.3)
@@ -202,6 +219,8 @@ def _atlas_map(fig: Figure, ax: Axes, values: list[np.ndarray], keys: Sequence[s
                                    **ORIGINAL_STYLE))
     ax.set_xlabel(_key_label(keys[0], units))
     ax.set_ylabel(_key_label(keys[1], units))
+    _rpm_axis(ax, keys[0], units, "x")
+    _rpm_axis(ax, keys[1], units, "y")
     ax.set_title(f"{words} of the balanced design at each point"
                  if mesh is not None else "No point has a balanced design")
     if handles:
@@ -232,7 +251,8 @@ def _perturbation_figure(table: Mapping[str, Sequence[Any]], perturbs: Sequence[
     spread = []
     for p in perturbs:
         unit = f" {units.get(p.key, '')}".rstrip()
-        about = f" = {original[p.key]:.4g}{unit}" if p.key in original else ""
+        about = (_key_value(p.key, original[p.key], units).removeprefix(p.key)
+                 if p.key in original else "")
         spread.append(f"{p.key}{about}, σ = {p.sigma:.3g}{unit}")
     title = f"Residual shaking force: {analysed}"
     if spread:

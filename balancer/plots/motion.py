@@ -26,6 +26,7 @@ from .style import (
     draw_frame,
     legend_outside,
     number,
+    speed_text,
 )
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
@@ -246,7 +247,7 @@ def verification_figure(design: Design, verification: Verification) -> Figure:
     title = design.title or "design"
     fig.suptitle(f"{title}: verification by simulation ({verification.method} formulation)")
     speed = design.operation.speed if design.operation else 0.0
-    runs = ((verification.driven, f"crank driven at {speed:g} rad/s", 0),
+    runs = ((verification.driven, f"crank driven at {speed_text(speed)}", 0),
             (verification.free, "free motion", 1))
     for run, label, col in runs:
         free = run is verification.free

@@ -1,7 +1,7 @@
 """Figures of one revolution at the operating speed, before and after a redesign.
 
 The shaking force's polar diagram (and the rocking couple's, for links in several planes), the
-shaking moment and the driving torque over the crank angle.
+shaking moment, the driving torque and an engine's mount torque over the crank angle.
 """
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..cycle import ROUNDING_SPAN, CycleAnalysis, drawn_panels, natural_scales
+from ..cycle import ROUNDING_SPAN, CycleAnalysis, drawn_panels, natural_scales, panel_keys
 from ..cycle import Figure as Figures
-from .style import AFTER_STYLE, BEFORE_STYLE, axes, legend_outside, number
+from .style import AFTER_STYLE, BEFORE_STYLE, axes, legend_outside, number, speed_text
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
     from matplotlib.axes import Axes
@@ -61,7 +61,17 @@ _POLAR = {"shaking_force": ("shaking force", "N"), "rocking_couple": ("rocking c
 
 #: Each drawn quantity's panel (:func:`balancer.cycle.natural_scales`).
 _PANEL = {"shaking_force": "force", "rocking_couple": "couple", "shaking_moment": "moment",
-          "driving_torque": "torque"}
+          "driving_torque": "torque", "mount_torque": "mount"}
+
+#: The quantities drawn over the crank angle: the axis' name and the panel's title.
+_OVER_ANGLE = {"shaking_moment": ("shaking moment about the origin", "shaking moment"),
+               "driving_torque": ("driving torque on the crank", "driving torque"),
+               "mount_torque": ("torque about z on the mounts", "mount torque")}
+
+
+def _values(analysis: CycleAnalysis, quantity: str) -> np.ndarray:
+    """A drawn quantity's samples over the cycle (:data:`_PANEL`'s names)."""
+    return np.asarray(drawn_panels(analysis, [_PANEL[quantity]])[_PANEL[quantity]])
 
 
 def _zero_below_rounding(analysis: CycleAnalysis, quantity: str) -> np.ndarray:
@@ -70,7 +80,7 @@ def _zero_below_rounding(analysis: CycleAnalysis, quantity: str) -> np.ndarray:
     (A balanced design's shaking moment of 1e-12 N·m is drawn as the zero it is, not as noise
     blown up to fill its panel; the label still gives its RMS and maximum.)
     """
-    values = np.asarray(getattr(analysis.reactions, quantity))
+    values = _values(analysis, quantity)
     floor = ROUNDING_SPAN * natural_scales(analysis)[_PANEL[quantity]]
     if np.nanmax(np.abs(values), initial=0.0) <= floor:
         return np.zeros_like(values)
@@ -96,8 +106,7 @@ def _polar(analysis: CycleAnalysis, before: CycleAnalysis | None, ax: Axes | Non
             continue
         colour, lw = style["color"], style["lw"]
         f = _closed(_zero_below_rounding(a, quantity))
-        ax.plot(f.real, f.imag, **style,
-                label=_cycle_label(role, getattr(a.reactions, quantity), unit))
+        ax.plot(f.real, f.imag, **style, label=_cycle_label(role, _values(a, quantity), unit))
         ax.plot(f.real[:1], f.imag[:1], "o", color=colour, ms=6, mec="k", mew=0.6, zorder=4)
         k = max(1, f.size // 8)
         if abs(f[k + 1] - f[k]) > 0:
@@ -118,15 +127,23 @@ def _polar(analysis: CycleAnalysis, before: CycleAnalysis | None, ax: Axes | Non
 def plot_over_crank_angle(analysis: CycleAnalysis, quantity: str,
                           before: CycleAnalysis | None = None, ax: Axes | None = None,
                           legend: bool = True) -> Axes:
-    """``quantity`` (``"shaking_moment"`` or ``"driving_torque"``, N·m) over the crank angle.
+    """``quantity`` over the crank angle, N·m, in degrees over the analysis' cycle.
 
-    Of ``analysis`` and, if given, ``before`` (the original's), over one revolution in degrees.
+    ``quantity`` ``"shaking_moment"``, ``"driving_torque"`` or (an engine's)
+    ``"mount_torque"``; of ``analysis`` and, if given, ``before`` (the original's).
+
+    Raises
+    ------
+    ValueError
+        For another ``quantity``, or ``"mount_torque"`` of a mechanism that has none (naming
+        what is drawn).
     """
     ax = axes(ax)
-    names = {"shaking_moment": ("shaking moment about the origin", "shaking moment"),
-             "driving_torque": ("driving torque on the crank", "driving torque")}
-    if quantity not in names:
-        raise ValueError(f"no such quantity: {quantity!r}")
+    names = _OVER_ANGLE
+    drawable = [q for q in names if _PANEL[q] in panel_keys(analysis, before)]
+    if quantity not in drawable:
+        raise ValueError(f"no such quantity to draw over the crank angle: {quantity!r} "
+                         f"(one of {', '.join(map(repr, drawable))})")
     after_role, before_role = _roles(before)
     for a, role, style in ((before, before_role, BEFORE_STYLE),
                            (analysis, after_role, AFTER_STYLE)):
@@ -134,7 +151,7 @@ def plot_over_crank_angle(analysis: CycleAnalysis, quantity: str,
             continue
         ax.plot(np.degrees(np.append(a.theta1, 2 * np.pi * a.revolutions)),
                 _closed(_zero_below_rounding(a, quantity)), **style,
-                label=_cycle_label(role, getattr(a.reactions, quantity), "N·m"))
+                label=_cycle_label(role, _values(a, quantity), "N·m"))
     span = 360.0 * analysis.revolutions
     ax.set_xlim(0.0, span)
     ax.set_xticks(np.arange(0, span + 1, 45 * analysis.revolutions))
@@ -151,40 +168,41 @@ def cycle_figure(analysis: CycleAnalysis, before: CycleAnalysis | None = None,
                  title: str = "") -> Figure:
     """The picture a balancing report starts with: one revolution at the operating speed.
 
-    The shaking force's polar diagram (beside it the rocking couple's, for links in several
-    planes), and the shaking moment and driving torque over the crank angle; of the design,
-    and of the original before it (``before``) if given. Each panel's title gives its RMS and
-    maximum (original → design); one legend below the panels.
+    The shaking force's polar diagram (beside it the rocking couple's, where the design or
+    the original has links in several planes), and the shaking moment, the driving torque and
+    (for an engine) the torque on its mounts over the crank angle; of the design, and of the
+    original before it (``before``) if given. Each panel's title gives its RMS and maximum
+    (original → design; N or N·m); one legend below the panels; the speed in rad/s and rpm.
     """
     from matplotlib.figure import Figure
 
-    planes = "couple" in drawn_panels(analysis)
-    if planes:
-        fig = Figure(figsize=(17, 7), layout="constrained")
-        axes = fig.subplot_mosaic([["force", "couple", "moment"], ["force", "couple", "torque"]],
-                                  width_ratios=[1.0, 1.0, 1.3])
-        plot_rocking_couple_polar(analysis, before, ax=axes["couple"], legend=False)
-    else:
-        fig = Figure(figsize=(12, 7), layout="constrained")
-        axes = fig.subplot_mosaic([["force", "moment"], ["force", "torque"]],
-                                  width_ratios=[1.0, 1.3])
+    keys = panel_keys(analysis, before)
+    left = [key for key in keys if key in ("force", "couple")]
+    right = [key for key in keys if key not in left]
+    fig = Figure(figsize=(7.0 + 5.0 * len(left), 3.5 * len(right)), layout="constrained")
+    axes = fig.subplot_mosaic([[*left, key] for key in right],
+                              width_ratios=[*([1.0] * len(left)), 1.3])
     plot_shaking_force_polar(analysis, before, ax=axes["force"], legend=False)
-    plot_over_crank_angle(analysis, "shaking_moment", before, ax=axes["moment"], legend=False)
-    plot_over_crank_angle(analysis, "driving_torque", before, ax=axes["torque"], legend=False)
-    units = {"force": "N", "moment": "N·m", "torque": "N·m", "couple": "N·m"}
-    for key in drawn_panels(analysis):
+    if "couple" in axes:
+        plot_rocking_couple_polar(analysis, before, ax=axes["couple"], legend=False)
+    quantities = {panel: quantity for quantity, panel in _PANEL.items()}
+    for key in right:
+        plot_over_crank_angle(analysis, quantities[key], before, ax=axes[key], legend=False)
+    units = {"force": "N", "moment": "N·m", "torque": "N·m", "couple": "N·m", "mount": "N·m"}
+    after_panels = drawn_panels(analysis, keys)
+    before_panels = drawn_panels(before, keys) if before is not None else None
+    for key in keys:
         unit = units[key]
         ax = axes[key]
-        after = drawn_panels(analysis)[key]
-        figures = [_figure_pair(drawn_panels(before)[key] if before is not None else None,
-                                after, stat) for stat in ("rms", "max")]
+        figures = [_figure_pair(before_panels[key] if before_panels is not None else None,
+                                after_panels[key], stat) for stat in ("rms", "max")]
         ax.set_title(f"{ax.get_title()}\nRMS {figures[0]} {unit}, max {figures[1]} {unit}",
                      fontsize="medium")
     handles, labels = axes["force"].get_legend_handles_labels()
     fig.legend(handles, [label.split(": RMS")[0] for label in labels],
                loc="outside lower center",
                ncols=len(handles), fontsize="small")
-    what = f"{_span(analysis)} at {analysis.speed:g} rad/s"
+    what = f"{_span(analysis)} at {speed_text(analysis.speed)}"
     if any(analysis.gravity):
         what += f", gravity ({analysis.gravity[0]:g}, {analysis.gravity[1]:g}) m/s²"
     if before is not None:

@@ -19,9 +19,10 @@ if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions t
     from matplotlib.lines import Line2D
 
 
-#: Colours for the sum, before and after (colour-blind safe, Okabe & Ito).
+#: Colours for the sum, before and after, links, centres of mass and balance shafts'
+#: eccentrics (colour-blind safe, Okabe & Ito).
 COLOURS = {"sum": "#000000", "before": "#999999", "after": "#009E73", "link": "#0072B2",
-           "com": "#D55E00"}
+           "com": "#D55E00", "eccentric": "#E69F00"}
 
 
 #: How a curve of the original (before) and of the design (after) is drawn where both are: the
@@ -55,6 +56,11 @@ def number(x: float) -> str:
     if 1.0 <= abs(x) < 1e6:
         return f"{x:.{max(3, int(np.log10(abs(x))) + 1)}g}"
     return f"{x:.3g}"
+
+
+def speed_text(speed: float) -> str:
+    """A crank speed as a designer reads it: ``"628.319 rad/s (6000 rpm)"`` from rad/s."""
+    return f"{speed:g} rad/s ({speed * 30 / np.pi:.4g} rpm)"
 
 
 def draw_frame(ax: Axes, linkage: Model | Mechanism,

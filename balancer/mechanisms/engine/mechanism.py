@@ -21,8 +21,8 @@ from functools import cached_property
 from ...linkage.rotors import Rotor, link_inertia
 from ...linkage.structure import Structure
 from ...model import Body, Linkage, Slider
-from ..base import Mechanism
-from .model import Engine
+from ..base import DrawnMass, Mechanism, piston_block
+from .model import COUNTERWEIGHT, Engine
 
 #: The main bearings' point (the crankshaft's axis at the origin).
 MAIN_BEARINGS = "O"
@@ -86,6 +86,8 @@ class EngineMechanism(Mechanism):
     #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.
     start_angle = 0.0
     reports_mount_torque = True
+    balanced_on_shafts = True
+    block_name = "pistons"
 
     @cached_property
     def linkage(self) -> Linkage:
@@ -114,3 +116,18 @@ class EngineMechanism(Mechanism):
 
     def _full_turn_rule(self) -> str:
         return " (each rod longer than its crank + |offset|)"
+
+    def slider_blocks(self) -> dict[str, tuple[float, float]]:
+        """Each piston by its cylinder's bore (without one, its stroke)."""
+        return {f"piston{k}": piston_block(c.crank, c.bore)
+                for k, c in enumerate(self.model.cylinders, start=1)}
+
+    def drawn_masses(self) -> tuple[DrawnMass, ...]:
+        """The crankshaft's counterweights (its masses labelled so) and every eccentric."""
+        weights = [DrawnMass(axis=0j, ratio=1.0, angle=math.radians(m.phase_deg), mr=m.mr,
+                             what="counterweight")
+                   for m in self.model.crankshaft.masses if m.label == COUNTERWEIGHT]
+        eccentrics = [DrawnMass(axis=complex(*s.at), ratio=float(s.ratio),
+                                angle=math.radians(m.phase_deg), mr=m.mr, what="eccentric")
+                      for s in self.model.balance_shafts for m in s.eccentrics]
+        return (*weights, *eccentrics)

@@ -21,7 +21,7 @@ from ...linkage.structure import Structure
 from ...linkage.vectors import V
 from ...model import Body, Branch, Linkage, Slider
 from ...model.assembly import AssemblyRange
-from ..base import Mechanism, Route
+from ..base import Mechanism, Route, piston_block
 from . import kinematics as closed
 from .conditions import force_balance_matrix
 from .dynamics import mass_matrix
@@ -69,6 +69,7 @@ class SliderCrankMechanism(Mechanism):
     guide_force_names = {"slider": "A3"}
     #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.
     start_angle = 0.0
+    block_name = "pistons"
 
     @cached_property
     def linkage(self) -> Linkage:
@@ -85,6 +86,10 @@ class SliderCrankMechanism(Mechanism):
     @property
     def branch(self) -> Branch:
         return self.model.branch
+
+    def slider_blocks(self) -> dict[str, tuple[float, float]]:
+        """The slider drawn as a piston (a slider-crank is mostly an engine's cylinder)."""
+        return {"slider": piston_block(self.model.lengths[0], None)}
 
     def assembly_range(self) -> AssemblyRange:
         return closed.assembly_range(self.model.lengths)
