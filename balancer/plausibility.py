@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from typing import Any, TypeGuard
 
+from . import validate as v
 from .cycle import sample_angles
 from .errors import BalancerError
 from .mechanisms import mechanism_of
@@ -71,7 +72,7 @@ def _lengths(data: dict[str, Any]) -> list[tuple[str, float, str]]:
     for i, spring in enumerate(springs if isinstance(springs, list) else ()):
         value = spring.get("free_length") if isinstance(spring, dict) else None
         if _number(value):
-            key = f"springs[{i}].free_length"
+            key = f"{v.item('springs', i)}.free_length"
             out.append((key, abs(value), f"{key} = {value:g} m"))
     return out
 

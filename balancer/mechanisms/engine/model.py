@@ -270,7 +270,7 @@ def _masses(items: Sequence[Mass], key: str) -> tuple[Mass, ...]:
     out = tuple(items)
     for i, m in enumerate(out):
         if not isinstance(m, Mass):
-            raise SpecError("must be a Mass", key=f"{key}[{i}]", value=m)
+            raise SpecError("must be a Mass", key=v.item(key, i), value=m)
     return out
 
 
@@ -318,7 +318,7 @@ class Engine(MechanismModel):
                             key="mechanism.cylinders", value=self.cylinders)
         for i, c in enumerate(cylinders):
             if not isinstance(c, Cylinder):
-                raise SpecError("must be a Cylinder", key=f"mechanism.cylinders[{i}]", value=c)
+                raise SpecError("must be a Cylinder", key=v.item("mechanism.cylinders", i), value=c)
         v.store(self, "cylinders", cylinders)
         if not isinstance(self.crankshaft, Crankshaft):
             raise SpecError("must be a Crankshaft", key="links.crankshaft",
@@ -329,7 +329,7 @@ class Engine(MechanismModel):
         shafts = tuple(self.balance_shafts)
         for j, s in enumerate(shafts):
             if not isinstance(s, BalanceShaft):
-                raise SpecError("must be a BalanceShaft", key=f"balance_shafts[{j}]", value=s)
+                raise SpecError("must be a BalanceShaft", key=v.item("balance_shafts", j), value=s)
         v.store(self, "balance_shafts", shafts)
         strokes = v.number(self.strokes, "mechanism.strokes")
         if strokes not in (2, 4):
@@ -352,7 +352,7 @@ class Engine(MechanismModel):
             for i, c in enumerate(cylinders):
                 if c.bore is None:
                     raise SpecError("an engine with gas needs each cylinder's bore",
-                                    key=f"mechanism.cylinders[{i}].bore", value=c.bore)
+                                    key=f"{v.item('mechanism.cylinders', i)}.bore", value=c.bore)
             angles = self.gas.crank_angle_deg
             if angles[0] < 0 or angles[-1] >= 180 * self.strokes or any(
                     b <= a for a, b in zip(angles, angles[1:], strict=False)):
@@ -440,11 +440,11 @@ class Engine(MechanismModel):
         """Each cylinder's crank, rod and offset, and each shaft's distance from the axis, m."""
         out: dict[str, float] = {}
         for i, c in enumerate(self.cylinders):
-            key = f"mechanism.cylinders[{i}]"
+            key = v.item("mechanism.cylinders", i)
             out.update({f"{key}.crank": c.crank, f"{key}.rod": c.rod,
                         f"{key}.offset": abs(c.offset)})
         for j, s in enumerate(self.balance_shafts):
-            out[f"balance_shafts[{j}].at"] = math.hypot(*s.at)
+            out[f"{v.item('balance_shafts', j)}.at"] = math.hypot(*s.at)
         return out
 
     @property
