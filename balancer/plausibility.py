@@ -133,7 +133,9 @@ def speed_note(design: Design) -> str | None:
     radius = tip_radius(design.mechanism)
     if radius is None or not speed * radius > MAX_TIP_SPEED:
         return None
-    return (f"operation.speed = {design.operation.speed:g} rad/s moves a point {radius:.4g} m "
+    rpm = design.operation.speed * 30 / math.pi
+    return (f"operation.speed = {design.operation.speed:g} rad/s ({rpm:.4g} rpm) moves a point "
+            f"{radius:.4g} m "
             f"from the crank's pivot at {speed * radius:.4g} m/s, faster than sound "
             f"({MAX_TIP_SPEED:g} m/s): the speed is in rad/s (rpm written as rad/s?) and "
             "lengths in metres (mm written as m?)")

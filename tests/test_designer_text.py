@@ -1,19 +1,183 @@
-"""What the designer reads is what is true (issue 40).
+"""What the designer reads is what is true (issue 40): rounding, engines' reports, the docs.
 
-- ``N_<link>`` points as docs/outputs.md says: the force of a sliding link on its guide, along
-  the guide's direction turned +90°, checked by summing the frame's forces.
+- A figure that is rounding of its quantity's scale is printed 0 in every text table (the
+  JSON keeps every digit), and a ratio between rounding figures is no figure
+  (:class:`balancer.rounding.Scales`).
+- ``N_<link>`` points as docs/outputs.md says; speeds come with rpm; a cycle of 720° says its
+  samples the same way in the API and the command line.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
 
 from balancer.api import analyze
+from balancer.balance.optimizer import optimize
+from balancer.cycle import CycleSummary, Figure
+from balancer.report import (
+    analysis_json,
+    analysis_text,
+    optimization_json,
+    optimization_text,
+    simulation_text,
+    verification_text,
+    worse_figures,
+)
+from balancer.rounding import ROUNDING, Scales
+from balancer.simulation import simulate
 from balancer.spec import load_design
+from balancer.verification import RunCheck, Verification
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
+
+
+def _row(text: str, label: str) -> list[str]:
+    """The cells of the table row that begins with ``label`` (split on two spaces or more)."""
+    for line in text.splitlines():
+        if line.startswith(label + "  "):
+            return [c.strip() for c in line[len(label):].split("  ") if c.strip()]
+    raise AssertionError(f"no row {label!r} in\n{text}")
+
+
+# ---------------------------------------------------------------------------------------------
+# The rule
+
+
+def test_the_rule_prints_rounding_as_zero_and_no_ratio_of_rounding():
+    sc = Scales([("N", 697.0), ("N", 4.3e-14), ("N·m", 573.0), ("N·m", None),
+                 ("N·m", math.nan)])
+    assert sc.scale == {"N": 697.0, "N·m": 573.0}
+    assert sc.fmt(4.3317e-14, "N").strip() == "0"
+    assert sc.fmt(697.254, "N").strip() == "697.254"
+    limit = ROUNDING * 697.0
+    assert sc.rounding(limit, "N") and not sc.rounding(2 * limit, "N")
+    assert sc.number(2 * limit, "N", ".4g") == f"{2 * limit:.4g}"  # above it: the figure
+    assert sc.ratio(4.3e-14, 430.0, "N") == "0"        # after rounding, before not
+    assert sc.ratio(8e-13, 8e-13, "N") == "—"          # both rounding
+    assert sc.ratio(430.0, 8e-13, "N") == "—"          # risen from rounding: no ratio
+    assert sc.ratio(1.0, None, "N") == "—" and sc.ratio(1.0, 0.0, "N") == "—"
+    assert sc.ratio(330.923, 147.315, "N") == "2.25"
+    assert Scales().fmt(1e-30, "N").strip() == "1.0000e-30"  # no scale: nothing is rounding
+
+
+def test_analyze_prints_the_v8s_shaking_moment_and_free_orders_as_zero_the_json_keeps_them():
+    """The issue's case: `analyze examples/v8.toml` listed 'shaking moment 8.0194e-13' and
+    orders of 1.4348e-11 N beside 523 N; the JSON keeps every digit."""
+    cycle = analyze(load_design(EXAMPLES / "v8.toml"))
+    text = analysis_text(cycle)
+    assert _row(text, "shaking moment") == ["0", "0", "N·m"]
+    assert _row(text, "shaking force")[:2] == ["369.977", "523.574"]
+    order1 = _row(text, "1")
+    assert order1[:6] == ["0"] * 6 and order1[-2] == "0.793019"  # only the couple's forward
+    doc = analysis_json(cycle)
+    assert 0 < doc["shaking_moment"]["rms"] < ROUNDING * doc["driving_torque"]["max"]
+    assert 0 < abs(doc["orders"][1]["shaking_force"]["x"]) < 1e-9
+    assert "e-1" not in text
+
+
+def test_analyze_of_a_mechanism_without_rounding_prints_every_figure():
+    text = analysis_text(analyze(load_design(EXAMPLES / "pb1.toml")))
+    assert _row(text, "shaking moment") == ["214.892", "573.986", "N·m"]
+    assert _row(text, "8")[:2] == ["1.13153", "0.921561"]
+
+
+@pytest.fixture(scope="module")
+def pb1():
+    design = load_design(EXAMPLES / "pb1.toml")
+    return design, optimize(design, "convex")
+
+
+def test_optimize_prints_the_balanced_force_as_zero_and_its_ratio_zero(pb1):
+    """PB1's after-figures of the shaking force were 7.6e-14 N beside 697 N, the ratio
+    1.76e-16: now 0 and 0; the JSON keeps them."""
+    _, result = pb1
+    before, after = result.operating
+    text = optimization_text(result, before, after)
+    assert _row(text, "shaking force") == ["430.272", "0", "0", "697.254", "0", "N"]
+    assert _row(text, "shaking moment")[1:3] == ["101.59", "0.473"]
+    assert _row(text, "1: force forward") == ["394.105", "0", "N"]
+    doc = optimization_json(result, before, after)
+    assert 0 < doc["after"]["shaking_force"]["rms"] < 1e-10
+    assert "force-balanced: yes" in text
+
+
+def test_a_ratio_of_two_rounding_figures_is_no_figure():
+    """`optimize examples/v8_to_balance.toml` printed the ratio 1 between 8e-13 and 8e-13."""
+    design = load_design(EXAMPLES / "v8_to_balance.toml")
+    result = optimize(design, "convex")
+    text = optimization_text(result, *result.operating)
+    assert _row(text, "shaking moment") == ["0", "0", "—", "0", "0", "N·m"]
+    assert _row(text, "driving torque")[2] == "1"
+    assert _row(text, "1: couple backward") == ["0", "0", "N·m"]
+
+
+def test_the_verdict_gives_a_rounding_optimum_as_zero():
+    """PB2's complete balance: 'RMS shaking moment 6.48695e-10 N·m (3.02e-12 of the
+    original's)' is 0 to the problem's scale (214.9 N·m)."""
+    result = optimize(load_design(EXAMPLES / "pb2.toml"), "convex")
+    assert "RMS shaking moment 0 N·m (0 of the original's)" in result.message
+    assert 0 < result.rms < ROUNDING * result.scale
+
+
+def _summary(force: float, moment: float, torque: float, ground: float) -> CycleSummary:
+    def fig(x: float) -> Figure:
+        return Figure(rms=x, max=x)
+
+    return CycleSummary(shaking_force=fig(force), shaking_moment=fig(moment),
+                        driving_torque=fig(torque), rocking_couple=fig(0.0),
+                        ground={"A0": fig(ground)}, slider_normal={}, slider_couple={})
+
+
+def test_a_rounding_figure_that_doubles_is_no_warning_one_that_rises_from_it_is():
+    before = SimpleNamespace(summary=_summary(400.0, 2e-13, 100.0, 900.0), orders=())
+    same = SimpleNamespace(summary=_summary(400.0, 5e-13, 100.0, 900.0), orders=())
+    assert worse_figures(before, same) == []  # (2.5× of rounding: no warning)
+    risen = SimpleNamespace(summary=_summary(400.0, 50.0, 100.0, 900.0), orders=())
+    warnings = worse_figures(before, risen)
+    assert warnings == [
+        "the shaking moment's RMS rises from 0 (to rounding) to 50 N·m",
+        "the shaking moment's maximum rises from 0 (to rounding) to 50 N·m"]
+
+
+def _run(force, original_force, moment, original_moment):
+    return RunCheck(trajectory=None, original=None, max_shaking_force=force,
+                    max_shaking_moment=moment, original_max_shaking_force=original_force,
+                    original_max_shaking_moment=original_moment, max_rocking_couple=0.0,
+                    original_max_rocking_couple=0.0)
+
+
+def test_verify_prints_rounding_as_zero_and_its_ratios_as_zero_or_none():
+    check = Verification(method="complex-masses",
+                         driven=_run(6.551e-14, 697.3, 1.211e-13, 574.0),
+                         free=_run(8.0e-16, 5.38, 3e-14, 2e-14))
+    text = verification_text(check)
+    assert _row(text, "driven at the operating speed") == [
+        "0", "697.3", "0", "—", "0", "574", "0"]
+    # The free run's moments are both rounding of the report's scale (574 N·m): no ratio.
+    assert _row(text, "free from the initial state") == ["0", "5.38", "0", "—", "0", "0", "—"]
+
+
+def test_simulate_prints_a_balanced_design_s_shaking_force_as_zero(pb1):
+    design, result = pb1
+    balanced = result.balanced_design(design)
+    settings = replace(balanced.simulation, drive="constant-speed", omega1=10.0,
+                       duration=0.2, outputs=11)
+    traj = simulate(balanced.mechanism, settings)
+    text = simulation_text(traj)
+    assert _row(text, "shaking force") == ["0", "0", "N"]
+    assert float(_row(text, "driving torque")[1]) > 100
+    assert "10 rad/s (95.49 rpm)" in text
+    assert 0 < max(abs(traj.shaking_force)) < 1e-10
+
+
+# ---------------------------------------------------------------------------------------------
+# The guide forces' direction, the cycle's words
 
 
 def test_a_piston_s_normal_force_points_along_its_axis_turned_a_quarter_turn():
@@ -29,3 +193,14 @@ def test_a_piston_s_normal_force_points_along_its_axis_turned_a_quarter_turn():
     force = col["shaking_force_x"] + 1j * col["shaking_force_y"]
     assert max(abs(total - force)) < 1e-12 * max(abs(col["N_piston1"]))
     assert max(abs(col["N_piston1"])) > 1000  # (not a sum of zeros)
+
+
+def test_a_four_stroke_cycle_says_its_samples_the_same_way_everywhere():
+    cycle = analyze(load_design(EXAMPLES / "inline_four.toml"))  # (with gas: over 720°)
+    assert cycle.samples == 1440
+    words = "720 angles per revolution over a cycle of 720° (1440 in all) at 628.319 rad/s"
+    assert words in repr(cycle) and "(6000 rpm)" in repr(cycle)
+    assert ("720 crank angles per revolution over a cycle of 720° (1440 in all) at 628.319 "
+            "rad/s (6000 rpm)") in analysis_text(cycle)
+    one = analyze(load_design(EXAMPLES / "pb1.toml"))
+    assert "360 angles per revolution at 10 rad/s (95.49 rpm)" in repr(one)
