@@ -3,12 +3,14 @@
 - A figure that is rounding of its quantity's scale is printed 0 in every text table (the
   JSON keeps every digit), and a ratio between rounding figures is no figure
   (:class:`balancer.rounding.Scales`).
-- ``N_<link>`` points as docs/outputs.md says; speeds come with rpm; a cycle of 720° says its
-  samples the same way in the API and the command line.
+- An engine's mount torque is a column of ``analyze --csv``; ``N_<link>`` points as
+  docs/outputs.md says; speeds come with rpm; a cycle of 720° says its samples the same way in
+  the API and the command line.
 """
 
 from __future__ import annotations
 
+import csv
 import math
 from dataclasses import replace
 from pathlib import Path
@@ -18,6 +20,7 @@ import pytest
 
 from balancer.api import analyze
 from balancer.balance.optimizer import optimize
+from balancer.cli import main
 from balancer.cycle import CycleSummary, Figure
 from balancer.report import (
     analysis_json,
@@ -177,7 +180,23 @@ def test_simulate_prints_a_balanced_design_s_shaking_force_as_zero(pb1):
 
 
 # ---------------------------------------------------------------------------------------------
-# The guide forces' direction, the cycle's words
+# The CSV's mount torque, the guide forces' direction, the cycle's words
+
+
+def test_the_mount_torque_is_the_analyze_csv_s_last_column(tmp_path, capsys):
+    out = tmp_path / "v8.csv"
+    assert main(["analyze", str(EXAMPLES / "v8.toml"), "--csv", str(out)]) == 0
+    rows = list(csv.reader(out.read_text().splitlines()))
+    assert rows[0][-2:] == ["driving_torque", "mount_torque"]
+    header = rows[0]
+    values = [dict(zip(header, map(float, r), strict=True)) for r in rows[1:]]
+    assert all(r["mount_torque"] == r["shaking_moment"] + r["driving_torque"] for r in values)
+    peak = max(abs(r["mount_torque"]) for r in values)
+    assert peak == pytest.approx(analyze(load_design(EXAMPLES / "v8.toml")).summary
+                                 .mount_torque.max, rel=1e-15)
+    pb1 = tmp_path / "pb1.csv"
+    assert main(["analyze", str(EXAMPLES / "pb1.toml"), "--csv", str(pb1)]) == 0
+    assert "mount_torque" not in pb1.read_text().splitlines()[0]
 
 
 def test_a_piston_s_normal_force_points_along_its_axis_turned_a_quarter_turn():
