@@ -3,7 +3,8 @@
 - A figure that is rounding of its quantity's scale is printed 0 in every text table (the
   JSON keeps every digit), and a ratio between rounding figures is no figure
   (:class:`balancer.rounding.Scales`).
-- An engine's mount torque is a column of ``analyze --csv``; ``N_<link>`` points as
+- An engine's balancing writes its original (``[original]``), which ``analyze``, ``plot`` and
+  ``verify`` read. An engine's mount torque is a column of ``analyze --csv``; ``N_<link>`` points as
   docs/outputs.md says; speeds come with rpm; a cycle of 720° says its samples the same way in
   the API and the command line.
 """
@@ -11,6 +12,8 @@
 from __future__ import annotations
 
 import csv
+import io
+import json
 import math
 from dataclasses import replace
 from pathlib import Path
@@ -18,10 +21,11 @@ from types import SimpleNamespace
 
 import pytest
 
-from balancer.api import analyze
+from balancer.api import analyze, cycle_analyses, verify
 from balancer.balance.optimizer import optimize
 from balancer.cli import main
 from balancer.cycle import CycleSummary, Figure
+from balancer.errors import SpecError
 from balancer.report import (
     analysis_json,
     analysis_text,
@@ -33,7 +37,7 @@ from balancer.report import (
 )
 from balancer.rounding import ROUNDING, Scales
 from balancer.simulation import simulate
-from balancer.spec import load_design
+from balancer.spec import load_design, loads_design
 from balancer.verification import RunCheck, Verification
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -177,6 +181,68 @@ def test_simulate_prints_a_balanced_design_s_shaking_force_as_zero(pb1):
     assert float(_row(text, "driving torque")[1]) > 100
     assert "10 rad/s (95.49 rpm)" in text
     assert 0 < max(abs(traj.shaking_force)) < 1e-10
+
+
+# ---------------------------------------------------------------------------------------------
+# An engine's balancing: its original, its costs, its balance factors
+
+
+@pytest.fixture(scope="module")
+def three(tmp_path_factory):
+    """``inline_three_to_balance`` balanced: the written spec, the report and the JSON."""
+    folder = tmp_path_factory.mktemp("three")
+    out = folder / "balanced.toml"
+    spec = str(EXAMPLES / "inline_three_to_balance.toml")
+    text, doc = io.StringIO(), io.StringIO()
+    from contextlib import redirect_stderr, redirect_stdout
+
+    with redirect_stdout(text), redirect_stderr(io.StringIO()):
+        assert main(["optimize", spec, "--no-verify", "--out", str(out)]) == 0
+    with redirect_stdout(doc):
+        assert main(["optimize", spec, "--no-verify", "--json", "--backend", "convex"]) == 0
+    return out, text.getvalue(), json.loads(doc.getvalue())
+
+
+def test_an_engine_s_written_spec_keeps_its_original(three):
+    out, _, _ = three
+    written = out.read_text()
+    assert "[original.crankshaft]" in written and "[original.piston]" in written
+    balanced = load_design(out)
+    original = load_design(EXAMPLES / "inline_three_to_balance.toml").mechanism
+    assert balanced.original == original  # read back exactly: masses, rod, piston, shafts
+    assert balanced.mechanism != original
+    assert loads_design(written).original == original
+
+
+def test_an_engine_s_original_is_what_plot_and_verify_show(three):
+    out, _, _ = three
+    design = load_design(out)
+    now, before = cycle_analyses(design, samples=720)
+    assert before is not None
+    unbalanced = analyze(load_design(EXAMPLES / "inline_three_to_balance.toml"))
+    assert before.summary.rocking_couple.rms == pytest.approx(
+        unbalanced.summary.rocking_couple.rms, rel=1e-12)
+    assert now.summary.rocking_couple.rms < 0.4 * before.summary.rocking_couple.rms
+    check = verify(design, duration=0.005)
+    for run in (check.driven, check.free):
+        assert run.original_max_rocking_couple is not None
+        assert run.max_rocking_couple < run.original_max_rocking_couple
+    text = verification_text(check)  # (the original's figures, not "—" as before)
+    couples = text.split("max |Mrock| (N·m)", 1)[1]
+    original = float(_row(couples.split("\n", 2)[2], "driven at the operating speed")[1])
+    assert original == pytest.approx(check.driven.original_max_rocking_couple, rel=1e-3)
+
+
+def test_an_engine_s_original_key_errors_are_named_there(three):
+    out, _, _ = three
+    text = out.read_text().replace("[original.piston]\nmass = 0.38", "[original.piston]\nmass = -1")
+    with pytest.raises(SpecError) as caught:
+        loads_design(text)
+    assert caught.value.key == "original.piston.mass"
+    text = out.read_text().replace("[original.rod]\nmass", "[original.rod]\nmas")
+    with pytest.raises(SpecError, match="original.rod.mas: unknown key 'mas'; did you mean "
+                                        "'mass'"):
+        loads_design(text)
 
 
 # ---------------------------------------------------------------------------------------------

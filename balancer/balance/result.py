@@ -363,12 +363,10 @@ class BalanceResult:
         return self.status is Status.OPTIMAL
 
     def balanced_design(self, design: Design) -> Design:
-        """The spec ``design`` with the balanced linkage, and the original kept as ``original``.
+        """The spec ``design`` with the balanced mechanism, and the original kept as ``original``.
 
-        (An engine's balancing keeps no original: what it added is labelled in its spec.)
+        (An engine's too: its crankshaft with the counterweights it had, its shafts.)
         """
-        if self.rotor_masses is not None:
-            return replace(design, mechanism=self.linkage)
         return replace(
             design,
             mechanism=self.linkage,
