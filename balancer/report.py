@@ -18,6 +18,7 @@ from .balance.counterweights import UNCHANGED, Counterweight
 from .balance.front import FIGURES, Front
 from .cycle import CycleAnalysis, Figure
 from .errors import SolverError
+from .mechanisms.engine.model import COUNTERWEIGHT, Engine, Throw
 from .orders import order_name
 from .rounding import Scales
 from .rounding import figure_text as _fmt
@@ -573,9 +574,17 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis, after: Cycle
                       **({} if result.rotor_masses is None else {
                           "mr": "kg·m", "phase_deg": "degrees at θ1 = 0", "z, at": "m",
                           "max_bearing_load": "N"}),
-                      "sigma": "rad", "disc radius, thickness": "m"},
+                      "sigma": "rad", "disc radius, thickness": "m",
+                      **({} if result.rotor_masses is None else {
+                          "rotating_mr, reciprocating_mr, counterweight_mr": "kg·m",
+                          "factor": "dimensionless: counterweight_mr / (rotating_mr + "
+                                    "reciprocating_mr/2)"})},
         }
     )
+    factors = balance_factors(result)
+    if factors is not None:  # an engine's (after the keys every document has)
+        doc["balance_factors"] = {"before": [t.as_dict() for t in factors[0]],
+                                  "after": [t.as_dict() for t in factors[1]]}
     return doc
 
 
@@ -673,11 +682,15 @@ def counterweight_text(weights: Mapping[str, Counterweight]) -> str:
             + "\n" + "\n".join(notes))
 
 
-def rotor_masses_text(masses: RotorMasses, speed: float) -> str:
+def rotor_masses_text(masses: RotorMasses, speed: float, before: CycleAnalysis | None = None,
+                      after: CycleAnalysis | None = None) -> str:
     """What an engine's balancing builds: per plane the counterweight, per shaft its eccentrics.
 
     Each mass·radius (kg·m) at its angle at θ1 = 0 (degrees), its plane (mm), its mass at the
-    given radius (kg); then what they cost: their centrifugal loads (N).
+    given radius (kg); then what they cost: their centrifugal forces (N, the objective's
+    unbalance), the main bearings' net reaction before and after (N, from ``before`` and
+    ``after``, the analyses at the operating speed) and each new shaft's net force on its
+    bearings.
     """
     rows = []
     for c in masses.counterweights:
@@ -698,15 +711,52 @@ def rotor_masses_text(masses: RotorMasses, speed: float) -> str:
                         "their planes")]
     if masses.radius is not None:
         notes[0] += f"; mass at radius {1e3 * masses.radius:.6g} mm"
-    notes.append(f"their centrifugal load √Σ(mr·ω²)²: {masses.unbalance_before:.6g} N before, "
-                 f"{masses.unbalance_after:.6g} N after (ω = {speed_text(speed)})")
+    notes.append(f"their centrifugal forces mr·ω² at ω = {speed_text(speed)}, "
+                 f"root-sum-square √Σ(mr·ω²)² (the objective's unbalance; the bearings share "
+                 f"these forces, it is no bearing's load): {masses.unbalance_before:.6g} N "
+                 f"before, {masses.unbalance_after:.6g} N after")
+    if before is not None and after is not None and "O" in before.reactions.ground:
+        b, a = before.summary.ground["O"].max, after.summary.ground["O"].max
+        notes.append(f"the main bearings' net reaction RO (all of them together: the force "
+                     f"they pass to the frame): largest {b:.6g} N before, {a:.6g} N after")
     for j, (s, load) in enumerate(zip(masses.shafts, masses.bearing_loads, strict=True),
                                   start=1):
-        # Its eccentrics' centrifugal forces are the scale of its bearing load (rounding where
-        # opposed eccentrics leave no net force).
+        # Its eccentrics' centrifugal forces are the scale of the force they leave on its
+        # bearings together (opposed eccentrics leave a couple, and no net force).
         sc = Scales(("N", e.mr * (s.ratio * speed) ** 2) for e in s.eccentrics)
-        notes.append(f"new shaft {j}: largest bearing load {sc.number(load, 'N')} N")
+        notes.append(f"new shaft {j}: largest net force on its bearings {sc.number(load, 'N')} N")
     return table(rows, header) + "\n" + "\n".join(notes)
+
+
+def balance_factors(result: BalanceResult) -> tuple[tuple[Throw, ...], tuple[Throw, ...]] | None:
+    """An engine's throws before and after balancing (:meth:`Engine.throws`), or ``None``.
+
+    The same throws for both: each design's counterweight planes separate the other's too.
+    """
+    old, new = result.original, result.linkage
+    if not isinstance(old, Engine) or not isinstance(new, Engine):
+        return None
+
+    def webs(engine: Engine) -> list[float]:
+        return [m.z for m in engine.crankshaft.masses
+                if m.label == COUNTERWEIGHT and m.mr > 0]
+
+    return old.throws(webs(new)), new.throws(webs(old))
+
+
+def balance_factors_text(before: Sequence[Throw], after: Sequence[Throw]) -> str:
+    """Each throw's balance factor before and after, as engine designers quote it."""
+    rows = []
+    for k, (b, a) in enumerate(zip(before, after, strict=True), start=1):
+        rows.append([f"{k}", ", ".join(str(c) for c in b.cylinders), f"{b.phase_deg:.6g}",
+                     f"{b.rotating_mr:.6g}", f"{b.reciprocating_mr:.6g}",
+                     f"{b.counterweight_mr:.6g}", f"{a.counterweight_mr:.6g}",
+                     f"{100 * b.factor:.3g} %", f"{100 * a.factor:.3g} %"])
+    return ("balance factor of each throw: its counterweights' mr (opposite its pin) over its "
+            "rotating mr + ½ its reciprocating mr (rods split at their centres of mass):\n"
+            + table(rows, ["throw", "cylinders", "pin °", "rotating kg·m",
+                           "reciprocating kg·m", "counterweights kg·m before", "after",
+                           "factor before", "after"]))
 
 
 def _parameters_text(result: BalanceResult) -> str:
@@ -825,7 +875,10 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
                              sc.fmt(a, "N·m"), "N·m"])
     lines += [table(rows, ["order amplitude", "before", "after", "unit"]), ""]
     if result.rotor_masses is not None:  # an engine: what to build, not changed links
-        lines += [rotor_masses_text(result.rotor_masses, before.speed), ""]
+        lines += [rotor_masses_text(result.rotor_masses, before.speed, before, after), ""]
+        factors = balance_factors(result)
+        if factors is not None:
+            lines += [balance_factors_text(*factors), ""]
     else:
         lines += [_parameters_text(result), "", counterweight_text(result.counterweights), ""]
     lines.append(_force_balance_line(after))

@@ -1,12 +1,12 @@
-"""What the designer reads is what is true (issue 40): rounding, engines' reports, the docs.
+"""What the designer reads is what is true (issue 40): rounding, engines' reports, messages.
 
 - A figure that is rounding of its quantity's scale is printed 0 in every text table (the
   JSON keeps every digit), and a ratio between rounding figures is no figure
   (:class:`balancer.rounding.Scales`).
 - An engine's balancing writes its original (``[original]``), which ``analyze``, ``plot`` and
-  ``verify`` read. An engine's mount torque is a column of ``analyze --csv``; ``N_<link>`` points as
-  docs/outputs.md says; speeds come with rpm; a cycle of 720° says its samples the same way in
-  the API and the command line.
+  ``verify`` read; its report names the counterweights' centrifugal forces as what they are and
+  gives each throw's balance factor, checked here by a route of its own from the spec's
+  numbers; the mount torque is a CSV column; speeds come with rpm.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ import csv
 import io
 import json
 import math
+import tomllib
 from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
@@ -243,6 +244,92 @@ def test_an_engine_s_original_key_errors_are_named_there(three):
     with pytest.raises(SpecError, match="original.rod.mas: unknown key 'mas'; did you mean "
                                         "'mass'"):
         loads_design(text)
+
+
+def test_an_engine_report_names_the_centrifugal_forces_and_gives_rpm(three):
+    _, text, doc = three
+    line = next(x for x in text.splitlines() if x.startswith("their centrifugal forces"))
+    assert "root-sum-square" in line and "no bearing's load" in line and "6000 rpm" in line
+    assert "the main bearings' net reaction RO" in text
+    # The shaft's two opposed eccentrics leave its bearings no net force: rounding, printed 0.
+    assert "new shaft 1: largest net force on its bearings 0 N" in text
+    assert 0 <= doc["balance_shafts"][0]["max_bearing_load"] < 1e-9
+
+
+def _factor_by_hand(rod_mass, e, rod, piston, crank, pin_mr, counterweights):
+    """A throw's balance factor from the spec's numbers: counterweights' mr opposite the pin
+    over pin + the rod's big-end share + half the reciprocating (piston + small-end share)."""
+    rotating = pin_mr + rod_mass * (1 - e / rod) * crank
+    reciprocating = (piston + rod_mass * e / rod) * crank
+    return counterweights / (rotating + reciprocating / 2)
+
+
+def test_a_single_s_counterweights_balance_its_rotating_and_half_its_reciprocating_mass():
+    """The single's comment: counterweights of m_pin·r + m_rod·(1 − e/l)·r + ½·m_rec·r — a
+    balance factor of 100 % in the convention engine designers quote for a throw."""
+    spec = tomllib.loads((EXAMPLES / "single_cylinder.toml").read_text())
+    (throw,) = load_design(EXAMPLES / "single_cylinder.toml").mechanism.throws()
+    rod, lengths = spec["links"]["rod"], spec["mechanism"]["lengths"]
+    expected = _factor_by_hand(rod["mass"], rod["com"]["e"], lengths["rod"],
+                               spec["links"]["piston"]["mass"], lengths["crank"], 0.0113,
+                               2 * 0.01539)
+    assert throw.cylinders == (1,)
+    assert throw.factor == pytest.approx(expected, rel=1e-12)
+    assert throw.factor == pytest.approx(1.0, abs=1e-3)
+
+
+def test_throws_are_the_cylinders_on_one_pin():
+    four = load_design(EXAMPLES / "inline_four.toml").mechanism
+    assert [t.cylinders for t in four.throws()] == [(1,), (2,), (3,), (4,)]
+    spec = tomllib.loads((EXAMPLES / "inline_four.toml").read_text())
+    rod, lengths = spec["links"]["rod"], spec["mechanism"]["lengths"]
+    expected = _factor_by_hand(rod["mass"], rod["com"]["e"], lengths["rod"],
+                               spec["links"]["piston"]["mass"], lengths["crank"], 0.0105,
+                               2 * 0.0103)
+    assert all(t.factor == pytest.approx(expected, rel=1e-12) for t in four.throws())
+    # Without counterweights between them, cylinders 2 and 3 (both at 180°) share a pin.
+    bare = replace(four, crankshaft=replace(four.crankshaft, masses=tuple(
+        m for m in four.crankshaft.masses if m.label != "counterweight")))
+    assert [t.cylinders for t in bare.throws()] == [(1,), (2, 3), (4,)]
+    assert all(t.factor == 0 for t in bare.throws())
+    v8 = load_design(EXAMPLES / "v8.toml").mechanism
+    assert [t.cylinders for t in v8.throws()] == [(1, 2), (3, 4), (5, 6), (7, 8)]
+
+
+def test_optimize_gives_each_throw_s_balance_factor_before_and_after(three):
+    """The balanced in-line three by hand: its end webs' new counterweights (from the JSON's
+    crankshaft_counterweights) and the inner webs' kept ones, each throw's nearest."""
+    _, text, doc = three
+    spec = tomllib.loads((EXAMPLES / "inline_three_to_balance.toml").read_text())
+    rod, lengths = spec["links"]["rod"], spec["mechanism"]["lengths"]
+    piston = spec["links"]["piston"]["mass"]
+    new = {c["z"]: c for c in doc["crankshaft_counterweights"]}
+    factors = doc["balance_factors"]
+    assert [t["cylinders"] for t in factors["before"]] == [[1], [2], [3]]
+    for k, (pin_z, phase) in enumerate(((-0.091, 0.0), (0.0, 120.0), (0.091, 240.0))):
+        kept = [m for m in spec["links"]["crankshaft"]["masses"]
+                if m.get("label") == "counterweight" and m["z"] not in new
+                and min((-0.091, 0.0, 0.091), key=lambda z: abs(z - m["z"])) == pin_z]
+        added = [c for z, c in new.items()
+                 if min((-0.091, 0.0, 0.091), key=lambda p: abs(p - z)) == pin_z]
+        opposite = sum(-m["mr"] * math.cos(math.radians(m["phase_deg"] - phase))
+                       for m in (*kept, *added))
+        expected = _factor_by_hand(rod["mass"], rod["com"]["e"], lengths["rod"], piston,
+                                   lengths["crank"], 0.012, opposite)
+        after = factors["after"][k]
+        assert after["counterweight_mr"] == pytest.approx(opposite, rel=1e-12)
+        assert after["factor"] == pytest.approx(expected, rel=1e-12)
+        assert factors["before"][k]["factor"] == pytest.approx(
+            _factor_by_hand(rod["mass"], rod["com"]["e"], lengths["rod"], piston,
+                            lengths["crank"], 0.012, 2 * 0.01438), rel=1e-12)
+    assert list(doc)[-1] == "balance_factors"  # after the keys every document has
+    assert "balance factor of each throw" in text
+    assert _row(text, "2")[-2:] == ["70.6 %", "70.6 %"]
+
+
+def test_a_linkage_s_optimize_json_has_no_balance_factors(pb1):
+    _, result = pb1
+    assert "balance_factors" not in optimization_json(result, *result.operating)
 
 
 # ---------------------------------------------------------------------------------------------
