@@ -70,6 +70,9 @@ class AnalysisLike(Protocol):
     @property
     def samples(self) -> int:
         """Number of samples."""
+    @property
+    def mount_torque(self) -> NDArray[np.float64] | None:
+        """An engine's torque about z on its mounts, N·m (``None``: not an engine)."""
 
 
 class TrajectoryLike(FrameForces, Protocol):
@@ -132,7 +135,8 @@ def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     ``t``; per moving link ``k`` (1, 2, … in the spec's order) ``theta{k}``, ``omega{k}``,
     ``alpha{k}`` (rad, rad/s, rad/s²); the forces on the frame (:func:`frame_force_columns`);
     the sliders on the frame (:func:`slider_columns`); then the shaking force's components,
-    the shaking moment, the rocking couple's components and the driving torque. For every
+    the shaking moment, the rocking couple's components and the driving torque; an engine's
+    ``mount_torque`` last (N·m: the shaking moment plus the driving torque). For every
     mechanism: the columns of ``simulate``'s CSV (whatever its formulation), then the shaking.
     """
     mo, r = analysis.motion, analysis.reactions
@@ -152,6 +156,9 @@ def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     names += list(SHAKING_COLUMNS)
     cols += [r.shaking_force.real, r.shaking_force.imag, r.shaking_moment,
              r.rocking_couple.real, r.rocking_couple.imag, r.driving_torque]
+    if analysis.mount_torque is not None:  # an engine's, after the columns every one has
+        names.append("mount_torque")
+        cols.append(analysis.mount_torque)
     return names, cols
 
 

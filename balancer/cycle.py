@@ -226,8 +226,11 @@ class CycleAnalysis:
 
     def __repr__(self) -> str:
         s = self.summary
-        return (f"CycleAnalysis({self.mechanism.kind}, {self.samples} angles at "
-                f"{self.speed:g} rad/s: RMS shaking force {s.shaking_force.rms:.4g} N, "
+        cycle = (f" over a cycle of 720° ({self.samples} in all)" if self.revolutions == 2
+                 else "")
+        return (f"CycleAnalysis({self.mechanism.kind}, {self.samples_per_revolution} angles per "
+                f"revolution{cycle} at {self.speed:g} rad/s ({self.speed * 30 / math.pi:.4g} "
+                f"rpm): RMS shaking force {s.shaking_force.rms:.4g} N, "
                 f"shaking moment {s.shaking_moment.rms:.4g} N·m, driving torque "
                 f"{s.driving_torque.rms:.4g} N·m)")
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from typing import Any, TypeGuard
 
+from . import validate as v
 from .cycle import sample_angles
 from .errors import BalancerError
 from .mechanisms import mechanism_of
@@ -71,7 +72,7 @@ def _lengths(data: dict[str, Any]) -> list[tuple[str, float, str]]:
     for i, spring in enumerate(springs if isinstance(springs, list) else ()):
         value = spring.get("free_length") if isinstance(spring, dict) else None
         if _number(value):
-            key = f"springs[{i}].free_length"
+            key = f"{v.item('springs', i)}.free_length"
             out.append((key, abs(value), f"{key} = {value:g} m"))
     return out
 
@@ -132,7 +133,9 @@ def speed_note(design: Design) -> str | None:
     radius = tip_radius(design.mechanism)
     if radius is None or not speed * radius > MAX_TIP_SPEED:
         return None
-    return (f"operation.speed = {design.operation.speed:g} rad/s moves a point {radius:.4g} m "
+    rpm = design.operation.speed * 30 / math.pi
+    return (f"operation.speed = {design.operation.speed:g} rad/s ({rpm:.4g} rpm) moves a point "
+            f"{radius:.4g} m "
             f"from the crank's pivot at {speed * radius:.4g} m/s, faster than sound "
             f"({MAX_TIP_SPEED:g} m/s): the speed is in rad/s (rpm written as rad/s?) and "
             "lengths in metres (mm written as m?)")

@@ -18,7 +18,10 @@ from .balance.counterweights import UNCHANGED, Counterweight
 from .balance.front import FIGURES, Front
 from .cycle import CycleAnalysis, Figure
 from .errors import SolverError
+from .mechanisms.engine.model import COUNTERWEIGHT, Engine, Throw
 from .orders import order_name
+from .rounding import Scales
+from .rounding import figure_text as _fmt
 
 if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these load them
     from .balance.result import BalanceResult, RotorMasses
@@ -28,14 +31,6 @@ if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these l
 
 UNITS = {"shaking_force": "N", "shaking_moment": "N·m", "driving_torque": "N·m",
          "rocking_couple": "N·m", "mount_torque": "N·m"}
-
-
-def _fmt(x: float, width: int = 12) -> str:
-    if x == 0:
-        return f"{0:>{width}.4g}"
-    if abs(x) >= 1e5 or abs(x) < 1e-3:
-        return f"{x:>{width}.4e}"
-    return f"{x:>{width}.6g}"
 
 
 def table(rows: Sequence[Sequence[str]], header: Sequence[str]) -> str:
@@ -85,18 +80,47 @@ def _orders_list(analysis: CycleAnalysis) -> list[dict[str, Any]]:
     return [order.as_dict() for order in analysis.orders]
 
 
-def orders_text(analysis: CycleAnalysis) -> str:
-    """The order table of ``analyze``: amplitudes by multiple of the crank speed."""
+def analysis_figures(analysis: CycleAnalysis) -> list[tuple[str, float]]:
+    """Every figure of a cycle analysis under its unit, for :class:`Scales`.
+
+    The shaking, the driving and mount torques and the rocking couple (RMS and maximum), the
+    forces on the frame at each ground point and guide, the guides' couples, every order.
+    """
+    s = analysis.summary
+    out: list[tuple[str, float]] = []
+    for name in ("shaking_force", "shaking_moment", "driving_torque", "rocking_couple",
+                 "mount_torque"):
+        fig = getattr(s, name)
+        if fig is not None:
+            out += [(UNITS[name], fig.rms), (UNITS[name], fig.max)]
+    out += [("N", f.max) for f in (*s.ground.values(), *s.slider_normal.values())]
+    out += [("N·m", f.max) for f in s.slider_couple.values()]
+    for o in analysis.orders:
+        out += [("N", abs(v)) for v in o.shaking_force.as_dict().values()]
+        out += [("N·m", abs(v)) for v in (*o.rocking_couple.as_dict().values(),
+                                           o.shaking_moment, o.driving_torque)]
+        if o.mount_torque is not None:
+            out.append(("N·m", abs(o.mount_torque)))
+    return out
+
+
+def orders_text(analysis: CycleAnalysis, scales: Scales | None = None) -> str:
+    """The order table of ``analyze``: amplitudes by multiple of the crank speed.
+
+    ``scales``: the report's (:class:`Scales`; default the analysis' own figures).
+    """
+    sc = scales if scales is not None else Scales(analysis_figures(analysis))
     planes = not analysis.mechanism.in_one_plane()
     rows = []
     for o in analysis.orders:
         f = o.shaking_force
-        row = [order_name(o.order), _fmt(f.x), _fmt(f.y), _fmt(f.forward), _fmt(f.backward),
-               _fmt(o.shaking_moment), _fmt(o.driving_torque)]
+        row = [order_name(o.order), *(sc.fmt(v, "N") for v in (f.x, f.y, f.forward, f.backward)),
+               sc.fmt(o.shaking_moment, "N·m"), sc.fmt(o.driving_torque, "N·m")]
         if o.mount_torque is not None:
-            row.append(_fmt(o.mount_torque))
+            row.append(sc.fmt(o.mount_torque, "N·m"))
         if planes:
-            row += [_fmt(o.rocking_couple.forward), _fmt(o.rocking_couple.backward)]
+            row += [sc.fmt(o.rocking_couple.forward, "N·m"),
+                    sc.fmt(o.rocking_couple.backward, "N·m")]
         rows.append(row)
     head = ["order", "force x (N)", "force y (N)", "forward (N)", "backward (N)",
             "moment (N·m)", "torque (N·m)"]
@@ -163,24 +187,31 @@ def _change_points(analysis: CycleAnalysis) -> list[float]:
     return [float(t) for t in analysis.theta1[analysis.singular]]
 
 
+def speed_text(speed: float) -> str:
+    """A crank speed as a report gives it: rad/s with rpm beside it."""
+    return f"{speed:g} rad/s ({speed * 30 / math.pi:.4g} rpm)"
+
+
 def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
     """The readable ``analyze`` report."""
     mech = analysis.mechanism
     s = analysis.summary
-    rpm = analysis.speed * 60 / (2 * math.pi)
+    sc = Scales(analysis_figures(analysis))
     head = f"balancer analyze — {spec}" if spec else "balancer analyze"
+    per_cycle = (f" over a cycle of 720° ({analysis.samples} in all)"
+                 if analysis.revolutions == 2 else "")
     lines = [
         head,
         f"{mech.kind} ({mech.describe()}), {analysis.samples_per_revolution} crank angles per "
-        f"revolution{' over a cycle of 720°' if analysis.revolutions == 2 else ''} at "
-        f"{analysis.speed:g} rad/s ({rpm:.4g} rpm), {analysis.route} route"
+        f"revolution{per_cycle} at {speed_text(analysis.speed)}, {analysis.route} route"
         + (f"; gravity ({analysis.gravity[0]:g}, {analysis.gravity[1]:g}) m/s² included"
            if any(analysis.gravity) else "; gravity not included")
         + ("" if analysis.loads else "; loads left out"),
         "",
         table(
             [
-                [name.replace("_", " "), _fmt(fig.rms), _fmt(fig.max), UNITS[name]]
+                [name.replace("_", " "), sc.fmt(fig.rms, UNITS[name]),
+                 sc.fmt(fig.max, UNITS[name]), UNITS[name]]
                 for name, fig in (
                     ("shaking_force", s.shaking_force),
                     ("shaking_moment", s.shaking_moment),
@@ -199,16 +230,17 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
     for point, values in analysis.reactions.ground.items():
         ex = reaction_extremes(values)
         rows.append([f"R{point}",
-                     *(_fmt(ex[k]) for k in ("max", "x_min", "x_max", "y_min", "y_max"))])
+                     *(sc.fmt(ex[k], "N") for k in ("max", "x_min", "x_max", "y_min", "y_max"))])
     lines.append(
         table(rows, ["reaction (N)", "|R| max", "Rx min", "Rx max", "Ry min", "Ry max"])
     )
     if analysis.reactions.slider_normal:
-        rows = [[link, _fmt(s.slider_normal[link].max), _fmt(s.slider_couple[link].max)]
+        rows = [[link, sc.fmt(s.slider_normal[link].max, "N"),
+                 sc.fmt(s.slider_couple[link].max, "N·m")]
                 for link in analysis.reactions.slider_normal]
         lines += ["", table(rows, ["slider on the frame", "normal force max (N)",
                                    "couple max (N·m)"])]
-    lines += ["", orders_text(analysis)]
+    lines += ["", orders_text(analysis, sc)]
     lines.append("")
     points = _change_points(analysis)
     if points:
@@ -353,25 +385,33 @@ def simulation_text(traj: Trajectory, spec: str | None = None) -> str:
     lines = [
         head,
         f"{traj.drive} motion"
-        + (f" at {traj.speed:g} rad/s ({traj.speed * 30 / math.pi:.4g} rpm)"
-           if traj.speed is not None else "")
+        + (f" at {speed_text(traj.speed)}" if traj.speed is not None else "")
         + f" for {traj.t[-1]:g} s, formulation {traj.method}, rtol "
         f"{traj.rtol:g}: {traj.steps} steps, {traj.nfev} right-hand sides, {traj.seconds:.3g} s",
         "",
     ]
+    # Each column's scale: the largest of its states (an angle's at least π: on the circle).
+    states = ("rad", "rad/s", "rad/s²")
+    sc = Scales([("rad", math.pi)])
+    for unit, values in zip(states, (traj.theta, traj.omega, traj.alpha), strict=True):
+        sc.add((unit, float(v)) for v in values[:, [0, -1]].ravel())
     rows = []
     for when, index in (("initial", 0), ("final", -1)):
         for k, name in enumerate(traj.links):
             label = name if traj.named_states else f"link {k + 1}"
-            rows.append([f"{when} {label}", _fmt(traj.theta[k, index], 14),
-                         _fmt(traj.omega[k, index], 14), _fmt(traj.alpha[k, index], 14)])
+            rows.append([f"{when} {label}",
+                         *(sc.fmt(values[k, index], unit, 14) for unit, values in
+                           zip(states, (traj.theta, traj.omega, traj.alpha), strict=True))])
     lines.append(table(rows, ["state", "θ (rad)", "θ̇ (rad/s)", "θ̈ (rad/s²)"]))
     lines.append("")
-    rows = [[name.replace("_", " "), _fmt(fig.rms), _fmt(fig.max), UNITS[name]] for name, fig in (
-        ("shaking_force", Figure.of(traj.shaking_force)),
-        ("shaking_moment", Figure.of(traj.shaking_moment)),
-        ("driving_torque", Figure.of(traj.driving_torque)),
-    )]
+    figures = (("shaking_force", Figure.of(traj.shaking_force)),
+               ("shaking_moment", Figure.of(traj.shaking_moment)),
+               ("driving_torque", Figure.of(traj.driving_torque)))
+    sc.add((UNITS[name], x) for name, fig in figures for x in (fig.rms, fig.max))
+    sc.add([("N", traj.largest_reaction)])
+    sc.add(("N·m", Figure.of(c).max) for c in traj.slider_couple.values())
+    rows = [[name.replace("_", " "), sc.fmt(fig.rms, UNITS[name]), sc.fmt(fig.max, UNITS[name]),
+             UNITS[name]] for name, fig in figures]
     lines.append(table(rows, ["quantity over time", "RMS", "max", "unit"]))
     lines.append("")
     lines.append(
@@ -386,27 +426,59 @@ def simulation_text(traj: Trajectory, spec: str | None = None) -> str:
 # verify
 
 
-def _opt(x: float | None, fmt: str = ".4g") -> str:
-    return "—" if x is None else format(x, fmt)
+def _verification_scales(verification: Verification) -> Scales:
+    """The scales of ``verify``'s figures: both runs', the design's and the original's.
 
+    Forces with the largest force on the frame of each run (the reactions the shaking force
+    sums); moments with the rocking couples and the driving torque.
+    """
+    sc = Scales()
+    for run in (verification.driven, verification.free):
+        sc.add(("N", x) for x in (run.max_shaking_force, run.original_max_shaking_force))
+        sc.add(("N·m", x) for x in (run.max_shaking_moment, run.original_max_shaking_moment,
+                                    run.max_rocking_couple, run.original_max_rocking_couple))
+        for traj in (run.trajectory, run.original):
+            if traj is not None and traj.t.size:
+                sc.add([("N", traj.largest_reaction),
+                        ("N·m", float(np.max(np.abs(traj.driving_torque))))])
+    return sc
 
 
 def verification_text(verification: Verification, spec: str | None = None) -> str:
-    """The readable ``verify`` report."""
+    """The readable ``verify`` report.
+
+    A figure that is rounding of its quantity's scale is printed 0, a ratio of it ``0`` (or
+    ``—`` where the original's is rounding too: :class:`Scales`).
+    """
     head = f"balancer verify — {spec}" if spec else "balancer verify"
-    lines = [head, f"simulated with the {verification.method} formulation", ""]
+    driven = verification.driven.trajectory
+    speed = (f"; driven at {speed_text(driven.speed)}"
+             if driven is not None and driven.speed is not None else "")
+    lines = [head, f"simulated with the {verification.method} formulation{speed}", ""]
+    sc = _verification_scales(verification)
+
+    def shown(x: float | None, unit: str) -> str:
+        return "—" if x is None else sc.number(x, unit, ".4g")
+
     rows = []
     for name, run in (("driven at the operating speed", verification.driven),
                       ("free from the initial state", verification.free)):
-        rows.append([name, _opt(run.max_shaking_force), _opt(run.original_max_shaking_force),
-                     _opt(run.force_ratio, ".2e"), _opt(run.force_level, ".1e"),
-                     _opt(run.max_shaking_moment), _opt(run.original_max_shaking_moment),
-                     _opt(run.moment_ratio, ".2e")])
+        rows.append([name, shown(run.max_shaking_force, "N"),
+                     shown(run.original_max_shaking_force, "N"),
+                     sc.ratio(run.max_shaking_force, run.original_max_shaking_force, "N",
+                              ".2e"),
+                     "—" if run.force_level is None else format(run.force_level, ".1e"),
+                     shown(run.max_shaking_moment, "N·m"),
+                     shown(run.original_max_shaking_moment, "N·m"),
+                     sc.ratio(run.max_shaking_moment, run.original_max_shaking_moment, "N·m",
+                              ".2e")])
     lines.append(table(rows, ["motion", "max |ΣR| (N)", "original", "ratio", "of |R|",
                               "max |Msh| (N·m)", "original", "ratio"]))
     if any(r.max_rocking_couple for r in (verification.driven, verification.free)):
-        rows = [[name, _opt(run.max_rocking_couple), _opt(run.original_max_rocking_couple),
-                 _opt(run.couple_ratio, ".2e")]
+        rows = [[name, shown(run.max_rocking_couple, "N·m"),
+                 shown(run.original_max_rocking_couple, "N·m"),
+                 sc.ratio(run.max_rocking_couple, run.original_max_rocking_couple, "N·m",
+                          ".2e")]
                 for name, run in (("driven at the operating speed", verification.driven),
                                   ("free from the initial state", verification.free))]
         lines += ["", table(rows, ["motion", "max |Mrock| (N·m)", "original", "ratio"])]
@@ -502,9 +574,17 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis, after: Cycle
                       **({} if result.rotor_masses is None else {
                           "mr": "kg·m", "phase_deg": "degrees at θ1 = 0", "z, at": "m",
                           "max_bearing_load": "N"}),
-                      "sigma": "rad", "disc radius, thickness": "m"},
+                      "sigma": "rad", "disc radius, thickness": "m",
+                      **({} if result.rotor_masses is None else {
+                          "rotating_mr, reciprocating_mr, counterweight_mr": "kg·m",
+                          "factor": "dimensionless: counterweight_mr / (rotating_mr + "
+                                    "reciprocating_mr/2)"})},
         }
     )
+    factors = balance_factors(result)
+    if factors is not None:  # an engine's (after the keys every document has)
+        doc["balance_factors"] = {"before": [t.as_dict() for t in factors[0]],
+                                  "after": [t.as_dict() for t in factors[1]]}
     return doc
 
 
@@ -526,21 +606,25 @@ def worse_figures(before: CycleAnalysis, after: CycleAnalysis) -> list[str]:
 
     The RMS and maximum of the shaking force, shaking moment and driving torque, and the largest
     force at a ground point (:attr:`~balancer.cycle.CycleSummary.max_ground_reaction`), at the
-    operating speed with the loads; a figure that was zero is not compared.
+    operating speed with the loads. A figure that was zero or rounding (:class:`Scales`: of its
+    quantity's scale before and after) has no ratio: it is reported where it rises beyond
+    rounding, not where it stays there.
     """
     out = []
+    sc = Scales([*analysis_figures(before), *analysis_figures(after)])
     b, a = before.summary, after.summary
-    for name, words, unit in _WATCHED:
-        for stat in ("rms", "max"):
-            old, new = getattr(getattr(b, name), stat), getattr(getattr(a, name), stat)
-            if old > 0 and new > WORSE_RATIO * old:
-                label = "RMS" if stat == "rms" else "maximum"
-                out.append(f"the {words}'s {label} rises {new / old:.3g}× "
-                           f"({_fmt(old).strip()} → {_fmt(new).strip()} {unit})")
-    old, new = b.max_ground_reaction, a.max_ground_reaction
-    if old > 0 and new > WORSE_RATIO * old:
-        out.append(f"the largest force on a ground pivot or guide rises {new / old:.3g}× "
-                   f"({_fmt(old).strip()} → {_fmt(new).strip()} N)")
+    figures = [(f"the {words}'s {'RMS' if stat == 'rms' else 'maximum'}", unit,
+                getattr(getattr(b, name), stat), getattr(getattr(a, name), stat))
+               for name, words, unit in _WATCHED for stat in ("rms", "max")]
+    figures.append(("the largest force on a ground pivot or guide", "N", b.max_ground_reaction,
+                    a.max_ground_reaction))
+    for what, unit, old, new in figures:
+        if sc.rounding(old, unit):
+            if not sc.rounding(new, unit):
+                out.append(f"{what} rises from 0 (to rounding) to {_fmt(new).strip()} {unit}")
+        elif new > WORSE_RATIO * old:
+            out.append(f"{what} rises {new / old:.3g}× "
+                       f"({_fmt(old).strip()} → {_fmt(new).strip()} {unit})")
     return out
 
 
@@ -598,11 +682,15 @@ def counterweight_text(weights: Mapping[str, Counterweight]) -> str:
             + "\n" + "\n".join(notes))
 
 
-def rotor_masses_text(masses: RotorMasses, speed: float) -> str:
+def rotor_masses_text(masses: RotorMasses, speed: float, before: CycleAnalysis | None = None,
+                      after: CycleAnalysis | None = None) -> str:
     """What an engine's balancing builds: per plane the counterweight, per shaft its eccentrics.
 
     Each mass·radius (kg·m) at its angle at θ1 = 0 (degrees), its plane (mm), its mass at the
-    given radius (kg); then what they cost: their centrifugal loads (N).
+    given radius (kg); then what they cost: their centrifugal forces (N, the objective's
+    unbalance), the main bearings' net reaction before and after (N, from ``before`` and
+    ``after``, the analyses at the operating speed) and each new shaft's net force on its
+    bearings.
     """
     rows = []
     for c in masses.counterweights:
@@ -623,11 +711,52 @@ def rotor_masses_text(masses: RotorMasses, speed: float) -> str:
                         "their planes")]
     if masses.radius is not None:
         notes[0] += f"; mass at radius {1e3 * masses.radius:.6g} mm"
-    notes.append(f"their centrifugal load √Σ(mr·ω²)²: {masses.unbalance_before:.6g} N before, "
-                 f"{masses.unbalance_after:.6g} N after (ω = {speed:.6g} rad/s)")
-    for j, load in enumerate(masses.bearing_loads, start=1):
-        notes.append(f"new shaft {j}: largest bearing load {load:.6g} N")
+    notes.append(f"their centrifugal forces mr·ω² at ω = {speed_text(speed)}, "
+                 f"root-sum-square √Σ(mr·ω²)² (the objective's unbalance; the bearings share "
+                 f"these forces, it is no bearing's load): {masses.unbalance_before:.6g} N "
+                 f"before, {masses.unbalance_after:.6g} N after")
+    if before is not None and after is not None and "O" in before.reactions.ground:
+        b, a = before.summary.ground["O"].max, after.summary.ground["O"].max
+        notes.append(f"the main bearings' net reaction RO (all of them together: the force "
+                     f"they pass to the frame): largest {b:.6g} N before, {a:.6g} N after")
+    for j, (s, load) in enumerate(zip(masses.shafts, masses.bearing_loads, strict=True),
+                                  start=1):
+        # Its eccentrics' centrifugal forces are the scale of the force they leave on its
+        # bearings together (opposed eccentrics leave a couple, and no net force).
+        sc = Scales(("N", e.mr * (s.ratio * speed) ** 2) for e in s.eccentrics)
+        notes.append(f"new shaft {j}: largest net force on its bearings {sc.number(load, 'N')} N")
     return table(rows, header) + "\n" + "\n".join(notes)
+
+
+def balance_factors(result: BalanceResult) -> tuple[tuple[Throw, ...], tuple[Throw, ...]] | None:
+    """An engine's throws before and after balancing (:meth:`Engine.throws`), or ``None``.
+
+    The same throws for both: each design's counterweight planes separate the other's too.
+    """
+    old, new = result.original, result.linkage
+    if not isinstance(old, Engine) or not isinstance(new, Engine):
+        return None
+
+    def webs(engine: Engine) -> list[float]:
+        return [m.z for m in engine.crankshaft.masses
+                if m.label == COUNTERWEIGHT and m.mr > 0]
+
+    return old.throws(webs(new)), new.throws(webs(old))
+
+
+def balance_factors_text(before: Sequence[Throw], after: Sequence[Throw]) -> str:
+    """Each throw's balance factor before and after, as engine designers quote it."""
+    rows = []
+    for k, (b, a) in enumerate(zip(before, after, strict=True), start=1):
+        rows.append([f"{k}", ", ".join(str(c) for c in b.cylinders), f"{b.phase_deg:.6g}",
+                     f"{b.rotating_mr:.6g}", f"{b.reciprocating_mr:.6g}",
+                     f"{b.counterweight_mr:.6g}", f"{a.counterweight_mr:.6g}",
+                     f"{100 * b.factor:.3g} %", f"{100 * a.factor:.3g} %"])
+    return ("balance factor of each throw: its counterweights' mr (opposite its pin) over its "
+            "rotating mr + ½ its reciprocating mr (rods split at their centres of mass):\n"
+            + table(rows, ["throw", "cylinders", "pin °", "rotating kg·m",
+                           "reciprocating kg·m", "counterweights kg·m before", "after",
+                           "factor before", "after"]))
 
 
 def _parameters_text(result: BalanceResult) -> str:
@@ -636,6 +765,7 @@ def _parameters_text(result: BalanceResult) -> str:
     for name in result.linkage.link_names:
         old, new = result.original.link(name), result.linkage.link(name)
         scales = _parameter_scales(old, new)
+        sc = Scales(scales.items())  # (a parameter within rounding of its kind's scale: 0)
         for key, unit in (("mass", "kg"), ("e", "m"), ("f", "m"), ("inertia", "kg·m²"),
                           ("counter_rotor", "kg·m²")):
             a, b = getattr(old, key), getattr(new, key)
@@ -645,7 +775,7 @@ def _parameters_text(result: BalanceResult) -> str:
             # resolution (a parameter nothing pulls, or held off its bound by the interior-point
             # solver): not marked.
             changed = "" if abs(a - b) <= MARKED_CHANGE * scales[key] else "changed"
-            rows.append([f"{name} {key}", f"{a:.6g}", f"{b:.6g}", unit, changed])
+            rows.append([f"{name} {key}", sc.number(a, key), sc.number(b, key), unit, changed])
     return table(rows, ["parameter", "before", "after", "unit", ""])
 
 
@@ -673,6 +803,22 @@ def _parameter_scales(old: Any, new: Any) -> dict[str, float]:
     return {"mass": m, "e": reach, "f": reach, "inertia": j, "counter_rotor": rotor}
 
 
+def optimization_scales(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis
+                        ) -> Scales:
+    """The scales of ``optimize``'s figures (:class:`Scales`): before and after together.
+
+    The operating figures of both designs and their inertial ones (the objective's terms),
+    and an engine's counterweights' centrifugal forces.
+    """
+    sc = Scales()
+    for analysis in (before, after, result.before, result.after):
+        sc.add(analysis_figures(analysis))
+    masses = result.rotor_masses
+    if masses is not None:
+        sc.add(("N", x) for x in (masses.unbalance_before, masses.unbalance_after))
+    return sc
+
+
 def optimization_text(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis,
                       verification: Verification | None = None,
                       spec: str | None = None) -> str:
@@ -686,16 +832,18 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
         "inertial shaking (loads left out)",
         "",
     ]
+    sc = optimization_scales(result, before, after)
     rows = []
     planes = () if after.mechanism.in_one_plane() else ("rocking_couple",)
     for name in ("shaking_force", "shaking_moment", "driving_torque", *planes):
         b, a = getattr(before.summary, name), getattr(after.summary, name)
-        ratio = f"{a.rms / b.rms:.3g}" if b.rms > 0 else "—"  # nothing to compare with
-        rows.append([name.replace("_", " "), _fmt(b.rms), _fmt(a.rms), ratio,
-                     _fmt(b.max), _fmt(a.max), UNITS[name]])
+        unit = UNITS[name]
+        rows.append([name.replace("_", " "), sc.fmt(b.rms, unit), sc.fmt(a.rms, unit),
+                     sc.ratio(a.rms, b.rms, unit), sc.fmt(b.max, unit), sc.fmt(a.max, unit),
+                     unit])
     b, a = before.summary.max_ground_reaction, after.summary.max_ground_reaction
-    rows.append(["largest ground load", "", "", f"{a / b:.3g}" if b > 0 else "—",
-                 _fmt(b), _fmt(a), "N"])
+    rows.append(["largest ground load", "", "", sc.ratio(a, b, "N"), sc.fmt(b, "N"),
+                 sc.fmt(a, "N"), "N"])
     lines.append(table(rows, ["at the operating speed", "RMS before", "RMS after", "ratio",
                               "max before", "max after", "unit"]))
     lines += [f"warning: {w}" for w in worse_figures(before, after)]
@@ -703,7 +851,8 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
     if result.single_term is None:
         terms = _objective_terms(result)
         rows = [[name.replace("_", " "), f"{t['weight']:.4g}",
-                 _fmt(float(t["before"])), _fmt(float(t["after"])), str(t["unit"])]
+                 sc.fmt(float(t["before"]), str(t["unit"])),
+                 sc.fmt(float(t["after"]), str(t["unit"])), str(t["unit"])]
                 for name, t in terms.items()]
         lines += ["objective J = Σ weight × mean square (added mass: weight × kg added), "
                   "inertial shaking at the operating speed:",
@@ -716,15 +865,20 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
                 ("force forward", ob.shaking_force.forward, oa.shaking_force.forward, "N"),
                 ("force backward", ob.shaking_force.backward, oa.shaking_force.backward, "N"),
                 ("shaking moment", ob.shaking_moment, oa.shaking_moment, "N·m")):
-            rows.append([f"{order_name(ob.order)}: {label}", _fmt(b), _fmt(a), unit])
+            rows.append([f"{order_name(ob.order)}: {label}", sc.fmt(b, unit), sc.fmt(a, unit),
+                         unit])
         if planes:
             for label, b, a in (
                     ("couple forward", ob.rocking_couple.forward, oa.rocking_couple.forward),
                     ("couple backward", ob.rocking_couple.backward, oa.rocking_couple.backward)):
-                rows.append([f"{order_name(ob.order)}: {label}", _fmt(b), _fmt(a), "N·m"])
+                rows.append([f"{order_name(ob.order)}: {label}", sc.fmt(b, "N·m"),
+                             sc.fmt(a, "N·m"), "N·m"])
     lines += [table(rows, ["order amplitude", "before", "after", "unit"]), ""]
     if result.rotor_masses is not None:  # an engine: what to build, not changed links
-        lines += [rotor_masses_text(result.rotor_masses, before.speed), ""]
+        lines += [rotor_masses_text(result.rotor_masses, before.speed, before, after), ""]
+        factors = balance_factors(result)
+        if factors is not None:
+            lines += [balance_factors_text(*factors), ""]
     else:
         lines += [_parameters_text(result), "", counterweight_text(result.counterweights), ""]
     lines.append(_force_balance_line(after))
@@ -750,8 +904,13 @@ def front_text(front: Front, spec: str | None = None) -> str:
     head = f"balancer pareto — {spec}" if spec else "balancer pareto"
     name = front.name.replace("_", " ")
     others = front.figure_names
-    rows = [[f"{i + 1}", _fmt(p.value), _fmt(p.least), *(_fmt(p.figures[n]) for n in others),
-             _fmt(p.lower_bound), "knee" if p.knee else ""] for i, p in enumerate(front.points)]
+    # Each column's scale its largest figure (the bound the minimised figure's).
+    sc = Scales([(front.name, p.value) for p in front.points]
+                + [(front.minimised, x) for p in front.points for x in (p.least, p.lower_bound)]
+                + [(n, p.figures[n]) for p in front.points for n in others])
+    rows = [[f"{i + 1}", sc.fmt(p.value, front.name), sc.fmt(p.least, front.minimised),
+             *(sc.fmt(p.figures[n], n) for n in others), sc.fmt(p.lower_bound, front.minimised),
+             "knee" if p.knee else ""] for i, p in enumerate(front.points)]
     unit = FIGURES[front.minimised][1]
     held = ("each mass·radius within its bound; the unbalance term's place taken by the "
             "bound on the mass" if front.masses

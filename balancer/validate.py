@@ -154,6 +154,16 @@ def relative_lengths(lengths: dict[str, float], prefix: str) -> None:
             )
 
 
+def item(array: str, index: int) -> str:
+    """The key of an item of a spec's array in a message, numbered from 1: ``array[n]``.
+
+    ``index`` counts from 0 (Python's); the message counts as the docs do — cylinder 1 is
+    ``mechanism.cylinders[1]``, the first spring ``springs[1]`` — so that a designer finds
+    the item by counting the tables in the spec.
+    """
+    return f"{array}[{index + 1}]"
+
+
 @contextmanager
 def under(prefix: str) -> Iterator[None]:
     """Put ``prefix`` in front of the key of a :class:`SpecError` raised inside."""

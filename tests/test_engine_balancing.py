@@ -315,8 +315,8 @@ CW, SHAFT = "[balance.counterweights]\n", "[[balance.shafts]]\n"
     (CW + "planes = [0.1, 0.1]\nmax_mr = 0.01\n", "balance.counterweights.planes"),
     (CW + "planes = [0.1, 0.2]\nmax_mr = [0.01]\n", "balance.counterweights.max_mr"),
     (CW + "planes = [0.1]\n", "balance.counterweights.max_mr"),
-    (SHAFT + "ratio = 0\nplanes = [0.1]\nmax_mr = 0.01\n", "balance.shafts[0].ratio"),
-    (SHAFT + "ratio = -1\nplanes = [0.1]\nmax_mr = -0.01\n", "balance.shafts[0].max_mr"),
+    (SHAFT + "ratio = 0\nplanes = [0.1]\nmax_mr = 0.01\n", "balance.shafts[1].ratio"),
+    (SHAFT + "ratio = -1\nplanes = [0.1]\nmax_mr = -0.01\n", "balance.shafts[1].max_mr"),
     ("[balance.objective]\nadded_mass = 1.0\n", "balance.objective.added_mass"),
     ("[balance.objective]\nrocking_couple = 1.0\n", "balance"),
 ])
@@ -587,7 +587,7 @@ def test_a_wrong_crankshaft_mass_is_named_once(tmp_path, capsys):
                                  "phase_deg = 225.0", 1))
     assert main(["analyze", str(spec)]) == 2
     err = capsys.readouterr().err
-    assert " links.crankshaft.masses[1].mr: must be zero or positive" in err
+    assert " links.crankshaft.masses[2].mr: must be zero or positive" in err
 
 
 def test_an_engine_front_of_the_shaking_moment_alone_says_so(tmp_path, capsys):

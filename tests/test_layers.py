@@ -23,7 +23,7 @@ PACKAGE = Path(balancer.__file__).resolve().parent
 #: The layers, lowest first: a module may import its own layer and those below. A module is
 #: placed by its longest matching prefix.
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("errors", "validate", "tomltext", "progress", "interrupts", "outputs", "lazy"),
+    ("errors", "validate", "tomltext", "progress", "interrupts", "outputs", "lazy", "rounding"),
     ("model",),
     ("linkage", "quadrature", "orders"),
     # The mechanism interface, and what every mechanism's formulations share.

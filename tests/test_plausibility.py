@@ -94,4 +94,4 @@ def test_points_centres_of_mass_and_springs_are_lengths_too():
     note = length_note(data)
     assert "mechanism.points.D = [350, 0] m (350 m from the origin)" in note
     assert "links.rod.com (120 m from its link's first point)" in note
-    assert "springs[0].free_length = 400 m" in note
+    assert "springs[1].free_length = 400 m" in note

@@ -60,10 +60,14 @@ def base(mechanism: str) -> dict:
 
 
 def original_of(data: dict) -> dict:
-    """``[original]`` for a base: its links' mass properties as they are."""
-    keep = ("mass", "inertia", "com")
-    return {name: {k: copy.deepcopy(v) for k, v in link.items() if k in keep}
-            for name, link in data["links"].items() if name != "ground"}
+    """``[original]`` for a base: its links' mass properties as they are (an engine's
+    crankshaft with its masses, and its balance shafts)."""
+    keep = ("mass", "inertia", "com", "masses")
+    out = {name: {k: copy.deepcopy(v) for k, v in link.items() if k in keep}
+           for name, link in data["links"].items() if name != "ground"}
+    if "balance_shafts" in data:
+        out["balance_shafts"] = copy.deepcopy(data["balance_shafts"])
+    return out
 
 
 def path_of(data: dict, pattern: str, key: str) -> list:
@@ -72,8 +76,8 @@ def path_of(data: dict, pattern: str, key: str) -> list:
     link = "slider" if slider else "crank"
     if "crankshaft" in data["links"]:  # an engine: the link that takes the key
         link = next((name for name, keys in schema.ENGINE_LINKS.items()
-                     if key in keys and pattern == "links.<link>"), "rod")
-        if pattern.startswith("links.<link>.masses"):
+                     if key in keys and pattern in ("links.<link>", "original.<link>")), "rod")
+        if pattern.startswith(("links.<link>.masses", "original.<link>.masses")):
             link = "crankshaft"
     out: list = []
     for part in pattern.split(".") if pattern else []:

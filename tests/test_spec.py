@@ -217,8 +217,8 @@ def test_a_linkage_with_names_toml_must_quote_round_trips_through_its_balanced_s
 
 @pytest.mark.parametrize(("edit", "key"), [
     ('counter_rotor = 0.0', "links.crank.counter_rotor"),
-    ('stiffness = 6313.2', "springs[0].stiffness"),
-    ('free_length = ', "springs[0].free_length"),
+    ('stiffness = 6313.2', "springs[1].stiffness"),
+    ('free_length = ', "springs[1].free_length"),
     ('com = { e = -0.53901', "links.coupler.com"),
 ])
 def test_an_absurd_scale_names_its_own_key(edit, key, tmp_path, capsys):
@@ -247,10 +247,10 @@ _QR_LINKS = ("crank", "block", "rocker", "rod", "ram")
 
 
 @pytest.mark.parametrize(("old", "new", "key", "names"), [
-    ('guide = "ground"', 'guide = "frame"', "mechanism.sliders[1].guide", (*_QR_LINKS, "ground")),
-    ('link = "ram"', 'link = "slide"', "mechanism.sliders[1].link", (*_QR_LINKS, "ground")),
+    ('guide = "ground"', 'guide = "frame"', "mechanism.sliders[2].guide", (*_QR_LINKS, "ground")),
+    ('link = "ram"', 'link = "slide"', "mechanism.sliders[2].link", (*_QR_LINKS, "ground")),
     ('input = "crank"', 'input = "ground"', "mechanism.input", (*_QR_LINKS, "ground")),
-    ('point = "D"', 'point = "C"', "mechanism.sliders[1].point", ("D",)),
+    ('point = "D"', 'point = "C"', "mechanism.sliders[2].point", ("D",)),
 ])
 def test_an_unknown_link_or_point_is_named_with_those_the_spec_has(old, new, key, names):
     """`guide = "frame"` said 'unknown link' without the links or that the frame is called
@@ -270,7 +270,7 @@ def test_a_spring_on_an_unknown_point_names_the_points():
         'free_length = 1.0\n'
     with pytest.raises(SpecError) as info:
         spec.loads_design(text)
-    assert info.value.key == "springs[0].points"
+    assert info.value.key == "springs[1].points"
     assert "'Q9'" in str(info.value) and "the points are A0, " in str(info.value)
 
 

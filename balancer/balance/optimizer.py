@@ -46,7 +46,7 @@ import numpy as np
 from ..cycle import CycleAnalysis, cycle_analysis
 from ..errors import SpecError
 from ..model import Design
-from ..model.balance import BalanceProblem, RotorBalanceProblem
+from ..model.balance import BalanceProblem, RotorBalanceProblem, missing_balance
 from . import rotors
 from .convex import ConvexSolution, ConvexSolver
 from .nlp import NlpSolution, NlpSolver
@@ -275,6 +275,8 @@ def optimize(design: Design, backend: Backend = "nlp") -> BalanceResult:
         raise SpecError(
             f"unknown backend; choose from {', '.join(BACKENDS)}", key="backend", value=backend
         )
+    if design.balance is None:
+        raise missing_balance(design.mechanism.type)
     if isinstance(design.balance, RotorBalanceProblem):  # an engine's counterweights, shafts
         return rotors.optimize(design, backend)
     return Optimizer.of(design).run(backend)

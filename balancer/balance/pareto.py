@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from ..errors import SolverError, SpecError
 from ..force_balance import RESIDUAL_FLOOR, force_balance_residual
 from ..model import Design
-from ..model.balance import Objective, RotorBalanceProblem
+from ..model.balance import Objective, RotorBalanceProblem, missing_balance
 from .certificate import Constraint, lower_bound
 from .certificate import Objective as Certified
 from .conic import ConicProgram, ConicSolution
@@ -167,8 +167,7 @@ def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
     if against not in AGAINST:
         raise SpecError(f"must be one of {', '.join(AGAINST)}", key="--against", value=against)
     if design.balance is None:
-        raise SpecError("missing required table: the redesign problem ([balance])",
-                        key="balance")
+        raise missing_balance(design.mechanism.type)
     if not 2 <= points <= MAX_POINTS:
         raise SpecError(f"a front has from 2 to {MAX_POINTS} points", key="--points",
                         value=points)

@@ -20,6 +20,7 @@ from ..errors import SolverError
 from ..model import Design
 from ..model import MechanismModel as Model
 from ..model.balance import Objective, ObjectiveTerm, PlacedMass, ShaftDesign
+from ..rounding import Scales
 from .counterweights import Counterweight, added_mass, counterweights
 
 #: Gap to the certified lower bound, relative to the problem's scale (the original design's
@@ -337,10 +338,13 @@ class BalanceResult:
             unit, name = term.unit, term.name.replace("_", " ")
             tolerance = (f"tolerance {GAP_TOLERANCE:g} of the problem's scale "
                          f"{self.in_unit(self.scale):.4g} {unit}")
-            value = f"RMS {name} {self.in_unit(self.rms):.6g} {unit}"
+            # (A figure within rounding of the problem's scale is 0: :class:`Scales`.)
+            sc = Scales([(unit, self.in_unit(self.scale))])
+            value = f"RMS {name} {sc.number(self.in_unit(self.rms), unit)} {unit}"
             if self.original_objective > 0:
-                ratio = self.rms / math.sqrt(self.original_objective)
-                value += f" ({ratio:.3g} of the original's)"
+                ratio = sc.ratio(self.in_unit(self.rms),
+                                 self.in_unit(math.sqrt(self.original_objective)), unit)
+                value += f" ({ratio} of the original's)"
             parts = [text, value,
                      f"certified lower bound {self.in_unit(self.rms_lower_bound):.6g} {unit}",
                      f"gap {self.in_unit(self.rms_gap):.2g} {unit} ({tolerance})"]
@@ -359,12 +363,10 @@ class BalanceResult:
         return self.status is Status.OPTIMAL
 
     def balanced_design(self, design: Design) -> Design:
-        """The spec ``design`` with the balanced linkage, and the original kept as ``original``.
+        """The spec ``design`` with the balanced mechanism, and the original kept as ``original``.
 
-        (An engine's balancing keeps no original: what it added is labelled in its spec.)
+        (An engine's too: its crankshaft with the counterweights it had, its shafts.)
         """
-        if self.rotor_masses is not None:
-            return replace(design, mechanism=self.linkage)
         return replace(
             design,
             mechanism=self.linkage,

@@ -213,7 +213,7 @@ def check_rotor_scales(problem: RotorBalanceProblem, speeds: dict[str, float]) -
         sites += [("balance.counterweights", b, 1.0, z, 0.0)
                   for b, z in zip(cws.max_mr, cws.planes, strict=True)]
     for j, shaft in enumerate(problem.shafts):
-        sites += [(f"balance.shafts[{j}]", b, float(shaft.ratio), z, math.hypot(*shaft.at))
+        sites += [(v.item("balance.shafts", j), b, float(shaft.ratio), z, math.hypot(*shaft.at))
                   for b, z in zip(shaft.max_mr, shaft.planes, strict=True)]
     for table, bound, ratio, z, arm in sites:
         force = [(f"{table}.max_mr", bound), (f"{table}.ratio", ratio),
@@ -266,8 +266,8 @@ def check_scales(mechanism: MechanismModel, speeds: dict[str, float],
     for i, spring in enumerate(mechanism.springs):
         # Its force k·(R + |l0|) at most, moment R times that, energy k·(R + |l0|)²/2: the
         # reach's and the free length's terms apart, each named by its own key.
-        stiffness = [(f"springs[{i}].stiffness", spring.stiffness)]
-        free = [(f"springs[{i}].free_length", spring.free_length)]
+        stiffness = [(f"{v.item('springs', i)}.stiffness", spring.stiffness)]
+        free = [(f"{v.item('springs', i)}.free_length", spring.free_length)]
         for stretch in (r, free):
             forces.append(stiffness + stretch)
             moments.append(stiffness + stretch + r)

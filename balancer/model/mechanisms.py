@@ -285,11 +285,11 @@ class Linkage(MechanismModel):
             self._check_slider(i, slider, names, points)
         for i, spring in enumerate(self.springs):
             if not isinstance(spring, Spring):
-                raise SpecError("must be a Spring", key=f"springs[{i}]", value=spring)
+                raise SpecError("must be a Spring", key=v.item("springs", i), value=spring)
             for p in spring.points:
                 if p not in points:
                     raise SpecError(f"names an unknown point '{p}' (the points are "
-                                    f"{', '.join(points)})", key=f"springs[{i}].points",
+                                    f"{', '.join(points)})", key=f"{v.item('springs', i)}.points",
                                     value=list(spring.points))
         for name, body in names.items():
             if name == GROUND or len(body.points) > 1:
@@ -323,7 +323,7 @@ class Linkage(MechanismModel):
     @staticmethod
     def _check_slider(i: int, slider: Slider, names: dict[str, Body],
                       points: dict[str, tuple[float, float]]) -> None:
-        key = f"mechanism.sliders[{i}]"
+        key = v.item("mechanism.sliders", i)
         if not isinstance(slider, Slider):
             raise SpecError("must be a Slider", key=key, value=slider)
         for attr in ("link", "guide"):

@@ -256,10 +256,11 @@ def simulate(
             t_event, th, traj)
     if run.stop_at is not None:
         th = f.crank_angle(run.stop_at)
+        speed = f.speed or 0.0  # (a run that stops where the linkage ends is driven)
         raise _lockup(
-            f"the crank, driven at {f.speed:g} rad/s, reaches the end of the range where the "
-            f"linkage assembles at t = {run.stop_at:.6g} s, θ1 = {th:.6g} rad: the linkage "
-            "locks", run.stop_at, th, traj)
+            f"the crank, driven at {speed:g} rad/s ({speed * 30 / math.pi:.4g} rpm), reaches "
+            f"the end of the range where the linkage assembles at t = {run.stop_at:.6g} s, "
+            f"θ1 = {th:.6g} rad: the linkage locks", run.stop_at, th, traj)
     return traj
 
 

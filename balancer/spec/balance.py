@@ -19,18 +19,14 @@ from ..model.balance import (
 )
 from ..validate import LENGTH_RANGE
 from . import schema
-from .tables import Table
+from .tables import Table, hint
 
 
 def _check_keys(table: Table, known: tuple[str, ...]) -> None:
     """Reject unknown keys first, with a suggestion for a typo."""
     for name in table.data:
         if name not in known:
-            import difflib  # only for a spec that is wrong
-
-            close = difflib.get_close_matches(name, known, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise SpecError(f"unknown key '{name}'{hint}", key=table.key(name))
+            raise SpecError(f"unknown key '{name}'{hint(name, known)}", key=table.key(name))
 
 
 def _read_range(
@@ -138,12 +134,8 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
     names = mech.link_names
     for name, value in table.data.items():  # a table for a link the mechanism does not have
         if isinstance(value, dict) and name not in ("objective", *names):
-            import difflib  # only for a spec that is wrong
-
-            close = difflib.get_close_matches(name, names, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
-            raise SpecError(f"names no moving link of the {mech.kind}{hint} (its moving links "
-                            f"are {', '.join(names)}; the frame stays as it is)",
+            raise SpecError(f"names no moving link of the {mech.kind}{hint(name, names)} (its "
+                            f"moving links are {', '.join(names)}; the frame stays as it is)",
                             key=table.key(name))
     _check_keys(table, (*schema.known("balance"), *names))
     force_balance = True

@@ -608,9 +608,47 @@ _ENGINE_BALANCE: dict[str, tuple[Key, ...]] = {
             example="0.0004"),
     ),
 }
+#: An engine's ``[original]`` (as ``optimize --out`` writes it): the links and balance shafts
+#: of the engine before its balancing, which chose its counterweights and shafts.
+_ENGINE_ORIGINAL: dict[str, tuple[Key, ...]] = {
+    "": (Key("original", "table", "none",
+             "An engine's: the engine before its balancing, as `optimize --out` writes it: "
+             "`verify` and `plot` show both.", (ENGINE,)),),
+    "original": (
+        Key("crankshaft", "table", "required",
+            "The original crankshaft: its inertia, mass and masses (counterweights included).",
+            (ENGINE,)),
+        Key("rod", "table", "required", "The original connecting rod.", (ENGINE,)),
+        Key("piston", "table", "required", "The original piston.", (ENGINE,)),
+        Key("balance_shafts", "table", "none",
+            "The original balance shafts (`[[original.balance_shafts]]`, as "
+            "`[[balance_shafts]]`); none where absent.", (ENGINE,)),
+    ),
+    "original.<link>": (
+        *(replace(k, mechanisms=(ENGINE,)) for k in _link_keys("`{ s, sigma }` or `{ e, f }`",
+                                                                engine=True)
+          if ENGINE in k.mechanisms),
+        Key("masses", "table", "none",
+            "The original crankshaft's masses, as `[links.crankshaft] masses`.", (ENGINE,),
+            example="[{ mr = 0.015, phase_deg = 0.0, z = -0.132 }]"),
+    ),
+    "original.<link>.com": tuple(replace(k, mechanisms=(ENGINE,)) for k in _COM),
+}
 SECTIONS = tuple(
     replace(s, keys=s.keys + _ENGINE_BALANCE[s.pattern], mechanisms=(*s.mechanisms, ENGINE))
-    if s.pattern in _ENGINE_BALANCE else s for s in SECTIONS) + (
+    if s.pattern in _ENGINE_BALANCE else s for s in SECTIONS)
+SECTIONS = tuple(
+    replace(s, keys=s.keys + _ENGINE_ORIGINAL[s.pattern],
+            mechanisms=tuple(dict.fromkeys((*s.mechanisms, ENGINE))))
+    if s.pattern in _ENGINE_ORIGINAL else s for s in SECTIONS) + (
+    Section("original.<link>.masses[]", "A mass·radius the original crankshaft carried.",
+            next(s for s in SECTIONS if s.pattern == "links.<link>.masses[]").keys, (ENGINE,)),
+    Section("original.balance_shafts[]", "An original balance shaft of an engine (as "
+            "`[[balance_shafts]]`).",
+            next(s for s in SECTIONS if s.pattern == "balance_shafts[]").keys, (ENGINE,)),
+    Section("original.balance_shafts[].eccentrics[]", "A mass·radius on an original balance "
+            "shaft.", _ECCENTRIC, (ENGINE,)),
+) + (
     Section("balance.counterweights", "An engine's counterweights on the crankshaft: the "
             "optimiser chooses each one's mass·radius (within `max_mr`) and angle (any); they "
             "replace the counterweights labelled `\"counterweight\"` in these planes.", (
@@ -648,7 +686,7 @@ def pattern(path: str) -> str:
     """The pattern of a table's dotted path (``links.crank.com`` → ``links.<link>.com``)."""
     parts = [_INDEX.sub("[]", part) for part in path.split(".")] if path else []
     if len(parts) >= 2 and parts[0] in ("links", "original", "balance"):
-        kept = {"links": ("ground",),
+        kept = {"links": ("ground",), "original": ("balance_shafts[]",),
                 "balance": ("objective", "counterweights", "shafts", "shafts[]")}.get(
             parts[0], ())
         if parts[1] not in kept:

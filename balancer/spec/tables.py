@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any, Literal, overload
 
 from .. import validate as v
@@ -129,7 +129,7 @@ class Table:
         key = self.key(name)
         if not isinstance(raw, list) or not all(isinstance(item, dict) for item in raw):
             raise SpecError(f"must be an array of tables ([[{key}]])", key=key, value=raw)
-        return [Table(item, f"{key}[{i}]") for i, item in enumerate(raw)]
+        return [Table(entry, v.item(key, i)) for i, entry in enumerate(raw)]
 
     def finish(self) -> None:
         """Raise on the first key that was not used (unknown, or a typo)."""
@@ -138,9 +138,39 @@ class Table:
                 self._unknown(name)
 
     def _unknown(self, name: str) -> None:
-        import difflib  # only for a spec that is wrong
+        raise SpecError(f"unknown key '{name}'{hint(name, self.known or ())}",
+                        key=self.key(name))
 
-        known = sorted(self.known or ())
-        close = difflib.get_close_matches(name, known, n=1)
-        hint = f"; did you mean '{close[0]}'?" if close else ""
-        raise SpecError(f"unknown key '{name}'{hint}", key=self.key(name))
+
+def meant(name: str, known: Iterable[str]) -> str | None:
+    """The known name a mistyped ``name`` most likely meant, or ``None``.
+
+    First a name that the typed one begins, or that begins it, ignoring case (``bank`` →
+    ``bank_deg``, ``mass_kg`` → ``mass``); then one with its stem, the part before the first
+    underscore (``phase_rad`` → ``phase_deg``); then the closest spelling (``mas`` → ``mass``).
+    Among several, the closest spelling.
+    """
+    import difflib  # only for a spec that is wrong
+
+    names = sorted(set(known))
+    low = name.lower()
+
+    def closest(candidates: list[str]) -> str:
+        return max(candidates,
+                   key=lambda k: difflib.SequenceMatcher(None, low, k.lower()).ratio())
+
+    prefixed = [k for k in names if k.lower().startswith(low) or low.startswith(k.lower())]
+    if low and prefixed:
+        return closest(prefixed)
+    stem = low.split("_", 1)[0]
+    stemmed = [k for k in names if "_" in k + low and k.lower().split("_", 1)[0] == stem]
+    if stem and stemmed:
+        return closest(stemmed)
+    close = difflib.get_close_matches(name, names, n=1)
+    return close[0] if close else None
+
+
+def hint(name: str, known: Iterable[str]) -> str:
+    """``"; did you mean '…'?"`` for a mistyped ``name`` (:func:`meant`), or ``""``."""
+    found = meant(name, known)
+    return f"; did you mean '{found}'?" if found is not None else ""

@@ -266,11 +266,56 @@ class GasCycle:
                             values=tuple(f for _, f in pairs), period=period)
 
 
+@dataclass(frozen=True, kw_only=True)
+class Throw:
+    """One crank throw: the cylinders on one crank pin, and the mass·radius that balances it.
+
+    As engine designers quote a throw's **balance factor**: its counterweights' mass·radius
+    against its rotating mass·radius plus half its reciprocating one (each rod split into two
+    point masses at its pins by its centre of mass: ``m_rod·(1 − e/l)`` rotating at the big
+    end, ``m_rod·e/l`` reciprocating with the piston). 100 % balances the rotating masses and
+    half the reciprocating ones (what a single's "50 %" means); an in-line four with eight
+    counterweights runs about 80 %, with four about 57 %.
+
+    Attributes
+    ----------
+    cylinders
+        Its cylinders, numbered from 1.
+    phase_deg
+        Its crank pin's angle at θ1 = 0, degrees.
+    rotating_mr
+        Its rotating mass·radius along its pin, kg·m: the crankshaft's masses not labelled
+        ``"counterweight"`` nearest to it (pin, webs; each by its component along the pin)
+        and each rod's big-end share ``m_rod·(1 − e/l)·r``.
+    reciprocating_mr
+        ``Σ (m_piston + m_rod·e/l)·r`` over its cylinders, kg·m.
+    counterweight_mr
+        The counterweights nearest to it, each by its component opposite the pin, kg·m.
+    """
+
+    cylinders: tuple[int, ...]
+    phase_deg: float
+    rotating_mr: float
+    reciprocating_mr: float
+    counterweight_mr: float
+
+    @property
+    def factor(self) -> float:
+        """The balance factor, ``counterweight_mr / (rotating_mr + reciprocating_mr/2)``."""
+        return self.counterweight_mr / (self.rotating_mr + self.reciprocating_mr / 2)
+
+    def as_dict(self) -> dict[str, object]:
+        """An entry of ``optimize --json``'s ``balance_factors``."""
+        return {"cylinders": list(self.cylinders), "phase_deg": self.phase_deg,
+                "rotating_mr": self.rotating_mr, "reciprocating_mr": self.reciprocating_mr,
+                "counterweight_mr": self.counterweight_mr, "factor": self.factor}
+
+
 def _masses(items: Sequence[Mass], key: str) -> tuple[Mass, ...]:
     out = tuple(items)
     for i, m in enumerate(out):
         if not isinstance(m, Mass):
-            raise SpecError("must be a Mass", key=f"{key}[{i}]", value=m)
+            raise SpecError("must be a Mass", key=v.item(key, i), value=m)
     return out
 
 
@@ -318,7 +363,7 @@ class Engine(MechanismModel):
                             key="mechanism.cylinders", value=self.cylinders)
         for i, c in enumerate(cylinders):
             if not isinstance(c, Cylinder):
-                raise SpecError("must be a Cylinder", key=f"mechanism.cylinders[{i}]", value=c)
+                raise SpecError("must be a Cylinder", key=v.item("mechanism.cylinders", i), value=c)
         v.store(self, "cylinders", cylinders)
         if not isinstance(self.crankshaft, Crankshaft):
             raise SpecError("must be a Crankshaft", key="links.crankshaft",
@@ -329,7 +374,7 @@ class Engine(MechanismModel):
         shafts = tuple(self.balance_shafts)
         for j, s in enumerate(shafts):
             if not isinstance(s, BalanceShaft):
-                raise SpecError("must be a BalanceShaft", key=f"balance_shafts[{j}]", value=s)
+                raise SpecError("must be a BalanceShaft", key=v.item("balance_shafts", j), value=s)
         v.store(self, "balance_shafts", shafts)
         strokes = v.number(self.strokes, "mechanism.strokes")
         if strokes not in (2, 4):
@@ -352,7 +397,7 @@ class Engine(MechanismModel):
             for i, c in enumerate(cylinders):
                 if c.bore is None:
                     raise SpecError("an engine with gas needs each cylinder's bore",
-                                    key=f"mechanism.cylinders[{i}].bore", value=c.bore)
+                                    key=f"{v.item('mechanism.cylinders', i)}.bore", value=c.bore)
             angles = self.gas.crank_angle_deg
             if angles[0] < 0 or angles[-1] >= 180 * self.strokes or any(
                     b <= a for a, b in zip(angles, angles[1:], strict=False)):
@@ -413,6 +458,57 @@ class Engine(MechanismModel):
         return self.gas.force(self.cylinders[k - 1], self.firing_angles()[k - 1],
                               self.cycle_angle)
 
+    def throws(self, webs: Sequence[float] = ()) -> tuple[Throw, ...]:
+        """The crank throws and their balance factors (:class:`Throw`), along the crankshaft.
+
+        Cylinders share a crank pin where their pins have the same phase and they are next to
+        each other along the crankshaft with no web between them: no plane of a labelled
+        counterweight (nor of ``webs``, m: another design's counterweights, so that two
+        designs' throws are the same) lies between their planes. Each crankshaft mass belongs
+        to the throw nearest its plane (shared evenly between two at the same distance).
+        """
+        order = sorted(range(len(self.cylinders)), key=lambda i: self.cylinders[i].z)
+        walls = sorted({m.z for m in self.crankshaft.masses
+                        if m.label == COUNTERWEIGHT and m.mr > 0} | set(webs))
+        groups: list[list[int]] = []
+        for i in order:
+            c = self.cylinders[i]
+            if groups:
+                last = self.cylinders[groups[-1][-1]]
+                turn = (c.phase_deg - last.phase_deg) % 360.0
+                if min(turn, 360.0 - turn) <= 1e-9 and not any(last.z < w < c.z for w in walls):
+                    groups[-1].append(i)
+                    continue
+            groups.append([i])
+        rotating = [0.0] * len(groups)
+        reciprocating = [0.0] * len(groups)
+        counter = [0.0] * len(groups)
+        rod = self.rod
+        for g, members in enumerate(groups):
+            for i in members:
+                c = self.cylinders[i]
+                share = rod.e / c.rod  # of the rod's mass at the small end
+                rotating[g] += rod.mass * (1 - share) * c.crank
+                reciprocating[g] += (self.piston + rod.mass * share) * c.crank
+        spans = [(min(self.cylinders[i].z for i in m), max(self.cylinders[i].z for i in m))
+                 for m in groups]
+        length = max(hi for _, hi in spans) - min(lo for lo, _ in spans)
+        for mass in self.crankshaft.masses:
+            gaps = [max(lo - mass.z, mass.z - hi, 0.0) for lo, hi in spans]
+            nearest = [g for g, d in enumerate(gaps) if d <= min(gaps) + 1e-12 * length]
+            for g in nearest:
+                pin = self.cylinders[groups[g][0]].phase_deg
+                along = mass.mr * math.cos(math.radians(mass.phase_deg - pin)) / len(nearest)
+                if mass.label == COUNTERWEIGHT:
+                    counter[g] -= along
+                else:
+                    rotating[g] += along
+        return tuple(Throw(cylinders=tuple(i + 1 for i in members),
+                           phase_deg=self.cylinders[members[0]].phase_deg,
+                           rotating_mr=rotating[g], reciprocating_mr=reciprocating[g],
+                           counterweight_mr=counter[g])
+                     for g, members in enumerate(groups))
+
     # -- what every mechanism model offers ---------------------------------------------------
 
     @property
@@ -440,11 +536,11 @@ class Engine(MechanismModel):
         """Each cylinder's crank, rod and offset, and each shaft's distance from the axis, m."""
         out: dict[str, float] = {}
         for i, c in enumerate(self.cylinders):
-            key = f"mechanism.cylinders[{i}]"
+            key = v.item("mechanism.cylinders", i)
             out.update({f"{key}.crank": c.crank, f"{key}.rod": c.rod,
                         f"{key}.offset": abs(c.offset)})
         for j, s in enumerate(self.balance_shafts):
-            out[f"balance_shafts[{j}].at"] = math.hypot(*s.at)
+            out[f"{v.item('balance_shafts', j)}.at"] = math.hypot(*s.at)
         return out
 
     @property

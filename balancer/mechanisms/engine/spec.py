@@ -177,6 +177,32 @@ def _masses_lines(key: str, masses: tuple[Mass, ...]) -> list[str]:
     return [f"{key} = [", *(f"  {_mass_text(m)}," for m in masses), "]  # kg·m, °, m"]
 
 
+def _links_lines(model: Engine, prefix: str) -> list[str]:
+    """``[<prefix>.crankshaft]``, ``[<prefix>.rod]`` and ``[<prefix>.piston]``."""
+    shaft, rod = model.crankshaft, model.rod
+    out = ["", f"[{prefix}.crankshaft]", f"inertia = {toml.number(shaft.inertia)}  # kg·m²"]
+    if shaft.mass:
+        out.append(f"mass = {toml.number(shaft.mass)}  # kg")
+    out += _masses_lines("masses", shaft.masses)
+    out += ["", f"[{prefix}.rod]", f"mass = {toml.number(rod.mass)}  # kg",
+            f"inertia = {toml.number(rod.inertia)}  # kg·m² about its centre of mass",
+            f"com = {{ e = {toml.number(rod.e)}, f = {toml.number(rod.f)} }}  # m from the big "
+            "end",
+            "", f"[{prefix}.piston]", f"mass = {toml.number(model.piston)}  # kg"]
+    return out
+
+
+def _shafts_lines(model: Engine, key: str) -> list[str]:
+    """Each balance shaft as ``[[<key>]]``."""
+    out: list[str] = []
+    for s in model.balance_shafts:
+        out += ["", f"[[{key}]]", f"ratio = {s.ratio}",
+                f"at = [{toml.number(s.at[0])}, {toml.number(s.at[1])}]  # m",
+                f"inertia = {toml.number(s.inertia)}  # kg·m²",
+                *_masses_lines("eccentrics", s.eccentrics)]
+    return out
+
+
 def lines(model: Model) -> list[str]:
     """The engine's ``[mechanism]``, ``[links]``, ``[[balance_shafts]]`` and ``[gas]``."""
     assert isinstance(model, Engine)
@@ -197,21 +223,7 @@ def lines(model: Model) -> list[str]:
         out += [f"{k} = {toml.number(getattr(c, k))}  # m" for k in LENGTHS
                 if getattr(c, k) is not None
                 and (getattr(c, k) != getattr(first, k) or (k == "bore" and not shared_bore))]
-    shaft, rod = model.crankshaft, model.rod
-    out += ["", "[links.crankshaft]", f"inertia = {toml.number(shaft.inertia)}  # kg·m²"]
-    if shaft.mass:
-        out.append(f"mass = {toml.number(shaft.mass)}  # kg")
-    out += _masses_lines("masses", shaft.masses)
-    out += ["", "[links.rod]", f"mass = {toml.number(rod.mass)}  # kg",
-            f"inertia = {toml.number(rod.inertia)}  # kg·m² about its centre of mass",
-            f"com = {{ e = {toml.number(rod.e)}, f = {toml.number(rod.f)} }}  # m from the big "
-            "end",
-            "", "[links.piston]", f"mass = {toml.number(model.piston)}  # kg"]
-    for s in model.balance_shafts:
-        out += ["", "[[balance_shafts]]", f"ratio = {s.ratio}",
-                f"at = [{toml.number(s.at[0])}, {toml.number(s.at[1])}]  # m",
-                f"inertia = {toml.number(s.inertia)}  # kg·m²",
-                *_masses_lines("eccentrics", s.eccentrics)]
+    out += _links_lines(model, "links") + _shafts_lines(model, "balance_shafts")
     if model.gas is not None:
         g = model.gas
         out += ["", "[gas]",
@@ -290,14 +302,29 @@ def balance_lines(problem: object) -> list[str]:
 
 
 def read_original(table: Table, model: Model) -> Model:
-    """An engine has no ``[original]`` (its balancing replaces labelled counterweights)."""
-    raise SpecError("an engine's spec has no [original]: its balancing replaces the "
-                    "crankshaft's labelled counterweights", key=table.path)
+    """``[original]``: the same engine with the links and balance shafts given there.
+
+    Its cylinders, firing order and gas are the design's; its crankshaft (with every mass it
+    carried), rod and piston are required, its balance shafts (``[[original.balance_shafts]]``)
+    none where there are none.
+    """
+    assert isinstance(model, Engine)
+    table.expect(schema.known("original", schema.ENGINE))
+    crankshaft, rod, piston = _crankshaft(table), _rod(table), _piston(table)
+    shafts = _shafts(table)
+    table.finish()
+    piston = v.positive(piston, table.key("piston.mass"))  # (named here, not as [links]')
+    return replace(model, crankshaft=crankshaft, rod=rod, piston=piston, balance_shafts=shafts)
 
 
 def original_lines(model: Model) -> list[str]:
-    """None: an engine's spec has no ``[original]``."""
-    return []
+    """``model``'s links and balance shafts as ``[original.…]`` tables (:func:`read_original`).
+
+    ``[original.crankshaft]``, ``[original.rod]``, ``[original.piston]`` and
+    ``[[original.balance_shafts]]``.
+    """
+    assert isinstance(model, Engine)
+    return _links_lines(model, "original") + _shafts_lines(model, "original.balance_shafts")
 
 
 __all__ = ["balance_lines", "lines", "original_lines", "read", "read_balance", "read_original"]
