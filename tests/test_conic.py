@@ -177,3 +177,33 @@ def test_the_matrices_clarabel_reads_are_scipys_csc_arrays():
         assert np.array_equal(mine.indptr, ref.indptr)
         assert np.array_equal(mine.indices, ref.indices)
         assert np.array_equal(mine.data, ref.data)
+
+
+def test_an_almost_solved_program_is_solved_again_with_shorter_steps():
+    """Clarabel "almost solved" (its reduced tolerances only): solve_program tries the
+    ACCURACY_FALLBACKS in turn and takes the first that solves fully, else keeps the first
+    answer; numerical trouble first tries NUMERICAL_FALLBACKS. (The Jansen leg's tie-break left
+    its j 5e-7 off its mass bound "almost solved" on one machine's arithmetic.)"""
+    from balancer.balance.convex import ACCURACY_FALLBACKS, NUMERICAL_FALLBACKS, solve_program
+
+    class Program:
+        def __init__(self, answers):
+            self.answers, self.asked = answers, []
+
+        def solve(self, settings, **data):
+            self.asked.append(settings)
+            status = self.answers(settings)
+            return type("Solution", (), {"status": status, "u": None})()
+
+    def shorter_steps_solve(settings):
+        return "optimal" if settings.get("max_step_fraction") == 0.9 else "optimal_inaccurate"
+
+    program = Program(shorter_steps_solve)
+    assert solve_program(program, {"max_iter": 200}).status == "optimal"
+    assert program.asked == [{"max_iter": 200}, {"max_iter": 200, **ACCURACY_FALLBACKS[0]}]
+    never = Program(lambda settings: "optimal_inaccurate")
+    assert solve_program(never, {}).status == "optimal_inaccurate"
+    assert len(never.asked) == 1 + len(ACCURACY_FALLBACKS)
+    trouble = Program(lambda settings: "solver_error" if not settings else "optimal")
+    assert solve_program(trouble, {}).status == "optimal"
+    assert trouble.asked == [{}, NUMERICAL_FALLBACKS[0]]

@@ -35,7 +35,7 @@ from ..model.balance import Objective, RotorBalanceProblem, missing_balance
 from .certificate import Constraint, lower_bound
 from .certificate import Objective as Certified
 from .conic import ConicProgram, ConicSolution
-from .convex import Compressed, ConvexSolver
+from .convex import Compressed, ConvexSolver, solve_program
 from .front import AGAINST, Against, Front, FrontPoint, mark_knee
 from .problem import NumericProblem, numeric_problem
 from .rotor_front import rotor_front
@@ -123,13 +123,13 @@ class _Programs:
         else:
             program = ConicProgram(self.n, cones, equality=self.equality, objective="norm",
                                    P=self.other.P, q=self.other.q)
-        return program.solve(self.solver.settings)
+        return solve_program(program, self.solver.settings)
 
     def least_moment(self, extra: list[Constraint]) -> ConicSolution:
         """The program ``min ‖R_M·x‖`` within the bounds and ``extra``; its solution."""
         program = ConicProgram(self.n, [*self.solver.constraints, *extra], equality=self.equality,
                                objective="norm", P=self.moment.P, q=self.moment.q)
-        return program.solve(self.solver.settings)
+        return solve_program(program, self.solver.settings)
 
 
 def _scale(factor: NDArray[np.float64], data: NumericProblem) -> float:

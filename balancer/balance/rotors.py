@@ -66,7 +66,7 @@ from ..model.balance import (
 from .certificate import Constraint, lower_bound
 from .certificate import Objective as Norm
 from .conic import ConicProgram, ConicSolution
-from .convex import CLARABEL_SETTINGS, NUMERICAL_FALLBACKS, TIE_ACCEPT
+from .convex import CLARABEL_SETTINGS, TIE_ACCEPT, solve_program
 from .nlp import IPOPT_OPTIONS
 from .problem import BALANCED_SHARE, ROUNDING_FACTOR
 from .result import GAP_TOLERANCE, BalanceResult, RotorMasses, StageReport, Status
@@ -345,13 +345,8 @@ class RotorSolver:
 
     def solve_program(self, program: ConicProgram,
                       **data: NDArray[np.float64]) -> ConicSolution:
-        """``program`` by Clarabel, again with looser settings where it fails numerically."""
-        solution = program.solve(self.settings, **data)
-        for fallback in NUMERICAL_FALLBACKS:
-            if solution.status != "solver_error":
-                break
-            solution = program.solve({**self.settings, **fallback}, **data)
-        return solution
+        """``program`` by Clarabel, again where it did not solve fully (:func:`.solve_program`)."""
+        return solve_program(program, self.settings, **data)
 
     def x(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
         """Physical ``x`` (kg·m) of scaled ``u``, each vector within its bound."""
