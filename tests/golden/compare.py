@@ -86,6 +86,8 @@ class Tolerance:
 
     def allows(self, a: float, b: float, scale: float, printed: float = 0.0) -> bool:
         """Whether ``a`` and ``b`` agree (``printed``: one unit of a table's last digit)."""
+        if math.isinf(self.relative):  # not compared (ANY)
+            return True
         d = abs(a - b)
         return d <= max(self.relative * max(abs(a), abs(b)), self.of_scale * scale,
                         self.absolute, printed)
@@ -111,6 +113,8 @@ class Bound:
 
 EXACT = Tolerance(EXACT_RELATIVE, EXACT_OF_SCALE)
 DESIGN = Tolerance(DESIGN_RELATIVE, DESIGN_RELATIVE)
+#: A figure that is not compared: of a design that the optimum leaves free (see ``unique``).
+ANY = Tolerance(math.inf, math.inf)
 Rule = Tolerance | Bound
 
 
@@ -205,8 +209,15 @@ def _runs_tolerance(doc: dict, *, turning: bool = True) -> Tolerance:
     return integrated(rtol, steps, _travel(doc) if turning else 0.0)
 
 
-def _optimize_rule(path: str, doc: dict) -> Rule:
-    """What a figure of ``optimize --json`` is (see the module docstring)."""
+def _optimize_rule(path: str, doc: dict, unique: bool = True) -> Rule:
+    """What a figure of ``optimize --json`` is (see the module docstring).
+
+    Where the optimum is not ``unique`` (the objective leaves a valley of optimal designs, and
+    the tie-break's choice in it is only as well determined as its solve), the design's own
+    figures are not compared: only what the optimum fixes is — the objective and its bound,
+    the figures of the quantities it weighs (a function of ``y = P·u``, unique), the
+    constraints met (the shaking force of a force-balanced design), the original's figures.
+    """
     scale = float(doc.get("scale") or 0.0)
     squared = doc.get("rms") is None  # J and its bound in J's unit, the scale's square
     if re.match(r"(inertial\.)?before\.|original_links\.|orders\.before\.|original_objective$"
@@ -224,13 +235,42 @@ def _optimize_rule(path: str, doc: dict) -> Rule:
     if path == "force_balance_residual":
         return Bound(ROUNDING_TOLERANCE)
     if path.startswith("verification."):
+        if not unique:  # a simulation of a design the optimum leaves free
+            return ANY
         run = _runs_tolerance(doc.get("verification") or {})
         if path.endswith("energy_error"):
             return Bound(_runs_tolerance(doc["verification"], turning=False).relative)
         if re.search(r"_(ratio|level)$", path):  # to the original's (or the reactions'): 1
             return Bound(DESIGN_RELATIVE, DESIGN.loosest(run))
         return DESIGN.loosest(run)
-    return DESIGN
+    if unique:
+        return DESIGN
+    fixed = "|".join(re.escape(k) for k in _weighed(doc))
+    if re.match(rf"((inertial\.)?after\.|orders\.after\[\]\.)({fixed})\b"
+                rf"|objective_terms\.({fixed})\.after$", path):
+        return DESIGN
+    return ANY
+
+
+def _weighed(doc: dict | None) -> list[str]:
+    """The quantities an optimisation's objective weighs (``objective_terms``), and the
+    shaking force (a force-balanced design's constraint: rounding)."""
+    terms = (doc or {}).get("objective_terms") or {}
+    return [*(k for k, t in terms.items() if isinstance(t, dict) and t.get("weight")
+              and k != "added_mass"), "shaking_force"]
+
+
+def fixed_lines(doc: dict | None) -> Callable[[str], str]:
+    """A text report's lines about what an optimum fixes, where its design is not unique.
+
+    The verdict (objective, bound, gap), the rows and orders of the quantities the objective
+    weighs and of the shaking force, and whether it is force-balanced; the rest (the design,
+    its counterweights, the warnings about its other figures) lies anywhere in the valley.
+    """
+    names = "|".join(re.escape(k.replace("_", " ")) for k in _weighed(doc))
+    keep = re.compile(rf"^\s*(balancer optimize|backend |force-balanced|(\d+(½)?: )?({names}|"
+                      rf"force (forward|backward))\b)")
+    return lambda text: "\n".join(line for line in text.splitlines() if keep.match(line))
 
 
 def _simulation_rule(path: str, doc: dict) -> Rule:
@@ -243,27 +283,28 @@ def _simulation_rule(path: str, doc: dict) -> Rule:
     return run
 
 
-def json_rules(verb: str) -> Callable[[str, dict], Rule]:
-    """The rule that says what each figure of ``verb``'s JSON is."""
+def json_rules(verb: str, unique: bool = True) -> Callable[[str, dict], Rule]:
+    """The rule that says what each figure of ``verb``'s JSON is (``unique``: its optimum)."""
     if verb in ("optimize", "pareto"):
-        return _optimize_rule
+        return lambda path, doc: _optimize_rule(path, doc, unique)
     if verb in ("simulate", "verify"):
         return _simulation_rule
     return lambda path, doc: EXACT
 
 
-def text_rule(verb: str, text: str, sibling: dict | None = None) -> Tolerance:
+def text_rule(verb: str, text: str, sibling: dict | None = None,
+              unique: bool = True) -> Tolerance:
     """The tolerance of a text output's figures: its verb's loosest.
 
     (The JSON output of the same run compares each figure by what it is; a text output guards
     the wording and the layout.) An integrator's run is known by the ``sibling`` JSON document
     of the same command (its steps, ``rtol``, travel), or else by what the text says
-    (``rtol 1e-10: 29 steps``).
+    (``rtol 1e-10: 29 steps``). An optimum that is not ``unique``: the wording alone.
     """
     if verb in ("simulate", "verify"):
         return _runs_tolerance(sibling) if sibling else _integrated_of_text(text)
     if verb in ("optimize", "pareto"):
-        return DESIGN.loosest(_integrated_of_text(text))
+        return DESIGN.loosest(_integrated_of_text(text)) if unique else ANY
     return EXACT
 
 
@@ -305,7 +346,11 @@ def compare_data(recorded: dict, now: dict, rule: Callable[[str, dict], Rule],
     The same keys and items; each figure by ``rule(path, recorded)``, on the circle where it
     is an angle; each string by its wording, the figures in it by ``text``.
     """
-    xs, ys = list(_figures(recorded)), list(_figures(now))
+    def compared(leaves: list[tuple[str, object]]) -> list[tuple[str, object]]:
+        # a leaf of a design the optimum leaves free (ANY): not compared, nor its presence
+        return [(p, v) for p, v in leaves if rule(p, recorded) is not ANY]
+
+    xs, ys = compared(list(_figures(recorded))), compared(list(_figures(now)))
     if [p for p, _ in xs] != [p for p, _ in ys]:
         return "other keys or items:\n" + _first_difference(recorded, now)
     scales: dict[str, float] = {}
