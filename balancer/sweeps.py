@@ -59,6 +59,7 @@ from .balance.result import InfeasibleError
 from .cycle import cycle_analysis, one_thread
 from .errors import AssemblyError, LockupError, OutputError, SolverError, SpecError
 from .model import Design
+from .model.balance import missing_balance
 from .outputs import write_with
 from .plots import sweep_figure
 from .spec import design_from_dict
@@ -615,8 +616,9 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
 
     design = design_from_dict(data, source=str(spec))  # the spec itself must be valid
     if not perturbs and design.balance is None:
-        raise SpecError("missing required table: a sweep balances each point as the spec's "
-                        "[balance] asks (or give --perturb to analyse perturbed designs)",
+        missing = missing_balance(design.mechanism.type)
+        raise SpecError(f"{missing.detail}; a sweep balances each point as the spec's [balance] "
+                        "asks (or give --perturb to analyse perturbed designs)",
                         key="balance", source=str(spec))
     if design.operation is None:
         raise SpecError("missing required key: the figures are taken at the operating speed",

@@ -68,8 +68,10 @@ def test_every_list_item_in_a_message_is_counted_from_one():
     assert caught.value.key == "mechanism.cylinders[5]"
 
 
-def test_an_engine_without_balance_is_told_what_to_write(capsys):
-    for verb in (["optimize", "--no-verify"], ["pareto", "--against", "added-mass"]):
+def test_an_engine_without_balance_is_told_what_to_write(capsys, tmp_path):
+    for verb in (["optimize", "--no-verify"], ["pareto", "--against", "added-mass"],
+                 ["sweep", "--vary", "operation.speed=100:200:2", "--workers", "0", "--out",
+                  str(tmp_path / "s.parquet")]):
         assert main([verb[0], str(EXAMPLES / "v8.toml"), *verb[1:]]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "Traceback" not in err
