@@ -343,7 +343,9 @@ def classify(case: LinkageCase, run: Run) -> None:
         if run.new_files:
             d.append(("output files left after a failure", ", ".join(run.new_files)))
     if done and rc == 0:
-        if run.stderr.strip():
+        # (The same lines as on failure: a plausibility note on a unit that looks wrong is
+        # what the command must say, exit code unchanged; anything else is not.)
+        if lines:
             d.append(("stderr output on success", run.stderr[-200:]))
         if run.new_files:
             d.append(("files written by a --json command", ", ".join(run.new_files)))
