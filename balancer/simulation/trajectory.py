@@ -255,15 +255,19 @@ def _followed_angles(f: Formulation, t: NDArray[np.float64], theta: NDArray[np.f
 def _exchangeable_energy(f: Formulation) -> float:
     """An energy the loads, gravity and springs could exchange over the linkage's size, J.
 
-    ``L·Σ(m·|g| + |F|) + 2π·Σ|M| + Σ k·(L + l0)²`` with ``L`` the linkage's length scale: the
-    energy balance's scale where the motion itself exchanges almost none (a linkage at rest in
-    equilibrium, whose kinetic energy and work are both rounding).
+    ``L·Σ(m·|g| + |F|) + L·Σ max|F_gas| + 2π·Σ|M| + Σ k·(L + l0)²`` with ``L`` the linkage's
+    length scale and ``F_gas`` a slider's force along its guide (a gas force): the energy
+    balance's scale where the motion itself exchanges almost none (a linkage at rest in
+    equilibrium, whose kinetic energy and work are both rounding; a slider-crank at rest on a
+    dead centre with its gas force pressing along the rod).
     """
     mech = mechanism_of(f.linkage)
     length = mech.structure.length_scale()
     g = abs(f.gravity)
     total = sum((link.mass * g + math.hypot(*link.force)) * length
                 + 2 * math.pi * abs(link.moment) for link in mech.links)
+    for _, gas in mech.model.gas_forces:
+        total += max(abs(x) for x in gas.values) * length
     for spring in mech.linkage.springs:
         total += spring.stiffness * (length + abs(spring.free_length)) ** 2
     return float(total)
