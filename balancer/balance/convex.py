@@ -523,6 +523,8 @@ class ConvexSolver(Repairs, Diagnosis):
             x, objective = self.polish(x, target, objective)
         x = data.settle(x)  # the inert entries, for a crank whose speed changes
         x, feasible = self.finalize(x)
+        if feasible and tie_break and data.nullable:
+            x = self.without_idle_counterweights(x)
         lower = self._certified(first, x if feasible else None)
         return ConvexSolution(
             x=x,

@@ -183,6 +183,8 @@ class Optimizer:
                         xp, exact = self.convex.finalize(polished)
                         if exact and data.within(data.objective(xp), data.objective(xb), 1e-12):
                             xb = xp
+                        if data.nullable:
+                            xb = self.convex.without_idle_counterweights(xb)
                         x, objective, feasible = xb, data.objective(xb), True
             elif nlp is not None:
                 notes.append(f"IPOPT: {nlp.stage.solver_status}")
