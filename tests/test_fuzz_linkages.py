@@ -50,3 +50,23 @@ def test_a_plausibility_note_on_success_is_no_defect(stderr, defect):
               stderr=stderr)
     classify(case, run)
     assert ("stderr output on success" in run.defects) == defect
+
+
+@pytest.mark.parametrize(("index", "message", "named"), [
+    (28, "balancer: error: spec.toml: springs[1].stiffness: must be a number (got 'stiff')",
+     True),
+    (28, "balancer: error: spec.toml: springs[0].stiffness: must be a number (got 'stiff')",
+     False),  # the first spring is springs[1] in a message
+    (306, "balancer: error: spec.toml: mechanism.sliders[1].direction[0]: must be a finite "
+          "number (got nan)", True),
+])
+def test_an_item_of_an_array_of_tables_is_named_as_the_docs_count_it(index, message, named):
+    """Seed 40 (issue 40's runs): the messages count springs and sliders from 1 (commit
+    f96e5e0, validate.item), the generator's keys from 0, and the campaign called 92 exit-2
+    messages that name the first spring ``springs[1]`` 'without the key named'."""
+    from fuzz.linkage_campaign import Run, classify
+
+    case = make_case(40, index)
+    run = Run(verb="analyze", argv=("analyze", "spec.toml", "--json"), rc=2, stderr=message)
+    classify(case, run)
+    assert any(d.startswith("exit 2 without the key named") for d in run.defects) != named

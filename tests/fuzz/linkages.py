@@ -41,6 +41,7 @@ import argparse
 import cmath
 import copy
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -66,6 +67,18 @@ TURN = np.linspace(0.0, 2.0 * np.pi, 2881)
 
 # ----------------------------------------------------------------------------------------------
 # The case
+
+
+_ITEM = re.compile(r"\b(sliders|springs)\[(\d+)\]")
+
+
+def message_key(key: str) -> str:
+    """A generator's key (items of arrays of tables counted from 0, as the spec's lists are
+    indexed) as a message names it: each ``sliders[i]``, ``springs[i]`` counted from 1, as
+    the docs count them (``balancer.validate.item``, issue 40: ``springs[1]`` is the first
+    spring). A value's list elements keep their index (``direction[0]``); the generator's
+    keys have none."""
+    return _ITEM.sub(lambda m: f"{m.group(1)}[{int(m.group(2)) + 1}]", key)
 
 
 @dataclass(frozen=True)
@@ -115,9 +128,10 @@ class LinkageCase:
         return frozenset({0})
 
     def expected_keys(self, verb: str) -> tuple[str, ...]:
-        """Keys one of which an exit-2 message should name for ``verb``."""
+        """Keys one of which an exit-2 message should name for ``verb``, as messages name
+        them (:func:`message_key`)."""
         if self.expect in ("error", "edge"):
-            return self.keys
+            return tuple(map(message_key, self.keys))
         if verb in ("analyze", "verify", "optimize") and not self.info.get("has_operation", True):
             return ("operation.speed",)
         if self.expect == "no-full-turn":
