@@ -1051,6 +1051,31 @@ def test_a_counterweight_whose_gain_was_a_bound_met_to_tolerance_is_taken_off(ba
     assert result.added_mass == 0.0
 
 
+@pytest.mark.parametrize("backend", ["convex", "nlp"])
+def test_force_balance_rows_carry_no_rounding_on_what_moves_no_centre_of_mass(backend):
+    # Linkage campaign (issue 40, under the second arithmetic and the native one alike), seed
+    # 40, case 751: a slider-crank written as a general linkage, force balance asked. The
+    # conditions are a basis of the sampled first moments' null space (an SVD); the crank's
+    # inertia moves no centre of mass (its column is exactly zero) but had entries of 1.1e-16
+    # in three rows, which times its 216 kg·m² left a residual of 2.4e-14, 1.7e-12 of that
+    # condition's terms (0.014 kg·m at the optimum), above FORCE_BALANCE_TOLERANCE; nothing
+    # free could restore it (the inertia is settled afterwards): 'the balancing failed: no
+    # feasible design found' (exit 1) with a certified optimum 1.3e-8 away.
+    from balancer.balance.problem import FORCE_BALANCE_TOLERANCE, numeric_problem
+    from balancer.force_balance import force_balance_conditions
+    from balancer.mechanisms import mechanism_of
+
+    design = spec.load_design(DATA / "linkage_slider_crank_force_balance_rows.toml")
+    mech = mechanism_of(design.mechanism)
+    rows = force_balance_conditions(mech).matrix
+    for name in ("crank", "rod", "piston"):
+        assert np.all(rows[:, mech.layout.index(name, "J")] == 0.0)
+    result = optimize(design, backend)
+    assert result.status is Status.OPTIMAL
+    data = numeric_problem(design)
+    assert data.force_balance_residual(result.x) <= FORCE_BALANCE_TOLERANCE
+
+
 def test_the_nlp_backend_keeps_the_convex_design_where_its_own_made_exact_is_worse():
     # Redesign campaign quick mode, cw-borderline family, seed 2611200, problem 21: IPOPT's
     # design was better than the convex stage's (J 56.41142 against 56.41151) only before it
