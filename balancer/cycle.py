@@ -36,6 +36,7 @@ from .mechanisms import mechanism_of
 from .mechanisms.base import KERNEL_STATES, Mechanism, Route
 from .model import MechanismModel as Model
 from .orders import Order, order_table
+from .rounding import speed_text
 
 #: Number of crank angles evaluated at once.
 CHUNK = 32768
@@ -229,8 +230,8 @@ class CycleAnalysis:
         cycle = (f" over a cycle of 720° ({self.samples} in all)" if self.revolutions == 2
                  else "")
         return (f"CycleAnalysis({self.mechanism.kind}, {self.samples_per_revolution} angles per "
-                f"revolution{cycle} at {self.speed:g} rad/s ({self.speed * 30 / math.pi:.4g} "
-                f"rpm): RMS shaking force {s.shaking_force.rms:.4g} N, "
+                f"revolution{cycle} at {speed_text(self.speed)}: RMS shaking force "
+                f"{s.shaking_force.rms:.4g} N, "
                 f"shaking moment {s.shaking_moment.rms:.4g} N·m, driving torque "
                 f"{s.driving_torque.rms:.4g} N·m)")
 

@@ -22,6 +22,7 @@ from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism
 from .model import Design
 from .model import MechanismModel as Model
+from .rounding import speed_text
 
 #: Longest length that is plausibly meant, m: no planar linkage this tool balances is longer.
 MAX_LENGTH = 100.0
@@ -133,8 +134,7 @@ def speed_note(design: Design) -> str | None:
     radius = tip_radius(design.mechanism)
     if radius is None or not speed * radius > MAX_TIP_SPEED:
         return None
-    rpm = design.operation.speed * 30 / math.pi
-    return (f"operation.speed = {design.operation.speed:g} rad/s ({rpm:.4g} rpm) moves a point "
+    return (f"operation.speed = {speed_text(design.operation.speed)} moves a point "
             f"{radius:.4g} m "
             f"from the crank's pivot at {speed * radius:.4g} m/s, faster than sound "
             f"({MAX_TIP_SPEED:g} m/s): the speed is in rad/s (rpm written as rad/s?) and "

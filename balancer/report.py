@@ -14,18 +14,18 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
-from .balance.counterweights import UNCHANGED, Counterweight
+from .balance.counterweights import UNCHANGED, Counterweight, link_scales
 from .balance.front import FIGURES, Front
 from .cycle import CycleAnalysis, Figure
 from .errors import SolverError
-from .mechanisms.engine.model import COUNTERWEIGHT, Engine, Throw
 from .orders import order_name
-from .rounding import Scales
+from .rounding import Scales, speed_text
 from .rounding import figure_text as _fmt
 
 if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these load them
     from .balance.result import BalanceResult, RotorMasses
     from .model import Link
+    from .model.mechanisms import ThrowBalance
     from .simulation import Trajectory
     from .verification import Verification
 
@@ -185,11 +185,6 @@ def _change_points(analysis: CycleAnalysis) -> list[float]:
     if analysis.singular is None:
         return []
     return [float(t) for t in analysis.theta1[analysis.singular]]
-
-
-def speed_text(speed: float) -> str:
-    """A crank speed as a report gives it: rad/s with rpm beside it."""
-    return f"{speed:g} rad/s ({speed * 30 / math.pi:.4g} rpm)"
 
 
 def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
@@ -581,7 +576,7 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis, after: Cycle
                                     "reciprocating_mr/2)"})},
         }
     )
-    factors = balance_factors(result)
+    factors = result.original.balance_factors(result.linkage)
     if factors is not None:  # an engine's (after the keys every document has)
         doc["balance_factors"] = {"before": [t.as_dict() for t in factors[0]],
                                   "after": [t.as_dict() for t in factors[1]]}
@@ -728,23 +723,7 @@ def rotor_masses_text(masses: RotorMasses, speed: float, before: CycleAnalysis |
     return table(rows, header) + "\n" + "\n".join(notes)
 
 
-def balance_factors(result: BalanceResult) -> tuple[tuple[Throw, ...], tuple[Throw, ...]] | None:
-    """An engine's throws before and after balancing (:meth:`Engine.throws`), or ``None``.
-
-    The same throws for both: each design's counterweight planes separate the other's too.
-    """
-    old, new = result.original, result.linkage
-    if not isinstance(old, Engine) or not isinstance(new, Engine):
-        return None
-
-    def webs(engine: Engine) -> list[float]:
-        return [m.z for m in engine.crankshaft.masses
-                if m.label == COUNTERWEIGHT and m.mr > 0]
-
-    return old.throws(webs(new)), new.throws(webs(old))
-
-
-def balance_factors_text(before: Sequence[Throw], after: Sequence[Throw]) -> str:
+def balance_factors_text(before: Sequence[ThrowBalance], after: Sequence[ThrowBalance]) -> str:
     """Each throw's balance factor before and after, as engine designers quote it."""
     rows = []
     for k, (b, a) in enumerate(zip(before, after, strict=True), start=1):
@@ -787,20 +766,14 @@ def _parameters_text(result: BalanceResult) -> str:
 MARKED_CHANGE = 1e-6
 
 
-def _parameter_scales(old: Any, new: Any) -> dict[str, float]:
-    """Each parameter kind's scale in a link before and after (as :func:`.counterweight` uses).
+def _parameter_scales(old: Link, new: Link) -> dict[str, float]:
+    """Each parameter kind's scale in a link before and after (:func:`.link_scales`).
 
-    Mass: the larger mass, kg; ``e``, ``f``: the link's reach (its centre's distance or radius
-    of gyration about its frame's origin), m; inertia and counter-rotor: the larger inertia
-    about the frame's origin (or counter-rotor), kg·m².
+    A counter-rotor's is the larger of the link's inertia and the counter-rotors.
     """
-    m = max(old.mass, new.mass)
-    j = max(old.inertia + old.mass * (old.e**2 + old.f**2),
-            new.inertia + new.mass * (new.e**2 + new.f**2))
-    reach = max(math.hypot(old.e, old.f), math.hypot(new.e, new.f),
-                math.sqrt(j / m) if m > 0 else 0.0)
-    rotor = max(j, abs(old.counter_rotor), abs(new.counter_rotor))
-    return {"mass": m, "e": reach, "f": reach, "inertia": j, "counter_rotor": rotor}
+    mass, reach, inertia = link_scales(old, new)
+    rotor = max(inertia, abs(old.counter_rotor), abs(new.counter_rotor))
+    return {"mass": mass, "e": reach, "f": reach, "inertia": inertia, "counter_rotor": rotor}
 
 
 def optimization_scales(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis
@@ -876,7 +849,7 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
     lines += [table(rows, ["order amplitude", "before", "after", "unit"]), ""]
     if result.rotor_masses is not None:  # an engine: what to build, not changed links
         lines += [rotor_masses_text(result.rotor_masses, before.speed, before, after), ""]
-        factors = balance_factors(result)
+        factors = result.original.balance_factors(result.linkage)
         if factors is not None:
             lines += [balance_factors_text(*factors), ""]
     else:

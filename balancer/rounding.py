@@ -1,4 +1,4 @@
-"""What a text table prints as 0: a figure that is rounding of its quantity's scale.
+"""How a report prints a figure: rounding of its quantity's scale as 0, a speed with its rpm.
 
 The one rule (:class:`Scales`) by which every readable report — ``analyze``, ``simulate``,
 ``optimize``, ``verify``, the order tables, an engine's tables, a balancing's verdict — prints
@@ -19,6 +19,15 @@ def figure_text(x: float, width: int = 12) -> str:
     if abs(x) >= 1e5 or abs(x) < 1e-3:
         return f"{x:>{width}.4e}"
     return f"{x:>{width}.6g}"
+
+
+#: rpm per rad/s.
+RPM = 30.0 / math.pi
+
+
+def speed_text(speed: float) -> str:
+    """A crank speed as a designer reads it: ``"628.319 rad/s (6000 rpm)"`` from rad/s."""
+    return f"{speed:g} rad/s ({speed * RPM:.4g} rpm)"
 
 
 #: A figure within this share of its quantity's scale is the arithmetic's rounding: a text

@@ -616,7 +616,7 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
 
     design = design_from_dict(data, source=str(spec))  # the spec itself must be valid
     if not perturbs and design.balance is None:
-        missing = missing_balance(design.mechanism.type)
+        missing = missing_balance(design.mechanism)
         raise SpecError(f"{missing.detail}; a sweep balances each point as the spec's [balance] "
                         "asks (or give --perturb to analyse perturbed designs)",
                         key="balance", source=str(spec))
@@ -822,10 +822,15 @@ def _close(client: Client | None, cluster: LocalCluster | None, futures: list[An
 
 @contextlib.contextmanager
 def _silenced(*names: str) -> Iterator[None]:
-    """The loggers ``names`` silent (above CRITICAL) for the block."""
+    """The loggers ``names`` and those under them silent (above CRITICAL) for the block."""
     import logging
 
-    loggers = [logging.getLogger(name) for name in names]
+    # Dask's logging config sets levels on children too (tornado.application: ERROR), which a
+    # parent's level does not override: every logger under the names is silenced.
+    existing = [name for name, lg in logging.root.manager.loggerDict.items()
+                if isinstance(lg, logging.Logger)
+                and any(name.startswith(f"{parent}.") for parent in names)]
+    loggers = [logging.getLogger(name) for name in (*names, *existing)]
     levels = [lg.level for lg in loggers]
     for lg in loggers:
         lg.setLevel(logging.CRITICAL + 1)

@@ -19,6 +19,7 @@ from balancer.api import analyze
 from balancer.cli import main
 from balancer.mechanisms import mechanism_of
 from balancer.plots import style
+from balancer.rounding import speed_text
 from balancer.spec import load_design
 from balancer.sweeps import atlas_figure
 
@@ -849,7 +850,7 @@ def test_figures_give_speeds_in_rpm_beside_rad_per_s(tmp_path):
     a = analyze(design)
     assert "680.678 rad/s (6500 rpm)" in plots.cycle_figure(a).get_suptitle()
     assert "680.678 rad/s (6500 rpm)" in plots.orders_figure(a).get_suptitle()
-    assert style.speed_text(10.0) == "10 rad/s (95.49 rpm)"
+    assert speed_text(10.0) == "10 rad/s (95.49 rpm)"  # the one text of a speed
     # A sweep over the speed: a second axis in rpm, the original's speed in both.
     path = _atlas_table(tmp_path / "speed.parquet", ["optimal"] * 3,
                         keys=("operation.speed",), values=((500.0, 600.0, 700.0),))

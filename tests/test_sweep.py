@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import math
 import os
 import re
@@ -16,7 +17,7 @@ from balancer.balance.optimizer import optimize
 from balancer.cli import main
 from balancer.errors import OutputError, SpecError
 from balancer.spec import design_from_dict, load_design
-from balancer.sweeps import Vary, design_points, sweep, with_values
+from balancer.sweeps import Vary, _silenced, design_points, sweep, with_values
 
 ROOT = Path(__file__).resolve().parent.parent
 PB1 = ROOT / "examples" / "pb1.toml"
@@ -342,3 +343,18 @@ def test_a_sweep_task_runs_its_cycles_on_its_own_thread(monkeypatch):
     assert rows[0]["status"] == "analysed" and len(pools) == 1
     cycle_module.cycle_analysis(design.mechanism, design.operation.speed, 360)
     assert len(pools) == 2  # (and again after it)
+
+
+def test_an_interrupted_sweep_silences_the_loggers_dask_configures_under_a_name(caplog):
+    """Dask's config gives ``tornado.application`` its own level (ERROR), which ``tornado``'s
+    does not override: its race on Ctrl-C (a cancel callback's NameError, logged by tornado)
+    reached a designer's terminal. Every logger under a silenced name is silenced, and each
+    gets its level back after."""
+    child = logging.getLogger("balancer-test-parent.application")
+    child.setLevel(logging.ERROR)
+    with _silenced("balancer-test-parent"):
+        child.error("a callback failed")
+    assert not [r for r in caplog.records if r.name == child.name]
+    assert child.level == logging.ERROR
+    child.error("after the block")
+    assert [r.getMessage() for r in caplog.records if r.name == child.name] == ["after the block"]

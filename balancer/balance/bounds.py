@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import sys
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Any
 
 from ..errors import SpecError
@@ -52,17 +52,16 @@ def check_problem(problem: BalanceProblem, mechanism: Model | Mechanism) -> None
     the bounds is the optimiser's question.)
     """
     mech = mechanism_of(mechanism)
-    checked: set[Any] = mech.__dict__.setdefault("_problems_checked", set())
     try:
-        if problem in checked:  # (the spec's reader and the optimiser ask the same)
-            return
+        _checked(problem, mech)  # once per problem and mechanism: the reader and the optimiser
     except TypeError:  # unhashable: checked every time
-        checked = set()
+        _check_problem(problem, mech)
+
+
+@lru_cache(maxsize=256)
+def _checked(problem: BalanceProblem, mech: Mechanism) -> None:
+    """:func:`_check_problem`, remembered where it passed (a refusal is raised again)."""
     _check_problem(problem, mech)
-    try:
-        checked.add(problem)
-    except TypeError:
-        pass
 
 
 def _check_problem(problem: BalanceProblem, mech: Mechanism) -> None:
@@ -362,14 +361,16 @@ def resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> Lin
     Resolved once per mechanism and freedom (the spec's reader checks what the optimiser then
     solves): the bounds are immutable.
     """
-    memo: dict[Any, LinkBounds] = mech.__dict__.setdefault("_resolved_links", {})
     try:
-        known = memo.get((name, freedom))
+        return _resolved(mech, name, freedom)
     except TypeError:  # unhashable: resolved every time
         return _resolve_link(mech, name, freedom)
-    if known is None:
-        known = memo[(name, freedom)] = _resolve_link(mech, name, freedom)
-    return known
+
+
+@lru_cache(maxsize=1024)
+def _resolved(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> LinkBounds:
+    """:func:`_resolve_link`, remembered (the bounds are immutable)."""
+    return _resolve_link(mech, name, freedom)
 
 
 def _resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> LinkBounds:

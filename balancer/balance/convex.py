@@ -89,7 +89,10 @@ NUMERICAL_FALLBACKS: tuple[dict[str, float | bool], ...] = (
 #: feasible set (a tie-break whose design has a mass, a centre and an inertia all at their
 #: bounds) loses fewer digits. The first that solves fully is taken. (The Jansen leg's
 #: tie-break: "almost solved" with the default 0.99, its j held 3e-8 to 5e-7 off its mass
-#: bound depending on the machine's arithmetic; at 0.9 solved, the mass on its bound.)
+#: bound depending on the machine's arithmetic; at 0.9 solved, the mass on its bound.) The same
+#: settings serve a loose certificate (:data:`CERTIFY_AGAIN`): each lands on another point of
+#: the central path, whose dual residual differs (the Jansen leg's gap of 2.7e-7, or 4e-6 on
+#: another arithmetic, tightened below 1e-8).
 ACCURACY_FALLBACKS: tuple[dict[str, float | bool], ...] = (
     {"max_step_fraction": 0.9},
     {"equilibrate_enable": False},
@@ -99,13 +102,6 @@ ACCURACY_FALLBACKS: tuple[dict[str, float | bool], ...] = (
 #: bound (:meth:`ConvexSolver._certified`): whether a design is proven optimal must not hinge on
 #: the machine's rounding.
 CERTIFY_AGAIN = 1e-8
-#: The settings of those solves, in turn: without equilibration, then with shorter steps (each
-#: lands on another point of the central path, whose dual residual differs; on the Jansen leg
-#: they tighten a gap of 2.7e-7, or 4e-6 on another arithmetic, to below 1e-8).
-CERTIFICATE_SETTINGS: tuple[dict[str, float | bool], ...] = (
-    {"equilibrate_enable": False},
-    {"max_step_fraction": 0.9},
-)
 #: The tie-break's design replaces the SOCP's if it is feasible and its objective is no worse
 #: by more than this, relative to the problem's scale (:meth:`NumericProblem.within`).
 TIE_ACCEPT = 1e-8
@@ -523,7 +519,7 @@ class ConvexSolver(Repairs, Diagnosis):
             x, objective = self.polish(x, target, objective)
         x = data.settle(x)  # the inert entries, for a crank whose speed changes
         x, feasible = self.finalize(x)
-        if feasible and tie_break and data.nullable:
+        if feasible and tie_break:
             x = self.without_idle_counterweights(x)
         lower = self._certified(first, x if feasible else None)
         return ConvexSolution(
@@ -590,7 +586,7 @@ class ConvexSolver(Repairs, Diagnosis):
         Where it leaves the design's gap above :data:`CERTIFY_AGAIN` (Clarabel "almost solved"
         with a dual that is off by more than its tolerance: on another machine's arithmetic the
         Jansen leg's gap was 4e-6, beyond the certified 1e-6), the SOCP is solved again with
-        each of :data:`CERTIFICATE_SETTINGS` and the highest bound kept (every one is valid by
+        each of :data:`ACCURACY_FALLBACKS` and the highest bound kept (every one is valid by
         weak duality), until one is tight.
         """
         data = self.data
@@ -598,7 +594,7 @@ class ConvexSolver(Repairs, Diagnosis):
         if feasible is None:
             return lower
         objective = data.objective(feasible)
-        for settings in CERTIFICATE_SETTINGS:
+        for settings in ACCURACY_FALLBACKS:
             if data.gap(objective, lower) <= CERTIFY_AGAIN:
                 break
             again = self._stage1.solve({**self.settings, **settings})

@@ -119,6 +119,22 @@ class Counterweight:
                            "inertia": self.inertia_change}}
 
 
+def link_scales(original: Link, balanced: Link) -> tuple[float, float, float]:
+    """The scales of a link's figures before and after: mass (kg), reach (m), inertia (kg·m²).
+
+    The larger mass; the reach, the farther centre of mass or the larger radius of gyration
+    about the frame's origin; the larger inertia about the frame's origin. A change within
+    :data:`UNCHANGED` of them is rounding.
+    """
+    m0, m1 = original.mass, balanced.mass
+    j0 = original.inertia + m0 * (original.e**2 + original.f**2)
+    j1 = balanced.inertia + m1 * (balanced.e**2 + balanced.f**2)
+    mass = max(m0, m1)
+    reach = max(math.hypot(original.e, original.f), math.hypot(balanced.e, balanced.f),
+                math.sqrt(max(j0, j1) / mass) if mass else 0.0)
+    return mass, reach, max(j0, j1)
+
+
 def counterweight(name: str, original: Link, balanced: Link) -> Counterweight:
     """The counterweight that makes link ``original`` into ``balanced``.
 
@@ -130,8 +146,7 @@ def counterweight(name: str, original: Link, balanced: Link) -> Counterweight:
     j0 = original.inertia + m0 * abs(s0) ** 2  # about the frame's origin
     j1 = balanced.inertia + m1 * abs(s1) ** 2
     dm, ds, dj = m1 - m0, m1 * s1 - m0 * s0, j1 - j0
-    mass_scale = max(m0, m1)
-    reach = max(abs(s0), abs(s1), math.sqrt(max(j0, j1) / mass_scale) if mass_scale else 0.0)
+    mass_scale, reach, _ = link_scales(original, balanced)
     mass_same = abs(dm) <= UNCHANGED * mass_scale
     moment_same = abs(ds) <= UNCHANGED * mass_scale * reach
     inertia_same = abs(dj) <= UNCHANGED * max(j0, j1)

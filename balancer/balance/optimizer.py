@@ -183,8 +183,7 @@ class Optimizer:
                         xp, exact = self.convex.finalize(polished)
                         if exact and data.within(data.objective(xp), data.objective(xb), 1e-12):
                             xb = xp
-                        if data.nullable:
-                            xb = self.convex.without_idle_counterweights(xb)
+                        xb = self.convex.without_idle_counterweights(xb)
                         x, objective, feasible = xb, data.objective(xb), True
             elif nlp is not None:
                 notes.append(f"IPOPT: {nlp.stage.solver_status}")
@@ -278,7 +277,7 @@ def optimize(design: Design, backend: Backend = "nlp") -> BalanceResult:
             f"unknown backend; choose from {', '.join(BACKENDS)}", key="backend", value=backend
         )
     if design.balance is None:
-        raise missing_balance(design.mechanism.type)
+        raise missing_balance(design.mechanism)
     if isinstance(design.balance, RotorBalanceProblem):  # an engine's counterweights, shafts
         return rotors.optimize(design, backend)
     return Optimizer.of(design).run(backend)

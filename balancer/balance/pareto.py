@@ -167,7 +167,7 @@ def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
     if against not in AGAINST:
         raise SpecError(f"must be one of {', '.join(AGAINST)}", key="--against", value=against)
     if design.balance is None:
-        raise missing_balance(design.mechanism.type)
+        raise missing_balance(design.mechanism)
     if not 2 <= points <= MAX_POINTS:
         raise SpecError(f"a front has from 2 to {MAX_POINTS} points", key="--points",
                         value=points)

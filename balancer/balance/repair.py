@@ -359,6 +359,8 @@ class Repairs:
         worse (:data:`TAKE_OFF_ACCEPT`).
         """
         data = self.data
+        if not data.nullable:
+            return x
         objective = data.objective(x)
         for b in data.nullable:
             if data.absent(b, data.own(x)):

@@ -423,18 +423,11 @@ class PlacedMassLike(Protocol):
         """Plane, m."""
 
 
-def missing_balance(mechanism_type: str) -> SpecError:
+def missing_balance(mechanism: MechanismModel) -> SpecError:
     """The error for a spec without ``[balance]`` that a verb must balance (exit code 2).
 
-    It says what the mechanism's ``[balance]`` holds: an engine's, where counterweights may go
-    and which shafts there may be (DESIGN.md, "Balancing an engine"); a linkage's, which links
-    may change.
+    It says what the mechanism's ``[balance]`` holds (:attr:`MechanismModel.balance_tables`):
+    an engine's, where counterweights may go and which shafts there may be; a linkage's, which
+    links may change.
     """
-    if mechanism_type == "engine":
-        return SpecError(
-            "missing required table: an engine is balanced by counterweights on its crankshaft "
-            "and new balance shafts; name where they may go: [balance.counterweights] with "
-            "max_mr (kg·m; planes, m, default each cylinder's; radius, m, for their masses), "
-            "and/or [[balance.shafts]] with ratio, at, planes and max_mr (docs/engines.md, "
-            "\"Balancing an engine\")", key="balance")
-    return SpecError("missing required table: the redesign problem ([balance])", key="balance")
+    return SpecError(f"missing required table: {mechanism.balance_tables}", key="balance")

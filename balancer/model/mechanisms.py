@@ -15,7 +15,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import Any, ClassVar, Literal, Self
+from typing import Any, ClassVar, Literal, Protocol, Self
 
 from .. import validate as v
 from ..errors import SpecError
@@ -23,6 +23,24 @@ from .links import GROUND, RESERVED_LINK_NAMES, Body, GasForce, Link, Slider, Sp
 
 #: An assembly branch of a mechanism given by its lengths.
 Branch = Literal["+", "-"]
+
+
+class ThrowBalance(Protocol):
+    """One crank throw's balance as engine designers quote it (an engine's ``Throw``)."""
+
+    @property
+    def cylinders(self) -> tuple[int, ...]: ...
+    @property
+    def phase_deg(self) -> float: ...
+    @property
+    def rotating_mr(self) -> float: ...
+    @property
+    def reciprocating_mr(self) -> float: ...
+    @property
+    def counterweight_mr(self) -> float: ...
+    @property
+    def factor(self) -> float: ...
+    def as_dict(self) -> dict[str, object]: ...
 
 
 class MechanismModel(ABC):
@@ -34,6 +52,9 @@ class MechanismModel(ABC):
 
     #: The spec's ``mechanism.type``.
     type: ClassVar[str]
+    #: What its spec's ``[balance]`` holds, for the error of a verb that must balance it
+    #: without one (:func:`balancer.model.balance.missing_balance`).
+    balance_tables: ClassVar[str] = "the redesign problem ([balance])"
 
     @property
     @abstractmethod
@@ -94,6 +115,14 @@ class MechanismModel(ABC):
     @abstractmethod
     def without_loads(self) -> Self:
         """Return a copy with every applied force, moment and slider force removed."""
+
+    def balance_factors(self, balanced: MechanismModel
+                        ) -> tuple[tuple[ThrowBalance, ...], tuple[ThrowBalance, ...]] | None:
+        """Each crank throw's balance before (this design) and after (``balanced``).
+
+        ``None``: a mechanism without crank throws (an engine's are its own).
+        """
+        return None
 
 
 class ChainModel(MechanismModel):

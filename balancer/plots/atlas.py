@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
+from ..rounding import RPM
 from .style import ORIGINAL_STYLE, legend_outside, mark_point, number
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
@@ -27,8 +28,6 @@ class PerturbLike(Protocol):
         """The standard deviation of its normal draws, in its unit."""
 
 
-#: rpm per rad/s.
-RPM = 30.0 / np.pi
 
 
 def _key_label(key: str, units: dict[str, str]) -> str:

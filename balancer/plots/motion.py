@@ -15,6 +15,7 @@ from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Design
 from ..model import MechanismModel as Model
+from ..rounding import speed_text
 from ..simulation import Trajectory
 from ..verification import Verification
 from .style import (
@@ -26,7 +27,6 @@ from .style import (
     draw_frame,
     legend_outside,
     number,
-    speed_text,
 )
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw

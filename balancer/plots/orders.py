@@ -14,7 +14,8 @@ import numpy as np
 
 from ..cycle import ROUNDING_SPAN, CycleAnalysis, natural_scales, panel_keys
 from ..orders import Order, order_name
-from .style import COLOURS, axes, number, speed_text
+from ..rounding import speed_text
+from .style import COLOURS, axes, number
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
     from matplotlib.axes import Axes

@@ -12,7 +12,8 @@ import numpy as np
 
 from ..cycle import ROUNDING_SPAN, CycleAnalysis, drawn_panels, natural_scales, panel_keys
 from ..cycle import Figure as Figures
-from .style import AFTER_STYLE, BEFORE_STYLE, axes, legend_outside, number, speed_text
+from ..rounding import speed_text
+from .style import AFTER_STYLE, BEFORE_STYLE, axes, legend_outside, number
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
     from matplotlib.axes import Axes

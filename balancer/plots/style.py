@@ -58,11 +58,6 @@ def number(x: float) -> str:
     return f"{x:.3g}"
 
 
-def speed_text(speed: float) -> str:
-    """A crank speed as a designer reads it: ``"628.319 rad/s (6000 rpm)"`` from rad/s."""
-    return f"{speed:g} rad/s ({speed * 30 / np.pi:.4g} rpm)"
-
-
 def draw_frame(ax: Axes, linkage: Model | Mechanism,
                label: str | None = "frame (pivots, guides)") -> None:
     """The frame: the ground pivots as triangles, the ground guides' travel as thick lines."""

@@ -58,6 +58,7 @@ from ..formulations import (
 from ..mechanisms import mechanism_of
 from ..model import Design, Drive, SimulationSettings, check_scales
 from ..model import MechanismModel as Model
+from ..rounding import speed_text
 from .stepper import MAX_OUTPUTS, MAX_STEPS, Stepper, passing
 from .trajectory import Trajectory, trajectory_of
 
@@ -258,7 +259,7 @@ def simulate(
         th = f.crank_angle(run.stop_at)
         speed = f.speed or 0.0  # (a run that stops where the linkage ends is driven)
         raise _lockup(
-            f"the crank, driven at {speed:g} rad/s ({speed * 30 / math.pi:.4g} rpm), reaches "
+            f"the crank, driven at {speed_text(speed)}, reaches "
             f"the end of the range where the linkage assembles at t = {run.stop_at:.6g} s, "
             f"θ1 = {th:.6g} rad: the linkage locks", run.stop_at, th, traj)
     return traj

@@ -53,7 +53,7 @@ from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 from .campaign import isolate  # noqa: E402
-from .checks import _is_number, _reject_constant  # noqa: E402
+from .checks import _is_number, _reject_constant, snapshot  # noqa: E402
 from .checks import _missing_fields as _fixed_fields  # noqa: E402
 from .linkages import SPEC, LinkageCase, directed_cases, make_case  # noqa: E402
 
@@ -145,21 +145,11 @@ class Run:
     details: dict[str, str] = field(default_factory=dict)
 
 
-def _snapshot(folder: Path) -> dict[str, str]:
-    out = {}
-    for p in folder.rglob("*"):
-        if p.is_file():
-            out[str(p.relative_to(folder))] = hashlib.sha256(p.read_bytes()).hexdigest()
-        else:
-            out[str(p.relative_to(folder))] = "<dir>"
-    return out
-
-
 def run_command(ctx, verb: str, argv: tuple[str, ...], folder: Path, scratch: Path,
                 timeout: float, memory: int) -> Run:
     io_dir = scratch / f"io-{verb}"
     io_dir.mkdir()
-    before = _snapshot(folder)
+    before = snapshot(folder)
     sys.stdout.flush()
     sys.stderr.flush()
     proc = ctx.Process(target=_child, args=(argv, str(folder), str(io_dir), memory),
@@ -189,7 +179,7 @@ def run_command(ctx, verb: str, argv: tuple[str, ...], folder: Path, scratch: Pa
     tb = io_dir / "traceback.txt"
     if tb.exists():
         run.traceback = tb.read_text(encoding="utf-8", errors="replace")
-    after = _snapshot(folder)
+    after = snapshot(folder)
     run.spec_changed = before.get(SPEC) != after.get(SPEC)
     run.new_files = sorted(set(after) - set(before))
     shutil.rmtree(io_dir, ignore_errors=True)

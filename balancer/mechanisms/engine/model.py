@@ -345,6 +345,11 @@ class Engine(MechanismModel):
     """
 
     type: ClassVar[str] = "engine"
+    balance_tables: ClassVar[str] = (
+        "an engine is balanced by counterweights on its crankshaft and new balance shafts; "
+        "name where they may go: [balance.counterweights] with max_mr (kg·m; planes, m, default "
+        "each cylinder's; radius, m, for their masses), and/or [[balance.shafts]] with ratio, "
+        "at, planes and max_mr (docs/engines.md, \"Balancing an engine\")")
 
     cylinders: tuple[Cylinder, ...]
     crankshaft: Crankshaft = field(default_factory=Crankshaft)
@@ -457,6 +462,21 @@ class Engine(MechanismModel):
             return GasForce()
         return self.gas.force(self.cylinders[k - 1], self.firing_angles()[k - 1],
                               self.cycle_angle)
+
+    def balance_factors(self, balanced: MechanismModel
+                        ) -> tuple[tuple[Throw, ...], tuple[Throw, ...]] | None:
+        """Each throw's balance before (this engine) and after (``balanced``: its redesign).
+
+        The same throws for both: each design's counterweight planes separate the other's too.
+        """
+        if not isinstance(balanced, Engine):  # (a redesign is the same kind of mechanism)
+            return None
+
+        def webs(engine: Engine) -> list[float]:
+            return [m.z for m in engine.crankshaft.masses
+                    if m.label == COUNTERWEIGHT and m.mr > 0]
+
+        return self.throws(webs(balanced)), balanced.throws(webs(self))
 
     def throws(self, webs: Sequence[float] = ()) -> tuple[Throw, ...]:
         """The crank throws and their balance factors (:class:`Throw`), along the crankshaft.
