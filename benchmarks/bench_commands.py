@@ -40,7 +40,8 @@ Rows and their anchors:
     default command's row shows both errors; the "equal accuracy" row runs balancer at the
     loosest ``--rtol`` whose error is no larger than Exudyn's. Goal ratio ≤ 0.5.
 ``analyze <example>``
-    Every shipped example, against the start-up anchor: the issue's ≤ 0.3 s each as a ratio.
+    Every shipped example, against the start-up anchor: the issue's ≤ 0.3 s each as a ratio;
+    the paper's four-bar also within 1.6× the anchor (issue 41's goal, a ratio itself).
     ``--help``: ≤ 0.1 s as a ratio.
 ``re-solve PB1``
     In process: PB1's certified convex optimum re-solved after its bounds change, through the
@@ -178,16 +179,18 @@ def yes(ok: bool) -> str:
     return "yes" if ok else "NO"
 
 
-def against_startup(goal: str, cmd: list[str], repeats: int, limit: float) -> Row:
+def against_startup(goal: str, cmd: list[str], repeats: int, limit: float,
+                    ratio_goal: float | None = None) -> Row:
     """A whole command's row judged against the start-up anchor, run alternately with it.
 
     One warm-up of each, then ``repeats`` pairs (the anchor, then the command): the ratio is
     the median of the pairs' ratios, so that a machine whose load changes during the run
     (another process taking a core for a while) moves both alike. ``limit`` is the issue's goal
-    in seconds; it becomes the ratio ``limit /`` :data:`STARTUP_REFERENCE`. Without the anchor
-    the row is judged on ``limit`` and says so.
+    in seconds; it becomes the ratio ``limit /`` :data:`STARTUP_REFERENCE`, unless the issue
+    set a ratio itself (``ratio_goal``). Without the anchor the row is judged on ``limit`` and
+    says so.
     """
-    target = limit / STARTUP_REFERENCE
+    target = limit / STARTUP_REFERENCE if ratio_goal is None else ratio_goal
     if STARTUP is None:
         seconds = wall(cmd, repeats)
         return Row(goal, measured=sec(seconds), anchor="start-up anchor failed",
@@ -203,7 +206,8 @@ def against_startup(goal: str, cmd: list[str], repeats: int, limit: float) -> Ro
     ratio = statistics.median(a / b for a, b in zip(ours, anchor, strict=True))
     return Row(goal, measured=sec(statistics.median(ours)),
                anchor=f"{sec(statistics.median(anchor))} (import numpy, alternated)",
-               ratio=f"{ratio:.2f}", target=f"ratio ≤ {target:.2f} (≤ {limit:g} s)",
+               ratio=f"{ratio:.2f}", target=(f"ratio ≤ {target:.2f} (≤ {limit:g} s)"
+                                             if ratio_goal is None else f"ratio ≤ {target:.2f}"),
                met=yes(ratio <= target))
 
 
@@ -339,10 +343,16 @@ def analyze_rows(repeats: int) -> list[Row]:
                                     [*bal, "analyze", f"examples/{spec.name}"], repeats, 0.3)]
         rows += guarded(f"analyze {spec.name}", "≤ 0.3 s", body)
 
+    def paper() -> list[Row]:  # issue 41: the paper's four-bar within 1.6× of numpy's start-up
+        return [against_startup("analyze meijaard2020.toml (issue 41)",
+                                [*bal, "analyze", "examples/meijaard2020.toml"], repeats, 0.3,
+                                ratio_goal=1.6)]
+
     def helps() -> list[Row]:
         return [against_startup("balancer --help", [*bal, "--help"], repeats, 0.1)]
 
-    return rows + guarded("balancer --help", "≤ 0.1 s", helps)
+    return (rows + guarded("analyze meijaard2020.toml (issue 41)", "ratio ≤ 1.6", paper)
+            + guarded("balancer --help", "≤ 0.1 s", helps))
 
 
 # -- 5. re-solve with new bounds (in process) ---------------------------------------------------

@@ -195,8 +195,8 @@ def test_the_command_line_lists_every_formulation_and_drive():
     from balancer import cli, formulations, mechanisms, model
 
     names = set(formulations.GENERAL)
-    for mechanism in mechanisms.REGISTRY.values():
-        names |= set(mechanism.own_formulations)
+    for kind in mechanisms.FOLDERS:
+        names |= set(mechanisms.mechanism_class(kind).own_formulations)
     assert set(cli.FORMULATION_NAMES) == names
     assert cli.DRIVES == model.DRIVES
 
@@ -238,6 +238,27 @@ def test_commands_import_only_what_they_need(args, also):
                          check=True).stdout
     loaded = set(json.loads(out.strip().splitlines()[-1]))
     assert not loaded & {*_HEAVY, *also}
+
+
+#: What analysing a four-bar may not load (issue 41): the other mechanisms' folders, the
+#: balancing layers and the long cycles' program, the other commands' reports.
+_NOT_FOR_A_FOURBAR = ("balancer.mechanisms.engine", "balancer.mechanisms.slidercrank",
+                      "balancer.balance", "balancer.model.balance", "balancer.spec.balance",
+                      "balancer.linkage.program", "balancer.linkage.kernel",
+                      "balancer.report.balancing", "balancer.report.motion",
+                      "balancer.report.fronts", "balancer.simulation", "balancer.examples")
+
+
+def test_analysing_a_fourbar_loads_its_folder_and_the_cycle_analysis_only():
+    code = ("import io, json, sys, contextlib\nfrom balancer.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            f"    assert main(['analyze', {EXAMPLE!r}]) == 0\n"
+            "print(json.dumps(sorted(m for m in sys.modules if m.startswith('balancer'))))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    loaded = json.loads(out.strip().splitlines()[-1])
+    assert "balancer.mechanisms.fourbar.mechanism" in loaded
+    assert not [m for m in loaded if m.startswith(_NOT_FOR_A_FOURBAR)]
 
 
 @pytest.mark.parametrize(("given", "used"), [(None, "1"), ("3", "3")])

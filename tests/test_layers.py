@@ -23,7 +23,8 @@ PACKAGE = Path(balancer.__file__).resolve().parent
 #: The layers, lowest first: a module may import its own layer and those below. A module is
 #: placed by its longest matching prefix.
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("errors", "validate", "tomltext", "progress", "interrupts", "outputs", "lazy", "rounding"),
+    ("errors", "validate", "tomltext", "progress", "interrupts", "outputs", "lazy", "rounding",
+     "quantities"),
     ("model",),
     ("linkage", "quadrature", "orders"),
     # The mechanism interface, and what every mechanism's formulations share.
@@ -54,7 +55,7 @@ def modules() -> dict[str, Path]:
 
 #: A mechanism's reader and writer of its tables of a spec (``mechanisms/<name>/spec.py``): it
 #: reads TOML tables, so it sits in the spec's layer, and the spec reader finds it by name
-#: through the registry (``Mechanism.spec_module``).
+#: through the registry (``balancer.mechanisms.folder_module``).
 SPEC_MODULE = re.compile(r"^mechanisms\.\w+\.spec$")
 
 
@@ -206,19 +207,25 @@ def test_the_architecture_page_draws_every_layer_as_the_test_holds_it():
 
 
 def test_every_registered_mechanism_reads_and_writes_its_spec_tables_in_its_folder():
-    """``spec`` in each mechanism's folder gives the reader and writer of its tables."""
+    """``spec`` in each mechanism's folder gives the reader and writer of its tables, and its
+    ``mechanism`` module the class the registry builds for that type."""
     import importlib
 
-    from balancer.mechanisms import REGISTRY
+    from balancer.mechanisms import FOLDERS, folder_module, mechanism_class
+    from balancer.spec.codecs import balance_spec_of
 
-    for kind, mechanism in REGISTRY.items():
-        name = mechanism.spec_module()
-        folder = mechanism.__module__.rpartition(".")[0]
+    for kind in FOLDERS:
+        cls = mechanism_class(kind)
+        folder = cls.__module__.rpartition(".")[0]
+        name = folder_module(kind, "spec")
         assert name == f"{folder}.spec" and folder.startswith("balancer.mechanisms.")
         module = importlib.import_module(name)
-        for function in ("read", "lines", "read_original", "original_lines", "read_balance",
-                         "balance_lines"):
+        for function in ("read", "lines", "read_original", "original_lines"):
             assert callable(getattr(module, function)), f"{kind}: {name}.{function}"
+        balance = balance_spec_of(kind)
+        assert balance.__name__ == module.BALANCE
+        for function in ("read_balance", "balance_lines"):
+            assert callable(getattr(balance, function)), f"{kind}: {module.BALANCE}.{function}"
 
 
 def test_the_spec_reader_and_writer_ask_no_mechanism_what_it_is():

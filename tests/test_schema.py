@@ -17,7 +17,7 @@ import pytest
 
 from balancer.errors import SpecError
 from balancer.formulations import GENERAL
-from balancer.mechanisms import REGISTRY
+from balancer.mechanisms import FOLDERS, mechanism_class
 from balancer.mechanisms.engine.model import Engine
 from balancer.mechanisms.fourbar.model import FourBar
 from balancer.mechanisms.slidercrank.model import SliderCrank
@@ -256,7 +256,7 @@ def test_the_schema_names_what_the_model_names():
     assert set(schema.known("simulation")) == {
         f.name for f in dataclasses.fields(SimulationSettings)} - {"given"}  # (what was given)
     method = next(k for k in schema.section("simulation").keys if k.name == "method")
-    for name in (*GENERAL, *(n for m in REGISTRY.values() for n in m.own_formulations)):
+    for name in (*GENERAL, *(n for m in FOLDERS for n in mechanism_class(m).own_formulations)):
         assert f"`{name}`" in method.meaning, name
     kind = next(k for k in schema.section("mechanism").keys if k.name == "type")
     assert all(f'`"{t}"`' in kind.meaning for t in MECHANISM_TYPES)

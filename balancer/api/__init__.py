@@ -7,7 +7,8 @@
 
 Each call takes a :class:`~balancer.model.Design` (from :func:`~balancer.spec.load_design`) and
 returns a result object; nothing here prints or writes files. The calls live in modules by
-what they need (:mod:`.analysis`, :mod:`.balancing`, :mod:`.motion`, :mod:`.results`), each
+what they need (:mod:`.analysis`, :mod:`.balancing`, :mod:`.motion`, :mod:`.results`,
+:mod:`.examples`), each
 loaded when one of its names is first used (PEP 562): a command that analyses does not load
 the optimisers.
 """
@@ -22,7 +23,7 @@ from ..lazy import lazy_exports
 _EXPORTS = {
     "analyze": "analysis",
     "cycle_analyses": "analysis",
-    "example": "analysis",
+    "example": "examples",
     "optimize": "balancing",
     "pareto": "balancing",
     "simulate": "motion",
@@ -48,7 +49,8 @@ __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
 
 
 if TYPE_CHECKING:  # for type checkers and editors: the names as they are
-    from .analysis import analyze, cycle_analyses, example
+    from .analysis import analyze, cycle_analyses
     from .balancing import optimize, pareto
+    from .examples import example
     from .motion import simulate, verify
     from .results import to_dict, to_table

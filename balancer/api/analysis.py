@@ -1,8 +1,7 @@
-"""The analysis of a design: one revolution at its operating speed, and the shipped examples."""
+"""The analysis of a design: one revolution at its operating speed."""
 
 from __future__ import annotations
 
-from .. import examples
 from .. import validate as v
 from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses
 from ..errors import SpecError
@@ -73,8 +72,3 @@ def cycle_analyses(design: Design, *, samples: int | None = None,
     analyses = drawn_analyses(models, op.speed, samples=samples, least=op.samples,
                               gravity=op.gravity, tolerance=tolerance)
     return analyses[0], (analyses[1] if len(analyses) > 1 else None)
-
-
-def example(name: str) -> Design:
-    """A design spec shipped with the package, by name (``balancer example`` lists them)."""
-    return examples.load(name)

@@ -15,21 +15,19 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from ..quantities import unit_of, words_of
+
 #: The second objectives of a front (``pareto --against``).
 Against = Literal["driving-torque", "added-mass", "shaking-force"]
 #: Each second objective's report name and unit.
 AGAINST: dict[str, tuple[str, str]] = {
-    "driving-torque": ("driving_torque", "N·m"),
-    "added-mass": ("added_mass", "kg"),
-    "shaking-force": ("shaking_force", "N"),
-}
+    against: (against.replace("-", "_"), unit_of(against.replace("-", "_")))
+    for against in ("driving-torque", "added-mass", "shaking-force")}
 #: What a front may minimise, and the figures its points report: their words and units.
 FIGURES: dict[str, tuple[str, str]] = {
     "rms": ("weighted RMS shaking √J", "N·m"),
-    "rocking_couple": ("RMS rocking couple", "N·m"),
-    "shaking_force": ("RMS shaking force", "N"),
-    "shaking_moment": ("RMS shaking moment", "N·m"),
-}
+    **{key: (f"RMS {words_of(key)}", unit_of(key))
+       for key in ("rocking_couple", "shaking_force", "shaking_moment")}}
 
 
 @dataclass(frozen=True)

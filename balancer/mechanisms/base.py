@@ -20,7 +20,7 @@ import threading
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import Any, ClassVar, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -30,12 +30,14 @@ from ..linkage import dynamics, kinematics
 from ..linkage.constraints import GROUND_INDEX, Pose
 from ..linkage.dynamics import Forces, Layout
 from ..linkage.kinematics import Motion
-from ..linkage.program import CrankForcesProgram
 from ..linkage.rotors import Rotor, ground_couple
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
 from ..model import GROUND, Branch, Link, Linkage, MechanismModel
 from ..model.assembly import AssemblyRange
+
+if TYPE_CHECKING:
+    from ..linkage.program import CrankForcesProgram
 
 #: The inverse-dynamics routes of every mechanism (``analyze --route``): the links' equations
 #: group by group, or all at once with the mass matrices and the constraints' multipliers.
@@ -187,16 +189,6 @@ class Mechanism:
     #: What a drawing calls the blocks of :meth:`slider_blocks`.
     block_name: ClassVar[str] = "sliding blocks"
 
-    @classmethod
-    def spec_module(cls) -> str:
-        """The module that reads and writes the mechanism's tables of a spec, dotted.
-
-        ``spec`` in the mechanism's folder (``balancer.mechanisms.fourbar.spec``): its
-        ``read``, ``lines``, ``read_original``, ``original_lines``, ``read_balance`` and
-        ``balance_lines`` (:class:`balancer.spec.codecs.MechanismSpec`). It sits above this
-        layer (it reads TOML tables), so the spec reader imports it by this name.
-        """
-        return f"{cls.__module__.rpartition('.')[0]}.spec"
     #: Sliders on ground guides whose force on the guide tables name as a force at a point
     #: (``R{name}x``, ``R{name}y``) rather than by its normal force ``N_{link}``.
     guide_force_names: ClassVar[dict[str, str]] = {}
@@ -636,6 +628,10 @@ class Mechanism:
     def _program(self, loads: bool, gravity: tuple[float, float]
                  ) -> CrankForcesProgram | None:
         """The mechanism's crank-forces program for these loads and gravity (built once)."""
+        # (imported here: the program and its compiler are for long cycles, and a short
+        # command's start-up should not pay for them)
+        from ..linkage.program import CrankForcesProgram
+
         key = (loads, gravity)
         with _PROGRAM_LOCK:
             cache: dict[tuple[bool, tuple[float, float]], CrankForcesProgram | None] = (

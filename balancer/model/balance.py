@@ -48,12 +48,14 @@ back; :mod:`balancer.balance` solves the problem they describe.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import ClassVar, Protocol
 
 from .. import validate as v
 from ..errors import SpecError
+from ..quantities import unit_of
 from .mechanisms import MechanismModel
 
 #: The keys of ``[balance.objective]``, ``[balance.<link>]`` and a counterweight's table.
@@ -124,15 +126,14 @@ class Objective:
         """
         fx = self.shaking_force + self.shaking_force_x
         fy = self.shaking_force + self.shaking_force_y
-        forces = ([ObjectiveTerm("shaking_force", fx, "N")] if fx == fy else
-                  [ObjectiveTerm("shaking_force_x", fx, "N"),
-                   ObjectiveTerm("shaking_force_y", fy, "N")])
-        terms = [ObjectiveTerm("shaking_moment", self.shaking_moment, "N·m"),
-                 ObjectiveTerm("driving_torque", self.driving_torque, "N·m"), *forces,
-                 ObjectiveTerm("rocking_couple", self.rocking_couple, "N·m"),
-                 ObjectiveTerm("added_mass", self.added_mass, "kg"),
-                 ObjectiveTerm("unbalance", self.unbalance, "N")]
-        return tuple(t for t in terms if t.weight > 0)
+        forces = ([("shaking_force", fx)] if fx == fy else
+                  [("shaking_force_x", fx), ("shaking_force_y", fy)])
+        weights = [("shaking_moment", self.shaking_moment),
+                   ("driving_torque", self.driving_torque), *forces,
+                   ("rocking_couple", self.rocking_couple), ("added_mass", self.added_mass),
+                   ("unbalance", self.unbalance)]
+        return tuple(ObjectiveTerm(name, weight, unit_of(name)) for name, weight in weights
+                     if weight > 0)
 
     @property
     def single(self) -> ObjectiveTerm | None:
@@ -258,6 +259,13 @@ class BalanceProblem:
         """Names of the listed links."""
         return tuple(n for n, _ in self.links)
 
+    def check_scales(self, speeds: dict[str, float]) -> None:
+        """Check nothing: a linkage's redesign bounds no load beyond its links' own.
+
+        (Those are checked with the mechanism; :meth:`RotorBalanceProblem.check_scales` is an
+        engine's.)
+        """
+
 
 # -- an engine's: counterweights on its crankshaft and eccentrics of new shafts ----------------
 
@@ -358,6 +366,34 @@ class RotorBalanceProblem:
     shafts: tuple[ShaftFreedom, ...] = ()
     #: The figure a balancing of this kind is about, as a sweep's atlas shows it.
     headline: ClassVar[str] = "rocking_couple"
+
+    def check_scales(self, speeds: dict[str, float]) -> None:
+        """Raise :class:`SpecError` if balancing could make a load beyond double precision.
+
+        Each bound's centrifugal force ``max_mr·(k·ω)²`` and its moments about the origin (its
+        plane ``z``, its axis ``|ā|``) as :func:`balancer.validate.check_magnitudes` scales,
+        each named by its spec key; ``speeds`` the design's speeds by their keys, rad/s.
+        """
+        speed_key = max(speeds, key=lambda k: abs(speeds[k]))
+        w2 = [(speed_key, speeds[speed_key])] * 2
+        forces, moments = [], []
+        # (table, bound, ratio, z, |ā|) of each mass·radius the optimiser may choose
+        sites: list[tuple[str, float, float, float, float]] = []
+        if self.counterweights is not None:
+            cws = self.counterweights
+            sites += [("balance.counterweights", b, 1.0, z, 0.0)
+                      for b, z in zip(cws.max_mr, cws.planes, strict=True)]
+        for j, shaft in enumerate(self.shafts):
+            sites += [(v.item("balance.shafts", j), b, float(shaft.ratio), z,
+                       math.hypot(*shaft.at))
+                      for b, z in zip(shaft.max_mr, shaft.planes, strict=True)]
+        for table, bound, ratio, z, arm in sites:
+            force = [(f"{table}.max_mr", bound), (f"{table}.ratio", ratio),
+                     (f"{table}.ratio", ratio), *w2]
+            forces.append(force)
+            moments += [force + [(f"{table}.planes", z)], force + [(f"{table}.at", arm)]]
+        v.check_magnitudes(forces, "the balancing's forces", "N")
+        v.check_magnitudes(moments, "the balancing's moments", "N·m")
 
 
 @dataclass(frozen=True)

@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import ClassVar, Literal
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 from .. import validate as v
 from ..errors import SpecError
-from .balance import BalanceProblem, RotorBalanceProblem
 from .mechanisms import MechanismModel
+
+if TYPE_CHECKING:  # (the balancing's tables load with a spec that has them)
+    from .balance import BalanceProblem, RotorBalanceProblem
 
 Drive = Literal["free", "constant-speed"]
 
@@ -192,36 +194,8 @@ class Design:
         for mech in (self.mechanism, self.original):
             if mech is not None:
                 check_scales(mech, speeds, gravity)
-        if isinstance(self.balance, RotorBalanceProblem):
-            check_rotor_scales(self.balance, speeds)
-
-
-def check_rotor_scales(problem: RotorBalanceProblem, speeds: dict[str, float]) -> None:
-    """Raise :class:`SpecError` if an engine's balancing could make a load beyond doubles.
-
-    Each bound's centrifugal force ``max_mr·(k·ω)²`` and its moments about the origin (its
-    plane ``z``, its axis ``|ā|``) as :func:`balancer.validate.check_magnitudes` scales, each
-    named by its spec key.
-    """
-    speed_key = max(speeds, key=lambda k: abs(speeds[k]))
-    w2 = [(speed_key, speeds[speed_key])] * 2
-    forces, moments = [], []
-    # (table, bound, ratio, z, |ā|) of each mass·radius the optimiser may choose
-    sites: list[tuple[str, float, float, float, float]] = []
-    if problem.counterweights is not None:
-        cws = problem.counterweights
-        sites += [("balance.counterweights", b, 1.0, z, 0.0)
-                  for b, z in zip(cws.max_mr, cws.planes, strict=True)]
-    for j, shaft in enumerate(problem.shafts):
-        sites += [(v.item("balance.shafts", j), b, float(shaft.ratio), z, math.hypot(*shaft.at))
-                  for b, z in zip(shaft.max_mr, shaft.planes, strict=True)]
-    for table, bound, ratio, z, arm in sites:
-        force = [(f"{table}.max_mr", bound), (f"{table}.ratio", ratio),
-                 (f"{table}.ratio", ratio), *w2]
-        forces.append(force)
-        moments += [force + [(f"{table}.planes", z)], force + [(f"{table}.at", arm)]]
-    v.check_magnitudes(forces, "the balancing's forces", "N")
-    v.check_magnitudes(moments, "the balancing's moments", "N·m")
+        if self.balance is not None:
+            self.balance.check_scales(speeds)
 
 
 def check_scales(mechanism: MechanismModel, speeds: dict[str, float],

@@ -14,21 +14,13 @@ import numpy as np
 
 from ..cycle import ROUNDING_SPAN, CycleAnalysis, natural_scales, panel_keys
 from ..orders import Order, order_name
+from ..quantities import PANELS
 from ..rounding import speed_text
 from .style import COLOURS, axes, number
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
-
-#: The panels: title, unit, and the bars of one order (label, value).
-_PANELS = {
-    "force": ("shaking force", "N"),
-    "couple": ("rocking couple", "N·m"),
-    "moment": ("shaking moment", "N·m"),
-    "torque": ("driving torque", "N·m"),
-    "mount": ("mount torque", "N·m"),
-}
 
 #: On a logarithmic axis, a bar at most this fraction of its panel's largest is rounding of
 #: it: left out (as the zero it is), so that it does not stretch the axis over decades of noise.
@@ -65,7 +57,7 @@ def plot_orders(analysis: CycleAnalysis, panel: str, before: CycleAnalysis | Non
     linear.
     """
     ax = axes(ax)
-    title, unit = _PANELS[panel]
+    title, unit = PANELS[panel].words, PANELS[panel].unit
     rows = [(None, before), ("design", analysis)] if before is not None else [
         ("design", analysis)]
     orders = analysis.orders

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..cycle import ROUNDING_SPAN, CycleAnalysis, drawn_panels, natural_scales, panel_keys
 from ..cycle import Figure as Figures
+from ..quantities import PANELS, QUANTITIES
 from ..rounding import speed_text
 from .style import AFTER_STYLE, BEFORE_STYLE, axes, legend_outside, number
 
@@ -56,23 +57,16 @@ def plot_rocking_couple_polar(analysis: CycleAnalysis, before: CycleAnalysis | N
     return _polar(analysis, before, ax, legend, "rocking_couple")
 
 
-#: A polar diagram's quantity: its axis name, unit and title.
-_POLAR = {"shaking_force": ("shaking force", "N"), "rocking_couple": ("rocking couple", "N·m")}
 
 
-#: Each drawn quantity's panel (:func:`balancer.cycle.natural_scales`).
-_PANEL = {"shaking_force": "force", "rocking_couple": "couple", "shaking_moment": "moment",
-          "driving_torque": "torque", "mount_torque": "mount"}
-
-#: The quantities drawn over the crank angle: the axis' name and the panel's title.
-_OVER_ANGLE = {"shaking_moment": ("shaking moment about the origin", "shaking moment"),
-               "driving_torque": ("driving torque on the crank", "driving torque"),
-               "mount_torque": ("torque about z on the mounts", "mount torque")}
+#: The quantities drawn over the crank angle (the others are polar diagrams).
+_OVER_ANGLE = ("shaking_moment", "driving_torque", "mount_torque")
 
 
 def _values(analysis: CycleAnalysis, quantity: str) -> np.ndarray:
-    """A drawn quantity's samples over the cycle (:data:`_PANEL`'s names)."""
-    return np.asarray(drawn_panels(analysis, [_PANEL[quantity]])[_PANEL[quantity]])
+    """A drawn quantity's samples over the cycle (``quantity`` a key of :data:`QUANTITIES`)."""
+    panel = QUANTITIES[quantity].panel
+    return np.asarray(drawn_panels(analysis, [panel])[panel])
 
 
 def _zero_below_rounding(analysis: CycleAnalysis, quantity: str) -> np.ndarray:
@@ -82,7 +76,7 @@ def _zero_below_rounding(analysis: CycleAnalysis, quantity: str) -> np.ndarray:
     blown up to fill its panel; the label still gives its RMS and maximum.)
     """
     values = _values(analysis, quantity)
-    floor = ROUNDING_SPAN * natural_scales(analysis)[_PANEL[quantity]]
+    floor = ROUNDING_SPAN * natural_scales(analysis)[QUANTITIES[quantity].panel]
     if np.nanmax(np.abs(values), initial=0.0) <= floor:
         return np.zeros_like(values)
     return values
@@ -95,7 +89,7 @@ def _span(analysis: CycleAnalysis) -> str:
 
 def _polar(analysis: CycleAnalysis, before: CycleAnalysis | None, ax: Axes | None,
            legend: bool, quantity: str) -> Axes:
-    name, unit = _POLAR[quantity]
+    name, unit = QUANTITIES[quantity].words, QUANTITIES[quantity].unit
     title = f"{name} over {_span(analysis)} (polar diagram)"
     ax = axes(ax)
     after_role, before_role = _roles(before)
@@ -141,7 +135,7 @@ def plot_over_crank_angle(analysis: CycleAnalysis, quantity: str,
     """
     ax = axes(ax)
     names = _OVER_ANGLE
-    drawable = [q for q in names if _PANEL[q] in panel_keys(analysis, before)]
+    drawable = [q for q in names if QUANTITIES[q].panel in panel_keys(analysis, before)]
     if quantity not in drawable:
         raise ValueError(f"no such quantity to draw over the crank angle: {quantity!r} "
                          f"(one of {', '.join(map(repr, drawable))})")
@@ -152,13 +146,13 @@ def plot_over_crank_angle(analysis: CycleAnalysis, quantity: str,
             continue
         ax.plot(np.degrees(np.append(a.theta1, 2 * np.pi * a.revolutions)),
                 _closed(_zero_below_rounding(a, quantity)), **style,
-                label=_cycle_label(role, _values(a, quantity), "N·m"))
+                label=_cycle_label(role, _values(a, quantity), QUANTITIES[quantity].unit))
     span = 360.0 * analysis.revolutions
     ax.set_xlim(0.0, span)
     ax.set_xticks(np.arange(0, span + 1, 45 * analysis.revolutions))
     ax.set_xlabel("crank angle θ1 (°)")
-    ax.set_ylabel(f"{names[quantity][0]} (N·m)")
-    ax.set_title(f"{names[quantity][1]} over {_span(analysis)}")
+    ax.set_ylabel(QUANTITIES[quantity].label)
+    ax.set_title(f"{QUANTITIES[quantity].words} over {_span(analysis)}")
     ax.grid(alpha=0.3)
     if legend:
         legend_outside(ax)
@@ -186,14 +180,12 @@ def cycle_figure(analysis: CycleAnalysis, before: CycleAnalysis | None = None,
     plot_shaking_force_polar(analysis, before, ax=axes["force"], legend=False)
     if "couple" in axes:
         plot_rocking_couple_polar(analysis, before, ax=axes["couple"], legend=False)
-    quantities = {panel: quantity for quantity, panel in _PANEL.items()}
     for key in right:
-        plot_over_crank_angle(analysis, quantities[key], before, ax=axes[key], legend=False)
-    units = {"force": "N", "moment": "N·m", "torque": "N·m", "couple": "N·m", "mount": "N·m"}
+        plot_over_crank_angle(analysis, PANELS[key].key, before, ax=axes[key], legend=False)
     after_panels = drawn_panels(analysis, keys)
     before_panels = drawn_panels(before, keys) if before is not None else None
     for key in keys:
-        unit = units[key]
+        unit = PANELS[key].unit
         ax = axes[key]
         figures = [_figure_pair(before_panels[key] if before_panels is not None else None,
                                 after_panels[key], stat) for stat in ("rms", "max")]

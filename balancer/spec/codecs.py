@@ -1,25 +1,24 @@
 """Each mechanism's reader and writer of its tables of a spec, found through the registry.
 
-A mechanism's folder holds its ``spec`` module (:meth:`balancer.mechanisms.base.Mechanism.
-spec_module`): the reader and writer of its ``[mechanism]`` and ``[links]`` tables (and those
-it adds: an engine's ``[[balance_shafts]]``, ``[gas]``), of ``[original]`` and of
-``[balance]``. The spec reader and writer (:mod:`.reader`, :mod:`.writer`) ask nothing else of
-a mechanism: adding one is its folder and its line in :data:`balancer.mechanisms.REGISTRY`.
+A mechanism's folder holds its ``spec`` module (:func:`balancer.mechanisms.folder_module`):
+the reader and writer of its ``[mechanism]`` and ``[links]`` tables (and those it adds: an
+engine's ``[[balance_shafts]]``, ``[gas]``) and of ``[original]``, and the name of the module
+that reads and writes its ``[balance]`` (loaded only for a spec that has one). The spec reader
+and writer (:mod:`.reader`, :mod:`.writer`) ask nothing else of a mechanism: adding one is its
+folder and its line in :data:`balancer.mechanisms.FOLDERS`.
 """
 
 from __future__ import annotations
 
 import importlib
-from typing import Protocol, cast
+from typing import TYPE_CHECKING, Protocol, cast
 
-from ..errors import SpecError
-from ..mechanisms import REGISTRY
+from ..mechanisms import MECHANISM_TYPES, folder_module
 from ..model import MechanismModel as Model
-from ..model.balance import BalanceProblem, RotorBalanceProblem
 from .tables import Table
 
-#: The spec's mechanism types (``[mechanism] type``), in the registry's order.
-MECHANISM_TYPES = tuple(REGISTRY)
+if TYPE_CHECKING:
+    from ..model.balance import BalanceProblem, RotorBalanceProblem
 
 
 class MechanismSpec(Protocol):
@@ -41,6 +40,15 @@ class MechanismSpec(Protocol):
         """``model``'s links as ``[original]`` tables."""
         ...
 
+    #: The dotted name of the module that reads and writes its ``[balance]``
+    #: (:class:`BalanceSpec`): the linkages' share :mod:`balancer.spec.balance`. Loaded only
+    #: for a spec that has the table.
+    BALANCE: str
+
+
+class BalanceSpec(Protocol):
+    """What the reader and writer of a mechanism's ``[balance]`` give (module-level functions)."""
+
     def read_balance(self, table: Table, model: Model) -> BalanceProblem | RotorBalanceProblem:
         """The redesign problem of ``[balance]`` (``table``) for ``model``."""
         ...
@@ -58,10 +66,18 @@ def spec_of(kind: str) -> MechanismSpec:
     SpecError
         If ``kind`` is not a mechanism the package knows.
     """
-    if kind not in REGISTRY:
-        raise SpecError(f"must be one of {', '.join(MECHANISM_TYPES)}", key="mechanism.type",
-                        value=kind)
-    return cast("MechanismSpec", importlib.import_module(REGISTRY[kind].spec_module()))
+    return cast("MechanismSpec", importlib.import_module(folder_module(kind, "spec")))
 
 
-__all__ = ["MECHANISM_TYPES", "MechanismSpec", "spec_of"]
+def balance_spec_of(kind: str) -> BalanceSpec:
+    """The reader and writer of ``[balance]`` of mechanism type ``kind`` (its ``BALANCE``).
+
+    Raises
+    ------
+    SpecError
+        If ``kind`` is not a mechanism the package knows.
+    """
+    return cast("BalanceSpec", importlib.import_module(spec_of(kind).BALANCE))
+
+
+__all__ = ["MECHANISM_TYPES", "BalanceSpec", "MechanismSpec", "balance_spec_of", "spec_of"]

@@ -50,7 +50,7 @@ from ..mechanisms import mechanism_of
 from ..model import Design, Operation, SimulationSettings
 from ..model import MechanismModel as Model
 from . import schema
-from .codecs import MECHANISM_TYPES, MechanismSpec, spec_of
+from .codecs import MECHANISM_TYPES, MechanismSpec, balance_spec_of, spec_of
 from .tables import Table
 
 
@@ -117,7 +117,8 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
         simulation = _read_simulation(root, mechanism)
         balance = None
         if root.has("balance"):
-            balance = codec.read_balance(root.table("balance"), mechanism)
+            balance = balance_spec_of(mechanism.type).read_balance(root.table("balance"),
+                                                                   mechanism)
         original = _read_original(root, mechanism, codec)
         root.finish()
         return Design(

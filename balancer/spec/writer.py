@@ -7,7 +7,7 @@ import os
 from .. import tomltext as toml
 from ..model import Design, SimulationSettings
 from ..outputs import write_atomic
-from .codecs import spec_of
+from .codecs import balance_spec_of, spec_of
 
 
 def dumps_design(design: Design) -> str:
@@ -48,7 +48,7 @@ def dumps_design(design: Design) -> str:
     if stated:
         out += ["", "[simulation]", *stated]
     if design.balance is not None:
-        out += ["", *codec.balance_lines(design.balance)]
+        out += ["", *balance_spec_of(design.mechanism.type).balance_lines(design.balance)]
     if design.original is not None:
         out += ["", "# The unbalanced design this one was derived from (same geometry)."]
         out += codec.original_lines(design.original)

@@ -131,3 +131,7 @@ class EngineMechanism(Mechanism):
                                 angle=math.radians(m.phase_deg), mr=m.mr, what="eccentric")
                       for s in self.model.balance_shafts for m in s.eccentrics]
         return (*weights, *eccentrics)
+
+
+#: The class the registry builds for this folder (:data:`balancer.mechanisms.FOLDERS`).
+MECHANISM = EngineMechanism

@@ -3,7 +3,7 @@
 ``[mechanism]`` (strokes, firing order, every cylinder's lengths and ``[[mechanism.cylinders]]``),
 ``[links.crankshaft]``, ``[links.rod]``, ``[links.piston]``, ``[[balance_shafts]]`` and ``[gas]``.
 Angles are in degrees, as the spec writes them: what is written reads back exactly. Reached
-through the registry (:meth:`balancer.mechanisms.base.Mechanism.spec_module`) by the spec
+through the registry (:func:`balancer.mechanisms.folder_module`) by the spec
 reader and writer (:mod:`balancer.spec`).
 """
 
@@ -327,4 +327,9 @@ def original_lines(model: Model) -> list[str]:
     return _links_lines(model, "original") + _shafts_lines(model, "original.balance_shafts")
 
 
-__all__ = ["balance_lines", "lines", "original_lines", "read", "read_balance", "read_original"]
+#: Its ``[balance]``: read and written by this module (:func:`read_balance`,
+#: :func:`balance_lines`).
+BALANCE = __name__
+
+__all__ = ["BALANCE", "balance_lines", "lines", "original_lines", "read", "read_balance",
+           "read_original"]

@@ -249,3 +249,7 @@ def fourbar_motion(model: FourBar, mo: Motion) -> fourbar.Motion:
         return mo.closed_form
     return fourbar.motion_from_angles(model.lengths, tuple(mo.pose.angles), tuple(mo.rate),
                                       tuple(mo.accel))
+
+
+#: The class the registry builds for this folder (:data:`balancer.mechanisms.FOLDERS`).
+MECHANISM = FourBarMechanism

@@ -1,13 +1,12 @@
 """The four-bar's tables of a spec: ``[mechanism]`` (branch, lengths) and its links' tables.
 
-Reached through the registry (:meth:`balancer.mechanisms.base.Mechanism.spec_module`) by the
+Reached through the registry (:func:`balancer.mechanisms.folder_module`) by the
 spec reader and writer (:mod:`balancer.spec`); ``[balance]`` is the linkages' own.
 """
 
 from __future__ import annotations
 
 from ...model import MechanismModel as Model
-from ...spec.balance import balance_lines, read_balance
 from ...spec.chains import chain_lines, read_chain
 from ...spec.links import links_lines, read_links
 from ...spec.tables import Table
@@ -35,4 +34,8 @@ def original_lines(model: Model) -> list[str]:
     return links_lines(model, "original")
 
 
-__all__ = ["balance_lines", "lines", "original_lines", "read", "read_balance", "read_original"]
+#: Its ``[balance]``: the linkages' own, read and written by this module (loaded only for a
+#: spec that has the table).
+BALANCE = "balancer.spec.balance"
+
+__all__ = ["BALANCE", "lines", "original_lines", "read", "read_original"]

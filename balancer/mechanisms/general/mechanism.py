@@ -11,3 +11,7 @@ class LinkageMechanism(Mechanism):
 
     model: Linkage
 
+
+
+#: The class the registry builds for this folder (:data:`balancer.mechanisms.FOLDERS`).
+MECHANISM = LinkageMechanism

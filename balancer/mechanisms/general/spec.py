@@ -3,7 +3,7 @@
 ``[mechanism]`` (input, points, sliders), its links' tables (each with its points) and
 ``[[springs]]``.
 
-Reached through the registry (:meth:`balancer.mechanisms.base.Mechanism.spec_module`) by the
+Reached through the registry (:func:`balancer.mechanisms.folder_module`) by the
 spec reader and writer (:mod:`balancer.spec`); ``[balance]`` is the linkages' own.
 """
 
@@ -18,7 +18,6 @@ from ...errors import SpecError
 from ...model import GROUND, Body, Linkage, Slider, Spring
 from ...model import MechanismModel as Model
 from ...spec import schema
-from ...spec.balance import balance_lines, read_balance
 from ...spec.links import link_lines, links_lines, read_link, read_links
 from ...spec.tables import Table
 
@@ -158,4 +157,8 @@ def original_lines(model: Model) -> list[str]:
     return links_lines(model, "original")
 
 
-__all__ = ["balance_lines", "lines", "original_lines", "read", "read_balance", "read_original"]
+#: Its ``[balance]``: the linkages' own, read and written by this module (loaded only for a
+#: spec that has the table).
+BALANCE = "balancer.spec.balance"
+
+__all__ = ["BALANCE", "lines", "original_lines", "read", "read_original"]

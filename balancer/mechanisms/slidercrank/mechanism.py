@@ -121,3 +121,7 @@ class SliderCrankMechanism(Mechanism):
             shaking_force=V(col(np.real(r.shaking_force)), col(np.imag(r.shaking_force))),
             shaking_moment=col(r.shaking_moment),
             rocking_couple=self.rocking_couple(mo, loads=loads, gravity=gravity))
+
+
+#: The class the registry builds for this folder (:data:`balancer.mechanisms.FOLDERS`).
+MECHANISM = SliderCrankMechanism

@@ -3,7 +3,7 @@
 ``[mechanism]`` (branch, lengths with the guide's offset), its links' tables, and the slider's
 gas force (``[links.slider] gas_force``).
 
-Reached through the registry (:meth:`balancer.mechanisms.base.Mechanism.spec_module`) by the
+Reached through the registry (:func:`balancer.mechanisms.folder_module`) by the
 spec reader and writer (:mod:`balancer.spec`); ``[balance]`` is the linkages' own.
 """
 
@@ -17,7 +17,6 @@ from ...errors import SpecError
 from ...model import GasForce
 from ...model import MechanismModel as Model
 from ...spec import schema
-from ...spec.balance import balance_lines, read_balance
 from ...spec.chains import chain_lines, read_chain
 from ...spec.links import links_lines, read_links
 from ...spec.tables import Table
@@ -101,4 +100,8 @@ def original_lines(model: Model) -> list[str]:
     return links_lines(model, "original", sliders=SLIDERS)
 
 
-__all__ = ["balance_lines", "lines", "original_lines", "read", "read_balance", "read_original"]
+#: Its ``[balance]``: the linkages' own, read and written by this module (loaded only for a
+#: spec that has the table).
+BALANCE = "balancer.spec.balance"
+
+__all__ = ["BALANCE", "lines", "original_lines", "read", "read_original"]
