@@ -25,7 +25,8 @@ PACKAGE = Path(balancer.__file__).resolve().parent
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("errors", "validate", "tomltext", "progress", "interrupts", "outputs", "lazy", "rounding"),
     ("model",),
-    ("linkage", "quadrature", "orders"),
+    # The general core; the profiles of parts and their sizing (link-level mass models).
+    ("linkage", "quadrature", "orders", "parts.shapes", "parts.sizing"),
     # The mechanism interface, and what every mechanism's formulations share.
     ("mechanisms.base", "mechanisms.formulation", "mechanisms.chains"),
     # Each mechanism in its own folder; the general formulations (any mechanism).
@@ -35,7 +36,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("mechanisms", "formulations", "force_balance", "columns", "cycle", "drawing",
      "integration"),
     ("balance",),
-    ("simulation", "verification", "report", "plots", "plausibility"),
+    ("simulation", "verification", "report", "plots", "plausibility", "parts"),
     ("spec", "examples", "api", "sweeps", "cli", "__main__"),
 )
 

@@ -55,6 +55,7 @@ from typing import ClassVar, Protocol
 from .. import validate as v
 from ..errors import SpecError
 from .mechanisms import MechanismModel
+from .parts import Part
 
 #: The keys of ``[balance.objective]``, ``[balance.<link>]`` and a counterweight's table.
 OBJECTIVE_KEYS = (
@@ -75,7 +76,7 @@ LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "coun
               "counterweight", "com_on_line")
 
 
-COUNTERWEIGHT_KEYS = ("mass", "radius", "gyration")
+COUNTERWEIGHT_KEYS = ("mass", "radius", "gyration", "part")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -169,11 +170,16 @@ class CounterweightFreedom:
         Its centre lies within this distance of the link's ``com_about`` point, m.
     gyration
         Least radius of gyration about its own centre, m.
+    part
+        The part that makes it (:mod:`balancer.model.parts`: a shape family, its room and
+        material), or ``None``. Its room narrows the bounds above to what the part can be
+        (:func:`balancer.parts.sizing.counterweight_bounds`).
     """
 
     mass: tuple[float, float]
     radius: float
     gyration: float = 0.0
+    part: Part | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
