@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from typing import TYPE_CHECKING
 
 from ..api import optimize, verify
 from ..errors import SolverError, SpecError
@@ -14,10 +15,42 @@ from ..spec import dumps_design, loads_design
 from ..verification import check_verification
 from .common import as_option, load, output_path, wrote
 
+if TYPE_CHECKING:
+    from ..balance.result import BalanceResult
+    from ..cycle import CycleAnalysis
+    from ..model import Design
+    from ..parts.made import LinkPart
+
+
+def _parts(design: Design, result: BalanceResult, cad: bool
+           ) -> tuple[dict[str, LinkPart], CycleAnalysis | None]:
+    """The counterweights as parts, and the analysis of the design as built from them.
+
+    Where the spec gives a counterweight a part or ``--cad`` asks for files; else none.
+    """
+    from ..model.balance import BalanceProblem
+
+    problem = design.balance
+    given = isinstance(problem, BalanceProblem) and any(
+        f.counterweight is not None and f.counterweight.part is not None
+        for _, f in problem.links)
+    if not (given or cad):
+        return {}, None
+    from ..parts.made import as_built, make_parts
+
+    parts = make_parts(design, result)
+    return parts, (as_built(result, parts) if parts else None)
+
 
 def run(args: argparse.Namespace) -> int:
     """Run ``balancer optimize``; the exit code."""
     out = output_path(args, args.out, "--out")
+    cad = None
+    if args.cad is not None:
+        from ..parts.cad import cad_folder, require_cad
+
+        require_cad()
+        cad = cad_folder(args.cad, force=args.force)
     design = load(args)
     if not args.no_verify:  # the check at the end refuses nothing after the work
 
@@ -42,14 +75,34 @@ def run(args: argparse.Namespace) -> int:
         except SpecError as exc:
             raise as_option(exc, "simulation.duration", "--verify-duration",
                              args.verify_duration) from None
+    parts, built = _parts(design, result, cad is not None)
     if args.json:
-        text = dumps_json(optimization_json(result, before, after, verification,
-                                            spec=args.spec, out=out))
+        doc = optimization_json(result, before, after, verification, spec=args.spec, out=out)
+        if parts:
+            from ..parts.report import parts_json
+
+            doc.update({"parts": parts_json(parts),
+                        "as_built": None if built is None else built.summary.as_dict()})
+        text = dumps_json(doc)
     else:
         text = optimization_text(result, before, after, verification,
                                  spec=args.spec) + "\n"
+        if parts:
+            from ..parts.report import parts_text
+
+            text += "\n" + parts_text(parts, after, built) + "\n"
     if out is not None:
         write_atomic(out, spec_text)
         wrote(out)
+    if cad is not None:
+        from ..parts.cad import write_cad
+        from ..plots.parts import write_part_drawing
+
+        if not any(p.sized.profile is not None for p in parts.values()):
+            print("balancer: note: no counterweight to make: --cad wrote no files",
+                  file=sys.stderr)
+        else:
+            for path in write_cad(cad, parts, write_part_drawing):
+                wrote(path)
     sys.stdout.write(text)
     return 0

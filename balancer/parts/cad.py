@@ -52,8 +52,10 @@ def require_cad(option: str = "--cad") -> None:
 
 
 def file_stem(link: str) -> str:
-    """A file name for link ``link``: its name, with characters other than letters, digits,
-    ``-``, ``_`` and ``.`` as ``_``."""
+    """A file name for link ``link``.
+
+    Its name, with characters other than letters, digits, ``-``, ``_`` and ``.`` as ``_``.
+    """
     stem = re.sub(r"[^A-Za-z0-9_.-]", "_", link)
     return stem if stem.strip(".") else f"link_{stem}"
 
@@ -190,7 +192,7 @@ def cad_folder(folder: str | os.PathLike[str], *, force: bool, option: str = "--
 
 
 def write_cad(folder: str | os.PathLike[str], parts: Mapping[str, LinkPart],
-              drawing: Callable[[LinkPart, Path], None] | None = None) -> list[Path]:
+              drawing: Callable[[LinkPart, Path], object] | None = None) -> list[Path]:
     """Per part ``<link>.step`` and ``<link>.dxf`` (and the drawing's files) into ``folder``.
 
     Everything is written into a temporary folder beside it first and moved in when all is

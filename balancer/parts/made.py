@@ -68,8 +68,11 @@ class LinkPart:
 
     @property
     def moves(self) -> tuple[float, complex, float] | None:
-        """How the link as built differs from the balanced link: its mass (kg), first moment in
-        its frame (kg·m) and inertia about its frame's origin (kg·m²); ``None`` without a part."""
+        """How the link as built differs from the balanced link.
+
+        Its mass (kg), first moment in its frame (kg·m) and inertia about its frame's origin
+        (kg·m²); ``None`` without a part.
+        """
         if self.built is None:
             return None
         m1, me1, mf1, j1 = self.built.inertial_parameters
@@ -147,7 +150,9 @@ def built_model(result: BalanceResult, parts: Mapping[str, LinkPart]) -> Model:
 
 
 def as_built(result: BalanceResult, parts: Mapping[str, LinkPart]) -> CycleAnalysis:
-    """The analysis at the operating speed of the design as built, loads and gravity included
-    (as :attr:`BalanceResult.operating`'s)."""
+    """The analysis at the operating speed of the design as built.
+
+    Loads and gravity included, as :attr:`BalanceResult.operating`'s.
+    """
     speed, samples = result.before.speed, result.before.samples
     return cycle_analysis(built_model(result, parts), speed, samples, gravity=result.gravity)

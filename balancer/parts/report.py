@@ -14,7 +14,7 @@ from ..cycle import CycleAnalysis
 from ..model.parts import Insert, Washers
 from ..report import table
 from .made import LinkPart
-from .shapes import Annulus, AnnularSector, Profile, Rectangle
+from .shapes import AnnularSector, Annulus, Profile, Rectangle
 
 
 def dimensions(profile: Profile) -> dict[str, float]:
@@ -60,8 +60,11 @@ def _material(part: LinkPart) -> str:
 
 def parts_text(parts: Mapping[str, LinkPart], balanced: CycleAnalysis | None = None,
                built: CycleAnalysis | None = None) -> str:
-    """The parts as a table (mm, kg), how each link as built moves from the balanced one, and
-    the shaking of the design as built beside the optimum's."""
+    """The parts as a table (mm, kg), and how the design as built differs from the optimum.
+
+    How each link as built moves from the balanced one, and the shaking of the design as
+    built beside the optimum's.
+    """
     rows = []
     notes = []
     for name, part in parts.items():

@@ -61,9 +61,11 @@ class Line:
 
 @dataclass(frozen=True)
 class Arc:
-    """A circular edge about ``centre`` (complex, m) of ``radius`` m from angle ``start`` to
-    ``end`` (rad): counter-clockwise where ``end > start``, clockwise where ``end < start``;
-    ``|end − start| = 2π``: the whole circle."""
+    """A circular edge about ``centre`` (complex, m) of ``radius`` m.
+
+    From angle ``start`` to ``end`` (rad): counter-clockwise where ``end > start``, clockwise
+    where ``end < start``; ``|end − start| = 2π``: the whole circle.
+    """
 
     centre: complex
     radius: float
@@ -131,9 +133,14 @@ class Annulus:
 
 
 def sector_reach(inner: float, outer: float) -> float:
-    """``g = (2/3)·(Ro³ − Ri³)/(Ro² − Ri²)``, m: an annular sector's centroid distance from its
-    pivot is ``g·sin(φ/2)/(φ/2)`` for a full angle ``φ``; ``g`` itself is the limit of a thin
-    sector (φ → 0). Written as ``(2/3)·(Ro² + Ro·Ri + Ri²)/(Ro + Ri)``, which has no 0/0."""
+    """``g = (2/3)·(Ro³ − Ri³)/(Ro² − Ri²)``, m: the reach of a thin annular sector.
+
+    An annular sector's centroid distance from its pivot is ``g·sin(φ/2)/(φ/2)`` for a
+    full angle ``φ``; ``g`` itself is the limit of a thin sector (φ → 0). Written as
+    ``(2/3)·(Ro² + Ro·Ri + Ri²)/(Ro + Ri)``, which has no 0/0 but at a point (0 there).
+    """
+    if outer + inner == 0:
+        return 0.0
     return 2.0 / 3.0 * (outer * outer + outer * inner + inner * inner) / (outer + inner)
 
 
@@ -144,8 +151,9 @@ def sinc(x: float) -> float:
 
 @dataclass(frozen=True, kw_only=True)
 class AnnularSector:
-    """A crescent between radii ``inner`` and ``outer`` (m) about ``pivot`` (complex, m), of full
-    angle ``angle`` (rad, in (0, 2π]) symmetric about the direction ``direction`` (rad).
+    """A crescent between radii ``inner`` and ``outer`` (m) about ``pivot`` (complex, m).
+
+    Of full angle ``angle`` (rad, in (0, 2π]), symmetric about the direction ``direction`` (rad).
 
     With ``α = angle/2``: ``A = α·(Ro² − Ri²)``; the centroid on the bisector at
     ``d = g·sin α/α`` from the pivot (:func:`sector_reach`); the polar second moment about the
@@ -186,8 +194,10 @@ class AnnularSector:
                               m * ((self.outer**2 + self.inner**2) / 2 - d * d))
 
     def loops(self) -> tuple[Loop, ...]:
-        """Outer arc (counter-clockwise), line in, inner arc back (clockwise), line out; a
-        whole annulus (angle 2π) as its two circles."""
+        """Outer arc (counter-clockwise), line in, inner arc back (clockwise), line out.
+
+        A whole annulus (angle 2π) as its two circles.
+        """
         if math.isclose(self.angle, 2 * math.pi, rel_tol=1e-15):
             return Annulus(centre=self.pivot, inner=self.inner, outer=self.outer,
                            thickness=self.thickness).loops()
@@ -203,8 +213,9 @@ class AnnularSector:
 
 @dataclass(frozen=True, kw_only=True)
 class Rectangle:
-    """A rectangle ``length`` × ``width`` (m) about ``centre`` (complex, m), its length along the
-    direction ``direction`` (rad).
+    """A rectangle ``length`` × ``width`` (m) about ``centre`` (complex, m).
+
+    Its length along the direction ``direction`` (rad).
 
     ``A = a·b``; centroid the centre; ``∫|r̄ − c̄|² dA = a·b·(a² + b²)/12``, so
     ``I = m·(a² + b²)/12``.

@@ -39,8 +39,8 @@ from dataclasses import dataclass
 
 from ..model.parts import Block, Insert, Part, Ring, Sector, Washers
 from .shapes import (
-    Annulus,
     AnnularSector,
+    Annulus,
     MassProperties,
     Profile,
     Rectangle,
@@ -147,19 +147,31 @@ def counterweight_bounds(mass: tuple[float, float], radius: float, gyration: flo
     """A counterweight's bounds ``(mass, radius, gyration)`` narrowed to what ``room`` holds.
 
     The mass's upper bound at most the room's largest mass, the radius (of the centre from
-    the pivot) at most the room's reach, the least gyration at least the room's. (The lower
-    bound of the mass may then exceed its upper bound: the caller says so.)
+    the pivot) at most the room's reach, the least gyration at least the room's. A sector's
+    reach is that of its heaviest part at the full outer radius and thickness,
+    ``g(Ri, Ro)·sin a/a`` with ``a = m_max/(ρ·T·(Ro² − Ri²))``: every lighter part with its
+    centre within it has a sector of that radius and no thicker than ``T``. (The lower bound
+    of the mass may then exceed its upper bound: the caller says so.)
     """
     if room is None:
         return mass, radius, gyration
     env = envelope(room)
-    return ((mass[0], min(mass[1], env.mass)), min(radius, env.reach),
-            max(gyration, env.gyration))
+    most = min(mass[1], env.mass)
+    reach = env.reach
+    if isinstance(room, Sector) and most > 0:
+        # The heaviest part's least half angle (at the full radius and thickness) bounds the
+        # reach of every lighter one: each then has a sector of ``Ro`` and at most ``T``.
+        ri, ro = room.inner_radius, room.outer_radius
+        least = most / (room.material.density * room.thickness * (ro * ro - ri * ri))
+        reach = sector_reach(ri, ro) * sinc(min(least, room.angle / 2))
+    return (mass[0], most), min(radius, reach), max(gyration, env.gyration)
 
 
 def _most_washers(room: Washers) -> int:
-    """How many washers the room's thickness holds (``inf`` thickness: no limit, as a count
-    far above any stack)."""
+    """How many washers the room's thickness holds.
+
+    (``inf`` thickness: no limit, as a count far above any stack.)
+    """
     h = room.washer[2]
     if math.isinf(room.thickness):
         return 10**9
@@ -194,6 +206,7 @@ def size_part(room: Part, target: MassProperties, pivot: complex = 0j) -> SizedP
         raise ValueError(f"a part is a body: mass {target.mass!r} kg must be positive and "
                          f"inertia {target.inertia!r} kg·m² at least 0")
     count = None
+    profile: Profile | None
     if isinstance(room, Ring):
         profile, density, limits = _ring(room, target)
     elif isinstance(room, Washers):
@@ -217,9 +230,11 @@ def size_part(room: Part, target: MassProperties, pivot: complex = 0j) -> SizedP
 
 def _annulus(centre: complex, density: float, ri: float, most: float, thickness: float,
              target: MassProperties) -> tuple[Annulus | None, tuple[str, ...]]:
-    """An annulus of inner radius ``ri`` about ``centre``: its outer radius (at most ``most``)
-    and thickness (at most ``thickness``) for ``target`` (module docstring); the limits it
-    stands at."""
+    """An annulus of inner radius ``ri`` about ``centre`` for ``target``, and its limits.
+
+    Its outer radius (at most ``most``) and thickness (at most ``thickness``) for ``target``
+    (module docstring); the room's limits it stands at.
+    """
     m, k2 = target.mass, target.inertia / target.mass
     want = 2 * k2 - ri * ri  # Ro² for the inertia
     lo = ri * ri + m / (density * math.pi * thickness)  # thinnest at the thickness limit
@@ -281,7 +296,7 @@ def half_angle(ratio: float) -> float:
     """``α`` in (0, π] with ``sin α/α = ratio`` (for ``ratio`` in [0, 1)), rad."""
     if not 0 <= ratio < 1:
         raise ValueError(f"sin α/α = {ratio!r} has no root in (0, π]")
-    if ratio == 0:
+    if ratio <= sinc(math.pi):  # 0, or below sin π/π's rounding
         return math.pi
     from scipy.optimize import brentq  # here: reading a spec needs no SciPy
 
@@ -317,7 +332,8 @@ def _sector(room: Sector, target: MassProperties, pivot: complex
         return sector_reach(ri, ro)
 
     def alpha(ro: float) -> float:
-        return half_angle(min(d / g(ro), 1 - 1e-16))
+        reach = g(ro)
+        return half_angle(min(d / reach if reach > 0 else float(d > 0), 1 - 1e-16))
 
     def area(ro: float) -> float:
         return alpha(ro) * (ro * ro - ri * ri)
@@ -329,7 +345,7 @@ def _sector(room: Sector, target: MassProperties, pivot: complex
     low_limit = "inner_radius"
     if g(most) <= d:
         lo = math.inf
-    elif d < ri:
+    elif d <= ri:  # g(Ri, Ro) > Ri ≥ D for every Ro > Ri
         lo = ri
     else:
         lo = root(lambda r: g(r) - d, ri, most)
@@ -348,7 +364,7 @@ def _sector(room: Sector, target: MassProperties, pivot: complex
         if area(hi) < need:
             lo = math.inf
         else:
-            start = max(lo, ri * (1 + 1e-12), 1e-300)
+            start = max(lo, ri) + 1e-12 * most
             if area(start) < need:
                 lo, low_limit = root(lambda r: area(r) - need, start, hi), "thickness"
     want2 = 2 * (target.inertia / m + d * d) - ri * ri
