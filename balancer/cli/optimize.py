@@ -90,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
         if parts:
             from ..parts.report import parts_text
 
-            text += "\n" + parts_text(parts, after, built) + "\n"
+            text += "\n" + parts_text(parts, before, after, built) + "\n"
     if out is not None:
         write_atomic(out, spec_text)
         wrote(out)

@@ -13,6 +13,7 @@ from typing import Any
 from ..cycle import CycleAnalysis
 from ..model.parts import Insert, Washers
 from ..report import table
+from ..rounding import Scales
 from .made import LinkPart
 from .shapes import AnnularSector, Annulus, Profile, Rectangle
 
@@ -58,12 +59,13 @@ def _material(part: LinkPart) -> str:
     return room.material.name
 
 
-def parts_text(parts: Mapping[str, LinkPart], balanced: CycleAnalysis | None = None,
+def parts_text(parts: Mapping[str, LinkPart], before: CycleAnalysis | None = None,
+               balanced: CycleAnalysis | None = None,
                built: CycleAnalysis | None = None) -> str:
     """The parts as a table (mm, kg), and how the design as built differs from the optimum.
 
     How each link as built moves from the balanced one, and the shaking of the design as
-    built beside the optimum's.
+    built beside the optimum's (a figure that is rounding of the original's as 0).
     """
     rows = []
     notes = []
@@ -81,17 +83,19 @@ def parts_text(parts: Mapping[str, LinkPart], balanced: CycleAnalysis | None = N
             dm, dfirst, dj = moves
             at = ", ".join(sized.limits) or "its room"
             notes.append(f"{name}: the nearest part stands at its room's {at}; the link as "
-                         f"built differs from the balanced one by {dm:+.4g} kg, "
+                         f"built differs from the balanced one by {dm:+.4g} kg of mass, "
                          f"{1e3 * abs(dfirst):.4g} kg·mm of first moment and {dj:+.4g} kg·m² "
                          "of inertia about its first point")
     lines = [table(rows, ["part", "shape", "material", "dimensions mm", "mass kg", "meets"])]
     lines += notes
-    if balanced is not None and built is not None:
-        b, a = balanced.summary, built.summary
+    if before is not None and balanced is not None and built is not None:
+        o, b, a = before.summary, balanced.summary, built.summary
+        scales = Scales([("N", o.shaking_force.rms), ("N·m", o.shaking_moment.rms)])
         lines.append(
-            f"as built: RMS shaking force {a.shaking_force.rms:.6g} N (optimum "
-            f"{b.shaking_force.rms:.6g}), RMS shaking moment {a.shaking_moment.rms:.6g} N·m "
-            f"(optimum {b.shaking_moment.rms:.6g})")
+            f"as built: RMS shaking force {scales.number(a.shaking_force.rms, 'N')} N "
+            f"(optimum {scales.number(b.shaking_force.rms, 'N')}), RMS shaking moment "
+            f"{scales.number(a.shaking_moment.rms, 'N·m')} N·m (optimum "
+            f"{scales.number(b.shaking_moment.rms, 'N·m')})")
     return "\n".join(lines)
 
 

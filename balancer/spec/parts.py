@@ -3,11 +3,13 @@
 ``[balance.<link>] counterweight = { …, part = { shape = "ring", … } }`` (or the table
 ``[balance.<link>.counterweight.part]``). Every family takes ``shape``, ``material`` (a name of
 :data:`~balancer.model.parts.MATERIALS`, default steel; with ``density``, any name) and
-``density`` (kg/m³); its room in its own keys (:data:`SHAPE_KEYS`), lengths in m, the angle in
+``density`` (kg/m³); its room in its own keys (:func:`own`), lengths in m, the angle in
 degrees. A key of another family is refused, naming it and the family's keys.
 """
 
 from __future__ import annotations
+
+from dataclasses import fields
 
 from .. import tomltext as toml
 from ..errors import SpecError
@@ -25,17 +27,17 @@ from ..model.parts import (
 )
 from .tables import Table
 
-#: Each family's own keys (besides ``shape``, ``material`` and ``density``), required first.
-SHAPE_KEYS: dict[str, tuple[str, ...]] = {
-    "ring": ("outer_radius", "thickness", "inner_radius"),
-    "washers": ("size", "thickness"),
-    "sector": ("outer_radius", "angle_deg", "thickness", "inner_radius"),
-    "block": ("length", "width", "thickness"),
-    "insert": ("radius", "thickness", "host", "host_density"),
-}
-#: Every key a part table may hold, in the schema's order.
-PART_KEYS = ("shape", "material", "density", "inner_radius", "outer_radius", "angle_deg",
-             "length", "width", "radius", "size", "thickness", "host", "host_density")
+#: The model's class of each family (:data:`balancer.model.parts.SHAPES`).
+FAMILIES: dict[str, type] = {"ring": Ring, "washers": Washers, "sector": Sector,
+                             "block": Block, "insert": Insert}
+
+
+def own(shape: str) -> tuple[str, ...]:
+    """A family's own keys of a ``part`` table: its model's fields (``host`` with
+    ``host_density``), beside ``shape``, ``material`` and ``density``, which every family takes."""
+    names = [f.name for f in fields(FAMILIES[shape]) if f.name != "material"]
+    return tuple(n for name in names for n in ((name, "host_density") if name == "host"
+                                                 else (name,)))
 
 
 def _material(table: Table, name_key: str, density_key: str, default: Material | None
@@ -60,11 +62,11 @@ def _material(table: Table, name_key: str, density_key: str, default: Material |
 def read_part(table: Table) -> Part:
     """The part of a counterweight's ``part`` table (:class:`SpecError` naming key and value)."""
     shape = table.string("shape", choices=SHAPES)
-    own = SHAPE_KEYS[shape]
+    keys = own(shape)
     for name in table.data:
-        if name not in ("shape", "material", "density", *own) and name in PART_KEYS:
+        if name not in ("shape", "material", "density", *keys):
             raise SpecError(f"does not apply to a {shape} part (its keys: "
-                            f"{', '.join(own)})", key=table.key(name), value=table.raw(name))
+                            f"{', '.join(keys)})", key=table.key(name), value=table.raw(name))
     material = _material(table, "material", "density", None if shape == "insert" else STEEL)
     try:
         part: Part
