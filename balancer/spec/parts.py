@@ -33,8 +33,11 @@ FAMILIES: dict[str, type] = {"ring": Ring, "washers": Washers, "sector": Sector,
 
 
 def own(shape: str) -> tuple[str, ...]:
-    """A family's own keys of a ``part`` table: its model's fields (``host`` with
-    ``host_density``), beside ``shape``, ``material`` and ``density``, which every family takes."""
+    """A family's own keys of a ``part`` table.
+
+    Its model's fields (``host`` with ``host_density``), beside ``shape``, ``material`` and
+    ``density``, which every family takes.
+    """
     names = [f.name for f in fields(FAMILIES[shape]) if f.name != "material"]
     return tuple(n for name in names for n in ((name, "host_density") if name == "host"
                                                  else (name,)))
