@@ -26,7 +26,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("errors", "validate", "tomltext", "progress", "interrupts", "outputs", "lazy", "rounding",
      "quantities"),
     ("model",),
-    ("linkage", "quadrature", "orders"),
+    # The general core; the profiles of parts and their sizing (link-level mass models).
+    ("linkage", "quadrature", "orders", "parts.shapes", "parts.sizing"),
     # The mechanism interface, and what every mechanism's formulations share.
     ("mechanisms.base", "mechanisms.formulation", "mechanisms.chains"),
     # Each mechanism in its own folder; the general formulations (any mechanism).
@@ -36,7 +37,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("mechanisms", "formulations", "force_balance", "columns", "cycle", "drawing",
      "integration"),
     ("balance",),
-    ("simulation", "verification", "report", "plots", "plausibility"),
+    ("simulation", "verification", "report", "plots", "plausibility", "parts"),
     ("spec", "examples", "api", "sweeps", "cli", "__main__"),
 )
 

@@ -51,6 +51,15 @@ METHOD = {schema.FOUR_BAR: "complex-masses", schema.SLIDER_CRANK: "complex-masse
 #: An engine's ``[balance]`` for its keys to stand in: its required keys only.
 ENGINE_BALANCE = {"objective": {}, "counterweights": {"max_mr": 0.03},
                   "shafts": [{"ratio": -1, "planes": [0.1], "max_mr": 0.01}]}
+#: A part of each family, for a key of a counterweight's ``part`` to stand in.
+PARTS = {
+    "ring": {"shape": "ring", "outer_radius": 0.1, "thickness": 0.05},
+    "sector": {"shape": "sector", "outer_radius": 0.1, "angle_deg": 90.0, "thickness": 0.05},
+    "block": {"shape": "block", "length": 0.04, "width": 0.1, "thickness": 0.05},
+    "insert": {"shape": "insert", "radius": 0.02, "thickness": 0.01,
+               "material": "tungsten-alloy", "host": "steel", "host_density": 7850.0},
+    "washers": {"shape": "washers", "size": "M12", "thickness": 0.05},
+}
 #: The centre of mass's partner keys (``s`` with ``sigma``, ``e`` with ``f``).
 PARTNER = {"s": ("sigma", 0.3), "sigma": ("s", 0.6), "e": ("f", 0.0), "f": ("e", 0.4)}
 
@@ -105,6 +114,10 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
         data["springs"] = [dict(SPRING)]
     if pattern == "balance.<link>.counterweight":
         data["balance"]["crank"] = {"counterweight": {"mass": [0.0, 1.0], "radius": 0.1}}
+    if pattern == "balance.<link>.counterweight.part":  # a part of a family that takes the key
+        family = next((f for f, part in PARTS.items() if name in part), "ring")
+        data["balance"]["crank"] = {"counterweight": {"mass": [0.0, 1.0], "radius": 0.1,
+                                                      "part": dict(PARTS[family])}}
     if pattern == "balance.<link>" and name == "counterweight":
         data["balance"]["crank"] = {}
     if mechanism == schema.ENGINE and "balance" not in data and (

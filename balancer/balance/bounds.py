@@ -20,6 +20,7 @@ from ..model import Link
 from ..model import MechanismModel as Model
 from ..model.balance import OBJECTIVE_KEYS, BalanceProblem, LinkFreedom
 from ..model.links import inertial_parameters
+from ..parts.sizing import counterweight_bounds
 from ..validate import LENGTH_RANGE
 
 
@@ -400,10 +401,17 @@ def _resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> Li
         about = freedom.com_about or points[0]
         m, me, mf, j = (float(v) for v in inertial_parameters(
             link.mass, link.com.real, link.com.imag, link.inertia))
+        # A part's room narrows the bounds to what the part can be (balancer.parts.sizing).
+        cw_mass, cw_radius, cw_gyration = counterweight_bounds(cw.mass, cw.radius,
+                                                               cw.gyration, cw.part)
+        if cw_mass[0] > cw_mass[1]:
+            raise SpecError(f"the part's room holds at most {cw_mass[1]:.6g} kg, less than the "
+                            "counterweight's least mass", key=f"balance.{name}.counterweight."
+                            "part", value=cw.part.shape if cw.part is not None else None)
         return LinkBounds(
-            **common, listed=True, mass=cw.mass, com_fixed=None, com_about=about,
-            com_centre=mech.structure.local[(k, about)].complex(), com_radius=cw.radius,
-            inertia=(0.0, math.inf), gyration=cw.gyration, counter_rotor=rotor,
+            **common, listed=True, mass=cw_mass, com_fixed=None, com_about=about,
+            com_centre=mech.structure.local[(k, about)].complex(), com_radius=cw_radius,
+            inertia=(0.0, math.inf), gyration=cw_gyration, counter_rotor=rotor,
             offset=(m, me, mf, j),
         )  # fmt: skip
     mass = freedom.mass if freedom.mass is not None else (link.mass, link.mass)

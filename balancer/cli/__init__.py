@@ -272,6 +272,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the check by simulation")
     p.add_argument("--verify-duration", type=_positive_float, metavar="T",
                    help="simulated time of each check, s (default: the spec's)")
+    p.add_argument("--cad", metavar="DIR",
+                   help="write each counterweight as a part into the folder DIR: a STEP solid "
+                   "and a DXF profile in the link's frame (mm) and a dimensioned drawing (SVG, "
+                   "PNG), named after the link (needs the cad extra: pip install "
+                   "'balancer[cad]')")
     p.set_defaults(verb="optimize")
 
     p = sub.add_parser(

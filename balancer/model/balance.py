@@ -57,6 +57,7 @@ from .. import validate as v
 from ..errors import SpecError
 from ..quantities import unit_of
 from .mechanisms import MechanismModel
+from .parts import Part
 
 #: The keys of ``[balance.objective]``, ``[balance.<link>]`` and a counterweight's table.
 OBJECTIVE_KEYS = (
@@ -77,7 +78,7 @@ LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "coun
               "counterweight", "com_on_line")
 
 
-COUNTERWEIGHT_KEYS = ("mass", "radius", "gyration")
+COUNTERWEIGHT_KEYS = ("mass", "radius", "gyration", "part")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -170,11 +171,16 @@ class CounterweightFreedom:
         Its centre lies within this distance of the link's ``com_about`` point, m.
     gyration
         Least radius of gyration about its own centre, m.
+    part
+        The part that makes it (:mod:`balancer.model.parts`: a shape family, its room and
+        material), or ``None``. Its room narrows the bounds above to what the part can be
+        (:func:`balancer.parts.sizing.counterweight_bounds`).
     """
 
     mass: tuple[float, float]
     radius: float
     gyration: float = 0.0
+    part: Part | None = None
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -3,9 +3,9 @@
 Computation lives elsewhere; these modules only turn result objects into text, one module per
 command family: :mod:`.text` (tables, JSON and CSV forms), :mod:`.analysis` (``analyze``),
 :mod:`.motion` (``simulate``, ``verify``), :mod:`.balancing` (``optimize``), :mod:`.fronts`
-(``pareto``, ``sweep``). Each is loaded when one of its names is first used (PEP 562): the
-analysis' report does not load the balancing's. The JSON field names that other tools rely on
-are fixed in DESIGN.md.
+(``pareto``, ``sweep``), :mod:`.parts` (counterweights as parts). Each is loaded when one of
+its names is first used (PEP 562): the analysis' report does not load the balancing's. The
+JSON field names that other tools rely on are fixed in DESIGN.md.
 """
 
 from __future__ import annotations
@@ -16,6 +16,10 @@ from ..lazy import lazy_exports
 
 #: Where each name lives.
 _EXPORTS = {
+    "dimensions": "parts",
+    "dimensions_text": "parts",
+    "parts_json": "parts",
+    "parts_text": "parts",
     "table": "text",
     "markdown_table": "text",
     "dumps_json": "text",
@@ -51,6 +55,10 @@ _EXPORTS = {
 }
 
 __all__ = [
+    "dimensions",
+    "dimensions_text",
+    "parts_json",
+    "parts_text",
     "MARKED_CHANGE",
     "SweepSummary",
     "WORSE_RATIO",
@@ -125,6 +133,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         simulation_text,
         verification_text,
     )
+    from .parts import dimensions, dimensions_text, parts_json, parts_text
     from .text import (
         csv_text,
         dumps_json,

@@ -19,6 +19,7 @@ from ..model.balance import (
 )
 from ..validate import LENGTH_RANGE
 from . import schema
+from .parts import part_text, read_part
 from .tables import Table, hint
 
 
@@ -83,9 +84,11 @@ def _read_link_freedom(table: Table, points: tuple[str, ...]) -> LinkFreedom:
         if mass is None:
             raise SpecError("missing required key (the counterweight's mass, [low, high] kg)",
                             key=sub.key("mass"))
+        part_table = sub.table("part", required=False)
         counterweight = CounterweightFreedom(
             mass=mass, radius=sub.nonnegative("radius"),
-            gyration=sub.nonnegative("gyration", default=0.0))
+            gyration=sub.nonnegative("gyration", default=0.0),
+            part=None if part_table is None else read_part(part_table))
         if counterweight.gyration > LENGTH_RANGE[1]:
             raise SpecError(f"must be at most {LENGTH_RANGE[1]:g} m", key=sub.key("gyration"),
                             value=counterweight.gyration)
@@ -212,9 +215,10 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
             lines.append("com_on_line = true")
         if freedom.counterweight is not None:
             cw = freedom.counterweight
+            part = "" if cw.part is None else f", part = {part_text(cw.part)}"
             lines.append(f"counterweight = {{ mass = {_bracketed(cw.mass)}, radius = "
-                         f"{toml.number(cw.radius)}, gyration = {toml.number(cw.gyration)} }}"
-                         "  # kg, m, m")
+                         f"{toml.number(cw.radius)}, gyration = {toml.number(cw.gyration)}"
+                         f"{part} }}  # kg, m, m")
         if freedom.counter_rotor is not None:
             lines.append(f"counter_rotor = {_range_text(freedom.counter_rotor)}  # kg·m²")
     return lines

@@ -544,6 +544,50 @@ SECTIONS: tuple[Section, ...] = (
             example="2.0"),
         Key("gyration", "m", "0",
             "Its own least radius of gyration about its centre; at least 0.", example="0.05"),
+        Key("part", "table", "none",
+            "The part that makes it: a shape family, its room and material (below). "
+            "`optimize` sizes it, and its room narrows `mass`, `radius` and `gyration` to "
+            "what the part can be.",
+            example='{ shape = "ring", inner_radius = 0.01, outer_radius = 0.1, '
+                    'thickness = 0.05 }'),
+    )),
+    Section("balance.<link>.counterweight.part", "The part that makes a counterweight: a "
+            "prism of one material centred on the link's plane, its dimensions solved within "
+            "its room for the mass, centre and inertia the optimiser asks (docs: From optimum "
+            "to part). Each shape takes its own keys; lengths in m.", (
+        Key("shape", "—", "required",
+            '`"ring"` (on a stud at the centre), `"washers"` (a stack of ISO 7089 washers), '
+            '`"sector"` (a crank-web crescent about `com_about`), `"block"`, `"insert"` (a '
+            "pocket in the link filled with a denser material).", example='"ring"'),
+        Key("material", "—", '"steel" (an insert: required)',
+            "steel (7850 kg/m³), brass (8500), tungsten-alloy (17000) or lead (11340); any "
+            "name with `density`.", example='"brass"'),
+        Key("density", "kg/m³", "the material's",
+            "The material's density; positive.", example="8800.0"),
+        Key("inner_radius", "m", "0",
+            "ring: the stud's hole; sector: the hub's radius about `com_about`. At least 0.",
+            example="0.01"),
+        Key("outer_radius", "m", "required (ring, sector)",
+            "ring, sector: the largest outer radius; more than `inner_radius`.",
+            example="0.1"),
+        Key("angle_deg", "°", "required (sector)",
+            "sector: the largest full angle, in (0, 360].", example="120.0"),
+        Key("length", "m", "required (block)",
+            "block: its length along the link's x-axis; positive.", example="0.04"),
+        Key("width", "m", "required (block)",
+            "block: its largest width across; positive.", example="0.1"),
+        Key("radius", "m", "required (insert)",
+            "insert: the pocket's largest radius; positive.", example="0.02"),
+        Key("size", "—", "required (washers)",
+            'washers: an ISO 7089 size, `"M3"` … `"M36"`.', example='"M12"'),
+        Key("thickness", "m", "required",
+            "The largest thickness along the crank's axis (washers: the stack's height; "
+            "insert: the pocket's depth); positive.", example="0.05"),
+        Key("host", "—", '"steel"',
+            "insert: the link's own material, which the pocket takes away.",
+            example='"steel"'),
+        Key("host_density", "kg/m³", "the host's",
+            "insert: the link's density; positive.", example="7850.0"),
     )),
     Section("original", "The unbalanced design, as `optimize --out` writes it: the same links "
             "by name (a general linkage's moving links), each with its own mass properties.", (
