@@ -604,6 +604,7 @@ _PB1 = str(ROOT / "examples" / "pb1.toml")
      True),
     (["example", "pb1", "--out", "{tmp}/e.toml"], ["e.toml"], False),
 ])
+@pytest.mark.slow
 def test_every_file_written_is_said_on_stderr_and_never_on_stdout(tmp_path, capsys, argv,
                                                                   files, json_too):
     """Some verbs said 'wrote PATH' on stdout (plot, example, inside optimize's, verify's and

@@ -82,6 +82,7 @@ _INERTIA = st.floats(0.0, 20.0)
 
 @settings(max_examples=300, deadline=None)
 @given(m0=_MASS, e0=_LEN, f0=_LEN, i0=_INERTIA, m1=_MASS, e1=_LEN, f1=_LEN, i1=_INERTIA)
+@pytest.mark.slow
 def test_any_change_of_a_link_is_the_reported_body(m0, e0, f0, i0, m1, e1, f1, i1):
     original, balanced = Body(m0, e0, f0, i0), Body(m1, e1, f1, i1)
     w = counterweight("link", original, balanced)

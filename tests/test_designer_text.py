@@ -215,6 +215,7 @@ def test_an_engine_s_written_spec_keeps_its_original(three):
     assert loads_design(written).original == original
 
 
+@pytest.mark.slow
 def test_an_engine_s_original_is_what_plot_and_verify_show(three):
     out, _, _ = three
     design = load_design(out)

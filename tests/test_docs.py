@@ -37,6 +37,9 @@ from golden.record import STORE, mask
 import balancer
 from balancer.spec import loads_design, schema
 
+#: The whole module is of the full suite, not of the fast lane (`pytest -m "not slow"`).
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 README = ROOT / "README.md"

@@ -229,6 +229,7 @@ def test_the_crank_angle_formulation_driven_is_a_function_of_time(example, monke
 @pytest.mark.parametrize("example", ["watt_sixbar", "stephenson_sixbar"])
 @pytest.mark.parametrize("method", ["crank-angle", "multibody"])
 @pytest.mark.parametrize("drive", ["free", "constant-speed"])
+@pytest.mark.slow
 def test_general_linkages_count_the_turns_between_coarse_outputs(example, method, drive):
     # Three output times over a run in which the crank turns several times: the links'
     # angles are followed through the states between them (the steps' ends; a prescribed

@@ -282,6 +282,7 @@ def test_an_inline_threes_end_webs_cancel_the_forward_primary_couple_and_a_shaft
 # -- the command line -------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_optimize_writes_a_spec_that_analyses_and_verifies_again(tmp_path, capsys):
     out = tmp_path / "balanced.toml"
     spec = str(EXAMPLES / "inline_three_to_balance.toml")
@@ -375,6 +376,7 @@ def front(request):
     return design, pareto_front(design, "added-mass", 5)
 
 
+@pytest.mark.slow
 def test_each_point_of_an_engines_front_is_the_independent_programs_optimum(front):
     """At each point's ε: CVXPY's least J' (the spec's weights, no unbalance term) under the
     bounds and Σ|mr|/radius ≤ ε is the point's (√J')², and the certified bound below it."""
@@ -507,6 +509,7 @@ def test_pareto_of_an_engine_weighing_only_the_unbalance_is_refused(tmp_path, ca
 # -- sweeps of engines -------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_a_sweep_of_an_engine_balances_each_point_as_the_independent_program_does(tmp_path):
     """In-line three over its crank radius and a shaft's plane: each row's couple before by
     the momentum sums, its optimum (J from the row's after figures: no unbalance term, no
@@ -537,6 +540,7 @@ def test_a_sweep_of_an_engine_balances_each_point_as_the_independent_program_doe
         assert rows["added_mass"][i] > 0
 
 
+@pytest.mark.slow
 def test_a_sweep_of_an_engine_draws_its_rocking_couple(tmp_path, capsys, monkeypatch):
     """``sweep --plot`` of an engine: the atlas of the balanced rocking couple."""
     monkeypatch.chdir(tmp_path)

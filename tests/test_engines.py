@@ -583,6 +583,7 @@ def trapezoid_bound(engine: Engine, samples: int) -> float:
 
 
 @pytest.mark.parametrize("strokes", [4, 2])
+@pytest.mark.slow
 def test_a_single_cylinders_mean_torque_is_its_indicated_work_over_the_cycle(strokes):
     """Mean driving torque = −W/L, W = ∮(p − p_crankcase)·dV; and every sample exact.
 
@@ -811,6 +812,7 @@ def test_every_engine_layout_ships_as_an_example():
 
 
 @pytest.mark.parametrize("name", shipped_engines())
+@pytest.mark.slow
 def test_a_shipped_engine_shakes_and_drives_as_its_slider_cranks_summed(name):
     """Every figure of the example's cycle, sample by sample, from the momentum sums and the
     gas torque of the spline started at each cylinder's firing: 1e-9 of the largest sample."""
@@ -888,6 +890,7 @@ def test_the_inline_threes_secondary_couple_is_root_three_s_m_rec_r_A2():
 
 
 @pytest.mark.parametrize("name", shipped_engines())
+@pytest.mark.slow
 def test_a_shipped_engine_driven_in_the_multibody_formulation_has_its_cycles_figures(name):
     """``verify``'s driven run: the multibody formulation at the operating speed over the
     working cycle, outputs on the analysis' samples. Driven, the crank angle is exact and the

@@ -150,6 +150,7 @@ def _bai(lengths):
     return FourBar(lengths=lengths, crank=links[0], coupler=links[1], rocker=links[2])
 
 
+@pytest.mark.slow
 def test_bai_crank_rocker_with_gravity():
     linkage = _bai((0.12, 0.25, 0.26, 0.3))
     # Their initial attitudes: q_A = (1, 0), q_B = (0.3044, 0.9534), q_D = (−0.3996, 0.9167),
@@ -181,6 +182,7 @@ def test_bai_crank_rocker_with_gravity():
         2 * integration_bound(ref) * scale)
 
 
+@pytest.mark.slow
 def test_bai_parallelogram_keeps_its_coupler_parallel():
     linkage = _bai((0.1, 0.25, 0.1, 0.25))
     assert str(assembly.classify(linkage.lengths)) == "change-point"
@@ -213,6 +215,7 @@ def _triple_rocker():
     return FourBar(lengths=lengths, crank=links[0], coupler=links[1], rocker=links[2])
 
 
+@pytest.mark.slow
 def test_non_minimal_formulations_swing_through_a_dead_point():
     linkage = _triple_rocker()
     rng = assembly.assembly_range(linkage.lengths)
@@ -241,6 +244,7 @@ def test_non_minimal_formulations_swing_through_a_dead_point():
 
 
 @pytest.mark.parametrize("method", ["complex-masses", "lie-group"])
+@pytest.mark.slow
 def test_crank_angle_formulations_stop_at_a_dead_point(method):
     linkage = _triple_rocker()
     settings = SimulationSettings(duration=3.0, theta1=0.0, omega1=6.0)
@@ -330,6 +334,7 @@ def test_counter_rotors_enter_every_formulation():
         assert tr.energy_error < 2 * integration_bound(tr), name  # first integral, quadratic
 
 
+@pytest.mark.slow
 def test_formulations_agree_at_every_state_along_a_trajectory(paper_runs):
     """The states of the paper's motion, put into each formulation's own state: accelerations
     and reactions agree to 1e-9 relative (the paper checked 501 such states)."""
@@ -408,6 +413,7 @@ def test_the_opened_loops_outputs_at_many_states_are_its_single_state_equations(
 
 @pytest.mark.parametrize("method", [*METHODS, "multibody"])
 @pytest.mark.parametrize("drive", ["free", "constant-speed"])
+@pytest.mark.slow
 def test_coarse_output_times_keep_count_of_the_turns(method, drive):
     # A double crank turning three revolutions between two output times: the links' angles,
     # continuous over the motion, take the branch the motion reached, followed through the

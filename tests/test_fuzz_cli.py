@@ -19,6 +19,9 @@ from fuzz.generate import make_case, prepare_workdir, release_workdir
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
+#: The whole module is of the full suite, not of the fast lane (`pytest -m "not slow"`).
+pytestmark = pytest.mark.slow
+
 #: Defect classes these tests fail on (the campaign reports more, e.g. exit codes that differ
 #: from what the input implies and DESIGN.md's planned checks of file extensions).
 ASSERTED = (

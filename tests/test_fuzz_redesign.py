@@ -13,6 +13,9 @@ from __future__ import annotations
 import pytest
 from fuzz.redesign_campaign import CLASSES, MAKERS, make_case, run_problem
 
+#: The whole module is of the full suite, not of the fast lane (`pytest -m "not slow"`).
+pytestmark = pytest.mark.slow
+
 SEED = 2611200
 #: Problems of each family: the counterweights' families (new in issue 25) get more.
 COUNTS = {"random": 12, "complete": 8, "zero-force": 6, "borderline": 12, "infeasible": 6,

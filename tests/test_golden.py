@@ -19,6 +19,9 @@ import pytest
 from golden import compare
 from golden.record import NOT_UNIQUE, STORE, commands, difference, examples, output
 
+#: The whole module is of the full suite, not of the fast lane (`pytest -m "not slow"`).
+pytestmark = pytest.mark.slow
+
 CASES = [(name, key) for name in examples() for key in commands(name)]
 
 

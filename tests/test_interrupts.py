@@ -20,8 +20,10 @@ ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 PB1 = EXAMPLES / "pb1.toml"
 
-pytestmark = pytest.mark.skipif(not Path("/proc/self/stat").exists(),
-                                reason="reads the child's CPU time from /proc")
+#: Of the full suite, not of the fast lane (`pytest -m "not slow"`).
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(not Path("/proc/self/stat").exists(),
+                                 reason="reads the child's CPU time from /proc")]
 
 
 def _env() -> dict[str, str]:

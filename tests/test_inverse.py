@@ -262,6 +262,7 @@ _VALUE = st.floats(allow_nan=False, allow_infinity=False, min_value=-1e300, max_
 @given(re=st.lists(_VALUE, min_size=1, max_size=40), im=st.lists(_VALUE, min_size=1,
                                                                  max_size=40),
        complex_=st.booleans(), holes=st.sets(st.integers(0, 39), max_size=5))
+@pytest.mark.slow
 def test_figures_of_any_samples_against_exact_arithmetic(re, im, complex_, holes):
     """Figure.of (its fast sums of squares, its scaled fallback, its NaN samples left out)
     against the RMS and maximum of the same magnitudes in exact rational arithmetic. Each

@@ -27,6 +27,9 @@ from balancer.linkage.program import Tape
 from balancer.mechanisms import mechanism_of
 from balancer.spec import load_design
 
+#: The whole module is of the full suite, not of the fast lane (`pytest -m "not slow"`).
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 #: Mechanisms of every kind of group: a four-bar's dyads, a slider-crank's, the Watt six-bar's
@@ -137,6 +140,7 @@ import json, sys, time
 import numpy as np
 from balancer.mechanisms import mechanism_of
 from balancer.spec import load_design
+
 mech = mechanism_of(load_design(sys.argv[1] if len(sys.argv) > 1 else {spec!r}).mechanism)
 program = mech._program(True, (0.0, 0.0))
 t = time.perf_counter()

@@ -106,6 +106,7 @@ def graph() -> dict[str, set[str]]:
     return {name: imports(name, path, known) for name, path in known.items()}
 
 
+@pytest.mark.slow
 def test_every_import_runs_down_or_sideways():
     upward = [f"balancer.{a} (layer {layer(a)}) imports balancer.{b} (layer {layer(b)})"
               for a, targets in graph().items() for b in sorted(targets) if layer(b) > layer(a)]
@@ -229,6 +230,7 @@ def test_every_registered_mechanism_reads_and_writes_its_spec_tables_in_its_fold
             assert callable(getattr(balance, function)), f"{kind}: {module.BALANCE}.{function}"
 
 
+@pytest.mark.slow
 def test_the_spec_reader_and_writer_ask_no_mechanism_what_it_is():
     """``balancer/spec`` imports no mechanism's folder: each is reached through the registry."""
     edges = graph()

@@ -233,6 +233,7 @@ def _scotch_yoke(seed: int) -> Design:
     lambda: _stephenson_with_crank_pin("[0.08, 0.138564064606]"),
     lambda: _scotch_yoke(0), lambda: _scotch_yoke(5)],
     ids=["stephenson", "stephenson-swinging", "stephenson-swinging-less", "yoke-0", "yoke-5"])
+@pytest.mark.slow
 def test_the_strided_continuation_finds_the_plain_ones_table(monkeypatch, make):
     """The table by strides (filled between by one Newton solve, the turn downwards by
     periodicity where the turn upwards closes) is the one-row-at-a-time continuation's: the

@@ -716,12 +716,14 @@ def _column(x):
 # -- tests ----------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_states_are_regular_and_the_crank_turns(case, solved):
     assert case.mech.assembly_range().full
     kappa = max(s["kappa"] for s in solved)
     assert kappa <= KAPPA_MAX, f"ill-conditioned state (κ = {kappa:.3g}): the tolerance fails"
 
 
+@pytest.mark.slow
 def test_oracle_is_consistent_with_the_momentum_theorems(case, solved):
     """Joint forces summed on the ground (with −τ and +2·J·α per counter-rotor) equal applied
     forces less the momentum's rate; pins carry no couple, ground guides no tangential force."""

@@ -199,6 +199,7 @@ def _random_crank_states(mech, count: int, seed: int):
 
 @pytest.mark.parametrize("example", ["watt", "quick_return.toml", "jansen_leg.toml",
                                      "stephenson_sixbar.toml"])
+@pytest.mark.slow
 def test_the_crank_angle_equation_agrees_with_the_multibody_at_random_states(example):
     # Lagrange's equation in the crank angle (u = dq/dθ1 and b = d²q/dθ1² from the core's
     # group-by-group solves, projected: m(θ1)·θ̈1 = uᵀ(Q − M·b·θ̇1²)) against the multibody's
@@ -236,6 +237,7 @@ def test_the_crank_angle_equation_agrees_with_the_multibody_at_random_states(exa
         assert rel_err(power / speed, torque, scale=np.max(np.abs(torque))) < 1e-9
 
 
+@pytest.mark.slow
 def test_the_six_bar_through_every_verb(tmp_path, capsys):
     import json
 

@@ -210,6 +210,7 @@ def test_a_driven_simulation_rocks_as_the_cycle_analysis(tmp_path):
     assert np.max(np.abs(got - want)) <= 1e-6 * np.max(np.abs(want))
 
 
+@pytest.mark.slow
 def test_the_balanced_two_plane_drive_is_verified_by_simulation():
     """The balanced design (with its [original]) simulated in a formulation the optimiser did
     not use: force balanced to integration level, and the largest rocking couple of the driven

@@ -30,6 +30,7 @@ def _notes(err: str) -> list[str]:
 
 
 @pytest.mark.parametrize("name", examples.names())
+@pytest.mark.slow
 def test_no_shipped_example_gets_a_note(name, capsys):
     path = EXAMPLES / f"{name}.toml"
     assert length_note(tomllib.loads(path.read_text())) is None

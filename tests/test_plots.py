@@ -174,6 +174,7 @@ def _check_legends_outside(fig):
 
 @pytest.mark.parametrize(("suffix", "magic"), [(".png", b"\x89PNG"), (".svg", b"<svg"),
                                                (".pdf", b"%PDF")])
+@pytest.mark.slow
 def test_plot_cycle_writes_the_type_its_extension_names(tmp_path, capsys, pb1_balanced, suffix,
                                                          magic):
     out = tmp_path / f"cycle{suffix}"
@@ -205,6 +206,7 @@ def test_plot_needs_something_to_draw_and_distinct_paths(tmp_path, capsys):
 
 
 @pytest.mark.parametrize(("name", "panels"), [("pb1_counterweights", 3), ("two_plane_drive", 4)])
+@pytest.mark.slow
 def test_plot_orders_draws_the_order_table(tmp_path, capsys, name, panels):
     """Bars of `analyze`'s orders: force, (rocking couple in planes,) moment, torque; the
     heights are the order table's, before and after for a spec with [original]."""
@@ -238,6 +240,7 @@ def test_plot_cycle_of_a_crank_that_cannot_turn_is_bad_input(tmp_path, capsys):
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_cycle_and_animation_in_one_call(tmp_path, capsys):
     cycle, gif = tmp_path / "c.pdf", tmp_path / "a.gif"
     assert main(["plot", str(EXAMPLES / "engine.toml"), "--cycle", str(cycle), "--animate",
@@ -251,6 +254,7 @@ needs_ffmpeg = pytest.mark.skipif(outputs.ffmpeg() is None,
 
 
 @needs_ffmpeg
+@pytest.mark.slow
 def test_an_mp4_animation_has_one_frame_per_crank_angle(tmp_path, capsys):
     import subprocess
 
@@ -301,6 +305,7 @@ def _verify(path, **kw):
     return verify(load_design(path), **kw)
 
 
+@pytest.mark.slow
 def test_the_verification_figure_draws_before_and_after_on_every_panel(pb1_balanced):
     design = load_design(pb1_balanced)
     from balancer.verification import verify
@@ -336,6 +341,7 @@ def test_the_verification_figure_draws_before_and_after_on_every_panel(pb1_balan
     _check_legends_outside(fig)
 
 
+@pytest.mark.slow
 def test_a_design_without_an_original_keeps_the_papers_components():
     v = _verify(EXAMPLES / "meijaard2020.toml", duration=0.2)
     design = load_design(EXAMPLES / "meijaard2020.toml")
@@ -845,6 +851,7 @@ def test_an_engines_cycle_figure_draws_the_torque_on_its_mounts():
                                     "mount_torque")
 
 
+@pytest.mark.slow
 def test_figures_give_speeds_in_rpm_beside_rad_per_s(tmp_path):
     design = load_design(EXAMPLES / "single_cylinder.toml")  # 680.678 rad/s, 6500 rpm
     a = analyze(design)
@@ -954,6 +961,7 @@ def test_plot_orders_log_flag(tmp_path, capsys, monkeypatch):
 # --- the animation: a design, pistons, engines' counterweights (issue 40) ------------------
 
 
+@pytest.mark.slow
 def test_animate_takes_a_design_as_every_other_call_does(tmp_path):
     """``animate(design, path)``: its mechanism, its title and (a balanced spec) the bodies
     added to its original's links, as ``plot --animate`` draws them; a model or a mechanism

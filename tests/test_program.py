@@ -210,6 +210,7 @@ TRIAD = {"mechanism": {"type": "linkage", "input": "crank",
                                            ("block", ["B"]))}}}
 
 
+@pytest.mark.slow
 def test_a_numeric_group_follows_its_branch_to_both_ends_of_its_table():
     """Within the last step of the table at each end, the start is the cubic through the last
     four rows (it was NaN, and Newton's method from zeros found another assembly), and an

@@ -34,6 +34,7 @@ def _never(what: str):
     ["sweep", PB1, "--vary", "mechanism.lengths.coupler=2.8:3.2:2", "--out", "{tmp}/s.parquet",
      "--plot", "{tmp}/atlas.jpeg", "--workers", "0"],
 ])
+@pytest.mark.slow
 def test_a_figure_path_of_no_type_is_refused_before_any_work(tmp_path, args):
     """`plot --cycle c.jpg` loaded matplotlib (2.4 s on a busy machine) before it was refused,
     where a missing folder was refused at once: now neither matplotlib nor the spec

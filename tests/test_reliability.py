@@ -258,6 +258,7 @@ def test_a_driven_lie_group_simulation_passes_a_change_point():
     assert tr.theta[0, -1] > 1.0 + 2 * math.pi  # through both change points, and on
 
 
+@pytest.mark.slow
 def test_a_run_that_stalls_at_a_change_point_fails_naming_it():
     """At rtol 1e-11 the opened loop shrank its steps near the change point without end."""
     from balancer.simulation import simulate
@@ -690,6 +691,7 @@ counter_rotor = [0.0, 45.3588349095985]
 
 
 @pytest.mark.parametrize("pid", sorted(NEARLY_FEASIBLE))
+@pytest.mark.slow
 def test_a_problem_infeasible_by_1e_7_is_called_infeasible_naming_the_bound(pid):
     """Both ended "failed" (no feasible design, no diagnosis). The diagnosis took the problem
     for feasible: on 337 from programs Clarabel solved only "almost" (their values, a crank
@@ -745,6 +747,7 @@ def test_a_centre_of_mass_put_onto_a_small_disc_far_from_the_frames_origin_stays
                                   "locking_stephenson_linkage.toml",
                                   "locking_quick_return_linkage.toml"])
 @pytest.mark.parametrize("method", ["crank-angle", "multibody"])
+@pytest.mark.slow
 def test_a_driven_crank_that_locks_says_so_with_every_formulation(spec, method, capsys):
     # Linkage fuzz campaign, seed 4242 (cases 165 and 61): a crank driven into the end of its
     # range. crank-angle raced its own dead-point event against the lock (the same root) and
@@ -920,6 +923,7 @@ def test_a_fixed_centre_of_mass_that_must_move_is_named(capsys):
     assert "numerical trouble" not in err
 
 
+@pytest.mark.slow
 def test_a_motion_that_starts_at_a_dead_point_is_refused_by_name(capsys):
     # Linkage fuzz campaign, seed 111, case 581: a Whitworth mechanism whose reference pose
     # (the motion's start) is the end of its assembly range; the multibody state's rates there
@@ -939,6 +943,7 @@ def test_a_motion_that_starts_at_a_dead_point_is_refused_by_name(capsys):
 
 @pytest.mark.parametrize(("spec", "code"), [("subnormal_mass_184.toml", 0),
                                             ("subnormal_mass_316.toml", 1)])
+@pytest.mark.slow
 def test_a_link_of_subnormal_mass_is_balanced_or_diagnosed(spec, code, capsys):
     # Linkage fuzz campaign, seed 4444 (valid-mutation): a link of mass 4.94e-324 kg is valid
     # input (as good as none) and analyze handles it; optimize divided by its inertia scale

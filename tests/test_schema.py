@@ -204,6 +204,7 @@ def test_an_original_link_takes_no_position_of_its_own():
         load(data)
 
 
+@pytest.mark.slow
 def test_the_reader_reads_no_key_without_an_entry(monkeypatch):
     read: set[tuple[str, str]] = set()
     raw = Table.raw

@@ -302,6 +302,7 @@ def test_formulations_agree_at_states(mech, driven):
             assert abs(ev.shaking_moment - ne.shaking_moment[0]) < 1e-9 * max(1.0, force)
 
 
+@pytest.mark.slow
 def test_engine_simulations_agree_and_balance_energy():
     design = spec.load_design(EXAMPLES / "engine.toml")
     runs = {}
@@ -345,6 +346,7 @@ def test_engine_simulations_agree_and_balance_energy():
     assert np.max(np.abs(tr.driving_torque - ca.reactions.driving_torque)) < 1e-9 * scale
 
 
+@pytest.mark.slow
 def test_partial_balancing_matches_the_classic_closed_form():
     """An in-line engine with only a crank counterweight, minimising w_x·RMS(Fx)² + w_y·RMS(Fy)²:
     the counterweight's force is a pure first harmonic, so the optimum balances the rotating
@@ -478,6 +480,7 @@ def test_slider_crank_spec_errors_and_round_trip(tmp_path):
     assert main(["analyze", str(path)]) == 2
 
 
+@pytest.mark.slow
 def test_slider_crank_through_the_command_line(tmp_path, capsys):
     engine = str(EXAMPLES / "engine.toml")
     assert main(["analyze", engine, "--json"]) == 0

@@ -23,6 +23,9 @@ from balancer.mechanisms.fourbar import kinematics as kin
 from balancer.model import SimulationSettings
 from balancer.simulation import simulate
 
+#: The whole module is of the full suite, not of the fast lane (`pytest -m "not slow"`).
+pytestmark = pytest.mark.slow
+
 STUDIES = Path(__file__).resolve().parent.parent / "studies"
 PNG = b"\x89PNG\r\n\x1a\n"
 

@@ -174,6 +174,7 @@ def test_resume_with_nothing_to_resume_runs_the_sweep_from_the_start(tmp_path, c
     assert _rows(out) == _rows(reference)
 
 
+@pytest.mark.slow
 def test_on_a_dask_cluster_a_killed_worker_loses_no_point(tmp_path):
     """Two local worker processes; after the first batch one of them is killed (os._exit).
     The scheduler reruns what it held, its nanny starts it again, and the table has every

@@ -5,6 +5,11 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import pytest
+
+#: The whole module is of the full suite, not of the fast lane (`pytest -m "not slow"`).
+pytestmark = pytest.mark.slow
+
 TUTORIAL = Path(__file__).resolve().parent.parent / "docs" / "tutorial.md"
 
 

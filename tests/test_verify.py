@@ -146,6 +146,7 @@ def test_infeasible_bounds_exit_1_naming_the_bound(tmp_path, capsys):
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_verify_plots_and_json(tmp_path, capsys, pb2_balanced):
     plot = tmp_path / "report.png"
     assert main(["verify", str(pb2_balanced), "--plot", str(plot), "--duration", "0.5",
@@ -158,6 +159,7 @@ def test_verify_plots_and_json(tmp_path, capsys, pb2_balanced):
 
 
 @pytest.mark.parametrize(("suffix", "magic"), [(".svg", b"<svg"), (".pdf", b"%PDF")])
+@pytest.mark.slow
 def test_verify_plot_type_comes_from_the_extension(tmp_path, capsys, pb2_balanced, suffix,
                                                    magic):
     plot = tmp_path / f"report{suffix}"
