@@ -27,15 +27,14 @@ LAYERS: tuple[tuple[str, ...], ...] = (
      "quantities"),
     ("model",),
     # The general core; the profiles of parts and their sizing (link-level mass models).
-    ("linkage", "quadrature", "orders", "parts.shapes", "parts.sizing"),
+    ("linkage", "orders", "parts.shapes", "parts.sizing"),
     # The mechanism interface, and what every mechanism's formulations share.
     ("mechanisms.base", "mechanisms.formulation", "mechanisms.chains"),
     # Each mechanism in its own folder; the general formulations (any mechanism).
     ("mechanisms.fourbar", "mechanisms.slidercrank", "mechanisms.general",
      "formulations.compiled", "formulations.crank_angle", "formulations.multibody"),
     # The registry of mechanisms and of formulations, and what runs over any mechanism.
-    ("mechanisms", "formulations", "force_balance", "columns", "cycle", "drawing",
-     "integration"),
+    ("mechanisms", "formulations", "force_balance", "columns", "cycle", "drawing"),
     ("balance",),
     ("simulation", "verification", "report", "plots", "plausibility", "parts"),
     ("spec", "examples", "api", "sweeps", "cli", "__main__"),

@@ -491,7 +491,7 @@ def test_a_compiled_dop853_step_is_scipys_step(method, driven):
     # stages' sums are in another order: a few ulps of the state per stage, 16 stages).
     from scipy.integrate import DOP853
 
-    from balancer.integration import CompiledDOP853, Stages, with_extra_work
+    from balancer.simulation.integrator import CompiledDOP853, Stages, with_extra_work
     from balancer.simulation.stepper import WithExtraWork
 
     design = _watt()

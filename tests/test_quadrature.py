@@ -1,4 +1,4 @@
-"""The cumulative Gauss–Kronrod quadrature (balancer.quadrature) against exact integrals."""
+"""Cumulative Gauss–Kronrod quadrature (balancer.simulation.quadrature) against exact integrals."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from balancer.errors import SolverError
-from balancer.quadrature import GAUSS, KRONROD, NODES, cumulative, partial_weights
+from balancer.simulation.quadrature import GAUSS, KRONROD, NODES, cumulative, partial_weights
 
 
 def test_the_rules_are_gauss_and_kronrod():
@@ -114,7 +114,7 @@ def test_an_integrand_that_halving_does_not_resolve_stops_within_a_budget():
     # a simulate that looked hung. An integrand whose estimates do not fall with halving
     # (here an oscillation far finer than any panel reached) is an error after
     # MAX_REFINED panels per first panel (and EXTRA_REFINED more) have been made.
-    from balancer.quadrature import EXTRA_REFINED, MAX_REFINED
+    from balancer.simulation.quadrature import EXTRA_REFINED, MAX_REFINED
 
     calls = []
 

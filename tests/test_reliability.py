@@ -880,7 +880,7 @@ def test_an_integrator_whose_rate_is_not_finite_cannot_start():
     # The first step's size (Hairer, Nørsett & Wanner) divides by the rate's size: a rate that
     # is not finite gives no step, a SolverError (exit 1), not a division by zero.
     from balancer.errors import SolverError
-    from balancer.integration import DOP853
+    from balancer.simulation.integrator import DOP853
 
     with pytest.raises(SolverError, match="not finite"):
         DOP853(lambda t, y: np.array([np.inf, 1.0]), 0.0, np.array([1.0, 1.0]), 1.0,

@@ -278,8 +278,8 @@ class Formulation(ABC):
         """:meth:`rhs` and :meth:`extra_power` at many times of a :attr:`time_only` motion.
 
         Vectorised over the times: the simulation then finds the motor's work at its output
-        times by quadrature (:mod:`balancer.quadrature`) instead of stepping an integrator.
-        ``None`` (the default) where a formulation has no vectorised form.
+        times by quadrature (:mod:`balancer.simulation.quadrature`) instead of stepping an
+        integrator. ``None`` (the default) where a formulation has no vectorised form.
         """
         return None
 
@@ -301,7 +301,7 @@ class Formulation(ABC):
         """:meth:`rhs` as a CasADi function ``(t, y) → ẏ``, or ``None``.
 
         Offered only where :meth:`extra_power` is zero: the integrator then evaluates a step's
-        stages in one compiled call (:mod:`balancer.integration`).
+        stages in one compiled call (:mod:`balancer.simulation.integrator`).
         """
         return None
 

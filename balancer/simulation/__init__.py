@@ -1,6 +1,6 @@
 """Forward dynamics: integrate a formulation, project, detect events, report what happened.
 
-The integrator is the explicit Runge–Kutta method of order 8, DOP853 (:mod:`.integration`),
+The integrator is the explicit Runge–Kutta method of order 8, DOP853 (:mod:`.integrator`),
 stepped by hand so that after every accepted step the non-minimal formulations' states are
 projected back onto the loop closure and its derivative (the drift before projection is
 reported). Output values come from the step's dense output, all those within a step in one
@@ -31,7 +31,7 @@ of the integrated system, which the integrator keeps to its tolerance: the repor
 A driven crank's motion is prescribed. A formulation whose coordinate is the crank angle
 (``complex-masses``) then has nothing to integrate but the work, a function of the time alone:
 it is found by adaptive Gauss–Kronrod quadrature of the vectorised power at the output times
-(:mod:`balancer.quadrature`, to the same tolerances), and the energy balance checks the driving
+(:mod:`.quadrature`, to the same tolerances), and the energy balance checks the driving
 torque of the formulation against its kinetic energy and the loads' work. Where the power is not
 vectorised, or the motion comes near a dead point, the integrator steps as for any motion.
 """

@@ -24,7 +24,10 @@ from ..formulations import (
     formulation_class,
     formulation_names,
 )
-from ..integration import (
+from ..mechanisms.base import Mechanism
+from ..model import RTOL_MIN
+from ..model import MechanismModel as Model
+from .integrator import (
     DOP853,
     CompiledDOP853,
     DenseOutput,
@@ -32,10 +35,7 @@ from ..integration import (
     TimeOnlyDOP853,
     with_extra_work,
 )
-from ..mechanisms.base import Mechanism
-from ..model import RTOL_MIN
-from ..model import MechanismModel as Model
-from ..quadrature import cumulative
+from .quadrature import cumulative
 
 #: Most integration steps a simulation may take (under a minute with the slowest formulation,
 #: multibody with its projections, at some 2 000 steps a second on a 2-core machine): a
@@ -242,7 +242,7 @@ class Stepper:
         The state of a :attr:`~balancer.formulations.Formulation.time_only` formulation is a
         function of the time whose derivative is known at every time: its values at the output
         times are the cumulative integrals of :meth:`~balancer.formulations.Formulation.
-        driven_rates` (:func:`balancer.quadrature.cumulative`, to the run's tolerances; a panel
+        driven_rates` (:func:`.quadrature.cumulative`, to the run's tolerances; a panel
         is reported as a step). ``None`` where the formulation has no vectorised rates, or the
         motion comes within :data:`~balancer.formulations.DEAD_POINT_THRESHOLD` of a dead point
         (away from a change point): the integrator then steps, and its event stops the run.
@@ -346,7 +346,7 @@ class Stepper:
         and rate analysis); the motor's work and the extra work are the cumulative integrals of
         their powers, the formulation's own driving torque times the crank's speed and
         :meth:`~balancer.formulations.Formulation.extra_power`, by quadrature
-        (:func:`balancer.quadrature.cumulative`, to the run's tolerances; a panel is reported
+        (:func:`.quadrature.cumulative`, to the run's tolerances; a panel is reported
         as a step). The drift is the constraints' residual at the output states. ``None`` where
         the formulation has no such route: the integrator then steps.
         """

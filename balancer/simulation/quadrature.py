@@ -28,7 +28,7 @@ from typing import TypeAlias
 import numpy as np
 from numpy.typing import NDArray
 
-from .errors import SolverError
+from ..errors import SolverError
 
 #: The Kronrod nodes on [−1, 1] from the end inwards (the negatives mirror them), then 0.
 _XK = np.array([

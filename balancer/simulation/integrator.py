@@ -29,8 +29,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import SolverError
-from .formulations.compiled import Compiled
+from ..errors import SolverError
+from ..formulations.compiled import Compiled
 
 if TYPE_CHECKING:
     import casadi as ca

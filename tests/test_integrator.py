@@ -1,11 +1,11 @@
-"""The DOP853 integrator (balancer.integration) against SciPy's, its oracle."""
+"""The DOP853 integrator (balancer.simulation.integrator) against SciPy's, its oracle."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from balancer.integration import DOP853, TimeOnlyDOP853
+from balancer.simulation.integrator import DOP853, TimeOnlyDOP853
 
 
 def _forced_pendulum(t, y):
