@@ -34,9 +34,9 @@ from matplotlib.figure import Figure
 from balancer.balance.optimizer import Optimizer, optimize
 from balancer.balance.problem import numeric_problem
 from balancer.cycle import cycle_analysis, sample_angles
-from balancer.drawing import frame
 from balancer.mechanisms import mechanism_of
 from balancer.plots import COLOURS, SERIES, save_png
+from balancer.plots.drawing import frame
 from balancer.report import markdown_table
 from balancer.spec import load_design
 from balancer.verification import verify

@@ -34,7 +34,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("mechanisms.fourbar", "mechanisms.slidercrank", "mechanisms.general",
      "formulations.compiled", "formulations.crank_angle", "formulations.multibody"),
     # The registry of mechanisms and of formulations, and what runs over any mechanism.
-    ("mechanisms", "formulations", "force_balance", "columns", "cycle", "drawing"),
+    ("mechanisms", "formulations", "force_balance", "columns", "cycle"),
     ("balance",),
     ("simulation", "verification", "report", "plots", "plausibility", "parts"),
     ("spec", "examples", "api", "sweeps", "cli", "__main__"),

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from balancer import api, cycle, drawing, outputs, plots
+from balancer import api, cycle, outputs, plots
 from balancer.api import analyze
 from balancer.cli import main
 from balancer.mechanisms import mechanism_of
-from balancer.plots import style
+from balancer.plots import drawing, style
 from balancer.rounding import speed_text
 from balancer.spec import load_design
 from balancer.sweeps import atlas_figure
@@ -395,7 +395,7 @@ def test_counterweights_turn_with_their_links_in_the_animation(tmp_path):
     its (e, f) in the link's frame, i.e. A0 + e^{iθ1}·(e + i·f) for the crank, whose angle the
     frames sample evenly; the animation of a balanced spec draws them."""
     import balancer
-    from balancer.drawing import counterweight_paths
+    from balancer.plots.drawing import counterweight_paths
 
     design = balancer.example("pb1_counterweights")
     result = balancer.optimize(design, backend="convex")

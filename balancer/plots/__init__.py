@@ -15,6 +15,8 @@ matplotlib is imported by the functions that draw, not by importing this package
 ``fronts``         a trade-off front
 ``atlas``          a sweep's atlas and a tolerance histogram
 ``style``          colours, styles, axes, numbers, writing files
+``drawing``        what pictures draw of a mechanism: its frame, links and centres of mass
+                   over a revolution, from its kinematics
 =================  ===========================================================================
 """
 

@@ -13,7 +13,13 @@ from numpy.typing import NDArray
 from .. import outputs
 from ..balance.counterweights import counterweights as link_counterweights
 from ..cycle import sample_angles
-from ..drawing import (
+from ..errors import OutputError, SpecError
+from ..mechanisms import mechanism_of
+from ..mechanisms.base import Mechanism
+from ..model import Design
+from ..model import MechanismModel as Model
+from ..outputs import animation_type, write_with
+from .drawing import (
     CounterweightLike,
     counterweight_paths,
     drawing_frames,
@@ -21,12 +27,6 @@ from ..drawing import (
     frame,
     slider_block_outlines,
 )
-from ..errors import OutputError, SpecError
-from ..mechanisms import mechanism_of
-from ..mechanisms.base import Mechanism
-from ..model import Design
-from ..model import MechanismModel as Model
-from ..outputs import animation_type, write_with
 from .style import COLOURS, draw_frame
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw

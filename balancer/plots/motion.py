@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..drawing import centre_of_mass_path
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Design
@@ -18,6 +17,7 @@ from ..model import MechanismModel as Model
 from ..rounding import speed_text
 from ..simulation import Trajectory
 from ..verification import Verification
+from .drawing import centre_of_mass_path
 from .style import (
     AFTER_STYLE,
     BEFORE_STYLE,

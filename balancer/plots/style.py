@@ -8,10 +8,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..drawing import frame
 from ..mechanisms.base import Mechanism
 from ..model import MechanismModel as Model
 from ..outputs import figure_type, write_with
+from .drawing import frame
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
     from matplotlib.axes import Axes

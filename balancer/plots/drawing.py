@@ -1,7 +1,7 @@
 """What pictures draw of a mechanism: its frame, its links over a revolution, centres of mass.
 
 Positions from the mechanism's kinematics at crank angles, for the figures and animations of
-:mod:`balancer.plots` (which compute nothing themselves).
+the other modules of :mod:`balancer.plots` (which compute nothing themselves).
 """
 
 from __future__ import annotations
@@ -12,13 +12,13 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from .columns import TrajectoryLike
-from .cycle import sample_angles
-from .linkage.vectors import V
-from .mechanisms import mechanism_of
-from .mechanisms.base import DrawnMass, Mechanism
-from .model import GROUND
-from .model import MechanismModel as Model
+from ..columns import TrajectoryLike
+from ..cycle import sample_angles
+from ..linkage.vectors import V
+from ..mechanisms import mechanism_of
+from ..mechanisms.base import DrawnMass, Mechanism
+from ..model import GROUND
+from ..model import MechanismModel as Model
 
 
 class CounterweightLike(Protocol):
