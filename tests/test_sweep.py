@@ -1,4 +1,4 @@
-"""Design-space sweeps (balancer/sweeps.py, ``balancer sweep``), on Dask and in process."""
+"""Design-space sweeps (balancer/sweeps/, ``balancer sweep``), on Dask and in process."""
 
 from __future__ import annotations
 
@@ -17,7 +17,8 @@ from balancer.balance.optimizer import optimize
 from balancer.cli import main
 from balancer.errors import OutputError, SpecError
 from balancer.spec import design_from_dict, load_design
-from balancer.sweeps import Vary, _silenced, design_points, sweep, with_values
+from balancer.sweeps import Vary, design_points, sweep, with_values
+from balancer.sweeps.cluster import _silenced
 
 ROOT = Path(__file__).resolve().parent.parent
 PB1 = ROOT / "examples" / "pb1.toml"
@@ -153,7 +154,7 @@ def test_resume_with_nothing_to_resume_runs_the_sweep_from_the_start(tmp_path, c
     """A sweep interrupted before any point finished keeps nothing; a scheduler that restarts
     the job runs the same command line, --resume included: it runs the sweep whole, with a
     note, and its table is the uninterrupted sweep's."""
-    import balancer.sweeps
+    import balancer.sweeps.run
 
     varies = [Vary.parse(f"{COUPLER}=2.6:3.4:3")]
     out, reference = tmp_path / "sweep.parquet", tmp_path / "reference.parquet"
@@ -162,7 +163,7 @@ def test_resume_with_nothing_to_resume_runs_the_sweep_from_the_start(tmp_path, c
         raise KeyboardInterrupt
 
     with monkeypatch.context() as patch:
-        patch.setattr(balancer.sweeps, "run_batch", interrupted)
+        patch.setattr(balancer.sweeps.run, "run_batch", interrupted)
         with pytest.raises(KeyboardInterrupt, match="nothing kept"):
             sweep(PB1, varies, out, workers=0, batch=3)
     args = ["sweep", str(PB1), "--vary", f"{COUPLER}=2.6:3.4:3", "--out", str(out),
