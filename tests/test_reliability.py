@@ -17,8 +17,9 @@ import pytest
 from fuzz.checks import without_dac_override
 
 from balancer import spec
+from balancer.balance.feasibility import FORCE_BALANCE_TOLERANCE
 from balancer.balance.optimizer import Status, optimize
-from balancer.balance.problem import FORCE_BALANCE_TOLERANCE, NumericProblem, numeric_problem
+from balancer.balance.problem import NumericProblem, numeric_problem
 from balancer.balance.result import GAP_TOLERANCE, InfeasibleError
 from balancer.cli import main
 from balancer.errors import AssemblyError, OutputError, SolverError, SpecError
@@ -1066,7 +1067,8 @@ def test_force_balance_rows_carry_no_rounding_on_what_moves_no_centre_of_mass(ba
     # condition's terms (0.014 kg·m at the optimum), above FORCE_BALANCE_TOLERANCE; nothing
     # free could restore it (the inertia is settled afterwards): 'the balancing failed: no
     # feasible design found' (exit 1) with a certified optimum 1.3e-8 away.
-    from balancer.balance.problem import FORCE_BALANCE_TOLERANCE, numeric_problem
+    from balancer.balance.feasibility import FORCE_BALANCE_TOLERANCE
+    from balancer.balance.problem import numeric_problem
     from balancer.force_balance import force_balance_conditions
     from balancer.mechanisms import mechanism_of
 

@@ -57,8 +57,9 @@ from numpy.typing import NDArray
 from .certificate import Constraint, Objective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .diagnosis import Diagnosis
+from .feasibility import FORCE_BALANCE_TOLERANCE
 from .lsq import pinv as pseudo_inverse
-from .problem import FORCE_BALANCE_TOLERANCE, NumericProblem
+from .problem import NumericProblem
 from .repair import Repairs
 from .result import StageReport
 from .variables import Compressed, layout

@@ -49,8 +49,9 @@ from ..model import Design
 from ..model.balance import BalanceProblem, RotorBalanceProblem, missing_balance
 from . import rotors
 from .convex import ConvexSolution, ConvexSolver
+from .feasibility import ROUNDING_TOLERANCE
 from .nlp import NlpSolution, NlpSolver
-from .problem import ROUNDING_TOLERANCE, NumericProblem, numeric_problem
+from .problem import NumericProblem, numeric_problem
 from .result import (
     GAP_TOLERANCE,
     BalanceResult,

@@ -18,8 +18,9 @@ from numpy.typing import NDArray
 
 from .certificate import Constraint
 from .conic import ConicProgram
+from .feasibility import FORCE_BALANCE_TOLERANCE, ROUNDING_TOLERANCE
 from .lsq import pinv as pseudo_inverse
-from .problem import FORCE_BALANCE_TOLERANCE, ROUNDING_TOLERANCE, NumericProblem
+from .problem import NumericProblem
 
 #: :meth:`Repairs.polish` puts a parameter back at its preferred value where the objective
 #: is worse by at most this of the problem's scale than the design's before polishing: far
@@ -75,8 +76,8 @@ class Repairs:
 
         Solvers meet bounds to their tolerance. First Eq. 58 is restored by the least change
         of the free variables; if a bound is still broken by more than rounding
-        (:data:`~balancer.balance.problem.ROUNDING_TOLERANCE`: a designer's spec must hold what the
-        problem promised, and :meth:`NumericProblem.physical` removes only rounding), the
+        (:data:`~balancer.balance.feasibility.ROUNDING_TOLERANCE`: a designer's spec must hold
+        what the problem promised, and :meth:`NumericProblem.physical` removes only rounding), the
         broken bounds are met as equations together with Eq. 58 (:meth:`onto_active`: a move
         of the size of the violations). Failing that, ``x`` is projected, as the least change
         in scaled variables, onto the bounds tightened by :data:`MARGIN`, with Eq. 58 as
@@ -455,7 +456,7 @@ class Repairs:
         Clarabel meets the constraints to its tolerance (``1e-10``, or ~``1e-5`` when it stops
         "almost solved"). First the least change of ``u`` restores Eq. 58 to rounding (it moves
         the design by about Clarabel's tolerance). A design that then meets every bound to
-        :data:`~balancer.balance.problem.FEASIBILITY_TOLERANCE` is kept as it is; otherwise
+        :data:`~balancer.balance.feasibility.FEASIBILITY_TOLERANCE` is kept as it is; otherwise
         masses and counter-rotors are clipped into their bounds and centres of mass pulled into
         their
         discs, Eq. 58 restored again (alternating twice), and each inertia about the centre of

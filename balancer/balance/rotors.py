@@ -68,7 +68,7 @@ from .certificate import Objective as Norm
 from .conic import ConicProgram, ConicSolution
 from .convex import CLARABEL_SETTINGS, TIE_ACCEPT, solve_program
 from .nlp import IPOPT_OPTIONS
-from .problem import BALANCED_SHARE, ROUNDING_FACTOR
+from .objective_scale import BALANCED_SHARE, ROUNDING_FACTOR
 from .result import GAP_TOLERANCE, BalanceResult, RotorMasses, StageReport, Status
 
 #: A mass·radius below this share of its bound is none (an interior-point method reaches the

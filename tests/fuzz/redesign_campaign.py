@@ -136,7 +136,7 @@ WEIGHT_NAMES = (
     "added_mass",
 )
 
-#: Relative tolerance of the tool's own feasibility check (balancer.balance.problem): a bound is
+#: Relative tolerance of the tool's own feasibility check (balancer.balance.feasibility): a bound is
 #: "violated" in the headline count when it is broken by more than this, on the link's scale.
 BOUND_TOL = 1e-9
 #: Force balance of a balanced design: RMS shaking force over M·ω²·l, and the total centre of

@@ -50,7 +50,7 @@ import tomllib
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
-from balancer.balance.problem import ROUNDING_TOLERANCE
+from balancer.balance.feasibility import ROUNDING_TOLERANCE
 from balancer.balance.result import GAP_TOLERANCE
 
 #: A closed form's or a compiled kernel's figures on another machine's arithmetic (another

@@ -1,0 +1,100 @@
+"""The objective's terms: its least-squares rows, their triangular factor, its value.
+
+``J(x) = ‖K·x‖² + w_m·(Σm − Σm_original)``: :func:`objective_rows` stacks the weighted regressor
+rows of each term of ``[balance.objective]`` (shaking moment, driving torque, shaking force,
+rocking couple) into ``K`` and factors it; :class:`ObjectiveTerms` evaluates ``J`` from the full
+regressors (:meth:`ObjectiveTerms.objective`) or through the factor
+(:meth:`ObjectiveTerms.reduced_objective`).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import cached_property
+from typing import cast
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..model.balance import Objective
+from .bounds import LinkBounds
+from .problem_data import ProblemData
+from .regressors import CycleRegressors
+
+
+def objective_rows(reg: CycleRegressors, w: Objective, links: tuple[LinkBounds, ...], p: int
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64], tuple[bool, ...]]:
+    """The objective's rows ``K``, their triangular factor ``R`` and the inert entries.
+
+    ``K`` stacks the weighted regressor rows divided by ``√N`` (see :class:`ProblemData`);
+    an entry is inert where its column of ``R`` vanishes (to ``1e-12`` of the largest).
+    """
+    n = reg.shaking_moment.shape[0]
+    blocks = []
+    if w.shaking_moment:
+        blocks.append(math.sqrt(w.shaking_moment) * reg.shaking_moment)
+    if w.driving_torque:
+        blocks.append(math.sqrt(w.driving_torque) * reg.driving_torque)
+    wx, wy = w.shaking_force + w.shaking_force_x, w.shaking_force + w.shaking_force_y
+    if wx:
+        blocks.append(math.sqrt(wx) * reg.shaking_force.real)
+    if wy:
+        blocks.append(math.sqrt(wy) * reg.shaking_force.imag)
+    if w.rocking_couple:
+        blocks += [math.sqrt(w.rocking_couple) * reg.rocking_couple.real,
+                   math.sqrt(w.rocking_couple) * reg.rocking_couple.imag]
+    rows = np.vstack(blocks) / math.sqrt(n) if blocks else np.zeros((0, p))
+    factor = (cast("NDArray[np.float64]", np.linalg.qr(rows, mode="r"))  # R alone (as above)
+              if blocks else np.zeros((0, p)))
+    norms = np.linalg.norm(factor, axis=0) if blocks else np.zeros(p)
+    threshold = 1e-12 * max(float(norms.max(initial=0.0)), 1e-300)
+    candidates = {b.start + 3 for b in links} | {b.rotor for b in links if b.rotor is not None}
+    inert = tuple(i in candidates and norms[i] <= threshold for i in range(p))
+    return rows, factor, inert
+
+
+class ObjectiveTerms(ProblemData):
+    """The objective of a :class:`~.problem.NumericProblem`: its value at a design vector."""
+
+    def quadratic(self, x: NDArray[np.float64]) -> float:
+        """``‖K·x‖²``: the weighted mean squares, (N·m)²."""
+        r = self.rows @ x
+        return float(r @ r)
+
+    def objective(self, x: NDArray[np.float64]) -> float:
+        """``J(x)`` from the full regressor matrices, (N·m)² (see the module docstring)."""
+        w = self.weights
+        reg = self.regressors
+        total = 0.0
+        if w.shaking_moment:
+            total += w.shaking_moment * float(np.mean((reg.shaking_moment @ x) ** 2))
+        if w.driving_torque:
+            total += w.driving_torque * float(np.mean((reg.driving_torque @ x) ** 2))
+        if w.shaking_force or w.shaking_force_x or w.shaking_force_y:
+            force = reg.shaking_force @ x
+            wx = w.shaking_force + w.shaking_force_x
+            wy = w.shaking_force + w.shaking_force_y
+            total += wx * float(np.mean(force.real**2)) + wy * float(np.mean(force.imag**2))
+        if w.rocking_couple:
+            couple = reg.rocking_couple @ x
+            total += w.rocking_couple * float(np.mean(couple.real**2 + couple.imag**2))
+        if w.added_mass:
+            total += w.added_mass * (self.total_mass(x) - self.original_mass)
+        return total
+
+    def reduced_objective(self, x: NDArray[np.float64]) -> float:
+        """``J(x)`` through the factor: ``‖R·x‖² + w_m·(Σm − Σm_original)``, (N·m)².
+
+        Equal to :meth:`objective` up to rounding, at a cost independent of the number of
+        sampled angles: what the solvers' inner loops compare.
+        """
+        r = self.factor @ x
+        total = float(r @ r)
+        if self.weights.added_mass:
+            total += self.weights.added_mass * (self.total_mass(x) - self.original_mass)
+        return total
+
+    @cached_property
+    def original_objective(self) -> float:
+        """``J`` of the original design, (N·m)²."""
+        return self.objective(self.x0)
