@@ -58,7 +58,7 @@ def _fd_tolerance(error: float, *terms) -> float:
     return error + ROUNDING / FD_MARGIN * max(float(np.max(np.abs(t))) for t in terms)
 
 
-def _scale(r: inverse.Reactions) -> dict[str, float]:
+def _scale(r: inverse.ChainReactions) -> dict[str, float]:
     return {
         "force": max(np.max(np.abs(r.RA0)), np.max(np.abs(r.RA3)), 1.0),
         "moment": max(np.max(np.abs(r.shaking_moment)), np.max(np.abs(r.driving_torque)), 1.0),

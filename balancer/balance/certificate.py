@@ -102,7 +102,7 @@ class Constraint:
 
 
 @dataclass(frozen=True)
-class Objective:
+class ConvexObjective:
     """``f(u) = ‖P·u + q‖`` (``norm``), else ``‖P·u + q‖² + g·u + g0``."""
 
     P: NDArray[np.float64]
@@ -138,7 +138,7 @@ class Bound:
     residual: float
 
 
-def _sublevel_box(objective: Objective, lo: NDArray[np.float64], hi: NDArray[np.float64],
+def _sublevel_box(objective: ConvexObjective, lo: NDArray[np.float64], hi: NDArray[np.float64],
                   upper: float) -> NDArray[np.float64] | None:
     """``hi`` with the entries at ``∞`` bounded on ``{u in the box: f(u) ≤ upper}``.
 
@@ -175,8 +175,8 @@ def _sublevel_box(objective: Objective, lo: NDArray[np.float64], hi: NDArray[np.
     return out
 
 
-def lower_bound(objective: Objective, constraints: list[Constraint], equality: Equality | None,
-                u: NDArray[np.float64], duals: list[NDArray[np.float64]],
+def lower_bound(objective: ConvexObjective, constraints: list[Constraint],
+                equality: Equality | None, u: NDArray[np.float64], duals: list[NDArray[np.float64]],
                 v: NDArray[np.float64] | None, lo: NDArray[np.float64],
                 hi: NDArray[np.float64], upper: float | None) -> Bound | None:
     """The bound of the module docstring, or ``None`` where the box does not bound it.
@@ -250,7 +250,7 @@ class _Refit:
     objective's sublevel set (:func:`_sublevel_box`).
     """
 
-    def __init__(self, objective: Objective, constraints: list[Constraint],
+    def __init__(self, objective: ConvexObjective, constraints: list[Constraint],
                  equality: Equality | None, active: Sequence[bool], u: NDArray[np.float64],
                  lo: NDArray[np.float64], hi: NDArray[np.float64], upper: float | None) -> None:
         self.objective, self.u, self.lo, self.upper = objective, u, lo, upper

@@ -54,7 +54,7 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 import numpy as np
 from numpy.typing import NDArray
 
-from .certificate import Constraint, Objective, lower_bound
+from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .diagnosis import Diagnosis
 from .feasibility import FORCE_BALANCE_TOLERANCE
@@ -210,8 +210,8 @@ class ConvexSolver(Repairs, Diagnosis):
         mass_offset = (float(lay.c[data.mass_entries].sum()) - data.original_mass) * w_mass
         self._norm_form = w_mass == 0 and k > 0
         # The objective as the certificate sees it: the full factor.
-        self._objective = Objective(P=p_matrix, q=q_vector, norm=self._norm_form,
-                                    g=mass_row, g0=mass_offset)
+        self._objective = ConvexObjective(P=p_matrix, q=q_vector, norm=self._norm_form,
+                                          g=mass_row, g0=mass_offset)
         compressed = Compressed.of(p_matrix, q_vector)
         self._dual_basis = compressed.basis if k else None
         sv, vt = compressed.singular_values, compressed.vt

@@ -24,7 +24,7 @@ from .result import InfeasibleError
 if TYPE_CHECKING:
     import cvxpy as cp
 
-    from .variables import Layout
+    from .variables import VariableMap
 
 #: A slack of the elastic problem above this (in scaled units) names a bound to widen.
 SLACK_TOLERANCE = 1e-7
@@ -38,7 +38,7 @@ class Diagnosis:
     """The infeasibility diagnosis of a convex solver (see the module docstring)."""
 
     data: NumericProblem
-    layout: Layout
+    layout: VariableMap
     settings: dict[str, Any]
     _failed_row: int
 

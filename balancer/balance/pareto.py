@@ -32,8 +32,7 @@ from ..errors import SolverError, SpecError
 from ..force_balance import RESIDUAL_FLOOR, force_balance_residual
 from ..model import Design
 from ..model.balance import Objective, RotorBalanceProblem, missing_balance
-from .certificate import Constraint, lower_bound
-from .certificate import Objective as Certified
+from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .convex import Compressed, ConvexSolver, solve_program
 from .front import AGAINST, Against, Front, FrontPoint, mark_knee
@@ -64,9 +63,9 @@ class _Programs:
         self.moment_scale = _scale(moment, data)
         self.moment = Compressed.of(moment @ lay.T / self.moment_scale,
                                     moment @ lay.c / self.moment_scale)
-        self.moment_full = Certified(P=moment @ lay.T / self.moment_scale,
-                                     q=moment @ lay.c / self.moment_scale, norm=True,
-                                     g=np.zeros(self.n), g0=0.0)
+        self.moment_full = ConvexObjective(P=moment @ lay.T / self.moment_scale,
+                                           q=moment @ lay.c / self.moment_scale, norm=True,
+                                           g=np.zeros(self.n), g0=0.0)
         self.against = against
         if against == "added-mass":
             self.other_scale = data.original_mass

@@ -33,7 +33,7 @@ POLISH_ACCEPT = 1e-10
 TAKE_OFF_ACCEPT = 1e-12
 
 if TYPE_CHECKING:
-    from .variables import Layout
+    from .variables import VariableMap
 
 #: Inward margin of the bounds (scaled units) in the final projection (:meth:`finalize`): a
 #: hundred times Clarabel's feasibility tolerance, so that its solution lies inside the bounds.
@@ -61,7 +61,7 @@ class Repairs:
     """
 
     data: NumericProblem
-    layout: Layout
+    layout: VariableMap
     settings: dict[str, Any]
     _fb: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]] | None
     _pinned_inverses: dict[bytes, NDArray[np.float64]]

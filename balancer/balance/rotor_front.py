@@ -30,8 +30,7 @@ from numpy.typing import NDArray
 from ..errors import SolverError, SpecError
 from ..model import Design
 from ..model.balance import RotorBalanceProblem
-from .certificate import Constraint, lower_bound
-from .certificate import Objective as Norm
+from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .front import Front, FrontPoint, mark_knee
 from .rotors import RotorProblem, RotorSolver
@@ -68,7 +67,7 @@ class _RotorFront:
         self.cones = cones
         self.P = np.hstack([solver.P, np.zeros((solver.P.shape[0], s))])
         self.q = solver.q
-        self.norm = Norm(P=self.P, q=self.q, norm=True, g=np.zeros(width), g0=0.0)
+        self.norm = ConvexObjective(P=self.P, q=self.q, norm=True, g=np.zeros(width), g0=0.0)
         self.lo = np.r_[-np.ones(n), np.zeros(s)]
         self.hi = np.ones(width)
         self.width = width

@@ -63,8 +63,7 @@ from ..model.balance import (
     RotorBalanceProblem,
     ShaftDesign,
 )
-from .certificate import Constraint, lower_bound
-from .certificate import Objective as Norm
+from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .convex import CLARABEL_SETTINGS, TIE_ACCEPT, solve_program
 from .nlp import IPOPT_OPTIONS
@@ -373,7 +372,7 @@ class RotorSolver:
                               f"{first.iterations} iterations")
         u = np.asarray(first.u, float)
         x = self.x(u)
-        norm = Norm(P=self.P, q=self.q, norm=True, g=np.zeros(data.size), g0=0.0)
+        norm = ConvexObjective(P=self.P, q=self.q, norm=True, g=np.zeros(data.size), g0=0.0)
         v = None if first.epigraph_dual is None else -np.asarray(first.epigraph_dual[1:])
         bound = lower_bound(norm, self.constraints, None, u, list(first.duals), v,
                             -np.ones(data.size), np.ones(data.size),

@@ -1,6 +1,6 @@
 """The convex program's variables: the design vector as an affine map of the free ones.
 
-:class:`Layout` eliminates what is fixed (entries, centres of mass, inertias); the objective's
+:class:`VariableMap` eliminates what is fixed (entries, centres of mass, inertias); the objective's
 factor is compressed to its numerical rank (:class:`Compressed`) for the solver.
 """
 
@@ -15,7 +15,7 @@ from .problem import NumericProblem
 
 
 @dataclass(frozen=True)
-class Layout:
+class VariableMap:
     """The design vector as an affine map of the free variables: ``x = c + T·u``.
 
     Fixed entries sit in ``c``; a fixed centre of mass makes ``m·e``, ``m·f`` multiples of
@@ -52,8 +52,8 @@ class Layout:
         return np.array([x[i] / self.T[i, j] for j, i in enumerate(self.primary)])
 
 
-def layout(data: NumericProblem) -> Layout:
-    """The affine map from the free variables to the design vector (see :class:`Layout`)."""
+def layout(data: NumericProblem) -> VariableMap:
+    """The affine map from the free variables to the design vector (see :class:`VariableMap`)."""
     scales = data.scales
     size = data.size
     c = np.zeros(size)
@@ -98,7 +98,7 @@ def layout(data: NumericProblem) -> Layout:
             new_variable(entry)
         else:
             c[entry] = lo
-    return Layout(c=c, T=rows[:, : len(primary)].copy(), primary=tuple(primary))
+    return VariableMap(c=c, T=rows[:, : len(primary)].copy(), primary=tuple(primary))
 
 
 @dataclass(frozen=True)

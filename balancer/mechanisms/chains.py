@@ -2,7 +2,7 @@
 
 The four-bar's (Meijaard & van der Wijk 2020; Bai, Xia & Ge 2024) and the slider-crank's
 (Wunderlich 1964) closed forms: the tolerance at which a closed-form position counts as singular,
-what their inverse dynamics give the frame (:class:`Reactions`), and the common ground of their
+what their inverse dynamics give the frame (:class:`ChainReactions`), and the common ground of their
 formulations of the equations of motion: :class:`ClosedForm` (the lengths, the links as the
 dynamics see them, the loads with the weights, the centres of mass as fractions of the link
 vectors ``ζk = s̄k/lk``) and :class:`NodalTruss` (truss elements with moving nodes A1 and A2,
@@ -30,7 +30,7 @@ SINGULAR_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
-class Reactions:
+class ChainReactions:
     """What the linkage exerts on its frame at each state.
 
     Attributes

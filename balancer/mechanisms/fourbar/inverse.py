@@ -23,7 +23,7 @@ whose housing is the ground, acts on the link as extra inertia (``(Ik + J)·αk`
 reaction moment ``2·J·αk`` on the ground; its angular momentum is ``−J·ωk``.
 
 Everything is vectorised over the states of a
-:class:`~balancer.mechanisms.fourbar.kinematics.Motion`.
+:class:`~balancer.mechanisms.fourbar.kinematics.FourBarMotion`.
 """
 
 from __future__ import annotations
@@ -39,9 +39,9 @@ from ...linkage.massmodels import equivalent_inertia_forces, equivalent_joint_fo
 from ...linkage.rotors import dynamic_link
 from ...linkage.vectors import cross
 from ...model import Link
-from ..chains import Reactions
+from ..chains import ChainReactions
 from .assembly import Lengths
-from .kinematics import Motion, change_point_angles
+from .kinematics import FourBarMotion, change_point_angles
 from .model import FourBar
 
 Route = Literal["newton-euler", "mass-matrix"]
@@ -53,7 +53,7 @@ ROUTES: tuple[Route, ...] = ("newton-euler", "mass-matrix")
 
 
 def link_com_kinematics(
-    linkage: FourBar, mo: Motion
+    linkage: FourBar, mo: FourBarMotion
 ) -> tuple[tuple[NDArray[np.complex128], ...], tuple[NDArray[np.complex128], ...]]:
     """Positions and accelerations of the three links' centres of mass, m and m/s².
 
@@ -76,7 +76,7 @@ def _applied_forces(linkage: FourBar, gravity: complex, loads: bool) -> list[com
     ]
 
 
-def _counter_rotor_moment(linkage: FourBar, mo: Motion) -> NDArray[np.float64] | float:
+def _counter_rotor_moment(linkage: FourBar, mo: FourBarMotion) -> NDArray[np.float64] | float:
     """Reaction moment of the counter-rotors' gear trains on the ground, ``2·Σ Jk·αk``, N·m."""
     total: NDArray[np.float64] | float = 0.0
     for k, link in enumerate(linkage.links):
@@ -87,11 +87,11 @@ def _counter_rotor_moment(linkage: FourBar, mo: Motion) -> NDArray[np.float64] |
 
 def newton_euler(
     linkage: FourBar,
-    mo: Motion,
+    mo: FourBarMotion,
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
-) -> Reactions:
+) -> ChainReactions:
     """Reactions, driving torque and shaking moment from the links' free-body equations.
 
     Pin forces: ``P̄0`` ground on crank at A0, ``P̄1`` crank on coupler at A1, ``P̄2`` coupler on
@@ -138,11 +138,11 @@ def newton_euler(
     ra0 = -p0
     ra3 = -p3
     moment = linkage.lengths[3] * ra3.imag - tau + _counter_rotor_moment(linkage, mo)
-    return Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
+    return ChainReactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
 
 
-def _combine_nodal_forces(mo: Motion, nodes: Sequence[NDArray[np.complex128]],
-                          l4: float) -> Reactions:
+def _combine_nodal_forces(mo: FourBarMotion, nodes: Sequence[NDArray[np.complex128]],
+                          l4: float) -> ChainReactions:
     """Reactions from nodal forces ``G_n`` at A0…A3 by length-keeping virtual displacements.
 
     The counter-rotors' gear reaction on the ground is not included.
@@ -156,12 +156,12 @@ def _combine_nodal_forces(mo: Motion, nodes: Sequence[NDArray[np.complex128]],
     ra3 = g3 + v3 * cross(v2, g2) / cross(v2, v3)  # A3 moved, A0 and A1 held
     ra0 = shaking - ra3
     moment = cross(v1, g1) + cross(mo.pos.A2, g2) + l4 * g3.imag  # rotation about A0
-    return Reactions(
+    return ChainReactions(
         RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment, shaking_force=shaking
     )
 
 
-def _inertial_nodal_forces(params: Sequence[float], lengths: Sequence[float], mo: Motion,
+def _inertial_nodal_forces(params: Sequence[float], lengths: Sequence[float], mo: FourBarMotion,
                            k: int) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
     """Nodal inertia forces ``−(Me·r̈)`` of link ``k`` (0-based) at its two joints (Eq. 45)."""
     acc_a1, acc_a2 = mo.joint_accelerations
@@ -172,11 +172,11 @@ def _inertial_nodal_forces(params: Sequence[float], lengths: Sequence[float], mo
 
 def mass_matrix(
     linkage: FourBar,
-    mo: Motion,
+    mo: FourBarMotion,
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
-) -> Reactions:
+) -> ChainReactions:
     """Reactions, driving torque and shaking moment from the equivalent mass matrices (Eq. 45–54).
 
     The nodal forces ``G_n = F_n − (M·r̈)_n`` at the joints A0…A3 (Eq. 45–46, 48–49, 53–54)
@@ -210,7 +210,7 @@ def mass_matrix(
     r = _combine_nodal_forces(mo, nodes, linkage.lengths[3])
     cr = _counter_rotor_moment(linkage, mo)
     if np.any(cr):
-        r = Reactions(
+        r = ChainReactions(
             RA0=r.RA0,
             RA3=r.RA3,
             driving_torque=r.driving_torque,
@@ -225,12 +225,12 @@ _ROUTE_FUNCTIONS = {"newton-euler": newton_euler, "mass-matrix": mass_matrix}
 
 def inverse_dynamics(
     linkage: FourBar,
-    mo: Motion,
+    mo: FourBarMotion,
     *,
     route: Route = "newton-euler",
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
-) -> Reactions:
+) -> ChainReactions:
     """Reactions of the four-bar for a prescribed motion by the chosen ``route``."""
     try:
         fn = _ROUTE_FUNCTIONS[route]
@@ -239,7 +239,7 @@ def inverse_dynamics(
     return fn(linkage, mo, gravity=gravity, loads=loads)
 
 
-def angular_momentum(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
+def angular_momentum(linkage: FourBar, mo: FourBarMotion) -> NDArray[np.float64]:
     """Angular momentum of the moving parts about A0, counter-rotors included, kg·m²/s.
 
     ``H = Σ (Ik·ωk + mk·r̄k × ṙk) − Σ Jk·ωk``; the shaking moment without loads equals ``−dH/dt``.
@@ -258,7 +258,7 @@ def angular_momentum(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
     return total
 
 
-def kinetic_energy(linkage: FourBar, mo: Motion) -> NDArray[np.float64]:
+def kinetic_energy(linkage: FourBar, mo: FourBarMotion) -> NDArray[np.float64]:
     """Kinetic energy of the moving parts, counter-rotors included, J."""
     l1, l2, l3, _ = linkage.lengths
     vel_a1, vel_a2 = mo.joint_velocities

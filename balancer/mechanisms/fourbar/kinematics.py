@@ -196,7 +196,7 @@ def transfer_functions(pos: Position) -> tuple[NDArray[np.float64], NDArray[np.f
 
 
 @dataclass(frozen=True)
-class Motion:
+class FourBarMotion:
     """Positions, angular velocities and accelerations of a four-bar at arrays of states.
 
     Attributes
@@ -296,7 +296,7 @@ def motion(
     branch: str | ArrayLike = "+",
     *,
     check: bool = True,
-) -> Motion:
+) -> FourBarMotion:
     """Full kinematics at crank states ``(θ1, θ̇1, θ̈1)`` (Eq. 2–10).
 
     Parameters
@@ -317,7 +317,7 @@ def motion(
     w2 = big[0] * w1  # Eq. 6
     w3 = big[1] * w1
     a2, a3 = dependent_accelerations(pos, big, (w1, w2, w3), a1)
-    return Motion(
+    return FourBarMotion(
         pos=pos,
         omega=(np.array(w1, dtype=float), w2, w3),
         alpha=(np.array(a1, dtype=float), a2, a3),
@@ -332,7 +332,7 @@ def motion_of(
     alpha1: ArrayLike = 0.0,
     *,
     check: bool = True,
-) -> Motion:
+) -> FourBarMotion:
     """:func:`motion` for a :class:`~balancer.FourBar` on its own branch."""
     return motion(linkage.lengths, theta1, omega1, alpha1, linkage.branch, check=check)
 
@@ -457,8 +457,8 @@ def motion_from_angles(
     theta: tuple[ArrayLike, ArrayLike, ArrayLike],
     omega: tuple[ArrayLike, ArrayLike, ArrayLike],
     alpha: tuple[ArrayLike, ArrayLike, ArrayLike],
-) -> Motion:
-    """A :class:`Motion` from given link angles, rates and accelerations (no loop solve).
+) -> FourBarMotion:
+    """A :class:`FourBarMotion` from given link angles, rates and accelerations (no loop solve).
 
     For states that come from a simulation, which carries all three angles; the loop closure is
     whatever the state satisfies.
@@ -480,7 +480,7 @@ def motion_from_angles(
     big = transfer_functions(pos)
     w1, w2, w3 = (np.broadcast_to(as_1d(x), (n,)).astype(float) for x in omega)
     a1, a2, a3 = (np.broadcast_to(as_1d(x), (n,)).astype(float) for x in alpha)
-    return Motion(pos=pos, omega=(w1, w2, w3), alpha=(a1, a2, a3), transfer=big)
+    return FourBarMotion(pos=pos, omega=(w1, w2, w3), alpha=(a1, a2, a3), transfer=big)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -148,7 +148,7 @@ class FourBarMechanism(Mechanism):
         return self.motion(theta1).pose
 
     def _closed_form_motion(self, theta1: ArrayLike, omega1: ArrayLike,
-                            alpha1: ArrayLike) -> fourbar.Motion:
+                            alpha1: ArrayLike) -> fourbar.FourBarMotion:
         """The closed form (Eq. 2–10) on the smooth motion's branch (arrays broadcast)."""
         t, w, a = (np.atleast_1d(np.asarray(x, dtype=float))
                    for x in np.broadcast_arrays(theta1, omega1, alpha1))
@@ -201,7 +201,7 @@ class FourBarMechanism(Mechanism):
         return self._closed_form_forces(self._closed_form_motion(*states), route, loads,
                                         gravity)
 
-    def _closed_form_forces(self, mo: fourbar.Motion, route: Route | None, loads: bool,
+    def _closed_form_forces(self, mo: fourbar.FourBarMotion, route: Route | None, loads: bool,
                             gravity: tuple[float, float]) -> Forces:
         route_fn = mass_matrix if (route or self.routes[0]) == "mass-matrix" else newton_euler
         r = route_fn(self.model, mo, gravity=gravity, loads=loads)
@@ -217,7 +217,7 @@ class FourBarMechanism(Mechanism):
             shaking_moment=col(r.shaking_moment),
             rocking_couple=self._rocking_couple(mo, loads, gravity))
 
-    def _rocking_couple(self, mo: fourbar.Motion, loads: bool,
+    def _rocking_couple(self, mo: fourbar.FourBarMotion, loads: bool,
                         gravity: tuple[float, float]) -> V:
         """The rocking couple at the closed-form motion (the general core's, from its motion)."""
         if self.in_one_plane():
@@ -226,7 +226,7 @@ class FourBarMechanism(Mechanism):
         return self.rocking_couple(general_motion(mo), loads=loads, gravity=gravity)
 
 
-def general_motion(mo: fourbar.Motion) -> Motion:
+def general_motion(mo: fourbar.FourBarMotion) -> Motion:
     """A four-bar's closed-form motion as the general core's (frames at A0, A1, A2)."""
     zero = 0.0 * mo.pos.theta1
     va1, va2 = mo.joint_velocities
@@ -243,9 +243,9 @@ def general_motion(mo: fourbar.Motion) -> Motion:
                   accel=tuple(mo.alpha), closed_form=mo)
 
 
-def fourbar_motion(model: FourBar, mo: Motion) -> fourbar.Motion:
+def fourbar_motion(model: FourBar, mo: Motion) -> fourbar.FourBarMotion:
     """A general motion of a four-bar as the closed form's (angles and rates)."""
-    if isinstance(mo.closed_form, fourbar.Motion):
+    if isinstance(mo.closed_form, fourbar.FourBarMotion):
         return mo.closed_form
     return fourbar.motion_from_angles(model.lengths, tuple(mo.pose.angles), tuple(mo.rate),
                                       tuple(mo.accel))

@@ -31,7 +31,7 @@ from ...linkage.massmodels import equivalent_inertia_forces, equivalent_joint_fo
 from ...linkage.rotors import dynamic_link
 from ...linkage.vectors import cross
 from ...model import Link
-from ..chains import Reactions
+from ..chains import ChainReactions
 from .kinematics import Lengths, SliderMotion
 from .model import SliderCrank
 
@@ -48,7 +48,7 @@ def _loads(mech: SliderCrank, mo: SliderMotion, gravity: complex, loads: bool
 def _finish(mech: SliderCrank, mo: SliderMotion, ra0: NDArray[np.complex128],
             n_guide: NDArray[np.float64], m_guide: NDArray[np.float64],
             tau: NDArray[np.float64], gas: NDArray[np.float64],
-            shaking: NDArray[np.complex128], alpha1: NDArray[np.float64]) -> Reactions:
+            shaking: NDArray[np.complex128], alpha1: NDArray[np.float64]) -> ChainReactions:
     """Frame loads from the pin and guide forces, the motor torque and the gas force.
 
     The guide's normal force and couple are those on the slider.
@@ -58,8 +58,8 @@ def _finish(mech: SliderCrank, mo: SliderMotion, ra0: NDArray[np.complex128],
     moment = -mo.x * n_guide - m_guide + h * gas - tau
     if mech.crank.counter_rotor:
         moment = moment + rotors.ground_couple(mech.crank.counter_rotor, alpha1)
-    return Reactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment,
-                     shaking_force=shaking, guide_couple=-m_guide + 0 * mo.x)
+    return ChainReactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment,
+                          shaking_force=shaking, guide_couple=-m_guide + 0 * mo.x)
 
 
 def newton_euler(
@@ -68,7 +68,7 @@ def newton_euler(
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
-) -> Reactions:
+) -> ChainReactions:
     """Frame loads from the free-body equations of slider, rod and crank.
 
     Pin forces: ``P̄0`` ground on crank, ``P̄1`` crank on rod, ``P̄2`` rod on slider. The slider's
@@ -145,7 +145,7 @@ def mass_matrix(
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
-) -> Reactions:
+) -> ChainReactions:
     """Frame loads from the equivalent mass matrices (Eq. 45–46) by virtual displacements.
 
     Crank and rod as truss elements, the slider a mass at its pin (see the module docstring).
@@ -172,16 +172,17 @@ def mass_matrix(
                                                   slider_moment, rotor)
     m_guide = -slider_moment
     reactions = _finish(mech, mo, ra0, n_guide, m_guide, tau, gas, shaking, mo.alpha[0])
-    return Reactions(RA0=reactions.RA0, RA3=reactions.RA3, driving_torque=tau,
-                     shaking_moment=moment, shaking_force=shaking,
-                     guide_couple=reactions.guide_couple)
+    return ChainReactions(RA0=reactions.RA0, RA3=reactions.RA3, driving_torque=tau,
+                          shaking_moment=moment, shaking_force=shaking,
+                          guide_couple=reactions.guide_couple)
 
 
 ROUTES = {"newton-euler": newton_euler, "mass-matrix": mass_matrix}
 
 
 def inverse_dynamics(mech: SliderCrank, mo: SliderMotion, *, route: str = "newton-euler",
-                     gravity: tuple[float, float] = (0.0, 0.0), loads: bool = True) -> Reactions:
+                     gravity: tuple[float, float] = (0.0, 0.0), loads: bool = True
+                     ) -> ChainReactions:
     """Frame loads of the slider-crank for a prescribed motion by the chosen ``route``."""
     try:
         fn = ROUTES[route]
