@@ -173,16 +173,16 @@ def test_the_least_assembly_gap_is_brents_minimum(example):
     # ~1e-15 of it: 1e-12 absolute (the gaps are ≤ 1).
     from scipy.optimize import minimize_scalar
 
-    from balancer.mechanisms.base import RANGE_SAMPLES, _gaps
+    from balancer.linkage.assembly import RANGE_SAMPLES, assembly_gaps
 
     mech = mechanism_of(load_design(EXAMPLES / example).mechanism)
     s = mech.structure
     step = 2 * np.pi / RANGE_SAMPLES
     theta = s.ref_angle[s.input] + step * np.arange(RANGE_SAMPLES + 1)
-    gap = _gaps(s, theta)
+    gap = assembly_gaps(s, theta)
     dips = np.flatnonzero((gap[1:-1] < gap[:-2]) & (gap[1:-1] <= gap[2:])) + 1
     assert dips.size
-    brent = min(minimize_scalar(lambda t: float(_gaps(s, np.array([t]))[0]),
+    brent = min(minimize_scalar(lambda t: float(assembly_gaps(s, np.array([t]))[0]),
                                 bounds=(theta[i - 1], theta[i + 1]), method="bounded",
                                 options={"xatol": 1e-10}).fun for i in dips)
     assert abs(mech.least_gap() - min(brent, float(np.min(gap)))) < 1e-12

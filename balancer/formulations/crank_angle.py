@@ -37,11 +37,12 @@ from numpy.typing import NDArray
 
 from ..errors import AssemblyError, SolverError
 from ..linkage import rotors
+from ..linkage.assembly import assembly_gaps
 from ..linkage.kinematics import numeric_table, positions, rates
 from ..linkage.numeric import TABLE_STEPS
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import Num, V
-from ..mechanisms.base import Mechanism, _gaps
+from ..mechanisms.base import Mechanism
 from ..mechanisms.formulation import DEAD_POINT_THRESHOLD, DrivenRates, Evaluation
 from .compiled import Compiled, LinkageFormulation, link_equations
 
@@ -152,7 +153,7 @@ class CrankAngle(LinkageFormulation):
         if least is not None and least > (10 * DEAD_POINT_THRESHOLD) ** 2:
             return least
 
-        return float(_gaps(self.structure, np.array([theta1]))[0])
+        return float(assembly_gaps(self.structure, np.array([theta1]))[0])
 
     def symbolic_rhs(self) -> ca.Function | None:
         """``(t, y) → ẏ`` as a CasADi function (none with slider forces: tables in Python)."""

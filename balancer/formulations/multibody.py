@@ -38,20 +38,11 @@ from numpy.typing import NDArray
 
 from ..errors import AssemblyError, SolverError
 from ..linkage import rotors
-from ..linkage.constraints import (
-    GROUND_INDEX,
-    Constraint,
-    Driver,
-    Pin,
-    Pose,
-    Prism,
-    constraint_jacobian,
-    constraint_residual,
-)
-from ..linkage.kinematics import _gamma
+from ..linkage.assembly import assembly_gaps
+from ..linkage.constraints import GROUND_INDEX, Constraint, FrameTally, Pose
 from ..linkage.symbols import CasadiOps
-from ..linkage.vectors import Num, OpsLike, V
-from ..mechanisms.base import Mechanism, _gaps
+from ..linkage.vectors import Num, OpsLike, V, _is_zero
+from ..mechanisms.base import Mechanism
 from ..mechanisms.formulation import Evaluation, continuous_angles, least_norm, least_norm_many
 from .compiled import Compiled, LinkageFormulation, link_equations, spring_forces
 
@@ -105,15 +96,15 @@ class Multibody(LinkageFormulation):
         gamma = ca.SX.zeros(self.rows)
         row = 0
         for c in self.constraints:
-            for link, coeffs in constraint_jacobian(c, pose):
+            for link, coeffs in c.jacobian(pose):
                 if link == GROUND_INDEX:
                     continue
                 for r in range(c.rows):
                     for col in range(3):
                         jac[row + r, 3 * link + col] += coeffs[r][col]
-            if not isinstance(c, Driver):
-                gam = _gamma(c, pose, vel, rate, CasadiOps)
-                for r in range(c.rows):
+            gam = c.gamma(pose, vel, rate)  # (the driver's: the input's, 0 here)
+            for r in range(c.rows):
+                if not _is_zero(gam[r]):
                     gamma[row + r] = gam[r]
             row += c.rows
         self._equations = ca.Function("equations", [q, qd, gas], [mass, force, jac, gamma])
@@ -132,24 +123,21 @@ class Multibody(LinkageFormulation):
         n, s = self.n, self.structure
         lam = ca.SX.sym("lam", self.rows)
         acc = ca.SX.sym("acc", 3 * n)
-        ground: dict[str, list[Num]] = {p: [0, 0] for p in self.general.ground.points}
-        normal: list[ca.SX] = []
-        couple: list[ca.SX] = []
+        frame = FrameTally(0.0)
         fx = fy = mz = ca.SX(0)
         row = 0
         for c in self.constraints:
-            for carrier, coeffs in constraint_jacobian(c, pose):
+            for carrier, coeffs in c.jacobian(pose):
                 if carrier != GROUND_INDEX:
                     continue
                 gen = [-sum(coeffs[r][col] * lam[row + r] for r in range(c.rows))
                        for col in range(3)]
                 fx, fy, mz = fx + gen[0], fy + gen[1], mz + gen[2]
-                if isinstance(c, Pin):
-                    ground[c.point] = [ground[c.point][0] + gen[0], ground[c.point][1] + gen[1]]
-                elif isinstance(c, Prism):
-                    normal.append(lam[row + 1])
-                    couple.append(lam[row])
+                c.tally(frame, gen, [lam[row + r] for r in range(c.rows)])
             row += c.rows
+        ground = {p: frame.reactions.get(p, V(0.0, 0.0)) for p in self.general.ground.points}
+        normal = list(frame.normal.values())
+        couple = list(frame.couple.values())
         for spring in self.general.springs:
             for k, f_vec, at in spring_forces(self.structure, spring, pose, CasadiOps):
                 if k == GROUND_INDEX:
@@ -166,7 +154,7 @@ class Multibody(LinkageFormulation):
         #: Names of the outputs of :attr:`_frame` and of the dynamics after ``q̈`` and ``λ``.
         self._ground_names = tuple(ground)
         self._slider_names = tuple(s.names[c.s] for c in s.prisms if c.g == GROUND_INDEX)
-        flat = [x for p in ground for x in ground[p]]
+        flat = [x for p in ground for x in (ground[p].x, ground[p].y)]
         self._frame = ca.Function("frame", [q, qd, gas, lam, acc], [
             ca.vertcat(*flat) if flat else ca.SX(0, 1),
             ca.vertcat(*normal) if normal else ca.SX(0, 1),
@@ -223,7 +211,7 @@ class Multibody(LinkageFormulation):
         import casadi as ca  # heavy: only where symbols are built
         angle = ca.SX.sym("angle")
         phi = ca.vertcat(*(r for c in self.constraints
-                           for r in constraint_residual(c, pose, angle)))
+                           for r in c.residual(pose, angle)))
         jac = ca.densify(ca.jacobian(phi, q))
         self._constraints = Compiled(ca.Function(
             "constraints", [ca.vertcat(q, angle)],
@@ -238,7 +226,7 @@ class Multibody(LinkageFormulation):
     # -- the formulation's interface ----------------------------------------------------------
 
     def transmission_of_crank(self, theta1: float) -> float:
-        return math.sqrt(max(float(_gaps(self.structure, np.array([theta1]))[0]), 0.0))
+        return math.sqrt(max(float(assembly_gaps(self.structure, np.array([theta1]))[0]), 0.0))
 
     def transmission(self, t: float, y: NDArray[np.float64]) -> float:
         return 1.0  # passes dead points: never stops for one

@@ -1,22 +1,56 @@
 """The constraints of a general linkage, the groups they close, and link frames at poses.
 
 The equations are those of :mod:`balancer.linkage.structure` (its docstring): a revolute joint
-(:class:`Pin`), a prismatic pair (:class:`Prism`) and the driver (:class:`Driver`), their
-residuals and Jacobians at a :class:`Pose`, and an Assur group (:class:`Group`) of them.
+(:class:`Pin`), a prismatic pair (:class:`Prism`) and the driver (:class:`Driver`), each
+with its own residual, Jacobian, velocity terms and share of the frame's loads at a
+:class:`Pose` (the core dispatches through these methods, never by a joint's kind), and an
+Assur group (:class:`Group`) of them.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TypeAlias
+from dataclasses import dataclass, field
+from typing import ClassVar, TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
 
-from .vectors import Num, OpsLike, V
+from .vectors import Num, OpsLike, V, _plus
 
 #: Index of the ground among the links.
 GROUND_INDEX = -1
+#: A constraint's Jacobian by link: ``(link, rows)``, each row three coefficients (for ``x``,
+#: ``y``, ``θ``).
+Blocks: TypeAlias = list[tuple[int, list[list[Num]]]]
+
+
+def _rate(rate: list[Num], k: int) -> Num:
+    return 0.0 if k == GROUND_INDEX else rate[k]
+
+
+def _velocity(vel: list[V], k: int) -> V:
+    return V(0.0, 0.0) if k == GROUND_INDEX else vel[k]
+
+
+@dataclass
+class FrameTally:
+    """What the joints put on the frame, collected joint by joint (:meth:`Pin.tally`, …).
+
+    ``reactions`` by ground point (N), the ground sliders' ``normal`` force (N) and ``couple``
+    (N·m) by the slider's link index, the motor's ``driving`` torque (N·m); ``zero`` what no
+    joint puts there (an array of zeros, or the float 0.0 on symbols).
+    """
+
+    zero: Num
+    driving: Num = 0.0
+    reactions: dict[str, V] = field(default_factory=dict)
+    normal: dict[int, Num] = field(default_factory=dict)
+    couple: dict[int, Num] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.driving = self.zero
+
+
 @dataclass(frozen=True)
 class Pin:
     """A revolute constraint: point ``pa`` of link ``a`` on point ``pb`` of link ``b``.
@@ -31,6 +65,52 @@ class Pin:
     pb: V
 
     rows = 2
+    #: What each row constrains (:meth:`Structure.row_kinds`), and the joint's letter in a
+    #: dyad's kind (``"RRP"``).
+    row_kinds: ClassVar[tuple[str, ...]] = ("length", "length")
+    letter: ClassVar[str] = "R"
+
+    @property
+    def members(self) -> tuple[int, int]:
+        """The two links it joins."""
+        return (self.a, self.b)
+
+    def held_at(self, k: int) -> V | None:
+        """The local point by which it holds link ``k``."""
+        return self.pa if self.a == k else self.pb
+
+    def residual(self, pose: Pose, angle: Num = 0.0) -> list[Num]:
+        """The two points' separation, m."""
+        d = pose.point(self.a, self.pa) - pose.point(self.b, self.pb)
+        return [d.x, d.y]
+
+    def jacobian(self, pose: Pose) -> Blocks:
+        """:meth:`residual`'s derivative by the links' coordinates."""
+        ra = pose.rotate(self.a, self.pa)
+        rb = pose.rotate(self.b, self.pb)
+        return [(self.a, [[1.0, 0.0, -ra.y], [0.0, 1.0, ra.x]]),
+                (self.b, [[-1.0, 0.0, rb.y], [0.0, -1.0, -rb.x]])]
+
+    def gamma(self, pose: Pose, vel: list[V], rate: list[Num],
+              input_acceleration: Num = 0.0) -> list[Num]:
+        """``γ`` (``Φ_q·q̈ = γ``): the velocity terms of the residual's second derivative."""
+        ra, rb = pose.rotate(self.a, self.pa), pose.rotate(self.b, self.pb)
+        wa, wb = _rate(rate, self.a), _rate(rate, self.b)
+        out = ra * (wa * wa) - rb * (wb * wb)
+        return [out.x, out.y]
+
+    def prescribed_rates(self, input_rate: Num) -> list[Num]:
+        """``Φ_q·q̇`` of its rows: zero (it prescribes no motion)."""
+        return [0.0, 0.0]
+
+    def row_scales(self, length: float) -> list[float]:
+        """What each row is multiplied by to be a length, given the linkage's ``length``."""
+        return [1.0, 1.0]
+
+    def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
+        """Its force on the frame (``force``: x, y, moment) as the reaction at its point."""
+        old = frame.reactions.get(self.point, V(frame.zero, frame.zero))
+        frame.reactions[self.point] = V(_plus(old.x, force[0]), _plus(old.y, force[1]))
 
 
 @dataclass(frozen=True)
@@ -51,6 +131,60 @@ class Prism:
     delta: float
 
     rows = 2
+    row_kinds: ClassVar[tuple[str, ...]] = ("angle", "length")
+    letter: ClassVar[str] = "P"
+
+    @property
+    def members(self) -> tuple[int, int]:
+        """The slider's link and the guide's."""
+        return (self.s, self.g)
+
+    def held_at(self, k: int) -> V | None:
+        """``None``: a prism holds a link by no point."""
+        return None
+
+    def residual(self, pose: Pose, angle: Num = 0.0) -> list[Num]:
+        """The relative angle's error (rad) and the slider point's distance from the line (m)."""
+        ts = 0.0 if self.s == GROUND_INDEX else pose.angles[self.s]
+        tg = 0.0 if self.g == GROUND_INDEX else pose.angles[self.g]
+        d = pose.rotate(self.g, self.dg)
+        return [ts - tg - self.delta,
+                d.cross(pose.point(self.s, self.ps) - pose.point(self.g, self.pg))]
+
+    def jacobian(self, pose: Pose) -> Blocks:
+        """:meth:`residual`'s derivative by the links' coordinates."""
+        d = pose.rotate(self.g, self.dg)
+        ps = pose.rotate(self.s, self.ps)
+        reach = pose.origin(self.s) + ps - pose.origin(self.g)  # r̄_s + R_s·s̄ − r̄_g
+        return [(self.s, [[0.0, 0.0, 1.0], [-d.y, d.x, d.dot(ps)]]),
+                (self.g, [[0.0, 0.0, -1.0], [d.y, -d.x, -d.dot(reach)]])]
+
+    def gamma(self, pose: Pose, vel: list[V], rate: list[Num],
+              input_acceleration: Num = 0.0) -> list[Num]:
+        """``γ`` (``Φ_q·q̈ = γ``): the velocity terms of the residual's second derivative."""
+        d = pose.rotate(self.g, self.dg)
+        ps, pg = pose.rotate(self.s, self.ps), pose.rotate(self.g, self.pg)
+        delta = pose.origin(self.s) + ps - pose.origin(self.g) - pg
+        ws, wg = _rate(rate, self.s), _rate(rate, self.g)
+        ddot = (_velocity(vel, self.s) + ps.perp() * ws - _velocity(vel, self.g)
+                - pg.perp() * wg)
+        line = (wg * wg * (d.cross(delta) - d.cross(pg)) + 2 * wg * d.dot(ddot)
+                + ws * ws * d.cross(ps))
+        return [0.0 * line, line]
+
+    def prescribed_rates(self, input_rate: Num) -> list[Num]:
+        """``Φ_q·q̇`` of its rows: zero (it prescribes no motion)."""
+        return [0.0, 0.0]
+
+    def row_scales(self, length: float) -> list[float]:
+        """What each row is multiplied by to be a length: the angle's row by ``length``."""
+        return [length, 1.0]
+
+    def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
+        """On a ground guide: the slider's normal force (N) and couple (N·m) on it."""
+        if self.g == GROUND_INDEX:
+            frame.normal[self.s] = multipliers[1]
+            frame.couple[self.s] = multipliers[0]
 
 
 @dataclass(frozen=True)
@@ -60,6 +194,42 @@ class Driver:
     link: int
 
     rows = 1
+    row_kinds: ClassVar[tuple[str, ...]] = ("angle",)
+    letter: ClassVar[str] = "D"
+
+    @property
+    def members(self) -> tuple[int, int]:
+        """The input's link and the ground."""
+        return (self.link, GROUND_INDEX)
+
+    def held_at(self, k: int) -> V | None:
+        """``None``: the driver holds a link by no point."""
+        return None
+
+    def residual(self, pose: Pose, angle: Num = 0.0) -> list[Num]:
+        """The input's angle less the prescribed ``angle``, rad."""
+        return [pose.angles[self.link] - angle]
+
+    def jacobian(self, pose: Pose) -> Blocks:
+        """:meth:`residual`'s derivative by the links' coordinates."""
+        return [(self.link, [[0.0, 0.0, 1.0]]), (GROUND_INDEX, [[0.0, 0.0, -1.0]])]
+
+    def gamma(self, pose: Pose, vel: list[V], rate: list[Num],
+              input_acceleration: Num = 0.0) -> list[Num]:
+        """``γ``: the input's prescribed acceleration (rad/s²)."""
+        return [input_acceleration]
+
+    def prescribed_rates(self, input_rate: Num) -> list[Num]:
+        """``Φ_q·q̇`` of its rows: the input's prescribed rate (rad/s)."""
+        return [input_rate]
+
+    def row_scales(self, length: float) -> list[float]:
+        """The angle's row, as it is."""
+        return [1.0]
+
+    def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
+        """The motor's torque on the input: minus its multiplier."""
+        frame.driving = -multipliers[0]
 
 
 Constraint = Pin | Prism | Driver
@@ -88,6 +258,14 @@ class Group:
     constraints: tuple[Constraint, ...]
     kind: str
     sign: float = 1.0
+
+    @property
+    def pivot(self) -> Pin:
+        """A crank group's pivot: the pin its first constraint is."""
+        c = self.constraints[0]
+        if not isinstance(c, Pin):
+            raise ValueError(f"a {self.kind} group has no pivot")
+        return c
 
 
 def unit(x: float, y: float) -> complex:
@@ -136,47 +314,6 @@ def pose_of(q: NDArray[np.float64]) -> Pose:
     return Pose([V(q[3 * k], q[3 * k + 1]) for k in range(n)], [q[3 * k + 2] for k in range(n)])
 
 
-def constraint_residual(c: Constraint, pose: Pose, angle: Num = 0.0) -> list[Num]:
-    """The residual of one constraint at a pose: ``c.rows`` values (m or rad).
-
-    ``angle`` is the crank angle a driver prescribes.
-    """
-    if isinstance(c, Pin):
-        d = pose.point(c.a, c.pa) - pose.point(c.b, c.pb)
-        return [d.x, d.y]
-    if isinstance(c, Prism):
-        ts = 0.0 if c.s == GROUND_INDEX else pose.angles[c.s]
-        tg = 0.0 if c.g == GROUND_INDEX else pose.angles[c.g]
-        d = pose.rotate(c.g, c.dg)
-        return [ts - tg - c.delta, d.cross(pose.point(c.s, c.ps) - pose.point(c.g, c.pg))]
-    return [pose.angles[c.link] - angle]
-
-
-#: A constraint's Jacobian by link: ``(link, rows)``, each row three coefficients (for ``x``,
-#: ``y``, ``θ``).
-Blocks: TypeAlias = list[tuple[int, list[list[Num]]]]
-
-
-def constraint_jacobian(c: Constraint, pose: Pose) -> Blocks:
-    """The Jacobian of one constraint at a pose.
-
-    ``(link, rows)`` pairs: per link, ``c.rows`` rows of three coefficients (for ``x``, ``y``,
-    ``θ``), each a value or an array.
-    """
-    if isinstance(c, Pin):
-        ra = pose.rotate(c.a, c.pa)
-        rb = pose.rotate(c.b, c.pb)
-        return [(c.a, [[1.0, 0.0, -ra.y], [0.0, 1.0, ra.x]]),
-                (c.b, [[-1.0, 0.0, rb.y], [0.0, -1.0, -rb.x]])]
-    if isinstance(c, Prism):
-        d = pose.rotate(c.g, c.dg)
-        ps = pose.rotate(c.s, c.ps)
-        reach = pose.origin(c.s) + ps - pose.origin(c.g)  # r̄_s + R_s·s̄ − r̄_g
-        return [(c.s, [[0.0, 0.0, 1.0], [-d.y, d.x, d.dot(ps)]]),
-                (c.g, [[0.0, 0.0, -1.0], [d.y, -d.x, -d.dot(reach)]])]
-    return [(c.link, [[0.0, 0.0, 1.0]]), (GROUND_INDEX, [[0.0, 0.0, -1.0]])]
-
-
 def group_jacobian(g: Group, pose: Pose
                    ) -> tuple[list[list[Num]], list[list[tuple[int, list[Num]]]]]:
     """The Jacobian of a group's constraints at a pose, split by links.
@@ -190,7 +327,7 @@ def group_jacobian(g: Group, pose: Pose
     rows: list[list[Num]] = []
     known: list[list[tuple[int, list[Num]]]] = []
     for c in g.constraints:
-        blocks = constraint_jacobian(c, pose)
+        blocks = c.jacobian(pose)
         for r in range(c.rows):
             row: list[Num] = [0.0] * k
             row_known = []

@@ -39,11 +39,8 @@ from .constraints import (
     GROUND_INDEX,
     Blocks,
     Constraint,
-    Driver,
-    Pin,
+    FrameTally,
     Pose,
-    Prism,
-    constraint_jacobian,
 )
 from .kinematics import Motion, rates
 from .structure import Structure
@@ -334,7 +331,7 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list[Num]],
         blocks_of: list[tuple[Constraint, int, Blocks]] = []
         row = 0
         for c in g.constraints:
-            blocks = constraint_jacobian(c, mo.pose)
+            blocks = c.jacobian(mo.pose)
             blocks_of.append((c, row, blocks))
             for link, coeffs in blocks:
                 if link in index:
@@ -392,7 +389,7 @@ def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list[
     row = 0
     blocks_of: list[tuple[Constraint, int, Blocks]] = []
     for c in constraints:
-        blocks = constraint_jacobian(c, mo.pose)
+        blocks = c.jacobian(mo.pose)
         blocks_of.append((c, row, blocks))
         for link, coeffs in blocks:
             if link == GROUND_INDEX:
@@ -431,36 +428,29 @@ def _collect(structure: Structure, constraints: Sequence[Constraint],
     ``zero`` fills what no constraint puts there: an ``(N, C)`` array, or the float 0.0 on
     symbols.
     """
-    reactions: dict[str, V] = {}
+    frame = FrameTally(zero)
     fx: Num = zero
     fy: Num = zero
     mz: Num = zero
-    driving: Num = zero
-    normal: dict[str, Num] = {}
-    couple: dict[str, Num] = {}
     for c in constraints:
-        if isinstance(c, Driver):
-            driving = -lam[id(c)][0]  # τ = −λ_driver
         force = ground_of.get(id(c))
-        if force is None:
+        if force is None:  # (the driver's is the motor's reaction: always there)
             continue
         fx, fy, mz = _plus(fx, force[0]), _plus(fy, force[1]), _plus(mz, force[2])
-        if isinstance(c, Pin):
-            old = reactions.get(c.point, V(zero, zero))
-            reactions[c.point] = V(_plus(old.x, force[0]), _plus(old.y, force[1]))
-        elif isinstance(c, Prism) and c.g == GROUND_INDEX:
-            name = structure.names[c.s]
-            normal[name] = lam[id(c)][1]
-            couple[name] = lam[id(c)][0]
+        c.tally(frame, force, lam[id(c)])
     if rotor_moment is not None:
         mz = _plus(mz, rotor_moment)
     if ground_extra is not None:
         fx, fy, mz = (_plus(fx, ground_extra[0]), _plus(fy, ground_extra[1]),
                       _plus(mz, ground_extra[2]))
+    reactions = frame.reactions
     for p in structure.linkage.ground.points:
         reactions.setdefault(p, V(zero, zero))
-    return Forces(reactions=reactions, slider_normal=normal, slider_couple=couple,
-                  driving_torque=driving, shaking_force=V(fx, fy), shaking_moment=mz,
+    names = structure.names
+    return Forces(reactions=reactions,
+                  slider_normal={names[k]: f for k, f in frame.normal.items()},
+                  slider_couple={names[k]: m for k, m in frame.couple.items()},
+                  driving_torque=frame.driving, shaking_force=V(fx, fy), shaking_moment=mz,
                   rocking_couple=V(zero, zero) if rocking is None else rocking)
 
 

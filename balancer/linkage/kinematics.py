@@ -36,17 +36,13 @@ from numpy.typing import ArrayLike, NDArray
 from . import numeric
 from .constraints import (
     GROUND_INDEX,
-    Constraint,
-    Driver,
     Group,
-    Pin,
     Pose,
-    Prism,
     group_jacobian,
 )
 from .dyads import Dyads, Frame, known_point
 from .structure import Structure
-from .vectors import NUMPY, Num, OpsLike, V
+from .vectors import NUMPY, Num, OpsLike, V, _minus
 
 
 def _place(pose: Pose, k: int, frame: Frame | Num, origin_or_pivot: V, local: V | None,
@@ -103,9 +99,7 @@ def positions(structure: Structure, theta1: Num, ops: OpsLike = NUMPY,
     pose = Pose([V(0.0, 0.0)] * n, [0.0] * n, [1.0] * n, [0.0] * n)
     for index, g in enumerate(structure.groups):
         if g.kind == "crank":
-            pin = g.constraints[0]
-            assert isinstance(pin, Pin)  # the crank's pivot
-            pivot, local = known_point(pose, pin, g.links[0])
+            pivot, local = known_point(pose, g.pivot, g.links[0])
             _place(pose, g.links[0], theta1, pivot, local, ops)
             continue
         if g.kind == "numeric":
@@ -189,31 +183,6 @@ class Motion:
         return self.acceleration[k] + r.perp() * self.accel[k] - r * (self.rate[k] ** 2)
 
 
-def _gamma(c: Constraint, pose: Pose, vel: list[V], rate: list[Num],
-           ops: OpsLike = NUMPY) -> list[Num]:
-    """``γ`` of one constraint (``Φ_q·q̈ = γ``): the velocity terms of its second derivative."""
-    def w(k: int) -> Num:
-        return 0.0 if k == GROUND_INDEX else rate[k]
-
-    def v(k: int) -> V:
-        return V(0.0, 0.0) if k == GROUND_INDEX else vel[k]
-
-    if isinstance(c, Pin):
-        ra, rb = pose.rotate(c.a, c.pa), pose.rotate(c.b, c.pb)
-        out = ra * (w(c.a) * w(c.a)) - rb * (w(c.b) * w(c.b))
-        return [out.x, out.y]
-    if isinstance(c, Prism):
-        d = pose.rotate(c.g, c.dg)
-        ps, pg = pose.rotate(c.s, c.ps), pose.rotate(c.g, c.pg)
-        delta = pose.origin(c.s) + ps - pose.origin(c.g) - pg
-        ddot = v(c.s) + ps.perp() * w(c.s) - v(c.g) - pg.perp() * w(c.g)
-        wg, ws = w(c.g), w(c.s)
-        line = (wg * wg * (d.cross(delta) - d.cross(pg)) + 2 * wg * d.dot(ddot)
-                + ws * ws * d.cross(ps))
-        return [0.0 * line, line]
-    return [0.0]
-
-
 def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
           theta1: Num | None = None, ops: OpsLike = NUMPY, *, accelerations: bool = True
           ) -> tuple[list[V], list[Num], list[V], list[Num]]:
@@ -231,7 +200,7 @@ def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
     accel: list[Num] = [zero] * n
     for g in structure.groups:
         rows, known = group_jacobian(g, pose)
-        drivers = [isinstance(c, Driver) for c in g.constraints for _ in range(c.rows)]
+        prescribed = [x for c in g.constraints for x in c.prescribed_rates(omega1)]
         rhs_v = []
         for r, row_known in enumerate(known):
             v_term: Num = 0.0
@@ -239,7 +208,7 @@ def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
                 v_term = v_term + coeffs[0] * vel[link].x + coeffs[1] * vel[link].y \
                     + coeffs[2] * rate[link]
             # the driver θ_input − θ1(t) = 0: its rates are the input's
-            rhs_v.append(omega1 - v_term if drivers[r] else -v_term)
+            rhs_v.append(_minus(prescribed[r], v_term))
         # velocities first: γ of the group's own rows needs the group's velocities
         factor = ops.factor(rows)
         sol_v = factor.solve([[x] for x in rhs_v])
@@ -248,15 +217,14 @@ def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
             rate[link] = zero + sol_v[3 * i + 2][0]
         if not accelerations:
             continue
-        gammas = [x for c in g.constraints for x in (_gamma(c, pose, vel, rate, ops)
-                                                     if not isinstance(c, Driver) else [0.0])]
+        gammas = [x for c in g.constraints for x in c.gamma(pose, vel, rate, alpha1)]
         rhs_a = []
         for r, row_known in enumerate(known):
             a_term: Num = 0.0
             for link, coeffs in row_known:
                 a_term = a_term + coeffs[0] * acc[link].x + coeffs[1] * acc[link].y \
                     + coeffs[2] * accel[link]
-            rhs_a.append(alpha1 - a_term if drivers[r] else gammas[r] - a_term)
+            rhs_a.append(gammas[r] - a_term)
         sol_a = factor.solve([[x] for x in rhs_a])
         for i, link in enumerate(g.links):
             acc[link] = V(zero + sol_a[3 * i][0], zero + sol_a[3 * i + 1][0])

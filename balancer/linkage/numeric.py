@@ -18,7 +18,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from .constraints import Group, Pose, Prism, constraint_residual, group_jacobian
+from .constraints import Group, Pose, group_jacobian
 from .structure import Structure
 from .vectors import NUMPY, Factor, Num, OpsLike, V
 
@@ -41,7 +41,7 @@ FEW_ANGLES = 128
 
 
 def _residual(g: Group, pose: Pose) -> list[Num]:
-    return [r for c in g.constraints for r in constraint_residual(c, pose)]
+    return [r for c in g.constraints for r in c.residual(pose)]
 
 
 def _set(pose: Pose, g: Group, q: NDArray[np.float64]) -> None:
@@ -391,8 +391,7 @@ def assembly_gap(structure: Structure, g: Group, pose: Pose, n: int) -> NDArray[
     scale = structure.length_scale()
     jac = _jacobian(g, pose, n)
     columns = np.tile([1.0, 1.0, 1.0 / scale], len(g.links))
-    rows = np.concatenate([[scale, 1.0] if isinstance(c, Prism) else [1.0] * c.rows
-                           for c in g.constraints])
+    rows = np.concatenate([c.row_scales(scale) for c in g.constraints])
     scaled = rows[None, :, None] * jac * columns[None, None, :]
     finite = np.all(np.isfinite(scaled), axis=(1, 2))
     out = np.full(n, np.nan)

@@ -46,7 +46,6 @@ from .constraints import (
     Group,
     Pin,
     Prism,
-    constraint_jacobian,
     pose_of,
     unit,
 )
@@ -259,9 +258,9 @@ class Structure:
 
     def row_kinds(self) -> list[str]:
         """``"length"`` or ``"angle"`` for each row of :meth:`jacobian`."""
-        out = []
+        out: list[str] = []
         for c in self.constraints:
-            out += ["length", "length"] if isinstance(c, Pin) else ["angle", "length"]
+            out += c.row_kinds
         return out
 
     def length_scale(self) -> float:
@@ -299,7 +298,7 @@ class Structure:
         rows = sum(c.rows for c in out)
         touched: set[int] = set()
         for joint in out:
-            touched |= {joint.a, joint.b} if isinstance(joint, Pin) else {joint.s, joint.g}
+            touched |= set(joint.members)
         if rows != 3 * len(group) or not group <= touched:
             return None
         return out
@@ -343,8 +342,7 @@ class Structure:
         a, b = links
 
         def between(c: Pin | Prism, x: int, y: int) -> bool:
-            pair = {c.a, c.b} if isinstance(c, Pin) else {c.s, c.g}
-            return pair == {x, y}
+            return set(c.members) == {x, y}
 
         middle = [c for c in closing if between(c, a, b)]
         ends_a = [c for c in closing if not between(c, a, b) and _touches(c, a)]
@@ -352,7 +350,7 @@ class Structure:
         if len(middle) != 1 or len(ends_a) != 1 or len(ends_b) != 1:
             return Group(links, tuple(closing), "numeric")
         j1, j2, j3 = ends_a[0], middle[0], ends_b[0]
-        kind = "".join("R" if isinstance(c, Pin) else "P" for c in (j1, j2, j3))
+        kind = "".join(c.letter for c in (j1, j2, j3))
         if kind == "PRR":  # the mirror of RRP: name the links the other way round
             a, b, j1, j3 = b, a, j3, j1
             kind = "RRP"
@@ -386,7 +384,7 @@ class Structure:
         pose = pose_of(q)
         for c in self.constraints:
             block = np.zeros((c.rows, 3 * self.size))
-            for link, coeffs in constraint_jacobian(c, pose):
+            for link, coeffs in c.jacobian(pose):
                 if link != GROUND_INDEX:
                     block[:, 3 * link : 3 * link + 3] += np.array(
                         [[float(x) for x in row] for row in coeffs])
@@ -395,12 +393,10 @@ class Structure:
 
 
 def _touches(c: Pin | Prism, k: int) -> bool:
-    return k in ((c.a, c.b) if isinstance(c, Pin) else (c.s, c.g))
+    return k in c.members
 
 
 def _pin_offset(c: Pin | Prism, k: int) -> tuple[float, float] | None:
     """The local point by which pin ``c`` holds link ``k`` (``None`` for a prism)."""
-    if not isinstance(c, Pin):
-        return None
-    p = c.pa if c.a == k else c.pb
-    return (p.x, p.y)
+    p = c.held_at(k)
+    return None if p is None else (p.x, p.y)
