@@ -180,8 +180,8 @@ def frame_force_columns(mech: Mechanism, ground: Mapping[str, NDArray[np.complex
         cols += [values.real, values.imag]
     normals = mech.guide_normals()
     for link in normal:
-        if link in mech.guide_force_names:
-            point = mech.guide_force_names[link]
+        if link in mech.presentation.guide_force_names:
+            point = mech.presentation.guide_force_names[link]
             force = normal[link] * normals[link]
             names += [f"R{point}x", f"R{point}y"]
             cols += [force.real, force.imag]

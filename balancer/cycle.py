@@ -247,7 +247,7 @@ class CycleAnalysis:
         With the load (what the engine drives) off the frame, the mounts carry ``−dH_z/dt``
         less the output torque (DESIGN.md); ``None`` for a mechanism that is not an engine.
         """
-        if not self.mechanism.reports_mount_torque:
+        if not self.mechanism.presentation.mount_torque:
             return None
         return self.reactions.shaking_moment + self.reactions.driving_torque
 

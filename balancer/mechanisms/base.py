@@ -36,6 +36,7 @@ from ..linkage.structure import Structure
 from ..linkage.vectors import V
 from ..model import GROUND, Branch, Link, Linkage, MechanismModel
 from ..model.assembly import AssemblyRange
+from .presentation import Presentation
 
 if TYPE_CHECKING:
     from ..linkage.program import CrankForcesProgram
@@ -157,9 +158,9 @@ class Mechanism:
         The mechanism's data.
     """
 
-    #: Where the force-balance conditions come from, as a report's sentence names them
-    #: ("… hold to 1e-16 of the links' first moments").
-    force_balance_source: ClassVar[str] = "the conditions found from the linkage"
+    #: How the layers that print name its figures (wording, columns, outputs); the core never
+    #: reads it.
+    presentation: ClassVar[Presentation] = Presentation()
     #: Inverse-dynamics routes (``analyze --route``), the default first.
     routes: ClassVar[tuple[Route, ...]] = ("newton-euler", "mass-matrix")
     #: The mechanism's own formulations of the equations of motion by name, the default first
@@ -170,22 +171,6 @@ class Mechanism:
     verify_method: ClassVar[str] = "multibody"
     #: The spec key that holds the geometry (named by errors about it).
     geometry_key: ClassVar[str] = "mechanism.points"
-    #: Whether ``simulate --json`` gives the link states keyed by link name (a general
-    #: linkage) or as lists of links 1–3 (the four-bar and slider-crank, fixed by DESIGN.md).
-    named_states: ClassVar[bool] = True
-    #: Whether the cycle analysis gives the torque about z on the mounts (an engine's
-    #: ``mount_torque``: the shaking moment plus the driving torque).
-    reports_mount_torque: ClassVar[bool] = False
-    #: Whether balancing adds masses on shafts geared to the crank (an engine's counterweights
-    #: and balance shafts: :meth:`drawn_masses`) rather than bodies to its links.
-    balanced_on_shafts: ClassVar[bool] = False
-    #: What a drawing calls the blocks of :meth:`slider_blocks`.
-    block_name: ClassVar[str] = "sliding blocks"
-
-    #: Sliders on ground guides whose force on the guide tables name as a force at a point
-    #: (``R{name}x``, ``R{name}y``) rather than by its normal force ``N_{link}``.
-    guide_force_names: ClassVar[dict[str, str]] = {}
-
     def __init__(self, model: MechanismModel) -> None:
         self.model = model
 

@@ -71,7 +71,7 @@ def _drawn(design: Design | Model | Mechanism, title: str,
     if isinstance(design, Design):
         weights = counterweights
         if (weights is None and design.original is not None
-                and not mechanism_of(design.mechanism).balanced_on_shafts):
+                and not mechanism_of(design.mechanism).presentation.balanced_on_shafts):
             weights = link_counterweights(design.original, design.mechanism)
         return design.mechanism, title or design.title, weights or {}
     if not isinstance(design, Model | Mechanism):
@@ -161,10 +161,11 @@ def animation_figure(design: Design | Model | Mechanism, *, frames: int = 72,
                          label="links" if i == 0 else None)
         lines.append((bar, points))
     outlines: list[tuple[Polygon, NDArray[np.complex128]]] = []
+    block_name = mechanism_of(linkage).presentation.block_name
     for i, outline in enumerate(blocks.values()):
         block = Polygon(np.column_stack([outline[0].real, outline[0].imag]), closed=True,
                         fc=COLOURS["link"], ec="k", lw=0.8, alpha=0.55, animated=True,
-                        zorder=1.8, label=mechanism_of(linkage).block_name if i == 0 else None)
+                        zorder=1.8, label=block_name if i == 0 else None)
         ax.add_patch(block)
         outlines.append((block, outline))
     wedges: list[tuple[Wedge, NDArray[np.float64]]] = []

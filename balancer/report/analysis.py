@@ -213,9 +213,9 @@ def force_balance_line(analysis: CycleAnalysis) -> str:
     """Whether the design is force-balanced, in words a designer pictures."""
     balanced, residual = analysis.force_balanced, analysis.force_balance_residual
     if balanced:
+        source = analysis.mechanism.presentation.force_balance_source
         return ("force-balanced: yes (the total centre of mass stands still; "
-                f"{analysis.mechanism.force_balance_source} hold to {residual:.1e} of the "
-                "links' first moments)")
+                f"{source} hold to {residual:.1e} of the links' first moments)")
     excursion = analysis.centre_of_mass_excursion
     return ("force-balanced: no (the total centre of mass moves up to "
             f"{_length(excursion)} from its mean place over a revolution)")

@@ -218,7 +218,7 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
         seconds=float(seconds),
         rtol=rtol,
         atol=atol,
-        named_states=mechanism_of(f.linkage).named_states,
+        named_states=mechanism_of(f.linkage).presentation.named_states,
         model=f.linkage,
         slider=slider,
     )

@@ -22,6 +22,7 @@ from ...linkage.rotors import Rotor, link_inertia
 from ...linkage.structure import Structure
 from ...model import Body, Linkage, Slider
 from ..base import DrawnMass, Mechanism, piston_block
+from ..presentation import Presentation
 from .model import COUNTERWEIGHT, Engine
 
 #: The main bearings' point (the crankshaft's axis at the origin).
@@ -85,9 +86,7 @@ class EngineMechanism(Mechanism):
     geometry_key = "mechanism.cylinders"
     #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.
     start_angle = 0.0
-    reports_mount_torque = True
-    balanced_on_shafts = True
-    block_name = "pistons"
+    presentation = Presentation(mount_torque=True, balanced_on_shafts=True, block_name="pistons")
 
     @cached_property
     def linkage(self) -> Linkage:

@@ -25,6 +25,7 @@ from ...linkage.vectors import V
 from ...model import Body, Branch, Linkage
 from ...model.assembly import AssemblyRange
 from ..base import Limit, Mechanism, Route
+from ..presentation import Presentation
 from . import kinematics as fourbar
 from .assembly import assembly_range, classify
 from .complex_masses import ComplexMasses
@@ -94,11 +95,11 @@ class FourBarMechanism(Mechanism):
 
     model: FourBar
 
-    force_balance_source = "the conditions, Eq. 57–58,"
     own_formulations = {"opened-loop": OpenedLoop, "complex-masses": ComplexMasses,
                         "mass-matrix": MassMatrix, "lie-group": LieGroup}
     geometry_key = "mechanism.lengths"
-    named_states = False
+    presentation = Presentation(force_balance_source="the conditions, Eq. 57–58,",
+                                named_states=False)
     #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.
     start_angle = 0.0
 

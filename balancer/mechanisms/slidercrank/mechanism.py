@@ -22,6 +22,7 @@ from ...linkage.vectors import V
 from ...model import Body, Branch, Linkage, Slider
 from ...model.assembly import AssemblyRange
 from ..base import Mechanism, Route, piston_block
+from ..presentation import Presentation
 from . import kinematics as closed
 from .conditions import force_balance_matrix
 from .dynamics import mass_matrix
@@ -60,16 +61,15 @@ class SliderCrankMechanism(Mechanism):
 
     model: SliderCrank
 
-    force_balance_source = "Wunderlich's conditions, Eq. 20a–b,"
     own_formulations = {"mass-matrix": SliderMassMatrix, "complex-masses": SliderComplexMasses}
     verify_method = "complex-masses"
     geometry_key = "mechanism.lengths"
-    named_states = False
     #: The guide's force as the four-bar's R̄A3 (DESIGN.md's fixed CSV columns).
-    guide_force_names = {"slider": "A3"}
+    presentation = Presentation(force_balance_source="Wunderlich's conditions, Eq. 20a–b,",
+                                named_states=False, guide_force_names={"slider": "A3"},
+                                block_name="pistons")
     #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.
     start_angle = 0.0
-    block_name = "pistons"
 
     @cached_property
     def linkage(self) -> Linkage:
