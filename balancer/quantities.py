@@ -30,6 +30,11 @@ class Quantity:
     panel
         The key of the panel of a cycle drawing that shows it (``force``), or ``""`` where no
         panel does.
+    frame
+        Whether it is a load on the frame over the cycle, whose RMS and maximum every analysis
+        reports (its summary's figure of that key, where the mechanism has one).
+    out_of_plane
+        Whether it is zero for a mechanism in one plane: a table then leaves it out.
     """
 
     key: str
@@ -37,6 +42,8 @@ class Quantity:
     unit: str
     axis: str = ""
     panel: str = ""
+    frame: bool = False
+    out_of_plane: bool = False
 
     @property
     def label(self) -> str:
@@ -47,14 +54,15 @@ class Quantity:
 #: Every reported quantity by key: the frame's loads over a revolution (their RMS and maxima
 #: in every report), then what balancing also weighs.
 QUANTITIES: Mapping[str, Quantity] = {q.key: q for q in (
-    Quantity("shaking_force", "shaking force", "N", panel="force"),
+    Quantity("shaking_force", "shaking force", "N", panel="force", frame=True),
     Quantity("shaking_moment", "shaking moment", "N·m",
-             axis="shaking moment about the origin", panel="moment"),
+             axis="shaking moment about the origin", panel="moment", frame=True),
     Quantity("driving_torque", "driving torque", "N·m", axis="driving torque on the crank",
-             panel="torque"),
-    Quantity("rocking_couple", "rocking couple", "N·m", panel="couple"),
+             panel="torque", frame=True),
+    Quantity("rocking_couple", "rocking couple", "N·m", panel="couple", frame=True,
+             out_of_plane=True),
     Quantity("mount_torque", "mount torque", "N·m", axis="torque about z on the mounts",
-             panel="mount"),
+             panel="mount", frame=True),
     Quantity("shaking_force_x", "shaking force along x", "N"),
     Quantity("shaking_force_y", "shaking force along y", "N"),
     Quantity("added_mass", "added mass", "kg"),
@@ -63,6 +71,8 @@ QUANTITIES: Mapping[str, Quantity] = {q.key: q for q in (
 
 #: The quantities a cycle drawing shows, by panel key.
 PANELS: Mapping[str, Quantity] = {q.panel: q for q in QUANTITIES.values() if q.panel}
+#: The loads on the frame every analysis reports, in the reports' order.
+FRAME_LOADS: tuple[Quantity, ...] = tuple(q for q in QUANTITIES.values() if q.frame)
 
 
 def unit_of(key: str) -> str:

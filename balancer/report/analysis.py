@@ -9,7 +9,7 @@ import numpy as np
 
 from ..cycle import CycleAnalysis
 from ..orders import order_name
-from ..quantities import unit_of
+from ..quantities import FRAME_LOADS
 from ..rounding import Scales, speed_text
 from .text import csv_text, table
 
@@ -47,11 +47,10 @@ def analysis_figures(analysis: CycleAnalysis) -> list[tuple[str, float]]:
     """
     s = analysis.summary
     out: list[tuple[str, float]] = []
-    for name in ("shaking_force", "shaking_moment", "driving_torque", "rocking_couple",
-                 "mount_torque"):
-        fig = getattr(s, name)
+    for q in FRAME_LOADS:
+        fig = getattr(s, q.key)
         if fig is not None:
-            out += [(unit_of(name), fig.rms), (unit_of(name), fig.max)]
+            out += [(q.unit, fig.rms), (q.unit, fig.max)]
     out += [("N", f.max) for f in (*s.ground.values(), *s.slider_normal.values())]
     out += [("N·m", f.max) for f in s.slider_couple.values()]
     for o in analysis.orders:
@@ -151,6 +150,7 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
     mech = analysis.mechanism
     s = analysis.summary
     sc = Scales(analysis_figures(analysis))
+    planar = mech.in_one_plane()
     head = f"balancer analyze — {spec}" if spec else "balancer analyze"
     per_cycle = (f" over a cycle of 720° ({analysis.samples} in all)"
                  if analysis.revolutions == 2 else "")
@@ -164,17 +164,10 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
         "",
         table(
             [
-                [name.replace("_", " "), sc.fmt(fig.rms, unit_of(name)),
-                 sc.fmt(fig.max, unit_of(name)), unit_of(name)]
-                for name, fig in (
-                    ("shaking_force", s.shaking_force),
-                    ("shaking_moment", s.shaking_moment),
-                    ("driving_torque", s.driving_torque),
-                    *((("rocking_couple", s.rocking_couple),)
-                      if not analysis.mechanism.in_one_plane() else ()),
-                    *((("mount_torque", s.mount_torque),) if s.mount_torque is not None
-                      else ()),
-                )
+                [q.key.replace("_", " "), sc.fmt(fig.rms, q.unit), sc.fmt(fig.max, q.unit),
+                 q.unit]
+                for q, fig in ((q, getattr(s, q.key)) for q in FRAME_LOADS)
+                if fig is not None and not (q.out_of_plane and planar)
             ],
             ["quantity", "RMS", "max", "unit"],
         ),
