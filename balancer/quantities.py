@@ -9,8 +9,9 @@ here; a new output quantity is a line here and the figure that computes it.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import Any
 
 
 @dataclass(frozen=True)
@@ -35,6 +36,11 @@ class Quantity:
         reports (its summary's figure of that key, where the mechanism has one).
     out_of_plane
         Whether it is zero for a mechanism in one plane: a table then leaves it out.
+    squares
+        As a mean-square term of a balancing's objective: the frame loads it squares and
+        averages, each ``(key, part)`` with part ``""`` (a real load), ``"x"`` or ``"y"`` (a
+        complex one's components); empty for a term that is no load's mean square (the added
+        mass, the unbalance).
     """
 
     key: str
@@ -44,6 +50,7 @@ class Quantity:
     panel: str = ""
     frame: bool = False
     out_of_plane: bool = False
+    squares: tuple[tuple[str, str], ...] = ()
 
     @property
     def label(self) -> str:
@@ -54,17 +61,21 @@ class Quantity:
 #: Every reported quantity by key: the frame's loads over a revolution (their RMS and maxima
 #: in every report), then what balancing also weighs.
 QUANTITIES: Mapping[str, Quantity] = {q.key: q for q in (
-    Quantity("shaking_force", "shaking force", "N", panel="force", frame=True),
+    Quantity("shaking_force", "shaking force", "N", panel="force", frame=True,
+             squares=(("shaking_force", "x"), ("shaking_force", "y"))),
     Quantity("shaking_moment", "shaking moment", "N·m",
-             axis="shaking moment about the origin", panel="moment", frame=True),
+             axis="shaking moment about the origin", panel="moment", frame=True,
+             squares=(("shaking_moment", ""),)),
     Quantity("driving_torque", "driving torque", "N·m", axis="driving torque on the crank",
-             panel="torque", frame=True),
+             panel="torque", frame=True, squares=(("driving_torque", ""),)),
     Quantity("rocking_couple", "rocking couple", "N·m", panel="couple", frame=True,
-             out_of_plane=True),
+             out_of_plane=True, squares=(("rocking_couple", "x"), ("rocking_couple", "y"))),
     Quantity("mount_torque", "mount torque", "N·m", axis="torque about z on the mounts",
              panel="mount", frame=True),
-    Quantity("shaking_force_x", "shaking force along x", "N"),
-    Quantity("shaking_force_y", "shaking force along y", "N"),
+    Quantity("shaking_force_x", "shaking force along x", "N",
+             squares=(("shaking_force", "x"),)),
+    Quantity("shaking_force_y", "shaking force along y", "N",
+             squares=(("shaking_force", "y"),)),
     Quantity("added_mass", "added mass", "kg"),
     Quantity("unbalance", "unbalance", "N"),
 )}
@@ -73,6 +84,19 @@ QUANTITIES: Mapping[str, Quantity] = {q.key: q for q in (
 PANELS: Mapping[str, Quantity] = {q.panel: q for q in QUANTITIES.values() if q.panel}
 #: The loads on the frame every analysis reports, in the reports' order.
 FRAME_LOADS: tuple[Quantity, ...] = tuple(q for q in QUANTITIES.values() if q.frame)
+
+
+def squared_parts(key: str, load: Callable[[str], Any]) -> list[Any]:
+    """The arrays the mean-square term ``key`` squares and averages (:attr:`Quantity.squares`).
+
+    ``load`` gives a frame load by its key: samples, or a linear map of a design vector whose
+    rows are samples (a complex load's ``x`` and ``y`` parts are its real and imaginary parts).
+    """
+    out = []
+    for name, part in QUANTITIES[key].squares:
+        value = load(name)
+        out.append(value if not part else value.real if part == "x" else value.imag)
+    return out
 
 
 def unit_of(key: str) -> str:

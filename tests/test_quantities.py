@@ -6,12 +6,13 @@ import dataclasses
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from balancer.api import analyze
 from balancer.cycle import panel_keys
 from balancer.model.balance import Objective
-from balancer.quantities import PANELS, QUANTITIES, unit_of
+from balancer.quantities import PANELS, QUANTITIES, squared_parts, unit_of
 from balancer.spec import load_design
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -64,3 +65,25 @@ def test_each_figures_unit_by_dimensional_analysis():
         for stat, value in figures.items():
             assert math.isclose(after[key][stat], lam**power * value, rel_tol=1e-9,
                                 abs_tol=1e-9 * lam**power * abs(value) + 1e-300), (key, stat)
+
+
+def test_each_mean_square_term_squares_the_parts_of_its_load():
+    """The table's squares against the loads themselves: a complex load's two parts add to its
+    squared magnitude, its x and y terms to the whole, a real load is itself."""
+    analysis = analyze(load_design(EXAMPLES / "engine.toml"))
+    r = analysis.reactions
+
+    def mean_square(key):
+        return sum(float(np.mean(p**2)) for p in squared_parts(key, lambda k: getattr(r, k)))
+
+    for key in ("shaking_force", "rocking_couple"):
+        assert math.isclose(mean_square(key), float(np.mean(np.abs(getattr(r, key)) ** 2)),
+                            rel_tol=1e-12)
+    assert math.isclose(mean_square("shaking_force_x") + mean_square("shaking_force_y"),
+                        mean_square("shaking_force"), rel_tol=1e-12)
+    for key in ("shaking_moment", "driving_torque"):
+        assert math.isclose(mean_square(key), float(np.mean(getattr(r, key) ** 2)),
+                            rel_tol=1e-12)
+    weights = {f.name: 1.0 for f in dataclasses.fields(Objective)}
+    squared = {t.name for t in Objective(**weights).terms if QUANTITIES[t.name].squares}
+    assert squared == {"shaking_moment", "driving_torque", "shaking_force", "rocking_couple"}

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..model.balance import Objective
+from ..quantities import squared_parts
 from .bounds import LinkBounds
 from .problem_data import ProblemData
 from .regressors import CycleRegressors
@@ -30,19 +31,8 @@ def objective_rows(reg: CycleRegressors, w: Objective, links: tuple[LinkBounds, 
     an entry is inert where its column of ``R`` vanishes (to ``1e-12`` of the largest).
     """
     n = reg.shaking_moment.shape[0]
-    blocks = []
-    if w.shaking_moment:
-        blocks.append(math.sqrt(w.shaking_moment) * reg.shaking_moment)
-    if w.driving_torque:
-        blocks.append(math.sqrt(w.driving_torque) * reg.driving_torque)
-    wx, wy = w.shaking_force + w.shaking_force_x, w.shaking_force + w.shaking_force_y
-    if wx:
-        blocks.append(math.sqrt(wx) * reg.shaking_force.real)
-    if wy:
-        blocks.append(math.sqrt(wy) * reg.shaking_force.imag)
-    if w.rocking_couple:
-        blocks += [math.sqrt(w.rocking_couple) * reg.rocking_couple.real,
-                   math.sqrt(w.rocking_couple) * reg.rocking_couple.imag]
+    blocks = [math.sqrt(term.weight) * part for term in w.terms
+              for part in squared_parts(term.name, lambda key: getattr(reg, key))]
     rows = np.vstack(blocks) / math.sqrt(n) if blocks else np.zeros((0, p))
     factor = (cast("NDArray[np.float64]", np.linalg.qr(rows, mode="r"))  # R alone (as above)
               if blocks else np.zeros((0, p)))
@@ -66,18 +56,9 @@ class ObjectiveTerms(ProblemData):
         w = self.weights
         reg = self.regressors
         total = 0.0
-        if w.shaking_moment:
-            total += w.shaking_moment * float(np.mean((reg.shaking_moment @ x) ** 2))
-        if w.driving_torque:
-            total += w.driving_torque * float(np.mean((reg.driving_torque @ x) ** 2))
-        if w.shaking_force or w.shaking_force_x or w.shaking_force_y:
-            force = reg.shaking_force @ x
-            wx = w.shaking_force + w.shaking_force_x
-            wy = w.shaking_force + w.shaking_force_y
-            total += wx * float(np.mean(force.real**2)) + wy * float(np.mean(force.imag**2))
-        if w.rocking_couple:
-            couple = reg.rocking_couple @ x
-            total += w.rocking_couple * float(np.mean(couple.real**2 + couple.imag**2))
+        for term in w.terms:
+            for part in squared_parts(term.name, lambda key: getattr(reg, key) @ x):
+                total += term.weight * float(np.mean(part**2))
         if w.added_mass:
             total += w.added_mass * (self.total_mass(x) - self.original_mass)
         return total

@@ -20,6 +20,7 @@ from ..errors import SolverError
 from ..model import Design
 from ..model import MechanismModel as Model
 from ..model.balance import Objective, ObjectiveTerm, PlacedMass, ShaftDesign
+from ..quantities import QUANTITIES, squared_parts
 from ..rounding import Scales
 from .counterweights import Counterweight, added_mass, counterweights
 
@@ -308,14 +309,10 @@ class BalanceResult:
         the mass added to the original, kg.
         """
         r = analysis.reactions
-        force = r.shaking_force
-        values = {"shaking_moment": analysis.summary.shaking_moment.rms,
-                  "driving_torque": analysis.summary.driving_torque.rms,
-                  "shaking_force": analysis.summary.shaking_force.rms,
-                  "shaking_force_x": float(np.sqrt(np.mean(force.real**2))),
-                  "shaking_force_y": float(np.sqrt(np.mean(force.imag**2))),
-                  "rocking_couple": analysis.summary.rocking_couple.rms,
-                  "added_mass": analysis.linkage.total_mass - self.original.total_mass}
+        values = {t.name: float(np.sqrt(np.mean(sum(
+            part**2 for part in squared_parts(t.name, lambda key: getattr(r, key))))))
+            for t in self.weights.terms if QUANTITIES[t.name].squares}
+        values["added_mass"] = analysis.linkage.total_mass - self.original.total_mass
         if self.rotor_masses is not None:  # (of the chosen masses, not of the analysis)
             rm = self.rotor_masses
             values["unbalance"] = (rm.unbalance_after if analysis is self.after

@@ -63,6 +63,7 @@ from ..model.balance import (
     RotorBalanceProblem,
     ShaftDesign,
 )
+from ..quantities import squared_parts
 from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .convex import CLARABEL_SETTINGS, TIE_ACCEPT, solve_program
@@ -184,14 +185,12 @@ class RotorProblem:
             "rocking_couple": (couple, r.rocking_couple),
             "shaking_moment": (moment, r.shaking_moment)}
         w = self.weights
-        blocks: list[tuple[float, NDArray[np.float64], NDArray[np.float64]]] = [
-            (w.shaking_force, force.real, r.shaking_force.real),
-            (w.shaking_force, force.imag, r.shaking_force.imag),
-            (w.rocking_couple, couple.real, r.rocking_couple.real),
-            (w.rocking_couple, couple.imag, r.rocking_couple.imag),
-            (w.shaking_moment, moment, r.shaking_moment)]
-        rows = [math.sqrt(weight / theta.size) * np.column_stack([a, b])
-                for weight, a, b in blocks if weight]
+        # each mean-square term's parts: the columns of its loads, and the base engine's
+        rows = [math.sqrt(term.weight / theta.size) * np.column_stack([a, b])
+                for term in w.terms
+                for a, b in zip(squared_parts(term.name, lambda key: self.loads[key][0]),
+                                squared_parts(term.name, lambda key: self.loads[key][1]),
+                                strict=True)]
         if w.unbalance:
             rows.append(np.column_stack([math.sqrt(w.unbalance) * self.speed**2 * np.eye(n),
                                          np.zeros(n)]))
