@@ -28,8 +28,10 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("model",),
     # The general core; the profiles of parts and their sizing (link-level mass models).
     ("linkage", "orders", "parts.shapes", "parts.sizing"),
-    # The mechanism interface, and what every mechanism's formulations share.
-    ("mechanisms.base", "mechanisms.formulation", "mechanisms.chains"),
+    # The mechanism interface (and its wording for the layers that print), and what every
+    # mechanism's formulations share.
+    ("mechanisms.base", "mechanisms.presentation", "mechanisms.formulation",
+     "mechanisms.chains"),
     # Each mechanism in its own folder; the general formulations (any mechanism).
     ("mechanisms.fourbar", "mechanisms.slidercrank", "mechanisms.general",
      "formulations.compiled", "formulations.crank_angle", "formulations.multibody"),
