@@ -75,7 +75,7 @@ _EXPORTS = {
     "CounterweightFreedom": "model.balance",
     "CycleAnalysis": "cycle",
     "CycleSummary": "cycle",
-    "Reactions": "cycle",
+    "Reactions": "linkage.loads",
     "Figure": "cycle",
     "Trajectory": "simulation",
     "Verification": "verification",
@@ -197,7 +197,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .balance.front import Against, Front, FrontPoint
     from .balance.optimizer import Backend, Optimizer
     from .balance.result import BalanceResult, InfeasibleError, StageReport, Status
-    from .cycle import CycleAnalysis, CycleSummary, Figure, Reactions
+    from .cycle import CycleAnalysis, CycleSummary, Figure
     from .errors import (
         AssemblyError,
         BalancerError,
@@ -207,6 +207,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         SpecError,
     )
     from .formulations import Method
+    from .linkage.loads import Reactions
     from .mechanisms import mechanism_of
     from .mechanisms.base import Mechanism, Route
     from .mechanisms.engine.model import Engine

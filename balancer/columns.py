@@ -11,45 +11,19 @@ formulation's simulation).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .linkage.kinematics import Motion
+from .linkage.loads import Reactions
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism
 from .model import MechanismModel as Model
 
 #: Columns of a CSV file: real arrays over its rows.
 Columns = list[NDArray[np.floating]]
-
-
-class FrameForces(Protocol):
-    """What a cycle analysis' reactions and a trajectory tell of the forces on the frame."""
-
-    @property
-    def ground(self) -> Mapping[str, NDArray[np.complex128]]:
-        """Force on the ground at each ground point, complex, N."""
-    @property
-    def slider_normal(self) -> Mapping[str, NDArray[np.float64]]:
-        """Normal force of each slider on a ground guide, by link, N."""
-    @property
-    def slider_couple(self) -> Mapping[str, NDArray[np.float64]]:
-        """Couple of each slider on a ground guide, by link, N·m."""
-    @property
-    def shaking_force(self) -> NDArray[np.complex128]:
-        """Sum of the forces on the frame, complex, N."""
-    @property
-    def shaking_moment(self) -> NDArray[np.float64]:
-        """Their moment about the origin, N·m."""
-    @property
-    def driving_torque(self) -> NDArray[np.float64]:
-        """Torque of the motor on the input, N·m."""
-    @property
-    def rocking_couple(self) -> NDArray[np.complex128]:
-        """The couple about x and y from links in several planes, complex, N·m."""
 
 
 class AnalysisLike(Protocol):
@@ -62,8 +36,8 @@ class AnalysisLike(Protocol):
     def motion(self) -> Motion:
         """Kinematics at the samples."""
     @property
-    def reactions(self) -> FrameForces:
-        """The forces on the frame at the samples."""
+    def reactions(self) -> Reactions:
+        """The loads on the frame at the samples."""
     @property
     def time(self) -> NDArray[np.float64]:
         """Time at each sample, s."""
@@ -75,9 +49,12 @@ class AnalysisLike(Protocol):
         """An engine's torque about z on its mounts, N·m (``None``: not an engine)."""
 
 
-class TrajectoryLike(FrameForces, Protocol):
+class TrajectoryLike(Protocol):
     """What the columns read of a simulation (:class:`balancer.simulation.Trajectory`)."""
 
+    @property
+    def reactions(self) -> Reactions:
+        """The loads on the frame at the output times."""
     @property
     def model(self) -> Model | None:
         """The simulated mechanism's model."""
@@ -146,8 +123,7 @@ def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     for group, values in (("theta", mo.pose.angles), ("omega", mo.rate), ("alpha", mo.accel)):
         names += [f"{group}{k + 1}" for k in range(n)]
         cols += [np.asarray(v, float) * np.ones(analysis.samples) for v in values]
-    frame_names, frame_cols = frame_force_columns(analysis.mechanism, r.ground, r.slider_normal,
-                                                  r.slider_couple)
+    frame_names, frame_cols = frame_force_columns(analysis.mechanism, r)
     names += frame_names
     cols += frame_cols
     slider_names, slider_cols = slider_columns(analysis.mechanism, mo.theta1, mo.omega1, mo.alpha1)
@@ -162,20 +138,18 @@ def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     return names, cols
 
 
-def frame_force_columns(mech: Mechanism, ground: Mapping[str, NDArray[np.complex128]],
-                        normal: Mapping[str, NDArray[np.float64]],
-                        couple: Mapping[str, NDArray[np.float64]]
-                        ) -> tuple[list[str], Columns]:
-    """Columns of the forces on the frame: names and values.
+def frame_force_columns(mech: Mechanism, reactions: Reactions) -> tuple[list[str], Columns]:
+    """Columns of the forces on the frame of ``reactions``: names and values.
 
     Per ground point ``P`` the force on it ``R{P}x``, ``R{P}y`` (N); per slider on the frame
     its normal force and couple ``N_{link}`` (N), ``C_{link}`` (N·m) — or, for a guide that the
     mechanism names as a point (the slider-crank's A3), the force as ``R{name}x``, ``R{name}y``
     and the couple.
     """
+    normal, couple = reactions.slider_normal, reactions.slider_couple
     names: list[str] = []
     cols: Columns = []
-    for point, values in ground.items():
+    for point, values in reactions.ground.items():
         names += [f"R{point}x", f"R{point}y"]
         cols += [values.real, values.imag]
     normals = mech.guide_normals()
@@ -243,8 +217,7 @@ def simulation_columns(traj: TrajectoryLike, all_columns: bool = False
         cols += list(values)
     assert traj.model is not None  # a simulation's trajectory names its model
     mech = mechanism_of(traj.model)
-    frame_names, frame_cols = frame_force_columns(mech, traj.ground, traj.slider_normal,
-                                                  traj.slider_couple)
+    frame_names, frame_cols = frame_force_columns(mech, traj.reactions)
     names += frame_names
     cols += frame_cols
     crank = list(traj.links).index(mech.input)
@@ -253,9 +226,9 @@ def simulation_columns(traj: TrajectoryLike, all_columns: bool = False
     names += slider_names
     cols += slider_cols
     if all_columns:
-        sf = traj.shaking_force
-        rc = traj.rocking_couple
-        cols += [sf.real, sf.imag, traj.shaking_moment, rc.real, rc.imag, traj.driving_torque,
+        r = traj.reactions
+        sf, rc = r.shaking_force, r.rocking_couple
+        cols += [sf.real, sf.imag, r.shaking_moment, rc.real, rc.imag, r.driving_torque,
                  traj.kinetic_energy, traj.work]
         names += SIMULATION_EXTRA_COLUMNS
     return names, cols

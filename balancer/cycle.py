@@ -31,7 +31,7 @@ from .errors import SpecError
 from .force_balance import RESIDUAL_FLOOR, force_balance_residual
 from .linkage.dynamics import Forces
 from .linkage.kinematics import Motion
-from .linkage.vectors import V
+from .linkage.loads import Reactions
 from .mechanisms import mechanism_of
 from .mechanisms.base import KERNEL_STATES, Mechanism, Route
 from .model import MechanismModel as Model
@@ -100,36 +100,6 @@ class Figure:
     def as_dict(self) -> dict[str, float]:
         """``{"rms": …, "max": …}``."""
         return {"rms": self.rms, "max": self.max}
-
-
-@dataclass(frozen=True)
-class Reactions:
-    """What the mechanism exerts on its frame at each sample (arrays of shape ``(N,)``).
-
-    Attributes
-    ----------
-    ground
-        Force on the ground at each ground point, complex ``x + i·y``, N.
-    slider_normal, slider_couple
-        Normal force (N) and couple (N·m) of each slider on a ground guide, by link.
-    shaking_force
-        Sum of all forces on the frame, complex, N.
-    shaking_moment
-        Their moment about the origin, with the motor's reaction and counter-rotors, N·m.
-    driving_torque
-        Torque of the motor on the input, N·m.
-    rocking_couple
-        The couple about ``x`` and ``y`` from links in planes along the crank's axis, complex
-        ``Mx + i·My``, N·m (zero for a mechanism in one plane).
-    """
-
-    ground: dict[str, NDArray[np.complex128]]
-    slider_normal: dict[str, NDArray[np.float64]]
-    slider_couple: dict[str, NDArray[np.float64]]
-    shaking_force: NDArray[np.complex128]
-    shaking_moment: NDArray[np.float64]
-    driving_torque: NDArray[np.float64]
-    rocking_couple: NDArray[np.complex128]
 
 
 @dataclass(frozen=True)
@@ -372,13 +342,7 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     angles = (sample_angles(samples, revolutions) if theta1 is None
               else np.asarray(theta1, dtype=float))
     n = angles.size
-    grounds = mech.ground_points
-    sliders = mech.ground_sliders
-    out = {"shaking_force": np.empty(n, complex), "shaking_moment": np.empty(n),
-           "driving_torque": np.empty(n), "rocking_couple": np.empty(n, complex)}
-    ground = {p: np.empty(n, complex) for p in grounds}
-    normal = {k: np.empty(n) for k in sliders}
-    couple = {k: np.empty(n) for k in sliders}
+    reactions = Reactions.empty(n, mech.ground_points, mech.ground_sliders)
 
     compiled = n >= KERNEL_STATES  # a long cycle: its chunks by the compiled program
 
@@ -388,25 +352,9 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
             return mech.crank_forces(theta, speed, 0.0, route=route, loads=loads,
                                      gravity=gravity, compiled=compiled and fast, into=into)
 
-    def columns(sl: slice) -> Forces:
-        """The cycle's columns at ``sl`` as forces (views: what is written there is theirs)."""
-        def real(a: NDArray[np.float64]) -> NDArray[np.float64]:
-            return a[sl, None]
-
-        def vector(a: NDArray[np.complex128]) -> V:
-            return V(a.real[sl, None], a.imag[sl, None])
-
-        return Forces(reactions={p: vector(ground[p]) for p in grounds},
-                      slider_normal={k: real(normal[k]) for k in sliders},
-                      slider_couple={k: real(couple[k]) for k in sliders},
-                      driving_torque=real(out["driving_torque"]),
-                      shaking_force=vector(out["shaking_force"]),
-                      shaking_moment=real(out["shaking_moment"]),
-                      rocking_couple=vector(out["rocking_couple"]))
-
     def fill(start: int) -> None:
         sl = slice(start, start + CHUNK)
-        evaluate(angles[sl], into=columns(sl))
+        evaluate(angles[sl], into=reactions.at(sl).forces())  # written into the cycle's
 
     starts = range(0, n, CHUNK)
     if len(starts) > 1 and WORKERS > 1 and not _ONE_THREAD.get():
@@ -425,22 +373,14 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
         hit = limit.mask
         # (A few states beside a change point: by the mechanism's own route, which takes the
         # limit best — a four-bar's closed forms, not the compiled general core.)
-        parts = [evaluate(angles[hit] + d, fast=False) for d in limit.offsets]
-        out["shaking_force"][hit] = sum(w * p.shaking_force.complex()[:, 0]
-                                        for w, p in zip(limit.weights, parts, strict=True))
-        out["shaking_moment"][hit] = sum(w * p.shaking_moment[:, 0]
-                                         for w, p in zip(limit.weights, parts, strict=True))
-        out["driving_torque"][hit] = sum(w * p.driving_torque[:, 0]
-                                         for w, p in zip(limit.weights, parts, strict=True))
-        out["rocking_couple"][hit] = sum(w * p.rocking_couple.complex()[:, 0]
-                                         for w, p in zip(limit.weights, parts, strict=True))
-        for p in grounds:
-            ground[p][hit] = np.nan
-        for k in sliders:
-            normal[k][hit] = np.nan
-            couple[k][hit] = np.nan
+        parts = [Reactions.of(evaluate(angles[hit] + d, fast=False)) for d in limit.offsets]
+        for name in ("shaking_force", "shaking_moment", "driving_torque", "rocking_couple"):
+            getattr(reactions, name)[hit] = sum(w * getattr(p, name) for w, p
+                                                in zip(limit.weights, parts, strict=True))
+        for values in (*reactions.ground.values(), *reactions.slider_normal.values(),
+                       *reactions.slider_couple.values()):
+            values[hit] = np.nan
         singular |= hit
-    reactions = Reactions(ground=ground, slider_normal=normal, slider_couple=couple, **out)
     return CycleAnalysis(mechanism=mech, speed=speed, theta1=angles, reactions=reactions,
                          route=route, gravity=(gravity[0], gravity[1]), loads=loads,
                          singular=singular, revolutions=revolutions)
@@ -528,9 +468,7 @@ def natural_scales(analysis: CycleAnalysis) -> dict[str, float]:
     times the mechanism's size (m) for a moment (N·m): a panel whose values are below
     :data:`ROUNDING_SPAN` of its scale is rounding, zero for a reader.
     """
-    force = max((float(np.nanmax(np.abs(v), initial=0.0)) for v in
-                 (*analysis.reactions.ground.values(),
-                  *analysis.reactions.slider_normal.values())), default=0.0)
+    force = analysis.reactions.largest_force()
     moment = force * analysis.mechanism.structure.length_scale()
     return {"force": force, "couple": moment, "moment": moment, "torque": moment,
             "mount": moment}
@@ -543,9 +481,7 @@ def _drawn_within(analyses: Sequence[CycleAnalysis], tolerance: float) -> bool:
     relative to the panel's span over all the analyses (floored at :data:`ROUNDING_SPAN` of
     its natural scale).
     """
-    force_scale = max(max((float(np.nanmax(np.abs(v), initial=0.0)) for v in
-                           (*a.reactions.ground.values(), *a.reactions.slider_normal.values())),
-                          default=0.0) for a in analyses)
+    force_scale = max(a.reactions.largest_force() for a in analyses)
     length = analyses[0].mechanism.structure.length_scale()
     keys = panel_keys(*analyses)
     panels = [drawn_panels(a, keys) for a in analyses]

@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 from balancer import cycle
 from balancer.errors import AssemblyError
+from balancer.linkage.loads import Reactions
 from balancer.mechanisms.fourbar import inverse
 from balancer.mechanisms.fourbar import kinematics as kin
 from balancer.mechanisms.fourbar import massmodels as mm
@@ -58,9 +59,9 @@ def _fd_tolerance(error: float, *terms) -> float:
     return error + ROUNDING / FD_MARGIN * max(float(np.max(np.abs(t))) for t in terms)
 
 
-def _scale(r: inverse.ChainReactions) -> dict[str, float]:
+def _scale(r: Reactions) -> dict[str, float]:
     return {
-        "force": max(np.max(np.abs(r.RA0)), np.max(np.abs(r.RA3)), 1.0),
+        "force": max(np.max(np.abs(r.ground["A0"])), np.max(np.abs(r.ground["A3"])), 1.0),
         "moment": max(np.max(np.abs(r.shaking_moment)), np.max(np.abs(r.driving_torque)), 1.0),
     }
 
@@ -72,8 +73,8 @@ def test_newton_euler_and_mass_matrix_routes_agree(linkage, t, w, a, g):
     ne = inverse.newton_euler(linkage, mo, gravity=g)
     mx = inverse.mass_matrix(linkage, mo, gravity=g)
     s = _scale(ne)
-    assert rel_err(ne.RA0, mx.RA0, scale=s["force"]) < 1e-9
-    assert rel_err(ne.RA3, mx.RA3, scale=s["force"]) < 1e-9
+    assert rel_err(ne.ground["A0"], mx.ground["A0"], scale=s["force"]) < 1e-9
+    assert rel_err(ne.ground["A3"], mx.ground["A3"], scale=s["force"]) < 1e-9
     assert rel_err(ne.driving_torque, mx.driving_torque, scale=s["moment"]) < 1e-9
     assert rel_err(ne.shaking_moment, mx.shaking_moment, scale=s["moment"]) < 1e-9
 
@@ -97,7 +98,8 @@ def test_routes_agree_for_every_grashof_class(name, branch):
     ne = inverse.newton_euler(linkage, mo, gravity=(0.0, -9.81))
     mx = inverse.mass_matrix(linkage, mo, gravity=(0.0, -9.81))
     s = _scale(ne)
-    for x, y, key in ((ne.RA0, mx.RA0, "force"), (ne.RA3, mx.RA3, "force"),
+    for x, y, key in ((ne.ground["A0"], mx.ground["A0"], "force"),
+                      (ne.ground["A3"], mx.ground["A3"], "force"),
                       (ne.driving_torque, mx.driving_torque, "moment"),
                       (ne.shaking_moment, mx.shaking_moment, "moment")):
         assert rel_err(x, y, scale=s[key]) < 1e-9
@@ -135,7 +137,7 @@ def test_shaking_force_is_loads_minus_rate_of_linear_momentum(linkage, t, w, a, 
             scale=_momentum_terms(linkage, traj(0.0)))
         loads = sum(c.force_complex + c.mass * complex(*g) for c in linkage.links)
         expected = loads - dp
-        tol = _fd_tolerance(error, r.RA0, r.RA3, loads, dp)
+        tol = _fd_tolerance(error, r.ground["A0"], r.ground["A3"], loads, dp)
         assert np.max(np.abs(r.shaking_force - expected)) < tol
 
 
@@ -173,7 +175,8 @@ def test_shaking_moment_is_load_moment_minus_rate_of_angular_momentum(linkage, t
         )
         expected = load_moment - dh
         arm = max(linkage.lengths)  # the moments' terms: forces times lever arms
-        tol = _fd_tolerance(error, arm * r.RA0, arm * r.RA3, r.driving_torque, load_moment, dh)
+        tol = _fd_tolerance(error, arm * r.ground["A0"], arm * r.ground["A3"], r.driving_torque,
+                            load_moment, dh)
         assert np.max(np.abs(r.shaking_moment - expected)) < tol
 
 
@@ -207,8 +210,8 @@ def test_force_balanced_paper_example_has_no_shaking_force():
         r = inverse.inverse_dynamics(linkage, mo, route=route)
         # Rounding: Eq. 57 is met to rounding and RA0 + RA3 cancels to ~ROUNDING·|R| times
         # the condition (|sin(θ3 − θ2)| ≥ 0.7 over the paper's revolution): ~2e-14·|R|.
-        assert np.max(np.abs(r.shaking_force)) < 1e-12 * np.max(np.abs(r.RA0))
-        assert np.max(np.abs(r.RA0)) > 1.0  # the individual reactions are far from zero
+        assert np.max(np.abs(r.shaking_force)) < 1e-12 * np.max(np.abs(r.ground["A0"]))
+        assert np.max(np.abs(r.ground["A0"])) > 1.0  # the individual reactions are far from zero
 
 
 def test_berkof_complete_balance_has_no_shaking_moment_at_any_motion():
@@ -232,7 +235,7 @@ def test_berkof_complete_balance_has_no_shaking_moment_at_any_motion():
         # Rounding, as above: the conditions hold to rounding, and the sums cancel to
         # ~ROUNDING·1.4 of their terms (reactions times lever arms, a few times the torque).
         scale = np.max(np.abs(r.driving_torque))
-        assert np.max(np.abs(r.shaking_force)) < 1e-12 * np.max(np.abs(r.RA0))
+        assert np.max(np.abs(r.shaking_force)) < 1e-12 * np.max(np.abs(r.ground["A0"]))
         assert np.max(np.abs(r.shaking_moment)) < 1e-12 * scale
 
 
@@ -306,10 +309,12 @@ def test_cycle_analysis_in_chunks_equals_one_evaluation_of_all_angles(paper, mon
     # An ulp of sin/cos carried through the analysis: ROUNDING times its condition.
     condition = 1 / np.min(np.abs(mo.pos.sin_transmission))
     r = ca.reactions
-    got = {"RA0": r.ground["A0"], "RA3": r.ground["A3"], "shaking_force": r.shaking_force,
-           "shaking_moment": r.shaking_moment, "driving_torque": r.driving_torque}
-    for name, values in got.items():
-        assert rel_err(values, getattr(whole, name)) < ROUNDING * condition, name
+    pairs = {"RA0": (r.ground["A0"], whole.ground["A0"]),
+             "RA3": (r.ground["A3"], whole.ground["A3"]),
+             **{name: (getattr(r, name), getattr(whole, name)) for name in
+                ("shaking_force", "shaking_moment", "driving_torque")}}
+    for name, (values, expected) in pairs.items():
+        assert rel_err(values, expected) < ROUNDING * condition, name
 
 
 def test_cycle_analysis_refuses_a_crank_that_cannot_turn():

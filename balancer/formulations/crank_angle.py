@@ -39,6 +39,7 @@ from ..errors import AssemblyError, SolverError
 from ..linkage import rotors
 from ..linkage.assembly import assembly_gaps
 from ..linkage.kinematics import numeric_table, positions, rates
+from ..linkage.loads import Reactions
 from ..linkage.numeric import TABLE_STEPS
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import Num, V
@@ -290,20 +291,21 @@ class CrankAngle(LinkageFormulation):
         theta = np.array([np.broadcast_to(np.asarray(mo.pose.angles[k], float), (count,))
                           + self.turns[k] for k in range(self.n)])
         theta[self.structure.input] = theta1
-        torque = forces.driving_torque[:, 0] if self.driven else np.zeros(count)
-        shaking_moment = forces.shaking_moment[:, 0]
+        loads = Reactions.of(forces)
+        torque = loads.driving_torque if self.driven else np.zeros(count)
+        shaking_moment = loads.shaking_moment
         if not self.driven:  # the free motion's motor exerts nothing: its rounding left out
-            shaking_moment = shaking_moment + forces.driving_torque[:, 0]
+            shaking_moment = shaking_moment + loads.driving_torque
         return Evaluation(
             theta=theta,
             omega=np.array([np.broadcast_to(np.asarray(w, float), (count,)) for w in mo.rate]),
             alpha=np.array([np.broadcast_to(np.asarray(a, float), (count,)) for a in mo.accel]),
-            ground={p: v.complex()[:, 0] for p, v in forces.reactions.items()},
+            ground=loads.ground,
             driving_torque=torque,
-            shaking_force=forces.shaking_force.complex()[:, 0],
+            shaking_force=loads.shaking_force,
             shaking_moment=shaking_moment,
-            slider_normal={k: v[:, 0] for k, v in forces.slider_normal.items()},
-            slider_couple={k: v[:, 0] for k, v in forces.slider_couple.items()})
+            slider_normal=loads.slider_normal,
+            slider_couple=loads.slider_couple)
 
     def energy(self, theta: NDArray[np.float64], omega: NDArray[np.float64],
                alpha: NDArray[np.float64], slider: NDArray[np.float64] | None = None,

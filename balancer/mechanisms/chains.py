@@ -2,18 +2,17 @@
 
 The four-bar's (Meijaard & van der Wijk 2020; Bai, Xia & Ge 2024) and the slider-crank's
 (Wunderlich 1964) closed forms: the tolerance at which a closed-form position counts as singular,
-what their inverse dynamics give the frame (:class:`ChainReactions`), and the common ground of their
-formulations of the equations of motion: :class:`ClosedForm` (the lengths, the links as the
-dynamics see them, the loads with the weights, the centres of mass as fractions of the link
-vectors ``ζk = s̄k/lk``) and :class:`NodalTruss` (truss elements with moving nodes A1 and A2,
-Eq. 41–55).
+and the common ground of their formulations of the equations of motion: :class:`ClosedForm` (the
+lengths, the links as the dynamics see them, the loads with the weights, the centres of mass as
+fractions of the link vectors ``ζk = s̄k/lk``) and :class:`NodalTruss` (truss elements with
+moving nodes A1 and A2, Eq. 41–55). Their inverse dynamics give the frame's loads as the
+general core's record, :class:`~balancer.linkage.loads.Reactions`.
 """
 
 from __future__ import annotations
 
 import math
 from abc import abstractmethod
-from dataclasses import dataclass
 from typing import ClassVar, TypeAlias
 
 import numpy as np
@@ -27,39 +26,6 @@ from .formulation import Formulation
 
 #: |sin(θ3 − θ2)| below which a position is flagged as (near) a dead or change point.
 SINGULAR_TOLERANCE = 1e-6
-
-
-@dataclass(frozen=True)
-class ChainReactions:
-    """What the linkage exerts on its frame at each state.
-
-    Attributes
-    ----------
-    RA0, RA3
-        Forces of the mechanism on the ground at A0 and A3, complex ``x + i·y``, N.
-    driving_torque
-        Torque of the motor on the crank, N·m (its reaction on the ground is the opposite).
-    shaking_moment
-        Moment about A0 of everything the mechanism exerts on the ground, N·m.
-    shaking_force
-        The sum of the forces on the frame, N: ``R̄A0 + R̄A3`` for a four-bar (computed from
-        them when not given).
-    guide_couple
-        For a slider-crank, whose R̄A3 is the slider's normal force on its guide: the couple
-        of the slider on its guide about the slider's pin, N·m (``None`` for a four-bar).
-    """
-
-    RA0: NDArray[np.complex128]
-    RA3: NDArray[np.complex128]
-    driving_torque: NDArray[np.float64]
-    shaking_moment: NDArray[np.float64]
-    # None (only as an argument) is replaced by RA0 + RA3 in __post_init__: never None after.
-    shaking_force: NDArray[np.complex128] = None  # type: ignore[assignment]  # see above
-    guide_couple: NDArray[np.float64] | None = None
-
-    def __post_init__(self) -> None:
-        if self.shaking_force is None:
-            object.__setattr__(self, "shaking_force", self.RA0 + self.RA3)
 
 
 class ClosedForm(Formulation):

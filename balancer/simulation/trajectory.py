@@ -19,6 +19,7 @@ from ..formulations import (
     Formulation,
     continuous_angles,
 )
+from ..linkage.loads import Reactions
 from ..mechanisms import mechanism_of
 from ..model import Drive
 from ..model import MechanismModel as Model
@@ -43,19 +44,11 @@ class Trajectory:
     theta, omega, alpha
         Link angles (rad, continuous from their initial values), angular velocities (rad/s)
         and accelerations (rad/s²), each of shape ``(links, n)``.
-    ground
-        Force of the mechanism on the ground at each ground point, complex, N.
-    slider_normal, slider_couple
-        For each slider on a ground guide (keyed by the sliding link): the normal force on the
-        guide (N) and its couple about the slider's point (N·m).
-    driving_torque
-        Motor torque on the crank, N·m (zero in free motion).
-    shaking_force, shaking_moment
-        Sum of the forces on the frame (N) and their moment about the origin with the motor's
-        reaction and the counter-rotors' (N·m).
-    rocking_couple
-        The couple about ``x`` and ``y`` on the frame from links in planes along the crank's
-        axis, complex ``Mx + i·My``, N·m (zero for a mechanism in one plane).
+    reactions
+        What the mechanism does to its frame at the output times: the forces at the ground
+        points, the sliders' on their ground guides, the shaking force and moment, the rocking
+        couple and the motor's torque on the crank (zero in free motion); each also an
+        attribute of the trajectory itself (:attr:`ground`, :attr:`shaking_force`, …).
     kinetic_energy
         Kinetic energy of the moving parts, counter-rotors included, J.
     work
@@ -91,13 +84,7 @@ class Trajectory:
     theta: NDArray[np.float64]
     omega: NDArray[np.float64]
     alpha: NDArray[np.float64]
-    ground: dict[str, NDArray[np.complex128]]
-    slider_normal: dict[str, NDArray[np.float64]]
-    slider_couple: dict[str, NDArray[np.float64]]
-    driving_torque: NDArray[np.float64]
-    shaking_force: NDArray[np.complex128]
-    shaking_moment: NDArray[np.float64]
-    rocking_couple: NDArray[np.complex128]
+    reactions: Reactions
     kinetic_energy: NDArray[np.float64]
     work: NDArray[np.float64]
     energy_error: float
@@ -118,8 +105,50 @@ class Trajectory:
                 f"{self.energy_error:.2g})")
 
     @property
+    def ground(self) -> dict[str, NDArray[np.complex128]]:
+        """Force of the mechanism on the ground at each ground point, complex, N."""
+        return self.reactions.ground
+
+    @property
+    def slider_normal(self) -> dict[str, NDArray[np.float64]]:
+        """For each slider on a ground guide (by the sliding link): its normal force on it, N."""
+        return self.reactions.slider_normal
+
+    @property
+    def slider_couple(self) -> dict[str, NDArray[np.float64]]:
+        """For each slider on a ground guide: its couple about the slider's point, N·m."""
+        return self.reactions.slider_couple
+
+    @property
+    def driving_torque(self) -> NDArray[np.float64]:
+        """Motor torque on the crank, N·m (zero in free motion)."""
+        return self.reactions.driving_torque
+
+    @property
+    def shaking_force(self) -> NDArray[np.complex128]:
+        """Sum of the forces on the frame, complex, N."""
+        return self.reactions.shaking_force
+
+    @property
+    def shaking_moment(self) -> NDArray[np.float64]:
+        """Their moment about the origin with the motor's reaction and the counter-rotors', N·m."""
+        return self.reactions.shaking_moment
+
+    @property
+    def rocking_couple(self) -> NDArray[np.complex128]:
+        """The couple about ``x`` and ``y`` from links in planes along the crank's axis, N·m.
+
+        Complex ``Mx + i·My``; zero for a mechanism in one plane.
+        """
+        return self.reactions.rocking_couple
+
+    @property
     def largest_reaction(self) -> float:
-        """Largest magnitude of any force on the frame over the run, N (0 if none)."""
+        """Largest magnitude of any force on the frame over the run, N (0 if none).
+
+        (A state that does not exist, NaN, makes it NaN: unlike a cycle analysis' samples at a
+        change point, a simulation's are all states of its motion.)
+        """
         values = [np.max(np.abs(v), initial=0.0) for v in (
             *self.ground.values(), *self.slider_normal.values())]
         return float(max(values, default=0.0))
@@ -198,17 +227,18 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
         theta=theta,
         omega=omega,
         alpha=alpha,
-        # (numpy's stubs type a complex array times a real one as real)
-        ground=ground,
-        slider_normal={k: np.asarray(v, float) * np.ones(t.size)
-                       for k, v in ev.slider_normal.items()},
-        slider_couple={k: np.asarray(v, float) * np.ones(t.size)
-                       for k, v in ev.slider_couple.items()},
-        driving_torque=tau,
-        shaking_force=cast("NDArray[np.complex128]",
-                           np.asarray(shaking_force, complex) * np.ones(t.size)),
-        shaking_moment=np.asarray(moment, float) * np.ones(t.size),
-        rocking_couple=rocking,
+        reactions=Reactions(
+            ground=ground,
+            slider_normal={k: np.asarray(v, float) * np.ones(t.size)
+                           for k, v in ev.slider_normal.items()},
+            slider_couple={k: np.asarray(v, float) * np.ones(t.size)
+                           for k, v in ev.slider_couple.items()},
+            driving_torque=tau,
+            # (numpy's stubs type a complex array times a real one as real)
+            shaking_force=cast("NDArray[np.complex128]",
+                               np.asarray(shaking_force, complex) * np.ones(t.size)),
+            shaking_moment=np.asarray(moment, float) * np.ones(t.size),
+            rocking_couple=rocking),
         kinetic_energy=kin,
         work=work,
         energy_error=energy_error,

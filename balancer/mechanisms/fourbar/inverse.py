@@ -29,17 +29,18 @@ Everything is vectorised over the states of a
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ...linkage import rotors
+from ...linkage.loads import Reactions
 from ...linkage.massmodels import equivalent_inertia_forces, equivalent_joint_forces
 from ...linkage.rotors import dynamic_link
 from ...linkage.vectors import cross
 from ...model import Link
-from ..chains import ChainReactions
 from .assembly import Lengths
 from .kinematics import FourBarMotion, change_point_angles
 from .model import FourBar
@@ -76,6 +77,19 @@ def _applied_forces(linkage: FourBar, gravity: complex, loads: bool) -> list[com
     ]
 
 
+def _reactions(ra0: NDArray[np.complex128], ra3: NDArray[np.complex128],
+               tau: NDArray[np.float64], moment: NDArray[np.float64],
+               shaking: NDArray[np.complex128]) -> Reactions:
+    """The frame loads of the forces at the pivots, the torque, the moment and the shaking force.
+
+    ``R̄A0`` and ``R̄A3`` the ground's entries, the shaking moment about A0 (the origin); the
+    rocking couple zero (the closed forms work in the plane).
+    """
+    return Reactions(ground={"A0": ra0, "A3": ra3}, slider_normal={}, slider_couple={},
+                     shaking_force=shaking, shaking_moment=moment, driving_torque=tau,
+                     rocking_couple=np.zeros(np.shape(tau), complex))
+
+
 def _counter_rotor_moment(linkage: FourBar, mo: FourBarMotion) -> NDArray[np.float64] | float:
     """Reaction moment of the counter-rotors' gear trains on the ground, ``2·Σ Jk·αk``, N·m."""
     total: NDArray[np.float64] | float = 0.0
@@ -91,7 +105,7 @@ def newton_euler(
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
-) -> ChainReactions:
+) -> Reactions:
     """Reactions, driving torque and shaking moment from the links' free-body equations.
 
     Pin forces: ``P̄0`` ground on crank at A0, ``P̄1`` crank on coupler at A1, ``P̄2`` coupler on
@@ -138,11 +152,11 @@ def newton_euler(
     ra0 = -p0
     ra3 = -p3
     moment = linkage.lengths[3] * ra3.imag - tau + _counter_rotor_moment(linkage, mo)
-    return ChainReactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment)
+    return _reactions(ra0, ra3, tau, moment, ra0 + ra3)
 
 
 def _combine_nodal_forces(mo: FourBarMotion, nodes: Sequence[NDArray[np.complex128]],
-                          l4: float) -> ChainReactions:
+                          l4: float) -> Reactions:
     """Reactions from nodal forces ``G_n`` at A0…A3 by length-keeping virtual displacements.
 
     The counter-rotors' gear reaction on the ground is not included.
@@ -156,9 +170,7 @@ def _combine_nodal_forces(mo: FourBarMotion, nodes: Sequence[NDArray[np.complex1
     ra3 = g3 + v3 * cross(v2, g2) / cross(v2, v3)  # A3 moved, A0 and A1 held
     ra0 = shaking - ra3
     moment = cross(v1, g1) + cross(mo.pos.A2, g2) + l4 * g3.imag  # rotation about A0
-    return ChainReactions(
-        RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment, shaking_force=shaking
-    )
+    return _reactions(ra0, ra3, tau, moment, shaking)
 
 
 def _inertial_nodal_forces(params: Sequence[float], lengths: Sequence[float], mo: FourBarMotion,
@@ -176,7 +188,7 @@ def mass_matrix(
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
-) -> ChainReactions:
+) -> Reactions:
     """Reactions, driving torque and shaking moment from the equivalent mass matrices (Eq. 45–54).
 
     The nodal forces ``G_n = F_n − (M·r̈)_n`` at the joints A0…A3 (Eq. 45–46, 48–49, 53–54)
@@ -210,13 +222,7 @@ def mass_matrix(
     r = _combine_nodal_forces(mo, nodes, linkage.lengths[3])
     cr = _counter_rotor_moment(linkage, mo)
     if np.any(cr):
-        r = ChainReactions(
-            RA0=r.RA0,
-            RA3=r.RA3,
-            driving_torque=r.driving_torque,
-            shaking_moment=r.shaking_moment + cr,
-            shaking_force=r.shaking_force,
-        )
+        r = replace(r, shaking_moment=r.shaking_moment + cr)
     return r
 
 
@@ -230,7 +236,7 @@ def inverse_dynamics(
     route: Route = "newton-euler",
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
-) -> ChainReactions:
+) -> Reactions:
     """Reactions of the four-bar for a prescribed motion by the chosen ``route``."""
     try:
         fn = _ROUTE_FUNCTIONS[route]

@@ -198,7 +198,7 @@ class LieGroup(FourBarFormulation):
         mo = motion_from_angles(self.lengths, tuple(theta), tuple(omega), tuple(alpha))
         ne = newton_euler(self.linkage, mo, gravity=(self.gravity.real, self.gravity.imag))
         return Evaluation(theta=theta, omega=omega, alpha=alpha,
-                          ground={"A0": ne.RA0, "A3": ne.RA3}, driving_torque=tau)
+                          ground=ne.ground, driving_torque=tau)
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         """The crank angle, continuous along the motion (:meth:`continuous_crank`).

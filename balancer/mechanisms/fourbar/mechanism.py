@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 from collections import OrderedDict
 from functools import cached_property, lru_cache
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -206,17 +205,7 @@ class FourBarMechanism(Mechanism):
                             gravity: tuple[float, float]) -> Forces:
         route_fn = mass_matrix if (route or self.routes[0]) == "mass-matrix" else newton_euler
         r = route_fn(self.model, mo, gravity=gravity, loads=loads)
-        def col(z: ArrayLike) -> NDArray[Any]:
-            return np.asarray(z)[:, None]
-
-        return Forces(
-            reactions={"A0": V(col(r.RA0.real), col(r.RA0.imag)),
-                       "A3": V(col(r.RA3.real), col(r.RA3.imag))},
-            slider_normal={}, slider_couple={},
-            driving_torque=col(r.driving_torque),
-            shaking_force=V(col(r.shaking_force.real), col(r.shaking_force.imag)),
-            shaking_moment=col(r.shaking_moment),
-            rocking_couple=self._rocking_couple(mo, loads, gravity))
+        return r.forces(rocking_couple=self._rocking_couple(mo, loads, gravity))
 
     def _rocking_couple(self, mo: fourbar.FourBarMotion, loads: bool,
                         gravity: tuple[float, float]) -> V:

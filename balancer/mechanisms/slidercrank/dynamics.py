@@ -22,16 +22,17 @@ Routes:
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ...linkage import rotors
+from ...linkage.loads import Reactions
 from ...linkage.massmodels import equivalent_inertia_forces, equivalent_joint_forces
 from ...linkage.rotors import dynamic_link
 from ...linkage.vectors import cross
 from ...model import Link
-from ..chains import ChainReactions
 from .kinematics import Lengths, SliderMotion
 from .model import SliderCrank
 
@@ -48,18 +49,24 @@ def _loads(mech: SliderCrank, mo: SliderMotion, gravity: complex, loads: bool
 def _finish(mech: SliderCrank, mo: SliderMotion, ra0: NDArray[np.complex128],
             n_guide: NDArray[np.float64], m_guide: NDArray[np.float64],
             tau: NDArray[np.float64], gas: NDArray[np.float64],
-            shaking: NDArray[np.complex128], alpha1: NDArray[np.float64]) -> ChainReactions:
+            shaking: NDArray[np.complex128], alpha1: NDArray[np.float64]) -> Reactions:
     """Frame loads from the pin and guide forces, the motor torque and the gas force.
 
-    The guide's normal force and couple are those on the slider.
+    ``n_guide`` and ``m_guide`` are the guide's normal force and couple on the slider; the
+    record carries the slider's on its guide (``R̄A3 = −i·N``: the normal force
+    ``Im R̄A3``), under the slider's link name, and the force ``R̄A0`` at A0. The rocking couple
+    is zero (the closed forms work in the plane).
     """
     h = mech.lengths[2]
     ra3 = np.asarray(-1j * n_guide, dtype=complex)  # the slider on its guide
     moment = -mo.x * n_guide - m_guide + h * gas - tau
     if mech.crank.counter_rotor:
         moment = moment + rotors.ground_couple(mech.crank.counter_rotor, alpha1)
-    return ChainReactions(RA0=ra0, RA3=ra3, driving_torque=tau, shaking_moment=moment,
-                          shaking_force=shaking, guide_couple=-m_guide + 0 * mo.x)
+    slider = mech.chain_links[2]
+    return Reactions(ground={"A0": ra0}, slider_normal={slider: np.imag(ra3)},
+                     slider_couple={slider: -m_guide + 0 * mo.x}, shaking_force=shaking,
+                     shaking_moment=moment, driving_torque=tau,
+                     rocking_couple=np.zeros(np.shape(tau), complex))
 
 
 def newton_euler(
@@ -68,7 +75,7 @@ def newton_euler(
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
-) -> ChainReactions:
+) -> Reactions:
     """Frame loads from the free-body equations of slider, rod and crank.
 
     Pin forces: ``P̄0`` ground on crank, ``P̄1`` crank on rod, ``P̄2`` rod on slider. The slider's
@@ -145,7 +152,7 @@ def mass_matrix(
     *,
     gravity: tuple[float, float] = (0.0, 0.0),
     loads: bool = True,
-) -> ChainReactions:
+) -> Reactions:
     """Frame loads from the equivalent mass matrices (Eq. 45–46) by virtual displacements.
 
     Crank and rod as truss elements, the slider a mass at its pin (see the module docstring).
@@ -172,9 +179,7 @@ def mass_matrix(
                                                   slider_moment, rotor)
     m_guide = -slider_moment
     reactions = _finish(mech, mo, ra0, n_guide, m_guide, tau, gas, shaking, mo.alpha[0])
-    return ChainReactions(RA0=reactions.RA0, RA3=reactions.RA3, driving_torque=tau,
-                          shaking_moment=moment, shaking_force=shaking,
-                          guide_couple=reactions.guide_couple)
+    return replace(reactions, shaking_moment=moment)
 
 
 ROUTES = {"newton-euler": newton_euler, "mass-matrix": mass_matrix}
@@ -182,7 +187,7 @@ ROUTES = {"newton-euler": newton_euler, "mass-matrix": mass_matrix}
 
 def inverse_dynamics(mech: SliderCrank, mo: SliderMotion, *, route: str = "newton-euler",
                      gravity: tuple[float, float] = (0.0, 0.0), loads: bool = True
-                     ) -> ChainReactions:
+                     ) -> Reactions:
     """Frame loads of the slider-crank for a prescribed motion by the chosen ``route``."""
     try:
         fn = ROUTES[route]

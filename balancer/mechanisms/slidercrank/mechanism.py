@@ -10,15 +10,13 @@ from __future__ import annotations
 
 import math
 from functools import cached_property
-from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from ...linkage.dynamics import Forces
 from ...linkage.kinematics import Motion
 from ...linkage.structure import Structure
-from ...linkage.vectors import V
 from ...model import Body, Branch, Linkage, Slider
 from ...model.assembly import AssemblyRange
 from ..base import Mechanism, Route, piston_block
@@ -109,18 +107,7 @@ class SliderCrankMechanism(Mechanism):
             return super().inverse_dynamics(mo, route=route, loads=loads, gravity=gravity)
         smo = closed.motion_of(self.model, mo.theta1, mo.omega1, mo.alpha1)
         r = mass_matrix(self.model, smo, gravity=gravity, loads=loads)
-        assert r.guide_couple is not None  # a slider-crank's reactions carry it
-        def col(z: ArrayLike) -> NDArray[Any]:
-            return np.asarray(z)[:, None] * np.ones((mo.theta1.size, 1))
-
-        return Forces(
-            reactions={"A0": V(col(np.real(r.RA0)), col(np.imag(r.RA0)))},
-            slider_normal={"slider": col(np.imag(r.RA3))},
-            slider_couple={"slider": col(r.guide_couple)},
-            driving_torque=col(r.driving_torque),
-            shaking_force=V(col(np.real(r.shaking_force)), col(np.imag(r.shaking_force))),
-            shaking_moment=col(r.shaking_moment),
-            rocking_couple=self.rocking_couple(mo, loads=loads, gravity=gravity))
+        return r.forces(rocking_couple=self.rocking_couple(mo, loads=loads, gravity=gravity))
 
 
 #: The class the registry builds for this folder (:data:`balancer.mechanisms.FOLDERS`).

@@ -1,0 +1,142 @@
+"""What a mechanism does to its frame at a set of states: one record, :class:`Reactions`.
+
+The cycle analysis, a simulation's trajectory and the seeds' closed forms all give their
+frame loads as this record. The core's arithmetic forms stay beside it:
+:class:`~balancer.linkage.dynamics.Forces` (columns of vectors, on numpy arrays or CasADi
+symbols, for designs or parameters) and :class:`~balancer.linkage.dynamics.Shaking` (linear
+maps of the design vector); :meth:`Reactions.of` is the one conversion from forces to the
+record, :meth:`Reactions.forces` the record's arrays seen as forces.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .dynamics import Forces
+from .vectors import V
+
+
+@dataclass(frozen=True)
+class Reactions:
+    """What the mechanism exerts on its frame at each sample (arrays of shape ``(N,)``).
+
+    The package's one numeric record of the frame's loads; the core computes them as
+    :class:`~balancer.linkage.dynamics.Forces` (on numpy arrays or CasADi symbols) and
+    :class:`~balancer.linkage.dynamics.Shaking` (maps of the design vector), and
+    :meth:`of` makes this record of forces.
+
+    Attributes
+    ----------
+    ground
+        Force on the ground at each ground point, complex ``x + i·y``, N.
+    slider_normal, slider_couple
+        Normal force (N) and couple (N·m) of each slider on a ground guide, by link.
+    shaking_force
+        Sum of all forces on the frame, complex, N.
+    shaking_moment
+        Their moment about the origin, with the motor's reaction and counter-rotors, N·m.
+    driving_torque
+        Torque of the motor on the input, N·m.
+    rocking_couple
+        The couple about ``x`` and ``y`` from links in planes along the crank's axis, complex
+        ``Mx + i·My``, N·m (zero for a mechanism in one plane).
+    """
+
+    ground: dict[str, NDArray[np.complex128]]
+    slider_normal: dict[str, NDArray[np.float64]]
+    slider_couple: dict[str, NDArray[np.float64]]
+    shaking_force: NDArray[np.complex128]
+    shaking_moment: NDArray[np.float64]
+    driving_torque: NDArray[np.float64]
+    rocking_couple: NDArray[np.complex128]
+
+    @classmethod
+    def of(cls, forces: Forces, column: int = 0) -> Reactions:
+        """The loads of one column of the core's ``forces`` (arrays ``(N, C)``), at its states."""
+        def real(a: Any) -> NDArray[np.float64]:
+            return np.asarray(a)[:, column]
+
+        def vector(v: V) -> NDArray[np.complex128]:
+            return np.asarray(v.complex())[:, column]
+
+        return cls(ground={p: vector(v) for p, v in forces.reactions.items()},
+                   slider_normal={k: real(v) for k, v in forces.slider_normal.items()},
+                   slider_couple={k: real(v) for k, v in forces.slider_couple.items()},
+                   shaking_force=vector(forces.shaking_force),
+                   shaking_moment=real(forces.shaking_moment),
+                   driving_torque=real(forces.driving_torque),
+                   rocking_couple=vector(forces.rocking_couple))
+
+    @classmethod
+    def empty(cls, n: int, ground_points: Iterable[str], sliders: Iterable[str]) -> Reactions:
+        """Uninitialised arrays for ``n`` states at these ground points and ground sliders."""
+        sliders = tuple(sliders)
+        return cls(ground={p: np.empty(n, complex) for p in ground_points},
+                   slider_normal={k: np.empty(n) for k in sliders},
+                   slider_couple={k: np.empty(n) for k in sliders},
+                   shaking_force=np.empty(n, complex), shaking_moment=np.empty(n),
+                   driving_torque=np.empty(n), rocking_couple=np.empty(n, complex))
+
+    def arrays(self) -> list[NDArray[Any]]:
+        """Every array of the record (the ground points' and sliders' first)."""
+        return [*self.ground.values(), *self.slider_normal.values(),
+                *self.slider_couple.values(), self.shaking_force, self.shaking_moment,
+                self.driving_torque, self.rocking_couple]
+
+    @property
+    def size(self) -> int:
+        """Number of states."""
+        return int(np.prod(np.broadcast_shapes(*(np.shape(a) for a in self.arrays()))))
+
+    def at(self, where: Any) -> Reactions:
+        """The loads at states ``where`` (an index array, a mask or a slice: views for a slice)."""
+        def pick(a: Any) -> Any:
+            return np.asarray(a)[where]
+
+        return Reactions(ground={p: pick(v) for p, v in self.ground.items()},
+                         slider_normal={k: pick(v) for k, v in self.slider_normal.items()},
+                         slider_couple={k: pick(v) for k, v in self.slider_couple.items()},
+                         shaking_force=pick(self.shaking_force),
+                         shaking_moment=pick(self.shaking_moment),
+                         driving_torque=pick(self.driving_torque),
+                         rocking_couple=pick(self.rocking_couple))
+
+    def forces(self, rocking_couple: V | None = None) -> Forces:
+        """The record as the core's forces of one column, ``(N, 1)``.
+
+        Views of the record's arrays (what is written there is the record's) where they have
+        all ``N`` states; an array given for fewer (a constant) is broadcast, read-only.
+        ``rocking_couple``: forces' own couple instead of the record's.
+        """
+        n = self.size
+
+        def real(a: Any) -> NDArray[np.float64]:
+            a = np.asarray(a)
+            return (a if a.shape == (n,) else np.broadcast_to(a, (n,)))[:, None]
+
+        def vector(a: NDArray[np.complex128]) -> V:
+            a = np.asarray(a)
+            return V(real(a.real), real(a.imag))
+
+        return Forces(reactions={p: vector(v) for p, v in self.ground.items()},
+                      slider_normal={k: real(v) for k, v in self.slider_normal.items()},
+                      slider_couple={k: real(v) for k, v in self.slider_couple.items()},
+                      driving_torque=real(self.driving_torque),
+                      shaking_force=vector(self.shaking_force),
+                      shaking_moment=real(self.shaking_moment),
+                      rocking_couple=(vector(self.rocking_couple) if rocking_couple is None
+                                      else rocking_couple))
+
+    def largest_force(self) -> float:
+        """The largest force on the frame at one ground point or guide, N (0 for neither).
+
+        The magnitudes of the forces at the ground points and the sliders' normal forces on
+        their guides, states that do not exist (NaN) left out.
+        """
+        return max((float(np.nanmax(np.abs(v), initial=0.0)) for v in
+                    (*self.ground.values(), *self.slider_normal.values())), default=0.0)
