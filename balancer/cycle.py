@@ -36,6 +36,7 @@ from .mechanisms import mechanism_of
 from .mechanisms.base import KERNEL_STATES, Mechanism, Route
 from .model import MechanismModel as Model
 from .orders import Order, order_table
+from .quantities import FRAME_LOADS
 from .rounding import speed_text
 
 #: Number of crank angles evaluated at once.
@@ -128,19 +129,13 @@ class CycleSummary:
         return max(values, default=0.0)
 
     def as_dict(self) -> dict[str, dict[str, float]]:
-        """The fixed figures with their JSON names (the rocking couple's: its magnitude).
+        """The frame loads' figures with their JSON names (the rocking couple's: its magnitude).
 
-        An engine's ``mount_torque`` too.
+        Those of :data:`balancer.quantities.FRAME_LOADS` the summary has (an engine's
+        ``mount_torque`` too), in its order.
         """
-        out = {
-            "shaking_force": self.shaking_force.as_dict(),
-            "shaking_moment": self.shaking_moment.as_dict(),
-            "driving_torque": self.driving_torque.as_dict(),
-            "rocking_couple": self.rocking_couple.as_dict(),
-        }
-        if self.mount_torque is not None:
-            out["mount_torque"] = self.mount_torque.as_dict()
-        return out
+        figures = ((q.key, getattr(self, q.key)) for q in FRAME_LOADS)
+        return {key: figure.as_dict() for key, figure in figures if figure is not None}
 
 
 @dataclass(frozen=True)
