@@ -240,3 +240,13 @@ def test_the_spec_reader_and_writer_ask_no_mechanism_what_it_is():
             folders = {t for t in targets if t.startswith("mechanisms.")
                        and t.count(".") >= 1 and not t.startswith("mechanisms.base")}
             assert not folders, f"balancer.{name} imports {sorted(folders)}"
+
+
+#: The most lines a module may have: one concept each (issue 41).
+MODULE_LINES = 800
+
+
+def test_no_module_is_over_800_lines():
+    long = {name: n for name, path in modules().items()
+            if (n := len(path.read_text(encoding="utf-8").splitlines())) > MODULE_LINES}
+    assert not long, f"modules over {MODULE_LINES} lines: {long}"
