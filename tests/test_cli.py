@@ -246,7 +246,11 @@ _NOT_FOR_A_FOURBAR = ("balancer.mechanisms.engine", "balancer.mechanisms.sliderc
                       "balancer.balance", "balancer.model.balance", "balancer.spec.balance",
                       "balancer.linkage.program", "balancer.linkage.kernel",
                       "balancer.report.balancing", "balancer.report.motion",
-                      "balancer.report.fronts", "balancer.simulation", "balancer.examples")
+                      "balancer.report.fronts", "balancer.simulation", "balancer.examples",
+                      "balancer.mechanisms.fourbar.opened_loop",
+                      "balancer.mechanisms.fourbar.lie_group",
+                      "balancer.mechanisms.fourbar.mass_matrix",
+                      "balancer.formulations")
 
 
 def test_analysing_a_fourbar_loads_its_folder_and_the_cycle_analysis_only():

@@ -88,7 +88,7 @@ def formulation_class(name: str, model: Model | Mechanism) -> type[Formulation]:
     if name not in names:
         raise SpecError(f"the {mech.kind} has no such formulation; choose from "
                         f"{', '.join(names)}", key="method", value=name)
-    own: type[Formulation] | None = mech.own_formulations.get(name)
+    own: type[Formulation] | None = mech.own_formulation(name)
     return own or GENERAL[name]
 
 

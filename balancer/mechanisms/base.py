@@ -15,6 +15,7 @@ registry.
 
 from __future__ import annotations
 
+import importlib
 import math
 import threading
 from collections.abc import Mapping
@@ -163,10 +164,12 @@ class Mechanism:
     presentation: ClassVar[Presentation] = Presentation()
     #: Inverse-dynamics routes (``analyze --route``), the default first.
     routes: ClassVar[tuple[Route, ...]] = ("newton-euler", "mass-matrix")
-    #: The mechanism's own formulations of the equations of motion by name, the default first
-    #: (classes of :class:`~balancer.mechanisms.formulation.Formulation`, in its folder): the
-    #: general ones (:mod:`balancer.formulations`) apply to every mechanism besides.
-    own_formulations: ClassVar[Mapping[str, Any]] = {}
+    #: The mechanism's own formulations of the equations of motion by name, the default first:
+    #: each a ``"module.Class"`` of its folder (a :class:`~balancer.mechanisms.formulation.
+    #: Formulation`), imported when asked for (:meth:`own_formulation`), so that analysing a
+    #: mechanism does not load its formulations. The general ones (:mod:`balancer.formulations`)
+    #: apply to every mechanism besides.
+    own_formulations: ClassVar[Mapping[str, str]] = {}
     #: The formulation a check by simulation uses: one the optimiser's route does not share.
     verify_method: ClassVar[str] = "multibody"
     #: The spec key that holds the geometry (named by errors about it).
@@ -280,6 +283,17 @@ class Mechanism:
         if self.assembly_range().full:
             return (*own, CRANK_ANGLE, MULTIBODY)
         return (*own, MULTIBODY, CRANK_ANGLE)
+
+    @classmethod
+    def own_formulation(cls, name: str) -> type[Any] | None:
+        """The class of its own formulation ``name`` (:attr:`own_formulations`), or ``None``."""
+        where = cls.own_formulations.get(name)
+        if where is None:
+            return None
+        module, _, attribute = where.rpartition(".")
+        folder = cls.__module__.rpartition(".")[0]
+        found: type[Any] = getattr(importlib.import_module(f"{folder}.{module}"), attribute)
+        return found
 
     def parameters(self) -> NDArray[np.float64]:
         """The design vector of the mechanism's own links (:attr:`layout`)."""

@@ -27,13 +27,9 @@ from ..base import Limit, Mechanism, Route
 from ..presentation import Presentation
 from . import kinematics as fourbar
 from .assembly import assembly_range, classify
-from .complex_masses import ComplexMasses
 from .conditions import force_balance_matrix
 from .inverse import change_point_limits, mass_matrix, newton_euler
-from .lie_group import LieGroup
-from .mass_matrix import MassMatrix
 from .model import FourBar
-from .opened_loop import OpenedLoop
 
 
 def fourbar_linkage(model: FourBar) -> Linkage:
@@ -94,8 +90,9 @@ class FourBarMechanism(Mechanism):
 
     model: FourBar
 
-    own_formulations = {"opened-loop": OpenedLoop, "complex-masses": ComplexMasses,
-                        "mass-matrix": MassMatrix, "lie-group": LieGroup}
+    own_formulations = {"opened-loop": "opened_loop.OpenedLoop",
+                        "complex-masses": "complex_masses.ComplexMasses",
+                        "mass-matrix": "mass_matrix.MassMatrix", "lie-group": "lie_group.LieGroup"}
     geometry_key = "mechanism.lengths"
     presentation = Presentation(force_balance_source="the conditions, Eq. 57–58,",
                                 named_states=False)

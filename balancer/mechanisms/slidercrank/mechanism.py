@@ -24,7 +24,6 @@ from ..presentation import Presentation
 from . import kinematics as closed
 from .conditions import force_balance_matrix
 from .dynamics import mass_matrix
-from .formulations import SliderComplexMasses, SliderMassMatrix
 from .model import SliderCrank
 
 
@@ -59,7 +58,8 @@ class SliderCrankMechanism(Mechanism):
 
     model: SliderCrank
 
-    own_formulations = {"mass-matrix": SliderMassMatrix, "complex-masses": SliderComplexMasses}
+    own_formulations = {"mass-matrix": "formulations.SliderMassMatrix",
+                        "complex-masses": "formulations.SliderComplexMasses"}
     verify_method = "complex-masses"
     geometry_key = "mechanism.lengths"
     #: The guide's force as the four-bar's R̄A3 (DESIGN.md's fixed CSV columns).
