@@ -538,3 +538,32 @@ def test_the_cad_libraries_are_not_loaded_by_analyze():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           check=True)
     assert done.stderr.strip().splitlines()[-1] == "[]"
+
+
+def test_the_six_bars_rings_are_exact_or_nearest_in_inertia_only():
+    """watt_sixbar_parts: each ring keeps the counterweight's mass and centre (exact where its
+    room holds the inertia too); the design as built is force-balanced, its shaking moment
+    the one of the links as built, analysed again."""
+    from balancer.parts.made import as_built
+
+    _, result, parts = parts_of("watt_sixbar_parts")
+    assert set(parts) == {"crank", "rocker", "pusher"}
+    assert parts["crank"].sized.exact and parts["pusher"].sized.exact
+    rocker = parts["rocker"]
+    assert not rocker.sized.exact and rocker.sized.limits == ("outer_radius",)
+    for part in parts.values():
+        t, m = part.sized.target, part.sized.made
+        assert m.mass == pytest.approx(t.mass, rel=1e-9)
+        assert abs(m.centre - t.centre) <= 1e-9 * abs(t.centre)
+        # the ring stands in its room, its inertia the largest it allows where it is short
+        ring = part.sized.profile
+        assert ring.outer <= part.sized.room.outer_radius * (1 + 1e-12)
+        assert ring.thickness <= part.sized.room.thickness * (1 + 1e-12)
+    ring = rocker.sized.profile
+    assert ring.outer == pytest.approx(rocker.sized.room.outer_radius, rel=1e-12)
+    assert rocker.moves[2] == pytest.approx(rocker.sized.made.inertia - rocker.sized.target.inertia,
+                                            rel=1e-9)
+    built = as_built(result, parts).summary
+    _, after = result.operating
+    assert built.shaking_force.rms <= 1e-9 * after.summary.shaking_moment.rms + 1e-9
+    assert built.shaking_moment.rms > after.summary.shaking_moment.rms  # less inertia than asked
