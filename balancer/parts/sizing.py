@@ -376,8 +376,11 @@ def _sector(room: Sector, target: MassProperties, pivot: complex
         a = alpha(ro)
         limits = ((low_limit,) if want < lo else ("outer_radius", "angle_deg")
                   if want > hi else ())
+        # (At the thickness limit by construction; a thin sector's α, from 1 − sin α/α, is
+        # known only to about ε/α², which would put it that far beyond.)
+        t = min(m / (rho * a * (ro * ro - ri * ri)), t_most)
         return AnnularSector(pivot=pivot, inner=ri, outer=ro, angle=2 * a, direction=direction,
-                             thickness=m / (rho * a * (ro * ro - ri * ri))), rho, limits
+                             thickness=t), rho, limits
     # Not even the mass and centre fit: the widest the room holds toward the centre.
     a = min(alpha(most), room.angle / 2) if g(most) > d else room.angle / 2
     t = t_most if math.isfinite(t_most) else m / (rho * a * (most * most - ri * ri))
