@@ -538,3 +538,72 @@ def test_the_cad_libraries_are_not_loaded_by_analyze():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           check=True)
     assert done.stderr.strip().splitlines()[-1] == "[]"
+
+
+def test_the_six_bars_rings_are_exact_or_nearest_in_inertia_only():
+    """watt_sixbar_parts: each ring keeps the counterweight's mass and centre (exact where its
+    room holds the inertia too); the design as built is force-balanced, its shaking moment
+    the one of the links as built, analysed again."""
+    from balancer.parts.made import as_built
+
+    _, result, parts = parts_of("watt_sixbar_parts")
+    assert set(parts) == {"crank", "rocker", "pusher"}
+    assert parts["crank"].sized.exact and parts["pusher"].sized.exact
+    rocker = parts["rocker"]
+    assert not rocker.sized.exact and rocker.sized.limits == ("outer_radius",)
+    for part in parts.values():
+        t, m = part.sized.target, part.sized.made
+        assert m.mass == pytest.approx(t.mass, rel=1e-9)
+        assert abs(m.centre - t.centre) <= 1e-9 * abs(t.centre)
+        # the ring stands in its room, its inertia the largest it allows where it is short
+        ring = part.sized.profile
+        assert ring.outer <= part.sized.room.outer_radius * (1 + 1e-12)
+        assert ring.thickness <= part.sized.room.thickness * (1 + 1e-12)
+    ring = rocker.sized.profile
+    assert ring.outer == pytest.approx(rocker.sized.room.outer_radius, rel=1e-12)
+    assert rocker.moves[2] == pytest.approx(rocker.sized.made.inertia - rocker.sized.target.inertia,
+                                            rel=1e-9)
+    built = as_built(result, parts).summary
+    _, after = result.operating
+    assert built.shaking_force.rms <= 1e-9 * after.summary.shaking_moment.rms + 1e-9
+    assert built.shaking_moment.rms > after.summary.shaking_moment.rms  # less inertia than asked
+
+
+def _pb1_parts_with(*edits: tuple[str, str]) -> str:
+    text = (ROOT / "examples" / "pb1_parts.toml").read_text()
+    for old, new in edits:
+        assert old in text
+        text = text.replace(old, new, 1)
+    return text
+
+
+def test_a_bound_the_room_narrowed_is_diagnosed_as_the_parts_room(tmp_path, capsys):
+    """Force balance out of reach: the diagnosis quotes the narrowed bound, says it is the
+    part's room's (naming the part's key) and what the spec wrote; one line, exit code 1."""
+    from balancer.cli import main
+    from balancer.parts.shapes import sector_reach, sinc
+
+    spec = tmp_path / "tight.toml"
+    spec.write_text(_pb1_parts_with(
+        ("radius = 0.5                      # m, its centre from A3", "radius = 2.0"),
+        ("mass = [0.01, 20.0]", "mass = [0.01, 3.0]"),
+        ("outer_radius = 0.9, angle_deg = 120.0", "outer_radius = 0.65, angle_deg = 120.0")))
+    assert main(["optimize", str(spec), "--no-verify", "--backend", "convex"]) == 1
+    err = capsys.readouterr().err.strip()
+    # the heaviest part's reach: a 3 kg sector at R 0.65 and 0.1 thick, by its closed form
+    half = 3.0 / (7850 * 0.1 * (0.65**2 - 0.3**2))
+    reach = sector_reach(0.3, 0.65) * sinc(half)
+    assert "\n" not in err
+    assert ("balance.rocker.counterweight.radius must be at least" in err
+            and f"(is {reach:.6g}: the reach of its part's room, "
+                "balance.rocker.counterweight.part, within the 2.0 written)" in err), err
+    # a ring too light for the crank: its mass bound is the room's
+    spec.write_text(_pb1_parts_with(
+        ("inner_radius = 0.01, outer_radius = 0.1, thickness = 0.06",
+         "inner_radius = 0.01, outer_radius = 0.05, thickness = 0.01")))
+    assert main(["optimize", str(spec), "--no-verify", "--backend", "convex"]) == 1
+    err = capsys.readouterr().err.strip()
+    most = 7850 * 0.01 * math.pi * (0.05**2 - 0.01**2)
+    assert ("balance.crank.counterweight.mass must allow up to" in err
+            and f"(is at most {most:.6g}: the most its part's room holds, "
+                "balance.crank.counterweight.part, of the 6.3 written)" in err), err

@@ -123,6 +123,8 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
     if mechanism == schema.ENGINE and "balance" not in data and (
             pattern.startswith("balance") or (pattern == "" and name == "balance")):
         data["balance"] = copy.deepcopy(ENGINE_BALANCE)
+    if pattern == "balance.counterweights.part":  # an engine's crank-web sector
+        data["balance"]["counterweights"]["part"] = dict(PARTS["sector"])
     if pattern == "links.<link>.gas_force":
         data["links"]["slider"]["gas_force"] = {"crank_angle": [0.0, 3.0], "force": [-1.0, 0.0]}
     table = data

@@ -236,6 +236,10 @@ class LinkBounds:
         fixed.
     on_line
         The centre of mass stays on the link's line: ``f = 0`` (``m·f`` is no variable).
+    room
+        The counterweight's bounds its part's room narrowed (``mass``, ``com_radius``,
+        ``min_gyration``), each with the value the spec wrote (kg, m): the diagnosis then
+        names the part (:meth:`room_written`).
     """
 
     name: str
@@ -257,11 +261,21 @@ class LinkBounds:
     default_about: str
     offset: tuple[float, float, float, float] | None = None
     on_line: bool = False
+    room: tuple[tuple[str, float], ...] = ()
 
     @property
     def key(self) -> str:
         """Spec key of the link's table, ``balance.<name>``."""
         return f"balance.{self.name}"
+
+    @property
+    def part_key(self) -> str:
+        """Spec key of its counterweight's part, ``balance.<name>.counterweight.part``."""
+        return f"{self.key}.counterweight.part"
+
+    def room_written(self, bound: str) -> float | None:
+        """The value the spec wrote for ``bound`` where the part's room narrowed it, else None."""
+        return dict(self.room).get(bound)
 
     @cached_property
     def line_span(self) -> tuple[float, float]:
@@ -408,11 +422,14 @@ def _resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> Li
             raise SpecError(f"the part's room holds at most {cw_mass[1]:.6g} kg, less than the "
                             "counterweight's least mass", key=f"balance.{name}.counterweight."
                             "part", value=cw.part.shape if cw.part is not None else None)
+        room = tuple((bound, written) for bound, written, now in (
+            ("mass", cw.mass[1], cw_mass[1]), ("com_radius", cw.radius, cw_radius),
+            ("min_gyration", cw.gyration, cw_gyration)) if now != written)
         return LinkBounds(
             **common, listed=True, mass=cw_mass, com_fixed=None, com_about=about,
             com_centre=mech.structure.local[(k, about)].complex(), com_radius=cw_radius,
             inertia=(0.0, math.inf), gyration=cw_gyration, counter_rotor=rotor,
-            offset=(m, me, mf, j),
+            offset=(m, me, mf, j), room=room,
         )  # fmt: skip
     mass = freedom.mass if freedom.mass is not None else (link.mass, link.mass)
     about = freedom.com_about or about_default

@@ -338,6 +338,10 @@ class Diagnosis:
                 words = (f"{key} must allow up to {v:.4g} kg (is at most {current:.6g}: "
                          f"{b.key}.inertia ≤ {b.inertia[1]:.6g} kg·m² with min_gyration "
                          f"{b.gyration:.6g} m caps it at I/ρ²)")
+            elif high and b.room_written("mass") is not None:
+                words = (f"{key} must allow up to {v:.4g} kg (is at most {current:.6g}: the "
+                         f"most its part's room holds, {b.part_key}, of the "
+                         f"{b.room_written('mass')!r} written)")
             elif high:
                 words = f"{key} must allow up to {v:.4g} kg (is at most {current!r})"
             else:
@@ -346,6 +350,12 @@ class Diagnosis:
         key = b.bound_key("com_radius")
         v = _up(value)
         if kind == "com":
+            written = b.room_written("com_radius")
+            if written is not None:  # the part's room narrowed what the spec wrote
+                return (key, v, b.com_radius, "m"), (
+                    f"{key} must be at least {v:.4g} m (is {b.com_radius:.6g}: the reach of "
+                    f"its part's room, {b.part_key}, within the {written!r} written)"
+                )
             return (key, v, b.com_radius, "m"), (
                 f"{key} must be at least {v:.4g} m (is {b.com_radius!r})"
             )

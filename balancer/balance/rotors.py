@@ -63,6 +63,7 @@ from ..model.balance import (
     RotorBalanceProblem,
     ShaftDesign,
 )
+from ..parts.sizing import most_mr
 from ..quantities import squared_parts
 from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
@@ -149,7 +150,9 @@ class RotorProblem:
         self.replaced: tuple[float, ...] = () if cws is None else cws.planes
         self.speed = design.operation.speed
         self.samples = design.operation.samples
-        sites = [Site(None, 1, 0j, z, mr) for z, mr in zip(
+        # A crank-web sector's room bounds each plane's mass·radius (balancer.parts.sizing).
+        room = math.inf if cws is None or cws.part is None else most_mr(cws.part)
+        sites = [Site(None, 1, 0j, z, min(mr, room)) for z, mr in zip(
             self.replaced, () if cws is None else cws.max_mr, strict=True)]
         for j, shaft in enumerate(problem.shafts):
             sites += [Site(j, shaft.ratio, complex(*shaft.at), z, mr)

@@ -275,8 +275,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--cad", metavar="DIR",
                    help="write each counterweight as a part into the folder DIR: a STEP solid "
                    "and a DXF profile in the link's frame (mm) and a dimensioned drawing (SVG, "
-                   "PNG), named after the link (needs the cad extra: pip install "
-                   "'balancer[cad]')")
+                   "PNG), named after the link; an engine's crank-web sectors (its "
+                   "[balance.counterweights] part) named by their plane, crankshaft_z<z>mm "
+                   "(needs the cad extra: pip install 'balancer[cad]')")
     p.set_defaults(verb="optimize")
 
     p = sub.add_parser(

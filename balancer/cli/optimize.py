@@ -10,6 +10,7 @@ from ..errors import SolverError, SpecError
 from ..outputs import write_atomic
 from ..parts.cad import cad_folder, require_cad, write_cad
 from ..parts.made import parts_of
+from ..parts.planes import require_webs
 from ..progress import Progress
 from ..report import dumps_json, optimization_json, optimization_text, parts_json, parts_text
 from ..spec import dumps_design, loads_design
@@ -25,6 +26,8 @@ def run(args: argparse.Namespace) -> int:
         require_cad()
         cad = cad_folder(args.cad, force=args.force)
     design = load(args)
+    if cad is not None:
+        require_webs(design)  # (an engine's sectors need their room: said before the work)
     if not args.no_verify:  # the check at the end refuses nothing after the work
 
         try:

@@ -57,7 +57,7 @@ from .. import validate as v
 from ..errors import SpecError
 from ..quantities import unit_of
 from .mechanisms import MechanismModel
-from .parts import Part
+from .parts import Part, Sector
 
 #: The keys of ``[balance.objective]``, ``[balance.<link>]`` and a counterweight's table.
 OBJECTIVE_KEYS = (
@@ -307,17 +307,27 @@ class CounterweightPlanes:
         Each plane's bound on the counterweight's mass·radius, kg·m (positive).
     radius
         The counterweights' radius, m, for their masses in the report (``None``: not given).
+    part
+        The crank-web sector that makes each plane's counterweight (its room and material:
+        :class:`~balancer.model.parts.Sector`, about the crank's axis), or ``None``. The room
+        bounds each plane's mass·radius (:func:`balancer.parts.sizing.most_mr`) and
+        ``optimize`` sizes each plane's sector (:mod:`balancer.parts.planes`).
     """
 
     planes: tuple[float, ...]
     max_mr: tuple[float, ...]
     radius: float | None = None
+    part: Sector | None = None
 
     def __post_init__(self) -> None:
         v.store(self, "planes", _planes(self.planes))
         v.store(self, "max_mr", _bounds(self.max_mr, len(self.planes)))
         if self.radius is not None:
             v.store(self, "radius", v.positive(self.radius, "radius"))
+        if self.part is not None and not isinstance(self.part, Sector):
+            raise SpecError('an engine\'s crankshaft counterweights are crank-web sectors: '
+                            'must be "sector"', key="part.shape",
+                            value=getattr(self.part, "shape", self.part))
 
 
 @dataclass(frozen=True)

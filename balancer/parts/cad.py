@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import OutputError
 from .made import LinkPart
+from .planes import PlanePart
 from .shapes import Arc, Line, Loop, Profile
 
 if TYPE_CHECKING:  # the cad extra's types, for the annotations only
@@ -68,8 +69,11 @@ def _arc_mid(edge: Arc) -> complex:
     return edge.point((edge.start + edge.end) / 2)
 
 
-def solid(profile: Profile) -> build123d.Solid:
-    """The part's solid (build123d, mm): its profile extruded from −t/2 to +t/2."""
+def solid(profile: Profile, z: float = 0.0) -> build123d.Solid:
+    """The part's solid (build123d, mm): its profile extruded from ``z − t/2`` to ``z + t/2``.
+
+    (``z`` m: a crank web's plane on the crankshaft; a link's part is about its plane, 0.)
+    """
     import build123d as bd
 
     def edge(e: Line | Arc) -> bd.Edge:
@@ -85,7 +89,7 @@ def solid(profile: Profile) -> build123d.Solid:
     wires = [bd.Wire([edge(e) for e in loop]) for loop in profile.loops()]
     face = bd.Face(wires[0], wires[1:])
     half = MM * profile.thickness / 2
-    face = face.moved(bd.Location((0.0, 0.0, -half)))
+    face = face.moved(bd.Location((0.0, 0.0, MM * z - half)))
     return bd.Solid.extrude(face, (0.0, 0.0, 2 * half))
 
 
@@ -106,11 +110,12 @@ def kernel_properties(shape: Any, density: float) -> tuple[float, complex, float
     return (density * volume, complex(c.X(), c.Y()) / MM, c.Z() / MM, density * izz)
 
 
-def write_step(profile: Profile, path: str | os.PathLike[str], name: str) -> None:
-    """Write the part's solid as STEP (mm) to ``path``."""
+def write_step(profile: Profile, path: str | os.PathLike[str], name: str, z: float = 0.0
+               ) -> None:
+    """Write the part's solid as STEP (mm) to ``path``, about the plane ``z`` (m)."""
     import build123d as bd
 
-    body = solid(profile)
+    body = solid(profile, z)
     body.label = name
     if not bd.export_step(body, str(path)):
         raise OutputError("the STEP writer failed", source=str(path))
@@ -121,7 +126,7 @@ def _bulge(edge: Arc) -> float:
     return math.tan((edge.end - edge.start) / 4)
 
 
-def write_dxf(part: LinkPart, path: str | os.PathLike[str]) -> None:
+def write_dxf(part: LinkPart | PlanePart, path: str | os.PathLike[str]) -> None:
     """Write the part's profile and the link's points as DXF (mm) to ``path``."""
     import ezdxf
     from ezdxf import units
@@ -145,7 +150,7 @@ def write_dxf(part: LinkPart, path: str | os.PathLike[str]) -> None:
     doc.saveas(str(path))
 
 
-def _text_height(part: LinkPart) -> float:
+def _text_height(part: LinkPart | PlanePart) -> float:
     """A label height, m: a fiftieth of the link's extent, at least a millimetre."""
     pts = [p for _, p in part.points]
     extent = max((abs(a - b) for a in pts for b in pts), default=0.0)
@@ -191,9 +196,14 @@ def cad_folder(folder: str | os.PathLike[str], *, force: bool, option: str = "--
     return target
 
 
-def write_cad(folder: str | os.PathLike[str], parts: Mapping[str, LinkPart],
-              drawing: Callable[[LinkPart, Path], object] | None = None) -> list[Path]:
-    """Per part ``<link>.step`` and ``<link>.dxf`` (and the drawing's files) into ``folder``.
+def write_cad(folder: str | os.PathLike[str],
+              parts: Mapping[str, LinkPart] | Mapping[str, PlanePart],
+              drawing: Callable[[Any, Path], object] | None = None) -> list[Path]:
+    """Per part ``<name>.step`` and ``<name>.dxf`` (and the drawing's files) into ``folder``.
+
+    A link's part is named after the link; an engine's crank-web sector after its plane
+    (:func:`balancer.parts.planes.plane_name`), its STEP solid at its plane on the
+    crankshaft (its z in mm: the planes' files assemble), its DXF profile in its plane.
 
     Everything is written into a temporary folder beside it first and moved in when all is
     written: a failure leaves ``folder`` as it was. ``drawing(part, stem)`` writes the
@@ -213,8 +223,9 @@ def write_cad(folder: str | os.PathLike[str], parts: Mapping[str, LinkPart],
             if part.sized.profile is None:
                 continue
             stem = scratch / file_stem(name)
-            write_step(part.sized.profile, stem.with_suffix(".step"), name)
-            write_dxf(part, stem.with_suffix(".dxf"))
+            write_step(part.sized.profile, stem.with_name(stem.name + ".step"), name,
+                       part.z if isinstance(part, PlanePart) else 0.0)
+            write_dxf(part, stem.with_name(stem.name + ".dxf"))
             if drawing is not None:
                 drawing(part, stem)
         names = sorted(p.name for p in scratch.iterdir())

@@ -23,6 +23,7 @@ from ..model import Design, Link
 from ..model import MechanismModel as Model
 from ..model.balance import BalanceProblem
 from ..model.parts import STEEL, Part, Ring
+from .planes import PlanePart, make_webs, webs_as_built
 from .shapes import MassProperties, union
 from .sizing import SizedPart, size_part
 
@@ -159,12 +160,17 @@ def as_built(result: BalanceResult, parts: Mapping[str, LinkPart]) -> CycleAnaly
 
 
 def parts_of(design: Design, result: BalanceResult, *, always: bool = False
-             ) -> tuple[dict[str, LinkPart], CycleAnalysis | None]:
+             ) -> tuple[dict[str, LinkPart] | dict[str, PlanePart], CycleAnalysis | None]:
     """The counterweights of ``result`` as parts, and the analysis of the design as built.
 
     Where the spec gives a counterweight a part, or ``always`` (``optimize --cad``: a steel
-    disc for a counterweight the spec gives none); else none: ``({}, None)``.
+    disc for a counterweight the spec gives none); else none: ``({}, None)``. An engine's:
+    each plane's crank-web sector where ``[balance.counterweights]`` gives a part
+    (:mod:`balancer.parts.planes`).
     """
+    if result.rotor_masses is not None:
+        webs = make_webs(design, result)
+        return webs, (webs_as_built(result, webs) if webs else None)
     given = any(_room(design.balance, name) is not None for name in result.counterweights)
     if not (given or always):
         return {}, None

@@ -376,10 +376,69 @@ def _sector(room: Sector, target: MassProperties, pivot: complex
         a = alpha(ro)
         limits = ((low_limit,) if want < lo else ("outer_radius", "angle_deg")
                   if want > hi else ())
+        # (At the thickness limit by construction; a thin sector's α, from 1 − sin α/α, is
+        # known only to about ε/α², which would put it that far beyond.)
+        t = min(m / (rho * a * (ro * ro - ri * ri)), t_most)
         return AnnularSector(pivot=pivot, inner=ri, outer=ro, angle=2 * a, direction=direction,
-                             thickness=m / (rho * a * (ro * ro - ri * ri))), rho, limits
+                             thickness=t), rho, limits
     # Not even the mass and centre fit: the widest the room holds toward the centre.
     a = min(alpha(most), room.angle / 2) if g(most) > d else room.angle / 2
     t = t_most if math.isfinite(t_most) else m / (rho * a * (most * most - ri * ri))
     return AnnularSector(pivot=pivot, inner=ri, outer=most, angle=2 * a, direction=direction,
                          thickness=t), rho, ("outer_radius", "angle_deg", "thickness")
+
+
+# -- a crank web's counterweight: a mass·radius about the crank's axis ---------------------------
+
+def sector_mr(inner: float, outer: float, half: float, thickness: float, density: float
+              ) -> float:
+    """An annular sector's mass times its centroid's reach from its pivot, kg·m.
+
+    ``m·d = ρ·t·α·(Ro² − Ri²)·g(Ri, Ro)·sin α/α = (2/3)·ρ·t·sin α·(Ro³ − Ri³)`` for the half
+    angle ``α`` (rad).
+    """
+    return 2.0 / 3.0 * density * thickness * math.sin(half) * (outer**3 - inner**3)
+
+
+def most_mr(room: Sector) -> float:
+    """The largest mass·radius about its pivot of a sector of ``room``, kg·m.
+
+    :func:`sector_mr` is largest at the full outer radius and thickness and at the half angle
+    nearest π/2 the room allows, ``min(φ/2, π/2)`` (a crescent wider than a half turn puts
+    material back on the other side); ``inf`` for an unlimited thickness.
+    """
+    return sector_mr(room.inner_radius, room.outer_radius, min(room.angle / 2, math.pi / 2),
+                     room.thickness, room.material.density)
+
+
+def web_target(room: Sector, mr: float, phase: float) -> MassProperties:
+    """The crank-web sector a mass·radius ``mr`` (kg·m) at ``phase`` (rad) asks of ``room``.
+
+    The lightest sector of the room with that mass·radius: the full outer radius and thickness
+    (a sector's mass over its mass·radius, ``α/sin α·…``, falls as it narrows and as its radius
+    and thickness grow), its half angle ``α = asin(mr/((2/3)·ρ·T·(Ro³ − Ri³)))``. Where that
+    angle is beyond the room's (or the thickness unlimited), the angle is the room's best,
+    ``min(φ/2, π/2)``, and the thickness is solved, beyond the room's where it cannot hold
+    ``mr``. Its bisector points at ``phase``, its arcs about the crank's axis (the origin).
+    Returns the sector's mass properties (:func:`size_part` then sizes it in ``room``).
+    """
+    if not (mr > 0 and math.isfinite(mr)):
+        raise ValueError(f"a crank web's counterweight has a positive mass·radius, not {mr!r}")
+    rho, ri, ro = room.material.density, room.inner_radius, room.outer_radius
+    best = min(room.angle / 2, math.pi / 2)
+    share = mr / sector_mr(ri, ro, math.pi / 2, room.thickness, rho)  # 0 for inf thickness
+    if 0 < share <= math.sin(best):
+        half, thickness = math.asin(share), room.thickness
+    else:
+        half, thickness = best, mr / sector_mr(ri, ro, best, 1.0, rho)
+    return AnnularSector(pivot=0j, inner=ri, outer=ro, angle=2 * half, direction=phase,
+                         thickness=thickness).mass_properties(rho)
+
+
+def size_web(room: Sector, mr: float, phase: float) -> SizedPart:
+    """The sector of ``room`` for a mass·radius ``mr`` (kg·m) at ``phase`` (rad) on a crank.
+
+    :func:`size_part` of :func:`web_target` about the crank's axis: exact where the room holds
+    ``mr`` (:func:`most_mr`), else the room's largest, nearest in direction and size.
+    """
+    return size_part(room, web_target(room, mr, phase), 0j)

@@ -3,7 +3,9 @@
 The link's points and the lines between them, the part's profile filled, its dimensions (radii,
 angle, length and width, thickness, bore), and three centres: the original link's, the part's
 and the balanced link's. Computes nothing: the part is given
-(:class:`balancer.parts.made.LinkPart`).
+(:class:`balancer.parts.made.LinkPart`). An engine's crank-web sector
+(:class:`balancer.parts.planes.PlanePart`) is drawn on the crankshaft at θ1 = 0: its axis, the
+nearest throws' pins, the sector and the direction the optimiser chose (:func:`web_figure`).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..parts.made import LinkPart
+from ..parts.planes import PlanePart
 from ..parts.shapes import AnnularSector, Annulus, Line, Loop, Rectangle
 from ..report.parts import dimensions_text
 from .style import write_figure
@@ -124,12 +127,58 @@ def _dimensions(ax: object, profile: Annulus | AnnularSector | Rectangle) -> Non
                    f"{1e3 * profile.width:.4g}, {t}")
 
 
-def write_part_drawing(part: LinkPart, stem: Path) -> list[Path]:
+def web_figure(part: PlanePart) -> Figure:
+    """The drawing of one plane's crank-web sector on the crankshaft at θ1 = 0 (mm).
+
+    The crank's axis O and the nearest throws' pins, the sector filled and dimensioned, its
+    centre, and the direction the optimiser chose.
+    """
+    fig = Figure(figsize=(7.5, 6.0))
+    ax = fig.add_subplot()
+    for name, p in part.points:
+        ax.plot(1e3 * p.real, 1e3 * p.imag, "o", ms=8, mfc="white", mec="0.2", zorder=3)
+        ax.annotate(name, (1e3 * p.real, 1e3 * p.imag), xytext=(6, 6),
+                    textcoords="offset points", fontsize="small")
+        if abs(p) > 0:
+            ax.plot([0.0, 1e3 * p.real], [0.0, 1e3 * p.imag], color="0.45", lw=3,
+                    solid_capstyle="round", zorder=1)
+    profile = part.sized.profile
+    if profile is not None:
+        loops = [_outline(loop) for loop in profile.loops()]
+        path = np.concatenate([np.append(x, np.nan) for x in loops])
+        ax.fill(loops[0].real, loops[0].imag, color="tab:orange", alpha=0.55, zorder=2,
+                label=f"sector: {dimensions_text(part)}")
+        for hole in loops[1:]:
+            ax.fill(hole.real, hole.imag, color="white", zorder=2)
+        ax.plot(path.real, path.imag, color="tab:orange", lw=1.2, zorder=2)
+        _dimensions(ax, profile)
+    made = part.sized.made
+    if made is not None:
+        c = 1e3 * made.centre
+        ax.plot(c.real, c.imag, "+", ms=10, mew=1.5, zorder=4, label="part's centre")
+    reach = 1e3 * (profile.outer if isinstance(profile, AnnularSector | Annulus)
+                   else abs(part.points[-1][1]))
+    u = cmath.rect(reach, math.radians(part.placed.phase_deg))
+    ax.plot([0.0, u.real], [0.0, u.imag], ls="--", color="0.3", lw=0.8, zorder=1,
+            label=f"asked: {part.placed.mr:.4g} kg·m at {part.placed.phase_deg:.4g}°")
+    state = ("exact" if part.sized.exact else "nearest in its room") if made else "not made"
+    mass = f", {made.mass:.4g} kg" if made else ""
+    ax.set_title(f"{part.name}: sector of {part.sized.room.material.name}{mass} ({state})",
+                 fontsize="medium")
+    ax.set_xlabel("x at θ1 = 0 (mm)")
+    ax.set_ylabel("y at θ1 = 0 (mm)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, lw=0.3, alpha=0.5)
+    ax.legend(fontsize="small", loc="best")
+    return fig
+
+
+def write_part_drawing(part: LinkPart | PlanePart, stem: Path) -> list[Path]:
     """Write the drawing at ``stem`` as SVG and PNG (:data:`DRAWING_TYPES`); the paths."""
-    fig = part_figure(part)
+    fig = web_figure(part) if isinstance(part, PlanePart) else part_figure(part)
     out = []
     for suffix in DRAWING_TYPES:
-        path = stem.with_suffix(suffix)
+        path = stem.with_name(stem.name + suffix)  # (a name with a dot keeps it)
         write_figure(fig, path, 150 if suffix == ".png" else None, suffix[1:])
         out.append(path)
     return out

@@ -705,6 +705,31 @@ SECTIONS = tuple(
                 Key("radius", "m", "none",
                     "The counterweights' radius: the report then gives each one's mass; "
                     "positive.", (ENGINE,), example="0.05"),
+                Key("part", "table", "none",
+                    "The crank-web sector that makes each plane's counterweight (below): "
+                    "`optimize` sizes it, and its room caps `max_mr` at what it holds.",
+                    (ENGINE,), example='{ shape = "sector", inner_radius = 0.02, '
+                    'outer_radius = 0.075, angle_deg = 160.0, thickness = 0.018 }'),
+            ), (ENGINE,)),
+    Section("balance.counterweights.part", "The crank-web sector of each plane's "
+            "counterweight, about the crank's axis, centred on its plane: its angle solved "
+            "for the plane's mass·radius at the full outer radius and thickness (docs: From "
+            "optimum to part). Lengths in m.", (
+                Key("shape", "—", "required", '`"sector"` (the one shape of a crank web).',
+                    (ENGINE,), example='"sector"'),
+                Key("material", "—", '"steel"',
+                    "steel (7850 kg/m³), brass (8500), tungsten-alloy (17000) or lead "
+                    "(11340); any name with `density`.", (ENGINE,), example='"steel"'),
+                Key("density", "kg/m³", "the material's", "The material's density; positive.",
+                    (ENGINE,), example="7850.0"),
+                Key("inner_radius", "m", "0", "The hub's radius about the crank's axis; at "
+                    "least 0.", (ENGINE,), example="0.02"),
+                Key("outer_radius", "m", "required", "The web's outer radius; more than "
+                    "`inner_radius`.", (ENGINE,), example="0.075"),
+                Key("angle_deg", "°", "required", "The largest full angle, in (0, 360].",
+                    (ENGINE,), example="160.0"),
+                Key("thickness", "m", "required", "The web's thickness along the crank's "
+                    "axis; positive.", (ENGINE,), example="0.018"),
             ), (ENGINE,)),
     Section("balance.shafts[]", "A new balance shaft, geared to the crank, with an eccentric "
             "in each of its planes sized by the optimiser.", (

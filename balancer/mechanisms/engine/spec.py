@@ -23,8 +23,10 @@ from ...model.balance import (
     RotorBalanceProblem,
     ShaftFreedom,
 )
+from ...model.parts import SHAPES, Sector
 from ...spec import schema
 from ...spec.links import read_link
+from ...spec.parts import part_text, read_part
 from ...spec.tables import Table
 from .model import BalanceShaft, Crankshaft, Cylinder, Engine, GasCycle, Mass
 
@@ -257,10 +259,11 @@ def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
         sub.expect(schema.known("balance.counterweights", schema.ENGINE))
         if not sub.has("max_mr"):
             raise sub._missing("max_mr")
+        part = _sector(sub.table("part", required=False))
         with v.under(sub.path):
             counterweights = CounterweightPlanes(
                 planes=sub.value("planes", list(cast("Engine", engine).counterweight_planes)),
-                max_mr=sub.raw("max_mr"), radius=sub.value("radius", None))
+                max_mr=sub.raw("max_mr"), radius=sub.value("radius", None), part=part)
         sub.finish()
     shafts = []
     for sub in table.tables("shafts"):
@@ -275,6 +278,19 @@ def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
     table.finish()
     return RotorBalanceProblem(objective=objective, counterweights=counterweights,
                                shafts=tuple(shafts))
+
+
+def _sector(table: Table | None) -> Sector | None:
+    """``[balance.counterweights] part``: a crank-web sector (another shape refused first)."""
+    if table is None:
+        return None
+    shape = table.data.get("shape")
+    if shape is not None and shape != "sector" and shape in SHAPES:
+        raise SpecError('an engine\'s crankshaft counterweights are crank-web sectors about the '
+                        'crank\'s axis: must be "sector"', key=table.key("shape"), value=shape)
+    part = read_part(table)
+    assert isinstance(part, Sector)
+    return part
 
 
 def _numbers(values: tuple[float, ...]) -> str:
@@ -294,6 +310,8 @@ def balance_lines(problem: object) -> list[str]:
                 f"max_mr = {_numbers(cws.max_mr)}  # kg·m"]
         if cws.radius is not None:
             out.append(f"radius = {toml.number(cws.radius)}  # m")
+        if cws.part is not None:
+            out.append(f"part = {part_text(cws.part)}  # m, °: each plane's crank-web sector")
     for s in problem.shafts:
         out += ["", "[[balance.shafts]]  # a new shaft, sized by the optimiser",
                 f"ratio = {s.ratio}", f"at = {_numbers(s.at)}  # m",
