@@ -6,7 +6,8 @@
 - the closed forms against a second formulation: Green's theorem on the outline, sampled;
 - a sized part meets its target (mass, centre, inertia) to 1e-9 where it says it is exact, and
   stays in its room where it is not;
-- the DXF read back by ezdxf, its area and centroid by the shoelace formula on its entities;
+- the DXF read back by ezdxf and by a reader of its group codes (no DXF library), its area and
+  centroid by the shoelace formula on its entities;
 - the design as built (original links + parts) analysed again gives the optimum's figures;
 - the spec's ``part`` table: read, written back equal, bad input one line naming key and value.
 """
@@ -297,25 +298,80 @@ def test_union_adds_inertial_parameters():
     close(back, a, 1e-12)
 
 
-# -- the DXF, read back by ezdxf and measured by the shoelace formula ----------------------------
+# -- the DXF, read back by two readers and measured by the shoelace formula ----------------------
 
-def dxf_region(path: Path) -> tuple[float, complex, float]:
-    """Area (mm²), centroid (mm) and the entities' thickness (mm) of the PART layer, from the
-    DXF's own entities: circles, and closed polylines whose bulges are arcs, each sampled and
-    measured by the shoelace formula; holes are the loops inside another."""
+#: A DXF entity of the PART layer: ``("circle", (centre, radius), thickness)`` or
+#: ``("polyline", [(x, y, bulge), …], thickness)`` (closed), mm.
+Entity = tuple[str, object, float]
+
+
+def ezdxf_entities(path: Path) -> list[Entity]:
+    """The PART layer's entities as ezdxf reads them (the library that wrote them)."""
     import ezdxf
 
-    doc = ezdxf.readfile(str(path))
-    loops, thickness = [], set()
-    for e in doc.modelspace().query("*[layer=='PART']"):
-        thickness.add(round(e.dxf.thickness, 9))
+    out: list[Entity] = []
+    for e in ezdxf.readfile(str(path)).modelspace().query("*[layer=='PART']"):
         if e.dxftype() == "CIRCLE":
-            c, r = complex(e.dxf.center.x, e.dxf.center.y), e.dxf.radius
+            out.append(("circle", (complex(e.dxf.center.x, e.dxf.center.y), e.dxf.radius),
+                        e.dxf.thickness))
+        else:
+            assert e.dxftype() == "LWPOLYLINE" and e.closed
+            out.append(("polyline", list(e.get_points("xyb")), e.dxf.thickness))
+    return out
+
+
+def group_code_entities(path: Path) -> list[Entity]:
+    """The PART layer's entities read from the DXF text itself, pairs of a group code and a value
+    (the format's own definition), with no DXF library: a second reader. CIRCLE: 10/20 centre,
+    40 radius; LWPOLYLINE: 70 flags (1 closed), then per vertex 10/20 and an optional 42 bulge;
+    8 the layer, 39 the thickness (default 0)."""
+    lines = path.read_text(encoding="utf-8").splitlines()
+    pairs = [(int(lines[i].strip()), lines[i + 1].strip()) for i in range(0, len(lines) - 1, 2)]
+    start = next(i for i, (c, v) in enumerate(pairs) if (c, v) == (2, "ENTITIES"))
+    entities: list[list[tuple[int, str]]] = []
+    for code, value in pairs[start + 1:]:
+        if code == 0:
+            if value in ("ENDSEC", "EOF"):
+                break
+            entities.append([(0, value)])
+        elif entities:
+            entities[-1].append((code, value))
+    out: list[Entity] = []
+    for e in entities:
+        kind = e[0][1]
+        if dict(e).get(8) != "PART":
+            continue
+        thickness = float(dict(e).get(39, 0.0))
+        if kind == "CIRCLE":
+            d = dict(e)
+            out.append(("circle", (complex(float(d[10]), float(d[20])), float(d[40])), thickness))
+            continue
+        assert kind == "LWPOLYLINE" and int(dict(e)[70]) & 1
+        vertices: list[list[float]] = []
+        for code, value in e:
+            if code == 10:
+                vertices.append([float(value), 0.0, 0.0])
+            elif code == 20 and vertices:
+                vertices[-1][1] = float(value)
+            elif code == 42 and vertices:
+                vertices[-1][2] = float(value)
+        out.append(("polyline", [tuple(v) for v in vertices], thickness))
+    return out
+
+
+def dxf_region(entities: list[Entity]) -> tuple[float, complex, float]:
+    """Area (mm²), centroid (mm) and the entities' thickness (mm) of the PART layer's entities:
+    circles, and closed polylines whose bulges are arcs, each sampled and measured by the
+    shoelace formula; holes are the loops inside another."""
+    loops, thickness = [], set()
+    for kind, data, thick in entities:
+        thickness.add(round(thick, 9))
+        if kind == "circle":
+            c, r = data
             t = np.linspace(0, 2 * math.pi, 200_000, endpoint=False)
             loops.append(c + r * np.exp(1j * t))
         else:
-            assert e.dxftype() == "LWPOLYLINE" and e.closed
-            pts = list(e.get_points("xyb"))
+            pts = data
             out = []
             for i, (x, y, b) in enumerate(pts):
                 p, q = complex(x, y), complex(*pts[(i + 1) % len(pts)][:2])
@@ -369,10 +425,13 @@ def test_the_dxf_read_back_has_the_parts_area_centroid_and_thickness(pb1_parts, 
     for name, part in parts.items():
         path = tmp_path / f"{name}.dxf"
         write_dxf(part, path)
-        area, centroid, thickness = dxf_region(path)
         made, density = part.sized.made, part.sized.density
-        assert density * area * thickness * 1e-9 == pytest.approx(made.mass, rel=1e-6)
-        assert abs(centroid / 1e3 - made.centre) <= 1e-6 * abs(made.centre)
+        by_ezdxf, by_codes = ezdxf_entities(path), group_code_entities(path)
+        assert len(by_ezdxf) == len(by_codes) > 0
+        for entities in (by_ezdxf, by_codes):  # the library that wrote it, and a second reader
+            area, centroid, thickness = dxf_region(entities)
+            assert density * area * thickness * 1e-9 == pytest.approx(made.mass, rel=1e-6)
+            assert abs(centroid / 1e3 - made.centre) <= 1e-6 * abs(made.centre)
 
 
 # -- the design as built -------------------------------------------------------------------------
