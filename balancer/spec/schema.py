@@ -4,7 +4,7 @@ The one list of the spec's keys. The reader takes the keys it knows from here â€
 screened when it is opened (:func:`screen`) and declares its keys for the spec's mechanism
 (:func:`known`) â€” so that it cannot accept a key that has no entry; the documentation's
 reference of the spec format (``docs/spec.md``) is generated from these entries when the site is
-built, and the tests hold the three together (``tests/test_schema.py``: every entry is accepted
+built, and the tests hold the three together (``tests/spec/test_schema.py``: every entry is accepted
 where it says, refused elsewhere, and nothing else is accepted).
 
 Tables are named by their pattern: the dotted path of the table with a link's name written

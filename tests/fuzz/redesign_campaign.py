@@ -86,7 +86,7 @@ a SpecError naming a contradiction of its bounds); of the 19,618 runs 12,972 opt
 feasible, 3 failed, 6,424 called infeasible, 6 solver errors. Nothing found in the classes of
 the optimiser's claims (load, bounds, force balance, optimality, lower bounds, infeasibility
 called, misreports, crashes, NaN) nor in the report's links, sums, added mass and objective
-terms. Found and left (strict xfails in tests/test_reliability.py): ``report-kind`` in 57
+terms. Found and left (strict xfails in tests/balance/test_reliability.py): ``report-kind`` in 57
 problems (111 runs), every one a kept link's counterweight reported as ``rebuild`` with mass 0
 (a counterweight of no mass carrying an inertia: the spec bounds its radius of gyration below
 only); ``counterweight-not-none`` in 16 problems (27 runs); a failure or solver error on a
