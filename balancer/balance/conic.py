@@ -14,8 +14,8 @@ bounds (nonnegative rows), then the second-order cones, each constraint as ``A =
 ``b = m``: ``s = M·u + m``. Clarabel's dual ``z ∈ K*`` then satisfies
 ``H·y + h = Σ Mᵀ·z``: each constraint's multiplier in the convention of the Lagrangian
 ``f − Σ zᵀ·(M·u + m)``, which :mod:`.certificate` uses. CVXPY stays the tests' independent
-route to the same optimum (``tests/balance/test_conic.py``) and builds the rarely solved programs of the
-infeasibility diagnosis.
+route to the same optimum (``tests/balance/test_conic.py``) and builds the rarely solved
+programs of the infeasibility diagnosis.
 """
 
 from __future__ import annotations

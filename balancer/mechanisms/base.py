@@ -285,15 +285,18 @@ class Mechanism:
         return (*own, MULTIBODY, CRANK_ANGLE)
 
     @classmethod
-    def own_formulation(cls, name: str) -> type[Any] | None:
-        """The class of its own formulation ``name`` (:attr:`own_formulations`), or ``None``."""
+    def own_formulation(cls, name: str) -> Any:
+        """Its own formulation ``name`` (:attr:`own_formulations`): the class, or ``None``.
+
+        (A subclass of :class:`~balancer.mechanisms.formulation.Formulation`, which builds on
+        this module, so that it is not named in the annotation.)
+        """
         where = cls.own_formulations.get(name)
         if where is None:
             return None
         module, _, attribute = where.rpartition(".")
         folder = cls.__module__.rpartition(".")[0]
-        found: type[Any] = getattr(importlib.import_module(f"{folder}.{module}"), attribute)
-        return found
+        return getattr(importlib.import_module(f"{folder}.{module}"), attribute)
 
     def parameters(self) -> NDArray[np.float64]:
         """The design vector of the mechanism's own links (:attr:`layout`)."""
