@@ -184,11 +184,14 @@ def cycle_figure(analysis: CycleAnalysis, before: CycleAnalysis | None = None,
         plot_over_crank_angle(analysis, PANELS[key].key, before, ax=axes[key], legend=False)
     after_panels = drawn_panels(analysis, keys)
     before_panels = drawn_panels(before, keys) if before is not None else None
+    drawn = [a for a in (analysis, before) if a is not None]
     for key in keys:
         unit = PANELS[key].unit
         ax = axes[key]
+        # what is rounding of the panel's natural scale reads as the zero its curve is drawn as
+        floor = ROUNDING_SPAN * max(natural_scales(a)[key] for a in drawn)
         figures = [_figure_pair(before_panels[key] if before_panels is not None else None,
-                                after_panels[key], stat) for stat in ("rms", "max")]
+                                after_panels[key], stat, floor) for stat in ("rms", "max")]
         ax.set_title(f"{ax.get_title()}\nRMS {figures[0]} {unit}, max {figures[1]} {unit}",
                      fontsize="medium")
     handles, labels = axes["force"].get_legend_handles_labels()
@@ -204,9 +207,14 @@ def cycle_figure(analysis: CycleAnalysis, before: CycleAnalysis | None = None,
     return fig
 
 
-def _figure_pair(before: np.ndarray | None, after: np.ndarray, stat: str) -> str:
-    """``"b → a"`` (or ``"a"``) of a figure of one revolution's values, to 3 digits."""
-    text = number(getattr(Figures.of(after), stat))
-    if before is None:
-        return text
-    return f"{number(getattr(Figures.of(before), stat))} → {text}"
+def _figure_pair(before: np.ndarray | None, after: np.ndarray, stat: str,
+                 floor: float = 0.0) -> str:
+    """``"b → a"`` (or ``"a"``) of a figure of one revolution's values, to 3 digits.
+
+    A figure at most ``floor`` (rounding of its panel's natural scale) reads ``0``.
+    """
+    def text(values: np.ndarray) -> str:
+        value = getattr(Figures.of(values), stat)
+        return "0" if abs(value) <= floor else number(value)
+
+    return text(after) if before is None else f"{text(before)} → {text(after)}"

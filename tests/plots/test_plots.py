@@ -1107,3 +1107,24 @@ def test_an_optimised_engines_animation_draws_the_counterweights_it_chose(flat_s
         patch.setattr(animation, "link_counterweights", asked)
         fig, _ = plots.animation_figure(replace(balanced, original=design.mechanism), frames=4)
     assert len([p for p in fig.axes[0].patches if isinstance(p, Wedge)]) == len(chosen)
+
+
+def test_a_figure_that_is_rounding_reads_zero_in_its_panels_title(tmp_path, capsys):
+    """PB2's complete balance leaves a shaking force and moment of rounding (1e-13 and the
+    like): the cycle figure draws them as zero and its titles say 0, as the text report does,
+    while the original's figures beside them keep their digits."""
+    out = tmp_path / "balanced.toml"
+    assert main(["optimize", str(EXAMPLES / "pb2.toml"), "--out", str(out), "--no-verify",
+                 "--backend", "convex", "--json"]) == 0
+    capsys.readouterr()
+    after, before = api.cycle_analyses(load_design(out))
+    force = float(np.sqrt(np.mean(np.abs(after.reactions.shaking_force) ** 2)))
+    scale = cycle.natural_scales(after)["force"]
+    assert 0 < force <= cycle.ROUNDING_SPAN * scale  # (rounding, not an exact zero)
+    fig = plots.cycle_figure(after, before)
+    titles = {ax.get_title().split("\n")[0]: ax.get_title() for ax in fig.axes}
+    force_title = next(t for k, t in titles.items() if k.startswith("shaking force"))
+    moment_title = next(t for k, t in titles.items() if k.startswith("shaking moment"))
+    for title in (force_title, moment_title):
+        assert "→ 0 N" in title and title.count("→ 0 ") == 2, title  # RMS and max
+        assert "e-1" not in title, title
