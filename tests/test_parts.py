@@ -626,3 +626,18 @@ def test_a_bound_the_room_narrowed_is_diagnosed_as_the_parts_room(tmp_path, caps
     assert ("balance.crank.counterweight.mass must allow up to" in err
             and f"(is at most {most:.6g}: the most its part's room holds, "
                 "balance.crank.counterweight.part, of the 6.3 written)" in err), err
+
+
+@pytest.mark.parametrize(("room", "key"), [
+    (lambda: Ring(inner_radius=0.0, outer_radius=1e300, thickness=0.1), "outer_radius"),
+    (lambda: Sector(inner_radius=0.01, outer_radius=1e300, angle_deg=360, thickness=1e-3),
+     "outer_radius"),
+    (lambda: Block(length=1e300, width=0.1, thickness=0.1), "length"),
+    (lambda: Insert(radius=0.1, thickness=1e51, material=Material.named("lead")), "thickness"),
+])
+def test_a_rooms_absurd_length_is_refused_naming_it(room, key):
+    """`outer_radius = 1e300` was an internal error (OverflowError of its square in the room's
+    mass, or of its cube in a web sector's mass·radius; fuzz campaign of issue 45)."""
+    with pytest.raises(SpecError) as info:
+        room()
+    assert info.value.key == key and "at most 1e+50 m" in str(info.value)
