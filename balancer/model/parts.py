@@ -44,6 +44,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from ..errors import SpecError
+from ..validate import LENGTH_RANGE
 
 #: The shape families (the spec's ``part.shape``).
 SHAPES = ("ring", "washers", "sector", "block", "insert")
@@ -111,6 +112,9 @@ def _length(value: float, key: str, *, zero: bool = False, infinite: bool = Fals
     if not ok:
         what = "zero or a positive length" if zero else "a positive length"
         raise SpecError(f"must be {what} in m", key=key, value=value)
+    if math.isfinite(value) and value > LENGTH_RANGE[1]:  # (a room's volume, a reach's cube)
+        raise SpecError(f"must be at most {LENGTH_RANGE[1]:g} m (its fourth power must stay "
+                        "within double precision)", key=key, value=value)
     return float(value)
 
 

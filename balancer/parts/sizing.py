@@ -381,11 +381,15 @@ def _sector(room: Sector, target: MassProperties, pivot: complex
         t = min(m / (rho * a * (ro * ro - ri * ri)), t_most)
         return AnnularSector(pivot=pivot, inner=ri, outer=ro, angle=2 * a, direction=direction,
                              thickness=t), rho, limits
-    # Not even the mass and centre fit: the widest the room holds toward the centre.
+    # Not both the mass and the centre fit: the widest the room holds toward the centre, of
+    # the mass where that fits (a centre nearer the pivot than a partial sector reaches: the
+    # mass kept, the centre as near as the room lets it), else the largest the room holds.
     a = min(alpha(most), room.angle / 2) if g(most) > d else room.angle / 2
-    t = t_most if math.isfinite(t_most) else m / (rho * a * (most * most - ri * ri))
+    t = min(m / (rho * a * (most * most - ri * ri)), t_most)
+    at = ("outer_radius", "angle_deg", "thickness") if t == t_most else ("outer_radius",
+                                                                          "angle_deg")
     return AnnularSector(pivot=pivot, inner=ri, outer=most, angle=2 * a, direction=direction,
-                         thickness=t), rho, ("outer_radius", "angle_deg", "thickness")
+                         thickness=t), rho, at
 
 
 # -- a crank web's counterweight: a mass·radius about the crank's axis ---------------------------

@@ -23,11 +23,21 @@ from .parts import part_text, read_part
 from .tables import Table, hint
 
 
-def _check_keys(table: Table, known: tuple[str, ...]) -> None:
-    """Reject unknown keys first, with a suggestion for a typo."""
+def _check_keys(table: Table, known: tuple[str, ...], *, elsewhere: tuple[str, ...] = (),
+                kind: str = "") -> None:
+    """Reject unknown keys first, with a suggestion for a typo.
+
+    A key of the table in another mechanism's spec (``elsewhere``: an engine's ``unbalance``
+    in a linkage's objective) is said not to apply to a ``kind``, with the keys that do.
+    """
     for name in table.data:
-        if name not in known:
-            raise SpecError(f"unknown key '{name}'{hint(name, known)}", key=table.key(name))
+        if name in known:
+            continue
+        if name in elsewhere:
+            raise SpecError(f"does not apply to a {kind}'s balancing (its keys here: "
+                            f"{', '.join(known)})", key=table.key(name),
+                            value=table.raw(name))
+        raise SpecError(f"unknown key '{name}'{hint(name, known)}", key=table.key(name))
 
 
 def _read_range(
@@ -150,7 +160,8 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
     objective = Objective()
     sub = table.table("objective", required=False)
     if sub is not None:
-        _check_keys(sub, schema.known("balance.objective"))
+        _check_keys(sub, schema.known("balance.objective", mech.kind),
+                    elsewhere=schema.known("balance.objective"), kind=mech.kind)
         objective = Objective(
             **{
                 name: sub.nonnegative(name, default=getattr(objective, name))

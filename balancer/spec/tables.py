@@ -171,6 +171,9 @@ def meant(name: str, known: Iterable[str]) -> str | None:
 
 
 def hint(name: str, known: Iterable[str]) -> str:
-    """``"; did you mean '…'?"`` for a mistyped ``name`` (:func:`meant`), or ``""``."""
-    found = meant(name, known)
+    """``"; did you mean '…'?"`` for a mistyped ``name`` (:func:`meant`), or ``""``.
+
+    Never ``name`` itself (a key known elsewhere but refused here).
+    """
+    found = meant(name, [k for k in known if k != name])
     return f"; did you mean '{found}'?" if found is not None else ""

@@ -282,3 +282,32 @@ def test_a_balance_table_for_a_link_the_mechanism_lacks_lists_its_links():
         spec.loads_design(text)
     assert info.value.key == "balance.frame"
     assert "crank, coupler, rocker" in str(info.value)
+
+
+@pytest.mark.parametrize(("example", "anchor", "weight", "kind"), [
+    ("pb1", "[balance.objective]", "unbalance", "four-bar"),
+    ("engine", "[balance.objective]", "unbalance", "slider-crank"),
+    ("quick_return", "[balance.objective]", "unbalance", "linkage"),
+    ("inline_three_parts", "[balance.objective]", "driving_torque", "engine"),
+    ("inline_three_parts", "[balance.objective]", "added_mass", "engine"),
+])
+def test_an_objective_weight_of_another_mechanism_is_refused_as_such(example, anchor, weight,
+                                                                       kind):
+    """A linkage's `unbalance = 1.0` said "unknown key 'unbalance'; did you mean 'unbalance'?"
+    (the fuzz campaign of issue 41): a weight of the other mechanisms' objective is said not to
+    apply, with the keys that do; an engine's `driving_torque` likewise."""
+    text = (EXAMPLES / f"{example}.toml").read_text()
+    assert text.count(anchor) == 1
+    with pytest.raises(SpecError) as info:
+        spec.loads_design(text.replace(anchor, f"{anchor}\n{weight} = 1.0"), source="test.toml")
+    message = str(info.value)
+    assert info.value.key == f"balance.objective.{weight}"
+    assert f"does not apply to a{'n' if kind == 'engine' else ''} {kind}'s balancing" in message
+    assert "did you mean" not in message and "shaking_moment" in message, message
+
+
+def test_a_hint_never_names_the_key_it_refuses():
+    from balancer.spec.tables import hint
+
+    assert hint("unbalance", ("unbalance", "shaking_moment")) == ""
+    assert hint("unbalanc", ("unbalance", "shaking_moment")) == "; did you mean 'unbalance'?"

@@ -249,7 +249,13 @@ def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
     objective = defaults
     sub = table.table("objective", required=False)
     if sub is not None:
-        sub.expect(schema.known("balance.objective", schema.ENGINE))
+        weights = schema.known("balance.objective", schema.ENGINE)
+        for name in sub.data:  # a linkage's weight (driving_torque, added_mass, …)
+            if name not in weights and name in schema.known("balance.objective"):
+                raise SpecError("does not apply to an engine's balancing (its keys here: "
+                                f"{', '.join(weights)})", key=sub.key(name),
+                                value=sub.raw(name))
+        sub.expect(weights)
         objective = replace(defaults, **{name: sub.nonnegative(name, default=getattr(
             defaults, name)) for name in ENGINE_OBJECTIVE_KEYS})
         sub.finish()
