@@ -155,8 +155,20 @@ class _VersionAction(argparse.Action):
         parser.exit()
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of the ``balancer`` command."""
+#: The verbs, in the order ``balancer --help`` lists them.
+VERBS: tuple[str, ...] = ("analyze", "simulate", "verify", "optimize", "plot", "pareto", "sweep",
+                          "example")
+
+
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of the ``balancer`` command.
+
+    ``only``: the one verb to build (its parser and arguments); ``None`` every verb with its
+    arguments; any other value (``""``, an unknown verb) every verb listed with its help alone,
+    so that ``balancer --help`` and an unknown verb's error name them all. A command builds its
+    own verb alone (:func:`_verb_of`): argparse's parsers, 72 arguments and their help cost a
+    tenth of a short command's time.
+    """
     parser = _Parser(
         prog="balancer",
         description=(
@@ -169,14 +181,126 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
 
-    p = sub.add_parser(
-        "analyze",
-        help="shaking force, shaking moment and driving torque over one revolution",
-        description=(
-            "Reactions at the ground pivots, shaking force, shaking moment about A0 and driving "
-            "torque over one crank revolution at the operating speed ([operation] speed)."
-        ),
-    )
+    # (a known verb: its parser alone; else every verb, listed for the help or the error)
+    listed = (only,) if only in VERBS else VERBS
+    if "analyze" in listed:
+        p = sub.add_parser(
+            "analyze",
+            help="shaking force, shaking moment and driving torque over one revolution",
+            description=(
+                "Reactions at the ground pivots, shaking force, shaking moment about A0 and "
+                "driving torque over one crank revolution at the operating speed ([operation] "
+                "speed)."
+            ),
+        )
+        if only is None or only == "analyze":
+            _analyze_arguments(p)
+
+    if "simulate" in listed:
+        p = sub.add_parser(
+            "simulate",
+            help="forward dynamics in a formulation of your choice",
+            description=(
+                "Forward dynamics of the linkage from the spec's [simulation] settings: free "
+                "motion under the loads (and gravity), or the crank held at constant speed by a "
+                "motor. Prints the initial and final angles, rates and accelerations, the "
+                "shaking figures, the energy balance and the constraint drift."
+            ),
+        )
+        if only is None or only == "simulate":
+            _simulate_arguments(p)
+
+    if "verify" in listed:
+        p = sub.add_parser(
+            "verify",
+            help="prove a design balanced by simulation, with plots",
+            description=(
+                "Simulate the design with a formulation other than the optimiser's, driven at the "
+                "operating speed and in free motion from the spec's initial state; report the "
+                "largest shaking force and moment, relative to the unbalanced original where the "
+                "spec names one ([original]); optionally plot reactions, shaking moment and the "
+                "path of the total centre of mass (PNG, SVG or PDF)."
+            ),
+        )
+        if only is None or only == "verify":
+            _verify_arguments(p)
+
+    if "optimize" in listed:
+        p = sub.add_parser(
+            "optimize",
+            help="redesign the links for exact force balance and least shaking moment",
+            description=(
+                "Solve the redesign problem of the spec's [balance] section: exact shaking-force "
+                "balance as constraints, the shaking moment (and optional weighted terms) "
+                "minimised over one revolution at the operating speed. The convex backend solves "
+                "the second-order cone program in the inertial parameters (a global optimum: the "
+                "lower bound); the nlp backend then solves the designer's physical parametrisation "
+                "with IPOPT from it and reports the gap. The result is checked by an independent "
+                "simulation and can be written as a complete spec."
+            ),
+        )
+        if only is None or only == "optimize":
+            _optimize_arguments(p)
+
+    if "plot" in listed:
+        p = sub.add_parser(
+            "plot",
+            help="pictures for a report: one revolution's shaking, its orders, an animation",
+            description="Pictures of one crank revolution at the operating speed. --cycle: the "
+            "shaking force's polar diagram (and the rocking couple's, for links in several "
+            "planes), and the shaking moment and driving torque over the crank angle, of the "
+            "design and (for a balanced spec that names its [original]) of the original before "
+            "it. --orders: the order table as bars, forward and backward whirl, before and after. "
+            "--animate: the linkage turning, its total centre of mass traced. The file type "
+            "comes from the extension.",
+        )
+        if only is None or only == "plot":
+            _plot_arguments(p)
+
+    if "pareto" in listed:
+        p = sub.add_parser(
+            "pareto",
+            help="the exact front of shaking moment against driving torque, added mass or force",
+            description="The least RMS shaking moment against a second objective, under the "
+            "balancing constraints of the spec's [balance] section (force balance and every "
+            "link's bounds): an even grid of bounds on the second objective between its two "
+            "ends, each point the global optimum of a convex program with its certified lower "
+            "bound; the knee marked. An engine's front (its [balance.counterweights] and "
+            "[[balance.shafts]]) is of its weighted shaking against the mass it adds "
+            "(--against added-mass).",
+        )
+        if only is None or only == "pareto":
+            _pareto_arguments(p)
+
+    if "sweep" in listed:
+        p = sub.add_parser(
+            "sweep",
+            help="the certified balanced optimum over a design space, on a Dask cluster",
+            description="Vary spec keys over ranges (a grid, or --samples points of a Latin "
+            "hypercube or a Sobol' sequence); at each point analyse the design and solve its "
+            "redesign problem to the certified global optimum (the convex backend), one row per "
+            "point in a Parquet table. The batches run on dask.distributed: a local cluster on "
+            "this machine's cores, or the scheduler at --scheduler. Each finished batch is kept "
+            "beside the table, so that an interrupted sweep resumes with --resume.",
+        )
+        if only is None or only == "sweep":
+            _sweep_arguments(p)
+
+    if "example" in listed:
+        p = sub.add_parser(
+            "example",
+            help="write a shipped example spec (without NAME: list them)",
+            description="The example specs shipped with the package: the paper's four-bar "
+            "(meijaard2020), its balancing problems PB1 and PB2, an engine, six-bars and more. "
+            "Without NAME, list them; with NAME, print its spec, or write it to --out PATH.",
+        )
+        if only is None or only == "example":
+            _example_arguments(p)
+    return parser
+
+
+def _analyze_arguments(p: argparse.ArgumentParser) -> None:
+    """``balancer analyze``'s arguments."""
     _spec_and_force(p)
     p.add_argument("--json", action="store_true", help="print a JSON document instead of a table")
     p.add_argument("--csv", metavar="PATH", help="write the per-angle values to a CSV file; "
@@ -195,23 +319,15 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(verb="analyze")
 
-    methods = FORMULATION_NAMES
 
-    p = sub.add_parser(
-        "simulate",
-        help="forward dynamics in a formulation of your choice",
-        description=(
-            "Forward dynamics of the linkage from the spec's [simulation] settings: free motion "
-            "under the loads (and gravity), or the crank held at constant speed by a motor. "
-            "Prints the initial and final angles, rates and accelerations, the shaking figures, "
-            "the energy balance and the constraint drift."
-        ),
-    )
+def _simulate_arguments(p: argparse.ArgumentParser) -> None:
+    """``balancer simulate``'s arguments."""
     _spec_and_force(p)
-    p.add_argument("--method", choices=methods, help="formulation (default: the spec's, or "
-                   "the mechanism's first: opened-loop for a four-bar, mass-matrix for a "
-                   "slider-crank, crank-angle for a general linkage whose crank turns fully, "
-                   "multibody for one whose crank does not)")
+    p.add_argument("--method", choices=FORMULATION_NAMES,
+                   help="formulation (default: the spec's, or the mechanism's first: "
+                   "opened-loop for a four-bar, mass-matrix for a slider-crank, crank-angle for "
+                   "a general linkage whose crank turns fully, multibody for one whose crank does "
+                   "not)")
     p.add_argument("--drive", choices=DRIVES, help="free motion or constant crank speed "
                    "(default: the spec's); the constant speed is [simulation] omega1 where "
                    "the spec gives it non-zero, else the operating speed [operation] speed")
@@ -226,23 +342,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
     p.set_defaults(verb="simulate")
 
-    p = sub.add_parser(
-        "verify",
-        help="prove a design balanced by simulation, with plots",
-        description=(
-            "Simulate the design with a formulation other than the optimiser's, driven at the "
-            "operating speed and in free motion from the spec's initial state; report the "
-            "largest shaking force and moment, relative to the unbalanced original where the "
-            "spec names one ([original]); optionally plot reactions, shaking moment and the "
-            "path of the total centre of mass (PNG, SVG or PDF)."
-        ),
-    )
+
+def _verify_arguments(p: argparse.ArgumentParser) -> None:
+    """``balancer verify``'s arguments."""
     _spec_and_force(p)
     p.add_argument("--plot", metavar="PATH",
                    help="write the report figure to PATH (.png, .svg or .pdf)")
     p.add_argument("--duration", type=_positive_float, metavar="T",
                    help="simulated time of each run, s (default: the spec's)")
-    p.add_argument("--method", choices=methods,
+    p.add_argument("--method", choices=FORMULATION_NAMES,
                    help="formulation for the simulations (default: one the optimiser did not "
                    "use: complex-masses for a four-bar whose crank turns fully, opened-loop for "
                    "one that swings or passes change points, complex-masses for a "
@@ -250,19 +358,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
     p.set_defaults(verb="verify")
 
-    p = sub.add_parser(
-        "optimize",
-        help="redesign the links for exact force balance and least shaking moment",
-        description=(
-            "Solve the redesign problem of the spec's [balance] section: exact shaking-force "
-            "balance as constraints, the shaking moment (and optional weighted terms) "
-            "minimised over one revolution at the operating speed. The convex backend solves "
-            "the second-order cone program in the inertial parameters (a global optimum: the "
-            "lower bound); the nlp backend then solves the designer's physical parametrisation "
-            "with IPOPT from it and reports the gap. The result is checked by an independent "
-            "simulation and can be written as a complete spec."
-        ),
-    )
+
+def _optimize_arguments(p: argparse.ArgumentParser) -> None:
+    """``balancer optimize``'s arguments."""
     _spec_and_force(p, balance=True)
     p.add_argument("--out", metavar="BALANCED.toml", help="write the balanced design as a spec")
     p.add_argument("--backend", choices=("nlp", "convex"), default="nlp",
@@ -280,17 +378,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "(needs the cad extra: pip install 'balancer[cad]')")
     p.set_defaults(verb="optimize")
 
-    p = sub.add_parser(
-        "plot",
-        help="pictures for a report: one revolution's shaking, its orders, an animation",
-        description="Pictures of one crank revolution at the operating speed. --cycle: the "
-        "shaking force's polar diagram (and the rocking couple's, for links in several "
-        "planes), and the shaking moment and driving torque over the crank angle, of the "
-        "design and (for a balanced spec that names its [original]) of the original before "
-        "it. --orders: the order table as bars, forward and backward whirl, before and after. "
-        "--animate: the linkage turning, its total centre of mass traced. The file type "
-        "comes from the extension.",
-    )
+
+def _plot_arguments(p: argparse.ArgumentParser) -> None:
+    """``balancer plot``'s arguments."""
     _spec_and_force(p)
     p.add_argument("--cycle", metavar="PATH",
                    help="write the figure of one revolution to PATH (.png, .svg or .pdf)")
@@ -305,17 +395,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "rounding of the largest left out)")
     p.set_defaults(verb="plot")
 
-    p = sub.add_parser(
-        "pareto",
-        help="the exact front of shaking moment against driving torque, added mass or force",
-        description="The least RMS shaking moment against a second objective, under the "
-        "balancing constraints of the spec's [balance] section (force balance and every "
-        "link's bounds): an even grid of bounds on the second objective between its two "
-        "ends, each point the global optimum of a convex program with its certified lower "
-        "bound; the knee marked. An engine's front (its [balance.counterweights] and "
-        "[[balance.shafts]]) is of its weighted shaking against the mass it adds "
-        "(--against added-mass).",
-    )
+
+def _pareto_arguments(p: argparse.ArgumentParser) -> None:
+    """``balancer pareto``'s arguments."""
     _spec_and_force(p, balance=True)
     p.add_argument("--against", required=True,
                    choices=("driving-torque", "added-mass", "shaking-force"),
@@ -327,16 +409,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
     p.set_defaults(verb="pareto")
 
-    p = sub.add_parser(
-        "sweep",
-        help="the certified balanced optimum over a design space, on a Dask cluster",
-        description="Vary spec keys over ranges (a grid, or --samples points of a Latin "
-        "hypercube or a Sobol' sequence); at each point analyse the design and solve its "
-        "redesign problem to the certified global optimum (the convex backend), one row per "
-        "point in a Parquet table. The batches run on dask.distributed: a local cluster on "
-        "this machine's cores, or the scheduler at --scheduler. Each finished batch is kept "
-        "beside the table, so that an interrupted sweep resumes with --resume.",
-    )
+
+def _sweep_arguments(p: argparse.ArgumentParser) -> None:
+    """``balancer sweep``'s arguments."""
     _spec_and_force(p, balance=True)
     p.add_argument("--vary", action="append", metavar="KEY=LOW:HIGH:N",
                    help="a dotted spec key and its range, e.g. mechanism.lengths.coupler="
@@ -367,18 +442,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print a JSON summary instead")
     p.set_defaults(verb="sweep")
 
-    p = sub.add_parser(
-        "example",
-        help="write a shipped example spec (without NAME: list them)",
-        description="The example specs shipped with the package: the paper's four-bar "
-        "(meijaard2020), its balancing problems PB1 and PB2, an engine, six-bars and more. "
-        "Without NAME, list them; with NAME, print its spec, or write it to --out PATH.",
-    )
+
+def _example_arguments(p: argparse.ArgumentParser) -> None:
+    """``balancer example``'s arguments."""
     p.add_argument("name", metavar="NAME", nargs="?", help="the example (e.g. pb1)")
     p.add_argument("--out", metavar="PATH", help="write the spec to PATH instead of printing it")
     p.add_argument("--force", action="store_true", help=_FORCE_HELP)
     p.set_defaults(verb="example")
-    return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -412,9 +482,14 @@ def _interrupted(exc: KeyboardInterrupt | None) -> str:
     return f"balancer: interrupted: {what}" if what else "balancer: interrupted"
 
 
+def _verb_of(argv: Sequence[str]) -> str:
+    """The verb a command line asks for: its first word that is no option (``""``: none)."""
+    return next((a for a in argv if not a.startswith("-")), "")
+
+
 def _run(argv: Sequence[str] | None) -> tuple[int, str | None]:
     """Parse and run the command: its exit code and the error line to print, if any."""
-    parser = build_parser()
+    parser = build_parser(_verb_of(sys.argv[1:] if argv is None else argv))
     args = None
     try:
         args = parser.parse_args(argv)

@@ -24,9 +24,6 @@ from ..model.mechanisms import ChainModel
 from .base import Mechanism
 from .formulation import Formulation
 
-#: |sin(θ3 − θ2)| below which a position is flagged as (near) a dead or change point.
-SINGULAR_TOLERANCE = 1e-6
-
 
 class ClosedForm(Formulation):
     """A formulation of a mechanism given by its lengths and its links in a chain.

@@ -13,6 +13,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+#: |sin(θ3 − θ2)| (a slider-crank's |cos θ2|) below which a closed form flags a position as
+#: (near) a dead or change point, where the dependent rates are ill-determined.
+SINGULAR_TOLERANCE = 1e-6
+
 
 @dataclass(frozen=True)
 class AssemblyRange:

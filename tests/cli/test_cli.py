@@ -645,3 +645,20 @@ def test_a_value_that_begins_with_a_dash_is_shown_in_its_equals_form(capsys, ver
     assert option in err and f"{option}={value}" in err and "'-'" in err
     assert main(["analyze", _PB1, "--csv", "--json"]) == 2  # a missing value: no such hint
     assert "=" not in _one_error_line(capsys.readouterr().err)
+
+
+def test_a_verb_built_alone_is_the_verb_of_the_whole_parser():
+    """A command builds only its own verb's arguments (start-up): each verb's parser, and the
+    top-level help listing every verb, must be what the whole parser gives."""
+    from balancer.cli import build_parser
+
+    def subparsers(parser):
+        action = next(a for a in parser._actions if a.dest == "command")
+        return action.choices
+
+    whole = build_parser()
+    assert build_parser("").format_help() == whole.format_help()
+    for verb, full in subparsers(whole).items():
+        alone = subparsers(build_parser(verb))[verb]
+        assert alone.format_help() == full.format_help(), verb
+        assert alone.get_default("verb") == full.get_default("verb") == verb

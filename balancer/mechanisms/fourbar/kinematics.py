@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import AssemblyError
 from ...linkage.vectors import as_1d, cross, inner
-from ..chains import SINGULAR_TOLERANCE
+from ...model.assembly import SINGULAR_TOLERANCE
 from .assembly import BOUND_TOLERANCE, Lengths, assembly_range, cosine_bounds
 from .model import FourBar
 

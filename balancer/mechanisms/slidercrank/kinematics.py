@@ -21,8 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import AssemblyError
 from ...linkage.vectors import as_1d
-from ...model.assembly import AssemblyRange
-from ..chains import SINGULAR_TOLERANCE
+from ...model.assembly import SINGULAR_TOLERANCE, AssemblyRange
 from .model import SliderCrank
 
 Lengths = tuple[float, float, float]
@@ -86,7 +85,7 @@ class SliderMotion:
     transfer
         ``Θ2 = dθ2/dθ1`` and ``X = dx/dθ1`` (m/rad).
     singular
-        At or near a dead point (|cos θ2| < :data:`~balancer.mechanisms.chains.SINGULAR_TOLERANCE`).
+        At or near a dead point (|cos θ2| < :data:`~balancer.model.assembly.SINGULAR_TOLERANCE`).
     """
 
     lengths: Lengths
