@@ -162,7 +162,12 @@ BOUND_RANGE = 1e9
 
 
 def _check_widths(freedom: LinkFreedom, bounds: LinkBounds, key: str) -> None:
-    """Refuse a bound beyond :data:`BOUND_RANGE` times the link's scale, naming it."""
+    """Refuse a bound beyond :data:`BOUND_RANGE` times the link's scale, naming it.
+
+    A link's mass range, too, may span at most :data:`BOUND_RANGE` (its upper end over its
+    lower): the optimum may take the link to its lower end, and the balanced spec, whose link
+    has that mass, must load again with the same bounds.
+    """
     mass = max(bounds.original.mass, bounds.mass[0])
     length = bounds.length
     inertia = bounds.original.inertia + mass * length * length
@@ -185,6 +190,11 @@ def _check_widths(freedom: LinkFreedom, bounds: LinkBounds, key: str) -> None:
                 f"({BOUND_RANGE * scale:.6g} {unit}): a wider bound leaves the optimiser's "
                 "precision", key=f"{key}.{name}", value=list(value) if isinstance(
                     value, tuple) else value)
+    if freedom.mass is not None and freedom.mass[1] > BOUND_RANGE * freedom.mass[0]:
+        raise SpecError(
+            f"must span at most {BOUND_RANGE:g} (its upper end over its lower): the optimum may "
+            "take the link to its lower end, where a wider bound leaves the optimiser's "
+            "precision", key=f"{key}.mass", value=list(freedom.mass))
 
 
 @dataclass(frozen=True, kw_only=True)

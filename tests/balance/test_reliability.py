@@ -1122,3 +1122,27 @@ def test_a_counterweight_at_a_pivot_beside_a_thin_set_is_found():
     result = optimize(spec.load_design(DATA / "counterweight_at_a_pivot_beside_a_thin_set.toml"),
                       "convex")
     assert result.success
+
+
+def test_a_link_mass_range_wider_than_the_optimisers_precision_is_refused_up_front(tmp_path,
+                                                                                   capsys):
+    """A mass range of 1e-12 kg to 0.25 kg let the optimum take the link to 1e-11 kg, and the
+    balanced spec optimize wrote then failed to load again (its bound over 1e9 times the
+    link's mass): exit 2 after the work (fuzz campaign, seed 551907). The range itself is now
+    refused before any work, naming its key and value; one that spans 1e9 is taken."""
+    from balancer.cli import main
+
+    text = (EXAMPLES / "pb1.toml").read_text()
+    assert "mass = [2.2, 8.8]" in text
+    spec = tmp_path / "wide.toml"
+    spec.write_text(text.replace("mass = [2.2, 8.8]", "mass = [1e-12, 8.8]"))
+    assert main(["optimize", str(spec), "--no-verify"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert "balance.rocker.mass" in err and "must span at most 1e+09" in err
+    assert "1e-12" in err and "8.8" in err
+    spec.write_text(text.replace("mass = [2.2, 8.8]", "mass = [1e-8, 8.8]"))
+    out = tmp_path / "balanced.toml"
+    assert main(["optimize", str(spec), "--no-verify", "--out", str(out), "--json"]) == 0
+    capsys.readouterr()
+    assert main(["analyze", str(out), "--json"]) == 0  # the balanced spec loads again
