@@ -507,7 +507,8 @@ SECTIONS: tuple[Section, ...] = (
             "mass or the centre of mass may change or `min_gyration` is given; otherwise it "
             "stays.", (
                 Key("mass", "kg", "the spec's mass, fixed",
-                    "A range `[low, high]`, or one number that fixes it; positive.",
+                    "A range `[low, high]`, or one number that fixes it; positive, its high "
+                    "end at most 1e9 times its low end.",
                     example="[2.1, 8.4]"),
                 Key("com_radius", "m", "the spec's centre of mass, fixed",
                     "The centre of mass may lie anywhere within this distance of `com_about`; "
