@@ -57,7 +57,7 @@ class SpecError(BalancerError, ValueError):
         head = ": ".join(where)
         text = self.detail
         if self.key is not None and self.value is not None:
-            text = f"{text} (got {self.value!r})"
+            text = f"{text} (got {_as_written(self.value)!r})"
         return f"{head}: {text}" if head else text
 
     def with_source(self, source: str) -> SpecError:
@@ -115,3 +115,13 @@ class LockupError(BalancerError):
         self.time = time
         self.theta1 = theta1
         super().__init__(message)
+
+
+def _as_written(value: object) -> object:
+    """A value as a spec writes it: tuples (the model's arrays) as lists, TOML's arrays."""
+    if isinstance(value, tuple):
+        return [_as_written(v) for v in value]
+    if isinstance(value, list):
+        return [_as_written(v) for v in value]
+    return value
+

@@ -311,3 +311,18 @@ def test_a_hint_never_names_the_key_it_refuses():
 
     assert hint("unbalance", ("unbalance", "shaking_moment")) == ""
     assert hint("unbalanc", ("unbalance", "shaking_moment")) == "; did you mean 'unbalance'?"
+
+
+def test_an_array_in_an_error_is_shown_as_the_spec_writes_it():
+    """A refused array is shown as TOML's array, not as the model's Python tuple: a body with
+    no points read '(got ())' (fuzz campaign)."""
+    root = Path(__file__).resolve().parents[2]
+    text = (root / "examples" / "quick_return.toml").read_text()
+    assert 'points = ["A1"]' in text
+    with pytest.raises(SpecError) as info:
+        spec.loads_design(text.replace('points = ["A1"]', "points = []"))
+    message = str(info.value)
+    assert "links.block.points" in message, message
+    assert "(got ())" not in message and "(got [])" in message, message
+    assert SpecError("x", key="k", value=((1.0, 2.0), 3)).args[0].endswith(
+        "(got [[1.0, 2.0], 3])")
