@@ -56,8 +56,15 @@ class ObjectiveTerms(ProblemData):
         w = self.weights
         reg = self.regressors
         total = 0.0
+        loads: dict[str, NDArray[np.number]] = {}
+
+        def at_x(key: str) -> NDArray[np.number]:  # each load at x once (its parts share it)
+            if key not in loads:
+                loads[key] = getattr(reg, key) @ x
+            return loads[key]
+
         for term in w.terms:
-            for part in squared_parts(term.name, lambda key: getattr(reg, key) @ x):
+            for part in squared_parts(term.name, at_x):
                 total += term.weight * float(np.mean(part**2))
         if w.added_mass:
             total += w.added_mass * (self.total_mass(x) - self.original_mass)

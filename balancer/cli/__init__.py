@@ -15,7 +15,7 @@ import importlib
 import os
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -155,9 +155,77 @@ class _VersionAction(argparse.Action):
         parser.exit()
 
 
+#: Each verb's one-line help and description, in the order ``balancer --help`` lists them.
+_VERB_TEXTS: dict[str, tuple[str, str]] = {
+    "analyze": (
+        "shaking force, shaking moment and driving torque over one revolution",
+        "Reactions at the ground pivots, shaking force, shaking moment about A0 and "
+        "driving torque over one crank revolution at the operating speed ([operation] "
+        "speed).",
+    ),
+    "simulate": (
+        "forward dynamics in a formulation of your choice",
+        "Forward dynamics of the linkage from the spec's [simulation] settings: free "
+        "motion under the loads (and gravity), or the crank held at constant speed by a "
+        "motor. Prints the initial and final angles, rates and accelerations, the "
+        "shaking figures, the energy balance and the constraint drift.",
+    ),
+    "verify": (
+        "prove a design balanced by simulation, with plots",
+        "Simulate the design with a formulation other than the optimiser's, driven at the "
+        "operating speed and in free motion from the spec's initial state; report the "
+        "largest shaking force and moment, relative to the unbalanced original where the "
+        "spec names one ([original]); optionally plot reactions, shaking moment and the "
+        "path of the total centre of mass (PNG, SVG or PDF).",
+    ),
+    "optimize": (
+        "redesign the links for exact force balance and least shaking moment",
+        "Solve the redesign problem of the spec's [balance] section: exact shaking-force "
+        "balance as constraints, the shaking moment (and optional weighted terms) "
+        "minimised over one revolution at the operating speed. The convex backend solves "
+        "the second-order cone program in the inertial parameters (a global optimum: the "
+        "lower bound); the nlp backend then solves the designer's physical parametrisation "
+        "with IPOPT from it and reports the gap. The result is checked by an independent "
+        "simulation and can be written as a complete spec.",
+    ),
+    "plot": (
+        "pictures for a report: one revolution's shaking, its orders, an animation",
+        "Pictures of one crank revolution at the operating speed. --cycle: the "
+        "shaking force's polar diagram (and the rocking couple's, for links in several "
+        "planes), and the shaking moment and driving torque over the crank angle, of the "
+        "design and (for a balanced spec that names its [original]) of the original before "
+        "it. --orders: the order table as bars, forward and backward whirl, before and after. "
+        "--animate: the linkage turning, its total centre of mass traced. The file type "
+        "comes from the extension.",
+    ),
+    "pareto": (
+        "the exact front of shaking moment against driving torque, added mass or force",
+        "The least RMS shaking moment against a second objective, under the "
+        "balancing constraints of the spec's [balance] section (force balance and every "
+        "link's bounds): an even grid of bounds on the second objective between its two "
+        "ends, each point the global optimum of a convex program with its certified lower "
+        "bound; the knee marked. An engine's front (its [balance.counterweights] and "
+        "[[balance.shafts]]) is of its weighted shaking against the mass it adds "
+        "(--against added-mass).",
+    ),
+    "sweep": (
+        "the certified balanced optimum over a design space, on a Dask cluster",
+        "Vary spec keys over ranges (a grid, or --samples points of a Latin "
+        "hypercube or a Sobol' sequence); at each point analyse the design and solve its "
+        "redesign problem to the certified global optimum (the convex backend), one row per "
+        "point in a Parquet table. The batches run on dask.distributed: a local cluster on "
+        "this machine's cores, or the scheduler at --scheduler. Each finished batch is kept "
+        "beside the table, so that an interrupted sweep resumes with --resume.",
+    ),
+    "example": (
+        "write a shipped example spec (without NAME: list them)",
+        "The example specs shipped with the package: the paper's four-bar "
+        "(meijaard2020), its balancing problems PB1 and PB2, an engine, six-bars and more. "
+        "Without NAME, list them; with NAME, print its spec, or write it to --out PATH.",
+    ),
+}
 #: The verbs, in the order ``balancer --help`` lists them.
-VERBS: tuple[str, ...] = ("analyze", "simulate", "verify", "optimize", "plot", "pareto", "sweep",
-                          "example")
+VERBS: tuple[str, ...] = tuple(_VERB_TEXTS)
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
@@ -182,120 +250,12 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     sub.required = True
 
     # (a known verb: its parser alone; else every verb, listed for the help or the error)
-    listed = (only,) if only in VERBS else VERBS
-    if "analyze" in listed:
-        p = sub.add_parser(
-            "analyze",
-            help="shaking force, shaking moment and driving torque over one revolution",
-            description=(
-                "Reactions at the ground pivots, shaking force, shaking moment about A0 and "
-                "driving torque over one crank revolution at the operating speed ([operation] "
-                "speed)."
-            ),
-        )
-        if only is None or only == "analyze":
-            _analyze_arguments(p)
-
-    if "simulate" in listed:
-        p = sub.add_parser(
-            "simulate",
-            help="forward dynamics in a formulation of your choice",
-            description=(
-                "Forward dynamics of the linkage from the spec's [simulation] settings: free "
-                "motion under the loads (and gravity), or the crank held at constant speed by a "
-                "motor. Prints the initial and final angles, rates and accelerations, the "
-                "shaking figures, the energy balance and the constraint drift."
-            ),
-        )
-        if only is None or only == "simulate":
-            _simulate_arguments(p)
-
-    if "verify" in listed:
-        p = sub.add_parser(
-            "verify",
-            help="prove a design balanced by simulation, with plots",
-            description=(
-                "Simulate the design with a formulation other than the optimiser's, driven at the "
-                "operating speed and in free motion from the spec's initial state; report the "
-                "largest shaking force and moment, relative to the unbalanced original where the "
-                "spec names one ([original]); optionally plot reactions, shaking moment and the "
-                "path of the total centre of mass (PNG, SVG or PDF)."
-            ),
-        )
-        if only is None or only == "verify":
-            _verify_arguments(p)
-
-    if "optimize" in listed:
-        p = sub.add_parser(
-            "optimize",
-            help="redesign the links for exact force balance and least shaking moment",
-            description=(
-                "Solve the redesign problem of the spec's [balance] section: exact shaking-force "
-                "balance as constraints, the shaking moment (and optional weighted terms) "
-                "minimised over one revolution at the operating speed. The convex backend solves "
-                "the second-order cone program in the inertial parameters (a global optimum: the "
-                "lower bound); the nlp backend then solves the designer's physical parametrisation "
-                "with IPOPT from it and reports the gap. The result is checked by an independent "
-                "simulation and can be written as a complete spec."
-            ),
-        )
-        if only is None or only == "optimize":
-            _optimize_arguments(p)
-
-    if "plot" in listed:
-        p = sub.add_parser(
-            "plot",
-            help="pictures for a report: one revolution's shaking, its orders, an animation",
-            description="Pictures of one crank revolution at the operating speed. --cycle: the "
-            "shaking force's polar diagram (and the rocking couple's, for links in several "
-            "planes), and the shaking moment and driving torque over the crank angle, of the "
-            "design and (for a balanced spec that names its [original]) of the original before "
-            "it. --orders: the order table as bars, forward and backward whirl, before and after. "
-            "--animate: the linkage turning, its total centre of mass traced. The file type "
-            "comes from the extension.",
-        )
-        if only is None or only == "plot":
-            _plot_arguments(p)
-
-    if "pareto" in listed:
-        p = sub.add_parser(
-            "pareto",
-            help="the exact front of shaking moment against driving torque, added mass or force",
-            description="The least RMS shaking moment against a second objective, under the "
-            "balancing constraints of the spec's [balance] section (force balance and every "
-            "link's bounds): an even grid of bounds on the second objective between its two "
-            "ends, each point the global optimum of a convex program with its certified lower "
-            "bound; the knee marked. An engine's front (its [balance.counterweights] and "
-            "[[balance.shafts]]) is of its weighted shaking against the mass it adds "
-            "(--against added-mass).",
-        )
-        if only is None or only == "pareto":
-            _pareto_arguments(p)
-
-    if "sweep" in listed:
-        p = sub.add_parser(
-            "sweep",
-            help="the certified balanced optimum over a design space, on a Dask cluster",
-            description="Vary spec keys over ranges (a grid, or --samples points of a Latin "
-            "hypercube or a Sobol' sequence); at each point analyse the design and solve its "
-            "redesign problem to the certified global optimum (the convex backend), one row per "
-            "point in a Parquet table. The batches run on dask.distributed: a local cluster on "
-            "this machine's cores, or the scheduler at --scheduler. Each finished batch is kept "
-            "beside the table, so that an interrupted sweep resumes with --resume.",
-        )
-        if only is None or only == "sweep":
-            _sweep_arguments(p)
-
-    if "example" in listed:
-        p = sub.add_parser(
-            "example",
-            help="write a shipped example spec (without NAME: list them)",
-            description="The example specs shipped with the package: the paper's four-bar "
-            "(meijaard2020), its balancing problems PB1 and PB2, an engine, six-bars and more. "
-            "Without NAME, list them; with NAME, print its spec, or write it to --out PATH.",
-        )
-        if only is None or only == "example":
-            _example_arguments(p)
+    for name in (only,) if only in VERBS else VERBS:
+        help_text, description = _VERB_TEXTS[name]
+        p = sub.add_parser(name, help=help_text, description=description)
+        if only is None or only == name:
+            _ARGUMENTS[name](p)
+            p.set_defaults(verb=name)
     return parser
 
 
@@ -317,7 +277,6 @@ def _analyze_arguments(p: argparse.ArgumentParser) -> None:
         "(default none): the frame then carries the weights too. Write a negative first "
         "value as --gravity=-1,-9.81",
     )
-    p.set_defaults(verb="analyze")
 
 
 def _simulate_arguments(p: argparse.ArgumentParser) -> None:
@@ -340,7 +299,6 @@ def _simulate_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--all-columns", action="store_true",
                    help="add shaking force and moment, driving torque, energy to the CSV")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
-    p.set_defaults(verb="simulate")
 
 
 def _verify_arguments(p: argparse.ArgumentParser) -> None:
@@ -356,7 +314,6 @@ def _verify_arguments(p: argparse.ArgumentParser) -> None:
                    "one that swings or passes change points, complex-masses for a "
                    "slider-crank, multibody for a general linkage)")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
-    p.set_defaults(verb="verify")
 
 
 def _optimize_arguments(p: argparse.ArgumentParser) -> None:
@@ -376,7 +333,6 @@ def _optimize_arguments(p: argparse.ArgumentParser) -> None:
                    "PNG), named after the link; an engine's crank-web sectors (its "
                    "[balance.counterweights] part) named by their plane, crankshaft_z<z>mm "
                    "(needs the cad extra: pip install 'balancer[cad]')")
-    p.set_defaults(verb="optimize")
 
 
 def _plot_arguments(p: argparse.ArgumentParser) -> None:
@@ -393,7 +349,6 @@ def _plot_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--log", action="store_true",
                    help="with --orders: the bars on a logarithmic axis (magnitudes; bars at "
                    "rounding of the largest left out)")
-    p.set_defaults(verb="plot")
 
 
 def _pareto_arguments(p: argparse.ArgumentParser) -> None:
@@ -407,7 +362,6 @@ def _pareto_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--plot", metavar="PATH", help="draw the front to PATH (.png, .svg or .pdf)")
     p.add_argument("--csv", metavar="PATH", help="write the points to a CSV file")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
-    p.set_defaults(verb="pareto")
 
 
 def _sweep_arguments(p: argparse.ArgumentParser) -> None:
@@ -440,7 +394,6 @@ def _sweep_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--plot", metavar="PATH",
                    help="draw the atlas (.png, .svg or .pdf): a heat map over two keys")
     p.add_argument("--json", action="store_true", help="print a JSON summary instead")
-    p.set_defaults(verb="sweep")
 
 
 def _example_arguments(p: argparse.ArgumentParser) -> None:
@@ -448,7 +401,19 @@ def _example_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("name", metavar="NAME", nargs="?", help="the example (e.g. pb1)")
     p.add_argument("--out", metavar="PATH", help="write the spec to PATH instead of printing it")
     p.add_argument("--force", action="store_true", help=_FORCE_HELP)
-    p.set_defaults(verb="example")
+
+
+#: Each verb's arguments (the verb's own module runs it: :mod:`.analyze`, …).
+_ARGUMENTS: dict[str, Callable[[argparse.ArgumentParser], None]] = {
+    "analyze": _analyze_arguments,
+    "simulate": _simulate_arguments,
+    "verify": _verify_arguments,
+    "optimize": _optimize_arguments,
+    "plot": _plot_arguments,
+    "pareto": _pareto_arguments,
+    "sweep": _sweep_arguments,
+    "example": _example_arguments,
+}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
