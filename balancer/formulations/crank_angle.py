@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 from ..errors import AssemblyError, SolverError
 from ..linkage import rotors
 from ..linkage.assembly import assembly_gaps
+from ..linkage.inputs import InputState
 from ..linkage.kinematics import numeric_table, positions, rates
 from ..linkage.loads import Reactions
 from ..linkage.numeric import TABLE_STEPS
@@ -83,8 +84,9 @@ class CrankAngle(LinkageFormulation):
                    for i, a, b in zip(numeric, starts[:-1], starts[1:], strict=True)}
         gaps: list[Num] = []
         residuals: list[Num] = []
-        pose = positions(s, theta1, CasadiOps, gaps=gaps, guesses=guesses, residuals=residuals)
-        u_vel, u_rate, b_acc, b_accel = rates(s, pose, 1.0, 0.0, theta1, CasadiOps)
+        unit = InputState.symbolic([theta1], [1.0], [0.0])
+        pose = positions(s, unit, CasadiOps, gaps=gaps, guesses=guesses, residuals=residuals)
+        u_vel, u_rate, b_acc, b_accel = rates(s, pose, unit, CasadiOps)
         u = ca.vertcat(*[x for k in range(self.n)
                          for x in (u_vel[k].x, u_vel[k].y, u_rate[k])])
         b = ca.vertcat(*[x for k in range(self.n)

@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from ..model.assembly import AssemblyRange
 from . import kinematics
+from .inputs import InputState
 from .structure import Structure
 
 #: Least normalised assembly gap of a dyad over a revolution for the crank to turn fully: at
@@ -33,7 +34,7 @@ def assembly_gaps(structure: Structure, theta1: NDArray[np.float64]) -> NDArray[
     """
     gaps: list[NDArray[np.float64]] = []
     with np.errstate(all="ignore"):
-        pose = kinematics.positions(structure, theta1, gaps=gaps)
+        pose = kinematics.positions(structure, InputState.crank(theta1), gaps=gaps)
     least = np.ones_like(theta1)
     for g in gaps:
         least = np.minimum(least, np.where(np.isnan(g), -1.0, g))

@@ -15,6 +15,7 @@ from typing import ClassVar, TypeAlias
 import numpy as np
 from numpy.typing import NDArray
 
+from .inputs import InputState
 from .vectors import Num, OpsLike, V, _plus
 
 #: Index of the ground among the links.
@@ -37,18 +38,15 @@ class FrameTally:
     """What the joints put on the frame, collected joint by joint (:meth:`Pin.tally`, …).
 
     ``reactions`` by ground point (N), the ground sliders' ``normal`` force (N) and ``couple``
-    (N·m) by the slider's link index, the motor's ``driving`` torque (N·m); ``zero`` what no
-    joint puts there (an array of zeros, or the float 0.0 on symbols).
+    (N·m) by the slider's link index, each motor's torque on its input by the input's index
+    (N·m); ``zero`` what no joint puts there (an array of zeros, or the float 0.0 on symbols).
     """
 
     zero: Num
-    driving: Num = 0.0
     reactions: dict[str, V] = field(default_factory=dict)
     normal: dict[int, Num] = field(default_factory=dict)
     couple: dict[int, Num] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        self.driving = self.zero
+    torques: dict[int, Num] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -92,14 +90,14 @@ class Pin:
                 (self.b, [[-1.0, 0.0, rb.y], [0.0, -1.0, -rb.x]])]
 
     def gamma(self, pose: Pose, vel: list[V], rate: list[Num],
-              input_acceleration: Num = 0.0) -> list[Num]:
+              state: InputState | None = None) -> list[Num]:
         """``γ`` (``Φ_q·q̈ = γ``): the velocity terms of the residual's second derivative."""
         ra, rb = pose.rotate(self.a, self.pa), pose.rotate(self.b, self.pb)
         wa, wb = _rate(rate, self.a), _rate(rate, self.b)
         out = ra * (wa * wa) - rb * (wb * wb)
         return [out.x, out.y]
 
-    def prescribed_rates(self, input_rate: Num) -> list[Num]:
+    def prescribed_rates(self, state: InputState) -> list[Num]:
         """``Φ_q·q̇`` of its rows: zero (it prescribes no motion)."""
         return [0.0, 0.0]
 
@@ -160,7 +158,7 @@ class Prism:
                 (self.g, [[0.0, 0.0, -1.0], [d.y, -d.x, -d.dot(reach)]])]
 
     def gamma(self, pose: Pose, vel: list[V], rate: list[Num],
-              input_acceleration: Num = 0.0) -> list[Num]:
+              state: InputState | None = None) -> list[Num]:
         """``γ`` (``Φ_q·q̈ = γ``): the velocity terms of the residual's second derivative."""
         d = pose.rotate(self.g, self.dg)
         ps, pg = pose.rotate(self.s, self.ps), pose.rotate(self.g, self.pg)
@@ -172,7 +170,7 @@ class Prism:
                 + ws * ws * d.cross(ps))
         return [0.0 * line, line]
 
-    def prescribed_rates(self, input_rate: Num) -> list[Num]:
+    def prescribed_rates(self, state: InputState) -> list[Num]:
         """``Φ_q·q̇`` of its rows: zero (it prescribes no motion)."""
         return [0.0, 0.0]
 
@@ -189,9 +187,12 @@ class Prism:
 
 @dataclass(frozen=True)
 class Driver:
-    """The driver: ``θ_input − θ_ground − θ1 = 0`` (its multiplier is minus the motor torque)."""
+    """An input's driver: ``θ_link − θ_ground − θ_i = 0`` for input ``index`` (its multiplier
+    is minus the motor's torque)."""
 
     link: int
+    #: Which input drives it (its place in the linkage's inputs and in an :class:`InputState`).
+    index: int = 0
 
     rows = 1
     row_kinds: ClassVar[tuple[str, ...]] = ("angle",)
@@ -215,21 +216,21 @@ class Driver:
         return [(self.link, [[0.0, 0.0, 1.0]]), (GROUND_INDEX, [[0.0, 0.0, -1.0]])]
 
     def gamma(self, pose: Pose, vel: list[V], rate: list[Num],
-              input_acceleration: Num = 0.0) -> list[Num]:
-        """``γ``: the input's prescribed acceleration (rad/s²)."""
-        return [input_acceleration]
+              state: InputState | None = None) -> list[Num]:
+        """``γ``: the input's prescribed acceleration (rad/s²; none given: zero)."""
+        return [0.0 if state is None else state.accelerations[self.index]]
 
-    def prescribed_rates(self, input_rate: Num) -> list[Num]:
+    def prescribed_rates(self, state: InputState) -> list[Num]:
         """``Φ_q·q̇`` of its rows: the input's prescribed rate (rad/s)."""
-        return [input_rate]
+        return [state.rates[self.index]]
 
     def row_scales(self, length: float) -> list[float]:
         """The angle's row, as it is."""
         return [1.0]
 
     def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
-        """The motor's torque on the input: minus its multiplier."""
-        frame.driving = -multipliers[0]
+        """The motor's torque on its input: minus its multiplier."""
+        frame.torques[self.index] = -multipliers[0]
 
 
 Constraint = Pin | Prism | Driver
@@ -247,7 +248,7 @@ class Group:
         The constraints that close the group: every row touches a link of the group, the other
         links they touch are found before.
     kind
-        ``"crank"`` (the input, from its pivot and the driver), ``"RRR"``, ``"RRP"``, ``"PRR"``,
+        ``"input"`` (a driven link, from its pivot and its driver), ``"RRR"``, ``"RRP"``, ``"PRR"``,
         ``"RPR"`` (dyads in closed form; the letters are the joints from the first link's
         known side to the second's) or ``"numeric"``.
     sign
@@ -261,10 +262,18 @@ class Group:
 
     @property
     def pivot(self) -> Pin:
-        """A crank group's pivot: the pin its first constraint is."""
+        """An input group's pivot: the pin its first constraint is."""
         c = self.constraints[0]
         if not isinstance(c, Pin):
             raise ValueError(f"a {self.kind} group has no pivot")
+        return c
+
+    @property
+    def driver(self) -> Driver:
+        """An input group's driver: its second constraint."""
+        c = self.constraints[-1]
+        if not isinstance(c, Driver):
+            raise ValueError(f"a {self.kind} group has no driver")
         return c
 
 

@@ -42,6 +42,7 @@ from .constraints import (
     FrameTally,
     Pose,
 )
+from .inputs import InputState
 from .kinematics import Motion, rates
 from .structure import Structure
 from .vectors import NUMPY, Num, OpsLike, V, _plus, _times
@@ -117,8 +118,9 @@ class Forces:
     slider_normal, slider_couple
         For each slider whose guide is the ground: the normal force (N) and the couple (N·m)
         its link exerts on the guide; keyed by the sliding link's name.
-    driving_torque
-        Torque of the motor on the input, N·m.
+    input_torques
+        Torque of each motor on its input, N·m, in the order of the linkage's inputs
+        (:attr:`driving_torque`: a one-input linkage's).
     shaking_force
         Sum of all forces of the mechanism on the ground (springs and slider forces anchored
         on it included), N.
@@ -133,19 +135,26 @@ class Forces:
     reactions: dict[str, V]
     slider_normal: dict[str, Num]
     slider_couple: dict[str, Num]
-    driving_torque: Num
+    input_torques: tuple[Num, ...]
     shaking_force: V
     shaking_moment: Num
     rocking_couple: V
 
+    @property
+    def driving_torque(self) -> Num:
+        """A one-input linkage's motor torque on its crank, N·m (``ValueError`` for several)."""
+        if len(self.input_torques) != 1:
+            raise ValueError(f"the forces have {len(self.input_torques)} input torques, not one")
+        return self.input_torques[0]
+
     def arrays(self) -> list[Num]:
         """Every figure in one fixed order (what :meth:`with_arrays` reads back).
 
-        Driving torque, shaking force ``x`` and ``y``, shaking moment, rocking couple ``x`` and
-        ``y``; each ground point's reaction ``x`` and ``y``, by name; each ground slider's normal
-        force and couple, by name.
+        Each input's torque, shaking force ``x`` and ``y``, shaking moment, rocking couple
+        ``x`` and ``y``; each ground point's reaction ``x`` and ``y``, by name; each ground
+        slider's normal force and couple, by name.
         """
-        out = [self.driving_torque, self.shaking_force.x, self.shaking_force.y,
+        out = [*self.input_torques, self.shaking_force.x, self.shaking_force.y,
                self.shaking_moment, self.rocking_couple.x, self.rocking_couple.y]
         for p in sorted(self.reactions):
             out += [self.reactions[p].x, self.reactions[p].y]
@@ -164,19 +173,22 @@ class Forces:
         return Forces(reactions={p: self.reactions[p] for p in names.reactions},
                       slider_normal={k: self.slider_normal[k] for k in names.slider_normal},
                       slider_couple={k: self.slider_couple[k] for k in names.slider_couple},
-                      driving_torque=self.driving_torque, shaking_force=self.shaking_force,
+                      input_torques=self.input_torques, shaking_force=self.shaking_force,
                       shaking_moment=self.shaking_moment, rocking_couple=self.rocking_couple)
 
     def with_arrays(self, values: Sequence[Num]) -> Forces:
         """Forces with the same names holding ``values`` in :meth:`arrays`' order."""
         points, sliders = sorted(self.reactions), sorted(self.slider_normal)
-        at = 6 + 2 * len(points)
+        m = len(self.input_torques)
+        base = m + 5
+        at = base + 2 * len(points)
         return Forces(
-            reactions={p: V(values[6 + 2 * i], values[7 + 2 * i]) for i, p in enumerate(points)},
+            reactions={p: V(values[base + 2 * i], values[base + 1 + 2 * i])
+                       for i, p in enumerate(points)},
             slider_normal={k: values[at + 2 * i] for i, k in enumerate(sliders)},
             slider_couple={k: values[at + 2 * i + 1] for i, k in enumerate(sliders)},
-            driving_torque=values[0], shaking_force=V(values[1], values[2]),
-            shaking_moment=values[3], rocking_couple=V(values[4], values[5]))
+            input_torques=tuple(values[:m]), shaking_force=V(values[m], values[m + 1]),
+            shaking_moment=values[m + 2], rocking_couple=V(values[m + 3], values[m + 4]))
 
 
 def _col(x: Num, n: int, c: int) -> NDArray[np.float64]:
@@ -231,7 +243,7 @@ def applied_column(structure: Structure, mo: Motion, gravity: V, loads: bool = T
     per: list[list[Num]]
     ground: list[Num]
     if ops is NUMPY:
-        zero = np.zeros(mo.theta1.size)
+        zero = np.zeros(mo.count)
         per = [[zero.copy(), zero.copy(), zero.copy()] for _ in structure.names]
         ground = [zero.copy(), zero.copy(), zero.copy()]
     else:
@@ -315,7 +327,7 @@ def kinetostatics(structure: Structure, mo: Motion, effective: list[list[Num]],
     """
     numeric = ops is NUMPY
     if numeric:
-        n, c_count = effective[0][0].shape if effective else (mo.theta1.size, 1)
+        n, c_count = effective[0][0].shape if effective else (mo.count, 1)
         applied = [[np.array(e, dtype=float, copy=True) for e in row] for row in effective]
         zero: Num = np.zeros((n, c_count))
     else:
@@ -380,7 +392,7 @@ def global_kinetostatics(structure: Structure, mo: Motion, effective: list[list[
     """
     n, c_count = effective[0][0].shape
     size = 3 * structure.size
-    constraints: list[Constraint] = [*structure.constraints, structure.driver]
+    constraints: list[Constraint] = [*structure.constraints, *structure.drivers]
     mat = np.zeros((n, size, size))
     rhs = np.zeros((n, size, c_count))
     for k in range(structure.size):
@@ -450,7 +462,9 @@ def _collect(structure: Structure, constraints: Sequence[Constraint],
     return Forces(reactions=reactions,
                   slider_normal={names[k]: f for k, f in frame.normal.items()},
                   slider_couple={names[k]: m for k, m in frame.couple.items()},
-                  driving_torque=frame.driving, shaking_force=V(fx, fy), shaking_moment=mz,
+                  input_torques=tuple(frame.torques.get(i, zero)
+                                      for i in range(len(structure.drivers))),
+                  shaking_force=V(fx, fy), shaking_moment=mz,
                   rocking_couple=V(zero, zero) if rocking is None else rocking)
 
 
@@ -462,7 +476,7 @@ def regressors(structure: Structure, mo: Motion, gravity: tuple[float, float] = 
     design vector's linear part only; :func:`inverse_dynamics` has the rest).
     """
     layout = Layout.of(structure)
-    n = mo.theta1.size
+    n = mo.count
     p = layout.size
     g = V(*gravity)
     effective = [[np.zeros((n, p)) for _ in range(3)] for _ in structure.names]
@@ -538,7 +552,7 @@ def shaking_regressors(structure: Structure, mo: Motion,
     feels there; every other figure is the same.
     """
     layout = Layout.of(structure)
-    n, p = mo.theta1.size, layout.size
+    n, p = mo.count, layout.size
     g = V(*gravity)
     omega = np.asarray(mo.omega1, dtype=float) * np.ones(n)
     turning = np.abs(omega) > TURNING
@@ -549,8 +563,9 @@ def shaking_regressors(structure: Structure, mo: Motion,
         # those states alone)
         idle = ~turning
         m = int(idle.sum())
-        vel, rate, _, _ = rates(structure, _pose_at(mo.pose, idle), np.ones(m), np.zeros(m),
-                                mo.theta1[idle], accelerations=False)
+        vel, rate, _, _ = rates(structure, _pose_at(mo.pose, idle),
+                                InputState.crank(mo.theta1[idle], np.ones(m), np.zeros(m)),
+                                accelerations=False)
         unit = [(V(_put_at(v.x, idle, u.x, n), _put_at(v.y, idle, u.y, n)),
                  _put_at(w, idle, r, n))
                 for (v, w), u, r in zip(unit, vel, rate, strict=True)]
@@ -628,7 +643,7 @@ def inverse_dynamics(structure: Structure, mo: Motion, linkage: Linkage | None =
     linkage = structure.linkage if linkage is None else linkage
     layout = Layout.of(structure)
     x = layout.vector(linkage)
-    n = mo.theta1.size
+    n = mo.count if ops is NUMPY else 1
     g = V(*gravity)
     structure_now = structure if linkage is structure.linkage else _with(structure, linkage)
     per, ground = applied_column(structure_now, mo, g, loads, ops, gas)
@@ -706,7 +721,7 @@ def rocking_couple_of(structure: Structure, mo: Motion, linkage: Linkage | None 
     linkage = structure.linkage if linkage is None else linkage
     layout = Layout.of(structure)
     inertial = _inertial_forces(structure, mo, layout, layout.vector(linkage), V(*gravity))
-    n = mo.theta1.size
+    n = mo.count
     shares = [V(np.asarray(s.x * np.ones(n))[:, None], np.asarray(s.y * np.ones(n))[:, None])
               for s in _shares(structure, linkage, inertial, loads)]
     return rocking_couple(linkage, shares, np.zeros((n, 1)))

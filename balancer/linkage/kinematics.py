@@ -1,6 +1,9 @@
-"""Kinematics of a general linkage, vectorised over arrays of crank angles.
+"""Kinematics of a general linkage, vectorised over arrays of input states.
 
-Positions, group by group (:mod:`.structure`): the input from the driver, dyads in closed form,
+An input state (:class:`~.inputs.InputState`) gives each input's angle, rate and acceleration;
+a one-input linkage's is its crank's ``(θ1, ω1, α1)``.
+
+Positions, group by group (:mod:`.structure`): each input from its driver, dyads in closed form,
 other groups by Newton's method from a continuation table; each on the branch of the reference
 pose. Velocities and accelerations, group by group, from the constraints' time derivatives:
 ``Φ_S·q̇_S = −Φ_K·q̇_K`` and ``Φ_S·q̈_S = γ − Φ_K·q̈_K`` (``S`` the group's coordinates, ``K``
@@ -31,7 +34,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from . import numeric
 from .constraints import (
@@ -41,6 +44,7 @@ from .constraints import (
     group_jacobian,
 )
 from .dyads import Dyads, Frame, known_point
+from .inputs import InputState
 from .structure import Structure
 from .vectors import NUMPY, Num, OpsLike, V, _minus
 
@@ -63,17 +67,17 @@ def _place(pose: Pose, k: int, frame: Frame | Num, origin_or_pivot: V, local: V 
         pose.origins[k] = origin_or_pivot - local.rotated(c, s)
 
 
-def positions(structure: Structure, theta1: Num, ops: OpsLike = NUMPY,
+def positions(structure: Structure, state: InputState, ops: OpsLike = NUMPY,
               gaps: list[Num] | None = None, guesses: dict[int, list[Num]] | None = None,
               residuals: list[Num] | None = None, steps: list[Num] | None = None) -> Pose:
-    """Every link's frame at crank angles ``theta1`` (rad), on the reference pose's branch.
+    """Every link's frame at the inputs' positions (rad), on the reference pose's branch.
 
     Parameters
     ----------
     structure
         The linkage's structure.
-    theta1
-        Input angles (an array, or for CasADi a symbol).
+    state
+        The inputs' states (only their positions are read: arrays, or for CasADi symbols).
     ops
         Elementary functions (numpy by default).
     gaps
@@ -94,17 +98,17 @@ def positions(structure: Structure, theta1: Num, ops: OpsLike = NUMPY,
         Origins (m) and angles (rad; ``atan2`` values, the input's as given).
     """
     n = structure.size
-    if ops is NUMPY:
-        theta1 = np.asarray(theta1, dtype=float)
+    angles = (tuple(np.asarray(x, dtype=float) for x in state.positions) if ops is NUMPY
+              else state.positions)
     pose = Pose([V(0.0, 0.0)] * n, [0.0] * n, [1.0] * n, [0.0] * n)
     for index, g in enumerate(structure.groups):
-        if g.kind == "crank":
+        if g.kind == "input":
             pivot, local = known_point(pose, g.pivot, g.links[0])
-            _place(pose, g.links[0], theta1, pivot, local, ops)
+            _place(pose, g.links[0], angles[g.driver.index], pivot, local, ops)
             continue
         if g.kind == "numeric":
             if ops is NUMPY:
-                numeric.solve_group(structure, g, pose, theta1, positions, gaps)
+                numeric.solve_group(structure, g, pose, state, positions, gaps)
             else:
                 if guesses is None or index not in guesses:
                     raise ValueError("a numeric group on symbols needs a starting guess")
@@ -131,19 +135,20 @@ def numeric_table(structure: Structure, g: Group
 
 def numeric_start(structure: Structure, g: Group, theta1: NDArray[np.float64]
                   ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Where Newton's method starts for numeric group ``g`` (:func:`~.numeric.start`)."""
+    """Where Newton's method starts for numeric group ``g`` of a one-input linkage at crank
+    angles ``theta1`` (:func:`~.numeric.start`)."""
     return numeric.start(structure, g, theta1, positions)
 
 
 @dataclass(frozen=True)
 class Motion:
-    """Frames of every moving link and their rates at arrays of crank states.
+    """Frames of every moving link and their rates at arrays of input states.
 
     Attributes
     ----------
-    theta1, omega1, alpha1
-        The input's angle (rad), rate (rad/s) and acceleration (rad/s²), shape ``(N,)`` (or
-        CasADi symbols, in the program of :mod:`.program`).
+    state
+        The inputs' angles (rad), rates (rad/s) and accelerations (rad/s²), each of shape
+        ``(N,)`` (or CasADi symbols, in the program of :mod:`.program`).
     pose
         Origins (m) and angles (rad) of the links' frames.
     velocity, rate
@@ -154,9 +159,7 @@ class Motion:
         The motion as a mechanism's closed form computed it (the four-bar's), or ``None``.
     """
 
-    theta1: Num
-    omega1: Num
-    alpha1: Num
+    state: InputState
     pose: Pose
     velocity: tuple[V, ...]
     rate: tuple[Num, ...]
@@ -165,6 +168,26 @@ class Motion:
     #: The same motion in a mechanism's own closed form, when it made it (reused by its routes).
     closed_form: Any = field(default=None, repr=False, compare=False)
 
+    @property
+    def theta1(self) -> Num:
+        """A one-input linkage's crank angle, rad (``ValueError`` for several inputs)."""
+        return self.state.sole()[0]
+
+    @property
+    def omega1(self) -> Num:
+        """A one-input linkage's crank rate, rad/s."""
+        return self.state.sole()[1]
+
+    @property
+    def alpha1(self) -> Num:
+        """A one-input linkage's crank acceleration, rad/s²."""
+        return self.state.sole()[2]
+
+    @property
+    def count(self) -> int:
+        """The number of states ``N``."""
+        return int(np.size(self.state.positions[0]))
+
     def point(self, k: int, local: V) -> V:
         """Position of a point of link ``k`` (``local`` in its frame), m."""
         return self.pose.point(k, local)
@@ -172,42 +195,44 @@ class Motion:
     def point_velocity(self, k: int, local: V) -> V:
         """Velocity of a point of link ``k``, m/s."""
         if k == GROUND_INDEX:
-            return V(0.0 * self.theta1, 0.0 * self.theta1)
+            zero = 0.0 * self.state.positions[0]
+            return V(zero, zero)
         return self.velocity[k] + self.pose.rotate(k, local).perp() * self.rate[k]
 
     def point_acceleration(self, k: int, local: V) -> V:
         """Acceleration of a point of link ``k``, m/s²."""
         if k == GROUND_INDEX:
-            return V(0.0 * self.theta1, 0.0 * self.theta1)
+            zero = 0.0 * self.state.positions[0]
+            return V(zero, zero)
         r = self.pose.rotate(k, local)
         return self.acceleration[k] + r.perp() * self.accel[k] - r * (self.rate[k] ** 2)
 
 
-def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
-          theta1: Num | None = None, ops: OpsLike = NUMPY, *, accelerations: bool = True
-          ) -> tuple[list[V], list[Num], list[V], list[Num]]:
-    """Velocities and accelerations of every link's frame (see the module docstring).
+def rates(structure: Structure, pose: Pose, state: InputState, ops: OpsLike = NUMPY, *,
+          accelerations: bool = True) -> tuple[list[V], list[Num], list[V], list[Num]]:
+    """Velocities and accelerations of every link's frame at ``pose`` (module docstring).
 
+    ``state`` gives the inputs' rates and accelerations (its positions are ``pose``'s).
     Returns ``(velocity, rate, acceleration, accel)``, each a list over the links; with
     ``accelerations`` false the last two are zeros (the velocities alone are solved, the same
     figures).
     """
     n = structure.size
-    zero = 0.0 * (pose.angles[structure.input] if theta1 is None else theta1)
+    zero = 0.0 * state.positions[0]
     vel: list[V] = [V(zero, zero)] * n
     rate: list[Num] = [zero] * n
     acc: list[V] = [V(zero, zero)] * n
     accel: list[Num] = [zero] * n
     for g in structure.groups:
         rows, known = group_jacobian(g, pose)
-        prescribed = [x for c in g.constraints for x in c.prescribed_rates(omega1)]
+        prescribed = [x for c in g.constraints for x in c.prescribed_rates(state)]
         rhs_v = []
         for r, row_known in enumerate(known):
             v_term: Num = 0.0
             for link, coeffs in row_known:
                 v_term = v_term + coeffs[0] * vel[link].x + coeffs[1] * vel[link].y \
                     + coeffs[2] * rate[link]
-            # the driver θ_input − θ1(t) = 0: its rates are the input's
+            # a driver θ_input − θ_i(t) = 0: its rates are the input's
             rhs_v.append(_minus(prescribed[r], v_term))
         # velocities first: γ of the group's own rows needs the group's velocities
         factor = ops.factor(rows)
@@ -217,7 +242,7 @@ def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
             rate[link] = zero + sol_v[3 * i + 2][0]
         if not accelerations:
             continue
-        gammas = [x for c in g.constraints for x in c.gamma(pose, vel, rate, alpha1)]
+        gammas = [x for c in g.constraints for x in c.gamma(pose, vel, rate, state)]
         rhs_a = []
         for r, row_known in enumerate(known):
             a_term: Num = 0.0
@@ -232,7 +257,7 @@ def rates(structure: Structure, pose: Pose, omega1: Num, alpha1: Num,
     return vel, rate, acc, accel
 
 
-#: Motions at up to this many crank states are kept with the geometry (a cycle's samples: the
+#: Motions at up to this many states are kept with the geometry (a cycle's samples: the
 #: cycle analysis, the regressors and the force-balance conditions of a design and of its
 #: redesign ask for the same motion), the last :data:`MOTIONS_KEPT` of them.
 MOTION_CACHE_STATES = 4096
@@ -240,9 +265,8 @@ MOTIONS_KEPT = 4
 _MOTIONS_LOCK = threading.Lock()
 
 
-def motion(structure: Structure, theta1: ArrayLike, omega1: ArrayLike = 0.0,
-           alpha1: ArrayLike = 0.0) -> Motion:
-    """Positions, velocities and accelerations at crank states (arrays broadcast together).
+def motion(structure: Structure, state: InputState) -> Motion:
+    """Positions, velocities and accelerations at the inputs' states.
 
     The motion depends on the geometry alone: one at a few states is kept with it
     (:attr:`Structure.kinematic`) and given again for the same states. (Its arrays are
@@ -252,25 +276,25 @@ def motion(structure: Structure, theta1: ArrayLike, omega1: ArrayLike = 0.0,
     ----------
     structure
         The linkage's structure.
-    theta1, omega1, alpha1
-        The input's angle (rad), rate (rad/s) and acceleration (rad/s²).
+    state
+        Each input's angle (rad), rate (rad/s) and acceleration (rad/s²), numeric, one per
+        input of ``structure``.
     """
-    theta1, omega1, alpha1 = (np.asarray(x, dtype=float) for x in
-                              np.broadcast_arrays(theta1, omega1, alpha1))
-    theta1, omega1, alpha1 = (np.atleast_1d(x) for x in (theta1, omega1, alpha1))
+    if state.size != len(structure.drivers):
+        raise ValueError(f"the state has {state.size} inputs; the linkage has "
+                         f"{len(structure.drivers)}")
     key = None
-    if theta1.size <= MOTION_CACHE_STATES:  # a cycle's samples: the same ones, asked again
-        key = (theta1.shape, theta1.tobytes(), omega1.tobytes(), alpha1.tobytes())
+    if state.count <= MOTION_CACHE_STATES:  # a cycle's samples: the same ones, asked again
+        key = state.key()
         with _MOTIONS_LOCK:
             motions = structure.kinematic.setdefault("motions", OrderedDict())
             known = motions.get(key)
         if known is not None:
             return known
-    pose = positions(structure, theta1)
-    vel, rate, acc, accel = rates(structure, pose, omega1, alpha1, theta1)
-    mo = Motion(theta1=theta1, omega1=omega1, alpha1=alpha1, pose=pose,
-                velocity=tuple(vel), rate=tuple(rate), acceleration=tuple(acc),
-                accel=tuple(accel))
+    pose = positions(structure, state)
+    vel, rate, acc, accel = rates(structure, pose, state)
+    mo = Motion(state=state, pose=pose, velocity=tuple(vel), rate=tuple(rate),
+                acceleration=tuple(acc), accel=tuple(accel))
     if key is not None:
         with _MOTIONS_LOCK:  # (threads may share a geometry)
             motions[key] = mo

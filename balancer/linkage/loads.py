@@ -126,7 +126,7 @@ class Reactions:
         return Forces(reactions={p: vector(v) for p, v in self.ground.items()},
                       slider_normal={k: real(v) for k, v in self.slider_normal.items()},
                       slider_couple={k: real(v) for k, v in self.slider_couple.items()},
-                      driving_torque=real(self.driving_torque),
+                      input_torques=(real(self.driving_torque),),
                       shaking_force=vector(self.shaking_force),
                       shaking_moment=real(self.shaking_moment),
                       rocking_couple=(vector(self.rocking_couple) if rocking_couple is None

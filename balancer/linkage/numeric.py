@@ -7,6 +7,11 @@ continuation from the reference pose (:data:`TABLE_STEPS` steps, each Newton's m
 from a quadratic extrapolation of the steps before); at any crank angle the table, interpolated,
 starts Newton's method, run on all the angles at once to rounding. Angles beyond where the
 continuation stopped (the group locks or cannot be assembled) are NaN.
+
+A linkage with several inputs has no one-dimensional table: each state is reached from the
+reference pose along the straight line in the inputs' space (:data:`PATH_STEPS` steps, each
+Newton's method from the linear extrapolation of the two before, all states at once); a state
+whose path meets a pose where the group cannot be assembled or locks is NaN.
 """
 
 from __future__ import annotations
@@ -19,14 +24,19 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .constraints import Group, Pose, group_jacobian
+from .inputs import InputState
 from .structure import Structure
 from .vectors import NUMPY, Factor, Num, OpsLike, V
 
-#: How the links found before a group are placed at crank angles: the general kinematics'
+#: How the links found before a group are placed at input states: the general kinematics'
 #: positions (:func:`balancer.linkage.kinematics.positions`), which solves the groups in order
 #: and calls this module for a numeric one; passed in, so that the two modules do not import
 #: each other.
-Positions = Callable[[Structure, NDArray[np.float64]], Pose]
+Positions = Callable[[Structure, InputState], Pose]
+
+#: Steps from the reference pose to each state along the line in the inputs' space, for a
+#: linkage with several inputs.
+PATH_STEPS = 48
 
 #: Steps of the continuation table over one revolution.
 TABLE_STEPS = 720
@@ -206,7 +216,7 @@ def _continue(structure: Structure, partial: Structure, g: Group, angles: NDArra
 
     def solve_at(rows: NDArray[np.intp], guess: NDArray[np.float64]
                  ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-        pose = place(partial, angles[rows])
+        pose = place(partial, InputState.crank(angles[rows]))
         with np.errstate(all="ignore"):
             return newton(g, pose, guess, scale)
 
@@ -295,14 +305,46 @@ def start(structure: Structure, g: Group, theta1: NDArray[np.float64],
     return guess, inside
 
 
-def solve_group(structure: Structure, g: Group, pose: Pose, theta1: NDArray[np.float64],
+def path_start(structure: Structure, g: Group, state: InputState, place: Positions
+               ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Where Newton's method starts for numeric group ``g`` of a linkage with several inputs.
+
+    Each state is reached from the reference pose along the straight line in the inputs'
+    space, :data:`PATH_STEPS` steps (see the module docstring). Returns the group's
+    coordinates there, ``(N, 3·|g|)``, NaN where the path was lost, and where it was not.
+    """
+    count = state.count
+    reference = np.array([structure.ref_angle[k] for k in structure.inputs])
+    target = np.array([np.broadcast_to(np.asarray(x, dtype=float), (count,))
+                       for x in state.positions])
+    before = structure.groups[: structure.groups.index(g)]
+    partial = replace(structure, groups=tuple(before), cache={}, kinematic={})
+    scale = structure.length_scale()
+    q = np.tile(_coordinates(structure, g), (count, 1))
+    previous = q.copy()
+    kept = np.all(np.isfinite(target), axis=0)
+    for j in range(1, PATH_STEPS + 1):
+        at = reference[:, None] + (j / PATH_STEPS) * (target - reference[:, None])
+        pose = place(partial, InputState.of(list(at)))
+        guess = q if j == 1 else 2 * q - previous
+        with np.errstate(all="ignore"):
+            found, done = newton(g, pose, guess, scale)
+        kept &= done & np.all(np.isfinite(found), axis=1)
+        previous, q = q, np.where(kept[:, None], found, q)
+    return np.where(kept[:, None], q, np.nan), kept
+
+
+def solve_group(structure: Structure, g: Group, pose: Pose, state: InputState,
                 place: Positions, gaps: list[Num] | None = None) -> None:
-    """Place the links of numeric group ``g`` in ``pose`` at crank angles ``theta1``.
+    """Place the links of numeric group ``g`` in ``pose`` at the input states ``state``.
 
     ``place`` places links found before it (:data:`Positions`); ``gaps``, if a list,
     receives the group's assembly gap (:func:`assembly_gap`).
     """
-    guess, inside = start(structure, g, theta1, place)
+    if state.size == 1:
+        guess, inside = start(structure, g, np.asarray(state.positions[0], dtype=float), place)
+    else:
+        guess, inside = path_start(structure, g, state, place)
     q, done = newton(g, pose, np.where(np.isfinite(guess), guess, 0.0), structure.length_scale())
     lost = ~(done & inside)
     if lost.any():

@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import numeric
 from .dynamics import Forces, inverse_dynamics
+from .inputs import InputState
 from .kernel import Kernel, compile_kernel, op_names
 from .kinematics import Motion, numeric_start, positions, rates
 from .structure import Structure
@@ -298,12 +299,12 @@ class CrankForcesProgram:
         residuals: list[Num] = []
         steps: list[Num] = []
         gaps: list[Num] = []
-        pose = positions(s, theta1, ops, gaps=gaps, guesses=guesses, residuals=residuals,
+        state = InputState.symbolic([theta1], [omega1], [alpha1])
+        pose = positions(s, state, ops, gaps=gaps, guesses=guesses, residuals=residuals,
                          steps=steps)
-        vel, rate, acc, accel = rates(s, pose, omega1, alpha1, theta1, ops)
-        mo = Motion(theta1=theta1, omega1=omega1, alpha1=alpha1, pose=pose,
-                    velocity=tuple(vel), rate=tuple(rate), acceleration=tuple(acc),
-                    accel=tuple(accel))
+        vel, rate, acc, accel = rates(s, pose, state, ops)
+        mo = Motion(state=state, pose=pose, velocity=tuple(vel), rate=tuple(rate),
+                    acceleration=tuple(acc), accel=tuple(accel))
         forces = inverse_dynamics(s, mo, gravity=gravity, loads=loads, ops=ops,
                                   gas=[gas[j] for j in range(len(s.prisms))])
         self.forces = forces  # the names, in :meth:`Forces.arrays`' order

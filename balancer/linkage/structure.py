@@ -13,13 +13,15 @@ Constraints (Nikravesh, *Computer-Aided Analysis of Mechanical Systems*, 1988, c
 - a prismatic pair, link ``s`` sliding on a line fixed in link ``g`` (direction ``d̄ =
   R_g·d̄_g``, through ``R_g·ḡ``): the relative angle ``θ_s − θ_g − δ = 0`` and the slider point
   on the line, ``d̄ × (r̄_s + R_s·s̄ − r̄_g − R_g·ḡ) = 0``;
-- the driver: ``θ_input − θ_ground − θ1 = 0``.
+- a driver per input ``i``: ``θ_input_i − θ_ground − θ_i = 0`` (a one-input linkage's
+  ``θ1``).
 
-A linkage is accepted when it has exactly one degree of freedom (``3·n`` coordinates, ``3·n −
-1`` independent constraints) and its reference pose is regular: the constraints' Jacobian has
-full rank, and with the driver's row it is invertible (the input drives every link).
+A linkage with ``m`` inputs is accepted when it has exactly ``m`` degrees of freedom (``3·n``
+coordinates, ``3·n − m`` independent constraints) and its reference pose is regular: the
+constraints' Jacobian has full rank, and with the drivers' rows it is invertible (the inputs
+drive every link).
 
-Assur groups. Starting from the ground and the input, the links are found in groups that,
+Assur groups. Starting from the ground and the inputs, the links are found in groups that,
 given the links found before, have no freedom left: dyads (two links, three joints) in closed
 form — RRR (two circles), RRP and PRR (a circle and a line), RPR (the angle of a line through a
 point) — and any other group (a triad of a Stephenson chain) by Newton's method. The same order
@@ -82,10 +84,10 @@ class Structure:
         origin.
     pins, prisms
         The joints as constraints.
-    driver
-        The input's driver.
+    drivers
+        The inputs' drivers, in the order of the linkage's inputs.
     groups
-        The order in which the links are found, the input's group first.
+        The order in which the links are found, the inputs' groups first.
     """
 
     linkage: Linkage
@@ -95,7 +97,7 @@ class Structure:
     ref_origin: tuple[V, ...]
     pins: tuple[Pin, ...]
     prisms: tuple[Prism, ...]
-    driver: Driver
+    drivers: tuple[Driver, ...]
     groups: tuple[Group, ...]
     point_links: dict[str, tuple[int, ...]] = field(repr=False)
     #: Results computed once per structure.
@@ -111,13 +113,27 @@ class Structure:
         return len(self.names)
 
     @property
+    def inputs(self) -> tuple[int, ...]:
+        """Indices of the input links, in the order of the linkage's inputs."""
+        return tuple(d.link for d in self.drivers)
+
+    @property
     def input(self) -> int:
-        """Index of the input link."""
-        return self.driver.link
+        """A one-input linkage's input link (its crank); ``ValueError`` for several."""
+        if len(self.drivers) != 1:
+            raise ValueError(f"the linkage has {len(self.drivers)} inputs, not one")
+        return self.drivers[0].link
+
+    @property
+    def driver(self) -> Driver:
+        """A one-input linkage's driver; ``ValueError`` for several."""
+        if len(self.drivers) != 1:
+            raise ValueError(f"the linkage has {len(self.drivers)} inputs, not one")
+        return self.drivers[0]
 
     @property
     def constraints(self) -> tuple[Pin | Prism, ...]:
-        """All constraints but the driver (``3·n − 1`` rows)."""
+        """All constraints but the drivers (``3·n − m`` rows for ``m`` inputs)."""
         return (*self.pins, *self.prisms)
 
     def index(self, name: str) -> int:
@@ -140,12 +156,12 @@ class Structure:
         Raises
         ------
         SpecError
-            If the mobility is not 1 (naming it and how it is counted), the reference pose is
-            singular or the input does not drive the linkage there, or no order of groups
-            finds every link.
+            If the mobility is not the number of inputs (naming it and how it is counted), the
+            reference pose is singular or the inputs do not drive the linkage there, or no
+            order of groups finds every link.
         """
         key = (linkage.points, tuple((b.name, b.points) for b in linkage.bodies),
-               linkage.sliders, linkage.input, tuple(sorted((lengths or {}).items())))
+               linkage.sliders, linkage.inputs, tuple(sorted((lengths or {}).items())))
         with _SKELETON_LOCK:
             known = _SKELETONS.get(key)
             if known is not None:
@@ -214,11 +230,11 @@ class Structure:
                 slider=i, s=ks, ps=local[(ks, s.point)], g=kg,
                 pg=V.of((positions[s.point] - origin_g) * rot_g), dg=V.of(d * rot_g),
                 delta=theta_s - theta_g))
-        driver = Driver(index[linkage.input])
+        drivers = tuple(Driver(index[name], i) for i, name in enumerate(linkage.inputs))
         structure = cls(
             linkage=linkage, names=names, local=local, ref_angle=tuple(ref_angle),
             ref_origin=tuple(ref_origin), pins=tuple(pins), prisms=tuple(prisms),
-            driver=driver, groups=(), point_links={p: tuple(v) for p, v in point_links.items()})
+            drivers=drivers, groups=(), point_links={p: tuple(v) for p, v in point_links.items()})
         structure._check_mobility()
         object.__setattr__(structure, "groups", structure._find_groups())
         return structure
@@ -228,21 +244,24 @@ class Structure:
         rows = sum(c.rows for c in self.constraints)
         joints = len(self.pins)
         mobility = 3 * n - rows
-        if mobility != 1:
+        count = len(self.drivers)
+        if mobility != count:
+            driven = ("the input must drive every link" if count == 1 else
+                      f"one per input ({', '.join(self.linkage.inputs)}): the inputs must "
+                      "drive every link")
             raise SpecError(
-                f"the linkage has {mobility} degrees of freedom, not 1: {n} moving links "
-                f"(3·{n} = {3 * n} coordinates) less {joints} revolute pairs and "
-                f"{len(self.prisms)} prismatic pairs (2 each) — the input must drive every "
-                "link, and nothing may be locked",
-                key="mechanism", value=mobility)
-        # Rows and columns in common units: angle rows (a prism's, the driver's) times a
+                f"the linkage has {mobility} degrees of freedom, not {count}: {n} moving "
+                f"links (3·{n} = {3 * n} coordinates) less {joints} revolute pairs and "
+                f"{len(self.prisms)} prismatic pairs (2 each) — {driven}, and nothing may be "
+                "locked", key="mechanism", value=mobility)
+        # Rows and columns in common units: angle rows (a prism's, the drivers') times a
         # length, angle columns over it.
         scale = self.length_scale()
-        full = np.vstack([self.jacobian(self.reference_coordinates()), self.driver_row()])
+        full = np.vstack([self.jacobian(self.reference_coordinates()), self.driver_rows()])
         angle_rows = [i for i, kind in enumerate(self.row_kinds()) if kind == "angle"]
-        full[[*angle_rows, full.shape[0] - 1]] *= scale
+        full[[*angle_rows, *range(full.shape[0] - count, full.shape[0])]] *= scale
         full[:, 2::3] /= scale
-        sv = np.linalg.svd(full[:-1], compute_uv=False)
+        sv = np.linalg.svd(full[:-count], compute_uv=False)
         if sv.size and sv[-1] <= RANK_TOLERANCE * sv[0]:
             raise SpecError(
                 "the reference pose is singular (joints in line: a dead point, a change point "
@@ -251,10 +270,15 @@ class Structure:
                 key="mechanism.points")
         sv = np.linalg.svd(full, compute_uv=False)
         if sv[-1] <= RANK_TOLERANCE * sv[0]:
+            if count == 1:
+                raise SpecError(
+                    "the input does not drive the linkage at the reference pose (turning it "
+                    "would not move the others, or they could move without it)",
+                    key="mechanism.input", value=self.linkage.inputs[0])
             raise SpecError(
-                "the input does not drive the linkage at the reference pose (turning it "
-                "would not move the others, or they could move without it)",
-                key="mechanism.input", value=self.linkage.input)
+                "the inputs do not drive the linkage at the reference pose (some links could "
+                "move with every input held, or the inputs cannot be turned independently)",
+                key="mechanism.inputs", value=list(self.linkage.inputs))
 
     def row_kinds(self) -> list[str]:
         """``"length"`` or ``"angle"`` for each row of :meth:`jacobian`."""
@@ -304,13 +328,19 @@ class Structure:
         return out
 
     def _find_groups(self) -> tuple[Group, ...]:
-        known = {GROUND_INDEX, self.input}
-        crank = [c for c in self.pins if c.a == self.input and c.b == GROUND_INDEX
-                 and c.point == self.linkage.moving[self.input].points[0]]
-        if not crank:
-            raise SpecError("the input must be pinned to the ground at its first point",
-                            key="mechanism.input", value=self.linkage.input)
-        groups = [Group((self.input,), (crank[0], self.driver), "crank")]
+        known = {GROUND_INDEX, *self.inputs}
+        groups = []
+        several = len(self.drivers) > 1
+        for driver in self.drivers:
+            k = driver.link
+            pivot = [c for c in self.pins if c.a == k and c.b == GROUND_INDEX
+                     and c.point == self.linkage.moving[k].points[0]]
+            if not pivot:
+                raise SpecError(
+                    "the input must be pinned to the ground at its first point",
+                    key="mechanism.inputs" if several else "mechanism.input",
+                    value=list(self.linkage.inputs) if several else self.linkage.inputs[0])
+            groups.append(Group((k,), (pivot[0], driver), "input"))
         unknown = set(range(self.size)) - known
         q_ref = self.reference_coordinates()
         while unknown:
@@ -325,9 +355,10 @@ class Structure:
                     break
             if found is None:
                 raise SpecError(
-                    "the links cannot be found one group after another from the input: "
+                    "the links cannot be found one group after another from the "
+                    f"{'inputs' if several else 'input'}: "
                     f"{', '.join(self.names[k] for k in sorted(unknown))} are not determined "
-                    "by the input", key="mechanism")
+                    f"by the {'inputs' if several else 'input'}", key="mechanism")
             combo, closing = found
             groups.append(self._classify(combo, closing, q_ref))
             known |= set(combo)
@@ -372,11 +403,12 @@ class Structure:
             q[3 * k + 2] = self.ref_angle[k]
         return q
 
-    def driver_row(self) -> NDArray[np.float64]:
-        """The driver's Jacobian row, shape ``(1, 3n)``."""
-        row = np.zeros((1, 3 * self.size))
-        row[0, 3 * self.input + 2] = 1.0
-        return row
+    def driver_rows(self) -> NDArray[np.float64]:
+        """The drivers' Jacobian rows, shape ``(m, 3n)`` for ``m`` inputs."""
+        rows = np.zeros((len(self.drivers), 3 * self.size))
+        for i, k in enumerate(self.inputs):
+            rows[i, 3 * k + 2] = 1.0
+        return rows
 
     def jacobian(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
         """The constraints' Jacobian at one pose ``q``, shape ``(3n − 1, 3n)``."""

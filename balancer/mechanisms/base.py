@@ -31,6 +31,7 @@ from ..linkage import dynamics, kinematics
 from ..linkage.assembly import assembly_range
 from ..linkage.constraints import GROUND_INDEX, Pose
 from ..linkage.dynamics import Forces, Layout
+from ..linkage.inputs import InputState
 from ..linkage.kinematics import Motion
 from ..linkage.rotors import Rotor, ground_couple
 from ..linkage.structure import Structure
@@ -367,11 +368,11 @@ class Mechanism:
     def motion(self, theta1: ArrayLike, omega1: ArrayLike = 0.0,
                alpha1: ArrayLike = 0.0) -> Motion:
         """Frames, rates and accelerations at crank states (arrays broadcast together)."""
-        return kinematics.motion(self.structure, theta1, omega1, alpha1)
+        return kinematics.motion(self.structure, InputState.crank(theta1, omega1, alpha1))
 
     def pose(self, theta1: ArrayLike) -> Pose:
         """The links' frames at crank angles (:attr:`Motion.pose` without the rates)."""
-        return kinematics.positions(self.structure, np.atleast_1d(np.asarray(theta1, float)))
+        return kinematics.positions(self.structure, InputState.crank(theta1))
 
     def continued_angles(self, theta1: float) -> NDArray[np.float64]:
         """The links' angles at crank angle ``theta1``, continuous from the reference pose.
@@ -482,7 +483,7 @@ class Mechanism:
             reactions = {p: forces.reactions.get(p, zero) for p in self.ground_points}
             forces = Forces(reactions=reactions, slider_normal=forces.slider_normal,
                             slider_couple=forces.slider_couple,
-                            driving_torque=forces.driving_torque,
+                            input_torques=forces.input_torques,
                             shaking_force=forces.shaking_force,
                             shaking_moment=forces.shaking_moment,
                             rocking_couple=forces.rocking_couple)

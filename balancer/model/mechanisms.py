@@ -220,7 +220,7 @@ class ChainModel(MechanismModel):
 
 @dataclass(frozen=True, kw_only=True)
 class Linkage(MechanismModel):
-    """A planar linkage with one degree of freedom, driven by a crank on a ground pivot.
+    """A planar linkage driven at one or several links, each turned about a ground pivot.
 
     See DESIGN.md, "General planar linkages". A point named by two or more links is a revolute
     joint between them; a point of one link only is a marker. The reference pose (the
@@ -236,8 +236,10 @@ class Linkage(MechanismModel):
         ``(name, (x, y))`` of every point at the reference pose, m.
     bodies
         The links, the ground (named ``"ground"``) among them.
-    input
-        The name of the driven link; its first point is its ground pivot.
+    inputs
+        The names of the driven links, in the order of their positions in an input state
+        (:class:`balancer.linkage.inputs.InputState`); each one's first point is its ground
+        pivot. A one-input linkage's is its crank (:attr:`input`).
     sliders
         Prismatic pairs.
     springs
@@ -248,7 +250,7 @@ class Linkage(MechanismModel):
 
     points: tuple[tuple[str, tuple[float, float]], ...]
     bodies: tuple[Body, ...]
-    input: str
+    inputs: tuple[str, ...]
     sliders: tuple[Slider, ...] = ()
     springs: tuple[Spring, ...] = ()
 
@@ -331,14 +333,7 @@ class Linkage(MechanismModel):
                     key=f"links.{name}.points", value=list(body.points))
         self._check_frames(names, points)
         ground = set(names[GROUND].points)
-        key = "mechanism.input"
-        if not isinstance(self.input, str) or self.input not in names or self.input == GROUND:
-            raise SpecError(f"must name a moving link ({_link_list(names)})", key=key,
-                            value=self.input)
-        if names[self.input].points[0] not in ground:
-            raise SpecError(f"the input's first point ({names[self.input].points[0]}) must be "
-                            "a ground point: the crank turns about it", key=key,
-                            value=self.input)
+        self._check_inputs(names, ground)
         for name, body in names.items():
             if (name != GROUND and body.props is not None and body.props.counter_rotor
                     and not ground & set(body.points)):
@@ -348,6 +343,34 @@ class Linkage(MechanismModel):
         v.store(self, "bodies", tuple(self.bodies))
         v.store(self, "sliders", tuple(self.sliders))
         v.store(self, "springs", tuple(self.springs))
+
+    @property
+    def input(self) -> str:
+        """A one-input linkage's driven link (its crank); ``ValueError`` for several."""
+        if len(self.inputs) != 1:
+            raise ValueError(f"the linkage has {len(self.inputs)} inputs, not one")
+        return self.inputs[0]
+
+    def _check_inputs(self, names: dict[str, Body], ground: set[str]) -> None:
+        """Each input a moving link turned about a ground point, none named twice."""
+        inputs = self.inputs
+        several = not (isinstance(inputs, tuple | list) and len(inputs) == 1)
+        key = "mechanism.inputs" if several else "mechanism.input"
+        if isinstance(inputs, str) or not isinstance(inputs, tuple | list) or not inputs:
+            raise SpecError("must name the driven links", key=key, value=inputs)
+        for name in inputs:
+            shown = list(inputs) if several else name
+            if not isinstance(name, str) or name not in names or name == GROUND:
+                raise SpecError(f"must name a moving link ({_link_list(names)})", key=key,
+                                value=shown)
+            if names[name].points[0] not in ground:
+                turned = "an input" if several else "the crank"
+                raise SpecError(f"the input's first point ({names[name].points[0]}) must be "
+                                f"a ground point: {turned} turns about it", key=key,
+                                value=shown)
+        if len(set(inputs)) != len(inputs):
+            raise SpecError("names a link twice", key=key, value=list(inputs))
+        v.store(self, "inputs", tuple(inputs))
 
     @staticmethod
     def _check_slider(i: int, slider: Slider, names: dict[str, Body],

@@ -240,8 +240,14 @@ SECTIONS: tuple[Section, ...] = (
             "An engine's cylinders, cylinder 1 first (`[[mechanism.cylinders]]`, below).",
             (ENGINE,)),
         Key("input", "—", "required",
-            "The name of the driven link (the crank); its first point is its ground pivot.",
+            "The name of the driven link (the crank); its first point is its ground pivot. A "
+            "linkage driven at several links names them in `inputs` instead.",
             (LINKAGE,), example='"crank"'),
+        Key("inputs", "—", "none",
+            "The names of the driven links of a linkage with several inputs (a five-bar's "
+            "two cranks), each turned about its first point, a ground pivot; the linkage's "
+            "degrees of freedom must equal their count. Instead of `input`.",
+            (LINKAGE,), example='["left", "right"]'),
         Key("points", "table", "required",
             "Every point at the reference pose (the table below).", (LINKAGE,)),
         Key("sliders", "table", "none",

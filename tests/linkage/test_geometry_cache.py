@@ -18,6 +18,7 @@ import pytest
 import balancer.linkage.structure as structure_module
 from balancer.cycle import cycle_analysis
 from balancer.force_balance import force_balance_conditions
+from balancer.linkage.inputs import InputState
 from balancer.linkage.kinematics import motion
 from balancer.mechanisms import mechanism_of
 from balancer.spec import load_design
@@ -42,14 +43,14 @@ def test_a_redesign_shares_its_geometrys_work_and_it_is_what_it_would_compute(na
     assert second.structure.kinematic is first.structure.kinematic
     assert second.structure.linkage is not first.structure.linkage
     theta = np.linspace(0, 2 * np.pi, 360, endpoint=False)
-    shared = motion(second.structure, theta, 7.0, 0.5)
-    assert motion(first.structure, theta, 7.0, 0.5) is shared
+    shared = motion(second.structure, InputState.crank(theta, 7.0, 0.5))
+    assert motion(first.structure, InputState.crank(theta, 7.0, 0.5)) is shared
     conditions = force_balance_conditions(second)
     analysis = cycle_analysis(second, 7.0, 360)
     structure_module._SKELETONS.clear()  # afresh: nothing kept
     fresh = mechanism_of(heavier(model, 3.0))  # (a model of its own: a mechanism of its own)
     assert fresh.structure.kinematic is not first.structure.kinematic
-    again = motion(fresh.structure, theta, 7.0, 0.5)
+    again = motion(fresh.structure, InputState.crank(theta, 7.0, 0.5))
     for a, b in zip([*shared.pose.cos, *shared.rate], [*again.pose.cos, *again.rate],
                     strict=True):
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b))

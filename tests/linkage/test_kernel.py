@@ -258,7 +258,7 @@ def test_forces_written_into_a_cycles_columns_are_the_forces_returned(name, comp
     into = Forces(reactions={p: vector(columns[f"R{p}"]) for p in mech.ground_points},
                   slider_normal={k: reals[f"N{k}"][:, None] for k in mech.ground_sliders},
                   slider_couple={k: reals[f"C{k}"][:, None] for k in mech.ground_sliders},
-                  driving_torque=reals["torque"][:, None], shaking_force=vector(columns["force"]),
+                  input_torques=(reals["torque"][:, None],), shaking_force=vector(columns["force"]),
                   shaking_moment=reals["moment"][:, None], rocking_couple=vector(columns["couple"]))
     written = mech.crank_forces(theta, omega, alpha, compiled=compiled, into=into)
     assert written is into

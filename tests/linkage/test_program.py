@@ -19,6 +19,7 @@ import pytest
 from fuzz.linkages import _random_transform, build_topology, spec_from_topology
 
 from balancer.linkage import kinematics, numeric
+from balancer.linkage.inputs import InputState
 from balancer.linkage import program as program_module
 from balancer.linkage.kinematics import numeric_table
 from balancer.linkage.program import CrankForcesProgram, Tape
@@ -94,11 +95,13 @@ def test_the_program_gives_the_numpy_routes_forces(name):
 
 def _take(value, rows):
     """``value`` (Forces, a dict, a vector or an array) at the given states."""
-    if hasattr(value, "driving_torque"):
+    if hasattr(value, "input_torques"):
         return type(value)(**{f: _take(getattr(value, f), rows) for f in
                               ("reactions", "slider_normal", "slider_couple",
-                               "driving_torque", "shaking_force", "shaking_moment",
+                               "input_torques", "shaking_force", "shaking_moment",
                                "rocking_couple")})
+    if isinstance(value, tuple):
+        return tuple(_take(v, rows) for v in value)
     if isinstance(value, dict):
         return {k: _take(v, rows) for k, v in value.items()}
     if hasattr(value, "x"):
@@ -247,7 +250,7 @@ def test_a_numeric_group_follows_its_branch_to_both_ends_of_its_table():
     # By a toggle the figures' rounding grows as 1/gap (the gap a squared ratio of the
     # Jacobian's singular values): RTOL holds down to gaps of 1e-3 (the module's docstring).
     gaps: list = []
-    kinematics.positions(s, theta, gaps=gaps)
+    kinematics.positions(s, InputState.crank(theta), gaps=gaps)
     slack = np.maximum(1.0, 1e-3 / gaps[-1])[:, None]
     _assert_same(mech.crank_forces(theta, omega, alpha), want, "triad's ends", s.length_scale(),
                  slack)

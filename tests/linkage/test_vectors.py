@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from balancer.linkage.constraints import group_jacobian
+from balancer.linkage.inputs import InputState
 from balancer.linkage.kinematics import positions
 from balancer.linkage.structure import Structure
 from balancer.linkage.vectors import Factor
@@ -87,7 +88,7 @@ def test_factor_solves_the_shipped_linkages_group_jacobians(example):
     mech = mechanism_of(load_design(EXAMPLES / example).mechanism)
     structure: Structure = mech.structure
     theta = np.linspace(0.0, 2 * np.pi, 181)
-    pose = positions(structure, theta)
+    pose = positions(structure, InputState.crank(theta))
     rng = np.random.default_rng(7)
     for g in structure.groups:
         rows, _ = group_jacobian(g, pose)

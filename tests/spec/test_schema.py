@@ -127,6 +127,9 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
         data["balance"]["counterweights"]["part"] = dict(PARTS["sector"])
     if pattern == "links.<link>.gas_force":
         data["links"]["slider"]["gas_force"] = {"crank_angle": [0.0, 3.0], "force": [-1.0, 0.0]}
+    if pattern == "mechanism" and name == "inputs" and "input" in data["mechanism"]:
+        data["mechanism"]["inputs"] = [data["mechanism"].pop("input")]  # its other spelling
+        return data
     table = data
     for part in path_of(data, pattern, name):
         table = table[part]

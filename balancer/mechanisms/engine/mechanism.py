@@ -74,7 +74,8 @@ def engine_linkage(model: Engine) -> Linkage:
     geared = sum(link_inertia(s.inertia, s.ratio) for s in model.balance_shafts)
     crankshaft = replace(links[0], inertia=links[0].inertia + geared)
     bodies.append(Body(name="crankshaft", points=tuple(shaft_points), props=crankshaft))
-    return Linkage(points=tuple(points), bodies=(*bodies, *rods, *pistons), input="crankshaft",
+    return Linkage(points=tuple(points), bodies=(*bodies, *rods, *pistons),
+                   inputs=("crankshaft",),
                    sliders=tuple(sliders))
 
 

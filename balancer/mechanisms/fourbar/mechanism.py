@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...linkage.constraints import Pose
 from ...linkage.dynamics import Forces
+from ...linkage.inputs import InputState
 from ...linkage.kinematics import _MOTIONS_LOCK, MOTION_CACHE_STATES, MOTIONS_KEPT, Motion
 from ...linkage.structure import Structure
 from ...linkage.vectors import V
@@ -45,7 +46,7 @@ def fourbar_linkage(model: FourBar) -> Linkage:
               Body(name="crank", points=("A0", "A1"), props=model.crank),
               Body(name="coupler", points=("A1", "A2"), props=model.coupler),
               Body(name="rocker", points=("A2", "A3"), props=model.rocker))
-    return Linkage(points=points, bodies=bodies, input="crank")
+    return Linkage(points=points, bodies=bodies, inputs=("crank",))
 
 
 @lru_cache(maxsize=64)
@@ -222,7 +223,7 @@ def general_motion(mo: fourbar.FourBarMotion) -> Motion:
     angles = list(mo.theta)
     cos = [np.real(v) / length for v, length in zip(mo.vectors, mo.lengths[:3], strict=True)]
     sin = [np.imag(v) / length for v, length in zip(mo.vectors, mo.lengths[:3], strict=True)]
-    return Motion(theta1=mo.pos.theta1, omega1=mo.omega[0], alpha1=mo.alpha[0],
+    return Motion(state=InputState((mo.pos.theta1,), (mo.omega[0],), (mo.alpha[0],)),
                   pose=Pose(origins, angles, cos, sin),
                   velocity=(V(zero, zero), V.of_array(va1), V.of_array(va2)),
                   rate=tuple(mo.omega),

@@ -32,17 +32,32 @@ def _names(table: Table, name: str) -> tuple[str, ...]:
     return tuple(raw)
 
 
+def _inputs(mech: Table) -> tuple[str, ...]:
+    """The driven links: ``input = "crank"`` (one) or ``inputs = ["left", "right"]``."""
+    if mech.has("input") and mech.has("inputs"):
+        raise SpecError("give either input (one driven link) or inputs (several), not both",
+                        key=mech.key("inputs"), value=mech.raw("inputs"))
+    if mech.has("inputs"):
+        names = _names(mech, "inputs")
+        if not names:
+            raise SpecError("must name at least one driven link", key=mech.key("inputs"),
+                            value=[])
+        return names
+    if not mech.has("input"):
+        raise mech._missing("input")
+    input_name = mech.raw("input")
+    if not isinstance(input_name, str):
+        raise SpecError("must be the name of a link", key=mech.key("input"), value=input_name)
+    return (input_name,)
+
+
 def read(root: Table, mech: Table) -> Linkage:
     """A general linkage (``type = "linkage"``; DESIGN.md, "General planar linkages").
 
     Its ``[mechanism]``, ``[links]`` and ``[[springs]]``.
     """
     mech.expect(schema.known("mechanism", schema.LINKAGE))
-    if not mech.has("input"):
-        raise mech._missing("input")
-    input_name = mech.raw("input")
-    if not isinstance(input_name, str):
-        raise SpecError("must be the name of a link", key=mech.key("input"), value=input_name)
+    inputs = _inputs(mech)
     points_table = mech.table("points")
     assert points_table is not None
     points_table.known = tuple(points_table.data)
@@ -95,7 +110,7 @@ def read(root: Table, mech: Table) -> Linkage:
             springs.append(Spring(points=ends, stiffness=sub.raw("stiffness"),
                                   free_length=sub.raw("free_length")))
         sub.finish()
-    return Linkage(points=tuple(points.items()), bodies=tuple(bodies), input=input_name,
+    return Linkage(points=tuple(points.items()), bodies=tuple(bodies), inputs=inputs,
                    sliders=tuple(Slider(**f) for f in sliders), springs=tuple(springs))
 
 
@@ -124,7 +139,9 @@ def lines(model: Model) -> list[str]:
     """Its ``[mechanism]``, ``[links]`` and ``[[springs]]``, as :func:`read` reads them."""
     assert isinstance(model, Linkage)
     mech = model
-    out = ["[mechanism]", 'type = "linkage"', f"input = {toml.string(mech.input)}", "",
+    driven = (f"input = {toml.string(mech.inputs[0])}" if len(mech.inputs) == 1 else
+              f"inputs = [{', '.join(toml.string(name) for name in mech.inputs)}]")
+    out = ["[mechanism]", 'type = "linkage"', driven, "",
            "[mechanism.points]  # m, at the reference pose"]
     out += [f"{toml.key(p)} = [{toml.number(x)}, {toml.number(y)}]" for p, (x, y) in mech.points]
     for s in mech.sliders:

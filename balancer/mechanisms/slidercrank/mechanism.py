@@ -50,7 +50,7 @@ def slider_crank_linkage(model: SliderCrank) -> Linkage:
               Body(name="slider", points=("A2",), props=model.slider))
     slider = Slider(link="slider", guide="ground", point="A2", direction=(1.0, 0.0),
                     force=model.gas_force)
-    return Linkage(points=points, bodies=bodies, input="crank", sliders=(slider,))
+    return Linkage(points=points, bodies=bodies, inputs=("crank",), sliders=(slider,))
 
 
 class SliderCrankMechanism(Mechanism):
