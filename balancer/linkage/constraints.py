@@ -188,7 +188,8 @@ class Prism:
 @dataclass(frozen=True)
 class Driver:
     """An input's driver: ``θ_link − θ_ground − θ_i = 0`` for input ``index`` (its multiplier
-    is minus the motor's torque)."""
+    is minus the motor's torque).
+    """
 
     link: int
     #: Which input drives it (its place in the linkage's inputs and in an :class:`InputState`).

@@ -61,7 +61,8 @@ class InputState:
     def crank(cls, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0
               ) -> InputState:
         """A one-input mechanism's crank states: angle (rad), rate (rad/s), acceleration
-        (rad/s²), broadcast together."""
+        (rad/s²), broadcast together.
+        """
         return cls.of([theta1], [omega1], [alpha1])
 
     @classmethod

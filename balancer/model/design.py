@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, ClassVar, Literal
 from .. import validate as v
 from ..errors import SpecError
 from .mechanisms import MechanismModel
+from .motions import MotionSpec, Workspace
 
 if TYPE_CHECKING:  # (the balancing's tables load with a spec that has them)
     from .balance import BalanceProblem, RotorBalanceProblem
@@ -159,6 +160,10 @@ class Design:
         The unbalanced design this one was derived from, if any (written by ``optimize``).
     title
         A free-text name for reports.
+    workspace
+        A linkage's configuration space (``[workspace]``), if the spec gives it.
+    motions
+        Its named motions (``[[motion]]``), in the spec's order.
     """
 
     mechanism: MechanismModel
@@ -167,6 +172,8 @@ class Design:
     balance: BalanceProblem | RotorBalanceProblem | None = None
     original: MechanismModel | None = None
     title: str = ""
+    workspace: Workspace | None = None
+    motions: tuple[MotionSpec, ...] = ()
 
     def __post_init__(self) -> None:
         """Check the parts' types and that the figures stay within double precision.
@@ -186,6 +193,7 @@ class Design:
                             key="original", value=type(self.original).__name__)
         if not isinstance(self.title, str):
             raise SpecError("must be a string", key="title", value=self.title)
+        self._check_motions()
         speeds = {"simulation.omega1": self.simulation.omega1}
         gravity = {"simulation.gravity": self.simulation.gravity}
         if self.operation is not None:
@@ -196,6 +204,40 @@ class Design:
                 check_scales(mech, speeds, gravity)
         if self.balance is not None:
             self.balance.check_scales(speeds)
+
+
+    def _check_motions(self) -> None:
+        """The workspace names the inputs, each motion's name is its own, and its rows fit."""
+        inputs = getattr(self.mechanism, "inputs", ())
+        if self.workspace is not None:
+            for r in self.workspace.ranges:
+                if r.name not in inputs:
+                    raise SpecError(f"names no input ({', '.join(inputs) or 'none'})",
+                                    key=f"workspace.{r.name}")
+        seen: set[str] = set()
+        for i, motion in enumerate(self.motions):
+            key = v.item("motion", i)
+            if motion.name in seen:
+                raise SpecError("is the name of another motion", key=f"{key}.name",
+                                value=motion.name)
+            seen.add(motion.name)
+            if motion.point is None and len(motion.path[0]) != len(inputs):
+                raise SpecError(f"each waypoint must give one angle per input "
+                                f"({', '.join(inputs)})", key=f"{key}.path",
+                                value=list(motion.path[0]))
+
+    def motion(self, name: str | None) -> MotionSpec:
+        """The motion called ``name`` (``None``: the first); :class:`SpecError` if none."""
+        if not self.motions:
+            raise SpecError("the spec has no [[motion]]", key="motion")
+        if name is None:
+            return self.motions[0]
+        for motion in self.motions:
+            if motion.name == name:
+                return motion
+        raise SpecError(f"names no motion of the spec "
+                        f"({', '.join(m.name for m in self.motions)})", key="--motion",
+                        value=name)
 
 
 def check_scales(mechanism: MechanismModel, speeds: dict[str, float],

@@ -49,6 +49,7 @@ from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..model import Design, Operation, SimulationSettings
 from ..model import MechanismModel as Model
+from ..model.motions import InputRange, MotionSpec, Workspace
 from . import schema
 from .codecs import MECHANISM_TYPES, MechanismSpec, balance_spec_of, spec_of
 from .tables import Table
@@ -93,6 +94,50 @@ def _read_simulation(root: Table, mechanism: Model) -> SimulationSettings:
     return settings
 
 
+def _read_workspace(root: Table) -> Workspace | None:
+    table = root.table("workspace", required=False)
+    if table is None:
+        return None
+    table.known = tuple(table.data)
+    joints: list[InputRange] = []
+    sub = table.table("joints", required=False)
+    if sub is not None:
+        sub.known = tuple(sub.data)
+        joints = [_input_range(sub, name) for name in sub.data]
+        sub.finish()
+    ranges = [_input_range(table, name) for name in table.data
+              if name not in ("samples", "joints")]
+    with v.under("workspace"):
+        workspace = Workspace(ranges=tuple(ranges), joints=tuple(joints),
+                              samples=table.value("samples", 40))
+    table.finish()
+    return workspace
+
+
+def _input_range(table: Table, name: str) -> InputRange:
+    low, high = v.vector2(table.raw(name), table.key(name))
+    return InputRange(name=name, low=low, high=high)
+
+
+def _read_motions(root: Table) -> tuple[MotionSpec, ...]:
+    out = []
+    for table in root.tables("motion"):
+        for name in ("name", "times", "path"):
+            if not table.has(name):
+                raise table._missing(name)
+        point = table.value("point", None)
+        if point is not None and not isinstance(point, str):
+            raise SpecError("must be the name of a point", key=table.key("point"), value=point)
+        with v.under(table.path):
+            out.append(MotionSpec(
+                name=table.text("name", default=""), times=table.raw("times"),
+                path=table.raw("path"), point=point,
+                law=table.value("law", "cubic"), acc_time=table.value("acc_time", None),
+                samples=table.value("samples", 400)))
+        table.finish()
+    return tuple(out)
+
+
 def _read_original(root: Table, mechanism: Model, codec: MechanismSpec) -> Model | None:
     table = root.table("original", required=False)
     if table is None:
@@ -120,6 +165,8 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
             balance = balance_spec_of(mechanism.type).read_balance(root.table("balance"),
                                                                    mechanism)
         original = _read_original(root, mechanism, codec)
+        workspace = _read_workspace(root)
+        motions = _read_motions(root)
         root.finish()
         return Design(
             mechanism=mechanism,
@@ -128,6 +175,8 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
             balance=balance,
             original=original,
             title=title,
+            workspace=workspace,
+            motions=motions,
         )
     except SpecError as exc:
         if source is not None and exc.source is None:

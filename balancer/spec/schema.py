@@ -17,85 +17,15 @@ brackets (:attr:`Section.names`).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from functools import lru_cache
 
-FOUR_BAR = "four-bar"
-SLIDER_CRANK = "slider-crank"
-LINKAGE = "linkage"
-ENGINE = "engine"
-#: The values of ``[mechanism] type``.
-MECHANISMS = (FOUR_BAR, SLIDER_CRANK, LINKAGE, ENGINE)
+from .entries import ENGINE, FOUR_BAR, LINKAGE, SLIDER_CRANK, Key, Section
+from .schema_motions import MOTION_SECTIONS
+
 _CLOSED = (FOUR_BAR, SLIDER_CRANK)
 #: The linkages (every mechanism but the engine): their links are the design's.
 _LINKAGES = (FOUR_BAR, SLIDER_CRANK, LINKAGE)
-
-
-@dataclass(frozen=True)
-class Key:
-    """One key of a table.
-
-    Attributes
-    ----------
-    name
-        The key as written in the spec (an entry for names the spec chooses: ``<point>``).
-    unit
-        Its unit (SI), ``—`` for none (a name, a flag, a weight without dimension), or
-        ``table`` for a table of its own.
-    default
-        What an absent key means (``required`` where it must be given).
-    meaning
-        What it is, its bounds and where it applies.
-    mechanisms
-        The mechanism types whose specs accept it.
-    example
-        A TOML value for it (empty for a table described by a section of its own).
-    """
-
-    name: str
-    unit: str
-    default: str
-    meaning: str
-    mechanisms: tuple[str, ...] = MECHANISMS
-    example: str = ""
-
-
-@dataclass(frozen=True)
-class Section:
-    """A table of the spec (by its pattern) and its keys.
-
-    Attributes
-    ----------
-    pattern
-        The table's dotted path, ``<link>`` for a link's name, ``[]`` for an array of tables.
-    summary
-        What the table is.
-    keys
-        Its fixed keys (a name may have one entry per set of mechanisms).
-    mechanisms
-        The mechanism types whose specs may have the table.
-    names
-        For a table whose keys are names the spec chooses: the entry that describes them.
-    """
-
-    pattern: str
-    summary: str
-    keys: tuple[Key, ...]
-    mechanisms: tuple[str, ...] = MECHANISMS
-    names: Key | None = None
-
-    def keys_for(self, mechanism: str | None = None) -> tuple[Key, ...]:
-        """The entries of the fixed keys that apply to ``mechanism`` (``None``: any)."""
-        return tuple(k for k in self.keys if mechanism is None or mechanism in k.mechanisms)
-
-    @property
-    def header(self) -> str:
-        """The table as TOML writes it (``[links.<link>]``, ``[[springs]]``, top level)."""
-        if not self.pattern:
-            return "top level"
-        if self.pattern.endswith("[]"):
-            return f"[[{self.pattern[:-2]}]]"
-        return f"[{self.pattern}]"
 
 
 _LINK_BODY = ("A link's frame: origin at its first joint (a general linkage: its first point), "
@@ -213,6 +143,12 @@ SECTIONS: tuple[Section, ...] = (
         Key("original", "table", "none",
             "The unbalanced design a balanced one was derived from (same geometry), as "
             "`optimize --out` writes it: `verify` and `plot` show both.", _LINKAGES),
+        Key("workspace", "table", "none",
+            "The configuration space of a linkage with several inputs (`[workspace]`, "
+            "below).", (LINKAGE,)),
+        Key("motion", "table", "none",
+            "Named motions of a linkage's inputs or of a marker point (`[[motion]]`, below).",
+            (LINKAGE,)),
     )),
     Section("mechanism", "The type of linkage and its geometry.", (
         Key("type", "—", "required",
@@ -440,6 +376,7 @@ SECTIONS: tuple[Section, ...] = (
                     "frame then carries the links' weights (`analyze --gravity` overrides it).",
                     example="[0.0, -9.81]"),
             )),
+    *MOTION_SECTIONS,
     Section("simulation", "Forward dynamics (`simulate`, `verify`).", (
         Key("duration", "s", "5", "Simulated time; positive.", example="5.0"),
         Key("theta1", "rad", "the reference pose (0 for a four-bar and a slider-crank)",

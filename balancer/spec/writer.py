@@ -52,7 +52,36 @@ def dumps_design(design: Design) -> str:
     if design.original is not None:
         out += ["", "# The unbalanced design this one was derived from (same geometry)."]
         out += codec.original_lines(design.original)
+    out += _motion_lines(design)
     return "\n".join(out) + "\n"
+
+
+def _motion_lines(design: Design) -> list[str]:
+    """``[workspace]`` and each ``[[motion]]``, as the reader reads them."""
+    def pair(low: float, high: float) -> str:
+        return f"[{toml.number(low)}, {toml.number(high)}]"
+
+    out: list[str] = []
+    w = design.workspace
+    if w is not None:
+        out += ["", "[workspace]  # each input's change from the reference pose, rad"]
+        out += [f"{toml.key(r.name)} = {pair(r.low, r.high)}" for r in w.ranges]
+        out.append(f"samples = {toml.number(w.samples)}")
+        if w.joints:
+            out += ["", "[workspace.joints]"]
+            out += [f"{toml.key(r.name)} = {pair(r.low, r.high)}" for r in w.joints]
+    for m in design.motions:
+        rows = ", ".join("[" + ", ".join(toml.number(x) for x in row) + "]" for row in m.path)
+        out += ["", "[[motion]]", f"name = {toml.string(m.name)}"]
+        if m.point is not None:
+            out.append(f"point = {toml.string(m.point)}")
+        out += [f"times = [{', '.join(toml.number(t) for t in m.times)}]  # s",
+                f"path = [{rows}]  # {'m' if m.point is not None else 'rad'}",
+                f"law = {toml.string(m.law)}"]
+        if m.acc_time is not None:
+            out.append(f"acc_time = {toml.number(m.acc_time)}  # s")
+        out.append(f"samples = {toml.number(m.samples)}")
+    return out
 
 
 def save_design(design: Design, path: str | os.PathLike[str]) -> None:

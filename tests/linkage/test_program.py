@@ -19,8 +19,8 @@ import pytest
 from fuzz.linkages import _random_transform, build_topology, spec_from_topology
 
 from balancer.linkage import kinematics, numeric
-from balancer.linkage.inputs import InputState
 from balancer.linkage import program as program_module
+from balancer.linkage.inputs import InputState
 from balancer.linkage.kinematics import numeric_table
 from balancer.linkage.program import CrankForcesProgram, Tape
 from balancer.mechanisms import base, mechanism_of

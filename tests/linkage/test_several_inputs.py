@@ -17,6 +17,7 @@ import tomllib
 
 import numpy as np
 import pytest
+from helpers import derivative_with_error
 
 from balancer.errors import SpecError
 from balancer.linkage import dynamics, kinematics
@@ -26,7 +27,6 @@ from balancer.linkage.vectors import V
 from balancer.model import Linkage
 from balancer.spec.reader import design_from_dict
 from balancer.spec.writer import dumps_design
-from helpers import derivative_with_error
 
 #: Relative tolerance between two formulations of the same figure (each a few linear solves
 #: of condition well below 1e4 at the sampled states: ≈ 1e4·64·ε ≈ 1.4e-10 per solve).

@@ -46,6 +46,8 @@ BASES = {schema.FOUR_BAR: "pb1", schema.SLIDER_CRANK: "engine", schema.LINKAGE: 
 SLIDER = ("links.<link>.gas_force", ("links.<link>", "gas_force"))
 #: Values that depend on the base's names (points, links) or must come whole.
 SPRING = {"points": ["D", "A0"], "stiffness": 100.0, "free_length": 0.3}
+#: A motion of the one-input base linkage: its crank's own waypoints.
+MOTION = {"name": "turn", "times": [0.0, 1.0], "path": [[0.0], [0.1]]}
 METHOD = {schema.FOUR_BAR: "complex-masses", schema.SLIDER_CRANK: "complex-masses",
           schema.LINKAGE: "multibody", schema.ENGINE: "multibody"}
 #: An engine's ``[balance]`` for its keys to stand in: its required keys only.
@@ -112,6 +114,10 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
         data["original"] = original_of(data)
     if pattern.startswith("springs") or (pattern == "" and name == "springs"):
         data["springs"] = [dict(SPRING)]
+    if pattern.startswith("motion") or (pattern == "" and name == "motion"):
+        data["motion"] = [copy.deepcopy(MOTION)]
+    if pattern.startswith("workspace") or (pattern == "" and name == "workspace"):
+        data["workspace"] = {"crank": [-0.5, 0.5]}
     if pattern == "balance.<link>.counterweight":
         data["balance"]["crank"] = {"counterweight": {"mass": [0.0, 1.0], "radius": 0.1}}
     if pattern == "balance.<link>.counterweight.part":  # a part of a family that takes the key
@@ -133,7 +139,8 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
     table = data
     for part in path_of(data, pattern, name):
         table = table[part]
-    if name in table and (pattern, name) not in (("", "original"), ("", "springs")):
+    if name in table and (pattern, name) not in (("", "original"), ("", "springs"),
+                                                 ("", "motion"), ("", "workspace")):
         return data  # the base has it already
     value = value_of(mechanism, pattern, key, name)
     if pattern.endswith(".com") and key is not None:
@@ -143,6 +150,10 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
             table[partner] = other
     if value is not None:
         table[name] = value
+    if pattern == "motion[]" and key is not None and name == "point":
+        table["path"] = [[0.0, 0.0], [0.1, 0.1]]  # a point's (x, y)
+    if pattern == "motion[]" and key is not None and name == "acc_time":
+        table |= {"law": "trapezoid", "acc_time": 0.25}
     return data
 
 
@@ -151,6 +162,12 @@ def value_of(mechanism: str, pattern: str, key: schema.Key | None, name: str):
         return 1.0  # an unknown key
     if (pattern, name) == ("", "springs"):
         return [dict(SPRING)]
+    if (pattern, name) == ("", "motion"):
+        return [copy.deepcopy(MOTION)]
+    if (pattern, name) == ("", "workspace"):
+        return {"crank": [-0.5, 0.5]}
+    if (pattern, name) == ("motion[]", "acc_time"):
+        return None  # written by variant() with its law
     if (pattern, name) == ("", "original"):
         return None  # written whole by variant()
     if (pattern, name) == ("simulation", "method"):
@@ -166,8 +183,9 @@ def cases(accepted: bool) -> list:
         open_for = section.names.mechanisms if section.names else ()
         for key in section.keys:
             for mechanism in section.mechanisms:
-                if (mechanism in key.mechanisms) != accepted or mechanism in open_for:
-                    continue
+                if (mechanism in key.mechanisms) != accepted or (
+                        not accepted and mechanism in open_for):
+                    continue  # (a table of names takes any other key as a name)
                 if not accepted and any(k.name == key.name and mechanism in k.mechanisms
                                         for k in section.keys):
                     continue  # another entry of the name is this mechanism's
