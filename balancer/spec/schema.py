@@ -20,7 +20,15 @@ import re
 from dataclasses import replace
 from functools import lru_cache
 
-from .entries import ENGINE, FOUR_BAR, LINKAGE, SLIDER_CRANK, Key, Section
+from .entries import (  # (the mechanism types are the schema's names too)
+    ENGINE,
+    FOUR_BAR,
+    LINKAGE,
+    MECHANISMS,  # noqa: F401
+    SLIDER_CRANK,
+    Key,
+    Section,
+)
 from .schema_motions import MOTION_SECTIONS
 
 _CLOSED = (FOUR_BAR, SLIDER_CRANK)

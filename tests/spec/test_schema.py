@@ -22,6 +22,7 @@ from balancer.mechanisms.engine.model import Engine
 from balancer.mechanisms.fourbar.model import FourBar
 from balancer.mechanisms.slidercrank.model import SliderCrank
 from balancer.model import Linkage, Operation, SimulationSettings
+from balancer.model.motions import MotionSpec
 from balancer.model.balance import (
     COUNTERWEIGHT_KEYS,
     ENGINE_OBJECTIVE_KEYS,
@@ -290,6 +291,8 @@ def test_the_schema_names_what_the_model_names():
     assert set(schema.known("balance.<link>")) == set(LINK_KEYS)
     assert schema.known("balance.<link>.counterweight") == COUNTERWEIGHT_KEYS
     assert schema.known("operation") == tuple(f.name for f in dataclasses.fields(Operation))
+    assert schema.known("motion[]") == tuple(f.name for f in dataclasses.fields(MotionSpec))
+    assert set(schema.known("workspace")) == {"samples", "joints"}
     assert set(schema.known("simulation")) == {
         f.name for f in dataclasses.fields(SimulationSettings)} - {"given"}  # (what was given)
     method = next(k for k in schema.section("simulation").keys if k.name == "method")
