@@ -5,13 +5,15 @@ the one this file also writes to TOML for :func:`balancer.spec.load_design`). Ea
 is a rigid body with its own coordinates: the position of its centre of mass and the angle of
 its frame (``(x, y, θ)``; balancer uses the frame's origin instead). sympy's ``Lagrangian`` and
 ``LagrangesMethod`` give the unconstrained bodies' equations ``M·q̈ = Q`` from their kinetic
-energy and the applied forces (weights, loads, springs, and the motor: an unknown torque ``τ``
-on the input); counter-rotors are zero-mass discs on their link's ground pivot turned at −1×
-its angle, so they enter through the kinetic energy only. The joints are holonomic constraints
-``Φ(q) = 0`` written here, added with multipliers: ``M·q̈ − Q + Φ_qᵀ·λ = 0``. Positions come
-from a continuation from the reference pose with Newton's method on those constraints;
-velocities and accelerations from ``[Φ_q; driver]``; then ``λ`` and ``τ`` from
-``Φ_qᵀ·λ − b·τ = Q₀ − M·q̈``.
+energy and the applied forces (weights, loads, springs, and the motors: an unknown torque
+``τ_i`` on each input ``i``); counter-rotors are zero-mass discs on their link's ground pivot
+turned at −1× its angle, so they enter through the kinetic energy only. The joints are
+holonomic constraints ``Φ(q) = 0`` written here, added with multipliers:
+``M·q̈ − Q + Φ_qᵀ·λ = 0``. Positions come from a continuation from the reference pose along
+the straight line to the inputs' angles, with Newton's method on those constraints;
+velocities and accelerations from ``[Φ_q; drivers]`` (one driver row per input: its link's
+angle); then ``λ`` and the torques ``τ`` from ``Φ_qᵀ·λ − B·τ = Q₀ − M·q̈`` (``B``: a column
+per motor).
 
 In these coordinates a joint's generalized force on a body, ``−Φ_qᵀ·λ`` over its rows, *is*
 the force on it (``x``, ``y``) and its moment about the centre of mass (``θ``), so the ground
@@ -22,9 +24,18 @@ need no convention for where a counter-rotor's reaction goes.
 
 Conventions checked (DESIGN.md, "General planar linkages"): reactions are forces of the
 mechanism on the ground, per ground point, springs not included; shaking moment about the
-origin of the spec's coordinates, with the motor's reaction (−τ) and ``+2·J·α`` per
+origin of the spec's coordinates, with each motor's reaction (−τ_i) and ``+2·J·α`` per
 counter-rotor; a slider on a ground guide exerts on it a normal force ``N`` along the guide's
 direction turned by +90° (``d̂⊥``), acting at the slider's point, and a pure couple.
+
+The one-input linkages (a Watt six-bar, a crank shaper, an offset slider-crank) are checked
+through their mechanism (:func:`balancer.mechanisms.mechanism_of`) at random crank states; the
+linkages with several inputs (a 5R five-bar, a 3-RRR parallel manipulator:
+``several_inputs_specs``, with loads, springs and counter-rotors added here) through the core
+itself (:meth:`Structure.of <balancer.linkage.structure.Structure.of>`,
+:func:`balancer.linkage.kinematics.motion`, :func:`balancer.linkage.dynamics.inverse_dynamics`
+and :func:`~balancer.linkage.dynamics.regressors`) along a smooth motion of the inputs near the
+reference pose, which both sides reach along the straight line from it.
 """
 
 from __future__ import annotations
@@ -36,27 +47,32 @@ import numpy as np
 import pytest
 import sympy as sp
 import sympy.physics.mechanics as me
+from linkage.several_inputs_specs import fivebar, three_rrr
 
+from balancer.linkage import dynamics, kinematics
+from balancer.linkage.inputs import InputState
+from balancer.linkage.structure import Structure
 from balancer.mechanisms import mechanism_of
 from balancer.spec import load_design
 
 EPS = float(np.finfo(float).eps)
 
 #: Largest condition number (2-norm) allowed at the sampled states for the oracle's matrices
-#: ``[Φ_q; driver]`` (positions, rates, accelerations) and ``[Φ_qᵀ, −b]`` (multipliers and
-#: torque), with angle columns divided and angle rows multiplied by the linkage's size so that
+#: ``[Φ_q; drivers]`` (positions, rates, accelerations) and ``[Φ_qᵀ, −B]`` (multipliers and
+#: torques), with angle columns divided and angle rows multiplied by the linkage's size so that
 #: every entry is in common units. balancer solves with the same matrices group by group.
 KAPPA_MAX = 1e4
 
 #: Relative tolerance of every comparison. Each side evaluates its terms with a few dozen
-#: roundings (≈ 64·ε of the largest term) and solves linear systems of size 3n ≤ 15 with
+#: roundings (≈ 64·ε of the largest term) and solves linear systems of size 3n ≤ 21 with
 #: condition ≤ KAPPA_MAX by backward-stable LU: ≤ KAPPA_MAX·64·ε ≈ 1.4e-10 of the scale of
 #: the unknowns per solve. Positions (Newton, converged to rounding), rates, accelerations and
 #: forces are such solves in sequence, each feeding the next: a few times 1.4e-10, below 1e-9.
 #: Scales: per quantity, the largest magnitude over what is compared — all links' rates (or
-#: ω1), all accelerations (or the largest rate squared), all forces, and all moments together
-#: with force × the linkage's reach from the origin (a moment about the origin of forces at
-#: points that far carries their rounding times that arm).
+#: the inputs'), all accelerations (or the largest rate squared), all forces, and all moments
+#: (the inputs' torques among them) together with force × the linkage's reach from the origin
+#: (a moment about the origin of forces at points that far carries their rounding times that
+#: arm).
 TOL = 1e-9
 
 SEED = 20261123
@@ -193,7 +209,63 @@ def offset_slider_crank() -> dict:
     }
 
 
-LINKAGES = {"watt": watt_six_bar, "shaper": crank_shaper, "slider_crank": offset_slider_crank}
+def loaded_fivebar() -> dict:
+    """The 5R five-bar of ``several_inputs_specs`` with loads, springs and counter-rotors.
+
+    A spring from a ground anchor K (no joint there) to the coupler's point E, another between
+    the cranks' pins C and D; counter-rotors on both cranks (the inputs). Each input swings
+    about its reference angle (``motion``: amplitudes in rad, angular frequencies in rad/s,
+    phases in rad).
+    """
+    spec = fivebar()
+    spec["mechanism"]["points"]["K"] = [0.35, 0.45]
+    spec["mechanism"]["sliders"] = []
+    links = spec["links"]
+    links["ground"]["points"].append("K")
+    links["left"]["counter_rotor"] = 0.0008
+    links["right"]["counter_rotor"] = 0.0005
+    links["upper_left"]["force"] = [3.0, -2.0]
+    links["upper_right"]["moment"] = 0.4
+    spec["springs"] = [{"points": ["K", "E"], "stiffness": 80.0, "free_length": 0.1},
+                       {"points": ["C", "D"], "stiffness": 40.0, "free_length": 0.2}]
+    spec["gravity"] = (0.5, -9.81)
+    spec["motion"] = {"amplitudes": (0.25, 0.2), "frequencies": (30.0, 50.0),
+                      "phases": (0.3, -0.7)}
+    return spec
+
+
+def loaded_three_rrr() -> dict:
+    """The 3-RRR of ``several_inputs_specs`` with loads, a spring and counter-rotors.
+
+    A force and a moment on the platform, a spring from a ground anchor K to the platform's
+    C2, counter-rotors on two of the three cranks; small swings of the inputs (about 0.08 rad:
+    the motion must stay inside the workspace, on the reference pose's branch).
+    """
+    spec = three_rrr()
+    spec["mechanism"]["points"]["K"] = [0.2, -0.25]
+    spec["mechanism"]["sliders"] = []
+    links = spec["links"]
+    links["ground"]["points"].append("K")
+    links["crank1"]["counter_rotor"] = 0.002
+    links["crank3"]["counter_rotor"] = 0.0015
+    links["platform"]["force"] = [-4.0, 2.5]
+    links["platform"]["moment"] = 0.3
+    links["distal2"]["force"] = [1.0, 1.5]
+    spec["springs"] = [{"points": ["K", "C2"], "stiffness": 150.0, "free_length": 0.15}]
+    spec["gravity"] = (-0.8, -9.81)
+    spec["motion"] = {"amplitudes": (0.08, 0.06, 0.07), "frequencies": (30.0, 50.0, 40.0),
+                      "phases": (0.3, -0.7, 1.1)}
+    return spec
+
+
+LINKAGES = {"watt": watt_six_bar, "shaper": crank_shaper, "slider_crank": offset_slider_crank,
+            "fivebar": loaded_fivebar, "3-RRR": loaded_three_rrr}
+
+
+def inputs_of(spec: dict) -> list[str]:
+    """The spec's driven links: ``inputs`` (several) or ``input`` (one)."""
+    mech = spec["mechanism"]
+    return list(mech["inputs"]) if "inputs" in mech else [mech["input"]]
 
 
 def to_toml(spec: dict) -> str:
@@ -208,10 +280,11 @@ def to_toml(spec: dict) -> str:
         return "[" + ", ".join(f'"{p}"' for p in ps) + "]"
 
     mech = spec["mechanism"]
-    out = ["[mechanism]", 'type = "linkage"', f'input = "{mech["input"]}"', "",
-           "[mechanism.points]"]
+    driven = (f'input = "{mech["input"]}"' if "input" in mech
+              else f"inputs = {names(mech['inputs'])}")
+    out = ["[mechanism]", 'type = "linkage"', driven, "", "[mechanism.points]"]
     out += [f"{p} = {vec(xy)}" for p, xy in mech["points"].items()]
-    for s in mech["sliders"]:
+    for s in mech.get("sliders", []):
         out += ["", "[[mechanism.sliders]]", f'link = "{s["link"]}"',
                 f'guide = "{s["guide"]}"', f'point = "{s["point"]}"',
                 f"direction = {vec(s['direction'])}"]
@@ -226,7 +299,7 @@ def to_toml(spec: dict) -> str:
                 out.append(f"{key} = {num(link[key])}")
         if "force" in link:
             out.append(f"force = {vec(link['force'])}")
-    for s in spec["springs"]:
+    for s in spec.get("springs", []):
         out += ["", "[[springs]]", f"points = {names(s['points'])}",
                 f"stiffness = {num(s['stiffness'])}", f"free_length = {num(s['free_length'])}"]
     return "\n".join(out) + "\n"
@@ -240,7 +313,8 @@ class Oracle:
 
     Parameters (the vector ``p``): per moving link ``m, e, f, I_G, Fx, Fy, M, J_c`` (mass,
     centre of mass in the link's frame, inertia about it, applied force at it and moment,
-    counter-rotor), per spring ``k, L0``, then gravity ``gx, gy``.
+    counter-rotor), per spring ``k, L0``, then gravity ``gx, gy``. One unknown torque per
+    input (the spec's ``inputs``, or its one ``input``), in their order.
     """
 
     PER_LINK = ("m", "e", "f", "I", "Fx", "Fy", "M", "Jc")
@@ -293,10 +367,11 @@ class Oracle:
         for i in range(len(springs)):
             par[("spring", i, "k")] = sp.Symbol(f"k_{i}", real=True)
             par[("spring", i, "L0")] = sp.Symbol(f"L0_{i}", real=True)
-        gx, gy, tau = sp.symbols("gx gy tau", real=True)
+        gx, gy = sp.symbols("gx gy", real=True)
         self.par_keys = [*par.keys(), "gx", "gy"]
         psyms = [*par.values(), gx, gy]
-        self.input = names.index(mech["input"])
+        self.inputs = [names.index(name) for name in inputs_of(spec)]
+        taus = list(sp.symbols(f"tau0:{len(self.inputs)}", real=True))
 
         # Bodies: the frame N is the ground's (the spec's coordinates), O its origin.
         frame = me.ReferenceFrame("N")
@@ -373,16 +448,17 @@ class Oracle:
             self.joints.append(("slider", s["point"], s["link"], gname, len(phis)))
             phis.append(q[3 * ks + 2] - th_g - (phi[s["link"]] - phi_g))
             phis.append(((turn * nrm).T * (xy(point(s["link"], s["point"])) - on_line))[0])
-        assert len(phis) == 3 * n - 1, "the oracle's linkages have one degree of freedom"
+        assert len(phis) == 3 * n - len(self.inputs), "one degree of freedom per input"
 
-        # Applied forces: weights and loads at the centres of mass, moments, springs, motor.
+        # Applied forces: weights and loads at the centres of mass, moments, springs, motors.
         forces = []
         for k in range(n):
             m = par[(k, "m")]
             forces.append((coms[k], (m * gx + par[(k, "Fx")]) * frame.x
                            + (m * gy + par[(k, "Fy")]) * frame.y))
             forces.append((frames[k], par[(k, "M")] * frame.z))
-        forces.append((frames[self.input], tau * frame.z))
+        for k, tau in zip(self.inputs, taus, strict=True):
+            forces.append((frames[k], tau * frame.z))
         # A spring's force on its first end enters as symbols (its law is put in below, on
         # plain symbols: differentiating square roots of time functions is slow in sympy).
         spring_ends, spring_force = [], []
@@ -455,7 +531,7 @@ class Oracle:
             + (par[(k, "m")] * gy + par[(k, "Fy")]) * frame.y).dot(frame.z) for k in range(n))
         shake_f = applied_f - linear.dt(frame)
         self._dyn = fn(
-            lm_mass, forcing.diff(tau), forcing.xreplace({tau: 0}),
+            lm_mass, forcing.jacobian(taus), forcing.xreplace(dict.fromkeys(taus, 0)),
             -(jac * qd_col).jacobian(qs) * qd_col,
             components(pt.pos_from(o_pt) for pt in frame_origins),
             components(pt.vel(frame) for pt in frame_origins),
@@ -496,22 +572,23 @@ class Oracle:
     # -- kinematics ---------------------------------------------------------------------------
 
     def _kin_matrix(self, q, p):
-        """``Φ(q)`` and ``[Φ_q; driver]``."""
+        """``Φ(q)`` and ``[Φ_q; drivers]`` (a driver row per input: its angle)."""
         z = np.zeros(3 * self.n)
         phi, jac = self._kin(q, z, z, p)
-        drive = np.zeros((1, 3 * self.n))
-        drive[0, 3 * self.input + 2] = 1.0
+        drive = np.zeros((len(self.inputs), 3 * self.n))
+        for j, k in enumerate(self.inputs):
+            drive[j, 3 * k + 2] = 1.0
         return np.ravel(phi), np.vstack([np.asarray(jac, dtype=float), drive])
 
     def _scaled(self, a):
-        """``a`` (rows like ``[Φ_q; driver]``) in common units: angles times the size."""
+        """``a`` (rows like ``[Φ_q; drivers]``) in common units: angles times the size."""
         a = np.array(a, dtype=float)
         a[:, 2::3] /= self.size
         kinds = ["length"] * (3 * self.n)
         for kind, _, _, _, row in self.joints:
             if kind == "slider":
                 kinds[row] = "angle"
-        kinds[-1] = "angle"  # the driver
+        kinds[3 * self.n - len(self.inputs):] = ["angle"] * len(self.inputs)  # the drivers
         a[[r for r, kind in enumerate(kinds) if kind == "angle"]] *= self.size
         return a
 
@@ -525,30 +602,40 @@ class Oracle:
             q += [gpos[0], gpos[1], self.phi[name]]
         return np.array(q)
 
-    def positions(self, theta1, p):
-        """``q`` at crank angle ``theta1``, continued from the reference pose (Newton)."""
-        key = (theta1, *(p[self.par_keys.index((k, w))] for k in range(self.n) for w in "ef"))
+    def positions(self, theta, p):
+        """``q`` at the inputs' angles ``theta`` (one per input), continued from the reference
+        pose along the straight line to them in the inputs' angles (Newton)."""
+        theta = np.atleast_1d(np.asarray(theta, dtype=float))
+        key = (*theta, *(p[self.par_keys.index((k, w))] for k in range(self.n) for w in "ef"))
         if key in self._positions:
             return self._positions[key]
-        ic = 3 * self.input + 2
+        m = len(self.inputs)
+        ic = [3 * k + 2 for k in self.inputs]
         q = self._q_ref(p)
         assert np.max(np.abs(self._kin_matrix(q, p)[0])) <= 64 * EPS * self.size
         start = q[ic]
-        steps = max(1, math.ceil(abs(theta1 - start) / 0.05))
+        steps = max(1, math.ceil(np.max(np.abs(theta - start)) / 0.05))
         for i in range(1, steps + 1):
-            target = start + (theta1 - start) * i / steps
+            target = start + (theta - start) * i / steps
             rhs = np.zeros(3 * self.n)
-            rhs[-1] = target - q[ic]
+            rhs[-m:] = target - q[ic]
             q = q + np.linalg.solve(self._kin_matrix(q, p)[1], rhs)  # the tangent predictor
+            last = math.inf
             for _ in range(30):
                 phi, a = self._kin_matrix(q, p)
                 step = np.linalg.solve(a, -np.append(phi, q[ic] - target))
                 q = q + step
-                if np.max(np.abs(step)) <= 4 * EPS * self.size:
+                moved = np.max(np.abs(step))
+                # Converged: the step at rounding, or no longer halving once below √ε (Newton
+                # squares the step from there: what is left is Φ's rounding through the
+                # matrix's inverse — a small platform's angle gets it times size/radius).
+                if moved <= 4 * EPS * self.size or (
+                        moved <= math.sqrt(EPS) * self.size and moved > last / 2):
                     break
+                last = moved
             else:
                 raise AssertionError("the oracle's Newton iteration did not converge")
-        q[ic] = theta1
+        q[ic] = theta
         res = self._kin_matrix(q, p)[0]
         assert np.max(np.abs(res)) <= 64 * EPS * self.size, "the oracle's pose does not close"
         self._positions[key] = q
@@ -556,25 +643,26 @@ class Oracle:
 
     # -- dynamics -----------------------------------------------------------------------------
 
-    def solve(self, theta1, omega1, alpha1, p):
-        """Everything at one crank state (a dict of numbers and arrays)."""
-        n3 = 3 * self.n
-        q = self.positions(theta1, p)
-        kin = self._kin_matrix(q, p)[1]  # [Φ_q; driver]
-        jac = kin[:-1]
+    def solve(self, theta, omega, alpha, p):
+        """Everything at one state of the inputs (their angles, rates and accelerations, one
+        each per input), as a dict of numbers and arrays (``tau``: one torque per input)."""
+        n3, m = 3 * self.n, len(self.inputs)
+        q = self.positions(theta, p)
+        kin = self._kin_matrix(q, p)[1]  # [Φ_q; drivers]
+        jac = kin[:-m]
         rhs = np.zeros(n3)
-        rhs[-1] = omega1
+        rhs[-m:] = omega
         qd = np.linalg.solve(kin, rhs)
         mass, motor, applied, gamma, *_ = self._dyn(q, qd, np.zeros(n3), p)
-        mass, motor = np.asarray(mass, dtype=float), np.ravel(motor)
-        qdd = np.linalg.solve(kin, np.append(np.ravel(gamma), alpha1))
-        # M·q̈ − Q + Φ_qᵀ·λ = 0 with Q = Q₀ + b·τ (Q₀ everything but the motor, b the motor's
-        # generalized direction): Φ_qᵀ·λ − b·τ = Q₀ − M·q̈. M (sympy's, from the kinetic
-        # energy) is positive on its diagonal: the inertia enters with +.
+        mass, motor = np.asarray(mass, dtype=float), np.asarray(motor, dtype=float).reshape(n3, m)
+        qdd = np.linalg.solve(kin, np.append(np.ravel(gamma), alpha))
+        # M·q̈ − Q + Φ_qᵀ·λ = 0 with Q = Q₀ + B·τ (Q₀ everything but the motors, B's columns
+        # the motors' generalized directions): Φ_qᵀ·λ − B·τ = Q₀ − M·q̈. M (sympy's, from the
+        # kinetic energy) is positive on its diagonal: the inertia enters with +.
         assert np.all(np.diag(mass) > 0)
         multipliers = np.column_stack([jac.T, -motor])
         lam_tau = np.linalg.solve(multipliers, np.ravel(applied) - mass @ qdd)
-        lam, tau = lam_tau[:-1], lam_tau[-1]
+        lam, tau = lam_tau[:-m], lam_tau[-m:]
         *_, origins, origin_vel, origin_acc, sliders, ends, momentum = self._dyn(q, qd, qdd, p)
         kappa = max(np.linalg.cond(self._scaled(kin)),
                     np.linalg.cond(self._scaled(multipliers.T)))
@@ -590,7 +678,7 @@ class Oracle:
         reactions = {pt: np.zeros(2) for pt in self.ground_points}
         normal, couple, tangential, pin_couple = {}, {}, [], []
         force = np.zeros(2)
-        moment = -tau  # the motor's reaction
+        moment = -np.sum(tau)  # the motors' reactions
         slider_index = 0
         for kind, pt, link, base, row in self.joints:
             if kind == "slider":
@@ -652,23 +740,86 @@ def _cross(a, b):
 # -- fixtures -------------------------------------------------------------------------------
 
 
+#: The general core's routes (:func:`balancer.linkage.dynamics.inverse_dynamics`) by the
+#: mechanism's names for them (what the tests are parametrized by).
+CORE_ROUTES = {"newton-euler": "groups", "mass-matrix": "global"}
+
+
+class Core:
+    """A linkage with several inputs through the general core itself: :meth:`Structure.of
+    <balancer.linkage.structure.Structure.of>` and the core's functions, answering what the
+    tests ask a one-input linkage's mechanism (:func:`mechanism_of`)."""
+
+    routes = tuple(CORE_ROUTES)
+
+    def __init__(self, linkage) -> None:
+        self.linkage = linkage
+        self.structure = Structure.of(linkage)
+        self.layout = dynamics.Layout.of(self.structure)
+        self.link_names = self.structure.names
+        self.grounded_links = linkage.grounded_links
+
+    def motion(self, theta, omega, alpha):
+        """The motion at the inputs' states (arrays ``(m, N)``: a row per input)."""
+        return kinematics.motion(self.structure, InputState.of(theta, omega, alpha))
+
+    def inverse_dynamics(self, mo, *, route=None, loads=True, gravity=(0.0, 0.0)):
+        return dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
+                                         loads=loads, route=CORE_ROUTES[route or "newton-euler"])
+
+    def regressors(self, mo, gravity=(0.0, 0.0)):
+        forces, _ = dynamics.regressors(self.structure, mo, gravity)
+        return forces
+
+
 @dataclass
 class Case:
+    """A linkage, its oracle and its states: ``theta``, ``omega``, ``alpha`` have a row per
+    input (rad, rad/s, rad/s²) and a column per state."""
+
     name: str
     spec: dict
     mech: object
     oracle: Oracle
-    theta1: np.ndarray
-    omega1: np.ndarray
-    alpha1: np.ndarray
+    theta: np.ndarray
+    omega: np.ndarray
+    alpha: np.ndarray
     gravity: tuple[float, float]
 
+    @property
+    def several(self) -> bool:
+        return len(self.theta) > 1
+
     def motion(self):
-        return self.mech.motion(self.theta1, self.omega1, self.alpha1)
+        if self.several:
+            return self.mech.motion(self.theta, self.omega, self.alpha)
+        return self.mech.motion(self.theta[0], self.omega[0], self.alpha[0])
 
     def oracle_states(self, p):
         return [self.oracle.solve(t, w, a, p)
-                for t, w, a in zip(self.theta1, self.omega1, self.alpha1, strict=True)]
+                for t, w, a in zip(self.theta.T, self.omega.T, self.alpha.T, strict=True)]
+
+
+def _random_crank_states(spec, rng):
+    """One input's states: random angles over a turn, rates and accelerations up to the
+    spec's ``speed`` (and twice its square)."""
+    speed = spec["speed"]
+    theta1 = rng.uniform(0.0, 2 * math.pi, STATES)
+    omega1 = rng.uniform(-speed, speed, STATES)
+    alpha1 = rng.uniform(-2 * speed**2, 2 * speed**2, STATES)
+    return theta1[None, :], omega1[None, :], alpha1[None, :]
+
+
+def _swinging_states(spec, oracle, rng):
+    """Several inputs' states along ``θ_i(t) = θ_i,ref + a_i·sin(w_i·t + φ_i)`` at random
+    times (the spec's ``motion``; the reference angles the oracle's)."""
+    motion = spec["motion"]
+    ref = np.array([oracle.phi[name] for name in inputs_of(spec)])[:, None]
+    a, w, phase = (np.array(motion[key], dtype=float)[:, None]
+                   for key in ("amplitudes", "frequencies", "phases"))
+    t = rng.uniform(0.0, 1.0, STATES)[None, :]
+    arg = w * t + phase
+    return ref + a * np.sin(arg), a * w * np.cos(arg), -a * w**2 * np.sin(arg)
 
 
 @pytest.fixture(scope="module", params=list(LINKAGES))
@@ -676,15 +827,17 @@ def case(request, tmp_path_factory) -> Case:
     spec = LINKAGES[request.param]()
     path = tmp_path_factory.mktemp(request.param) / "spec.toml"
     path.write_text(to_toml(spec), encoding="utf-8")
-    mech = mechanism_of(load_design(path).mechanism)
+    linkage = load_design(path).mechanism
+    oracle = Oracle(spec)
     rng = np.random.default_rng([SEED, list(LINKAGES).index(request.param)])
-    speed = spec["speed"]
-    theta1 = rng.uniform(0.0, 2 * math.pi, STATES)
-    omega1 = rng.uniform(-speed, speed, STATES)
-    alpha1 = rng.uniform(-2 * speed**2, 2 * speed**2, STATES)
-    omega1[-1] = alpha1[-1] = 0.0  # at rest: statics of gravity, loads and springs
-    return Case(request.param, spec, mech, Oracle(spec), theta1, omega1, alpha1,
-                spec["gravity"])
+    if len(inputs_of(spec)) == 1:
+        mech = mechanism_of(linkage)
+        theta, omega, alpha = _random_crank_states(spec, rng)
+    else:  # (the mechanism's interface is a crank's)
+        mech = Core(linkage)
+        theta, omega, alpha = _swinging_states(spec, oracle, rng)
+    omega[:, -1] = alpha[:, -1] = 0.0  # at rest: statics of gravity, loads and springs
+    return Case(request.param, spec, mech, oracle, theta, omega, alpha, spec["gravity"])
 
 
 @pytest.fixture(scope="module")
@@ -718,15 +871,24 @@ def _column(x):
 
 @pytest.mark.slow
 def test_states_are_regular_and_the_crank_turns(case, solved):
-    assert case.mech.assembly_range().full
+    """A one-input linkage's crank turns fully; several inputs' motion (near the reference
+    pose) places every link at every state; the oracle's matrices are well conditioned."""
+    if case.several:
+        mo = case.motion()
+        for k in range(len(case.mech.link_names)):
+            for x in (mo.pose.angles[k], mo.pose.origins[k].x, mo.pose.origins[k].y):
+                assert np.all(np.isfinite(x))
+    else:
+        assert case.mech.assembly_range().full
     kappa = max(s["kappa"] for s in solved)
     assert kappa <= KAPPA_MAX, f"ill-conditioned state (κ = {kappa:.3g}): the tolerance fails"
 
 
 @pytest.mark.slow
 def test_oracle_is_consistent_with_the_momentum_theorems(case, solved):
-    """Joint forces summed on the ground (with −τ and +2·J·α per counter-rotor) equal applied
-    forces less the momentum's rate; pins carry no couple, ground guides no tangential force."""
+    """Joint forces summed on the ground (with −τ_i per motor and +2·J·α per counter-rotor)
+    equal applied forces less the momentum's rate; pins carry no couple, ground guides no
+    tangential force."""
     o = case.oracle
     force_scale = max(max(np.max(np.abs(s["force"])), *(np.max(np.abs(r)) for r in
                                                          s["reactions"].values()))
@@ -769,20 +931,20 @@ def test_kinematics(case, solved):
     o = case.oracle
 
     def at(x, i):  # a link that does not turn has a constant angle (a float)
-        return float(np.broadcast_to(np.asarray(x, dtype=float), case.theta1.shape)[i])
+        return float(np.broadcast_to(np.asarray(x, dtype=float), (STATES,))[i])
 
     errs = Errors()
     for k, name in enumerate(case.mech.link_names):
         j = o.names.index(name)
         for i, s in enumerate(solved):
             rates = np.abs(s["qd"][2::3])
-            w_scale = max(np.max(rates), abs(case.omega1[i]))
+            w_scale = max(np.max(rates), np.max(np.abs(case.omega[:, i])))
             a_scale = max(np.max(np.abs(s["qdd"][2::3])), np.max(rates) ** 2)
             turn = at(mo.pose.angles[k], i) - s["q"][3 * j + 2]
             errs.add(f"{name} angle", math.remainder(turn, 2 * math.pi), 0.0, 1.0)
             errs.add(f"{name} origin", [at(mo.pose.origins[k].x, i), at(mo.pose.origins[k].y, i)],
                      s["origins"][j], o.reach)
-            if case.omega1[i] == 0 and case.alpha1[i] == 0:  # at rest: exactly
+            if not np.any(case.omega[:, i]) and not np.any(case.alpha[:, i]):  # at rest
                 errs.add(f"{name} rates at rest",
                          [at(mo.rate[k], i), at(mo.accel[k], i), at(mo.velocity[k].x, i),
                           at(mo.velocity[k].y, i), at(mo.acceleration[k].x, i),
@@ -812,7 +974,7 @@ def _compare(case, forces, states, column=None):
                   max(np.max(np.abs(r)) for s in states for r in s["reactions"].values()),
                   max((abs(v) for s in states for v in s["normal"].values()), default=0.0))
     m_scale = max(f_scale * o.reach, max(abs(s["moment"]) for s in states),
-                  max(abs(s["tau"]) for s in states),
+                  max(np.max(np.abs(s["tau"])) for s in states),
                   max((abs(v) for s in states for v in s["couple"].values()), default=0.0))
     errs = Errors()
     assert set(forces.reactions) == set(o.ground_points)
@@ -835,7 +997,14 @@ def _compare(case, forces, states, column=None):
              f_scale)
     errs.add("shaking moment", at(forces.shaking_moment), [s["moment"] for s in states],
              m_scale)
-    errs.add("driving torque", at(forces.driving_torque), [s["tau"] for s in states], m_scale)
+    assert len(forces.input_torques) == len(o.inputs)
+    if len(o.inputs) == 1:
+        errs.add("driving torque", at(forces.driving_torque), [s["tau"][0] for s in states],
+                 m_scale)
+    else:
+        for j, name in enumerate(inputs_of(case.spec)):
+            errs.add(f"torque on input {name}", at(forces.input_torques[j]),
+                     [s["tau"][j] for s in states], m_scale)
     errs.check()
 
 
@@ -882,9 +1051,10 @@ def test_regressors(case, design):
         ref = mech.inverse_dynamics(mo, loads=False, gravity=case.gravity)
         reg = mech.regressors(mo, gravity=case.gravity)
         scale = max(np.max(np.abs(ref.shaking_force.x)), np.max(np.abs(ref.shaking_force.y)),
-                    np.max(np.abs(ref.driving_torque)) / o.reach)
+                    *(np.max(np.abs(tau)) / o.reach for tau in ref.input_torques))
         for a, b, s in ((reg.shaking_force.x @ x, ref.shaking_force.x, scale),
                         (reg.shaking_force.y @ x, ref.shaking_force.y, scale),
                         (reg.shaking_moment @ x, ref.shaking_moment, scale * o.reach),
-                        (reg.driving_torque @ x, ref.driving_torque, scale * o.reach)):
+                        *((r @ x, f, scale * o.reach) for r, f in
+                          zip(reg.input_torques, ref.input_torques, strict=True))):
             assert np.max(np.abs(_column(a) - _column(b))) <= TOL * s

@@ -18,6 +18,7 @@ import tomllib
 import numpy as np
 import pytest
 from helpers import derivative_with_error
+from linkage.several_inputs_specs import _link, fivebar, three_rrr
 
 from balancer.errors import SpecError
 from balancer.linkage import dynamics, kinematics
@@ -31,47 +32,6 @@ from balancer.spec.writer import dumps_design
 #: Relative tolerance between two formulations of the same figure (each a few linear solves
 #: of condition well below 1e4 at the sampled states: ≈ 1e4·64·ε ≈ 1.4e-10 per solve).
 RTOL = 1e-9
-
-
-def _link(points, mass, inertia, e, f):
-    return {"points": points, "mass": mass, "inertia": inertia, "com": {"e": e, "f": f}}
-
-
-def fivebar() -> dict:
-    """A general (not parallelogram) 5R five-bar: two cranks on ground pivots A and B."""
-    return {
-        "mechanism": {"type": "linkage", "inputs": ["left", "right"],
-                      "points": {"A": [0.0, 0.0], "B": [0.15, 0.0], "C": [-0.05, 0.2],
-                                 "D": [0.22, 0.18], "E": [0.1, 0.35]}},
-        "links": {"ground": {"points": ["A", "B"]},
-                  "left": _link(["A", "C"], 0.3, 0.002, 0.08, 0.01),
-                  "right": _link(["B", "D"], 0.25, 0.0015, 0.09, -0.005),
-                  "upper_left": _link(["C", "E"], 0.2, 0.001, 0.07, 0.0),
-                  "upper_right": _link(["D", "E"], 0.22, 0.0012, 0.06, 0.004)},
-    }
-
-
-def three_rrr() -> dict:
-    """A symmetric 3-RRR planar parallel manipulator: three cranks (0.15 m) on a base circle
-    of 0.3 m, three distal links (0.15 m), a platform of radius 0.06 m turned 0.2 rad; each
-    elbow placed on the circles' intersection that bends it the same way."""
-    points, links = {}, {"ground": {"points": ["A1", "A2", "A3"]}}
-    platform = []
-    for i in range(1, 4):
-        at = math.pi / 2 + 2 * math.pi * (i - 1) / 3
-        a = 0.3 * complex(math.cos(at), math.sin(at))
-        c = 0.06 * complex(math.cos(at + 0.2), math.sin(at + 0.2))
-        d = c - a
-        half = abs(d) / 2
-        b = a + d / 2 + 1j * d / abs(d) * math.sqrt(0.15 ** 2 - half ** 2)
-        points |= {f"A{i}": [a.real, a.imag], f"B{i}": [b.real, b.imag],
-                   f"C{i}": [c.real, c.imag]}
-        links[f"crank{i}"] = _link([f"A{i}", f"B{i}"], 0.4 + 0.05 * i, 0.003, 0.05, 0.002 * i)
-        links[f"distal{i}"] = _link([f"B{i}", f"C{i}"], 0.25, 0.0018, 0.06, -0.003)
-        platform.append(f"C{i}")
-    links["platform"] = _link(platform, 0.5, 0.0012, 0.01, 0.01)
-    return {"mechanism": {"type": "linkage", "inputs": ["crank1", "crank2", "crank3"],
-                          "points": points}, "links": links}
 
 
 CASES = {"fivebar": fivebar, "3-RRR": three_rrr}

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 from helpers import derivative_with_error
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
-from test_several_inputs import fivebar, linkage_of, three_rrr
+from linkage.several_inputs_specs import fivebar, three_rrr
+from test_several_inputs import linkage_of
 
 from balancer.errors import AssemblyError, SpecError
 from balancer.linkage import kinematics, trajectory
