@@ -12,6 +12,16 @@ from __future__ import annotations
 
 import math
 
+from balancer.model import Linkage
+from balancer.spec.reader import design_from_dict
+
+
+def linkage_of(spec: dict) -> Linkage:
+    """The linkage a spec dict describes."""
+    mechanism = design_from_dict(spec).mechanism
+    assert isinstance(mechanism, Linkage)
+    return mechanism
+
 
 def _link(points, mass, inertia, e, f):
     return {"points": points, "mass": mass, "inertia": inertia, "com": {"e": e, "f": f}}

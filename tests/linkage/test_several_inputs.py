@@ -18,7 +18,7 @@ import tomllib
 import numpy as np
 import pytest
 from helpers import derivative_with_error
-from linkage.several_inputs_specs import _link, fivebar, three_rrr
+from linkage.several_inputs_specs import _link, fivebar, linkage_of, three_rrr
 
 from balancer.errors import SpecError
 from balancer.linkage import dynamics, kinematics
@@ -35,12 +35,6 @@ RTOL = 1e-9
 
 
 CASES = {"fivebar": fivebar, "3-RRR": three_rrr}
-
-
-def linkage_of(spec: dict) -> Linkage:
-    mechanism = design_from_dict(spec).mechanism
-    assert isinstance(mechanism, Linkage)
-    return mechanism
 
 
 @pytest.fixture(params=sorted(CASES))

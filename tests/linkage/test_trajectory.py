@@ -11,9 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers import derivative_with_error
+from linkage.several_inputs_specs import fivebar, linkage_of, three_rrr
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
-from linkage.several_inputs_specs import fivebar, three_rrr
-from test_several_inputs import linkage_of
 
 from balancer.errors import AssemblyError, SpecError
 from balancer.linkage import kinematics, trajectory
