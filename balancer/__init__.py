@@ -27,6 +27,7 @@ from .lazy import lazy_exports
 #: Where each public name lives.
 _EXPORTS = {
     "analyze": "api",
+    "analyze_motions": "api",
     "cycle_analyses": "api",
     "example": "api",
     "optimize": "api",
@@ -76,6 +77,10 @@ _EXPORTS = {
     "CycleAnalysis": "cycle",
     "CycleSummary": "cycle",
     "Reactions": "linkage.loads",
+    "InputState": "linkage.inputs",
+    "MotionAnalysis": "motion_analysis",
+    "MotionSpec": "model.motions",
+    "Workspace": "model.motions",
     "Figure": "cycle",
     "Trajectory": "simulation",
     "Verification": "verification",
@@ -103,6 +108,7 @@ _EXPORTS = {
 __all__ = [
     "Against",
     "analyze",
+    "analyze_motions",
     "animate",
     "AssemblyError",
     "AssemblyRange",
@@ -150,6 +156,10 @@ __all__ = [
     "pareto",
     "Perturb",
     "Reactions",
+    "InputState",
+    "MotionAnalysis",
+    "MotionSpec",
+    "Workspace",
     "Route",
     "RunCheck",
     "save_design",
@@ -184,6 +194,7 @@ __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
 if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .api import (
         analyze,
+        analyze_motions,
         cycle_analyses,
         example,
         optimize,
@@ -207,9 +218,12 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         SpecError,
     )
     from .formulations import Method
+    from .linkage.inputs import InputState
     from .linkage.loads import Reactions
     from .mechanisms import mechanism_of
     from .mechanisms.base import Mechanism, Route
+    from .model.motions import MotionSpec, Workspace
+    from .motion_analysis import MotionAnalysis
     from .mechanisms.engine.model import Engine
     from .mechanisms.fourbar.assembly import LinkageClass
     from .mechanisms.fourbar.model import FourBar

@@ -36,7 +36,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("mechanisms.fourbar", "mechanisms.slidercrank", "mechanisms.general",
      "formulations.compiled", "formulations.crank_angle", "formulations.multibody"),
     # The registry of mechanisms and of formulations, and what runs over any mechanism.
-    ("mechanisms", "formulations", "force_balance", "columns", "cycle"),
+    ("mechanisms", "formulations", "force_balance", "columns", "cycle", "motion_analysis"),
     ("balance",),
     ("simulation", "verification", "report", "plots", "plausibility", "parts"),
     ("spec", "examples", "api", "sweeps", "cli", "__main__"),

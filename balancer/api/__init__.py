@@ -22,6 +22,7 @@ from ..lazy import lazy_exports
 #: Where each name lives.
 _EXPORTS = {
     "analyze": "analysis",
+    "analyze_motions": "analysis",
     "cycle_analyses": "analysis",
     "example": "examples",
     "optimize": "balancing",
@@ -34,6 +35,7 @@ _EXPORTS = {
 
 __all__ = [
     "analyze",
+    "analyze_motions",
     "cycle_analyses",
     "example",
     "optimize",
@@ -49,7 +51,7 @@ __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
 
 
 if TYPE_CHECKING:  # for type checkers and editors: the names as they are
-    from .analysis import analyze, cycle_analyses
+    from .analysis import analyze, analyze_motions, cycle_analyses
     from .balancing import optimize, pareto
     from .examples import example
     from .motion import simulate, verify

@@ -1,12 +1,16 @@
-"""The analysis of a design: one revolution at its operating speed."""
+"""The analysis of a design: one revolution at its operating speed, or along its motions."""
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 from .. import validate as v
 from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses
 from ..errors import SpecError
+from ..mechanisms import mechanism_of
 from ..mechanisms.base import Route
 from ..model import Design, check_scales
+from ..motion_analysis import MotionAnalysis, motion_analysis
 
 
 def analyze(design: Design, *, route: Route | None = None,
@@ -41,6 +45,48 @@ def analyze(design: Design, *, route: Route | None = None,
         gravity = v.vector2(gravity, "gravity")
         check_scales(design.mechanism, {"operation.speed": op.speed}, {"gravity": gravity})
     return cycle_analysis(design.mechanism, op.speed, op.samples, route=route, gravity=gravity)
+
+
+def analyze_motions(design: Design, names: Sequence[str] | None = None, *,
+                    gravity: tuple[float, float] | None = None) -> list[MotionAnalysis]:
+    """The frame's loads along the design's motions (``[[motion]]``), or those named.
+
+    Parameters
+    ----------
+    design
+        The design.
+    names
+        The motions to run (default: every one, in the spec's order).
+    gravity
+        Gravitational acceleration ``(gx, gy)``, m/s², instead of the spec's
+        ``[operation] gravity`` (default none).
+
+    Raises
+    ------
+    SpecError
+        If the spec has no motion or none of that name, or a motion does not fit the linkage.
+    AssemblyError
+        If a point's path leaves the workspace.
+    """
+    if gravity is None:
+        gravity = design.operation.gravity if design.operation is not None else (0.0, 0.0)
+    else:
+        gravity = v.vector2(gravity, "gravity")
+    chosen = list(design.motions) if not names else [design.motion(n) for n in names]
+    if not chosen:
+        raise SpecError("a linkage is analysed along its motions: the spec has no [[motion]]",
+                        key="motion")
+    mech = mechanism_of(design.mechanism)
+    out = []
+    for motion in chosen:
+        with v.under(v.item("motion", design.motions.index(motion))):
+            out.append(motion_analysis(mech, motion, gravity=gravity))
+    return out
+
+
+def several_inputs(design: Design) -> bool:
+    """Whether the design's mechanism is driven at more than one input."""
+    return len(mechanism_of(design.mechanism).linkage.inputs) > 1
 
 
 def cycle_analyses(design: Design, *, samples: int | None = None,

@@ -7,6 +7,7 @@ from ..balance.optimizer import Backend
 from ..balance.optimizer import optimize as run_optimizer
 from ..balance.pareto import pareto_front
 from ..balance.result import BalanceResult
+from ..mechanisms import mechanism_of
 from ..model import Design
 
 
@@ -16,6 +17,7 @@ def optimize(design: Design, *, backend: Backend = "nlp") -> BalanceResult:
     ``backend`` ``"nlp"`` (the certified convex optimum, then IPOPT on the designer's own
     parameters) or ``"convex"``. See :func:`balancer.balance.optimizer.optimize`.
     """
+    mechanism_of(design.mechanism).require_one_input("a balancing over a revolution")
     return run_optimizer(design, backend)
 
 
@@ -27,4 +29,5 @@ def pareto(design: Design, *, against: Against, points: int = 11) -> Front:
     against the mass·radius it adds (``"added-mass"``; :mod:`balancer.balance.rotor_front`).
     See :func:`balancer.balance.pareto.pareto_front`.
     """
+    mechanism_of(design.mechanism).require_one_input("a front over a revolution")
     return pareto_front(design, against, points)

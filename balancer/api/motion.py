@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ..formulations import Method
+from ..mechanisms import mechanism_of
 from ..model import Design, Drive
 from ..simulation import Trajectory, simulate_design
 from ..verification import Verification
@@ -22,6 +23,7 @@ def simulate(design: Design, *, method: Method | None = None, drive: Drive | Non
     ``progress(done, total)`` in simulated seconds. See
     :func:`balancer.simulation.simulate_design`.
     """
+    mechanism_of(design.mechanism).require_one_input("a simulation")
     return simulate_design(design, method=method, drive=drive, duration=duration, rtol=rtol,
                            atol=atol, outputs=outputs, progress=progress)
 
@@ -32,4 +34,5 @@ def verify(design: Design, *, method: Method | None = None, duration: float | No
 
     See :func:`balancer.verification.verify`.
     """
+    mechanism_of(design.mechanism).require_one_input("a verification")
     return run_verification(design, method=method, duration=duration, progress=progress)

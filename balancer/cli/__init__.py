@@ -161,7 +161,8 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "shaking force, shaking moment and driving torque over one revolution",
         "Reactions at the ground pivots, shaking force, shaking moment about A0 and "
         "driving torque over one crank revolution at the operating speed ([operation] "
-        "speed).",
+        "speed); for a linkage with several inputs, or with --motion, the same loads and "
+        "each input's torque along the spec's motions ([[motion]]).",
     ),
     "simulate": (
         "forward dynamics in a formulation of your choice",
@@ -270,6 +271,11 @@ def _analyze_arguments(p: argparse.ArgumentParser) -> None:
         choices=("newton-euler", "mass-matrix"),
         default="newton-euler",
         help="inverse-dynamics route (both agree to rounding; default newton-euler)",
+    )
+    p.add_argument(
+        "--motion", metavar="NAME",
+        help="the loads along the spec's motion NAME ([[motion]]) instead of one revolution; "
+        "a linkage with several inputs is analysed along every motion without it",
     )
     p.add_argument(
         "--gravity", type=_gravity, metavar="GX,GY",

@@ -1,14 +1,26 @@
-"""``balancer analyze``: one revolution at the operating speed, as a table, JSON or CSV."""
+"""``balancer analyze``: one revolution at the operating speed, or along the spec's motions.
+
+As a table, JSON or CSV.
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
-from ..api import analyze
+from ..api.analysis import analyze, analyze_motions, several_inputs
 from ..errors import SpecError
+from ..model import Design
 from ..outputs import write_atomic
-from ..report import analysis_csv, analysis_json, analysis_text, dumps_json
+from ..report import (
+    analysis_csv,
+    analysis_json,
+    analysis_text,
+    dumps_json,
+    motion_csv,
+    motions_json,
+    motions_text,
+)
 from .common import load, output_path, wrote
 
 
@@ -16,18 +28,50 @@ def run(args: argparse.Namespace) -> int:
     """Run ``balancer analyze``; the exit code."""
     csv_path = output_path(args, args.csv, "--csv")
     design = load(args)
+    if args.motion is not None or several_inputs(design):
+        return _along_motions(args, design, csv_path)
     try:
         analysis = analyze(design, route=args.route, gravity=args.gravity)
     except SpecError as exc:
-        if exc.key == "gravity":  # the option's value, not the spec's
-            raise SpecError(exc.detail, key="--gravity", value=",".join(
-                map(format, args.gravity))) from None
+        _option_error(args, exc)
         raise
     csv = analysis_csv(analysis) if csv_path is not None else None
     if args.json:
         text = dumps_json(analysis_json(analysis, spec=args.spec))
     else:
         text = analysis_text(analysis, spec=args.spec) + "\n"
+    if csv_path is not None:
+        assert csv is not None  # (made above for that path)
+        write_atomic(csv_path, csv)
+        wrote(csv_path)
+    sys.stdout.write(text)
+    return 0
+
+
+def _option_error(args: argparse.Namespace, exc: SpecError) -> None:
+    """Raise ``exc`` as the option's error where it is about ``--gravity``'s value."""
+    if exc.key == "gravity":  # the option's value, not the spec's
+        raise SpecError(exc.detail, key="--gravity", value=",".join(
+            map(format, args.gravity))) from None
+
+
+def _along_motions(args: argparse.Namespace, design: Design, csv_path: str | None) -> int:
+    """``analyze`` along the spec's motions (all, or ``--motion``'s)."""
+    if csv_path is not None and args.motion is None and len(design.motions) > 1:
+        raise SpecError("writes one motion's values: name it with --motion "
+                        f"({', '.join(m.name for m in design.motions)})", key="--csv",
+                        value=csv_path)
+    try:
+        analyses = analyze_motions(design, [args.motion] if args.motion else None,
+                                   gravity=args.gravity)
+    except SpecError as exc:
+        _option_error(args, exc)
+        raise
+    csv = motion_csv(analyses[0]) if csv_path is not None else None
+    if args.json:
+        text = dumps_json(motions_json(analyses, spec=args.spec))
+    else:
+        text = motions_text(analyses, spec=args.spec) + "\n"
     if csv_path is not None:
         assert csv is not None  # (made above for that path)
         write_atomic(csv_path, csv)

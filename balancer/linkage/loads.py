@@ -39,9 +39,10 @@ class Reactions:
     shaking_force
         Sum of all forces on the frame, complex, N.
     shaking_moment
-        Their moment about the origin, with the motor's reaction and counter-rotors, N·m.
-    driving_torque
-        Torque of the motor on the input, N·m.
+        Their moment about the origin, with the motors' reactions and counter-rotors, N·m.
+    torques
+        Torque of each motor on its input, N·m, in the order of the mechanism's inputs
+        (:attr:`driving_torque`: a one-input mechanism's).
     rocking_couple
         The couple about ``x`` and ``y`` from links in planes along the crank's axis, complex
         ``Mx + i·My``, N·m (zero for a mechanism in one plane).
@@ -52,8 +53,15 @@ class Reactions:
     slider_couple: dict[str, NDArray[np.float64]]
     shaking_force: NDArray[np.complex128]
     shaking_moment: NDArray[np.float64]
-    driving_torque: NDArray[np.float64]
+    torques: tuple[NDArray[np.float64], ...]
     rocking_couple: NDArray[np.complex128]
+
+    @property
+    def driving_torque(self) -> NDArray[np.float64]:
+        """A one-input mechanism's motor torque on its crank, N·m (``ValueError`` for several)."""
+        if len(self.torques) != 1:
+            raise ValueError(f"the loads have {len(self.torques)} input torques, not one")
+        return self.torques[0]
 
     @classmethod
     def of(cls, forces: Forces, column: int = 0) -> Reactions:
@@ -69,24 +77,27 @@ class Reactions:
                    slider_couple={k: real(v) for k, v in forces.slider_couple.items()},
                    shaking_force=vector(forces.shaking_force),
                    shaking_moment=real(forces.shaking_moment),
-                   driving_torque=real(forces.driving_torque),
+                   torques=tuple(real(t) for t in forces.input_torques),
                    rocking_couple=vector(forces.rocking_couple))
 
     @classmethod
-    def empty(cls, n: int, ground_points: Iterable[str], sliders: Iterable[str]) -> Reactions:
-        """Uninitialised arrays for ``n`` states at these ground points and ground sliders."""
+    def empty(cls, n: int, ground_points: Iterable[str], sliders: Iterable[str],
+              inputs: int = 1) -> Reactions:
+        """Uninitialised arrays for ``n`` states at these ground points and ground sliders
+        (and ``inputs`` motors' torques)."""
         sliders = tuple(sliders)
         return cls(ground={p: np.empty(n, complex) for p in ground_points},
                    slider_normal={k: np.empty(n) for k in sliders},
                    slider_couple={k: np.empty(n) for k in sliders},
                    shaking_force=np.empty(n, complex), shaking_moment=np.empty(n),
-                   driving_torque=np.empty(n), rocking_couple=np.empty(n, complex))
+                   torques=tuple(np.empty(n) for _ in range(inputs)),
+                   rocking_couple=np.empty(n, complex))
 
     def arrays(self) -> list[NDArray[Any]]:
         """Every array of the record (the ground points' and sliders' first)."""
         return [*self.ground.values(), *self.slider_normal.values(),
                 *self.slider_couple.values(), self.shaking_force, self.shaking_moment,
-                self.driving_torque, self.rocking_couple]
+                *self.torques, self.rocking_couple]
 
     @property
     def size(self) -> int:
@@ -103,7 +114,7 @@ class Reactions:
                          slider_couple={k: pick(v) for k, v in self.slider_couple.items()},
                          shaking_force=pick(self.shaking_force),
                          shaking_moment=pick(self.shaking_moment),
-                         driving_torque=pick(self.driving_torque),
+                         torques=tuple(pick(t) for t in self.torques),
                          rocking_couple=pick(self.rocking_couple))
 
     def forces(self, rocking_couple: V | None = None) -> Forces:
@@ -126,7 +137,7 @@ class Reactions:
         return Forces(reactions={p: vector(v) for p, v in self.ground.items()},
                       slider_normal={k: real(v) for k, v in self.slider_normal.items()},
                       slider_couple={k: real(v) for k, v in self.slider_couple.items()},
-                      input_torques=(real(self.driving_torque),),
+                      input_torques=tuple(real(t) for t in self.torques),
                       shaking_force=vector(self.shaking_force),
                       shaking_moment=real(self.shaking_moment),
                       rocking_couple=(vector(self.rocking_couple) if rocking_couple is None

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import AssemblyError
+from ..errors import AssemblyError, SpecError
 from ..linkage import dynamics, kinematics
 from ..linkage.assembly import assembly_range
 from ..linkage.constraints import GROUND_INDEX, Pose
@@ -308,7 +308,11 @@ class Mechanism:
         return type(self)(self.model.with_links(links))
 
     def describe(self) -> str:
-        """A short word on how it moves: whether the crank turns fully."""
+        """A short word on how it moves: whether the crank turns fully (or how many inputs
+        drive it)."""
+        count = len(self.linkage.inputs)
+        if count > 1:
+            return f"{count} inputs"
         return "full turn" if self.assembly_range().full else "swinging crank"
 
     @property
@@ -345,6 +349,23 @@ class Mechanism:
         """
         return ()
 
+    def require_one_input(self, purpose: str) -> None:
+        """Nothing, if one input drives the mechanism (a crank).
+
+        Raises
+        ------
+        SpecError
+            Otherwise (exit code 2): ``purpose`` (e.g. "a simulation") turns a crank; a
+            linkage with several inputs is analysed along its motions.
+        """
+        inputs = self.linkage.inputs
+        if len(inputs) > 1:
+            raise SpecError(
+                f"{purpose} turns one crank, and this linkage has {len(inputs)} inputs; "
+                "`balancer analyze` gives its loads along its motions ([[motion]]), and the "
+                "other commands come to several inputs next", key="mechanism.inputs",
+                value=list(inputs))
+
     def require_full_revolution(self, purpose: str) -> AssemblyRange:
         """The assembly range, if the crank turns a full revolution.
 
@@ -354,6 +375,7 @@ class Mechanism:
             Otherwise (exit code 2): ``purpose`` (e.g. "a cycle analysis") needs a crank that
             turns.
         """
+        self.require_one_input(purpose)
         rng = self.assembly_range()
         if not rng.full:
             raise AssemblyError(
@@ -369,6 +391,10 @@ class Mechanism:
                alpha1: ArrayLike = 0.0) -> Motion:
         """Frames, rates and accelerations at crank states (arrays broadcast together)."""
         return kinematics.motion(self.structure, InputState.crank(theta1, omega1, alpha1))
+
+    def motion_at(self, state: InputState) -> Motion:
+        """Frames, rates and accelerations at the inputs' states (any number of inputs)."""
+        return kinematics.motion(self.structure, state)
 
     def pose(self, theta1: ArrayLike) -> Pose:
         """The links' frames at crank angles (:attr:`Motion.pose` without the rates)."""
@@ -424,6 +450,8 @@ class Mechanism:
         general = _GENERAL_ROUTES[route]
         forces = dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
                                            loads=loads, route=general)
+        if not self.rotors:  # (geared rotors turn with a crank: one-input mechanisms only)
+            return forces
         return self._with_rotors(forces, mo.theta1, mo.omega1, mo.alpha1, gravity)
 
     def rotor_loads(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike,
@@ -530,10 +558,12 @@ class Mechanism:
         forces; zeros for a mechanism in one plane.
         """
         if self.in_one_plane():
-            zero = np.zeros((np.size(mo.theta1), 1))
+            zero = np.zeros((mo.count, 1))
             return V(zero, zero.copy())
         couple = dynamics.rocking_couple_of(self.structure, mo, self.linkage, gravity=gravity,
                                             loads=loads)
+        if not self.rotors:
+            return couple
         geared = self.rotor_loads(mo.theta1, mo.omega1, mo.alpha1, gravity)
         if geared is None:
             return couple

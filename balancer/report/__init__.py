@@ -33,6 +33,9 @@ _EXPORTS = {
     "analysis_text": "analysis",
     "force_balance_line": "analysis",
     "analysis_csv": "analysis",
+    "motions_text": "along",
+    "motions_json": "along",
+    "motion_csv": "along",
     "simulation_csv": "motion",
     "simulation_json": "motion",
     "simulation_text": "motion",
@@ -63,6 +66,9 @@ __all__ = [
     "SweepSummary",
     "WORSE_RATIO",
     "analysis_csv",
+    "motion_csv",
+    "motions_json",
+    "motions_text",
     "analysis_figures",
     "analysis_json",
     "analysis_text",
@@ -97,6 +103,7 @@ __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
 
 
 if TYPE_CHECKING:  # for type checkers and editors: the names as they are
+    from .along import motion_csv, motions_json, motions_text
     from .analysis import (
         analysis_csv,
         analysis_figures,

@@ -233,7 +233,7 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
                            for k, v in ev.slider_normal.items()},
             slider_couple={k: np.asarray(v, float) * np.ones(t.size)
                            for k, v in ev.slider_couple.items()},
-            driving_torque=tau,
+            torques=(tau,),
             # (numpy's stubs type a complex array times a real one as real)
             shaking_force=cast("NDArray[np.complex128]",
                                np.asarray(shaking_force, complex) * np.ones(t.size)),

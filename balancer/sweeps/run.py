@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from .. import interrupts
 from ..errors import OutputError, SpecError
+from ..mechanisms import mechanism_of
 from ..model.balance import missing_balance
 from ..spec import design_from_dict
 from .cluster import batch_size, run_on_dask
@@ -181,6 +182,10 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
         raise SpecError(f"not valid TOML: {exc}", value=str(spec)) from None
 
     design = design_from_dict(data, source=str(spec))  # the spec itself must be valid
+    try:
+        mechanism_of(design.mechanism).require_one_input("a sweep")
+    except SpecError as exc:
+        raise exc.with_source(str(spec)) from None
     if not perturbs and design.balance is None:
         missing = missing_balance(design.mechanism)
         raise SpecError(f"{missing.detail}; a sweep balances each point as the spec's [balance] "

@@ -86,7 +86,7 @@ def _reactions(ra0: NDArray[np.complex128], ra3: NDArray[np.complex128],
     rocking couple zero (the closed forms work in the plane).
     """
     return Reactions(ground={"A0": ra0, "A3": ra3}, slider_normal={}, slider_couple={},
-                     shaking_force=shaking, shaking_moment=moment, driving_torque=tau,
+                     shaking_force=shaking, shaking_moment=moment, torques=(tau,),
                      rocking_couple=np.zeros(np.shape(tau), complex))
 
 

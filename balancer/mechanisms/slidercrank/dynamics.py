@@ -65,7 +65,7 @@ def _finish(mech: SliderCrank, mo: SliderMotion, ra0: NDArray[np.complex128],
     slider = mech.chain_links[2]
     return Reactions(ground={"A0": ra0}, slider_normal={slider: np.imag(ra3)},
                      slider_couple={slider: -m_guide + 0 * mo.x}, shaking_force=shaking,
-                     shaking_moment=moment, driving_torque=tau,
+                     shaking_moment=moment, torques=(tau,),
                      rocking_couple=np.zeros(np.shape(tau), complex))
 
 

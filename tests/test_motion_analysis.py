@@ -1,0 +1,180 @@
+"""The loads along a motion (:mod:`balancer.motion_analysis`) and ``balancer analyze`` on them.
+
+End to end against the momentum theorem: along a smooth motion (the quintic law), the shaking
+force and moment are minus the rates of the linear and angular momentum, whose finite
+differences in time use only the motion's velocities — so the inverse kinematics' rates, its
+accelerations and the time law's derivatives are all checked against each other. Gravity adds
+the total weight to the shaking force. The report's figures against the CSV's columns.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from helpers import derivative_with_error
+from linkage.several_inputs_specs import fivebar
+
+from balancer.errors import SpecError
+from balancer.linkage import trajectory
+from balancer.linkage.inputs import InputState
+from balancer.linkage.vectors import V
+from balancer.mechanisms import mechanism_of
+from balancer.model import Design
+from balancer.motion_analysis import motion_analysis
+from balancer.spec.reader import design_from_dict
+from balancer.spec.writer import dumps_design
+
+MOTIONS = [
+    {"name": "diamond", "point": "E", "times": [0.0, 1.0, 2.0, 3.0, 4.0],
+     "path": [[0.1, 0.35], [0.13, 0.38], [0.16, 0.35], [0.13, 0.32], [0.1, 0.35]],
+     "law": "quintic", "samples": 41},
+    {"name": "wave", "times": [0.0, 0.5, 1.0], "path": [[0.0, 0.0], [0.2, -0.1], [0.0, 0.0]],
+     "law": "spline", "samples": 64},
+]
+
+
+@pytest.fixture(scope="module")
+def design() -> Design:
+    spec = fivebar() | {"motion": MOTIONS}
+    return design_from_dict(spec)
+
+
+def _momenta(mech, mo) -> np.ndarray:
+    px, py, lz = (np.zeros(mo.count) for _ in range(3))
+    for k, link in enumerate(mech.links):
+        r, v = mo.point(k, V(link.e, link.f)), mo.point_velocity(k, V(link.e, link.f))
+        px += link.mass * v.x
+        py += link.mass * v.y
+        lz += link.mass * (r.x * v.y - r.y * v.x) + link.inertia * mo.rate[k]
+    return np.array([px, py, lz])
+
+
+@pytest.mark.parametrize("which", [0, 1])
+def test_the_frame_feels_the_momentums_rate_along_the_motion(design, which):
+    motion = design.motions[which]
+    mech = mechanism_of(design.mechanism)
+    analysis = motion_analysis(mech, motion)
+    r = analysis.reactions
+    inner = range(4, motion.samples - 4, 5)  # (the differences stay inside the motion)
+    for i in inner:
+        t = float(analysis.t[i])
+
+        def momenta(u: float) -> np.ndarray:
+            state = trajectory.input_state(mech.structure, motion, np.array([u]))
+            return _momenta(mech, mech.motion_at(state))[:, 0]
+
+        rate, err = derivative_with_error(momenta, t, h=1e-3)
+        got = np.array([r.shaking_force.real[i], r.shaking_force.imag[i], r.shaking_moment[i]])
+        assert np.max(np.abs(got + rate)) <= err + 1e-9 * np.max(np.abs(rate)), t
+
+
+def test_gravity_adds_the_weight_to_the_shaking_force(design):
+    mech = mechanism_of(design.mechanism)
+    g = (0.3, -9.81)
+    plain = motion_analysis(mech, design.motions[0])
+    heavy = motion_analysis(mech, design.motions[0], gravity=g)
+    total = sum(link.mass for link in mech.links)
+    weight = total * complex(*g)
+    gap = heavy.reactions.shaking_force - plain.reactions.shaking_force
+    assert np.max(np.abs(gap - weight)) <= 1e-12 * abs(weight)
+
+
+def _spec_file(tmp_path, design: Design):
+    path = tmp_path / "fivebar.toml"
+    path.write_text(dumps_design(design))
+    return path
+
+
+def _run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "balancer", *args], capture_output=True,
+                          text=True, check=False)
+
+
+def test_analyze_runs_every_motion_and_its_figures_are_the_csvs(tmp_path, design):
+    spec = _spec_file(tmp_path, design)
+    done = _run("analyze", str(spec), "--json")
+    assert done.returncode == 0, done.stderr
+    doc = json.loads(done.stdout)
+    assert doc["inputs"] == ["left", "right"]
+    assert list(doc["motions"]) == ["diamond", "wave"]
+    out = tmp_path / "diamond.csv"
+    done = _run("analyze", str(spec), "--motion", "diamond", "--csv", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "motion diamond:" in done.stdout and "torque on left" in done.stdout
+    rows = list(csv.reader(io.StringIO(out.read_text())))
+    header = rows[0]
+    assert header[:10] == ["t", "left", "right", "shaking_force_x", "shaking_force_y",
+                           "shaking_moment", "rocking_couple_x", "rocking_couple_y",
+                           "torque_left", "torque_right"]
+    assert header[10:] == ["RAx", "RAy", "RBx", "RBy"]
+    values = np.array(rows[1:], dtype=float)
+    assert values.shape[0] == MOTIONS[0]["samples"]
+    figures = doc["motions"]["diamond"]
+    force = np.hypot(values[:, 3], values[:, 4])
+    for key, column in (("shaking_force", force), ("shaking_moment", values[:, 5]),
+                        ("torque_left", values[:, 8]), ("torque_right", values[:, 9])):
+        assert figures[key]["rms"] == pytest.approx(np.sqrt(np.mean(column**2)), rel=1e-12)
+        assert figures[key]["max"] == pytest.approx(np.max(np.abs(column)), rel=1e-12)
+    # the inputs' columns are their changes from the reference pose: both zero at the start
+    # only where the path starts at the reference pose's point (it does: E at (0.1, 0.35))
+    assert np.max(np.abs(values[0, 1:3])) <= 1e-12
+
+
+@pytest.mark.parametrize(("args", "key"), [
+    (("--csv", "OUT"), "--csv"),
+    (("--motion", "nowhere"), "--motion"),
+])
+def test_a_bad_motion_option_is_refused(tmp_path, design, args, key):
+    spec = _spec_file(tmp_path, design)
+    args = tuple(str(tmp_path / "x.csv") if a == "OUT" else a for a in args)
+    done = _run("analyze", str(spec), *args)
+    assert done.returncode == 2 and f"{key}:" in done.stderr, done.stderr
+    assert "Traceback" not in done.stderr
+    assert not (tmp_path / "x.csv").exists()
+
+
+@pytest.mark.parametrize("verb", [["simulate"], ["verify"], ["plot", "--cycle", "c.png"]])
+def test_the_revolutions_verbs_say_they_turn_one_crank(tmp_path, design, verb):
+    spec = _spec_file(tmp_path, design)
+    done = _run(verb[0], str(spec), *verb[1:])
+    assert done.returncode == 2, done.stderr
+    assert "mechanism.inputs: " in done.stderr and "turns one crank" in done.stderr
+    assert "Traceback" not in done.stderr
+
+
+def test_a_one_input_linkage_runs_along_its_cranks_own_motion():
+    spec = {
+        "mechanism": {"type": "linkage", "input": "crank",
+                      "points": {"A0": [0.0, 0.0], "A1": [0.1, 0.0], "A2": [0.35, 0.2],
+                                 "A3": [0.3, 0.0]}},
+        "links": {"ground": {"points": ["A0", "A3"]},
+                  "crank": {"points": ["A0", "A1"], "mass": 1.0, "inertia": 0.01,
+                            "com": {"e": 0.05, "f": 0.0}},
+                  "coupler": {"points": ["A1", "A2"], "mass": 1.0, "inertia": 0.02,
+                              "com": {"e": 0.1, "f": 0.0}},
+                  "rocker": {"points": ["A3", "A2"], "mass": 1.0, "inertia": 0.01,
+                             "com": {"e": 0.1, "f": 0.0}}},
+        "operation": {"speed": 10.0},
+        # a constant-speed turn as a motion: the crank's change from the reference, linear in t
+        "motion": [{"name": "turn", "times": [0.0, 0.5, 1.0],
+                    "path": [[0.0], [np.pi], [2 * np.pi]], "law": "spline",
+                    "samples": 16}],
+    }
+    # (a periodic spline through 0, π, 2π is not closed: the path's own check refuses it)
+    with pytest.raises(SpecError, match="closed"):
+        design_from_dict(spec)
+    spec["motion"][0]["law"] = "cubic"
+    design = design_from_dict(spec)
+    analysis = motion_analysis(design.mechanism, design.motions[0])
+    mech = mechanism_of(design.mechanism)
+    theta = analysis.state.positions[0]
+    omega, alpha = analysis.state.rates[0], analysis.state.accelerations[0]
+    want = mech.inverse_dynamics(mech.motion_at(InputState.crank(theta, omega, alpha)))
+    assert np.array_equal(analysis.reactions.driving_torque,
+                          np.asarray(want.driving_torque)[:, 0])
