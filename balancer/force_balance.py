@@ -2,14 +2,17 @@
 
 The total first moment of mass of the moving links, ``Σ_k (m_k·r̄_Ok + R(θ_k)·(m·s̄)_k)``, is
 linear in the design vector ``π`` (:class:`balancer.linkage.dynamics.Layout`) with coefficients
-that are functions of the crank angle: ``G(θ1)·π``. The shaking force vanishes for every motion
-exactly when the total centre of mass is stationary, ``(G(θ1) − G(θ0))·π = 0`` for all θ1
-(DESIGN.md; Meijaard & van der Wijk 2020, Eq. 57–58 for the four-bar; Wunderlich 1964, Eq. 10d
-and 20a–b). Those coefficient functions span a space of finite dimension, so the conditions are
-the row space of their variation sampled at enough angles: an SVD gives it, with a rank test in
+that are functions of the inputs' positions: ``G(q)·π`` (a one-input linkage's ``q`` is its
+crank angle θ1). The shaking force vanishes for every motion exactly when the total centre of
+mass is stationary, ``(G(q) − G(q0))·π = 0`` for all ``q`` (DESIGN.md; Meijaard & van der Wijk
+2020, Eq. 57–58 for the four-bar; Wunderlich 1964, Eq. 10d and 20a–b). Those coefficient
+functions span a space of finite dimension, so the conditions are the row space of their
+variation sampled at enough states — angles over the crank's range, or for several inputs
+states spread over a box of :data:`SPREAD` rad about the reference pose (the functions are
+analytic: a neighbourhood shows their span): an SVD gives it, with a rank test in
 units where every column is a mass (the first moments' columns, and a mass column times a
 length) so that no link's size hides a condition, and a clear gap between the singular values
-kept and those of rounding. The conditions are then checked at angles not used to find them:
+kept and those of rounding. The conditions are then checked at states not used to find them:
 a condition missed by the sampling would show there.
 """
 
@@ -21,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .errors import SolverError
+from .linkage.inputs import InputState
 from .mechanisms.base import Mechanism
 
 #: Singular values below this share of the largest are rounding (a condition that holds).
@@ -39,6 +43,9 @@ SMALL_ROW = 1e-6
 #: Samples per design-vector entry (and at least :data:`MIN_SAMPLES`) to find the conditions.
 SAMPLES_PER_ENTRY = 6
 MIN_SAMPLES = 64
+#: Half the side, rad, of the box about the reference pose whose states find the conditions of
+#: a linkage with several inputs.
+SPREAD = 0.3
 
 
 @dataclass(frozen=True)
@@ -102,16 +109,16 @@ class ForceBalance:
         return float(np.max(self.rows(x), initial=0.0))
 
 
-def first_moment_map(mech: Mechanism, theta1: NDArray[np.float64]) -> NDArray[np.complex128]:
-    """``G(θ1)``: the moving links' total first moment of mass per unit design entry.
+def first_moment_map(mech: Mechanism, state: InputState) -> NDArray[np.complex128]:
+    """``G(q)``: the moving links' total first moment of mass per unit design entry.
 
-    Shape ``(N, P)``, complex (x + i·y), kg·m per kg (mass entries) or per kg·m (first
-    moments); inertias and counter-rotors do not enter.
+    At the inputs' positions of ``state``; shape ``(N, P)``, complex (x + i·y), kg·m per kg
+    (mass entries) or per kg·m (first moments); inertias and counter-rotors do not enter.
     """
     layout, structure = mech.layout, mech.structure
     with np.errstate(all="ignore"):
-        pose = mech.pose(theta1)  # (positions alone: no rates)
-    g = np.zeros((theta1.size, layout.size), dtype=complex)
+        pose = mech.pose_at(state)  # (positions alone: no rates)
+    g = np.zeros((state.count, layout.size), dtype=complex)
     for k, name in enumerate(structure.names):
         s = layout.link_slice(name)
         c, sn = pose.cos[k], pose.sin[k]
@@ -119,6 +126,48 @@ def first_moment_map(mech: Mechanism, theta1: NDArray[np.float64]) -> NDArray[np
         g[:, s.start + 1] = c + 1j * sn
         g[:, s.start + 2] = -sn + 1j * c
     return g
+
+
+def _states(mech: Mechanism, count: int, rng: np.random.Generator,
+            within: InputState | None = None) -> InputState:
+    """States where the mechanism assembles, spread over its range (seeded).
+
+    One input: :func:`_angles` (``within`` given: shifted by half a step, within the range of
+    ``within``'s angles where the crank does not turn fully). Several: uniform in the box of
+    :data:`SPREAD` about the reference pose (``within``: in the box the states of ``within``
+    span), those that do not assemble left out — drawn again until ``count`` are found.
+    """
+    inputs = mech.structure.inputs
+    if len(inputs) == 1:
+        angles = _angles(mech, count, rng)
+        if within is not None:
+            angles = angles + np.pi / count
+            if not mech.assembly_range().full:
+                first = np.asarray(within.positions[0])
+                angles = np.clip(angles, first.min(), first.max())
+        return InputState.crank(angles)
+    if within is None:
+        reference = np.array([mech.structure.ref_angle[k] for k in inputs])
+        low, high = reference - SPREAD, reference + SPREAD
+    else:
+        spans = np.array([np.asarray(p) for p in within.positions])
+        low, high = spans.min(axis=1), spans.max(axis=1)
+    found: list[NDArray[np.float64]] = []
+    total = 0
+    for _ in range(8):
+        q = low[:, None] + (high - low)[:, None] * rng.uniform(0, 1, (len(inputs), 2 * count))
+        with np.errstate(all="ignore"):
+            pose = mech.pose_at(InputState.of(list(q)))
+        ok = np.all([np.isfinite(a) for a in pose.angles], axis=0)
+        found.append(q[:, ok])
+        total += int(ok.sum())
+        if total >= count:
+            break
+    q = np.hstack(found)[:, :count]
+    if q.shape[1] < count:
+        raise SolverError("the linkage assembles at too few states about its reference pose "
+                          "to find its force-balance conditions")
+    return InputState.of(list(q))
 
 
 def _angles(mech: Mechanism, count: int, rng: np.random.Generator) -> NDArray[np.float64]:
@@ -163,8 +212,8 @@ def force_balance_conditions(mech: Mechanism) -> ForceBalance:
         scales[layout.index(name, "m")] = length
     count = max(MIN_SAMPLES, SAMPLES_PER_ENTRY * layout.size)
     rng = np.random.default_rng(20260101)  # the same angles every run
-    theta = _angles(mech, count, rng)
-    g = first_moment_map(mech, theta)
+    states = _states(mech, count, rng)
+    g = first_moment_map(mech, states)
     d = g - g.mean(axis=0)
     d = np.vstack([d.real, d.imag]) / scales  # columns in units of a first moment
     # (Rows ≥ columns: the reduced factorisation has every right singular vector, without
@@ -190,10 +239,8 @@ def force_balance_conditions(mech: Mechanism) -> ForceBalance:
     # first moments could restore (linkage campaign, seed 40, case 751: 'no feasible design
     # found'). They are zero.
     rows[:, ~np.any(d, axis=0)] = 0.0
-    # Check at fresh angles that the null space found is stationary there too.
-    fresh = _angles(mech, count, np.random.default_rng(20260102)) + np.pi / count
-    if not mech.assembly_range().full:
-        fresh = np.clip(fresh, theta.min(), theta.max())
+    # Check at fresh states that the null space found is stationary there too.
+    fresh = _states(mech, count, np.random.default_rng(20260102), within=states)
     gf = first_moment_map(mech, fresh)
     df = gf - gf.mean(axis=0)
     df = np.vstack([df.real, df.imag]) / scales

@@ -396,6 +396,13 @@ class Mechanism:
         """Frames, rates and accelerations at the inputs' states (any number of inputs)."""
         return kinematics.motion(self.structure, state)
 
+    def pose_at(self, state: InputState) -> Pose:
+        """The links' frames at the inputs' positions of ``state`` (its rates unused): a
+        one-input mechanism's by :meth:`pose` (its closed form, where it has one)."""
+        if state.size == 1:
+            return self.pose(state.positions[0])
+        return kinematics.positions(self.structure, state)
+
     def pose(self, theta1: ArrayLike) -> Pose:
         """The links' frames at crank angles (:attr:`Motion.pose` without the rates)."""
         return kinematics.positions(self.structure, InputState.crank(theta1))
