@@ -9,6 +9,7 @@ import tomllib
 from pathlib import Path
 
 import pytest
+from golden.record import NOT_RUN
 
 from balancer import examples
 from balancer.cli import main
@@ -29,7 +30,9 @@ def _notes(err: str) -> list[str]:
     return [line for line in err.splitlines() if line.startswith("balancer: note: ")]
 
 
-@pytest.mark.parametrize("name", examples.names())
+@pytest.mark.parametrize("name", [
+    pytest.param(name, marks=pytest.mark.skip(reason=NOT_RUN[name])) if name in NOT_RUN
+    else name for name in examples.names()])
 @pytest.mark.slow
 def test_no_shipped_example_gets_a_note(name, capsys):
     path = EXAMPLES / f"{name}.toml"

@@ -117,9 +117,19 @@ def mask(text: str, folder: Path | None = None) -> str:
     return text.replace(str(ROOT), "<root>")
 
 
+#: Shipped examples the verbs do not run yet, each with the reason: neither recorded nor
+#: compared (``tests/test_golden.py`` lists them as skipped), nor analysed by the tests that run
+#: a verb on every example (``tests/test_plausibility.py``).
+NOT_RUN = {
+    "forbal2": "a linkage with two inputs: analyze, simulate, verify and optimize take a "
+               "one-input mechanism so far (its structure, motions, mass properties and force "
+               "balance are checked in tests/mechanisms/test_forbal2.py)",
+}
+
+
 def examples() -> list[str]:
-    """The shipped examples' names."""
-    return sorted(p.stem for p in EXAMPLES.glob("*.toml"))
+    """The shipped examples' names that the verbs run (all but :data:`NOT_RUN`)."""
+    return sorted(p.stem for p in EXAMPLES.glob("*.toml") if p.stem not in NOT_RUN)
 
 
 def commands(name: str) -> dict[str, list[str]]:
