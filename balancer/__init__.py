@@ -79,6 +79,8 @@ _EXPORTS = {
     "Reactions": "linkage.loads",
     "InputState": "linkage.inputs",
     "MotionAnalysis": "motion_analysis",
+    "AlongMotions": "motion_analysis",
+    "WorkspaceCheck": "motion_analysis",
     "MotionSpec": "model.motions",
     "Workspace": "model.motions",
     "Figure": "cycle",
@@ -158,6 +160,8 @@ __all__ = [
     "Reactions",
     "InputState",
     "MotionAnalysis",
+    "AlongMotions",
+    "WorkspaceCheck",
     "MotionSpec",
     "Workspace",
     "Route",
@@ -223,7 +227,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .mechanisms import mechanism_of
     from .mechanisms.base import Mechanism, Route
     from .model.motions import MotionSpec, Workspace
-    from .motion_analysis import MotionAnalysis
+    from .motion_analysis import AlongMotions, MotionAnalysis, WorkspaceCheck
     from .mechanisms.engine.model import Engine
     from .mechanisms.fourbar.assembly import LinkageClass
     from .mechanisms.fourbar.model import FourBar

@@ -17,12 +17,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .columns import Columns, frame_force_columns
+from .force_balance import RESIDUAL_FLOOR, force_balance_residual
 from .linkage import trajectory
 from .linkage.inputs import InputState
 from .linkage.loads import Reactions
 from .mechanisms import Mechanism, mechanism_of
 from .model import MechanismModel
-from .model.motions import MotionSpec
+from .model.motions import MotionSpec, Workspace
 
 
 @dataclass(frozen=True)
@@ -98,6 +99,12 @@ class MotionAnalysis:
         frame_names, frame_cols = frame_force_columns(self.mechanism, r)
         return names + frame_names, cols + frame_cols
 
+    @property
+    def centre_of_mass_excursion(self) -> float:
+        """The largest distance of the total centre of mass from its mean place, m."""
+        return excursion(self.mechanism.total_centre_of_mass(self.mechanism.motion_at(
+            self.state)))
+
     def loads(self) -> dict[str, Load]:
         """RMS and maximum of each frame load.
 
@@ -137,3 +144,105 @@ def motion_analysis(model: MechanismModel | Mechanism, motion: MotionSpec, *,
                     for p, k in zip(state.positions, structure.inputs, strict=True))
     return MotionAnalysis(mechanism=mech, motion=motion, inputs=structure.linkage.inputs, t=t,
                           state=state, changes=changes, reactions=reactions, gravity=gravity)
+
+
+def excursion(centre: NDArray[np.complex128]) -> float:
+    """The largest distance of points (complex, m) from their mean, m (NaN left out)."""
+    centre = np.asarray(centre)[np.isfinite(centre)]
+    return float(np.max(np.abs(centre - centre.mean()), initial=0.0)) if centre.size else 0.0
+
+
+@dataclass(frozen=True)
+class WorkspaceCheck:
+    """The total centre of mass over the workspace's grid.
+
+    Attributes
+    ----------
+    states
+        The grid's states that assemble and keep the passive joints within their limits.
+    grid
+        The grid's size (``samples`` per input, every combination).
+    centre_of_mass_excursion
+        The largest distance of the total centre of mass from its mean place over those
+        states, m.
+    """
+
+    states: int
+    grid: int
+    centre_of_mass_excursion: float
+
+
+def workspace_states(mech: Mechanism, workspace: Workspace) -> tuple[InputState, int]:
+    """The states of the workspace's grid where the linkage assembles within its joint limits.
+
+    Each input over its range (its change from the reference pose), ``samples`` values from
+    one end to the other, every combination; a passive joint's angle is the second link's
+    angle less the first's (in the spec's order of ``[links]``; the ground's is 0), its change
+    from the reference pose taken within ±π. Returns the states and the grid's size.
+    """
+    structure = mech.structure
+    names = structure.linkage.inputs
+    axes = []
+    for name, k in zip(names, structure.inputs, strict=True):
+        r = workspace.range_of(name)
+        low, high = (r.low, r.high) if r is not None else (0.0, 0.0)
+        count = workspace.samples if r is not None else 1
+        axes.append(structure.ref_angle[k] + np.linspace(low, high, count))
+    grid = np.meshgrid(*axes, indexing="ij")
+    q = [g.ravel() for g in grid]
+    state = InputState.of(q)
+    with np.errstate(all="ignore"):
+        pose = mech.pose_at(state)
+    kept = np.all([np.isfinite(a) for a in pose.angles], axis=0)
+    for joint in workspace.joints:
+        a, b = _joint_links(mech, joint.name)
+        angle = [np.zeros(state.count) if k < 0 else np.asarray(pose.angles[k]) for k in (a, b)]
+        ref = [0.0 if k < 0 else structure.ref_angle[k] for k in (a, b)]
+        change = np.remainder(angle[1] - angle[0] - (ref[1] - ref[0]) + np.pi, 2 * np.pi) - np.pi
+        kept &= (change >= joint.low) & (change <= joint.high)
+    return state.at(kept), int(q[0].size)
+
+
+def _joint_links(mech: Mechanism, point: str) -> tuple[int, int]:
+    """The two links a passive joint joins, in the spec's order (the ground as -1)."""
+    structure = mech.structure
+    order = [b.name for b in structure.linkage.bodies]
+    links = sorted((b.name for b in structure.linkage.bodies if point in b.points),
+                   key=order.index)
+    return structure.index(links[0]), structure.index(links[1])
+
+
+def workspace_check(model: MechanismModel | Mechanism, workspace: Workspace) -> WorkspaceCheck:
+    """The total centre of mass over the workspace (:func:`workspace_states`)."""
+    mech = model if isinstance(model, Mechanism) else mechanism_of(model)
+    state, grid = workspace_states(mech, workspace)
+    centre = (mech.total_centre_of_mass(mech.motion_at(state)) if state.count
+              else np.zeros(0, dtype=complex))
+    return WorkspaceCheck(states=state.count, grid=grid,
+                          centre_of_mass_excursion=excursion(centre))
+
+
+@dataclass(frozen=True)
+class AlongMotions:
+    """A linkage's analysis along its motions, with its force balance over its workspace.
+
+    Attributes
+    ----------
+    motions
+        The loads along each motion analysed, in the spec's order.
+    force_balance_residual
+        How far the design is from the force-balance conditions, relative to their terms
+        (:func:`balancer.force_balance.force_balance_residual`; 0: balanced).
+    workspace
+        The total centre of mass over the workspace's grid, if the spec gives a workspace.
+    """
+
+    motions: tuple[MotionAnalysis, ...]
+    force_balance_residual: float
+    workspace: WorkspaceCheck | None = None
+
+    @property
+    def force_balanced(self) -> bool:
+        """Whether the conditions hold to rounding: the total centre of mass stands still for
+        every motion."""
+        return self.force_balance_residual <= RESIDUAL_FLOOR

@@ -178,3 +178,64 @@ def test_a_one_input_linkage_runs_along_its_cranks_own_motion():
     want = mech.inverse_dynamics(mech.motion_at(InputState.crank(theta, omega, alpha)))
     assert np.array_equal(analysis.reactions.driving_torque,
                           np.asarray(want.driving_torque)[:, 0])
+
+
+def _balanced_parallelogram() -> dict:
+    """The parallelogram five-bar of tests/test_force_balance.py, balanced in closed form:
+    p's and q's centres put where the first moments along each direction cancel."""
+    from test_force_balance import A, B, parallelogram
+
+    spec = parallelogram()
+    links = spec["links"]
+
+    def moment(name):
+        link = links[name]
+        return link["mass"] * complex(link["com"]["e"], link["com"]["f"])
+
+    along_p = -(A * links["r"]["mass"] + moment("s"))
+    along_q = -(B * links["s"]["mass"] + moment("r"))
+    for name, total in (("p", along_p), ("q", along_q)):
+        m = links[name]["mass"]
+        links[name]["com"] = {"e": total.real / m, "f": total.imag / m}
+    spec["workspace"] = {"p": [-0.4, 0.4], "q": [-0.4, 0.4], "samples": 9}
+    spec["motion"] = [{"name": "wave", "times": [0.0, 0.5, 1.0],
+                       "path": [[0.0, 0.0], [0.2, -0.1], [0.0, 0.0]], "law": "spline",
+                       "samples": 32}]
+    return spec
+
+
+def test_a_balanced_design_keeps_its_centre_of_mass_over_the_workspace():
+    from balancer.api import analyze_motions
+
+    along = analyze_motions(design_from_dict(_balanced_parallelogram()))
+    assert along.force_balanced
+    assert along.workspace is not None and along.workspace.states > 40
+    assert along.workspace.centre_of_mass_excursion <= 1e-15
+    assert along.motions[0].centre_of_mass_excursion <= 1e-15
+    assert np.max(np.abs(along.motions[0].reactions.shaking_force)) <= 1e-12
+
+
+def test_the_workspace_keeps_the_states_within_the_joints_limits():
+    from balancer.motion_analysis import workspace_states
+
+    spec = _balanced_parallelogram()
+    spec["workspace"]["joints"] = {"Q": [-0.3, 0.2]}
+    design = design_from_dict(spec)
+    mech = mechanism_of(design.mechanism)
+    state, grid = workspace_states(mech, design.workspace)
+    assert grid == 81 and 0 < state.count < grid
+    # Q joins r and s (in that order): the angle from r's line to s's, from the points alone
+    points = mech.points(mech.motion_at(state))
+    ref = dict(design.mechanism.points)
+
+    def turn(a, b, c, d, where):  # the angle from a→b to c→d
+        return np.angle((where[d] - where[c]) / (where[b] - where[a]))
+
+    at_ref = {k: complex(*v) for k, v in ref.items()}
+    change = turn("P1", "Q", "P2", "Q", points) - turn("P1", "Q", "P2", "Q", at_ref)
+    change = np.remainder(change + np.pi, 2 * np.pi) - np.pi
+    assert np.all((change >= -0.3 - 1e-12) & (change <= 0.2 + 1e-12))
+    # and those left out are out of the limits (or do not assemble)
+    full = design_from_dict(_balanced_parallelogram())
+    everything, _ = workspace_states(mech, full.workspace)
+    assert everything.count > state.count

@@ -10,7 +10,8 @@ from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Route
 from ..model import Design, check_scales
-from ..motion_analysis import MotionAnalysis, motion_analysis
+from ..force_balance import force_balance_residual
+from ..motion_analysis import AlongMotions, motion_analysis, workspace_check
 
 
 def analyze(design: Design, *, route: Route | None = None,
@@ -48,8 +49,11 @@ def analyze(design: Design, *, route: Route | None = None,
 
 
 def analyze_motions(design: Design, names: Sequence[str] | None = None, *,
-                    gravity: tuple[float, float] | None = None) -> list[MotionAnalysis]:
+                    gravity: tuple[float, float] | None = None) -> AlongMotions:
     """The frame's loads along the design's motions (``[[motion]]``), or those named.
+
+    With the force balance: the conditions' residual, and the total centre of mass over the
+    spec's ``[workspace]`` grid where it gives one.
 
     Parameters
     ----------
@@ -77,11 +81,13 @@ def analyze_motions(design: Design, names: Sequence[str] | None = None, *,
         raise SpecError("a linkage is analysed along its motions: the spec has no [[motion]]",
                         key="motion")
     mech = mechanism_of(design.mechanism)
-    out = []
-    for motion in chosen:
+    analyses = []
+    for motion in chosen:  # (each motion's errors under its own key)
         with v.under(v.item("motion", design.motions.index(motion))):
-            out.append(motion_analysis(mech, motion, gravity=gravity))
-    return out
+            analyses.append(motion_analysis(mech, motion, gravity=gravity))
+    return AlongMotions(
+        motions=tuple(analyses), force_balance_residual=force_balance_residual(mech),
+        workspace=None if design.workspace is None else workspace_check(mech, design.workspace))
 
 
 def several_inputs(design: Design) -> bool:

@@ -67,7 +67,7 @@ def _along_motions(args: argparse.Namespace, design: Design, csv_path: str | Non
     except SpecError as exc:
         _option_error(args, exc)
         raise
-    csv = motion_csv(analyses[0]) if csv_path is not None else None
+    csv = motion_csv(analyses.motions[0]) if csv_path is not None else None
     if args.json:
         text = dumps_json(motions_json(analyses, spec=args.spec))
     else:

@@ -732,7 +732,7 @@ class Mechanism:
         out: dict[str, NDArray[np.complex128]] = {}
         for p, links in self.structure.point_links.items():
             k = GROUND_INDEX if GROUND_INDEX in links else links[0]
-            out[p] = mo.point(k, self.structure.local[(k, p)]).complex() + 0 * mo.theta1
+            out[p] = mo.point(k, self.structure.local[(k, p)]).complex() + 0 * mo.state.positions[0]
         return out
 
     def drawing(self) -> dict[str, tuple[str, ...]]:
@@ -770,8 +770,8 @@ class Mechanism:
         """Each slider's guide as a point on the line and the line's unit direction, complex."""
         out: list[tuple[NDArray[np.complex128], NDArray[np.complex128]]] = []
         for c in self.structure.prisms:
-            base = mo.point(c.g, c.pg).complex() + 0 * mo.theta1
+            base = mo.point(c.g, c.pg).complex() + 0 * mo.state.positions[0]
             d = mo.pose.rotate(c.g, c.dg)
-            out.append((base, d.x + 1j * d.y + 0 * mo.theta1))
+            out.append((base, d.x + 1j * d.y + 0 * mo.state.positions[0]))
         return out
 

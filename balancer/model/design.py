@@ -214,6 +214,12 @@ class Design:
                 if r.name not in inputs:
                     raise SpecError(f"names no input ({', '.join(inputs) or 'none'})",
                                     key=f"workspace.{r.name}")
+            bodies = getattr(self.mechanism, "bodies", ())
+            for r in self.workspace.joints:
+                count = sum(r.name in b.points for b in bodies)
+                if count != 2:
+                    raise SpecError(f"must name a point that joins two links (it is on {count})",
+                                    key=f"workspace.joints.{r.name}")
         seen: set[str] = set()
         for i, motion in enumerate(self.motions):
             key = v.item("motion", i)

@@ -97,7 +97,7 @@ def drawing_frames(linkage: Model | Mechanism, frames: int
             continue
         ring = [*names, names[0]] if len(names) > 2 else list(names)
         links[name] = np.column_stack([points[p] for p in ring])
-    coms = {name: np.asarray(c.complex() + 0 * mo.theta1, complex)
+    coms = {name: np.asarray(c.complex() + 0 * mo.state.positions[0], complex)
             for name, c in zip(mech.link_names, mech.centres_of_mass(mo), strict=True)}
     return links, coms, np.asarray(mech.total_centre_of_mass(mo), complex)
 
@@ -117,7 +117,7 @@ def counterweight_paths(linkage: Model | Mechanism,
         w = counterweights.get(name)
         if w is None or w.kind != "add":
             continue
-        centre = mo.point(k, V(w.e, w.f)).complex() + 0 * mo.theta1
+        centre = mo.point(k, V(w.e, w.f)).complex() + 0 * mo.state.positions[0]
         out[name] = (np.asarray(centre, complex), w.disc_radius or 0.0)
     return out
 
@@ -137,7 +137,7 @@ def slider_block_outlines(linkage: Model | Mechanism, frames: int
         k = mech.link_names.index(name)
         corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5), (-0.5, -0.5)]
         out[name] = np.column_stack([
-            mo.point(k, V(u * length, v * width)).complex() + 0 * mo.theta1
+            mo.point(k, V(u * length, v * width)).complex() + 0 * mo.state.positions[0]
             for u, v in corners])
     return out
 

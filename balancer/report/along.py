@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from typing import Any
 
-from ..motion_analysis import MotionAnalysis
+from ..motion_analysis import AlongMotions, MotionAnalysis
 from ..rounding import Scales
 from .analysis import reaction_extremes
 from .text import csv_text, table
@@ -31,9 +30,10 @@ def _law(analysis: MotionAnalysis) -> str:
             f"{len(m.times)} waypoints")
 
 
-def motions_text(analyses: Sequence[MotionAnalysis], spec: str | None = None) -> str:
+def motions_text(along: AlongMotions, spec: str | None = None) -> str:
     """The readable ``analyze`` report of a linkage along its motions."""
     head = f"balancer analyze — {spec}" if spec else "balancer analyze"
+    analyses = along.motions
     first = analyses[0]
     mech = first.mechanism
     gravity = first.gravity
@@ -50,7 +50,9 @@ def motions_text(analyses: Sequence[MotionAnalysis], spec: str | None = None) ->
                 for key, figure in loads.items()
                 if not (key == "rocking_couple" and planar)]
         lines += ["", f"motion {analysis.name}: {_law(analysis)}", "",
-                  table(rows, ["quantity", "RMS", "max", "unit"])]
+                  table(rows, ["quantity", "RMS", "max", "unit"]), "",
+                  "the total centre of mass moves up to "
+                  f"{_length(analysis.centre_of_mass_excursion)} from its mean place along it"]
         reactions = []
         for point, values in analysis.reactions.ground.items():
             ex = reaction_extremes(values)
@@ -59,22 +61,48 @@ def motions_text(analyses: Sequence[MotionAnalysis], spec: str | None = None) ->
         if reactions:
             lines += ["", table(reactions, ["reaction (N)", "|R| max", "Rx min", "Rx max",
                                             "Ry min", "Ry max"])]
+    lines += ["", force_balance_words(along)]
     return "\n".join(lines)
 
 
-def motions_json(analyses: Sequence[MotionAnalysis], spec: str | None = None
-                 ) -> dict[str, Any]:
+def force_balance_words(along: AlongMotions) -> str:
+    """Whether the design is force-balanced for every motion, in words a designer pictures."""
+    w = along.workspace
+    over = ("" if w is None else
+            f"; over the workspace ({w.states} of its {w.grid} grid states) the total centre of "
+            f"mass moves up to {_length(w.centre_of_mass_excursion)} from its mean place")
+    if along.force_balanced:
+        return ("force-balanced: yes (the total centre of mass stands still for every motion; "
+                f"the conditions hold to {along.force_balance_residual:.1e} of the links' first "
+                f"moments{over})")
+    return ("force-balanced: no (the conditions are off by "
+            f"{along.force_balance_residual:.2g} of the links' first moments{over})")
+
+
+def _length(metres: float) -> str:
+    """A length for a reader: mm below a metre, else m."""
+    return f"{1e3 * metres:.4g} mm" if abs(metres) < 1.0 else f"{metres:.4g} m"
+
+
+def motions_json(along: AlongMotions, spec: str | None = None) -> dict[str, Any]:
     """``analyze --json`` along the motions: each motion's figures under ``motions.<name>``."""
-    first = analyses[0]
-    out: dict[str, Any] = {"spec": spec, "mechanism": first.mechanism.kind,
-                           "inputs": list(first.inputs), "gravity": list(first.gravity),
-                           "motions": {}}
-    for analysis in analyses:
+    first = along.motions[0]
+    w = along.workspace
+    out: dict[str, Any] = {
+        "spec": spec, "mechanism": first.mechanism.kind, "inputs": list(first.inputs),
+        "gravity": list(first.gravity), "force_balanced": along.force_balanced,
+        "force_balance_residual": {"relative": along.force_balance_residual},
+        "workspace": None if w is None else {
+            "states": w.states, "grid": w.grid,
+            "centre_of_mass_excursion": w.centre_of_mass_excursion},
+        "motions": {}}
+    for analysis in along.motions:
         m = analysis.motion
         entry: dict[str, Any] = {"duration": m.duration, "samples": m.samples, "law": m.law,
                                  "point": m.point}
         for key, figure in analysis.loads().items():
             entry[key] = {"rms": figure.rms, "max": figure.max}
+        entry["centre_of_mass_excursion"] = analysis.centre_of_mass_excursion
         entry["reactions"] = {p: reaction_extremes(v)
                               for p, v in analysis.reactions.ground.items()}
         out["motions"][analysis.name] = entry
