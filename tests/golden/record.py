@@ -120,11 +120,12 @@ def mask(text: str, folder: Path | None = None) -> str:
 #: Shipped examples the verbs do not run yet, each with the reason: neither recorded nor
 #: compared (``tests/test_golden.py`` lists them as skipped), nor analysed by the tests that run
 #: a verb on every example (``tests/test_plausibility.py``).
-NOT_RUN = {
-    "forbal2": "a linkage with two inputs: analyze, simulate, verify and optimize take a "
-               "one-input mechanism so far (its structure, motions, mass properties and force "
-               "balance are checked in tests/mechanisms/test_forbal2.py)",
-}
+NOT_RUN: dict[str, str] = {}
+#: Shipped examples with several inputs, analysed along their motions (the motion whose CSV is
+#: recorded): ``analyze`` alone runs them so far (simulate, verify and optimize take a one-input
+#: mechanism; their structure, motions, mass properties and force balance are checked in
+#: ``tests/mechanisms/test_forbal2.py``).
+ALONG_MOTIONS = {"forbal2": "diamond"}
 
 
 def examples() -> list[str]:
@@ -135,6 +136,11 @@ def examples() -> list[str]:
 def commands(name: str) -> dict[str, list[str]]:
     """The command lines recorded for example ``name`` (``{tmp}`` is the output folder)."""
     spec = str(EXAMPLES / f"{name}.toml")
+    if name in ALONG_MOTIONS:
+        return {"analyze.txt": ["analyze", spec],
+                "analyze.json": ["analyze", spec, "--json"],
+                "analyze.csv": ["analyze", spec, "--motion", ALONG_MOTIONS[name], "--csv",
+                                "{tmp}/out.csv"]}
     out = {
         "analyze.txt": ["analyze", spec],
         "analyze.json": ["analyze", spec, "--json"],
