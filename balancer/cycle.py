@@ -23,6 +23,8 @@ from contextvars import ContextVar
 from dataclasses import dataclass
 from functools import cached_property
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -189,6 +191,10 @@ class CycleAnalysis:
             slider_couple={k: Figure.of(v) for k, v in r.slider_couple.items()},
             mount_torque=None if self.mount_torque is None else Figure.of(self.mount_torque),
         )
+
+    def load(self, key: str) -> NDArray[Any]:
+        """A frame load by its key (:data:`balancer.quantities.QUANTITIES`), at the samples."""
+        return np.asarray(getattr(self.reactions, key))
 
     def __repr__(self) -> str:
         s = self.summary

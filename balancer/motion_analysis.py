@@ -11,12 +11,17 @@ the one record of frame loads (:class:`balancer.linkage.loads.Reactions`). The c
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from functools import cached_property
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .columns import Columns, frame_force_columns
+from .cycle import CycleSummary, Figure
 from .force_balance import RESIDUAL_FLOOR, force_balance_residual
 from .linkage import trajectory
 from .linkage.inputs import InputState
@@ -240,9 +245,93 @@ class AlongMotions:
     motions: tuple[MotionAnalysis, ...]
     force_balance_residual: float
     workspace: WorkspaceCheck | None = None
+    #: The workspace the check was made over (``None``: none).
+    workspace_spec: Workspace | None = None
 
     @property
     def force_balanced(self) -> bool:
         """Whether the conditions hold to rounding: the total centre of mass stands still for
         every motion."""
         return self.force_balance_residual <= RESIDUAL_FLOOR
+
+    @property
+    def mechanism(self) -> Mechanism:
+        """The analysed mechanism."""
+        return self.motions[0].mechanism
+
+    @property
+    def orders(self) -> tuple[()]:
+        """No orders: a motion is no revolution at constant speed."""
+        return ()
+
+    @property
+    def linkage(self) -> MechanismModel:
+        """The analysed design's model."""
+        return self.motions[0].mechanism.model
+
+    @cached_property
+    def reactions(self) -> Reactions:
+        """The frame's loads along every motion, one after another."""
+        parts = [m.reactions for m in self.motions]
+        first = parts[0]
+
+        def joined(arrays: list[NDArray[Any]]) -> NDArray[Any]:
+            return np.concatenate(arrays)
+
+        return Reactions(
+            ground={p: joined([r.ground[p] for r in parts]) for p in first.ground},
+            slider_normal={k: joined([r.slider_normal[k] for r in parts])
+                           for k in first.slider_normal},
+            slider_couple={k: joined([r.slider_couple[k] for r in parts])
+                           for k in first.slider_couple},
+            shaking_force=joined([r.shaking_force for r in parts]),
+            shaking_moment=joined([r.shaking_moment for r in parts]),
+            torques=tuple(joined([r.torques[i] for r in parts])
+                          for i in range(len(first.torques))),
+            rocking_couple=joined([r.rocking_couple for r in parts]))
+
+    @cached_property
+    def summary(self) -> CycleSummary:
+        """Each load's RMS and largest magnitude over every motion's samples (the driving
+        torque's: over every input's torque)."""
+        r = self.reactions
+        return CycleSummary(
+            shaking_force=Figure.of(r.shaking_force),
+            shaking_moment=Figure.of(r.shaking_moment),
+            driving_torque=Figure.of(np.concatenate(r.torques)),
+            rocking_couple=Figure.of(r.rocking_couple),
+            ground={p: Figure.of(v) for p, v in r.ground.items()},
+            slider_normal={k: Figure.of(v) for k, v in r.slider_normal.items()},
+            slider_couple={k: Figure.of(v) for k, v in r.slider_couple.items()})
+
+    def load(self, key: str) -> NDArray[Any]:
+        """A frame load as a balancing weighs it: each motion's samples weighted by its share
+        (:func:`motion_weights`), every input's torque stacked for ``driving_torque`` (its mean
+        square the sum of theirs)."""
+        scale = motion_weights([m.t.size for m in self.motions])
+        r = self.reactions
+        if key == "driving_torque":
+            m = len(r.torques)
+            return np.concatenate([t * scale for t in r.torques]) * math.sqrt(m)
+        return np.asarray(getattr(r, key)) * scale
+
+
+def motion_weights(counts: Sequence[int]) -> NDArray[np.float64]:
+    """Each sample's factor when motions of ``counts`` samples are weighted equally.
+
+    Motion ``k``'s samples are multiplied by ``√(N/(K·N_k))`` (``N`` in all, ``K`` motions),
+    so that the mean square over all samples is the mean over the motions of each one's.
+    """
+    total, count = sum(counts), len(counts)
+    return np.concatenate([np.full(n, math.sqrt(total / (count * n))) for n in counts])
+
+
+def along_motions(model: MechanismModel | Mechanism, motions: Sequence[MotionSpec], *,
+                  workspace: Workspace | None = None, gravity: tuple[float, float] = (0.0, 0.0),
+                  loads: bool = True) -> AlongMotions:
+    """:func:`motion_analysis` of each motion, with the force balance and the workspace's."""
+    mech = model if isinstance(model, Mechanism) else mechanism_of(model)
+    analyses = tuple(motion_analysis(mech, m, gravity=gravity, loads=loads) for m in motions)
+    return AlongMotions(motions=analyses, force_balance_residual=force_balance_residual(mech),
+                        workspace=None if workspace is None else workspace_check(mech, workspace),
+                        workspace_spec=workspace)

@@ -12,31 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from linkage.several_inputs_specs import _link, fivebar, linkage_of, three_rrr
+from linkage.several_inputs_specs import A, B, fivebar, linkage_of, parallelogram, three_rrr
 
 from balancer.force_balance import first_moment_map, force_balance_conditions
 from balancer.linkage.inputs import InputState
 from balancer.mechanisms import mechanism_of
-
-A, B = 0.2, 0.15  # the parallelogram's sides: p (A→P1) and q (A→P2)
-
-
-def parallelogram() -> dict:
-    """Both motors at A: p = A→P1, q = A→P2; r = P1→Q ∥ q, s = P2→Q→E ∥ p (E beyond Q)."""
-    u1, u2 = np.exp(1j * 0.6), np.exp(1j * 2.0)
-    p1, p2 = A * u1, B * u2
-    q = p1 + B * u2
-    e = p2 + 1.4 * A * u1
-    pts = {"A": 0j, "P1": p1, "P2": p2, "Q": q, "E": e}
-    return {
-        "mechanism": {"type": "linkage", "inputs": ["p", "q"],
-                      "points": {k: [v.real, v.imag] for k, v in pts.items()}},
-        "links": {"ground": {"points": ["A"]},
-                  "p": _link(["A", "P1"], 0.29, 0.005, -0.005, 0.002),
-                  "q": _link(["A", "P2"], 0.29, 0.005, -0.012, 0.002),
-                  "r": _link(["P1", "Q"], 0.1, 0.0004, 0.12, 0.002),
-                  "s": _link(["P2", "Q", "E"], 0.15, 0.0026, -0.02, 0.002)},
-    }
 
 
 def _rank(m: np.ndarray) -> int:

@@ -18,7 +18,7 @@ import sys
 import numpy as np
 import pytest
 from helpers import derivative_with_error
-from linkage.several_inputs_specs import fivebar
+from linkage.several_inputs_specs import A, B, fivebar, parallelogram
 
 from balancer.errors import SpecError
 from balancer.linkage import trajectory
@@ -183,8 +183,6 @@ def test_a_one_input_linkage_runs_along_its_cranks_own_motion():
 def _balanced_parallelogram() -> dict:
     """The parallelogram five-bar of tests/test_force_balance.py, balanced in closed form:
     p's and q's centres put where the first moments along each direction cancel."""
-    from test_force_balance import A, B, parallelogram
-
     spec = parallelogram()
     links = spec["links"]
 

@@ -17,7 +17,6 @@ def optimize(design: Design, *, backend: Backend = "nlp") -> BalanceResult:
     ``backend`` ``"nlp"`` (the certified convex optimum, then IPOPT on the designer's own
     parameters) or ``"convex"``. See :func:`balancer.balance.optimizer.optimize`.
     """
-    mechanism_of(design.mechanism).require_one_input("a balancing over a revolution")
     return run_optimizer(design, backend)
 
 

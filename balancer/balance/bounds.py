@@ -377,7 +377,8 @@ def link_length(mech: Mechanism, name: str) -> float:
     extent = max((abs(a.complex() - b.complex()) for a in points for b in points), default=0.0)
     if extent > 0:
         return extent
-    return link_length(mech, mech.input) if name != mech.input else structure.length_scale()
+    first = mech.linkage.inputs[0]
+    return link_length(mech, first) if name != first else structure.length_scale()
 
 
 def resolve_link(mech: Mechanism, name: str, freedom: LinkFreedom | None) -> LinkBounds:

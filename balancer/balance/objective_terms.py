@@ -27,13 +27,13 @@ def objective_rows(reg: CycleRegressors, w: Objective, links: tuple[LinkBounds, 
              ) -> tuple[NDArray[np.float64], NDArray[np.float64], tuple[bool, ...]]:
     """The objective's rows ``K``, their triangular factor ``R`` and the inert entries.
 
-    ``K`` stacks the weighted regressor rows divided by ``√N`` (see :class:`ProblemData`);
-    an entry is inert where its column of ``R`` vanishes (to ``1e-12`` of the largest).
+    ``K`` stacks the weighted regressor rows, each block divided by the square root of its
+    number of rows (``√N``: a mean square; see :class:`ProblemData`); an entry is inert where
+    its column of ``R`` vanishes (to ``1e-12`` of the largest).
     """
-    n = reg.shaking_moment.shape[0]
-    blocks = [math.sqrt(term.weight) * part for term in w.terms
+    blocks = [math.sqrt(term.weight) * part / math.sqrt(part.shape[0]) for term in w.terms
               for part in squared_parts(term.name, lambda key: getattr(reg, key))]
-    rows = np.vstack(blocks) / math.sqrt(n) if blocks else np.zeros((0, p))
+    rows = np.vstack(blocks) if blocks else np.zeros((0, p))
     factor = (cast("NDArray[np.float64]", np.linalg.qr(rows, mode="r"))  # R alone (as above)
               if blocks else np.zeros((0, p)))
     norms = np.linalg.norm(factor, axis=0) if blocks else np.zeros(p)

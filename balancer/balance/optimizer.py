@@ -45,7 +45,9 @@ import numpy as np
 
 from ..cycle import CycleAnalysis, cycle_analysis
 from ..errors import SpecError
-from ..model import Design
+from ..model import Design, MechanismModel
+from ..model.motions import MotionSpec, Workspace
+from ..motion_analysis import AlongMotions, along_motions
 from ..model.balance import BalanceProblem, RotorBalanceProblem, missing_balance
 from . import rotors
 from .convex import ConvexSolution, ConvexSolver
@@ -95,13 +97,20 @@ class Optimizer:
     """
 
     def __init__(self, data: NumericProblem, *, like: Optimizer | None = None,
-                 gravity: tuple[float, float] = (0.0, 0.0)) -> None:
+                 gravity: tuple[float, float] = (0.0, 0.0),
+                 motions: tuple[MotionSpec, ...] = (),
+                 workspace: Workspace | None = None) -> None:
         self.data = data
         self.gravity: tuple[float, float] = gravity if like is None else like.gravity
+        #: The motions a linkage with several inputs is balanced along (its before and after
+        #: are analysed along them).
+        self.motions: tuple[MotionSpec, ...] = motions if like is None else like.motions
+        self.workspace: Workspace | None = workspace if like is None else like.workspace
         self.convex: ConvexSolver = ConvexSolver(data, like=None if like is None else like.convex)
         self._nlp: NlpSolver | None = None
-        # The original design's cycle analysis: the same under any bounds.
-        self._before: CycleAnalysis | None = None if like is None else like._before
+        # The original design's analysis: the same under any bounds.
+        self._before: CycleAnalysis | AlongMotions | None = (None if like is None
+                                                             else like._before)
 
     @classmethod
     def of(cls, design: Design) -> Optimizer:
@@ -112,9 +121,9 @@ class Optimizer:
         if isinstance(design.balance, RotorBalanceProblem):
             raise SpecError("not yet for an engine: its counterweights and shafts are chosen by "
                             "`balancer optimize`", key="balance")
-        data = numeric_problem(design)  # it has checked that [operation] is there
-        assert design.operation is not None
-        return cls(data, gravity=design.operation.gravity)
+        data = numeric_problem(design)  # (it has checked [operation], or the motions)
+        gravity = design.operation.gravity if design.operation is not None else (0.0, 0.0)
+        return cls(data, gravity=gravity, motions=design.motions, workspace=design.workspace)
 
     def with_problem(self, problem: BalanceProblem) -> Optimizer:
         """The optimiser of the same design under another redesign problem (new bounds).
@@ -213,13 +222,9 @@ class Optimizer:
                              "of very different masses): optimality cannot be decided finer")
         balanced = data.linkage_of(x)
         if self._before is None:
-            self._before = cycle_analysis(
-                data.linkage, data.speed, data.samples, route="newton-euler", loads=False
-            )
+            self._before = self._inertial(data.linkage)
         before = self._before
-        after = cycle_analysis(
-            balanced, data.speed, data.samples, route="newton-euler", loads=False
-        )
+        after = self._inertial(balanced)
         result = BalanceResult(
             success=status is not Status.FAILED,
             status=status,
@@ -244,6 +249,16 @@ class Optimizer:
             weights=data.weights,
         )
         return replace(result, message=result.summary(notes))
+
+
+    def _inertial(self, model: MechanismModel) -> CycleAnalysis | AlongMotions:
+        """A design's inertial loads, as the objective weighs them (loads and gravity left out):
+        over the revolution at the operating speed, or along the motions."""
+        data = self.data
+        if data.speed is None:
+            return along_motions(model, self.motions, workspace=self.workspace, loads=False)
+        return cycle_analysis(model, data.speed, data.samples, route="newton-euler",
+                              loads=False)
 
 
 def optimize(design: Design, backend: Backend = "nlp") -> BalanceResult:

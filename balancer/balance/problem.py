@@ -27,20 +27,31 @@ This module imports neither CVXPY nor CasADi.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from dataclasses import replace
+from typing import cast
 
+import numpy as np
+from numpy.typing import NDArray
+
+from .. import validate as v
 from ..cycle import sample_angles
 from ..errors import SpecError
+from ..linkage import trajectory
 from ..linkage.dynamics import TURNING
-from ..mechanisms import mechanism_of
+from ..linkage.inputs import InputState
+from ..linkage.vectors import V
+from ..mechanisms import Mechanism, mechanism_of
 from ..model import Design
 from ..model.balance import BalanceProblem
+from ..motion_analysis import motion_weights
 from .bounds import check_problem, resolve_link
 from .feasibility import Feasibility, force_balance_system
 from .objective_scale import ObjectiveScale
 from .objective_terms import objective_rows
 from .physical import PhysicalValues
-from .regressors import cycle_regressors_at
+from .regressors import CycleRegressors, cycle_regressors_at
 from .settling import Settling
 
 
@@ -111,12 +122,15 @@ def numeric_problem(design: Design) -> NumericProblem:
         If the crank cannot turn a full revolution.
     """
     problem = _checked_problem(design.balance)
+    mech = mechanism_of(design.mechanism)
+    if len(mech.linkage.inputs) > 1:
+        check_problem(problem, mech)
+        return _along_motions(design, problem, mech)
     if design.operation is None:
         raise SpecError(
             "missing required key: the balancing objective is evaluated at the operating speed",
             key="operation.speed",
         )
-    mech = mechanism_of(design.mechanism)
     check_problem(problem, mech)
     mech.require_full_revolution("balancing")
     speed = design.operation.speed
@@ -131,7 +145,7 @@ def numeric_problem(design: Design) -> NumericProblem:
         problem=problem,
         mechanism=mech,
         speed=speed,
-        theta1=angles,
+        states=InputState.crank(angles, speed),
         regressors=reg,
         links=links,
         x0=mech.parameters(),
@@ -140,6 +154,59 @@ def numeric_problem(design: Design) -> NumericProblem:
         force_balance=force_balance_system(mech) if problem.force_balance else None,
         inert=inert,
         unit_acceleration=unit,
+    )
+
+
+def _along_motions(design: Design, problem: BalanceProblem, mech: Mechanism) -> NumericProblem:
+    """The problem of a linkage with several inputs, its objective along the spec's motions.
+
+    The states of every motion one after another (:func:`balancer.linkage.trajectory.
+    input_state`), each motion weighted equally (its rows by
+    :func:`balancer.motion_analysis.motion_weights`); the regressors from the core's inverse
+    dynamics (:func:`balancer.linkage.dynamics.regressors`), every input's torque stacked
+    under ``driving_torque`` times ``√m`` (``m`` inputs: its mean square the sum of the
+    inputs'). Force balance: the total centre of mass still for every motion (the conditions
+    of :mod:`balancer.force_balance`, over the inputs' space). What the frame feels as the
+    inputs accelerate is the objective's own (the motions accelerate): the counter-rotors'
+    settling weighs the shaking moment along them.
+    """
+    if not design.motions:
+        raise SpecError("balancing a linkage with several inputs weighs its loads along its "
+                        "motions: the spec has no [[motion]]", key="motion")
+    parts = []
+    for i, motion in enumerate(design.motions):
+        with v.under(v.item("motion", i)):
+            parts.append(trajectory.input_state(mech.structure, motion))
+    states = InputState.of(
+        [np.concatenate([p.positions[j] for p in parts]) for j in range(parts[0].size)],
+        [np.concatenate([p.rates[j] for p in parts]) for j in range(parts[0].size)],
+        [np.concatenate([p.accelerations[j] for p in parts]) for j in range(parts[0].size)])
+    scale = motion_weights([p.count for p in parts])[:, None]
+    with np.errstate(all="ignore"):
+        f = mech.regressors(mech.motion_at(states))
+    torques = np.vstack([np.asarray(t) * scale for t in f.input_torques])
+    complex_rows = cast("Callable[[V], NDArray[np.complex128]]",
+                        lambda vector: np.asarray(vector.complex(), dtype=complex) * scale)
+    reg = CycleRegressors(
+        shaking_force=complex_rows(f.shaking_force),
+        shaking_moment=np.asarray(f.shaking_moment) * scale,
+        driving_torque=torques * math.sqrt(len(f.input_torques)),
+        rocking_couple=complex_rows(f.rocking_couple))
+    links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
+    rows, factor, inert = objective_rows(reg, problem.objective, links, mech.layout.size)
+    return NumericProblem(
+        problem=problem,
+        mechanism=mech,
+        speed=None,
+        states=states,
+        regressors=reg,
+        links=links,
+        x0=mech.parameters(),
+        rows=rows,
+        factor=factor,
+        force_balance=force_balance_system(mech) if problem.force_balance else None,
+        inert=inert,
+        unit_acceleration=reg,
     )
 
 

@@ -16,6 +16,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
+from ..linkage.inputs import InputState
 from ..mechanisms.base import Mechanism
 from ..model import MechanismModel as Model
 from ..model.balance import BalanceProblem, Objective
@@ -46,11 +47,14 @@ class ProblemData:
     mechanism
         The original design's mechanism.
     speed
-        Crank speed, rad/s.
-    theta1
-        Sampled crank angles, rad.
+        Crank speed, rad/s (``None``: a linkage with several inputs, sampled along motions).
+    states
+        The sampled states: a one-input mechanism's crank angles over a revolution at
+        :attr:`speed`, or the states along the spec's motions, one after another.
     regressors
-        The inertial shaking at those angles per unit entry (:class:`CycleRegressors`).
+        The inertial shaking at those states per unit entry (:class:`CycleRegressors`; a
+        linkage with several inputs: each row weighted by its motion's share, the inputs'
+        torques stacked, see :func:`~.problem.numeric_problem`).
     links
         Resolved bounds of every moving link.
     x0
@@ -73,8 +77,8 @@ class ProblemData:
 
     problem: BalanceProblem
     mechanism: Mechanism
-    speed: float
-    theta1: NDArray[np.float64]
+    speed: float | None
+    states: InputState
     regressors: CycleRegressors
     links: tuple[LinkBounds, ...]
     x0: NDArray[np.float64]
@@ -101,8 +105,8 @@ class ProblemData:
 
     @property
     def samples(self) -> int:
-        """Number of sampled crank angles ``N``."""
-        return self.theta1.size
+        """Number of sampled states ``N``."""
+        return self.states.count
 
     @property
     def weights(self) -> Objective:

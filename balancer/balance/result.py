@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..cycle import CycleAnalysis, cycle_analysis
+from ..motion_analysis import AlongMotions, along_motions
 from ..errors import SolverError
 from ..model import Design
 from ..model import MechanismModel as Model
@@ -224,8 +225,8 @@ class BalanceResult:
     iterations: int
     time: float
     stages: tuple[StageReport, ...]
-    before: CycleAnalysis
-    after: CycleAnalysis
+    before: CycleAnalysis | AlongMotions
+    after: CycleAnalysis | AlongMotions
     gravity: tuple[float, float] = (0.0, 0.0)
     weights: Objective = Objective()
     rotor_masses: RotorMasses | None = None
@@ -236,7 +237,7 @@ class BalanceResult:
         return f"BalanceResult({self.status}, {self.backend}: {self.message}{added})"
 
     @cached_property
-    def operating(self) -> tuple[CycleAnalysis, CycleAnalysis]:
+    def operating(self) -> tuple[CycleAnalysis | AlongMotions, CycleAnalysis | AlongMotions]:
         """The original's and the balanced design's figures as ``analyze`` gives them.
 
         At the operating speed with the links' loads (a gas force, applied forces) and the
@@ -244,6 +245,13 @@ class BalanceResult:
         :attr:`after` are the inertial part alone, which the optimiser balances; without loads
         and gravity the two agree.
         """
+        if isinstance(self.before, AlongMotions):
+            motions = [a.motion for a in self.before.motions]
+            workspace = self.before.workspace_spec
+            return (along_motions(self.original, motions, gravity=self.gravity,
+                                  workspace=workspace),
+                    along_motions(self.linkage, motions, gravity=self.gravity,
+                                  workspace=workspace))
         speed, samples = self.before.speed, self.before.samples
         original, balanced = (cycle_analysis(model, speed, samples, gravity=self.gravity)
                               for model in (self.original, self.linkage))
@@ -302,15 +310,14 @@ class BalanceResult:
         term = self.single_term
         return rms if term is None else rms / float(np.sqrt(term.weight))
 
-    def term_rms(self, analysis: CycleAnalysis) -> dict[str, float]:
+    def term_rms(self, analysis: CycleAnalysis | AlongMotions) -> dict[str, float]:
         """Each mean-square term's RMS in ``analysis`` (inertial: :attr:`before`, :attr:`after`).
 
         Keyed by the term's name (:attr:`Objective.terms`), in its unit; ``added_mass`` gives
         the mass added to the original, kg.
         """
-        r = analysis.reactions
         values = {t.name: float(np.sqrt(np.mean(sum(
-            part**2 for part in squared_parts(t.name, lambda key: getattr(r, key))))))
+            part**2 for part in squared_parts(t.name, analysis.load)))))
             for t in self.weights.terms if QUANTITIES[t.name].squares}
         values["added_mass"] = analysis.linkage.total_mass - self.original.total_mass
         if self.rotor_masses is not None:  # (of the chosen masses, not of the analysis)

@@ -63,8 +63,9 @@ class Settling(ProblemData):
         objective, at constant speed, does not see what the crank's rotary inertia does when
         the speed changes; this does.
         """
-        reg = self.unit_acceleration or cycle_regressors(self.mechanism, self.theta1, 0.0, 1.0)
-        rows = reg.shaking_moment / math.sqrt(self.theta1.size)
+        reg = self.unit_acceleration or cycle_regressors(
+            self.mechanism, np.asarray(self.states.positions[0], dtype=float), 0.0, 1.0)
+        rows = reg.shaking_moment / math.sqrt(reg.shaking_moment.shape[0])
         # (R alone: numpy's stubs say qr gives a QRResult whatever its mode.)
         return cast("NDArray[np.float64]", np.linalg.qr(rows, mode="r"))
 

@@ -16,6 +16,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from ..balance.counterweights import Counterweight
+from ..errors import SpecError
 from ..balance.result import BalanceResult
 from ..cycle import CycleAnalysis, cycle_analysis
 from ..mechanisms import mechanism_of
@@ -155,8 +156,12 @@ def as_built(result: BalanceResult, parts: Mapping[str, LinkPart]) -> CycleAnaly
 
     Loads and gravity included, as :attr:`BalanceResult.operating`'s.
     """
-    speed, samples = result.before.speed, result.before.samples
-    return cycle_analysis(built_model(result, parts), speed, samples, gravity=result.gravity)
+    before = result.before
+    if not isinstance(before, CycleAnalysis):
+        raise SpecError("counterweights as parts are made for a linkage turned by one crank so "
+                        "far", key="balance")
+    return cycle_analysis(built_model(result, parts), before.speed, before.samples,
+                          gravity=result.gravity)
 
 
 def parts_of(design: Design, result: BalanceResult, *, always: bool = False

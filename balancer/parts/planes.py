@@ -176,5 +176,7 @@ def built_engine(result: BalanceResult, parts: dict[str, PlanePart]) -> Model:
 
 def webs_as_built(result: BalanceResult, parts: dict[str, PlanePart]) -> CycleAnalysis:
     """The analysis at the operating speed of the engine as built (loads and gravity)."""
-    speed, samples = result.before.speed, result.before.samples
-    return cycle_analysis(built_engine(result, parts), speed, samples, gravity=result.gravity)
+    before = result.before
+    assert isinstance(before, CycleAnalysis)  # (an engine: over its revolution)
+    return cycle_analysis(built_engine(result, parts), before.speed, before.samples,
+                          gravity=result.gravity)

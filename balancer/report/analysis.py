@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..cycle import CycleAnalysis
+from ..motion_analysis import AlongMotions
 from ..orders import order_name
 from ..quantities import FRAME_LOADS
 from ..rounding import Scales, speed_text
@@ -34,12 +35,12 @@ def figures_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
     return analysis.summary.as_dict()
 
 
-def orders_list(analysis: CycleAnalysis) -> list[dict[str, Any]]:
+def orders_list(analysis: CycleAnalysis | AlongMotions) -> list[dict[str, Any]]:
     """The ``orders`` table (DESIGN.md's names; :mod:`balancer.orders`)."""
     return [order.as_dict() for order in analysis.orders]
 
 
-def analysis_figures(analysis: CycleAnalysis) -> list[tuple[str, float]]:
+def analysis_figures(analysis: CycleAnalysis | AlongMotions) -> list[tuple[str, float]]:
     """Every figure of a cycle analysis under its unit, for :class:`Scales`.
 
     The shaking, the driving and mount torques and the rocking couple (RMS and maximum), the

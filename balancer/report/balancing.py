@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..balance.counterweights import UNCHANGED, Counterweight, link_scales
 from ..cycle import CycleAnalysis
+from ..motion_analysis import AlongMotions
 from ..orders import order_name
 from ..quantities import unit_of, words_of
 from ..rounding import Scales, speed_text
@@ -37,7 +38,8 @@ def link_parameters(link: Link) -> dict[str, float]:
     }
 
 
-def optimization_json(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis,
+def optimization_json(result: BalanceResult, before: CycleAnalysis | AlongMotions,
+                      after: CycleAnalysis | AlongMotions,
                       verification: Verification | None = None, spec: str | None = None,
                       out: str | os.PathLike[str] | None = None) -> dict[str, Any]:
     """The ``optimize --json`` document.
@@ -120,13 +122,14 @@ _WATCHED = tuple((name, words_of(name), unit_of(name))
                  for name in ("shaking_force", "shaking_moment", "driving_torque"))
 
 
-def _operating_figures(analysis: CycleAnalysis) -> dict[str, Any]:
+def _operating_figures(analysis: CycleAnalysis | AlongMotions) -> dict[str, Any]:
     """``optimize``'s ``before``/``after``: the analyze figures and the largest ground load."""
     return {**analysis.summary.as_dict(),
             "max_ground_reaction": analysis.summary.max_ground_reaction}
 
 
-def worse_figures(before: CycleAnalysis, after: CycleAnalysis) -> list[str]:
+def worse_figures(before: CycleAnalysis | AlongMotions, after: CycleAnalysis | AlongMotions
+                  ) -> list[str]:
     """One sentence for each figure that the balanced design more than doubles.
 
     The RMS and maximum of the shaking force, shaking moment and driving torque, and the largest
@@ -306,8 +309,8 @@ def _parameter_scales(old: Link, new: Link) -> dict[str, float]:
     return {"mass": mass, "e": reach, "f": reach, "inertia": inertia, "counter_rotor": rotor}
 
 
-def optimization_scales(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis
-                        ) -> Scales:
+def optimization_scales(result: BalanceResult, before: CycleAnalysis | AlongMotions,
+                        after: CycleAnalysis | AlongMotions) -> Scales:
     """The scales of ``optimize``'s figures (:class:`Scales`): before and after together.
 
     The operating figures of both designs and their inertial ones (the objective's terms),
@@ -322,10 +325,14 @@ def optimization_scales(result: BalanceResult, before: CycleAnalysis, after: Cyc
     return sc
 
 
-def optimization_text(result: BalanceResult, before: CycleAnalysis, after: CycleAnalysis,
+def optimization_text(result: BalanceResult, before: CycleAnalysis | AlongMotions,
+                      after: CycleAnalysis | AlongMotions,
                       verification: Verification | None = None,
                       spec: str | None = None) -> str:
     """The readable ``optimize`` report."""
+    if isinstance(before, AlongMotions) or isinstance(after, AlongMotions):
+        assert isinstance(before, AlongMotions) and isinstance(after, AlongMotions)
+        return _along_motions_text(result, before, after, spec)
     head = f"balancer optimize — {spec}" if spec else "balancer optimize"
     lines = [
         head,
@@ -388,4 +395,51 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis, after: Cycle
     if verification is not None:
         lines.append("")
         lines.append(verification_text(verification).split("\n", 1)[1].strip("\n"))
+    return "\n".join(lines)
+
+
+def _along_motions_text(result: BalanceResult, before: AlongMotions, after: AlongMotions,
+                        spec: str | None) -> str:
+    """``optimize``'s report of a linkage with several inputs, along its motions."""
+    from .along import force_balance_words  # (the analysis' words along motions)
+
+    head = f"balancer optimize — {spec}" if spec else "balancer optimize"
+    names = ", ".join(a.name for a in before.motions)
+    lines = [
+        head,
+        f"backend {result.backend}: {result.message}",
+        f"{result.iterations} solver iterations in {1e3 * result.time:.1f} ms "
+        f"({', '.join(s.name for s in result.stages)}); the objective is the mean-square "
+        f"inertial shaking along the motions ({names}; loads left out)",
+        "",
+    ]
+    sc = optimization_scales(result, before, after)
+    rows = []
+    for b_motion, a_motion in zip(before.motions, after.motions, strict=True):
+        b_loads, a_loads = b_motion.loads(), a_motion.loads()
+        for key, b in b_loads.items():
+            if key == "rocking_couple" and after.mechanism.in_one_plane():
+                continue
+            a = a_loads[key]
+            unit = "N" if key == "shaking_force" else "N·m"
+            words = (f"torque on {key[len('torque_'):]}" if key.startswith("torque_")
+                     else key.replace("_", " "))
+            rows.append([f"{b_motion.name}: {words}", sc.fmt(b.rms, unit), sc.fmt(a.rms, unit),
+                         sc.ratio(a.rms, b.rms, unit), sc.fmt(b.max, unit), sc.fmt(a.max, unit),
+                         unit])
+    lines.append(table(rows, ["along the motions", "RMS before", "RMS after", "ratio",
+                              "max before", "max after", "unit"]))
+    lines += [f"warning: {w}" for w in worse_figures(before, after)]
+    lines.append("")
+    if result.single_term is None:
+        terms = _objective_terms(result)
+        rows = [[name.replace("_", " "), f"{t['weight']:.4g}",
+                 sc.fmt(float(t["before"]), str(t["unit"])),
+                 sc.fmt(float(t["after"]), str(t["unit"])), str(t["unit"])]
+                for name, t in terms.items()]
+        lines += ["objective J = Σ weight × mean square (added mass: weight × kg added), "
+                  "inertial shaking along the motions, each weighted alike:",
+                  table(rows, ["term", "weight", "RMS before", "RMS after", "unit"]), ""]
+    lines += [_parameters_text(result), "", counterweight_text(result.counterweights), "",
+              force_balance_words(after)]
     return "\n".join(lines)

@@ -400,7 +400,7 @@ def test_settling_the_inert_entries_changes_nothing_measured():
     # They are chosen for a crank whose speed changes: no setting within the bounds gives a
     # smaller mean-square shaking moment per unit crank acceleration (from the sampled
     # regressors, not the factor that settling uses).
-    a = cycle_regressors(data.mechanism, data.theta1, 0.0, 1.0).shaking_moment
+    a = cycle_regressors(data.mechanism, data.states.positions[0], 0.0, 1.0).shaking_moment
 
     def accel(z):
         return float(np.sum((a @ z) ** 2))
@@ -438,9 +438,9 @@ def test_regressors_at_two_rates_in_one_pass_are_each_alone(name):
     asked for, it is the one computed alone too."""
     design = spec.load_design(EXAMPLES / f"{name}.toml")
     data = numeric_problem(design)
-    alone = [cycle_regressors(data.mechanism, data.theta1, data.speed),
-             cycle_regressors(data.mechanism, data.theta1, 0.0, 1.0)]
-    full = cycle_regressors_at(data.mechanism, data.theta1, [(data.speed, 0.0), (0.0, 1.0)])
+    alone = [cycle_regressors(data.mechanism, data.states.positions[0], data.speed),
+             cycle_regressors(data.mechanism, data.states.positions[0], 0.0, 1.0)]
+    full = cycle_regressors_at(data.mechanism, data.states.positions[0], [(data.speed, 0.0), (0.0, 1.0)])
     for together, single in zip([data.regressors, data.unit_acceleration], alone, strict=True):
         for key in ("shaking_force", "shaking_moment", "rocking_couple"):
             np.testing.assert_array_equal(getattr(together, key), getattr(single, key))

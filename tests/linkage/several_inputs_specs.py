@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from balancer.model import Linkage
 from balancer.spec.reader import design_from_dict
 
@@ -62,3 +64,24 @@ def three_rrr() -> dict:
     links["platform"] = _link(platform, 0.5, 0.0012, 0.01, 0.01)
     return {"mechanism": {"type": "linkage", "inputs": ["crank1", "crank2", "crank3"],
                           "points": points}, "links": links}
+
+
+A, B = 0.2, 0.15  # the parallelogram's sides: p (A→P1) and q (A→P2)
+
+
+def parallelogram() -> dict:
+    """Both motors at A: p = A→P1, q = A→P2; r = P1→Q ∥ q, s = P2→Q→E ∥ p (E beyond Q)."""
+    u1, u2 = np.exp(1j * 0.6), np.exp(1j * 2.0)
+    p1, p2 = A * u1, B * u2
+    q = p1 + B * u2
+    e = p2 + 1.4 * A * u1
+    pts = {"A": 0j, "P1": p1, "P2": p2, "Q": q, "E": e}
+    return {
+        "mechanism": {"type": "linkage", "inputs": ["p", "q"],
+                      "points": {k: [v.real, v.imag] for k, v in pts.items()}},
+        "links": {"ground": {"points": ["A"]},
+                  "p": _link(["A", "P1"], 0.29, 0.005, -0.005, 0.002),
+                  "q": _link(["A", "P2"], 0.29, 0.005, -0.012, 0.002),
+                  "r": _link(["P1", "Q"], 0.1, 0.0004, 0.12, 0.002),
+                  "s": _link(["P2", "Q", "E"], 0.15, 0.0026, -0.02, 0.002)},
+    }

@@ -1,0 +1,108 @@
+"""Balancing a linkage with several inputs: force balance for every motion, the objective along
+the spec's motions (:func:`balancer.balance.problem.numeric_problem`'s ``_along_motions``).
+
+Each optimum against a second route: the least added mass that force-balances the parallelogram
+five-bar with a counterweight on each crank, in closed form (each crank must carry the first
+moment that cancels its direction's: its counterweight's mass that moment's magnitude over its
+radius); the balanced design's centre of mass over the workspace, by the forward kinematics of
+the redesigned linkage; the objective along the motions, from the redesigned linkage's own
+inverse dynamics along each motion (not the problem's regressors), each motion weighted alike.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+from linkage.several_inputs_specs import A, B, parallelogram
+
+from balancer.balance.optimizer import optimize
+from balancer.balance.result import GAP_TOLERANCE
+from balancer.errors import SpecError
+from balancer.motion_analysis import along_motions, workspace_check
+from balancer.spec.reader import design_from_dict
+
+RADIUS = 0.1
+
+MOTIONS = [
+    {"name": "wave", "times": [0.0, 0.5, 1.0], "path": [[0.0, 0.0], [0.2, -0.1], [0.0, 0.0]],
+     "law": "spline", "samples": 48},
+    {"name": "swing", "times": [0.0, 0.6, 1.2], "path": [[0.0, 0.0], [-0.15, 0.25], [0.1, 0.0]],
+     "law": "quintic", "samples": 40},
+]
+
+
+def spec(objective: dict, counter_rotor: bool = False) -> dict:
+    out = parallelogram()
+    cw = {"counterweight": {"mass": [0.0, 3.0], "radius": RADIUS}}
+    if counter_rotor:
+        cw["counter_rotor"] = [0.0, 0.01]
+    out["balance"] = {"force_balance": True, "objective": objective,
+                      "p": copy.deepcopy(cw), "q": copy.deepcopy(cw)}
+    out["motion"] = copy.deepcopy(MOTIONS)
+    out["workspace"] = {"p": [-0.5, 0.5], "q": [-0.5, 0.5], "samples": 11}
+    return out
+
+
+def _first_moment(link: dict) -> complex:
+    return link["mass"] * complex(link["com"]["e"], link["com"]["f"])
+
+
+def test_the_least_added_mass_is_each_cranks_missing_first_moment_over_its_radius():
+    data = spec({"added_mass": 1.0, "shaking_moment": 0.0})
+    result = optimize(design_from_dict(data))
+    assert result.success and str(result.status) == "optimal"
+    links = data["links"]
+    # along p's direction p, r (at A from p's pivot) and s carry first moments; p must cancel
+    need_p = -(A * links["r"]["mass"] + _first_moment(links["s"])) - _first_moment(links["p"])
+    need_q = -(B * links["s"]["mass"] + _first_moment(links["r"])) - _first_moment(links["q"])
+    closed = (abs(need_p) + abs(need_q)) / RADIUS
+    assert result.added_mass == pytest.approx(closed, rel=10 * GAP_TOLERANCE)
+    # each counterweight at its radius, opposite what it cancels
+    for name, need in (("p", need_p), ("q", need_q)):
+        w = result.counterweights[name]
+        assert abs(complex(w.e, w.f)) == pytest.approx(RADIUS, rel=1e-6)
+        assert w.mass * complex(w.e, w.f) == pytest.approx(need, rel=1e-6, abs=1e-9)
+
+
+def test_the_balanced_design_keeps_its_centre_of_mass_over_the_workspace():
+    design = design_from_dict(spec({"added_mass": 1.0, "shaking_moment": 0.0}))
+    result = optimize(design)
+    check = workspace_check(result.linkage, design.workspace)
+    assert check.states > 60
+    assert check.centre_of_mass_excursion <= 1e-14
+    original = workspace_check(design.mechanism, design.workspace)
+    assert original.centre_of_mass_excursion > 1e-3
+
+
+@pytest.mark.parametrize("objective", [{"shaking_moment": 1.0},
+                                       {"shaking_moment": 1.0, "driving_torque": 0.5}])
+def test_the_objective_is_the_redesigns_own_loads_along_the_motions(objective):
+    design = design_from_dict(spec(objective, counter_rotor=True))
+    result = optimize(design)
+    assert result.success and str(result.status) == "optimal"
+    # The redesigned linkage's loads, by its own inverse dynamics along each motion.
+    along = along_motions(result.linkage, design.motions, loads=False)
+    moment = np.mean([np.mean(m.reactions.shaking_moment**2) for m in along.motions])
+    torque = np.mean([sum(np.mean(t**2) for t in m.reactions.torques) for m in along.motions])
+    j = objective["shaking_moment"] * moment + objective.get("driving_torque", 0.0) * torque
+    assert result.objective == pytest.approx(j, rel=1e-9)
+    assert np.max(np.abs(along.reactions.shaking_force)) <= 1e-12
+    # and it is the best: no lower than its certified bound, within the certificate's gap
+    assert result.lower_bound <= result.objective * (1 + 1e-12)
+    assert result.gap <= GAP_TOLERANCE
+    # the original's, the same way
+    before = along_motions(design.mechanism, design.motions, loads=False)
+    moment0 = np.mean([np.mean(m.reactions.shaking_moment**2) for m in before.motions])
+    torque0 = np.mean([sum(np.mean(t**2) for t in m.reactions.torques) for m in before.motions])
+    j0 = objective["shaking_moment"] * moment0 + objective.get("driving_torque", 0.0) * torque0
+    assert result.original_objective == pytest.approx(j0, rel=1e-9)
+
+
+def test_a_linkage_with_several_inputs_and_no_motion_is_refused():
+    data = spec({"shaking_moment": 1.0})
+    del data["motion"]
+    with pytest.raises(SpecError, match="no \\[\\[motion\\]\\]") as caught:
+        optimize(design_from_dict(data))
+    assert caught.value.key == "motion"
