@@ -226,8 +226,6 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .linkage.loads import Reactions
     from .mechanisms import mechanism_of
     from .mechanisms.base import Mechanism, Route
-    from .model.motions import MotionSpec, Workspace
-    from .motion_analysis import AlongMotions, MotionAnalysis, WorkspaceCheck
     from .mechanisms.engine.model import Engine
     from .mechanisms.fourbar.assembly import LinkageClass
     from .mechanisms.fourbar.model import FourBar
@@ -253,6 +251,8 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         Objective,
         ObjectiveTerm,
     )
+    from .model.motions import MotionSpec, Workspace
+    from .motion_analysis import AlongMotions, MotionAnalysis, WorkspaceCheck
     from .plots import (
         animate,
         cycle_figure,

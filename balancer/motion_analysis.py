@@ -250,8 +250,10 @@ class AlongMotions:
 
     @property
     def force_balanced(self) -> bool:
-        """Whether the conditions hold to rounding: the total centre of mass stands still for
-        every motion."""
+        """Whether the conditions hold to rounding.
+
+        Then the total centre of mass stands still for every motion.
+        """
         return self.force_balance_residual <= RESIDUAL_FLOOR
 
     @property
@@ -292,8 +294,10 @@ class AlongMotions:
 
     @cached_property
     def summary(self) -> CycleSummary:
-        """Each load's RMS and largest magnitude over every motion's samples (the driving
-        torque's: over every input's torque)."""
+        """Each load's RMS and largest magnitude over every motion's samples.
+
+        The driving torque's: over every input's torque.
+        """
         r = self.reactions
         return CycleSummary(
             shaking_force=Figure.of(r.shaking_force),
@@ -305,9 +309,11 @@ class AlongMotions:
             slider_couple={k: Figure.of(v) for k, v in r.slider_couple.items()})
 
     def load(self, key: str) -> NDArray[Any]:
-        """A frame load as a balancing weighs it: each motion's samples weighted by its share
-        (:func:`motion_weights`), every input's torque stacked for ``driving_torque`` (its mean
-        square the sum of theirs)."""
+        """A frame load as a balancing weighs it.
+
+        Each motion's samples weighted by its share (:func:`motion_weights`), every input's
+        torque stacked for ``driving_torque`` (its mean square the sum of theirs).
+        """
         scale = motion_weights([m.t.size for m in self.motions])
         r = self.reactions
         if key == "driving_torque":

@@ -7,10 +7,10 @@ from collections.abc import Sequence
 from .. import validate as v
 from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses
 from ..errors import SpecError
+from ..force_balance import force_balance_residual
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Route
 from ..model import Design, check_scales
-from ..force_balance import force_balance_residual
 from ..motion_analysis import AlongMotions, motion_analysis, workspace_check
 
 

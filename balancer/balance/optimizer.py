@@ -46,9 +46,9 @@ import numpy as np
 from ..cycle import CycleAnalysis, cycle_analysis
 from ..errors import SpecError
 from ..model import Design, MechanismModel
+from ..model.balance import BalanceProblem, RotorBalanceProblem, missing_balance
 from ..model.motions import MotionSpec, Workspace
 from ..motion_analysis import AlongMotions, along_motions
-from ..model.balance import BalanceProblem, RotorBalanceProblem, missing_balance
 from . import rotors
 from .convex import ConvexSolution, ConvexSolver
 from .feasibility import ROUNDING_TOLERANCE
@@ -252,8 +252,10 @@ class Optimizer:
 
 
     def _inertial(self, model: MechanismModel) -> CycleAnalysis | AlongMotions:
-        """A design's inertial loads, as the objective weighs them (loads and gravity left out):
-        over the revolution at the operating speed, or along the motions."""
+        """A design's inertial loads, as the objective weighs them (loads and gravity left out).
+
+        Over the revolution at the operating speed, or along the motions.
+        """
         data = self.data
         if data.speed is None:
             return along_motions(model, self.motions, workspace=self.workspace, loads=False)

@@ -16,11 +16,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..cycle import CycleAnalysis, cycle_analysis
-from ..motion_analysis import AlongMotions, along_motions
 from ..errors import SolverError
 from ..model import Design
 from ..model import MechanismModel as Model
 from ..model.balance import Objective, ObjectiveTerm, PlacedMass, ShaftDesign
+from ..motion_analysis import AlongMotions, along_motions
 from ..quantities import QUANTITIES, squared_parts
 from ..rounding import Scales
 from .counterweights import Counterweight, added_mass, counterweights

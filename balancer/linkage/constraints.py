@@ -187,8 +187,9 @@ class Prism:
 
 @dataclass(frozen=True)
 class Driver:
-    """An input's driver: ``θ_link − θ_ground − θ_i = 0`` for input ``index`` (its multiplier
-    is minus the motor's torque).
+    """An input's driver: ``θ_link − θ_ground − θ_i = 0`` for input ``index``.
+
+    Its multiplier is minus the motor's torque.
     """
 
     link: int

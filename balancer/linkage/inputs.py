@@ -41,8 +41,10 @@ class InputState:
            rates: Sequence[ArrayLike] | NDArray[np.float64] | None = None,
            accelerations: Sequence[ArrayLike] | NDArray[np.float64] | None = None
            ) -> InputState:
-        """Numeric states: one row of positions per input (rad), rates and accelerations
-        likewise (default zero), broadcast to one shape ``(N,)`` (a scalar gives ``N = 1``).
+        """Numeric states: one row of positions per input (rad), rates and accelerations.
+
+        Rates and accelerations likewise (default zero), all broadcast to one shape ``(N,)``
+        (a scalar gives ``N = 1``).
         """
         count = len(positions)
         if count == 0:
@@ -60,8 +62,9 @@ class InputState:
     @classmethod
     def crank(cls, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0
               ) -> InputState:
-        """A one-input mechanism's crank states: angle (rad), rate (rad/s), acceleration
-        (rad/s²), broadcast together.
+        """A one-input mechanism's crank states, broadcast together.
+
+        Angle (rad), rate (rad/s), acceleration (rad/s²).
         """
         return cls.of([theta1], [omega1], [alpha1])
 

@@ -135,8 +135,9 @@ def numeric_table(structure: Structure, g: Group
 
 def numeric_start(structure: Structure, g: Group, theta1: NDArray[np.float64]
                   ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Where Newton's method starts for numeric group ``g`` of a one-input linkage at crank
-    angles ``theta1`` (:func:`~.numeric.start`).
+    """Where Newton's method starts for numeric group ``g`` of a one-input linkage.
+
+    At crank angles ``theta1`` (:func:`~.numeric.start`).
     """
     return numeric.start(structure, g, theta1, positions)
 

@@ -83,8 +83,10 @@ class Reactions:
     @classmethod
     def empty(cls, n: int, ground_points: Iterable[str], sliders: Iterable[str],
               inputs: int = 1) -> Reactions:
-        """Uninitialised arrays for ``n`` states at these ground points and ground sliders
-        (and ``inputs`` motors' torques)."""
+        """Uninitialised arrays for ``n`` states.
+
+        At these ground points and ground sliders, and ``inputs`` motors' torques.
+        """
         sliders = tuple(sliders)
         return cls(ground={p: np.empty(n, complex) for p in ground_points},
                    slider_normal={k: np.empty(n) for k in sliders},

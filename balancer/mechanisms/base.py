@@ -308,8 +308,10 @@ class Mechanism:
         return type(self)(self.model.with_links(links))
 
     def describe(self) -> str:
-        """A short word on how it moves: whether the crank turns fully (or how many inputs
-        drive it)."""
+        """A short word on how it moves.
+
+        Whether the crank turns fully, or how many inputs drive it.
+        """
         count = len(self.linkage.inputs)
         if count > 1:
             return f"{count} inputs"
@@ -397,8 +399,10 @@ class Mechanism:
         return kinematics.motion(self.structure, state)
 
     def pose_at(self, state: InputState) -> Pose:
-        """The links' frames at the inputs' positions of ``state`` (its rates unused): a
-        one-input mechanism's by :meth:`pose` (its closed form, where it has one)."""
+        """The links' frames at the inputs' positions of ``state`` (its rates unused).
+
+        A one-input mechanism's by :meth:`pose` (its closed form, where it has one).
+        """
         if state.size == 1:
             return self.pose(state.positions[0])
         return kinematics.positions(self.structure, state)

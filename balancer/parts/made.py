@@ -16,9 +16,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 from ..balance.counterweights import Counterweight
-from ..errors import SpecError
 from ..balance.result import BalanceResult
 from ..cycle import CycleAnalysis, cycle_analysis
+from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..model import Design, Link
 from ..model import MechanismModel as Model

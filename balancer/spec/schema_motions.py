@@ -1,5 +1,6 @@
-"""The spec's tables of a linkage's configuration space and motions (``[workspace]``,
-``[[motion]]``; DESIGN.md, "Mechanisms with several inputs"), listed in
+"""The spec's tables of a linkage's configuration space and motions.
+
+``[workspace]`` and ``[[motion]]`` (DESIGN.md, "Mechanisms with several inputs"), listed in
 :data:`balancer.spec.schema.SECTIONS`.
 """
 

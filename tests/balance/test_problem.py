@@ -440,7 +440,8 @@ def test_regressors_at_two_rates_in_one_pass_are_each_alone(name):
     data = numeric_problem(design)
     alone = [cycle_regressors(data.mechanism, data.states.positions[0], data.speed),
              cycle_regressors(data.mechanism, data.states.positions[0], 0.0, 1.0)]
-    full = cycle_regressors_at(data.mechanism, data.states.positions[0], [(data.speed, 0.0), (0.0, 1.0)])
+    full = cycle_regressors_at(data.mechanism, data.states.positions[0],
+                               [(data.speed, 0.0), (0.0, 1.0)])
     for together, single in zip([data.regressors, data.unit_acceleration], alone, strict=True):
         for key in ("shaking_force", "shaking_moment", "rocking_couple"):
             np.testing.assert_array_equal(getattr(together, key), getattr(single, key))

@@ -22,7 +22,6 @@ from balancer.mechanisms.engine.model import Engine
 from balancer.mechanisms.fourbar.model import FourBar
 from balancer.mechanisms.slidercrank.model import SliderCrank
 from balancer.model import Linkage, Operation, SimulationSettings
-from balancer.model.motions import MotionSpec
 from balancer.model.balance import (
     COUNTERWEIGHT_KEYS,
     ENGINE_OBJECTIVE_KEYS,
@@ -32,6 +31,7 @@ from balancer.model.balance import (
     Objective,
     ShaftFreedom,
 )
+from balancer.model.motions import MotionSpec
 from balancer.spec import MECHANISM_TYPES, design_from_dict, schema
 from balancer.spec.tables import Table
 
