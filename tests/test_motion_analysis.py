@@ -237,3 +237,28 @@ def test_the_workspace_keeps_the_states_within_the_joints_limits():
     full = design_from_dict(_balanced_parallelogram())
     everything, _ = workspace_states(mech, full.workspace)
     assert everything.count > state.count
+
+
+def test_optimize_balances_a_linkage_with_several_inputs_and_writes_its_spec(tmp_path):
+    spec = _balanced_parallelogram()
+    for name in ("p", "q"):  # the original, unbalanced: its cranks' centres on their lines
+        spec["links"][name]["com"] = {"e": -0.005, "f": 0.002}
+    spec["balance"] = {"force_balance": True, "objective": {"shaking_moment": 1.0},
+                       "p": {"counterweight": {"mass": [0.0, 3.0], "radius": 0.1}},
+                       "q": {"counterweight": {"mass": [0.0, 3.0], "radius": 0.1}}}
+    path = _spec_file(tmp_path, design_from_dict(spec))
+    out = tmp_path / "balanced.toml"
+    done = _run("optimize", str(path), "--json", "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    doc = json.loads(done.stdout)
+    assert doc["status"] == "optimal" and doc["force_balanced"]
+    assert doc["after"]["shaking_force"]["max"] <= 1e-12
+    assert "not yet verified by simulation" in done.stderr
+    # the balanced spec loads again and analyses as force-balanced over its workspace
+    done = _run("analyze", str(out), "--json")
+    assert done.returncode == 0, done.stderr
+    again = json.loads(done.stdout)
+    assert again["force_balanced"] and again["workspace"]["centre_of_mass_excursion"] <= 1e-14
+    done = _run("optimize", str(path), "--no-verify")
+    assert done.returncode == 0 and "along the motions" in done.stdout
+    assert "force-balanced: yes" in done.stdout

@@ -42,6 +42,7 @@ def motions_text(along: AlongMotions, spec: str | None = None) -> str:
              + (f"; gravity ({gravity[0]:g}, {gravity[1]:g}) m/s² included"
                 if any(gravity) else "; gravity not included")]
     planar = mech.in_one_plane()
+    size = mech.structure.length_scale()
     for analysis in analyses:
         loads = analysis.loads()
         sc = Scales([(key, figure.max) for key, figure in loads.items()])
@@ -52,7 +53,8 @@ def motions_text(along: AlongMotions, spec: str | None = None) -> str:
         lines += ["", f"motion {analysis.name}: {_law(analysis)}", "",
                   table(rows, ["quantity", "RMS", "max", "unit"]), "",
                   "the total centre of mass moves up to "
-                  f"{_length(analysis.centre_of_mass_excursion)} from its mean place along it"]
+                  f"{_length(analysis.centre_of_mass_excursion, size)} from its mean place "
+                  "along it"]
         reactions = []
         for point, values in analysis.reactions.ground.items():
             ex = reaction_extremes(values)
@@ -68,9 +70,10 @@ def motions_text(along: AlongMotions, spec: str | None = None) -> str:
 def force_balance_words(along: AlongMotions) -> str:
     """Whether the design is force-balanced for every motion, in words a designer pictures."""
     w = along.workspace
+    size = along.mechanism.structure.length_scale()
     over = ("" if w is None else
             f"; over the workspace ({w.states} of its {w.grid} grid states) the total centre of "
-            f"mass moves up to {_length(w.centre_of_mass_excursion)} from its mean place")
+            f"mass moves up to {_length(w.centre_of_mass_excursion, size)} from its mean place")
     if along.force_balanced:
         return ("force-balanced: yes (the total centre of mass stands still for every motion; "
                 f"the conditions hold to {along.force_balance_residual:.1e} of the links' first "
@@ -79,8 +82,14 @@ def force_balance_words(along: AlongMotions) -> str:
             f"{along.force_balance_residual:.2g} of the links' first moments{over})")
 
 
-def _length(metres: float) -> str:
-    """A length for a reader: mm below a metre, else m."""
+def _length(metres: float, size: float) -> str:
+    """A length for a reader: mm below a metre, else m.
+
+    0 where it is rounding of ``size``: within 1e-10 of the linkage's size, as every readable
+    figure (docs: outputs).
+    """
+    if abs(metres) <= 1e-10 * size:
+        return "0 mm"
     return f"{1e3 * metres:.4g} mm" if abs(metres) < 1.0 else f"{metres:.4g} m"
 
 

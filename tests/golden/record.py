@@ -122,10 +122,9 @@ def mask(text: str, folder: Path | None = None) -> str:
 #: a verb on every example (``tests/test_plausibility.py``).
 NOT_RUN: dict[str, str] = {}
 #: Shipped examples with several inputs, analysed along their motions (the motion whose CSV is
-#: recorded): ``analyze`` alone runs them so far (simulate, verify and optimize take a one-input
-#: mechanism; their structure, motions, mass properties and force balance are checked in
-#: ``tests/mechanisms/test_forbal2.py``).
-ALONG_MOTIONS = {"forbal2": "diamond"}
+#: recorded): ``analyze``, and ``optimize`` where the spec has ``[balance]`` (simulate and
+#: verify take a one-input mechanism so far).
+ALONG_MOTIONS = {"forbal2": "diamond", "pick_fivebar": "pick"}
 
 
 def examples() -> list[str]:
@@ -137,10 +136,19 @@ def commands(name: str) -> dict[str, list[str]]:
     """The command lines recorded for example ``name`` (``{tmp}`` is the output folder)."""
     spec = str(EXAMPLES / f"{name}.toml")
     if name in ALONG_MOTIONS:
-        return {"analyze.txt": ["analyze", spec],
-                "analyze.json": ["analyze", spec, "--json"],
-                "analyze.csv": ["analyze", spec, "--motion", ALONG_MOTIONS[name], "--csv",
-                                "{tmp}/out.csv"]}
+        along = {"analyze.txt": ["analyze", spec],
+                 "analyze.json": ["analyze", spec, "--json"],
+                 "analyze.csv": ["analyze", spec, "--motion", ALONG_MOTIONS[name], "--csv",
+                                 "{tmp}/out.csv"]}
+        if "[balance]" in (EXAMPLES / f"{name}.toml").read_text():
+            along.update({
+                "optimize.txt": ["optimize", spec, "--no-verify"],
+                "optimize.json": ["optimize", spec, "--json", "--no-verify"],
+                "optimize-convex.json": ["optimize", spec, "--json", "--no-verify",
+                                         "--backend", "convex"],
+                "optimize.toml": ["optimize", spec, "--no-verify", "--out", "{tmp}/out.toml"],
+            })
+        return along
     out = {
         "analyze.txt": ["analyze", spec],
         "analyze.json": ["analyze", spec, "--json"],
