@@ -7,7 +7,6 @@ from ..balance.optimizer import Backend
 from ..balance.optimizer import optimize as run_optimizer
 from ..balance.pareto import pareto_front
 from ..balance.result import BalanceResult
-from ..mechanisms import mechanism_of
 from ..model import Design
 
 
@@ -28,5 +27,4 @@ def pareto(design: Design, *, against: Against, points: int = 11) -> Front:
     against the mass·radius it adds (``"added-mass"``; :mod:`balancer.balance.rotor_front`).
     See :func:`balancer.balance.pareto.pareto_front`.
     """
-    mechanism_of(design.mechanism).require_one_input("a front over a revolution")
     return pareto_front(design, against, points)

@@ -79,12 +79,13 @@ class _Programs:
             self.mass_offset = (float(lay.c[data.mass_entries].sum()) - data.original_mass) \
                 / self.other_scale
         else:
-            if against == "driving-torque":
-                rows = reg.driving_torque
-            else:
+            if against == "driving-torque":  # (several inputs: every input's rows, stacked)
+                rows, count = reg.driving_torque, reg.driving_torque.shape[0]
+            else:  # (x and y: the mean square of the magnitude over the samples)
                 rows = np.vstack([reg.shaking_force.real, reg.shaking_force.imag])
+                count = n_samples
             factor = cast("NDArray[np.float64]",
-                          np.linalg.qr(rows / math.sqrt(n_samples), mode="r"))  # (as above)
+                          np.linalg.qr(rows / math.sqrt(count), mode="r"))  # (as above)
             self.other_scale = _scale(factor, data)
             self.other = Compressed.of(factor @ lay.T / self.other_scale,
                                        factor @ lay.c / self.other_scale)

@@ -18,6 +18,8 @@ import pytest
 from linkage.several_inputs_specs import A, B, parallelogram
 
 from balancer.balance.optimizer import optimize
+from balancer.balance.pareto import pareto_front
+from balancer.balance.problem import numeric_problem
 from balancer.balance.result import GAP_TOLERANCE
 from balancer.errors import SpecError
 from balancer.motion_analysis import along_motions, workspace_check
@@ -49,16 +51,26 @@ def _first_moment(link: dict) -> complex:
     return link["mass"] * complex(link["com"]["e"], link["com"]["f"])
 
 
+def _missing_first_moments() -> tuple[complex, complex]:
+    """What each arm must add: along p's direction p, r (at A from p's pivot) and s carry
+    first moments, along q's q, s (at B) and r; each arm cancels its direction's."""
+    links = parallelogram()["links"]
+    need_p = -(A * links["r"]["mass"] + _first_moment(links["s"])) - _first_moment(links["p"])
+    need_q = -(B * links["s"]["mass"] + _first_moment(links["r"])) - _first_moment(links["q"])
+    return need_p, need_q
+
+
+def _least_added_mass() -> float:
+    """Each arm's counterweight at its radius: its missing first moment over the radius, kg."""
+    return sum(abs(need) for need in _missing_first_moments()) / RADIUS
+
+
 def test_the_least_added_mass_is_each_cranks_missing_first_moment_over_its_radius():
     data = spec({"added_mass": 1.0, "shaking_moment": 0.0})
     result = optimize(design_from_dict(data))
     assert result.success and str(result.status) == "optimal"
-    links = data["links"]
-    # along p's direction p, r (at A from p's pivot) and s carry first moments; p must cancel
-    need_p = -(A * links["r"]["mass"] + _first_moment(links["s"])) - _first_moment(links["p"])
-    need_q = -(B * links["s"]["mass"] + _first_moment(links["r"])) - _first_moment(links["q"])
-    closed = (abs(need_p) + abs(need_q)) / RADIUS
-    assert result.added_mass == pytest.approx(closed, rel=10 * GAP_TOLERANCE)
+    need_p, need_q = _missing_first_moments()
+    assert result.added_mass == pytest.approx(_least_added_mass(), rel=10 * GAP_TOLERANCE)
     # each counterweight at its radius, opposite what it cancels
     for name, need in (("p", need_p), ("q", need_q)):
         w = result.counterweights[name]
@@ -106,3 +118,22 @@ def test_a_linkage_with_several_inputs_and_no_motion_is_refused():
     with pytest.raises(SpecError, match="no \\[\\[motion\\]\\]") as caught:
         optimize(design_from_dict(data))
     assert caught.value.key == "motion"
+
+
+@pytest.mark.parametrize("against", ["added-mass", "driving-torque"])
+def test_the_front_along_the_motions_is_the_redesigns_own(against):
+    design = design_from_dict(spec({"shaking_moment": 1.0}))
+    front = pareto_front(design, against, 4)
+    data = numeric_problem(design)
+    for point in front.points:
+        along = along_motions(data.linkage_of(point.x), design.motions, loads=False)
+        moment = np.sqrt(np.mean([np.mean(m.reactions.shaking_moment**2)
+                                  for m in along.motions]))
+        assert point.least == pytest.approx(moment, rel=1e-9)
+        if against == "driving-torque":  # the inputs' mean squares summed, motions alike
+            torque = np.sqrt(np.mean([sum(np.mean(t**2) for t in m.reactions.torques)
+                                      for m in along.motions]))
+            assert point.value == pytest.approx(torque, rel=1e-9)
+        assert point.lower_bound <= point.least * (1 + 1e-9)
+    if against == "added-mass":  # its least end: the least mass that balances it
+        assert front.points[0].value == pytest.approx(_least_added_mass(), rel=1e-5)
