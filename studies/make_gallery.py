@@ -4,12 +4,12 @@ Runs every study (``studies/*.py`` with a ``run``) in full mode into ``studies/o
 copies the figures listed in :data:`CHOSEN` into ``docs/gallery/`` under stable names, runs the
 ``balancer`` commands of :data:`COMMANDS` (docs/gallery.md's, word for word: the report pictures
 of ``plot --cycle``, ``plot --orders`` and ``verify --plot``, from designs balanced by
-``optimize`` into ``studies/out/gallery/``), and writes animations (:data:`ANIMATIONS`) of the
-example of Meijaard & van der Wijk (2020), Eq. 56 (``examples/meijaard2020.toml``) and of the
-single-cylinder engine (``examples/single_cylinder.toml``: its piston and counterweights) with
-:func:`balancer.plots.animate`. The gallery is committed,
-so each file must stay small (:data:`MAX_BYTES`); the script says which one does not and exits
-with status 1.
+``optimize`` into ``studies/out/gallery/``, and of ``plot --motion``), and writes animations
+(:data:`ANIMATIONS`) of the example of Meijaard & van der Wijk (2020), Eq. 56
+(``examples/meijaard2020.toml``) and of the single-cylinder engine
+(``examples/single_cylinder.toml``: its piston and counterweights) with
+:func:`balancer.plots.animate`. The gallery is committed, so each file must stay small
+(:data:`MAX_BYTES`); the script says which one does not and exits with status 1.
 
 Run ``python studies/make_gallery.py`` from anywhere; ``docs/gallery.md`` shows the figures with
 the commands and studies that make them.
@@ -72,6 +72,10 @@ COMMANDS = (
     ("single_cylinder_orders.png", (
         "balancer plot examples/single_cylinder.toml --orders "
         "docs/gallery/single_cylinder_orders.png --log",
+    )),
+    ("forbal2_diamond.png", (
+        "balancer plot examples/forbal2.toml --motion diamond --cycle "
+        "docs/gallery/forbal2_diamond.png",
     )),
 )
 #: Animations: (gallery name, example spec, frames per revolution).

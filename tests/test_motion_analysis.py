@@ -139,10 +139,11 @@ def test_a_bad_motion_option_is_refused(tmp_path, design, args, key):
     assert not (tmp_path / "x.csv").exists()
 
 
-@pytest.mark.parametrize("verb", [["simulate"], ["verify"], ["plot", "--cycle", "c.png"]])
+@pytest.mark.parametrize("verb", [["simulate"], ["verify"], ["plot", "--animate", "a.gif"]])
 def test_the_revolutions_verbs_say_they_turn_one_crank(tmp_path, design, verb):
+    # (plot --cycle draws a motion: tests/plots/test_motion_figure.py)
     spec = _spec_file(tmp_path, design)
-    done = _run(verb[0], str(spec), *verb[1:])
+    done = _run(verb[0], str(spec), *(str(tmp_path / a) if "." in a else a for a in verb[1:]))
     assert done.returncode == 2, done.stderr
     assert "mechanism.inputs: " in done.stderr and "turns one crank" in done.stderr
     assert "Traceback" not in done.stderr

@@ -8,7 +8,7 @@
 Each call takes a :class:`~balancer.model.Design` (from :func:`~balancer.spec.load_design`) and
 returns a result object; nothing here prints or writes files. The calls live in modules by
 what they need (:mod:`.analysis`, :mod:`.balancing`, :mod:`.motion`, :mod:`.results`,
-:mod:`.examples`), each
+:mod:`.examples`, :mod:`.drawings`), each
 loaded when one of its names is first used (PEP 562): a command that analyses does not load
 the optimisers.
 """
@@ -25,6 +25,7 @@ _EXPORTS = {
     "analyze_motions": "analysis",
     "cycle_analyses": "analysis",
     "example": "examples",
+    "motion_drawing": "drawings",
     "optimize": "balancing",
     "pareto": "balancing",
     "simulate": "motion",
@@ -38,6 +39,7 @@ __all__ = [
     "analyze_motions",
     "cycle_analyses",
     "example",
+    "motion_drawing",
     "optimize",
     "pareto",
     "simulate",
@@ -53,6 +55,7 @@ __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
 if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .analysis import analyze, analyze_motions, cycle_analyses
     from .balancing import optimize, pareto
+    from .drawings import motion_drawing
     from .examples import example
     from .motion import simulate, verify
     from .results import to_dict, to_table

@@ -11,7 +11,7 @@ from ..force_balance import force_balance_residual
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Route
 from ..model import Design, check_scales
-from ..motion_analysis import AlongMotions, motion_analysis, workspace_check
+from ..motion_analysis import AlongMotions, MotionAnalysis, motion_analysis, workspace_check
 
 
 def analyze(design: Design, *, route: Route | None = None,
@@ -88,6 +88,25 @@ def analyze_motions(design: Design, names: Sequence[str] | None = None, *,
     return AlongMotions(
         motions=tuple(analyses), force_balance_residual=force_balance_residual(mech),
         workspace=None if design.workspace is None else workspace_check(mech, design.workspace))
+
+
+def analyze_motion(design: Design, name: str | None = None) -> MotionAnalysis:
+    """The frame's loads along one of the design's motions (``None``: its first).
+
+    As :func:`analyze_motions` gives it (the spec's gravity), without the force balance and
+    the workspace's grid: what a figure of the motion draws.
+
+    Raises
+    ------
+    SpecError
+        If the spec has no motion or none of that name, or the motion does not fit the linkage.
+    AssemblyError
+        If a point's path leaves the workspace.
+    """
+    motion = design.motion(name)
+    gravity = design.operation.gravity if design.operation is not None else (0.0, 0.0)
+    with v.under(v.item("motion", design.motions.index(motion))):
+        return motion_analysis(design.mechanism, motion, gravity=gravity)
 
 
 def several_inputs(design: Design) -> bool:

@@ -190,14 +190,17 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "simulation and can be written as a complete spec.",
     ),
     "plot": (
-        "pictures for a report: one revolution's shaking, its orders, an animation",
+        "pictures for a report: one revolution's shaking, its orders, an animation; the "
+        "loads along a motion",
         "Pictures of one crank revolution at the operating speed. --cycle: the "
         "shaking force's polar diagram (and the rocking couple's, for links in several "
         "planes), and the shaking moment and driving torque over the crank angle, of the "
         "design and (for a balanced spec that names its [original]) of the original before "
         "it. --orders: the order table as bars, forward and backward whirl, before and after. "
-        "--animate: the linkage turning, its total centre of mass traced. The file type "
-        "comes from the extension.",
+        "--animate: the linkage turning, its total centre of mass traced. For a linkage with "
+        "several inputs, or with --motion, --cycle draws the loads along the spec's motion "
+        "([[motion]]) over time instead, with the mechanism at a few poses along it. The file "
+        "type comes from the extension.",
     ),
     "pareto": (
         "the exact front of shaking moment against driving torque, added mass or force",
@@ -345,7 +348,13 @@ def _plot_arguments(p: argparse.ArgumentParser) -> None:
     """``balancer plot``'s arguments."""
     _spec_and_force(p)
     p.add_argument("--cycle", metavar="PATH",
-                   help="write the figure of one revolution to PATH (.png, .svg or .pdf)")
+                   help="write the figure of one revolution (or, along a motion, of the "
+                   "motion) to PATH (.png, .svg or .pdf)")
+    p.add_argument("--motion", metavar="NAME",
+                   help="with --cycle: the loads along the spec's motion NAME ([[motion]]) "
+                   "over time and the mechanism at a few poses along it, instead of one "
+                   "revolution; a linkage with several inputs is drawn along its first motion "
+                   "without it")
     p.add_argument("--orders", metavar="PATH",
                    help="write the order table's bars to PATH (.png, .svg or .pdf)")
     p.add_argument("--animate", metavar="PATH",

@@ -1,15 +1,20 @@
-"""``balancer plot``: one revolution's figure, and the mechanism turning."""
+"""``balancer plot``: one revolution's figure, and the mechanism turning; or along a motion."""
 
 from __future__ import annotations
 
 import argparse
 import os
+import sys
+from pathlib import Path
 
 from ..api import cycle_analyses
+from ..api.analysis import analyze_motion, several_inputs
+from ..api.drawings import motion_drawing
 from ..errors import OutputError, SpecError
 from ..mechanisms import mechanism_of
+from ..model import Design
 from ..outputs import animation_type, figure_type
-from ..plots import animate, cycle_figure, orders_figure, save_figure
+from ..plots import animate, cycle_figure, motion_figure, orders_figure, save_figure
 from .common import load, output_path, wrote
 
 
@@ -38,6 +43,8 @@ def run(args: argparse.Namespace) -> int:
     if animation is not None:
         animation_type(animation, "--animate")  # its extension, and ffmpeg for an MP4
     design = load(args)
+    if args.motion is not None or several_inputs(design):
+        return _along_motion(args, design, cycle, orders, animation)
 
     mechanism_of(design.mechanism).require_full_revolution(
         "an animation of one revolution" if animation is not None else "a cycle plot")
@@ -56,4 +63,32 @@ def run(args: argparse.Namespace) -> int:
     for figure, path in figures:
         save_figure(figure, path)
         wrote(path)
+    return 0
+
+
+def _along_motion(args: argparse.Namespace, design: Design, cycle: Path | None,
+                  orders: Path | None, animation: Path | None) -> int:
+    """``plot --cycle`` along the spec's motion ``--motion`` (without it: its first).
+
+    The loads over time and the mechanism at a few poses along the motion, with the spec's
+    gravity (as ``analyze`` along its motions). The order bars and the animation are of one
+    crank revolution: refused here (exit code 2).
+    """
+    for option, path, what in (("--orders", orders, "an order table"),
+                               ("--animate", animation, "an animation")):
+        if path is None:
+            continue
+        mechanism_of(design.mechanism).require_one_input(what)  # (several inputs: its words)
+        raise SpecError(f"{what} is of one crank revolution, not of a motion: --motion draws "
+                        "its loads with --cycle PATH alone", key=option, value=str(path))
+    assert cycle is not None  # (one of the three was given)
+    motion = design.motion(args.motion)  # (without --motion: the first, said below)
+    if args.motion is None and len(design.motions) > 1:
+        others = ", ".join(m.name for m in design.motions[1:])
+        print(f"balancer: note: drawing motion {motion.name}, the spec's first; --motion NAME "
+              f"draws another ({others})", file=sys.stderr)
+    analysis = analyze_motion(design, motion.name)
+    figure = motion_figure(analysis, motion_drawing(analysis), title=design.title)
+    save_figure(figure, cycle)
+    wrote(cycle)
     return 0

@@ -364,8 +364,9 @@ class Mechanism:
         if len(inputs) > 1:
             raise SpecError(
                 f"{purpose} turns one crank, and this linkage has {len(inputs)} inputs; "
-                "`balancer analyze` gives its loads along its motions ([[motion]]), and the "
-                "other commands come to several inputs next", key="mechanism.inputs",
+                "`balancer analyze` gives its loads along its motions ([[motion]]) and "
+                "`balancer plot --cycle` draws them; the other commands come to several "
+                "inputs next", key="mechanism.inputs",
                 value=list(inputs))
 
     def require_full_revolution(self, purpose: str) -> AssemblyRange:

@@ -2,12 +2,14 @@
 
 Each ``plot_*`` function draws on the axes it is given (or a new figure's) and returns them;
 the ``*_figure`` functions assemble a report's figure from results (a cycle analysis, a
-simulation's verification, a front, a sweep's table), computing nothing themselves; and
-:func:`save_figure` writes one as PNG, SVG or PDF (from the extension), whole or not at all.
-matplotlib is imported by the functions that draw, not by importing this package.
+motion's analysis, a simulation's verification, a front, a sweep's table), computing nothing
+themselves; and :func:`save_figure` writes one as PNG, SVG or PDF (from the extension), whole
+or not at all. matplotlib is imported by the functions that draw, not by importing this package.
 
 =================  ===========================================================================
 ``revolution``     one revolution: the shaking force's polar diagram, moment and torque
+``along``          along a motion of the inputs: the loads over time, the mechanism at a few
+                   poses with its point's path and its centre of mass' track
 ``orders``         the order table as bars: forward and backward whirl, before and after
 ``motion``         a simulated motion: forces on the ground, shaking moment, the centre of
                    mass' path; ``balancer verify``'s figure
@@ -22,6 +24,13 @@ matplotlib is imported by the functions that draw, not by importing this package
 
 from __future__ import annotations
 
+from .along import (
+    MotionDrawing,
+    motion_figure,
+    plot_centre_of_mass_track,
+    plot_over_time,
+    plot_poses,
+)
 from .animation import animate, animation_figure
 from .atlas import sweep_figure
 from .fronts import front_figure
@@ -38,14 +47,19 @@ from .style import COLOURS, SERIES, save_figure, save_png
 __all__ = [
     "COLOURS",
     "SERIES",
+    "MotionDrawing",
     "animate",
     "animation_figure",
     "cycle_figure",
     "front_figure",
+    "motion_figure",
     "orders_figure",
+    "plot_centre_of_mass_track",
     "plot_com_path",
     "plot_orders",
     "plot_over_crank_angle",
+    "plot_over_time",
+    "plot_poses",
     "plot_reactions",
     "plot_rocking_couple_polar",
     "plot_shaking_force_polar",
