@@ -263,3 +263,13 @@ def test_optimize_balances_a_linkage_with_several_inputs_and_writes_its_spec(tmp
     done = _run("optimize", str(path), "--no-verify")
     assert done.returncode == 0 and "along the motions" in done.stdout
     assert "force-balanced: yes" in done.stdout
+
+
+def test_a_balanced_robots_shaking_force_reads_zero_in_the_report(tmp_path):
+    spec = _balanced_parallelogram()
+    path = _spec_file(tmp_path, design_from_dict(spec))
+    done = _run("analyze", str(path))
+    assert done.returncode == 0, done.stderr
+    row = next(line for line in done.stdout.splitlines() if line.startswith("shaking force"))
+    assert row.split()[2:4] == ["0", "0"], row  # (rounding of the motors' efforts: 1e-17 N)
+    assert "moves up to 0 mm from its mean place along it" in done.stdout

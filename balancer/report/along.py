@@ -43,9 +43,9 @@ def motions_text(along: AlongMotions, spec: str | None = None) -> str:
                 if any(gravity) else "; gravity not included")]
     planar = mech.in_one_plane()
     size = mech.structure.length_scale()
+    sc = _scales(along)
     for analysis in analyses:
         loads = analysis.loads()
-        sc = Scales([(key, figure.max) for key, figure in loads.items()])
         rows = [[_words(key)[0], sc.fmt(figure.rms, _words(key)[1]),
                  sc.fmt(figure.max, _words(key)[1]), _words(key)[1]]
                 for key, figure in loads.items()
@@ -65,6 +65,25 @@ def motions_text(along: AlongMotions, spec: str | None = None) -> str:
                                             "Ry min", "Ry max"])]
     lines += ["", force_balance_words(along)]
     return "\n".join(lines)
+
+
+def _scales(along: AlongMotions) -> Scales:
+    """The scales of the report's figures (:class:`Scales`), every motion's together.
+
+    Each load's largest under its unit, the forces at the ground points, and each input's
+    torque over the linkage's size as a force (a motor's effort: where the motors share the
+    one ground pivot, the force on it is the shaking force itself, and a balanced robot's
+    rounding would otherwise be its own scale).
+    """
+    size = along.mechanism.structure.length_scale()
+    sc = Scales()
+    for analysis in along.motions:
+        for key, figure in analysis.loads().items():
+            sc.add([(_words(key)[1], figure.max)])
+            if key.startswith("torque_"):
+                sc.add([("N", figure.max / size)])
+        sc.add(("N", reaction_extremes(v)["max"]) for v in analysis.reactions.ground.values())
+    return sc
 
 
 def force_balance_words(along: AlongMotions) -> str:
