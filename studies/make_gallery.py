@@ -33,7 +33,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 GALLERY = ROOT / "docs" / "gallery"
 STUDIES = ("meijaard2020_example", "meijaard2020_balanced", "wunderlich1964",
-           "bai2024_lie_group", "benchmarks_pb", "linkages", "atlas_and_fronts")
+           "bai2024_lie_group", "benchmarks_pb", "linkages", "atlas_and_fronts", "forbal2")
 #: (study, figure it writes, name in the gallery).
 CHOSEN = (
     ("meijaard2020_balanced", "comparison.png", "balancing_four_designs.png"),

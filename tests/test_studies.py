@@ -15,6 +15,7 @@ from types import ModuleType
 
 import numpy as np
 import pytest
+import test_forbal2 as forbal
 from conftest import PAPER_LENGTHS
 from helpers import drift_bound, growth, integration_bound
 
@@ -63,7 +64,7 @@ def run_quick(name: str, out: Path) -> dict:
         module.cycle_analysis = recording(module.cycle_analysis, analysed)
     results = module.run(out, quick=True)
     results["simulated"], results["analysed"] = simulated, analysed
-    report = (out / "report.md").read_text(encoding="utf-8")
+    report = (out / getattr(module, "REPORT", "report.md")).read_text(encoding="utf-8")
     assert report.startswith("# ") and "Source" in report
     assert results["figures"]
     for figure in results["figures"]:
@@ -302,9 +303,157 @@ def test_atlas_and_fronts(quick):
     assert ends[0] == pytest.approx(ends[1], rel=GAP_TOLERANCE)
 
 
+def _authors_bare_link(name: str) -> tuple[float, complex, float]:
+    """A Forbal-2 link without its ring, from the authors' URDF (tests/mechanisms/test_forbal2):
+    its mass (kg), centre ``e + i·f`` in the link's frame (m) and inertia about it (kg·m²);
+    link 22 with the end effector 0.2 m along it."""
+    parts = [forbal.URDF[name]]
+    if name == "link22":
+        m, (x, z), iyy = forbal.EE
+        parts.append((m, (forbal.LENGTH + x, z), iyy))
+    mass = math.fsum(m for m, _, _ in parts)
+    centre = complex(math.fsum(m * c[0] for m, c, _ in parts),
+                     math.fsum(m * c[1] for m, c, _ in parts)) / mass
+    inertia = math.fsum(i + m * abs(complex(*c) - centre) ** 2 for m, c, i in parts)
+    return mass, centre, inertia
+
+
+def _parallelogram_first_moments(links: dict) -> tuple[complex, complex]:
+    """K11, K21 (kg·m) of links ``{name: (mass, centre)}``: link 11's direction carries links
+    11, 22 and link 12's mass at link 11's end; link 21's links 21, 12 and link 22's mass."""
+    def first(name):
+        return links[name][0] * links[name][1]
+
+    l = forbal.LENGTH
+    return (first("link11") + first("link22") + links["link12"][0] * l,
+            first("link21") + first("link12") + links["link22"][0] * l)
+
+
+def test_forbal2(quick):
+    """The Forbal-2 study's numbers, each against a route of its own.
+
+    The bare robot against the authors' URDF inertials; the least added mass against the
+    parallelogram's closed form from those numbers; the published design's excursion against
+    the closed form of tests/mechanisms/test_forbal2.py over the workspace's grid; the loads
+    with gravity against the weight's closed forms; the front's points against their designs
+    analysed as linkages.
+    """
+    r = quick("forbal2")
+    study = load("forbal2")
+    assert {f.name for f in r["figures"]} == {"front.png", "diamond.png",
+                                              "least_mass_diamond.png"}
+    assert study.RINGS == forbal.RINGS and study.RING_RADII == forbal.RING_RADII
+    # The rings taken off the example's links give back the URDF's inertials (to the rounding
+    # of the example's combined numbers, given to 15 digits).
+    bare = r["designs"]["bare"].mechanism
+    authors = {name: _authors_bare_link(name) for name in forbal.URDF}
+    for name, (mass, centre, inertia) in authors.items():
+        link = bare.link(name)
+        assert link.mass == pytest.approx(mass, rel=1e-12), name
+        assert abs(complex(link.e, link.f) - centre) <= 1e-12 * abs(centre), name
+        assert link.inertia == pytest.approx(inertia, rel=1e-12), name
+    # The least added mass: each direction's missing first moment over the counterweights'
+    # radius (one on link 22 would spare its mass on link 11 and cost it again on link 21: it is
+    # not used). Certified: the design within GAP_TOLERANCE·scale² of the bound (an objective
+    # in kg, weight 1 (N·m)²/kg).
+    k11, k21 = _parallelogram_first_moments(authors)
+    radius = study.COUNTERWEIGHT.radius
+    closed = (abs(k11) + abs(k21)) / radius
+    result = r["result"]
+    assert result.status == "optimal"
+    assert abs(r["least_added_mass"] - closed) <= GAP_TOLERANCE * result.scale**2
+    assert result.lower_bound <= closed * (1 + 1e-12)
+    assert r["closed_form"] == pytest.approx(closed, rel=1e-12)
+    # ... each counterweight carrying its direction's first moment, at the radius (off the
+    # link's line where K is), none on link 22; the centre of mass then stands still.
+    cws = r["counterweights"]
+    assert set(cws) == {"link11", "link21"}
+    for cw, k in ((cws["link11"], k11), (cws["link21"], k21)):
+        assert abs(cw.first_moment + k) <= 1e-12
+        # (|c| = |K|/m: a mass within the certified gap δ of the least has |c| within δ/m)
+        assert abs(complex(cw.e, cw.f)) == pytest.approx(
+            radius, rel=GAP_TOLERANCE * result.scale**2 / cw.mass)
+        assert cw.f * k.imag < 0   # off the line, across from the links' own centres
+    assert r["least_excursion"] < 1e-12
+    assert r["analyses"]["least mass"]["inertial"].force_balanced
+    assert not r["analyses"]["published"]["inertial"].force_balanced
+    # The published design over the workspace's grid: the closed form of test_forbal2
+    # (O + (e^{iθ11}·K11 + e^{iθ21}·K21)/M, the authors' numbers with the rings), on the
+    # states whose joint 22 (θ11 − θ21 in a parallelogram) is within its limits.
+    design = r["designs"]["published"]
+    w = design.workspace
+    r11, r21 = w.range_of("link11"), w.range_of("link21")
+    g11, g21 = np.meshgrid(np.linspace(r11.low, r11.high, w.samples),
+                           np.linspace(r21.low, r21.high, w.samples), indexing="ij")
+    theta11, theta21 = -forbal.Q11 + g11.ravel(), forbal.Q21 + g21.ravel()
+    (joint,) = w.joints
+    change = np.remainder(g11.ravel() - g21.ravel() + np.pi, 2 * np.pi) - np.pi
+    kept = (joint.low <= change) & (change <= joint.high)
+    p11, p21, mass = forbal._first_moments()
+    centre = (np.exp(1j * theta11[kept]) * complex(*p11)
+              + np.exp(1j * theta21[kept]) * complex(*p21)) / mass
+    assert r["workspace"]["published"].states == kept.sum() == 630
+    assert r["published_excursion"] == pytest.approx(
+        np.max(np.abs(centre - centre.mean())), rel=1e-9)
+    # With gravity, every load differs from the inertial one by the weight's: the frame
+    # carries −i·g·M; each motor holds g·Re(e^{iθ}·K) of its direction; the moment about the
+    # origin gains −g·M·x_c (x_c from the closed form). Bare robot and published design, from
+    # the authors' numbers.
+    g = -study.GRAVITY[1]
+    first = {"bare": (k11, k21, sum(m for m, _, _ in authors.values())),
+             "published": (complex(*p11), complex(*p21), mass)}
+    for name, (c11, c21, total) in first.items():
+        inertial, weighed = (r["analyses"][name][w_] for w_ in ("inertial", "gravity"))
+        for a, b in zip(inertial.motions, weighed.motions, strict=True):
+            t11, t21 = a.state.positions
+            x_c = (study.AXIS + (np.exp(1j * t11) * c11 + np.exp(1j * t21) * c21) / total).real
+            scale = g * total * 0.5   # the weight times the robot's reach, N·m
+            ra, rb = a.reactions, b.reactions
+            assert np.max(np.abs(rb.shaking_force - ra.shaking_force + 1j * g * total)) \
+                <= 1e-12 * g * total
+            assert np.max(np.abs(rb.shaking_moment - ra.shaking_moment + g * total * x_c)) \
+                <= 1e-12 * scale
+            for i, (t, k) in enumerate(((t11, c11), (t21, c21))):
+                held = g * np.real(np.exp(1j * t) * k)
+                assert np.max(np.abs(rb.torques[i] - ra.torques[i] - held)) <= 1e-12 * scale
+    # The rings' reductions with gravity are the RMS the study reports.
+    for motion, row in r["reductions"]["gravity"].items():
+        for key, cut in row.items():
+            assert cut == pytest.approx(1 - r["rms"]["published"]["gravity"][motion][key]
+                                        / r["rms"]["bare"]["gravity"][motion][key])
+    # The front: from the least mass up, non-increasing; each point's design, rebuilt from
+    # its design vector and analysed as a linkage (not through the optimiser's regressors),
+    # has the point's added mass and RMS shaking moment, and a still centre of mass over the
+    # workspace's grid.
+    front = r["front"]
+    values = [p.value for p in front.points]
+    moments = [p.least for p in front.points]
+    scale = max(moments)
+    assert values == sorted(values) and front.force_balance
+    assert values[0] == pytest.approx(r["least_added_mass"], abs=1e-6)
+    assert all(b <= a + GAP_TOLERANCE * scale for a, b in zip(moments, moments[1:],
+                                                              strict=False))
+    for p, check in zip(front.points, r["front_checks"], strict=True):
+        assert check["added_mass"] == pytest.approx(p.value, abs=1e-12)
+        assert check["shaking_moment"] == pytest.approx(p.least, rel=1e-9)
+        assert check["excursion"] < 1e-12
+    # (the least-mass design is one of the designs the front's first point minimises over)
+    assert moments[0] <= r["least_point"][1] * (1 + 1e-12)
+    # With counterweights on links 11 and 21 only the points are certified, and the front is
+    # the same: the counterweight on link 22 buys nothing.
+    for p, q in zip(front.points, r["pair_front"].points, strict=True):
+        assert q.lower_bound <= q.least * (1 + 1e-12)
+        assert q.least - q.lower_bound <= GAP_TOLERANCE * scale
+        assert abs(p.least - q.least) <= GAP_TOLERANCE * scale
+    # The published design lies above the front (a convex front is below its chords).
+    published_mass, published_moment = r["published_point"]
+    assert published_mass == pytest.approx(sum(forbal.RINGS.values()), rel=1e-12)
+    assert published_moment > r["front_at_published"]
+
+
 @pytest.mark.parametrize("name", ["meijaard2020_example", "meijaard2020_balanced",
                                   "wunderlich1964", "bai2024_lie_group", "benchmarks_pb",
-                                  "linkages", "atlas_and_fronts"])
+                                  "linkages", "atlas_and_fronts", "forbal2"])
 def test_study_is_a_script_with_run(name):
     module = load(name)
     assert module.NAME == name and callable(module.run)
