@@ -55,6 +55,10 @@ from balancer.linkage.structure import Structure
 from balancer.mechanisms import mechanism_of
 from balancer.spec import load_design
 
+#: The whole module is of the full suite, not of the fast lane (`pytest -m "not slow"`): each
+#: case builds its oracle with sympy (a second or two), whichever of its tests runs.
+pytestmark = pytest.mark.slow
+
 EPS = float(np.finfo(float).eps)
 
 #: Largest condition number (2-norm) allowed at the sampled states for the oracle's matrices

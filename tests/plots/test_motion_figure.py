@@ -243,8 +243,10 @@ def forbal2_file(tmp_path):
     return spec, out
 
 
-@pytest.mark.parametrize(("suffix", "magic"), [(".png", b"\x89PNG\r\n\x1a\n"), (".svg", b"<svg"),
-                                               (".pdf", b"%PDF")])
+@pytest.mark.parametrize(("suffix", "magic"), [
+    (".png", b"\x89PNG\r\n\x1a\n"),
+    pytest.param(".svg", b"<svg", marks=pytest.mark.slow),  # (a second or so each: the full
+    pytest.param(".pdf", b"%PDF", marks=pytest.mark.slow)])  # suite's)
 def test_plot_motion_writes_the_type_its_extension_names(forbal2_file, capsys, suffix, magic):
     spec, out = forbal2_file
     path = out / f"diamond{suffix}"
@@ -264,6 +266,7 @@ def test_plot_motion_with_another_extension_is_refused_and_writes_nothing(forbal
     assert list(out.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_without_motion_several_inputs_draw_the_first_and_say_so(forbal2_file, capsys):
     spec, out = forbal2_file
     path = out / "first.png"
@@ -311,6 +314,7 @@ def _one_input_with_a_motion(z: float = 0.0) -> str:
     return dumps_design(design_from_dict(spec))
 
 
+@pytest.mark.slow
 def test_a_one_input_linkage_is_drawn_along_its_motion_when_asked(tmp_path, capsys):
     spec = tmp_path / "crank.toml"
     spec.write_text(_one_input_with_a_motion(), encoding="utf-8")
