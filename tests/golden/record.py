@@ -124,7 +124,8 @@ NOT_RUN: dict[str, str] = {}
 #: Shipped examples with several inputs, analysed along their motions (the motion whose CSV is
 #: recorded): ``analyze``, and ``optimize`` where the spec has ``[balance]`` (simulate and
 #: verify take a one-input mechanism so far).
-ALONG_MOTIONS = {"forbal2": "diamond", "pick_fivebar": "pick"}
+ALONG_MOTIONS = {"forbal2": "diamond", "pick_fivebar": "pick", "fivebar_5r": "stroke",
+                 "three_rrr": "shake"}
 
 
 def examples() -> list[str]:
