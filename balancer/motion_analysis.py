@@ -294,16 +294,22 @@ class AlongMotions:
 
     @cached_property
     def summary(self) -> CycleSummary:
-        """Each load's RMS and largest magnitude over every motion's samples.
+        """Each load's RMS and largest magnitude along the motions.
 
-        The driving torque's: over every input's torque.
+        The RMS as a balancing weighs it (:meth:`load`: each motion alike; the driving torque's
+        the root of the inputs' mean squares summed), the maximum over every sample (the
+        driving torque's over every input's).
         """
         r = self.reactions
+
+        def figure(key: str, values: NDArray[Any]) -> Figure:
+            return Figure(rms=Figure.of(self.load(key)).rms, max=Figure.of(values).max)
+
         return CycleSummary(
-            shaking_force=Figure.of(r.shaking_force),
-            shaking_moment=Figure.of(r.shaking_moment),
-            driving_torque=Figure.of(np.concatenate(r.torques)),
-            rocking_couple=Figure.of(r.rocking_couple),
+            shaking_force=figure("shaking_force", r.shaking_force),
+            shaking_moment=figure("shaking_moment", r.shaking_moment),
+            driving_torque=figure("driving_torque", np.concatenate(r.torques)),
+            rocking_couple=figure("rocking_couple", r.rocking_couple),
             ground={p: Figure.of(v) for p, v in r.ground.items()},
             slider_normal={k: Figure.of(v) for k, v in r.slider_normal.items()},
             slider_couple={k: Figure.of(v) for k, v in r.slider_couple.items()})

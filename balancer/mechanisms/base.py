@@ -364,9 +364,9 @@ class Mechanism:
         if len(inputs) > 1:
             raise SpecError(
                 f"{purpose} turns one crank, and this linkage has {len(inputs)} inputs; "
-                "`balancer analyze` gives its loads along its motions ([[motion]]) and "
-                "`balancer plot --cycle` draws them; the other commands come to several "
-                "inputs next", key="mechanism.inputs",
+                "along its motions ([[motion]]) `balancer analyze` gives its loads, `plot "
+                "--cycle` draws them, and `optimize`, `pareto` and `sweep` balance it; "
+                "simulations come to several inputs next", key="mechanism.inputs",
                 value=list(inputs))
 
     def require_full_revolution(self, purpose: str) -> AssemblyRange:

@@ -16,6 +16,7 @@ from ..balance.result import InfeasibleError
 from ..cycle import cycle_analysis, one_thread
 from ..errors import AssemblyError, LockupError, SolverError, SpecError
 from ..model import Design
+from ..motion_analysis import along_motions
 from ..spec import design_from_dict
 from .keys import with_values
 
@@ -32,10 +33,15 @@ def _empty_row(values: dict[str, float], index: int) -> dict[str, Any]:
 
 
 def _own_figures(design: Design) -> dict[str, float]:
-    """The design's own inertial figures at the operating speed (the ``before`` columns)."""
-    assert design.operation is not None  # (the sweep has checked the spec's)
-    summary = cycle_analysis(design.mechanism, design.operation.speed,
-                             design.operation.samples, loads=False).summary
+    """The design's own inertial figures (the ``before`` columns).
+
+    At the operating speed, or along its motions (a linkage with several inputs).
+    """
+    if design.operation is None:  # (the sweep has checked: several inputs, with motions)
+        summary = along_motions(design.mechanism, design.motions, loads=False).summary
+    else:
+        summary = cycle_analysis(design.mechanism, design.operation.speed,
+                                 design.operation.samples, loads=False).summary
     return {"shaking_moment_before": summary.shaking_moment.rms,
             "shaking_force_before": summary.shaking_force.rms,
             "rocking_couple_before": summary.rocking_couple.rms}
@@ -81,7 +87,7 @@ def analyse_point(data: dict[str, Any], values: dict[str, float], index: int
     row = _empty_row(values, index)
     try:
         design = design_from_dict(with_values(data, values))
-        if design.operation is None:
+        if design.operation is None and not design.motions:
             raise SpecError("missing required key", key="operation.speed")
         row.update(_own_figures(design), status="analysed")
     except (AssemblyError, LockupError, SpecError) as exc:

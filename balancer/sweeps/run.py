@@ -182,16 +182,16 @@ def sweep(spec: str | os.PathLike[str], varies: Sequence[Vary], out: str | os.Pa
         raise SpecError(f"not valid TOML: {exc}", value=str(spec)) from None
 
     design = design_from_dict(data, source=str(spec))  # the spec itself must be valid
-    try:
-        mechanism_of(design.mechanism).require_one_input("a sweep")
-    except SpecError as exc:
-        raise exc.with_source(str(spec)) from None
+    several = len(mechanism_of(design.mechanism).linkage.inputs) > 1
     if not perturbs and design.balance is None:
         missing = missing_balance(design.mechanism)
         raise SpecError(f"{missing.detail}; a sweep balances each point as the spec's [balance] "
                         "asks (or give --perturb to analyse perturbed designs)",
                         key="balance", source=str(spec))
-    if design.operation is None:
+    if several and not design.motions:
+        raise SpecError("a linkage with several inputs is swept along its motions: the spec "
+                        "has no [[motion]]", key="motion", source=str(spec))
+    if design.operation is None and not several:
         raise SpecError("missing required key: the figures are taken at the operating speed",
                         key="operation.speed", source=str(spec))
     if perturbs and varies:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import copy
 
 import numpy as np
+import pyarrow.parquet as pq
 import pytest
 from linkage.several_inputs_specs import A, B, parallelogram
 
@@ -24,6 +25,8 @@ from balancer.balance.result import GAP_TOLERANCE
 from balancer.errors import SpecError
 from balancer.motion_analysis import along_motions, workspace_check
 from balancer.spec.reader import design_from_dict
+from balancer.spec.writer import dumps_design
+from balancer.sweeps import Vary, sweep
 
 RADIUS = 0.1
 
@@ -137,3 +140,24 @@ def test_the_front_along_the_motions_is_the_redesigns_own(against):
         assert point.lower_bound <= point.least * (1 + 1e-9)
     if against == "added-mass":  # its least end: the least mass that balances it
         assert front.points[0].value == pytest.approx(_least_added_mass(), rel=1e-5)
+
+
+def test_a_sweep_balances_each_point_along_the_motions(tmp_path):
+    """A sweep over the coupler r's mass: each point's least added mass is its closed form's
+    (each arm's missing first moment over its radius, r's mass entering along p's)."""
+    path = tmp_path / "pick.toml"
+    path.write_text(dumps_design(design_from_dict(spec({"added_mass": 1.0,
+                                                        "shaking_moment": 0.0}))))
+    out = tmp_path / "sweep.parquet"
+    sweep(path, [Vary("links.r.mass", 0.05, 0.2, 3)], out, workers=0)
+    rows = pq.read_table(out).to_pylist()
+    assert [r["status"] for r in rows] == ["optimal"] * 3
+    links = parallelogram()["links"]
+    for row in rows:
+        mass = row["links.r.mass"]
+        r = dict(links["r"], mass=mass)
+        need_p = -(A * mass + _first_moment(links["s"])) - _first_moment(links["p"])
+        need_q = -(B * links["s"]["mass"] + _first_moment(r)) - _first_moment(links["q"])
+        closed = (abs(need_p) + abs(need_q)) / RADIUS
+        assert row["added_mass"] == pytest.approx(closed, rel=10 * GAP_TOLERANCE)
+        assert row["shaking_force_after"] <= 1e-12 < row["shaking_force_before"]
