@@ -247,6 +247,8 @@ class AlongMotions:
     workspace: WorkspaceCheck | None = None
     #: The workspace the check was made over (``None``: none).
     workspace_spec: Workspace | None = None
+    #: Each motion's weight as a balancing weighs it (:meth:`load`; ``None``: alike).
+    weights: tuple[float, ...] | None = None
 
     @property
     def force_balanced(self) -> bool:
@@ -320,7 +322,7 @@ class AlongMotions:
         Each motion's samples weighted by its share (:func:`motion_weights`), every input's
         torque stacked for ``driving_torque`` (its mean square the sum of theirs).
         """
-        scale = motion_weights([m.t.size for m in self.motions])
+        scale = motion_weights([m.t.size for m in self.motions], self.weights)
         r = self.reactions
         if key == "driving_torque":
             m = len(r.torques)
@@ -328,22 +330,28 @@ class AlongMotions:
         return np.asarray(getattr(r, key)) * scale
 
 
-def motion_weights(counts: Sequence[int]) -> NDArray[np.float64]:
-    """Each sample's factor when motions of ``counts`` samples are weighted equally.
+def motion_weights(counts: Sequence[int], weights: Sequence[float] | None = None
+                   ) -> NDArray[np.float64]:
+    """Each sample's factor when motions of ``counts`` samples are weighted by ``weights``.
 
-    Motion ``k``'s samples are multiplied by ``√(N/(K·N_k))`` (``N`` in all, ``K`` motions),
-    so that the mean square over all samples is the mean over the motions of each one's.
+    Motion ``k``'s samples are multiplied by ``√(N·w_k/(W·N_k))`` (``N`` in all, ``W`` the
+    weights' sum; equal weights by default), so that the mean square over all samples is the
+    weighted mean over the motions of each one's.
     """
-    total, count = sum(counts), len(counts)
-    return np.concatenate([np.full(n, math.sqrt(total / (count * n))) for n in counts])
+    total = sum(counts)
+    w = [1.0] * len(counts) if weights is None else [float(x) for x in weights]
+    whole = sum(w)
+    return np.concatenate([np.full(n, math.sqrt(total * wk / (whole * n)))
+                           for n, wk in zip(counts, w, strict=True)])
 
 
 def along_motions(model: MechanismModel | Mechanism, motions: Sequence[MotionSpec], *,
                   workspace: Workspace | None = None, gravity: tuple[float, float] = (0.0, 0.0),
-                  loads: bool = True) -> AlongMotions:
+                  loads: bool = True, weights: Sequence[float] | None = None) -> AlongMotions:
     """:func:`motion_analysis` of each motion, with the force balance and the workspace's."""
     mech = model if isinstance(model, Mechanism) else mechanism_of(model)
     analyses = tuple(motion_analysis(mech, m, gravity=gravity, loads=loads) for m in motions)
     return AlongMotions(motions=analyses, force_balance_residual=force_balance_residual(mech),
                         workspace=None if workspace is None else workspace_check(mech, workspace),
-                        workspace_spec=workspace)
+                        workspace_spec=workspace,
+                        weights=None if weights is None else tuple(weights))

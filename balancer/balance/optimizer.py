@@ -258,7 +258,9 @@ class Optimizer:
         """
         data = self.data
         if data.speed is None:
-            return along_motions(model, self.motions, workspace=self.workspace, loads=False)
+            weights = data.problem.weights_of([m.name for m in self.motions])
+            return along_motions(model, self.motions, workspace=self.workspace, loads=False,
+                                 weights=weights)
         return cycle_analysis(model, data.speed, data.samples, route="newton-euler",
                               loads=False)
 

@@ -181,7 +181,8 @@ def _along_motions(design: Design, problem: BalanceProblem, mech: Mechanism) -> 
         [np.concatenate([p.positions[j] for p in parts]) for j in range(parts[0].size)],
         [np.concatenate([p.rates[j] for p in parts]) for j in range(parts[0].size)],
         [np.concatenate([p.accelerations[j] for p in parts]) for j in range(parts[0].size)])
-    scale = motion_weights([p.count for p in parts])[:, None]
+    weights = problem.weights_of([m.name for m in design.motions])
+    scale = motion_weights([p.count for p in parts], weights)[:, None]
     with np.errstate(all="ignore"):
         f = mech.regressors(mech.motion_at(states))
     torques = np.vstack([np.asarray(t) * scale for t in f.input_torques])

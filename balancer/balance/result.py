@@ -248,10 +248,11 @@ class BalanceResult:
         if isinstance(self.before, AlongMotions):
             motions = [a.motion for a in self.before.motions]
             workspace = self.before.workspace_spec
+            weights = self.before.weights
             return (along_motions(self.original, motions, gravity=self.gravity,
-                                  workspace=workspace),
+                                  workspace=workspace, weights=weights),
                     along_motions(self.linkage, motions, gravity=self.gravity,
-                                  workspace=workspace))
+                                  workspace=workspace, weights=weights))
         speed, samples = self.before.speed, self.before.samples
         original, balanced = (cycle_analysis(model, speed, samples, gravity=self.gravity)
                               for model in (self.original, self.linkage))

@@ -236,11 +236,15 @@ class BalanceProblem:
     links
         What may change on each listed link, by name (a dict is accepted); a link not listed
         stays as it is.
+    motion_weights
+        A linkage with several inputs: each named motion's weight in the objective (one not
+        named weighs 1), by name (a dict is accepted).
     """
 
     force_balance: bool = True
     objective: Objective = field(default_factory=Objective)
     links: tuple[tuple[str, LinkFreedom], ...] = ()
+    motion_weights: tuple[tuple[str, float], ...] = ()
     #: The figure a balancing of this kind is about, as a sweep's atlas shows it.
     headline: ClassVar[str] = "shaking_moment"
 
@@ -248,6 +252,15 @@ class BalanceProblem:
         """Store ``links`` as pairs (a dict is accepted)."""
         links = self.links.items() if isinstance(self.links, dict) else self.links
         object.__setattr__(self, "links", tuple((str(n), f) for n, f in links))
+        weights = (self.motion_weights.items() if isinstance(self.motion_weights, dict)
+                   else self.motion_weights)
+        checked = tuple((str(n), v.nonnegative(w, f"balance.motions.{n}")) for n, w in weights)
+        object.__setattr__(self, "motion_weights", checked)
+
+    def weights_of(self, names: Sequence[str]) -> tuple[float, ...]:
+        """The weights of the motions called ``names`` (1 where none is given)."""
+        given = dict(self.motion_weights)
+        return tuple(given.get(name, 1.0) for name in names)
 
     def link(self, name: str) -> LinkFreedom | None:
         """The freedom of link ``name``, or ``None`` if it is not listed."""

@@ -220,6 +220,17 @@ class Design:
                 if count != 2:
                     raise SpecError(f"must name a point that joins two links (it is on {count})",
                                     key=f"workspace.joints.{r.name}")
+        balance = self.balance
+        weights = getattr(balance, "motion_weights", ())
+        names = [m.name for m in self.motions]
+        for name, _ in weights:
+            if name not in names:
+                raise SpecError(f"names no motion of the spec ({', '.join(names) or 'none'})",
+                                key=f"balance.motions.{name}")
+        given = dict(weights)
+        if weights and self.motions and not any(given.get(n, 1.0) > 0 for n in names):
+            raise SpecError("every motion weighs 0: one at least must count",
+                            key="balance.motions")
         seen: set[str] = set()
         for i, motion in enumerate(self.motions):
             key = v.item("motion", i)

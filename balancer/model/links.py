@@ -280,7 +280,7 @@ class _PeriodicCubic:
 #: The name of the general linkage's frame: a link without mass whose points do not move.
 GROUND = "ground"
 #: Names a moving link may not have: the keys of ``[balance]`` beside the links' tables.
-RESERVED_LINK_NAMES = ("objective", "force_balance")
+RESERVED_LINK_NAMES = ("objective", "force_balance", "motions")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -146,7 +146,7 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
     mech = mechanism_of(mechanism)
     names = mech.link_names
     for name, value in table.data.items():  # a table for a link the mechanism does not have
-        if isinstance(value, dict) and name not in ("objective", *names):
+        if isinstance(value, dict) and name not in ("objective", "motions", *names):
             raise SpecError(f"names no moving link of the {mech.kind}{hint(name, names)} (its "
                             f"moving links are {', '.join(names)}; the frame stays as it is)",
                             key=table.key(name))
@@ -169,6 +169,12 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
             }
         )
         sub.finish()
+    weights: dict[str, float] = {}
+    sub = table.table("motions", required=False)
+    if sub is not None:
+        sub.known = tuple(sub.data)
+        weights = {name: sub.nonnegative(name) for name in sub.data}
+        sub.finish()
     points = tuple(p for p, _ in mech.linkage.points)
     links: dict[str, LinkFreedom] = {}
     for name in names:
@@ -177,7 +183,7 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
             links[name] = _read_link_freedom(sub, points)
     table.finish()
     problem = BalanceProblem(force_balance=force_balance, objective=objective,
-                             links=tuple(links.items()))
+                             links=tuple(links.items()), motion_weights=tuple(weights.items()))
     check_problem(problem, mech)
     return problem
 
@@ -210,6 +216,9 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
           if w.rocking_couple else []),
         f"added_mass = {toml.number(w.added_mass)}  # (N·m)²/kg",
     ]
+    if problem.motion_weights:
+        lines += ["", "[balance.motions]  # each motion's weight in the objective"]
+        lines += [f"{toml.key(name)} = {toml.number(w)}" for name, w in problem.motion_weights]
     for name, freedom in problem.links:
         lines += ["", f"[balance.{toml.key(name)}]"]
         if freedom.mass is not None:

@@ -423,10 +423,21 @@ SECTIONS: tuple[Section, ...] = (
                 Key("objective", "table", "the defaults below",
                     "The weights of the objective (the table below).",
                     example="{ shaking_moment = 1.0 }"),
+                Key("motions", "table", "each motion alike",
+                    "A linkage with several inputs: each motion's weight in the objective's "
+                    "mean squares (`[balance.motions]`, below).", (LINKAGE,),
+                    example="{ turn = 2.0 }"),
             ),
             names=Key("<link>", "table", "—",
                       "A moving link that may change, by its name: its bounds (the table "
                       "below).")),
+    Section("balance.motions", "The weight of each motion in the objective of a linkage with "
+            "several inputs: its terms are the mean squares along the motions, each motion's "
+            "mean weighted by its share of the weights (those not named weigh 1).", (),
+            (LINKAGE,),
+            names=Key("<motion>", "—", "1",
+                      "A motion's weight, by its name: at least 0; one of them positive.",
+                      (LINKAGE,), example="2.0")),
     Section("balance.objective", "The weights of the objective J = w_M·mean(Msh²) + "
             "w_τ·mean(τ²) + w_F·mean(|F̄sh|²) + w_R·mean(|M̄rock|²) + w_m·Δm, in (N·m)², over "
             "the sampled crank angles; the inertial shaking only (applied loads are left "
@@ -565,7 +576,8 @@ def _for_linkages(section: Section) -> Section:
     def only(key: Key) -> Key:
         return replace(key, mechanisms=tuple(m for m in key.mechanisms if m in _LINKAGES))
 
-    return replace(section, keys=tuple(only(k) for k in section.keys), mechanisms=_LINKAGES,
+    mechanisms = tuple(m for m in section.mechanisms if m in _LINKAGES)
+    return replace(section, keys=tuple(only(k) for k in section.keys), mechanisms=mechanisms,
                    names=None if section.names is None else only(section.names))
 
 
@@ -708,7 +720,7 @@ def pattern(path: str) -> str:
     parts = [_INDEX.sub("[]", part) for part in path.split(".")] if path else []
     if len(parts) >= 2 and parts[0] in ("links", "original", "balance"):
         kept = {"links": ("ground",), "original": ("balance_shafts[]",),
-                "balance": ("objective", "counterweights", "shafts", "shafts[]")}.get(
+                "balance": ("objective", "counterweights", "shafts", "shafts[]", "motions")}.get(
             parts[0], ())
         if parts[1] not in kept:
             parts[1] = "<link>"

@@ -12,6 +12,7 @@ inverse dynamics along each motion (not the problem's regressors), each motion w
 from __future__ import annotations
 
 import copy
+import tomllib
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -161,3 +162,26 @@ def test_a_sweep_balances_each_point_along_the_motions(tmp_path):
         closed = (abs(need_p) + abs(need_q)) / RADIUS
         assert row["added_mass"] == pytest.approx(closed, rel=10 * GAP_TOLERANCE)
         assert row["shaking_force_after"] <= 1e-12 < row["shaking_force_before"]
+
+
+def test_a_motions_weight_weighs_its_mean_squares():
+    """``[balance.motions] wave = 3``: J is (3·J_wave + J_swing)/4, from the redesign's own
+    inverse dynamics; the weights are read, written back and refused where they name no
+    motion."""
+    data = spec({"shaking_moment": 1.0})
+    data["balance"]["motions"] = {"wave": 3.0}
+    design = design_from_dict(data)
+    result = optimize(design)
+    assert result.success
+    along = along_motions(result.linkage, design.motions, loads=False)
+    means = [np.mean(m.reactions.shaking_moment**2) for m in along.motions]
+    assert result.objective == pytest.approx((3 * means[0] + means[1]) / 4, rel=1e-9)
+    again = design_from_dict(tomllib.loads(dumps_design(design)))
+    assert again.balance == design.balance
+    data["balance"]["motions"] = {"nowhere": 1.0}
+    with pytest.raises(SpecError, match="names no motion") as caught:
+        design_from_dict(data)
+    assert caught.value.key == "balance.motions.nowhere"
+    data["balance"]["motions"] = {"wave": 0.0, "swing": 0.0}
+    with pytest.raises(SpecError, match="every motion weighs 0"):
+        design_from_dict(data)

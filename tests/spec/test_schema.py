@@ -115,7 +115,9 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
         data["original"] = original_of(data)
     if pattern.startswith("springs") or (pattern == "" and name == "springs"):
         data["springs"] = [dict(SPRING)]
-    if pattern.startswith("motion") or (pattern == "" and name == "motion"):
+    weighing = mechanism == schema.LINKAGE and (
+        pattern == "balance.motions" or (pattern == "balance" and name == "motions"))
+    if pattern.startswith("motion") or (pattern == "" and name == "motion") or weighing:
         data["motion"] = [copy.deepcopy(MOTION)]
     if pattern.startswith("workspace") or (pattern == "" and name == "workspace"):
         data["workspace"] = {"crank": [-0.5, 0.5]}
