@@ -105,8 +105,9 @@ def analyze_motion(design: Design, name: str | None = None) -> MotionAnalysis:
     """
     motion = design.motion(name)
     gravity = design.operation.gravity if design.operation is not None else (0.0, 0.0)
+    mech = mechanism_of(design.mechanism)  # (its errors are the mechanism's, not the motion's)
     with v.under(v.item("motion", design.motions.index(motion))):
-        return motion_analysis(design.mechanism, motion, gravity=gravity)
+        return motion_analysis(mech, motion, gravity=gravity)
 
 
 def several_inputs(design: Design) -> bool:

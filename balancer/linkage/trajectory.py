@@ -158,8 +158,26 @@ def input_state(structure: Structure, spec: MotionSpec,
             raise SpecError(f"each waypoint must give one angle per input "
                             f"({', '.join(structure.linkage.inputs)})", key="path",
                             value=list(spec.path[0]))
-        return InputState.of(list((p + reference).T), list(v.T), list(a.T))
+        state = InputState.of(list((p + reference).T), list(v.T), list(a.T))
+        _check_assembles(structure, spec, state, times, p)
+        return state
     return _inverse_kinematics(structure, spec, p, v, a)
+
+
+def _check_assembles(structure: Structure, spec: MotionSpec, state: InputState,
+                     times: NDArray[np.float64], p: NDArray[np.float64]) -> None:
+    """Raise where the inputs' own path puts the linkage where it does not assemble."""
+    with np.errstate(all="ignore"):
+        pose = kinematics.positions(structure, state)
+    count = times.size
+    kept = np.ones(count, dtype=bool)
+    for angle in pose.angles:
+        kept &= np.isfinite(np.broadcast_to(np.asarray(angle, dtype=float), (count,)))
+    if not kept.all():
+        i = int(np.argmin(kept))
+        raise AssemblyError(
+            f"the inputs' path leaves the workspace at t = {float(times[i]):g} s (the linkage "
+            "does not assemble there)", key="path", value=[float(x) for x in p[i]])
 
 
 def marker(structure: Structure, point: str) -> tuple[int, V]:

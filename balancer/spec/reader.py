@@ -128,9 +128,10 @@ def _read_motions(root: Table) -> tuple[MotionSpec, ...]:
         point = table.value("point", None)
         if point is not None and not isinstance(point, str):
             raise SpecError("must be the name of a point", key=table.key("point"), value=point)
+        name = table.text("name", default="")  # (its error names its own full key)
         with v.under(table.path):
             out.append(MotionSpec(
-                name=table.text("name", default=""), times=table.raw("times"),
+                name=name, times=table.raw("times"),
                 path=table.raw("path"), point=point,
                 law=table.value("law", "cubic"), acc_time=table.value("acc_time", None),
                 samples=table.value("samples", 400)))
