@@ -288,3 +288,18 @@ def test_a_balanced_robots_shaking_force_reads_zero_in_the_report(tmp_path):
     row = next(line for line in done.stdout.splitlines() if line.startswith("shaking force"))
     assert row.split()[2:4] == ["0", "0"], row  # (rounding of the motors' efforts: 1e-17 N)
     assert "moves up to 0 mm from its mean place along it" in done.stdout
+
+
+@pytest.mark.parametrize(("workspace", "key", "match"), [
+    ({"p": [0.1], "q": [-0.4, 0.4]}, "workspace.p", r"must be \[low, high\], two numbers"),
+    ({"p": [-0.4, 0.4], "q": [-0.4, 0.4], "joints": {"Z": [0.0, 1.0]}},
+     "workspace.joints.Z", "names no point of the linkage"),
+    ({"p": [-0.4, 0.4], "q": [-0.4, 0.4], "joints": {"A": [0.0, 1.0]}},
+     "workspace.joints.A", "joins two links \\(it is on 3\\)"),
+])
+def test_a_bad_workspace_is_refused_naming_its_key(workspace, key, match):
+    spec = _balanced_parallelogram()
+    spec["workspace"] = workspace
+    with pytest.raises(SpecError, match=match) as caught:
+        design_from_dict(spec)
+    assert caught.value.key == key

@@ -60,7 +60,7 @@ def _along_motions(args: argparse.Namespace, design: Design, csv_path: str | Non
     if csv_path is not None and args.motion is None and len(design.motions) > 1:
         raise SpecError("writes one motion's values: name it with --motion "
                         f"({', '.join(m.name for m in design.motions)})", key="--csv",
-                        value=csv_path)
+                        value=str(csv_path))
     try:
         analyses = analyze_motions(design, [args.motion] if args.motion else None,
                                    gravity=args.gravity)

@@ -215,7 +215,11 @@ class Design:
                     raise SpecError(f"names no input ({', '.join(inputs) or 'none'})",
                                     key=f"workspace.{r.name}")
             bodies = getattr(self.mechanism, "bodies", ())
+            points = {p for b in bodies for p in b.points}
             for r in self.workspace.joints:
+                if r.name not in points:
+                    raise SpecError(f"names no point of the linkage ({', '.join(sorted(points))})",
+                                    key=f"workspace.joints.{r.name}")
                 count = sum(r.name in b.points for b in bodies)
                 if count != 2:
                     raise SpecError(f"must name a point that joins two links (it is on {count})",

@@ -115,7 +115,10 @@ def _read_workspace(root: Table) -> Workspace | None:
 
 
 def _input_range(table: Table, name: str) -> InputRange:
-    low, high = v.vector2(table.raw(name), table.key(name))
+    raw = table.raw(name)
+    if isinstance(raw, str | bytes) or not hasattr(raw, "__len__") or len(raw) != 2:
+        raise SpecError("must be [low, high], two numbers", key=table.key(name), value=raw)
+    low, high = (v.number(x, table.key(name)) for x in raw)
     return InputRange(name=name, low=low, high=high)
 
 
