@@ -231,7 +231,7 @@ def _newton(structure: Structure, k: int, local: V, theta: NDArray[np.float64],
 
 
 #: Samples of a point's path solved one after another (the rest at once, from those).
-PATH_STEPS = 64
+PATH_STEPS = 24
 
 
 def _along_path(structure: Structure, spec: MotionSpec, k: int, local: V,
