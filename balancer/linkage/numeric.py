@@ -9,9 +9,10 @@ starts Newton's method, run on all the angles at once to rounding. Angles beyond
 continuation stopped (the group locks or cannot be assembled) are NaN.
 
 A linkage with several inputs has no one-dimensional table: each state is reached from the
-reference pose along the straight line in the inputs' space (:data:`PATH_STEPS` steps, each
-Newton's method from the linear extrapolation of the two before, all states at once); a state
-whose path meets a pose where the group cannot be assembled or locks is NaN.
+reference pose along the straight line in the inputs' space (:data:`PATH_STEPS` steps per
+radian of the largest input's change, each Newton's method from the linear extrapolation of
+the two before, all states at once); a state whose path meets a pose where the group cannot
+be assembled or locks is NaN.
 """
 
 from __future__ import annotations
@@ -34,9 +35,11 @@ from .vectors import NUMPY, Factor, Num, OpsLike, V
 #: each other.
 Positions = Callable[[Structure, InputState], Pose]
 
-#: Steps from the reference pose to each state along the line in the inputs' space, for a
-#: linkage with several inputs.
+#: Steps per radian from the reference pose to each state along the line in the inputs'
+#: space, for a linkage with several inputs (by the largest input's change; at least
+#: :data:`LEAST_PATH_STEPS`): a step of 1.2° at most.
 PATH_STEPS = 48
+LEAST_PATH_STEPS = 4
 
 #: Steps of the continuation table over one revolution.
 TABLE_STEPS = 720
@@ -310,7 +313,8 @@ def path_start(structure: Structure, g: Group, state: InputState, place: Positio
     """Where Newton's method starts for numeric group ``g`` of a linkage with several inputs.
 
     Each state is reached from the reference pose along the straight line in the inputs'
-    space, :data:`PATH_STEPS` steps (see the module docstring). Returns the group's
+    space, :data:`PATH_STEPS` steps per radian of the largest change (see the module
+    docstring). Returns the group's
     coordinates there, ``(N, 3·|g|)``, NaN where the path was lost, and where it was not.
     """
     count = state.count
@@ -323,8 +327,10 @@ def path_start(structure: Structure, g: Group, state: InputState, place: Positio
     q = np.tile(_coordinates(structure, g), (count, 1))
     previous = q.copy()
     kept = np.all(np.isfinite(target), axis=0)
-    for j in range(1, PATH_STEPS + 1):
-        at = reference[:, None] + (j / PATH_STEPS) * (target - reference[:, None])
+    reach = float(np.max(np.abs(target - reference[:, None])[:, kept], initial=0.0))
+    steps = max(LEAST_PATH_STEPS, math.ceil(PATH_STEPS * reach))
+    for j in range(1, steps + 1):
+        at = reference[:, None] + (j / steps) * (target - reference[:, None])
         pose = place(partial, InputState.of(list(at)))
         guess = q if j == 1 else 2 * q - previous
         with np.errstate(all="ignore"):
