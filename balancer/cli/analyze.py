@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 
 from ..api.analysis import analyze, analyze_motions, several_inputs
 from ..errors import SpecError
@@ -35,17 +36,9 @@ def run(args: argparse.Namespace) -> int:
     except SpecError as exc:
         _option_error(args, exc)
         raise
-    csv = analysis_csv(analysis) if csv_path is not None else None
-    if args.json:
-        text = dumps_json(analysis_json(analysis, spec=args.spec))
-    else:
-        text = analysis_text(analysis, spec=args.spec) + "\n"
-    if csv_path is not None:
-        assert csv is not None  # (made above for that path)
-        write_atomic(csv_path, csv)
-        wrote(csv_path)
-    sys.stdout.write(text)
-    return 0
+    return _emit(args, csv_path, lambda: analysis_csv(analysis),
+                 lambda: dumps_json(analysis_json(analysis, spec=args.spec)),
+                 lambda: analysis_text(analysis, spec=args.spec) + "\n")
 
 
 def _option_error(args: argparse.Namespace, exc: SpecError) -> None:
@@ -67,14 +60,19 @@ def _along_motions(args: argparse.Namespace, design: Design, csv_path: str | Non
     except SpecError as exc:
         _option_error(args, exc)
         raise
-    csv = motion_csv(analyses.motions[0]) if csv_path is not None else None
-    if args.json:
-        text = dumps_json(motions_json(analyses, spec=args.spec))
-    else:
-        text = motions_text(analyses, spec=args.spec) + "\n"
+    return _emit(args, csv_path, lambda: motion_csv(analyses.motions[0]),
+                 lambda: dumps_json(motions_json(analyses, spec=args.spec)),
+                 lambda: motions_text(analyses, spec=args.spec) + "\n")
+
+
+def _emit(args: argparse.Namespace, csv_path: str | None, csv: Callable[[], str],
+          json_text: Callable[[], str], table_text: Callable[[], str]) -> int:
+    """Make every output first, then write the CSV file whole and print: nothing partial."""
+    csv_text = csv() if csv_path is not None else None
+    text = json_text() if args.json else table_text()
     if csv_path is not None:
-        assert csv is not None  # (made above for that path)
-        write_atomic(csv_path, csv)
+        assert csv_text is not None  # (made above for that path)
+        write_atomic(csv_path, csv_text)
         wrote(csv_path)
     sys.stdout.write(text)
     return 0

@@ -163,6 +163,18 @@ def _objective_terms(result: BalanceResult) -> dict[str, dict[str, float | str]]
                      "after": after[t.name]} for t in result.weights.terms}
 
 
+def _objective_terms_lines(result: BalanceResult, sc: Scales, where: str) -> list[str]:
+    """The objective's terms as a table (none with one term: the headline says it)."""
+    if result.single_term is not None:
+        return []
+    rows = [[name.replace("_", " "), f"{t['weight']:.4g}",
+             sc.fmt(float(t["before"]), str(t["unit"])),
+             sc.fmt(float(t["after"]), str(t["unit"])), str(t["unit"])]
+            for name, t in _objective_terms(result).items()]
+    return ["objective J = Σ weight × mean square (added mass: weight × kg added), "
+            f"{where}:", table(rows, ["term", "weight", "RMS before", "RMS after", "unit"]), ""]
+
+
 #: What each kind of counterweight asks of the workshop.
 _COUNTERWEIGHT_KINDS = {
     "none": "unchanged",
@@ -358,15 +370,7 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis | AlongMotion
                               "max before", "max after", "unit"]))
     lines += [f"warning: {w}" for w in worse_figures(before, after)]
     lines.append("")
-    if result.single_term is None:
-        terms = _objective_terms(result)
-        rows = [[name.replace("_", " "), f"{t['weight']:.4g}",
-                 sc.fmt(float(t["before"]), str(t["unit"])),
-                 sc.fmt(float(t["after"]), str(t["unit"])), str(t["unit"])]
-                for name, t in terms.items()]
-        lines += ["objective J = Σ weight × mean square (added mass: weight × kg added), "
-                  "inertial shaking at the operating speed:",
-                  table(rows, ["term", "weight", "RMS before", "RMS after", "unit"]), ""]
+    lines += _objective_terms_lines(result, sc, "inertial shaking at the operating speed")
     rows = []
     for ob, oa in zip(before.orders, after.orders, strict=True):
         if ob.order not in (1.0, 2.0):
@@ -431,15 +435,8 @@ def _along_motions_text(result: BalanceResult, before: AlongMotions, after: Alon
                               "max before", "max after", "unit"]))
     lines += [f"warning: {w}" for w in worse_figures(before, after)]
     lines.append("")
-    if result.single_term is None:
-        terms = _objective_terms(result)
-        rows = [[name.replace("_", " "), f"{t['weight']:.4g}",
-                 sc.fmt(float(t["before"]), str(t["unit"])),
-                 sc.fmt(float(t["after"]), str(t["unit"])), str(t["unit"])]
-                for name, t in terms.items()]
-        lines += ["objective J = Σ weight × mean square (added mass: weight × kg added), "
-                  "inertial shaking along the motions, each weighted alike:",
-                  table(rows, ["term", "weight", "RMS before", "RMS after", "unit"]), ""]
+    lines += _objective_terms_lines(
+        result, sc, "inertial shaking along the motions, each motion by its weight")
     lines += [_parameters_text(result), "", counterweight_text(result.counterweights), "",
               force_balance_words(after)]
     return "\n".join(lines)
