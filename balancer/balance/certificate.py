@@ -164,14 +164,56 @@ def _sublevel_box(objective: ConvexObjective, lo: NDArray[np.float64], hi: NDArr
     rest = float(np.linalg.norm(po @ mid + objective.q)) + float(
         np.linalg.norm(po, axis=0) @ half)
     _, sv, vt = np.linalg.svd(P[:, free], full_matrices=False)
-    if sv.size < int(free.sum()):
-        return None
-    safe = sv - 64 * _EPS * sv[0] * max(P.shape)  # the SVD's own rounding
-    if not np.all(safe > 0):
-        return None
+    safe = sv - 64 * _EPS * sv[0] * max(P.shape) if sv.size else sv  # the SVD's own rounding
+    if sv.size < int(free.sum()) or not np.all(safe > 0):
+        return _bounded_below_box(P[:, free], lo[free], radius + rest, hi, free)
     rows = np.sqrt(((vt / safe[:, None]) ** 2).sum(axis=0))  # ‖row j of P_J⁺‖
     out = np.array(hi, dtype=float)
     out[free] = (radius + rest) * rows * (1 + 1e-9)
+    return out
+
+
+def _bounded_below_box(pj: NDArray[np.float64], low: NDArray[np.float64], reach: float,
+                       hi: NDArray[np.float64], free: NDArray[np.bool_]
+                       ) -> NDArray[np.float64] | None:
+    """:func:`_sublevel_box`'s bounds where ``P_J`` has not full column rank.
+
+    Entries the objective sees only together (two counter-rotors' inertias of links that
+    turn alike: equal columns) are each bounded by the objective's bound on their combination
+    and the others' lower bounds. For each free ``j``, a combination ``λ`` of ``P_J``'s rows
+    and ``μ ≥ 0`` with ``P_Jᵀ·λ − μ = e_j − r`` give, on ``‖P_J·u_J‖ ≤ reach`` and
+    ``u_J ≥ low``, ``u_j ≤ b_j + r·u_J`` with ``b_j = ‖λ‖·reach − μ·low``. At any such
+    point let ``M = max(L, max_k u_k)`` (``L`` the largest ``|low|``: ``|u_k| ≤ M``); then
+    ``u_j ≤ b + ρ·M`` for ``b = max b_j`` and ``ρ = max ‖r‖₁`` (its rounding included), so
+    ``M ≤ max(L, b/(1 − ρ))`` when ``ρ < 1``, and every ``u_j ≤ b + ρ·max(L, b/(1 − ρ))``.
+    ``None`` if a lower bound is infinite or no such ``λ``, ``μ`` is found (a direction along
+    which every entry may grow).
+    """
+    if not np.all(np.isfinite(low)):
+        return None
+    rows, count = pj.shape
+    scale = max(float(np.max(np.abs(pj))), 1e-300)
+    a = np.hstack([pj.T / scale, -np.eye(count)])  # in λ·scale, μ
+    a = np.vstack([a, np.hstack([1e-6 * np.eye(rows), np.zeros((rows, count))])])
+    lower = np.r_[np.full(rows, -np.inf), np.zeros(count)]
+    upper = np.full(rows + count, np.inf)
+    bounds, residuals = [], []
+    for j in range(count):
+        target = np.r_[np.eye(count)[j], np.zeros(rows)]
+        fit = bounded_lstsq(a, target, lower, upper, tol=1e-14).x
+        lam, mu = fit[:rows] / scale, np.maximum(fit[rows:], 0.0)
+        terms = np.abs(pj.T * lam[None, :]).sum(axis=1) + mu + np.eye(count)[j]
+        r = np.eye(count)[j] - (pj.T @ lam - mu)
+        residuals.append(float(np.sum(np.abs(r)) + 64 * _EPS * np.sum(terms)))
+        bounds.append(float(np.linalg.norm(lam)) * reach - float(mu @ low))
+    rho = max(residuals)
+    if not rho < 0.5:
+        return None
+    largest = float(np.max(np.abs(low), initial=0.0))
+    b = max(bounds)
+    top = b + rho * max(largest, b / (1 - rho))
+    out = np.array(hi, dtype=float)
+    out[free] = np.maximum(top, low) * (1 + 1e-9) + 1e-300
     return out
 
 

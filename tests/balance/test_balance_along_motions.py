@@ -14,11 +14,13 @@ from __future__ import annotations
 import copy
 import tomllib
 
+import cvxpy as cp
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
 from linkage.several_inputs_specs import A, B, parallelogram
 
+from balancer.balance.certificate import _bounded_below_box
 from balancer.balance.optimizer import optimize
 from balancer.balance.pareto import pareto_front
 from balancer.balance.problem import numeric_problem
@@ -185,3 +187,46 @@ def test_a_motions_weight_weighs_its_mean_squares():
     data["balance"]["motions"] = {"wave": 0.0, "swing": 0.0}
     with pytest.raises(SpecError, match="every motion weighs 0"):
         design_from_dict(data)
+
+
+def test_entries_the_objective_sees_only_together_are_bounded_and_the_optimum_certified():
+    """Two counterweights on links that turn alike (p and s of the parallelogram): their
+    inertias enter the shaking moment only through their sum, and have no upper bound. The
+    certificate bounds each by the sum's bound and the other's lower bound: the optimum and
+    every point of the front are certified (each bound at most its value, within the gap)."""
+    data = spec({"shaking_moment": 1.0})
+    data["balance"]["s"] = copy.deepcopy(data["balance"]["p"])
+    design = design_from_dict(data)
+    result = optimize(design)
+    assert str(result.status) == "optimal", result.message
+    assert 0 < result.lower_bound <= result.objective * (1 + 1e-12)
+    assert result.gap <= GAP_TOLERANCE
+    front = pareto_front(design, "added-mass", 3)
+    for point in front.points:
+        assert 0 < point.lower_bound <= point.least * (1 + 1e-9)
+        assert point.least - point.lower_bound <= 1e-6 * point.least
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_box_of_entries_seen_together_holds_every_point_of_the_sublevel_set(seed):
+    """:func:`certificate._bounded_below_box` against CVXPY's largest entry over the set it
+    bounds (``‖P_J·u‖ ≤ reach``, ``u ≥ low``), for columns repeated or combined."""
+
+
+    rng = np.random.default_rng(seed)
+    base = rng.normal(size=(5, 2))
+    pj = np.column_stack([base[:, 0], base[:, 0], base[:, 1], base[:, 0] + 0.5 * base[:, 1]])
+    low = rng.uniform(-1.0, 1.0, 4)
+    reach = float(rng.uniform(1.0, 5.0)) + float(np.linalg.norm(pj @ low))
+    free = np.ones(4, dtype=bool)
+    box = _bounded_below_box(pj, low, reach, np.full(4, np.inf), free)
+    assert box is not None
+    for j in range(4):
+        u = cp.Variable(4)
+        problem = cp.Problem(cp.Maximize(u[j]), [cp.norm(pj @ u) <= reach, u >= low])
+        problem.solve(solver=cp.CLARABEL)
+        assert problem.value <= box[j] * (1 + 1e-7) + 1e-7
+    # a direction along which every entry may grow (columns c and −c): no box
+    unbounded = np.column_stack([base[:, 0], -base[:, 0]])
+    assert _bounded_below_box(unbounded, np.zeros(2), 1.0, np.full(2, np.inf),
+                              np.ones(2, dtype=bool)) is None
