@@ -110,6 +110,21 @@ class MotionAnalysis:
         return excursion(self.mechanism.total_centre_of_mass(self.mechanism.motion_at(
             self.state)))
 
+    def natural_scales(self) -> dict[str, float]:
+        """The natural scale of a force (N) and of a moment (N·m) along the motion.
+
+        As a cycle's (:func:`balancer.cycle.natural_scales`): the largest force on the frame
+        at one ground point or guide, times the mechanism's size for a moment — or, where they
+        are larger, the inputs' torques over the size: a robot whose motors share one pivot has
+        one ground point, whose force is the shaking force itself (a balanced one's is
+        rounding), and its motors' torques are made of the inertial forces that it sums.
+        """
+        size = self.mechanism.structure.length_scale()
+        torques = max((float(np.nanmax(np.abs(t), initial=0.0)) for t in self.reactions.torques),
+                      default=0.0)
+        force = max(self.reactions.largest_force(), torques / size)
+        return {"N": force, "N·m": force * size}
+
     def loads(self) -> dict[str, Load]:
         """RMS and maximum of each frame load.
 
@@ -139,7 +154,7 @@ def motion_analysis(model: MechanismModel | Mechanism, motion: MotionSpec, *,
     mech = model if isinstance(model, Mechanism) else mechanism_of(model)
     structure = mech.structure
     t = trajectory.sample_times(motion)
-    state = trajectory.input_state(structure, motion, t)
+    state = trajectory.input_state(structure, motion)  # (at t: its samples, kept)
     mo = mech.motion_at(state)
     with np.errstate(all="ignore"):
         forces = mech.inverse_dynamics(mo, loads=loads, gravity=gravity)
@@ -276,23 +291,7 @@ class AlongMotions:
     @cached_property
     def reactions(self) -> Reactions:
         """The frame's loads along every motion, one after another."""
-        parts = [m.reactions for m in self.motions]
-        first = parts[0]
-
-        def joined(arrays: list[NDArray[Any]]) -> NDArray[Any]:
-            return np.concatenate(arrays)
-
-        return Reactions(
-            ground={p: joined([r.ground[p] for r in parts]) for p in first.ground},
-            slider_normal={k: joined([r.slider_normal[k] for r in parts])
-                           for k in first.slider_normal},
-            slider_couple={k: joined([r.slider_couple[k] for r in parts])
-                           for k in first.slider_couple},
-            shaking_force=joined([r.shaking_force for r in parts]),
-            shaking_moment=joined([r.shaking_moment for r in parts]),
-            torques=tuple(joined([r.torques[i] for r in parts])
-                          for i in range(len(first.torques))),
-            rocking_couple=joined([r.rocking_couple for r in parts]))
+        return Reactions.join([m.reactions for m in self.motions])
 
     @cached_property
     def summary(self) -> CycleSummary:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 from helpers import derivative_with_error
-from linkage.several_inputs_specs import A, B, fivebar, parallelogram
+from linkage.several_inputs_specs import A, B, crank_rocker, fivebar, parallelogram
 
 from balancer.cli import main
 from balancer.errors import SpecError
@@ -165,19 +165,9 @@ def test_the_revolutions_verbs_say_they_turn_one_crank(tmp_path, design, verb):
 
 
 def test_a_one_input_linkage_runs_along_its_cranks_own_motion():
-    spec = {
-        "mechanism": {"type": "linkage", "input": "crank",
-                      "points": {"A0": [0.0, 0.0], "A1": [0.1, 0.0], "A2": [0.35, 0.2],
-                                 "A3": [0.3, 0.0]}},
-        "links": {"ground": {"points": ["A0", "A3"]},
-                  "crank": {"points": ["A0", "A1"], "mass": 1.0, "inertia": 0.01,
-                            "com": {"e": 0.05, "f": 0.0}},
-                  "coupler": {"points": ["A1", "A2"], "mass": 1.0, "inertia": 0.02,
-                              "com": {"e": 0.1, "f": 0.0}},
-                  "rocker": {"points": ["A3", "A2"], "mass": 1.0, "inertia": 0.01,
-                             "com": {"e": 0.1, "f": 0.0}}},
+    spec = crank_rocker() | {
         "operation": {"speed": 10.0},
-        # a constant-speed turn as a motion: the crank's change from the reference, linear in t
+        # a turn as a motion: the crank's change from the reference over a turn
         "motion": [{"name": "turn", "times": [0.0, 0.5, 1.0],
                     "path": [[0.0], [np.pi], [2 * np.pi]], "law": "spline",
                     "samples": 16}],

@@ -9,8 +9,9 @@ from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_anal
 from ..errors import SpecError
 from ..force_balance import force_balance_residual
 from ..mechanisms import mechanism_of
-from ..mechanisms.base import Route
+from ..mechanisms.base import Mechanism, Route
 from ..model import Design, check_scales
+from ..model.motions import MotionSpec
 from ..motion_analysis import AlongMotions, MotionAnalysis, motion_analysis, workspace_check
 
 
@@ -72,21 +73,15 @@ def analyze_motions(design: Design, names: Sequence[str] | None = None, *,
     AssemblyError
         If a point's path leaves the workspace.
     """
-    if gravity is None:
-        gravity = design.operation.gravity if design.operation is not None else (0.0, 0.0)
-    else:
-        gravity = v.vector2(gravity, "gravity")
+    gravity = _spec_gravity(design) if gravity is None else v.vector2(gravity, "gravity")
     chosen = list(design.motions) if not names else [design.motion(n) for n in names]
     if not chosen:
         raise SpecError("a linkage is analysed along its motions: the spec has no [[motion]]",
                         key="motion")
     mech = mechanism_of(design.mechanism)
-    analyses = []
-    for motion in chosen:  # (each motion's errors under its own key)
-        with v.under(v.item("motion", design.motions.index(motion))):
-            analyses.append(motion_analysis(mech, motion, gravity=gravity))
     return AlongMotions(
-        motions=tuple(analyses), force_balance_residual=force_balance_residual(mech),
+        motions=tuple(_along(design, mech, m, gravity) for m in chosen),
+        force_balance_residual=force_balance_residual(mech),
         workspace=None if design.workspace is None else workspace_check(mech, design.workspace))
 
 
@@ -104,8 +99,18 @@ def analyze_motion(design: Design, name: str | None = None) -> MotionAnalysis:
         If a point's path leaves the workspace.
     """
     motion = design.motion(name)
-    gravity = design.operation.gravity if design.operation is not None else (0.0, 0.0)
     mech = mechanism_of(design.mechanism)  # (its errors are the mechanism's, not the motion's)
+    return _along(design, mech, motion, _spec_gravity(design))
+
+
+def _spec_gravity(design: Design) -> tuple[float, float]:
+    """The spec's gravity, m/s² (``[operation] gravity``; none without ``[operation]``)."""
+    return design.operation.gravity if design.operation is not None else (0.0, 0.0)
+
+
+def _along(design: Design, mech: Mechanism, motion: MotionSpec,
+           gravity: tuple[float, float]) -> MotionAnalysis:
+    """:func:`~balancer.motion_analysis.motion_analysis`, its errors under the motion's key."""
     with v.under(v.item("motion", design.motions.index(motion))):
         return motion_analysis(mech, motion, gravity=gravity)
 

@@ -139,13 +139,24 @@ def numeric_problem(design: Design) -> NumericProblem:
     # its shaking moment alone is used, so its driving torque at rest is not computed.)
     reg, unit = cycle_regressors_at(mech, angles, [(speed, 0.0), (0.0, 1.0)],
                                     torque_at_rest=not abs(speed) > TURNING)
+    return _problem(problem, mech, speed, InputState.crank(angles, speed), reg, unit)
+
+
+def _problem(problem: BalanceProblem, mech: Mechanism, speed: float | None,
+             states: InputState, reg: CycleRegressors, unit: CycleRegressors | None
+             ) -> NumericProblem:
+    """The problem of ``mech`` whose samples are ``states`` with regressors ``reg``.
+
+    The links' bounds, the objective's rows and the force balance are the same whatever the
+    samples are: a revolution at ``speed``, or motions (``speed`` ``None``).
+    """
     links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
     rows, factor, inert = objective_rows(reg, problem.objective, links, mech.layout.size)
     return NumericProblem(
         problem=problem,
         mechanism=mech,
         speed=speed,
-        states=InputState.crank(angles, speed),
+        states=states,
         regressors=reg,
         links=links,
         x0=mech.parameters(),
@@ -177,10 +188,7 @@ def _along_motions(design: Design, problem: BalanceProblem, mech: Mechanism) -> 
     for i, motion in enumerate(design.motions):
         with v.under(v.item("motion", i)):
             parts.append(trajectory.input_state(mech.structure, motion))
-    states = InputState.of(
-        [np.concatenate([p.positions[j] for p in parts]) for j in range(parts[0].size)],
-        [np.concatenate([p.rates[j] for p in parts]) for j in range(parts[0].size)],
-        [np.concatenate([p.accelerations[j] for p in parts]) for j in range(parts[0].size)])
+    states = InputState.join(parts)
     weights = problem.weights_of([m.name for m in design.motions])
     scale = motion_weights([p.count for p in parts], weights)[:, None]
     with np.errstate(all="ignore"):
@@ -193,22 +201,7 @@ def _along_motions(design: Design, problem: BalanceProblem, mech: Mechanism) -> 
         shaking_moment=np.asarray(f.shaking_moment) * scale,
         driving_torque=torques * math.sqrt(len(f.input_torques)),
         rocking_couple=complex_rows(f.rocking_couple))
-    links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
-    rows, factor, inert = objective_rows(reg, problem.objective, links, mech.layout.size)
-    return NumericProblem(
-        problem=problem,
-        mechanism=mech,
-        speed=None,
-        states=states,
-        regressors=reg,
-        links=links,
-        x0=mech.parameters(),
-        rows=rows,
-        factor=factor,
-        force_balance=force_balance_system(mech) if problem.force_balance else None,
-        inert=inert,
-        unit_acceleration=reg,
-    )
+    return _problem(problem, mech, None, states, reg, reg)
 
 
 def _checked_problem(problem: object) -> BalanceProblem:

@@ -74,6 +74,15 @@ class InputState:
         """States on symbols (CasADi's), taken as given."""
         return cls(tuple(positions), tuple(rates), tuple(accelerations))
 
+    @classmethod
+    def join(cls, parts: Sequence[InputState]) -> InputState:
+        """Numeric states of ``parts`` one after another (the same inputs)."""
+        def joined(get: str) -> list[NDArray[np.float64]]:
+            return [np.concatenate([np.asarray(getattr(p, get)[i], dtype=float) for p in parts])
+                    for i in range(parts[0].size)]
+
+        return cls.of(joined("positions"), joined("rates"), joined("accelerations"))
+
     @property
     def size(self) -> int:
         """The number of inputs ``n``."""

@@ -10,7 +10,7 @@ record, :meth:`Reactions.forces` the record's arrays seen as forces.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -94,6 +94,26 @@ class Reactions:
                    shaking_force=np.empty(n, complex), shaking_moment=np.empty(n),
                    torques=tuple(np.empty(n) for _ in range(inputs)),
                    rocking_couple=np.empty(n, complex))
+
+    @classmethod
+    def join(cls, parts: Sequence[Reactions]) -> Reactions:
+        """The loads of ``parts`` one after another (the same ground points, sliders, inputs)."""
+        first = parts[0]
+
+        def joined(arrays: list[NDArray[Any]]) -> NDArray[Any]:
+            return np.concatenate(arrays)
+
+        return cls(
+            ground={p: joined([r.ground[p] for r in parts]) for p in first.ground},
+            slider_normal={k: joined([r.slider_normal[k] for r in parts])
+                           for k in first.slider_normal},
+            slider_couple={k: joined([r.slider_couple[k] for r in parts])
+                           for k in first.slider_couple},
+            shaking_force=joined([r.shaking_force for r in parts]),
+            shaking_moment=joined([r.shaking_moment for r in parts]),
+            torques=tuple(joined([r.torques[i] for r in parts])
+                          for i in range(len(first.torques))),
+            rocking_couple=joined([r.rocking_couple for r in parts]))
 
     def arrays(self) -> list[NDArray[Any]]:
         """Every array of the record (the ground points' and sliders' first)."""

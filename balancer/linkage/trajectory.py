@@ -17,6 +17,9 @@ P̈|θ̈=0)``. The forward kinematics then places every link, on the reference p
 
 from __future__ import annotations
 
+import threading
+from collections import OrderedDict
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -141,6 +144,9 @@ def input_state(structure: Structure, spec: MotionSpec,
                 t: NDArray[np.float64] | None = None) -> InputState:
     """The inputs' states along a motion at times ``t`` (default: :func:`sample_times`).
 
+    At the motion's samples they depend on the geometry and the motion alone: kept with the
+    geometry and given again (their arrays shared: not to be written into).
+
     Raises
     ------
     SpecError
@@ -149,7 +155,30 @@ def input_state(structure: Structure, spec: MotionSpec,
         If a point's path leaves the workspace (no pose puts the point there, or the path
         passes a singular pose).
     """
-    times = sample_times(spec) if t is None else np.asarray(t, dtype=float)
+    if t is None:  # the motion's samples: what it is analysed and balanced at, again and again
+        with _STATES_LOCK:
+            kept = structure.kinematic.setdefault("motion states", OrderedDict())
+            known = kept.get(spec)
+        if known is None:
+            known = _input_state(structure, spec, sample_times(spec))
+            with _STATES_LOCK:
+                kept[spec] = known
+                while len(kept) > STATES_KEPT:
+                    kept.popitem(last=False)
+        return known
+    return _input_state(structure, spec, np.asarray(t, dtype=float))
+
+
+#: A motion's input states at its samples are kept with the geometry
+#: (:attr:`~balancer.linkage.structure.Structure.kinematic`): a design, its redesign and their
+#: analyses ask for the same ones (the last :data:`STATES_KEPT` motions).
+STATES_KEPT = 16
+_STATES_LOCK = threading.Lock()
+
+
+def _input_state(structure: Structure, spec: MotionSpec, times: NDArray[np.float64]
+                 ) -> InputState:
+    """:func:`input_state` at ``times``, computed."""
     p, v, a = path_values(spec, times)
     inputs = structure.inputs
     reference = np.array([structure.ref_angle[k] for k in inputs])

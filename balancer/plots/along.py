@@ -106,18 +106,10 @@ def _values(analysis: MotionAnalysis, key: str) -> NDArray[np.number]:
 def rounding_floors(analysis: MotionAnalysis) -> dict[str, float]:
     """What is rounding of a force (N) and of a moment (N·m) along the motion, by unit.
 
-    :data:`~balancer.cycle.ROUNDING_SPAN` of each unit's natural scale, as the cycle figure's
-    (:func:`balancer.cycle.natural_scales`): the largest force on the frame at one ground point
-    or guide, times the mechanism's size for a moment. Where the inputs' torques over the size
-    are larger, they give the force's scale: a robot whose motors share one pivot has one
-    ground point, whose force is the shaking force itself (a balanced one's is rounding), and
-    its motors' torques are made of the inertial forces that the shaking force sums.
+    :data:`~balancer.cycle.ROUNDING_SPAN` of each unit's natural scale
+    (:meth:`~balancer.motion_analysis.MotionAnalysis.natural_scales`).
     """
-    size = analysis.mechanism.structure.length_scale()
-    torques = max((float(np.nanmax(np.abs(t), initial=0.0)) for t in analysis.reactions.torques),
-                  default=0.0)
-    force = max(analysis.reactions.largest_force(), torques / size)
-    return {"N": ROUNDING_SPAN * force, "N·m": ROUNDING_SPAN * force * size}
+    return {unit: ROUNDING_SPAN * scale for unit, scale in analysis.natural_scales().items()}
 
 
 def _figure_text(value: float, floor: float) -> str:

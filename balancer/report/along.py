@@ -70,19 +70,15 @@ def motions_text(along: AlongMotions, spec: str | None = None) -> str:
 def _scales(along: AlongMotions) -> Scales:
     """The scales of the report's figures (:class:`Scales`), every motion's together.
 
-    Each load's largest under its unit, the forces at the ground points, and each input's
-    torque over the linkage's size as a force (a motor's effort: where the motors share the
-    one ground pivot, the force on it is the shaking force itself, and a balanced robot's
-    rounding would otherwise be its own scale).
+    Each load's largest under its unit, and each motion's natural scales
+    (:meth:`~balancer.motion_analysis.MotionAnalysis.natural_scales`: the ground forces, or
+    the motors' torques over the size where a balanced robot's one ground force is its own
+    rounding).
     """
-    size = along.mechanism.structure.length_scale()
     sc = Scales()
     for analysis in along.motions:
-        for key, figure in analysis.loads().items():
-            sc.add([(_words(key)[1], figure.max)])
-            if key.startswith("torque_"):
-                sc.add([("N", figure.max / size)])
-        sc.add(("N", reaction_extremes(v)["max"]) for v in analysis.reactions.ground.values())
+        sc.add((_words(key)[1], figure.max) for key, figure in analysis.loads().items())
+        sc.add(analysis.natural_scales().items())
     return sc
 
 

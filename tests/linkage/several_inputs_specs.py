@@ -29,6 +29,19 @@ def _link(points, mass, inertia, e, f):
     return {"points": points, "mass": mass, "inertia": inertia, "com": {"e": e, "f": f}}
 
 
+def crank_rocker() -> dict:
+    """A one-input crank-rocker (the crank at A0, the rocker at A3), to set beside them."""
+    return {
+        "mechanism": {"type": "linkage", "input": "crank",
+                      "points": {"A0": [0.0, 0.0], "A1": [0.1, 0.0], "A2": [0.35, 0.2],
+                                 "A3": [0.3, 0.0]}},
+        "links": {"ground": {"points": ["A0", "A3"]},
+                  "crank": _link(["A0", "A1"], 1.0, 0.01, 0.05, 0.0),
+                  "coupler": _link(["A1", "A2"], 1.0, 0.02, 0.1, 0.0),
+                  "rocker": _link(["A3", "A2"], 1.0, 0.01, 0.1, 0.0)},
+    }
+
+
 def fivebar() -> dict:
     """A general (not parallelogram) 5R five-bar: two cranks on ground pivots A and B."""
     return {

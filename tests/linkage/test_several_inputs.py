@@ -18,7 +18,7 @@ import tomllib
 import numpy as np
 import pytest
 from helpers import derivative_with_error
-from linkage.several_inputs_specs import _link, fivebar, linkage_of, three_rrr
+from linkage.several_inputs_specs import crank_rocker, fivebar, linkage_of, three_rrr
 
 from balancer.errors import SpecError
 from balancer.linkage import dynamics, kinematics
@@ -185,15 +185,7 @@ def test_the_groups_and_the_global_solve_agree(case):
 
 
 def test_one_input_spelled_as_a_list_is_the_crank():
-    spec = {
-        "mechanism": {"type": "linkage", "input": "crank",
-                      "points": {"A0": [0.0, 0.0], "A1": [0.1, 0.0], "A2": [0.35, 0.2],
-                                 "A3": [0.3, 0.0]}},
-        "links": {"ground": {"points": ["A0", "A3"]},
-                  "crank": _link(["A0", "A1"], 1.0, 0.01, 0.05, 0.0),
-                  "coupler": _link(["A1", "A2"], 1.0, 0.02, 0.1, 0.0),
-                  "rocker": _link(["A3", "A2"], 1.0, 0.01, 0.1, 0.0)},
-    }
+    spec = crank_rocker()
     one = linkage_of(spec)
     listed = dict(spec, mechanism={**spec["mechanism"], "inputs": ["crank"]})
     del listed["mechanism"]["input"]

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from linkage.several_inputs_specs import crank_rocker
 
 import balancer
 from balancer.api.analysis import analyze_motion
@@ -294,17 +295,7 @@ def test_what_plot_cannot_draw_along_a_motion_is_refused(forbal2_file, capsys, a
 def _one_input_with_a_motion(z: float = 0.0) -> str:
     """A crank-rocker whose spec gives a motion of its crank (a cubic law over a turn); its
     coupler ``z`` m along the crank's axis from the others."""
-    spec: dict = {
-        "mechanism": {"type": "linkage", "input": "crank",
-                      "points": {"A0": [0.0, 0.0], "A1": [0.1, 0.0], "A2": [0.35, 0.2],
-                                 "A3": [0.3, 0.0]}},
-        "links": {"ground": {"points": ["A0", "A3"]},
-                  "crank": {"points": ["A0", "A1"], "mass": 1.0, "inertia": 0.01,
-                            "com": {"e": 0.05, "f": 0.0}},
-                  "coupler": {"points": ["A1", "A2"], "mass": 1.0, "inertia": 0.02,
-                              "com": {"e": 0.1, "f": 0.0}},
-                  "rocker": {"points": ["A3", "A2"], "mass": 1.0, "inertia": 0.01,
-                             "com": {"e": 0.1, "f": 0.0}}},
+    spec: dict = crank_rocker() | {
         "operation": {"speed": 10.0},
         "motion": [{"name": "turn", "times": [0.0, 0.5, 1.0],
                     "path": [[0.0], [np.pi], [2 * np.pi]], "law": "cubic", "samples": 16}],
