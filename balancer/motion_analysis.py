@@ -253,17 +253,26 @@ class AlongMotions:
     force_balance_residual
         How far the design is from the force-balance conditions, relative to their terms
         (:func:`balancer.force_balance.force_balance_residual`; 0: balanced).
-    workspace
-        The total centre of mass over the workspace's grid, if the spec gives a workspace.
+    workspace_spec
+        The spec's workspace (``None``: none), over which :attr:`workspace` checks the total
+        centre of mass when asked.
     """
 
     motions: tuple[MotionAnalysis, ...]
     force_balance_residual: float
-    workspace: WorkspaceCheck | None = None
-    #: The workspace the check was made over (``None``: none).
     workspace_spec: Workspace | None = None
     #: Each motion's weight as a balancing weighs it (:meth:`load`; ``None``: alike).
     weights: tuple[float, ...] | None = None
+
+    @cached_property
+    def workspace(self) -> WorkspaceCheck | None:
+        """The total centre of mass over the workspace's grid, if the spec gives a workspace.
+
+        Computed when first asked: an inertial analysis that no report reads makes none.
+        """
+        if self.workspace_spec is None:
+            return None
+        return workspace_check(self.mechanism, self.workspace_spec)
 
     @property
     def force_balanced(self) -> bool:
@@ -324,9 +333,18 @@ class AlongMotions:
         scale = motion_weights([m.t.size for m in self.motions], self.weights)
         r = self.reactions
         if key == "driving_torque":
-            m = len(r.torques)
-            return np.concatenate([t * scale for t in r.torques]) * math.sqrt(m)
+            return stacked_torques(r.torques, scale)
         return np.asarray(getattr(r, key)) * scale
+
+
+def stacked_torques(torques: Sequence[NDArray[Any]], scale: NDArray[np.float64]
+                    ) -> NDArray[Any]:
+    """Every input's torque weighted by ``scale`` and stacked, times ``√m`` for ``m`` inputs.
+
+    Samples, or maps of a design vector whose rows are samples: their mean square is the sum
+    of the inputs' mean squares, as the balancing's ``driving_torque`` term weighs them.
+    """
+    return np.concatenate([np.asarray(t) * scale for t in torques]) * math.sqrt(len(torques))
 
 
 def motion_weights(counts: Sequence[int], weights: Sequence[float] | None = None
@@ -351,6 +369,5 @@ def along_motions(model: MechanismModel | Mechanism, motions: Sequence[MotionSpe
     mech = model if isinstance(model, Mechanism) else mechanism_of(model)
     analyses = tuple(motion_analysis(mech, m, gravity=gravity, loads=loads) for m in motions)
     return AlongMotions(motions=analyses, force_balance_residual=force_balance_residual(mech),
-                        workspace=None if workspace is None else workspace_check(mech, workspace),
                         workspace_spec=workspace,
                         weights=None if weights is None else tuple(weights))

@@ -12,7 +12,7 @@ from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism, Route
 from ..model import Design, check_scales
 from ..model.motions import MotionSpec
-from ..motion_analysis import AlongMotions, MotionAnalysis, motion_analysis, workspace_check
+from ..motion_analysis import AlongMotions, MotionAnalysis, motion_analysis
 
 
 def analyze(design: Design, *, route: Route | None = None,
@@ -82,7 +82,7 @@ def analyze_motions(design: Design, names: Sequence[str] | None = None, *,
     return AlongMotions(
         motions=tuple(_along(design, mech, m, gravity) for m in chosen),
         force_balance_residual=force_balance_residual(mech),
-        workspace=None if design.workspace is None else workspace_check(mech, design.workspace))
+        workspace_spec=design.workspace)
 
 
 def analyze_motion(design: Design, name: str | None = None) -> MotionAnalysis:

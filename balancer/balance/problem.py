@@ -27,7 +27,6 @@ This module imports neither CVXPY nor CasADi.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import replace
 from typing import cast
@@ -45,7 +44,7 @@ from ..linkage.vectors import V
 from ..mechanisms import Mechanism, mechanism_of
 from ..model import Design
 from ..model.balance import BalanceProblem
-from ..motion_analysis import motion_weights
+from ..motion_analysis import motion_weights, stacked_torques
 from .bounds import check_problem, resolve_link
 from .feasibility import Feasibility, force_balance_system
 from .objective_scale import ObjectiveScale
@@ -193,13 +192,12 @@ def _along_motions(design: Design, problem: BalanceProblem, mech: Mechanism) -> 
     scale = motion_weights([p.count for p in parts], weights)[:, None]
     with np.errstate(all="ignore"):
         f = mech.regressors(mech.motion_at(states))
-    torques = np.vstack([np.asarray(t) * scale for t in f.input_torques])
     complex_rows = cast("Callable[[V], NDArray[np.complex128]]",
                         lambda vector: np.asarray(vector.complex(), dtype=complex) * scale)
     reg = CycleRegressors(
         shaking_force=complex_rows(f.shaking_force),
         shaking_moment=np.asarray(f.shaking_moment) * scale,
-        driving_torque=torques * math.sqrt(len(f.input_torques)),
+        driving_torque=stacked_torques(f.input_torques, scale),
         rocking_couple=complex_rows(f.rocking_couple))
     return _problem(problem, mech, None, states, reg, reg)
 
