@@ -67,6 +67,8 @@ class MotionAnalysis:
         workspace give).
     reactions
         The loads on the frame at those times.
+    centre_of_mass
+        The moving links' total centre of mass at those times, complex, m.
     gravity
         ``(gx, gy)``, m/s², that the loads include.
     """
@@ -78,6 +80,7 @@ class MotionAnalysis:
     state: InputState
     changes: tuple[NDArray[np.float64], ...]
     reactions: Reactions
+    centre_of_mass: NDArray[np.complex128]
     gravity: tuple[float, float] = (0.0, 0.0)
 
     @property
@@ -107,8 +110,7 @@ class MotionAnalysis:
     @property
     def centre_of_mass_excursion(self) -> float:
         """The largest distance of the total centre of mass from its mean place, m."""
-        return excursion(self.mechanism.total_centre_of_mass(self.mechanism.motion_at(
-            self.state)))
+        return excursion(self.centre_of_mass)
 
     def natural_scales(self) -> dict[str, float]:
         """The natural scale of a force (N) and of a moment (N·m) along the motion.
@@ -159,11 +161,14 @@ def motion_analysis(model: MechanismModel | Mechanism, motion: MotionSpec, *,
     with np.errstate(all="ignore"):
         forces = mech.inverse_dynamics(mo, loads=loads, gravity=gravity)
         couple = mech.rocking_couple(mo, loads=loads, gravity=gravity)
+        centre = np.broadcast_to(np.asarray(mech.total_centre_of_mass(mo), np.complex128),
+                                 t.shape).copy()
     reactions = Reactions.of(replace(forces, rocking_couple=couple))
     changes = tuple(np.asarray(p, dtype=float) - structure.ref_angle[k]
                     for p, k in zip(state.positions, structure.inputs, strict=True))
     return MotionAnalysis(mechanism=mech, motion=motion, inputs=structure.linkage.inputs, t=t,
-                          state=state, changes=changes, reactions=reactions, gravity=gravity)
+                          state=state, changes=changes, reactions=reactions,
+                          centre_of_mass=centre, gravity=gravity)
 
 
 def excursion(centre: NDArray[np.complex128]) -> float:

@@ -44,8 +44,6 @@ def motion_drawing(analysis: MotionAnalysis, *, poses: int = 5) -> MotionDrawing
     with np.errstate(all="ignore"):
         mo = mech.motion_at(analysis.state)
         points = mech.points(mo)
-        centre = np.broadcast_to(np.asarray(mech.total_centre_of_mass(mo), np.complex128),
-                                 analysis.t.shape).copy()
     n = analysis.t.size
     index = np.unique(np.rint(np.linspace(0, n - 1, count)).astype(int))
     links = {}
@@ -61,6 +59,7 @@ def motion_drawing(analysis: MotionAnalysis, *, poses: int = 5) -> MotionDrawing
         links = {name: p[:-1] for name, p in links.items()}
     point = analysis.motion.point
     return MotionDrawing(t=np.asarray(analysis.t[index], float), links=links,
-                         ground=dict(mech.ground_positions), centre_of_mass=centre,
+                         ground=dict(mech.ground_positions),
+                         centre_of_mass=analysis.centre_of_mass,
                          point=point,
                          path=None if point is None else np.asarray(points[point], complex))
