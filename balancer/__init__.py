@@ -34,6 +34,7 @@ _EXPORTS = {
     "optimize": "api",
     "pareto": "api",
     "simulate": "api",
+    "simulate_motion": "api",
     "to_dict": "api",
     "to_table": "api",
     "verify": "api",
@@ -89,6 +90,9 @@ _EXPORTS = {
     "Figure": "cycle",
     "Trajectory": "simulation",
     "Verification": "verification",
+    "MotionRun": "simulation.motions",
+    "MotionVerification": "motion_verification",
+    "MotionCheck": "motion_verification",
     "RunCheck": "verification",
     "BalanceResult": "balance.result",
     "Status": "balance.result",
@@ -175,6 +179,7 @@ __all__ = [
     "save_design",
     "save_figure",
     "simulate",
+    "simulate_motion",
     "SimulationSettings",
     "Slider",
     "SliderCrank",
@@ -191,6 +196,9 @@ __all__ = [
     "Trajectory",
     "Vary",
     "Verification",
+    "MotionRun",
+    "MotionVerification",
+    "MotionCheck",
     "verification_figure",
     "verify",
 ]
@@ -211,6 +219,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         optimize,
         pareto,
         simulate,
+        simulate_motion,
         to_dict,
         to_table,
         verify,
@@ -260,6 +269,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     )
     from .model.motions import MotionSpec, Workspace
     from .motion_analysis import AlongMotions, MotionAnalysis, WorkspaceCheck
+    from .motion_verification import MotionCheck, MotionVerification
     from .plots import (
         MotionDrawing,
         animate,
@@ -272,6 +282,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         verification_figure,
     )
     from .simulation import Trajectory
+    from .simulation.motions import MotionRun
     from .spec import dumps_design, load_design, loads_design, save_design
     from .sweeps import Perturb, SweepResult, Vary, sweep
     from .verification import RunCheck, Verification

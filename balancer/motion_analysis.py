@@ -89,23 +89,8 @@ class MotionAnalysis:
         return self.motion.name
 
     def columns(self) -> tuple[list[str], Columns]:
-        """The columns of ``analyze --csv`` along a motion: names and values.
-
-        ``t`` (s); each input's change from the reference pose, named by the input (rad);
-        ``shaking_force_x``, ``shaking_force_y`` (N), ``shaking_moment`` (N·m),
-        ``rocking_couple_x``, ``rocking_couple_y`` (N·m), ``torque_<input>`` per input
-        (N·m); then the forces on the frame as the cycle analysis' columns
-        (:func:`balancer.columns.frame_force_columns`).
-        """
-        r = self.reactions
-        names = ["t", *self.inputs, "shaking_force_x", "shaking_force_y", "shaking_moment",
-                 "rocking_couple_x", "rocking_couple_y",
-                 *(f"torque_{name}" for name in self.inputs)]
-        cols: Columns = [self.t, *self.changes, r.shaking_force.real, r.shaking_force.imag,
-                         r.shaking_moment, r.rocking_couple.real, r.rocking_couple.imag,
-                         *r.torques]
-        frame_names, frame_cols = frame_force_columns(self.mechanism, r)
-        return names + frame_names, cols + frame_cols
+        """The columns of ``analyze --csv`` along a motion (:func:`motion_columns`)."""
+        return motion_columns(self.mechanism, self.t, self.changes, self.reactions)
 
     @property
     def centre_of_mass_excursion(self) -> float:
@@ -132,13 +117,43 @@ class MotionAnalysis:
 
         The shaking force, moment, rocking couple and each input's torque (``torque_<input>``).
         """
-        r = self.reactions
-        out = {"shaking_force": Load.of(r.shaking_force),
-               "shaking_moment": Load.of(r.shaking_moment),
-               "rocking_couple": Load.of(r.rocking_couple)}
-        for name, torque in zip(self.inputs, r.torques, strict=True):
-            out[f"torque_{name}"] = Load.of(torque)
-        return out
+        return frame_loads(self.inputs, self.reactions)
+
+
+def frame_loads(inputs: Sequence[str], reactions: Reactions) -> dict[str, Load]:
+    """RMS and maximum of each frame load of a record along a motion (its samples alike).
+
+    ``shaking_force``, ``shaking_moment``, ``rocking_couple`` and ``torque_<input>`` per input.
+    """
+    r = reactions
+    out = {"shaking_force": Load.of(r.shaking_force),
+           "shaking_moment": Load.of(r.shaking_moment),
+           "rocking_couple": Load.of(r.rocking_couple)}
+    for name, torque in zip(inputs, r.torques, strict=True):
+        out[f"torque_{name}"] = Load.of(torque)
+    return out
+
+
+def motion_columns(mech: Mechanism, t: NDArray[np.float64],
+                   changes: Sequence[NDArray[np.float64]], reactions: Reactions
+                   ) -> tuple[list[str], Columns]:
+    """The columns of the loads along a motion (:meth:`MotionAnalysis.columns`).
+
+    ``t`` (s); each input's change from the reference pose, named by the input (rad);
+    ``shaking_force_x``, ``shaking_force_y`` (N), ``shaking_moment`` (N·m),
+    ``rocking_couple_x``, ``rocking_couple_y`` (N·m), ``torque_<input>`` per input (N·m);
+    then the forces on the frame as the cycle analysis' columns
+    (:func:`balancer.columns.frame_force_columns`). An analysis and a simulation write these.
+    """
+    r = reactions
+    inputs = mech.linkage.inputs
+    names = ["t", *inputs, "shaking_force_x", "shaking_force_y", "shaking_moment",
+             "rocking_couple_x", "rocking_couple_y", *(f"torque_{name}" for name in inputs)]
+    cols: Columns = [t, *changes, r.shaking_force.real, r.shaking_force.imag,
+                     r.shaking_moment, r.rocking_couple.real, r.rocking_couple.imag,
+                     *r.torques]
+    frame_names, frame_cols = frame_force_columns(mech, r)
+    return names + frame_names, cols + frame_cols
 
 
 def motion_analysis(model: MechanismModel | Mechanism, motion: MotionSpec, *,

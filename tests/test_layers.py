@@ -38,7 +38,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     # The registry of mechanisms and of formulations, and what runs over any mechanism.
     ("mechanisms", "formulations", "force_balance", "columns", "cycle", "motion_analysis"),
     ("balance",),
-    ("simulation", "verification", "report", "plots", "plausibility", "parts"),
+    ("simulation", "verification", "motion_verification", "report", "plots", "plausibility",
+     "parts"),
     ("spec", "examples", "api", "sweeps", "cli", "__main__"),
 )
 

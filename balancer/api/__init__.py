@@ -29,6 +29,7 @@ _EXPORTS = {
     "optimize": "balancing",
     "pareto": "balancing",
     "simulate": "motion",
+    "simulate_motion": "motion",
     "verify": "motion",
     "to_dict": "results",
     "to_table": "results",
@@ -43,6 +44,7 @@ __all__ = [
     "optimize",
     "pareto",
     "simulate",
+    "simulate_motion",
     "to_dict",
     "to_table",
     "verify",
@@ -57,5 +59,5 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .balancing import optimize, pareto
     from .drawings import motion_drawing
     from .examples import example
-    from .motion import simulate, verify
+    from .motion import simulate, simulate_motion, verify
     from .results import to_dict, to_table

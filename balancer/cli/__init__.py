@@ -30,7 +30,8 @@ DRIVES: tuple[str, ...] = ("free", "constant-speed")
 #: ``--method`` values: every formulation of any mechanism (:mod:`balancer.formulations`), here
 #: so that ``--help`` needs no numerics (a test keeps them equal to the registry's).
 FORMULATION_NAMES: tuple[str, ...] = (
-    "opened-loop", "complex-masses", "mass-matrix", "lie-group", "multibody", "crank-angle")
+    "opened-loop", "complex-masses", "mass-matrix", "lie-group", "multibody", "crank-angle",
+    "input-coordinates")
 
 
 #: Most frames per revolution of an animation: ten a degree, more than any screen shows.
@@ -169,7 +170,10 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "Forward dynamics of the linkage from the spec's [simulation] settings: free "
         "motion under the loads (and gravity), or the crank held at constant speed by a "
         "motor. Prints the initial and final angles, rates and accelerations, the "
-        "shaking figures, the energy balance and the constraint drift.",
+        "shaking figures, the energy balance and the constraint drift. A linkage with "
+        "several inputs (or with --motion) is driven along the spec's motion ([[motion]]), "
+        "every input prescribed, or with --drive free coasts from the state where the "
+        "motion's inputs turn fastest.",
     ),
     "verify": (
         "prove a design balanced by simulation, with plots",
@@ -177,7 +181,9 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "operating speed and in free motion from the spec's initial state; report the "
         "largest shaking force and moment, relative to the unbalanced original where the "
         "spec names one ([original]); optionally plot reactions, shaking moment and the "
-        "path of the total centre of mass (PNG, SVG or PDF).",
+        "path of the total centre of mass (PNG, SVG or PDF). A linkage with several inputs "
+        "is driven along each of its motions ([[motion]]) in two formulations that must "
+        "agree, and runs free once.",
     ),
     "optimize": (
         "redesign the links for exact force balance and least shaking moment",
@@ -296,9 +302,14 @@ def _simulate_arguments(p: argparse.ArgumentParser) -> None:
                    "opened-loop for a four-bar, mass-matrix for a slider-crank, crank-angle for "
                    "a general linkage whose crank turns fully, multibody for one whose crank does "
                    "not)")
-    p.add_argument("--drive", choices=DRIVES, help="free motion or constant crank speed "
+    p.add_argument("--drive", choices=(*DRIVES, "motion"),
+                   help="free motion or constant crank speed "
                    "(default: the spec's); the constant speed is [simulation] omega1 where "
-                   "the spec gives it non-zero, else the operating speed [operation] speed")
+                   "the spec gives it non-zero, else the operating speed [operation] speed; "
+                   "along a motion: motion (default, every input prescribed) or free")
+    p.add_argument("--motion", metavar="NAME",
+                   help="drive the inputs along the spec's motion NAME ([[motion]]); a "
+                   "linkage with several inputs runs along its first motion without it")
     p.add_argument("--duration", type=_positive_float, metavar="T", help="simulated time, s")
     p.add_argument("--rtol", type=_positive_float, metavar="R", help="relative tolerance")
     p.add_argument("--atol", type=_positive_float, metavar="A", help="absolute tolerance")
@@ -321,7 +332,8 @@ def _verify_arguments(p: argparse.ArgumentParser) -> None:
                    help="formulation for the simulations (default: one the optimiser did not "
                    "use: complex-masses for a four-bar whose crank turns fully, opened-loop for "
                    "one that swings or passes change points, complex-masses for a "
-                   "slider-crank, multibody for a general linkage)")
+                   "slider-crank, multibody for a general linkage and one with several "
+                   "inputs, checked against input-coordinates)")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
 
 

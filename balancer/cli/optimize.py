@@ -31,12 +31,7 @@ def run(args: argparse.Namespace) -> int:
     if cad is not None:
         require_webs(design)  # (an engine's sectors need their room: said before the work)
     verifying = not args.no_verify
-    if verifying and several_inputs(design):
-        verifying = False
-        print("balancer: note: a linkage with several inputs is not yet verified by "
-              "simulation; its loads before and after are analysed along its motions",
-              file=sys.stderr)
-    if verifying:  # the check at the end refuses nothing after the work
+    if verifying and not several_inputs(design):  # the check refuses nothing after the work
 
         try:
             check_verification(design, duration=args.verify_duration)

@@ -7,9 +7,10 @@ import sys
 
 from ..api import verify
 from ..errors import SpecError
-from ..plots import save_figure, verification_figure
+from ..motion_verification import MotionVerification
+from ..plots import motion_verification_figure, save_figure, verification_figure
 from ..progress import Progress
-from ..report import dumps_json, verification_text
+from ..report import dumps_json, motion_verification_text, verification_text
 from .common import as_option, figure_path, load, wrote
 
 
@@ -28,10 +29,14 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         doc = {"spec": args.spec, **verification.as_dict(), "plots": [str(p) for p in paths]}
         text = dumps_json(doc)
+    elif isinstance(verification, MotionVerification):
+        text = motion_verification_text(verification, spec=args.spec) + "\n"
     else:
         text = verification_text(verification, spec=args.spec) + "\n"
     if plot is not None:
-        save_figure(verification_figure(design, verification), plot)
+        save_figure(motion_verification_figure(design, verification)
+                    if isinstance(verification, MotionVerification)
+                    else verification_figure(design, verification), plot)
         wrote(plot)
     sys.stdout.write(text)
     return 0

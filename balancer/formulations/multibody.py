@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from types import ModuleType
 from typing import TYPE_CHECKING
 
@@ -40,6 +41,8 @@ from ..errors import AssemblyError, SolverError
 from ..linkage import rotors
 from ..linkage.assembly import assembly_gaps
 from ..linkage.constraints import GROUND_INDEX, Constraint, FrameTally, Pose
+from ..linkage.inputs import InputState
+from ..linkage.kinematics import Motion
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import Num, OpsLike, V, _is_zero
 from ..mechanisms.base import Mechanism
@@ -48,6 +51,39 @@ from .compiled import Compiled, LinkageFormulation, link_equations, spring_force
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
     import casadi as ca
+
+
+@dataclass(frozen=True)
+class PrescribedDynamics:
+    """The multibody formulation at states where every input is prescribed.
+
+    Attributes
+    ----------
+    q, qd, qdd
+        The links' frame coordinates ``(x, y, θ)``, their rates and accelerations, each
+        ``(count, 3n)`` (m, rad; per s, per s²).
+    multipliers
+        The constraints' multipliers, ``(count, rows)``.
+    ground, slider_normal, slider_couple
+        The force on each ground point (complex, N), each ground slider's normal force (N) and
+        couple (N·m) on its guide.
+    shaking_force, shaking_moment
+        Their sum (complex, N) and its moment about the origin with the motors' reactions and
+        the counter-rotors' (N·m).
+    torques
+        Each motor's torque on its input (N·m), in the order of the linkage's inputs.
+    """
+
+    q: NDArray[np.float64]
+    qd: NDArray[np.float64]
+    qdd: NDArray[np.float64]
+    multipliers: NDArray[np.float64]
+    ground: dict[str, NDArray[np.complex128]]
+    slider_normal: dict[str, NDArray[np.float64]]
+    slider_couple: dict[str, NDArray[np.float64]]
+    shaking_force: NDArray[np.complex128]
+    shaking_moment: NDArray[np.float64]
+    torques: tuple[NDArray[np.float64], ...]
 
 
 class Multibody(LinkageFormulation):
@@ -60,14 +96,21 @@ class Multibody(LinkageFormulation):
     passes_change_points = False
 
     def __init__(self, mechanism: Mechanism, *, gravity: tuple[float, float] = (0.0, 0.0),
-                 speed: float | None = None) -> None:
+                 speed: float | None = None, prescribed: bool = False) -> None:
         super().__init__(mechanism, gravity=gravity, speed=speed)
         #: The mechanism as a general linkage (springs, sliders, ground points).
         self.general = self.mech.linkage
         s = self.structure
-        self.theta1_start = s.ref_angle[s.input]
+        if self.driven and len(s.drivers) != 1:
+            raise ValueError("a crank at constant speed drives a linkage of one input")
+        #: Every input driven (a crank at constant speed, or ``prescribed``: each input along
+        #: a motion, its accelerations an argument of the dynamics).
+        self.inputs_driven = self.driven or prescribed
+        self.theta1_start = s.ref_angle[s.inputs[0]]
         self.constraints: list[Constraint] = [*s.constraints,
-                                              *([s.driver] if self.driven else [])]
+                                              *(s.drivers if self.inputs_driven else ())]
+        #: The number of inputs (each driver's prescribed acceleration is an argument).
+        self.input_count = len(s.drivers)
         self.rows = sum(c.rows for c in self.constraints)
         self.scale = s.length_scale()
         self._build()
@@ -86,6 +129,9 @@ class Multibody(LinkageFormulation):
         q = ca.SX.sym("q", 3 * n)
         qd = ca.SX.sym("qd", 3 * n)
         gas = ca.SX.sym("gas", max(1, len(s.prisms)))
+        inputs = ca.SX.sym("inputs", self.input_count)  # the inputs' accelerations
+        zero = [ca.SX(0)] * self.input_count
+        prescribed = InputState.symbolic(zero, zero, [inputs[i] for i in range(self.input_count)])
         pose = self._pose(q, CasadiOps)
         vel = [V(qd[3 * k], qd[3 * k + 1]) for k in range(n)]
         rate = [qd[3 * k + 2] for k in range(n)]
@@ -102,12 +148,13 @@ class Multibody(LinkageFormulation):
                 for r in range(c.rows):
                     for col in range(3):
                         jac[row + r, 3 * link + col] += coeffs[r][col]
-            gam = c.gamma(pose, vel, rate)  # (the driver's: the input's, 0 here)
+            gam = c.gamma(pose, vel, rate, prescribed)  # (a driver's: its input's)
             for r in range(c.rows):
                 if not _is_zero(gam[r]):
                     gamma[row + r] = gam[r]
             row += c.rows
-        self._equations = ca.Function("equations", [q, qd, gas], [mass, force, jac, gamma])
+        self._equations = ca.Function("equations", [q, qd, gas, inputs],
+                                      [mass, force, jac, gamma])
         self._kinetic = ca.Function("kinetic", [q, qd], [0.5 * ca.dot(qd, ca.mtimes(mass, qd))])
         self._build_frame(q, qd, gas, pose)
         self._build_dynamics()
@@ -150,7 +197,8 @@ class Multibody(LinkageFormulation):
         for k, link in enumerate(self.links):
             if link.counter_rotor:
                 mz = mz + rotors.ground_couple(link.counter_rotor, acc[3 * k + 2])
-        torque = -lam[-1] if self.driven else ca.SX(0)  # the driver's multiplier
+        # Each motor's torque: minus its driver's multiplier (zero in free motion).
+        torques = [frame.torques.get(i, ca.SX(0)) for i in range(self.input_count)]
         #: Names of the outputs of :attr:`_frame` and of the dynamics after ``q̈`` and ``λ``.
         self._ground_names = tuple(ground)
         self._slider_names = tuple(s.names[c.s] for c in s.prisms if c.g == GROUND_INDEX)
@@ -159,7 +207,7 @@ class Multibody(LinkageFormulation):
             ca.vertcat(*flat) if flat else ca.SX(0, 1),
             ca.vertcat(*normal) if normal else ca.SX(0, 1),
             ca.vertcat(*couple) if couple else ca.SX(0, 1),
-            ca.vertcat(fx, fy, mz, torque)])
+            ca.vertcat(fx, fy, mz, *torques)])
 
     def _build_dynamics(self) -> None:
         """One function from a state to ``q̈``, ``λ`` and the forces on the frame (MX).
@@ -176,7 +224,8 @@ class Multibody(LinkageFormulation):
         q = ca.MX.sym("q", k)
         qd = ca.MX.sym("qd", k)
         gas = ca.MX.sym("gas", max(1, len(self.structure.prisms)))
-        mass, force, jac, gamma = self._equations(q, qd, gas)
+        inputs = ca.MX.sym("inputs", self.input_count)
+        mass, force, jac, gamma = self._equations(q, qd, gas, inputs)
         d, r = self._equilibration()
         dq, rl = ca.diag(ca.DM(d)), ca.diag(ca.DM(r))
         kkt = ca.blockcat([[dq @ mass @ dq, dq @ jac.T @ rl],
@@ -184,22 +233,23 @@ class Multibody(LinkageFormulation):
         z = ca.solve(kkt, ca.vertcat(dq @ force, rl @ gamma), "qr")
         acc, lam = dq @ z[:k], rl @ z[k:]
         outputs = [acc, lam, *self._frame(q, qd, gas, lam, acc)]
-        self._dynamics = ca.Function("dynamics", [q, qd, gas], outputs)
+        self._dynamics = ca.Function("dynamics", [q, qd, gas, inputs], outputs)
         #: Where each output sits in the flat vector of :attr:`_fast_dynamics`.
         sizes = np.cumsum([0, *(o.size1() for o in outputs)])
         self._slices = [slice(a, b) for a, b in zip(sizes[:-1], sizes[1:], strict=True)]
-        flat = ca.vertcat(q, qd, gas)
+        flat = ca.vertcat(q, qd, gas, inputs)
+        gas_end = 2 * k + gas.size1()
         self._fast_dynamics = Compiled(ca.Function(
             "dynamics_flat", [flat], [ca.densify(ca.vertcat(*self._dynamics(
-                flat[:k], flat[k : 2 * k], flat[2 * k :])))]))
+                flat[:k], flat[k : 2 * k], flat[2 * k : gas_end], flat[gas_end:])))]))
 
     def _equilibration(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The constant scalings ``D`` (coordinates) and ``R`` (constraint rows), diagonals."""
         k = 3 * self.n
         q0 = self.structure.reference_coordinates()
-        mass, _, jac, _ = (np.array(x) for x in self._equations(q0, np.zeros(k),
-                                                                 np.zeros(max(1, len(
-                                                                     self.structure.prisms)))))
+        mass, _, jac, _ = (np.array(x) for x in self._equations(
+            q0, np.zeros(k), np.zeros(max(1, len(self.structure.prisms))),
+            np.zeros(self.input_count)))
         diag = np.diag(mass)
         d = np.where(diag > 0, 1.0 / np.sqrt(np.where(diag > 0, diag, 1.0)), 1.0)
         norms = np.linalg.norm(jac * d[None, :], axis=1)
@@ -207,20 +257,22 @@ class Multibody(LinkageFormulation):
         return d, r
 
     def _build_constraints(self, q: ca.SX, pose: Pose) -> None:
-        """The constraints' residual and Jacobian at a pose and a prescribed crank angle (SX)."""
+        """The constraints' residual and Jacobian at a pose and the inputs' positions (SX)."""
         import casadi as ca  # heavy: only where symbols are built
-        angle = ca.SX.sym("angle")
-        phi = ca.vertcat(*(r for c in self.constraints
-                           for r in c.residual(pose, angle)))
+        angles = ca.SX.sym("angles", self.input_count)
+        zero = [ca.SX(0)] * self.input_count
+        at = InputState.symbolic([angles[i] for i in range(self.input_count)], zero, zero)
+        phi = ca.vertcat(*(r for c in self.constraints for r in c.residual(pose, at)))
         jac = ca.densify(ca.jacobian(phi, q))
         self._constraints = Compiled(ca.Function(
-            "constraints", [ca.vertcat(q, angle)],
+            "constraints", [ca.vertcat(q, angles)],
             [ca.vertcat(phi, ca.reshape(jac, -1, 1))]))
 
     def _call(self, t: float, y: NDArray[np.float64]) -> list[NDArray[np.float64]]:
         """The compiled dynamics at a state: ``q̈``, ``λ``, then the forces on the frame."""
         k = 3 * self.n
-        flat = self._fast_dynamics(np.concatenate([y[: 2 * k], self._gas(self.theta1_of(t, y))]))
+        flat = self._fast_dynamics(np.concatenate([y[: 2 * k], self._gas(self.theta1_of(t, y)),
+                                                   np.zeros(self.input_count)]))
         return [flat[s] for s in self._slices]
 
     # -- the formulation's interface ----------------------------------------------------------
@@ -234,7 +286,7 @@ class Multibody(LinkageFormulation):
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         if self.driven:
             return self.crank_angle(t)
-        return float(y[3 * self.structure.input + 2])
+        return float(y[3 * self.structure.inputs[0] + 2])
 
     def initial_state(self, theta1: float, omega1: float) -> NDArray[np.float64]:
         self.theta1_start = float(theta1)
@@ -270,21 +322,77 @@ class Multibody(LinkageFormulation):
         theta1 = self.crank_angle(times)
         with np.errstate(all="ignore"):
             mo = self.mech.motion(theta1, self._motor_speed, 0.0)
-        count, n = times.size, self.n
-        q, qd = np.empty((count, 3 * n)), np.empty((count, 3 * n))
-        for k in range(n):
-            q[:, 3 * k], q[:, 3 * k + 1] = mo.pose.origins[k].x, mo.pose.origins[k].y
-            q[:, 3 * k + 2] = mo.pose.angles[k]
-            qd[:, 3 * k], qd[:, 3 * k + 1] = mo.velocity[k].x, mo.velocity[k].y
-            qd[:, 3 * k + 2] = mo.rate[k]
+        q, qd = self.coordinates(mo, times.size)
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
             return None
+        n = self.n
         angles, rates = q[:, 2::3], qd[:, 2::3]
         angles += 2 * np.pi * np.round((start[2 : 3 * n : 3] - angles[0]) / (2 * np.pi))
         for k in range(n):
             angles[:, k] = continuous_angles(angles[:, k], rates[:, k], times)
         angles[:, self.structure.input] = theta1
         return np.hstack([q, qd])
+
+    def coordinates(self, mo: Motion, count: int
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The frames' coordinates and rates at ``count`` states of a motion, each ``(count, 3n)``.
+
+        From the linkage core's position and rate analysis (the angles as it gives them).
+        """
+        n = self.n
+        q, qd = np.empty((count, 3 * n)), np.empty((count, 3 * n))
+        for k in range(n):
+            q[:, 3 * k], q[:, 3 * k + 1] = mo.pose.origins[k].x, mo.pose.origins[k].y
+            q[:, 3 * k + 2] = mo.pose.angles[k]
+            qd[:, 3 * k], qd[:, 3 * k + 1] = mo.velocity[k].x, mo.velocity[k].y
+            qd[:, 3 * k + 2] = mo.rate[k]
+        return q, qd
+
+    def prescribed_dynamics(self, state: InputState) -> PrescribedDynamics:
+        """The saddle-point system at states where every input is prescribed.
+
+        The links' coordinates and rates ``(q, q̇)`` come from the linkage core's position and
+        rate analysis at the inputs' positions and rates (on the constraints and their
+        derivative); each driver's ``γ`` is its input's prescribed acceleration. The solve
+        ``[[M, Φ_qᵀ], [Φ_q, 0]]·[q̈; λ] = [Q; γ]`` gives the links' accelerations and the
+        multipliers: the forces on the frame and each motor's torque (minus its driver's
+        multiplier). Needs the formulation built with ``prescribed=True``.
+
+        Raises
+        ------
+        SolverError
+            If the system is singular to working precision at a state (a singular pose).
+        """
+        assert self.inputs_driven and not self.driven, "built with prescribed=True"
+        count = state.count
+        with np.errstate(all="ignore"):
+            mo = self.mech.motion_at(state)
+        q, qd = self.coordinates(mo, count)
+        gas = np.zeros((count, max(1, len(self.structure.prisms))))
+        acc_in = np.array([np.broadcast_to(a, (count,)) for a in state.accelerations]).T
+        flat = self._fast_dynamics.columns(np.hstack([q, qd, gas, acc_in]).T)
+        if not np.all(np.isfinite(flat)):
+            raise SolverError(
+                "the multibody equations of motion are singular to working precision at a "
+                "state of the motion (a singular pose)")
+        acc, lam, ground, normal, couple, frame = (flat[s] for s in self._slices)
+        ground = ground.reshape(-1, count)
+        return PrescribedDynamics(
+            q=q, qd=qd, qdd=acc.T, multipliers=lam.T,
+            ground={p: ground[2 * i] + 1j * ground[2 * i + 1]
+                    for i, p in enumerate(self._ground_names)},
+            slider_normal={name: normal[i] for i, name in enumerate(self._slider_names)},
+            slider_couple={name: couple[i] for i, name in enumerate(self._slider_names)},
+            shaking_force=frame[0] + 1j * frame[1], shaking_moment=frame[2],
+            torques=tuple(frame[3 + i] for i in range(self.input_count)))
+
+    def kinetic_energy(self, q: NDArray[np.float64], qd: NDArray[np.float64]
+                       ) -> NDArray[np.float64]:
+        """``T = q̇ᵀ·M(q)·q̇/2`` at states ``(count, 3n)``, J (compiled)."""
+        import casadi as ca  # heavy: only where symbols are built
+        count = q.shape[0]
+        return np.asarray(self._kinetic.map(count).call(
+            [ca.DM(q.T), ca.DM(qd.T)])[0].full()).ravel()
 
     def symbolic_rhs(self) -> ca.Function | None:
         """``(t, y) → ẏ`` as a CasADi function (none with slider forces: tables in Python)."""
@@ -295,7 +403,8 @@ class Multibody(LinkageFormulation):
         k = 3 * self.n
         t = ca.MX.sym("t")
         y = ca.MX.sym("y", 2 * k + (1 if self.driven else 0))
-        out = self._dynamics(y[:k], y[k : 2 * k], ca.MX.zeros(max(1, len(s.prisms))))
+        out = self._dynamics(y[:k], y[k : 2 * k], ca.MX.zeros(max(1, len(s.prisms))),
+                             ca.MX.zeros(self.input_count))
         acc, frame = out[0], out[-1]
         dy = [y[k : 2 * k], acc]
         if self.driven:
@@ -313,8 +422,8 @@ class Multibody(LinkageFormulation):
     def _constraint_values(self, t: float, q: NDArray[np.float64]
                            ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Residual and Jacobian of the constraints (the driver's at time ``t``)."""
-        angle = self.crank_angle(t) if self.driven else 0.0
-        out = self._constraints(np.append(q, angle))
+        angles = np.full(self.input_count, self.crank_angle(t) if self.driven else 0.0)
+        out = self._constraints(np.append(q, angles))
         rows = self.rows
         return out[:rows], out[rows:].reshape(3 * self.n, rows).T  # column-major
 
@@ -349,8 +458,8 @@ class Multibody(LinkageFormulation):
         Residuals ``(k, rows)`` and Jacobians ``(k, rows, n)``.
         """
         count, n = q.shape
-        angles = (self.crank_angle(np.asarray(times, dtype=float)) if self.driven
-                  else np.zeros(count))
+        angles = np.broadcast_to(self.crank_angle(np.asarray(times, dtype=float)) if self.driven
+                                 else 0.0, (self.input_count, count))
         out = self._constraints.columns(np.vstack([q.T, angles]))  # one column each
         rows = self.rows
         return out[:rows].T, out[rows:].T.reshape(count, n, rows).transpose(0, 2, 1)
@@ -442,7 +551,8 @@ class Multibody(LinkageFormulation):
         count = len(times)
         ys = np.array(states, dtype=float).reshape(count, -1)
         gas = np.array([self._gas(self.theta1_of(t, y)) for t, y in zip(times, ys, strict=True)])
-        flat = self._fast_dynamics.columns(np.hstack([ys[:, : 2 * n], gas.reshape(count, -1)]).T)
+        flat = self._fast_dynamics.columns(np.hstack([ys[:, : 2 * n], gas.reshape(count, -1),
+                                                      np.zeros((count, self.input_count))]).T)
         if not np.all(np.isfinite(flat)):  # QR of a system singular to working precision
 
             raise SolverError(
@@ -471,10 +581,17 @@ class Multibody(LinkageFormulation):
         the loads' and gravity's work from the centres of mass' and the angles'
         displacements; the springs' from their potential energy.
         """
-        import casadi as ca  # heavy: only where symbols are built
         assert states is not None  # the simulation passes them
         n = 3 * self.n
         ys = np.array(states, dtype=float).reshape(len(states), -1)
-        q, qd = ys[:, :n].T, ys[:, n : 2 * n].T  # (3n, count)
-        kin = np.asarray(self._kinetic.map(ys.shape[0]).call([ca.DM(q), ca.DM(qd)])[0].full())
-        return kin.ravel(), self.configuration_work(self._pose(q, np), q[2::3])
+        return self.energies(ys[:, :n], ys[:, n : 2 * n])
+
+    def energies(self, q: NDArray[np.float64], qd: NDArray[np.float64]
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Kinetic energy and the configuration's work since the first state at ``(count, 3n)``.
+
+        ``T = q̇ᵀ·M·q̇/2`` (compiled) and the loads', gravity's and springs' work from the
+        centres of mass' and the angles' displacements (angles continuous over the states), J.
+        """
+        return (self.kinetic_energy(q, qd),
+                self.configuration_work(self._pose(q.T, np), q.T[2::3]))

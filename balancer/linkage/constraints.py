@@ -77,7 +77,7 @@ class Pin:
         """The local point by which it holds link ``k``."""
         return self.pa if self.a == k else self.pb
 
-    def residual(self, pose: Pose, angle: Num = 0.0) -> list[Num]:
+    def residual(self, pose: Pose, state: InputState | None = None) -> list[Num]:
         """The two points' separation, m."""
         d = pose.point(self.a, self.pa) - pose.point(self.b, self.pb)
         return [d.x, d.y]
@@ -141,7 +141,7 @@ class Prism:
         """``None``: a prism holds a link by no point."""
         return None
 
-    def residual(self, pose: Pose, angle: Num = 0.0) -> list[Num]:
+    def residual(self, pose: Pose, state: InputState | None = None) -> list[Num]:
         """The relative angle's error (rad) and the slider point's distance from the line (m)."""
         ts = 0.0 if self.s == GROUND_INDEX else pose.angles[self.s]
         tg = 0.0 if self.g == GROUND_INDEX else pose.angles[self.g]
@@ -209,9 +209,9 @@ class Driver:
         """``None``: the driver holds a link by no point."""
         return None
 
-    def residual(self, pose: Pose, angle: Num = 0.0) -> list[Num]:
-        """The input's angle less the prescribed ``angle``, rad."""
-        return [pose.angles[self.link] - angle]
+    def residual(self, pose: Pose, state: InputState | None = None) -> list[Num]:
+        """The input's angle less its prescribed position in ``state`` (none given: 0), rad."""
+        return [pose.angles[self.link] - (0.0 if state is None else state.positions[self.index])]
 
     def jacobian(self, pose: Pose) -> Blocks:
         """:meth:`residual`'s derivative by the links' coordinates."""

@@ -166,7 +166,10 @@ def input_state(structure: Structure, spec: MotionSpec,
                 while len(kept) > STATES_KEPT:
                     kept.popitem(last=False)
         return known
-    return _input_state(structure, spec, np.asarray(t, dtype=float))
+    t = np.asarray(t, dtype=float)
+    if spec.point is None:
+        return _input_state(structure, spec, t)
+    return _point_state_at(structure, spec, t)
 
 
 #: A motion's input states at its samples are kept with the geometry
@@ -332,6 +335,46 @@ def _inverse_kinematics(structure: Structure, spec: MotionSpec, p: NDArray[np.fl
                 "puts it there, or the way passes a singular pose)", key="path",
                 value=list(spec.path[0]))
     out = _along_path(structure, spec, k, local, theta[:, 0], p)
+    return _point_state(structure, k, local, out, v, a)
+
+
+def _point_state_at(structure: Structure, spec: MotionSpec, t: NDArray[np.float64]
+                    ) -> InputState:
+    """A point's path at any times ``t`` of the motion (in any order).
+
+    From the motion's samples (:func:`input_state`, found by continuation): their inputs
+    interpolated in time start Newton's steps at every time at once; a time whose solution
+    does not converge, or lands farther from its start than the samples are apart (another
+    branch), is refused.
+    """
+    assert spec.point is not None
+    k, local = marker(structure, spec.point)
+    known = input_state(structure, spec)
+    samples = sample_times(spec)
+    guess = np.array([np.interp(t, samples, np.asarray(x, dtype=float))
+                      for x in known.positions])
+    p, v, a = path_values(spec, t)
+    theta, done = _newton(structure, k, local, guess, p)
+    apart = max(float(np.max(np.abs(np.diff(np.asarray(x, dtype=float)))))
+                for x in known.positions) if samples.size > 1 else 0.0
+    off = np.max(np.abs(theta - guess), axis=0) > max(apart, 1e-12)
+    if not done.all() or off.any():
+        bad = int(np.argmax(~done | off))
+        raise AssemblyError(
+            f"the point's path cannot be followed at t = {float(t[bad]):g} s from the "
+            "motion's samples (a singular pose near it: take more samples)", key="path",
+            value=[float(p[bad, 0]), float(p[bad, 1])])
+    return _point_state(structure, k, local, theta, v, a)
+
+
+def _point_state(structure: Structure, k: int, local: V, out: NDArray[np.float64],
+                 v: NDArray[np.float64], a: NDArray[np.float64]) -> InputState:
+    """The inputs' rates and accelerations where point ``local`` of link ``k`` has ``(v, a)``.
+
+    ``out`` the inputs' positions ``(2, N)``; ``v``, ``a`` the point's velocity and
+    acceleration ``(N, 2)``: the point's Jacobian by the inputs solves for the rates, and
+    for the accelerations less the point's acceleration at zero input accelerations.
+    """
     _, jac = _point_and_jacobian(structure, k, local, out)
     rates = np.linalg.solve(jac, v[:, :, None])[:, :, 0]
     mo = kinematics.motion(structure, InputState.of(list(out), list(rates.T)))

@@ -13,6 +13,8 @@ or not at all. matplotlib is imported by the functions that draw, not by importi
 ``orders``         the order table as bars: forward and backward whirl, before and after
 ``motion``         a simulated motion: forces on the ground, shaking moment, the centre of
                    mass' path; ``balancer verify``'s figure
+``motion_runs``    ``balancer verify``'s figure of a linkage with several inputs: its runs
+                   along the motions and free
 ``animation``      the mechanism turning (GIF, MP4)
 ``fronts``         a trade-off front
 ``atlas``          a sweep's atlas and a tolerance histogram
@@ -35,6 +37,7 @@ from .animation import animate, animation_figure
 from .atlas import sweep_figure
 from .fronts import front_figure
 from .motion import plot_com_path, plot_reactions, plot_shaking_moment, verification_figure
+from .motion_runs import motion_verification_figure
 from .orders import orders_figure, plot_orders
 from .revolution import (
     cycle_figure,
@@ -53,6 +56,7 @@ __all__ = [
     "cycle_figure",
     "front_figure",
     "motion_figure",
+    "motion_verification_figure",
     "orders_figure",
     "plot_centre_of_mass_track",
     "plot_com_path",

@@ -40,6 +40,10 @@ _EXPORTS = {
     "simulation_json": "motion",
     "simulation_text": "motion",
     "verification_text": "motion",
+    "motion_run_text": "motion_runs",
+    "motion_run_json": "motion_runs",
+    "motion_run_csv": "motion_runs",
+    "motion_verification_text": "motion_runs",
     "link_parameters": "balancing",
     "optimization_json": "balancing",
     "WORSE_RATIO": "balancing",
@@ -67,6 +71,10 @@ __all__ = [
     "WORSE_RATIO",
     "analysis_csv",
     "motion_csv",
+    "motion_run_csv",
+    "motion_run_json",
+    "motion_run_text",
+    "motion_verification_text",
     "motions_json",
     "motions_text",
     "analysis_figures",
@@ -139,6 +147,12 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         simulation_json,
         simulation_text,
         verification_text,
+    )
+    from .motion_runs import (
+        motion_run_csv,
+        motion_run_json,
+        motion_run_text,
+        motion_verification_text,
     )
     from .parts import dimensions, dimensions_text, parts_json, parts_text
     from .text import (

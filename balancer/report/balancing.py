@@ -10,12 +10,14 @@ from typing import TYPE_CHECKING, Any
 from ..balance.counterweights import UNCHANGED, Counterweight, link_scales
 from ..cycle import CycleAnalysis
 from ..motion_analysis import AlongMotions
+from ..motion_verification import MotionVerification
 from ..orders import order_name
 from ..quantities import unit_of, words_of
 from ..rounding import Scales, speed_text
 from ..rounding import figure_text as _fmt
 from .analysis import analysis_figures, force_balance_line, orders_list
 from .motion import verification_text
+from .motion_runs import motion_verification_text
 from .text import table
 
 if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these load them
@@ -40,7 +42,8 @@ def link_parameters(link: Link) -> dict[str, float]:
 
 def optimization_json(result: BalanceResult, before: CycleAnalysis | AlongMotions,
                       after: CycleAnalysis | AlongMotions,
-                      verification: Verification | None = None, spec: str | None = None,
+                      verification: Verification | MotionVerification | None = None,
+                      spec: str | None = None,
                       out: str | os.PathLike[str] | None = None) -> dict[str, Any]:
     """The ``optimize --json`` document.
 
@@ -339,12 +342,13 @@ def optimization_scales(result: BalanceResult, before: CycleAnalysis | AlongMoti
 
 def optimization_text(result: BalanceResult, before: CycleAnalysis | AlongMotions,
                       after: CycleAnalysis | AlongMotions,
-                      verification: Verification | None = None,
+                      verification: Verification | MotionVerification | None = None,
                       spec: str | None = None) -> str:
     """The readable ``optimize`` report."""
     if isinstance(before, AlongMotions) or isinstance(after, AlongMotions):
         assert isinstance(before, AlongMotions) and isinstance(after, AlongMotions)
-        return _along_motions_text(result, before, after, spec)
+        assert verification is None or isinstance(verification, MotionVerification)
+        return _along_motions_text(result, before, after, verification, spec)
     head = f"balancer optimize — {spec}" if spec else "balancer optimize"
     lines = [
         head,
@@ -397,13 +401,14 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis | AlongMotion
         lines += [_parameters_text(result), "", counterweight_text(result.counterweights), ""]
     lines.append(force_balance_line(after))
     if verification is not None:
+        assert not isinstance(verification, MotionVerification)  # (one input: a revolution)
         lines.append("")
         lines.append(verification_text(verification).split("\n", 1)[1].strip("\n"))
     return "\n".join(lines)
 
 
 def _along_motions_text(result: BalanceResult, before: AlongMotions, after: AlongMotions,
-                        spec: str | None) -> str:
+                        verification: MotionVerification | None, spec: str | None) -> str:
     """``optimize``'s report of a linkage with several inputs, along its motions."""
     from .along import force_balance_words  # (the analysis' words along motions)
 
@@ -439,4 +444,6 @@ def _along_motions_text(result: BalanceResult, before: AlongMotions, after: Alon
         result, sc, "inertial shaking along the motions, each motion by its weight")
     lines += [_parameters_text(result), "", counterweight_text(result.counterweights), "",
               force_balance_words(after)]
+    if verification is not None:
+        lines += ["", motion_verification_text(verification).split("\n", 1)[1].strip("\n")]
     return "\n".join(lines)

@@ -193,8 +193,9 @@ def test_the_command_line_lists_every_formulation_and_drive():
     # The names the parser offers without importing the mechanisms (for a fast --help), against
     # the mechanisms' own tables and the model's drives.
     from balancer import cli, formulations, mechanisms, model
+    from balancer.simulation import motions
 
-    names = set(formulations.GENERAL)
+    names = set(formulations.GENERAL) | set(motions.METHODS)  # (several inputs: their own)
     for kind in mechanisms.FOLDERS:
         names |= set(mechanisms.mechanism_class(kind).own_formulations)
     assert set(cli.FORMULATION_NAMES) == names
