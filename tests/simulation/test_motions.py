@@ -26,7 +26,6 @@ from balancer.mechanisms import mechanism_of
 from balancer.model.motions import MotionSpec
 from balancer.motion_verification import _agreement, fastest_state
 from balancer.simulation.motions import simulate_along, simulate_free
-from balancer.spec.reader import design_from_dict
 
 GRAVITY = (0.0, -9.81)
 #: The runs' quadrature tolerance (relative): the energy balance holds to the panels' count
