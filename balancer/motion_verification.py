@@ -115,12 +115,12 @@ class MotionCheck:
 
     @property
     def max_shaking_moment(self) -> float:
-        """Largest |shaking moment| over the run, N·m."""
+        """Largest magnitude of the shaking moment over the run, N·m."""
         return _largest(self.run.reactions.shaking_moment)
 
     @property
     def max_torques(self) -> dict[str, float]:
-        """Each input's largest |torque| over the run, N·m."""
+        """Each input's largest magnitude of torque over the run, N·m."""
         return {name: _largest(t) for name, t in
                 zip(self.run.inputs, self.run.reactions.torques, strict=True)}
 
@@ -131,7 +131,7 @@ class MotionCheck:
 
     @property
     def original_max_shaking_moment(self) -> float | None:
-        """The original's largest |shaking moment|, N·m."""
+        """The original's largest magnitude of the shaking moment, N·m."""
         return (None if self.original is None
                 else _largest(self.original.reactions.shaking_moment))
 
@@ -193,7 +193,7 @@ class MotionVerification:
 
     @property
     def max_shaking_moment(self) -> float:
-        """Largest |shaking moment| over the runs, N·m."""
+        """Largest magnitude of the shaking moment over the runs, N·m."""
         return max(c.max_shaking_moment for c in self.checks)
 
     def as_dict(self) -> dict[str, Any]:
