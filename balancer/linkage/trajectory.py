@@ -77,8 +77,11 @@ def _slopes(spec: MotionSpec) -> NDArray[np.float64]:
     """The path's slopes ``dp/dτ`` at the waypoints, ``(K, width)``.
 
     Hermite: zero at the ends, the three-point difference ``(h₋·δ₊ + h₊·δ₋)/(h₋ + h₊)`` inside.
-    Periodic spline: the slopes that make the second derivative continuous everywhere, the
-    last waypoint the first (a cyclic tridiagonal system, solved densely: a few waypoints).
+    Spline: the slopes that make the second derivative continuous everywhere — periodic for a
+    closed path (the last waypoint the first), clamped for an open one (zero slopes at its
+    ends: from rest to rest). A tridiagonal system (cyclic where periodic), solved densely for a
+    few waypoints; a table of many (a motion read from a file) by SciPy's ``CubicSpline`` with
+    the same end conditions (its import costs half a second: only then).
     """
     knots = np.asarray(spec.times, dtype=float)
     values = np.asarray(spec.path, dtype=float)
@@ -89,20 +92,46 @@ def _slopes(spec: MotionSpec) -> NDArray[np.float64]:
         slopes[1:-1] = ((h[:-1, None] * delta[1:] + h[1:, None] * delta[:-1])
                         / (h[:-1] + h[1:])[:, None])
         return slopes
-    # At waypoint i (cyclic, K − 1 of them), continuity of p'' between the segments before
-    # (h₋, δ₋) and after (h₊, δ₊): h₊·m₋ + 2(h₋ + h₊)·m + h₋·m₊ = 3(h₊·δ₋ + h₋·δ₊).
+    periodic = spec.closed
+    if len(knots) > DENSE_KNOTS:
+        from scipy.interpolate import CubicSpline  # (a long table: a banded solve)
+
+        fitted = CubicSpline(knots, values, bc_type="periodic" if periodic else "clamped")
+        return np.asarray(fitted(knots, 1), dtype=float)
+    # At waypoint i, continuity of p'' between the segments before (h₋, δ₋) and after
+    # (h₊, δ₊): h₊·m₋ + 2(h₋ + h₊)·m + h₋·m₊ = 3(h₊·δ₋ + h₋·δ₊); cyclic over the K − 1
+    # waypoints where periodic, else the inner ones with m = 0 at both ends.
     count = len(h)
-    system = np.zeros((count, count))
-    rhs = np.zeros((count, values.shape[1]))
-    for i in range(count):
-        before, after = (i - 1) % count, i
-        system[i, before] += h[after]
-        system[i, i] += 2 * (h[before] + h[after])
-        system[i, (i + 1) % count] += h[before]
-        rhs[i] = 3 * (h[after] * delta[before] + h[before] * delta[after])
-    slopes[:-1] = np.linalg.solve(system, rhs)
-    slopes[-1] = slopes[0]
+    if periodic:
+        system = np.zeros((count, count))
+        rhs = np.zeros((count, values.shape[1]))
+        for i in range(count):
+            before, after = (i - 1) % count, i
+            system[i, before] += h[after]
+            system[i, i] += 2 * (h[before] + h[after])
+            system[i, (i + 1) % count] += h[before]
+            rhs[i] = 3 * (h[after] * delta[before] + h[before] * delta[after])
+        slopes[:-1] = np.linalg.solve(system, rhs)
+        slopes[-1] = slopes[0]
+        return slopes
+    inner = count - 1
+    if inner > 0:
+        system = np.zeros((inner, inner))
+        rhs = np.zeros((inner, values.shape[1]))
+        for j in range(inner):  # waypoint j + 1, between segments j and j + 1
+            before, after = j, j + 1
+            system[j, j] = 2 * (h[before] + h[after])
+            if j > 0:
+                system[j, j - 1] = h[after]
+            if j < inner - 1:
+                system[j, j + 1] = h[before]
+            rhs[j] = 3 * (h[after] * delta[before] + h[before] * delta[after])
+        slopes[1:-1] = np.linalg.solve(system, rhs)
     return slopes
+
+
+#: Waypoints up to which a spline's slopes are solved densely here (more: SciPy's banded solve).
+DENSE_KNOTS = 200
 
 
 def path_values(spec: MotionSpec, t: NDArray[np.float64]
@@ -117,7 +146,7 @@ def path_values(spec: MotionSpec, t: NDArray[np.float64]
     """
     knots = np.asarray(spec.times, dtype=float)
     values = np.asarray(spec.path, dtype=float)
-    if spec.law == "spline":
+    if spec.law == "spline" and spec.closed:
         values = values.copy()
         values[-1] = values[0]
     slopes = _slopes(spec)

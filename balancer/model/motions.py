@@ -13,10 +13,11 @@ waypoints at given times, run by a time law:
     ``τ`` by the rest-to-rest polynomial ``3u² − 2u³`` or ``10u³ − 15u⁴ + 6u⁵`` of the
     normalised time ``u``;
 ``"spline"``
-    ``τ = t``, the path a periodic cubic spline (a closed path run at its waypoints' pace).
+    ``τ = t``, the path a cubic spline at its waypoints' pace: periodic for a closed path,
+    clamped (at rest at both ends) for an open one.
 
 The path through the waypoints is a cubic Hermite spline of ``τ`` with zero end slopes (its
-inner slopes the three-point differences), or the periodic cubic spline for ``"spline"``
+inner slopes the three-point differences), or the cubic spline for ``"spline"``
 (:mod:`balancer.linkage.trajectory`).
 """
 
@@ -165,13 +166,14 @@ class MotionSpec:
         elif self.acc_time is not None:
             raise SpecError(f"is the trapezoid law's; this motion's law is {self.law}",
                             key="acc_time", value=self.acc_time)
-        if self.law == "spline" and not all(
-                math.isclose(a, b, rel_tol=0.0, abs_tol=1e-12 * max(1.0, abs(a)))
-                for a, b in zip(path[0], path[-1], strict=True)):
-            raise SpecError("a spline's path is closed: its last waypoint must be its first",
-                            key="path", value=[list(path[0]), list(path[-1])])
         v.store(self, "samples", v.integer(self.samples, "samples", minimum=self.SAMPLES[0],
                                            maximum=self.SAMPLES[1]))
+
+    @property
+    def closed(self) -> bool:
+        """Whether the path ends where it starts (to 1e-12 of its figures)."""
+        return all(math.isclose(a, b, rel_tol=0.0, abs_tol=1e-12 * max(1.0, abs(a)))
+                   for a, b in zip(self.path[0], self.path[-1], strict=True))
 
     @property
     def duration(self) -> float:

@@ -162,12 +162,14 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
     if sub is not None:
         _check_keys(sub, schema.known("balance.objective", mech.kind),
                     elsewhere=schema.known("balance.objective"), kind=mech.kind)
-        objective = Objective(
-            **{
-                name: sub.nonnegative(name, default=getattr(objective, name))
-                for name in OBJECTIVE_KEYS
-            }
-        )
+        weights_of = {name: sub.nonnegative(name, default=getattr(objective, name))
+                      for name in OBJECTIVE_KEYS}
+        if sub.has("torque"):  # (DESIGN.md's name of the inputs' torques' term)
+            if sub.has("driving_torque"):
+                raise SpecError("give driving_torque or torque, not both (they are one term)",
+                                key=sub.key("torque"), value=sub.raw("torque"))
+            weights_of["driving_torque"] = sub.nonnegative("torque")
+        objective = Objective(**weights_of)
         sub.finish()
     weights: dict[str, float] = {}
     sub = table.table("motions", required=False)

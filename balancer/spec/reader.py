@@ -39,6 +39,9 @@ Every error names the file, the key and the value; unknown keys are errors (a ty
 
 from __future__ import annotations
 
+import csv
+import io
+import math
 import os
 import tomllib
 from pathlib import Path
@@ -122,24 +125,74 @@ def _input_range(table: Table, name: str) -> InputRange:
     return InputRange(name=name, low=low, high=high)
 
 
-def _read_motions(root: Table) -> tuple[MotionSpec, ...]:
+def _read_motions(root: Table, inputs: tuple[str, ...], folder: Path) -> tuple[MotionSpec, ...]:
     out = []
     for table in root.tables("motion"):
-        for name in ("name", "times", "path"):
-            if not table.has(name):
-                raise table._missing(name)
-        point = table.value("point", None)
+        if not table.has("name"):
+            raise table._missing("name")
+        if table.has("file"):
+            for name in ("times", "path", "point"):
+                if table.has(name):
+                    raise SpecError("a motion read from a file takes its times and path from "
+                                    "it", key=table.key(name), value=table.raw(name))
+            times, path = _motion_file(table, inputs, folder)
+            point = None
+        else:
+            for name in ("times", "path"):
+                if not table.has(name):
+                    raise table._missing(name)
+            times, path = table.raw("times"), table.raw("path")
+            point = table.value("point", None)
         if point is not None and not isinstance(point, str):
             raise SpecError("must be the name of a point", key=table.key("point"), value=point)
         name = table.text("name", default="")  # (its error names its own full key)
+        law = table.value("law", "spline" if table.has("file") else "cubic")
         with v.under(table.path):
             out.append(MotionSpec(
-                name=name, times=table.raw("times"),
-                path=table.raw("path"), point=point,
-                law=table.value("law", "cubic"), acc_time=table.value("acc_time", None),
-                samples=table.value("samples", 400)))
+                name=name, times=times, path=path, point=point, law=law,
+                acc_time=table.value("acc_time", None), samples=table.value("samples", 400)))
         table.finish()
     return tuple(out)
+
+
+def _motion_file(table: Table, inputs: tuple[str, ...], folder: Path
+                 ) -> tuple[tuple[float, ...], tuple[tuple[float, ...], ...]]:
+    """A motion's times and inputs' path from its CSV ``file`` (header ``t,<input>,…``)."""
+    key = table.key("file")
+    name = table.raw("file")
+    if not isinstance(name, str) or not name:
+        raise SpecError("must be the path of a CSV file", key=key, value=name)
+    path = Path(name) if Path(name).is_absolute() else folder / name
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SpecError(f"cannot be read ({exc.__class__.__name__}: "
+                        f"{getattr(exc, 'strerror', None) or exc})", key=key, value=name) from None
+    rows = [r for r in csv.reader(io.StringIO(text)) if any(c.strip() for c in r)]
+    header = [c.strip() for c in rows[0]] if rows else []
+    if header != ["t", *inputs]:
+        raise SpecError(f"its header must be t,{','.join(inputs)} (the time, then each input "
+                        f"in the linkage's order); it is {','.join(header) or 'empty'}",
+                        key=key, value=name)
+    times: list[float] = []
+    values: list[tuple[float, ...]] = []
+    for line, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise SpecError(f"line {line} has {len(row)} values, not {len(header)}", key=key,
+                            value=name)
+        try:
+            numbers = [float(c) for c in row]
+        except ValueError:
+            raise SpecError(f"line {line} is not numbers: {','.join(row)}", key=key,
+                            value=name) from None
+        if not all(math.isfinite(x) for x in numbers):
+            raise SpecError(f"line {line} is not finite: {','.join(row)}", key=key, value=name)
+        if times and not numbers[0] > times[-1]:
+            raise SpecError(f"line {line}'s time {numbers[0]:g} s does not increase",
+                            key=key, value=name)
+        times.append(numbers[0])
+        values.append(tuple(numbers[1:]))
+    return tuple(times), tuple(values)
 
 
 def _read_original(root: Table, mechanism: Model, codec: MechanismSpec) -> Model | None:
@@ -170,7 +223,9 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
                                                                    mechanism)
         original = _read_original(root, mechanism, codec)
         workspace = _read_workspace(root)
-        motions = _read_motions(root)
+        folder = Path(source).parent if source and Path(source).is_file() else Path.cwd()
+        motions = (_read_motions(root, mechanism_of(mechanism).linkage.inputs, folder)
+                   if root.has("motion") else ())
         root.finish()
         return Design(
             mechanism=mechanism,

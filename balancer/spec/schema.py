@@ -445,7 +445,12 @@ SECTIONS: tuple[Section, ...] = (
                 Key("shaking_moment", "—", "1", "w_M, of the mean-square shaking moment.",
                     example="1.0"),
                 Key("driving_torque", "—", "0",
-                    "w_τ, of the mean-square driving torque ((N·m)²/(N·m)²).", example="0.0"),
+                    "w_τ, of the mean-square driving torque ((N·m)²/(N·m)²); with several "
+                    "inputs, of their torques' mean squares summed.", example="0.0"),
+                Key("torque", "—", "0",
+                    "`driving_torque` by the name a linkage with several inputs gives it "
+                    "(one of the two; written back as `driving_torque`).", (LINKAGE,),
+                    example="0.5"),
                 Key("shaking_force", "m²", "0",
                     "w_F, of the mean-square shaking force ((N·m)²/N²; useful with "
                     "`force_balance = false`).", example="0.0"),

@@ -230,3 +230,22 @@ def test_the_box_of_entries_seen_together_holds_every_point_of_the_sublevel_set(
     unbounded = np.column_stack([base[:, 0], -base[:, 0]])
     assert _bounded_below_box(unbounded, np.zeros(2), 1.0, np.full(2, np.inf),
                               np.ones(2, dtype=bool)) is None
+
+
+def test_torque_is_the_inputs_torques_term_by_designs_name():
+    # `[balance.objective] torque` (DESIGN.md's name for several inputs) is driving_torque.
+    from importlib.resources import files
+
+    base = tomllib.loads((files("balancer") / "examples" / "pick_fivebar.toml").read_text())
+    by_name = copy.deepcopy(base)
+    by_name["balance"].setdefault("objective", {}).pop("driving_torque", None)
+    by_name["balance"]["objective"]["torque"] = 0.5
+    by_key = copy.deepcopy(base)
+    by_key["balance"].setdefault("objective", {})["driving_torque"] = 0.5
+    a, b = (design_from_dict(d).balance for d in (by_name, by_key))
+    assert a == b and a is not None and a.objective.driving_torque == 0.5
+    both = copy.deepcopy(by_key)
+    both["balance"]["objective"]["torque"] = 0.5
+    with pytest.raises(SpecError, match="not both") as caught:
+        design_from_dict(both)
+    assert caught.value.key == "balance.objective.torque"

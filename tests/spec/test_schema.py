@@ -10,6 +10,8 @@ from __future__ import annotations
 import ast
 import copy
 import dataclasses
+import os
+import tempfile
 import tomllib
 from pathlib import Path
 
@@ -157,7 +159,20 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
         table["path"] = [[0.0, 0.0], [0.1, 0.1]]  # a point's (x, y)
     if pattern == "motion[]" and key is not None and name == "acc_time":
         table |= {"law": "trapezoid", "acc_time": 0.25}
+    if pattern == "motion[]" and key is not None and name == "file":  # instead of the table
+        del table["times"], table["path"]
+        table["file"] = str(_motion_csv(data["mechanism"].get("input", "crank")))
     return data
+
+
+def _motion_csv(input_name: str) -> Path:
+    """A CSV of MOTION's table for a one-input linkage (kept for the session's tests)."""
+    folder = Path(tempfile.gettempdir()) / f"balancer-schema-{os.getpid()}"
+    folder.mkdir(exist_ok=True)
+    path = folder / f"{input_name}.csv"
+    rows = [f"{t!r},{p[0]!r}" for t, p in zip(MOTION["times"], MOTION["path"], strict=True)]
+    path.write_text("\n".join([f"t,{input_name}", *rows]) + "\n")
+    return path
 
 
 def value_of(mechanism: str, pattern: str, key: schema.Key | None, name: str):
@@ -282,8 +297,12 @@ def test_the_schema_names_what_the_model_names():
         assert schema.known("mechanism.lengths", kind) == cls.length_names
         assert schema.known("links", kind) == cls.chain_links
         assert schema.known("original", kind) == cls.chain_links
-    for kind in (schema.FOUR_BAR, schema.SLIDER_CRANK, schema.LINKAGE):
+    for kind in (schema.FOUR_BAR, schema.SLIDER_CRANK):
         assert schema.known("balance.objective", kind) == OBJECTIVE_KEYS
+    # A linkage's also by DESIGN.md's name for several inputs' torques (read as driving_torque).
+    linkage_terms = schema.known("balance.objective", schema.LINKAGE)
+    assert tuple(k for k in linkage_terms if k != "torque") == OBJECTIVE_KEYS
+    assert "torque" in linkage_terms
     assert schema.known("balance.objective", schema.ENGINE) == ENGINE_OBJECTIVE_KEYS
     objective = {f.name for f in dataclasses.fields(Objective)}
     assert set(OBJECTIVE_KEYS) | set(ENGINE_OBJECTIVE_KEYS) == objective
@@ -293,7 +312,9 @@ def test_the_schema_names_what_the_model_names():
     assert set(schema.known("balance.<link>")) == set(LINK_KEYS)
     assert schema.known("balance.<link>.counterweight") == COUNTERWEIGHT_KEYS
     assert schema.known("operation") == tuple(f.name for f in dataclasses.fields(Operation))
-    assert schema.known("motion[]") == tuple(f.name for f in dataclasses.fields(MotionSpec))
+    # (`file` is read into the motion's times and path)
+    assert tuple(k for k in schema.known("motion[]") if k != "file") == tuple(
+        f.name for f in dataclasses.fields(MotionSpec))
     assert set(schema.known("workspace")) == {"samples", "joints"}
     assert set(schema.known("simulation")) == {
         f.name for f in dataclasses.fields(SimulationSettings)} - {"given"}  # (what was given)
