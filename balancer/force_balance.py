@@ -18,6 +18,7 @@ a condition missed by the sampling would show there.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -207,31 +208,93 @@ def force_balance_conditions(mech: Mechanism) -> ForceBalance:
                               singular_values=np.zeros(0), links=links, length=length)
         cache["force balance"] = result
         return result
-    scales = np.ones(layout.size)
-    for name in mech.structure.names:
-        scales[layout.index(name, "m")] = length
+    scales = _mass_scales(mech)
     count = max(MIN_SAMPLES, SAMPLES_PER_ENTRY * layout.size)
     rng = np.random.default_rng(20260101)  # the same angles every run
     states = _states(mech, count, rng)
-    g = first_moment_map(mech, states)
-    d = g - g.mean(axis=0)
-    d = np.vstack([d.real, d.imag]) / scales  # columns in units of a first moment
+    d = _variation(mech, [states], scales)
+    rows, sv, null = _row_space(d)
+    if rows.shape[0] and null.size:  # at fresh states the null space is stationary too
+        fresh = _states(mech, count, np.random.default_rng(20260102), within=states)
+        df = _variation(mech, [fresh], scales)
+        if np.max(np.abs(df @ null)) > 1e3 * NULL_TOLERANCE * sv[0]:
+            raise SolverError("the force-balance conditions found at sampled angles do not "
+                              "hold at others: the sampling missed a condition")
+    result = ForceBalance(matrix=rows * scales, scales=scales, singular_values=sv, links=links,
+                          length=length)
+    cache["force balance"] = result
+    return result
+
+
+def force_balance_along(mech: Mechanism, motions: Sequence[InputState]) -> ForceBalance:
+    """The conditions that hold the total centre of mass still along each of ``motions``.
+
+    ``[balance] force = "motion"``: the states of each motion (its samples), the first
+    moment's variation about its own mean along it — a motion need not end where another
+    starts — stacked, and their row space as for :func:`force_balance_conditions`. A path
+    through the inputs' space visits fewer of the coefficient functions' combinations than
+    the whole space: fewer conditions. Kept with the geometry, per set of motions.
+
+    Raises
+    ------
+    SolverError
+        If the singular values show no clear gap (the rank cannot be trusted).
+    """
+    cache = mech.structure.kinematic.setdefault("force balance along", {})
+    key = tuple(m.key() for m in motions)
+    if key in cache:
+        return cache[key]
+    scales = _mass_scales(mech)
+    rows, sv, _ = _row_space(_variation(mech, motions, scales))
+    layout = mech.layout
+    result = ForceBalance(matrix=rows * scales, scales=scales, singular_values=sv,
+                          links=tuple(layout.link_slice(n) for n in mech.structure.names),
+                          length=mech.structure.length_scale())
+    cache[key] = result
+    return result
+
+
+def _mass_scales(mech: Mechanism) -> NDArray[np.float64]:
+    """Each entry's scale: the linkage's size for a mass (its column then a first moment), 1."""
+    layout = mech.layout
+    scales = np.ones(layout.size)
+    for name in mech.structure.names:
+        scales[layout.index(name, "m")] = mech.structure.length_scale()
+    return scales
+
+
+def _variation(mech: Mechanism, parts: Sequence[InputState], scales: NDArray[np.float64]
+               ) -> NDArray[np.float64]:
+    """The first moment's variation about each part's mean, x and y rows stacked, scaled."""
+    blocks = []
+    for states in parts:
+        g = first_moment_map(mech, states)
+        d = g - g.mean(axis=0)
+        blocks += [d.real, d.imag]
+    return np.vstack(blocks) / scales  # columns in units of a first moment
+
+
+def _row_space(d: NDArray[np.float64]
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The rows of the sampled variation's row space, its singular values, its null space.
+
+    Raises
+    ------
+    SolverError
+        If singular values lie between rounding and a clear condition.
+    """
     # (Rows ≥ columns: the reduced factorisation has every right singular vector, without
     # the square left factor of the samples' size.)
     _, sv, vt = np.linalg.svd(d, full_matrices=False)
     top = sv[0] if sv.size else 0.0
     if top == 0:
-        result = ForceBalance(matrix=np.zeros((0, layout.size)), scales=scales,
-                              singular_values=sv)
-        cache["force balance"] = result
-        return result
-    kept = sv > NULL_TOLERANCE * top
-    rank = int(np.sum(kept))
+        return np.zeros((0, d.shape[1])), sv, np.eye(d.shape[1])
+    rank = int(np.sum(sv > NULL_TOLERANCE * top))
     if np.any((sv > NULL_TOLERANCE * top) & (sv < KEPT_TOLERANCE * top)):
         raise SolverError(
             "the force-balance conditions cannot be told from rounding: singular values "
             f"{', '.join(f'{x / top:.1e}' for x in sv)} of the largest show no clear gap")
-    rows = vt[:rank]
+    rows = vt[:rank].copy()
     # A parameter that moves no centre of mass at any sampled angle (an inertia, a
     # counter-rotor, the mass of a link whose frame's origin is fixed) has a column of exact
     # zeros; its entries in the rows are the SVD's rounding (1e-16), which times an inertia
@@ -239,19 +302,7 @@ def force_balance_conditions(mech: Mechanism) -> ForceBalance:
     # first moments could restore (linkage campaign, seed 40, case 751: 'no feasible design
     # found'). They are zero.
     rows[:, ~np.any(d, axis=0)] = 0.0
-    # Check at fresh states that the null space found is stationary there too.
-    fresh = _states(mech, count, np.random.default_rng(20260102), within=states)
-    gf = first_moment_map(mech, fresh)
-    df = gf - gf.mean(axis=0)
-    df = np.vstack([df.real, df.imag]) / scales
-    null = vt[rank:].T
-    if null.size and np.max(np.abs(df @ null)) > 1e3 * NULL_TOLERANCE * top:
-        raise SolverError("the force-balance conditions found at sampled angles do not hold "
-                          "at others: the sampling missed a condition")
-    result = ForceBalance(matrix=rows * scales, scales=scales, singular_values=sv, links=links,
-                          length=length)
-    cache["force balance"] = result
-    return result
+    return rows, sv, vt[rank:].T
 
 
 #: Crank angles over a revolution at which a mechanism with rotors is judged.

@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 from .. import validate as v
 from ..cycle import sample_angles
 from ..errors import SpecError
+from ..force_balance import ForceBalance, force_balance_along
 from ..linkage import trajectory
 from ..linkage.dynamics import TURNING
 from ..linkage.inputs import InputState
@@ -91,8 +92,14 @@ class NumericProblem(Feasibility, PhysicalValues, Settling, ObjectiveScale):
                                                   self.size)
         fb = None
         if problem.force_balance:
-            fb = (self.force_balance if self.force_balance is not None
-                  else force_balance_system(mech))
+            same_scope = problem.force_scope == self.problem.force_scope
+            if self.force_balance is not None and same_scope:
+                fb = self.force_balance
+            elif problem.force_scope == "motion":
+                raise ValueError("force balance along the motions: build the problem from "
+                                 "its design (numeric_problem), which has them")
+            else:
+                fb = force_balance_system(mech)
         new = replace(self, problem=problem, links=links, rows=rows, factor=factor,
                       force_balance=fb, inert=inert)
         kept = ["acceleration_factor", "scales", "original_mass"]
@@ -142,8 +149,8 @@ def numeric_problem(design: Design) -> NumericProblem:
 
 
 def _problem(problem: BalanceProblem, mech: Mechanism, speed: float | None,
-             states: InputState, reg: CycleRegressors, unit: CycleRegressors | None
-             ) -> NumericProblem:
+             states: InputState, reg: CycleRegressors, unit: CycleRegressors | None,
+             along: ForceBalance | None = None) -> NumericProblem:
     """The problem of ``mech`` whose samples are ``states`` with regressors ``reg``.
 
     The links' bounds, the objective's rows and the force balance are the same whatever the
@@ -161,7 +168,7 @@ def _problem(problem: BalanceProblem, mech: Mechanism, speed: float | None,
         x0=mech.parameters(),
         rows=rows,
         factor=factor,
-        force_balance=force_balance_system(mech) if problem.force_balance else None,
+        force_balance=_force_balance(problem, mech, along),
         inert=inert,
         unit_acceleration=unit,
     )
@@ -199,7 +206,23 @@ def _along_motions(design: Design, problem: BalanceProblem, mech: Mechanism) -> 
         shaking_moment=np.asarray(f.shaking_moment) * scale,
         driving_torque=stacked_torques(f.input_torques, scale),
         rocking_couple=complex_rows(f.rocking_couple))
-    return _problem(problem, mech, None, states, reg, reg)
+    along = force_balance_along(mech, parts) if problem.force_scope == "motion" else None
+    return _problem(problem, mech, None, states, reg, reg, along)
+
+
+def _force_balance(problem: BalanceProblem, mech: Mechanism,
+                   along: ForceBalance | None = None
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """``(A, b)`` of the problem's force balance, or none.
+
+    Over the inputs' space, or ``along`` the motions (``[balance] force = "motion"``).
+    """
+    if not problem.force_balance:
+        return None
+    if problem.force_scope == "motion":
+        assert along is not None, "the motions' conditions"
+        return along.matrix, np.zeros(along.count)
+    return force_balance_system(mech)
 
 
 def _checked_problem(problem: object) -> BalanceProblem:

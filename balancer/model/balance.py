@@ -60,6 +60,10 @@ from .mechanisms import MechanismModel
 from .parts import Part, Sector
 
 #: The keys of ``[balance.objective]``, ``[balance.<link>]`` and a counterweight's table.
+#: Where a linkage with several inputs is force-balanced (``[balance] force``): over its whole
+#: configuration space, or along its motions only.
+FORCE_SCOPES = ("every-motion", "motion")
+
 OBJECTIVE_KEYS = (
     "shaking_moment",
     "driving_torque",
@@ -231,6 +235,10 @@ class BalanceProblem:
     ----------
     force_balance
         Impose exact shaking-force balance as equality constraints.
+    force_scope
+        A linkage with several inputs: ``"every-motion"`` (the total centre of mass still over
+        the whole configuration space) or ``"motion"`` (still along each of the spec's motions
+        only: fewer conditions, more freedom for the objective).
     objective
         Weights of the objective.
     links
@@ -242,6 +250,7 @@ class BalanceProblem:
     """
 
     force_balance: bool = True
+    force_scope: str = "every-motion"
     objective: Objective = field(default_factory=Objective)
     links: tuple[tuple[str, LinkFreedom], ...] = ()
     motion_weights: tuple[tuple[str, float], ...] = ()
@@ -256,6 +265,9 @@ class BalanceProblem:
                    else self.motion_weights)
         checked = tuple((str(n), v.nonnegative(w, f"balance.motions.{n}")) for n, w in weights)
         object.__setattr__(self, "motion_weights", checked)
+        if self.force_scope not in FORCE_SCOPES:
+            raise SpecError(f"must be one of {', '.join(FORCE_SCOPES)}", key="balance.force",
+                            value=self.force_scope)
 
     def weights_of(self, names: Sequence[str]) -> tuple[float, ...]:
         """The weights of the motions called ``names`` (1 where none is given)."""

@@ -93,8 +93,20 @@ def force_balance_words(along: AlongMotions) -> str:
         return ("force-balanced: yes (the total centre of mass stands still for every motion; "
                 f"the conditions hold to {along.force_balance_residual:.1e} of the links' first "
                 f"moments{over})")
+    still = all(a.loads()["shaking_force"].max <= MOTION_ROUNDING * a.natural_scales()["N"]
+                for a in along.motions)
+    if still:  # ([balance] force = "motion": still along its motions, not everywhere)
+        return ("force-balanced along its motions only: the total centre of mass stands "
+                "still along each of them (its shaking force is rounding there), not for every "
+                f"motion (the conditions are off by {along.force_balance_residual:.2g} of the "
+                f"links' first moments{over})")
     return ("force-balanced: no (the conditions are off by "
             f"{along.force_balance_residual:.2g} of the links' first moments{over})")
+
+
+#: A motion's shaking force at most this share of its force scale is rounding: the design is
+#: force-balanced along it.
+MOTION_ROUNDING = 1e-9
 
 
 def _length(metres: float, size: float) -> str:

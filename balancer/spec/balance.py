@@ -11,6 +11,7 @@ from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import MechanismModel as Model
 from ..model.balance import (
+    FORCE_SCOPES,
     OBJECTIVE_KEYS,
     BalanceProblem,
     CounterweightFreedom,
@@ -157,6 +158,16 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
         if not isinstance(value, bool):
             raise SpecError("must be true or false", key=table.key("force_balance"), value=value)
         force_balance = value
+    force_scope = "every-motion"
+    if table.has("force"):
+        force_scope = table.raw("force")
+        if force_scope not in FORCE_SCOPES:
+            raise SpecError(f"must be one of {', '.join(FORCE_SCOPES)}",
+                            key=table.key("force"), value=force_scope)
+        if force_scope == "motion" and len(mech.linkage.inputs) < 2:
+            raise SpecError("balances a linkage with several inputs along its motions only; "
+                            "a one-input mechanism's balance holds over its revolution",
+                            key=table.key("force"), value=force_scope)
     objective = Objective()
     sub = table.table("objective", required=False)
     if sub is not None:
@@ -184,8 +195,9 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
         if sub is not None:
             links[name] = _read_link_freedom(sub, points)
     table.finish()
-    problem = BalanceProblem(force_balance=force_balance, objective=objective,
-                             links=tuple(links.items()), motion_weights=tuple(weights.items()))
+    problem = BalanceProblem(force_balance=force_balance, force_scope=force_scope,
+                             objective=objective, links=tuple(links.items()),
+                             motion_weights=tuple(weights.items()))
     check_problem(problem, mech)
     return problem
 
@@ -205,6 +217,8 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
     lines = [
         "[balance]",
         f"force_balance = {'true' if problem.force_balance else 'false'}",
+        *([f"force = {toml.string(problem.force_scope)}  # along the motions only"]
+          if problem.force_scope != "every-motion" else []),
         "",
         "[balance.objective]  # J = mean(Msh²) + w_tau·mean(tau²) + w_force·mean(|Fsh|²)"
         " + w_mass·Δmass",

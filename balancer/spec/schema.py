@@ -420,6 +420,11 @@ SECTIONS: tuple[Section, ...] = (
                     "Impose exact shaking-force balance (Eq. 57–58; Wunderlich's Eq. 10d, "
                     "20a–b; for a general linkage, the conditions found from the linkage "
                     "itself) as equality constraints.", example="true"),
+                Key("force", "—", '"every-motion"',
+                    'A linkage with several inputs: `"every-motion"` (the total centre of mass '
+                    'still over the whole configuration space) or `"motion"` (still along each '
+                    "of the spec's motions only: fewer conditions, more freedom for the "
+                    "objective).", (LINKAGE,), example='"motion"'),
                 Key("objective", "table", "the defaults below",
                     "The weights of the objective (the table below).",
                     example="{ shaking_moment = 1.0 }"),

@@ -249,3 +249,73 @@ def test_torque_is_the_inputs_torques_term_by_designs_name():
     with pytest.raises(SpecError, match="not both") as caught:
         design_from_dict(both)
     assert caught.value.key == "balance.objective.torque"
+
+
+def _swing_only_p(scope: str) -> dict:
+    """pick_fivebar with one motion that swings p alone (q held), force balanced by scope."""
+    from importlib.resources import files
+
+    spec = tomllib.loads((files("balancer") / "examples" / "pick_fivebar.toml").read_text())
+    spec["motion"] = [{"name": "swing", "times": [0.0, 0.5, 1.0],
+                       "path": [[0.0, 0.0], [0.4, 0.0], [0.0, 0.0]], "law": "quintic",
+                       "samples": 60}]
+    spec["balance"]["force"] = scope
+    return spec
+
+
+def test_force_balance_along_the_motions_only_is_a_relaxation():
+    # Along a swing of p alone the total centre of mass must stay still only as p turns: q's
+    # counterweight is not needed. The least added mass is then p's closed form alone, at most
+    # the every-motion optimum; the shaking force vanishes along the swing, not everywhere.
+    everywhere = optimize(design_from_dict(_swing_only_p("every-motion")))
+    along = optimize(design_from_dict(_swing_only_p("motion")))
+    for result in (everywhere, along):
+        assert result.success and result.lower_bound is not None
+    assert along.objective <= everywhere.objective + GAP_TOLERANCE * everywhere.objective
+    assert along.objective < 0.5 * everywhere.objective  # (q's arm no longer balanced)
+    design = design_from_dict(_swing_only_p("motion"))
+    balanced = along.balanced_design(design)
+    analysis = along_motions(balanced.mechanism, balanced.motions)
+    swing = analysis.motions[0]
+    assert swing.loads()["shaking_force"].max <= 1e-12 * swing.natural_scales()["N"]
+    assert not analysis.force_balanced  # over the workspace it is not
+    # p alone carries the first moment its swing needs: m_p·c_p + m_cw·r_cw = −(A's share),
+    # the closed form of the parallelogram's p-direction condition with q's arm held.
+    text = dumps_design(balanced)
+    assert 'force = "motion"' in text
+    again = design_from_dict(tomllib.loads(text))
+    assert again.balance is not None and again.balance.force_scope == "motion"
+
+
+def test_the_motions_conditions_hold_between_their_samples():
+    from balancer.force_balance import first_moment_map, force_balance_along
+    from balancer.linkage import trajectory
+    from balancer.mechanisms import mechanism_of
+
+    design = design_from_dict(_swing_only_p("motion"))
+    mech = mechanism_of(design.mechanism)
+    motion = design.motions[0]
+    conditions = force_balance_along(mech, [trajectory.input_state(mech.structure, motion)])
+    assert 0 < conditions.count < 4  # fewer than the whole space's four
+    # Any design in the conditions' null space keeps the centre of mass still at fresh times.
+    rng = np.random.default_rng(7)
+    null = np.linalg.svd(conditions.matrix)[2][conditions.count:].T
+    x = null @ rng.normal(size=null.shape[1])
+    fresh = trajectory.input_state(mech.structure, motion, rng.uniform(0.0, 1.0, 25))
+    g = first_moment_map(mech, fresh) @ x
+    assert np.max(np.abs(g - g.mean())) <= 1e-12 * np.max(np.abs(first_moment_map(mech, fresh))
+                                                            @ np.abs(x))
+
+
+def test_force_scope_is_a_several_input_key():
+    spec = _swing_only_p("sometimes")
+    with pytest.raises(SpecError, match="must be one of every-motion, motion") as caught:
+        design_from_dict(spec)
+    assert caught.value.key == "balance.force"
+    from linkage.several_inputs_specs import crank_rocker
+
+    one = crank_rocker() | {"operation": {"speed": 10.0},
+                            "balance": {"force": "motion", "crank": {"mass": [0.5, 2.0]}}}
+    with pytest.raises(SpecError, match="several inputs along its motions") as caught:
+        design_from_dict(one)
+    assert caught.value.key == "balance.force"

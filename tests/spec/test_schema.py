@@ -190,6 +190,8 @@ def value_of(mechanism: str, pattern: str, key: schema.Key | None, name: str):
         return None  # written whole by variant()
     if (pattern, name) == ("simulation", "method"):
         return METHOD[mechanism]
+    if (pattern, name) == ("balance", "force"):
+        return "every-motion"  # (the base is a one-input linkage: "motion" is several inputs')
     if key.example:
         return tomllib.loads(f"x = {key.example}")["x"]
     return {}  # a table of its own, where its mechanism does not have it
