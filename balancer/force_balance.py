@@ -148,8 +148,12 @@ def _states(mech: Mechanism, count: int, rng: np.random.Generator,
                 angles = np.clip(angles, first.min(), first.max())
         return InputState.crank(angles)
     if within is None:
-        reference = np.array([mech.structure.ref_angle[k] for k in inputs])
-        low, high = reference - SPREAD, reference + SPREAD
+        reference = np.array(mech.structure.input_references)
+        # (SPREAD rad about a pivot; along a slide, SPREAD of the linkage's size)
+        spread = np.array([SPREAD * (mech.structure.length_scale()
+                                     if d.position_unit == "m" else 1.0)
+                           for d in mech.structure.drivers])
+        low, high = reference - spread, reference + spread
     else:
         spans = np.array([np.asarray(p) for p in within.positions])
         low, high = spans.min(axis=1), spans.max(axis=1)

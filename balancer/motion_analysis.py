@@ -120,6 +120,28 @@ class MotionAnalysis:
         return frame_loads(self.inputs, self.reactions)
 
 
+#: What a report calls each frame load along a motion, and its unit (the inputs' own:
+#: :func:`load_words`).
+LOAD_WORDS = {"shaking_force": ("shaking force", "N"),
+              "shaking_moment": ("shaking moment", "N·m"),
+              "rocking_couple": ("rocking couple", "N·m")}
+
+
+def load_words(mech: Mechanism, key: str) -> tuple[str, str]:
+    """A frame load's words and unit.
+
+    ``torque_<input>`` is a motor's torque on its link (N·m), or an actuator's force on its
+    slider along a slide (N).
+    """
+    if not key.startswith("torque_"):
+        return LOAD_WORDS[key]
+    name = key[len("torque_"):]
+    driver = mech.structure.drivers[mech.linkage.inputs.index(name)]
+    if driver.load_unit == "N":
+        return f"force on {name}", "N"
+    return f"torque on {name}", "N·m"
+
+
 def frame_loads(inputs: Sequence[str], reactions: Reactions) -> dict[str, Load]:
     """RMS and maximum of each frame load of a record along a motion (its samples alike).
 
@@ -179,8 +201,8 @@ def motion_analysis(model: MechanismModel | Mechanism, motion: MotionSpec, *,
         centre = np.broadcast_to(np.asarray(mech.total_centre_of_mass(mo), np.complex128),
                                  t.shape).copy()
     reactions = Reactions.of(replace(forces, rocking_couple=couple))
-    changes = tuple(np.asarray(p, dtype=float) - structure.ref_angle[k]
-                    for p, k in zip(state.positions, structure.inputs, strict=True))
+    changes = tuple(np.asarray(p, dtype=float) - ref
+                    for p, ref in zip(state.positions, structure.input_references, strict=True))
     return MotionAnalysis(mechanism=mech, motion=motion, inputs=structure.linkage.inputs, t=t,
                           state=state, changes=changes, reactions=reactions,
                           centre_of_mass=centre, gravity=gravity)
@@ -223,11 +245,11 @@ def workspace_states(mech: Mechanism, workspace: Workspace) -> tuple[InputState,
     structure = mech.structure
     names = structure.linkage.inputs
     axes = []
-    for name, k in zip(names, structure.inputs, strict=True):
+    for name, start in zip(names, structure.input_references, strict=True):
         r = workspace.range_of(name)
         low, high = (r.low, r.high) if r is not None else (0.0, 0.0)
         count = workspace.samples if r is not None else 1
-        axes.append(structure.ref_angle[k] + np.linspace(low, high, count))
+        axes.append(start + np.linspace(low, high, count))
     grid = np.meshgrid(*axes, indexing="ij")
     q = [g.ravel() for g in grid]
     state = InputState.of(q)

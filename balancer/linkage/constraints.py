@@ -199,6 +199,13 @@ class Driver:
     rows = 1
     row_kinds: ClassVar[tuple[str, ...]] = ("angle",)
     letter: ClassVar[str] = "D"
+    #: Units of the input's position and of its motor's load.
+    position_unit: ClassVar[str] = "rad"
+    load_unit: ClassVar[str] = "N·m"
+
+    def position(self, pose: Pose) -> Num:
+        """The input link's angle, rad."""
+        return pose.angles[self.link]
 
     @property
     def members(self) -> tuple[int, int]:
@@ -235,7 +242,76 @@ class Driver:
         frame.torques[self.index] = -multipliers[0]
 
 
-Constraint = Pin | Prism | Driver
+@dataclass(frozen=True)
+class SlideDriver:
+    """An input along a ground slide: ``d̄·(r̄_s + R_s·s̄ − p̄_g) − s_i = 0`` for input ``index``.
+
+    The slider of ``prism`` (a prismatic pair on a ground guide, direction ``d̄``, point
+    ``p̄_g``) is at ``s_i`` m along the guide from ``p̄_g``; its multiplier is minus the
+    actuator's force on it along the guide (N).
+    """
+
+    link: int
+    index: int
+    prism: Prism
+
+    rows = 1
+    row_kinds: ClassVar[tuple[str, ...]] = ("length",)
+    letter: ClassVar[str] = "S"
+    #: Units of the input's position and of its actuator's load.
+    position_unit: ClassVar[str] = "m"
+    load_unit: ClassVar[str] = "N"
+
+    @property
+    def members(self) -> tuple[int, int]:
+        """The slider's link and the ground."""
+        return (self.link, GROUND_INDEX)
+
+    def held_at(self, k: int) -> V | None:
+        """``None``: the driver holds a link by no point."""
+        return None
+
+    def position(self, pose: Pose) -> Num:
+        """The slider point's place along the guide from its point, m."""
+        p = self.prism
+        return p.dg.dot(pose.point(self.link, p.ps) - p.pg)
+
+    def residual(self, pose: Pose, state: InputState | None = None) -> list[Num]:
+        """The slider's place along the guide less its prescribed one in ``state``, m."""
+        return [self.position(pose) - (0.0 if state is None else state.positions[self.index])]
+
+    def jacobian(self, pose: Pose) -> Blocks:
+        """:meth:`residual`'s derivative by the links' coordinates (the ground's at rest)."""
+        d = self.prism.dg
+        ps = pose.rotate(self.link, self.prism.ps)
+        reach = pose.origin(self.link) + ps  # r̄_s + R_s·s̄ − r̄_g, the ground's at its origin
+        return [(self.link, [[d.x, d.y, d.dot(ps.perp())]]),
+                (GROUND_INDEX, [[-d.x, -d.y, d.cross(reach)]])]
+
+    def gamma(self, pose: Pose, vel: list[V], rate: list[Num],
+              state: InputState | None = None) -> list[Num]:
+        """``γ``: the prescribed acceleration along the guide and ``ω_s²·d̄·(R_s·s̄)``, m/s²."""
+        ps = pose.rotate(self.link, self.prism.ps)
+        w = _rate(rate, self.link)
+        spin = self.prism.dg.dot(ps) * (w * w)
+        return [spin if state is None else state.accelerations[self.index] + spin]
+
+    def prescribed_rates(self, state: InputState) -> list[Num]:
+        """``Φ_q·q̇`` of its row: the input's prescribed rate (m/s)."""
+        return [state.rates[self.index]]
+
+    def row_scales(self, length: float) -> list[float]:
+        """A length's row, as it is."""
+        return [1.0]
+
+    def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
+        """The actuator's force on its slider along the guide: minus its multiplier."""
+        frame.torques[self.index] = -multipliers[0]
+
+
+Constraint = Pin | Prism | Driver | SlideDriver
+#: A driver of an input: about a ground pivot, or along a ground slide.
+InputDriver = Driver | SlideDriver
 
 
 @dataclass(frozen=True)
@@ -271,10 +347,10 @@ class Group:
         return c
 
     @property
-    def driver(self) -> Driver:
-        """An input group's driver: its second constraint."""
+    def driver(self) -> Driver | SlideDriver:
+        """An input group's driver: its last constraint."""
         c = self.constraints[-1]
-        if not isinstance(c, Driver):
+        if not isinstance(c, Driver | SlideDriver):
             raise ValueError(f"a {self.kind} group has no driver")
         return c
 

@@ -41,6 +41,7 @@ from .constraints import (
     GROUND_INDEX,
     Group,
     Pose,
+    Prism,
     group_jacobian,
 )
 from .dyads import Dyads, Frame, known_point
@@ -105,6 +106,13 @@ def positions(structure: Structure, state: InputState, ops: OpsLike = NUMPY,
         if g.kind == "input":
             pivot, local = known_point(pose, g.pivot, g.links[0])
             _place(pose, g.links[0], angles[g.driver.index], pivot, local, ops)
+            continue
+        if g.kind == "slide":  # on its ground guide, at its input's place along it
+            prism = g.constraints[0]
+            assert isinstance(prism, Prism)
+            along = prism.pg + prism.dg * angles[g.driver.index]
+            _place(pose, g.links[0], prism.delta + 0.0 * angles[g.driver.index], along,
+                   prism.ps, ops)
             continue
         if g.kind == "numeric":
             if ops is NUMPY:

@@ -318,7 +318,7 @@ def path_start(structure: Structure, g: Group, state: InputState, place: Positio
     coordinates there, ``(N, 3·|g|)``, NaN where the path was lost, and where it was not.
     """
     count = state.count
-    reference = np.array([structure.ref_angle[k] for k in structure.inputs])
+    reference = np.array(structure.input_references)
     target = np.array([np.broadcast_to(np.asarray(x, dtype=float), (count,))
                        for x in state.positions])
     before = structure.groups[: structure.groups.index(g)]

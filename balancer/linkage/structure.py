@@ -34,6 +34,7 @@ import itertools
 import math
 import threading
 from collections import OrderedDict
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -48,6 +49,7 @@ from .constraints import (
     Group,
     Pin,
     Prism,
+    SlideDriver,
     pose_of,
     unit,
 )
@@ -97,7 +99,7 @@ class Structure:
     ref_origin: tuple[V, ...]
     pins: tuple[Pin, ...]
     prisms: tuple[Prism, ...]
-    drivers: tuple[Driver, ...]
+    drivers: tuple[Driver | SlideDriver, ...]
     groups: tuple[Group, ...]
     point_links: dict[str, tuple[int, ...]] = field(repr=False)
     #: Results computed once per structure.
@@ -126,10 +128,12 @@ class Structure:
 
     @property
     def driver(self) -> Driver:
-        """A one-input linkage's driver; ``ValueError`` for several."""
+        """A one-input linkage's driver (about its pivot); ``ValueError`` for several."""
         if len(self.drivers) != 1:
             raise ValueError(f"the linkage has {len(self.drivers)} inputs, not one")
-        return self.drivers[0]
+        driver = self.drivers[0]
+        assert isinstance(driver, Driver)  # (a slide is never the only input: _driver)
+        return driver
 
     @property
     def constraints(self) -> tuple[Pin | Prism, ...]:
@@ -230,7 +234,8 @@ class Structure:
                 slider=i, s=ks, ps=local[(ks, s.point)], g=kg,
                 pg=V.of((positions[s.point] - origin_g) * rot_g), dg=V.of(d * rot_g),
                 delta=theta_s - theta_g))
-        drivers = tuple(Driver(index[name], i) for i, name in enumerate(linkage.inputs))
+        drivers = tuple(_driver(linkage, index[name], i, pins, prisms)
+                        for i, name in enumerate(linkage.inputs))
         structure = cls(
             linkage=linkage, names=names, local=local, ref_angle=tuple(ref_angle),
             ref_origin=tuple(ref_origin), pins=tuple(pins), prisms=tuple(prisms),
@@ -258,8 +263,8 @@ class Structure:
         # length, angle columns over it.
         scale = self.length_scale()
         full = np.vstack([self.jacobian(self.reference_coordinates()), self.driver_rows()])
-        angle_rows = [i for i, kind in enumerate(self.row_kinds()) if kind == "angle"]
-        full[[*angle_rows, *range(full.shape[0] - count, full.shape[0])]] *= scale
+        kinds = [*self.row_kinds(), *(d.row_kinds[0] for d in self.drivers)]
+        full[[i for i, kind in enumerate(kinds) if kind == "angle"]] *= scale
         full[:, 2::3] /= scale
         sv = np.linalg.svd(full[:-count], compute_uv=False)
         if sv.size and sv[-1] <= RANK_TOLERANCE * sv[0]:
@@ -333,6 +338,9 @@ class Structure:
         several = len(self.drivers) > 1
         for driver in self.drivers:
             k = driver.link
+            if isinstance(driver, SlideDriver):  # (its prism and itself place it)
+                groups.append(Group((k,), (driver.prism, driver), "slide"))
+                continue
             pivot = [c for c in self.pins if c.a == k and c.b == GROUND_INDEX
                      and c.point == self.linkage.moving[k].points[0]]
             if not pivot:
@@ -404,11 +412,23 @@ class Structure:
         return q
 
     def driver_rows(self) -> NDArray[np.float64]:
-        """The drivers' Jacobian rows, shape ``(m, 3n)`` for ``m`` inputs."""
+        """The drivers' Jacobian rows at the reference pose, shape ``(m, 3n)`` (``m`` inputs)."""
         rows = np.zeros((len(self.drivers), 3 * self.size))
-        for i, k in enumerate(self.inputs):
-            rows[i, 3 * k + 2] = 1.0
+        pose = pose_of(self.reference_coordinates())
+        for i, d in enumerate(self.drivers):
+            for link, coeffs in d.jacobian(pose):
+                if link != GROUND_INDEX:
+                    rows[i, 3 * link : 3 * link + 3] += [float(x) for x in coeffs[0]]
         return rows
+
+    @property
+    def input_references(self) -> tuple[float, ...]:
+        """Each input's position at the reference pose, in the order of the linkage's inputs.
+
+        An angle (rad), or a place along its slide (m).
+        """
+        pose = pose_of(self.reference_coordinates())
+        return tuple(float(d.position(pose)) for d in self.drivers)
 
     def jacobian(self, q: NDArray[np.float64]) -> NDArray[np.float64]:
         """The constraints' Jacobian at one pose ``q``, shape ``(3n − 1, 3n)``."""
@@ -422,6 +442,31 @@ class Structure:
                         [[float(x) for x in row] for row in coeffs])
             rows.append(block)
         return np.vstack(rows) if rows else np.zeros((0, 3 * self.size))
+
+
+def _driver(linkage: Linkage, k: int, i: int, pins: Sequence[Pin], prisms: Sequence[Prism]
+            ) -> Driver | SlideDriver:
+    """Input ``i``'s driver: about link ``k``'s ground pivot, or along its ground slide.
+
+    A link pinned to the ground turns about its pivot; one that slides on a ground guide and
+    is pinned to none is driven along it (a linkage with several inputs: its verbs run along
+    motions, not a crank's revolution).
+
+    Raises
+    ------
+    SpecError
+        If a slide is the only input.
+    """
+    pinned = any(GROUND_INDEX in c.members and k in c.members for c in pins)
+    slide = [p for p in prisms if p.s == k and p.g == GROUND_INDEX]
+    if pinned or not slide:
+        return Driver(k, i)
+    if len(linkage.inputs) < 2:
+        raise SpecError(
+            "a linkage driven along a slide alone is not turned by a crank: name it with the "
+            "other inputs of a linkage with several (inputs = [...]), whose verbs run along "
+            "its motions", key="mechanism.input", value=linkage.inputs[0])
+    return SlideDriver(k, i, slide[0])
 
 
 def _touches(c: Pin | Prism, k: int) -> bool:

@@ -213,7 +213,7 @@ def _input_state(structure: Structure, spec: MotionSpec, times: NDArray[np.float
     """:func:`input_state` at ``times``, computed."""
     p, v, a = path_values(spec, times)
     inputs = structure.inputs
-    reference = np.array([structure.ref_angle[k] for k in inputs])
+    reference = np.array(structure.input_references)
     if spec.point is None:
         if p.shape[1] != len(inputs):
             raise SpecError(f"each waypoint must give one angle per input "
@@ -349,7 +349,7 @@ def _inverse_kinematics(structure: Structure, spec: MotionSpec, p: NDArray[np.fl
                         key="point", value=spec.point)
     assert spec.point is not None
     k, local = marker(structure, spec.point)
-    reference = np.array([[structure.ref_angle[j]] for j in structure.inputs])
+    reference = np.array(structure.input_references)[:, None]
     start = structure.point_position(spec.point)
     theta = reference.copy()
     way = float(np.hypot(p[0, 0] - start.x, p[0, 1] - start.y)) / structure.length_scale()

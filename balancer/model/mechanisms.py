@@ -352,7 +352,10 @@ class Linkage(MechanismModel):
         return self.inputs[0]
 
     def _check_inputs(self, names: dict[str, Body], ground: set[str]) -> None:
-        """Each input a moving link turned about a ground point, none named twice."""
+        """Each input a moving link turned about a ground point, none named twice.
+
+        With several inputs, a link may be driven along a ground guide instead.
+        """
         inputs = self.inputs
         several = not (isinstance(inputs, tuple | list) and len(inputs) == 1)
         key = "mechanism.inputs" if several else "mechanism.input"
@@ -363,11 +366,13 @@ class Linkage(MechanismModel):
             if not isinstance(name, str) or name not in names or name == GROUND:
                 raise SpecError(f"must name a moving link ({_link_list(names)})", key=key,
                                 value=shown)
-            if names[name].points[0] not in ground:
-                turned = "an input" if several else "the crank"
+            sliding = several and any(s.link == name and s.guide == GROUND
+                                      for s in self.sliders)
+            if names[name].points[0] not in ground and not sliding:
+                turned = ("an input turns about it, or slides on a ground guide"
+                          if several else "the crank turns about it")
                 raise SpecError(f"the input's first point ({names[name].points[0]}) must be "
-                                f"a ground point: {turned} turns about it", key=key,
-                                value=shown)
+                                f"a ground point: {turned}", key=key, value=shown)
         if len(set(inputs)) != len(inputs):
             raise SpecError("names a link twice", key=key, value=list(inputs))
         v.store(self, "inputs", tuple(inputs))

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..cycle import ROUNDING_SPAN
-from ..motion_analysis import MotionAnalysis
+from ..motion_analysis import MotionAnalysis, load_words
 from ..quantities import QUANTITIES
 from .style import COLOURS, SERIES, axes, legend_outside, number
 
@@ -89,8 +89,8 @@ def loads_over_time(analysis: MotionAnalysis) -> dict[str, tuple[str, str]]:
            for key in ("shaking_force", "shaking_moment")}
     if not analysis.mechanism.in_one_plane():
         out["rocking_couple"] = (q["rocking_couple"].words, q["rocking_couple"].unit)
-    for name in analysis.inputs:
-        out[f"torque_{name}"] = (f"torque on {name}", q["driving_torque"].unit)
+    for name in analysis.inputs:  # (a slide's actuator: a force, N)
+        out[f"torque_{name}"] = load_words(analysis.mechanism, f"torque_{name}")
     return out
 
 

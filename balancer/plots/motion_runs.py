@@ -49,9 +49,9 @@ def motion_verification_figure(design: Design, verification: MotionVerification)
         force.set_ylabel("N")
         moment.set_title(f"shaking moment about the origin, {label}")
         moment.set_ylabel("N·m")
-        torque.set_title(f"input torques, {label}" if check.name != "free"
+        torque.set_title(f"input torques and forces, {label}" if check.name != "free"
                          else "input torques: none (free)")
-        torque.set_ylabel("N·m")
+        torque.set_ylabel("N·m (N along a slide)")
         for ax in (force, moment, torque):
             ax.set_xlabel("t (s)")
             ax.grid(True, alpha=0.3)

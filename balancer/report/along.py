@@ -4,21 +4,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..motion_analysis import AlongMotions, MotionAnalysis
+from ..motion_analysis import AlongMotions, MotionAnalysis, load_words
 from ..rounding import Scales
 from .analysis import reaction_extremes
 from .text import csv_text, table
-
-#: What a table calls each load, and its unit.
-_WORDS = {"shaking_force": ("shaking force", "N"),
-          "shaking_moment": ("shaking moment", "N·m"),
-          "rocking_couple": ("rocking couple", "N·m")}
-
-
-def _words(key: str) -> tuple[str, str]:
-    if key.startswith("torque_"):
-        return f"torque on {key[len('torque_'):]}", "N·m"
-    return _WORDS[key]
 
 
 def _law(analysis: MotionAnalysis) -> str:
@@ -46,8 +35,8 @@ def motions_text(along: AlongMotions, spec: str | None = None) -> str:
     sc = _scales(along)
     for analysis in analyses:
         loads = analysis.loads()
-        rows = [[_words(key)[0], sc.fmt(figure.rms, _words(key)[1]),
-                 sc.fmt(figure.max, _words(key)[1]), _words(key)[1]]
+        rows = [[load_words(mech, key)[0], sc.fmt(figure.rms, load_words(mech, key)[1]),
+                 sc.fmt(figure.max, load_words(mech, key)[1]), load_words(mech, key)[1]]
                 for key, figure in loads.items()
                 if not (key == "rocking_couple" and planar)]
         lines += ["", f"motion {analysis.name}: {_law(analysis)}", "",
@@ -77,7 +66,8 @@ def _scales(along: AlongMotions) -> Scales:
     """
     sc = Scales()
     for analysis in along.motions:
-        sc.add((_words(key)[1], figure.max) for key, figure in analysis.loads().items())
+        sc.add((load_words(analysis.mechanism, key)[1], figure.max)
+               for key, figure in analysis.loads().items())
         sc.add(analysis.natural_scales().items())
     return sc
 

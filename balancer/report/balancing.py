@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..balance.counterweights import UNCHANGED, Counterweight, link_scales
 from ..cycle import CycleAnalysis
-from ..motion_analysis import AlongMotions
+from ..motion_analysis import AlongMotions, load_words
 from ..motion_verification import MotionVerification
 from ..orders import order_name
 from ..quantities import unit_of, words_of
@@ -430,9 +430,7 @@ def _along_motions_text(result: BalanceResult, before: AlongMotions, after: Alon
             if key == "rocking_couple" and after.mechanism.in_one_plane():
                 continue
             a = a_loads[key]
-            unit = "N" if key == "shaking_force" else "N·m"
-            words = (f"torque on {key[len('torque_'):]}" if key.startswith("torque_")
-                     else key.replace("_", " "))
+            words, unit = load_words(after.mechanism, key)
             rows.append([f"{b_motion.name}: {words}", sc.fmt(b.rms, unit), sc.fmt(a.rms, unit),
                          sc.ratio(a.rms, b.rms, unit), sc.fmt(b.max, unit), sc.fmt(a.max, unit),
                          unit])

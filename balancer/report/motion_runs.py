@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from ..motion_analysis import load_words
 from ..rounding import Scales
-from .along import _words
 from .analysis import reaction_extremes
 from .text import csv_text, table
 
@@ -30,11 +30,16 @@ def motion_run_text(run: MotionRun, spec: str | None = None) -> str:
              f"{run.method} ({how}, rtol {run.rtol:g}: {run.evaluations} evaluations)", ""]
     sc = Scales()
     loads = run.loads()
-    sc.add((_words(k)[1], f.max) for k, f in loads.items())
+    mech = run.mechanism
+
+    def words(key: str) -> tuple[str, str]:
+        return load_words(mech, key)
+
+    sc.add((words(k)[1], f.max) for k, f in loads.items())
     sc.add([("N", run.largest_reaction)])
-    planar = run.mechanism.in_one_plane()
-    rows = [[_words(k)[0], sc.fmt(f.rms, _words(k)[1]), sc.fmt(f.max, _words(k)[1]),
-             _words(k)[1]] for k, f in loads.items()
+    planar = mech.in_one_plane()
+    rows = [[words(k)[0], sc.fmt(f.rms, words(k)[1]), sc.fmt(f.max, words(k)[1]),
+             words(k)[1]] for k, f in loads.items()
             if not (k == "rocking_couple" and planar)
             and not (k.startswith("torque_") and run.drive == "free")]
     lines.append(table(rows, ["quantity over time", "RMS", "max", "unit"]))
@@ -99,7 +104,7 @@ def _verification_scales(v: MotionVerification) -> Scales:
             if run is None:
                 continue
             sc.add([("N", run.largest_reaction)])
-            sc.add((_words(k)[1], f.max) for k, f in run.loads().items())
+            sc.add((load_words(run.mechanism, k)[1], f.max) for k, f in run.loads().items())
     return sc
 
 
@@ -124,9 +129,12 @@ def motion_verification_text(v: MotionVerification, spec: str | None = None) -> 
     lines.append(table(rows, ["motion", "max |ΣR| (N)", "original", "ratio", "of scale",
                               "max |Msh| (N·m)", "original", "ratio"]))
     inputs = v.free.run.inputs
-    torque_rows = [[f"along {c.name}", *(shown(c.max_torques[n], "N·m") for n in inputs)]
+    units = [load_words(v.free.run.mechanism, f"torque_{n}")[1] for n in inputs]
+    torque_rows = [[f"along {c.name}", *(shown(c.max_torques[n], u)
+                                         for n, u in zip(inputs, units, strict=True))]
                    for c in v.motions]
-    lines += ["", table(torque_rows, ["motion", *(f"max |τ {n}| (N·m)" for n in inputs)])]
+    lines += ["", table(torque_rows, ["motion", *(f"max |{'F' if u == 'N' else 'τ'} {n}| ({u})"
+                                                  for n, u in zip(inputs, units, strict=True))])]
     for c in v.motions:
         lines.append(f"along {c.name}: the {c.other.method if c.other else ''} formulation "
                      f"agrees to {c.agreement:.1e}; energy balance to "

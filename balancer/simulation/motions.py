@@ -43,10 +43,11 @@ from ..columns import Columns
 from ..errors import AssemblyError, SolverError, SpecError
 from ..formulations.multibody import Multibody
 from ..linkage import rotors, trajectory
-from ..linkage.constraints import Pose
+from ..linkage.constraints import GROUND_INDEX, Pose
 from ..linkage.inputs import InputState
 from ..linkage.kinematics import Motion
 from ..linkage.loads import Reactions
+from ..linkage.vectors import V
 from ..mechanisms import Mechanism, mechanism_of
 from ..model import MechanismModel
 from ..model.motions import MotionSpec
@@ -120,10 +121,10 @@ class MotionRun:
 
     @property
     def changes(self) -> tuple[NDArray[np.float64], ...]:
-        """Each input's change from the reference pose, rad."""
+        """Each input's change from the reference pose, rad (m along a slide)."""
         s = self.mechanism.structure
-        return tuple(np.asarray(p, dtype=float) - s.ref_angle[k]
-                     for p, k in zip(self.state.positions, s.inputs, strict=True))
+        return tuple(np.asarray(p, dtype=float) - ref
+                     for p, ref in zip(self.state.positions, s.input_references, strict=True))
 
     def columns(self) -> tuple[list[str], Columns]:
         """The columns of ``simulate --out``: those of ``analyze --csv`` along a motion."""
@@ -289,6 +290,56 @@ def _check_method(method: str) -> None:
 # -- free motion --------------------------------------------------------------------------------
 
 
+def _inputs_of(mech: Mechanism, q: NDArray[np.float64], qd: NDArray[np.float64],
+               qdd: NDArray[np.float64]) -> InputState:
+    """The inputs' positions, rates and accelerations at the links' coordinates ``(N, 3n)``.
+
+    Each driver's position at the pose, its Jacobian row times the rates, and times the
+    accelerations less its ``γ`` without a prescribed acceleration (an angle's: θ, θ̇, θ̈; a
+    slide's: the place, speed and acceleration along it).
+    """
+    n = mech.structure.size
+    pose = Pose([V(q[:, 3 * k], q[:, 3 * k + 1]) for k in range(n)],
+                [q[:, 3 * k + 2] for k in range(n)])
+    vel = [V(qd[:, 3 * k], qd[:, 3 * k + 1]) for k in range(n)]
+    rate = [qd[:, 3 * k + 2] for k in range(n)]
+    positions, rates, accelerations = [], [], []
+    for d in mech.structure.drivers:
+        row = [(k, c[0]) for k, c in d.jacobian(pose) if k != GROUND_INDEX]
+        positions.append(np.asarray(d.position(pose), dtype=float))
+        rates.append(sum(c[0] * qd[:, 3 * k] + c[1] * qd[:, 3 * k + 1] + c[2] * qd[:, 3 * k + 2]
+                         for k, c in row))
+        accelerations.append(sum(c[0] * qdd[:, 3 * k] + c[1] * qdd[:, 3 * k + 1]
+                                 + c[2] * qdd[:, 3 * k + 2] for k, c in row)
+                             - d.gamma(pose, vel, rate)[0])
+    return InputState.of(positions, rates, accelerations)
+
+
+def _free_multibody(mech: Mechanism, f: Multibody, t: NDArray[np.float64],
+                    ys: NDArray[np.float64], gravity: tuple[float, float]
+                    ) -> tuple[InputState, Reactions, NDArray[np.float64], NDArray[np.float64]]:
+    """A free multibody run's inputs, loads on the frame and energies at its output states."""
+    k = 3 * f.n
+    q, qd = ys[:, :k], ys[:, k : 2 * k]
+    ev = f.evaluate_batch(t, list(ys))
+    qdd = np.array([f.rhs(float(ti), y)[k : 2 * k] for ti, y in zip(t, ys, strict=True)])
+    state = _inputs_of(mech, q, qd, qdd)
+    with np.errstate(all="ignore"):
+        couple = mech.rocking_couple(mech.motion_at(state), gravity=gravity)
+    reactions = Reactions(
+        ground={p: np.asarray(v, complex) for p, v in ev.ground.items()},
+        slider_normal={name: np.asarray(v, float) for name, v in ev.slider_normal.items()},
+        slider_couple={name: np.asarray(v, float) for name, v in ev.slider_couple.items()},
+        shaking_force=np.asarray(ev.shaking_force, complex),
+        shaking_moment=np.asarray(ev.shaking_moment, float),
+        torques=tuple(np.zeros(t.size) for _ in mech.structure.drivers),
+        rocking_couple=np.ravel(couple.complex()))
+    q_cont = q.copy()
+    q_cont[:, 2::3] = _continuous(q[:, 2::3])
+    kinetic, work = f.energies(q_cont, qd)
+    return state, reactions, kinetic, work
+
+
 class _InputCoordinates:
     """Lagrange's equations in the inputs' coordinates from the core's inverse dynamics."""
 
@@ -410,8 +461,6 @@ def simulate_free(model: MechanismModel | Mechanism, start: InputState, duration
         raise AssemblyError("the linkage cannot be assembled at the initial state",
                             key="simulation.start", value=[float(np.ravel(p)[0])
                                                            for p in start.positions])
-    inputs = mech.structure.inputs
-    n = len(inputs)
     if method == "multibody":
         stages = f.compiled.get("dop853 free")
         if stages is None and "dop853 free" not in f.compiled:
@@ -421,40 +470,18 @@ def simulate_free(model: MechanismModel | Mechanism, start: InputState, duration
             f.rhs, np.concatenate([q0[0], qd0[0]]), t, rtol=rtol, atol=atol, stages=stages,
             project=f.project, residual=f.constraint_residual, groups=f.like_components(),
             max_seconds=max_seconds)
-        k = 3 * f.n
-        q, qd = ys[:, :k], ys[:, k : 2 * k]
-        theta = np.array([q[:, 3 * i + 2] for i in inputs])
-        omega = np.array([qd[:, 3 * i + 2] for i in inputs])
+        state, reactions, kinetic, work = _free_multibody(mech, f, t, ys, gravity)
     else:
+        n = len(mech.structure.inputs)
         system = _InputCoordinates(mech, gravity)
         y0 = np.array([*(float(np.ravel(p)[0]) for p in start.positions),
                        *(float(np.ravel(r)[0]) for r in start.rates)])
         ys, drift, evaluations = _integrate(system.rhs, y0, t, rtol=rtol, atol=atol,
                                             max_seconds=max_seconds)
         theta, omega = ys[:, :n].T, ys[:, n:].T
-    alpha = np.array([_InputCoordinates(mech, gravity).accelerations(th, om)
-                      for th, om in zip(theta.T, omega.T, strict=True)]).T \
-        if method == "input-coordinates" else None
-    state = InputState.of(list(theta), list(omega),
-                          None if alpha is None else list(alpha))
-    if method == "multibody":
-        ev = f.evaluate_batch(t, list(ys))
-        acc = np.asarray(ev.alpha)
-        state = InputState.of(list(theta), list(omega), [acc[i] for i in inputs])
-        with np.errstate(all="ignore"):
-            couple = mech.rocking_couple(mech.motion_at(state), gravity=gravity)
-        reactions = Reactions(
-            ground={p: np.asarray(v, complex) for p, v in ev.ground.items()},
-            slider_normal={k_: np.asarray(v, float) for k_, v in ev.slider_normal.items()},
-            slider_couple={k_: np.asarray(v, float) for k_, v in ev.slider_couple.items()},
-            shaking_force=np.asarray(ev.shaking_force, complex),
-            shaking_moment=np.asarray(ev.shaking_moment, float),
-            torques=tuple(np.zeros(t.size) for _ in range(n)),
-            rocking_couple=np.ravel(couple.complex()))
-        q_cont = q.copy()
-        q_cont[:, 2::3] = _continuous(q[:, 2::3])
-        kinetic, work = f.energies(q_cont, qd)
-    else:
+        alpha = np.array([system.accelerations(th, om)
+                          for th, om in zip(theta.T, omega.T, strict=True)]).T
+        state = InputState.of(list(theta), list(omega), list(alpha))
         reactions, mo, _ = _driven_loads(mech, method, state, gravity)
         assert mo is not None
         kinetic, work = _core_energies(mech, mo, gravity)

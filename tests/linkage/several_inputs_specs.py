@@ -98,3 +98,20 @@ def parallelogram() -> dict:
                   "r": _link(["P1", "Q"], 0.1, 0.0004, 0.12, 0.002),
                   "s": _link(["P2", "Q", "E"], 0.15, 0.0026, -0.02, 0.002)},
     }
+
+
+def crank_slider() -> dict:
+    """A crank on a ground pivot A and a block driven along a horizontal ground guide through
+    B, joined by two links at E: two inputs, one about a pivot and one along a slide."""
+    return {
+        "mechanism": {"type": "linkage", "inputs": ["crank", "block"],
+                      "points": {"A": [0.0, 0.0], "C": [0.04, 0.15], "E": [0.2, 0.3],
+                                 "B": [0.32, 0.0]},
+                      "sliders": [{"link": "block", "guide": "ground", "point": "B",
+                                   "direction": [1.0, 0.0]}]},
+        "links": {"ground": {"points": ["A"]},
+                  "crank": _link(["A", "C"], 0.3, 0.002, 0.07, 0.01),
+                  "upper": _link(["C", "E"], 0.2, 0.001, 0.1, 0.0),
+                  "lower": _link(["B", "E"], 0.25, 0.0015, 0.12, -0.004),
+                  "block": _link(["B"], 0.8, 0.0004, 0.01, -0.005)},
+    }
