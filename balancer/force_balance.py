@@ -249,7 +249,12 @@ def force_balance_along(mech: Mechanism, motions: Sequence[InputState]) -> Force
     if key in cache:
         return cache[key]
     scales = _mass_scales(mech)
-    rows, sv, _ = _row_space(_variation(mech, motions, scales))
+    try:
+        rows, sv, _ = _row_space(_variation(mech, motions, scales))
+    except SolverError as exc:
+        raise SolverError(f"{exc} along the motions (a motion too small to tell a "
+                          "condition from rounding: force-balance it for every motion)"
+                          ) from None
     layout = mech.layout
     result = ForceBalance(matrix=rows * scales, scales=scales, singular_values=sv,
                           links=tuple(layout.link_slice(n) for n in mech.structure.names),

@@ -93,6 +93,9 @@ def _slopes(spec: MotionSpec) -> NDArray[np.float64]:
                         / (h[:-1] + h[1:])[:, None])
         return slopes
     periodic = spec.closed
+    if periodic:  # (its ends equal to 1e-12: made one, as SciPy's periodic spline asks)
+        values = values.copy()
+        values[-1] = values[0]
     if len(knots) > DENSE_KNOTS:
         from scipy.interpolate import CubicSpline  # (a long table: a banded solve)
 

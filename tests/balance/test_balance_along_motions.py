@@ -279,8 +279,11 @@ def test_force_balance_along_the_motions_only_is_a_relaxation():
     swing = analysis.motions[0]
     assert swing.loads()["shaking_force"].max <= 1e-12 * swing.natural_scales()["N"]
     assert not analysis.force_balanced  # over the workspace it is not
-    # p alone carries the first moment its swing needs: m_p·c_p + m_cw·r_cw = −(A's share),
-    # the closed form of the parallelogram's p-direction condition with q's arm held.
+    # p alone carries the first moment its swing needs: the every-motion optimum's own
+    # counterweight on p (the parallelogram's p-direction condition), not q's.
+    p_weight = everywhere.counterweights["p"].mass
+    assert abs(along.added_mass - p_weight) <= 1e-6 * p_weight
+    assert everywhere.counterweights["q"].mass > 0.1
     text = dumps_design(balanced)
     assert 'force = "motion"' in text
     again = design_from_dict(tomllib.loads(text))

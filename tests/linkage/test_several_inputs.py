@@ -18,7 +18,13 @@ import tomllib
 import numpy as np
 import pytest
 from helpers import derivative_with_error
-from linkage.several_inputs_specs import crank_rocker, fivebar, linkage_of, three_rrr
+from linkage.several_inputs_specs import (
+    crank_rocker,
+    crank_slider,
+    fivebar,
+    linkage_of,
+    three_rrr,
+)
 
 from balancer.errors import SpecError
 from balancer.linkage import dynamics, kinematics
@@ -34,7 +40,7 @@ from balancer.spec.writer import dumps_design
 RTOL = 1e-9
 
 
-CASES = {"fivebar": fivebar, "3-RRR": three_rrr}
+CASES = {"fivebar": fivebar, "3-RRR": three_rrr, "crank and slide": crank_slider}
 
 
 @pytest.fixture(params=sorted(CASES))
@@ -52,9 +58,11 @@ RATE, PHASE = (3.0, 5.0, 4.0), (0.3, -0.7, 1.1)
 
 def state_at(structure: Structure, t: np.ndarray | float) -> InputState:
     t = np.atleast_1d(np.asarray(t, dtype=float))
-    ref = [structure.ref_angle[k] for k in structure.inputs]
+    ref = list(structure.input_references)
     m = len(ref)
     a, w, p = (np.array(x[:m]) for x in (AMPLITUDES[m], RATE, PHASE))
+    # (along a slide, m: a fifth of the amplitude in rad, 0.04 m on a 0.4 m linkage)
+    a = a * np.array([0.2 if d.position_unit == "m" else 1.0 for d in structure.drivers])
     arg = w[:, None] * t[None, :] + p[:, None]
     return InputState.of(np.array(ref)[:, None] + a[:, None] * np.sin(arg),
                          a[:, None] * w[:, None] * np.cos(arg),
@@ -68,12 +76,13 @@ def test_the_structure_has_a_group_per_input_then_the_rest(case):
     linkage, s = case
     assert s.inputs == tuple(s.index(name) for name in linkage.inputs)
     kinds = [g.kind for g in s.groups]
-    assert kinds[: len(s.inputs)] == ["input"] * len(s.inputs)
+    assert kinds[: len(s.inputs)] == ["slide" if d.position_unit == "m" else "input"
+                                      for d in s.drivers]
     assert [g.driver.index for g in s.groups[: len(s.inputs)]] == list(range(len(s.inputs)))
     expected = "RRR" if len(s.inputs) == 2 else "numeric"
     assert kinds[len(s.inputs):] == [expected]
     # the reference pose is the motion at the reference inputs, to rounding
-    at_ref = kinematics.positions(s, InputState.of([[s.ref_angle[k]] for k in s.inputs]))
+    at_ref = kinematics.positions(s, InputState.of([[x] for x in s.input_references]))
     q = s.reference_coordinates()
     scale = s.length_scale()
     for k in range(s.size):

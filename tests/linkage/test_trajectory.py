@@ -190,3 +190,14 @@ def test_a_bad_motion_is_refused_naming_its_key(fields, key, match):
     with pytest.raises(SpecError, match=match) as caught:
         MotionSpec(**({"name": "m", "times": TIMES, "path": DIAMOND, "point": "E"} | fields))
     assert caught.value.key == key
+
+
+def test_a_long_nearly_closed_table_is_periodic(monkeypatch):
+    # A recorded loop whose last row is its first to 1e-13 (closed to 1e-12): made exactly
+    # closed for the banded periodic solve, as for the dense one.
+    spec = motion("spline", path=DIAMOND[:-1] + ((DIAMOND[0][0] + 1e-13, DIAMOND[0][1]),))
+    assert spec.closed
+    dense = trajectory.path_values(spec, np.linspace(0.0, 4.0, 9))
+    monkeypatch.setattr(trajectory, "DENSE_KNOTS", 2)
+    banded = trajectory.path_values(spec, np.linspace(0.0, 4.0, 9))
+    assert np.max(np.abs(dense[0] - banded[0])) <= 1e-13
