@@ -189,7 +189,9 @@ SECTIONS: tuple[Section, ...] = (
             (LINKAGE,), example='"crank"'),
         Key("inputs", "—", "none",
             "The names of the driven links of a linkage with several inputs (a five-bar's "
-            "two cranks), each turned about its first point, a ground pivot; the linkage's "
+            "two cranks), each turned about its first point, a ground pivot — or driven along "
+            "its slide on a ground guide (`[[mechanism.sliders]]`, a link pinned to no ground "
+            "point: its position in m, its actuator's load a force in N); the linkage's "
             "degrees of freedom must equal their count. Instead of `input`.",
             (LINKAGE,), example='["left", "right"]'),
         Key("points", "table", "required",
