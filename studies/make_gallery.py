@@ -77,6 +77,11 @@ COMMANDS = (
         "balancer plot examples/forbal2.toml --motion diamond --cycle "
         "docs/gallery/forbal2_diamond.png",
     )),
+    ("fivebar_5r_verify.png", (
+        "balancer optimize examples/fivebar_5r.toml --no-verify --out "
+        "OUT/fivebar_5r_balanced.toml",
+        "balancer verify OUT/fivebar_5r_balanced.toml --plot docs/gallery/fivebar_5r_verify.png",
+    )),
 )
 #: Animations: (gallery name, example spec, frames per revolution).
 ANIMATIONS = (("meijaard2020.gif", "meijaard2020", 48),

@@ -31,6 +31,8 @@ def motion_verification_figure(design: Design, verification: MotionVerification)
     title = design.title or "design"
     fig.suptitle(f"{title}: verification by simulation ({verification.method} formulation)")
     inputs = verification.free.run.inputs
+    slides = any(d.load_unit == "N" for d in verification.free.run.mechanism.structure.drivers)
+    loads, unit = ("torques and forces", "N·m; N along a slide") if slides else ("torques", "N·m")
     for col, check in enumerate(checks):
         label = "free (no motor)" if check.name == "free" else f"along {check.name}"
         runs = [("design", check.run, "-", COLOURS["after"])]
@@ -49,9 +51,9 @@ def motion_verification_figure(design: Design, verification: MotionVerification)
         force.set_ylabel("N")
         moment.set_title(f"shaking moment about the origin, {label}")
         moment.set_ylabel("N·m")
-        torque.set_title(f"input torques and forces, {label}" if check.name != "free"
-                         else "input torques: none (free)")
-        torque.set_ylabel("N·m (N along a slide)")
+        torque.set_title(f"input {loads}, {label}" if check.name != "free"
+                         else f"input {loads}: none (free)")
+        torque.set_ylabel(unit)
         for ax in (force, moment, torque):
             ax.set_xlabel("t (s)")
             ax.grid(True, alpha=0.3)
