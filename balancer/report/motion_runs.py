@@ -77,18 +77,20 @@ def motion_run_json(run: MotionRun, spec: str | None = None) -> dict[str, Any]:
                        "acceleration": float(s.accelerations[i][index])}
                 for i, name in enumerate(run.inputs)}
 
+    loads: dict[str, Any] = {k: {"rms": f.rms, "max": f.max} for k, f in run.loads().items()}
+    loads["reactions"] = {p: reaction_extremes(v) for p, v in run.reactions.ground.items()}
     doc: dict[str, Any] = {} if spec is None else {"spec": spec}
     doc.update({
         "method": run.method, "drive": run.drive, "motion": run.motion,
         "inputs": list(run.inputs), "duration": float(run.t[-1] - run.t[0]),
         "outputs": int(run.t.size), "rtol": run.rtol, "atol": run.atol,
-        "evaluations": run.evaluations, "initial": state(0), "final": state(-1),
-        "energy_error": run.energy_error,
+        "steps": run.steps, "evaluations": run.evaluations, "initial": state(0),
+        "final": state(-1), "energy_error": run.energy_error,
         "constraint_drift": {"position": run.drift[0], "velocity": run.drift[1]},
-        **{k: {"rms": f.rms, "max": f.max} for k, f in run.loads().items()},
-        "reactions": {p: reaction_extremes(v) for p, v in run.reactions.ground.items()},
-        "units": {"position": "rad", "rate": "rad/s", "acceleration": "rad/s²", "force": "N",
-                  "moment": "N·m", "constraint_drift": "m, m/s"}})
+        "motions": {run.motion or "free": loads},
+        "units": {"position": "rad (m along a slide)", "rate": "rad/s (m/s)",
+                  "acceleration": "rad/s² (m/s²)", "force": "N",
+                  "moment": "N·m (a slide's actuator: N)", "constraint_drift": "m, m/s"}})
     return doc
 
 

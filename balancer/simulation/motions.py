@@ -95,6 +95,9 @@ class MotionRun:
         (a free multibody run; zeros otherwise).
     evaluations
         The equations' evaluations: the integrator's (free) or the quadrature's (driven).
+    steps
+        The integrator's accepted steps (free), or the quadrature's panels (driven): what
+        the run's error grows with.
     rtol, atol
         The tolerances of the integration or quadrature.
     """
@@ -113,6 +116,7 @@ class MotionRun:
     evaluations: int
     rtol: float
     atol: float
+    steps: int = 0
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -302,12 +306,16 @@ def simulate_along(model: MechanismModel | Mechanism, spec: MotionSpec, *,
     else:
         assert mo is not None
         kinetic, config = _core_energies(mech, mo, t, gravity)
-    motors = cumulative(_power(mech, method, spec, gravity), t, rtol=rtol, atol=atol)
+    # The work's absolute tolerance at most rtol of the energy the motion exchanges (a light
+    # robot's joules are few: atol alone would be its whole error).
+    exchanged = max(float(np.max(np.abs(kinetic))), float(np.ptp(config)), 1e-300)
+    motors = cumulative(_power(mech, method, spec, gravity), t, rtol=rtol,
+                        atol=min(atol, rtol * exchanged))
     return _checked(MotionRun(
         mechanism=mech, method=method, drive="motion", motion=spec.name, t=t, state=state,
         reactions=reactions, kinetic_energy=kinetic, work=config + motors.values[:, 0],
         energy_error=_energy_error(kinetic, config, motors.values[:, 0]), drift=(0.0, 0.0),
-        evaluations=motors.evaluations, rtol=rtol, atol=atol))
+        evaluations=motors.evaluations, rtol=rtol, atol=atol, steps=motors.panels))
 
 
 def _check_method(method: str) -> None:
@@ -414,8 +422,8 @@ def _integrate(rhs: Callable[[float, NDArray[np.float64]], NDArray[np.float64]],
                project: Callable[[float, NDArray[np.float64]], NDArray[np.float64]] | None = None,
                residual: Callable[[float, NDArray[np.float64]], tuple[float, float]] | None = None,
                groups: tuple[NDArray[np.intp], ...] = (), max_seconds: float | None = None,
-               ) -> tuple[NDArray[np.float64], tuple[float, float], int]:
-    """DOP853 from ``y0`` at ``t_out[0] = 0``; the states at ``t_out``, the drift, evaluations.
+               ) -> tuple[NDArray[np.float64], tuple[float, float], int, int]:
+    """DOP853 from ``y0`` at ``t_out[0] = 0``: the states at ``t_out``, drift, evaluations, steps.
 
     After each step a non-minimal state is projected (``project``) and its residual before
     (``residual``) kept; the outputs come from each step's dense output.
@@ -459,7 +467,7 @@ def _integrate(rhs: Callable[[float, NDArray[np.float64]], NDArray[np.float64]],
     if project is not None:
         out[1:] = np.array([project(float(t), y) for t, y in zip(t_out[1:], out[1:],
                                                                   strict=True)])
-    return out, drift, solver.nfev
+    return out, drift, solver.nfev, steps
 
 
 def simulate_free(model: MechanismModel | Mechanism, start: InputState, duration: float, *,
@@ -498,7 +506,7 @@ def simulate_free(model: MechanismModel | Mechanism, start: InputState, duration
         if stages is None and "dop853 free" not in f.compiled:
             symbolic = f.symbolic_rhs()
             stages = f.compiled["dop853 free"] = None if symbolic is None else Stages(symbolic)
-        ys, drift, evaluations = _integrate(
+        ys, drift, evaluations, steps = _integrate(
             f.rhs, np.concatenate([q0[0], qd0[0]]), t, rtol=rtol, atol=atol, stages=stages,
             project=f.project, residual=f.constraint_residual, groups=f.like_components(),
             max_seconds=max_seconds)
@@ -508,8 +516,8 @@ def simulate_free(model: MechanismModel | Mechanism, start: InputState, duration
         system = _InputCoordinates(mech, gravity)
         y0 = np.array([*(float(np.ravel(p)[0]) for p in start.positions),
                        *(float(np.ravel(r)[0]) for r in start.rates)])
-        ys, drift, evaluations = _integrate(system.rhs, y0, t, rtol=rtol, atol=atol,
-                                            max_seconds=max_seconds)
+        ys, drift, evaluations, steps = _integrate(system.rhs, y0, t, rtol=rtol, atol=atol,
+                                                   max_seconds=max_seconds)
         theta, omega = ys[:, :n].T, ys[:, n:].T
         alpha = np.array([system.accelerations(th, om)
                           for th, om in zip(theta.T, omega.T, strict=True)]).T
@@ -521,4 +529,4 @@ def simulate_free(model: MechanismModel | Mechanism, start: InputState, duration
         mechanism=mech, method=method, drive="free", motion=None, t=t, state=state,
         reactions=reactions, kinetic_energy=kinetic, work=work,
         energy_error=_energy_error(kinetic, work, np.zeros_like(work)), drift=drift,
-        evaluations=evaluations, rtol=rtol, atol=atol))
+        evaluations=evaluations, rtol=rtol, atol=atol, steps=steps))

@@ -276,7 +276,7 @@ def fixed_lines(doc: dict | None) -> Callable[[str], str]:
 def _simulation_rule(path: str, doc: dict) -> Rule:
     """What a figure of ``simulate --json`` or ``verify --json`` is."""
     run = _runs_tolerance(doc)
-    if re.search(r"energy_error$|constraint_drift\.", path):  # relative to their scales
+    if re.search(r"energy_error$|formulations_agree_to$|constraint_drift\.", path):  # (relative)
         return Bound(_runs_tolerance(doc, turning=False).relative)
     if re.search(r"force_(ratio|level)$", path):  # rounding where force-balanced
         return Bound(run.relative, run)

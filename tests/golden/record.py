@@ -140,7 +140,14 @@ def commands(name: str) -> dict[str, list[str]]:
         along = {"analyze.txt": ["analyze", spec],
                  "analyze.json": ["analyze", spec, "--json"],
                  "analyze.csv": ["analyze", spec, "--motion", ALONG_MOTIONS[name], "--csv",
-                                 "{tmp}/out.csv"]}
+                                 "{tmp}/out.csv"],
+                 "simulate.txt": ["simulate", spec],
+                 "simulate.json": ["simulate", spec, "--json"],
+                 "simulate-free.json": ["simulate", spec, "--drive", "free", "--outputs", "41",
+                                        "--json"],
+                 "simulate.csv": ["simulate", spec, "--motion", ALONG_MOTIONS[name], "--out",
+                                  "{tmp}/out.csv"],
+                 "verify.json": ["verify", spec, "--json"]}
         if "[balance]" in (EXAMPLES / f"{name}.toml").read_text():
             along.update({
                 "optimize.txt": ["optimize", spec, "--no-verify"],
