@@ -137,8 +137,6 @@ def test_bad_input_names_its_key(capsys, tmp_path, example, change, key, verb):
     argv = [verb, str(spec)]
     argv += (["--out", str(tmp_path / "out.toml"), "--no-verify"] if verb == "optimize"
              else ["--json"])
-    if verb == "optimize" and example in ("three_rrr", "forbal2"):
-        pytest.skip("the example has no [balance]")
     if verb == "simulate" and key.startswith("motion[1]"):
         pytest.skip("simulate runs the first motion (or --motion NAME's) alone")
     code, line = _run(capsys, tmp_path, argv)
