@@ -167,6 +167,27 @@ def path_values(spec: MotionSpec, t: NDArray[np.float64]
     return p, d1 * rate[:, None], d2 * rate[:, None] ** 2 + d1 * acc[:, None]
 
 
+def break_times(spec: MotionSpec) -> NDArray[np.float64]:
+    """The times (s) inside the motion where its accelerations may jump or kink.
+
+    Where the path's argument ``τ`` passes an inner waypoint (the cubic pieces join there),
+    and the trapezoid's ends of acceleration and deceleration. ``τ(t)`` increases: each
+    waypoint's time is found by bisection to rounding.
+    """
+    t0, t1 = spec.times[0], spec.times[-1]
+    inner = np.asarray(spec.times[1:-1], dtype=float)
+    low, high = np.full(inner.shape, t0), np.full(inner.shape, t1)
+    for _ in range(64):
+        mid = 0.5 * (low + high)
+        below = time_argument(spec, mid)[0] < inner
+        low, high = np.where(below, mid, low), np.where(below, high, mid)
+    out = [*(0.5 * (low + high))]
+    if spec.law == "trapezoid":
+        assert spec.acc_time is not None
+        out += [t0 + spec.acc_time, t1 - spec.acc_time]
+    return np.unique(np.array([t for t in out if t0 < t < t1], dtype=float))
+
+
 def sample_times(spec: MotionSpec) -> NDArray[np.float64]:
     """The motion's sampled times: ``samples`` equally spaced, both ends included, s."""
     return np.linspace(spec.times[0], spec.times[-1], spec.samples)

@@ -310,7 +310,8 @@ def simulate_along(model: MechanismModel | Mechanism, spec: MotionSpec, *,
     # robot's joules are few: atol alone would be its whole error).
     exchanged = max(float(np.max(np.abs(kinetic))), float(np.ptp(config)), 1e-300)
     motors = cumulative(_power(mech, method, spec, gravity), t, rtol=rtol,
-                        atol=min(atol, rtol * exchanged))
+                        atol=min(atol, rtol * exchanged),
+                        breaks=trajectory.break_times(spec).tolist())
     return _checked(MotionRun(
         mechanism=mech, method=method, drive="motion", motion=spec.name, t=t, state=state,
         reactions=reactions, kinetic_energy=kinetic, work=config + motors.values[:, 0],

@@ -21,7 +21,7 @@ quadrature of a verification run (0.3–0.6 s): the dozen lines are written here
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TypeAlias
 
@@ -138,7 +138,7 @@ def partial_weights(u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArra
 
 def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
                times: NDArray[np.float64], *, rtol: float, atol: float,
-               max_width: float = math.inf) -> Cumulative:
+               max_width: float = math.inf, breaks: Sequence[float] = ()) -> Cumulative:
     """``∫ integrand`` from ``times[0]`` to each of ``times`` (increasing), adaptively.
 
     The span is split into panels (of at most ``max_width``), which need not end at the
@@ -161,6 +161,10 @@ def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
     max_width
         Widest first panel: the span is split evenly into panels no wider (a periodic
         integrand needs several per period, or both rules can agree on a wrong value).
+    breaks
+        Times inside the span where the integrand is not smooth (a motion's waypoints, where
+        its acceleration may jump): the first panels end there, so that no panel straddles
+        a jump and the halvings do not chase it.
 
     Raises
     ------
@@ -173,9 +177,13 @@ def cumulative(integrand: Callable[[NDArray[np.float64]], NDArray[np.float64]],
         shape = np.asarray(integrand(times[:1]), dtype=float).shape[1:]
         return Cumulative(values=np.zeros((times.size, *shape)), panels=0, evaluations=0)
     start, end = float(times[0]), float(times[-1])
-    pieces = max(1, math.ceil((end - start) / max_width))
-    edges = start + (end - start) * np.arange(pieces + 1) / pieces
-    edges[-1] = end
+    knots = np.unique([start, *(b for b in breaks if start < b < end), end])
+    parts = []
+    for a, b in zip(knots[:-1], knots[1:], strict=True):
+        count = max(1, math.ceil((b - a) / max_width))
+        parts.append(a + (b - a) * np.arange(count) / count)
+    edges = np.append(np.concatenate(parts), end)
+    pieces = edges.size - 1
     left, right = edges[:-1], edges[1:]
     refined = 0  # panels made by halving
     accepted: list[Panels] = []  # (left, right, kronrod sum) of the accepted panels

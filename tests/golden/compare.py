@@ -72,7 +72,7 @@ NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.
 #: the design's status, ``status``, is compared): masked.
 _COUNTERS = re.compile(r'("(?:iterations|steps|nfev|evaluations)": )\d+'
                        r'|("solver_status": )"[^"]*"'
-                       r"|\b\d+( solver iterations| steps| right-hand sides)")
+                       r"|\b\d+( solver iterations| steps| right-hand sides| evaluations)")
 
 
 @dataclass(frozen=True)

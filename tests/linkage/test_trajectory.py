@@ -201,3 +201,16 @@ def test_a_long_nearly_closed_table_is_periodic(monkeypatch):
     monkeypatch.setattr(trajectory, "DENSE_KNOTS", 2)
     banded = trajectory.path_values(spec, np.linspace(0.0, 4.0, 9))
     assert np.max(np.abs(dense[0] - banded[0])) <= 1e-13
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_the_break_times_are_where_the_path_passes_its_waypoints(law):
+    spec = motion(law)
+    breaks = trajectory.break_times(spec)
+    tau = trajectory.time_argument(spec, breaks)[0]
+    inner = np.array(TIMES[1:-1])
+    hits = [np.min(np.abs(tau - w)) for w in inner]
+    assert max(hits) <= 1e-12  # each inner waypoint's time, through the law
+    if law == "trapezoid":  # and where the acceleration ends and the deceleration starts
+        assert np.min(np.abs(breaks - 0.5)) <= 1e-15 and np.min(np.abs(breaks - 3.5)) <= 1e-15
+    assert np.all(np.diff(breaks) > 0) and breaks[0] > 0.0 and breaks[-1] < 4.0

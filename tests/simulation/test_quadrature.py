@@ -126,3 +126,17 @@ def test_an_integrand_that_halving_does_not_resolve_stops_within_a_budget():
         cumulative(rough, np.linspace(0.0, 1.0, 11), rtol=1e-10, atol=1e-12, max_width=0.5)
     budget = 2 + MAX_REFINED * 2 + EXTRA_REFINED + 2 * (MAX_REFINED * 2 + EXTRA_REFINED)
     assert sum(calls) <= 15 * budget
+
+
+def test_panels_end_at_the_breaks_of_a_jump():
+    # A step at t = 0.3: its integral is exact from the first panels when one ends there; a
+    # panel across the step is halved round after round instead.
+    def step(t):
+        return np.where(t < 0.3, 1.0, 3.0)[:, None]
+
+    times = np.linspace(0.0, 1.0, 11)
+    exact = np.where(times < 0.3, times, 0.3 + 3.0 * (times - 0.3))
+    broken = cumulative(step, times, rtol=1e-12, atol=1e-14, breaks=[0.3])
+    assert np.max(np.abs(broken.values[:, 0] - exact)) <= 1e-14
+    whole = cumulative(step, times, rtol=1e-12, atol=1e-14)
+    assert broken.evaluations < whole.evaluations / 3
