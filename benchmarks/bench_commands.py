@@ -347,6 +347,17 @@ def analyze_rows(repeats: int) -> list[Row]:
                                     [*bal, "analyze", f"examples/{spec.name}"], repeats, limit)]
         rows += guarded(f"analyze {spec.name}", f"≤ {limit:g} s", body)
 
+    for spec in sorted(EXAMPLES.glob("*.toml")):
+        if "\ninputs = [" not in spec.read_text():
+            continue
+        # A linkage with several inputs simulated along its first motion (two formulations'
+        # check in verify, every motion and a free run): issue 42's verbs, their own budgets.
+        for verb, limit in (("simulate", 1.0), ("verify", 1.5)):
+            def along(spec=spec, verb=verb, limit=limit) -> list[Row]:
+                return [against_startup(f"{verb} {spec.name}",
+                                        [*bal, verb, f"examples/{spec.name}"], repeats, limit)]
+            rows += guarded(f"{verb} {spec.name}", f"≤ {limit:g} s", along)
+
     def paper() -> list[Row]:  # issue 41: the paper's four-bar within 1.6× of numpy's start-up
         return [against_startup("analyze meijaard2020.toml (issue 41)",
                                 [*bal, "analyze", "examples/meijaard2020.toml"], repeats, 0.3,
