@@ -31,9 +31,15 @@ def front_text(front: Front, spec: str | None = None) -> str:
     sc = Scales([(front.name, p.value) for p in front.points]
                 + [(front.minimised, x) for p in front.points for x in (p.least, p.lower_bound)]
                 + [(n, p.figures[n]) for p in front.points for n in others])
+    # A bound of 0 under a positive optimum is none made (the certificate could not bound the
+    # program's box): shown as such, not as a certified 0.
+    uncertified = [p.lower_bound <= 0 and not sc.rounding(p.least, front.minimised)
+                   for p in front.points]
     rows = [[f"{i + 1}", sc.fmt(p.value, front.name), sc.fmt(p.least, front.minimised),
-             *(sc.fmt(p.figures[n], n) for n in others), sc.fmt(p.lower_bound, front.minimised),
-             "knee" if p.knee else ""] for i, p in enumerate(front.points)]
+             *(sc.fmt(p.figures[n], n) for n in others),
+             "—" if bare else sc.fmt(p.lower_bound, front.minimised),
+             "knee" if p.knee else ""]
+            for i, (p, bare) in enumerate(zip(front.points, uncertified, strict=True))]
     unit = FIGURES[front.minimised][1]
     held = ("each mass·radius within its bound; the unbalance term's place taken by the "
             "bound on the mass" if front.masses
@@ -41,7 +47,10 @@ def front_text(front: Front, spec: str | None = None) -> str:
     lines = [head,
              f"least {front.words} against {name} ({len(front.points)} "
              f"point{'s' if len(front.points) != 1 else ''}, each a "
-             f"global optimum with its certified lower bound; {held})", "",
+             + ("global optimum with its certified lower bound" if not any(uncertified) else
+                "solver's optimum, its lower bound certified where shown (— : the "
+                "certificate could not bound it)")
+             + f"; {held})", "",
              table(rows, ["point", f"{name} {front.unit}", f"{front.words} {unit}",
                           *(f"{FIGURES[n][0]} {FIGURES[n][1]}" for n in others),
                           f"certified bound {unit}", ""])]

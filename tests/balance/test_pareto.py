@@ -139,3 +139,21 @@ def test_a_loose_bound_of_a_front_point_is_tightened_by_another_solve(monkeypatc
     for p in front.points:
         assert p.lower_bound <= p.least + 1e-9 * scale  # (the certificate's rounding)
         assert p.least - p.lower_bound <= 10 * convex.CERTIFY_AGAIN * scale
+
+
+def test_a_point_whose_bound_was_not_made_is_not_called_certified(pb1_front):
+    # A lower bound of 0 under a positive optimum is no certificate (the certificate could not
+    # bound the program's box): the table shows it as such and the heading stops claiming one.
+    import dataclasses
+
+    from balancer.report.fronts import front_text
+
+    _, front = pb1_front
+    text = front_text(front)
+    assert "each a global optimum with its certified lower bound" in text and "—" not in text
+    first = dataclasses.replace(front.points[0], lower_bound=0.0)
+    bare = dataclasses.replace(front, points=(first, *front.points[1:]))
+    text = front_text(bare)
+    assert "certified where shown" in text
+    row = next(line for line in text.splitlines() if line.startswith("1 "))
+    assert "—" in row
