@@ -131,12 +131,13 @@ def _read_motions(root: Table, inputs: tuple[str, ...], folder: Path) -> tuple[M
         if not table.has("name"):
             raise table._missing("name")
         if table.has("file"):
-            for name in ("times", "path", "point"):
+            for name in ("times", "path"):
                 if table.has(name):
                     raise SpecError("a motion read from a file takes its times and path from "
                                     "it", key=table.key(name), value=table.raw(name))
-            times, path = _motion_file(table, inputs, folder)
-            point = None
+            point = table.value("point", None)
+            columns = ("x", "y") if isinstance(point, str) else inputs
+            times, path = _motion_file(table, columns, folder)
         else:
             for name in ("times", "path"):
                 if not table.has(name):
@@ -157,7 +158,11 @@ def _read_motions(root: Table, inputs: tuple[str, ...], folder: Path) -> tuple[M
 
 def _motion_file(table: Table, inputs: tuple[str, ...], folder: Path
                  ) -> tuple[tuple[float, ...], tuple[tuple[float, ...], ...]]:
-    """A motion's times and inputs' path from its CSV ``file`` (header ``t,<input>,…``)."""
+    """A motion's times and path from its CSV ``file``.
+
+    Its header ``t`` and ``inputs``: the linkage's inputs (their changes from the reference
+    pose), or ``x,y`` for a point's path (m).
+    """
     key = table.key("file")
     name = table.raw("file")
     if not isinstance(name, str) or not name:
@@ -171,9 +176,10 @@ def _motion_file(table: Table, inputs: tuple[str, ...], folder: Path
     rows = [r for r in csv.reader(io.StringIO(text)) if any(c.strip() for c in r)]
     header = [c.strip() for c in rows[0]] if rows else []
     if header != ["t", *inputs]:
-        raise SpecError(f"its header must be t,{','.join(inputs)} (the time, then each input "
-                        f"in the linkage's order); it is {','.join(header) or 'empty'}",
-                        key=key, value=name)
+        what = ("the time, then the point's x and y" if inputs == ("x", "y")
+                else "the time, then each input in the linkage's order")
+        raise SpecError(f"its header must be t,{','.join(inputs)} ({what}); it is "
+                        f"{','.join(header) or 'empty'}", key=key, value=name)
     times: list[float] = []
     values: list[tuple[float, ...]] = []
     for line, row in enumerate(rows[1:], start=2):

@@ -44,8 +44,9 @@ MOTION_SECTIONS: tuple[Section, ...] = (
                     "A CSV file (its path relative to the spec's folder) of the inputs over "
                     "time instead of `times` and `path`: a header `t,<input>,…` (the "
                     "linkage's inputs in its order), then one row per time (s; each input's "
-                    "change from the reference pose, rad). Its law is `\"spline\"` unless "
-                    "given; a spec written back holds the table as `times` and `path`.",
+                    "change from the reference pose, rad) — or, with `point`, `t,x,y` (m). Its "
+                    "law is `\"spline\"` unless given; a spec written back holds the table as "
+                    "`times` and `path`.",
                     (LINKAGE,), example='"motion.csv"'),
                 Key("law", "—", '"cubic" ("spline" with `file`)',
                     '`"trapezoid"` (with `acc_time`), `"cubic"`, `"quintic"` (rest to rest '

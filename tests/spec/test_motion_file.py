@@ -81,6 +81,23 @@ def test_a_bad_file_is_refused_naming_the_key(tmp_path, capsys, content, words):
     assert "motion[1].file: " in err and words in err and "Traceback" not in err, err
 
 
+def test_a_points_path_from_a_file(tmp_path):
+    # With `point`, the file gives the point's x and y (m): the same motion as written inline.
+    rows = [(0.0, 0.1, 0.35), (0.4, 0.115, 0.36), (0.7, 0.12, 0.345), (1.0, 0.1, 0.35)]
+    (tmp_path / "apex.csv").write_text("t,x,y\n" + "\n".join(
+        ",".join(repr(x) for x in r) for r in rows) + "\n")
+    (tmp_path / "file.toml").write_text(_spec_text('point = "E"\nfile = "apex.csv"\n'))
+    inline = _spec_text('point = "E"\ntimes = [0.0, 0.4, 0.7, 1.0]\npath = [[0.1, 0.35], '
+                        '[0.115, 0.36], [0.12, 0.345], [0.1, 0.35]]\nlaw = "spline"\n')
+    (tmp_path / "inline.toml").write_text(inline)
+    from_file, written = (load_design(tmp_path / n) for n in ("file.toml", "inline.toml"))
+    assert from_file.motions == written.motions and from_file.motions[-1].closed
+    (tmp_path / "apex.csv").write_text("t,left,right\n0.0,0.0,0.0\n1.0,0.1,0.1\n")
+    with pytest.raises(SpecError, match="its header must be t,x,y") as caught:
+        load_design(tmp_path / "file.toml")
+    assert caught.value.key == "motion[1].file"
+
+
 def test_a_file_motion_takes_no_times_or_path(tmp_path):
     (tmp_path / "swing.csv").write_text(_csv())
     spec = tmp_path / "spec.toml"
