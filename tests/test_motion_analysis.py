@@ -155,7 +155,7 @@ def test_a_bad_motion_option_is_refused(tmp_path, design, args, key):
     assert not (tmp_path / "x.csv").exists()
 
 
-@pytest.mark.parametrize("verb", [["plot", "--animate", "a.gif"], ["plot", "--orders", "o.png"]])
+@pytest.mark.parametrize("verb", [["plot", "--orders", "o.png"]])
 def test_the_revolutions_verbs_say_they_turn_one_crank(tmp_path, design, verb):
     # (plot --cycle draws a motion: tests/plots/test_motion_figure.py)
     spec = _spec_file(tmp_path, design)

@@ -205,7 +205,8 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "it. --orders: the order table as bars, forward and backward whirl, before and after. "
         "--animate: the linkage turning, its total centre of mass traced. For a linkage with "
         "several inputs, or with --motion, --cycle draws the loads along the spec's motion "
-        "([[motion]]) over time instead, with the mechanism at a few poses along it. The file "
+        "([[motion]]) over time instead, with the mechanism at a few poses along it, and "
+        "--animate the mechanism moving along it. The file "
         "type comes from the extension.",
     ),
     "pareto": (
@@ -372,7 +373,8 @@ def _plot_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--animate", metavar="PATH",
                    help="write an animation to PATH (.gif, or .mp4 with ffmpeg)")
     p.add_argument("--frames", type=_frames, default=72, metavar="N",
-                   help=f"frames per revolution (default 72, at most {MAX_FRAMES})")
+                   help=f"frames, at most {MAX_FRAMES} (default 72): per revolution, or "
+                   "along a motion")
     p.add_argument("--log", action="store_true",
                    help="with --orders: the bars on a logarithmic axis (magnitudes; bars at "
                    "rounding of the largest left out)")

@@ -68,27 +68,28 @@ def run(args: argparse.Namespace) -> int:
 
 def _along_motion(args: argparse.Namespace, design: Design, cycle: Path | None,
                   orders: Path | None, animation: Path | None) -> int:
-    """``plot --cycle`` along the spec's motion ``--motion`` (without it: its first).
+    """``plot --cycle`` and ``--animate`` along the spec's motion ``--motion`` (its first).
 
     The loads over time and the mechanism at a few poses along the motion, with the spec's
-    gravity (as ``analyze`` along its motions). The order bars and the animation are of one
-    crank revolution: refused here (exit code 2).
+    gravity (as ``analyze`` along its motions); the mechanism moving along it. The order bars
+    are of one crank revolution: refused here (exit code 2).
     """
-    for option, path, what in (("--orders", orders, "an order table"),
-                               ("--animate", animation, "an animation")):
-        if path is None:
-            continue
-        mechanism_of(design.mechanism).require_one_input(what)  # (several inputs: its words)
-        raise SpecError(f"{what} is of one crank revolution, not of a motion: --motion draws "
-                        "its loads with --cycle PATH alone", key=option, value=str(path))
-    assert cycle is not None  # (one of the three was given)
+    if orders is not None:
+        mechanism_of(design.mechanism).require_one_input("an order table")  # (its words)
+        raise SpecError("an order table is of one crank revolution, not of a motion: --motion "
+                        "draws its loads with --cycle PATH and the mechanism with --animate "
+                        "PATH", key="--orders", value=str(orders))
     motion = design.motion(args.motion)  # (without --motion: the first, said below)
     if args.motion is None and len(design.motions) > 1:
         others = ", ".join(m.name for m in design.motions[1:])
         print(f"balancer: note: drawing motion {motion.name}, the spec's first; --motion NAME "
               f"draws another ({others})", file=sys.stderr)
-    analysis = analyze_motion(design, motion.name)
-    figure = motion_figure(analysis, motion_drawing(analysis), title=design.title)
-    save_figure(figure, cycle)
-    wrote(cycle)
+    if cycle is not None:
+        analysis = analyze_motion(design, motion.name)
+        figure = motion_figure(analysis, motion_drawing(analysis), title=design.title)
+        save_figure(figure, cycle)
+        wrote(cycle)
+    if animation is not None:
+        animate(design, animation, frames=args.frames, motion=motion)
+        wrote(animation)
     return 0

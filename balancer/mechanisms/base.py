@@ -365,8 +365,8 @@ class Mechanism:
             raise SpecError(
                 f"{purpose} turns one crank, and this linkage has {len(inputs)} inputs; "
                 "along its motions ([[motion]]) `balancer analyze` gives its loads, `plot "
-                "--cycle` draws them, and `optimize`, `pareto` and `sweep` balance it; "
-                "simulations come to several inputs next", key="mechanism.inputs",
+                "--cycle` and `--animate` draw them, `simulate` and `verify` run them, and "
+                "`optimize`, `pareto` and `sweep` balance it", key="mechanism.inputs",
                 value=list(inputs))
 
     def require_full_revolution(self, purpose: str) -> AssemblyRange:
@@ -745,11 +745,17 @@ class Mechanism:
         return {b.name: b.points for b in self.linkage.bodies}
 
     def crank_reach(self) -> float:
-        """The input link's reach: its farthest point from its first (its pivot), m."""
+        """The input link's reach: its farthest point from its first (its pivot), m.
+
+        With several inputs, the largest of theirs.
+        """
         places = dict(self.linkage.points)
-        first, *others = next(b.points for b in self.linkage.bodies if b.name == self.input)
-        pivot = complex(*places[first])
-        return max((abs(complex(*places[p]) - pivot) for p in others), default=0.0)
+        reach = 0.0
+        for name in self.linkage.inputs:
+            first, *others = next(b.points for b in self.linkage.bodies if b.name == name)
+            pivot = complex(*places[first])
+            reach = max([reach, *(abs(complex(*places[p]) - pivot) for p in others)])
+        return reach
 
     def slider_blocks(self) -> dict[str, tuple[float, float]]:
         """What a drawing shows of each sliding link that is one point: a block, m.

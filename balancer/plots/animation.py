@@ -1,4 +1,7 @@
-"""An animation of the mechanism turning one revolution (GIF, or MP4 with ffmpeg)."""
+"""An animation of the mechanism turning one revolution, or along a motion (GIF, or MP4).
+
+An MP4 needs ffmpeg; a motion is of the inputs of a linkage with several.
+"""
 
 from __future__ import annotations
 
@@ -14,10 +17,13 @@ from .. import outputs
 from ..balance.counterweights import counterweights as link_counterweights
 from ..cycle import sample_angles
 from ..errors import OutputError, SpecError
+from ..linkage import trajectory
+from ..linkage.inputs import InputState
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism
 from ..model import Design
 from ..model import MechanismModel as Model
+from ..model.motions import MotionSpec
 from ..outputs import animation_type, write_with
 from .drawing import (
     CounterweightLike,
@@ -25,6 +31,7 @@ from .drawing import (
     drawing_frames,
     drawn_mass_sectors,
     frame,
+    revolution,
     slider_block_outlines,
 )
 from .style import COLOURS, draw_frame
@@ -79,11 +86,30 @@ def _drawn(design: Design | Model | Mechanism, title: str,
     return design, title, counterweights or {}
 
 
+def _frames_of(linkage: Model | Mechanism, frames: int, motion: MotionSpec | None
+               ) -> tuple[InputState, list[str]]:
+    """The frames' input states and their readouts.
+
+    A revolution's crank angles, or a motion's equally spaced times (its inputs' states there).
+    """
+    if motion is None:
+        return revolution(frames), [f"crank angle θ1 = {d:5.1f}°"
+                                    for d in np.degrees(sample_angles(frames))]
+    times = np.linspace(motion.times[0], motion.times[-1], frames)
+    states = trajectory.input_state(mechanism_of(linkage).structure, motion, times)
+    return states, [f"{motion.name}: t = {t:.3g} s" for t in times]
+
+
 def animation_figure(design: Design | Model | Mechanism, *, frames: int = 72,
                      title: str = "",
-                     counterweights: Mapping[str, CounterweightLike] | None = None
+                     counterweights: Mapping[str, CounterweightLike] | None = None,
+                     motion: MotionSpec | str | None = None
                      ) -> tuple[Figure, Callable[[int], list[Artist]]]:
     """The figure of an animation of one revolution, and what changes from frame to frame.
+
+    Along a ``motion`` instead (a :class:`~balancer.model.motions.MotionSpec`, or a name of
+    the design's ``[[motion]]``; a linkage with several inputs runs along its first without
+    it): the frames at equally spaced times, the readout the time.
 
     ``design`` a :class:`~balancer.model.Design` (its mechanism, its title where ``title`` is
     empty, and for a balanced spec that names its original the counterweights added to its
@@ -123,12 +149,14 @@ def animation_figure(design: Design | Model | Mechanism, *, frames: int = 72,
     from matplotlib.lines import Line2D
     from matplotlib.patches import Circle, Polygon, Wedge
 
+    spec = _motion_of(design, motion)
     linkage, title, weights = _drawn(design, title, counterweights)
-    links, coms, total = drawing_frames(linkage, frames)
-    pivots, guides = frame(linkage)
-    discs = counterweight_paths(linkage, weights, frames)
-    blocks = slider_block_outlines(linkage, frames)
-    sectors = drawn_mass_sectors(linkage, frames)
+    states, readouts = _frames_of(linkage, frames, spec)
+    links, coms, total = drawing_frames(linkage, states)
+    pivots, guides = frame(linkage, states=None if spec is None else states)
+    discs = counterweight_paths(linkage, weights, states)
+    blocks = slider_block_outlines(linkage, states)
+    sectors = drawn_mass_sectors(linkage, states)
     fig = Figure(figsize=(6, 4.5), dpi=100, layout="constrained")
     ax = fig.add_subplot()
     rims = [c + r * s for c, r in discs.values() for s in (1, -1, 1j, -1j)]
@@ -147,11 +175,12 @@ def animation_figure(design: Design | Model | Mechanism, *, frames: int = 72,
     ax.set_ylabel("y (m)")
     # The title above the whole figure (wrapped to its width): an axes' title wider than the
     # axes pushes the constrained layout's axes off the figure's edge, the y label clipped.
-    fig.suptitle(title or "linkage over one crank revolution", wrap=True)
+    fig.suptitle(title or ("linkage over one crank revolution" if spec is None
+                           else f"linkage along its motion {spec.name}"), wrap=True)
     ax.grid(alpha=0.3)
     ax.plot(total.real, total.imag, color=COLOURS["before"], lw=1, ls=":",
             label="path of the total centre of mass")
-    draw_frame(ax, linkage, label=None)
+    draw_frame(ax, linkage, label=None, states=None if spec is None else states)
     lines: list[tuple[Line2D, NDArray[np.complex128]]] = []  # (artist, (frames, n) joined)
     for name, points in links.items():
         (arm,) = ax.plot([], [], "-", color=COLOURS["com"], lw=1.0, animated=True, zorder=1.5)
@@ -210,7 +239,6 @@ def animation_figure(design: Design | Model | Mechanism, *, frames: int = 72,
                                   label=textwrap.fill(f"{what}: {', '.join(names)}", 36)))
     fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize="small")
     fig.draw_without_rendering()  # the constrained layout's first pass leaves the title out
-    degrees = np.degrees(sample_angles(frames))
     link_com_values = np.column_stack(list(coms.values()))
 
     def update(k: int) -> list[Artist]:
@@ -229,17 +257,43 @@ def animation_figure(design: Design | Model | Mechanism, *, frames: int = 72,
         link_coms.set_data(link_com_values[k].real, link_com_values[k].imag)
         trace.set_data(total[: k + 1].real, total[: k + 1].imag)
         com.set_data([total[k].real], [total[k].imag])
-        angle.set_text(f"crank angle θ1 = {degrees[k]:5.1f}°")
+        angle.set_text(readouts[k])
         return [trace, *(w for w, _ in wedges), *(b for b, _ in outlines),
                 *(line for line, _ in lines), *(b for b, _, _ in bodies), link_coms, com, angle]
 
     return fig, update
 
 
+def _motion_of(design: Design | Model | Mechanism, motion: MotionSpec | str | None
+               ) -> MotionSpec | None:
+    """The motion an animation runs along, or ``None`` (a revolution).
+
+    ``motion`` itself, the design's motion of that name, or a several-input design's first.
+
+    Raises
+    ------
+    SpecError
+        For a name without a design, or a design without such a motion.
+    """
+    if isinstance(motion, MotionSpec):
+        return motion
+    if isinstance(design, Design):
+        several = len(mechanism_of(design.mechanism).linkage.inputs) > 1
+        return design.motion(motion) if motion is not None or several else None
+    if motion is not None:
+        raise SpecError("names a motion of a design: give the Design, or the MotionSpec",
+                        key="motion", value=motion)
+    return None
+
+
 def animate(design: Design | Model | Mechanism, path: str | os.PathLike[str], *,
             frames: int = 72, fps: int = 24, title: str = "",
-            counterweights: Mapping[str, CounterweightLike] | None = None) -> Path:
+            counterweights: Mapping[str, CounterweightLike] | None = None,
+            motion: MotionSpec | str | None = None) -> Path:
     """Write an animation of the mechanism turning one revolution, its centre of mass traced.
+
+    Along a ``motion`` of its inputs instead (:func:`animation_figure`): a linkage with
+    several inputs runs along its first without one.
 
     ``design`` a :class:`~balancer.model.Design` (as every other call takes: its title where
     ``title`` is empty, and for a balanced spec the bodies added to its original's links), a
@@ -267,7 +321,7 @@ def animate(design: Design | Model | Mechanism, path: str | os.PathLike[str], *,
 
     kind = animation_type(path)
     fig, update = animation_figure(design, frames=frames, title=title,
-                                   counterweights=counterweights)
+                                   counterweights=counterweights, motion=motion)
     canvas = FigureCanvasAgg(fig)
     canvas.draw()
     fig.set_layout_engine("none")

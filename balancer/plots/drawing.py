@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from ..columns import TrajectoryLike
 from ..cycle import sample_angles
+from ..linkage.inputs import InputState
 from ..linkage.vectors import V
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import DrawnMass, Mechanism
@@ -52,20 +53,29 @@ def centre_of_mass_path(linkage: Model | Mechanism, traj: TrajectoryLike
     return np.asarray(mech.total_centre_of_mass(mo), complex)
 
 
-def frame(linkage: Model | Mechanism, samples: int = 72
+def revolution(frames: int) -> InputState:
+    """A crank's states at ``frames`` equally spaced angles of a revolution, at 1 rad/s."""
+    return InputState.crank(sample_angles(frames), 1.0)
+
+
+def frame(linkage: Model | Mechanism, samples: int = 72, states: InputState | None = None
           ) -> tuple[NDArray[np.complex128], list[NDArray[np.complex128]]]:
     """What to draw of the frame: the ground points, and each ground guide's travel, m.
 
     Returns the ground points (complex) and, per slider on a ground guide, the two ends of
     the stretch of its line that its point covers over a revolution (or near the reference
-    pose, for a crank that does not turn fully).
+    pose, for a crank that does not turn fully) — or over the input ``states`` given (a
+    motion's).
     """
     mech = mechanism_of(linkage)
     pivots = np.array(list(mech.ground_positions.values()), complex)
-    rng = mech.assembly_range()
-    angles = sample_angles(samples) if rng.full else np.linspace(*rng.intervals[0], samples)
+    if states is None:
+        rng = mech.assembly_range()
+        angles = sample_angles(samples) if rng.full else np.linspace(*rng.intervals[0],
+                                                                     samples)
+        states = InputState.crank(angles)
     with np.errstate(all="ignore"):
-        mo = mech.motion(angles)
+        mo = mech.motion_at(states)
     points = mech.points(mo)
     guides: list[NDArray[np.complex128]] = []
     for slider in mech.linkage.sliders:
@@ -79,17 +89,17 @@ def frame(linkage: Model | Mechanism, samples: int = 72
     return pivots, guides
 
 
-def drawing_frames(linkage: Model | Mechanism, frames: int
+def drawing_frames(linkage: Model | Mechanism, states: InputState
                    ) -> tuple[dict[str, NDArray[np.complex128]], dict[str, NDArray[np.complex128]],
                               NDArray[np.complex128]]:
-    """What an animation draws over a revolution at equally spaced crank angles.
+    """What an animation draws at its frames' input states (a revolution's, or a motion's).
 
     Returns ``(links, coms, total)``: per link (the ground's left out) a ``(frames, k)``
     complex array of its points in drawing order (a ternary link closed into a triangle),
     per link its centre of mass ``(frames,)``, and ``(frames,)`` the total, m.
     """
     mech = mechanism_of(linkage)
-    mo = mech.motion(sample_angles(frames), 1.0)
+    mo = mech.motion_at(states)
     points = mech.points(mo)
     links: dict[str, NDArray[np.complex128]] = {}
     for name, names in mech.drawing().items():
@@ -103,15 +113,17 @@ def drawing_frames(linkage: Model | Mechanism, frames: int
 
 
 def counterweight_paths(linkage: Model | Mechanism,
-                        counterweights: Mapping[str, CounterweightLike], frames: int
+                        counterweights: Mapping[str, CounterweightLike], states: InputState
                         ) -> dict[str, tuple[NDArray[np.complex128], float]]:
-    """Where each counterweight to add is over a revolution: ``(centres, radius)`` per link.
+    """Where each counterweight to add is at the input ``states``: per link, its path.
+
+    ``(centres, radius)``.
 
     ``centres`` a ``(frames,)`` complex array (m): the counterweight's centre ``(e, f)`` in its
     link's frame, carried by the link; ``radius`` its steel disc's (m; 0 for a point).
     """
     mech = mechanism_of(linkage)
-    mo = mech.motion(sample_angles(frames), 1.0)
+    mo = mech.motion_at(states)
     out: dict[str, tuple[NDArray[np.complex128], float]] = {}
     for k, name in enumerate(mech.link_names):
         w = counterweights.get(name)
@@ -122,16 +134,16 @@ def counterweight_paths(linkage: Model | Mechanism,
     return out
 
 
-def slider_block_outlines(linkage: Model | Mechanism, frames: int
+def slider_block_outlines(linkage: Model | Mechanism, states: InputState
                           ) -> dict[str, NDArray[np.complex128]]:
-    """Each sliding block's outline over a revolution: per link a ``(frames, 5)`` array, m.
+    """Each sliding block's outline at the input ``states``: per link ``(frames, 5)``, m.
 
     The rectangle of :meth:`~balancer.mechanisms.base.Mechanism.slider_blocks` (an engine's
     pistons, sized by their bore), centred on the link's point and along its slider, its four
-    corners and the first again (complex), carried by the link at equally spaced crank angles.
+    corners and the first again (complex), carried by the link.
     """
     mech = mechanism_of(linkage)
-    mo = mech.motion(sample_angles(frames), 1.0)
+    mo = mech.motion_at(states)
     out: dict[str, NDArray[np.complex128]] = {}
     for name, (length, width) in mech.slider_blocks().items():
         k = mech.link_names.index(name)
@@ -142,20 +154,22 @@ def slider_block_outlines(linkage: Model | Mechanism, frames: int
     return out
 
 
-def drawn_mass_sectors(linkage: Model | Mechanism, frames: int
+def drawn_mass_sectors(linkage: Model | Mechanism, states: InputState
                        ) -> list[tuple[DrawnMass, NDArray[np.float64], float]]:
-    """The shafts' counterweights and eccentrics as sectors over a revolution.
+    """The shafts' counterweights and eccentrics as sectors at the crank's ``states``.
 
-    Per mass (:meth:`~balancer.mechanisms.base.Mechanism.drawn_masses`): the mass, its
-    direction from its axis at equally spaced crank angles ``(frames,)`` (rad, ``ratio·θ1 +
-    angle``), and the radius of the sector that shows it (m): sectors of one thickness and
-    angle, so their radius goes as the cube root of their mass·radius, the largest reaching
-    the crank's reach.
+    Per mass (:meth:`~balancer.mechanisms.base.Mechanism.drawn_masses`, a one-input
+    mechanism's): the mass, its direction from its axis at the crank angles ``(frames,)``
+    (rad, ``ratio·θ1 + angle``), and the radius of the sector that shows it (m): sectors of
+    one thickness and angle, so their radius goes as the cube root of their mass·radius, the
+    largest reaching the crank's reach.
     """
     mech = mechanism_of(linkage)
     masses = mech.drawn_masses()
+    if not masses:
+        return []
     largest = max((m.mr for m in masses), default=0.0)
-    theta1 = sample_angles(frames)
+    theta1 = np.asarray(states.positions[0], dtype=float)
     reach = mech.crank_reach()
     return [(m, m.ratio * theta1 + m.angle, reach * float(np.cbrt(m.mr / largest)))
             for m in masses if m.mr > 0]

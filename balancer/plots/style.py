@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..linkage.inputs import InputState
 from ..mechanisms.base import Mechanism
 from ..model import MechanismModel as Model
 from ..outputs import figure_type, write_with
@@ -59,9 +60,13 @@ def number(x: float) -> str:
 
 
 def draw_frame(ax: Axes, linkage: Model | Mechanism,
-               label: str | None = "frame (pivots, guides)") -> None:
-    """The frame: the ground pivots as triangles, the ground guides' travel as thick lines."""
-    pivots, guides = frame(linkage)
+               label: str | None = "frame (pivots, guides)", states: InputState | None = None
+               ) -> None:
+    """The frame: the ground pivots as triangles, the ground guides' travel as thick lines.
+
+    The travel over a revolution, or over the input ``states`` given (a motion's).
+    """
+    pivots, guides = frame(linkage, states=states)
     ax.plot(pivots.real, pivots.imag, "k^", ms=8, label=label, zorder=5)
     for ends in guides:
         ax.plot(ends.real, ends.imag, "k-", lw=6, alpha=0.25, zorder=1)

@@ -280,7 +280,6 @@ def test_without_motion_several_inputs_draw_the_first_and_say_so(forbal2_file, c
 @pytest.mark.parametrize(("args", "key", "words"), [
     (["--motion", "nowhere", "--cycle", "c.png"], "--motion", "names no motion of the spec"),
     (["--motion", "diamond", "--orders", "o.png"], "mechanism.inputs", "turns one crank"),
-    (["--cycle", "c.png", "--animate", "a.gif"], "mechanism.inputs", "turns one crank"),
 ])
 def test_what_plot_cannot_draw_along_a_motion_is_refused(forbal2_file, capsys, args, key,
                                                          words):
@@ -321,11 +320,38 @@ def test_a_one_input_linkage_is_drawn_along_its_motion_when_asked(tmp_path, caps
     assert main(["plot", str(spec), "--cycle", str(cycle)]) == 0  # (a revolution, as ever)
     assert motion.read_bytes()[:4] == cycle.read_bytes()[:4] == b"\x89PNG"
     capsys.readouterr()
-    gif = tmp_path / "turn.gif"
-    assert main(["plot", str(spec), "--motion", "turn", "--animate", str(gif)]) == 2
-    err = capsys.readouterr().err
-    assert "--animate: an animation is of one crank revolution, not of a motion" in err
-    assert not gif.exists()
+    gif = tmp_path / "turn.gif"  # (and the crank turning along its motion)
+    assert main(["plot", str(spec), "--motion", "turn", "--animate", str(gif),
+                 "--frames", "6"]) == 0
+    assert gif.read_bytes()[:3] == b"GIF"
+
+
+def test_an_animation_runs_along_the_motion(forbal2_file):
+    # Along the robot's first motion: the frames at equally spaced times of it, its readout
+    # the time; the total centre of mass drawn is the links' centres weighed by their masses.
+    from balancer.linkage import trajectory
+    from balancer.mechanisms import mechanism_of
+    from balancer.plots.animation import _frames_of
+    from balancer.plots.drawing import drawing_frames
+
+    spec, _ = forbal2_file
+    design = loads_design(spec.read_text(encoding="utf-8"))
+    diamond = design.motions[0]
+    mech = mechanism_of(design.mechanism)
+    states, readouts = _frames_of(design.mechanism, 9, diamond)
+    assert readouts[0] == "diamond: t = 0 s" and readouts[-1] == "diamond: t = 4 s"
+    want = trajectory.input_state(mech.structure, diamond, np.linspace(0.0, 4.0, 9))
+    for a, b in zip(states.positions, want.positions, strict=True):
+        np.testing.assert_array_equal(a, b)
+    _, coms, total = drawing_frames(design.mechanism, states)
+    masses = np.array([link.mass for link in mech.links])
+    weighed = sum(m * coms[name] for m, name in zip(masses, mech.link_names, strict=True))
+    np.testing.assert_allclose(total, weighed / masses.sum(), rtol=0, atol=1e-15)
+    from balancer.plots import animation_figure
+
+    fig, update = animation_figure(design, frames=9)  # (several inputs: the first)
+    artists = update(4)
+    assert any(getattr(a, "get_text", lambda: "")() == readouts[4] for a in artists)
 
 
 def test_links_in_several_planes_add_the_rocking_couple():

@@ -395,13 +395,14 @@ def test_counterweights_turn_with_their_links_in_the_animation(tmp_path):
     its (e, f) in the link's frame, i.e. A0 + e^{iθ1}·(e + i·f) for the crank, whose angle the
     frames sample evenly; the animation of a balanced spec draws them."""
     import balancer
-    from balancer.plots.drawing import counterweight_paths
+    from balancer.plots.drawing import counterweight_paths, revolution
 
     design = balancer.example("pb1_counterweights")
     result = balancer.optimize(design, backend="convex")
     balanced = result.balanced_design(design)
     frames = 16
-    paths = counterweight_paths(balanced.mechanism, result.counterweights, frames)
+    paths = counterweight_paths(balanced.mechanism, result.counterweights,
+                                revolution(frames))
     assert set(paths) == {"crank", "rocker"}
     centres, radius = paths["crank"]
     w = result.counterweights["crank"]
@@ -668,7 +669,7 @@ def test_the_animation_carries_each_centre_of_mass_and_counterweight_with_its_li
     frames = 6
     weights = counterweights(design.original, design.mechanism)
     fig, update, _ = _drawn_animation(design, frames, counterweights=weights)
-    _, coms, _ = drawing.drawing_frames(design.mechanism, frames)
+    _, coms, _ = drawing.drawing_frames(design.mechanism, drawing.revolution(frames))
     reach = {}  # per link: the length of its centre of mass's arm
     for k in range(frames):
         arms = [a.get_xydata() for a in update(k) if isinstance(a, Line2D)
@@ -685,7 +686,8 @@ def test_the_animation_carries_each_centre_of_mass_and_counterweight_with_its_li
     result = balancer.optimize(cw, backend="convex")
     balanced = result.balanced_design(cw)
     fig, update, _ = _drawn_animation(balanced, frames, counterweights=result.counterweights)
-    paths = drawing.counterweight_paths(balanced.mechanism, result.counterweights, frames)
+    paths = drawing.counterweight_paths(balanced.mechanism, result.counterweights,
+                                        drawing.revolution(frames))
     discs = [p for p in fig.axes[0].patches if isinstance(p, Circle)]
     assert len(discs) == len(paths) == 2
     for k in (0, 3):
