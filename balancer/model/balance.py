@@ -59,11 +59,11 @@ from ..quantities import unit_of
 from .mechanisms import MechanismModel
 from .parts import Part, Sector
 
-#: The keys of ``[balance.objective]``, ``[balance.<link>]`` and a counterweight's table.
 #: Where a linkage with several inputs is force-balanced (``[balance] force``): over its whole
 #: configuration space, or along its motions only.
 FORCE_SCOPES = ("every-motion", "motion")
 
+#: The keys of ``[balance.objective]``, ``[balance.<link>]`` and a counterweight's table.
 OBJECTIVE_KEYS = (
     "shaking_moment",
     "driving_torque",

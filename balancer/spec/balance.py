@@ -18,6 +18,7 @@ from ..model.balance import (
     LinkFreedom,
     Objective,
 )
+from ..quantities import unit_of
 from ..validate import LENGTH_RANGE
 from . import schema
 from .parts import part_text, read_part
@@ -211,6 +212,34 @@ def _range_text(bounds: tuple[float, float]) -> str:
     return toml.number(lo) if lo == hi else f"[{toml.number(lo)}, {toml.number(hi)}]"
 
 
+#: The objective's weights written whatever their value (the others where not zero; the
+#: shaking force's components both where either is).
+ALWAYS_WRITTEN = ("shaking_moment", "driving_torque", "shaking_force", "added_mass")
+
+
+def _objective_lines(w: Objective) -> list[str]:
+    """``[balance.objective]``'s lines: each weight of :data:`OBJECTIVE_KEYS` with its unit.
+
+    The unit of a mean square's weight is ``(N·m)²`` over its quantity's unit squared (its
+    unit from the quantity table), of the added mass's ``(N·m)²/kg``; the shaking moment's is
+    1 and goes unsaid.
+    """
+    components = bool(w.shaking_force_x or w.shaking_force_y)
+    out = []
+    for key in OBJECTIVE_KEYS:
+        weight = getattr(w, key)
+        along = key.removeprefix("shaking_force_") if key.startswith("shaking_force_") else ""
+        if key not in ALWAYS_WRITTEN and not weight and not (along and components):
+            continue
+        unit = unit_of(key)
+        per = ("" if key == "shaking_moment" else
+               "(N·m)²/kg" if key == "added_mass" else
+               f"(N·m)²/{'(N·m)²' if unit == 'N·m' else unit + '²'}")
+        note = per + (f", along {along}" if along else "")
+        out.append(f"{key} = {toml.number(weight)}" + (f"  # {note}" if note else ""))
+    return out
+
+
 def balance_lines(problem: BalanceProblem) -> list[str]:
     """The problem as TOML lines that :func:`read_balance` reads back to an equal problem."""
     w = problem.objective
@@ -222,15 +251,7 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
         "",
         "[balance.objective]  # J = mean(Msh²) + w_tau·mean(tau²) + w_force·mean(|Fsh|²)"
         " + w_mass·Δmass",
-        f"shaking_moment = {toml.number(w.shaking_moment)}",
-        f"driving_torque = {toml.number(w.driving_torque)}  # (N·m)²/(N·m)²",
-        f"shaking_force = {toml.number(w.shaking_force)}  # (N·m)²/N²",
-        *([f"shaking_force_x = {toml.number(w.shaking_force_x)}  # (N·m)²/N², along x",
-           f"shaking_force_y = {toml.number(w.shaking_force_y)}  # (N·m)²/N², along y"]
-          if w.shaking_force_x or w.shaking_force_y else []),
-        *([f"rocking_couple = {toml.number(w.rocking_couple)}  # (N·m)²/(N·m)²"]
-          if w.rocking_couple else []),
-        f"added_mass = {toml.number(w.added_mass)}  # (N·m)²/kg",
+        *_objective_lines(w),
     ]
     if problem.motion_weights:
         lines += ["", "[balance.motions]  # each motion's weight in the objective"]
