@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from . import validate as v
 from .errors import SpecError
 from .linkage import trajectory
 from .linkage.inputs import InputState
@@ -32,6 +33,9 @@ from .simulation.motions import METHODS, MotionRun, simulate_along, simulate_fre
 #: The free run lasts this share of the first motion's duration (short enough that a robot
 #: coasting from the middle of its motion does not reach a singular pose).
 FREE_SHARE = 0.1
+#: Most wall-clock time a free run may take, s (the one-input check's): a run that creeps
+#: past a singular pose, or a motion far faster than its duration, is refused, not waited on.
+FREE_SECONDS = 20.0
 #: Quadrature and integration tolerances of the runs (those of the one-input check).
 RTOL = 1e-9
 ATOL = 1e-11
@@ -251,11 +255,15 @@ def verify_motions(design: Design, names: Sequence[str] | None = None, *,
     mech = mechanism_of(design.mechanism)
     original = None if design.original is None else mechanism_of(design.original)
     def along(m: Mechanism, motion: MotionSpec, how: str) -> MotionRun:
-        return simulate_along(m, motion, method=how, gravity=gravity, rtol=rtol, atol=atol)
+        with v.under(v.item("motion", design.motions.index(motion))):  # (its keys' errors)
+            return simulate_along(m, motion, method=how, gravity=gravity, rtol=rtol,
+                                  atol=atol)
 
     def free_run(m: Mechanism, motion: MotionSpec, span: float) -> MotionRun:
-        return simulate_free(m, fastest_state(m, motion), span, method=method,
-                             gravity=gravity, rtol=rtol, atol=atol)
+        with v.under(v.item("motion", design.motions.index(motion))):
+            start = fastest_state(m, motion)
+        return simulate_free(m, start, span, method=method, gravity=gravity, rtol=rtol,
+                             atol=atol, max_seconds=FREE_SECONDS)
 
     checks = []
     for motion in chosen:

@@ -5,10 +5,17 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Literal
 
+from .. import validate as v
 from ..formulations import Method
 from ..mechanisms import mechanism_of
 from ..model import Design, Drive
-from ..motion_verification import FREE_SHARE, MotionVerification, fastest_state, verify_motions
+from ..motion_verification import (
+    FREE_SECONDS,
+    FREE_SHARE,
+    MotionVerification,
+    fastest_state,
+    verify_motions,
+)
 from ..simulation import Trajectory, simulate_design
 from ..simulation.motions import MotionRun, simulate_along, simulate_free
 from ..verification import Verification
@@ -51,18 +58,20 @@ def simulate_motion(design: Design, name: str | None = None, *, method: str | No
     mech = mechanism_of(design.mechanism)
     settings = design.simulation
     gravity = _gravity(design)
-    method = method or "multibody"
+    method = method or settings.method or "multibody"
     rtol = settings.rtol if rtol is None else rtol
     atol = settings.atol if atol is None else atol
-    if drive == "motion":
-        return simulate_along(mech, motion, method=method, gravity=gravity, rtol=rtol,
-                              atol=atol)
+    with v.under(v.item("motion", design.motions.index(motion))):  # (its keys' errors)
+        if drive == "motion":
+            return simulate_along(mech, motion, method=method, gravity=gravity, rtol=rtol,
+                                  atol=atol)
+        start = fastest_state(mech, motion)
     if duration is None:
         duration = (settings.duration if "duration" in settings.given
                     else FREE_SHARE * motion.duration)
-    return simulate_free(mech, fastest_state(mech, motion), duration, method=method,
-                         gravity=gravity, rtol=rtol, atol=atol,
-                         outputs=settings.outputs if outputs is None else outputs)
+    return simulate_free(mech, start, duration, method=method, gravity=gravity, rtol=rtol,
+                         atol=atol, outputs=settings.outputs if outputs is None else outputs,
+                         max_seconds=FREE_SECONDS)
 
 
 def _gravity(design: Design) -> tuple[float, float]:

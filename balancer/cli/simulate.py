@@ -70,6 +70,12 @@ def _along_motion(args: argparse.Namespace, design: Design, out: Path | None) ->
     if args.drive == "constant-speed":
         raise SpecError("a linkage driven along a motion has no constant crank speed: choose "
                         "motion or free", key="--drive", value=args.drive)
+    if args.drive != "free":  # (a driven run is its motion's: its times and samples)
+        for option in ("duration", "outputs"):
+            if getattr(args, option) is not None:
+                raise SpecError("is a free run's (--drive free); a run driven along a motion "
+                                "lasts its [[motion]] times, at its samples",
+                                key=f"--{option}", value=getattr(args, option))
     if args.method is not None and args.method not in ("multibody", "input-coordinates"):
         raise SpecError("along a motion the formulations are multibody and input-coordinates",
                         key="--method", value=args.method)

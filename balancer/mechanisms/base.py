@@ -50,6 +50,8 @@ Route = Literal["newton-euler", "mass-matrix"]
 #: coordinates with the constraints' multipliers, and in the crank angle.
 MULTIBODY = "multibody"
 CRANK_ANGLE = "crank-angle"
+#: A linkage with several inputs: Lagrange's equations in its inputs (balancer.simulation.motions).
+INPUT_COORDINATES = "input-coordinates"
 #: From this many crank states on, :meth:`Mechanism.crank_forces` evaluates the groups' route
 #: as a straight-line program (:mod:`balancer.linkage.program`): the same arithmetic in
 #: fewer operations, whose one-time build (about 0.1 s) then pays off.
@@ -281,6 +283,8 @@ class Mechanism:
         (no dead point of the crank to stop it).
         """
         own = tuple(self.own_formulations)
+        if len(self.linkage.inputs) > 1:  # (driven along motions, or free: no crank)
+            return (MULTIBODY, INPUT_COORDINATES)
         if self.assembly_range().full:
             return (*own, CRANK_ANGLE, MULTIBODY)
         return (*own, MULTIBODY, CRANK_ANGLE)

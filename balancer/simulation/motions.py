@@ -31,6 +31,7 @@ integral of the integrated system: it measures the integration.
 from __future__ import annotations
 
 import time as _time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Literal
@@ -54,7 +55,7 @@ from ..model.motions import MotionSpec
 from ..motion_analysis import Load, frame_loads, motion_columns
 from .integrator import DOP853, CompiledDOP853, DenseOutput, Stages
 from .quadrature import cumulative
-from .stepper import MAX_STEPS, floored_atol
+from .stepper import MAX_STEPS, STALL_WINDOW, floored_atol
 
 #: The formulations of a linkage with several inputs, the default (the check's) first.
 METHODS = ("multibody", "input-coordinates")
@@ -185,8 +186,19 @@ def _core_energies(mech: Mechanism, mo: Motion, t: NDArray[np.float64],
     return kinetic, work
 
 
+def _energy_floor(mech: Mechanism, duration: float) -> float:
+    """The rounding of the linkage's energies over a run, J: ``10³·ε·M·L²/T²``.
+
+    ``M`` its moving mass, ``L`` its size, ``T`` the run's duration: what a motion across the
+    linkage in that time would exchange, to rounding.
+    """
+    mass = sum(link.mass for link in mech.links)
+    size = mech.structure.length_scale()
+    return max(1e3 * float(np.finfo(float).eps) * mass * size**2 / duration**2, 1e-300)
+
+
 def _energy_error(kinetic: NDArray[np.float64], config: NDArray[np.float64],
-                  motors: NDArray[np.float64]) -> float:
+                  motors: NDArray[np.float64], floor: float = 1e-300) -> float:
     """``max|T − T0 − W|`` over the energy the run exchanges, relative.
 
     ``W`` the configuration's work (loads, gravity, springs) and the motors'; the scale the
@@ -197,7 +209,7 @@ def _energy_error(kinetic: NDArray[np.float64], config: NDArray[np.float64],
     def swing(x: NDArray[np.float64]) -> float:
         return float(np.max(x) - np.min(x)) if x.size else 0.0
 
-    scale = max(float(np.max(np.abs(kinetic))), swing(config), swing(motors), 1e-300)
+    scale = max(float(np.max(np.abs(kinetic))), swing(config), swing(motors), floor)
     return float(np.max(np.abs(kinetic - kinetic[0] - config - motors)) / scale)
 
 
@@ -309,13 +321,17 @@ def simulate_along(model: MechanismModel | Mechanism, spec: MotionSpec, *,
     # The work's absolute tolerance at most rtol of the energy the motion exchanges (a light
     # robot's joules are few: atol alone would be its whole error).
     exchanged = max(float(np.max(np.abs(kinetic))), float(np.ptp(config)), 1e-300)
+    # ... and at least the rounding of the linkage's energies (a motion of a picometre
+    # exchanges energy below it: its power is rounding, its work 0 to that).
+    floor = _energy_floor(mech, spec.duration)
     motors = cumulative(_power(mech, method, spec, gravity), t, rtol=rtol,
-                        atol=min(atol, rtol * exchanged),
+                        atol=max(min(atol, rtol * exchanged), floor),
                         breaks=trajectory.break_times(spec).tolist())
     return _checked(MotionRun(
         mechanism=mech, method=method, drive="motion", motion=spec.name, t=t, state=state,
         reactions=reactions, kinetic_energy=kinetic, work=config + motors.values[:, 0],
-        energy_error=_energy_error(kinetic, config, motors.values[:, 0]), drift=(0.0, 0.0),
+        energy_error=_energy_error(kinetic, config, motors.values[:, 0], floor),
+        drift=(0.0, 0.0),
         evaluations=motors.evaluations, rtol=rtol, atol=atol, steps=motors.panels))
 
 
@@ -438,17 +454,29 @@ def _integrate(rhs: Callable[[float, NDArray[np.float64]], NDArray[np.float64]],
     out[0] = y0
     k, steps, drift = 1, 0, (0.0, 0.0)
     started = _time.perf_counter()
+    recent: deque[float] = deque([0.0], maxlen=STALL_WINDOW + 1)
     while solver.status == "running" and k < t_out.size:
         message = solver.step()
         if solver.status == "failed":
             raise SolverError(f"the integrator failed at t = {solver.t:.6g} s: {message}")
         steps += 1
+        recent.append(solver.t)
+        if len(recent) > STALL_WINDOW:  # (the steps shrink without end: a singular pose)
+            advance, remaining = recent[-1] - recent[0], duration - solver.t
+            if remaining > 0 and advance * MAX_STEPS < remaining * STALL_WINDOW:
+                raise SolverError(
+                    f"the free motion stalled at t = {solver.t:.6g} s: its last "
+                    f"{STALL_WINDOW} steps advanced {advance:.3g} s, near a singular pose "
+                    "(the input coordinates cannot pass one; the multibody formulation can), "
+                    "or with loads far stiffer than the motion")
         if steps > MAX_STEPS:
             raise SolverError(f"the free motion needed more than {MAX_STEPS:.0e} steps by "
                               f"t = {solver.t:.6g} s (a near-singular pose?)")
         if max_seconds is not None and _time.perf_counter() - started > max_seconds:
             raise SolverError(f"the free motion took more than {max_seconds:g} s to reach "
-                              f"t = {solver.t:.6g} s")
+                              f"t = {solver.t:.6g} s: its steps shrink near a singular pose "
+                              "(the input coordinates cannot pass one; the multibody "
+                              "formulation can), or its loads are far stiffer than the motion")
         dense: DenseOutput | None = None
         end = k
         while end < t_out.size and t_out[end] <= solver.t + 1e-14 * max(1.0, solver.t):
@@ -529,5 +557,6 @@ def simulate_free(model: MechanismModel | Mechanism, start: InputState, duration
     return _checked(MotionRun(
         mechanism=mech, method=method, drive="free", motion=None, t=t, state=state,
         reactions=reactions, kinetic_energy=kinetic, work=work,
-        energy_error=_energy_error(kinetic, work, np.zeros_like(work)), drift=drift,
+        energy_error=_energy_error(kinetic, work, np.zeros_like(work),
+                                   _energy_floor(mech, duration)), drift=drift,
         evaluations=evaluations, rtol=rtol, atol=atol, steps=steps))

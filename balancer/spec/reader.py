@@ -173,7 +173,10 @@ def _motion_file(table: Table, inputs: tuple[str, ...], folder: Path
     except (OSError, UnicodeDecodeError) as exc:
         raise SpecError(f"cannot be read ({exc.__class__.__name__}: "
                         f"{getattr(exc, 'strerror', None) or exc})", key=key, value=name) from None
-    rows = [r for r in csv.reader(io.StringIO(text)) if any(c.strip() for c in r)]
+    try:
+        rows = [r for r in csv.reader(io.StringIO(text)) if any(c.strip() for c in r)]
+    except csv.Error as exc:
+        raise SpecError(f"is not a CSV table ({exc})", key=key, value=name) from None
     header = [c.strip() for c in rows[0]] if rows else []
     if header != ["t", *inputs]:
         what = ("the time, then the point's x and y" if inputs == ("x", "y")

@@ -301,3 +301,42 @@ def test_a_link_turning_far_between_samples_keeps_its_turns():
     for method in ("multibody", "input-coordinates"):
         run = simulate_along(mech, motion, method=method, rtol=RTOL)
         assert run.energy_error <= 100 * RTOL
+
+
+def test_what_a_fuzz_campaign_found_along_motions(tmp_path, capsys):
+    # A [simulation] table on a robot is read (its method among the robot's formulations);
+    # a driven run's --duration is refused (it lasts its motion); a motion that moves a
+    # picometre is simulated (its power is rounding: the work's tolerance floors there); a
+    # bad waypoint is named with its motion's index.
+    spec = _example(tmp_path, "pick_fivebar")
+    text = spec.read_text()
+    spec.write_text(text + '\n[simulation]\nduration = 0.05\nmethod = "input-coordinates"\n')
+    code, out, err = _cli(capsys, "simulate", spec, "--drive", "free", "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["method"] == "input-coordinates" and doc["duration"] == 0.05
+    code, _, err = _cli(capsys, "simulate", spec, "--duration", "0.3")
+    assert code == 2 and "--duration: is a free run's" in err, err
+    start = "[0.16867194669263857, 0.2944945065744622]"
+    tiny = text.replace("[0.22, 0.25]", "[0.16867194669363858, 0.2944945065744622]")
+    assert tiny != text and start in tiny
+    spec.write_text(tiny)
+    code, out, err = _cli(capsys, "simulate", spec, "--json")
+    assert code == 0, err
+    spec.write_text(text.replace("[0.22, 0.25]", "[2.2, 2.5]"))
+    for verb in ("simulate", "verify"):
+        code, _, err = _cli(capsys, verb, spec)
+        assert code == 2 and ": motion[1].path: " in err, err
+
+
+def test_a_csv_field_too_long_is_bad_input(tmp_path, capsys):
+    spec = _example(tmp_path, "pick_fivebar")
+    (tmp_path / "pick.csv").write_text("t,p,q\n0,0,0\n0.5,0.1,0.05\n1,0,0\n2," + "1" * 140_000
+                                       + ",0\n")
+    text = spec.read_text()
+    start = text.index("[[motion]]")
+    end = text.index("\n[", start + 10) if "\n[" in text[start + 10:] else len(text)
+    spec.write_text(text[:start] + '[[motion]]\nname = "pick"\nfile = "pick.csv"\n'
+                    + text[end:])
+    code, _, err = _cli(capsys, "analyze", spec)
+    assert code == 2 and "motion[1].file: is not a CSV table" in err, err
