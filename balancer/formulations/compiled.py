@@ -200,27 +200,35 @@ class LinkageFormulation(Formulation):
         return np.array(values if values else [0.0])
 
     def configuration_work(self, pose: Pose, angles: ArrayLike) -> NDArray[np.float64]:
-        """Work of the loads and gravity less the springs' energy gained since the first state.
+        """:func:`configuration_work` of the formulation's mechanism under its gravity, J."""
+        return configuration_work(self.mech, (self.gravity.real, self.gravity.imag), pose,
+                                  angles)
 
-        ``pose`` holds the links' frames at the states (arrays over them) and ``angles`` their
-        continuous angles, ``(n, count)``: the loads' and gravity's work from the centres of
-        mass' and the angles' displacements (the rotors' eccentrics' from their first
-        moments, turned with the input), the springs' from their potential energy, J.
-        """
-        g = V(self.gravity.real, self.gravity.imag)
-        theta = np.asarray(angles, dtype=float)
-        count = theta.shape[1]
-        work = np.zeros(count)
-        for k, link in enumerate(self.links):
-            com = pose.point(k, V(link.e, link.f))
-            work += (g * link.mass + V(*link.force)).dot(com - V(com.x[0], com.y[0]))
-            work += link.moment * (theta[k] - theta[k, 0])
-        for _, rotor in self.mech.rotors:  # its eccentrics' weights (a crank geared rotor's)
-            turned = rotor.first_moment(theta[self.structure.input])
-            work += (np.conj(self.gravity) * (turned - turned[0])).real
-        energy: Num = 0.0
-        for s in self.structure.linkage.springs:
-            (_, _, a), (_, _, b) = spring_forces(self.structure, s, pose, NUMPY)
-            energy = energy + 0.5 * s.stiffness * (np.sqrt((b - a).norm2()) - s.free_length) ** 2
-        spring = np.asarray(energy, dtype=float) * np.ones(count)
-        return work - (spring - spring[0])
+
+def configuration_work(mech: Mechanism, gravity: tuple[float, float], pose: Pose,
+                       angles: ArrayLike) -> NDArray[np.float64]:
+    """Work of the loads and gravity less the springs' energy gained since the first state.
+
+    ``pose`` holds the links' frames at the states (arrays over them) and ``angles`` their
+    continuous angles, ``(n, count)``: the loads' and gravity's work from the centres of
+    mass' and the angles' displacements (the rotors' eccentrics' from their first moments,
+    turned with the input), the springs' from their potential energy, J. ``gravity``
+    ``(gx, gy)``, m/s².
+    """
+    g = V(*gravity)
+    theta = np.asarray(angles, dtype=float)
+    count = theta.shape[1]
+    work = np.zeros(count)
+    for k, link in enumerate(mech.links):
+        com = pose.point(k, V(link.e, link.f))
+        work += (g * link.mass + V(*link.force)).dot(com - V(com.x[0], com.y[0]))
+        work += link.moment * (theta[k] - theta[k, 0])
+    for _, rotor in mech.rotors:  # its eccentrics' weights (a crank geared rotor's)
+        turned = rotor.first_moment(theta[mech.structure.input])
+        work += (np.conj(complex(*gravity)) * (turned - turned[0])).real
+    energy: Num = 0.0
+    for s in mech.structure.linkage.springs:
+        (_, _, a), (_, _, b) = spring_forces(mech.structure, s, pose, NUMPY)
+        energy = energy + 0.5 * s.stiffness * (np.sqrt((b - a).norm2()) - s.free_length) ** 2
+    spring = np.asarray(energy, dtype=float) * np.ones(count)
+    return work - (spring - spring[0])

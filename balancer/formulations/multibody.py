@@ -43,6 +43,7 @@ from ..linkage.assembly import assembly_gaps
 from ..linkage.constraints import GROUND_INDEX, Constraint, FrameTally, Pose
 from ..linkage.inputs import InputState
 from ..linkage.kinematics import Motion
+from ..linkage.loads import Reactions
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import Num, OpsLike, V, _is_zero
 from ..mechanisms.base import Mechanism
@@ -54,8 +55,8 @@ if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are buil
 
 
 @dataclass(frozen=True)
-class PrescribedDynamics:
-    """The multibody formulation at states where every input is prescribed.
+class StateDynamics:
+    """The multibody formulation's solve at many states, and what it exerts on the frame.
 
     Attributes
     ----------
@@ -64,26 +65,16 @@ class PrescribedDynamics:
         ``(count, 3n)`` (m, rad; per s, per s²).
     multipliers
         The constraints' multipliers, ``(count, rows)``.
-    ground, slider_normal, slider_couple
-        The force on each ground point (complex, N), each ground slider's normal force (N) and
-        couple (N·m) on its guide.
-    shaking_force, shaking_moment
-        Their sum (complex, N) and its moment about the origin with the motors' reactions and
-        the counter-rotors' (N·m).
-    torques
-        Each motor's torque on its input (N·m), in the order of the linkage's inputs.
+    reactions
+        The loads on the frame (the formulation works in the plane: its rocking couple is
+        zero, the caller's to add), each motor's torque minus its driver's multiplier.
     """
 
     q: NDArray[np.float64]
     qd: NDArray[np.float64]
     qdd: NDArray[np.float64]
     multipliers: NDArray[np.float64]
-    ground: dict[str, NDArray[np.complex128]]
-    slider_normal: dict[str, NDArray[np.float64]]
-    slider_couple: dict[str, NDArray[np.float64]]
-    shaking_force: NDArray[np.complex128]
-    shaking_moment: NDArray[np.float64]
-    torques: tuple[NDArray[np.float64], ...]
+    reactions: Reactions
 
 
 class Multibody(LinkageFormulation):
@@ -348,7 +339,7 @@ class Multibody(LinkageFormulation):
             qd[:, 3 * k + 2] = mo.rate[k]
         return q, qd
 
-    def prescribed_dynamics(self, state: InputState) -> PrescribedDynamics:
+    def prescribed_dynamics(self, state: InputState) -> StateDynamics:
         """The saddle-point system at states where every input is prescribed.
 
         The links' coordinates and rates ``(q, q̇)`` come from the linkage core's position and
@@ -368,23 +359,49 @@ class Multibody(LinkageFormulation):
         with np.errstate(all="ignore"):
             mo = self.mech.motion_at(state)
         q, qd = self.coordinates(mo, count)
-        gas = np.zeros((count, max(1, len(self.structure.prisms))))
+        # (slider forces: tables of the crank's angle, a one-input linkage's alone)
+        crank = np.broadcast_to(np.asarray(state.positions[0], dtype=float), (count,))
+        gas = np.array([self._gas(float(th)) for th in crank])
         acc_in = np.array([np.broadcast_to(a, (count,)) for a in state.accelerations]).T
+        return self._solve(q, qd, gas, acc_in, "a state of the motion")
+
+    def free_dynamics(self, times: NDArray[np.float64], ys: NDArray[np.float64]
+                      ) -> StateDynamics:
+        """The solve at the states ``ys`` ``(count, 6n)`` of a free run at ``times``.
+
+        No driver; all in one call of the compiled dynamics.
+
+        Raises
+        ------
+        SolverError
+            If the system is singular to working precision at a state.
+        """
+        k = 3 * self.n
+        gas = np.array([self._gas(self.theta1_of(float(t), y)) for t, y in zip(times, ys,
+                                                                              strict=True)])
+        return self._solve(ys[:, :k], ys[:, k : 2 * k], gas,
+                           np.zeros((ys.shape[0], self.input_count)), "an output state")
+
+    def _solve(self, q: NDArray[np.float64], qd: NDArray[np.float64], gas: NDArray[np.float64],
+               acc_in: NDArray[np.float64], where: str) -> StateDynamics:
+        """The compiled dynamics at the states' columns, as their record."""
+        count = q.shape[0]
         flat = self._fast_dynamics.columns(np.hstack([q, qd, gas, acc_in]).T)
         if not np.all(np.isfinite(flat)):
             raise SolverError(
-                "the multibody equations of motion are singular to working precision at a "
-                "state of the motion (a singular pose)")
+                "the multibody equations of motion are singular to working precision at "
+                f"{where} (a singular pose)")
         acc, lam, ground, normal, couple, frame = (flat[s] for s in self._slices)
         ground = ground.reshape(-1, count)
-        return PrescribedDynamics(
-            q=q, qd=qd, qdd=acc.T, multipliers=lam.T,
+        reactions = Reactions(
             ground={p: ground[2 * i] + 1j * ground[2 * i + 1]
                     for i, p in enumerate(self._ground_names)},
             slider_normal={name: normal[i] for i, name in enumerate(self._slider_names)},
             slider_couple={name: couple[i] for i, name in enumerate(self._slider_names)},
             shaking_force=frame[0] + 1j * frame[1], shaking_moment=frame[2],
-            torques=tuple(frame[3 + i] for i in range(self.input_count)))
+            torques=tuple(frame[3 + i] for i in range(self.input_count)),
+            rocking_couple=np.zeros(count, complex))
+        return StateDynamics(q=q, qd=qd, qdd=acc.T, multipliers=lam.T, reactions=reactions)
 
     def kinetic_energy(self, q: NDArray[np.float64], qd: NDArray[np.float64]
                        ) -> NDArray[np.float64]:

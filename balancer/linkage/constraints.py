@@ -185,27 +185,24 @@ class Prism:
             frame.couple[self.s] = multipliers[0]
 
 
-@dataclass(frozen=True)
-class Driver:
-    """An input's driver: ``θ_link − θ_ground − θ_i = 0`` for input ``index``.
+class _InputDriver:
+    """What an input's drivers share: one row prescribing input ``index`` of link ``link``.
 
-    Its multiplier is minus the motor's torque.
+    Its rate is the input's, its row a length or an angle as it is, its multiplier minus the
+    motor's or actuator's load on the input; it holds the link by no point.
     """
 
     link: int
-    #: Which input drives it (its place in the linkage's inputs and in an :class:`InputState`).
-    index: int = 0
-
+    index: int
     rows = 1
-    row_kinds: ClassVar[tuple[str, ...]] = ("angle",)
-    letter: ClassVar[str] = "D"
-    #: Units of the input's position and of its motor's load.
-    position_unit: ClassVar[str] = "rad"
-    load_unit: ClassVar[str] = "N·m"
 
     def position(self, pose: Pose) -> Num:
-        """The input link's angle, rad."""
-        return pose.angles[self.link]
+        """The input's position at ``pose``: an angle (rad), or a place along a slide (m)."""
+        raise NotImplementedError
+
+    def residual(self, pose: Pose, state: InputState | None = None) -> list[Num]:
+        """The input's position less its prescribed one in ``state`` (none given: 0)."""
+        return [self.position(pose) - (0.0 if state is None else state.positions[self.index])]
 
     @property
     def members(self) -> tuple[int, int]:
@@ -216,9 +213,39 @@ class Driver:
         """``None``: the driver holds a link by no point."""
         return None
 
-    def residual(self, pose: Pose, state: InputState | None = None) -> list[Num]:
-        """The input's angle less its prescribed position in ``state`` (none given: 0), rad."""
-        return [pose.angles[self.link] - (0.0 if state is None else state.positions[self.index])]
+    def prescribed_rates(self, state: InputState) -> list[Num]:
+        """``Φ_q·q̇`` of its row: the input's prescribed rate (rad/s, or m/s along a slide)."""
+        return [state.rates[self.index]]
+
+    def row_scales(self, length: float) -> list[float]:
+        """Its row, as it is."""
+        return [1.0]
+
+    def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
+        """The motor's torque (an actuator's force) on its input: minus its multiplier."""
+        frame.torques[self.index] = -multipliers[0]
+
+
+@dataclass(frozen=True)
+class Driver(_InputDriver):
+    """An input's driver: ``θ_link − θ_ground − θ_i = 0`` for input ``index``.
+
+    Its multiplier is minus the motor's torque.
+    """
+
+    link: int
+    #: Which input drives it (its place in the linkage's inputs and in an :class:`InputState`).
+    index: int = 0
+
+    row_kinds: ClassVar[tuple[str, ...]] = ("angle",)
+    letter: ClassVar[str] = "D"
+    #: Units of the input's position and of its motor's load.
+    position_unit: ClassVar[str] = "rad"
+    load_unit: ClassVar[str] = "N·m"
+
+    def position(self, pose: Pose) -> Num:
+        """The input link's angle, rad."""
+        return pose.angles[self.link]
 
     def jacobian(self, pose: Pose) -> Blocks:
         """:meth:`residual`'s derivative by the links' coordinates."""
@@ -229,21 +256,9 @@ class Driver:
         """``γ``: the input's prescribed acceleration (rad/s²; none given: zero)."""
         return [0.0 if state is None else state.accelerations[self.index]]
 
-    def prescribed_rates(self, state: InputState) -> list[Num]:
-        """``Φ_q·q̇`` of its rows: the input's prescribed rate (rad/s)."""
-        return [state.rates[self.index]]
-
-    def row_scales(self, length: float) -> list[float]:
-        """The angle's row, as it is."""
-        return [1.0]
-
-    def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
-        """The motor's torque on its input: minus its multiplier."""
-        frame.torques[self.index] = -multipliers[0]
-
 
 @dataclass(frozen=True)
-class SlideDriver:
+class SlideDriver(_InputDriver):
     """An input along a ground slide: ``d̄·(r̄_s + R_s·s̄ − p̄_g) − s_i = 0`` for input ``index``.
 
     The slider of ``prism`` (a prismatic pair on a ground guide, direction ``d̄``, point
@@ -255,30 +270,16 @@ class SlideDriver:
     index: int
     prism: Prism
 
-    rows = 1
     row_kinds: ClassVar[tuple[str, ...]] = ("length",)
     letter: ClassVar[str] = "S"
     #: Units of the input's position and of its actuator's load.
     position_unit: ClassVar[str] = "m"
     load_unit: ClassVar[str] = "N"
 
-    @property
-    def members(self) -> tuple[int, int]:
-        """The slider's link and the ground."""
-        return (self.link, GROUND_INDEX)
-
-    def held_at(self, k: int) -> V | None:
-        """``None``: the driver holds a link by no point."""
-        return None
-
     def position(self, pose: Pose) -> Num:
         """The slider point's place along the guide from its point, m."""
         p = self.prism
         return p.dg.dot(pose.point(self.link, p.ps) - p.pg)
-
-    def residual(self, pose: Pose, state: InputState | None = None) -> list[Num]:
-        """The slider's place along the guide less its prescribed one in ``state``, m."""
-        return [self.position(pose) - (0.0 if state is None else state.positions[self.index])]
 
     def jacobian(self, pose: Pose) -> Blocks:
         """:meth:`residual`'s derivative by the links' coordinates (the ground's at rest)."""
@@ -296,22 +297,8 @@ class SlideDriver:
         spin = self.prism.dg.dot(ps) * (w * w)
         return [spin if state is None else state.accelerations[self.index] + spin]
 
-    def prescribed_rates(self, state: InputState) -> list[Num]:
-        """``Φ_q·q̇`` of its row: the input's prescribed rate (m/s)."""
-        return [state.rates[self.index]]
-
-    def row_scales(self, length: float) -> list[float]:
-        """A length's row, as it is."""
-        return [1.0]
-
-    def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
-        """The actuator's force on its slider along the guide: minus its multiplier."""
-        frame.torques[self.index] = -multipliers[0]
-
 
 Constraint = Pin | Prism | Driver | SlideDriver
-#: A driver of an input: about a ground pivot, or along a ground slide.
-InputDriver = Driver | SlideDriver
 
 
 @dataclass(frozen=True)

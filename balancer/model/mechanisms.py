@@ -334,6 +334,12 @@ class Linkage(MechanismModel):
         self._check_frames(names, points)
         ground = set(names[GROUND].points)
         self._check_inputs(names, ground)
+        if len(self.inputs) > 1:  # (a slider force is a table of the crank angle)
+            for key, gas in self.gas_forces:
+                if not gas.is_zero:
+                    raise SpecError("is a table of the crank's angle: a linkage with several "
+                                    "inputs has no crank", key=key,
+                                    value=list(self.inputs))
         for name, body in names.items():
             if (name != GROUND and body.props is not None and body.props.counter_rotor
                     and not ground & set(body.points)):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..linkage.loads import Reactions
 from ..motion_analysis import AlongMotions, MotionAnalysis, load_words
 from ..rounding import Scales
 from .analysis import reaction_extremes
@@ -44,16 +45,22 @@ def motions_text(along: AlongMotions, spec: str | None = None) -> str:
                   "the total centre of mass moves up to "
                   f"{_length(analysis.centre_of_mass_excursion, size)} from its mean place "
                   "along it"]
-        reactions = []
-        for point, values in analysis.reactions.ground.items():
-            ex = reaction_extremes(values)
-            reactions.append([f"R{point}", *(sc.fmt(ex[k], "N") for k in
-                                             ("max", "x_min", "x_max", "y_min", "y_max"))])
-        if reactions:
-            lines += ["", table(reactions, ["reaction (N)", "|R| max", "Rx min", "Rx max",
-                                            "Ry min", "Ry max"])]
+        lines += reactions_lines(analysis.reactions, sc)
     lines += ["", force_balance_words(along)]
     return "\n".join(lines)
+
+
+def reactions_lines(reactions: Reactions, sc: Scales) -> list[str]:
+    """The table of each ground point's force along a motion (a blank line first), or none."""
+    rows = []
+    for point, values in reactions.ground.items():
+        ex = reaction_extremes(values)
+        rows.append([f"R{point}", *(sc.fmt(ex[k], "N") for k in
+                                    ("max", "x_min", "x_max", "y_min", "y_max"))])
+    if not rows:
+        return []
+    return ["", table(rows, ["reaction (N)", "|R| max", "Rx min", "Rx max", "Ry min",
+                             "Ry max"])]
 
 
 def _scales(along: AlongMotions) -> Scales:

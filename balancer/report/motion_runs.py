@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..motion_analysis import load_words
 from ..rounding import Scales
+from .along import reactions_lines
 from .analysis import reaction_extremes
 from .text import csv_text, table
 
@@ -43,14 +44,7 @@ def motion_run_text(run: MotionRun, spec: str | None = None) -> str:
             if not (k == "rocking_couple" and planar)
             and not (k.startswith("torque_") and run.drive == "free")]
     lines.append(table(rows, ["quantity over time", "RMS", "max", "unit"]))
-    reactions = []
-    for point, values in run.reactions.ground.items():
-        ex = reaction_extremes(values)
-        reactions.append([f"R{point}", *(sc.fmt(ex[k], "N") for k in
-                                         ("max", "x_min", "x_max", "y_min", "y_max"))])
-    if reactions:
-        lines += ["", table(reactions, ["reaction (N)", "|R| max", "Rx min", "Rx max",
-                                        "Ry min", "Ry max"])]
+    lines += reactions_lines(run.reactions, sc)
     lines += ["", _energy_words(run)]
     return "\n".join(lines)
 

@@ -34,13 +34,14 @@ import time as _time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..columns import Columns
 from ..errors import AssemblyError, SolverError, SpecError
+from ..formulations.compiled import configuration_work
 from ..formulations.multibody import Multibody
 from ..linkage import rotors, trajectory
 from ..linkage.constraints import GROUND_INDEX, Pose
@@ -162,9 +163,9 @@ def _core_energies(mech: Mechanism, mo: Motion, t: NDArray[np.float64],
 
     Per link, with ``v`` its frame origin's velocity, ``ω`` its rate, ``S̄`` its first moment
     about the origin (turned with it) and ``J_O`` its inertia there (a counter-rotor's added):
-    ``T = m·|v|²/2 + ω·(S̄ × v) + J_O·ω²/2``. The work is the multibody formulation's
-    configuration work (loads, gravity and springs, functions of the configuration:
-    :meth:`~balancer.formulations.compiled.LinkageFormulation.configuration_work`).
+    ``T = m·|v|²/2 + ω·(S̄ × v) + J_O·ω²/2``. The work is the configuration's (loads,
+    gravity and springs, functions of the configuration:
+    :func:`~balancer.formulations.compiled.configuration_work`).
     """
     kinetic: NDArray[np.float64] = np.zeros(mo.count)
     for k, link in enumerate(mech.links):
@@ -182,7 +183,7 @@ def _core_energies(mech: Mechanism, mo: Motion, t: NDArray[np.float64],
                          np.array([np.broadcast_to(np.asarray(w, float), (count,))
                                    for w in mo.rate]).T, t).T
     pose = Pose(list(mo.pose.origins), list(angles), list(mo.pose.cos), list(mo.pose.sin))
-    work = _multibody(mech, gravity, False).configuration_work(pose, angles)
+    work = configuration_work(mech, gravity, pose, angles)
     return kinetic, work
 
 
@@ -257,15 +258,11 @@ def _driven_loads(mech: Mechanism, method: str, state: InputState,
     energies.
     """
     if method == "multibody":
-        f = _multibody(mech, gravity, True)
-        pd = f.prescribed_dynamics(state)
+        solved = _multibody(mech, gravity, True).prescribed_dynamics(state)
         with np.errstate(all="ignore"):
             couple = mech.rocking_couple(mech.motion_at(state), gravity=gravity)
-        reactions = Reactions(ground=pd.ground, slider_normal=pd.slider_normal,
-                              slider_couple=pd.slider_couple, shaking_force=pd.shaking_force,
-                              shaking_moment=pd.shaking_moment, torques=pd.torques,
-                              rocking_couple=np.ravel(couple.complex()))
-        return reactions, None, np.hstack([pd.q, pd.qd])
+        reactions = replace(solved.reactions, rocking_couple=np.ravel(couple.complex()))
+        return reactions, None, np.hstack([solved.q, solved.qd])
     with np.errstate(all="ignore"):
         mo = mech.motion_at(state)
         forces = mech.inverse_dynamics(mo, gravity=gravity)
@@ -280,9 +277,15 @@ def _power(mech: Mechanism, method: str, spec: MotionSpec, gravity: tuple[float,
 
     def power(t: NDArray[np.float64]) -> NDArray[np.float64]:
         state = trajectory.input_state(structure, spec, t)
-        reactions, _, _ = _driven_loads(mech, method, state, gravity)
-        total = sum(np.asarray(tau) * np.asarray(rate)
-                    for tau, rate in zip(reactions.torques, state.rates, strict=True))
+        torques: tuple[Any, ...]
+        if method == "multibody":  # (the torques alone: no rocking couple, no record)
+            torques = _multibody(mech, gravity, True).prescribed_dynamics(state).reactions.torques
+        else:
+            with np.errstate(all="ignore"):
+                torques = mech.inverse_dynamics(mech.motion_at(state),
+                                                gravity=gravity).input_torques
+        total = sum(np.ravel(tau) * np.asarray(rate)
+                    for tau, rate in zip(torques, state.rates, strict=True))
         return np.asarray(total, dtype=float).reshape(-1, 1)
 
     return power
@@ -373,22 +376,12 @@ def _free_multibody(mech: Mechanism, f: Multibody, t: NDArray[np.float64],
                     ys: NDArray[np.float64], gravity: tuple[float, float]
                     ) -> tuple[InputState, Reactions, NDArray[np.float64], NDArray[np.float64]]:
     """A free multibody run's inputs, loads on the frame and energies at its output states."""
-    k = 3 * f.n
-    q, qd = ys[:, :k], ys[:, k : 2 * k]
-    ev = f.evaluate_batch(t, list(ys))
-    qdd = np.array([f.rhs(float(ti), y)[k : 2 * k] for ti, y in zip(t, ys, strict=True)])
-    state = _inputs_of(mech, q, qd, qdd)
+    solved = f.free_dynamics(t, ys)  # (one compiled call for every output state)
+    state = _inputs_of(mech, solved.q, solved.qd, solved.qdd)
     with np.errstate(all="ignore"):
         couple = mech.rocking_couple(mech.motion_at(state), gravity=gravity)
-    reactions = Reactions(
-        ground={p: np.asarray(v, complex) for p, v in ev.ground.items()},
-        slider_normal={name: np.asarray(v, float) for name, v in ev.slider_normal.items()},
-        slider_couple={name: np.asarray(v, float) for name, v in ev.slider_couple.items()},
-        shaking_force=np.asarray(ev.shaking_force, complex),
-        shaking_moment=np.asarray(ev.shaking_moment, float),
-        torques=tuple(np.zeros(t.size) for _ in mech.structure.drivers),
-        rocking_couple=np.ravel(couple.complex()))
-    kinetic, work = f.energies(q, qd)  # (its angles integrated: continuous)
+    reactions = replace(solved.reactions, rocking_couple=np.ravel(couple.complex()))
+    kinetic, work = f.energies(solved.q, solved.qd)  # (its angles integrated: continuous)
     return state, reactions, kinetic, work
 
 

@@ -86,3 +86,19 @@ def test_a_slide_alone_is_not_an_input():
     with pytest.raises(SpecError) as caught:
         design_from_dict(spec)
     assert caught.value.key in ("mechanism", "mechanism.input", "mechanism.inputs")
+
+
+def test_a_slider_force_of_the_crank_angle_needs_a_crank():
+    # A slider's gas force is a table of the crank's angle (a spec gives one to a slider-crank
+    # alone; a model made in Python may put one on any slider): a linkage with several inputs
+    # has no crank to read it at, and is refused naming it.
+    import dataclasses
+
+    from balancer.model import GasForce
+
+    linkage = design_from_dict(crank_slider()).mechanism
+    pushed = dataclasses.replace(linkage.sliders[0], force=GasForce(angles=(0.0, 3.0),
+                                                                    values=(-1.0, 0.0)))
+    with pytest.raises(SpecError, match="a linkage with several inputs has no crank") as caught:
+        dataclasses.replace(linkage, sliders=(pushed,))
+    assert caught.value.key == "links.block.gas_force"
