@@ -73,7 +73,7 @@ def analyze_motions(design: Design, names: Sequence[str] | None = None, *,
     AssemblyError
         If a point's path leaves the workspace.
     """
-    gravity = _spec_gravity(design) if gravity is None else v.vector2(gravity, "gravity")
+    gravity = spec_gravity(design) if gravity is None else v.vector2(gravity, "gravity")
     chosen = list(design.motions) if not names else [design.motion(n) for n in names]
     if not chosen:
         raise SpecError("a linkage is analysed along its motions: the spec has no [[motion]]",
@@ -100,10 +100,10 @@ def analyze_motion(design: Design, name: str | None = None) -> MotionAnalysis:
     """
     motion = design.motion(name)
     mech = mechanism_of(design.mechanism)  # (its errors are the mechanism's, not the motion's)
-    return _along(design, mech, motion, _spec_gravity(design))
+    return _along(design, mech, motion, spec_gravity(design))
 
 
-def _spec_gravity(design: Design) -> tuple[float, float]:
+def spec_gravity(design: Design) -> tuple[float, float]:
     """The spec's gravity, m/s² (``[operation] gravity``; none without ``[operation]``)."""
     return design.operation.gravity if design.operation is not None else (0.0, 0.0)
 

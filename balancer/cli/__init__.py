@@ -228,6 +228,17 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "this machine's cores, or the scheduler at --scheduler. Each finished batch is kept "
         "beside the table, so that an interrupted sweep resumes with --resume.",
     ),
+    "plan": (
+        "the time law of a motion's path that shakes the frame least",
+        "Keep the path of a motion of the spec ([plan] motion, or --motion; a one-input "
+        "linkage's revolution) and choose how fast it is run — its time law, within the "
+        "inputs' speed, acceleration and torque limits of [plan], in the same duration — to "
+        "minimise the mean square (or the peak) of the weighted shaking force, shaking "
+        "moment, rocking couple and input torques ([plan.objective]). Direct transcription "
+        "solved by IPOPT: convex, so the optimum is global for its mesh. Reports the loads "
+        "before and after; writes the spec with the planned motion (--out), its loads over "
+        "time (--csv) and a figure (--plot).",
+    ),
     "example": (
         "write a shipped example spec (without NAME: list them)",
         "The example specs shipped with the package: the paper's four-bar "
@@ -425,6 +436,32 @@ def _sweep_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print a JSON summary instead")
 
 
+def _plan_arguments(p: argparse.ArgumentParser) -> None:
+    """``balancer plan``'s arguments."""
+    _spec_and_force(p)
+    p.add_argument("--motion", metavar="NAME",
+                   help="the motion whose path is run (default: [plan] motion, else the "
+                   "spec's first; 'revolution' for a one-input linkage's revolution)")
+    p.add_argument("--measure", choices=("rms", "peak"),
+                   help="minimise the objective's mean square over time or its largest value "
+                   "(default: [plan] measure, rms)")
+    p.add_argument("--duration", type=_positive_float, metavar="T",
+                   help="the planned motion's duration, s (default: the motion's)")
+    p.add_argument("--intervals", type=_count, metavar="N",
+                   help="intervals of the path in the transcription (default: [plan] "
+                   "intervals, 200)")
+    p.add_argument("--out", metavar="PLANNED.toml",
+                   help="write the spec with the planned motion ([[motion]] along the path, "
+                   "at its pace)")
+    p.add_argument("--csv", metavar="PATH",
+                   help="write the loads along the planned motion to a CSV file (analyze "
+                   "--motion's columns)")
+    p.add_argument("--plot", metavar="PATH",
+                   help="write the figure of the loads before and after and the pace (.png, "
+                   ".svg or .pdf)")
+    p.add_argument("--json", action="store_true", help="print a JSON document instead")
+
+
 def _example_arguments(p: argparse.ArgumentParser) -> None:
     """``balancer example``'s arguments."""
     p.add_argument("name", metavar="NAME", nargs="?", help="the example (e.g. pb1)")
@@ -441,6 +478,7 @@ _ARGUMENTS: dict[str, Callable[[argparse.ArgumentParser], None]] = {
     "plot": _plot_arguments,
     "pareto": _pareto_arguments,
     "sweep": _sweep_arguments,
+    "plan": _plan_arguments,
     "example": _example_arguments,
 }
 

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import AssemblyError, SpecError
-from ..model.motions import MotionSpec
+from ..model.motions import REVOLUTION, MotionSpec
 from . import kinematics
 from .constraints import GROUND_INDEX
 from .inputs import InputState
@@ -47,8 +47,12 @@ def time_argument(spec: MotionSpec, t: NDArray[np.float64]
 
     With ``u = (t − t₀)/T`` over the duration ``T``, ``τ = t₀ + T·g(u)``: the trapezoid's
     ``g`` has rate ``1/(1 − a)`` after a constant acceleration over ``a = acc_time/T``; the
-    cubic's ``3u² − 2u³``; the quintic's ``10u³ − 15u⁴ + 6u⁵``; the spline's ``u``.
+    cubic's ``3u² − 2u³``; the quintic's ``10u³ − 15u⁴ + 6u⁵``; the spline's ``u``. A planned
+    motion's pace (rows ``(τₖ, τ̇ₖ)`` at times ``tₖ``) has ``τ̈ = (τ̇ₖ₊₁² − τ̇ₖ²)/(2·Δτₖ)`` on
+    each interval: ``τ = τₖ + τ̇ₖ·(t − tₖ) + τ̈·(t − tₖ)²/2``.
     """
+    if spec.pace is not None:
+        return _paced(spec, np.asarray(t, dtype=float))
     t0, duration = spec.times[0], spec.duration
     u = np.clip((np.asarray(t, dtype=float) - t0) / duration, 0.0, 1.0)
     if spec.law == "cubic":
@@ -71,6 +75,21 @@ def time_argument(spec: MotionSpec, t: NDArray[np.float64]
     else:  # spline: the waypoints' own pace
         g, g1, g2 = u, np.ones_like(u), np.zeros_like(u)
     return t0 + duration * g, g1, g2 / duration
+
+
+def _paced(spec: MotionSpec, t: NDArray[np.float64]
+           ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`time_argument` of a planned motion's pace (constant ``τ̈`` between its rows)."""
+    assert spec.pace is not None
+    rows = np.asarray(spec.pace, dtype=float)
+    knots = spec.pace_times
+    tau, rate = rows[:, 0], rows[:, 1]
+    acc = (rate[1:] ** 2 - rate[:-1] ** 2) / (2.0 * np.diff(tau))
+    t = np.clip(t, knots[0], knots[-1])
+    k = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, len(knots) - 2)
+    dt = t - knots[k]
+    return (np.minimum(tau[k] + rate[k] * dt + 0.5 * acc[k] * dt**2, tau[k + 1]),
+            rate[k] + acc[k] * dt, acc[k])
 
 
 def _slopes(spec: MotionSpec) -> NDArray[np.float64]:
@@ -137,23 +156,29 @@ def _slopes(spec: MotionSpec) -> NDArray[np.float64]:
 DENSE_KNOTS = 200
 
 
-def path_values(spec: MotionSpec, t: NDArray[np.float64]
-                ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """The path's values at times ``t`` and their first and second time derivatives.
+def path_at(spec: MotionSpec, tau: NDArray[np.float64]
+            ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The path's values at arguments ``tau`` (s) and their first two derivatives by ``τ``.
 
     Arrays ``(N, width)``: a point's ``(x, y)`` (m) or each input's change from the reference
     pose (rad). The cubic on each segment in Hermite form (``s`` its share of the segment
     ``h``): ``p = (2s³ − 3s² + 1)·p₀ + (s³ − 2s² + s)·h·m₀ + (−2s³ + 3s²)·p₁ + (s³ − s²)·h·m₁``.
-    (Written here rather than taken from scipy.interpolate, whose import alone costs a command
-    half a second; the tests compare it with scipy's splines.)
+    A revolution's path (:data:`~balancer.model.motions.REVOLUTION`) is straight: its input
+    turns at one rate. (Written here rather than taken from scipy.interpolate, whose import
+    alone costs a command half a second; the tests compare it with scipy's splines.)
     """
     knots = np.asarray(spec.times, dtype=float)
     values = np.asarray(spec.path, dtype=float)
+    tau = np.asarray(tau, dtype=float)
+    if spec.along == REVOLUTION:
+        slope = (values[-1] - values[0]) / (knots[-1] - knots[0])
+        return (values[0] + np.multiply.outer(tau - knots[0], slope),
+                np.broadcast_to(slope, (tau.size, slope.size)).copy(),
+                np.zeros((tau.size, slope.size)))
     if spec.law == "spline" and spec.closed:
         values = values.copy()
         values[-1] = values[0]
     slopes = _slopes(spec)
-    tau, rate, acc = time_argument(spec, t)
     seg = np.clip(np.searchsorted(knots, tau, side="right") - 1, 0, len(knots) - 2)
     h = (knots[seg + 1] - knots[seg])[:, None]
     s = ((tau - knots[seg])[:, None]) / h
@@ -164,6 +189,18 @@ def path_values(spec: MotionSpec, t: NDArray[np.float64]
     d1 = ((6 * s2 - 6 * s) * p0 + (3 * s2 - 4 * s + 1) * m0 + (-6 * s2 + 6 * s) * p1
           + (3 * s2 - 2 * s) * m1) / h
     d2 = ((12 * s - 6) * p0 + (6 * s - 4) * m0 + (-12 * s + 6) * p1 + (6 * s - 2) * m1) / h**2
+    return p, d1, d2
+
+
+def path_values(spec: MotionSpec, t: NDArray[np.float64]
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The path's values at times ``t`` and their first and second time derivatives.
+
+    :func:`path_at` at the time law's argument, by the chain rule: ``ṗ = p'·τ̇``,
+    ``p̈ = p''·τ̇² + p'·τ̈``.
+    """
+    tau, rate, acc = time_argument(spec, t)
+    p, d1, d2 = path_at(spec, tau)
     return p, d1 * rate[:, None], d2 * rate[:, None] ** 2 + d1 * acc[:, None]
 
 
@@ -171,10 +208,10 @@ def break_times(spec: MotionSpec) -> NDArray[np.float64]:
     """The times (s) inside the motion where its accelerations may jump or kink.
 
     Where the path's argument ``τ`` passes an inner waypoint (the cubic pieces join there),
-    and the trapezoid's ends of acceleration and deceleration. ``τ(t)`` increases: each
-    waypoint's time is found by bisection to rounding.
+    the trapezoid's ends of acceleration and deceleration, and a pace's rows. ``τ(t)``
+    increases: each waypoint's time is found by bisection to rounding.
     """
-    t0, t1 = spec.times[0], spec.times[-1]
+    t0, t1 = spec.start, spec.end
     inner = np.asarray(spec.times[1:-1], dtype=float)
     low, high = np.full(inner.shape, t0), np.full(inner.shape, t1)
     for _ in range(64):
@@ -182,7 +219,9 @@ def break_times(spec: MotionSpec) -> NDArray[np.float64]:
         below = time_argument(spec, mid)[0] < inner
         low, high = np.where(below, mid, low), np.where(below, high, mid)
     out = [*(0.5 * (low + high))]
-    if spec.law == "trapezoid":
+    if spec.pace is not None:
+        out += [*spec.pace_times]
+    elif spec.law == "trapezoid":
         assert spec.acc_time is not None
         out += [t0 + spec.acc_time, t1 - spec.acc_time]
     return np.unique(np.array([t for t in out if t0 < t < t1], dtype=float))
@@ -190,7 +229,7 @@ def break_times(spec: MotionSpec) -> NDArray[np.float64]:
 
 def sample_times(spec: MotionSpec) -> NDArray[np.float64]:
     """The motion's sampled times: ``samples`` equally spaced, both ends included, s."""
-    return np.linspace(spec.times[0], spec.times[-1], spec.samples)
+    return np.linspace(spec.start, spec.end, spec.samples)
 
 
 def input_state(structure: Structure, spec: MotionSpec,
@@ -355,7 +394,7 @@ def _in_order(structure: Structure, spec: MotionSpec, k: int, local: V,
         if not done.all():
             theta, done = _newton(structure, k, local, out[:, i - 1 : i], target)
         if not done.all():
-            when = spec.times[0] + rows[i] * spec.duration / (p.shape[0] - 1)
+            when = spec.start + rows[i] * spec.duration / (p.shape[0] - 1)
             raise AssemblyError(
                 f"the point's path leaves the workspace at t = {when:g} s (no pose puts the "
                 "point there, or the path passes a singular pose)",
@@ -418,6 +457,42 @@ def _point_state_at(structure: Structure, spec: MotionSpec, t: NDArray[np.float6
             "motion's samples (a singular pose near it: take more samples)", key="path",
             value=[float(p[bad, 0]), float(p[bad, 1])])
     return _point_state(structure, k, local, theta, v, a)
+
+
+def path_derivatives(structure: Structure, spec: MotionSpec, tau: NDArray[np.float64]
+                     ) -> InputState:
+    """The inputs along the path at arguments ``tau`` (s): ``q``, ``dq/dτ``, ``d²q/dτ²``.
+
+    As an :class:`InputState` of positions (rad, absolute), first and second derivatives by
+    the path's argument — the inputs' state where ``τ̇ = 1``, ``τ̈ = 0``: at any time law,
+    ``q̇ = q'·τ̇`` and ``q̈ = q''·τ̇² + q'·τ̈``. A point's path by inverse kinematics, each
+    argument's Newton steps started from the motion's samples (on their branch).
+
+    Raises
+    ------
+    AssemblyError
+        If the path leaves the workspace at one of the arguments.
+    """
+    tau = np.asarray(tau, dtype=float)
+    p, d1, d2 = path_at(spec, tau)
+    if spec.point is None:
+        reference = np.array(structure.input_references)
+        state = InputState.of(list((p + reference).T), list(d1.T), list(d2.T))
+        _check_assembles(structure, spec, state, tau, p)
+        return state
+    k, local = marker(structure, spec.point)
+    known = input_state(structure, spec)
+    argument = time_argument(spec, sample_times(spec))[0]
+    guess = np.array([np.interp(tau, argument, np.asarray(x, dtype=float))
+                      for x in known.positions])
+    theta, done = _newton(structure, k, local, guess, p)
+    if not done.all():
+        bad = int(np.argmin(done))
+        raise AssemblyError(
+            f"the point's path cannot be followed at its argument {float(tau[bad]):g} s from "
+            "the motion's samples (a singular pose near it: take more samples)", key="path",
+            value=[float(p[bad, 0]), float(p[bad, 1])])
+    return _point_state(structure, k, local, theta, d1, d2)
 
 
 def _point_state(structure: Structure, k: int, local: V, out: NDArray[np.float64],

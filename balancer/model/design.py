@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING, ClassVar, Literal
 from .. import validate as v
 from ..errors import SpecError
 from .mechanisms import MechanismModel
-from .motions import MotionSpec, Workspace
+from .motions import REVOLUTION, MotionSpec, Workspace
+from .plan import PlanSpec
 
 if TYPE_CHECKING:  # (the balancing's tables load with a spec that has them)
     from .balance import BalanceProblem, RotorBalanceProblem
@@ -164,6 +165,8 @@ class Design:
         A linkage's configuration space (``[workspace]``), if the spec gives it.
     motions
         Its named motions (``[[motion]]``), in the spec's order.
+    plan
+        The time law to plan (``[plan]``), if the spec gives one.
     """
 
     mechanism: MechanismModel
@@ -174,6 +177,7 @@ class Design:
     title: str = ""
     workspace: Workspace | None = None
     motions: tuple[MotionSpec, ...] = ()
+    plan: PlanSpec | None = None
 
     def __post_init__(self) -> None:
         """Check the parts' types and that the figures stay within double precision.
@@ -235,6 +239,14 @@ class Design:
         if weights and self.motions and not any(given.get(n, 1.0) > 0 for n in names):
             raise SpecError("every motion weighs 0: one at least must count",
                             key="balance.motions")
+        plan = self.plan
+        if plan is not None and plan.motion not in (None, REVOLUTION, *names):
+            raise SpecError(f"names no motion of the spec ({', '.join(names) or 'none'})",
+                            key="plan.motion", value=plan.motion)
+        own = [m.name for m in self.motions if m.pace is None]
+        if plan is not None and plan.name is not None and plan.name in own:
+            raise SpecError("is a motion of the spec with a path of its own: the planned "
+                            "motion needs another name", key="plan.name", value=plan.name)
         seen: set[str] = set()
         for i, motion in enumerate(self.motions):
             key = v.item("motion", i)

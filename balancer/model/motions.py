@@ -19,19 +19,34 @@ waypoints at given times, run by a time law:
 The path through the waypoints is a cubic Hermite spline of ``τ`` with zero end slopes (its
 inner slopes the three-point differences), or the cubic spline for ``"spline"``
 (:mod:`balancer.linkage.trajectory`).
+
+A planned motion (``balancer plan``) runs another motion's path ``along`` it — or a one-input
+linkage's revolution at constant speed, :data:`REVOLUTION` — at a ``pace``: rows ``(τ, τ̇)`` of
+the path's argument (s) and its rate (s/s), ``τ̈`` constant between rows; its duration is
+what the pace makes it.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
 
 from .. import validate as v
 from ..errors import SpecError
 
 #: The time laws a motion may follow.
 LAWS: tuple[str, ...] = ("trapezoid", "cubic", "quintic", "spline")
+
+#: The path a planned motion of a one-input linkage runs ``along``: its input turning one
+#: revolution from the reference pose at the operating speed (a straight path of the input,
+#: periodic).
+REVOLUTION = "revolution"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -109,6 +124,13 @@ class MotionSpec:
     samples
         States along the motion for the analysis and the balancing (equally spaced in time,
         both ends included).
+    along
+        A planned motion's: the motion whose path (its ``times``, ``path``, ``point``,
+        ``law``) it runs, or :data:`REVOLUTION`; ``None`` for a motion of its own.
+    pace
+        A planned motion's time law: rows ``(τ, τ̇)``, the path's argument (s, from the
+        first waypoint's time to the last, increasing) and its rate (s/s, at least 0, no two
+        rows in a row at rest); the argument's acceleration is constant between rows.
     """
 
     name: str
@@ -118,6 +140,8 @@ class MotionSpec:
     law: str = "cubic"
     acc_time: float | None = None
     samples: int = 400
+    along: str | None = None
+    pace: tuple[tuple[float, float], ...] | None = None
 
     #: Least and most states along a motion.
     SAMPLES: ClassVar[tuple[int, int]] = (8, 1_000_000)
@@ -168,6 +192,8 @@ class MotionSpec:
                             key="acc_time", value=self.acc_time)
         v.store(self, "samples", v.integer(self.samples, "samples", minimum=self.SAMPLES[0],
                                            maximum=self.SAMPLES[1]))
+        if self.pace is not None:
+            v.store(self, "pace", _checked_pace(self.pace, times))
 
     @property
     def closed(self) -> bool:
@@ -176,6 +202,66 @@ class MotionSpec:
                    for a, b in zip(self.path[0], self.path[-1], strict=True))
 
     @property
+    def start(self) -> float:
+        """The motion's first time, s (its first waypoint's)."""
+        return self.times[0]
+
+    @property
+    def end(self) -> float:
+        """The motion's last time, s."""
+        return self.start + self.duration
+
+    @property
     def duration(self) -> float:
-        """The motion's duration, s."""
-        return self.times[-1] - self.times[0]
+        """The motion's duration, s: its waypoints' span, or what its pace makes it."""
+        if self.pace is None:
+            return self.times[-1] - self.times[0]
+        return float(self.pace_times[-1] - self.pace_times[0])
+
+    @property
+    def periodic(self) -> bool:
+        """Whether the motion repeats: a closed spline path, or a revolution."""
+        return self.along == REVOLUTION or (self.law == "spline" and self.closed)
+
+    @cached_property
+    def pace_times(self) -> NDArray[np.float64]:
+        """The times (s) of the pace's rows, from the motion's start.
+
+        Between rows the argument's acceleration is constant, so a row's interval lasts
+        ``2·Δτ/(τ̇₀ + τ̇₁)``.
+        """
+        if self.pace is None:
+            raise ValueError(f"motion {self.name} has no pace")
+        rows = np.asarray(self.pace, dtype=float)
+        spans = 2.0 * np.diff(rows[:, 0]) / (rows[:-1, 1] + rows[1:, 1])
+        return np.concatenate([[self.times[0]], self.times[0] + np.cumsum(spans)])
+
+
+#: How near a pace's first and last arguments must be to the path's ends (a share of its span).
+PACE_ENDS = 1e-9
+
+
+def _checked_pace(rows: object, times: Sequence[float]) -> tuple[tuple[float, float], ...]:
+    """A pace's rows ``(τ, τ̇)`` checked (key ``pace``); its ends made the path's exactly."""
+    if not isinstance(rows, tuple | list) or len(rows) < 2:
+        raise SpecError("must be at least two rows [argument s, rate]", key="pace", value=rows)
+    out: list[tuple[float, float]] = []
+    for row in rows:
+        if not isinstance(row, tuple | list) or len(row) != 2:
+            raise SpecError("each row must be [argument s, rate]", key="pace", value=row)
+        tau, rate = v.numbers(row, "pace")
+        if not rate >= 0:
+            raise SpecError("a rate must be at least 0", key="pace", value=list(row))
+        if out and not tau > out[-1][0]:
+            raise SpecError("its arguments must increase", key="pace", value=list(row))
+        if out and rate == 0.0 and out[-1][1] == 0.0:
+            raise SpecError("two rows in a row at rest never move on", key="pace",
+                            value=list(row))
+        out.append((tau, rate))
+    span = times[-1] - times[0]
+    for at, end in ((0, times[0]), (-1, times[-1])):
+        if abs(out[at][0] - end) > PACE_ENDS * span:
+            raise SpecError(f"must run the path's argument from {times[0]:g} s to "
+                            f"{times[-1]:g} s", key="pace", value=list(out[at]))
+    out[0], out[-1] = (times[0], out[0][1]), (times[-1], out[-1][1])
+    return tuple(out)

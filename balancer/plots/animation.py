@@ -95,7 +95,7 @@ def _frames_of(linkage: Model | Mechanism, frames: int, motion: MotionSpec | Non
     if motion is None:
         return revolution(frames), [f"crank angle θ1 = {d:5.1f}°"
                                     for d in np.degrees(sample_angles(frames))]
-    times = np.linspace(motion.times[0], motion.times[-1], frames)
+    times = np.linspace(motion.start, motion.end, frames)
     states = trajectory.input_state(mechanism_of(linkage).structure, motion, times)
     return states, [f"{motion.name}: t = {t:.3g} s" for t in times]
 

@@ -52,7 +52,8 @@ from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..model import Design, Operation, SimulationSettings
 from ..model import MechanismModel as Model
-from ..model.motions import InputRange, MotionSpec, Workspace
+from ..model.motions import REVOLUTION, InputRange, MotionSpec, Workspace
+from ..model.plan import LIMIT_KEYS, PLAN_OBJECTIVE_KEYS, InputLimits, PlanSpec, PlanWeights
 from . import schema
 from .codecs import MECHANISM_TYPES, MechanismSpec, balance_spec_of, spec_of
 from .tables import Table
@@ -125,11 +126,53 @@ def _input_range(table: Table, name: str) -> InputRange:
     return InputRange(name=name, low=low, high=high)
 
 
-def _read_motions(root: Table, inputs: tuple[str, ...], folder: Path) -> tuple[MotionSpec, ...]:
-    out = []
+def _read_plan(root: Table) -> PlanSpec | None:
+    table = root.table("plan", required=False)
+    if table is None:
+        return None
+    weights: dict[str, Any] = {"shaking_moment": 1.0}
+    sub = table.table("objective", required=False)
+    if sub is not None:
+        weights = {name: sub.value(name, 0.0) for name in PLAN_OBJECTIVE_KEYS}
+        with v.under(sub.path):
+            objective = PlanWeights(**weights)
+        sub.finish()
+    else:
+        objective = PlanWeights(**weights)
+    limits = {key: _input_limits(table, key) for key in LIMIT_KEYS}
+    with v.under("plan"):
+        plan = PlanSpec(motion=table.value("motion", None), name=table.value("name", None),
+                        duration=table.value("duration", None),
+                        measure=table.value("measure", "rms"), objective=objective,
+                        intervals=table.value("intervals", 200), **limits)
+    table.finish()
+    return plan
+
+
+def _input_limits(table: Table, key: str) -> InputLimits:
+    """A limit of ``[plan]``: one number for every input, or a table of numbers by input."""
+    if not table.has(key):
+        return InputLimits()
+    raw = table.raw(key)
+    if isinstance(raw, dict):
+        sub = table.table(key)
+        sub.known = tuple(sub.data)
+        each = tuple((name, v.positive(sub.raw(name), sub.key(name))) for name in sub.data)
+        sub.finish()
+        return InputLimits(each=each)
+    return InputLimits(every=v.positive(raw, table.key(key)))
+
+
+def _read_motions(root: Table, inputs: tuple[str, ...], folder: Path,
+                  speed: float | None) -> tuple[MotionSpec, ...]:
+    out: list[MotionSpec] = []
+    planned: list[tuple[int, Table]] = []
     for table in root.tables("motion"):
         if not table.has("name"):
             raise table._missing("name")
+        if table.has("along") or table.has("pace"):
+            planned.append((len(out), table))  # (its path is another's: read below)
+            continue
         if table.has("file"):
             for name in ("times", "path"):
                 if table.has(name):
@@ -153,7 +196,47 @@ def _read_motions(root: Table, inputs: tuple[str, ...], folder: Path) -> tuple[M
                 name=name, times=times, path=path, point=point, law=law,
                 acc_time=table.value("acc_time", None), samples=table.value("samples", 400)))
         table.finish()
+    for at, table in reversed(planned):
+        out.insert(at, _planned_motion(table, out, inputs, speed))
     return tuple(out)
+
+
+def _planned_motion(table: Table, motions: list[MotionSpec], inputs: tuple[str, ...],
+                    speed: float | None) -> MotionSpec:
+    """A planned motion: another motion's path (``along``) run at a ``pace``."""
+    for name in ("along", "pace"):
+        if not table.has(name):
+            raise table._missing(name)
+    for name in ("times", "path", "point", "file", "law", "acc_time"):
+        if table.has(name):
+            raise SpecError("a planned motion runs the path of the motion it is along",
+                            key=table.key(name), value=table.raw(name))
+    along = table.raw("along")
+    name = table.text("name", default="")
+    samples = table.value("samples", 400)
+    if along == REVOLUTION:
+        if len(inputs) != 1 or speed is None:
+            raise SpecError("a revolution is a one-input linkage's, at its [operation] speed",
+                            key=table.key("along"), value=along)
+        period = 2.0 * math.pi / abs(speed)
+        with v.under(table.path):
+            motion = MotionSpec(name=name, times=(0.0, period),
+                                path=((0.0,), (math.copysign(2.0 * math.pi, speed),)),
+                                law="spline", samples=samples, along=REVOLUTION,
+                                pace=table.raw("pace"))
+    else:
+        path = next((m for m in motions if m.name == along), None)
+        if path is None:
+            known = ", ".join([m.name for m in motions] + ([REVOLUTION] if len(inputs) == 1
+                                                          else []))
+            raise SpecError(f"must name a motion of the spec with a path of its own ({known})",
+                            key=table.key("along"), value=along)
+        with v.under(table.path):
+            motion = MotionSpec(name=name, times=path.times, path=path.path, point=path.point,
+                                law=path.law, acc_time=path.acc_time, samples=samples,
+                                along=along, pace=table.raw("pace"))
+    table.finish()
+    return motion
 
 
 def _motion_file(table: Table, inputs: tuple[str, ...], folder: Path
@@ -233,8 +316,10 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
         original = _read_original(root, mechanism, codec)
         workspace = _read_workspace(root)
         folder = Path(source).parent if source and Path(source).is_file() else Path.cwd()
-        motions = (_read_motions(root, mechanism_of(mechanism).linkage.inputs, folder)
+        motions = (_read_motions(root, mechanism_of(mechanism).linkage.inputs, folder,
+                                 None if operation is None else operation.speed)
                    if root.has("motion") else ())
+        plan = _read_plan(root)
         root.finish()
         return Design(
             mechanism=mechanism,
@@ -245,6 +330,7 @@ def design_from_dict(data: dict[str, Any], source: str | None = None) -> Design:
             title=title,
             workspace=workspace,
             motions=motions,
+            plan=plan,
         )
     except SpecError as exc:
         if source is not None and exc.source is None:

@@ -29,7 +29,7 @@ from .entries import (  # (the mechanism types are the schema's names too)
     Key,
     Section,
 )
-from .schema_motions import MOTION_SECTIONS
+from .schema_motions import MOTION_SECTIONS, PLAN_SECTIONS
 
 _CLOSED = (FOUR_BAR, SLIDER_CRANK)
 #: The linkages (every mechanism but the engine): their links are the design's.
@@ -157,6 +157,8 @@ SECTIONS: tuple[Section, ...] = (
         Key("motion", "table", "none",
             "Named motions of a linkage's inputs or of a marker point (`[[motion]]`, below).",
             (LINKAGE,)),
+        Key("plan", "table", "none",
+            "The time law `plan` chooses for a motion's path (`[plan]`, below).", (LINKAGE,)),
     )),
     Section("mechanism", "The type of linkage and its geometry.", (
         Key("type", "—", "required",
@@ -387,6 +389,7 @@ SECTIONS: tuple[Section, ...] = (
                     example="[0.0, -9.81]"),
             )),
     *MOTION_SECTIONS,
+    *PLAN_SECTIONS,
     Section("simulation", "Forward dynamics (`simulate`, `verify`).", (
         Key("duration", "s", "5", "Simulated time; positive.", example="5.0"),
         Key("theta1", "rad", "the reference pose (0 for a four-bar and a slider-crank)",

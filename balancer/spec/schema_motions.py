@@ -1,4 +1,4 @@
-"""The spec's tables of a linkage's configuration space and motions.
+"""The spec's tables of a linkage's configuration space, motions and motion planning.
 
 ``[workspace]`` and ``[[motion]]`` (DESIGN.md, "Mechanisms with several inputs"), listed in
 :data:`balancer.spec.schema.SECTIONS`.
@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+from ..model.plan import LIMIT_KEYS, PLAN_OBJECTIVE_KEYS
 from .entries import LINKAGE, Key, Section
 
 MOTION_SECTIONS: tuple[Section, ...] = (
@@ -58,5 +59,64 @@ MOTION_SECTIONS: tuple[Section, ...] = (
                     "duration.", (LINKAGE,), example="0.25"),
                 Key("samples", "—", "400", "States along the motion, 8 to 1e6.", (LINKAGE,),
                     example="400"),
+                Key("along", "—", "none",
+                    "A planned motion's (`balancer plan` writes it): the motion whose path it "
+                    "runs, by name, or `\"revolution\"` (a one-input linkage's input turning "
+                    "once from the reference pose at the `[operation]` speed); with `pace` "
+                    "instead of `times`, `path`, `point`, `law` and `file`.", (LINKAGE,),
+                    example='"diamond"'),
+                Key("pace", "s, s/s", "none",
+                    "A planned motion's time law: rows `[τ, τ̇]`, the path's argument (from "
+                    "its first waypoint's time to its last, increasing) and its rate (at "
+                    "least 0); the argument's acceleration is constant between rows.",
+                    (LINKAGE,), example="[[0.0, 1.0], [1.0, 1.0]]"),
             ), (LINKAGE,)),
+)
+
+
+#: What each limit of ``[plan]`` bounds.
+_LIMIT_WORDS = {"max_speed": "rate", "max_acceleration": "acceleration",
+                "max_torque": "torque (a slide's force, N)"}
+
+#: What each weight of ``[plan.objective]`` weighs, and its unit.
+_WEIGHTS = {"shaking_moment": ("the shaking moment's", "—"),
+            "shaking_force": ("the shaking force's", "(N·m)²/N²"),
+            "shaking_force_x": ("the shaking force's x part's", "(N·m)²/N²"),
+            "shaking_force_y": ("the shaking force's y part's", "(N·m)²/N²"),
+            "rocking_couple": ("the rocking couple's", "—"),
+            "torque": ("the inputs' torques' (summed)", "—")}
+
+PLAN_SECTIONS: tuple[Section, ...] = (
+    Section("plan", "The time law `balancer plan` chooses for a motion's path: the path stays, "
+            "how fast it is run changes, to shake the frame least within the inputs' limits "
+            "in the same duration.", (
+                Key("motion", "—", "the first motion (one input without motions: "
+                    '`"revolution"`)',
+                    'The motion whose path is run, by name, or `"revolution"` (a one-input '
+                    "linkage's input turning once at the `[operation]` speed).", (LINKAGE,),
+                    example='"diamond"'),
+                Key("name", "—", '"<motion> planned"', "The planned motion's name.",
+                    (LINKAGE,), example='"diamond planned"'),
+                Key("duration", "s", "the motion's", "The planned motion's duration.",
+                    (LINKAGE,), example="4.0"),
+                Key("measure", "—", '"rms"',
+                    '`"rms"` (the objective\'s mean square over time) or `"peak"` (its '
+                    "largest value).", (LINKAGE,), example='"rms"'),
+                Key("intervals", "—", "200",
+                    "Intervals of the path's argument in the transcription, 4 to 20000.",
+                    (LINKAGE,), example="200"),
+                Key("objective", "table", "shaking_moment = 1",
+                    "The objective's weights (`[plan.objective]`, below).", (LINKAGE,)),
+                *(Key(key, f"{unit} (a slide's: m/s, m/s², N)" if key != "max_torque"
+                      else f"{unit} (a slide's: N)", "none",
+                      f"The largest {_LIMIT_WORDS[key]} of every input: one number, or a "
+                      "table by input.", (LINKAGE,), example="10.0")
+                  for key, unit in LIMIT_KEYS.items()),
+            ), (LINKAGE,)),
+    Section("plan.objective", "The weights of the objective `plan` minimises: the weighted sum "
+            "of the loads' squares, its mean over time or its largest value.", tuple(
+                Key(key, _WEIGHTS[key][1], "1" if key == "shaking_moment" else "0",
+                    f"The weight of {_WEIGHTS[key][0]} square, at least 0.", (LINKAGE,),
+                    example="1.0")
+                for key in PLAN_OBJECTIVE_KEYS), (LINKAGE,)),
 )

@@ -6,6 +6,7 @@ import os
 
 from .. import tomltext as toml
 from ..model import Design, SimulationSettings
+from ..model.plan import LIMIT_KEYS
 from ..outputs import write_atomic
 from .codecs import balance_spec_of, spec_of
 
@@ -71,8 +72,15 @@ def _motion_lines(design: Design) -> list[str]:
             out += ["", "[workspace.joints]"]
             out += [f"{toml.key(r.name)} = {pair(r.low, r.high)}" for r in w.joints]
     for m in design.motions:
-        rows = ", ".join("[" + ", ".join(toml.number(x) for x in row) + "]" for row in m.path)
         out += ["", "[[motion]]", f"name = {toml.string(m.name)}"]
+        if m.along is not None and m.pace is not None:  # a planned motion: a path and a pace
+            rows = ",\n        ".join(f"[{toml.number(tau)}, {toml.number(rate)}]"
+                                       for tau, rate in m.pace)
+            out += [f"along = {toml.string(m.along)}",
+                    f"pace = [{rows}]  # the path's argument (s) and its rate (s/s)",
+                    f"samples = {toml.number(m.samples)}"]
+            continue
+        rows = ", ".join("[" + ", ".join(toml.number(x) for x in row) + "]" for row in m.path)
         if m.point is not None:
             out.append(f"point = {toml.string(m.point)}")
         out += [f"times = [{', '.join(toml.number(t) for t in m.times)}]  # s",
@@ -81,6 +89,32 @@ def _motion_lines(design: Design) -> list[str]:
         if m.acc_time is not None:
             out.append(f"acc_time = {toml.number(m.acc_time)}  # s")
         out.append(f"samples = {toml.number(m.samples)}")
+    return out + _plan_lines(design)
+
+
+def _plan_lines(design: Design) -> list[str]:
+    """``[plan]`` and its objective, as the reader reads them (given values only)."""
+    plan = design.plan
+    if plan is None:
+        return []
+    out = ["", "[plan]"]
+    for key in ("motion", "name"):
+        value = getattr(plan, key)
+        if value is not None:
+            out.append(f"{key} = {toml.string(value)}")
+    if plan.duration is not None:
+        out.append(f"duration = {toml.number(plan.duration)}  # s")
+    out += [f"measure = {toml.string(plan.measure)}",
+            f"intervals = {toml.number(plan.intervals)}"]
+    for key, unit in LIMIT_KEYS.items():
+        limits = getattr(plan, key)
+        if limits.every is not None:
+            out.append(f"{key} = {toml.number(limits.every)}  # {unit}")
+        elif limits.each:
+            rows = ", ".join(f"{toml.key(name)} = {toml.number(x)}" for name, x in limits.each)
+            out.append(f"{key} = {{ {rows} }}  # {unit}")
+    out += ["", "[plan.objective]"]
+    out += [f"{name} = {toml.number(weight)}" for name, weight in plan.objective.terms().items()]
     return out
 
 

@@ -141,6 +141,10 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
     if pattern == "mechanism" and name == "inputs" and "input" in data["mechanism"]:
         data["mechanism"]["inputs"] = [data["mechanism"].pop("input")]  # its other spelling
         return data
+    if pattern == "motion[]" and key is not None and name in ("along", "pace"):
+        data["motion"].append({"name": "turn planned", "along": "turn",
+                               "pace": [[0.0, 1.0], [1.0, 1.0]]})  # a planned motion
+        return data
     table = data
     for part in path_of(data, pattern, name):
         table = table[part]

@@ -1,0 +1,232 @@
+"""Motion as a balancing lever: a path's time law chosen to shake the frame least.
+
+A motion's path stays; how fast it is run — its argument ``τ(t)`` — is chosen by direct
+transcription (:mod:`.transcription`) of the loads along the path (:mod:`.path_loads`), within
+the inputs' limits and the duration. The result is a planned motion (its ``along`` and
+``pace``, :class:`~balancer.model.motions.MotionSpec`) that every verb reads; its loads are the
+one core's analysis along it (:func:`balancer.motion_analysis.motion_analysis`).
+
+What is certified: the transcription is convex (its objective and limits, with the duration
+relaxed to an upper bound); where that bound is active at the optimum, IPOPT's point is the
+global optimum of the transcription, and the planned motion's analysis gives its figures
+exactly. The transcription's own error falls with its mesh (second order in the intervals on
+smooth paths). For a path from rest to rest, the least RMS shaking force of any time law has a
+closed form (the total centre of mass moved along each axis by a cubic: ``√12·M·Δc/T²``,
+with the weight's constant part), a lower bound the plan reports.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import SpecError
+from ..linkage import trajectory
+from ..mechanisms import Mechanism
+from ..model.motions import REVOLUTION, MotionSpec
+from ..model.plan import PlanSpec, PlanWeights
+from ..motion_analysis import MotionAnalysis, motion_analysis
+from .path_loads import PathLoads, load_rows, path_loads, reactions_at
+from .transcription import Problem, Transcribed, mesh, solve
+
+__all__ = ["Plan", "plan_motion", "revolution", "objective_of"]
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A planned time law and what it buys.
+
+    Attributes
+    ----------
+    spec
+        The ``[plan]`` it answers.
+    path
+        The motion whose path is run, at its own time law (a revolution: at constant speed).
+    planned
+        The planned motion: ``path``'s path at the planned pace.
+    problem
+        The transcription.
+    solution
+        Its optimum.
+    starts
+        The transcription's optimum from each start (the path's own time law, a constant pace).
+    before, after
+        The loads along ``path`` and along ``planned`` (the core's analysis).
+    objective_before, objective_after
+        The objective ``J`` along each motion (:func:`objective_of`), in its squared units.
+    bound
+        A lower bound of ``J`` over every time law where one is known (from rest to rest:
+        the shaking force's closed form), or ``None``.
+    """
+
+    spec: PlanSpec
+    path: MotionSpec
+    planned: MotionSpec
+    problem: Problem
+    solution: Transcribed
+    starts: tuple[float, ...]
+    before: MotionAnalysis
+    after: MotionAnalysis
+    objective_before: float
+    objective_after: float
+    bound: float | None
+
+    @property
+    def certified(self) -> bool:
+        """Whether the transcription's optimum is certified global (module docstring)."""
+        return self.solution.certified
+
+
+def revolution(speed: float, samples: int = 400) -> MotionSpec:
+    """A one-input linkage's revolution from its reference pose at constant ``speed`` (rad/s)."""
+    period = 2.0 * math.pi / abs(speed)
+    return MotionSpec(name=REVOLUTION, times=(0.0, period),
+                      path=((0.0,), (math.copysign(2.0 * math.pi, speed),)), law="spline",
+                      samples=samples, along=REVOLUTION, pace=((0.0, 1.0), (period, 1.0)))
+
+
+def weights_of(names: tuple[str, ...], weights: PlanWeights) -> NDArray[np.float64]:
+    """Each load's weight in ``J`` (``names`` as :class:`~.path_loads.PathLoads`')."""
+    w = weights
+    table = {"shaking_force_x": w.shaking_force + w.shaking_force_x,
+             "shaking_force_y": w.shaking_force + w.shaking_force_y,
+             "shaking_moment": w.shaking_moment,
+             "rocking_couple_x": w.rocking_couple, "rocking_couple_y": w.rocking_couple}
+    return np.array([table.get(name, w.torque) for name in names])
+
+
+#: Gauss–Legendre points per panel of :func:`objective_of`.
+GAUSS_POINTS = 5
+#: Panels at least along a motion in :func:`objective_of`.
+LEAST_PANELS = 256
+
+
+def objective_of(mech: Mechanism, motion: MotionSpec, weights: NDArray[np.float64],
+                 measure: str, gravity: tuple[float, float] = (0.0, 0.0)) -> float:
+    """``J`` along a motion: the weighted sum of its loads' squares, ``Σ w·L²``.
+
+    Its mean over the motion's time (``"rms"``) by Gauss–Legendre quadrature on panels that
+    end at the motion's breaks (:func:`~balancer.linkage.trajectory.break_times`: between
+    them the loads are smooth), or its largest value at the quadrature's points and the
+    panels' ends (``"peak"``).
+    """
+    ends = np.concatenate([[motion.start], trajectory.break_times(motion), [motion.end]])
+    per = max(1, -(-LEAST_PANELS // (ends.size - 1)))
+    edges = np.concatenate([np.linspace(a, b, per + 1)[:-1] for a, b in zip(ends[:-1], ends[1:],
+                                                                         strict=True)]
+                           + [ends[-1:]])
+    nodes, gauss = np.polynomial.legendre.leggauss(GAUSS_POINTS)
+    half = np.diff(edges)[:, None] / 2.0
+    t = ((edges[:-1, None] + edges[1:, None]) / 2.0 + half * nodes).ravel()
+    if measure == "peak":
+        t = np.concatenate([t, edges])
+    state = trajectory.input_state(mech.structure, motion, t)
+    _, rows = load_rows(mech.linkage.inputs, reactions_at(mech, state, gravity))
+    total = np.sum(weights[:, None] * rows**2, axis=0)
+    if measure == "peak":
+        return float(np.max(total))
+    return float(np.sum((half * gauss) * total.reshape(half.size, GAUSS_POINTS))
+                 / motion.duration)
+
+
+def _rest_bound(loads: PathLoads, weights: NDArray[np.float64], duration: float,
+                measure: str) -> float | None:
+    """The closed-form lower bound of ``J`` from rest to rest (module docstring), if any.
+
+    Along each axis the total centre of mass moves ``Δc`` from rest to rest in ``T``: its
+    least ``∫c̈²`` is the cubic's ``12·Δc²/T³`` and its least peak ``|c̈|`` the bang-bang's
+    ``4·|Δc|/T²``. The shaking force is ``−M·c̈`` plus the weights (a constant ``C``; the mean
+    of ``c̈`` is zero), so ``mean(F²) ≥ C² + 12·(M·Δc)²/T⁴``. Only where the loads at rest
+    are constant along the path (no spring or applied load), and for a peak only without them.
+    """
+    rows = [loads.index("shaking_force_x"), loads.index("shaking_force_y")]
+    if not np.any(weights[rows] > 0):
+        return None
+    static = loads.static[rows]
+    scale = max(float(np.max(np.abs(loads.inertial[rows]))), float(np.max(np.abs(static))),
+                np.finfo(float).tiny)
+    if np.max(np.abs(static - static[:, :1])) > 1e-12 * scale:
+        return None
+    moved = loads.first_moment[-1] - loads.first_moment[0]
+    w = weights[rows]
+    if measure == "peak":
+        if np.max(np.abs(static)) > 1e-12 * scale:
+            return None
+        return float(max(w[0] * (4 * moved.real / duration**2) ** 2,
+                         w[1] * (4 * moved.imag / duration**2) ** 2))
+    return float(w[0] * (static[0, 0] ** 2 + 12 * moved.real**2 / duration**4)
+                 + w[1] * (static[1, 0] ** 2 + 12 * moved.imag**2 / duration**4))
+
+
+def _rate2_of(motion: MotionSpec, tau: NDArray[np.float64], duration: float
+              ) -> NDArray[np.float64]:
+    """The motion's own ``τ̇²`` at arguments ``tau``, its time scaled to ``duration``."""
+    low = np.full(tau.shape, motion.start)
+    high = np.full(tau.shape, motion.end)
+    for _ in range(64):  # τ(t) increases: bisection
+        mid = 0.5 * (low + high)
+        below = trajectory.time_argument(motion, mid)[0] < tau
+        low, high = np.where(below, mid, low), np.where(below, high, mid)
+    rate = trajectory.time_argument(motion, 0.5 * (low + high))[1]
+    return np.asarray(rate, dtype=float) ** 2 * (motion.duration / duration) ** 2
+
+
+def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
+                gravity: tuple[float, float] = (0.0, 0.0)) -> Plan:
+    """The time law of ``path``'s path that ``spec`` asks for (module docstring).
+
+    Parameters
+    ----------
+    mech
+        The mechanism.
+    path
+        The motion whose path is run (a revolution: :func:`revolution`).
+    spec
+        The plan.
+    gravity
+        ``(gx, gy)``, m/s², that the loads include.
+
+    Raises
+    ------
+    SpecError
+        If a limit names an unknown input.
+    AssemblyError
+        If the path leaves the workspace.
+    SolverError
+        If the limits cannot be met in the duration, or IPOPT fails.
+    """
+    inputs = mech.linkage.inputs
+    for key in ("max_speed", "max_acceleration", "max_torque"):
+        for name, _ in getattr(spec, key).each:
+            if name not in inputs:
+                raise SpecError(f"must name an input ({', '.join(inputs)})",
+                                key=f"plan.{key}.{name}", value=name)
+    duration = path.duration if spec.duration is None else spec.duration
+    tau = mesh(np.asarray(path.times, dtype=float), spec.intervals)
+    loads = path_loads(mech, path, tau, gravity)
+    weights = weights_of(loads.names, spec.objective)
+    problem = Problem(loads=loads, weights=weights, duration=duration, measure=spec.measure,
+                      periodic=path.periodic,
+                      max_speed=tuple(spec.max_speed.of(n) for n in inputs),
+                      max_acceleration=tuple(spec.max_acceleration.of(n) for n in inputs),
+                      max_load=tuple(spec.max_torque.of(n) for n in inputs))
+    own = _rate2_of(path, tau, duration)
+    steady = np.full(tau.shape, (problem.span / duration) ** 2)
+    solutions = [solve(problem, own), solve(problem, steady)]
+    best = min(solutions, key=lambda s: s.objective)
+    rate = np.sqrt(np.maximum(best.rate2, 0.0))
+    name = spec.name or f"{path.name} planned"
+    planned = replace(path, name=name, along=path.along or path.name,
+                      pace=tuple((float(t), float(r)) for t, r in zip(tau, rate, strict=True)),
+                      acc_time=None if path.law != "trapezoid" else path.acc_time)
+    before = motion_analysis(mech, path, gravity=gravity)
+    after = motion_analysis(mech, planned, gravity=gravity)
+    return Plan(spec=spec, path=path, planned=planned, problem=problem, solution=best,
+                starts=tuple(s.objective for s in solutions), before=before, after=after,
+                objective_before=objective_of(mech, path, weights, spec.measure, gravity),
+                objective_after=objective_of(mech, planned, weights, spec.measure, gravity),
+                bound=None if path.periodic else _rest_bound(loads, weights, duration,
+                                                             spec.measure))

@@ -1,0 +1,124 @@
+"""``plan``'s report: the time law chosen for a motion's path, and what it buys."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..motion_analysis import load_words
+from ..rounding import Scales
+from .text import table
+
+if TYPE_CHECKING:  # annotations only: the command that makes it loads it
+    from ..planning import Plan
+
+#: What the report calls each objective term.
+_TERM_WORDS = {"shaking_moment": "shaking moment", "shaking_force": "shaking force",
+               "shaking_force_x": "shaking force along x",
+               "shaking_force_y": "shaking force along y",
+               "rocking_couple": "rocking couple", "torque": "inputs' torques"}
+
+
+def _objective_words(plan: Plan) -> str:
+    terms = plan.spec.objective.terms()
+    words = " + ".join(f"{w:g}·{_TERM_WORDS[k]}²" if w != 1 else f"{_TERM_WORDS[k]}²"
+                       for k, w in terms.items())
+    return (f"the mean square over time of {words}" if plan.spec.measure == "rms"
+            else f"the largest value of {words}")
+
+
+def _path_words(plan: Plan) -> str:
+    path = plan.path
+    if path.pace is not None and path.along == "revolution":
+        return "one revolution of the input at constant speed"
+    what = f"point {path.point}'s path" if path.point else "the inputs' path"
+    return f"motion {path.name} ({what} through {len(path.times)} waypoints, law {path.law})"
+
+
+def _figure(value: float, measure: str) -> float:
+    """The objective's figure in its load's unit: the root of ``J``."""
+    return math.sqrt(max(value, 0.0))
+
+
+def plan_text(plan: Plan, spec: str | None = None) -> str:
+    """The readable ``plan`` report."""
+    head = f"balancer plan — {spec}" if spec else "balancer plan"
+    solution = plan.solution
+    lines = [head,
+             f"time law planned for {_path_words(plan)}: {plan.planned.name}, "
+             f"{plan.planned.duration:g} s (was {plan.path.duration:g} s)",
+             f"objective: {_objective_words(plan)}", ""]
+    before, after = plan.before.loads(), plan.after.loads()
+    mech = plan.before.mechanism
+    sc = Scales()
+    sc.add((load_words(mech, k)[1], f.max) for k, f in (*before.items(), *after.items()))
+    planar = mech.in_one_plane()
+    rows = []
+    for key, old in before.items():
+        if key == "rocking_couple" and planar:
+            continue
+        new = after[key]
+        what, unit = load_words(mech, key)
+        rows.append([what, sc.fmt(old.rms, unit), sc.fmt(new.rms, unit), _change(old.rms, new.rms),
+                     sc.fmt(old.max, unit), sc.fmt(new.max, unit), _change(old.max, new.max),
+                     unit])
+    lines.append(table(rows, ["load", "RMS before", "RMS after", "change", "max before",
+                              "max after", "change", "unit"]))
+    lines += ["", *_certificate_lines(plan, solution)]
+    return "\n".join(lines)
+
+
+def _change(before: float, after: float) -> str:
+    if before == 0.0:
+        return "—"
+    return f"{100.0 * (after / before - 1.0):+.1f} %"
+
+
+def _certificate_lines(plan: Plan, solution: Any) -> list[str]:
+    root = "√J" if plan.spec.measure == "rms" else "√(max)"
+    lines = [f"objective {root}: {_figure(plan.objective_before, plan.spec.measure):.6g} before, "
+             f"{_figure(plan.objective_after, plan.spec.measure):.6g} after (along each motion "
+             f"by quadrature); the transcription's optimum "
+             f"{_figure(solution.objective, plan.spec.measure):.6g} on "
+             f"{plan.problem.loads.tau.size - 1} intervals"]
+    if plan.bound is not None:
+        lines.append(f"least possible from rest to rest (closed form, any time law): "
+                     f"{_figure(plan.bound, plan.spec.measure):.6g}")
+    if solution.certified:
+        lines.append("the transcription is convex: its optimum is global (the same from "
+                     f"{len(plan.starts)} starts to {_spread(plan.starts):.0e})")
+    else:
+        lines.append("a local optimum: a faster motion would shake less, and the duration is "
+                     f"held (best of {len(plan.starts)} starts, spread {_spread(plan.starts):.0e})")
+    lines.append(f"largest limit violation {solution.violation:.1e} of its limit; IPOPT "
+                 f"{solution.iterations} iterations")
+    return lines
+
+
+def _spread(values: tuple[float, ...]) -> float:
+    top = max(abs(x) for x in values) or 1.0
+    return (max(values) - min(values)) / top
+
+
+def plan_json(plan: Plan, spec: str | None = None) -> dict[str, Any]:
+    """The ``plan --json`` document."""
+    def loads(analysis: Any) -> dict[str, Any]:
+        return {k: {"rms": f.rms, "max": f.max} for k, f in analysis.loads().items()}
+
+    doc: dict[str, Any] = {} if spec is None else {"spec": spec}
+    doc.update({
+        "motion": plan.path.name, "planned": plan.planned.name,
+        "measure": plan.spec.measure, "objective": plan.spec.objective.terms(),
+        "duration": plan.planned.duration, "duration_before": plan.path.duration,
+        "intervals": int(plan.problem.loads.tau.size - 1),
+        "objective_before": plan.objective_before, "objective_after": plan.objective_after,
+        "transcription_objective": plan.solution.objective, "lower_bound": plan.bound,
+        "certified": plan.solution.certified, "starts": list(plan.starts),
+        "violation": plan.solution.violation, "iterations": plan.solution.iterations,
+        "before": loads(plan.before), "after": loads(plan.after),
+        "pace": [[float(t), float(r)] for t, r in plan.planned.pace or ()],
+        "pace_times": [float(t) for t in np.asarray(plan.planned.pace_times)],
+    })
+    return doc
