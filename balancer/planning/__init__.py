@@ -218,6 +218,7 @@ def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
     solutions = [solve(problem, own), solve(problem, steady)]
     best = min(solutions, key=lambda s: s.objective)
     rate = np.sqrt(np.maximum(best.rate2, 0.0))
+    rate *= float(np.sum(problem.times(best.rate2))) / duration  # (the duration to rounding)
     name = spec.name or f"{path.name} planned"
     planned = replace(path, name=name, along=path.along or path.name,
                       pace=tuple((float(t), float(r)) for t, r in zip(tau, rate, strict=True)),

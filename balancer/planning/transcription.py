@@ -37,6 +37,9 @@ from .path_loads import PathLoads
 TOLERANCE = 1e-10
 #: Iterations at most.
 MAX_ITERATIONS = 3000
+#: IPOPT's ends short of its tolerance that are its optimum where the limits hold: at an
+#: objective of zero (a constant pace that shakes nothing) its steps become too small.
+SETTLED = ("Solved_To_Acceptable_Level", "Search_Direction_Becomes_Too_Small")
 #: A convex optimum lasting less than ``T`` by this share ends early.
 EARLY = 1e-8
 #: The least squared rate, as a share of the mean's (IPOPT keeps within bounds: √b stays real).
@@ -94,6 +97,17 @@ class Problem:
         start = at.inertial[:, :-1] * a + at.centripetal[:, :-1] * rate2[:-1] + at.static[:, :-1]
         end = at.inertial[:, 1:] * a + at.centripetal[:, 1:] * rate2[1:] + at.static[:, 1:]
         return start, end
+
+    def natural_objective(self) -> float:
+        """``J``'s natural scale: each load's coefficients at a constant pace, summed unsigned.
+
+        ``mean Σ w·(|A|·s/T² + |B|·s²/T² + |C|)²`` over the rows, ``s`` the argument's span:
+        what the objective is measured against where the spec's own law makes it vanish.
+        """
+        at, span = self.loads, self.span
+        typical = (np.abs(at.inertial) * span / self.duration**2
+                   + np.abs(at.centripetal) * (span / self.duration) ** 2 + np.abs(at.static))
+        return float(np.mean(np.sum(self.weights[:, None] * typical**2, axis=0)))
 
     def objective(self, rate2: NDArray[np.float64]) -> float:
         """``J`` at squared rates ``rate2`` (in the loads' squared units)."""
@@ -166,7 +180,7 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
     root = ca.sqrt(b)
     dt = 2.0 * dtau / (root[:-1] + root[1:])
     reference = max(problem.objective(np.maximum(start, LEAST_RATE2 * scale2)),
-                    np.finfo(float).tiny)
+                    problem.natural_objective(), np.finfo(float).tiny)
     constraints: list[Any] = [(ca.sum1(dt) - problem.duration) / problem.duration]
     low: list[float] = [-math.inf if relaxed else 0.0]
     high: list[float] = [0.0]
@@ -245,7 +259,7 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
         raise SolverError(f"the time law cannot meet its limits in {problem.duration:g} s "
                           f"(IPOPT: {stats['return_status']}; largest violation "
                           f"{violation:.2g} of a limit): lengthen the duration or widen them")
-    if not stats["success"] and stats["return_status"] not in ("Solved_To_Acceptable_Level",):
+    if not stats["success"] and (stats["return_status"] not in SETTLED or violation > 1e-8):
         raise SolverError(f"IPOPT did not converge on the time law ({stats['return_status']})")
     rate2 = np.asarray(result["x"]).ravel()[:count] * scale2
     early = bool(values[0] < -EARLY)

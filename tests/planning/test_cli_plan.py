@@ -1,0 +1,72 @@
+"""``balancer plan`` end to end: its report, JSON, written spec, CSV, figure and refusals."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+
+import pytest
+
+from balancer.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+FORBAL = str(EXAMPLES / "forbal2.toml")
+
+
+def test_plan_reports_writes_and_the_written_spec_runs(capsys, tmp_path):
+    out, table, figure = tmp_path / "planned.toml", tmp_path / "p.csv", tmp_path / "p.png"
+    code = main(["plan", FORBAL, "--intervals", "40", "--out", str(out), "--csv", str(table),
+                 "--plot", str(figure), "--json"])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    doc = json.loads(captured.out)
+    assert doc["certified"] and doc["planned"] == "diamond planned"
+    assert doc["objective_after"] < doc["objective_before"]
+    assert doc["after"]["shaking_moment"]["rms"] < doc["before"]["shaking_moment"]["rms"]
+    assert len(doc["pace"]) == 41 and doc["out"] == str(out)
+    assert figure.stat().st_size > 10_000
+    header = next(csv.reader(io.StringIO(table.read_text())))
+    assert header[:3] == ["t", "link11", "link21"] and "torque_link21" in header
+    assert main(["analyze", str(out), "--motion", "diamond planned", "--json"]) == 0
+    along = json.loads(capsys.readouterr().out)
+    rms = along["motions"]["diamond planned"]["shaking_moment"]["rms"]
+    assert rms == pytest.approx(doc["after"]["shaking_moment"]["rms"], rel=1e-12)
+
+
+def test_plan_s_text_says_what_is_certified(capsys):
+    assert main(["plan", FORBAL, "--intervals", "24"]) == 0
+    out = capsys.readouterr().out
+    for words in ("time law planned for motion diamond", "RMS before", "RMS after",
+                  "shaking moment", "torque on link11", "convex: its optimum is global"):
+        assert words in out
+
+
+def _spec(tmp_path, extra: str) -> str:
+    path = tmp_path / "s.toml"
+    path.write_text(Path(FORBAL).read_text() + "\n" + extra)
+    return str(path)
+
+
+@pytest.mark.parametrize(("args", "extra", "code", "words"), [
+    (["--motion", "nosuch"], "", 2, "--motion"),
+    (["--motion", "revolution"], "", 2, "one-input"),
+    (["--intervals", "3"], "", 2, "--intervals"),
+    ([], '[plan]\nmeasure = "max"\n', 2, "plan.measure"),
+    ([], '[plan]\nmotion = "nosuch"\n', 2, "plan.motion"),
+    ([], "[plan]\nmax_speed = { nosuch = 1.0 }\n", 2, "plan.max_speed.nosuch"),
+    ([], "[plan]\nmax_speed = -1.0\n", 2, "plan.max_speed"),
+    ([], "[plan.objective]\nshaking_moment = 0.0\n", 2, "plan.objective"),
+    ([], '[plan]\nname = "circle"\n', 2, "plan.name"),
+    ([], "[plan]\nmax_speed = 0.01\n", 1, "lengthen the duration"),
+])
+def test_plan_refuses_bad_input_in_one_line(tmp_path, capsys, args, extra, code, words):
+    assert main(["plan", _spec(tmp_path, extra), *(args or ["--intervals", "24"])]) == code
+    err = capsys.readouterr().err
+    assert words in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_plan_refuses_a_mechanism_of_another_type(capsys):
+    assert main(["plan", str(EXAMPLES / "meijaard2020.toml")]) == 2
+    assert "mechanism.type" in capsys.readouterr().err
