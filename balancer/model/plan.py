@@ -35,6 +35,7 @@ LIMIT_KEYS = {"max_speed": "rad/s", "max_acceleration": "rad/s²", "max_torque":
 class PlanWeights:
     """The objective's weights (``[plan.objective]``), each at least 0, not all 0.
 
+    Its errors' keys are within ``[plan.objective]``.
     Units as ``[balance.objective]``'s: the shaking moment's and the torques' dimensionless,
     the forces' (N·m)²/N².
     """
@@ -54,8 +55,7 @@ class PlanWeights:
                 raise SpecError("must be at least 0", key=name, value=value)
             v.store(self, name, value)
         if not any(getattr(self, name) for name in PLAN_OBJECTIVE_KEYS):
-            raise SpecError(f"needs a weight above 0 ({', '.join(PLAN_OBJECTIVE_KEYS)})",
-                            key="objective")
+            raise SpecError(f"needs a weight above 0 ({', '.join(PLAN_OBJECTIVE_KEYS)})")
 
     def terms(self) -> dict[str, float]:
         """The weights above 0, by key."""

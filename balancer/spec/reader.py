@@ -53,7 +53,7 @@ from ..mechanisms import mechanism_of
 from ..model import Design, Operation, SimulationSettings
 from ..model import MechanismModel as Model
 from ..model.motions import REVOLUTION, InputRange, MotionSpec, Workspace
-from ..model.plan import LIMIT_KEYS, PLAN_OBJECTIVE_KEYS, InputLimits, PlanSpec, PlanWeights
+from ..model.plan import InputLimits, PlanSpec, PlanWeights
 from . import schema
 from .codecs import MECHANISM_TYPES, MechanismSpec, balance_spec_of, spec_of
 from .tables import Table
@@ -130,16 +130,17 @@ def _read_plan(root: Table) -> PlanSpec | None:
     table = root.table("plan", required=False)
     if table is None:
         return None
-    weights: dict[str, Any] = {"shaking_moment": 1.0}
+    terms = [k.name for k in _section("plan.objective").keys]
     sub = table.table("objective", required=False)
+    weights = {name: 1.0 if name == "shaking_moment" else 0.0 for name in terms}
     if sub is not None:
-        weights = {name: sub.value(name, 0.0) for name in PLAN_OBJECTIVE_KEYS}
-        with v.under(sub.path):
-            objective = PlanWeights(**weights)
-        sub.finish()
-    else:
+        weights = {name: sub.value(name, weights[name]) for name in terms}
+    with v.under("plan.objective"):
         objective = PlanWeights(**weights)
-    limits = {key: _input_limits(table, key) for key in LIMIT_KEYS}
+    if sub is not None:
+        sub.finish()
+    limits = {k.name: _input_limits(table, k.name) for k in _section("plan").keys
+              if k.name.startswith("max_")}
     with v.under("plan"):
         plan = PlanSpec(motion=table.value("motion", None), name=table.value("name", None),
                         duration=table.value("duration", None),
@@ -147,6 +148,13 @@ def _read_plan(root: Table) -> PlanSpec | None:
                         intervals=table.value("intervals", 200), **limits)
     table.finish()
     return plan
+
+
+def _section(path: str) -> schema.Section:
+    """The schema's section of a table the reader reads."""
+    found = schema.section(path)
+    assert found is not None, path
+    return found
 
 
 def _input_limits(table: Table, key: str) -> InputLimits:

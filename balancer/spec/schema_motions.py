@@ -6,7 +6,6 @@
 
 from __future__ import annotations
 
-from ..model.plan import LIMIT_KEYS, PLAN_OBJECTIVE_KEYS
 from .entries import LINKAGE, Key, Section
 
 MOTION_SECTIONS: tuple[Section, ...] = (
@@ -74,11 +73,12 @@ MOTION_SECTIONS: tuple[Section, ...] = (
 )
 
 
-#: What each limit of ``[plan]`` bounds.
-_LIMIT_WORDS = {"max_speed": "rate", "max_acceleration": "acceleration",
-                "max_torque": "torque (a slide's force, N)"}
+#: Each limit of ``[plan]``: what it bounds and its unit (an input about a pivot; a slide's).
+_LIMITS = {"max_speed": ("rate", "rad/s (a slide's: m/s)"),
+           "max_acceleration": ("acceleration", "rad/s² (a slide's: m/s²)"),
+           "max_torque": ("torque (a slide's force)", "N·m (a slide's: N)")}
 
-#: What each weight of ``[plan.objective]`` weighs, and its unit.
+#: Each weight of ``[plan.objective]``: what it weighs and its unit.
 _WEIGHTS = {"shaking_moment": ("the shaking moment's", "—"),
             "shaking_force": ("the shaking force's", "(N·m)²/N²"),
             "shaking_force_x": ("the shaking force's x part's", "(N·m)²/N²"),
@@ -94,9 +94,9 @@ PLAN_SECTIONS: tuple[Section, ...] = (
                     '`"revolution"`)',
                     'The motion whose path is run, by name, or `"revolution"` (a one-input '
                     "linkage's input turning once at the `[operation]` speed).", (LINKAGE,),
-                    example='"diamond"'),
+                    example='"turn"'),
                 Key("name", "—", '"<motion> planned"', "The planned motion's name.",
-                    (LINKAGE,), example='"diamond planned"'),
+                    (LINKAGE,), example='"turn planned"'),
                 Key("duration", "s", "the motion's", "The planned motion's duration.",
                     (LINKAGE,), example="4.0"),
                 Key("measure", "—", '"rms"',
@@ -107,16 +107,14 @@ PLAN_SECTIONS: tuple[Section, ...] = (
                     (LINKAGE,), example="200"),
                 Key("objective", "table", "shaking_moment = 1",
                     "The objective's weights (`[plan.objective]`, below).", (LINKAGE,)),
-                *(Key(key, f"{unit} (a slide's: m/s, m/s², N)" if key != "max_torque"
-                      else f"{unit} (a slide's: N)", "none",
-                      f"The largest {_LIMIT_WORDS[key]} of every input: one number, or a "
-                      "table by input.", (LINKAGE,), example="10.0")
-                  for key, unit in LIMIT_KEYS.items()),
+                *(Key(key, unit, "none",
+                      f"The largest {what} of every input, held at the transcription's rows: "
+                      "one number, or a table by input.", (LINKAGE,), example="10.0")
+                  for key, (what, unit) in _LIMITS.items()),
             ), (LINKAGE,)),
     Section("plan.objective", "The weights of the objective `plan` minimises: the weighted sum "
             "of the loads' squares, its mean over time or its largest value.", tuple(
-                Key(key, _WEIGHTS[key][1], "1" if key == "shaking_moment" else "0",
-                    f"The weight of {_WEIGHTS[key][0]} square, at least 0.", (LINKAGE,),
-                    example="1.0")
-                for key in PLAN_OBJECTIVE_KEYS), (LINKAGE,)),
+                Key(key, unit, "1" if key == "shaking_moment" else "0",
+                    f"The weight of {what} square, at least 0.", (LINKAGE,), example="1.0")
+                for key, (what, unit) in _WEIGHTS.items()), (LINKAGE,)),
 )

@@ -6,8 +6,8 @@ import os
 
 from .. import tomltext as toml
 from ..model import Design, SimulationSettings
-from ..model.plan import LIMIT_KEYS
 from ..outputs import write_atomic
+from . import schema
 from .codecs import balance_spec_of, spec_of
 
 
@@ -106,7 +106,9 @@ def _plan_lines(design: Design) -> list[str]:
         out.append(f"duration = {toml.number(plan.duration)}  # s")
     out += [f"measure = {toml.string(plan.measure)}",
             f"intervals = {toml.number(plan.intervals)}"]
-    for key, unit in LIMIT_KEYS.items():
+    section = schema.section("plan")
+    assert section is not None
+    for key, unit in ((k.name, k.unit) for k in section.keys if k.name.startswith("max_")):
         limits = getattr(plan, key)
         if limits.every is not None:
             out.append(f"{key} = {toml.number(limits.every)}  # {unit}")

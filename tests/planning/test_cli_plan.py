@@ -70,3 +70,12 @@ def test_plan_refuses_bad_input_in_one_line(tmp_path, capsys, args, extra, code,
 def test_plan_refuses_a_mechanism_of_another_type(capsys):
     assert main(["plan", str(EXAMPLES / "meijaard2020.toml")]) == 2
     assert "mechanism.type" in capsys.readouterr().err
+
+
+def test_the_schema_names_the_plan_s_keys_as_the_model_does():
+    from balancer.model.plan import LIMIT_KEYS, PLAN_OBJECTIVE_KEYS
+    from balancer.spec import schema
+
+    assert tuple(k.name for k in schema.section("plan.objective").keys) == PLAN_OBJECTIVE_KEYS
+    limits = tuple(k.name for k in schema.section("plan").keys if k.name.startswith("max_"))
+    assert limits == tuple(LIMIT_KEYS)

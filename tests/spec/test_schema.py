@@ -141,6 +141,14 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
     if pattern == "mechanism" and name == "inputs" and "input" in data["mechanism"]:
         data["mechanism"]["inputs"] = [data["mechanism"].pop("input")]  # its other spelling
         return data
+    if pattern.startswith("plan") or (pattern == "" and name == "plan"):
+        if mechanism == schema.LINKAGE:
+            data.setdefault("motion", [copy.deepcopy(MOTION)])
+        if pattern.startswith("plan"):
+            data["plan"] = {"objective": {}} if pattern == "plan.objective" else {}
+        if pattern == "plan" and key is not None and name == "motion":
+            data["plan"]["motion"] = MOTION["name"]
+            return data
     if pattern == "motion[]" and key is not None and name in ("along", "pace"):
         data["motion"].append({"name": "turn planned", "along": "turn",
                                "pace": [[0.0, 1.0], [1.0, 1.0]]})  # a planned motion
