@@ -38,6 +38,13 @@ _EXPORTS = {
     "to_dict": "api",
     "to_table": "api",
     "verify": "api",
+    "plan": "api",
+    "planned_design": "api",
+    "Plan": "planning",
+    "PlanSpec": "model.plan",
+    "PlanWeights": "model.plan",
+    "InputLimits": "model.plan",
+    "plan_figure": "plots",
     "Optimizer": "balance.optimizer",
     "Backend": "balance.optimizer",
     "sweep": "sweeps",
@@ -164,6 +171,13 @@ __all__ = [
     "OutputError",
     "pareto",
     "Perturb",
+    "plan",
+    "plan_figure",
+    "planned_design",
+    "Plan",
+    "PlanSpec",
+    "PlanWeights",
+    "InputLimits",
     "Reactions",
     "InputState",
     "MotionAnalysis",
@@ -218,6 +232,8 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         motion_drawing,
         optimize,
         pareto,
+        plan,
+        planned_design,
         simulate,
         simulate_motion,
         to_dict,
@@ -268,8 +284,10 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         ObjectiveTerm,
     )
     from .model.motions import MotionSpec, Workspace
+    from .model.plan import InputLimits, PlanSpec, PlanWeights
     from .motion_analysis import AlongMotions, MotionAnalysis, WorkspaceCheck
     from .motion_verification import MotionCheck, MotionVerification
+    from .planning import Plan
     from .plots import (
         MotionDrawing,
         animate,
@@ -277,6 +295,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         front_figure,
         motion_figure,
         orders_figure,
+        plan_figure,
         save_figure,
         sweep_figure,
         verification_figure,

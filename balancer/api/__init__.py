@@ -28,6 +28,8 @@ _EXPORTS = {
     "motion_drawing": "drawings",
     "optimize": "balancing",
     "pareto": "balancing",
+    "plan": "planning",
+    "planned_design": "planning",
     "simulate": "motion",
     "simulate_motion": "motion",
     "verify": "motion",
@@ -43,6 +45,8 @@ __all__ = [
     "motion_drawing",
     "optimize",
     "pareto",
+    "plan",
+    "planned_design",
     "simulate",
     "simulate_motion",
     "to_dict",
@@ -60,4 +64,5 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .drawings import motion_drawing
     from .examples import example
     from .motion import simulate, simulate_motion, verify
+    from .planning import plan, planned_design
     from .results import to_dict, to_table

@@ -30,7 +30,7 @@ from ..model.motions import REVOLUTION, MotionSpec
 from ..model.plan import PlanSpec, PlanWeights
 from ..motion_analysis import MotionAnalysis, motion_analysis
 from .path_loads import PathLoads, load_rows, path_loads, reactions_at
-from .transcription import Problem, Transcribed, mesh, solve
+from .transcription import Problem, Transcribed, constant_parts, mesh, solve
 
 __all__ = ["Plan", "plan_motion", "revolution", "objective_of"]
 
@@ -212,10 +212,13 @@ def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
                       periodic=path.periodic,
                       max_speed=tuple(spec.max_speed.of(n) for n in inputs),
                       max_acceleration=tuple(spec.max_acceleration.of(n) for n in inputs),
-                      max_load=tuple(spec.max_torque.of(n) for n in inputs))
+                      max_load=tuple(spec.max_torque.of(n) for n in inputs),
+                      offsets=(constant_parts(loads) if spec.measure == "rms"
+                               else np.zeros(len(loads.names))))
     own = _rate2_of(path, tau, duration)
     steady = np.full(tau.shape, (problem.span / duration) ** 2)
-    solutions = [solve(problem, own), solve(problem, steady)]
+    starts = [own] if np.allclose(own, steady, rtol=1e-12, atol=0.0) else [own, steady]
+    solutions = [solve(problem, start) for start in starts]
     best = min(solutions, key=lambda s: s.objective)
     rate = np.sqrt(np.maximum(best.rate2, 0.0))
     rate *= float(np.sum(problem.times(best.rate2))) / duration  # (the duration to rounding)

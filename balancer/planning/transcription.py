@@ -64,6 +64,9 @@ class Problem:
         Whether ``b₀ = b_N``.
     max_speed, max_acceleration, max_load
         Per input: its limit or ``None``.
+    offsets
+        Each load's constant part taken out of a mean square (:func:`constant_parts`), in its
+        unit; zeros for a peak.
     """
 
     loads: PathLoads
@@ -74,6 +77,7 @@ class Problem:
     max_speed: tuple[float | None, ...]
     max_acceleration: tuple[float | None, ...]
     max_load: tuple[float | None, ...]
+    offsets: NDArray[np.float64]
 
     @property
     def span(self) -> float:
@@ -110,13 +114,18 @@ class Problem:
         return float(np.mean(np.sum(self.weights[:, None] * typical**2, axis=0)))
 
     def objective(self, rate2: NDArray[np.float64]) -> float:
-        """``J`` at squared rates ``rate2`` (in the loads' squared units)."""
+        """``J`` at squared rates ``rate2`` (in the loads' squared units).
+
+        A mean square of loads less their constant parts, plus the parts' squares.
+        """
         start, end = self.sides(rate2)
+        start, end = start - self.offsets[:, None], end - self.offsets[:, None]
         w = self.weights[:, None]
         left, right = np.sum(w * start**2, axis=0), np.sum(w * end**2, axis=0)
         if self.measure == "peak":
             return float(max(left.max(), right.max()))
-        return float(np.sum(self.times(rate2) * (left + right) / 2.0) / self.duration)
+        return float(np.sum(self.times(rate2) * (left + right) / 2.0) / self.duration
+                     + np.sum(self.weights * self.offsets**2))
 
 
 @dataclass(frozen=True)
@@ -196,10 +205,10 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
     for row, weight in enumerate(problem.weights):
         if weight > 0:
             s, e = sides(row)
-            left += weight * s**2
-            right += weight * e**2
+            left += weight * (s - problem.offsets[row]) ** 2
+            right += weight * (e - problem.offsets[row]) ** 2
     peak = ca.SX.sym("z") if problem.measure == "peak" else None
-    if peak is None:
+    if peak is None:  # (the constant parts' squares added back by Problem.objective)
         cost = ca.sum1(dt * (left + right) / 2.0) / problem.duration / reference
         unknowns = b_hat
     else:
@@ -266,6 +275,32 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
     return Transcribed(rate2=rate2, objective=problem.objective(rate2), violation=violation,
                        certified=relaxed and not early, ends_early=relaxed and early,
                        iterations=int(stats["iter_count"]))
+
+
+#: The loads that are a momentum's rate of change on the frame (with their parts at rest): a
+#: constant part of one adds its square to a mean square, its cross term with the rest being
+#: the constant times the momentum's change — zero from rest to rest and over a period.
+MOMENTUM_RATES = ("shaking_force_x", "shaking_force_y", "shaking_moment", "rocking_couple_x",
+                  "rocking_couple_y")
+
+
+def constant_parts(loads: PathLoads) -> NDArray[np.float64]:
+    """Each load's part at rest where it is constant along the path and a momentum's rate.
+
+    The weights (``M·g``, constant) in a shaking force: its mean square over ``T`` is the
+    weights' square plus the mean square of the rest, whatever the time law; taken out of
+    the transcription, a motion that ends early does not gain by carrying them for less time.
+    """
+    out = np.zeros(len(loads.names))
+    for name in MOMENTUM_RATES:
+        row = loads.index(name)
+        static = loads.static[row]
+        scale = max(float(np.max(np.abs(loads.inertial[row]))),
+                    float(np.max(np.abs(loads.centripetal[row]))),
+                    float(np.max(np.abs(static))), np.finfo(float).tiny)
+        if np.max(np.abs(static - static[0])) <= 1e-12 * scale:
+            out[row] = static[0]
+    return out
 
 
 def mesh(knots: NDArray[np.float64], intervals: int) -> NDArray[np.float64]:

@@ -16,6 +16,8 @@ or not at all. matplotlib is imported by the functions that draw, not by importi
 ``motion_runs``    ``balancer verify``'s figure of a linkage with several inputs: its runs
                    along the motions and free
 ``animation``      the mechanism turning (GIF, MP4)
+``plan``           ``balancer plan``'s figure: the loads before and after a planned time law,
+                   and its pace
 ``fronts``         a trade-off front
 ``atlas``          a sweep's atlas and a tolerance histogram
 ``style``          colours, styles, axes, numbers, writing files
@@ -39,6 +41,7 @@ from .fronts import front_figure
 from .motion import plot_com_path, plot_reactions, plot_shaking_moment, verification_figure
 from .motion_runs import motion_verification_figure
 from .orders import orders_figure, plot_orders
+from .plan import plan_figure
 from .revolution import (
     cycle_figure,
     plot_over_crank_angle,
@@ -58,6 +61,7 @@ __all__ = [
     "motion_figure",
     "motion_verification_figure",
     "orders_figure",
+    "plan_figure",
     "plot_centre_of_mass_track",
     "plot_com_path",
     "plot_orders",

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..linkage import trajectory
+from ..model.motions import REVOLUTION
 from .style import COLOURS, SERIES, legend_outside
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
@@ -27,7 +28,9 @@ def plan_figure(plan: Plan, title: str = "") -> Figure:
 
     fig = Figure(figsize=(8.5, 11), layout="constrained")
     force, moment, torque, pace = fig.subplots(4, 1)
-    fig.suptitle(f"{title or 'design'}\nthe time law of {plan.path.name} planned "
+    what = ("one revolution" if plan.path.along == REVOLUTION
+            else f"motion {plan.path.name}")
+    fig.suptitle(f"{title or 'design'}\nthe time law of {what} planned "
                  f"(least {plan.spec.measure} of the objective)")
     runs = (("spec's law", plan.before, "--", COLOURS["before"]),
             ("planned", plan.after, "-", COLOURS["after"]))

@@ -87,14 +87,34 @@ def _certificate_lines(plan: Plan, solution: Any) -> list[str]:
         lines.append(f"least possible from rest to rest (closed form, any time law): "
                      f"{_figure(plan.bound, plan.spec.measure):.6g}")
     if solution.certified:
-        lines.append("the transcription is convex: its optimum is global (the same from "
-                     f"{len(plan.starts)} starts to {_spread(plan.starts):.0e})")
+        starts = ("" if len(plan.starts) == 1 else f" (the same from {len(plan.starts)} starts "
+                  f"to {_spread(plan.starts):.0e})")
+        lines.append(f"the transcription is convex: its optimum is global{starts}")
     else:
         lines.append("a local optimum: a faster motion would shake less, and the duration is "
                      f"held (best of {len(plan.starts)} starts, spread {_spread(plan.starts):.0e})")
-    lines.append(f"largest limit violation {solution.violation:.1e} of its limit; IPOPT "
-                 f"{solution.iterations} iterations")
+    lines += _limit_lines(plan)
+    lines.append(f"largest limit violation at the transcription's rows {solution.violation:.1e} "
+                 f"of its limit; IPOPT {solution.iterations} iterations")
     return lines
+
+
+def _limit_lines(plan: Plan) -> list[str]:
+    """Each limit of the plan against the largest value along the planned motion."""
+    after, out = plan.after, []
+    state, torques = after.state, after.reactions.torques
+    kinds = (("max_speed", "speed", state.rates), ("max_acceleration", "acceleration",
+                                                   state.accelerations),
+             ("max_torque", "torque", torques))
+    for key, words, values in kinds:
+        for i, name in enumerate(after.inputs):
+            limit = getattr(plan.spec, key).of(name)
+            if limit is None:
+                continue
+            reached = float(np.max(np.abs(np.asarray(values[i]))))
+            lines = f"{words} of {name}: at most {reached:.6g} along the planned motion, "
+            out.append(lines + f"its limit {limit:g} ({100 * reached / limit:.1f} %)")
+    return out
 
 
 def _spread(values: tuple[float, ...]) -> float:
