@@ -82,6 +82,12 @@ COMMANDS = (
         "OUT/fivebar_5r_balanced.toml",
         "balancer verify OUT/fivebar_5r_balanced.toml --plot docs/gallery/fivebar_5r_verify.png",
     )),
+    ("forbal2_plan.png", (
+        "balancer plan examples/forbal2.toml --plot docs/gallery/forbal2_plan.png",
+    )),
+    ("servo_press_plan.png", (
+        "balancer plan examples/servo_press.toml --plot docs/gallery/servo_press_plan.png",
+    )),
 )
 #: Animations: (gallery name, example spec, frames per revolution).
 ANIMATIONS = (("meijaard2020.gif", "meijaard2020", 48),

@@ -117,7 +117,7 @@ def test_the_site_builds_without_a_warning(tmp_path):
             assert "".join(row.replace("`", "").split()) in spec, (section.header, key.name)
     cli = text_of(out / "cli.html")
     for verb in ("analyze", "simulate", "optimize", "verify", "plot", "pareto", "sweep",
-                 "example"):
+                 "plan", "example"):
         assert f"balancer{verb}[-h]" in cli, verb
     assert "--verify-duration" in cli and "--all-columns" in cli
 
@@ -310,7 +310,7 @@ def _recorded_json(verb: str) -> set[str]:
     return keys
 
 
-@pytest.mark.parametrize("verb", ["analyze", "simulate", "optimize", "verify"])
+@pytest.mark.parametrize("verb", ["analyze", "simulate", "optimize", "verify", "plan"])
 def test_the_outputs_page_names_every_json_key(verb):
     documented = _documented_keys(f"`{verb} --json`")
     if verb == "analyze":  # (a linkage with several inputs: along its motions)

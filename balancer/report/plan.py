@@ -95,7 +95,7 @@ def _certificate_lines(plan: Plan, solution: Any) -> list[str]:
                      f"held (best of {len(plan.starts)} starts, spread {_spread(plan.starts):.0e})")
     lines += _limit_lines(plan)
     lines.append(f"largest limit violation at the transcription's rows {solution.violation:.1e} "
-                 f"of its limit; IPOPT {solution.iterations} iterations")
+                 f"of its limit; IPOPT: {solution.iterations} solver iterations")
     return lines
 
 

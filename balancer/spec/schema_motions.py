@@ -95,7 +95,7 @@ PLAN_SECTIONS: tuple[Section, ...] = (
                     'The motion whose path is run, by name, or `"revolution"` (a one-input '
                     "linkage's input turning once at the `[operation]` speed).", (LINKAGE,),
                     example='"turn"'),
-                Key("name", "—", '"<motion> planned"', "The planned motion's name.",
+                Key("name", "—", "the motion's name and ` planned`", "The planned motion's name.",
                     (LINKAGE,), example='"turn planned"'),
                 Key("duration", "s", "the motion's", "The planned motion's duration.",
                     (LINKAGE,), example="4.0"),

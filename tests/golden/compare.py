@@ -113,6 +113,12 @@ class Bound:
 
 EXACT = Tolerance(EXACT_RELATIVE, EXACT_OF_SCALE)
 DESIGN = Tolerance(DESIGN_RELATIVE, DESIGN_RELATIVE)
+#: A planned time law's objective (``plan``): IPOPT's optimum of a convex transcription, its
+#: objective of order one to 1e-10, known from another start to a few 1e-9 of itself.
+PLAN_GAP = 1e-8
+PLAN_OBJECTIVE = Tolerance(PLAN_GAP, PLAN_GAP)
+#: A planned time law's figures (its pace, the loads along it): within √(2ε) of the optimum.
+PLAN_DESIGN = Tolerance(math.sqrt(2.0 * PLAN_GAP), math.sqrt(2.0 * PLAN_GAP))
 #: A figure that is not compared: of a design that the optimum leaves free (see ``unique``).
 ANY = Tolerance(math.inf, math.inf)
 Rule = Tolerance | Bound
@@ -283,8 +289,21 @@ def _simulation_rule(path: str, doc: dict) -> Rule:
     return run
 
 
+def _plan_rule(path: str, doc: dict) -> Rule:
+    """What a figure of ``plan --json`` is: the path's own (exact), or the optimum's."""
+    if re.match(r"(before\.|objective_before$|lower_bound$|duration_before$|intervals$)", path):
+        return EXACT
+    if path == "violation":
+        return Bound(PLAN_GAP)
+    if re.match(r"(objective_after|transcription_objective|starts)", path):
+        return PLAN_OBJECTIVE
+    return PLAN_DESIGN
+
+
 def json_rules(verb: str, unique: bool = True) -> Callable[[str, dict], Rule]:
     """The rule that says what each figure of ``verb``'s JSON is (``unique``: its optimum)."""
+    if verb == "plan":
+        return _plan_rule
     if verb in ("optimize", "pareto"):
         return lambda path, doc: _optimize_rule(path, doc, unique)
     if verb in ("simulate", "verify"):
@@ -303,6 +322,8 @@ def text_rule(verb: str, text: str, sibling: dict | None = None,
     """
     if verb in ("simulate", "verify"):
         return _runs_tolerance(sibling) if sibling else _integrated_of_text(text)
+    if verb == "plan":
+        return PLAN_DESIGN
     if verb in ("optimize", "pareto"):
         return DESIGN.loosest(_integrated_of_text(text)) if unique else ANY
     return EXACT

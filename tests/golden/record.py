@@ -31,7 +31,8 @@ STORE = Path(__file__).resolve().parent / "outputs"
 
 #: Examples without a ``[balance]`` section (no optimize, pareto): engines are balanced by
 #: counterweights and shafts of their own (issue 31).
-UNBALANCED = ("meijaard2020", "single_cylinder", "inline_three", "inline_four", "v6", "v8")
+UNBALANCED = ("meijaard2020", "single_cylinder", "inline_three", "inline_four", "v6", "v8",
+              "servo_press")
 #: Fields and phrases that measure wall-clock time or name a temporary folder.
 _MASKS = (
     (re.compile(r'("(?:time|seconds)": )[-+0-9.eE]+'), r'\1"<t>"'),
@@ -156,7 +157,7 @@ def commands(name: str) -> dict[str, list[str]]:
                                          "--backend", "convex"],
                 "optimize.toml": ["optimize", spec, "--no-verify", "--out", "{tmp}/out.toml"],
             })
-        return along
+        return along | _plans(name, spec)
     out = {
         "analyze.txt": ["analyze", spec],
         "analyze.json": ["analyze", spec, "--json"],
@@ -176,7 +177,14 @@ def commands(name: str) -> dict[str, list[str]]:
                                      "convex"],
             "optimize.toml": ["optimize", spec, "--no-verify", "--out", "{tmp}/out.toml"],
         })
-    return out
+    return out | _plans(name, spec)
+
+
+def _plans(name: str, spec: str) -> dict[str, list[str]]:
+    """``plan``'s command lines where the example has ``[plan]``."""
+    if "[plan]" not in (EXAMPLES / f"{name}.toml").read_text():
+        return {}
+    return {"plan.txt": ["plan", spec], "plan.json": ["plan", spec, "--json"]}
 
 
 def run(argv: list[str]) -> tuple[int, str, str, dict[str, str]]:
