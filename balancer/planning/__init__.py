@@ -60,6 +60,9 @@ class Plan:
     bound
         A lower bound of ``J`` over every time law where one is known (from rest to rest:
         the shaking force's closed form), or ``None``.
+    halved
+        The transcription's optimum on half the intervals: their difference estimates the
+        transcription's error (it bounds it where the error falls at first order or faster).
     """
 
     spec: PlanSpec
@@ -73,6 +76,12 @@ class Plan:
     objective_before: float
     objective_after: float
     bound: float | None
+    halved: float
+
+    @property
+    def mesh_error(self) -> float:
+        """The transcription's error estimate: its optimum's change from half its mesh."""
+        return abs(self.solution.objective - self.halved)
 
     @property
     def certified(self) -> bool:
@@ -205,21 +214,15 @@ def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
                 raise SpecError(f"must name an input ({', '.join(inputs)})",
                                 key=f"plan.{key}.{name}", value=name)
     duration = path.duration if spec.duration is None else spec.duration
-    tau = mesh(np.asarray(path.times, dtype=float), spec.intervals)
-    loads = path_loads(mech, path, tau, gravity)
-    weights = weights_of(loads.names, spec.objective)
-    problem = Problem(loads=loads, weights=weights, duration=duration, measure=spec.measure,
-                      periodic=path.periodic,
-                      max_speed=tuple(spec.max_speed.of(n) for n in inputs),
-                      max_acceleration=tuple(spec.max_acceleration.of(n) for n in inputs),
-                      max_load=tuple(spec.max_torque.of(n) for n in inputs),
-                      offsets=(constant_parts(loads) if spec.measure == "rms"
-                               else np.zeros(len(loads.names))))
+    problem = _problem(mech, path, spec, spec.intervals, duration, gravity)
+    tau, weights = problem.loads.tau, problem.weights
     own = _rate2_of(path, tau, duration)
     steady = np.full(tau.shape, (problem.span / duration) ** 2)
     starts = [own] if np.allclose(own, steady, rtol=1e-12, atol=0.0) else [own, steady]
     solutions = [solve(problem, start) for start in starts]
     best = min(solutions, key=lambda s: s.objective)
+    coarse = _problem(mech, path, spec, max(spec.intervals // 2, 2), duration, gravity)
+    halved = solve(coarse, _rate2_of(path, coarse.loads.tau, duration)).objective
     rate = np.sqrt(np.maximum(best.rate2, 0.0))
     rate *= float(np.sum(problem.times(best.rate2))) / duration  # (the duration to rounding)
     name = spec.name or f"{path.name} planned"
@@ -232,5 +235,21 @@ def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
                 starts=tuple(s.objective for s in solutions), before=before, after=after,
                 objective_before=objective_of(mech, path, weights, spec.measure, gravity),
                 objective_after=objective_of(mech, planned, weights, spec.measure, gravity),
-                bound=None if path.periodic else _rest_bound(loads, weights, duration,
-                                                             spec.measure))
+                bound=None if path.periodic else _rest_bound(problem.loads, weights, duration,
+                                                             spec.measure),
+                halved=halved)
+
+
+def _problem(mech: Mechanism, path: MotionSpec, spec: PlanSpec, intervals: int,
+             duration: float, gravity: tuple[float, float]) -> Problem:
+    """The transcription of ``spec`` on ``intervals`` intervals of ``path``'s path."""
+    inputs = mech.linkage.inputs
+    tau = mesh(np.asarray(path.times, dtype=float), intervals)
+    loads = path_loads(mech, path, tau, gravity)
+    return Problem(loads=loads, weights=weights_of(loads.names, spec.objective),
+                   duration=duration, measure=spec.measure, periodic=path.periodic,
+                   max_speed=tuple(spec.max_speed.of(n) for n in inputs),
+                   max_acceleration=tuple(spec.max_acceleration.of(n) for n in inputs),
+                   max_load=tuple(spec.max_torque.of(n) for n in inputs),
+                   offsets=(constant_parts(loads) if spec.measure == "rms"
+                            else np.zeros(len(loads.names))))

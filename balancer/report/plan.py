@@ -82,7 +82,8 @@ def _certificate_lines(plan: Plan, solution: Any) -> list[str]:
              f"{_figure(plan.objective_after, plan.spec.measure):.6g} after (along each motion "
              f"by quadrature); the transcription's optimum "
              f"{_figure(solution.objective, plan.spec.measure):.6g} on "
-             f"{plan.problem.loads.tau.size - 1} intervals"]
+             f"{plan.problem.loads.tau.size - 1} intervals "
+             f"({_figure(plan.halved, plan.spec.measure):.6g} on half as many)"]
     if plan.bound is not None:
         lines.append(f"least possible from rest to rest (closed form, any time law): "
                      f"{_figure(plan.bound, plan.spec.measure):.6g}")
@@ -135,6 +136,7 @@ def plan_json(plan: Plan, spec: str | None = None) -> dict[str, Any]:
         "intervals": int(plan.problem.loads.tau.size - 1),
         "objective_before": plan.objective_before, "objective_after": plan.objective_after,
         "transcription_objective": plan.solution.objective, "lower_bound": plan.bound,
+        "halved_objective": plan.halved,
         "certified": plan.solution.certified, "starts": list(plan.starts),
         "violation": plan.solution.violation, "iterations": plan.solution.iterations,
         "before": loads(plan.before), "after": loads(plan.after),

@@ -295,7 +295,7 @@ def _plan_rule(path: str, doc: dict) -> Rule:
         return EXACT
     if path == "violation":
         return Bound(PLAN_GAP)
-    if re.match(r"(objective_after|transcription_objective|starts)", path):
+    if re.match(r"(objective_after|transcription_objective|halved_objective|starts)", path):
         return PLAN_OBJECTIVE
     return PLAN_DESIGN
 

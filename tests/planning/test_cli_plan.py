@@ -45,7 +45,8 @@ def test_plan_s_text_says_what_is_certified(capsys):
 
 def _spec(tmp_path, extra: str) -> str:
     path = tmp_path / "s.toml"
-    path.write_text(Path(FORBAL).read_text() + "\n" + extra)
+    own = Path(FORBAL).read_text().split("\n[plan]")[0]  # (the example's own [plan] is last)
+    path.write_text(own + "\n" + extra)
     return str(path)
 
 
