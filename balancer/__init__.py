@@ -40,6 +40,8 @@ _EXPORTS = {
     "verify": "api",
     "plan": "api",
     "planned_design": "api",
+    "codesign": "api",
+    "CoDesign": "planning.codesign",
     "Plan": "planning",
     "PlanSpec": "model.plan",
     "PlanWeights": "model.plan",
@@ -172,6 +174,8 @@ __all__ = [
     "pareto",
     "Perturb",
     "plan",
+    "codesign",
+    "CoDesign",
     "plan_figure",
     "planned_design",
     "Plan",
@@ -232,6 +236,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         motion_drawing,
         optimize,
         pareto,
+        codesign,
         plan,
         planned_design,
         simulate,
@@ -288,6 +293,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .motion_analysis import AlongMotions, MotionAnalysis, WorkspaceCheck
     from .motion_verification import MotionCheck, MotionVerification
     from .planning import Plan
+    from .planning.codesign import CoDesign
     from .plots import (
         MotionDrawing,
         animate,

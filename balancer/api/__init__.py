@@ -29,6 +29,7 @@ _EXPORTS = {
     "optimize": "balancing",
     "pareto": "balancing",
     "plan": "planning",
+    "codesign": "planning",
     "planned_design": "planning",
     "simulate": "motion",
     "simulate_motion": "motion",
@@ -46,6 +47,7 @@ __all__ = [
     "optimize",
     "pareto",
     "plan",
+    "codesign",
     "planned_design",
     "simulate",
     "simulate_motion",
@@ -64,5 +66,5 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .drawings import motion_drawing
     from .examples import example
     from .motion import simulate, simulate_motion, verify
-    from .planning import plan, planned_design
+    from .planning import codesign, plan, planned_design
     from .results import to_dict, to_table

@@ -8,9 +8,10 @@ from .. import validate as v
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..model import Design
-from ..model.motions import REVOLUTION, MotionSpec
 from ..model.plan import PlanSpec
-from ..planning import Plan, plan_motion, revolution
+from ..planning import Plan, path_of, plan_motion
+from ..planning.codesign import CoDesign
+from ..planning.codesign import codesign as run_codesign
 from .analysis import spec_gravity
 
 
@@ -48,24 +49,25 @@ def plan(design: Design, motion: str | None = None, *, settings: PlanSpec | None
         return plan_motion(mech, path, spec, gravity=spec_gravity(design))
 
 
-def path_of(design: Design, name: str | None, *, key: str = "plan.motion") -> MotionSpec:
-    """The motion whose path a plan runs: by name, the first, or a one-input revolution."""
-    inputs = mechanism_of(design.mechanism).linkage.inputs
-    if name == REVOLUTION or (name is None and not design.motions):
-        if len(inputs) != 1 or design.operation is None:
-            raise SpecError("a revolution is a one-input linkage's at its [operation] speed; "
-                            "name a [[motion]]" if design.motions or len(inputs) != 1 else
-                            "a one-input linkage's revolution needs its [operation] speed",
-                            key=key, value=name)
-        return revolution(design.operation.speed)
-    if name is None:
-        return design.motions[0]
-    found = next((m for m in design.motions if m.name == name), None)
-    if found is None:
-        known = [m.name for m in design.motions] + ([REVOLUTION] if len(inputs) == 1 else [])
-        raise SpecError(f"names no motion of the spec ({', '.join(known)})", key=key,
-                        value=name)
-    return found
+def codesign(design: Design, motion: str | None = None, *, settings: PlanSpec | None = None
+             ) -> CoDesign:
+    """The masses of ``[balance]`` and a motion's time law chosen together.
+
+    Each lever's certified problem in turn until neither improves the plan's objective
+    (:mod:`balancer.planning.codesign`); with what each alone buys from the spec.
+
+    Raises
+    ------
+    SpecError
+        If the spec has no ``[balance]``, its linkage has one input, or the motion is unknown.
+    SolverError
+        If a step fails.
+    """
+    if design.mechanism.type != "linkage":
+        raise SpecError(f"plans a general linkage's motion (type = \"linkage\"; this spec's is "
+                        f"\"{design.mechanism.type}\")", key="mechanism.type")
+    spec = settings or design.plan or PlanSpec()
+    return run_codesign(design, spec, motion, gravity=spec_gravity(design))
 
 
 def planned_design(design: Design, result: Plan) -> Design:

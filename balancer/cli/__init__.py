@@ -450,9 +450,13 @@ def _plan_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--intervals", type=_count, metavar="N",
                    help="intervals of the path in the transcription (default: [plan] "
                    "intervals, 200)")
+    p.add_argument("--with-masses", action="store_true",
+                   help="choose the links' masses of [balance] with the time law: each "
+                   "lever's certified problem in turn until neither improves; report what "
+                   "the masses, the time law and both buy (a linkage with several inputs)")
     p.add_argument("--out", metavar="PLANNED.toml",
                    help="write the spec with the planned motion ([[motion]] along the path, "
-                   "at its pace)")
+                   "at its pace), and with --with-masses the chosen masses")
     p.add_argument("--csv", metavar="PATH",
                    help="write the loads along the planned motion to a CSV file (analyze "
                    "--motion's columns)")

@@ -6,14 +6,14 @@ import argparse
 import sys
 from dataclasses import replace
 
-from ..api.planning import plan, planned_design
+from ..api.planning import codesign, plan, planned_design
 from ..errors import SpecError
 from ..model.plan import PlanSpec
 from ..outputs import write_atomic
 from ..plots.plan import plan_figure
 from ..plots.style import save_figure
 from ..report import dumps_json
-from ..report.plan import plan_json, plan_text
+from ..report.plan import codesign_json, codesign_text, plan_json, plan_text
 from ..report.text import csv_text
 from ..spec import dumps_design, loads_design
 from .common import as_option, figure_path, load, output_path, wrote
@@ -33,15 +33,23 @@ def run(args: argparse.Namespace) -> int:
             settings = replace(settings or PlanSpec(), **{key: value})
         except SpecError as exc:
             raise as_option(exc, key, f"--{key}", value) from None
-    result = plan(design, args.motion, settings=settings)
+    together = None
+    if args.with_masses:
+        together = codesign(design, args.motion, settings=settings)
+        result, chosen = together.plan, together.design
+    else:
+        result, chosen = plan(design, args.motion, settings=settings), design
     spec_text = None
     if out is not None:
-        spec_text = dumps_design(planned_design(design, result))
+        spec_text = dumps_design(planned_design(chosen, result))
         loads_design(spec_text, source=str(out))  # it must load again
     if args.json:
-        doc = plan_json(result, spec=args.spec)
+        doc = (plan_json(result, spec=args.spec) if together is None
+               else codesign_json(together, spec=args.spec))
         doc["out"] = None if out is None else str(out)
         text = dumps_json(doc)
+    elif together is not None:
+        text = codesign_text(together, spec=args.spec) + "\n"
     else:
         text = plan_text(result, spec=args.spec) + "\n"
     if spec_text is not None and out is not None:

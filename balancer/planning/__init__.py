@@ -25,14 +25,15 @@ from numpy.typing import NDArray
 
 from ..errors import SpecError
 from ..linkage import trajectory
-from ..mechanisms import Mechanism
+from ..mechanisms import Mechanism, mechanism_of
+from ..model import Design
 from ..model.motions import REVOLUTION, MotionSpec
 from ..model.plan import PlanSpec, PlanWeights
 from ..motion_analysis import MotionAnalysis, motion_analysis
 from .path_loads import PathLoads, load_rows, path_loads, reactions_at
 from .transcription import Problem, Transcribed, constant_parts, mesh, solve
 
-__all__ = ["Plan", "plan_motion", "revolution", "objective_of"]
+__all__ = ["Plan", "objective_of", "path_of", "plan_motion", "revolution"]
 
 
 @dataclass(frozen=True)
@@ -95,6 +96,26 @@ def revolution(speed: float, samples: int = 400) -> MotionSpec:
     return MotionSpec(name=REVOLUTION, times=(0.0, period),
                       path=((0.0,), (math.copysign(2.0 * math.pi, speed),)), law="spline",
                       samples=samples, along=REVOLUTION, pace=((0.0, 1.0), (period, 1.0)))
+
+
+def path_of(design: Design, name: str | None, *, key: str = "plan.motion") -> MotionSpec:
+    """The motion whose path a plan runs: by name, the first, or a one-input revolution."""
+    inputs = mechanism_of(design.mechanism).linkage.inputs
+    if name == REVOLUTION or (name is None and not design.motions):
+        if len(inputs) != 1 or design.operation is None:
+            raise SpecError("a revolution is a one-input linkage's at its [operation] speed; "
+                            "name a [[motion]]" if design.motions or len(inputs) != 1 else
+                            "a one-input linkage's revolution needs its [operation] speed",
+                            key=key, value=name)
+        return revolution(design.operation.speed)
+    if name is None:
+        return design.motions[0]
+    found = next((m for m in design.motions if m.name == name), None)
+    if found is None:
+        known = [m.name for m in design.motions] + ([REVOLUTION] if len(inputs) == 1 else [])
+        raise SpecError(f"names no motion of the spec ({', '.join(known)})", key=key,
+                        value=name)
+    return found
 
 
 def weights_of(names: tuple[str, ...], weights: PlanWeights) -> NDArray[np.float64]:

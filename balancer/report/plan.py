@@ -13,6 +13,7 @@ from .text import table
 
 if TYPE_CHECKING:  # annotations only: the command that makes it loads it
     from ..planning import Plan
+    from ..planning.codesign import CoDesign
 
 #: What the report calls each objective term.
 _TERM_WORDS = {"shaking_moment": "shaking moment", "shaking_force": "shaking force",
@@ -143,4 +144,51 @@ def plan_json(plan: Plan, spec: str | None = None) -> dict[str, Any]:
         "pace": [[float(t), float(r)] for t, r in plan.planned.pace or ()],
         "pace_times": [float(t) for t in np.asarray(plan.planned.pace_times)],
     })
+    return doc
+
+
+#: What the co-design's table calls each case.
+_LEVER_WORDS = {"spec": "as specified", "masses": "the masses alone",
+                "motion": "the time law alone", "both": "both"}
+
+
+def codesign_text(result: CoDesign, spec: str | None = None) -> str:
+    """The readable ``plan --with-masses`` report: each lever alone and both together."""
+    plan = result.plan
+    head = f"balancer plan --with-masses — {spec}" if spec else "balancer plan --with-masses"
+    lines = [head,
+             f"the masses of [balance] and the time law of {_path_words(plan)} chosen together "
+             f"({(len(result.rounds) - 1) // 2} rounds)",
+             f"objective: {_objective_words(plan)}", ""]
+    mech = plan.before.mechanism
+    keys = [k for k in plan.before.loads()
+            if not (k == "rocking_couple" and mech.in_one_plane())]
+    sc = Scales()
+    loads = {lever: a.loads() for lever, a in result.analyses.items()}
+    sc.add((load_words(mech, k)[1], f.rms) for one in loads.values() for k, f in one.items())
+    root = "√J" if plan.spec.measure == "rms" else "√(max)"
+    heading = ["lever", root, "change"] + [f"RMS {load_words(mech, k)[0]} "
+                                            f"({load_words(mech, k)[1]})" for k in keys]
+    start = result.objectives["spec"]
+    rows = []
+    for lever in ("spec", "masses", "motion", "both"):
+        value = result.objectives[lever]
+        rows.append([_LEVER_WORDS[lever], f"{_figure(value, plan.spec.measure):.6g}",
+                     "—" if lever == "spec" else _change(_figure(start, ""), _figure(value, "")),
+                     *(sc.fmt(loads[lever][k].rms, load_words(mech, k)[1]) for k in keys)])
+    lines.append(table(rows, heading))
+    lines += ["", "each step's problem is convex and solved to its optimum; together they are "
+              "not: the result is where neither lever alone does better (J never rose: "
+              + ", ".join(f"{_figure(j, ''):.6g}" for j in result.rounds) + ")"]
+    return "\n".join(lines)
+
+
+def codesign_json(result: CoDesign, spec: str | None = None) -> dict[str, Any]:
+    """The ``plan --with-masses --json`` document: the plan's, with each lever's figures."""
+    doc = plan_json(result.plan, spec=spec)
+    doc["levers"] = {lever: {"objective": result.objectives[lever],
+                             "loads": {k: {"rms": f.rms, "max": f.max}
+                                       for k, f in result.analyses[lever].loads().items()}}
+                     for lever in result.objectives}
+    doc["rounds"] = list(result.rounds)
     return doc

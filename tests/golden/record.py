@@ -182,9 +182,13 @@ def commands(name: str) -> dict[str, list[str]]:
 
 def _plans(name: str, spec: str) -> dict[str, list[str]]:
     """``plan``'s command lines where the example has ``[plan]``."""
-    if "[plan]" not in (EXAMPLES / f"{name}.toml").read_text():
+    text = (EXAMPLES / f"{name}.toml").read_text()
+    if "[plan]" not in text:
         return {}
-    return {"plan.txt": ["plan", spec], "plan.json": ["plan", spec, "--json"]}
+    out = {"plan.txt": ["plan", spec], "plan.json": ["plan", spec, "--json"]}
+    if "[balance]" in text and name in ALONG_MOTIONS:  # (masses chosen along a motion)
+        out["plan-masses.json"] = ["plan", spec, "--with-masses", "--json"]
+    return out
 
 
 def run(argv: list[str]) -> tuple[int, str, str, dict[str, str]]:
