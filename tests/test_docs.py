@@ -302,7 +302,7 @@ def _documented_keys(heading: str) -> set[str]:
 
 def _recorded_json(verb: str) -> set[str]:
     keys: set[str] = set()
-    for path in STORE.glob(f"*/{verb}.json"):
+    for path in [*STORE.glob(f"*/{verb}.json"), *STORE.glob(f"*/{verb}-*.json")]:
         text = path.read_text(encoding="utf-8")
         document = text.split("--- stdout\n", 1)[1].split("--- stderr", 1)[0]
         keys |= set(json.loads(re.sub(r"<t>", "0", document)))
