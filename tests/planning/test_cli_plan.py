@@ -11,6 +11,9 @@ import pytest
 
 from balancer.cli import main
 
+#: A few seconds of optimisation: the full suite's, not the fast lane's.
+pytestmark = pytest.mark.slow
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 FORBAL = str(EXAMPLES / "forbal2.toml")
 

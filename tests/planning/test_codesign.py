@@ -22,6 +22,9 @@ from balancer.planning import objective_of, plan_motion, weights_of
 from balancer.planning.codesign import _balanced, _mass_objective
 from balancer.spec import dumps_design, load_design, loads_design
 
+#: A few seconds of optimisation: the full suite's, not the fast lane's.
+pytestmark = pytest.mark.slow
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
@@ -51,7 +54,6 @@ def test_at_the_result_neither_lever_alone_does_better(forbal):
     problem = replace(design.balance, objective=_mass_objective(settings.objective,
                                                                 design.balance.objective))
     masses = _balanced(chosen, problem, result.plan.planned)
-    from balancer.planning import objective_of, weights_of
     weights = weights_of(result.plan.problem.loads.names, settings.objective)
     rebalanced = objective_of(mechanism_of(masses.linkage), result.plan.planned, weights, "rms")
     assert rebalanced >= result.objectives["both"] * (1 - 1e-5)

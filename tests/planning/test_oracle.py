@@ -19,6 +19,9 @@ from balancer.model.plan import PlanSpec, PlanWeights
 from balancer.planning import plan_motion
 from balancer.spec import load_design
 
+#: A few seconds of optimisation: the full suite's, not the fast lane's.
+pytestmark = pytest.mark.slow
+
 cp = pytest.importorskip("cvxpy")
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"

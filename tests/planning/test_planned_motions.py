@@ -26,6 +26,9 @@ from balancer.planning.path_loads import load_rows, reactions_at
 from balancer.spec import dumps_design, load_design, loads_design
 from balancer.spec.reader import design_from_dict
 
+#: A few seconds of optimisation: the full suite's, not the fast lane's.
+pytestmark = pytest.mark.slow
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
