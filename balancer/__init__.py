@@ -231,12 +231,12 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .api import (
         analyze,
         analyze_motions,
+        codesign,
         cycle_analyses,
         example,
         motion_drawing,
         optimize,
         pareto,
-        codesign,
         plan,
         planned_design,
         simulate,
