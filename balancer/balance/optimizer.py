@@ -113,15 +113,15 @@ class Optimizer:
                                                              else like._before)
 
     @classmethod
-    def of(cls, design: Design) -> Optimizer:
-        """The optimiser of a design spec's ``[balance]`` problem.
+    def of(cls, design: Design, *, along: bool = False) -> Optimizer:
+        """The optimiser of a design spec's ``[balance]`` problem (``along`` its motions).
 
         Raises as :func:`~balancer.balance.problem.numeric_problem`.
         """
         if isinstance(design.balance, RotorBalanceProblem):
             raise SpecError("not yet for an engine: its counterweights and shafts are chosen by "
                             "`balancer optimize`", key="balance")
-        data = numeric_problem(design)  # (it has checked [operation], or the motions)
+        data = numeric_problem(design, along=along)  # (it has checked [operation], or motions)
         gravity = design.operation.gravity if design.operation is not None else (0.0, 0.0)
         return cls(data, gravity=gravity, motions=design.motions, workspace=design.workspace)
 

@@ -113,11 +113,13 @@ class NumericProblem(Feasibility, PhysicalValues, Settling, ObjectiveScale):
         return new
 
 
-def numeric_problem(design: Design) -> NumericProblem:
+def numeric_problem(design: Design, *, along: bool = False) -> NumericProblem:
     """Build the numeric redesign problem of a design spec once.
 
     For the same design under other bounds, :meth:`NumericProblem.with_problem` reuses what
-    does not depend on them.
+    does not depend on them. A linkage with several inputs is balanced along its motions; one
+    with one input over a revolution at the operating speed, or along its motions where
+    ``along`` (a time law that varies the crank's speed: ``plan --with-masses``).
 
     Raises
     ------
@@ -129,7 +131,7 @@ def numeric_problem(design: Design) -> NumericProblem:
     """
     problem = _checked_problem(design.balance)
     mech = mechanism_of(design.mechanism)
-    if len(mech.linkage.inputs) > 1:
+    if len(mech.linkage.inputs) > 1 or along:
         check_problem(problem, mech)
         return _along_motions(design, problem, mech)
     if design.operation is None:

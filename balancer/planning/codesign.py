@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from ..balance.optimizer import optimize
+from ..balance.optimizer import Optimizer
 from ..balance.result import BalanceResult
 from ..errors import SolverError, SpecError
 from ..mechanisms import mechanism_of
@@ -78,7 +78,7 @@ def _balanced(design: Design, problem: BalanceProblem, motion: MotionSpec) -> Ba
     """The masses of ``problem`` along ``motion`` alone (the certified convex optimum)."""
     along = replace(design, motions=(replace(motion, name="plan"),), plan=None,
                     balance=replace(problem, motion_weights=()))
-    result = optimize(along, backend="convex")
+    result = Optimizer.of(along, along=True).run("convex")
     if not result.success:
         raise SolverError(f"the balancing along the planned motion failed: {result.message}")
     return result
@@ -91,16 +91,11 @@ def codesign(design: Design, spec: PlanSpec, motion: str | None = None, *,
     Raises
     ------
     SpecError
-        If the spec has no ``[balance]``, or its linkage has one input (its balancing is
-        at constant speed).
+        If the spec has no ``[balance]``.
     SolverError
         If a step fails.
     """
     mech = mechanism_of(design.mechanism)
-    if len(mech.linkage.inputs) < 2:
-        raise SpecError("chooses the masses along a motion of a linkage with several inputs "
-                        "(a one-input linkage is balanced at constant speed)",
-                        key="--with-masses")
     problem = design.balance
     if not isinstance(problem, BalanceProblem):
         raise SpecError("chooses the masses of the spec's [balance] with the time law: the "

@@ -31,8 +31,7 @@ STORE = Path(__file__).resolve().parent / "outputs"
 
 #: Examples without a ``[balance]`` section (no optimize, pareto): engines are balanced by
 #: counterweights and shafts of their own (issue 31).
-UNBALANCED = ("meijaard2020", "single_cylinder", "inline_three", "inline_four", "v6", "v8",
-              "servo_press")
+UNBALANCED = ("meijaard2020", "single_cylinder", "inline_three", "inline_four", "v6", "v8")
 #: Fields and phrases that measure wall-clock time or name a temporary folder.
 _MASKS = (
     (re.compile(r'("(?:time|seconds)": )[-+0-9.eE]+'), r'\1"<t>"'),
@@ -186,7 +185,7 @@ def _plans(name: str, spec: str) -> dict[str, list[str]]:
     if "[plan]" not in text:
         return {}
     out = {"plan.txt": ["plan", spec], "plan.json": ["plan", spec, "--json"]}
-    if "[balance]" in text and name in ALONG_MOTIONS:  # (masses chosen along a motion)
+    if "[balance]" in text:  # (the masses chosen with the time law)
         out["plan-masses.json"] = ["plan", spec, "--with-masses", "--json"]
     return out
 

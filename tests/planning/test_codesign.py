@@ -81,14 +81,25 @@ def test_the_verb_reports_each_lever(capsys):
         assert words in out
 
 
-@pytest.mark.parametrize(("example", "words"), [("servo_press", "--with-masses"),
-                                                ("three_rrr", "balance")])
-def test_the_verb_refuses_what_it_cannot_choose(capsys, example, words, tmp_path):
-    spec = EXAMPLES / f"{example}.toml"
-    if example == "three_rrr":  # without its [balance]
-        text = spec.read_text().split("\n[balance]")[0]
-        spec = tmp_path / "bare.toml"
-        spec.write_text(text)
+def test_the_verb_refuses_a_spec_without_balance(capsys, tmp_path):
+    spec = tmp_path / "bare.toml"
+    spec.write_text((EXAMPLES / "three_rrr.toml").read_text().split("\n[balance]")[0])
     assert main(["plan", str(spec), "--with-masses"]) == 2
     err = capsys.readouterr().err
-    assert words in err and len(err.strip().splitlines()) == 1
+    assert "balance" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_one_input_press_s_masses_are_chosen_along_its_varying_speed():
+    # the crank's counterweight along the planned revolution (its speed varies): balanced
+    # along the motion, not at constant speed — at constant speed the counterweight leaves the
+    # torque as it was; along a varying speed it does not
+    design = load_design(EXAMPLES / "servo_press.toml")
+    result = codesign(design, settings=replace(design.plan, intervals=60))
+    rounds = np.array(result.rounds)
+    assert np.all(np.diff(rounds) <= 1e-9 * rounds[:-1])
+    j = result.objectives
+    assert j["both"] <= min(j["masses"], j["motion"]) * (1 + 1e-12)
+    spec_torque = result.analyses["spec"].loads()["torque_crank"].rms
+    masses_torque = result.analyses["masses"].loads()["torque_crank"].rms
+    assert masses_torque == pytest.approx(spec_torque, rel=1e-9)  # (constant speed)
+    assert result.design.mechanism != design.mechanism
