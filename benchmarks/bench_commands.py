@@ -358,6 +358,23 @@ def analyze_rows(repeats: int) -> list[Row]:
                                         [*bal, verb, f"examples/{spec.name}"], repeats, limit)]
             rows += guarded(f"{verb} {spec.name}", f"≤ {limit:g} s", along)
 
+    for spec in sorted(EXAMPLES.glob("*.toml")):
+        text = spec.read_text()
+        if "\n[plan]" not in text:
+            continue
+        # A motion's time law planned (issue 43): the transcription on its mesh and on half
+        # of it, IPOPT from one or two starts, the analyses before and after; with the masses,
+        # the balancing and the plan in turn until neither improves.
+        verbs = [("plan", [], 1.5)]
+        if "\n[balance]" in text:
+            verbs.append(("plan --with-masses", ["--with-masses"], 2.5))
+        for verb, flags, limit in verbs:
+            def planned(spec=spec, verb=verb, flags=flags, limit=limit) -> list[Row]:
+                return [against_startup(f"{verb} {spec.name}",
+                                        [*bal, "plan", f"examples/{spec.name}", *flags],
+                                        repeats, limit)]
+            rows += guarded(f"{verb} {spec.name}", f"≤ {limit:g} s", planned)
+
     def paper() -> list[Row]:  # issue 41: the paper's four-bar within 1.6× of numpy's start-up
         return [against_startup("analyze meijaard2020.toml (issue 41)",
                                 [*bal, "analyze", "examples/meijaard2020.toml"], repeats, 0.3,

@@ -53,7 +53,8 @@ class Plan:
     solution
         Its optimum.
     starts
-        The transcription's optimum from each start (the path's own time law, a constant pace).
+        The transcription's optimum from each start: the path's own time law, and where that
+        optimum is not certified global, a constant pace.
     before, after
         The loads along ``path`` and along ``planned`` (the core's analysis).
     objective_before, objective_after
@@ -239,8 +240,9 @@ def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
     tau, weights = problem.loads.tau, problem.weights
     own = _rate2_of(path, tau, duration)
     steady = np.full(tau.shape, (problem.span / duration) ** 2)
-    starts = [own] if np.allclose(own, steady, rtol=1e-12, atol=0.0) else [own, steady]
-    solutions = [solve(problem, start) for start in starts]
+    solutions = [solve(problem, own)]
+    if not solutions[0].certified and not np.allclose(own, steady, rtol=1e-12, atol=0.0):
+        solutions.append(solve(problem, steady))  # (a local optimum: another start)
     best = min(solutions, key=lambda s: s.objective)
     coarse = _problem(mech, path, spec, max(spec.intervals // 2, 2), duration, gravity)
     halved = solve(coarse, _rate2_of(path, coarse.loads.tau, duration)).objective
