@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import threading
 from collections import OrderedDict
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,6 +31,9 @@ from .constraints import GROUND_INDEX
 from .inputs import InputState
 from .structure import Structure
 from .vectors import V
+
+#: Which piece of the path a waypoint belongs to: the one after it, or the one before.
+Side = Literal["left", "right"]
 
 #: Steps from the reference pose to a point path's first waypoint, when it is the linkage's
 #: length scale away (fewer when nearer).
@@ -156,9 +160,12 @@ def _slopes(spec: MotionSpec) -> NDArray[np.float64]:
 DENSE_KNOTS = 200
 
 
-def path_at(spec: MotionSpec, tau: NDArray[np.float64]
+def path_at(spec: MotionSpec, tau: NDArray[np.float64], side: Side = "right"
             ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The path's values at arguments ``tau`` (s) and their first two derivatives by ``τ``.
+
+    At a waypoint, the piece after it (``side="right"``) or before it (``"left"``): the
+    Hermite pieces' second derivatives differ there.
 
     Arrays ``(N, width)``: a point's ``(x, y)`` (m) or each input's change from the reference
     pose (rad). The cubic on each segment in Hermite form (``s`` its share of the segment
@@ -179,7 +186,7 @@ def path_at(spec: MotionSpec, tau: NDArray[np.float64]
         values = values.copy()
         values[-1] = values[0]
     slopes = _slopes(spec)
-    seg = np.clip(np.searchsorted(knots, tau, side="right") - 1, 0, len(knots) - 2)
+    seg = np.clip(np.searchsorted(knots, tau, side=side) - 1, 0, len(knots) - 2)
     h = (knots[seg + 1] - knots[seg])[:, None]
     s = ((tau - knots[seg])[:, None]) / h
     p0, p1, m0, m1 = values[seg], values[seg + 1], slopes[seg] * h, slopes[seg + 1] * h
@@ -459,14 +466,15 @@ def _point_state_at(structure: Structure, spec: MotionSpec, t: NDArray[np.float6
     return _point_state(structure, k, local, theta, v, a)
 
 
-def path_derivatives(structure: Structure, spec: MotionSpec, tau: NDArray[np.float64]
-                     ) -> InputState:
+def path_derivatives(structure: Structure, spec: MotionSpec, tau: NDArray[np.float64],
+                     side: Side = "right") -> InputState:
     """The inputs along the path at arguments ``tau`` (s): ``q``, ``dq/dτ``, ``d²q/dτ²``.
 
     As an :class:`InputState` of positions (rad, absolute), first and second derivatives by
     the path's argument — the inputs' state where ``τ̇ = 1``, ``τ̈ = 0``: at any time law,
     ``q̇ = q'·τ̇`` and ``q̈ = q''·τ̇² + q'·τ̈``. A point's path by inverse kinematics, each
-    argument's Newton steps started from the motion's samples (on their branch).
+    argument's Newton steps started from the motion's samples (on their branch). At a
+    waypoint, the path's piece after it or before it (``side``, as :func:`path_at`).
 
     Raises
     ------
@@ -474,7 +482,7 @@ def path_derivatives(structure: Structure, spec: MotionSpec, tau: NDArray[np.flo
         If the path leaves the workspace at one of the arguments.
     """
     tau = np.asarray(tau, dtype=float)
-    p, d1, d2 = path_at(spec, tau)
+    p, d1, d2 = path_at(spec, tau, side)
     if spec.point is None:
         reference = np.array(structure.input_references)
         state = InputState.of(list((p + reference).T), list(d1.T), list(d2.T))

@@ -17,6 +17,7 @@ fourth state, ``q̇ = 2q'``, ``q̈ = 4q''`` (``4B + C``), checks the form where 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -53,6 +54,10 @@ class PathLoads:
         kg·m (the total mass times its centre).
     mass
         The moving masses' total, kg.
+    left
+        The same at each argument from the path's piece before it (where the pieces join, at
+        a waypoint, the path's curvature jumps: ``B`` and ``q''`` with it), or ``None`` where
+        no argument is a waypoint inside the path.
     """
 
     tau: NDArray[np.float64]
@@ -64,6 +69,12 @@ class PathLoads:
     curvature: NDArray[np.float64]
     first_moment: NDArray[np.complex128]
     mass: float
+    left: PathLoads | None = None
+
+    @property
+    def arriving(self) -> PathLoads:
+        """The coefficients an interval ending at each argument sees (:attr:`left`'s)."""
+        return self if self.left is None else self.left
 
     def at(self, rate2: NDArray[np.float64], acceleration: NDArray[np.float64]
            ) -> NDArray[np.float64]:
@@ -100,6 +111,9 @@ def path_loads(mech: Mechanism, motion: MotionSpec, tau: NDArray[np.float64],
                gravity: tuple[float, float] = (0.0, 0.0)) -> PathLoads:
     """The loads along ``motion``'s path at arguments ``tau`` (module docstring).
 
+    With their left limits where an argument is a waypoint inside the path (:attr:`PathLoads.
+    left`).
+
     Raises
     ------
     AssemblyError
@@ -109,7 +123,26 @@ def path_loads(mech: Mechanism, motion: MotionSpec, tau: NDArray[np.float64],
         quadratically).
     """
     tau = np.asarray(tau, dtype=float)
-    along = trajectory.path_derivatives(mech.structure, motion, tau)
+    after = _path_loads(mech, motion, tau, gravity, "right")
+    joins = np.isin(tau, np.asarray(motion.times[1:-1], dtype=float))
+    if not joins.any():
+        return after
+    before = _path_loads(mech, motion, tau[joins], gravity, "left")
+
+    def spliced(name: str) -> NDArray[Any]:
+        whole = np.array(getattr(after, name), copy=True)
+        whole[..., joins] = getattr(before, name)
+        return whole
+    left = replace(after, inertial=spliced("inertial"), centripetal=spliced("centripetal"),
+                   static=spliced("static"), slope=spliced("slope"),
+                   curvature=spliced("curvature"))
+    return replace(after, left=left)
+
+
+def _path_loads(mech: Mechanism, motion: MotionSpec, tau: NDArray[np.float64],
+                gravity: tuple[float, float], side: trajectory.Side) -> PathLoads:
+    """:func:`path_loads` at arguments ``tau``, each from the path's piece on ``side``."""
+    along = trajectory.path_derivatives(mech.structure, motion, tau, side)
     q, d1, d2 = (np.array([np.asarray(x, dtype=float) for x in part])
                  for part in (along.positions, along.rates, along.accelerations))
     zero = np.zeros_like(q)

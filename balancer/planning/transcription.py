@@ -5,7 +5,8 @@ the argument's acceleration is constant, ``aₖ = (bₖ₊₁ − bₖ)/(2·Δτ
 ``Δtₖ = 2·Δτₖ/(√bₖ + √bₖ₊₁)`` and the time law is exact between the rows (a pace,
 :attr:`balancer.model.motions.MotionSpec.pace`). At each row the loads are
 ``Lₖ = Aₖ·a + Bₖ·bₖ + Cₖ`` (:mod:`.path_loads`) with the acceleration of the interval before
-and of the interval after.
+and of the interval after — and at a waypoint, the coefficients of the path's piece each
+interval runs on (its curvature jumps there).
 
 - ``"rms"``: ``J = (1/T)·Σₖ Δtₖ/2·(Σ w·L²(τₖ, aₖ) + Σ w·L²(τₖ₊₁, aₖ))``, the trapezoid rule
   in time of the weighted mean square.
@@ -97,9 +98,9 @@ class Problem:
                                                           NDArray[np.float64]]:
         """The loads at each interval's start and end, ``(loads, N)`` each."""
         a = self.accelerations(rate2)
-        at = self.loads
+        at, to = self.loads, self.loads.arriving
         start = at.inertial[:, :-1] * a + at.centripetal[:, :-1] * rate2[:-1] + at.static[:, :-1]
-        end = at.inertial[:, 1:] * a + at.centripetal[:, 1:] * rate2[1:] + at.static[:, 1:]
+        end = to.inertial[:, 1:] * a + to.centripetal[:, 1:] * rate2[1:] + to.static[:, 1:]
         return start, end
 
     def natural_objective(self) -> float:
@@ -194,10 +195,12 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
     low: list[float] = [-math.inf if relaxed else 0.0]
     high: list[float] = [0.0]
 
+    to = at.arriving  # (an interval's end: the path's piece it arrives on)
+
     def sides(row: int) -> tuple[Any, Any]:
         start_ = at.inertial[row, :-1] * a + at.centripetal[row, :-1] * b[:-1] \
             + at.static[row, :-1]
-        end_ = at.inertial[row, 1:] * a + at.centripetal[row, 1:] * b[1:] + at.static[row, 1:]
+        end_ = to.inertial[row, 1:] * a + to.centripetal[row, 1:] * b[1:] + to.static[row, 1:]
         return start_, end_
 
     left: Any = ca.SX.zeros(count - 1)
@@ -224,8 +227,8 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
     for i, limit in enumerate(problem.max_acceleration):
         if limit is None:
             continue
-        for side in (slice(None, -1), slice(1, None)):
-            q_acc = at.curvature[i, side] * b[side] + at.slope[i, side] * a
+        for side, of in ((slice(None, -1), at), (slice(1, None), to)):
+            q_acc = of.curvature[i, side] * b[side] + of.slope[i, side] * a
             constraints.append(q_acc / limit)
             low += [-1.0] * (count - 1)
             high += [1.0] * (count - 1)
@@ -241,7 +244,8 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
     for i, limit in enumerate(problem.max_speed):
         if limit is not None:
             with np.errstate(divide="ignore"):
-                upper = np.minimum(upper, limit**2 / at.slope[i] ** 2 / scale2)
+                steepest = np.maximum(at.slope[i] ** 2, to.slope[i] ** 2)
+                upper = np.minimum(upper, limit**2 / steepest / scale2)
     lower = np.full(count, LEAST_RATE2)
     if np.any(upper < lower):
         raise SolverError("the speed limits stop the motion on its path (an input's limit is 0 "

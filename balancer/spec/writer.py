@@ -116,7 +116,9 @@ def _plan_lines(design: Design) -> list[str]:
             rows = ", ".join(f"{toml.key(name)} = {toml.number(x)}" for name, x in limits.each)
             out.append(f"{key} = {{ {rows} }}  # {unit}")
     out += ["", "[plan.objective]"]
-    out += [f"{name} = {toml.number(weight)}" for name, weight in plan.objective.terms().items()]
+    weights = {"shaking_moment": plan.objective.shaking_moment,  # (its default is 1)
+               **plan.objective.terms()}
+    out += [f"{name} = {toml.number(weight)}" for name, weight in weights.items()]
     return out
 
 

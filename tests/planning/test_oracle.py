@@ -4,7 +4,8 @@ CVXPY's disciplined form of the problem of :mod:`balancer.planning.transcription
 independently from its docstring: unknowns ``bₖ`` and ``yₖ ≤ √bₖ``; each interval's weighted
 sum of squares over ``yₖ + yₖ₊₁`` (``quad_over_lin``), its duration ``2·Δτ/(yₖ + yₖ₊₁)``
 (``inv_pos``) summed to at most ``T``. At the optimum ``y = √b`` (both decrease in ``y``), so
-its value is the transcription's optimum.
+its value is the transcription's optimum. An interval ending at a waypoint sees the path's
+piece before it (its curvature jumps there).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 def _cvxpy_optimum(problem) -> float:
     at = problem.loads
+    to = at.left if at.left is not None else at  # (an interval's end: the piece it arrives on)
     dtau = np.diff(at.tau)
     count = at.tau.size
     b = cp.Variable(count, nonneg=True)
@@ -45,8 +47,8 @@ def _cvxpy_optimum(problem) -> float:
             root = np.sqrt(problem.weights[i]) / unit
             sides += [root * (at.inertial[i, k] * a[k] + at.centripetal[i, k] * b[k]
                               + at.static[i, k]),
-                      root * (at.inertial[i, k + 1] * a[k] + at.centripetal[i, k + 1] * b[k + 1]
-                              + at.static[i, k + 1])]
+                      root * (to.inertial[i, k + 1] * a[k] + to.centripetal[i, k + 1] * b[k + 1]
+                              + to.static[i, k + 1])]
         # Δt/2·Σ(L²) = Δτ·Σ L²/(yₖ + yₖ₊₁)
         terms.append(dtau[k] * cp.quad_over_lin(cp.hstack(sides), y[k] + y[k + 1]))
         times.append(2.0 * dtau[k] * cp.inv_pos(y[k] + y[k + 1]))
