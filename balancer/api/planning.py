@@ -8,6 +8,7 @@ from .. import validate as v
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
 from ..model import Design
+from ..model.motions import REVOLUTION
 from ..model.plan import PlanSpec
 from ..planning import Plan, path_of, plan_motion
 from ..planning.codesign import CoDesign
@@ -40,7 +41,7 @@ def plan(design: Design, motion: str | None = None, *, settings: PlanSpec | None
     if design.mechanism.type != "linkage":
         raise SpecError(f"plans a general linkage's motion (type = \"linkage\"; this spec's is "
                         f"\"{design.mechanism.type}\")", key="mechanism.type")
-    spec = settings or design.plan or PlanSpec()
+    spec = _for_motion(design, settings or design.plan or PlanSpec(), motion)
     mech = mechanism_of(design.mechanism)
     name = motion if motion is not None else spec.motion
     path = path_of(design, name, key="--motion" if motion is not None else "plan.motion")
@@ -66,8 +67,17 @@ def codesign(design: Design, motion: str | None = None, *, settings: PlanSpec | 
     if design.mechanism.type != "linkage":
         raise SpecError(f"plans a general linkage's motion (type = \"linkage\"; this spec's is "
                         f"\"{design.mechanism.type}\")", key="mechanism.type")
-    spec = settings or design.plan or PlanSpec()
+    spec = _for_motion(design, settings or design.plan or PlanSpec(), motion)
     return run_codesign(design, spec, motion, gravity=spec_gravity(design))
+
+
+def _for_motion(design: Design, spec: PlanSpec, motion: str | None) -> PlanSpec:
+    """The plan for another motion than its own: its planned motion's name is that motion's."""
+    own = path_of(design, spec.motion).name if spec.motion is not None or design.motions \
+        else REVOLUTION
+    if motion is None or motion == own or spec.name is None:
+        return spec
+    return replace(spec, name=None)
 
 
 def planned_design(design: Design, result: Plan) -> Design:

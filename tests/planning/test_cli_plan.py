@@ -83,3 +83,9 @@ def test_the_schema_names_the_plan_s_keys_as_the_model_does():
     assert tuple(k.name for k in schema.section("plan.objective").keys) == PLAN_OBJECTIVE_KEYS
     limits = tuple(k.name for k in schema.section("plan").keys if k.name.startswith("max_"))
     assert limits == tuple(LIMIT_KEYS)
+
+
+def test_another_motion_than_the_plan_s_is_named_after_itself(capsys):
+    assert main(["plan", FORBAL, "--motion", "circle", "--intervals", "24", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["motion"] == "circle" and doc["planned"] == "circle planned"
