@@ -531,3 +531,20 @@ def test_engine_orders_gives_the_classic_verdicts_and_the_series_shortfall(tmp_p
             assert math.isclose(exact[1], series[1], rel_tol=1e-9, abs_tol=nothing)
             if series[2] > nothing:
                 assert math.isclose(exact[2] / series[2], a2 / lam, rel_tol=1e-9), (name, kind)
+
+
+def test_motion_planning_reaches_the_closed_forms_at_the_schemes_orders(quick):
+    r = quick("motion_planning")
+    closed = r["closed"]
+    # the last meshes' observed orders (the first ones still pre-asymptotic): second for the
+    # mean square, first for the peak
+    assert abs(closed["rms"]["orders"][-1] - 2.0) < 0.2
+    assert abs(closed["peak"]["orders"][-1] - 1.0) < 0.15
+    assert closed["rms"]["bound"] == pytest.approx(closed["exact"]["rms"], rel=1e-13)
+    for case in (r["forbal"]["levers"], r["press"]["levers"]):
+        assert case["both"] <= min(case["masses"], case["motion"]) * (1 + 1e-12)
+        assert max(case["masses"], case["motion"]) <= case["spec"]
+    rows = r["forbal"]["rows"]
+    assert all(x["certified"] for x in rows)
+    # refining the mesh, the transcription's optimum falls toward the planned motions' own
+    assert rows[-1]["transcription"] < rows[0]["transcription"]
