@@ -38,9 +38,7 @@ def plan(design: Design, motion: str | None = None, *, settings: PlanSpec | None
     SolverError
         If the limits cannot be met in the duration, or IPOPT fails.
     """
-    if design.mechanism.type != "linkage":
-        raise SpecError(f"plans a general linkage's motion (type = \"linkage\"; this spec's is "
-                        f"\"{design.mechanism.type}\")", key="mechanism.type")
+    _check_type(design)
     spec = _for_motion(design, settings or design.plan or PlanSpec(), motion)
     mech = mechanism_of(design.mechanism)
     name = motion if motion is not None else spec.motion
@@ -64,11 +62,20 @@ def codesign(design: Design, motion: str | None = None, *, settings: PlanSpec | 
     SolverError
         If a step fails.
     """
-    if design.mechanism.type != "linkage":
-        raise SpecError(f"plans a general linkage's motion (type = \"linkage\"; this spec's is "
-                        f"\"{design.mechanism.type}\")", key="mechanism.type")
+    _check_type(design)
     spec = _for_motion(design, settings or design.plan or PlanSpec(), motion)
     return run_codesign(design, spec, motion, gravity=spec_gravity(design))
+
+
+#: The mechanisms whose motions are planned: linkages (an engine's crank turns at its speed).
+PLANNED = ("four-bar", "slider-crank", "linkage")
+
+
+def _check_type(design: Design) -> None:
+    """Refuse a mechanism whose motion is not planned (an engine), naming its type."""
+    if design.mechanism.type not in PLANNED:
+        raise SpecError(f"plans a linkage's motion ({', '.join(PLANNED)}); this spec's type is "
+                        f"\"{design.mechanism.type}\"", key="mechanism.type")
 
 
 def _for_motion(design: Design, spec: PlanSpec, motion: str | None) -> PlanSpec:

@@ -254,7 +254,7 @@ class Design:
                 raise SpecError("is the name of another motion", key=f"{key}.name",
                                 value=motion.name)
             seen.add(motion.name)
-            if motion.point is None and len(motion.path[0]) != len(inputs):
+            if motion.point is None and inputs and len(motion.path[0]) != len(inputs):
                 raise SpecError(f"each waypoint must give one angle per input "
                                 f"({', '.join(inputs)})", key=f"{key}.path",
                                 value=list(motion.path[0]))

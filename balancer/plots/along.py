@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from ..cycle import ROUNDING_SPAN
 from ..motion_analysis import MotionAnalysis, load_words
 from ..quantities import QUANTITIES
+from ..report.along import law_words
 from .style import COLOURS, SERIES, axes, legend_outside, number
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
@@ -230,9 +231,8 @@ def plot_centre_of_mass_track(analysis: MotionAnalysis, drawing: MotionDrawing,
 
 def _law_words(analysis: MotionAnalysis) -> str:
     m = analysis.motion
-    law = (f"trapezoid law, acceleration {m.acc_time:g} s" if m.law == "trapezoid"
-           else f"{m.law} law")
-    return f"motion {m.name} over {m.duration:g} s ({law}, {analysis.t.size} states)"
+    return (f"motion {m.name} over {m.duration:g} s ({law_words(m)}, {analysis.t.size} "
+            "states)")
 
 
 def motion_figure(analysis: MotionAnalysis, drawing: MotionDrawing | None = None,

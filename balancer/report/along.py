@@ -5,19 +5,32 @@ from __future__ import annotations
 from typing import Any
 
 from ..linkage.loads import Reactions
+from ..model.motions import REVOLUTION, MotionSpec
 from ..motion_analysis import AlongMotions, MotionAnalysis, load_words
 from ..rounding import Scales
 from .analysis import reaction_extremes
 from .text import csv_text, table
 
 
+def law_words(m: MotionSpec) -> str:
+    """A motion's time law in words: the law's name, or a planned motion's pace."""
+    if m.pace is not None:
+        return f"a planned pace ({len(m.pace)} rows)"
+    if m.law == "trapezoid":
+        return f"trapezoid law (acceleration {m.acc_time:g} s)"
+    return f"{m.law} law"
+
+
 def _law(analysis: MotionAnalysis) -> str:
     m = analysis.motion
-    law = (f"trapezoid law (acceleration {m.acc_time:g} s)" if m.law == "trapezoid"
-           else f"{m.law} law")
-    path = f"point {m.point}'s path" if m.point is not None else "the inputs' own path"
-    return (f"{m.samples} states over {m.duration:g} s, {law}, {path} through "
-            f"{len(m.times)} waypoints")
+    if m.along == REVOLUTION:
+        path = "one revolution of the input"
+    else:
+        path = f"point {m.point}'s path" if m.point is not None else "the inputs' own path"
+        path += f" through {len(m.times)} waypoints"
+        if m.along is not None:
+            path += f" (motion {m.along}'s)"
+    return f"{m.samples} states over {m.duration:g} s, {law_words(m)}, {path}"
 
 
 def motions_text(along: AlongMotions, spec: str | None = None) -> str:

@@ -156,9 +156,9 @@ SECTIONS: tuple[Section, ...] = (
             "below).", (LINKAGE,)),
         Key("motion", "table", "none",
             "Named motions of a linkage's inputs or of a marker point (`[[motion]]`, below).",
-            (LINKAGE,)),
+            _LINKAGES),
         Key("plan", "table", "none",
-            "The time law `plan` chooses for a motion's path (`[plan]`, below).", (LINKAGE,)),
+            "The time law `plan` chooses for a motion's path (`[plan]`, below).", _LINKAGES),
     )),
     Section("mechanism", "The type of linkage and its geometry.", (
         Key("type", "—", "required",

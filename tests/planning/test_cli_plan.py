@@ -71,9 +71,11 @@ def test_plan_refuses_bad_input_in_one_line(tmp_path, capsys, args, extra, code,
     assert words in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
 
 
-def test_plan_refuses_a_mechanism_of_another_type(capsys):
-    assert main(["plan", str(EXAMPLES / "meijaard2020.toml")]) == 2
+def test_plan_refuses_an_engine(capsys):
+    # (an engine's crank turns at its speed; the closed-form four-bar and slider-crank plan)
+    assert main(["plan", str(EXAMPLES / "single_cylinder.toml")]) == 2
     assert "mechanism.type" in capsys.readouterr().err
+    assert main(["plan", str(EXAMPLES / "meijaard2020.toml"), "--intervals", "16"]) == 0
 
 
 def test_the_schema_names_the_plan_s_keys_as_the_model_does():

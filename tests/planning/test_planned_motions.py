@@ -19,9 +19,12 @@ from linkage.several_inputs_specs import crank_rocker
 
 from balancer.api import simulate_motion
 from balancer.api.planning import path_of, plan, planned_design
+from balancer.cycle import cycle_analysis
 from balancer.linkage import trajectory
 from balancer.mechanisms import mechanism_of
-from balancer.model.plan import PlanSpec, PlanWeights
+from balancer.model.plan import InputLimits, PlanSpec, PlanWeights
+from balancer.motion_analysis import motion_analysis
+from balancer.planning import revolution
 from balancer.planning.path_loads import load_rows, reactions_at
 from balancer.spec import dumps_design, load_design, loads_design
 from balancer.spec.reader import design_from_dict
@@ -110,3 +113,37 @@ def test_a_balanced_rotor_s_least_torque_is_the_constant_speed_s():
     rate = np.asarray(result.planned.pace)[:, 1]
     assert np.max(np.abs(rate - 1.0)) < 1e-6
     assert path_of(design, None).name == "revolution"
+
+
+def test_a_revolution_at_its_constant_pace_is_the_cycle_analysis():
+    # the paper's four-bar (its closed-form type): its revolution as a motion at the constant
+    # pace against the cycle analysis at the same crank angles (the seed's own route)
+    design = load_design(EXAMPLES / "meijaard2020.toml")
+    mech = mechanism_of(design.mechanism)
+    speed = design.operation.speed
+    along = motion_analysis(mech, revolution(speed, samples=361),
+                            gravity=design.operation.gravity)
+    cycle = cycle_analysis(design.mechanism, speed, 360, gravity=design.operation.gravity)
+    assert mech.structure.input_references == (0.0,)
+    np.testing.assert_allclose(np.asarray(along.state.positions[0])[:-1], cycle.theta1,
+                               rtol=0, atol=1e-13)
+    for ours, theirs in ((along.reactions.shaking_moment, cycle.reactions.shaking_moment),
+                         (along.reactions.shaking_force, cycle.reactions.shaking_force),
+                         (along.reactions.torques[0], cycle.reactions.driving_torque)):
+        scale = np.max(np.abs(theirs))
+        assert np.max(np.abs(np.asarray(ours)[:-1] - theirs)) <= 1e-10 * scale
+
+
+def test_the_paper_s_four_bar_planned_and_proved_by_simulation(tmp_path):
+    design = load_design(EXAMPLES / "meijaard2020.toml")
+    settings = PlanSpec(objective=PlanWeights(shaking_moment=1.0, torque=0.1), intervals=80,
+                        max_speed=InputLimits(every=15.0))
+    result = plan(design, settings=settings)
+    assert result.certified and result.objective_after < result.objective_before
+    written = loads_design(dumps_design(planned_design(design, result)))
+    run = simulate_motion(written, result.planned.name, method="multibody")
+    assert run.energy_error < 1e-9
+    scale = np.max(np.abs(result.after.reactions.shaking_moment))
+    assert np.max(np.abs(run.reactions.shaking_moment
+                         - result.after.reactions.shaking_moment)) <= 1e-9 * scale
+    assert np.max(np.abs(run.state.rates[0])) <= 15.0 * (1 + 1e-6)

@@ -142,7 +142,7 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
         data["mechanism"]["inputs"] = [data["mechanism"].pop("input")]  # its other spelling
         return data
     if pattern.startswith("plan") or (pattern == "" and name == "plan"):
-        if mechanism == schema.LINKAGE:
+        if mechanism in (schema.LINKAGE, schema.FOUR_BAR, schema.SLIDER_CRANK):
             data.setdefault("motion", [copy.deepcopy(MOTION)])
         if pattern.startswith("plan"):
             data["plan"] = {"objective": {}} if pattern == "plan.objective" else {}
