@@ -235,8 +235,8 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "inputs' speed, acceleration and torque limits of [plan], in the same duration — to "
         "minimise the mean square (or the peak) of the weighted shaking force, shaking "
         "moment, rocking couple and input torques ([plan.objective]). Direct transcription "
-        "solved by IPOPT: convex, so the optimum is global for its mesh. Reports the loads "
-        "before and after; writes the spec with the planned motion (--out), its loads over "
+        "solved by IPOPT: convex where the duration binds, and then the optimum is global for "
+        "its mesh (the report says which). Reports the loads before and after; writes the spec with the planned motion (--out), its loads over "
         "time (--csv) and a figure (--plot).",
     ),
     "example": (
@@ -453,7 +453,7 @@ def _plan_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--with-masses", action="store_true",
                    help="choose the links' masses of [balance] with the time law: each "
                    "lever's certified problem in turn until neither improves; report what "
-                   "the masses, the time law and both buy (a linkage with several inputs)")
+                   "the masses, the time law and both buy")
     p.add_argument("--out", metavar="PLANNED.toml",
                    help="write the spec with the planned motion ([[motion]] along the path, "
                    "at its pace), and with --with-masses the chosen masses")
