@@ -236,8 +236,9 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "minimise the mean square (or the peak) of the weighted shaking force, shaking "
         "moment, rocking couple and input torques ([plan.objective]). Direct transcription "
         "solved by IPOPT: convex where the duration binds, and then the optimum is global for "
-        "its mesh (the report says which). Reports the loads before and after; writes the spec with the planned motion (--out), its loads over "
-        "time (--csv) and a figure (--plot).",
+        "its mesh (the report says which). Reports the loads before and after; writes the "
+        "spec with the planned motion (--out), its loads over time (--csv) and a figure "
+        "(--plot).",
     ),
     "example": (
         "write a shipped example spec (without NAME: list them)",
