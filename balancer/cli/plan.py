@@ -35,7 +35,10 @@ def run(args: argparse.Namespace) -> int:
             raise as_option(exc, key, f"--{key}", value) from None
     together = None
     if args.with_masses:
-        together = codesign(design, args.motion, settings=settings)
+        try:
+            together = codesign(design, args.motion, settings=settings)
+        except SpecError as exc:
+            raise as_option(exc, "plan.measure", "--measure", args.measure) from None
         result, chosen = together.plan, together.design
     else:
         result, chosen = plan(design, args.motion, settings=settings), design

@@ -91,10 +91,14 @@ def codesign(design: Design, spec: PlanSpec, motion: str | None = None, *,
     Raises
     ------
     SpecError
-        If the spec has no ``[balance]``.
+        If the spec has no ``[balance]``, or the plan measures a peak.
     SolverError
         If a step fails.
     """
+    if spec.measure != "rms":
+        raise SpecError("chooses the masses for a mean square (the balancing's objective): "
+                        "plan the masses and the time law with measure = \"rms\"",
+                        key="plan.measure", value=spec.measure)
     mech = mechanism_of(design.mechanism)
     problem = design.balance
     if not isinstance(problem, BalanceProblem):

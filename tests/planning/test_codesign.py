@@ -103,3 +103,10 @@ def test_a_one_input_press_s_masses_are_chosen_along_its_varying_speed():
     masses_torque = result.analyses["masses"].loads()["torque_crank"].rms
     assert masses_torque == pytest.approx(spec_torque, rel=1e-9)  # (constant speed)
     assert result.design.mechanism != design.mechanism
+
+
+def test_the_masses_are_chosen_for_a_mean_square_only(capsys):
+    assert main(["plan", str(EXAMPLES / "forbal2.toml"), "--with-masses", "--measure",
+                 "peak"]) == 2
+    err = capsys.readouterr().err
+    assert "--measure" in err and len(err.strip().splitlines()) == 1
