@@ -10,7 +10,7 @@ from ..mechanisms import mechanism_of
 from ..model import Design
 from ..model.motions import REVOLUTION
 from ..model.plan import PlanSpec
-from ..planning import Plan, path_of, plan_motion
+from ..planning import Plan, check_plan, path_of, plan_motion
 from ..planning.codesign import CoDesign
 from ..planning.codesign import codesign as run_codesign
 from .analysis import spec_gravity
@@ -43,6 +43,7 @@ def plan(design: Design, motion: str | None = None, *, settings: PlanSpec | None
     mech = mechanism_of(design.mechanism)
     name = motion if motion is not None else spec.motion
     path = path_of(design, name, key="--motion" if motion is not None else "plan.motion")
+    check_plan(mech, path, spec)  # (its keys the spec's, not under the motion's)
     index = next((i for i, m in enumerate(design.motions) if m is path), None)
     with v.under("plan" if index is None else v.item("motion", index)):
         return plan_motion(mech, path, spec, gravity=spec_gravity(design))

@@ -122,6 +122,16 @@ def _frames(text: str) -> int:
     return value
 
 
+def _intervals(text: str) -> int:
+    """A transcription's intervals: a whole number, at least 4 (:class:`~balancer.model.plan.
+    PlanSpec`'s least).
+    """
+    value = _count(text)
+    if value < 4:
+        raise argparse.ArgumentTypeError(f"must be at least 4: {text!r}")
+    return value
+
+
 def _count(text: str) -> int:
     try:
         value = int(text)
@@ -448,7 +458,7 @@ def _plan_arguments(p: argparse.ArgumentParser) -> None:
                    "(default: [plan] measure, rms)")
     p.add_argument("--duration", type=_positive_float, metavar="T",
                    help="the planned motion's duration, s (default: the motion's)")
-    p.add_argument("--intervals", type=_count, metavar="N",
+    p.add_argument("--intervals", type=_intervals, metavar="N",
                    help="intervals of the path in the transcription (default: [plan] "
                    "intervals, 200)")
     p.add_argument("--with-masses", action="store_true",

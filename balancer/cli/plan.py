@@ -34,14 +34,16 @@ def run(args: argparse.Namespace) -> int:
         except SpecError as exc:
             raise as_option(exc, key, f"--{key}", value) from None
     together = None
-    if args.with_masses:
-        try:
+    try:
+        if args.with_masses:
             together = codesign(design, args.motion, settings=settings)
-        except SpecError as exc:
-            raise as_option(exc, "plan.measure", "--measure", args.measure) from None
-        result, chosen = together.plan, together.design
-    else:
-        result, chosen = plan(design, args.motion, settings=settings), design
+            result, chosen = together.plan, together.design
+        else:
+            result, chosen = plan(design, args.motion, settings=settings), design
+    except SpecError as exc:
+        for key in ("measure", "duration", "intervals"):
+            exc = as_option(exc, f"plan.{key}", f"--{key}", getattr(args, key))
+        raise exc from None
     spec_text = None
     if out is not None:
         spec_text = dumps_design(planned_design(chosen, result))

@@ -239,6 +239,8 @@ class MotionSpec:
 
 #: How near a pace's first and last arguments must be to the path's ends (a share of its span).
 PACE_ENDS = 1e-9
+#: A pace's rates (s/s): 0 (at rest) or within this factor of 1, either way.
+PACE_RATES = 1e9
 
 
 def _checked_pace(rows: object, times: Sequence[float]) -> tuple[tuple[float, float], ...]:
@@ -252,6 +254,9 @@ def _checked_pace(rows: object, times: Sequence[float]) -> tuple[tuple[float, fl
         tau, rate = v.numbers(row, "pace")
         if not rate >= 0:
             raise SpecError("a rate must be at least 0", key="pace", value=list(row))
+        if rate != 0.0 and not 1 / PACE_RATES <= rate <= PACE_RATES:
+            raise SpecError(f"a rate must be 0 or within {1 / PACE_RATES:g} to {PACE_RATES:g}",
+                            key="pace", value=list(row))
         if out and not tau > out[-1][0]:
             raise SpecError("its arguments must increase", key="pace", value=list(row))
         if out and rate == 0.0 and out[-1][1] == 0.0:

@@ -23,7 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import SpecError
+from ..errors import SolverError, SpecError
 from ..linkage import trajectory
 from ..mechanisms import Mechanism, mechanism_of
 from ..model import Design
@@ -64,7 +64,8 @@ class Plan:
         the shaking force's closed form), or ``None``.
     halved
         The transcription's optimum on half the intervals: their difference estimates the
-        transcription's error (it bounds it where the error falls at first order or faster).
+        transcription's error (it bounds it where the error falls at first order or faster);
+        ``None`` where half the mesh is no coarser (a segment per interval) or did not solve.
     """
 
     spec: PlanSpec
@@ -78,12 +79,12 @@ class Plan:
     objective_before: float
     objective_after: float
     bound: float | None
-    halved: float
+    halved: float | None
 
     @property
-    def mesh_error(self) -> float:
+    def mesh_error(self) -> float | None:
         """The transcription's error estimate: its optimum's change from half its mesh."""
-        return abs(self.solution.objective - self.halved)
+        return None if self.halved is None else abs(self.solution.objective - self.halved)
 
     @property
     def certified(self) -> bool:
@@ -205,6 +206,41 @@ def _rate2_of(motion: MotionSpec, tau: NDArray[np.float64], duration: float
     return np.asarray(rate, dtype=float) ** 2 * (motion.duration / duration) ** 2
 
 
+#: A plan's duration at most this factor from its motion's own, either way.
+DURATION_RANGE = 1e6
+#: A limit's value within this factor of 1 in SI units, either way (its square stays finite).
+LIMIT_RANGE = 1e100
+
+
+def check_plan(mech: Mechanism, path: MotionSpec, spec: PlanSpec) -> None:
+    """Refuse a plan that does not fit its mechanism and path (keys within ``[plan]``).
+
+    Its limits name the mechanism's inputs and stay within :data:`LIMIT_RANGE`; its duration
+    within :data:`DURATION_RANGE` of the motion's own; its mesh gives each of the path's
+    segments an interval at least (the waypoints are its rows).
+    """
+    inputs = mech.linkage.inputs
+    for key in ("max_speed", "max_acceleration", "max_torque"):
+        limits = getattr(spec, key)
+        for name, value in ((None, limits.every), *limits.each):
+            where = f"plan.{key}" if name is None else f"plan.{key}.{name}"
+            if name is not None and name not in inputs:
+                raise SpecError(f"must name an input ({', '.join(inputs)})", key=where,
+                                value=name)
+            if value is not None and not 1 / LIMIT_RANGE <= value <= LIMIT_RANGE:
+                raise SpecError(f"must be within {1 / LIMIT_RANGE:g} to {LIMIT_RANGE:g}",
+                                key=where, value=value)
+    if spec.duration is not None and not (path.duration / DURATION_RANGE <= spec.duration
+                                          <= path.duration * DURATION_RANGE):
+        raise SpecError(f"must be within {DURATION_RANGE:g} times the motion's own "
+                        f"({path.duration:g} s) either way", key="plan.duration",
+                        value=spec.duration)
+    segments = len(path.times) - 1
+    if spec.intervals < segments:
+        raise SpecError(f"must be at least the path's segments ({segments}): its waypoints are "
+                        "the transcription's rows", key="plan.intervals", value=spec.intervals)
+
+
 def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
                 gravity: tuple[float, float] = (0.0, 0.0)) -> Plan:
     """The time law of ``path``'s path that ``spec`` asks for (module docstring).
@@ -229,23 +265,33 @@ def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
     SolverError
         If the limits cannot be met in the duration, or IPOPT fails.
     """
-    inputs = mech.linkage.inputs
-    for key in ("max_speed", "max_acceleration", "max_torque"):
-        for name, _ in getattr(spec, key).each:
-            if name not in inputs:
-                raise SpecError(f"must name an input ({', '.join(inputs)})",
-                                key=f"plan.{key}.{name}", value=name)
+    check_plan(mech, path, spec)
     duration = path.duration if spec.duration is None else spec.duration
     problem = _problem(mech, path, spec, spec.intervals, duration, gravity)
     tau, weights = problem.loads.tau, problem.weights
     own = _rate2_of(path, tau, duration)
     steady = np.full(tau.shape, (problem.span / duration) ** 2)
-    solutions = [solve(problem, own)]
-    if not solutions[0].certified and not np.allclose(own, steady, rtol=1e-12, atol=0.0):
-        solutions.append(solve(problem, steady))  # (a local optimum: another start)
+    solutions: list[Transcribed] = []
+    failures: list[SolverError] = []
+    for start in (own, steady):
+        if solutions and (solutions[0].certified or np.allclose(own, steady, rtol=1e-12,
+                                                                atol=0.0)):
+            break  # (a global optimum, or one start: no other)
+        try:
+            solutions.append(solve(problem, start))
+        except SolverError as exc:
+            failures.append(exc)
+    if not solutions:
+        raise failures[0]
     best = min(solutions, key=lambda s: s.objective)
-    coarse = _problem(mech, path, spec, max(spec.intervals // 2, 2), duration, gravity)
-    halved = solve(coarse, _rate2_of(path, coarse.loads.tau, duration)).objective
+    halved = None
+    coarse_intervals = spec.intervals // 2
+    if coarse_intervals >= len(path.times) - 1 and coarse_intervals >= 2:
+        try:  # (an estimate of the mesh's error: not worth failing the plan for)
+            coarse = _problem(mech, path, spec, coarse_intervals, duration, gravity)
+            halved = solve(coarse, _rate2_of(path, coarse.loads.tau, duration)).objective
+        except SolverError:
+            halved = None
     rate = np.sqrt(np.maximum(best.rate2, 0.0))
     rate *= float(np.sum(problem.times(best.rate2))) / duration  # (the duration to rounding)
     name = spec.name or f"{path.name} planned"

@@ -5,8 +5,10 @@ along the motion (convex: :mod:`balancer.balance`); with the masses fixed, the t
 plan's transcription (convex: :mod:`.transcription`). Their joint problem is not convex (the
 loads are products of the masses and the motion), so the two are solved in turn — block
 coordinate descent on one objective, the plan's ``J`` — until neither improves it by more
-than :data:`IMPROVEMENT`: ``J`` never rises (each step's optimum is at most its start's), and
-the result is a point where neither lever alone can do better, not a certified joint optimum.
+than :data:`IMPROVEMENT`. From the first masses on, ``J`` never rises (each step's optimum is at
+most its start's); the first masses step rises where the spec's masses do not meet
+``[balance]``'s constraints (its force balance: it projects onto them). The result is a point
+where neither lever alone can do better, not a certified joint optimum.
 
 Reported beside it, what each lever buys alone from the spec: the masses at the spec's own time
 law (the balancing), the time law at the spec's masses (the plan).
@@ -55,6 +57,9 @@ class CoDesign:
         The loads along the motion in each of those four cases.
     rounds
         ``J`` after each step, in order (a time law, then masses, …).
+    projected
+        Whether the first masses step raised ``J``: the spec's masses do not meet
+        ``[balance]``'s constraints, and the descent starts from the first masses.
     """
 
     plan: Plan
@@ -64,14 +69,19 @@ class CoDesign:
     analyses: dict[str, MotionAnalysis]
     rounds: tuple[float, ...]
 
+    @property
+    def projected(self) -> bool:
+        """Whether the first masses step raised ``J`` (the spec's masses infeasible)."""
+        return len(self.rounds) > 1 and self.rounds[1] > self.rounds[0]
+
 
 def _mass_objective(weights: PlanWeights, like: Objective) -> Objective:
-    """The balancing's objective weighing what the plan weighs (the added mass's as given)."""
+    """The balancing's objective weighing what the plan weighs, and nothing else."""
     return replace(like, shaking_moment=weights.shaking_moment,
                    driving_torque=weights.torque, shaking_force=weights.shaking_force,
                    shaking_force_x=weights.shaking_force_x,
                    shaking_force_y=weights.shaking_force_y,
-                   rocking_couple=weights.rocking_couple)
+                   rocking_couple=weights.rocking_couple, added_mass=0.0, unbalance=0.0)
 
 
 def _balanced(design: Design, problem: BalanceProblem, motion: MotionSpec) -> BalanceResult:

@@ -25,7 +25,7 @@ transcription's (:attr:`Transcribed.certified`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -38,9 +38,13 @@ from .path_loads import PathLoads
 TOLERANCE = 1e-10
 #: Iterations at most.
 MAX_ITERATIONS = 3000
+#: IPOPT's time at most per solve, s (an unattainable limit is declared so, not waited on).
+MAX_SECONDS = 30.0
 #: IPOPT's ends short of its tolerance that are its optimum where the limits hold: at an
 #: objective of zero (a constant pace that shakes nothing) its steps become too small.
 SETTLED = ("Solved_To_Acceptable_Level", "Search_Direction_Becomes_Too_Small")
+#: How near the convex relaxation's optimum a motion lasting ``T`` must come to be certified.
+BOUND_TOLERANCE = 1e-8
 #: A convex optimum lasting less than ``T`` by this share ends early.
 EARLY = 1e-8
 #: The least squared rate, as a share of the mean's (IPOPT keeps within bounds: √b stays real).
@@ -106,12 +110,14 @@ class Problem:
     def natural_objective(self) -> float:
         """``J``'s natural scale: each load's coefficients at a constant pace, summed unsigned.
 
-        ``mean Σ w·(|A|·s/T² + |B|·s²/T² + |C|)²`` over the rows, ``s`` the argument's span:
-        what the objective is measured against where the spec's own law makes it vanish.
+        ``mean Σ w·(|A|·s/T² + |B|·s²/T² + |C − C₀|)²`` over the rows, ``s`` the argument's
+        span, ``C₀`` the constant parts taken out: what the objective is measured against
+        where the spec's own law makes it vanish.
         """
         at, span = self.loads, self.span
         typical = (np.abs(at.inertial) * span / self.duration**2
-                   + np.abs(at.centripetal) * (span / self.duration) ** 2 + np.abs(at.static))
+                   + np.abs(at.centripetal) * (span / self.duration) ** 2
+                   + np.abs(at.static - self.offsets[:, None]))
         return float(np.mean(np.sum(self.weights[:, None] * typical**2, axis=0)))
 
     def objective(self, rate2: NDArray[np.float64]) -> float:
@@ -163,7 +169,7 @@ def solve(problem: Problem, start: NDArray[np.float64]) -> Transcribed:
 
     The convex problem first (its duration at most ``T``); where its optimum ends early (a
     faster motion shakes less: loads at rest dominate), the problem with the duration exactly
-    ``T``, whose optimum is local.
+    ``T``, whose optimum is local — certified global where it reaches the convex one's bound.
 
     Raises
     ------
@@ -171,9 +177,13 @@ def solve(problem: Problem, start: NDArray[np.float64]) -> Transcribed:
         If IPOPT does not converge, or the limits cannot all be met.
     """
     convex = _solve(problem, start, relaxed=True)
-    if convex.ends_early:
-        return _solve(problem, convex.rate2, relaxed=False)
-    return convex
+    if not convex.ends_early:
+        return convex
+    held = _solve(problem, convex.rate2, relaxed=False)
+    # The convex optimum bounds every motion's from below: one that lasts T and reaches it
+    # (a shorter motion only ties) is global too.
+    reached = held.objective <= convex.objective + BOUND_TOLERANCE * abs(convex.objective)
+    return replace(held, certified=reached) if reached else held
 
 
 def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Transcribed:
@@ -189,7 +199,8 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
     a = (b[1:] - b[:-1]) / (2.0 * dtau)
     root = ca.sqrt(b)
     dt = 2.0 * dtau / (root[:-1] + root[1:])
-    reference = max(problem.objective(np.maximum(start, LEAST_RATE2 * scale2)),
+    constant = float(np.sum(problem.weights * problem.offsets**2))  # (not IPOPT's to see)
+    reference = max(problem.objective(np.maximum(start, LEAST_RATE2 * scale2)) - constant,
                     problem.natural_objective(), np.finfo(float).tiny)
     constraints: list[Any] = [(ca.sum1(dt) - problem.duration) / problem.duration]
     low: list[float] = [-math.inf if relaxed else 0.0]
@@ -255,7 +266,9 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
                        {"print_time": False,
                         "ipopt": {"print_level": 0, "sb": "yes", "tol": TOLERANCE,
                                   "bound_relax_factor": 0.0,  # (√b of b within its bounds)
-                                  "max_iter": MAX_ITERATIONS, "mu_strategy": "adaptive"}})
+                                  "max_iter": MAX_ITERATIONS, "max_cpu_time": MAX_SECONDS,
+                                  # (adaptive μ stalls on a peak's many constraints)
+                                  "mu_strategy": "monotone"}})
     x0 = np.clip(start / scale2, lower, np.minimum(upper, 1e6))
     lbx, ubx = lower, np.minimum(upper, 1e12)
     if peak is not None:
@@ -268,17 +281,20 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
     values = np.asarray(result["g"]).ravel()
     violation = float(np.max(np.maximum(np.array(low) - values, values - np.array(high)),
                              initial=0.0))
-    if not stats["success"] and violation > 1e-6:
+    limited = any(x is not None for x in (*problem.max_speed, *problem.max_acceleration,
+                                           *problem.max_load))
+    if not stats["success"] and violation > 1e-6 and limited:
         raise SolverError(f"the time law cannot meet its limits in {problem.duration:g} s "
                           f"(IPOPT: {stats['return_status']}; largest violation "
                           f"{violation:.2g} of a limit): lengthen the duration or widen them")
     if not stats["success"] and (stats["return_status"] not in SETTLED or violation > 1e-8):
-        raise SolverError(f"IPOPT did not converge on the time law ({stats['return_status']})")
+        raise SolverError(f"IPOPT did not converge on the time law ({stats['return_status']}; "
+                          f"largest constraint violation {violation:.2g})")
     rate2 = np.asarray(result["x"]).ravel()[:count] * scale2
     early = bool(values[0] < -EARLY)
     return Transcribed(rate2=rate2, objective=problem.objective(rate2), violation=violation,
-                       certified=relaxed and not early, ends_early=relaxed and early,
-                       iterations=int(stats["iter_count"]))
+                       certified=relaxed and not early and bool(stats["success"]),
+                       ends_early=relaxed and early, iterations=int(stats["iter_count"]))
 
 
 #: The loads that are a momentum's rate of change on the frame (with their parts at rest): a

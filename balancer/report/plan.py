@@ -32,8 +32,10 @@ def _objective_words(plan: Plan) -> str:
 
 def _path_words(plan: Plan) -> str:
     path = plan.path
-    if path.pace is not None and path.along == "revolution":
-        return "one revolution of the input at constant speed"
+    if path.along == "revolution":
+        steady = path.pace is not None and len({rate for _, rate in path.pace}) == 1
+        return ("one revolution of the input at constant speed" if steady else
+                f"one revolution of the input (motion {path.name}'s pace to start from)")
     what = f"point {path.point}'s path" if path.point else "the inputs' path"
     return f"motion {path.name} ({what} through {len(path.times)} waypoints, law {path.law})"
 
@@ -79,19 +81,22 @@ def _change(before: float, after: float) -> str:
 
 def _certificate_lines(plan: Plan, solution: Any) -> list[str]:
     root = "√J" if plan.spec.measure == "rms" else "√(max)"
+    how = "by quadrature" if plan.spec.measure == "rms" else "its largest"
     lines = [f"objective {root}: {_figure(plan.objective_before, plan.spec.measure):.6g} before, "
-             f"{_figure(plan.objective_after, plan.spec.measure):.6g} after (along each motion "
-             f"by quadrature); the transcription's optimum "
+             f"{_figure(plan.objective_after, plan.spec.measure):.6g} after (along each motion, "
+             f"{how}); the transcription's optimum "
              f"{_figure(solution.objective, plan.spec.measure):.6g} on "
-             f"{plan.problem.loads.tau.size - 1} intervals "
-             f"({_figure(plan.halved, plan.spec.measure):.6g} on half as many)"]
+             f"{plan.problem.loads.tau.size - 1} intervals"
+             + ("" if plan.halved is None else
+                f" ({_figure(plan.halved, plan.spec.measure):.6g} on half as many)")]
     if plan.bound is not None:
         lines.append(f"least possible from rest to rest (closed form, any time law): "
                      f"{_figure(plan.bound, plan.spec.measure):.6g}")
     if solution.certified:
         starts = ("" if len(plan.starts) == 1 else f" (the same from {len(plan.starts)} starts "
                   f"to {_spread(plan.starts):.0e})")
-        lines.append(f"the transcription is convex: its optimum is global{starts}")
+        lines.append("the optimum is the transcription's global one (convex, or reaching its "
+                     f"convex relaxation's bound){starts}")
     else:
         lines.append("a local optimum: a faster motion would shake less, and the duration is "
                      f"held (best of {len(plan.starts)} starts, spread {_spread(plan.starts):.0e})")
@@ -177,9 +182,15 @@ def codesign_text(result: CoDesign, spec: str | None = None) -> str:
                      "—" if lever == "spec" else _change(_figure(start, ""), _figure(value, "")),
                      *(sc.fmt(loads[lever][k].rms, load_words(mech, k)[1]) for k in keys)])
     lines.append(table(rows, heading))
+    steps = ", ".join(f"{_figure(j, ''):.6g}" for j in result.rounds)
     lines += ["", "each step's problem is convex and solved to its optimum; together they are "
-              "not: the result is where neither lever alone does better (J never rose: "
-              + ", ".join(f"{_figure(j, ''):.6g}" for j in result.rounds) + ")"]
+              "not: the result is where neither lever alone does better"]
+    if result.projected:
+        lines.append("the spec's masses do not meet [balance]'s constraints (its force "
+                     "balance): the first masses step projects onto them and √J rose; from "
+                     f"there it never rose ({steps})")
+    else:
+        lines.append(f"√J never rose ({steps})")
     return "\n".join(lines)
 
 
