@@ -123,9 +123,7 @@ def _frames(text: str) -> int:
 
 
 def _intervals(text: str) -> int:
-    """A transcription's intervals: a whole number, at least 4 (:class:`~balancer.model.plan.
-    PlanSpec`'s least).
-    """
+    """A transcription's intervals: a whole number, at least 4 (``PlanSpec``'s least)."""
     value = _count(text)
     if value < 4:
         raise argparse.ArgumentTypeError(f"must be at least 4: {text!r}")
