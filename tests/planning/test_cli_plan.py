@@ -92,3 +92,23 @@ def test_another_motion_than_the_plan_s_is_named_after_itself(capsys):
     assert main(["plan", FORBAL, "--motion", "circle", "--intervals", "48", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["motion"] == "circle" and doc["planned"] == "circle planned"
+
+
+def test_a_peak_is_planned_on_the_examples_without_limits(capsys):
+    for spec in (str(EXAMPLES / "three_rrr.toml"), FORBAL):
+        assert main(["plan", spec, "--measure", "peak", "--json"]) == 0
+        assert json.loads(capsys.readouterr().out)["certified"]
+
+
+@pytest.mark.parametrize(("args", "extra", "words"), [
+    (["--duration", "1e-300"], "", "--duration"),
+    (["--duration", "1e300"], "", "--duration"),
+    ([], "[plan]\nmax_speed = 1e200\n", "plan.max_speed"),
+    ([], "[plan]\nmax_acceleration = 1e-300\n", "plan.max_acceleration"),
+    ([], '[[motion]]\nname = "fast"\nalong = "diamond"\npace = [[0.0, 1e160], [4.0, 1e160]]\n',
+     "pace"),
+])
+def test_extreme_numbers_are_refused_naming_the_key(tmp_path, capsys, args, extra, words):
+    assert main(["plan", _spec(tmp_path, extra), *args]) == 2
+    err = capsys.readouterr().err
+    assert words in err and len(err.strip().splitlines()) == 1 and "internal" not in err

@@ -88,3 +88,18 @@ def test_where_a_faster_motion_shakes_less_the_plan_is_local_and_the_convex_one_
     assert plan.planned.duration == pytest.approx(design.motions[0].duration, rel=1e-9)
     oracle = _cvxpy_optimum(plan.problem)
     assert oracle <= plan.solution.objective * (1 + 1e-9)
+
+
+def test_the_weights_constant_part_leaves_the_least_shaking_force_s_time_law():
+    # the weights add a constant to the shaking force: its mean square grows by their square
+    # whatever the time law, so the optimal pace is the one without gravity (and global)
+    design = load_design(EXAMPLES / "forbal2.toml")
+    mech = mechanism_of(design.mechanism)
+    spec = PlanSpec(objective=PlanWeights(shaking_moment=0.0, shaking_force=1.0), intervals=40)
+    plain = plan_motion(mech, design.motions[0], spec)
+    heavy = plan_motion(mech, design.motions[0], spec, gravity=(0.0, -9.81))
+    assert heavy.certified and plain.certified
+    assert heavy.planned.duration == pytest.approx(plain.planned.duration, rel=1e-12)
+    rates = np.asarray(heavy.planned.pace)[:, 1], np.asarray(plain.planned.pace)[:, 1]
+    # (an optimum to IPOPT's 1e-10 of its objective: its variables to about the square root)
+    assert np.max(np.abs(rates[0] - rates[1])) <= 1e-4 * np.max(rates[1])
