@@ -57,9 +57,6 @@ class CoDesign:
         The loads along the motion in each of those four cases.
     rounds
         ``J`` after each step, in order (a time law, then masses, …).
-    projected
-        Whether the first masses step raised ``J``: the spec's masses do not meet
-        ``[balance]``'s constraints, and the descent starts from the first masses.
     """
 
     plan: Plan
@@ -71,7 +68,11 @@ class CoDesign:
 
     @property
     def projected(self) -> bool:
-        """Whether the first masses step raised ``J`` (the spec's masses infeasible)."""
+        """Whether the first masses step raised ``J``.
+
+        The spec's masses do not meet ``[balance]``'s constraints, and the descent starts from
+        the first masses.
+        """
         return len(self.rounds) > 1 and self.rounds[1] > self.rounds[0]
 
 
