@@ -26,6 +26,10 @@ MEASURES = ("rms", "peak")
 PLAN_OBJECTIVE_KEYS = ("shaking_moment", "shaking_force", "shaking_force_x", "shaking_force_y",
                        "rocking_couple", "torque")
 
+#: A transcription's intervals where ``[plan] intervals`` is not given (at least one per
+#: segment of the path).
+DEFAULT_INTERVALS = 200
+
 #: The limits a plan keeps each input within (``[plan]``), with their units for an input
 #: turned about a pivot (a slide's: m/s, m/s², N).
 LIMIT_KEYS = {"max_speed": "rad/s", "max_acceleration": "rad/s²", "max_torque": "N·m"}
@@ -95,7 +99,8 @@ class PlanSpec:
     objective
         The weights.
     intervals
-        Intervals of the path's argument in the transcription (the pace's rows less one).
+        Intervals of the path's argument in the transcription (the pace's rows less one);
+        ``None``: :data:`DEFAULT_INTERVALS`, or the path's segments where it has more.
     max_speed, max_acceleration, max_torque
         Limits on each input's rate, acceleration and load.
     """
@@ -105,7 +110,7 @@ class PlanSpec:
     duration: float | None = None
     measure: str = "rms"
     objective: PlanWeights = field(default_factory=lambda: PlanWeights(shaking_moment=1.0))
-    intervals: int = 200
+    intervals: int | None = None
     max_speed: InputLimits = field(default_factory=InputLimits)
     max_acceleration: InputLimits = field(default_factory=InputLimits)
     max_torque: InputLimits = field(default_factory=InputLimits)
@@ -124,9 +129,16 @@ class PlanSpec:
         if self.measure not in MEASURES:
             raise SpecError(f"must be one of {', '.join(MEASURES)}", key="measure",
                             value=self.measure)
-        v.store(self, "intervals", v.integer(self.intervals, "intervals",
-                                             minimum=self.INTERVALS[0],
-                                             maximum=self.INTERVALS[1]))
+        if self.intervals is not None:
+            v.store(self, "intervals", v.integer(self.intervals, "intervals",
+                                                 minimum=self.INTERVALS[0],
+                                                 maximum=self.INTERVALS[1]))
+
+    def intervals_for(self, segments: int) -> int:
+        """The transcription's intervals on a path of ``segments`` waypoint segments."""
+        if self.intervals is not None:
+            return self.intervals
+        return max(DEFAULT_INTERVALS, segments)
         for key in LIMIT_KEYS:
             limits: InputLimits = getattr(self, key)
             given: list[tuple[str, float | None]] = [(key, limits.every)]

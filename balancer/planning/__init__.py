@@ -236,9 +236,13 @@ def check_plan(mech: Mechanism, path: MotionSpec, spec: PlanSpec) -> None:
                         f"({path.duration:g} s) either way", key="plan.duration",
                         value=spec.duration)
     segments = len(path.times) - 1
-    if spec.intervals < segments:
+    if spec.intervals is not None and spec.intervals < segments:
         raise SpecError(f"must be at least the path's segments ({segments}): its waypoints are "
                         "the transcription's rows", key="plan.intervals", value=spec.intervals)
+    if spec.intervals_for(segments) > PlanSpec.INTERVALS[1]:
+        raise SpecError(f"the path has {segments} segments, more than a transcription takes "
+                        f"({PlanSpec.INTERVALS[1]}): resample the motion",
+                        key="plan.intervals")
 
 
 def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
@@ -267,7 +271,8 @@ def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
     """
     check_plan(mech, path, spec)
     duration = path.duration if spec.duration is None else spec.duration
-    problem = _problem(mech, path, spec, spec.intervals, duration, gravity)
+    intervals = spec.intervals_for(len(path.times) - 1)
+    problem = _problem(mech, path, spec, intervals, duration, gravity)
     tau, weights = problem.loads.tau, problem.weights
     own = _rate2_of(path, tau, duration)
     steady = np.full(tau.shape, (problem.span / duration) ** 2)
@@ -285,7 +290,7 @@ def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
         raise failures[0]
     best = min(solutions, key=lambda s: s.objective)
     halved = None
-    coarse_intervals = spec.intervals // 2
+    coarse_intervals = intervals // 2
     if coarse_intervals >= len(path.times) - 1 and coarse_intervals >= 2:
         try:  # (an estimate of the mesh's error: not worth failing the plan for)
             coarse = _problem(mech, path, spec, coarse_intervals, duration, gravity)

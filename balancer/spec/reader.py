@@ -145,7 +145,7 @@ def _read_plan(root: Table) -> PlanSpec | None:
         plan = PlanSpec(motion=table.value("motion", None), name=table.value("name", None),
                         duration=table.value("duration", None),
                         measure=table.value("measure", "rms"), objective=objective,
-                        intervals=table.value("intervals", 200), **limits)
+                        intervals=table.value("intervals", None), **limits)
     table.finish()
     return plan
 

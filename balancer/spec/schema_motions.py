@@ -109,8 +109,9 @@ PLAN_SECTIONS: tuple[Section, ...] = (
                 Key("measure", "—", '"rms"',
                     '`"rms"` (the objective\'s mean square over time) or `"peak"` (its '
                     "largest value).", ONE_INPUT_OR_MORE, example='"rms"'),
-                Key("intervals", "—", "200",
-                    "Intervals of the path's argument in the transcription, 4 to 20000.",
+                Key("intervals", "—", "200, or the path's segments where more",
+                    "Intervals of the path's argument in the transcription, 4 to 20000, at "
+                    "least the path's segments (its waypoints are among the rows).",
                     ONE_INPUT_OR_MORE, example="200"),
                 Key("objective", "table", "shaking_moment = 1",
                     "The objective's weights (`[plan.objective]`, below).", ONE_INPUT_OR_MORE),

@@ -104,8 +104,9 @@ def _plan_lines(design: Design) -> list[str]:
             out.append(f"{key} = {toml.string(value)}")
     if plan.duration is not None:
         out.append(f"duration = {toml.number(plan.duration)}  # s")
-    out += [f"measure = {toml.string(plan.measure)}",
-            f"intervals = {toml.number(plan.intervals)}"]
+    out.append(f"measure = {toml.string(plan.measure)}")
+    if plan.intervals is not None:
+        out.append(f"intervals = {toml.number(plan.intervals)}")
     section = schema.section("plan")
     assert section is not None
     for key, unit in ((k.name, k.unit) for k in section.keys if k.name.startswith("max_")):

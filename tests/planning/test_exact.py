@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from planning.specs import DURATION, MASS, STROKE, carriage
 
+from balancer.errors import SpecError
 from balancer.mechanisms import mechanism_of
 from balancer.model.plan import PlanSpec, PlanWeights
 from balancer.planning import plan_motion
@@ -78,3 +79,20 @@ def test_the_optimum_does_not_depend_on_the_spec_s_own_law(law):
     assert p.solution.objective == pytest.approx(reference.solution.objective, rel=1e-8)
     steady = np.full(p.problem.loads.tau.size, (p.problem.span / p.problem.duration) ** 2)
     assert solve(p.problem, steady).objective == pytest.approx(p.solution.objective, rel=1e-8)
+
+
+def test_a_path_of_many_waypoints_gets_an_interval_each_unless_asked():
+    # a recorded motion (a table of 301 rows): its waypoints are the mesh's rows, so the
+    # transcription's default intervals grow to its 300 segments; asked for fewer, it refuses
+    spec = carriage("spline")
+    times = np.linspace(0.0, DURATION, 301)
+    spec["motion"][0].update(times=list(times),
+                             path=[[STROKE * (3 * u**2 - 2 * u**3), 0.0] for u in times])
+    design = design_from_dict(spec)
+    mech = mechanism_of(design.mechanism)
+    result = plan_motion(mech, design.motions[0],
+                         PlanSpec(objective=PlanWeights(shaking_force=1.0)))
+    assert result.problem.loads.tau.size == 301
+    assert math.sqrt(result.solution.objective) == pytest.approx(RMS, rel=1e-3)
+    with pytest.raises(SpecError, match="at least the path's segments"):
+        plan_motion(mech, design.motions[0], PlanSpec(intervals=100))
