@@ -124,7 +124,10 @@ def _frames(text: str) -> int:
 
 def _intervals(text: str) -> int:
     """A transcription's intervals: a whole number, at least 4 (``PlanSpec``'s least)."""
-    value = _count(text)
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
     if value < 4:
         raise argparse.ArgumentTypeError(f"must be at least 4: {text!r}")
     return value

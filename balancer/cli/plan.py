@@ -24,6 +24,13 @@ def run(args: argparse.Namespace) -> int:
     out = output_path(args, args.out, "--out")
     csv = output_path(args, args.csv, "--csv")
     figure = figure_path(args, args.plot, "--plot")
+    named = [(option, path) for option, path in (("--out", out), ("--csv", csv),
+                                                 ("--plot", figure)) if path is not None]
+    for i, (option, path) in enumerate(named):
+        for other, already in named[:i]:
+            if path.resolve() == already.resolve():
+                raise SpecError(f"names the file {other} writes: give each output its own",
+                                key=option, value=str(path))
     design = load(args)
     settings = design.plan
     changes = {key: getattr(args, key) for key in ("intervals", "measure", "duration")

@@ -115,8 +115,9 @@ class PlanSpec:
     max_acceleration: InputLimits = field(default_factory=InputLimits)
     max_torque: InputLimits = field(default_factory=InputLimits)
 
-    #: Least and most intervals.
-    INTERVALS: ClassVar[tuple[int, int]] = (4, 20_000)
+    #: Least and most intervals (setting up a transcription with limits or a peak grows with
+    #: the square of its rows: 2000 take some 20 s).
+    INTERVALS: ClassVar[tuple[int, int]] = (4, 2_000)
 
     def __post_init__(self) -> None:
         """Check the values (keys within ``[plan]``)."""

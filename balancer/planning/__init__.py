@@ -18,6 +18,7 @@ with the weight's constant part), a lower bound the plan reports.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -206,6 +207,9 @@ def _rate2_of(motion: MotionSpec, tau: NDArray[np.float64], duration: float
     return np.asarray(rate, dtype=float) ** 2 * (motion.duration / duration) ** 2
 
 
+#: Past this many seconds of solving, a plan makes no optional solve (another start, the
+#: half-mesh estimate).
+OPTIONAL_SECONDS = 10.0
 #: A plan's duration at most this factor from its motion's own, either way.
 DURATION_RANGE = 1e6
 #: A limit's value within this factor of 1 in SI units, either way (its square stays finite).
@@ -278,10 +282,12 @@ def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
     steady = np.full(tau.shape, (problem.span / duration) ** 2)
     solutions: list[Transcribed] = []
     failures: list[SolverError] = []
+    began = time.perf_counter()
     for start in (own, steady):
         if solutions and (solutions[0].certified or np.allclose(own, steady, rtol=1e-12,
-                                                                atol=0.0)):
-            break  # (a global optimum, or one start: no other)
+                                                                atol=0.0)
+                          or time.perf_counter() - began > OPTIONAL_SECONDS):
+            break  # (a global optimum, one start, or no time for another)
         try:
             solutions.append(solve(problem, start))
         except SolverError as exc:
@@ -291,7 +297,8 @@ def plan_motion(mech: Mechanism, path: MotionSpec, spec: PlanSpec, *,
     best = min(solutions, key=lambda s: s.objective)
     halved = None
     coarse_intervals = intervals // 2
-    if coarse_intervals >= len(path.times) - 1 and coarse_intervals >= 2:
+    if (coarse_intervals >= len(path.times) - 1 and coarse_intervals >= 2
+            and time.perf_counter() - began <= OPTIONAL_SECONDS):
         try:  # (an estimate of the mesh's error: not worth failing the plan for)
             coarse = _problem(mech, path, spec, coarse_intervals, duration, gravity)
             halved = solve(coarse, _rate2_of(path, coarse.loads.tau, duration)).objective

@@ -39,7 +39,7 @@ TOLERANCE = 1e-10
 #: Iterations at most.
 MAX_ITERATIONS = 3000
 #: IPOPT's time at most per solve, s (an unattainable limit is declared so, not waited on).
-MAX_SECONDS = 30.0
+MAX_SECONDS = 20.0
 #: IPOPT's ends short of its tolerance that are its optimum where the limits hold: at an
 #: objective of zero (a constant pace that shakes nothing) its steps become too small.
 SETTLED = ("Solved_To_Acceptable_Level", "Search_Direction_Becomes_Too_Small")
@@ -252,15 +252,18 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
             low += [-1.0] * (count - 1)
             high += [1.0] * (count - 1)
     upper = np.full(count, math.inf)
+    lower = np.full(count, LEAST_RATE2)
     for i, limit in enumerate(problem.max_speed):
         if limit is not None:
             with np.errstate(divide="ignore"):
                 steepest = np.maximum(at.slope[i] ** 2, to.slope[i] ** 2)
-                upper = np.minimum(upper, limit**2 / steepest / scale2)
-    lower = np.full(count, LEAST_RATE2)
-    if np.any(upper < lower):
-        raise SolverError("the speed limits stop the motion on its path (an input's limit is 0 "
-                          "where it must move)")
+                own = limit**2 / steepest / scale2
+            if np.any(own < lower):
+                raise SolverError(f"plan.max_speed: input {at.names[5 + i][len('torque_'):]}'s "
+                                  f"limit {limit:g} all but stops the motion on its path "
+                                  f"in {problem.duration:g} s: widen it or lengthen the "
+                                  "duration")
+            upper = np.minimum(upper, own)
     g = ca.vertcat(*constraints)
     solver = ca.nlpsol("plan", "ipopt", {"x": unknowns, "f": cost, "g": g},
                        {"print_time": False,
@@ -281,6 +284,9 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
     values = np.asarray(result["g"]).ravel()
     violation = float(np.max(np.maximum(np.array(low) - values, values - np.array(high)),
                              initial=0.0))
+    if stats["return_status"] == "Maximum_CpuTime_Exceeded":
+        raise SolverError(f"IPOPT did not solve the time law within {MAX_SECONDS:g} s: take "
+                          f"fewer intervals (its mesh has {count - 1})")
     limited = any(x is not None for x in (*problem.max_speed, *problem.max_acceleration,
                                            *problem.max_load))
     if not stats["success"] and violation > 1e-6 and limited:

@@ -110,7 +110,7 @@ PLAN_SECTIONS: tuple[Section, ...] = (
                     '`"rms"` (the objective\'s mean square over time) or `"peak"` (its '
                     "largest value).", ONE_INPUT_OR_MORE, example='"rms"'),
                 Key("intervals", "—", "200, or the path's segments where more",
-                    "Intervals of the path's argument in the transcription, 4 to 20000, at "
+                    "Intervals of the path's argument in the transcription, 4 to 2000, at "
                     "least the path's segments (its waypoints are among the rows).",
                     ONE_INPUT_OR_MORE, example="200"),
                 Key("objective", "table", "shaking_moment = 1",

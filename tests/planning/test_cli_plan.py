@@ -112,3 +112,18 @@ def test_extreme_numbers_are_refused_naming_the_key(tmp_path, capsys, args, extr
     assert main(["plan", _spec(tmp_path, extra), *args]) == 2
     err = capsys.readouterr().err
     assert words in err and len(err.strip().splitlines()) == 1 and "internal" not in err
+
+
+def test_outputs_that_share_a_file_are_refused(tmp_path, capsys):
+    same = tmp_path / "same.toml"
+    assert main(["plan", FORBAL, "--intervals", "24", "--out", str(same), "--csv",
+                 str(same)]) == 2
+    err = capsys.readouterr().err
+    assert "--csv" in err and "--out" in err and not same.exists()
+
+
+def test_a_speed_limit_that_stops_the_motion_is_named(tmp_path, capsys):
+    assert main(["plan", _spec(tmp_path, "[plan]\nmax_speed = 1e-6\n"), "--intervals",
+                 "24"]) == 1
+    err = capsys.readouterr().err
+    assert "plan.max_speed" in err and "1e-06" in err and len(err.strip().splitlines()) == 1
