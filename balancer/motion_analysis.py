@@ -25,6 +25,7 @@ from .cycle import CycleSummary, Figure
 from .force_balance import RESIDUAL_FLOOR, force_balance_residual
 from .linkage import trajectory
 from .linkage.inputs import InputState
+from .linkage.kinematics import Motion
 from .linkage.loads import Reactions
 from .mechanisms import Mechanism, mechanism_of
 from .model import MechanismModel
@@ -178,6 +179,19 @@ def motion_columns(mech: Mechanism, t: NDArray[np.float64],
     return names + frame_names, cols + frame_cols
 
 
+def frame_reactions(mech: Mechanism, mo: Motion, *, gravity: tuple[float, float] = (0.0, 0.0),
+                    loads: bool = True) -> Reactions:
+    """The frame's loads at a motion's states: the inverse dynamics and the rocking couple.
+
+    With the applied loads (``loads``) and ``gravity`` (m/s²); one record
+    (:class:`~balancer.linkage.loads.Reactions`).
+    """
+    with np.errstate(all="ignore"):
+        forces = mech.inverse_dynamics(mo, loads=loads, gravity=gravity)
+        couple = mech.rocking_couple(mo, loads=loads, gravity=gravity)
+    return Reactions.of(replace(forces, rocking_couple=couple))
+
+
 def motion_analysis(model: MechanismModel | Mechanism, motion: MotionSpec, *,
                     gravity: tuple[float, float] = (0.0, 0.0), loads: bool = True
                     ) -> MotionAnalysis:
@@ -195,12 +209,10 @@ def motion_analysis(model: MechanismModel | Mechanism, motion: MotionSpec, *,
     t = trajectory.sample_times(motion)
     state = trajectory.input_state(structure, motion)  # (at t: its samples, kept)
     mo = mech.motion_at(state)
+    reactions = frame_reactions(mech, mo, gravity=gravity, loads=loads)
     with np.errstate(all="ignore"):
-        forces = mech.inverse_dynamics(mo, loads=loads, gravity=gravity)
-        couple = mech.rocking_couple(mo, loads=loads, gravity=gravity)
         centre = np.broadcast_to(np.asarray(mech.total_centre_of_mass(mo), np.complex128),
                                  t.shape).copy()
-    reactions = Reactions.of(replace(forces, rocking_couple=couple))
     changes = tuple(np.asarray(p, dtype=float) - ref
                     for p, ref in zip(state.positions, structure.input_references, strict=True))
     return MotionAnalysis(mechanism=mech, motion=motion, inputs=structure.linkage.inputs, t=t,

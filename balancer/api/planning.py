@@ -13,6 +13,7 @@ from ..model.plan import PlanSpec
 from ..planning import Plan, check_plan, path_of, plan_motion
 from ..planning.codesign import CoDesign
 from ..planning.codesign import codesign as run_codesign
+from ..spec import schema
 from .analysis import spec_gravity
 
 
@@ -23,7 +24,7 @@ def plan(design: Design, motion: str | None = None, *, settings: PlanSpec | None
     Parameters
     ----------
     design
-        The design (a general linkage, ``type = "linkage"``).
+        The design (a linkage whose spec takes ``[plan]``: four-bar, slider-crank, general).
     motion
         The motion whose path is run (its name, or ``"revolution"``), instead of the plan's.
     settings
@@ -68,15 +69,11 @@ def codesign(design: Design, motion: str | None = None, *, settings: PlanSpec | 
     return run_codesign(design, spec, motion, gravity=spec_gravity(design))
 
 
-#: The mechanisms whose motions are planned: linkages (an engine's crank turns at its speed).
-PLANNED = ("four-bar", "slider-crank", "linkage")
-
-
 def _check_type(design: Design) -> None:
-    """Refuse a mechanism whose motion is not planned (an engine), naming its type."""
-    if design.mechanism.type not in PLANNED:
-        raise SpecError(f"plans a linkage's motion ({', '.join(PLANNED)}); this spec's type is "
-                        f"\"{design.mechanism.type}\"", key="mechanism.type")
+    """Refuse a mechanism whose spec takes no plan (an engine's crank turns at its speed)."""
+    if "plan" not in schema.known("", design.mechanism.type):
+        raise SpecError(f"plans a linkage's motion; a spec of type \"{design.mechanism.type}\" "
+                        "has no [plan] and no [[motion]]", key="mechanism.type")
 
 
 def _for_motion(design: Design, spec: PlanSpec, motion: str | None) -> PlanSpec:

@@ -122,25 +122,25 @@ def _frames(text: str) -> int:
     return value
 
 
-def _intervals(text: str) -> int:
-    """A transcription's intervals: a whole number, at least 4 (``PlanSpec``'s least)."""
+def _whole(text: str, least: int) -> int:
+    """A whole number of the command line, at least ``least``."""
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if value < 4:
-        raise argparse.ArgumentTypeError(f"must be at least 4: {text!r}")
+    if value < least:
+        raise argparse.ArgumentTypeError(f"must be at least {least}: {text!r}")
     return value
+
+
+def _intervals(text: str) -> int:
+    """A transcription's intervals: at least 4 (``PlanSpec``'s least)."""
+    return _whole(text, 4)
 
 
 def _count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if value < 2:
-        raise argparse.ArgumentTypeError(f"must be at least 2: {text!r}")
-    return value
+    """A count of samples, outputs or points: at least 2."""
+    return _whole(text, 2)
 
 
 def _version() -> str:

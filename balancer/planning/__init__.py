@@ -30,8 +30,8 @@ from ..mechanisms import Mechanism, mechanism_of
 from ..model import Design
 from ..model.motions import REVOLUTION, MotionSpec
 from ..model.plan import PlanSpec, PlanWeights
-from ..motion_analysis import MotionAnalysis, motion_analysis
-from .path_loads import PathLoads, load_rows, path_loads, reactions_at
+from ..motion_analysis import MotionAnalysis, frame_reactions, motion_analysis
+from .path_loads import PathLoads, load_rows, path_loads
 from .transcription import Problem, Transcribed, constant_parts, mesh, solve
 
 __all__ = ["Plan", "objective_of", "path_of", "plan_motion", "revolution"]
@@ -157,7 +157,8 @@ def objective_of(mech: Mechanism, motion: MotionSpec, weights: NDArray[np.float6
     if measure == "peak":
         t = np.concatenate([t, edges])
     state = trajectory.input_state(mech.structure, motion, t)
-    _, rows = load_rows(mech.linkage.inputs, reactions_at(mech, state, gravity))
+    _, rows = load_rows(mech.linkage.inputs,
+                        frame_reactions(mech, mech.motion_at(state), gravity=gravity))
     total = np.sum(weights[:, None] * rows**2, axis=0)
     if measure == "peak":
         return float(np.max(total))

@@ -28,6 +28,7 @@ from ..linkage.inputs import InputState
 from ..linkage.loads import Reactions
 from ..mechanisms import Mechanism
 from ..model.motions import MotionSpec
+from ..motion_analysis import frame_reactions
 
 #: The form ``A·τ̈ + B·τ̇² + C`` must give the fourth state's loads to this share of their scale.
 FORM_TOLERANCE = 1e-9
@@ -97,16 +98,6 @@ def load_rows(inputs: tuple[str, ...], reactions: Reactions) -> tuple[tuple[str,
     return names, np.array([np.asarray(x, dtype=float) for x in rows])
 
 
-def reactions_at(mech: Mechanism, state: InputState, gravity: tuple[float, float]
-                 ) -> Reactions:
-    """The frame's loads at the inputs' states (with the applied loads and ``gravity``)."""
-    mo = mech.motion_at(state)
-    with np.errstate(all="ignore"):
-        forces = mech.inverse_dynamics(mo, loads=True, gravity=gravity)
-        couple = mech.rocking_couple(mo, loads=True, gravity=gravity)
-    return Reactions.of(replace(forces, rocking_couple=couple))
-
-
 def path_loads(mech: Mechanism, motion: MotionSpec, tau: NDArray[np.float64],
                gravity: tuple[float, float] = (0.0, 0.0)) -> PathLoads:
     """The loads along ``motion``'s path at arguments ``tau`` (module docstring).
@@ -150,8 +141,8 @@ def _path_loads(mech: Mechanism, motion: MotionSpec, tau: NDArray[np.float64],
                               InputState.of(list(q), list(zero), list(d1)),
                               InputState.of(list(q), list(d1), list(d2)),
                               InputState.of(list(q), list(2 * d1), list(4 * d2))])
-    reactions = reactions_at(mech, states, gravity)
-    names, rows = load_rows(mech.linkage.inputs, reactions)
+    mo = mech.motion_at(states)
+    names, rows = load_rows(mech.linkage.inputs, frame_reactions(mech, mo, gravity=gravity))
     count = tau.size
     rest, pushed, moving, fast = (rows[:, i * count:(i + 1) * count] for i in range(4))
     inertial, centripetal = pushed - rest, moving - rest
@@ -159,8 +150,8 @@ def _path_loads(mech: Mechanism, motion: MotionSpec, tau: NDArray[np.float64],
     if not np.all(np.abs(4 * centripetal + rest - fast) <= FORM_TOLERANCE * scale):
         raise SolverError("the loads are not quadratic in the inputs' rates (a force that "
                           "depends on the speed otherwise): a time law cannot be planned")
-    mo = mech.motion_at(InputState.of(list(q)))
-    first = np.sum(np.broadcast_arrays(*mech.first_moments(mo)), axis=0)
+    # (the first moments at the states at rest: the joined motion's first ones)
+    first = np.sum(np.broadcast_arrays(*mech.first_moments(mo)), axis=0)[:count]
     mass = mech.linkage.total_mass + sum(e.mass for _, r in mech.rotors for e in r.eccentrics)
     return PathLoads(tau=tau, names=names, inertial=inertial, centripetal=centripetal,
                      static=rest, slope=d1, curvature=d2,

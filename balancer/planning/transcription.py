@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -83,6 +84,11 @@ class Problem:
     max_acceleration: tuple[float | None, ...]
     max_load: tuple[float | None, ...]
     offsets: NDArray[np.float64]
+
+    @cached_property
+    def compiled(self) -> _Compiled:
+        """Its NLP, built once for every start and for the duration relaxed or held."""
+        return _compile(self)
 
     @property
     def span(self) -> float:
@@ -186,8 +192,24 @@ def solve(problem: Problem, start: NDArray[np.float64]) -> Transcribed:
     return replace(held, certified=reached) if reached else held
 
 
-def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Transcribed:
-    """:func:`solve` with the duration at most ``T`` (``relaxed``) or exactly ``T``."""
+@dataclass(frozen=True)
+class _Compiled:
+    """A problem's NLP, built once: IPOPT's solver and the bounds of its unknowns and rows.
+
+    ``low`` holds the duration's row exactly (``T``); :func:`_solve` relaxes it.
+    """
+
+    solver: Any
+    low: NDArray[np.float64]
+    high: NDArray[np.float64]
+    lower: NDArray[np.float64]
+    upper: NDArray[np.float64]
+    scale2: float
+    reference: float
+
+
+def _compile(problem: Problem) -> _Compiled:
+    """The NLP of ``problem`` (module docstring), scaled to unknowns and a cost of order one."""
     import casadi as ca
 
     at = problem.loads
@@ -200,10 +222,11 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
     root = ca.sqrt(b)
     dt = 2.0 * dtau / (root[:-1] + root[1:])
     constant = float(np.sum(problem.weights * problem.offsets**2))  # (not IPOPT's to see)
-    reference = max(problem.objective(np.maximum(start, LEAST_RATE2 * scale2)) - constant,
-                    problem.natural_objective(), np.finfo(float).tiny)
+    steady = np.full(count, scale2)
+    reference = max(problem.objective(steady) - constant, problem.natural_objective(),
+                    np.finfo(float).tiny)
     constraints: list[Any] = [(ca.sum1(dt) - problem.duration) / problem.duration]
-    low: list[float] = [-math.inf if relaxed else 0.0]
+    low: list[float] = [0.0]
     high: list[float] = [0.0]
 
     to = at.arriving  # (an interval's end: the path's piece it arrives on)
@@ -221,11 +244,11 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
             s, e = sides(row)
             left += weight * (s - problem.offsets[row]) ** 2
             right += weight * (e - problem.offsets[row]) ** 2
-    peak = ca.SX.sym("z") if problem.measure == "peak" else None
-    if peak is None:  # (the constant parts' squares added back by Problem.objective)
+    if problem.measure != "peak":  # (the constant parts' squares added back by objective())
         cost = ca.sum1(dt * (left + right) / 2.0) / problem.duration / reference
         unknowns = b_hat
     else:
+        peak = ca.SX.sym("z")
         cost = peak
         unknowns = ca.vertcat(b_hat, peak)
         constraints += [(left / reference - peak), (right / reference - peak)]
@@ -264,26 +287,41 @@ def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Tr
                                   f"in {problem.duration:g} s: widen it or lengthen the "
                                   "duration")
             upper = np.minimum(upper, own)
-    g = ca.vertcat(*constraints)
-    solver = ca.nlpsol("plan", "ipopt", {"x": unknowns, "f": cost, "g": g},
+    solver = ca.nlpsol("plan", "ipopt", {"x": unknowns, "f": cost,
+                                         "g": ca.vertcat(*constraints)},
                        {"print_time": False,
                         "ipopt": {"print_level": 0, "sb": "yes", "tol": TOLERANCE,
                                   "bound_relax_factor": 0.0,  # (√b of b within its bounds)
                                   "max_iter": MAX_ITERATIONS, "max_cpu_time": MAX_SECONDS,
                                   # (adaptive μ stalls on a peak's many constraints)
                                   "mu_strategy": "monotone"}})
-    x0 = np.clip(start / scale2, lower, np.minimum(upper, 1e6))
-    lbx, ubx = lower, np.minimum(upper, 1e12)
-    if peak is not None:
+    return _Compiled(solver=solver, low=np.array(low), high=np.array(high), lower=lower,
+                     upper=upper, scale2=scale2, reference=reference)
+
+
+def _solve(problem: Problem, start: NDArray[np.float64], *, relaxed: bool) -> Transcribed:
+    """:func:`solve` with the duration at most ``T`` (``relaxed``) or exactly ``T``.
+
+    On the problem's one NLP (:attr:`Problem.compiled`), from squared rates ``start``.
+    """
+    nlp = problem.compiled
+    count = problem.loads.tau.size
+    scale2 = nlp.scale2
+    low = nlp.low.copy()
+    if relaxed:
+        low[0] = -math.inf
+    x0 = np.clip(start / scale2, nlp.lower, np.minimum(nlp.upper, 1e6))
+    lbx, ubx = nlp.lower, np.minimum(nlp.upper, 1e12)
+    if problem.measure == "peak":
         first = np.asarray(problem.sides(x0 * scale2))
         x0 = np.append(x0, 1.5 * float(np.max(np.sum(problem.weights[None, :, None]
-                                                            * first**2, axis=1))) / reference)
+                                                            * first**2, axis=1)))
+                       / nlp.reference)
         lbx, ubx = np.append(lbx, 0.0), np.append(ubx, math.inf)
-    result = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=np.array(low), ubg=np.array(high))
-    stats = solver.stats()
+    result = nlp.solver(x0=x0, lbx=lbx, ubx=ubx, lbg=low, ubg=nlp.high)
+    stats = nlp.solver.stats()
     values = np.asarray(result["g"]).ravel()
-    violation = float(np.max(np.maximum(np.array(low) - values, values - np.array(high)),
-                             initial=0.0))
+    violation = float(np.max(np.maximum(low - values, values - nlp.high), initial=0.0))
     if stats["return_status"] == "Maximum_CpuTime_Exceeded":
         raise SolverError(f"IPOPT did not solve the time law within {MAX_SECONDS:g} s: take "
                           f"fewer intervals (its mesh has {count - 1})")

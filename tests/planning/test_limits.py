@@ -13,8 +13,9 @@ import pytest
 from balancer.linkage import trajectory
 from balancer.mechanisms import mechanism_of
 from balancer.model.plan import InputLimits, PlanSpec, PlanWeights
+from balancer.motion_analysis import frame_reactions
 from balancer.planning import plan_motion
-from balancer.planning.path_loads import load_rows, reactions_at
+from balancer.planning.path_loads import load_rows
 from balancer.spec import dumps_design, load_design, loads_design
 
 #: A few seconds of optimisation: the full suite's, not the fast lane's.
@@ -29,7 +30,8 @@ def _sides(mech, motion):
     out = []
     for t in (knots[:-1], knots[1:] - 1e-12 * (knots[-1] - knots[0])):
         state = trajectory.input_state(mech.structure, motion, t)
-        _, loads = load_rows(mech.linkage.inputs, reactions_at(mech, state, (0.0, 0.0)))
+        reactions = frame_reactions(mech, mech.motion_at(state), gravity=(0.0, 0.0))
+        _, loads = load_rows(mech.linkage.inputs, reactions)
         out.append((state, loads))
     return out
 

@@ -19,7 +19,8 @@ from balancer.errors import SpecError
 from balancer.linkage import trajectory
 from balancer.mechanisms import mechanism_of
 from balancer.model.motions import MotionSpec
-from balancer.planning.path_loads import load_rows, path_loads, reactions_at
+from balancer.motion_analysis import frame_reactions
+from balancer.planning.path_loads import load_rows, path_loads
 from balancer.spec import load_design
 from balancer.spec.reader import design_from_dict
 
@@ -38,7 +39,8 @@ def test_the_form_gives_the_cores_loads_along_the_motion(example, gravity):
     loads = path_loads(mech, motion, tau, gravity)
     form = loads.at(rate**2, acc)
     state = trajectory.input_state(mech.structure, motion, t)
-    _, direct = load_rows(mech.linkage.inputs, reactions_at(mech, state, gravity))
+    reactions = frame_reactions(mech, mech.motion_at(state), gravity=gravity)
+    _, direct = load_rows(mech.linkage.inputs, reactions)
     scale = np.max(np.abs(direct), axis=1, keepdims=True) + 1e-300
     assert np.max(np.abs(form - direct) / scale) < 1e-9
 

@@ -23,9 +23,9 @@ from balancer.cycle import cycle_analysis
 from balancer.linkage import trajectory
 from balancer.mechanisms import mechanism_of
 from balancer.model.plan import InputLimits, PlanSpec, PlanWeights
-from balancer.motion_analysis import motion_analysis
+from balancer.motion_analysis import frame_reactions, motion_analysis
 from balancer.planning import revolution
-from balancer.planning.path_loads import load_rows, reactions_at
+from balancer.planning.path_loads import load_rows
 from balancer.spec import dumps_design, load_design, loads_design
 from balancer.spec.reader import design_from_dict
 
@@ -52,7 +52,8 @@ def test_the_planned_motion_s_loads_are_the_planner_s(forbal):
     before = knots[1:] - 1e-12 * (knots[-1] - knots[0])
     for mine, times in ((start, knots[:-1]), (end, before)):
         state = trajectory.input_state(mech.structure, result.planned, times)
-        _, core = load_rows(mech.linkage.inputs, reactions_at(mech, state, (0.0, 0.0)))
+        reactions = frame_reactions(mech, mech.motion_at(state), gravity=(0.0, 0.0))
+        _, core = load_rows(mech.linkage.inputs, reactions)
         scale = np.max(np.abs(core), axis=1, keepdims=True) + 1e-300
         assert np.max(np.abs(mine - core) / scale) < 1e-9
 
