@@ -213,6 +213,9 @@ class ConvexSolver(Repairs, Diagnosis):
         self._objective = ConvexObjective(P=p_matrix, q=q_vector, norm=self._norm_form,
                                           g=mass_row, g0=mass_offset)
         compressed = Compressed.of(p_matrix, q_vector)
+        #: The objective's factor in the scaled variables, compressed to its rank (its root,
+        #: ``‖P·u + q‖``, in units of the problem's scale): what a front's programs minimise.
+        self.compressed = compressed
         self._dual_basis = compressed.basis if k else None
         sv, vt = compressed.singular_values, compressed.vt
         if self._norm_form:
@@ -243,6 +246,10 @@ class ConvexSolver(Repairs, Diagnosis):
         fixed = [] if equality is None else [equality]
         if rows:
             fixed.append((self._seen, np.zeros(len(rows))))
+        #: Whether the tie-break has a choice: its equations leave some design free (otherwise
+        #: the optimum is unique, and the SOCP's is it).
+        self._tie_free = bool(fixed) and np.linalg.matrix_rank(
+            np.vstack([e for e, _ in fixed])) < n or not fixed
         self._stage2 = ConicProgram(
             n, self._cones, objective="nearest",
             equality=(np.vstack([e for e, _ in fixed]), np.concatenate([r for _, r in fixed]))
@@ -379,6 +386,12 @@ class ConvexSolver(Repairs, Diagnosis):
                 lo, hi = inside(b.counter_rotor[0] / scale, b.counter_rotor[1] / scale)
                 at_least(entry(k, scale), lo)
                 at_most(entry(k, scale), hi)
+        if data.sites is not None:  # |x_i| ≤ max_mr: in the scaled variables, ‖u_i‖ ≤ 1
+            for i in data.sites.chosen:
+                entries = range(data.size)[data.sites.entries(i)]
+                bound = data.sites.sites[i].max_mr / data.scales[entries.start]
+                norm_at_most([entry(k, data.scales[k]) for k in entries],
+                             (np.zeros(lay.size), bound * (1 - margin) if margin < 0.5 else bound))
         return out, relaxed
 
     def box(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -421,6 +434,11 @@ class ConvexSolver(Repairs, Diagnosis):
                 assert b.counter_rotor is not None
                 j = index[b.rotor_entry]
                 lo[j], hi[j] = (v / data.scales[b.rotor_entry] for v in b.counter_rotor)
+        if data.sites is not None:
+            for i in data.sites.chosen:
+                for k in range(data.size)[data.sites.entries(i)]:
+                    bound = data.sites.sites[i].max_mr / data.scales[k]
+                    lo[index[k]], hi[index[k]] = -bound, bound
         return lo, hi
 
     def _force_balance(self) -> bool:
@@ -501,13 +519,15 @@ class ConvexSolver(Repairs, Diagnosis):
         x, tight = self.repair(u1)
         objective = data.reduced_objective(x)
         if tie_break and lay.size:
-            target = data.x0 if prefer is None else np.asarray(prefer, float)
+            target = data.preferred if prefer is None else np.asarray(prefer, float)
             fixed = [] if self._fb is None else [self._fb[1]]
-            report2, second = self._run(self._stage2, "tie-break", target=lay.u(target),
-                                        equality_rhs=np.concatenate([*fixed, self._seen @ u1]))
-            stages.append(report2)
             probe = x
-            if second.u is not None:
+            if self._tie_free:
+                report2, second = self._run(
+                    self._stage2, "tie-break", target=lay.u(target),
+                    equality_rhs=np.concatenate([*fixed, self._seen @ u1]))
+                stages.append(report2)
+            if self._tie_free and second.u is not None:
                 x2, tight2 = self.repair(second.u)
                 objective2 = data.reduced_objective(x2)
                 probe = x2
@@ -518,6 +538,7 @@ class ConvexSolver(Repairs, Diagnosis):
             x, objective = self._without_small_counterweights(x, probe, u1, target, objective,
                                                               stages)
             x, objective = self.polish(x, target, objective)
+            x = self.polish_sites(x)
         x = data.settle(x)  # the inert entries, for a crank whose speed changes
         x, feasible = self.finalize(x)
         if feasible and tie_break:

@@ -107,6 +107,8 @@ class Feasibility(ProblemData):
                 out.append(
                     f"{b.key}.counter_rotor: {value:.9g} kg·m² outside [{lo:.9g}, {hi:.9g}]"
                 )
+        if self.sites is not None:
+            out += self.sites.violations(x, tol)
         residual = self.force_balance_residual(x)
         if residual > max(tol, FORCE_BALANCE_TOLERANCE):
             out.append(f"force balance: residual {residual:.3g} of its terms")

@@ -181,6 +181,20 @@ class NlpSolver:
             else:
                 parts[entry] = scale * variable(f"Jc{entry}", lo / scale, hi / scale,
                                                 (entry, "Jc"))
+        if data.sites is not None:  # a chosen mass·radius within its disc; a kept one as it is
+            for i, site in enumerate(data.sites.sites):
+                entries = range(data.size)[data.sites.entries(i)]
+                if not site.free:
+                    for k in entries:
+                        parts[k] = float(data.x0[k])
+                    continue
+                bound = site.max_mr / data.scales[entries.start]
+                re, im = (data.scales[k] * variable(f"x{k}", -bound, bound, (k, "mr"))
+                          for k in entries)
+                parts[entries.start], parts[entries.start + 1] = re, im
+                g.append((re * re + im * im) / data.scales[entries.start] ** 2)
+                lbg.append(-math.inf)
+                ubg.append(bound * bound)
         pi = ca.vertcat(*parts)
         if data.force_balance is not None:
             a, rhs = data.force_balance
@@ -232,7 +246,7 @@ class NlpSolver:
                     else physical_parameters(own[b.entries]) for b in data.links]
         out = []
         for index, kind in self._names:
-            if kind == "Jc":
+            if kind in ("Jc", "mr"):
                 out.append(x[index] / data.scales[index])
                 continue
             b = data.links[index]

@@ -2,7 +2,8 @@
 
 ``J(x) = ‖K·x‖² + w_m·(Σm − Σm_original)``: :func:`objective_rows` stacks the weighted regressor
 rows of each term of ``[balance.objective]`` (shaking moment, driving torque, shaking force,
-rocking couple) into ``K`` and factors it; :class:`ObjectiveTerms` evaluates ``J`` from the full
+rocking couple; an engine's unbalance, ``w_U·Σ (|x_i|·ω²)²`` over its chosen mass·radius sites)
+into ``K`` and factors it; :class:`ObjectiveTerms` evaluates ``J`` from the full
 regressors (:meth:`ObjectiveTerms.objective`) or through the factor
 (:meth:`ObjectiveTerms.reduced_objective`).
 """
@@ -21,18 +22,26 @@ from ..quantities import squared_parts
 from .bounds import LinkBounds
 from .problem_data import ProblemData
 from .regressors import CycleRegressors
+from .sites import Sites
 
 
-def objective_rows(reg: CycleRegressors, w: Objective, links: tuple[LinkBounds, ...], p: int
-             ) -> tuple[NDArray[np.float64], NDArray[np.float64], tuple[bool, ...]]:
+def objective_rows(reg: CycleRegressors, w: Objective, links: tuple[LinkBounds, ...], p: int,
+                   sites: Sites | None = None
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64], tuple[bool, ...]]:
     """The objective's rows ``K``, their triangular factor ``R`` and the inert entries.
 
     ``K`` stacks the weighted regressor rows, each block divided by the square root of its
-    number of rows (``√N``: a mean square; see :class:`ProblemData`); an entry is inert where
+    number of rows (``√N``: a mean square; see :class:`ProblemData`), and the unbalance's
+    ``√w_U·ω²`` on each chosen site's entries (a sum of squares); an entry is inert where
     its column of ``R`` vanishes (to ``1e-12`` of the largest).
     """
     blocks = [math.sqrt(term.weight) * part / math.sqrt(part.shape[0]) for term in w.terms
               for part in squared_parts(term.name, lambda key: getattr(reg, key))]
+    if w.unbalance and sites is not None:
+        chosen = np.flatnonzero(sites.chosen_entries(p))
+        block = np.zeros((chosen.size, p))
+        block[np.arange(chosen.size), chosen] = math.sqrt(w.unbalance) * sites.speed**2
+        blocks.append(block)
     rows = np.vstack(blocks) if blocks else np.zeros((0, p))
     factor = (cast("NDArray[np.float64]", np.linalg.qr(rows, mode="r"))  # R alone (as above)
               if blocks else np.zeros((0, p)))
@@ -68,6 +77,8 @@ class ObjectiveTerms(ProblemData):
                 total += term.weight * float(np.mean(part**2))
         if w.added_mass:
             total += w.added_mass * (self.total_mass(x) - self.original_mass)
+        if w.unbalance and self.sites is not None:
+            total += w.unbalance * self.sites.unbalance(x) ** 2
         return total
 
     def reduced_objective(self, x: NDArray[np.float64]) -> float:

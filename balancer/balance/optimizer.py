@@ -39,9 +39,10 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import replace
-from typing import Literal, get_args
+from typing import Literal, cast, get_args
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..cycle import CycleAnalysis, cycle_analysis
 from ..errors import SpecError
@@ -49,7 +50,6 @@ from ..model import Design, MechanismModel
 from ..model.balance import BalanceProblem, RotorBalanceProblem, missing_balance
 from ..model.motions import MotionSpec, Workspace
 from ..motion_analysis import AlongMotions, along_motions
-from . import rotors
 from .convex import ConvexSolution, ConvexSolver
 from .feasibility import ROUNDING_TOLERANCE
 from .nlp import NlpSolution, NlpSolver
@@ -58,6 +58,7 @@ from .result import (
     GAP_TOLERANCE,
     BalanceResult,
     InfeasibleError,
+    RotorMasses,
     StageReport,
     Status,
 )
@@ -118,9 +119,10 @@ class Optimizer:
 
         Raises as :func:`~balancer.balance.problem.numeric_problem`.
         """
-        if isinstance(design.balance, RotorBalanceProblem):
-            raise SpecError("not yet for an engine: its counterweights and shafts are chosen by "
-                            "`balancer optimize`", key="balance")
+        if along and isinstance(design.balance, RotorBalanceProblem):
+            raise SpecError("an engine's counterweights and shafts are balanced over a "
+                            "revolution at its operating speed, not along a motion",
+                            key="balance")
         data = numeric_problem(design, along=along)  # (it has checked [operation], or motions)
         gravity = design.operation.gravity if design.operation is not None else (0.0, 0.0)
         return cls(data, gravity=gravity, motions=design.motions, workspace=design.workspace)
@@ -188,7 +190,7 @@ class Optimizer:
                     if ok and (not feasible or data.objective(xb) < objective):
                         # What IPOPT left where nothing pulls (a counterweight that may be none
                         # at its barrier's middle) is put back as the convex stage puts it.
-                        polished, _ = self.convex.polish(xb, data.x0,
+                        polished, _ = self.convex.polish(xb, data.preferred,
                                                          data.reduced_objective(xb))
                         xp, exact = self.convex.finalize(polished)
                         if exact and data.within(data.objective(xp), data.objective(xb), 1e-12):
@@ -198,7 +200,7 @@ class Optimizer:
             elif nlp is not None:
                 notes.append(f"IPOPT: {nlp.stage.solver_status}")
         # The design as its physical values, exactly in their bounds (what the spec will say).
-        x = data.vector_of(data.physical(x))
+        x = data.built(x)
         objective = data.objective(x)
         feasible = feasible and not data.violations(x, tol=ROUNDING_TOLERANCE)
         if not feasible and data.force_balance is not None:
@@ -247,8 +249,23 @@ class Optimizer:
             after=after,
             gravity=self.gravity,
             weights=data.weights,
+            rotor_masses=None if data.sites is None else self._rotor_masses(x),
         )
         return replace(result, message=result.summary(notes))
+
+    def _rotor_masses(self, x: NDArray[np.float64]) -> RotorMasses:
+        """What an engine's balancing builds: its chosen masses in ``x``, and their figures."""
+        data = self.data
+        sites = data.sites
+        assert sites is not None
+        counterweights, shafts = sites.masses(x)
+        problem = cast("RotorBalanceProblem", data.problem)
+        return RotorMasses(
+            counterweights=counterweights, shafts=shafts,
+            radius=None if problem.counterweights is None else problem.counterweights.radius,
+            replaced=sites.replaced, unbalance_before=sites.unbalance(data.x0),
+            unbalance_after=sites.unbalance(x),
+            bearing_loads=sites.bearing_loads(x, data.regressors.shaking_force))
 
 
     def _inertial(self, model: MechanismModel) -> CycleAnalysis | AlongMotions:
@@ -258,7 +275,9 @@ class Optimizer:
         """
         data = self.data
         if data.speed is None:
-            weights = data.problem.weights_of([m.name for m in self.motions])
+            # (a linkage's: an engine's turns at its operating speed)
+            problem = cast("BalanceProblem", data.problem)
+            weights = problem.weights_of([m.name for m in self.motions])
             return along_motions(model, self.motions, workspace=self.workspace, loads=False,
                                  weights=weights)
         return cycle_analysis(model, data.speed, data.samples, route="newton-euler",
@@ -298,6 +317,4 @@ def optimize(design: Design, backend: Backend = "nlp") -> BalanceResult:
         )
     if design.balance is None:
         raise missing_balance(design.mechanism)
-    if isinstance(design.balance, RotorBalanceProblem):  # an engine's counterweights, shafts
-        return rotors.optimize(design, backend)
     return Optimizer.of(design).run(backend)

@@ -3,7 +3,9 @@
 :meth:`PhysicalValues.physical` turns a design vector's inertial parameters (``m``, ``m·e``,
 ``m·f``, ``J``) into each link's mass, centre of mass, inertia and counter-rotor, each within
 its bounds exactly (:meth:`PhysicalValues.clamp`); :meth:`PhysicalValues.vector_of` goes back,
-and :meth:`PhysicalValues.linkage_of` builds the balanced mechanism's model.
+:meth:`PhysicalValues.built` is the design vector as built (an engine's mass·radius sites as
+their placed masses say them), and :meth:`PhysicalValues.linkage_of` builds the balanced
+mechanism's model.
 """
 
 from __future__ import annotations
@@ -37,6 +39,11 @@ class PhysicalValues(ProblemData):
         own_x = self.own(x)
         for b in self.links:
             rotor = float(x[b.rotor]) if b.rotor is not None else 0.0
+            if not b.listed:  # held: as it is (an engine's links may have no mass)
+                original = b.original
+                out[b.name] = (original.mass, original.e, original.f, original.inertia,
+                               original.counter_rotor)
+                continue
             if self.absent(b, own_x) or (b.offset is not None and b.mass[0] == 0
                                          and not own_x[b.start] > 0):
                 # no counterweight (none, or no mass where none is allowed: its mass put into
@@ -127,7 +134,19 @@ class PhysicalValues(ProblemData):
 
         The largest change of an entry over its scale (:attr:`scales`).
         """
-        return float(np.max(np.abs(self.vector_of(self.physical(x)) - x) / self.scales))
+        return float(np.max(np.abs(self.built(x) - x) / self.scales))
+
+    def built(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The design vector as the spec will say it: physical values exactly in their bounds.
+
+        Each link's through :meth:`physical`; each chosen mass·radius site as its size (within
+        its bound) and angle (:meth:`.sites.Sites.as_placed`), a kept one as it is.
+        """
+        out = self.vector_of(self.physical(x))
+        if self.sites is not None:
+            part = slice(self.sites.start, self.size)
+            out[part] = self.sites.as_placed(x)[part]
+        return out
 
     def vector_of(self, physical: Mapping[str, tuple[float, float, float, float, float]]
                   ) -> NDArray[np.float64]:
@@ -143,8 +162,11 @@ class PhysicalValues(ProblemData):
     def linkage_of(self, x: NDArray[np.float64]) -> Model:
         """The mechanism's model with design vector ``x`` (loads kept from the original links).
 
-        Physical values from :meth:`physical`, in their bounds exactly.
+        Physical values from :meth:`physical`, in their bounds exactly; an engine's chosen
+        masses in place of those they replace (:meth:`.sites.Sites.model_of`).
         """
+        if self.sites is not None and not any(b.listed for b in self.links):
+            return self.sites.model_of(self.linkage, x)
         links = {}
         values = self.physical(x)
         for b in self.links:
@@ -152,4 +174,5 @@ class PhysicalValues(ProblemData):
             links[b.name] = replace(
                 b.original, mass=m, e=e, f=f, inertia=inertia, counter_rotor=rotor
             )
-        return self.linkage.with_links(links)
+        model = self.linkage.with_links(links)
+        return model if self.sites is None else self.sites.model_of(model, x)

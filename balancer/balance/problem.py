@@ -44,7 +44,7 @@ from ..linkage.inputs import InputState
 from ..linkage.vectors import V
 from ..mechanisms import Mechanism, mechanism_of
 from ..model import Design
-from ..model.balance import BalanceProblem
+from ..model.balance import BalanceProblem, RotorBalanceProblem
 from ..motion_analysis import motion_weights, stacked_torques
 from .bounds import check_problem, resolve_link
 from .feasibility import Feasibility, force_balance_system
@@ -53,6 +53,7 @@ from .objective_terms import objective_rows
 from .physical import PhysicalValues
 from .regressors import CycleRegressors, cycle_regressors_at
 from .settling import Settling
+from .sites import site_columns, sites_of
 
 
 class NumericProblem(Feasibility, PhysicalValues, Settling, ObjectiveScale):
@@ -80,6 +81,9 @@ class NumericProblem(Feasibility, PhysicalValues, Settling, ObjectiveScale):
         SpecError
             If ``problem`` is contradictory (:func:`check_problem`).
         """
+        if self.sites is not None:
+            raise SpecError("an engine's counterweights and shafts: build its problem from its "
+                            "design (numeric_problem)", key="balance")
         problem = _checked_problem(problem)
         mech = self.mechanism
         check_problem(problem, mech)
@@ -92,7 +96,7 @@ class NumericProblem(Feasibility, PhysicalValues, Settling, ObjectiveScale):
                                                   self.size)
         fb = None
         if problem.force_balance:
-            same_scope = problem.force_scope == self.problem.force_scope
+            same_scope = problem.force_scope == cast("BalanceProblem", self.problem).force_scope
             if self.force_balance is not None and same_scope:
                 fb = self.force_balance
             elif problem.force_scope == "motion":
@@ -119,7 +123,9 @@ def numeric_problem(design: Design, *, along: bool = False) -> NumericProblem:
     For the same design under other bounds, :meth:`NumericProblem.with_problem` reuses what
     does not depend on them. A linkage with several inputs is balanced along its motions; one
     with one input over a revolution at the operating speed, or along its motions where
-    ``along`` (a time law that varies the crank's speed: ``plan --with-masses``).
+    ``along`` (a time law that varies the crank's speed: ``plan --with-masses``); an engine's
+    counterweights and shafts (:class:`~balancer.model.balance.RotorBalanceProblem`) are
+    mass·radius sites after its links' entries (:mod:`.sites`), over a revolution.
 
     Raises
     ------
@@ -129,6 +135,8 @@ def numeric_problem(design: Design, *, along: bool = False) -> NumericProblem:
     AssemblyError
         If the crank cannot turn a full revolution.
     """
+    if isinstance(design.balance, RotorBalanceProblem) and not along:
+        return _engine_problem(design, design.balance)
     problem = _checked_problem(design.balance)
     mech = mechanism_of(design.mechanism)
     if len(mech.linkage.inputs) > 1 or along:
@@ -174,6 +182,36 @@ def _problem(problem: BalanceProblem, mech: Mechanism, speed: float | None,
         inert=inert,
         unit_acceleration=unit,
     )
+
+
+def _engine_problem(design: Design, problem: RotorBalanceProblem) -> NumericProblem:
+    """The problem of an engine's counterweights and shafts: its links held, its sites chosen.
+
+    The design vector is the linkage's entries (every link as it is) then two per mass·radius
+    site (:func:`.sites.sites_of`: the chosen ones, then the masses kept); the regressors are
+    the linkage's over the revolution at the operating speed with the sites' columns beside
+    them (:func:`.sites.site_columns`), so that ``J(x0)`` is the original's and the chosen
+    sites' columns the loads each mass·radius makes.
+    """
+    mech = mechanism_of(design.mechanism)
+    sites, site_values = sites_of(design, mech.layout.size)
+    assert design.operation is not None, "sites_of checked it"
+    speed = design.operation.speed
+    angles = sample_angles(design.operation.samples)
+    (linkage,) = cycle_regressors_at(mech, angles, [(speed, 0.0)])
+    force, moment, couple = site_columns(sites.sites, angles, speed)
+    reg = CycleRegressors(  # no driving torque from a site at constant speed
+        shaking_force=np.hstack([linkage.shaking_force, force]),
+        shaking_moment=np.hstack([linkage.shaking_moment, moment]),
+        driving_torque=np.hstack([linkage.driving_torque, np.zeros(moment.shape)]),
+        rocking_couple=np.hstack([linkage.rocking_couple, couple]))
+    links = tuple(resolve_link(mech, name, None) for name in mech.link_names)
+    x0 = np.concatenate([mech.parameters(), site_values])
+    rows, factor, inert = objective_rows(reg, problem.objective, links, x0.size, sites)
+    return NumericProblem(problem=problem, mechanism=mech, speed=speed,
+                          states=InputState.crank(angles, speed), regressors=reg, links=links,
+                          x0=x0, rows=rows, factor=factor, force_balance=None, inert=inert,
+                          sites=sites)
 
 
 def _along_motions(design: Design, problem: BalanceProblem, mech: Mechanism) -> NumericProblem:

@@ -19,9 +19,10 @@ from numpy.typing import NDArray
 from ..linkage.inputs import InputState
 from ..mechanisms.base import Mechanism
 from ..model import MechanismModel as Model
-from ..model.balance import BalanceProblem, Objective
+from ..model.balance import BalanceProblem, Objective, RotorBalanceProblem
 from .bounds import LinkBounds
 from .regressors import CycleRegressors
+from .sites import Sites
 
 #: A counterweight whose mass may be zero (``counterweight = { mass = [0, hi], … }``) and whose
 #: own mass, first moments and inertia are all within this share of the link's scales (``m``,
@@ -75,7 +76,7 @@ class ProblemData:
         that the bounds allow.
     """
 
-    problem: BalanceProblem
+    problem: BalanceProblem | RotorBalanceProblem
     mechanism: Mechanism
     speed: float | None
     states: InputState
@@ -92,6 +93,9 @@ class ProblemData:
     #: uses, their shaking moment (their driving torque is NaN where the crank turns at the
     #: operating speed: not computed).
     unit_acceleration: CycleRegressors | None = None
+    #: An engine's mass·radius sites (:mod:`.sites`), whose two entries each follow the
+    #: linkage's in the design vector; ``None`` for a linkage's redesign.
+    sites: Sites | None = None
 
     @property
     def linkage(self) -> Model:
@@ -112,6 +116,19 @@ class ProblemData:
     def weights(self) -> Objective:
         """The objective's weights."""
         return self.problem.objective
+
+    @cached_property
+    def preferred(self) -> NDArray[np.float64]:
+        """The design the tie-break moves towards among optimal ones.
+
+        The original (the least change), with an engine's chosen mass·radius sites none (the
+        least mass·radius, as their bounds scale it).
+        """
+        if self.sites is None:
+            return self.x0
+        out = self.x0.copy()
+        out[self.sites.chosen_entries(self.size)] = 0.0
+        return out
 
     @cached_property
     def mass_entries(self) -> list[int]:
@@ -196,7 +213,7 @@ class ProblemData:
         """Typical magnitude of each entry of ``x``, for scaling the optimisers' variables.
 
         ``m``, ``m·l``, ``m·l``, ``m·l²`` per link (original mass); counter-rotors like their
-        link's ``m·l²``.
+        link's ``m·l²``; a mass·radius site its bound (kg·m).
         """
         out = np.ones(self.size)
         for b in self.links:
@@ -204,6 +221,10 @@ class ProblemData:
             out[b.entries] = (m, m * l, m * l, m * l * l)
             if b.rotor is not None:
                 out[b.rotor] = b.inertia_ref
+        if self.sites is not None:
+            for i, site in enumerate(self.sites.sites):
+                if site.max_mr > 0:
+                    out[self.sites.entries(i)] = site.max_mr
         return out
 
     def total_mass(self, x: NDArray[np.float64]) -> float:

@@ -48,6 +48,13 @@ EQ58_ROUNDING = 16 * float(np.finfo(float).eps)
 _EPS = float(np.finfo(float).eps)
 
 
+#: A mass·radius within this share of its bound is held by it (:meth:`Repairs.polish_sites`).
+ACTIVE_SHARE = 1e-6
+#: Singular values of the objective's factor below this share of the largest are rounding
+#: (:meth:`Repairs.polish_sites`).
+RANK_TOLERANCE = 1e-12
+
+
 def _norm(v: NDArray[np.float64]) -> float:
     """The 2-norm of a real vector, as ``numpy.linalg.norm`` computes it: ``√(v·v)``."""
     return math.sqrt(float(v.dot(v)))
@@ -204,7 +211,7 @@ class Repairs:
         best: tuple[float, NDArray[np.float64]] | None = None
         pinned = np.zeros(lay.size, dtype=bool)
         for _ in range(4):
-            xp = data.vector_of(data.physical(x))
+            xp = data.built(x)
             residual = data.force_balance_residual(xp)
             if (residual <= FORCE_BALANCE_TOLERANCE
                     and not data.violations(xp, tol=ROUNDING_TOLERANCE)
@@ -345,6 +352,35 @@ class Repairs:
             if not data.violations(xt):
                 u, x, objective, pinned = trial, xt, jt, trial_pinned
         return x, objective
+
+    def polish_sites(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``x`` with its mass·radius sites off their bounds solved for exactly, the rest kept.
+
+        Where its bound does not hold a site, the objective is a least-squares problem in it:
+        solved by a factorisation its residual is rounding, where the interior-point iterate
+        leaves what those masses can cancel at the square root of its tolerance. The
+        least-norm solution in the scaled variables (as the tie-break chooses); kept only if
+        every site stays within its bound and the objective is no worse.
+        """
+        data = self.data
+        sites = data.sites
+        if sites is None:
+            return x
+        x = np.asarray(x, dtype=float)
+        free = np.zeros(data.size, dtype=bool)
+        for i in sites.chosen:
+            if abs(sites.vector(x, i)) < (1 - ACTIVE_SHARE) * sites.sites[i].max_mr:
+                free[sites.entries(i)] = True
+        if not free.any():
+            return x
+        scaled = data.factor[:, free] * data.scales[free]
+        rhs = -(data.factor[:, ~free] @ x[~free])
+        solved, *_ = np.linalg.lstsq(scaled, rhs, rcond=RANK_TOLERANCE)
+        candidate = x.copy()
+        candidate[free] = solved * data.scales[free]
+        if sites.violations(candidate, 0.0):
+            return x
+        return candidate if data.reduced_objective(candidate) <= data.reduced_objective(x) else x
 
     def without_idle_counterweights(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The exactly feasible design ``x`` without the counterweights that do nothing in it.

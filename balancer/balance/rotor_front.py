@@ -3,12 +3,13 @@
 DESIGN.md, "Balancing an engine": ``pareto --against added-mass`` for an engine bounds the sum of
 the chosen ``|mr|`` (kg·m; their masses, kg, where ``[balance.counterweights] radius`` is given —
 the new shafts' eccentrics then counted at the same radius). What it minimises is the spec's
-objective without its unbalance term, ``J'`` (:mod:`.rotors`; the bound on the masses takes the
+objective without its unbalance term, ``J'`` (:mod:`.sites`; the bound on the masses takes the
 unbalance term's place): where ``J'`` weighs one quantity alone the front is of that quantity's
 RMS (the RMS rocking couple by default), else of ``√J'``, the weighted RMS (N·m).
 
-Each point is the convex program of :mod:`.rotors` (in its scaled variables ``u = x/max_mr``,
-``‖u_i‖ ≤ 1``) with one more variable per mass·radius, ``t_i ≥ ‖u_i‖``, and the cap
+Each point is the balancing's convex program (:class:`.convex.ConvexSolver`, in its scaled
+variables ``u = x/max_mr``, ``‖u_i‖ ≤ 1``) with one more variable per mass·radius,
+``t_i ≥ ‖u_i‖``, and the cap
 
     Σ c_i·t_i ≤ ε,   c_i = max_mr_i (kg·m) or max_mr_i/radius (kg),
 
@@ -33,9 +34,10 @@ from ..model import Design
 from ..model.balance import RotorBalanceProblem
 from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
-from .convex import ACCURACY_FALLBACKS, CERTIFY_AGAIN, solve_program
+from .convex import ACCURACY_FALLBACKS, CERTIFY_AGAIN, ConvexSolver, solve_program
 from .front import Front, FrontPoint, mark_knee
-from .rotors import RotorProblem, RotorSolver
+from .problem import NumericProblem, numeric_problem
+from .sites import Sites
 
 #: Room given to an end of the front when it becomes a constraint (relative to its scale): a
 #: hundred times Clarabel's tolerance, so that the constrained program stays feasible.
@@ -47,32 +49,48 @@ SINGLE = ("rocking_couple", "shaking_force", "shaking_moment")
 class _RotorFront:
     """The ε-constraint programs of an engine's balancing, in ``(u, t)``."""
 
-    def __init__(self, data: RotorProblem) -> None:
+    def __init__(self, data: NumericProblem) -> None:
+        assert data.sites is not None, "an engine's problem"
         self.data = data
-        self.solver = solver = RotorSolver(data)
-        n, s = data.size, len(data.sites)
+        self.sites: Sites = data.sites
+        self.solver = solver = ConvexSolver(data)
+        n, s = solver.layout.size, len(self.sites.chosen)
+        chosen = [k for i in self.sites.chosen for k in range(data.size)[self.sites.entries(i)]]
+        assert list(solver.layout.primary) == chosen, "the variables are the chosen sites'"
         self.n, self.s = n, s
         width = n + s
-        radius = (None if data.problem.counterweights is None
-                  else data.problem.counterweights.radius)
+        problem = self.sites.problem
+        radius = None if problem.counterweights is None else problem.counterweights.radius
         self.per_mr = 1.0 if radius is None else 1.0 / radius
         self.unit = "kg·m" if radius is None else "kg"
-        self.weights = np.array([site.max_mr for site in data.sites]) * self.per_mr
+        self.weights = np.array([self.sites.sites[i].max_mr for i in self.sites.chosen]
+                                ) * self.per_mr
         self.rescale(float(self.weights.sum()))
         cones = [Constraint("soc", np.hstack([c.M, np.zeros((3, s))]), c.m)
                  for c in solver.constraints]
-        for i in range(s):
+        for i in range(s):  # the variables are the chosen sites' scaled entries, in order
             m = np.zeros((3, width))
             m[0, n + i] = 1.0
             m[1, 2 * i] = m[2, 2 * i + 1] = 1.0
             cones.append(Constraint("soc", m, np.zeros(3)))
         self.cones = cones
-        self.P = np.hstack([solver.P, np.zeros((solver.P.shape[0], s))])
-        self.q = solver.q
+        compressed = solver.compressed
+        self.P = np.hstack([compressed.P, np.zeros((compressed.P.shape[0], s))])
+        self.q = compressed.q
         self.norm = ConvexObjective(P=self.P, q=self.q, norm=True, g=np.zeros(width), g0=0.0)
         self.lo = np.r_[-np.ones(n), np.zeros(s)]
         self.hi = np.ones(width)
         self.width = width
+
+    def x(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The design vector (kg·m) of scaled ``u``, each mass·radius within its bound."""
+        return self.sites.into_bounds(self.solver.layout.x(u[: self.n]))
+
+    def figures(self, x: NDArray[np.float64]) -> dict[str, float]:
+        """The RMS of the shaking force, rocking couple and shaking moment at ``x`` (N, N·m)."""
+        reg = self.data.regressors
+        return {name: float(np.sqrt(np.mean(np.abs(getattr(reg, name) @ x) ** 2)))
+                for name in ("shaking_force", "rocking_couple", "shaking_moment")}
 
     def rescale(self, scale: float) -> None:
         """Measure the cap in units of ``scale`` (its unit).
@@ -84,8 +102,8 @@ class _RotorFront:
         self.cap_row = np.r_[np.zeros(self.n), self.weights / self.value_scale]
 
     def value(self, x: NDArray[np.float64]) -> float:
-        """``Σ |mr_i|`` of ``x`` (kg·m), or the masses at the radius (kg)."""
-        return math.fsum(np.hypot(x[0::2], x[1::2])) * self.per_mr
+        """``Σ |mr_i|`` of ``x``'s chosen sites (kg·m), or the masses at the radius (kg)."""
+        return math.fsum(abs(self.sites.vector(x, i)) for i in self.sites.chosen) * self.per_mr
 
     def cap(self, epsilon: float) -> Constraint:
         """``Σ c_i·t_i ≤ ε`` (``ε`` in :attr:`unit`) as a cone constraint."""
@@ -102,7 +120,7 @@ class _RotorFront:
                                q=self.q)
         if settings:
             return solve_program(program, {**self.solver.settings, **settings})
-        return self.solver.solve_program(program)
+        return solve_program(program, self.solver.settings)
 
     def least_value(self, root: float) -> ConicSolution:
         """``min Σ c_i·t_i`` among the designs with ``‖P·u + q‖ ≤ root``."""
@@ -110,7 +128,7 @@ class _RotorFront:
                          np.r_[root, self.q])
         program = ConicProgram(self.width, [*self.cones, cap], objective="squares",
                                P=np.zeros((0, self.width)), q=np.zeros(0), g=self.cap_row)
-        return self.solver.solve_program(program)
+        return solve_program(program, self.solver.settings)
 
     def certified(self, solution: ConicSolution, cap: Constraint) -> float:
         """The certified least ``√J'`` under ``cap``, N·m (0 where none is made)."""
@@ -146,12 +164,11 @@ def rotor_front(design: Design, against: str, points: int) -> Front:
         raise SpecError(f"weighs {what}: nothing to trade against the added mass; weigh the "
                         "rocking couple, the shaking force or the shaking moment",
                         key="balance.objective")
-    data = RotorProblem(replace(design, balance=replace(problem, objective=weights)))
+    data = numeric_problem(replace(design, balance=replace(problem, objective=weights)))
     single = weights.single
     minimised = single.name if single is not None and single.name in SINGLE else "rms"
     per_weight = 1.0 / math.sqrt(single.weight) if minimised != "rms" and single else 1.0
     programs = _RotorFront(data)
-    solver = programs.solver
     scale = data.objective_scale
 
     def least(x: NDArray[np.float64]) -> float:
@@ -160,7 +177,7 @@ def rotor_front(design: Design, against: str, points: int) -> Front:
     def solved(solution: ConicSolution, what: str) -> NDArray[np.float64]:
         if solution.u is None:
             raise SolverError(f"{what} could not be solved (Clarabel: {solution.status})")
-        return solver.x(solution.u[: programs.n])
+        return programs.x(solution.u)
 
     best = solved(programs.least_objective([]), "the least shaking")
     # The front's extent is at most the mass of that optimum: the cap's unit from here on
@@ -176,8 +193,7 @@ def rotor_front(design: Design, against: str, points: int) -> Front:
         cap = programs.cap(float(epsilon))
         solution = programs.least_objective([cap])
         x = solved(solution, f"a point of the front (ε = {epsilon:.6g} {programs.unit})")
-        counterweights, shafts = data.masses(x)
-        x = data.vector_of(counterweights, shafts)  # as the spec would say it
+        x = data.built(x)  # as the spec would say it
         bound = programs.certified(solution, cap)
         # A dual off by more than its tolerance leaves the bound loose: solved again with other
         # settings, the highest bound kept (each valid by weak duality), as the convex
@@ -190,12 +206,12 @@ def rotor_front(design: Design, against: str, points: int) -> Front:
                 bound = max(bound, programs.certified(again, cap))
         out.append(FrontPoint(least=least(x), value=programs.value(x), epsilon=float(epsilon),
                               lower_bound=bound * per_weight,
-                              x=x, figures=data.figures(x)))
+                              x=x, figures=programs.figures(x)))
     out.sort(key=lambda p: p.value)
     return Front(against=against, points=tuple(mark_knee(out)),
                  original=(programs.value(data.x0), least(data.x0)),
                  minimised=minimised, value_unit=None if programs.unit == "kg" else "kg·m",
-                 original_figures=data.figures(data.x0), masses=True)
+                 original_figures=programs.figures(data.x0), masses=True)
 
 
 __all__ = ["rotor_front"]

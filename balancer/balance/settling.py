@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 from .lsq import bounded_lstsq
 from .problem_data import ProblemData
 from .regressors import cycle_regressors
+from .sites import site_columns
 
 
 def _bounded_least_squares(a: NDArray[np.float64], x: NDArray[np.float64],
@@ -63,9 +64,12 @@ class Settling(ProblemData):
         objective, at constant speed, does not see what the crank's rotary inertia does when
         the speed changes; this does.
         """
-        reg = self.unit_acceleration or cycle_regressors(
-            self.mechanism, np.asarray(self.states.positions[0], dtype=float), 0.0, 1.0)
-        rows = reg.shaking_moment / math.sqrt(reg.shaking_moment.shape[0])
+        angles = np.asarray(self.states.positions[0], dtype=float)
+        reg = self.unit_acceleration or cycle_regressors(self.mechanism, angles, 0.0, 1.0)
+        moment = reg.shaking_moment
+        if moment.shape[1] < self.size and self.sites is not None:  # the sites' columns
+            moment = np.hstack([moment, site_columns(self.sites.sites, angles, 0.0, 1.0)[1]])
+        rows = moment / math.sqrt(moment.shape[0])
         # (R alone: numpy's stubs say qr gives a QRResult whatever its mode.)
         return cast("NDArray[np.float64]", np.linalg.qr(rows, mode="r"))
 
@@ -119,13 +123,12 @@ class Settling(ProblemData):
         x[entries] = original
         if not for_motion:
             return x
-        a = self.acceleration_factor
         lower_a, upper_a, original_a = (np.array(v, dtype=float) for v in (lower, upper,
                                                                              original))
         rotor_entries = {b.rotor for b in self.rotor_links}
         rotors = np.array([i in rotor_entries for i in entries])
         if rotors.any():
             idx = [e for e, r in zip(entries, rotors, strict=True) if r]
-            x[idx] = _bounded_least_squares(a, x, idx, lower_a[rotors], upper_a[rotors],
-                                            original_a[rotors])
+            x[idx] = _bounded_least_squares(self.acceleration_factor, x, idx, lower_a[rotors],
+                                            upper_a[rotors], original_a[rotors])
         return x

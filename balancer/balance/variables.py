@@ -98,6 +98,14 @@ def layout(data: NumericProblem) -> VariableMap:
             new_variable(entry)
         else:
             c[entry] = lo
+    if data.sites is not None:  # a chosen mass·radius's two entries; a kept one's values
+        for i, site in enumerate(data.sites.sites):
+            entries = range(size)[data.sites.entries(i)]
+            if site.free:
+                for entry in entries:
+                    new_variable(entry)
+            else:
+                c[entries.start : entries.stop] = data.x0[entries.start : entries.stop]
     return VariableMap(c=c, T=rows[:, : len(primary)].copy(), primary=tuple(primary))
 
 

@@ -388,7 +388,7 @@ class RotorBalanceProblem:
     """An engine's redesign problem: counterweights and new shafts, each mass·radius bounded.
 
     The loads are linear in each counterweight's and eccentric's mass·radius vector and each
-    bound is a cone, so the problem is convex (:mod:`balancer.balance.rotors`).
+    bound is a cone, so the problem is convex (:mod:`balancer.balance.sites`).
 
     Attributes
     ----------

@@ -1,6 +1,6 @@
 """An engine's crank-web sectors: each plane's counterweight on the crankshaft as a part.
 
-An engine's balancing (:mod:`balancer.balance.rotors`) chooses per plane of
+An engine's balancing (:mod:`balancer.balance.sites`) chooses per plane of
 ``[balance.counterweights]`` a mass·radius ``mr`` (kg·m) at an angle: a point mass on the
 crankshaft. Where the spec gives those counterweights a ``part`` (a
 :class:`~balancer.model.parts.Sector`: a crank web's crescent about the crank's axis), each

@@ -18,7 +18,7 @@ single ``balancer optimize --backend convex`` run gives). Each point becomes one
   counterweights' radius, empty where none is given), ``message``.
 
 An engine's spec (``[balance.counterweights]``, ``[[balance.shafts]]``) is balanced at each point
-as ``optimize`` balances it (:mod:`balancer.balance.rotors`); its keys — a crank radius
+as ``optimize`` balances it (:mod:`balancer.balance.sites`); its keys — a crank radius
 ``mechanism.lengths.crank``, a bank angle ``mechanism.cylinders.1.bank_deg``, a plane
 ``balance.counterweights.planes.0`` — vary like any other.
 

@@ -31,8 +31,10 @@ from test_engines import EXAMPLES, flat_four, harmonic_coefficients, momentum_lo
 
 from balancer.balance.optimizer import optimize
 from balancer.balance.pareto import pareto_front
+from balancer.balance.problem import NumericProblem, numeric_problem
 from balancer.balance.rotor_front import END_ROOM
 from balancer.cli import main
+from balancer.mechanisms import mechanism_of
 from balancer.mechanisms.engine.model import BalanceShaft, Cylinder, Engine, Mass
 from balancer.model import Design, Link, Operation
 from balancer.model.balance import (
@@ -159,6 +161,31 @@ def test_the_optimum_is_the_independent_programs(balanced):
         assert result.lower_bound <= best * (1 + SOLVERS)
         assert result.gap <= 1e-6
     assert convex.original_objective > 2 * best  # (there was something to balance)
+
+
+def test_an_engines_problem_is_the_linkages_with_its_sites_after_the_links(balanced):
+    """One balancing problem: the engine's is a NumericProblem whose design vector is the
+    linkage's entries (held) then each site's ``(Re x, Im x)``; its J at random masses is the
+    momentum sums' ``‖A·X + b‖²`` (the unbalance's rows ``√w_U·ω²`` in it), through the full
+    regressors and through the factor; J(x0) the original's."""
+    design, convex, _ = balanced
+    data = numeric_problem(design)
+    assert isinstance(data, NumericProblem) and data.force_balance is None
+    a, b = quadratic(design, convex.before.theta1)
+    start = mechanism_of(design.mechanism).layout.size
+    count = 2 * len(sites(design.balance))
+    assert data.sites is not None and data.sites.start == start
+    np.testing.assert_array_equal(data.x0[:start], mechanism_of(design.mechanism).parameters())
+    rng = np.random.default_rng(41)
+    bounds = np.repeat([bound for *_, bound in sites(design.balance)], 2)
+    for _ in range(5):
+        chosen = rng.uniform(-1, 1, count) * bounds
+        x = data.x0.copy()
+        x[start : start + count] = chosen
+        want = float(np.sum((a @ chosen + b) ** 2))
+        assert data.objective(x) == pytest.approx(want, rel=1e-9)
+        assert data.reduced_objective(x) == pytest.approx(want, rel=1e-9)
+    assert data.original_objective == pytest.approx(convex.original_objective, rel=1e-12)
 
 
 def test_the_optimality_conditions_hold_at_the_optimum(balanced):
@@ -370,6 +397,15 @@ def masses_of(design: Design, x: np.ndarray) -> Engine:
                    balance_shafts=base.balance_shafts + shafts)
 
 
+def chosen_of(design: Design, x: np.ndarray) -> np.ndarray:
+    """The chosen mass·radius vectors of a balancing's design vector, in :func:`sites`' order.
+
+    The design vector's layout: the linkage's entries, then two per site, the chosen first.
+    """
+    start = mechanism_of(design.mechanism).layout.size
+    return np.asarray(x)[start : start + 2 * len(sites(design.balance))]
+
+
 @pytest.fixture(scope="module", params=EXAMPLES_TO_BALANCE)
 def front(request):
     design = load_design(EXAMPLES / f"{request.param}.toml")
@@ -425,7 +461,7 @@ def test_an_engines_front_points_figures_are_its_masses_added_by_hand(front):
     w = design.balance.objective
     radius = design.balance.counterweights.radius
     for p in result.points:
-        x = p.x
+        x = chosen_of(design, p.x)
         loads = momentum_loads(masses_of(design, x), theta, speed)
         want = {"rocking_couple": float(np.sqrt(np.mean(np.abs(loads.couple) ** 2))),
                 "shaking_force": float(np.sqrt(np.mean(np.abs(loads.force) ** 2))),
@@ -452,7 +488,8 @@ def test_an_engines_front_of_the_couple_alone_is_of_its_rms():
     assert result.minimised == "rocking_couple" and result.unit == "kg·m"
     for p in result.points:
         assert p.least == pytest.approx(p.figures["rocking_couple"], rel=EXACT)
-        assert p.value == pytest.approx(sum(np.hypot(p.x[0::2], p.x[1::2])), rel=EXACT)
+        x = chosen_of(design, p.x)
+        assert p.value == pytest.approx(sum(np.hypot(x[0::2], x[1::2])), rel=EXACT)
     engine = design.mechanism
     c = engine.cylinders
     m_rec = engine.piston + engine.rod.mass * engine.rod.e / c[0].rod

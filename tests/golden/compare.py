@@ -238,8 +238,8 @@ def _optimize_rule(path: str, doc: dict, unique: bool = True) -> Rule:
         return Bound(GAP_TOLERANCE)
     if path == "rms_gap":
         return Bound(GAP_TOLERANCE * scale)
-    if path == "force_balance_residual":
-        return Bound(ROUNDING_TOLERANCE)
+    if path == "force_balance_residual":  # a constraint met, or the design's own figure
+        return Bound(ROUNDING_TOLERANCE, DESIGN if unique else ANY)
     if path.startswith("verification."):
         if not unique:  # a simulation of a design the optimum leaves free
             return ANY
