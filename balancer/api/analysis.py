@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from .. import validate as v
 from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses
@@ -11,8 +12,10 @@ from ..force_balance import force_balance_residual
 from ..mechanisms import mechanism_of
 from ..mechanisms.base import Mechanism, Route
 from ..model import Design, check_scales
-from ..model.motions import MotionSpec
-from ..motion_analysis import AlongMotions, MotionAnalysis, motion_analysis
+
+if TYPE_CHECKING:  # (the loads along motions: imported when a spec asks for them)
+    from ..model.motions import MotionSpec
+    from ..motion_analysis import AlongMotions, MotionAnalysis
 
 
 def analyze(design: Design, *, route: Route | None = None,
@@ -78,6 +81,8 @@ def analyze_motions(design: Design, names: Sequence[str] | None = None, *,
     if not chosen:
         raise SpecError("a linkage is analysed along its motions: the spec has no [[motion]]",
                         key="motion")
+    from ..motion_analysis import AlongMotions
+
     mech = mechanism_of(design.mechanism)
     return AlongMotions(
         motions=tuple(_along(design, mech, m, gravity) for m in chosen),
@@ -111,6 +116,8 @@ def spec_gravity(design: Design) -> tuple[float, float]:
 def _along(design: Design, mech: Mechanism, motion: MotionSpec,
            gravity: tuple[float, float]) -> MotionAnalysis:
     """:func:`~balancer.motion_analysis.motion_analysis`, its errors under the motion's key."""
+    from ..motion_analysis import motion_analysis
+
     with v.under(v.item("motion", design.motions.index(motion))):
         return motion_analysis(mech, motion, gravity=gravity)
 

@@ -18,9 +18,6 @@ from ..report import (
     analysis_json,
     analysis_text,
     dumps_json,
-    motion_csv,
-    motions_json,
-    motions_text,
 )
 from .common import load, output_path, wrote
 
@@ -50,6 +47,9 @@ def _option_error(args: argparse.Namespace, exc: SpecError) -> None:
 
 def _along_motions(args: argparse.Namespace, design: Design, csv_path: str | None) -> int:
     """``analyze`` along the spec's motions (all, or ``--motion``'s)."""
+    # (the loads along motions' report: loaded when a spec has motions)
+    from ..report import motion_csv, motions_json, motions_text
+
     if csv_path is not None and args.motion is None and len(design.motions) > 1:
         raise SpecError("writes one motion's values: name it with --motion "
                         f"({', '.join(m.name for m in design.motions)})", key="--csv",

@@ -13,11 +13,11 @@ from typing import TYPE_CHECKING, ClassVar, Literal
 from .. import validate as v
 from ..errors import SpecError
 from .mechanisms import MechanismModel
-from .motions import REVOLUTION, MotionSpec, Workspace
-from .plan import PlanSpec
 
 if TYPE_CHECKING:  # (the balancing's tables load with a spec that has them)
     from .balance import BalanceProblem, RotorBalanceProblem
+    from .motions import MotionSpec, Workspace
+    from .plan import PlanSpec
 
 Drive = Literal["free", "constant-speed"]
 
@@ -240,6 +240,8 @@ class Design:
             raise SpecError("every motion weighs 0: one at least must count",
                             key="balance.motions")
         plan = self.plan
+        if plan is not None:  # (motions and plans loaded where a spec has them)
+            from .motions import REVOLUTION
         if plan is not None and plan.motion not in (None, REVOLUTION, *names):
             raise SpecError(f"names no motion of the spec ({', '.join(names) or 'none'})",
                             key="plan.motion", value=plan.motion)

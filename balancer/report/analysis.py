@@ -3,16 +3,18 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..cycle import CycleAnalysis
-from ..motion_analysis import AlongMotions
 from ..orders import order_name
 from ..quantities import FRAME_LOADS
 from ..rounding import Scales, speed_text
 from .text import csv_text, table
+
+if TYPE_CHECKING:
+    from ..motion_analysis import AlongMotions
 
 
 def reaction_extremes(values: np.ndarray) -> dict[str, float]:

@@ -8,9 +8,17 @@ the registry (:mod:`.codecs`); the linkages' ``[balance]`` table by :mod:`.balan
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from ..lazy import lazy_exports
 from .codecs import MECHANISM_TYPES
 from .reader import design_from_dict, load_design, loads_design
-from .writer import dumps_design, save_design
+
+if TYPE_CHECKING:
+    from .writer import dumps_design, save_design
+
+#: The writer, loaded when a spec is written (a command that only reads one does not).
+_EXPORTS = {"dumps_design": "writer", "save_design": "writer"}
 
 __all__ = [
     "MECHANISM_TYPES",
@@ -20,3 +28,5 @@ __all__ = [
     "loads_design",
     "save_design",
 ]
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())

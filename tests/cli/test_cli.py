@@ -251,7 +251,11 @@ _NOT_FOR_A_FOURBAR = ("balancer.mechanisms.engine", "balancer.mechanisms.sliderc
                       "balancer.mechanisms.fourbar.opened_loop",
                       "balancer.mechanisms.fourbar.lie_group",
                       "balancer.mechanisms.fourbar.mass_matrix",
-                      "balancer.formulations")
+                      "balancer.formulations",
+                      # a spec without [[motion]], [workspace] or [plan], and nothing written
+                      "balancer.motion_analysis", "balancer.linkage.trajectory",
+                      "balancer.model.motions", "balancer.model.plan", "balancer.spec.motions",
+                      "balancer.spec.writer", "balancer.report.along", "balancer.planning")
 
 
 def test_analysing_a_fourbar_loads_its_folder_and_the_cycle_analysis_only():
