@@ -28,6 +28,7 @@ from .lazy import lazy_exports
 _EXPORTS = {
     "analyze": "api",
     "analyze_motions": "api",
+    "flywheel": "api",
     "cycle_analyses": "api",
     "example": "api",
     "motion_drawing": "api",
@@ -93,6 +94,7 @@ _EXPORTS = {
     "InputState": "linkage.inputs",
     "MotionAnalysis": "motion_analysis",
     "AlongMotions": "motion_analysis",
+    "Flywheel": "speed_fluctuation",
     "WorkspaceCheck": "motion_analysis",
     "MotionSpec": "model.motions",
     "Workspace": "model.motions",
@@ -127,6 +129,7 @@ __all__ = [
     "Against",
     "analyze",
     "analyze_motions",
+    "flywheel",
     "animate",
     "AssemblyError",
     "AssemblyRange",
@@ -189,6 +192,7 @@ __all__ = [
     "motion_drawing",
     "motion_figure",
     "AlongMotions",
+    "Flywheel",
     "WorkspaceCheck",
     "MotionSpec",
     "Workspace",
@@ -234,6 +238,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         codesign,
         cycle_analyses,
         example,
+        flywheel,
         motion_drawing,
         optimize,
         pareto,
@@ -309,5 +314,6 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .simulation import Trajectory
     from .simulation.motions import MotionRun
     from .spec import dumps_design, load_design, loads_design, save_design
+    from .speed_fluctuation import Flywheel
     from .sweeps import Perturb, SweepResult, Vary, sweep
     from .verification import RunCheck, Verification

@@ -36,7 +36,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("mechanisms.fourbar", "mechanisms.slidercrank", "mechanisms.general",
      "formulations.compiled", "formulations.crank_angle", "formulations.multibody"),
     # The registry of mechanisms and of formulations, and what runs over any mechanism.
-    ("mechanisms", "formulations", "force_balance", "columns", "cycle", "motion_analysis"),
+    ("mechanisms", "formulations", "force_balance", "columns", "cycle", "motion_analysis",
+     "speed_fluctuation"),
     ("balance", "planning"),
     ("simulation", "verification", "motion_verification", "report", "plots", "plausibility",
      "parts"),

@@ -23,6 +23,7 @@ from ..lazy import lazy_exports
 _EXPORTS = {
     "analyze": "analysis",
     "analyze_motions": "analysis",
+    "flywheel": "analysis",
     "cycle_analyses": "analysis",
     "example": "examples",
     "motion_drawing": "drawings",
@@ -41,6 +42,7 @@ _EXPORTS = {
 __all__ = [
     "analyze",
     "analyze_motions",
+    "flywheel",
     "cycle_analyses",
     "example",
     "motion_drawing",
@@ -61,7 +63,7 @@ __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
 
 
 if TYPE_CHECKING:  # for type checkers and editors: the names as they are
-    from .analysis import analyze, analyze_motions, cycle_analyses
+    from .analysis import analyze, analyze_motions, cycle_analyses, flywheel
     from .balancing import optimize, pareto
     from .drawings import motion_drawing
     from .examples import example

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from .. import validate as v
-from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses
+from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses, sample_angles
 from ..errors import SpecError
 from ..force_balance import force_balance_residual
 from ..mechanisms import mechanism_of
@@ -16,6 +17,7 @@ from ..model import Design, check_scales
 if TYPE_CHECKING:  # (the loads along motions: imported when a spec asks for them)
     from ..model.motions import MotionSpec
     from ..motion_analysis import AlongMotions, MotionAnalysis
+    from ..speed_fluctuation import Flywheel
 
 
 def analyze(design: Design, *, route: Route | None = None,
@@ -50,6 +52,51 @@ def analyze(design: Design, *, route: Route | None = None,
         gravity = v.vector2(gravity, "gravity")
         check_scales(design.mechanism, {"operation.speed": op.speed}, {"gravity": gravity})
     return cycle_analysis(design.mechanism, op.speed, op.samples, route=route, gravity=gravity)
+
+
+def flywheel(design: Design, fluctuation: float | None = None, *,
+             gravity: tuple[float, float] | None = None) -> Flywheel:
+    """The least flywheel on the crank for a speed fluctuation (:mod:`balancer.speed_fluctuation`).
+
+    Over the design's cycle at its operating speed (``[operation]``, its gravity included),
+    from the exact energy balance of the mechanism with its applied loads (gas, springs,
+    weights) under a constant torque that takes or gives their mean work.
+
+    Parameters
+    ----------
+    design
+        A one-input design with ``[operation]``.
+    fluctuation
+        The largest ``(ω_max − ω_min)/ω_mean`` allowed (default the spec's
+        ``[operation] speed_fluctuation``).
+    gravity
+        Gravitational acceleration ``(gx, gy)``, m/s², instead of the spec's.
+
+    Raises
+    ------
+    SpecError
+        Without ``[operation]``, without a fluctuation, with several inputs, or where a load
+        depends on the crank's speed.
+    """
+    from ..speed_fluctuation import CrankEnergy
+    from ..speed_fluctuation import flywheel as least_flywheel
+
+    op = design.operation
+    if op is None:
+        raise SpecError("missing required key: a flywheel is sized at the operating speed",
+                        key="operation.speed")
+    if fluctuation is None:
+        if op.speed_fluctuation is None:
+            raise SpecError("missing required key: the speed fluctuation to keep",
+                            key="operation.speed_fluctuation")
+        fluctuation = op.speed_fluctuation
+    mech = mechanism_of(design.mechanism)
+    mech.require_full_revolution("sizing a flywheel")
+    revolutions = mech.cycle_revolutions
+    g = op.gravity if gravity is None else v.vector2(gravity, "gravity")
+    energy = CrankEnergy.of(mech, sample_angles(op.samples, revolutions),
+                            2 * math.pi * revolutions, g)
+    return least_flywheel(energy, op.speed, fluctuation)
 
 
 def analyze_motions(design: Design, names: Sequence[str] | None = None, *,

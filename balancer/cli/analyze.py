@@ -9,7 +9,7 @@ import argparse
 import sys
 from collections.abc import Callable
 
-from ..api.analysis import analyze, analyze_motions, several_inputs
+from ..api.analysis import analyze, analyze_motions, flywheel, several_inputs
 from ..errors import SpecError
 from ..model import Design
 from ..outputs import write_atomic
@@ -33,9 +33,11 @@ def run(args: argparse.Namespace) -> int:
     except SpecError as exc:
         _option_error(args, exc)
         raise
+    asked = design.operation is not None and design.operation.speed_fluctuation is not None
+    wheel = flywheel(design, gravity=args.gravity) if asked else None
     return _emit(args, csv_path, lambda: analysis_csv(analysis),
-                 lambda: dumps_json(analysis_json(analysis, spec=args.spec)),
-                 lambda: analysis_text(analysis, spec=args.spec) + "\n")
+                 lambda: dumps_json(analysis_json(analysis, spec=args.spec, flywheel=wheel)),
+                 lambda: analysis_text(analysis, spec=args.spec, flywheel=wheel) + "\n")
 
 
 def _option_error(args: argparse.Namespace, exc: SpecError) -> None:

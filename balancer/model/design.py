@@ -45,11 +45,15 @@ class Operation:
     gravity
         Gravitational acceleration ``(gx, gy)`` the cycle analysis includes, m/s² (``(0, 0)``:
         none): the frame then carries the links' weights too.
+    speed_fluctuation
+        The largest speed fluctuation ``(ω_max − ω_min)/ω_mean`` allowed, for which the analysis
+        gives the least flywheel (:mod:`balancer.speed_fluctuation`); ``None``: none asked for.
     """
 
     speed: float
     samples: int = 360
     gravity: tuple[float, float] = (0.0, 0.0)
+    speed_fluctuation: float | None = None
 
     #: Memory a cycle analysis or a balancing takes per sampled angle, bytes (the regressors'
     #: complex (N, 14) arrays and the motion's, with room for temporaries).
@@ -62,6 +66,12 @@ class Operation:
         v.require_memory(samples, self.BYTES_PER_SAMPLE, "samples", "samples of a revolution")
         v.store(self, "samples", samples)
         v.store(self, "gravity", v.vector2(self.gravity, "gravity"))
+        if self.speed_fluctuation is not None:
+            delta = v.positive(self.speed_fluctuation, "speed_fluctuation")
+            if not delta < 2:
+                raise SpecError("must be below 2: (ω_max − ω_min)/ω_mean",
+                                key="speed_fluctuation", value=delta)
+            v.store(self, "speed_fluctuation", delta)
 
 
 @dataclass(frozen=True, kw_only=True)

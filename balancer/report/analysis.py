@@ -15,6 +15,7 @@ from .text import csv_text, table
 
 if TYPE_CHECKING:
     from ..motion_analysis import AlongMotions
+    from ..speed_fluctuation import Flywheel
 
 
 def reaction_extremes(values: np.ndarray) -> dict[str, float]:
@@ -93,8 +94,9 @@ def orders_text(analysis: CycleAnalysis, scales: Scales | None = None) -> str:
             "against it):\n" + table(rows, head))
 
 
-def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str, Any]:
-    """The ``analyze --json`` document."""
+def analysis_json(analysis: CycleAnalysis, spec: str | None = None,
+                  flywheel: Flywheel | None = None) -> dict[str, Any]:
+    """The ``analyze --json`` document (with ``flywheel`` where the spec asks for one)."""
     mech = analysis.mechanism
     balanced, residual = analysis.force_balanced, analysis.force_balance_residual
     doc: dict[str, Any] = {}
@@ -117,6 +119,7 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
             "reactions": _reactions_dict(analysis),
             "change_points": _change_points(analysis),
             "orders": orders_list(analysis),
+            **({} if flywheel is None else {"flywheel": flywheel.as_dict()}),
             "units": {
                 "force": "N",
                 "moment": "N·m",
@@ -126,6 +129,10 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None) -> dict[str,
                                           "that make them)",
                 "centre_of_mass_excursion": "m (largest distance of the total centre of mass "
                                             "from its mean place over the cycle)",
+                **({} if flywheel is None else {
+                    "flywheel": "inertia, mechanism_inertia, classical_inertia: kg·m² about the "
+                                "crank; energy_swing: J; mean_torque: N·m; speed_min, speed_max: "
+                                "rad/s; fluctuation, fluctuation_without: (ω_max − ω_min)/ω_mean"}),
             },
         }
     )
@@ -148,8 +155,9 @@ def _change_points(analysis: CycleAnalysis) -> list[float]:
     return [float(t) for t in analysis.theta1[analysis.singular]]
 
 
-def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
-    """The readable ``analyze`` report."""
+def analysis_text(analysis: CycleAnalysis, spec: str | None = None,
+                  flywheel: Flywheel | None = None) -> str:
+    """The readable ``analyze`` report (with ``flywheel`` where the spec asks for one)."""
     mech = analysis.mechanism
     s = analysis.summary
     sc = Scales(analysis_figures(analysis))
@@ -202,7 +210,28 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None) -> str:
             "",
         ]
     lines.append(force_balance_line(analysis))
+    if flywheel is not None:
+        lines += ["", flywheel_text(flywheel)]
     return "\n".join(lines)
+
+
+def flywheel_text(f: Flywheel) -> str:
+    """The least flywheel for the spec's speed fluctuation, and the figures it comes from."""
+    low, mean, high = f.mechanism_inertia
+    if f.inertia > 0:
+        verdict = (f"least flywheel on the crank for a speed fluctuation of {f.fluctuation:g}: "
+                   f"{f.inertia:.6g} kg·m² (the mechanism alone: {f.fluctuation_without:.4g})")
+    else:
+        verdict = (f"no flywheel needed for a speed fluctuation of {f.fluctuation:g}: the "
+                   f"mechanism alone keeps {f.fluctuation_without:.4g}")
+    return "\n".join([
+        verdict,
+        f"  from the exact energy balance: the speed between {f.speeds[0]:.6g} and "
+        f"{f.speeds[1]:.6g} rad/s, mean {f.speed:.6g}; the mechanism's inertia on the crank "
+        f"{low:.4g} to {high:.4g} kg·m² (mean {mean:.4g})",
+        f"  turning-moment diagram: energy swing {f.energy_swing:.6g} J about the mean torque "
+        f"{f.mean_torque:.6g} N·m; the classical ΔE/(δ·ω²) − J̄ = {f.classical:.6g} kg·m²",
+    ])
 
 
 def force_balance_line(analysis: CycleAnalysis) -> str:

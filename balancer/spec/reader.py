@@ -73,7 +73,8 @@ def _read_operation(root: Table) -> Operation | None:
         raise table._missing("speed")
     with v.under("operation"):
         operation = Operation(speed=table.raw("speed"), samples=table.value("samples", 360),
-                              gravity=table.value("gravity", (0.0, 0.0)))
+                              gravity=table.value("gravity", (0.0, 0.0)),
+                              speed_fluctuation=table.value("speed_fluctuation", None))
     table.finish()
     return operation
 

@@ -387,6 +387,11 @@ SECTIONS: tuple[Section, ...] = (
                     "Gravitational acceleration `[gx, gy]` the cycle analysis includes: the "
                     "frame then carries the links' weights (`analyze --gravity` overrides it).",
                     example="[0.0, -9.81]"),
+                Key("speed_fluctuation", "—", "none",
+                    "The largest speed fluctuation (ω_max − ω_min)/ω_mean allowed: `analyze` then "
+                    "gives the least flywheel inertia on the crank that keeps it, from the "
+                    "machine's exact energy balance (one input); in (0, 2).",
+                    example="0.02"),
             )),
     *MOTION_SECTIONS,
     *PLAN_SECTIONS,

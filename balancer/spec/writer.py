@@ -27,6 +27,8 @@ def dumps_design(design: Design) -> str:
             f"samples = {toml.number(op.samples)}",
             *([f"gravity = [{toml.number(op.gravity[0])}, {toml.number(op.gravity[1])}]  # m/s²"]
               if any(op.gravity) else []),
+            *([f"speed_fluctuation = {toml.number(op.speed_fluctuation)}"]
+              if op.speed_fluctuation is not None else []),
         ]
     sim, default = design.simulation, SimulationSettings()
     lines = {
