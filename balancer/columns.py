@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .linkage.kinematics import Motion
-from .linkage.loads import Reactions
+from .linkage.loads import Reactions, SupportLoad
 from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism
 from .model import MechanismModel as Model
@@ -47,6 +47,9 @@ class AnalysisLike(Protocol):
     @property
     def mount_torque(self) -> NDArray[np.float64] | None:
         """An engine's torque about z on its mounts, N·m (``None``: not an engine)."""
+    @property
+    def supports(self) -> tuple[SupportLoad, ...]:
+        """The loads at supports sharing a ground point's reaction (an engine's main bearings)."""
 
 
 class TrajectoryLike(Protocol):
@@ -113,7 +116,8 @@ def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     ``alpha{k}`` (rad, rad/s, rad/s²); the forces on the frame (:func:`frame_force_columns`);
     the sliders on the frame (:func:`slider_columns`); then the shaking force's components,
     the shaking moment, the rocking couple's components and the driving torque; an engine's
-    ``mount_torque`` last (N·m: the shaking moment plus the driving torque). For every
+    ``mount_torque`` (N·m: the shaking moment plus the driving torque), then its main bearings'
+    ``R<B>x``, ``R<B>y`` where its spec places them (N). For every
     mechanism: the columns of ``simulate``'s CSV (whatever its formulation), then the shaking.
     """
     mo, r = analysis.motion, analysis.reactions
@@ -135,6 +139,9 @@ def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     if analysis.mount_torque is not None:  # an engine's, after the columns every one has
         names.append("mount_torque")
         cols.append(analysis.mount_torque)
+    for support in analysis.supports:  # an engine's main bearings, where its spec places them
+        names += [f"R{support.name}x", f"R{support.name}y"]
+        cols += [support.force.real, support.force.imag]
     return names, cols
 
 

@@ -32,11 +32,11 @@ from .errors import SpecError
 from .force_balance import RESIDUAL_FLOOR, force_balance_residual
 from .linkage.dynamics import Forces
 from .linkage.kinematics import Motion
-from .linkage.loads import Reactions
-from .mechanisms import mechanism_of
+from .linkage.loads import Reactions, SupportLoad
+from .mechanisms import geometry, mechanism_of
 from .mechanisms.base import KERNEL_STATES, Mechanism, Route
 from .model import MechanismModel as Model
-from .orders import Order, order_table
+from .orders import Order, Whirl, order_bins, order_table, whirls
 from .quantities import FRAME_LOADS
 from .rounding import speed_text
 
@@ -222,6 +222,23 @@ class CycleAnalysis:
         return self.reactions.shaking_moment + self.reactions.driving_torque
 
     @cached_property
+    def supports(self) -> tuple[SupportLoad, ...]:
+        """The loads at the supports that share a ground point's reaction, at the samples.
+
+        An engine's main bearings where its spec places them
+        (:meth:`~balancer.mechanisms.base.Mechanism.support_loads`); none in general.
+        """
+        return self.mechanism.support_loads(self.theta1, self.speed, 0.0, loads=self.loads,
+                                            gravity=self.gravity)
+
+    def support_orders(self, support: SupportLoad) -> list[tuple[float, Whirl]]:
+        """A support's load by order of the crank speed (as :attr:`orders`' shaking force)."""
+        bins = order_bins(self.samples, self.revolutions)
+        return [(float(q), w) for (q, _), w in zip(bins, whirls(support.force,
+                                                                  [j for _, j in bins]),
+                                                  strict=True)]
+
+    @cached_property
     def motion(self) -> Motion:
         """Kinematics at the sampled angles (computed when first asked for)."""
         with np.errstate(all="ignore"):
@@ -236,7 +253,7 @@ class CycleAnalysis:
         of an unbalance. Samples at a singular pose are left out.
         """
         with np.errstate(all="ignore"):
-            centre = self.mechanism.total_centre_of_mass(self.motion)
+            centre = geometry.total_centre_of_mass(self.mechanism, self.motion)
         path = np.asarray(centre, dtype=complex) * np.ones(self.samples)
         path = path[np.isfinite(path)]
         if not path.size:

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 
 from .errors import SolverError
 from .linkage.inputs import InputState
+from .mechanisms import geometry
 from .mechanisms.base import Mechanism
 
 #: Singular values below this share of the largest are rounding (a condition that holds).
@@ -330,7 +331,7 @@ def force_balance_residual(mech: Mechanism) -> float:
         return force_balance_conditions(mech).residual(mech.parameters())
     theta = 2 * np.pi * np.arange(ROTOR_SAMPLES) / ROTOR_SAMPLES
     with np.errstate(all="ignore"):
-        moments = mech.first_moments(mech.motion(theta))
+        moments = geometry.first_moments(mech, mech.motion(theta))
     swings = [np.asarray(m, dtype=complex) * np.ones(theta.size) for m in moments]
     swings = [m - m.mean() for m in swings]
     total = float(np.max(np.abs(sum(swings))))

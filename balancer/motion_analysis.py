@@ -27,7 +27,7 @@ from .linkage import trajectory
 from .linkage.inputs import InputState
 from .linkage.kinematics import Motion
 from .linkage.loads import Reactions
-from .mechanisms import Mechanism, mechanism_of
+from .mechanisms import Mechanism, geometry, mechanism_of
 from .model import MechanismModel
 from .model.motions import MotionSpec, Workspace
 
@@ -211,7 +211,7 @@ def motion_analysis(model: MechanismModel | Mechanism, motion: MotionSpec, *,
     mo = mech.motion_at(state)
     reactions = frame_reactions(mech, mo, gravity=gravity, loads=loads)
     with np.errstate(all="ignore"):
-        centre = np.broadcast_to(np.asarray(mech.total_centre_of_mass(mo), np.complex128),
+        centre = np.broadcast_to(np.asarray(geometry.total_centre_of_mass(mech, mo), np.complex128),
                                  t.shape).copy()
     changes = tuple(np.asarray(p, dtype=float) - ref
                     for p, ref in zip(state.positions, structure.input_references, strict=True))
@@ -290,7 +290,7 @@ def workspace_check(model: MechanismModel | Mechanism, workspace: Workspace) -> 
     """The total centre of mass over the workspace (:func:`workspace_states`)."""
     mech = model if isinstance(model, Mechanism) else mechanism_of(model)
     state, grid = workspace_states(mech, workspace)
-    centre = (mech.total_centre_of_mass(mech.motion_at(state)) if state.count
+    centre = (geometry.total_centre_of_mass(mech, mech.motion_at(state)) if state.count
               else np.zeros(0, dtype=complex))
     return WorkspaceCheck(states=state.count, grid=grid,
                           centre_of_mass_excursion=excursion(centre))

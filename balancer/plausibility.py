@@ -18,7 +18,7 @@ from typing import Any, TypeGuard
 from . import validate as v
 from .cycle import sample_angles
 from .errors import BalancerError
-from .mechanisms import mechanism_of
+from .mechanisms import geometry, mechanism_of
 from .mechanisms.base import Mechanism
 from .model import Design
 from .model import MechanismModel as Model
@@ -111,11 +111,11 @@ def tip_radius(mechanism: Model | Mechanism, samples: int = 72) -> float | None:
         body = next(b for b in mech.linkage.bodies if b.name == mech.input)
         with np.errstate(all="ignore"):
             mo = mech.motion(sample_angles(samples), 1.0)
-            points = mech.points(mo)
+            points = geometry.points(mech, mo)
             pivot = points[body.points[0]]
             where = [np.abs(np.asarray(p, complex) - pivot) for p in points.values()]
             where += [np.abs(c.complex() + 0 * mo.theta1 - pivot)
-                      for c in mech.centres_of_mass(mo)]
+                      for c in geometry.centres_of_mass(mech, mo)]
             radius = float(np.nanmax(np.concatenate([np.ravel(w) for w in where])))
     except (BalancerError, ValueError, KeyError, StopIteration, FloatingPointError):
         return None

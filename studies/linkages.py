@@ -34,7 +34,7 @@ from matplotlib.figure import Figure
 from balancer.balance.optimizer import Optimizer, optimize
 from balancer.balance.problem import numeric_problem
 from balancer.cycle import cycle_analysis, sample_angles
-from balancer.mechanisms import mechanism_of
+from balancer.mechanisms import geometry, mechanism_of
 from balancer.plots import COLOURS, SERIES, save_png
 from balancer.plots.drawing import frame
 from balancer.report import markdown_table
@@ -60,7 +60,7 @@ def _slug(name: str) -> str:
 def com_excursion(model) -> float:
     """Largest distance of the total centre of mass from its mean over a revolution, m."""
     mech = mechanism_of(model)
-    path = mech.total_centre_of_mass(mech.motion(sample_angles(720)))
+    path = geometry.total_centre_of_mass(mech, mech.motion(sample_angles(720)))
     return float(np.max(np.abs(path - np.mean(path))))
 
 
@@ -102,8 +102,8 @@ def figure(name: str, design, result) -> Figure:
     ax = grid[0, 0]
     mech = mechanism_of(design.mechanism)
     mo = mech.motion(np.array([mech.start_angle]))
-    points = mech.points(mo)
-    for link, names in mech.drawing().items():
+    points = geometry.points(mech, mo)
+    for link, names in geometry.drawing(mech).items():
         if link == "ground":
             continue
         ring = [*names, names[0]] if len(names) > 2 else list(names)
@@ -117,7 +117,7 @@ def figure(name: str, design, result) -> Figure:
     for model, label, colour in ((design.mechanism, "before", COLOURS["before"]),
                                  (result.linkage, "after (force-balanced)", COLOURS["after"])):
         m = mechanism_of(model)
-        path = m.total_centre_of_mass(m.motion(theta))
+        path = geometry.total_centre_of_mass(m, m.motion(theta))
         _curve_or_point(ax, path, colour, f"total centre of mass, {label}",
                         1e-9 * m.structure.length_scale())
     ax.set_aspect("equal", adjustable="datalim")

@@ -25,7 +25,7 @@ from balancer.errors import SpecError
 from balancer.linkage import trajectory
 from balancer.linkage.inputs import InputState
 from balancer.linkage.vectors import V
-from balancer.mechanisms import mechanism_of
+from balancer.mechanisms import geometry, mechanism_of
 from balancer.model import Design
 from balancer.motion_analysis import motion_analysis
 from balancer.motion_verification import RTOL
@@ -229,7 +229,7 @@ def test_the_workspace_keeps_the_states_within_the_joints_limits():
     state, grid = workspace_states(mech, design.workspace)
     assert grid == 81 and 0 < state.count < grid
     # Q joins r and s (in that order): the angle from r's line to s's, from the points alone
-    points = mech.points(mech.motion_at(state))
+    points = geometry.points(mech, mech.motion_at(state))
     ref = dict(design.mechanism.points)
 
     def turn(a, b, c, d, where):  # the angle from a→b to c→d

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import validate as v
+from ..mechanisms import geometry
 from ..model import GROUND
 from ..motion_analysis import MotionAnalysis
 from ..plots.along import MotionDrawing
@@ -43,11 +44,11 @@ def motion_drawing(analysis: MotionAnalysis, *, poses: int = 5) -> MotionDrawing
     mech = analysis.mechanism
     with np.errstate(all="ignore"):
         mo = mech.motion_at(analysis.state)
-        points = mech.points(mo)
+        points = geometry.points(mech, mo)
     n = analysis.t.size
     index = np.unique(np.rint(np.linspace(0, n - 1, count)).astype(int))
     links = {}
-    for name, names in mech.drawing().items():
+    for name, names in geometry.drawing(mech).items():
         if name == GROUND:
             continue
         ring = [*names, names[0]] if len(names) > 2 else list(names)

@@ -22,6 +22,28 @@ from .vectors import V
 
 
 @dataclass(frozen=True)
+class SupportLoad:
+    """The load on the frame at one of the supports that share a ground point's reaction.
+
+    An engine's main bearing, each carrying its share of the crankshaft's loads: the supports
+    of one ground point sum to its reaction in :class:`Reactions`.
+
+    Attributes
+    ----------
+    name
+        The support's name (``B1``, ``B2``, …).
+    z
+        Its plane along the axis, m.
+    force
+        Its load on the frame at each sample, complex ``x + i·y``, N.
+    """
+
+    name: str
+    z: float
+    force: NDArray[np.complex128]
+
+
+@dataclass(frozen=True)
 class Reactions:
     """What the mechanism exerts on its frame at each sample (arrays of shape ``(N,)``).
 

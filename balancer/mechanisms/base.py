@@ -29,10 +29,11 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import AssemblyError, SpecError
 from ..linkage import dynamics, kinematics
 from ..linkage.assembly import assembly_range
-from ..linkage.constraints import GROUND_INDEX, Pose
+from ..linkage.constraints import Pose
 from ..linkage.dynamics import Forces, Layout
 from ..linkage.inputs import InputState
 from ..linkage.kinematics import Motion
+from ..linkage.loads import SupportLoad
 from ..linkage.rotors import Rotor, ground_couple
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
@@ -704,6 +705,16 @@ class Mechanism:
         return dynamics.shaking_regressors(self.structure, mo, gravity,
                                            torque_at_rest=torque_at_rest)
 
+    def support_loads(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike = 0.0, *,
+                      loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)
+                      ) -> tuple[SupportLoad, ...]:
+        """The loads at supports that share a ground point's reaction, at crank states.
+
+        None in general; an engine's main bearings where its spec places them (each carries
+        its share of the crankshaft's loads by the lever rule).
+        """
+        return ()
+
     def closed_form_force_balance(self) -> NDArray[np.float64] | None:
         """Shaking-force balance in closed form, ``A`` with ``A·π = 0`` over :attr:`layout`.
 
@@ -713,40 +724,7 @@ class Mechanism:
         """
         return None
 
-    # -- geometry -----------------------------------------------------------------------------
-
-    def centres_of_mass(self, mo: Motion) -> list[V]:
-        """Each moving link's centre of mass, m."""
-        return [mo.point(k, V(link.e, link.f)) for k, link in enumerate(self.links)]
-
-    def first_moments(self, mo: Motion) -> list[NDArray[np.complex128]]:
-        """Each moving link's first moment of mass about the origin, then each rotor's, kg·m.
-
-        Complex ``x + i·y``; the shaking force is minus the second time derivative of their
-        sum.
-        """
-        links = [c.complex() * link.mass
-                 for c, link in zip(self.centres_of_mass(mo), self.links, strict=True)]
-        return [*links, *(rotor.first_moment(mo.theta1) for _, rotor in self.rotors)]
-
-    def total_centre_of_mass(self, mo: Motion) -> NDArray[np.complex128]:
-        """The moving links' total centre of mass, complex, m (rotors' moving masses in)."""
-        mass = self.linkage.total_mass + sum(e.mass for _, r in self.rotors for e in r.eccentrics)
-        total: NDArray[np.complex128] = np.sum(np.broadcast_arrays(*self.first_moments(mo)),
-                                               axis=0)
-        return total / mass
-
-    def points(self, mo: Motion) -> dict[str, NDArray[np.complex128]]:
-        """Every point's position, complex, m (a point of the frame: its fixed place)."""
-        out: dict[str, NDArray[np.complex128]] = {}
-        for p, links in self.structure.point_links.items():
-            k = GROUND_INDEX if GROUND_INDEX in links else links[0]
-            out[p] = mo.point(k, self.structure.local[(k, p)]).complex() + 0 * mo.state.positions[0]
-        return out
-
-    def drawing(self) -> dict[str, tuple[str, ...]]:
-        """What to draw: each link's points in the order to join them (the ground's too)."""
-        return {b.name: b.points for b in self.linkage.bodies}
+    # -- what a drawing shows ------------------------------------------------------------------
 
     def crank_reach(self) -> float:
         """The input link's reach: its farthest point from its first (its pivot), m.
@@ -781,12 +759,4 @@ class Mechanism:
         """
         return ()
 
-    def guides(self, mo: Motion) -> list[tuple[NDArray[np.complex128], NDArray[np.complex128]]]:
-        """Each slider's guide as a point on the line and the line's unit direction, complex."""
-        out: list[tuple[NDArray[np.complex128], NDArray[np.complex128]]] = []
-        for c in self.structure.prisms:
-            base = mo.point(c.g, c.pg).complex() + 0 * mo.state.positions[0]
-            d = mo.pose.rotate(c.g, c.dg)
-            out.append((base, d.x + 1j * d.y + 0 * mo.state.positions[0]))
-        return out
 

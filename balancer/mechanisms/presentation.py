@@ -37,6 +37,9 @@ class Presentation:
     guide_force_names
         Sliders on ground guides whose force on the guide tables name as a force at a point
         (``R{name}x``, ``R{name}y``) rather than by its normal force ``N_{link}``.
+    support_words, supports_key
+        What a report calls the supports that share a ground point's reaction
+        (:meth:`~balancer.mechanisms.base.Mechanism.support_loads`), and their JSON key.
     """
 
     force_balance_source: str = "the conditions found from the linkage"
@@ -45,3 +48,5 @@ class Presentation:
     balanced_on_shafts: bool = False
     block_name: str = "sliding blocks"
     guide_force_names: Mapping[str, str] = field(default_factory=dict)
+    support_words: str = "support"
+    supports_key: str = "supports"

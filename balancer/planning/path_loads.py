@@ -26,7 +26,7 @@ from ..errors import SolverError
 from ..linkage import trajectory
 from ..linkage.inputs import InputState
 from ..linkage.loads import Reactions
-from ..mechanisms import Mechanism
+from ..mechanisms import Mechanism, geometry
 from ..model.motions import MotionSpec
 from ..motion_analysis import frame_reactions
 
@@ -151,7 +151,7 @@ def _path_loads(mech: Mechanism, motion: MotionSpec, tau: NDArray[np.float64],
         raise SolverError("the loads are not quadratic in the inputs' rates (a force that "
                           "depends on the speed otherwise): a time law cannot be planned")
     # (the first moments at the states at rest: the joined motion's first ones)
-    first = np.sum(np.broadcast_arrays(*mech.first_moments(mo)), axis=0)[:count]
+    first = np.sum(np.broadcast_arrays(*geometry.first_moments(mech, mo)), axis=0)[:count]
     mass = mech.linkage.total_mass + sum(e.mass for _, r in mech.rotors for e in r.eccentrics)
     return PathLoads(tau=tau, names=names, inertial=inertial, centripetal=centripetal,
                      static=rest, slope=d1, curvature=d2,

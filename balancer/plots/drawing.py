@@ -16,7 +16,7 @@ from ..columns import TrajectoryLike
 from ..cycle import sample_angles
 from ..linkage.inputs import InputState
 from ..linkage.vectors import V
-from ..mechanisms import mechanism_of
+from ..mechanisms import geometry, mechanism_of
 from ..mechanisms.base import DrawnMass, Mechanism
 from ..model import GROUND
 from ..model import MechanismModel as Model
@@ -50,7 +50,7 @@ def centre_of_mass_path(linkage: Model | Mechanism, traj: TrajectoryLike
     mech = mechanism_of(linkage)
     crank = traj.links.index(mech.input)
     mo = mech.motion(traj.theta[crank], traj.omega[crank], traj.alpha[crank])
-    return np.asarray(mech.total_centre_of_mass(mo), complex)
+    return np.asarray(geometry.total_centre_of_mass(mech, mo), complex)
 
 
 def revolution(frames: int) -> InputState:
@@ -76,7 +76,7 @@ def frame(linkage: Model | Mechanism, samples: int = 72, states: InputState | No
         states = InputState.crank(angles)
     with np.errstate(all="ignore"):
         mo = mech.motion_at(states)
-    points = mech.points(mo)
+    points = geometry.points(mech, mo)
     guides: list[NDArray[np.complex128]] = []
     for slider in mech.linkage.sliders:
         if slider.guide == GROUND:
@@ -100,16 +100,16 @@ def drawing_frames(linkage: Model | Mechanism, states: InputState
     """
     mech = mechanism_of(linkage)
     mo = mech.motion_at(states)
-    points = mech.points(mo)
+    points = geometry.points(mech, mo)
     links: dict[str, NDArray[np.complex128]] = {}
-    for name, names in mech.drawing().items():
+    for name, names in geometry.drawing(mech).items():
         if name == GROUND:
             continue
         ring = [*names, names[0]] if len(names) > 2 else list(names)
         links[name] = np.column_stack([points[p] for p in ring])
     coms = {name: np.asarray(c.complex() + 0 * mo.state.positions[0], complex)
-            for name, c in zip(mech.link_names, mech.centres_of_mass(mo), strict=True)}
-    return links, coms, np.asarray(mech.total_centre_of_mass(mo), complex)
+            for name, c in zip(mech.link_names, geometry.centres_of_mass(mech, mo), strict=True)}
+    return links, coms, np.asarray(geometry.total_centre_of_mass(mech, mo), complex)
 
 
 def counterweight_paths(linkage: Model | Mechanism,

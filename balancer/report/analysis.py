@@ -119,6 +119,8 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None,
             "reactions": _reactions_dict(analysis),
             "change_points": _change_points(analysis),
             "orders": orders_list(analysis),
+            **({mech.presentation.supports_key: _supports_list(analysis)}
+               if analysis.supports else {}),
             **({} if flywheel is None else {"flywheel": flywheel.as_dict()}),
             "units": {
                 "force": "N",
@@ -137,6 +139,14 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None,
         }
     )
     return doc
+
+
+def _supports_list(analysis: CycleAnalysis) -> list[dict[str, Any]]:
+    """Each support's (an engine's main bearing's) plane, extremes, RMS and orders."""
+    return [{"name": s.name, "z": s.z, "rms": float(np.sqrt(np.mean(np.abs(s.force) ** 2))),
+             **reaction_extremes(s.force),
+             "orders": [{"order": q, **w.as_dict()} for q, w in analysis.support_orders(s)]}
+            for s in analysis.supports]
 
 
 def _reactions_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
@@ -192,6 +202,8 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None,
     lines.append(
         table(rows, ["reaction (N)", "|R| max", "Rx min", "Rx max", "Ry min", "Ry max"])
     )
+    if analysis.supports:
+        lines += ["", supports_text(analysis, sc)]
     if analysis.reactions.slider_normal:
         rows = [[link, sc.fmt(s.slider_normal[link].max, "N"),
                  sc.fmt(s.slider_couple[link].max, "N·m")]
@@ -232,6 +244,24 @@ def flywheel_text(f: Flywheel) -> str:
         f"  turning-moment diagram: energy swing {f.energy_swing:.6g} J about the mean torque "
         f"{f.mean_torque:.6g} N·m; the classical ΔE/(δ·ω²) − J̄ = {f.classical:.6g} kg·m²",
     ])
+
+
+def supports_text(analysis: CycleAnalysis, sc: Scales) -> str:
+    """The supports' (an engine's main bearings') loads: RMS, largest, orders 1 and 2.
+
+    An order's figure is the largest magnitude of its part of the load, its forward and
+    backward whirls' sum (N).
+    """
+    words = analysis.mechanism.presentation.support_words
+    rows = []
+    for s in analysis.supports:
+        orders = dict(analysis.support_orders(s))
+        rows.append([s.name, f"{s.z:g}", sc.fmt(float(np.sqrt(np.mean(np.abs(s.force) ** 2))),
+                                                "N"),
+                     sc.fmt(float(np.max(np.abs(s.force), initial=0.0)), "N"),
+                     *(sc.fmt(orders[q].forward + orders[q].backward, "N") if q in orders
+                       else "—" for q in (1.0, 2.0))])
+    return table(rows, [f"{words} (N)", "z (m)", "|R| RMS", "|R| max", "order 1", "order 2"])
 
 
 def force_balance_line(analysis: CycleAnalysis) -> str:

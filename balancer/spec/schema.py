@@ -182,6 +182,12 @@ SECTIONS: tuple[Section, ...] = (
             "order they fire: the first at its first top dead centre at or after θ1 = 0, each "
             "next at its own first top dead centre after the previous firing, all within one "
             "working cycle.", (ENGINE,), example="[1, 3, 4, 2]"),
+        Key("main_bearings", "m", "none (the main bearings' load summed as `O`)",
+            "An engine's main bearings: their planes along the crankshaft, two or more, "
+            "increasing. Each load on the crankshaft (a crank pin's force from its rods, a "
+            "mass's centrifugal force and weight) is shared by the two bearings around its plane "
+            "by the lever rule, and `analyze` gives each bearing's load (`B1`, `B2`, …).",
+            (ENGINE,), example="[-0.2, -0.1, 0.0, 0.1, 0.2]"),
         Key("cylinders", "table", "required",
             "An engine's cylinders, cylinder 1 first (`[[mechanism.cylinders]]`, below).",
             (ENGINE,)),

@@ -46,7 +46,7 @@ from balancer.cycle import cycle_analysis
 from balancer.formulations import make
 from balancer.linkage import rotors
 from balancer.linkage.vectors import V
-from balancer.mechanisms import mechanism_of
+from balancer.mechanisms import geometry, mechanism_of
 from balancer.mechanisms.engine.model import (
     BalanceShaft,
     Crankshaft,
@@ -943,7 +943,7 @@ def test_an_engine_with_eccentrics_moves_under_gravity_as_its_weights_say(shaft,
     g = complex(*gravity)
 
     def potential(theta: float) -> np.ndarray:
-        moments = mech.first_moments(mech.motion(np.array([theta])))
+        moments = geometry.first_moments(mech, mech.motion(np.array([theta])))
         total = sum(np.asarray(m, dtype=complex).ravel()[0] for m in moments)
         return np.array([-(np.conj(g) * total).real])
 

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from balancer.cycle import cycle_analysis
-from balancer.mechanisms import mechanism_of
+from balancer.mechanisms import geometry, mechanism_of
 from balancer.mechanisms.fourbar.kinematics import position
 from balancer.mechanisms.fourbar.massmodels import link_centres_of_mass
 from balancer.spec import dumps_design, load_design, loads_design
@@ -92,7 +92,7 @@ def test_a_six_bar_in_two_planes_rocks_as_its_momentum_says():
     # Positions only: the core's pose at each angle, no rates or accelerations.
     mo = mech.motion(analysis.theta1, 0.0, 0.0)
     centres = [c.complex()[:, 0] if np.ndim(c.complex()) == 2 else c.complex()
-               for c in mech.centres_of_mass(mo)]
+               for c in geometry.centres_of_mass(mech, mo)]
     want, bound = _momentum_couple([link.z for link in model.links],
                                    [link.mass for link in model.links],
                                    [link.force_complex for link in model.links], centres, speed)

@@ -20,6 +20,7 @@ import balancer
 from balancer.api.analysis import analyze_motion
 from balancer.cli import main
 from balancer.errors import SpecError
+from balancer.mechanisms import geometry
 from balancer.plots.style import number
 from balancer.spec import loads_design
 from balancer.spec.reader import design_from_dict
@@ -132,12 +133,12 @@ def test_the_mechanism_panels_draw_its_poses_path_and_centre_of_mass(forbal2):
     poses = next(ax for ax in fig.axes if ax.get_title().startswith("the mechanism"))
     lines = {line.get_label(): line for line in poses.get_lines()}
     path = lines["path of E"]
-    places = mech.points(mech.motion_at(analysis.state))
+    places = geometry.points(mech, mech.motion_at(analysis.state))
     np.testing.assert_array_equal(path.get_xdata(), places["E"].real)
     np.testing.assert_array_equal(path.get_ydata(), places["E"].imag)
     waypoints = lines["waypoints of E"]
     np.testing.assert_array_equal(waypoints.get_xdata(), [p[0] for p in analysis.motion.path])
-    centre = mech.total_centre_of_mass(mech.motion_at(analysis.state))
+    centre = geometry.total_centre_of_mass(mech, mech.motion_at(analysis.state))
     track = lines["track of the total centre of mass"]
     np.testing.assert_array_equal(track.get_xdata(), centre.real)
     # the links at each pose: 4 links × 4 poses, each its points joined in the spec's order

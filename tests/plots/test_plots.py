@@ -17,7 +17,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from balancer import api, cycle, outputs, plots
 from balancer.api import analyze
 from balancer.cli import main
-from balancer.mechanisms import mechanism_of
+from balancer.mechanisms import geometry, mechanism_of
 from balancer.plots import drawing, style
 from balancer.rounding import speed_text
 from balancer.spec import load_design
@@ -1032,8 +1032,9 @@ def test_pistons_and_blocks_are_rectangles_along_their_sliders(name, size):
     assert len(blocks) == len(sliders) > 0
     length, width = size
     mo = mech.motion(cycle.sample_angles(frames), 1.0)
-    points = mech.points(mo)
-    guides = dict(zip((s.link for s in mech.linkage.sliders), mech.guides(mo), strict=True))
+    points = geometry.points(mech, mo)
+    guides = dict(zip((s.link for s in mech.linkage.sliders), geometry.guides(mech, mo),
+                      strict=True))
     for k in (0, 2, 5):
         update(k)
         for block, slider in zip(blocks, sliders, strict=True):

@@ -18,11 +18,15 @@ import math
 from dataclasses import replace
 from functools import cached_property
 
+from numpy.typing import ArrayLike
+
+from ...linkage.loads import SupportLoad
 from ...linkage.rotors import Rotor, link_inertia
 from ...linkage.structure import Structure
 from ...model import Body, Linkage, Slider
 from ..base import DrawnMass, Mechanism, piston_block
 from ..presentation import Presentation
+from .bearings import main_bearing_loads
 from .model import COUNTERWEIGHT, Engine
 
 #: The main bearings' point (the crankshaft's axis at the origin).
@@ -87,7 +91,8 @@ class EngineMechanism(Mechanism):
     geometry_key = "mechanism.cylinders"
     #: Without ``[simulation] theta1`` a simulation starts at θ1 = 0.
     start_angle = 0.0
-    presentation = Presentation(mount_torque=True, balanced_on_shafts=True, block_name="pistons")
+    presentation = Presentation(mount_torque=True, balanced_on_shafts=True, block_name="pistons",
+                                support_words="main bearing", supports_key="main_bearings")
 
     @cached_property
     def linkage(self) -> Linkage:
@@ -108,6 +113,18 @@ class EngineMechanism(Mechanism):
         out += [(f"shaft{j}", s.rotor)
                 for j, s in enumerate(self.model.balance_shafts, start=1)]
         return tuple(out)
+
+    def support_loads(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike = 0.0, *,
+                      loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)
+                      ) -> tuple[SupportLoad, ...]:
+        """Each main bearing's load (:mod:`.bearings`), where the spec places them."""
+        planes = self.model.main_bearings
+        if not planes:
+            return ()
+        found = main_bearing_loads(self, planes, MAIN_BEARINGS, theta1, omega1, alpha1,
+                                   loads=loads, gravity=gravity)
+        return tuple(SupportLoad(name=name, z=z, force=force)
+                     for (name, force), z in zip(found.items(), planes, strict=True))
 
     def describe(self) -> str:
         n = len(self.model.cylinders)

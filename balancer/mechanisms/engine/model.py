@@ -342,6 +342,10 @@ class Engine(MechanismModel):
         The cylinders (numbered from 1) in the order they fire; needed with ``gas``.
     gas
         Cylinder 1's pressure over its working cycle (``None``: no gas forces).
+    main_bearings
+        The main bearings' planes along the crankshaft, m, increasing (none: their loads are
+        reported summed as ``O``); each throw's loads are shared by the two bearings around it
+        by the lever rule (:mod:`.bearings`).
     """
 
     type: ClassVar[str] = "engine"
@@ -359,6 +363,7 @@ class Engine(MechanismModel):
     strokes: int = 4
     firing_order: tuple[int, ...] | None = None
     gas: GasCycle | None = None
+    main_bearings: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         """Check the fields (keys are the spec's, from its root)."""
@@ -411,6 +416,13 @@ class Engine(MechanismModel):
                     f"({180 * self.strokes}°), from 0", key="gas.crank_angle_deg",
                     value=list(angles))
             self.firing_angles()  # (checks that the order fits in the cycle)
+        bearings = (v.numbers(self.main_bearings, "mechanism.main_bearings")
+                    if self.main_bearings != () else ())
+        if bearings and (len(bearings) < 2 or any(
+                b <= a for a, b in zip(bearings, bearings[1:], strict=False))):
+            raise SpecError("must be two planes or more, increasing along the crankshaft (m)",
+                            key="mechanism.main_bearings", value=list(bearings))
+        v.store(self, "main_bearings", bearings)
 
     # -- the working cycle -------------------------------------------------------------------
 

@@ -156,6 +156,10 @@ def read(root: Table, mech: Table) -> Engine:
     if order is not None and not isinstance(order, list):
         raise SpecError("must be a list of cylinder numbers", key=mech.key("firing_order"),
                         value=order)
+    bearings = mech.value("main_bearings", ())
+    if not isinstance(bearings, list | tuple):
+        raise SpecError("must be a list of planes (m)", key=mech.key("main_bearings"),
+                        value=bearings)
     cylinders = _cylinders(mech)
     mech.finish()
     links = root.table("links")
@@ -164,7 +168,8 @@ def read(root: Table, mech: Table) -> Engine:
     links.finish()
     return Engine(cylinders=cylinders, crankshaft=crankshaft, rod=rod, piston=piston,
                   balance_shafts=_shafts(root), strokes=strokes,
-                  firing_order=None if order is None else tuple(order), gas=_gas(root))
+                  firing_order=None if order is None else tuple(order), gas=_gas(root),
+                  main_bearings=tuple(bearings))
 
 
 def _mass_text(m: Mass) -> str:
@@ -211,6 +216,9 @@ def lines(model: Model) -> list[str]:
     out = ["[mechanism]", 'type = "engine"', f"strokes = {model.strokes}"]
     if model.firing_order is not None:
         out.append(f"firing_order = [{', '.join(str(k) for k in model.firing_order)}]")
+    if model.main_bearings:
+        out.append(f"main_bearings = [{', '.join(toml.number(z) for z in model.main_bearings)}]"
+                   "  # m")
     first = model.cylinders[0]
     out += ["", "[mechanism.lengths]  # m, every cylinder's",
             f"crank = {toml.number(first.crank)}", f"rod = {toml.number(first.rod)}",

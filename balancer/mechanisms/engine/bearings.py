@@ -1,0 +1,107 @@
+"""An engine's main-bearing loads: the crankshaft's loads shared by the lever rule.
+
+The crankshaft is rigid and simply supported at its main bearings (``[mechanism]
+main_bearings``, planes ``z_1 < … < z_m``); as engine designers share them, each load on it is
+carried by the two bearings around its plane ``z`` (the bay ``z_j ≤ z ≤ z_{j+1}``; beyond an end
+bearing, the end bay, the far bearing's share then negative) in inverse proportion to their
+distances from it:
+
+    share_j = (z_{j+1} − z)/(z_{j+1} − z_j),      share_{j+1} = (z − z_j)/(z_{j+1} − z_j).
+
+The loads the crankshaft passes on, each at its plane (what it puts on the frame, N):
+
+- each crank pin's force from its cylinder's rod and piston, from that chain's momentum:
+  ``P_k = Σ m·(ḡ − ā)`` over the rod and the piston, less the guide's normal force on the frame
+  ``N_k·n̂_k`` (its reaction holds the piston), plus the gas force on the piston ``F_k·û_k``
+  (its reaction is on the head: it reaches the bearings only through the rod);
+- the crankshaft link's own ``m·(ḡ − ā)`` at its plane;
+- each of its masses' (pin, webs, counterweights) centrifugal force and weight at its plane
+  (:meth:`~balancer.linkage.rotors.Rotor.loads`).
+
+Their sum is the main bearings' summed reaction ``O`` that the inverse dynamics gives (the
+crankshaft's Newton equation): the tests hold the split to it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ...linkage.rotors import Rotor
+from ...linkage.vectors import V
+from ..base import Mechanism
+
+
+def lever_shares(planes: Sequence[float], z: float) -> tuple[tuple[int, float], ...]:
+    """The two bearings (indices into ``planes``) that carry a load at ``z``, and their shares.
+
+    ``planes`` increasing, two or more; the shares sum to 1.
+    """
+    j = int(np.searchsorted(np.asarray(planes), z, side="right")) - 1
+    j = min(max(j, 0), len(planes) - 2)
+    low, high = planes[j], planes[j + 1]
+    t = (z - low) / (high - low)
+    return ((j, 1.0 - t), (j + 1, t))
+
+
+def bearing_name(j: int) -> str:
+    """Main bearing ``j``'s name (from 0): ``B1``, ``B2``, …."""
+    return f"B{j + 1}"
+
+
+def main_bearing_loads(mech: Mechanism, planes: Sequence[float], ground_point: str,
+                       theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike = 0.0, *,
+                       loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)
+                       ) -> dict[str, NDArray[np.complex128]]:
+    """Each main bearing's load on the frame at crank states, complex ``x + i·y``, N.
+
+    ``mech`` an engine's mechanism (its crankshaft the link ``crankshaft``, cylinder ``k``'s
+    rod and piston ``rod<k>`` and ``piston<k>`` at its plane); ``ground_point`` the crankshaft's
+    rotors' bearing (``O``). ``loads``: the gas forces included.
+    """
+    theta, omega, alpha = np.broadcast_arrays(
+        *(np.atleast_1d(np.asarray(x, dtype=float)) for x in (theta1, omega1, alpha1)))
+    with np.errstate(all="ignore"):
+        mo = mech.motion(theta, omega, alpha)
+        forces = mech.crank_forces(theta, omega, alpha, loads=loads, gravity=gravity)
+    g = complex(*gravity)
+    linkage, structure = mech.linkage, mech.structure
+    out = [np.zeros(theta.size, complex) for _ in planes]
+
+    def carried(name: str) -> NDArray[np.complex128]:
+        """A link's ``m·(ḡ − ā)`` at its centre of mass."""
+        link = linkage.link(name)
+        a = mo.point_acceleration(structure.index(name), V(link.e, link.f)).complex()
+        return link.mass * (g - np.reshape(a, theta.size))
+
+    def add(z: float, load: NDArray[np.complex128]) -> None:
+        for j, share in lever_shares(planes, z):
+            out[j] = out[j] + share * load
+
+    normals = mech.guide_normals()
+    sliders = {s.link: s for s in linkage.sliders}
+    for name in linkage.link_names:
+        if name in sliders:  # a piston: its chain's force on its crank pin, at its plane
+            rod = next(b.name for b in linkage.bodies
+                       if sliders[name].point in b.points and b.name != name)
+            s = sliders[name]
+            pin = carried(rod) + carried(name)
+            pin = pin - np.reshape(np.asarray(forces.slider_normal[name], float),
+                                   theta.size) * normals[name]
+            if loads:
+                u = complex(*s.direction)
+                pin = pin + np.asarray(s.force.at(theta), float) * (u / abs(u))
+            add(linkage.link(rod).z, pin)
+    add(linkage.link(linkage.input).z, carried(linkage.input))
+    for point, rotor in mech.rotors:
+        if point != ground_point:
+            continue
+        for e in rotor.eccentrics:
+            single = Rotor(ratio=rotor.ratio, inertia=0.0, axis=rotor.axis, eccentrics=(e,))
+            add(e.z, single.loads(theta, omega, alpha, gravity).force)
+    return {bearing_name(j): out[j] for j in range(len(planes))}
+
+
+__all__ = ["bearing_name", "lever_shares", "main_bearing_loads"]
