@@ -192,7 +192,12 @@ class CycleAnalysis:
         )
 
     def load(self, key: str) -> NDArray[Any]:
-        """A frame load by its key (:data:`balancer.quantities.QUANTITIES`), at the samples."""
+        """A frame load by its key (:data:`balancer.quantities.QUANTITIES`), at the samples.
+
+        ``supports``: the supports' loads one after another (:attr:`supports`).
+        """
+        if key == "supports":
+            return np.concatenate([s.force for s in self.supports])
         return np.asarray(getattr(self.reactions, key))
 
     def __repr__(self) -> str:

@@ -78,6 +78,8 @@ QUANTITIES: Mapping[str, Quantity] = {q.key: q for q in (
              squares=(("shaking_force", "y"),)),
     Quantity("added_mass", "added mass", "kg"),
     Quantity("unbalance", "unbalance", "N"),
+    Quantity("main_bearing_load", "main-bearing load", "N",
+             squares=(("supports", "x"), ("supports", "y"))),
 )}
 
 #: The quantities a cycle drawing shows, by panel key.

@@ -86,4 +86,11 @@ def test_each_mean_square_term_squares_the_parts_of_its_load():
                             rel_tol=1e-12)
     weights = {f.name: 1.0 for f in dataclasses.fields(Objective)}
     squared = {t.name for t in Objective(**weights).terms if QUANTITIES[t.name].squares}
-    assert squared == {"shaking_moment", "driving_torque", "shaking_force", "rocking_couple"}
+    assert squared == {"shaking_moment", "driving_torque", "shaking_force", "rocking_couple",
+                       "main_bearing_load"}
+    # an engine's main bearings: their loads one after another, each part squared
+    four = analyze(load_design(EXAMPLES / "inline_four.toml"))
+    loads = np.concatenate([s.force for s in four.supports])
+    parts = squared_parts("main_bearing_load", four.load)
+    assert math.isclose(sum(float(np.mean(p**2)) for p in parts),
+                        float(np.mean(np.abs(loads) ** 2)), rel_tol=1e-12)

@@ -281,8 +281,11 @@ class ConvexSolver(Repairs, Diagnosis):
 
     # -- building ------------------------------------------------------------------------------
 
-    def _constraints(self, margin: float = 0.0) -> tuple[list[Constraint], list[str]]:
+    def _constraints(self, margin: float = 0.0, *, supports: bool = True
+                     ) -> tuple[list[Constraint], list[str]]:
         """The bounds as cone constraints, each tightened by ``margin`` (relative, scaled units).
+
+        ``supports``: with the bound on the supports' loads (``max_bearing_load``), if any.
 
         Returns the constraints (:class:`~.certificate.Constraint`, in the order their
         multipliers come back: the certificate evaluates them) and the links whose upper
@@ -392,6 +395,14 @@ class ConvexSolver(Repairs, Diagnosis):
                 bound = data.sites.sites[i].max_mr / data.scales[entries.start]
                 norm_at_most([entry(k, data.scales[k]) for k in entries],
                              (np.zeros(lay.size), bound * (1 - margin) if margin < 0.5 else bound))
+        support, rows = data.support_bound, data.regressors.supports
+        if supports and support is not None and rows is not None:  # |load| ≤ bound, each sample
+            a, a0 = rows @ lay.T / support, rows @ lay.c / support
+            top = 1 - margin if margin < 0.5 else 1.0
+            zero = np.zeros(lay.size)
+            for r in range(rows.shape[0]):
+                out.append(Constraint("soc", np.array([zero, a[r].real, a[r].imag]),
+                                      np.array([top, a0[r].real, a0[r].imag])))
         return out, relaxed
 
     def box(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

@@ -17,7 +17,8 @@ import numpy as np
 
 from ..errors import SolverError
 from .bounds import LinkBounds
-from .conic import SOLVED
+from .certificate import Constraint
+from .conic import SOLVED, ConicProgram
 from .problem import NumericProblem
 from .result import InfeasibleError
 
@@ -42,6 +43,11 @@ class Diagnosis:
     settings: dict[str, Any]
     _failed_row: int
 
+    def _constraints(self, margin: float = 0.0, *, supports: bool = True
+                     ) -> tuple[list[Constraint], list[str]]:
+        """The bounds as cone constraints (the solver's)."""
+        raise NotImplementedError
+
     def _fixed_row_error(self) -> InfeasibleError:
         """A condition of Eq. 58 that nothing free enters, and fails: name its links."""
         data = self.data
@@ -61,12 +67,53 @@ class Diagnosis:
             f"change; let a mass or a centre of mass change ({keys})")
 
     def infeasible(self, why: str) -> SolverError:
-        """The error for an SOCP that could not be solved: diagnosed infeasibility, or not."""
+        """The error for an SOCP that could not be solved: diagnosed infeasibility, or not.
+
+        With a bound on the supports' loads (``max_bearing_load``), the least bound any design
+        within the other bounds meets, where it is above the spec's.
+        """
         diagnosis = self.diagnose() if self.data.force_balance is not None else None
         if diagnosis is not None:
             return diagnosis
+        bound = self.data.support_bound
+        if bound is not None:
+            least = self.least_support_load()
+            if least is not None and least > bound * (1 - 1e-9):
+                words = self.data.mechanism.presentation.support_words
+                return InfeasibleError(
+                    f"no design within the other bounds keeps every {words} at or below "
+                    f"{bound:.6g} N: the least largest load is {least:.6g} N "
+                    "(balance.max_bearing_load)",
+                    needed=(("balance.max_bearing_load", least, bound, "N"),))
         return SolverError(f"the convex balancing problem could not be solved ({why}), though "
                            "a design within the bounds meets force balance: numerical trouble")
+
+    def least_support_load(self) -> float | None:
+        """The least largest support load any design within the other bounds has, N.
+
+        ``min t`` with ``|load_r(x)| ≤ t`` at every sample and support and every other cone of
+        the program (Clarabel); ``None`` if it fails.
+        """
+        data, lay = self.data, self.layout
+        rows = data.regressors.supports
+        bound = data.support_bound
+        if rows is None or bound is None:
+            return None
+        n = lay.size
+        others, _ = self._constraints(supports=False)
+        cones = [Constraint(c.kind, np.hstack([c.M, np.zeros((c.M.shape[0], 1))]), c.m)
+                 for c in others]
+        a, a0 = rows @ lay.T / bound, rows @ lay.c / bound
+        top = np.zeros(n + 1)
+        top[n] = 1.0
+        for r in range(rows.shape[0]):
+            cones.append(Constraint("soc", np.array([top, np.append(a[r].real, 0.0),
+                                                     np.append(a[r].imag, 0.0)]),
+                                    np.array([0.0, a0[r].real, a0[r].imag])))
+        program = ConicProgram(n + 1, cones, objective="squares", P=np.zeros((0, n + 1)),
+                               q=np.zeros(0), g=top)
+        solution = program.solve(self.settings)
+        return None if solution.u is None else float(solution.u[n]) * bound
 
     def _bound_constraints(self, m: cp.Variable, s: cp.Variable, tau: float | cp.Variable,
                            slack: Callable[[tuple[int, str]], cp.Variable] | None = None,

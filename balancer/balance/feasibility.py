@@ -65,7 +65,8 @@ class Feasibility(ProblemData):
             if self.absent(b, own):
                 continue  # none added: the link as it is
             if not m > 0:
-                out.append(f"{whose}: mass {m:.6g} kg is not positive")
+                if b.listed:  # (a held link may have none: an engine's crankshaft on its axis)
+                    out.append(f"{whose}: mass {m:.6g} kg is not positive")
                 continue
             l, mref, iref = b.length, b.mass_ref, b.inertia_ref
             if m < b.mass[0] - tol * mref or m > b.mass[1] + tol * mref:
@@ -109,6 +110,13 @@ class Feasibility(ProblemData):
                 )
         if self.sites is not None:
             out += self.sites.violations(x, tol)
+        bound, rows = self.support_bound, self.regressors.supports
+        if bound is not None and rows is not None:
+            largest = float(np.max(np.abs(rows @ np.asarray(x, float)), initial=0.0))
+            if largest > bound * (1 + tol):
+                words = self.mechanism.presentation.support_words
+                out.append(f"balance.max_bearing_load: a {words} carries {largest:.9g} N, above "
+                           f"{bound:.9g}")
         residual = self.force_balance_residual(x)
         if residual > max(tol, FORCE_BALANCE_TOLERANCE):
             out.append(f"force balance: residual {residual:.3g} of its terms")

@@ -56,6 +56,12 @@ IPOPT_OPTIONS: dict[str, object] = {
     "ipopt.max_iter": 300,
 }
 
+#: With a bound on the supports' loads (``max_bearing_load``), the NLP started from a design
+#: holds only the samples where that design's load is at least this share of the bound (the
+#: bound's Hessian over every sample is costly to build); its design is kept only if it meets
+#: the bound at every sample (:meth:`~balancer.balance.feasibility.Feasibility.violations`).
+NEAR_BOUND = 0.5
+
 _CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 _INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed")
 
@@ -96,7 +102,8 @@ class NlpSolver:
         IPOPT/CasADi options to override :data:`IPOPT_OPTIONS`.
     """
 
-    def __init__(self, data: NumericProblem, *, options: dict[str, Any] | None = None) -> None:
+    def __init__(self, data: NumericProblem, *, options: dict[str, Any] | None = None,
+                 start: NDArray[np.float64] | None = None) -> None:
         import casadi as ca  # heavy: only where symbols are built
         self.data = data
         self.options = {**IPOPT_OPTIONS, **(options or {})}
@@ -196,6 +203,23 @@ class NlpSolver:
                 lbg.append(-math.inf)
                 ubg.append(bound * bound)
         pi = ca.vertcat(*parts)
+        support, rows = data.support_bound, data.regressors.supports
+        if support is not None and rows is not None:  # |load|² ≤ bound² at every sample
+            # (the entries that are numbers folded into one column: a graph as small as the
+            # variables, not as the design vector)
+            if start is not None:  # the rows near the bound at the start: a working set
+                near = np.abs(rows @ np.asarray(start, float)) >= NEAR_BOUND * support
+                rows = rows[near]
+            fixed = [i for i, part in enumerate(parts) if isinstance(part, float)]
+            moving = [i for i, part in enumerate(parts) if not isinstance(part, float)]
+            known = rows[:, fixed] @ np.array([parts[i] for i in fixed], dtype=float) / support
+            scaled = rows[:, moving] / support
+            unknown = ca.vertcat(*(parts[i] for i in moving))
+            re = ca.mtimes(ca.DM(scaled.real), unknown) + ca.DM(known.real)
+            im = ca.mtimes(ca.DM(scaled.imag), unknown) + ca.DM(known.imag)
+            g.append(re * re + im * im)
+            lbg += [-math.inf] * rows.shape[0]
+            ubg += [1.0] * rows.shape[0]
         if data.force_balance is not None:
             a, rhs = data.force_balance
             terms = np.abs(a) @ np.abs(data.scales)  # each condition by its own size

@@ -179,7 +179,9 @@ class Optimizer:
         objective = data.objective(x)
         notes: list[str] = []
         if backend == "nlp":
-            nlp = self.nlp.solve(convex.x)  # None: no freedom beyond Eq. 58 to improve on
+            if self._nlp is None:  # (from the convex optimum: a bound's working set there)
+                self._nlp = NlpSolver(data, start=convex.x)
+            nlp = self._nlp.solve(convex.x)  # None: no freedom beyond Eq. 58 to improve on
             if nlp is not None:
                 stages.append(nlp.stage)
             if nlp is not None and nlp.status == "optimal" and nlp.feasible:

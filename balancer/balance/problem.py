@@ -53,7 +53,7 @@ from .objective_terms import objective_rows
 from .physical import PhysicalValues
 from .regressors import CycleRegressors, cycle_regressors_at
 from .settling import Settling
-from .sites import site_columns, sites_of
+from .sites import Sites, site_columns, sites_of
 
 
 class NumericProblem(Feasibility, PhysicalValues, Settling, ObjectiveScale):
@@ -200,11 +200,14 @@ def _engine_problem(design: Design, problem: RotorBalanceProblem) -> NumericProb
     angles = sample_angles(design.operation.samples)
     (linkage,) = cycle_regressors_at(mech, angles, [(speed, 0.0)])
     force, moment, couple = site_columns(sites.sites, angles, speed)
+    supports = None
+    if problem.objective.main_bearing_load or problem.max_bearing_load is not None:
+        supports = _support_rows(mech, sites, angles, speed, force)
     reg = CycleRegressors(  # no driving torque from a site at constant speed
         shaking_force=np.hstack([linkage.shaking_force, force]),
         shaking_moment=np.hstack([linkage.shaking_moment, moment]),
         driving_torque=np.hstack([linkage.driving_torque, np.zeros(moment.shape)]),
-        rocking_couple=np.hstack([linkage.rocking_couple, couple]))
+        rocking_couple=np.hstack([linkage.rocking_couple, couple]), supports=supports)
     links = tuple(resolve_link(mech, name, None) for name in mech.link_names)
     x0 = np.concatenate([mech.parameters(), site_values])
     rows, factor, inert = objective_rows(reg, problem.objective, links, x0.size, sites)
@@ -212,6 +215,31 @@ def _engine_problem(design: Design, problem: RotorBalanceProblem) -> NumericProb
                           states=InputState.crank(angles, speed), regressors=reg, links=links,
                           x0=x0, rows=rows, factor=factor, force_balance=None, inert=inert,
                           sites=sites)
+
+
+def _support_rows(mech: Mechanism, sites: Sites, angles: NDArray[np.float64], speed: float,
+                  force: NDArray[np.complex128]) -> NDArray[np.complex128]:
+    """The supports' (an engine's main bearings') loads over the design vector, ``(S·N, P)``.
+
+    The linkage's entries by the mechanism's regressors
+    (:meth:`~balancer.mechanisms.base.Mechanism.support_regressors`); each mass·radius on the
+    crankshaft (ratio 1, on its axis) its centrifugal force ``force``'s columns shared by
+    :meth:`~balancer.mechanisms.base.Mechanism.support_shares`; a shaft's on its own bearings.
+    """
+    with np.errstate(all="ignore"):
+        per = mech.support_regressors(mech.motion(angles, speed, 0.0))
+    if not per:
+        raise SpecError("needs the main bearings' planes: [mechanism] main_bearings",
+                        key="balance")
+    rows = []
+    for j, linkage_rows in enumerate(per):
+        cols = np.zeros(force.shape, complex)
+        for i, site in enumerate(sites.sites):
+            if site.ratio == 1 and site.at == 0:
+                share = dict(mech.support_shares(site.z)).get(j, 0.0)
+                cols[:, 2 * i : 2 * i + 2] = share * force[:, 2 * i : 2 * i + 2]
+        rows.append(np.hstack([linkage_rows, cols]))
+    return np.vstack(rows)
 
 
 def _along_motions(design: Design, problem: BalanceProblem, mech: Mechanism) -> NumericProblem:

@@ -117,6 +117,12 @@ class ProblemData:
         """The objective's weights."""
         return self.problem.objective
 
+    @property
+    def support_bound(self) -> float | None:
+        """The largest load a support (an engine's main bearing) may carry, N, or none."""
+        problem = self.problem
+        return problem.max_bearing_load if isinstance(problem, RotorBalanceProblem) else None
+
     @cached_property
     def preferred(self) -> NDArray[np.float64]:
         """The design the tie-break moves towards among optimal ones.

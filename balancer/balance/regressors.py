@@ -24,13 +24,16 @@ class CycleRegressors:
     """The inertial shaking over a revolution as linear maps of the design vector.
 
     Arrays ``(N, P)``: shaking force (complex, N), shaking moment and driving torque (N·m),
-    rocking couple (complex ``Mx + i·My``, N·m), per unit of each entry.
+    rocking couple (complex ``Mx + i·My``, N·m), per unit of each entry; and where the
+    mechanism has supports that share a ground point's reaction (an engine's main bearings),
+    their loads one support after another, ``(S·N, P)`` complex, N.
     """
 
     shaking_force: NDArray[np.complex128]
     shaking_moment: NDArray[np.float64]
     driving_torque: NDArray[np.float64]
     rocking_couple: NDArray[np.complex128]
+    supports: NDArray[np.complex128] | None = None
 
 
 def cycle_regressors(mech: Mechanism, angles: NDArray[np.float64], omega: float,

@@ -74,7 +74,8 @@ class Repairs:
     _pinned_inverses: dict[bytes, NDArray[np.float64]]
     _projections: dict[float, ConicProgram]
 
-    def _constraints(self, margin: float = 0.0) -> tuple[list[Constraint], list[str]]:
+    def _constraints(self, margin: float = 0.0, *, supports: bool = True
+                     ) -> tuple[list[Constraint], list[str]]:
         """The bounds as cone constraints tightened by ``margin`` (the solver's)."""
         raise NotImplementedError
 
@@ -378,7 +379,7 @@ class Repairs:
         solved, *_ = np.linalg.lstsq(scaled, rhs, rcond=RANK_TOLERANCE)
         candidate = x.copy()
         candidate[free] = solved * data.scales[free]
-        if sites.violations(candidate, 0.0):
+        if sites.violations(candidate, 0.0) or data.violations(candidate):
             return x
         return candidate if data.reduced_objective(candidate) <= data.reduced_objective(x) else x
 

@@ -130,6 +130,22 @@ class _RotorFront:
                                P=np.zeros((0, self.width)), q=np.zeros(0), g=self.cap_row)
         return solve_program(program, self.solver.settings)
 
+    def least_feasible(self) -> float:
+        """The least ``Σ c_i·t_i`` of any design within the bounds (0 without a support bound).
+
+        Raises :class:`SolverError` if Clarabel fails (an unreachable bound: the optimiser's
+        own error names it first).
+        """
+        if self.data.support_bound is None:
+            return 0.0
+        program = ConicProgram(self.width, self.cones, objective="squares",
+                               P=np.zeros((0, self.width)), q=np.zeros(0), g=self.cap_row)
+        solution = solve_program(program, self.solver.settings)
+        if solution.u is None:
+            raise SolverError(f"the least added mass within the bounds could not be solved "
+                              f"(Clarabel: {solution.status})")
+        return float(self.cap_row @ solution.u) * self.value_scale
+
     def certified(self, solution: ConicSolution, cap: Constraint) -> float:
         """The certified least ``√J'`` under ``cap``, N·m (0 where none is made)."""
         assert solution.u is not None  # solved: the caller has checked
@@ -187,7 +203,11 @@ def rotor_front(design: Design, against: str, points: int) -> Front:
     high = programs.value(solved(top, "the least mass of the least shaking")
                           if top.u is not None else best)
     slack = END_ROOM * programs.value_scale
-    grid = [slack] if high <= slack else list(np.linspace(slack, high + slack, points))
+    # (the least mass any design within the bounds has: none, unless a bound on the main
+    # bearings' loads asks for some)
+    low = programs.least_feasible()
+    grid = ([low + slack] if high <= low + slack
+            else list(np.linspace(low + slack, high + slack, points)))
     out: list[FrontPoint] = []
     for epsilon in grid:
         cap = programs.cap(float(epsilon))

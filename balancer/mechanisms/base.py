@@ -715,6 +715,18 @@ class Mechanism:
         """
         return ()
 
+    def support_regressors(self, mo: Motion) -> tuple[NDArray[np.complex128], ...]:
+        """:meth:`support_loads` (inertial) as linear maps of the design vector, ``(N, P)`` each.
+
+        Over :attr:`layout`; the rotors' masses are left out (a balancing's mass·radius sites,
+        shared among the supports by :meth:`support_shares`).
+        """
+        return ()
+
+    def support_shares(self, z: float) -> tuple[tuple[int, float], ...]:
+        """How the supports share a load at plane ``z`` on their shaft: ``(support, share)``."""
+        return ()
+
     def closed_form_force_balance(self) -> NDArray[np.float64] | None:
         """Shaking-force balance in closed form, ``A`` with ``A·π = 0`` over :attr:`layout`.
 

@@ -75,7 +75,8 @@ OBJECTIVE_KEYS = (
 )
 
 #: The keys of an engine's ``[balance.objective]`` (DESIGN.md, "Balancing an engine").
-ENGINE_OBJECTIVE_KEYS = ("rocking_couple", "shaking_force", "shaking_moment", "unbalance")
+ENGINE_OBJECTIVE_KEYS = ("rocking_couple", "shaking_force", "shaking_moment", "unbalance",
+                         "main_bearing_load")
 
 
 LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "counter_rotor",
@@ -111,6 +112,9 @@ class Objective:
     unbalance
         ``w_U``, m²: of ``Σ (mr·ω²)²`` over an engine's chosen counterweights and eccentrics
         (``ω`` the crank's speed), the centrifugal load they put on their bearings.
+    main_bearing_load
+        ``w_B``, m²: of an engine's main-bearing loads' mean-square magnitude, over its bearings
+        and the samples (``[mechanism] main_bearings``).
     """
 
     shaking_moment: float = 1.0
@@ -121,6 +125,7 @@ class Objective:
     rocking_couple: float = 0.0
     added_mass: float = 0.0
     unbalance: float = 0.0
+    main_bearing_load: float = 0.0
 
     @property
     def terms(self) -> tuple[ObjectiveTerm, ...]:
@@ -136,7 +141,7 @@ class Objective:
         weights = [("shaking_moment", self.shaking_moment),
                    ("driving_torque", self.driving_torque), *forces,
                    ("rocking_couple", self.rocking_couple), ("added_mass", self.added_mass),
-                   ("unbalance", self.unbalance)]
+                   ("unbalance", self.unbalance), ("main_bearing_load", self.main_bearing_load)]
         return tuple(ObjectiveTerm(name, weight, unit_of(name)) for name, weight in weights
                      if weight > 0)
 
@@ -405,8 +410,16 @@ class RotorBalanceProblem:
                                                                   rocking_couple=1.0))
     counterweights: CounterweightPlanes | None = None
     shafts: tuple[ShaftFreedom, ...] = ()
+    #: The largest load any main bearing may carry over the cycle, N (``None``: no bound).
+    max_bearing_load: float | None = None
     #: The figure a balancing of this kind is about, as a sweep's atlas shows it.
     headline: ClassVar[str] = "rocking_couple"
+
+    def __post_init__(self) -> None:
+        """Check the bound (key ``max_bearing_load``)."""
+        if self.max_bearing_load is not None:
+            v.store(self, "max_bearing_load",
+                    v.positive(self.max_bearing_load, "max_bearing_load"))
 
     def check_scales(self, speeds: dict[str, float]) -> None:
         """Raise :class:`SpecError` if balancing could make a load beyond double precision.

@@ -625,6 +625,11 @@ _ENGINE_BALANCE: dict[str, tuple[Key, ...]] = {
         Key("shafts", "table", "none",
             "New balance shafts, sized by the optimiser (`[[balance.shafts]]`, below); those "
             "of `[[balance_shafts]]` stay as given.", (ENGINE,)),
+        Key("max_bearing_load", "N", "none",
+            "An engine's: the largest load any main bearing may carry over the cycle "
+            "(inertial: at the operating speed, without gas or weights), a bound the balancing "
+            "keeps (needs `[mechanism] main_bearings`); positive.", (ENGINE,),
+            example="6000.0"),
     ),
     "balance.objective": (
         Key("rocking_couple", "—", "1",
@@ -640,6 +645,10 @@ _ENGINE_BALANCE: dict[str, tuple[Key, ...]] = {
             "An engine's: w_U, of Σ (mr·ω²)² over the chosen counterweights and eccentrics (ω "
             "the crank's speed): the load they put on their bearings.", (ENGINE,),
             example="0.0004"),
+        Key("main_bearing_load", "m²", "0",
+            "An engine's: w_B, of its main-bearing loads' mean-square magnitude over its "
+            "bearings and the cycle (inertial; needs `[mechanism] main_bearings`).", (ENGINE,),
+            example="0.01"),
     ),
 }
 #: An engine's ``[original]`` (as ``optimize --out`` writes it): the links and balance shafts

@@ -230,8 +230,11 @@ def _optimize_rule(path: str, doc: dict, unique: bool = True) -> Rule:
                 r"|scale$|objective_terms\.[^.]+\.(before|weight)$", path):
         return EXACT
     if path in ("objective", "lower_bound", "stages[].objective"):
+        # (where rms is given, the gap is of √J: J within (√J + ε·s)² − J = ε·s·(2√J + ε·s))
+        gap = GAP_TOLERANCE * scale
+        root = math.sqrt(abs(float(doc.get("objective") or 0.0)))
         return Tolerance(EXACT_RELATIVE, EXACT_OF_SCALE,
-                         GAP_TOLERANCE * (scale**2 if squared else scale))
+                         GAP_TOLERANCE * scale**2 if squared else gap * (2 * root + gap))
     if path in ("rms", "rms_lower_bound"):
         return Tolerance(EXACT_RELATIVE, EXACT_OF_SCALE, GAP_TOLERANCE * scale)
     if path == "gap":  # relative to the scale (of √J where rms is given, else of J)

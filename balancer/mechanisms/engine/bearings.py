@@ -29,6 +29,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ...linkage.dynamics import inertial_columns
+from ...linkage.kinematics import Motion
 from ...linkage.rotors import Rotor
 from ...linkage.vectors import V
 from ..base import Mechanism
@@ -104,4 +106,38 @@ def main_bearing_loads(mech: Mechanism, planes: Sequence[float], ground_point: s
     return {bearing_name(j): out[j] for j in range(len(planes))}
 
 
-__all__ = ["bearing_name", "lever_shares", "main_bearing_loads"]
+def main_bearing_regressors(mech: Mechanism, planes: Sequence[float], mo: Motion
+                            ) -> list[NDArray[np.complex128]]:
+    """Each main bearing's inertial load as a linear map of the design vector, ``(N, P)``.
+
+    As :func:`main_bearing_loads` without gas, weights or the crankshaft's masses (those are
+    the balancing's mass·radius sites, shared by :func:`lever_shares`): each link's
+    ``m·(ḡ − ā)`` per unit inertial parameter (:func:`~balancer.linkage.dynamics.
+    inertial_columns`) at its plane, less each guide's normal force on the frame
+    (:meth:`~balancer.mechanisms.base.Mechanism.regressors`) at its cylinder's; columns in the
+    mechanism's :attr:`~balancer.mechanisms.base.Mechanism.layout`.
+    """
+    linkage, structure, layout = mech.linkage, mech.structure, mech.layout
+    n = mo.count
+    out = [np.zeros((n, layout.size), complex) for _ in planes]
+    columns = inertial_columns(structure, mo, V(0.0, 0.0))
+    sliders = {s.link: s for s in linkage.sliders}
+    plane = {name: linkage.link(name).z for name in linkage.link_names}
+    for name, cols in columns.items():
+        for param, (fx, fy, _) in cols:
+            force = np.broadcast_to(np.asarray(fx) + 1j * np.asarray(fy), (n,))
+            for j, share in lever_shares(planes, plane[name]):
+                out[j][:, layout.index(name, param)] += share * force
+    if sliders:
+        with np.errstate(all="ignore"):
+            normal = mech.regressors(mo).slider_normal
+        normals = mech.guide_normals()
+        for name in sliders:
+            if name not in normal:
+                continue
+            for j, share in lever_shares(planes, plane[name]):
+                out[j] -= share * np.asarray(normal[name], float) * normals[name]
+    return out
+
+
+__all__ = ["bearing_name", "lever_shares", "main_bearing_loads", "main_bearing_regressors"]

@@ -18,15 +18,17 @@ import math
 from dataclasses import replace
 from functools import cached_property
 
-from numpy.typing import ArrayLike
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
+from ...linkage.kinematics import Motion
 from ...linkage.loads import SupportLoad
 from ...linkage.rotors import Rotor, link_inertia
 from ...linkage.structure import Structure
 from ...model import Body, Linkage, Slider
 from ..base import DrawnMass, Mechanism, piston_block
 from ..presentation import Presentation
-from .bearings import main_bearing_loads
+from .bearings import lever_shares, main_bearing_loads, main_bearing_regressors
 from .model import COUNTERWEIGHT, Engine
 
 #: The main bearings' point (the crankshaft's axis at the origin).
@@ -125,6 +127,16 @@ class EngineMechanism(Mechanism):
                                    loads=loads, gravity=gravity)
         return tuple(SupportLoad(name=name, z=z, force=force)
                      for (name, force), z in zip(found.items(), planes, strict=True))
+
+    def support_regressors(self, mo: Motion) -> tuple[NDArray[np.complex128], ...]:
+        """Each main bearing's inertial load over the layout (:mod:`.bearings`)."""
+        planes = self.model.main_bearings
+        return tuple(main_bearing_regressors(self, planes, mo)) if planes else ()
+
+    def support_shares(self, z: float) -> tuple[tuple[int, float], ...]:
+        """The lever rule's shares of a load at ``z`` on the crankshaft (:mod:`.bearings`)."""
+        planes = self.model.main_bearings
+        return lever_shares(planes, z) if planes else ()
 
     def describe(self) -> str:
         n = len(self.model.cylinders)

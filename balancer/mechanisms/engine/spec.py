@@ -289,9 +289,16 @@ def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
             shafts.append(ShaftFreedom(ratio=sub.raw("ratio"), at=sub.value("at", (0.0, 0.0)),
                                        planes=sub.raw("planes"), max_mr=sub.raw("max_mr")))
         sub.finish()
+    bound = table.value("max_bearing_load", None)
+    if (bound is not None or objective.main_bearing_load) and not cast(
+            "Engine", engine).main_bearings:
+        key = (table.key("max_bearing_load") if bound is not None
+               else "balance.objective.main_bearing_load")
+        raise SpecError("needs the main bearings' planes: [mechanism] main_bearings", key=key)
     table.finish()
-    return RotorBalanceProblem(objective=objective, counterweights=counterweights,
-                               shafts=tuple(shafts))
+    with v.under(table.path):
+        return RotorBalanceProblem(objective=objective, counterweights=counterweights,
+                                   shafts=tuple(shafts), max_bearing_load=bound)
 
 
 def _sector(table: Table | None) -> Sector | None:
@@ -316,7 +323,11 @@ def balance_lines(problem: object) -> list[str]:
     assert isinstance(problem, RotorBalanceProblem)
     w = problem.objective
     out = ["[balance.objective]  # weights of the mean squares over the cycle",
-           *(f"{name} = {toml.number(getattr(w, name))}" for name in ENGINE_OBJECTIVE_KEYS)]
+           *(f"{name} = {toml.number(getattr(w, name))}" for name in ENGINE_OBJECTIVE_KEYS
+             if name != "main_bearing_load" or w.main_bearing_load)]
+    if problem.max_bearing_load is not None:
+        out = ["[balance]", f"max_bearing_load = {toml.number(problem.max_bearing_load)}  # N",
+               "", *out]
     cws = problem.counterweights
     if cws is not None:
         out += ["", "[balance.counterweights]  # on the crankshaft",

@@ -1,0 +1,190 @@
+"""Balancing an engine for its main bearings: the objective term and the bound, each checked.
+
+- ``main_bearing_load``'s J at random counterweights is the mean square of the bearings' loads
+  of the engine built with them, by the chain-momentum route (not the problem's regressors).
+- The optimum is an independent program's: CVXPY over the bearings' loads assembled from the
+  base engine's (chain momentum) and each counterweight's centrifugal force shared by the lever
+  rule by hand, with every bound and ``max_bearing_load`` as cones.
+- The bound holds at the balanced design, and binds; the least feasible bound the error names is
+  the threshold (just above it: optimal; just below: infeasible).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import cvxpy as cp
+import numpy as np
+import pytest
+
+from balancer.balance.optimizer import Optimizer, optimize
+from balancer.balance.problem import numeric_problem
+from balancer.balance.result import InfeasibleError
+from balancer.cli import main
+from balancer.cycle import cycle_analysis
+from balancer.mechanisms import mechanism_of
+from balancer.mechanisms.engine.bearings import lever_shares
+from balancer.spec import dumps_design, load_design, loads_design
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+#: Clarabel's and the tie-break's accuracy on the optimum, relative.
+SOLVERS = 1e-7
+
+
+@pytest.fixture(scope="module")
+def design():
+    return load_design(EXAMPLES / "inline_four_mains.toml")
+
+
+def bearing_map(design, theta):
+    """``B(x) = B0 + Σ C_i·x_i`` per bearing, ``(S, N)`` and ``(S, N, 2·planes)``, by hand."""
+    engine, problem = design.mechanism, design.balance
+    speed = design.operation.speed
+    planes = problem.counterweights.planes
+    base = replace(engine, crankshaft=replace(engine.crankshaft, masses=tuple(
+        m for m in engine.crankshaft.masses
+        if not (m.label == "counterweight" and m.z in planes))))
+    b0 = np.array([s.force for s in mechanism_of(base).support_loads(theta, speed, 0.0,
+                                                                      loads=False)])
+    cols = np.zeros((len(engine.main_bearings), theta.size, 2 * len(planes)), complex)
+    turn = speed**2 * np.exp(1j * theta)
+    for i, z in enumerate(planes):
+        for j, share in lever_shares(engine.main_bearings, z):
+            cols[j, :, 2 * i] += share * turn
+            cols[j, :, 2 * i + 1] += share * 1j * turn
+    return b0, cols
+
+
+def analyze_inertial(engine, speed, theta) -> np.ndarray:
+    """The engine's inertial shaking force at ``theta``, complex, N (its cycle analysis)."""
+    return cycle_analysis(engine, speed, theta1=theta, loads=False).reactions.shaking_force
+
+
+def chosen(result) -> np.ndarray:
+    """The balanced counterweights as ``(Re, Im)`` per plane, kg·m."""
+    return np.concatenate([[c.mr * math.cos(math.radians(c.phase_deg)),
+                            c.mr * math.sin(math.radians(c.phase_deg))]
+                           for c in result.rotor_masses.counterweights])
+
+
+def test_the_bearing_term_is_the_mean_square_of_the_built_engines_bearing_loads(design):
+    weights = replace(design.balance.objective, unbalance=0.0, shaking_force=0.0)
+    plain = replace(design, balance=replace(design.balance, objective=weights))
+    data = numeric_problem(plain)
+    sites = data.sites
+    speed = design.operation.speed
+    rng = np.random.default_rng(44)
+    for _ in range(4):
+        x = data.x0.copy()
+        for i in sites.chosen:
+            x[sites.entries(i)] = rng.uniform(-0.02, 0.02, 2)
+        built = sites.model_of(design.mechanism, x)
+        loads = mechanism_of(built).support_loads(data.states.positions[0], speed, 0.0,
+                                                  loads=False)
+        want = float(np.mean(np.concatenate([np.abs(s.force) ** 2 for s in loads])))
+        assert data.objective(x) == pytest.approx(want, rel=1e-9)
+        assert data.reduced_objective(x) == pytest.approx(want, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_the_optimum_is_the_independent_programs_and_the_bound_binds(design):
+    result = optimize(design, "nlp")
+    assert result.optimal
+    theta = result.before.theta1
+    b0, cols = bearing_map(design, theta)
+    problem = design.balance
+    w = problem.objective
+    speed = design.operation.speed
+    n_sites = cols.shape[2]
+    x = cp.Variable(n_sites)
+    loads = [b0[j] + cols[j] @ x for j in range(b0.shape[0])]
+    count = b0.shape[0] * theta.size
+    mean_square = sum(cp.sum_squares(cp.real(b)) + cp.sum_squares(cp.imag(b))
+                      for b in loads) / count
+    # the shaking force: the base engine's (its inertial analysis) and each counterweight's
+    planes = problem.counterweights.planes
+    engine = design.mechanism
+    base = replace(engine, crankshaft=replace(engine.crankshaft, masses=tuple(
+        m for m in engine.crankshaft.masses
+        if not (m.label == "counterweight" and m.z in planes))))
+    f0 = analyze_inertial(base, speed, theta)
+    turn = speed**2 * np.exp(1j * theta)
+    fcols = np.column_stack([c for _ in planes for c in (turn, 1j * turn)])
+    shaking = f0 + fcols @ x
+    force_ms = (cp.sum_squares(cp.real(shaking)) + cp.sum_squares(cp.imag(shaking))) / theta.size
+    cost = (w.main_bearing_load * mean_square + w.shaking_force * force_ms
+            + w.unbalance * speed**4 * cp.sum_squares(x))
+    bound = problem.max_bearing_load
+    cons = [cp.norm(x[2 * i : 2 * i + 2]) <= m
+            for i, m in enumerate(problem.counterweights.max_mr)]
+    cons += [cp.abs(b) <= bound for b in loads]
+    oracle = cp.Problem(cp.Minimize(cost), cons)
+    oracle.solve(solver=cp.CLARABEL)
+    assert oracle.status == cp.OPTIMAL
+    assert result.objective == pytest.approx(oracle.value, rel=SOLVERS)
+    assert result.lower_bound <= oracle.value * (1 + SOLVERS)
+    after = b0 + cols @ chosen(result)
+    largest = float(np.max(np.abs(after)))
+    assert largest <= bound * (1 + 1e-9)
+    assert largest >= bound * (1 - 1e-4)  # it binds: without it the optimum goes above
+    free = replace(design, balance=replace(problem, max_bearing_load=None))
+    unbounded = b0 + cols @ chosen(optimize(free, "convex"))
+    assert float(np.max(np.abs(unbounded))) > bound * 1.05
+
+
+@pytest.mark.slow
+def test_an_unreachable_bound_names_the_least_one_that_is(design):
+    with pytest.raises(InfeasibleError) as caught:
+        optimize(replace(design, balance=replace(design.balance, max_bearing_load=5000.0)),
+                 "convex")
+    (key, least, given, unit), = caught.value.needed
+    assert (key, given, unit) == ("balance.max_bearing_load", 5000.0, "N")
+    assert least > 5000.0
+    for factor, ok in ((1 + 1e-6, True), (1 - 1e-4, False)):
+        trial = replace(design, balance=replace(design.balance, max_bearing_load=least * factor))
+        if ok:
+            assert optimize(trial, "convex").optimal
+        else:
+            with pytest.raises(InfeasibleError):
+                optimize(trial, "convex")
+
+
+def test_the_spec_keys_are_written_back_and_refused_where_they_cannot_apply(design, tmp_path,
+                                                                            capsys):
+    again = loads_design(dumps_design(design))
+    assert again.balance.max_bearing_load == design.balance.max_bearing_load
+    assert again.balance.objective.main_bearing_load == design.balance.objective.main_bearing_load
+    text = (EXAMPLES / "inline_four_mains.toml").read_text()
+    cases = [
+        (text.replace("main_bearings = [", "# main_bearings = ["), "balance.max_bearing_load"),
+        (text.replace("max_bearing_load = 7000.0", "# "), "balance.objective.main_bearing_load"),
+        (text.replace("max_bearing_load = 7000.0", "max_bearing_load = -1.0"),
+         "balance.max_bearing_load"),
+        ((EXAMPLES / "pb1.toml").read_text().replace(
+            "[balance.objective]\n", "[balance.objective]\nmain_bearing_load = 1.0\n"),
+         "main_bearing_load")]
+    for i, (spec_text, key) in enumerate(cases):
+        spec = tmp_path / f"bad{i}.toml"
+        spec.write_text(spec_text if i != 1 else spec_text.replace(
+            "main_bearings = [", "# main_bearings = ["))
+        assert main(["optimize", str(spec)]) == 2, spec_text[-300:]
+        err = capsys.readouterr().err.strip()
+        assert key in err and len(err.splitlines()) == 1
+
+
+@pytest.mark.slow
+def test_the_engine_front_keeps_the_bound(design):
+    """pareto --against added-mass: every point within the bearings' bound (to Clarabel's
+    tolerance: a front's points are its programs' optima, not projected as optimize's design
+    is), from the least added mass that meets it."""
+    from balancer.balance.pareto import pareto_front
+
+    front = pareto_front(design, "added-mass", 3)
+    data = Optimizer.of(replace(design, balance=replace(
+        design.balance, objective=replace(design.balance.objective, unbalance=0.0)))).data
+    rows = data.regressors.supports
+    for p in front.points:
+        assert float(np.max(np.abs(rows @ p.x))) <= design.balance.max_bearing_load * (1 + 1e-6)
+    assert front.points[0].value > 0.1  # (none added would leave the centre main at 16 kN)
