@@ -29,6 +29,7 @@ _EXPORTS = {
     "analyze": "api",
     "analyze_motions": "api",
     "flywheel": "api",
+    "phasors": "api",
     "cycle_analyses": "api",
     "example": "api",
     "motion_drawing": "api",
@@ -63,6 +64,7 @@ _EXPORTS = {
     "motion_figure": "plots",
     "MotionDrawing": "plots",
     "orders_figure": "plots",
+    "phasors_figure": "plots",
     "front_figure": "plots",
     "save_figure": "plots",
     "sweep_figure": "plots",
@@ -95,6 +97,7 @@ _EXPORTS = {
     "MotionAnalysis": "motion_analysis",
     "AlongMotions": "motion_analysis",
     "Flywheel": "speed_fluctuation",
+    "Phasors": "phasors",
     "WorkspaceCheck": "motion_analysis",
     "MotionSpec": "model.motions",
     "Workspace": "model.motions",
@@ -130,6 +133,7 @@ __all__ = [
     "analyze",
     "analyze_motions",
     "flywheel",
+    "phasors",
     "animate",
     "AssemblyError",
     "AssemblyRange",
@@ -173,6 +177,7 @@ __all__ = [
     "optimize",
     "Optimizer",
     "orders_figure",
+    "phasors_figure",
     "OutputError",
     "pareto",
     "Perturb",
@@ -193,6 +198,7 @@ __all__ = [
     "motion_figure",
     "AlongMotions",
     "Flywheel",
+    "Phasors",
     "WorkspaceCheck",
     "MotionSpec",
     "Workspace",
@@ -242,6 +248,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         motion_drawing,
         optimize,
         pareto,
+        phasors,
         plan,
         planned_design,
         simulate,
@@ -297,6 +304,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .model.plan import InputLimits, PlanSpec, PlanWeights
     from .motion_analysis import AlongMotions, MotionAnalysis, WorkspaceCheck
     from .motion_verification import MotionCheck, MotionVerification
+    from .phasors import Phasors
     from .planning import Plan
     from .planning.codesign import CoDesign
     from .plots import (
@@ -306,6 +314,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         front_figure,
         motion_figure,
         orders_figure,
+        phasors_figure,
         plan_figure,
         save_figure,
         sweep_figure,

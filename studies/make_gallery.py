@@ -69,6 +69,10 @@ COMMANDS = (
     ("inline_four_orders.png", (
         "balancer plot examples/inline_four.toml --orders docs/gallery/inline_four_orders.png",
     )),
+    ("inline_three_phasors.png", (
+        "balancer plot examples/inline_three_to_balance.toml --phasors "
+        "docs/gallery/inline_three_phasors.png",
+    )),
     ("single_cylinder_orders.png", (
         "balancer plot examples/single_cylinder.toml --orders "
         "docs/gallery/single_cylinder_orders.png --log",

@@ -24,6 +24,7 @@ _EXPORTS = {
     "analyze": "analysis",
     "analyze_motions": "analysis",
     "flywheel": "analysis",
+    "phasors": "analysis",
     "cycle_analyses": "analysis",
     "example": "examples",
     "motion_drawing": "drawings",
@@ -43,6 +44,7 @@ __all__ = [
     "analyze",
     "analyze_motions",
     "flywheel",
+    "phasors",
     "cycle_analyses",
     "example",
     "motion_drawing",
@@ -63,7 +65,7 @@ __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
 
 
 if TYPE_CHECKING:  # for type checkers and editors: the names as they are
-    from .analysis import analyze, analyze_motions, cycle_analyses, flywheel
+    from .analysis import analyze, analyze_motions, cycle_analyses, flywheel, phasors
     from .balancing import optimize, pareto
     from .drawings import motion_drawing
     from .examples import example

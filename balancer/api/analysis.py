@@ -17,6 +17,7 @@ from ..model import Design, check_scales
 if TYPE_CHECKING:  # (the loads along motions: imported when a spec asks for them)
     from ..model.motions import MotionSpec
     from ..motion_analysis import AlongMotions, MotionAnalysis
+    from ..phasors import Phasors
     from ..speed_fluctuation import Flywheel
 
 
@@ -97,6 +98,27 @@ def flywheel(design: Design, fluctuation: float | None = None, *,
     energy = CrankEnergy.of(mech, sample_angles(op.samples, revolutions),
                             2 * math.pi * revolutions, g)
     return least_flywheel(energy, op.speed, fluctuation)
+
+
+def phasors(design: Design, orders: Sequence[int] = (1, 2)) -> Phasors:
+    """Each plane's inertial force and couple by order at the operating speed, as phasors.
+
+    The arrows at θ1 = 0 of each plane's forward and backward whirl at each of ``orders``
+    (:mod:`balancer.phasors`); drawn by :func:`balancer.phasors_figure`.
+
+    Raises
+    ------
+    SpecError
+        Without ``[operation]``, or for an order that is not a whole number from 1.
+    AssemblyError
+        If the crank cannot turn a full revolution.
+    """
+    from ..phasors import phasors as plane_phasors
+
+    if design.operation is None:
+        raise SpecError("missing required key: the phasors are of the operating speed",
+                        key="operation.speed")
+    return plane_phasors(mechanism_of(design.mechanism), design.operation.speed, tuple(orders))
 
 
 def analyze_motions(design: Design, names: Sequence[str] | None = None, *,

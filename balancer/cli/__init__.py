@@ -214,6 +214,7 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "planes), and the shaking moment and driving torque over the crank angle, of the "
         "design and (for a balanced spec that names its [original]) of the original before "
         "it. --orders: the order table as bars, forward and backward whirl, before and after. "
+        "--phasors: each plane's force and couple at orders 1 and 2 as arrows, head to tail. "
         "--animate: the linkage turning, its total centre of mass traced. For a linkage with "
         "several inputs, or with --motion, --cycle draws the loads along the spec's motion "
         "([[motion]]) over time instead, with the mechanism at a few poses along it, and "
@@ -393,6 +394,10 @@ def _plot_arguments(p: argparse.ArgumentParser) -> None:
                    "without it")
     p.add_argument("--orders", metavar="PATH",
                    help="write the order table's bars to PATH (.png, .svg or .pdf)")
+    p.add_argument("--phasors", metavar="PATH",
+                   help="write the phasors of orders 1 and 2 to PATH (.png, .svg or .pdf): "
+                   "each plane's force (and couple) as arrows at θ1 = 0, forward and backward "
+                   "whirls head to tail, and their sums")
     p.add_argument("--animate", metavar="PATH",
                    help="write an animation to PATH (.gif, or .mp4 with ffmpeg)")
     p.add_argument("--frames", type=_frames, default=72, metavar="N",

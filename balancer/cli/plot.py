@@ -8,42 +8,56 @@ import sys
 from pathlib import Path
 
 from ..api import cycle_analyses
-from ..api.analysis import analyze_motion, several_inputs
+from ..api.analysis import analyze_motion, phasors, several_inputs
 from ..api.drawings import motion_drawing
 from ..errors import OutputError, SpecError
 from ..mechanisms import mechanism_of
 from ..model import Design
 from ..outputs import animation_type, figure_type
-from ..plots import animate, cycle_figure, motion_figure, orders_figure, save_figure
+from ..plots import (
+    animate,
+    cycle_figure,
+    motion_figure,
+    orders_figure,
+    phasors_figure,
+    save_figure,
+)
 from .common import load, output_path, wrote
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``balancer plot``; the exit code."""
-    if args.animate is None and args.cycle is None and args.orders is None:
-        raise SpecError("nothing to plot: give --cycle PATH, --orders PATH or --animate PATH",
-                        key="--cycle")
+    if (args.animate is None and args.cycle is None and args.orders is None
+            and args.phasors is None):
+        raise SpecError("nothing to plot: give --cycle PATH, --orders PATH, --phasors PATH or "
+                        "--animate PATH", key="--cycle")
     if args.log and args.orders is None:
         raise SpecError("draws the order bars on a logarithmic axis: give --orders PATH too",
                         key="--log")
     cycle = output_path(args, args.cycle, "--cycle")
     orders = output_path(args, args.orders, "--orders")
     animation = output_path(args, args.animate, "--animate")
+    phasor = output_path(args, args.phasors, "--phasors")
     named: dict[str, str] = {}
-    for option, path in (("--cycle", cycle), ("--orders", orders), ("--animate", animation)):
+    for option, path in (("--cycle", cycle), ("--orders", orders), ("--phasors", phasor),
+                         ("--animate", animation)):
         if path is None:
             continue
         same = named.get(os.path.realpath(path))
         if same is not None:
             raise OutputError(f"names the same file as {same}", key=option, value=path)
         named[os.path.realpath(path)] = option
-    for option, path in (("--cycle", cycle), ("--orders", orders)):
+    for option, path in (("--cycle", cycle), ("--orders", orders), ("--phasors", phasor)):
         if path is not None:
             figure_type(path, option)
     if animation is not None:
         animation_type(animation, "--animate")  # its extension, and ffmpeg for an MP4
     design = load(args)
     if args.motion is not None or several_inputs(design):
+        if phasor is not None:
+            mechanism_of(design.mechanism).require_one_input("a phasor picture")
+            raise SpecError("phasors are of one crank revolution, not of a motion",
+                            key="--phasors", value=str(phasor))
         return _along_motion(args, design, cycle, orders, animation)
 
     mechanism_of(design.mechanism).require_full_revolution(
@@ -57,6 +71,8 @@ def run(args: argparse.Namespace) -> int:
         analyses = cycle_analyses(design, samples=None if design.operation is None
                                   else design.operation.samples)
         figures.append((orders_figure(*analyses, title=design.title, log=args.log), orders))
+    if phasor is not None:
+        figures.append((phasors_figure(phasors(design), title=design.title), phasor))
     if animation is not None:  # (a balanced spec: what was added to the links drawn too)
         animate(design, animation, frames=args.frames)
         wrote(animation)

@@ -11,6 +11,7 @@ or not at all. matplotlib is imported by the functions that draw, not by importi
 ``along``          along a motion of the inputs: the loads over time, the mechanism at a few
                    poses with its point's path and its centre of mass' track
 ``orders``         the order table as bars: forward and backward whirl, before and after
+``phasors``        each plane's force and couple at an order as arrows, head to tail, and sums
 ``motion``         a simulated motion: forces on the ground, shaking moment, the centre of
                    mass' path; ``balancer verify``'s figure
 ``motion_runs``    ``balancer verify``'s figure of a linkage with several inputs: its runs
@@ -41,6 +42,7 @@ from .fronts import front_figure
 from .motion import plot_com_path, plot_reactions, plot_shaking_moment, verification_figure
 from .motion_runs import motion_verification_figure
 from .orders import orders_figure, plot_orders
+from .phasors import phasors_figure, plot_phasors
 from .plan import plan_figure
 from .revolution import (
     cycle_figure,
@@ -61,10 +63,12 @@ __all__ = [
     "motion_figure",
     "motion_verification_figure",
     "orders_figure",
+    "phasors_figure",
     "plan_figure",
     "plot_centre_of_mass_track",
     "plot_com_path",
     "plot_orders",
+    "plot_phasors",
     "plot_over_crank_angle",
     "plot_over_time",
     "plot_poses",
