@@ -30,6 +30,7 @@ _EXPORTS = {
     "analyze_motions": "api",
     "flywheel": "api",
     "phasors": "api",
+    "search": "api",
     "cycle_analyses": "api",
     "example": "api",
     "motion_drawing": "api",
@@ -98,6 +99,8 @@ _EXPORTS = {
     "AlongMotions": "motion_analysis",
     "Flywheel": "speed_fluctuation",
     "Phasors": "phasors",
+    "Search": "arrangements",
+    "Arrangement": "arrangements",
     "WorkspaceCheck": "motion_analysis",
     "MotionSpec": "model.motions",
     "Workspace": "model.motions",
@@ -134,6 +137,7 @@ __all__ = [
     "analyze_motions",
     "flywheel",
     "phasors",
+    "search",
     "animate",
     "AssemblyError",
     "AssemblyRange",
@@ -199,6 +203,8 @@ __all__ = [
     "AlongMotions",
     "Flywheel",
     "Phasors",
+    "Search",
+    "Arrangement",
     "WorkspaceCheck",
     "MotionSpec",
     "Workspace",
@@ -251,12 +257,14 @@ if TYPE_CHECKING:  # for type checkers and editors: the names as they are
         phasors,
         plan,
         planned_design,
+        search,
         simulate,
         simulate_motion,
         to_dict,
         to_table,
         verify,
     )
+    from .arrangements import Arrangement, Search
     from .balance.counterweights import Counterweight
     from .balance.front import Against, Front, FrontPoint
     from .balance.optimizer import Backend, Optimizer

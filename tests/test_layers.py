@@ -37,7 +37,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
      "formulations.compiled", "formulations.crank_angle", "formulations.multibody"),
     # The registry of mechanisms and of formulations, and what runs over any mechanism.
     ("mechanisms", "formulations", "force_balance", "columns", "cycle", "motion_analysis",
-     "speed_fluctuation", "phasors"),
+     "speed_fluctuation", "phasors", "arrangements"),
     ("balance", "planning"),
     ("simulation", "verification", "motion_verification", "report", "plots", "plausibility",
      "parts"),

@@ -69,6 +69,7 @@ def test_a_single_upright_cylinders_primary_in_closed_form():
     assert backward == pytest.approx(-0.5 * m_rec * rw2, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_the_figure_has_a_panel_per_order_and_load(tmp_path, capsys):
     design = load_design(EXAMPLES / "inline_three_to_balance.toml")
     fig = phasors_figure(phasors(mechanism_of(design.mechanism), design.operation.speed))

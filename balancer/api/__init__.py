@@ -25,6 +25,7 @@ _EXPORTS = {
     "analyze_motions": "analysis",
     "flywheel": "analysis",
     "phasors": "analysis",
+    "search": "arrangements",
     "cycle_analyses": "analysis",
     "example": "examples",
     "motion_drawing": "drawings",
@@ -45,6 +46,7 @@ __all__ = [
     "analyze_motions",
     "flywheel",
     "phasors",
+    "search",
     "cycle_analyses",
     "example",
     "motion_drawing",
@@ -66,6 +68,7 @@ __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, globals())
 
 if TYPE_CHECKING:  # for type checkers and editors: the names as they are
     from .analysis import analyze, analyze_motions, cycle_analyses, flywheel, phasors
+    from .arrangements import search
     from .balancing import optimize, pareto
     from .drawings import motion_drawing
     from .examples import example

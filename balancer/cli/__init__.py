@@ -252,6 +252,16 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "spec with the planned motion (--out), its loads over time (--csv) and a figure "
         "(--plot).",
     ),
+    "search": (
+        "an engine's crank arrangements and firing orders, ranked by what they leave free",
+        "For an engine's cylinders as the spec places them (planes, banks, V pairs on shared "
+        "pins), every crank whose cylinders fire evenly over the working cycle and every "
+        "firing order it allows, cylinder 1 first, each judged exactly from its cylinders' "
+        "inertial loads at the operating speed: ranked by what crank counterweights cannot "
+        "take (the primary force's and couple's backward whirls, the secondary force and "
+        "couple), then by the firings that follow in the same half of the crank. The flat-"
+        "plane four, the in-line six's 1-5-3-6-2-4 and the cross-plane V8 come out on top.",
+    ),
     "example": (
         "write a shipped example spec (without NAME: list them)",
         "The example specs shipped with the package: the paper's four-bar "
@@ -483,6 +493,14 @@ def _plan_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
 
 
+def _search_arguments(p: argparse.ArgumentParser) -> None:
+    """``balancer search``'s arguments."""
+    p.add_argument("spec", metavar="SPEC", help="an engine's design spec (TOML)")
+    p.add_argument("--top", type=lambda text: _whole(text, 1), default=10, metavar="N",
+                   help="the best N cranks and firing orders (default 10)")
+    p.add_argument("--json", action="store_true", help="print a JSON document instead")
+
+
 def _example_arguments(p: argparse.ArgumentParser) -> None:
     """``balancer example``'s arguments."""
     p.add_argument("name", metavar="NAME", nargs="?", help="the example (e.g. pb1)")
@@ -500,6 +518,7 @@ _ARGUMENTS: dict[str, Callable[[argparse.ArgumentParser], None]] = {
     "pareto": _pareto_arguments,
     "sweep": _sweep_arguments,
     "plan": _plan_arguments,
+    "search": _search_arguments,
     "example": _example_arguments,
 }
 

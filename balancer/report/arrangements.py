@@ -1,0 +1,53 @@
+"""``search``'s report: the ranked cranks and firing orders, as a table and a JSON document."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..arrangements import Search
+from ..model import Design
+from ..rounding import speed_text
+from .text import table
+
+
+def search_text(found: Search, design: Design, spec: str | None = None) -> str:
+    """The readable ``search`` report: one row per crank and firing order, best first."""
+    head = f"balancer search — {spec}" if spec else "balancer search"
+    rows = []
+    zero = 1e-9 * found.scale
+
+    def fmt(value: float) -> str:
+        return "0" if value <= zero else f"{value:.6g}"
+
+    for a in found.arrangements:
+        rows.append([str(a.rank), " ".join(f"{p:g}" for p in a.phases),
+                     "-".join(str(k) for k in a.firing_order),
+                     fmt(a.free["force_1_backward"]), fmt(a.free["couple_1_backward"]),
+                     fmt(a.free["force_2"]), fmt(a.free["couple_2"]),
+                     fmt(a.counterweights["force_1_forward"]),
+                     fmt(a.counterweights["couple_1_forward"]), str(a.same_half)])
+    return "\n".join([
+        head,
+        f"{design.title or 'engine'}: every crank whose cylinders fire evenly, at "
+        f"{speed_text(found.speed)}; each cylinder's rods and pistons (the crankshaft's own "
+        "masses left out), ranked by what crank counterweights cannot take",
+        "",
+        table(rows, ["rank", "pin phases (°, by cylinder)", "firing order", "F1 bwd (N)",
+                     "C1 bwd (N·m)", "F2 (N)", "C2 (N·m)", "F1 fwd (N)", "C1 fwd (N·m)",
+                     "same half"]),
+        "",
+        "F1/C1: the primary force and couple, bwd turning against the crank (left free), fwd "
+        "with it (what counterweights can take); F2/C2: the secondary force and couple, both "
+        "whirls; same half: firings that follow one another in the same half of the crank",
+    ])
+
+
+def search_json(found: Search, spec: str | None = None) -> dict[str, Any]:
+    """The ``search --json`` document."""
+    doc: dict[str, Any] = {} if spec is None else {"spec": spec}
+    doc.update({"speed": found.speed, "scale": found.scale,
+                "arrangements": [a.as_dict() for a in found.arrangements],
+                "units": {"force_1_backward, force_1_forward, force_2": "N",
+                          "couple_1_backward, couple_1_forward, couple_2": "N·m",
+                          "phases_deg": "°", "scale": "N (a cylinder's m·r·ω²)"}})
+    return doc
