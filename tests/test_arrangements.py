@@ -86,20 +86,14 @@ def test_the_inline_fives_known_compromise_is_first():
 
 @pytest.mark.parametrize("which", ["four", "v8", "five"])
 def test_each_arrangements_figures_are_its_engines_cycle_analysis(which):
-    if which == "four":
-        design = load_design(EXAMPLES / "inline_four.toml")
-        engine = replace(design.mechanism, crankshaft=replace(design.mechanism.crankshaft,
-                                                              masses=()), balance_shafts=(),
-                         gas=None)
-        speed = design.operation.speed
-    elif which == "v8":
-        design = load_design(EXAMPLES / "v8.toml")
-        engine = replace(design.mechanism, crankshaft=replace(design.mechanism.crankshaft,
-                                                              masses=()), balance_shafts=(),
-                         gas=None)
-        speed = design.operation.speed
-    else:
+    if which == "five":
         engine, speed = inline(5)
+    else:  # a shipped engine's cylinders alone
+        design = load_design(EXAMPLES / {"four": "inline_four.toml", "v8": "v8.toml"}[which])
+        engine = replace(design.mechanism, crankshaft=replace(design.mechanism.crankshaft,
+                                                              masses=()), balance_shafts=(),
+                         gas=None)
+        speed = design.operation.speed
     found = search(engine, speed, top=6)
     n = len(engine.cylinders)
     for a in found.arrangements:

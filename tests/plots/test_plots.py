@@ -195,7 +195,8 @@ def test_plot_cycle_with_another_extension_is_refused_before_any_work(tmp_path, 
 def test_plot_needs_something_to_draw_and_distinct_paths(tmp_path, capsys):
     spec = str(EXAMPLES / "pb1.toml")
     assert main(["plot", spec]) == 2
-    assert "--cycle PATH, --orders PATH, --phasors PATH or --animate PATH" in capsys.readouterr().err
+    assert ("--cycle PATH, --orders PATH, --phasors PATH or --animate PATH"
+            in capsys.readouterr().err)
     assert main(["plot", spec, "--cycle", str(tmp_path / "a.png"), "--animate",
                  str(tmp_path / "a.png")]) == 2
     assert "same file" in capsys.readouterr().err
