@@ -133,6 +133,8 @@ def phasors(mech: Mechanism, speed: float, orders: tuple[int, ...] = (1, 2),
     planes = []
     for z in sorted(by_plane):
         names, load = by_plane[z]
+        if not np.any(load):  # (a link on the axis: the crankshaft's own mass puts none)
+            continue
         coefficients = {}
         for n in orders:
             forward = complex(np.mean(load * np.exp(-1j * n * theta)))

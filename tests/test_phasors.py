@@ -102,3 +102,4 @@ def test_a_plane_is_what_moves_in_it():
     assert set(z[round(-0.1365, 9)]) == {"rod1", "piston1", "O mass"}
     assert z[round(-0.1635, 9)] == ("O mass",)  # a web's counterweight alone
     assert math.isclose(sorted(z)[0], -0.1635)
+    assert all(any(plane.force[n] != (0, 0) for n in p.orders) for plane in p.planes)

@@ -266,7 +266,10 @@ class NlpSolver:
         data = self.data
         own = data.own(x)
         # A counterweight of no mass has no centre: it starts at its disc's centre.
-        physical = [(0.0, b.com_centre.real, b.com_centre.imag, 0.0) if data.absent(b, own)
+        # (a held link as it is: it may have no mass, an engine's crankshaft on its axis)
+        physical = [(b.original.mass, b.original.e, b.original.f, b.original.inertia)
+                    if not b.listed
+                    else (0.0, b.com_centre.real, b.com_centre.imag, 0.0) if data.absent(b, own)
                     else physical_parameters(own[b.entries]) for b in data.links]
         out = []
         for index, kind in self._names:

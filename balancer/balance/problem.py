@@ -223,8 +223,9 @@ def _support_rows(mech: Mechanism, sites: Sites, angles: NDArray[np.float64], sp
 
     The linkage's entries by the mechanism's regressors
     (:meth:`~balancer.mechanisms.base.Mechanism.support_regressors`); each mass·radius on the
-    crankshaft (ratio 1, on its axis) its centrifugal force ``force``'s columns shared by
-    :meth:`~balancer.mechanisms.base.Mechanism.support_shares`; a shaft's on its own bearings.
+    crankshaft (:meth:`.sites.Site.on_crank`) its centrifugal force ``force``'s columns shared
+    by :meth:`~balancer.mechanisms.base.Mechanism.support_shares`; a shaft's, coaxial or not,
+    on its own bearings.
     """
     with np.errstate(all="ignore"):
         per = mech.support_regressors(mech.motion(angles, speed, 0.0))
@@ -232,10 +233,11 @@ def _support_rows(mech: Mechanism, sites: Sites, angles: NDArray[np.float64], sp
         raise SpecError("needs the main bearings' planes: [mechanism] main_bearings",
                         key="balance")
     rows = []
+    frame = mech.linkage.ground.points
     for j, linkage_rows in enumerate(per):
         cols = np.zeros(force.shape, complex)
         for i, site in enumerate(sites.sites):
-            if site.ratio == 1 and site.at == 0:
+            if site.on_crank(frame):
                 share = dict(mech.support_shares(site.z)).get(j, 0.0)
                 cols[:, 2 * i : 2 * i + 2] = share * force[:, 2 * i : 2 * i + 2]
         rows.append(np.hstack([linkage_rows, cols]))

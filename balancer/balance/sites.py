@@ -62,6 +62,10 @@ class Site:
         Its bound, kg·m (a kept mass: its own mass·radius).
     kept
         ``None`` for a site the balancing chooses; else the kept mass·radius vector, kg·m.
+    bearing
+        A kept mass's rotor's bearing, the frame's point its force acts at (the crankshaft's
+        masses: the main bearings' ``O``; a balance shaft's: its own); ``None`` for a chosen
+        site (on the crankshaft where :attr:`shaft` is ``None``, else on its new shaft).
     """
 
     shaft: int | None
@@ -70,6 +74,7 @@ class Site:
     z: float
     max_mr: float
     kept: complex | None = None
+    bearing: str | None = None
 
     @property
     def free(self) -> bool:
@@ -80,6 +85,14 @@ class Site:
         """A unit mass·radius here at ``angle`` (rad), as a rotor without inertia."""
         return Rotor(ratio=float(self.ratio), inertia=0.0, axis=self.at,
                      eccentrics=(Eccentric(mr=1.0, angle=angle, z=self.z),))
+
+    def on_crank(self, frame_points: tuple[str, ...]) -> bool:
+        """Whether it is on the crankshaft, its force on the main bearings.
+
+        ``frame_points``: the linkage's ground points, where the crankshaft's masses bear (a
+        balance shaft's bearing is a point of its own, even where it turns with the crank).
+        """
+        return self.shaft is None or (self.bearing is not None and self.bearing in frame_points)
 
     @property
     def where(self) -> str:
@@ -254,8 +267,9 @@ def sites_of(design: Design, start: int) -> tuple[Sites, NDArray[np.float64]]:
                                                        math.sin(math.radians(c.phase_deg))])
     base = model.with_rotor_masses((), (), replaced)
     kept = [Site(-1, rotor.ratio, rotor.axis, e.z, e.mr, e.mr * complex(math.cos(e.angle),
-                                                                         math.sin(e.angle)))
-            for _, rotor in mechanism_of(base).rotors for e in rotor.eccentrics if e.mr]
+                                                                         math.sin(e.angle)),
+                 bearing=point)
+            for point, rotor in mechanism_of(base).rotors for e in rotor.eccentrics if e.mr]
     values = [v for s in kept for v in (cast("complex", s.kept).real,
                                         cast("complex", s.kept).imag)]
     return (Sites(tuple(sites + kept), start, problem, replaced, design.operation.speed),

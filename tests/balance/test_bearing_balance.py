@@ -26,6 +26,7 @@ from balancer.cli import main
 from balancer.cycle import cycle_analysis
 from balancer.mechanisms import mechanism_of
 from balancer.mechanisms.engine.bearings import lever_shares
+from balancer.model.balance import ShaftFreedom
 from balancer.spec import dumps_design, load_design, loads_design
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -188,3 +189,26 @@ def test_the_engine_front_keeps_the_bound(design):
     for p in front.points:
         assert float(np.max(np.abs(rows @ p.x))) <= design.balance.max_bearing_load * (1 + 1e-6)
     assert front.points[0].value > 0.1  # (none added would leave the centre main at 16 kN)
+
+
+@pytest.mark.slow
+def test_regressions_of_the_audit(design):
+    """A crankshaft without mass (the default) balances with the NLP backend too (it divided by
+    its zero mass); a shaft at ratio 1 on the crank's axis bears on its own bearings, not on the
+    mains: the objective's bearing term is the analysis's, and the bound holds in it."""
+    bare = replace(design, mechanism=replace(design.mechanism, crankshaft=replace(
+        design.mechanism.crankshaft, mass=0.0)))
+    nlp, convex = optimize(bare, "nlp"), optimize(bare, "convex")
+    assert nlp.optimal and nlp.objective == pytest.approx(convex.objective, rel=SOLVERS)
+    shaft = ShaftFreedom(ratio=1, at=(0.0, 0.0), planes=(-0.2, 0.2), max_mr=(0.02, 0.02))
+    coaxial = replace(design, balance=replace(design.balance, shafts=(shaft,)))
+    result = optimize(coaxial, "convex")
+    assert result.optimal
+    after = result.term_rms(result.after)
+    w = coaxial.balance.objective
+    want = (w.main_bearing_load * after["main_bearing_load"] ** 2
+            + w.shaking_force * after["shaking_force"] ** 2
+            + w.unbalance * after["unbalance"] ** 2)
+    assert result.objective == pytest.approx(want, rel=1e-9)
+    largest = max(float(np.max(np.abs(s.force))) for s in result.after.supports)
+    assert largest <= coaxial.balance.max_bearing_load * (1 + 1e-9)

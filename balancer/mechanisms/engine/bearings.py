@@ -14,9 +14,12 @@ The loads the crankshaft passes on, each at its plane (what it puts on the frame
   ``P_k = Σ m·(ḡ − ā)`` over the rod and the piston, less the guide's normal force on the frame
   ``N_k·n̂_k`` (its reaction holds the piston), plus the gas force on the piston ``F_k·û_k``
   (its reaction is on the head: it reaches the bearings only through the rod);
-- the crankshaft link's own ``m·(ḡ − ā)`` at its plane;
-- each of its masses' (pin, webs, counterweights) centrifugal force and weight at its plane
-  (:meth:`~balancer.linkage.rotors.Rotor.loads`).
+- the crankshaft link's own ``m·(ḡ − ā)``: its weight, its centre of mass on the axis in the
+  plane ``z = 0`` (the spec gives its mass, not where along the crank it lies: mains placed
+  about ``z = 0`` share it as the crankshaft does);
+- each of its masses' (pin, webs, counterweights) centrifugal force at its plane
+  (:meth:`~balancer.linkage.rotors.Rotor.loads`; a mass·radius carries no weight of its own:
+  the crankshaft's mass holds it).
 
 Their sum is the main bearings' summed reaction ``O`` that the inverse dynamics gives (the
 crankshaft's Newton equation): the tests hold the split to it.
