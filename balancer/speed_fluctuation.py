@@ -36,6 +36,7 @@ limited by the samples' spacing.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -212,11 +213,43 @@ def speeds(energy: CrankEnergy, added: float, speed: float, refine: int = REFINE
     high = max(low, 0.0) + 0.5 * float(np.max(total)) * target**2 + float(np.ptp(work)) + 1e-300
     while mean(high) < target:
         high *= 2
-    from scipy.optimize import brentq  # (only where a flywheel is asked for)
-
-    e0 = float(brentq(lambda e: mean(e) - target, low * (1 + 1e-15) + 1e-300, high,
-                      xtol=1e-300, rtol=ROOT_TOLERANCE))
+    e0 = bracketed_root(lambda e: mean(e) - target, low + abs(low) * 1e-15 + 1e-300, high)
     return float(np.sign(speed)) * np.sqrt(2 * (e0 + work) / total)
+
+
+def bracketed_root(f: Callable[[float], float], low: float, high: float,
+                   rtol: float = ROOT_TOLERANCE) -> float:
+    """A root of ``f`` between ``low`` and ``high``, where ``f`` changes sign (Illinois method).
+
+    Regula falsi with the Illinois modification: superlinear, and the bracket holds the root
+    throughout; to ``rtol`` of the root (or of the bracket's size where the root is 0). By
+    hand rather than :func:`scipy.optimize.brentq`, whose import costs ``analyze`` more than
+    its whole budget.
+    """
+    f_low, f_high = f(low), f(high)
+    if f_low == 0:
+        return low
+    if f_high == 0:
+        return high
+    if (f_low > 0) == (f_high > 0):
+        raise SolverError("the speed fluctuation's root is not bracketed")
+    side = 0
+    for _ in range(400):
+        x = high - f_high * (high - low) / (f_high - f_low)
+        fx = f(x)
+        if fx == 0 or abs(high - low) <= rtol * max(abs(x), 1e-300):
+            return x
+        if (fx > 0) == (f_high > 0):
+            high, f_high = x, fx
+            if side == 1:
+                f_low /= 2
+            side = 1
+        else:
+            low, f_low = x, fx
+            if side == -1:
+                f_high /= 2
+            side = -1
+    return x
 
 
 def fluctuation_of(omega: NDArray[np.float64]) -> float:
@@ -243,15 +276,13 @@ def flywheel(energy: CrankEnergy, speed: float, fluctuation: float) -> Flywheel:
     if alone <= fluctuation:
         added = 0.0
     else:
-        from scipy.optimize import brentq
-
         def excess(i_f: float) -> float:
             return fluctuation_of(speeds(energy, i_f, speed)) - fluctuation
 
         high = max(swing / (fluctuation * speed**2), j_range[2], 1e-300)
         while excess(high) > 0:
             high *= 2
-        added = float(brentq(excess, 0.0, high, xtol=1e-300, rtol=ROOT_TOLERANCE))
+        added = bracketed_root(excess, 0.0, high)
     omega = np.abs(speeds(energy, added, speed))
     return Flywheel(fluctuation=fluctuation, speed=abs(speed), inertia=added,
                     energy_swing=swing, mean_torque=energy.mean_load, mechanism_inertia=j_range,

@@ -245,3 +245,17 @@ def test_a_bad_speed_fluctuation_is_one_line_naming_the_key(tmp_path, capsys, va
     assert main(["analyze", str(spec)]) == 2
     err = capsys.readouterr().err.strip()
     assert "operation.speed_fluctuation" in err and len(err.splitlines()) == 1
+
+
+def test_the_bracketed_root_is_the_roots_closed_form():
+    """The Illinois method against closed forms: ∛2, a root at 0, a steep exponential."""
+    from balancer.errors import SolverError
+    from balancer.speed_fluctuation import bracketed_root
+
+    assert bracketed_root(lambda x: x**3 - 2.0, 0.0, 2.0) == pytest.approx(2 ** (1 / 3),
+                                                                            rel=1e-13)
+    assert abs(bracketed_root(lambda x: math.sin(x), -1.0, 2.0)) <= 1e-13
+    assert bracketed_root(lambda x: math.exp(40 * x) - 3.0, -1.0, 1.0) == pytest.approx(
+        math.log(3.0) / 40, rel=1e-12)
+    with pytest.raises(SolverError):
+        bracketed_root(lambda x: x * x + 1.0, -1.0, 1.0)
