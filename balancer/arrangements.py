@@ -28,11 +28,15 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from fractions import Fraction
+from typing import TYPE_CHECKING
 
 from .errors import SpecError
 from .mechanisms import mechanism_of
 from .mechanisms.engine.model import Crankshaft, Engine
 from .phasors import phasors
+
+if TYPE_CHECKING:  # (a balancing's result, where search --balance asks for one)
+    from .balance.result import BalanceResult
 
 #: Figures below this share of the engine's scale are rounding (zero) in the ranking.
 ROUNDING = 1e-9
@@ -62,6 +66,9 @@ class Arrangement:
     rank
         Its place, from 1; equal for arrangements the ranking cannot tell apart (the same
         figures to rounding and the same ``same_half``).
+    balanced
+        The engine with it balanced as the spec's ``[balance]`` asks (``search --balance``),
+        or ``None``.
     """
 
     phases: tuple[float, ...]
@@ -70,12 +77,20 @@ class Arrangement:
     counterweights: dict[str, float]
     same_half: int
     rank: int = 0
+    balanced: BalanceResult | None = None
 
     def as_dict(self) -> dict[str, object]:
         """An entry of ``search --json``'s ``arrangements``."""
-        return {"rank": self.rank, "phases_deg": list(self.phases),
-                "firing_order": list(self.firing_order), **self.free, **self.counterweights,
-                "same_half": self.same_half}
+        out: dict[str, object] = {
+            "rank": self.rank, "phases_deg": list(self.phases),
+            "firing_order": list(self.firing_order), **self.free, **self.counterweights,
+            "same_half": self.same_half}
+        if self.balanced is not None:
+            b = self.balanced
+            out["balanced"] = {"status": str(b.status), "objective": b.objective,
+                               "lower_bound": b.lower_bound,
+                               "terms": b.term_rms(b.after)}
+        return out
 
 
 @dataclass(frozen=True)

@@ -130,3 +130,24 @@ def test_the_command_prints_and_refuses(capsys):
     assert main(["search", str(EXAMPLES / "pb1.toml")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "mechanism.type" in err[0]
+
+
+@pytest.mark.slow
+def test_search_balance_sizes_each_cranks_counterweights_as_the_spec_asks(capsys):
+    """--balance: the spec's own crank balances as optimize balances it; its mirror image (the
+    pins and webs turned with their cylinders) to the solvers' accuracy; no [balance]: refused."""
+    from balancer.api.arrangements import search as search_design
+    from balancer.balance.optimizer import optimize
+
+    design = load_design(EXAMPLES / "inline_three_to_balance.toml")
+    found = search_design(design, top=2, balance=True)
+    own = optimize(design, "convex").objective
+    for a in found.arrangements:
+        assert a.balanced is not None and a.balanced.optimal
+        assert a.balanced.objective == pytest.approx(own, rel=1e-7)
+    spec_crank = [a for a in found.arrangements
+                  if a.phases == tuple(c.phase_deg for c in design.mechanism.cylinders)]
+    assert spec_crank and spec_crank[0].balanced.objective == pytest.approx(own, rel=1e-9)
+    assert main(["search", str(EXAMPLES / "v8.toml"), "--balance"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--balance" in err[0]

@@ -498,6 +498,9 @@ def _search_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("spec", metavar="SPEC", help="an engine's design spec (TOML)")
     p.add_argument("--top", type=lambda text: _whole(text, 1), default=10, metavar="N",
                    help="the best N cranks and firing orders (default 10)")
+    p.add_argument("--balance", action="store_true",
+                   help="balance each of them as the spec's [balance] asks (its certified "
+                   "counterweights and shafts) and give the objective left")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
 
 

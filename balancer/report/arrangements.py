@@ -25,7 +25,10 @@ def search_text(found: Search, design: Design, spec: str | None = None) -> str:
                      fmt(a.free["force_1_backward"]), fmt(a.free["couple_1_backward"]),
                      fmt(a.free["force_2"]), fmt(a.free["couple_2"]),
                      fmt(a.counterweights["force_1_forward"]),
-                     fmt(a.counterweights["couple_1_forward"]), str(a.same_half)])
+                     fmt(a.counterweights["couple_1_forward"]), str(a.same_half),
+                     *([] if a.balanced is None else [f"{a.balanced.objective:.6g}",
+                                                      str(a.balanced.status)])])
+    balanced = bool(found.arrangements) and found.arrangements[0].balanced is not None
     return "\n".join([
         head,
         f"{design.title or 'engine'}: every crank whose cylinders fire evenly, at "
@@ -34,11 +37,13 @@ def search_text(found: Search, design: Design, spec: str | None = None) -> str:
         "",
         table(rows, ["rank", "pin phases (°, by cylinder)", "firing order", "F1 bwd (N)",
                      "C1 bwd (N·m)", "F2 (N)", "C2 (N·m)", "F1 fwd (N)", "C1 fwd (N·m)",
-                     "same half"]),
+                     "same half", *(["balanced J", "status"] if balanced else [])]),
         "",
         "F1/C1: the primary force and couple, bwd turning against the crank (left free), fwd "
         "with it (what counterweights can take); F2/C2: the secondary force and couple, both "
-        "whirls; same half: firings that follow one another in the same half of the crank",
+        "whirls; same half: firings that follow one another in the same half of the crank"
+        + ("; balanced J: the objective of [balance] left by the certified counterweights and "
+           "shafts of each ((N·m)²)" if balanced else ""),
     ])
 
 
