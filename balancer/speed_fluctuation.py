@@ -78,7 +78,8 @@ class Flywheel:
     classical
         The classical estimate ``ΔE/(δ·ω²) − J̄``, kg·m² (it may be negative).
     fluctuation_without
-        ``δ`` of the mechanism alone (no flywheel).
+        ``δ`` of the mechanism alone (no flywheel); ``inf`` where it cannot run at that mean
+        speed (it stops within its cycle).
     speeds
         ``ω_min`` and ``ω_max`` with the flywheel, rad/s.
     """
@@ -100,7 +101,8 @@ class Flywheel:
                 "mechanism_inertia": dict(zip(("min", "mean", "max"), self.mechanism_inertia,
                                               strict=True)),
                 "classical_inertia": self.classical,
-                "fluctuation_without": self.fluctuation_without,
+                "fluctuation_without": (None if math.isinf(self.fluctuation_without)
+                                        else self.fluctuation_without),
                 "speed_min": self.speeds[0], "speed_max": self.speeds[1]}
 
 
@@ -210,11 +212,19 @@ def speeds(energy: CrankEnergy, added: float, speed: float, refine: int = REFINE
         return 1.0 / float(np.mean(1.0 / omega))
 
     low = -float(np.min(work))  # ω reaches 0 there
+    low = low + abs(low) * 1e-15 + 1e-300
+    if mean(low) >= target:
+        raise TooSlow("at this mean speed the crank stops within the cycle: the loads' work "
+                      "swing is more than its kinetic energy")
     high = max(low, 0.0) + 0.5 * float(np.max(total)) * target**2 + float(np.ptp(work)) + 1e-300
     while mean(high) < target:
         high *= 2
-    e0 = bracketed_root(lambda e: mean(e) - target, low + abs(low) * 1e-15 + 1e-300, high)
+    e0 = bracketed_root(lambda e: mean(e) - target, low, high)
     return float(np.sign(speed)) * np.sqrt(2 * (e0 + work) / total)
+
+
+class TooSlow(SolverError):
+    """The mechanism cannot run at the mean speed asked: it stops within its cycle."""
 
 
 def bracketed_root(f: Callable[[float], float], low: float, high: float,
@@ -252,6 +262,14 @@ def bracketed_root(f: Callable[[float], float], low: float, high: float,
     return x
 
 
+def _excess_or_too_slow(excess: Callable[[float], float], added: float) -> float:
+    """``excess(added)``, or ``inf`` where the mechanism stops within its cycle."""
+    try:
+        return excess(added)
+    except TooSlow:
+        return math.inf
+
+
 def fluctuation_of(omega: NDArray[np.float64]) -> float:
     """``δ = (ω_max − ω_min)/ω_mean`` of speeds over a cycle on an even grid of angle."""
     w = np.abs(omega)
@@ -272,17 +290,32 @@ def flywheel(energy: CrankEnergy, speed: float, fluctuation: float) -> Flywheel:
     j = energy.inertia_on(REFINE)
     swing = float(np.ptp(energy.work(REFINE) - 0.5 * speed**2 * (j - j[0])))
     j_range = (float(np.min(j)), float(np.mean(j)), float(np.max(j)))
-    alone = fluctuation_of(speeds(energy, 0.0, speed))
+    def excess(i_f: float) -> float:
+        return fluctuation_of(speeds(energy, i_f, speed)) - fluctuation
+
+    try:
+        alone = fluctuation_of(speeds(energy, 0.0, speed))
+    except TooSlow:  # (it stops within its cycle: no fluctuation to speak of)
+        alone = math.inf
     if alone <= fluctuation:
         added = 0.0
     else:
-        def excess(i_f: float) -> float:
-            return fluctuation_of(speeds(energy, i_f, speed)) - fluctuation
-
         high = max(swing / (fluctuation * speed**2), j_range[2], 1e-300)
-        while excess(high) > 0:
+        while _excess_or_too_slow(excess, high) > 0:
             high *= 2
-        added = bracketed_root(excess, 0.0, high)
+        low = 0.0
+        if math.isinf(alone):  # the least inertia with which it runs at all, bracketed
+            runs = high
+            for _ in range(200):
+                trial = (low + runs) / 2
+                if math.isinf(_excess_or_too_slow(excess, trial)):
+                    low = trial
+                else:
+                    runs = trial
+                if runs - low <= ROOT_TOLERANCE * runs:
+                    break
+            low = runs
+        added = low if excess(low) <= 0 else bracketed_root(excess, low, high)
     omega = np.abs(speeds(energy, added, speed))
     return Flywheel(fluctuation=fluctuation, speed=abs(speed), inertia=added,
                     energy_swing=swing, mean_torque=energy.mean_load, mechanism_inertia=j_range,

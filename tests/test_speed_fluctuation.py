@@ -259,3 +259,39 @@ def test_the_bracketed_root_is_the_roots_closed_form():
         math.log(3.0) / 40, rel=1e-12)
     with pytest.raises(SolverError):
         bracketed_root(lambda x: x * x + 1.0, -1.0, 1.0)
+
+
+def test_a_mechanism_too_slow_to_run_alone_gets_the_flywheel_it_needs(tmp_path, capsys):
+    """The fuzz campaign's: at 0.1 rad/s the single cylinder alone stops within its cycle (its
+    gas work swings more than its kinetic energy): the least flywheel still, the mechanism's
+    own fluctuation none (JSON null); at 0.5 rad/s a finite one, both as the energy balance
+    says; a linkage with several inputs refuses the key, naming it."""
+    import json
+
+    from balancer.cli import main
+
+    text = (EXAMPLES / "single_cylinder.toml").read_text()
+    for speed, alone in (("0.1", None), ("0.5", 1252.0)):
+        spec = tmp_path / f"slow{speed}.toml"
+        spec.write_text("\n".join(
+            f"speed = {speed}" if line.startswith("speed = ") else line
+            for line in text.splitlines()))
+        assert main(["analyze", str(spec), "--json"]) == 0
+        doc = json.loads(capsys.readouterr().out)["flywheel"]
+        if alone is None:
+            assert doc["fluctuation_without"] is None
+        else:
+            assert doc["fluctuation_without"] == pytest.approx(alone, rel=1e-3)
+        design = load_design(spec)
+        mech = mechanism_of(design.mechanism)
+        energy = CrankEnergy.of(mech, sample_angles(720, 2), 4 * math.pi)
+        omega = speeds(energy, doc["inertia"], design.operation.speed)
+        assert fluctuation_of(omega) == pytest.approx(0.02, rel=1e-9)
+    five = (EXAMPLES / "fivebar_5r.toml").read_text()
+    spec = tmp_path / "five.toml"
+    spec.write_text(five.replace("[operation]\n", "[operation]\nspeed_fluctuation = 0.02\n", 1)
+                    if "[operation]\n" in five else five + "\n[operation]\nspeed = 1.0\n"
+                    "speed_fluctuation = 0.02\n")
+    assert main(["analyze", str(spec)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "operation.speed_fluctuation" in err[0]

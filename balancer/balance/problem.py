@@ -211,6 +211,9 @@ def _engine_problem(design: Design, problem: RotorBalanceProblem) -> NumericProb
     links = tuple(resolve_link(mech, name, None) for name in mech.link_names)
     x0 = np.concatenate([mech.parameters(), site_values])
     rows, factor, inert = objective_rows(reg, problem.objective, links, x0.size, sites)
+    if supports is not None:  # (a rod's inertia moves its guide's force: the bound sees it)
+        seen = np.any(supports != 0, axis=0)
+        inert = tuple(bool(i and not seen[k]) for k, i in enumerate(inert))
     return NumericProblem(problem=problem, mechanism=mech, speed=speed,
                           states=InputState.crank(angles, speed), regressors=reg, links=links,
                           x0=x0, rows=rows, factor=factor, force_balance=None, inert=inert,

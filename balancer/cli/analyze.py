@@ -52,6 +52,10 @@ def _along_motions(args: argparse.Namespace, design: Design, csv_path: str | Non
     # (the loads along motions' report: loaded when a spec has motions)
     from ..report import motion_csv, motions_json, motions_text
 
+    if design.operation is not None and design.operation.speed_fluctuation is not None:
+        raise SpecError("sizes a flywheel on a crank: a linkage with several inputs, or a "
+                        "motion, has none", key="operation.speed_fluctuation",
+                        value=design.operation.speed_fluctuation)
     if csv_path is not None and args.motion is None and len(design.motions) > 1:
         raise SpecError("writes one motion's values: name it with --motion "
                         f"({', '.join(m.name for m in design.motions)})", key="--csv",

@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
             continue
         same = named.get(os.path.realpath(path))
         if same is not None:
-            raise OutputError(f"names the same file as {same}", key=option, value=path)
+            raise OutputError(f"names the same file as {same}", key=option, value=str(path))
         named[os.path.realpath(path)] = option
     for option, path in (("--cycle", cycle), ("--orders", orders), ("--phasors", phasor)):
         if path is not None:

@@ -231,8 +231,10 @@ def flywheel_text(f: Flywheel) -> str:
     """The least flywheel for the spec's speed fluctuation, and the figures it comes from."""
     low, mean, high = f.mechanism_inertia
     if f.inertia > 0:
+        alone = ("stops within its cycle at this mean speed" if math.isinf(f.fluctuation_without)
+                 else f"{f.fluctuation_without:.4g}")
         verdict = (f"least flywheel on the crank for a speed fluctuation of {f.fluctuation:g}: "
-                   f"{f.inertia:.6g} kg·m² (the mechanism alone: {f.fluctuation_without:.4g})")
+                   f"{f.inertia:.6g} kg·m² (the mechanism alone: {alone})")
     else:
         verdict = (f"no flywheel needed for a speed fluctuation of {f.fluctuation:g}: the "
                    f"mechanism alone keeps {f.fluctuation_without:.4g}")

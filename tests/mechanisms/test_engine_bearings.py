@@ -149,3 +149,21 @@ def test_a_model_refuses_main_bearings_out_of_order():
     engine = load_design(EXAMPLES / "v8.toml").mechanism
     with pytest.raises(SpecError, match="increasing"):
         replace(engine, main_bearings=(0.1, -0.1))
+
+
+@pytest.mark.parametrize(("old", "new", "key"), [
+    ("z = -0.1365", "z = -1e300", "mechanism.cylinders[1].z"),
+    ("main_bearings = [-0.182, -0.091, 0.0, 0.091, 0.182]",
+     "main_bearings = [-1e300, -0.091, 0.0, 0.091, 0.182]", "mechanism.main_bearings[1]"),
+    ("crank = 0.043 ", "crank = 1e-9 ", "crank")])
+def test_planes_and_cranks_beyond_what_can_be_computed_are_refused(tmp_path, capsys, old, new,
+                                                                   key):
+    """The fuzz campaign's: a plane of 1e300 m printed inf in the text (exit 0) and a crank of
+    a nanometre named the linkage's hidden points; now each is refused naming its key."""
+    text = (EXAMPLES / "inline_four.toml").read_text()
+    assert old in text
+    spec = tmp_path / "bad.toml"
+    spec.write_text(text.replace(old, new, 1))
+    assert main(["analyze", str(spec)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and key in err[0], err

@@ -69,6 +69,10 @@ class Cylinder:
         v.store(self, "rod", v.length(self.rod, "rod"))
         if self.bore is not None:
             v.store(self, "bore", v.positive(self.bore, "bore"))
+        if self.crank < SHORTEST_CRANK * self.rod:  # (the crank's marker would meet its axis)
+            raise SpecError(f"must be at least {SHORTEST_CRANK:g} of the rod "
+                            f"({SHORTEST_CRANK * self.rod:.3g} m)", key="crank",
+                            value=self.crank)
         if not self.rod > self.crank + abs(self.offset):
             raise AssemblyError(
                 f"the crank cannot turn: the rod ({self.rod:.6g} m) must be longer than the "
@@ -100,6 +104,9 @@ class Cylinder:
         """The crank angle θ1 in [0, 2π) where its crank pin points along its axis, rad."""
         return (self.bank - self.phase) % (2 * math.pi)
 
+
+#: The shortest crank, a share of its rod: below, the crank's points meet within rounding.
+SHORTEST_CRANK = 1e-6
 
 #: The label of a counterweight that balancing may replace.
 COUNTERWEIGHT = "counterweight"
@@ -565,14 +572,20 @@ class Engine(MechanismModel):
 
     @property
     def sizes(self) -> dict[str, float]:
-        """Each cylinder's crank, rod and offset, and each shaft's distance from the axis, m."""
+        """The geometry's sizes by spec key, m.
+
+        Each cylinder's crank, rod, offset and plane, each shaft's distance from the axis and
+        each main bearing's plane (a plane's distance from the origin).
+        """
         out: dict[str, float] = {}
         for i, c in enumerate(self.cylinders):
             key = v.item("mechanism.cylinders", i)
             out.update({f"{key}.crank": c.crank, f"{key}.rod": c.rod,
-                        f"{key}.offset": abs(c.offset)})
+                        f"{key}.offset": abs(c.offset), f"{key}.z": abs(c.z)})
         for j, s in enumerate(self.balance_shafts):
             out[f"{v.item('balance_shafts', j)}.at"] = math.hypot(*s.at)
+        for j, z in enumerate(self.main_bearings):
+            out[v.item("mechanism.main_bearings", j)] = abs(z)
         return out
 
     @property
