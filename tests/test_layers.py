@@ -37,8 +37,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
      "formulations.compiled", "formulations.crank_angle", "formulations.multibody"),
     # The registry of mechanisms and of formulations, and what runs over any mechanism.
     ("mechanisms", "formulations", "force_balance", "columns", "cycle", "motion_analysis",
-     "speed_fluctuation", "phasors", "arrangements"),
-    ("balance", "planning"),
+     "speed_fluctuation", "phasors"),
+    ("balance", "planning", "arrangements"),
     ("simulation", "verification", "motion_verification", "report", "plots", "plausibility",
      "parts"),
     ("spec", "examples", "api", "sweeps", "cli", "__main__"),

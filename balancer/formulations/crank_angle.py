@@ -44,6 +44,7 @@ from ..linkage.loads import Reactions
 from ..linkage.numeric import TABLE_STEPS
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import Num, V
+from ..mechanisms import geometry
 from ..mechanisms.base import Mechanism
 from ..mechanisms.formulation import DEAD_POINT_THRESHOLD, DrivenRates, Evaluation
 from .compiled import Compiled, LinkageFormulation, link_equations
@@ -187,7 +188,7 @@ class CrankAngle(LinkageFormulation):
         self.theta1_start = float(theta1)
         if self.driven:
             omega1 = self._motor_speed
-        continued = self.mech.continued_angles(theta1)
+        continued = geometry.continued_angles(self.mech, theta1)
         with np.errstate(all="ignore"):
             principal = self.mech.motion(theta1).pose.angles
         raw = np.array([float(np.ravel(x)[0]) for x in principal])

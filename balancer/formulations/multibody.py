@@ -46,6 +46,7 @@ from ..linkage.kinematics import Motion
 from ..linkage.loads import Reactions
 from ..linkage.symbols import CasadiOps
 from ..linkage.vectors import Num, OpsLike, V, _is_zero
+from ..mechanisms import geometry
 from ..mechanisms.base import Mechanism
 from ..mechanisms.formulation import Evaluation, continuous_angles, least_norm, least_norm_many
 from .compiled import Compiled, LinkageFormulation, link_equations, spring_forces
@@ -297,7 +298,7 @@ class Multibody(LinkageFormulation):
         if not np.all(np.isfinite(q)):
             raise AssemblyError("the linkage cannot be assembled at the initial crank angle",
                                 key="simulation.theta1", value=theta1)
-        q[2::3] = self.mech.continued_angles(theta1)
+        q[2::3] = geometry.continued_angles(self.mech, theta1)
         y = np.concatenate([q, qd])
         return np.append(y, 0.0) if self.driven else y
 

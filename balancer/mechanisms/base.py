@@ -417,38 +417,6 @@ class Mechanism:
         """The links' frames at crank angles (:attr:`Motion.pose` without the rates)."""
         return kinematics.positions(self.structure, InputState.crank(theta1))
 
-    def continued_angles(self, theta1: float) -> NDArray[np.float64]:
-        """The links' angles at crank angle ``theta1``, continuous from the reference pose.
-
-        DESIGN.md: each link's angle is its principal value at the reference pose and
-        continuous from there on; the crank is followed from the reference's angle to
-        ``theta1`` in steps of at most 0.05 rad, each link's angle unwrapped along the way (the
-        input's is ``theta1`` as given). A crank that turns fully is followed over the part of
-        a turn only, and each whole turn adds what one revolution adds to each link's angle.
-        """
-        s = self.structure
-        start = s.ref_angle[s.input]
-        turn = 2 * math.pi
-        turns = math.floor((theta1 - start) / turn) if self.assembly_range().full else 0
-        out = self._followed(start, theta1 - turns * turn)
-        if turns:
-            out = out + turns * (self._followed(start, start + turn) - np.array(s.ref_angle))
-        out[s.input] = theta1
-        return out
-
-    def _followed(self, start: float, end: float) -> NDArray[np.float64]:
-        """The links' angles followed from the reference pose (at crank angle ``start``)."""
-        s = self.structure
-        steps = max(2, int(math.ceil(abs(end - start) / 0.05)) + 1)
-        with np.errstate(all="ignore"):
-            mo = self.motion(np.linspace(start, end, steps))
-        out = np.empty(self.structure.size)
-        for k in range(self.structure.size):
-            path = np.concatenate([[s.ref_angle[k]], np.broadcast_to(
-                np.asarray(mo.pose.angles[k], dtype=float), (steps,))])
-            out[k] = np.unwrap(path)[-1] if np.all(np.isfinite(path)) else path[-1]
-        return out
-
     def limits(self, theta1: NDArray[np.float64]) -> list[Limit]:
         """Samples at singular poses that the smooth motion passes (none in general)."""
         return []

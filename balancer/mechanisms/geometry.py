@@ -3,10 +3,13 @@
 Functions of any :class:`~balancer.mechanisms.base.Mechanism`, none of which a mechanism
 overrides (so they are not members of its interface): every point's position and each ground
 guide's line (what pictures draw), each link's centre of mass and first moment and the total
-centre of mass (what force balance and the centre of mass's excursion measure).
+centre of mass (what force balance and the centre of mass's excursion measure); the links' angles
+continued from the reference pose (where a simulation starts).
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numpy.typing import NDArray
@@ -66,5 +69,38 @@ def guides(mech: Mechanism, mo: Motion
     return out
 
 
-__all__ = ["centres_of_mass", "drawing", "first_moments", "guides", "points",
+def continued_angles(mech: Mechanism, theta1: float) -> NDArray[np.float64]:
+    """The links' angles at crank angle ``theta1``, continuous from the reference pose.
+
+    DESIGN.md: each link's angle is its principal value at the reference pose and
+    continuous from there on; the crank is followed from the reference's angle to
+    ``theta1`` in steps of at most 0.05 rad, each link's angle unwrapped along the way (the
+    input's is ``theta1`` as given). A crank that turns fully is followed over the part of
+    a turn only, and each whole turn adds what one revolution adds to each link's angle.
+    """
+    s = mech.structure
+    start = s.ref_angle[s.input]
+    turn = 2 * math.pi
+    turns = math.floor((theta1 - start) / turn) if mech.assembly_range().full else 0
+    out = _followed(mech, start, theta1 - turns * turn)
+    if turns:
+        out = out + turns * (_followed(mech, start, start + turn) - np.array(s.ref_angle))
+    out[s.input] = theta1
+    return out
+
+def _followed(mech: Mechanism, start: float, end: float) -> NDArray[np.float64]:
+    """The links' angles followed from the reference pose (at crank angle ``start``)."""
+    s = mech.structure
+    steps = max(2, int(math.ceil(abs(end - start) / 0.05)) + 1)
+    with np.errstate(all="ignore"):
+        mo = mech.motion(np.linspace(start, end, steps))
+    out = np.empty(mech.structure.size)
+    for k in range(mech.structure.size):
+        path = np.concatenate([[s.ref_angle[k]], np.broadcast_to(
+            np.asarray(mo.pose.angles[k], dtype=float), (steps,))])
+        out[k] = np.unwrap(path)[-1] if np.all(np.isfinite(path)) else path[-1]
+    return out
+
+
+__all__ = ["centres_of_mass", "continued_angles", "drawing", "first_moments", "guides", "points",
            "total_centre_of_mass"]
