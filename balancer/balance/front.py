@@ -27,7 +27,7 @@ AGAINST: dict[str, tuple[str, str]] = {
 FIGURES: dict[str, tuple[str, str]] = {
     "rms": ("weighted RMS shaking √J", "N·m"),
     **{key: (f"RMS {words_of(key)}", unit_of(key))
-       for key in ("rocking_couple", "shaking_force", "shaking_moment")}}
+       for key in ("rocking_couple", "shaking_force", "shaking_moment", "main_bearing_load")}}
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,7 @@ from .sites import Sites
 #: hundred times Clarabel's tolerance, so that the constrained program stays feasible.
 END_ROOM = 1e-8
 #: The quantities ``J'`` may weigh alone, whose RMS the front then shows in its own unit.
-SINGLE = ("rocking_couple", "shaking_force", "shaking_moment")
+SINGLE = ("rocking_couple", "shaking_force", "shaking_moment", "main_bearing_load")
 
 
 class _RotorFront:
@@ -87,10 +87,17 @@ class _RotorFront:
         return self.sites.into_bounds(self.solver.layout.x(u[: self.n]))
 
     def figures(self, x: NDArray[np.float64]) -> dict[str, float]:
-        """The RMS of the shaking force, rocking couple and shaking moment at ``x`` (N, N·m)."""
+        """The RMS of each load at ``x``, N or N·m.
+
+        The shaking force, rocking couple and shaking moment; the main-bearing loads too (over
+        the bearings) where the problem has them.
+        """
         reg = self.data.regressors
-        return {name: float(np.sqrt(np.mean(np.abs(getattr(reg, name) @ x) ** 2)))
-                for name in ("shaking_force", "rocking_couple", "shaking_moment")}
+        out = {name: float(np.sqrt(np.mean(np.abs(getattr(reg, name) @ x) ** 2)))
+               for name in ("shaking_force", "rocking_couple", "shaking_moment")}
+        if reg.supports is not None:
+            out["main_bearing_load"] = float(np.sqrt(np.mean(np.abs(reg.supports @ x) ** 2)))
+        return out
 
     def rescale(self, scale: float) -> None:
         """Measure the cap in units of ``scale`` (its unit).

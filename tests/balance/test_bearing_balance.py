@@ -228,3 +228,32 @@ def test_a_bound_without_the_bearing_term_sees_the_rods_inertia(design):
     rows = data.regressors.supports
     assert float(np.max(np.abs(rows @ data.x0))) == pytest.approx(
         max(float(np.max(np.abs(s.force))) for s in result.before.supports), rel=1e-12)
+
+
+@pytest.mark.slow
+def test_the_front_of_the_bearing_load_against_added_mass(design):
+    """With main_bearing_load weighed alone, pareto --against added-mass is the front of the
+    RMS main-bearing load (N) against the counterweights' mass: from the least mass that keeps
+    the bound; each point's RMS is the built engine's bearing loads' (chain momentum), above
+    its certified bound, and falls as the mass grows."""
+    from balancer.balance.pareto import pareto_front
+
+    weights = replace(design.balance.objective, unbalance=0.0, shaking_force=0.0)
+    alone = replace(design, balance=replace(design.balance, objective=weights))
+    front = pareto_front(alone, "added-mass", 4)
+    assert front.minimised == "main_bearing_load"
+    data = numeric_problem(alone)
+    speed = design.operation.speed
+    radius = design.balance.counterweights.radius
+    for p in front.points:
+        built = data.sites.model_of(design.mechanism, p.x)
+        loads = mechanism_of(built).support_loads(data.states.positions[0], speed, 0.0,
+                                                  loads=False)
+        rms = math.sqrt(float(np.mean(np.concatenate([np.abs(s.force) ** 2 for s in loads]))))
+        assert p.least == pytest.approx(rms, rel=1e-9)
+        assert p.figures["main_bearing_load"] == pytest.approx(rms, rel=1e-9)
+        assert p.lower_bound <= p.least * (1 + 1e-9)
+        mass = sum(abs(data.sites.vector(p.x, i)) for i in data.sites.chosen) / radius
+        assert p.value == pytest.approx(mass, rel=1e-9)
+    least = [p.least for p in front.points]
+    assert all(a >= b * (1 - 1e-7) for a, b in zip(least, least[1:], strict=False))
