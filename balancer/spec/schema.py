@@ -29,6 +29,7 @@ from .entries import (  # (the mechanism types are the schema's names too)
     Key,
     Section,
 )
+from .schema_engines import ENGINE_BALANCE, ENGINE_BALANCE_SECTIONS
 from .schema_motions import MOTION_SECTIONS, PLAN_SECTIONS
 
 _CLOSED = (FOUR_BAR, SLIDER_CRANK)
@@ -612,45 +613,6 @@ def _for_linkages(section: Section) -> Section:
 SECTIONS = tuple(_for_linkages(s) if s.pattern.split(".")[0] in ("balance", "original") else s
                  for s in SECTIONS)
 
-#: An engine's ``[balance]`` (DESIGN.md, "Balancing an engine"): the objective's weights, the
-#: crankshaft's planes for counterweights, the new shafts.
-_ENGINE_BALANCE: dict[str, tuple[Key, ...]] = {
-    "balance": (
-        Key("objective", "table", "the defaults below",
-            "The weights of the objective (the table below).", (ENGINE,),
-            example="{ rocking_couple = 1.0 }"),
-        Key("counterweights", "table", "none",
-            "Where counterweights may go on the crankshaft (`[balance.counterweights]`, "
-            "below).", (ENGINE,)),
-        Key("shafts", "table", "none",
-            "New balance shafts, sized by the optimiser (`[[balance.shafts]]`, below); those "
-            "of `[[balance_shafts]]` stay as given.", (ENGINE,)),
-        Key("max_bearing_load", "N", "none",
-            "An engine's: the largest load any main bearing may carry over the cycle "
-            "(inertial: at the operating speed, without gas or weights), a bound the balancing "
-            "keeps (needs `[mechanism] main_bearings`); positive.", (ENGINE,),
-            example="6000.0"),
-    ),
-    "balance.objective": (
-        Key("rocking_couple", "—", "1",
-            "An engine's: w_R, of the rocking couple's mean-square magnitude.", (ENGINE,),
-            example="1.0"),
-        Key("shaking_force", "m²", "0",
-            "An engine's: w_F, of the shaking force's mean-square magnitude ((N·m)²/N²).",
-            (ENGINE,), example="0.04"),
-        Key("shaking_moment", "—", "0",
-            "An engine's: w_M, of the mean-square shaking moment about z.", (ENGINE,),
-            example="0.0"),
-        Key("unbalance", "m²", "0",
-            "An engine's: w_U, of Σ (mr·ω²)² over the chosen counterweights and eccentrics (ω "
-            "the crank's speed): the load they put on their bearings.", (ENGINE,),
-            example="0.0004"),
-        Key("main_bearing_load", "m²", "0",
-            "An engine's: w_B, of its main-bearing loads' mean-square magnitude over its "
-            "bearings and the cycle (inertial; needs `[mechanism] main_bearings`).", (ENGINE,),
-            example="0.01"),
-    ),
-}
 #: An engine's ``[original]`` (as ``optimize --out`` writes it): the links and balance shafts
 #: of the engine before its balancing, which chose its counterweights and shafts.
 _ENGINE_ORIGINAL: dict[str, tuple[Key, ...]] = {
@@ -678,8 +640,8 @@ _ENGINE_ORIGINAL: dict[str, tuple[Key, ...]] = {
     "original.<link>.com": tuple(replace(k, mechanisms=(ENGINE,)) for k in _COM),
 }
 SECTIONS = tuple(
-    replace(s, keys=s.keys + _ENGINE_BALANCE[s.pattern], mechanisms=(*s.mechanisms, ENGINE))
-    if s.pattern in _ENGINE_BALANCE else s for s in SECTIONS)
+    replace(s, keys=s.keys + ENGINE_BALANCE[s.pattern], mechanisms=(*s.mechanisms, ENGINE))
+    if s.pattern in ENGINE_BALANCE else s for s in SECTIONS)
 SECTIONS = tuple(
     replace(s, keys=s.keys + _ENGINE_ORIGINAL[s.pattern],
             mechanisms=tuple(dict.fromkeys((*s.mechanisms, ENGINE))))
@@ -691,59 +653,7 @@ SECTIONS = tuple(
             next(s for s in SECTIONS if s.pattern == "balance_shafts[]").keys, (ENGINE,)),
     Section("original.balance_shafts[].eccentrics[]", "A mass·radius on an original balance "
             "shaft.", _ECCENTRIC, (ENGINE,)),
-) + (
-    Section("balance.counterweights", "An engine's counterweights on the crankshaft: the "
-            "optimiser chooses each one's mass·radius (within `max_mr`) and angle (any); they "
-            "replace the counterweights labelled `\"counterweight\"` in these planes.", (
-                Key("planes", "m", "each cylinder's plane",
-                    "The z of each plane, each once.", (ENGINE,),
-                    example="[-0.088, 0.0, 0.088]"),
-                Key("max_mr", "kg·m", "required",
-                    "The largest mass·radius in each plane: one number, or one per plane; "
-                    "positive.", (ENGINE,), example="0.035"),
-                Key("radius", "m", "none",
-                    "The counterweights' radius: the report then gives each one's mass; "
-                    "positive.", (ENGINE,), example="0.05"),
-                Key("part", "table", "none",
-                    "The crank-web sector that makes each plane's counterweight (below): "
-                    "`optimize` sizes it, and its room caps `max_mr` at what it holds.",
-                    (ENGINE,), example='{ shape = "sector", inner_radius = 0.02, '
-                    'outer_radius = 0.075, angle_deg = 160.0, thickness = 0.018 }'),
-            ), (ENGINE,)),
-    Section("balance.counterweights.part", "The crank-web sector of each plane's "
-            "counterweight, about the crank's axis, centred on its plane: its angle solved "
-            "for the plane's mass·radius at the full outer radius and thickness (docs: From "
-            "optimum to part). Lengths in m.", (
-                Key("shape", "—", "required", '`"sector"` (the one shape of a crank web).',
-                    (ENGINE,), example='"sector"'),
-                Key("material", "—", '"steel"',
-                    "steel (7850 kg/m³), brass (8500), tungsten-alloy (17000) or lead "
-                    "(11340); any name with `density`.", (ENGINE,), example='"steel"'),
-                Key("density", "kg/m³", "the material's", "The material's density; positive.",
-                    (ENGINE,), example="7850.0"),
-                Key("inner_radius", "m", "0", "The hub's radius about the crank's axis; at "
-                    "least 0.", (ENGINE,), example="0.02"),
-                Key("outer_radius", "m", "required", "The web's outer radius; more than "
-                    "`inner_radius`.", (ENGINE,), example="0.075"),
-                Key("angle_deg", "°", "required", "The largest full angle, in (0, 360].",
-                    (ENGINE,), example="160.0"),
-                Key("thickness", "m", "required", "The web's thickness along the crank's "
-                    "axis; positive.", (ENGINE,), example="0.018"),
-            ), (ENGINE,)),
-    Section("balance.shafts[]", "A new balance shaft, geared to the crank, with an eccentric "
-            "in each of its planes sized by the optimiser.", (
-                Key("ratio", "—", "required",
-                    "Its speed over the crank's, a non-zero whole number; negative turns the "
-                    "other way.", (ENGINE,), example="-1"),
-                Key("at", "m", "[0, 0]", "Its axis in the x–y plane `[x, y]`.", (ENGINE,),
-                    example="[-0.06, 0.09]"),
-                Key("planes", "m", "required", "The z of each eccentric, each once.",
-                    (ENGINE,), example="[0.11, -0.11]"),
-                Key("max_mr", "kg·m", "required",
-                    "The largest mass·radius of each eccentric: one number, or one per plane; "
-                    "positive.", (ENGINE,), example="0.006"),
-            ), (ENGINE,)),
-)
+) + ENGINE_BALANCE_SECTIONS
 
 _BY_PATTERN = {s.pattern: s for s in SECTIONS}
 _INDEX = re.compile(r"\[\d+\]$")
