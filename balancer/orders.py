@@ -22,7 +22,6 @@ samples is given.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from fractions import Fraction
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -96,14 +95,14 @@ def order_name(order: float) -> str:
 
 
 def order_bins(samples: int, revolutions: int = 1,
-               highest: int = HIGHEST_ORDER) -> list[tuple[Fraction, int]]:
+               highest: int = HIGHEST_ORDER) -> list[tuple[float, int]]:
     """The table's orders and their DFT bins: ``(q, j)`` with ``q = j/revolutions``.
 
     Every ``j`` from 0 to ``highest·revolutions``, none above ``samples/2`` (``samples`` the
     cycle's number of samples, over all its revolutions).
     """
     top = min(highest * revolutions, samples // 2)
-    return [(Fraction(j, revolutions), j) for j in range(top + 1)]
+    return [(j / revolutions, j) for j in range(top + 1)]  # (exact: halves at most)
 
 
 def scalar_amplitudes(values: ArrayLike, bins: list[int]) -> NDArray[np.float64]:
