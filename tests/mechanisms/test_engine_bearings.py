@@ -167,3 +167,16 @@ def test_planes_and_cranks_beyond_what_can_be_computed_are_refused(tmp_path, cap
     assert main(["analyze", str(spec)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and key in err[0], err
+
+
+def test_a_cylinders_own_offset_that_stops_the_crank_is_named(tmp_path, capsys):
+    """The fuzz campaign's: a cylinder's own offset too large for the common rod was named
+    mechanism.lengths.rod; it is the cylinder's offset that stops its crank."""
+    text = (EXAMPLES / "inline_four.toml").read_text()
+    first = text.index("[[mechanism.cylinders]]")
+    end = text.index("\n", text.index("bank_deg", first))
+    spec = tmp_path / "offset.toml"
+    spec.write_text(text[:end] + "\noffset = 0.12" + text[end:])
+    assert main(["analyze", str(spec)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "mechanism.cylinders[1].offset" in err[0] and "(got 0.12)" in err[0]

@@ -70,6 +70,10 @@ def _cylinders(mech: Table) -> tuple[Cylinder, ...]:
                                 bank_deg=sub.value("bank_deg", 0.0), **fields)
         except SpecError as exc:  # named where the value was given: here, or for every cylinder
             name = (exc.key or "").split(".")[-1]
+            mine = [k for k in ("offset", "crank") if k in own]
+            if name == "rod" and "rod" not in own and mine:  # (this cylinder's own length)
+                raise SpecError(exc.detail, key=sub.key(mine[0]),
+                                value=own[mine[0]]) from None
             raise exc.under(lengths.path if name in common and name not in own
                             else sub.path) from None
         out.append(cylinder)
