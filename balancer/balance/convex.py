@@ -249,8 +249,8 @@ class ConvexSolver(Repairs, Diagnosis):
         #: Whether the tie-break has a choice: its equations leave some design free (otherwise
         #: the optimum is unique, and the SOCP's is it).
         count = sum(e.shape[0] for e, _ in fixed)  # (fewer rows than variables: free)
-        self._tie_free = count < n or np.linalg.matrix_rank(
-            np.vstack([e for e, _ in fixed])) < n
+        self._tie_free = count < n or (bool(fixed) and np.linalg.matrix_rank(
+            np.vstack([e for e, _ in fixed])) < n)
         self._stage2 = ConicProgram(
             n, self._cones, objective="nearest",
             equality=(np.vstack([e for e, _ in fixed]), np.concatenate([r for _, r in fixed]))
