@@ -233,7 +233,7 @@ class CycleAnalysis:
         An engine's main bearings where its spec places them
         (:meth:`~balancer.mechanisms.base.Mechanism.support_loads`); none in general.
         """
-        return self.mechanism.support_loads(self.theta1, self.speed, 0.0, loads=self.loads,
+        return self.mechanism.support_loads(self.motion, self.reactions, loads=self.loads,
                                             gravity=self.gravity)
 
     def support_orders(self, support: SupportLoad) -> list[tuple[float, Whirl]]:

@@ -38,6 +38,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -162,11 +163,21 @@ class CrankEnergy:
         """``Q̄``, N·m."""
         return float(np.mean(self.load))
 
+    @cached_property
+    def _fine(self) -> dict[tuple[str, int], NDArray[np.float64]]:
+        """:meth:`work` and :meth:`inertia_on` by grid, each computed once.
+
+        The root finders ask for them at every step.
+        """
+        return {}
+
     def work(self, refine: int = 1) -> NDArray[np.float64]:
-        """``W(θ) = ∫₀^θ (Q − Q̄) dθ`` on the grid ``refine`` times finer, J.
+        """``W(θ) = ∫₀^θ (Q − Q̄) dθ`` on the grid ``refine`` times finer, J (read only).
 
         The integral of ``Q``'s trigonometric interpolant (its mean term left out).
         """
+        if ("work", refine) in self._fine:
+            return self._fine[("work", refine)]
         n = self.load.size
         coefficients = np.fft.rfft(self.load - self.mean_load)
         k = np.arange(coefficients.size) * (2 * math.pi / self.cycle)
@@ -175,11 +186,15 @@ class CrankEnergy:
         if n % 2 == 0:  # the Nyquist term of a real sequence integrates to a sine: none
             integral[-1] = 0.0
         values = _interpolated(integral, n, refine)
-        return values - values[0]
+        out = self._fine[("work", refine)] = values - values[0]
+        return out
 
     def inertia_on(self, refine: int = 1) -> NDArray[np.float64]:
-        """``J(θ)`` on the grid ``refine`` times finer, kg·m²."""
-        return _interpolated(np.fft.rfft(self.inertia), self.inertia.size, refine)
+        """``J(θ)`` on the grid ``refine`` times finer, kg·m² (read only)."""
+        if ("inertia", refine) not in self._fine:
+            self._fine[("inertia", refine)] = _interpolated(np.fft.rfft(self.inertia),
+                                                            self.inertia.size, refine)
+        return self._fine[("inertia", refine)]
 
 
 def _interpolated(coefficients: NDArray[np.complex128], n: int, refine: int

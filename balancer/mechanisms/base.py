@@ -33,7 +33,7 @@ from ..linkage.constraints import Pose
 from ..linkage.dynamics import Forces, Layout
 from ..linkage.inputs import InputState
 from ..linkage.kinematics import Motion
-from ..linkage.loads import SupportLoad
+from ..linkage.loads import Reactions, SupportLoad
 from ..linkage.rotors import Rotor, ground_couple
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
@@ -673,13 +673,14 @@ class Mechanism:
         return dynamics.shaking_regressors(self.structure, mo, gravity,
                                            torque_at_rest=torque_at_rest)
 
-    def support_loads(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike = 0.0, *,
-                      loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)
-                      ) -> tuple[SupportLoad, ...]:
-        """The loads at supports that share a ground point's reaction, at crank states.
+    def support_loads(self, mo: Motion, reactions: Reactions, *, loads: bool = True,
+                      gravity: tuple[float, float] = (0.0, 0.0)) -> tuple[SupportLoad, ...]:
+        """The loads at supports that share a ground point's reaction, at a motion's states.
 
-        None in general; an engine's main bearings where its spec places them (each carries
-        its share of the crankshaft's loads by the lever rule).
+        From the motion ``mo`` and the frame loads ``reactions`` computed there (with the
+        applied ``loads`` and ``gravity`` they were computed with). None in general; an
+        engine's main bearings where its spec places them (each carries its share of the
+        crankshaft's loads by the lever rule).
         """
         return ()
 

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from ..orders import order_name
 from ..phasors import Phasors
-from ..rounding import speed_text
+from ..rounding import Scales, speed_text
 from .style import COLOURS, number
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
@@ -23,8 +23,6 @@ if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions t
 
 #: The forward chain's colour, the backward's (colour-blind safe, Okabe & Ito).
 FORWARD, BACKWARD = "#0072B2", "#D55E00"
-#: A sum below this share of its chain's reach is rounding: the chain closes (none drawn).
-ROUNDING = 1e-9
 
 
 def plot_phasors(phasors: Phasors, order: int, load: str, ax: Axes) -> Axes:
@@ -46,7 +44,8 @@ def plot_phasors(phasors: Phasors, order: int, load: str, ax: Axes) -> Axes:
             reach = max(reach, abs(tip))
         total = (phasors.total_force(order) if load == "force"
                  else phasors.total_couple(order))[k]
-        size = abs(total) if abs(total) > ROUNDING * reach else 0.0  # (a closed chain: none)
+        # a sum at rounding of its chain's reach: the chain closes (none drawn, 0 printed)
+        size = 0.0 if Scales([(unit, reach)]).rounding(abs(total), unit) else abs(total)
         if size:
             ax.annotate("", xy=(total.real, total.imag), xytext=(0.0, 0.0),
                         arrowprops={"arrowstyle": "-|>", "color": COLOURS["sum"], "lw": 2.4})

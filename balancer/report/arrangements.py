@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..arrangements import Search
+from ..arrangements import Arrangement, Search
 from ..model import Design
-from ..rounding import speed_text
+from ..rounding import Scales, speed_text
 from .text import table
 
 
@@ -14,18 +14,18 @@ def search_text(found: Search, design: Design, spec: str | None = None) -> str:
     """The readable ``search`` report: one row per crank and firing order, best first."""
     head = f"balancer search — {spec}" if spec else "balancer search"
     rows = []
-    zero = 1e-9 * found.scale
+    # (a figure at rounding of its unit's scale prints as 0: the free loads of a balanced
+    # crank, beside a cylinder's own force m·r·ω²)
+    sc = Scales([("N", found.scale), *((unit, value) for a in found.arrangements
+                                       for unit, value in _figures(a))])
 
-    def fmt(value: float) -> str:
-        return "0" if value <= zero else f"{value:.6g}"
+    def fmt(value: float, unit: str) -> str:
+        return sc.number(value, unit)
 
     for a in found.arrangements:
         rows.append([str(a.rank), " ".join(f"{p:g}" for p in a.phases),
                      "-".join(str(k) for k in a.firing_order),
-                     fmt(a.free["force_1_backward"]), fmt(a.free["couple_1_backward"]),
-                     fmt(a.free["force_2"]), fmt(a.free["couple_2"]),
-                     fmt(a.counterweights["force_1_forward"]),
-                     fmt(a.counterweights["couple_1_forward"]), str(a.same_half),
+                     *(fmt(value, unit) for unit, value in _figures(a)), str(a.same_half),
                      *([] if a.balanced is None else [f"{a.balanced.objective:.6g}",
                                                       str(a.balanced.status)])])
     balanced = bool(found.arrangements) and found.arrangements[0].balanced is not None
@@ -45,6 +45,14 @@ def search_text(found: Search, design: Design, spec: str | None = None) -> str:
         + ("; balanced J: the objective of [balance] left by the certified counterweights and "
            "shafts of each ((N·m)²)" if balanced else ""),
     ])
+
+
+def _figures(a: Arrangement) -> list[tuple[str, float]]:
+    """An arrangement's figures in the table's order, each with its unit."""
+    return [("N", a.free["force_1_backward"]), ("N·m", a.free["couple_1_backward"]),
+            ("N", a.free["force_2"]), ("N·m", a.free["couple_2"]),
+            ("N", a.counterweights["force_1_forward"]),
+            ("N·m", a.counterweights["couple_1_forward"])]
 
 
 def search_json(found: Search, spec: str | None = None) -> dict[str, Any]:

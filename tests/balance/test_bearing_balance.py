@@ -24,7 +24,6 @@ from balancer.balance.problem import numeric_problem
 from balancer.balance.result import InfeasibleError
 from balancer.cli import main
 from balancer.cycle import cycle_analysis
-from balancer.mechanisms import mechanism_of
 from balancer.mechanisms.engine.bearings import lever_shares
 from balancer.model.balance import ShaftFreedom
 from balancer.spec import dumps_design, load_design, loads_design
@@ -47,8 +46,8 @@ def bearing_map(design, theta):
     base = replace(engine, crankshaft=replace(engine.crankshaft, masses=tuple(
         m for m in engine.crankshaft.masses
         if not (m.label == "counterweight" and m.z in planes))))
-    b0 = np.array([s.force for s in mechanism_of(base).support_loads(theta, speed, 0.0,
-                                                                      loads=False)])
+    b0 = np.array([s.force for s in cycle_analysis(base, speed, theta1=theta,
+                                                    loads=False).supports])
     cols = np.zeros((len(engine.main_bearings), theta.size, 2 * len(planes)), complex)
     turn = speed**2 * np.exp(1j * theta)
     for i, z in enumerate(planes):
@@ -82,8 +81,8 @@ def test_the_bearing_term_is_the_mean_square_of_the_built_engines_bearing_loads(
         for i in sites.chosen:
             x[sites.entries(i)] = rng.uniform(-0.02, 0.02, 2)
         built = sites.model_of(design.mechanism, x)
-        loads = mechanism_of(built).support_loads(data.states.positions[0], speed, 0.0,
-                                                  loads=False)
+        loads = cycle_analysis(built, speed, theta1=data.states.positions[0],
+                               loads=False).supports
         want = float(np.mean(np.concatenate([np.abs(s.force) ** 2 for s in loads])))
         assert data.objective(x) == pytest.approx(want, rel=1e-9)
         assert data.reduced_objective(x) == pytest.approx(want, rel=1e-9)
@@ -247,8 +246,8 @@ def test_the_front_of_the_bearing_load_against_added_mass(design):
     radius = design.balance.counterweights.radius
     for p in front.points:
         built = data.sites.model_of(design.mechanism, p.x)
-        loads = mechanism_of(built).support_loads(data.states.positions[0], speed, 0.0,
-                                                  loads=False)
+        loads = cycle_analysis(built, speed, theta1=data.states.positions[0],
+                               loads=False).supports
         rms = math.sqrt(float(np.mean(np.concatenate([np.abs(s.force) ** 2 for s in loads]))))
         assert p.least == pytest.approx(rms, rel=1e-9)
         assert p.figures["main_bearing_load"] == pytest.approx(rms, rel=1e-9)

@@ -79,7 +79,7 @@ def test_each_cylinders_share_is_the_lever_rule_on_its_one_cylinder_engines_reac
         single = Rotor(ratio=1.0, inertia=0.0, eccentrics=(m.eccentric,))
         for j, share in lever_shares(planes, m.z):
             want[j] += share * single.loads(theta, speed, 0.0, g).force
-    got = mechanism_of(engine).support_loads(theta, speed, 0.0, gravity=g)
+    got = cycle_analysis(engine, speed, theta1=theta, gravity=g).supports
     scale = max(float(np.max(np.abs(w))) for w in want)
     for s, w in zip(got, want, strict=True):
         assert np.max(np.abs(s.force - w)) <= 1e-11 * scale

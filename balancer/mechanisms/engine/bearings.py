@@ -30,10 +30,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from ...linkage.dynamics import inertial_columns
 from ...linkage.kinematics import Motion
+from ...linkage.loads import Reactions
 from ...linkage.rotors import Rotor
 from ...linkage.vectors import V
 from ..base import Mechanism
@@ -57,20 +58,19 @@ def bearing_name(j: int) -> str:
 
 
 def main_bearing_loads(mech: Mechanism, planes: Sequence[float], ground_point: str,
-                       theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike = 0.0, *,
-                       loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)
+                       mo: Motion, reactions: Reactions, *, loads: bool = True,
+                       gravity: tuple[float, float] = (0.0, 0.0)
                        ) -> dict[str, NDArray[np.complex128]]:
-    """Each main bearing's load on the frame at crank states, complex ``x + i·y``, N.
+    """Each main bearing's load on the frame at a motion's states, complex ``x + i·y``, N.
 
     ``mech`` an engine's mechanism (its crankshaft the link ``crankshaft``, cylinder ``k``'s
-    rod and piston ``rod<k>`` and ``piston<k>`` at its plane); ``ground_point`` the crankshaft's
-    rotors' bearing (``O``). ``loads``: the gas forces included.
+    rod and piston ``rod<k>`` and ``piston<k>`` at its plane); ``mo`` its motion and
+    ``reactions`` its frame loads there (their guides' normal forces: a cycle analysis's own,
+    not computed again); ``ground_point`` the crankshaft's rotors' bearing (``O``). ``loads``:
+    the gas forces included (as in ``reactions``).
     """
-    theta, omega, alpha = np.broadcast_arrays(
-        *(np.atleast_1d(np.asarray(x, dtype=float)) for x in (theta1, omega1, alpha1)))
-    with np.errstate(all="ignore"):
-        mo = mech.motion(theta, omega, alpha)
-        forces = mech.crank_forces(theta, omega, alpha, loads=loads, gravity=gravity)
+    theta, omega, alpha = (np.reshape(np.asarray(x, dtype=float) * np.ones(mo.count),
+                                      mo.count) for x in (mo.theta1, mo.omega1, mo.alpha1))
     g = complex(*gravity)
     linkage, structure = mech.linkage, mech.structure
     out = [np.zeros(theta.size, complex) for _ in planes]
@@ -93,8 +93,7 @@ def main_bearing_loads(mech: Mechanism, planes: Sequence[float], ground_point: s
                        if sliders[name].point in b.points and b.name != name)
             s = sliders[name]
             pin = carried(rod) + carried(name)
-            pin = pin - np.reshape(np.asarray(forces.slider_normal[name], float),
-                                   theta.size) * normals[name]
+            pin = pin - np.asarray(reactions.slider_normal[name], float) * normals[name]
             if loads:
                 u = complex(*s.direction)
                 pin = pin + np.asarray(s.force.at(theta), float) * (u / abs(u))

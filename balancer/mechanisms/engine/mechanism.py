@@ -19,10 +19,10 @@ from dataclasses import replace
 from functools import cached_property
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from ...linkage.kinematics import Motion
-from ...linkage.loads import SupportLoad
+from ...linkage.loads import Reactions, SupportLoad
 from ...linkage.rotors import Rotor, link_inertia
 from ...linkage.structure import Structure
 from ...model import Body, Linkage, Slider
@@ -116,15 +116,14 @@ class EngineMechanism(Mechanism):
                 for j, s in enumerate(self.model.balance_shafts, start=1)]
         return tuple(out)
 
-    def support_loads(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike = 0.0, *,
-                      loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)
-                      ) -> tuple[SupportLoad, ...]:
+    def support_loads(self, mo: Motion, reactions: Reactions, *, loads: bool = True,
+                      gravity: tuple[float, float] = (0.0, 0.0)) -> tuple[SupportLoad, ...]:
         """Each main bearing's load (:mod:`.bearings`), where the spec places them."""
         planes = self.model.main_bearings
         if not planes:
             return ()
-        found = main_bearing_loads(self, planes, MAIN_BEARINGS, theta1, omega1, alpha1,
-                                   loads=loads, gravity=gravity)
+        found = main_bearing_loads(self, planes, MAIN_BEARINGS, mo, reactions, loads=loads,
+                                   gravity=gravity)
         return tuple(SupportLoad(name=name, z=z, force=force)
                      for (name, force), z in zip(found.items(), planes, strict=True))
 
