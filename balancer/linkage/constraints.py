@@ -1,7 +1,8 @@
 """The constraints of a general linkage, the groups they close, and link frames at poses.
 
 The equations are those of :mod:`balancer.linkage.structure` (its docstring): a revolute joint
-(:class:`Pin`), a prismatic pair (:class:`Prism`) and the driver (:class:`Driver`), each
+(:class:`Pin`), a prismatic pair (:class:`Prism`), a gear pair's mesh (:class:`Mesh`) and the
+driver (:class:`Driver`), each
 with its own residual, Jacobian, velocity terms and share of the frame's loads at a
 :class:`Pose` (the core dispatches through these methods, never by a joint's kind), and an
 Assur group (:class:`Group`) of them.
@@ -47,6 +48,8 @@ class FrameTally:
     normal: dict[int, Num] = field(default_factory=dict)
     couple: dict[int, Num] = field(default_factory=dict)
     torques: dict[int, Num] = field(default_factory=dict)
+    #: Each gear pair's tooth force on its driven gear at the pitch point (N), by the pair's name.
+    teeth: dict[str, V] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -105,8 +108,13 @@ class Pin:
         """What each row is multiplied by to be a length, given the linkage's ``length``."""
         return [1.0, 1.0]
 
-    def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
-        """Its force on the frame (``force``: x, y, moment) as the reaction at its point."""
+    def tally(self, frame: FrameTally, force: list[Num] | None, multipliers: list[Num]) -> None:
+        """Its force on the frame (``force``: x, y, moment) as the reaction at its point.
+
+        ``None``: it joins two moving links, and puts nothing on the frame.
+        """
+        if force is None:
+            return
         old = frame.reactions.get(self.point, V(frame.zero, frame.zero))
         frame.reactions[self.point] = V(_plus(old.x, force[0]), _plus(old.y, force[1]))
 
@@ -178,11 +186,126 @@ class Prism:
         """What each row is multiplied by to be a length: the angle's row by ``length``."""
         return [length, 1.0]
 
-    def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
+    def tally(self, frame: FrameTally, force: list[Num] | None, multipliers: list[Num]) -> None:
         """On a ground guide: the slider's normal force (N) and couple (N·m) on it."""
         if self.g == GROUND_INDEX:
             frame.normal[self.s] = multipliers[1]
             frame.couple[self.s] = multipliers[0]
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """A gear pair's mesh: link ``b`` turns at ``ratio`` times link ``a``, each about its pivot.
+
+    The pivots (``pa`` of ``a`` on the ground's ``oa``, ``pb`` of ``b`` on ``ob``) are held by
+    pins of their own; along the unit ``u`` from ``oa`` to ``ob`` (distance ``d``) the pitch
+    circles touch at ``P = oa + ρ_a·u = ob + ρ_b·u``, ``ρ_b = d/(k − 1)`` and ``ρ_a = k·ρ_b``
+    (``k`` the ratio), where the two gears' points have one velocity along the tangent
+    ``t = i·u``. The residual (a length)
+
+    ``ρ_b·sin(k·(θ_a − θ_a⁰) − (θ_b − θ_b⁰)) + t·(r̄_a + R_a·p̄_a − ō_a) − t·(r̄_b + R_b·p̄_b − ō_b)``
+
+    vanishes where the angles keep the ratio from the reference pose and the pivots hold; its
+    Jacobian there is the rolling condition ``t·(v_a(P) − v_b(P)) = 0``, so that its
+    multiplier ``λ`` is the tooth force along ``t`` at ``P``: ``λ·t`` on ``b``, ``−λ·t`` on
+    ``a`` (internal: nothing on the frame but through the pivots).
+    """
+
+    name: str
+    a: int
+    pa: V
+    oa: V
+    b: int
+    pb: V
+    ob: V
+    ratio: float
+    a_ref: float
+    b_ref: float
+
+    rows = 1
+    row_kinds: ClassVar[tuple[str, ...]] = ("length",)
+    letter: ClassVar[str] = "G"
+
+    @property
+    def members(self) -> tuple[int, int]:
+        """The driver's link and the driven one's."""
+        return (self.a, self.b)
+
+    def held_at(self, k: int) -> V | None:
+        """``None``: the mesh holds a link by no point."""
+        return None
+
+    @property
+    def tangent(self) -> V:
+        """``t``, the unit tangent of the pitch circles at the pitch point."""
+        d = self.ob - self.oa
+        size = (d.x * d.x + d.y * d.y) ** 0.5
+        return V(-d.y / size, d.x / size)
+
+    @property
+    def radii(self) -> tuple[float, float]:
+        """The signed pitch radii ``(ρ_a, ρ_b)`` along ``u``, m."""
+        d = self.ob - self.oa
+        rho_b = float((d.x * d.x + d.y * d.y) ** 0.5) / (self.ratio - 1)
+        return self.ratio * rho_b, rho_b
+
+    @property
+    def pitch_point(self) -> V:
+        """``P``, where the pitch circles touch (in the ground's frame), m."""
+        d = self.ob - self.oa
+        return self.oa + d * (self.ratio / (self.ratio - 1))
+
+    def driven_angle(self, theta_a: Num) -> Num:
+        """Link ``b``'s angle with link ``a`` at ``theta_a`` (rad), the ratio kept."""
+        return self.b_ref + self.ratio * (theta_a - self.a_ref)
+
+    def _slip(self, pose: Pose) -> Num:
+        ta = 0.0 if self.a == GROUND_INDEX else pose.angles[self.a]
+        tb = 0.0 if self.b == GROUND_INDEX else pose.angles[self.b]
+        return self.ratio * (ta - self.a_ref) - (tb - self.b_ref)
+
+    def residual(self, pose: Pose, state: InputState | None = None) -> list[Num]:
+        """The pitch circles' slip along ``t`` (m), and the pivots' gaps along it."""
+        t = self.tangent
+        gap = (pose.point(self.a, self.pa) - self.oa) - (pose.point(self.b, self.pb) - self.ob)
+        slip = self._slip(pose)
+        sine = np.sin(slip) if not hasattr(slip, "sin") else slip.sin()  # (CasADi's: its own)
+        return [_plus(self.radii[1] * sine, t.dot(gap))]
+
+    def jacobian(self, pose: Pose) -> Blocks:
+        """:meth:`residual`'s derivative by the links' coordinates."""
+        t = self.tangent
+        slip = self._slip(pose)
+        cosine = np.cos(slip) if not hasattr(slip, "cos") else slip.cos()
+        rho_b = self.radii[1]
+        ra, rb = pose.rotate(self.a, self.pa), pose.rotate(self.b, self.pb)
+        return [(self.a, [[t.x, t.y, rho_b * self.ratio * cosine + ra.cross(t)]]),
+                (self.b, [[-t.x, -t.y, -rho_b * cosine - rb.cross(t)]])]
+
+    def gamma(self, pose: Pose, vel: list[V], rate: list[Num],
+              state: InputState | None = None) -> list[Num]:
+        """``γ`` (``Φ_q·q̈ = γ``): the velocity terms of the residual's second derivative."""
+        t = self.tangent
+        slip = self._slip(pose)
+        sine = np.sin(slip) if not hasattr(slip, "sin") else slip.sin()
+        ra, rb = pose.rotate(self.a, self.pa), pose.rotate(self.b, self.pb)
+        wa, wb = _rate(rate, self.a), _rate(rate, self.b)
+        turn = self.ratio * wa - wb
+        return [self.radii[1] * sine * (turn * turn)
+                + t.dot(ra * (wa * wa) - rb * (wb * wb))]
+
+    def prescribed_rates(self, state: InputState) -> list[Num]:
+        """``Φ_q·q̇`` of its row: zero (it prescribes no motion of its own)."""
+        return [0.0]
+
+    def row_scales(self, length: float) -> list[float]:
+        """Its row, a length."""
+        return [1.0]
+
+    def tally(self, frame: FrameTally, force: list[Num] | None, multipliers: list[Num]) -> None:
+        """The tooth force on the driven gear, ``λ·t`` (N), by the pair's name."""
+        t = self.tangent
+        frame.teeth[self.name] = V(multipliers[0] * t.x, multipliers[0] * t.y)
 
 
 class _InputDriver:
@@ -221,7 +344,7 @@ class _InputDriver:
         """Its row, as it is."""
         return [1.0]
 
-    def tally(self, frame: FrameTally, force: list[Num], multipliers: list[Num]) -> None:
+    def tally(self, frame: FrameTally, force: list[Num] | None, multipliers: list[Num]) -> None:
         """The motor's torque (an actuator's force) on its input: minus its multiplier."""
         frame.torques[self.index] = -multipliers[0]
 
@@ -298,7 +421,7 @@ class SlideDriver(_InputDriver):
         return [spin if state is None else state.accelerations[self.index] + spin]
 
 
-Constraint = Pin | Prism | Driver | SlideDriver
+Constraint = Pin | Prism | Mesh | Driver | SlideDriver
 
 
 @dataclass(frozen=True)
@@ -313,7 +436,8 @@ class Group:
         The constraints that close the group: every row touches a link of the group, the other
         links they touch are found before.
     kind
-        ``"input"`` (a driven link, from its pivot and its driver), ``"RRR"``, ``"RRP"``, ``"PRR"``,
+        ``"input"`` (a driven link, from its pivot and its driver), ``"geared"`` (a link
+        turned by a gear pair, from its pivot and the mesh), ``"RRR"``, ``"RRP"``, ``"PRR"``,
         ``"RPR"`` (dyads in closed form; the letters are the joints from the first link's
         known side to the second's) or ``"numeric"``.
     sign

@@ -27,7 +27,7 @@ per inertial parameter (and one for the constant part) for the regressors.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal, TypeAlias
 
 import numpy as np
@@ -130,6 +130,9 @@ class Forces:
     rocking_couple
         The couple about ``x`` and ``y`` on the frame from links in planes along the crank's
         axis (:func:`rocking_couple`), N·m; zero for a mechanism in one plane.
+    teeth
+        Each gear pair's tooth force on its driven gear at the pitch point, N, by the pair's
+        name (internal to the machine: it reaches the frame through the gears' pivots).
     """
 
     reactions: dict[str, V]
@@ -139,6 +142,7 @@ class Forces:
     shaking_force: V
     shaking_moment: Num
     rocking_couple: V
+    teeth: dict[str, V] = field(default_factory=dict)
 
     @property
     def driving_torque(self) -> Num:
@@ -160,6 +164,8 @@ class Forces:
             out += [self.reactions[p].x, self.reactions[p].y]
         for k in sorted(self.slider_normal):
             out += [self.slider_normal[k], self.slider_couple[k]]
+        for g in sorted(self.teeth):
+            out += [self.teeth[g].x, self.teeth[g].y]
         return out
 
     def matching(self, names: Forces) -> Forces:
@@ -174,7 +180,8 @@ class Forces:
                       slider_normal={k: self.slider_normal[k] for k in names.slider_normal},
                       slider_couple={k: self.slider_couple[k] for k in names.slider_couple},
                       input_torques=self.input_torques, shaking_force=self.shaking_force,
-                      shaking_moment=self.shaking_moment, rocking_couple=self.rocking_couple)
+                      shaking_moment=self.shaking_moment, rocking_couple=self.rocking_couple,
+                      teeth={g: self.teeth[g] for g in names.teeth})
 
     def with_arrays(self, values: Sequence[Num]) -> Forces:
         """Forces with the same names holding ``values`` in :meth:`arrays`' order."""
@@ -182,13 +189,16 @@ class Forces:
         m = len(self.input_torques)
         base = m + 5
         at = base + 2 * len(points)
+        teeth = at + 2 * len(sliders)
         return Forces(
             reactions={p: V(values[base + 2 * i], values[base + 1 + 2 * i])
                        for i, p in enumerate(points)},
             slider_normal={k: values[at + 2 * i] for i, k in enumerate(sliders)},
             slider_couple={k: values[at + 2 * i + 1] for i, k in enumerate(sliders)},
             input_torques=tuple(values[:m]), shaking_force=V(values[m], values[m + 1]),
-            shaking_moment=values[m + 2], rocking_couple=V(values[m + 3], values[m + 4]))
+            shaking_moment=values[m + 2], rocking_couple=V(values[m + 3], values[m + 4]),
+            teeth={g: V(values[teeth + 2 * i], values[teeth + 1 + 2 * i])
+                   for i, g in enumerate(sorted(self.teeth))})
 
 
 def _col(x: Num, n: int, c: int) -> NDArray[np.float64]:
@@ -445,10 +455,9 @@ def _collect(structure: Structure, constraints: Sequence[Constraint],
     fy: Num = zero
     mz: Num = zero
     for c in constraints:
-        force = ground_of.get(id(c))
-        if force is None:  # (the driver's is the motor's reaction: always there)
-            continue
-        fx, fy, mz = _plus(fx, force[0]), _plus(fy, force[1]), _plus(mz, force[2])
+        force = ground_of.get(id(c))  # (None: between moving links; a driver's always there)
+        if force is not None:
+            fx, fy, mz = _plus(fx, force[0]), _plus(fy, force[1]), _plus(mz, force[2])
         c.tally(frame, force, lam[id(c)])
     if rotor_moment is not None:
         mz = _plus(mz, rotor_moment)
@@ -465,7 +474,8 @@ def _collect(structure: Structure, constraints: Sequence[Constraint],
                   input_torques=tuple(frame.torques.get(i, zero)
                                       for i in range(len(structure.drivers))),
                   shaking_force=V(fx, fy), shaking_moment=mz,
-                  rocking_couple=V(zero, zero) if rocking is None else rocking)
+                  rocking_couple=V(zero, zero) if rocking is None else rocking,
+                  teeth=frame.teeth)
 
 
 def regressors(structure: Structure, mo: Motion, gravity: tuple[float, float] = (0.0, 0.0)

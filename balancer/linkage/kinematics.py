@@ -40,6 +40,7 @@ from . import numeric
 from .constraints import (
     GROUND_INDEX,
     Group,
+    Mesh,
     Pose,
     Prism,
     group_jacobian,
@@ -106,6 +107,12 @@ def positions(structure: Structure, state: InputState, ops: OpsLike = NUMPY,
         if g.kind == "input":
             pivot, local = known_point(pose, g.pivot, g.links[0])
             _place(pose, g.links[0], angles[g.driver.index], pivot, local, ops)
+            continue
+        if g.kind == "geared":  # about its pivot, at its driver's angle times the ratio
+            mesh = g.constraints[1]
+            assert isinstance(mesh, Mesh)
+            pivot, local = known_point(pose, g.pivot, g.links[0])
+            _place(pose, g.links[0], mesh.driven_angle(pose.angles[mesh.a]), pivot, local, ops)
             continue
         if g.kind == "slide":  # on its ground guide, at its input's place along it
             prism = g.constraints[0]

@@ -11,7 +11,7 @@ record, :meth:`Reactions.forces` the record's arrays seen as forces.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -68,6 +68,9 @@ class Reactions:
     rocking_couple
         The couple about ``x`` and ``y`` from links in planes along the crank's axis, complex
         ``Mx + i·My``, N·m (zero for a mechanism in one plane).
+    teeth
+        Each gear pair's tooth force on its driven gear at the pitch point, complex, N, by
+        the pair's name (internal: it reaches the frame through the gears' pivots).
     """
 
     ground: dict[str, NDArray[np.complex128]]
@@ -77,6 +80,7 @@ class Reactions:
     shaking_moment: NDArray[np.float64]
     torques: tuple[NDArray[np.float64], ...]
     rocking_couple: NDArray[np.complex128]
+    teeth: dict[str, NDArray[np.complex128]] = field(default_factory=dict)
 
     @property
     def driving_torque(self) -> NDArray[np.float64]:
@@ -100,14 +104,16 @@ class Reactions:
                    shaking_force=vector(forces.shaking_force),
                    shaking_moment=real(forces.shaking_moment),
                    torques=tuple(real(t) for t in forces.input_torques),
-                   rocking_couple=vector(forces.rocking_couple))
+                   rocking_couple=vector(forces.rocking_couple),
+                   teeth={g: vector(v) for g, v in forces.teeth.items()})
 
     @classmethod
     def empty(cls, n: int, ground_points: Iterable[str], sliders: Iterable[str],
-              inputs: int = 1) -> Reactions:
+              inputs: int = 1, teeth: Iterable[str] = ()) -> Reactions:
         """Uninitialised arrays for ``n`` states.
 
-        At these ground points and ground sliders, and ``inputs`` motors' torques.
+        At these ground points and ground sliders, ``inputs`` motors' torques and these gear
+        pairs' tooth forces.
         """
         sliders = tuple(sliders)
         return cls(ground={p: np.empty(n, complex) for p in ground_points},
@@ -115,7 +121,8 @@ class Reactions:
                    slider_couple={k: np.empty(n) for k in sliders},
                    shaking_force=np.empty(n, complex), shaking_moment=np.empty(n),
                    torques=tuple(np.empty(n) for _ in range(inputs)),
-                   rocking_couple=np.empty(n, complex))
+                   rocking_couple=np.empty(n, complex),
+                   teeth={g: np.empty(n, complex) for g in teeth})
 
     @classmethod
     def join(cls, parts: Sequence[Reactions]) -> Reactions:
@@ -135,13 +142,14 @@ class Reactions:
             shaking_moment=joined([r.shaking_moment for r in parts]),
             torques=tuple(joined([r.torques[i] for r in parts])
                           for i in range(len(first.torques))),
-            rocking_couple=joined([r.rocking_couple for r in parts]))
+            rocking_couple=joined([r.rocking_couple for r in parts]),
+            teeth={g: joined([r.teeth[g] for r in parts]) for g in first.teeth})
 
     def arrays(self) -> list[NDArray[Any]]:
         """Every array of the record (the ground points' and sliders' first)."""
         return [*self.ground.values(), *self.slider_normal.values(),
                 *self.slider_couple.values(), self.shaking_force, self.shaking_moment,
-                *self.torques, self.rocking_couple]
+                *self.torques, self.rocking_couple, *self.teeth.values()]
 
     @property
     def size(self) -> int:
@@ -159,7 +167,8 @@ class Reactions:
                          shaking_force=pick(self.shaking_force),
                          shaking_moment=pick(self.shaking_moment),
                          torques=tuple(pick(t) for t in self.torques),
-                         rocking_couple=pick(self.rocking_couple))
+                         rocking_couple=pick(self.rocking_couple),
+                         teeth={g: pick(v) for g, v in self.teeth.items()})
 
     def forces(self, rocking_couple: V | None = None) -> Forces:
         """The record as the core's forces of one column, ``(N, 1)``.
@@ -185,7 +194,8 @@ class Reactions:
                       shaking_force=vector(self.shaking_force),
                       shaking_moment=real(self.shaking_moment),
                       rocking_couple=(vector(self.rocking_couple) if rocking_couple is None
-                                      else rocking_couple))
+                                      else rocking_couple),
+                      teeth={g: vector(v) for g, v in self.teeth.items()})
 
     def largest_force(self) -> float:
         """The largest force on the frame at one ground point or guide, N (0 for neither).

@@ -13,6 +13,8 @@ Constraints (Nikravesh, *Computer-Aided Analysis of Mechanical Systems*, 1988, c
 - a prismatic pair, link ``s`` sliding on a line fixed in link ``g`` (direction ``d̄ =
   R_g·d̄_g``, through ``R_g·ḡ``): the relative angle ``θ_s − θ_g − δ = 0`` and the slider point
   on the line, ``d̄ × (r̄_s + R_s·s̄ − r̄_g − R_g·ḡ) = 0``;
+- a gear pair's mesh, link ``b`` turned at ``k`` times link ``a`` about their ground pivots:
+  one row, the pitch circles rolling at the pitch point (:class:`~.constraints.Mesh`);
 - a driver per input ``i``: ``θ_input_i − θ_ground − θ_i = 0`` (a one-input linkage's
   ``θ1``).
 
@@ -24,8 +26,8 @@ drive every link).
 Assur groups. Starting from the ground and the inputs, the links are found in groups that,
 given the links found before, have no freedom left: dyads (two links, three joints) in closed
 form — RRR (two circles), RRP and PRR (a circle and a line), RPR (the angle of a line through a
-point) — and any other group (a triad of a Stephenson chain) by Newton's method. The same order
-solves velocities, accelerations and, in reverse, the joint forces (kinetostatics).
+point) —, a geared link by its pivot and its driver's angle, and any other group (a triad of
+a Stephenson chain) by Newton's method. The same order solves velocities, accelerations and, in reverse, the joint forces (kinetostatics).
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ from .constraints import (
     GROUND_INDEX,
     Driver,
     Group,
+    Mesh,
     Pin,
     Prism,
     SlideDriver,
@@ -84,8 +87,8 @@ class Structure:
     ref_angle, ref_origin
         Each moving link's frame at the reference pose: angle (rad, principal value) and
         origin.
-    pins, prisms
-        The joints as constraints.
+    pins, prisms, meshes
+        The joints as constraints (a mesh per gear pair).
     drivers
         The inputs' drivers, in the order of the linkage's inputs.
     groups
@@ -101,6 +104,7 @@ class Structure:
     prisms: tuple[Prism, ...]
     drivers: tuple[Driver | SlideDriver, ...]
     groups: tuple[Group, ...]
+    meshes: tuple[Mesh, ...]
     point_links: dict[str, tuple[int, ...]] = field(repr=False)
     #: Results computed once per structure.
     cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
@@ -136,9 +140,9 @@ class Structure:
         return driver
 
     @property
-    def constraints(self) -> tuple[Pin | Prism, ...]:
+    def constraints(self) -> tuple[Pin | Prism | Mesh, ...]:
         """All constraints but the drivers (``3·n − m`` rows for ``m`` inputs)."""
-        return (*self.pins, *self.prisms)
+        return (*self.pins, *self.prisms, *self.meshes)
 
     def index(self, name: str) -> int:
         """Index of the link called ``name`` (``-1`` for the ground)."""
@@ -165,7 +169,8 @@ class Structure:
             order of groups finds every link.
         """
         key = (linkage.points, tuple((b.name, b.points) for b in linkage.bodies),
-               linkage.sliders, linkage.inputs, tuple(sorted((lengths or {}).items())))
+               linkage.sliders, linkage.inputs, linkage.gears,
+               tuple(sorted((lengths or {}).items())))
         with _SKELETON_LOCK:
             known = _SKELETONS.get(key)
             if known is not None:
@@ -236,10 +241,18 @@ class Structure:
                 delta=theta_s - theta_g))
         drivers = tuple(_driver(linkage, index[name], i, pins, prisms)
                         for i, name in enumerate(linkage.inputs))
+        meshes = []
+        for gear in linkage.gears:
+            a, b = index[gear.driver], index[gear.driven]
+            pivot_a, pivot_b = (linkage.moving[k].points[0] for k in (a, b))
+            meshes.append(Mesh(gear.name, a, local[(a, pivot_a)], V.of(positions[pivot_a]),
+                               b, local[(b, pivot_b)], V.of(positions[pivot_b]),
+                               gear.ratio, ref_angle[a], ref_angle[b]))
         structure = cls(
             linkage=linkage, names=names, local=local, ref_angle=tuple(ref_angle),
             ref_origin=tuple(ref_origin), pins=tuple(pins), prisms=tuple(prisms),
-            drivers=drivers, groups=(), point_links={p: tuple(v) for p, v in point_links.items()})
+            drivers=drivers, groups=(), meshes=tuple(meshes),
+            point_links={p: tuple(v) for p, v in point_links.items()})
         structure._check_mobility()
         object.__setattr__(structure, "groups", structure._find_groups())
         return structure
@@ -257,8 +270,9 @@ class Structure:
             raise SpecError(
                 f"the linkage has {mobility} degrees of freedom, not {count}: {n} moving "
                 f"links (3·{n} = {3 * n} coordinates) less {joints} revolute pairs and "
-                f"{len(self.prisms)} prismatic pairs (2 each) — {driven}, and nothing may be "
-                "locked", key="mechanism", value=mobility)
+                f"{len(self.prisms)} prismatic pairs (2 each)"
+                + (f" and {len(self.meshes)} gear pairs (1 each)" if self.meshes else "")
+                + f" — {driven}, and nothing may be locked", key="mechanism", value=mobility)
         # Rows and columns in common units: angle rows (a prism's, the drivers') times a
         # length, angle columns over it.
         scale = self.length_scale()
@@ -352,6 +366,12 @@ class Structure:
         unknown = set(range(self.size)) - known
         q_ref = self.reference_coordinates()
         while unknown:
+            geared = self._geared(known)
+            if geared is not None:
+                groups.append(geared)
+                known.add(geared.links[0])
+                unknown.discard(geared.links[0])
+                continue
             found: tuple[tuple[int, ...], list[Pin | Prism]] | None = None
             for size in range(2, len(unknown) + 1):
                 for combo in itertools.combinations(sorted(unknown), size):
@@ -372,6 +392,15 @@ class Structure:
             known |= set(combo)
             unknown -= set(combo)
         return tuple(groups)
+
+    def _geared(self, known: set[int]) -> Group | None:
+        """A link turned by a gear pair whose driver is known: its pivot and its mesh."""
+        for mesh in self.meshes:
+            if mesh.a in known and mesh.b not in known:
+                pivot = next(c for c in self.pins if c.a == mesh.b and c.b == GROUND_INDEX
+                             and c.point == self.linkage.moving[mesh.b].points[0])
+                return Group((mesh.b,), (pivot, mesh), "geared")
+        return None
 
     def _classify(self, links: tuple[int, ...], closing: list[Pin | Prism],
                   q_ref: NDArray[np.float64]) -> Group:

@@ -499,7 +499,7 @@ class Mechanism:
                             input_torques=forces.input_torques,
                             shaking_force=forces.shaking_force,
                             shaking_moment=forces.shaking_moment,
-                            rocking_couple=forces.rocking_couple)
+                            rocking_couple=forces.rocking_couple, teeth=forces.teeth)
             forces = forces.with_arrays([np.array(np.broadcast_to(a, (n, 1)), dtype=float)
                                          for a in forces.arrays()])
 

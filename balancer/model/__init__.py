@@ -30,7 +30,7 @@ from .design import (
     SimulationSettings,
     check_scales,
 )
-from .links import GROUND, RESERVED_LINK_NAMES, Body, GasForce, Link, Slider, Spring
+from .links import GROUND, RESERVED_LINK_NAMES, Body, GasForce, Gear, Link, Slider, Spring
 from .mechanisms import Branch, ChainModel, Linkage, MechanismModel
 
 __all__ = [
@@ -46,6 +46,7 @@ __all__ = [
     "Design",
     "Drive",
     "GasForce",
+    "Gear",
     "Link",
     "Linkage",
     "ChainModel",

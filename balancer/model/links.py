@@ -333,6 +333,34 @@ class Slider:
 
 
 @dataclass(frozen=True, kw_only=True)
+class Gear:
+    """A pair of spur gears on two links, each turned about its ground pivot.
+
+    The driven link turns at ``ratio`` times the driver's rate (``ω_driven = ratio·ω_driver``):
+    negative for two gears in mesh (they turn opposite ways), above 1 for a pinion inside a
+    ring gear. Their pitch circles touch at the pitch point on the line of their pivots (the
+    links' first points), where ``ω_a·ρ_a = ω_b·ρ_b`` for the signed radii ``ρ`` along that
+    line; the teeth push along the common tangent there (the pitch-line force: the separating
+    force of a pressure angle is left out). A ratio of 1 has no pitch point (two shafts at one
+    speed mesh through an idler).
+
+    Attributes
+    ----------
+    name
+        The pair's name, as outputs call its tooth load.
+    driver, driven
+        The two links' names.
+    ratio
+        ``ω_driven / ω_driver``; not 0 nor 1.
+    """
+
+    name: str
+    driver: str
+    driven: str
+    ratio: float
+
+
+@dataclass(frozen=True, kw_only=True)
 class Spring:
     """A linear spring between two points (of one or two links, or the ground).
 

@@ -19,7 +19,7 @@ from typing import Any, ClassVar, Literal, Protocol, Self
 
 from .. import validate as v
 from ..errors import SpecError
-from .links import GROUND, RESERVED_LINK_NAMES, Body, GasForce, Link, Slider, Spring
+from .links import GROUND, RESERVED_LINK_NAMES, Body, GasForce, Gear, Link, Slider, Spring
 
 #: An assembly branch of a mechanism given by its lengths.
 Branch = Literal["+", "-"]
@@ -244,6 +244,8 @@ class Linkage(MechanismModel):
         Prismatic pairs.
     springs
         Linear springs.
+    gears
+        Gear pairs: each driven link turned by its driver's gear about its own ground pivot.
     """
 
     type: ClassVar[str] = "linkage"
@@ -253,6 +255,7 @@ class Linkage(MechanismModel):
     inputs: tuple[str, ...]
     sliders: tuple[Slider, ...] = ()
     springs: tuple[Spring, ...] = ()
+    gears: tuple[Gear, ...] = ()
 
     def __post_init__(self) -> None:
         """Check names and references (keys are the spec's, from its root)."""
@@ -334,6 +337,7 @@ class Linkage(MechanismModel):
         self._check_frames(names, points)
         ground = set(names[GROUND].points)
         self._check_inputs(names, ground)
+        self._check_gears(names, ground, points)
         if len(self.inputs) > 1:  # (a slider force is a table of the crank angle)
             for key, gas in self.gas_forces:
                 if not gas.is_zero:
@@ -382,6 +386,47 @@ class Linkage(MechanismModel):
         if len(set(inputs)) != len(inputs):
             raise SpecError("names a link twice", key=key, value=list(inputs))
         v.store(self, "inputs", tuple(inputs))
+
+    def _check_gears(self, names: dict[str, Body], ground: set[str],
+                     points: dict[str, tuple[float, float]]) -> None:
+        """Each gear pair between two moving links turned about ground pivots apart.
+
+        Its driver an input or a driven gear found before it (their angles run on, unwrapped),
+        its driven link no input and driven once, its ratio neither 0 nor 1.
+        """
+        driven: set[str] = set()
+        for i, gear in enumerate(self.gears):
+            key = v.item("mechanism.gears", i)
+            if not isinstance(gear, Gear):
+                raise SpecError("must be a Gear", key=key, value=gear)
+            for attr in ("driver", "driven"):
+                name = getattr(gear, attr)
+                if name not in names or name == GROUND:
+                    raise SpecError(f"must name a moving link ({_link_list(names)})",
+                                    key=f"{key}.{attr}", value=name)
+                if names[name].points[0] not in ground:
+                    raise SpecError(f"the link's first point ({names[name].points[0]}) must "
+                                    "be a ground point: its gear turns about it",
+                                    key=f"{key}.{attr}", value=name)
+            if gear.driver not in self.inputs and gear.driver not in driven:
+                raise SpecError("must be an input or a link driven by a gear named before",
+                                key=f"{key}.driver", value=gear.driver)
+            if gear.driven in self.inputs or gear.driven in driven:
+                raise SpecError("is turned already (an input, or driven by another gear)",
+                                key=f"{key}.driven", value=gear.driven)
+            ratio = v.number(gear.ratio, f"{key}.ratio")
+            if ratio == 0 or ratio == 1:
+                raise SpecError("must be neither 0 nor 1 (two shafts at one speed mesh "
+                                "through an idler)", key=f"{key}.ratio", value=gear.ratio)
+            a = points[names[gear.driver].points[0]]
+            b = points[names[gear.driven].points[0]]
+            scale = max(math.hypot(*xy) for xy in points.values()) or 1.0
+            if math.hypot(b[0] - a[0], b[1] - a[1]) <= v.RELATIVE_LENGTH * scale:
+                raise SpecError("the two gears' pivots coincide: they must be apart",
+                                key=f"{key}.driven", value=gear.driven)
+            object.__setattr__(gear, "ratio", ratio)
+            driven.add(gear.driven)
+        v.store(self, "gears", tuple(self.gears))
 
     @staticmethod
     def _check_slider(i: int, slider: Slider, names: dict[str, Body],
