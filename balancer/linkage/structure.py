@@ -27,7 +27,8 @@ Assur groups. Starting from the ground and the inputs, the links are found in gr
 given the links found before, have no freedom left: dyads (two links, three joints) in closed
 form — RRR (two circles), RRP and PRR (a circle and a line), RPR (the angle of a line through a
 point) —, a geared link by its pivot and its driver's angle, and any other group (a triad of
-a Stephenson chain) by Newton's method. The same order solves velocities, accelerations and, in reverse, the joint forces (kinetostatics).
+a Stephenson chain) by Newton's method. The same order solves velocities, accelerations and,
+in reverse, the joint forces (kinetostatics).
 """
 
 from __future__ import annotations
