@@ -117,7 +117,8 @@ def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     the sliders on the frame (:func:`slider_columns`); then the shaking force's components,
     the shaking moment, the rocking couple's components and the driving torque; an engine's
     ``mount_torque`` (N·m: the shaking moment plus the driving torque), then its main bearings'
-    ``R<B>x``, ``R<B>y`` where its spec places them (N). For every
+    ``R<B>x``, ``R<B>y`` where its spec places them (N); each gear pair's tooth force on its
+    driven gear ``G_<name>x``, ``G_<name>y`` (N). For every
     mechanism: the columns of ``simulate``'s CSV (whatever its formulation), then the shaking.
     """
     mo, r = analysis.motion, analysis.reactions
@@ -142,6 +143,9 @@ def analysis_columns(analysis: AnalysisLike) -> tuple[list[str], Columns]:
     for support in analysis.supports:  # an engine's main bearings, where its spec places them
         names += [f"R{support.name}x", f"R{support.name}y"]
         cols += [support.force.real, support.force.imag]
+    for name, force in r.teeth.items():  # each gear pair's, where the mechanism has them
+        names += [f"G_{name}x", f"G_{name}y"]
+        cols += [force.real, force.imag]
     return names, cols
 
 

@@ -121,6 +121,7 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None,
             "orders": orders_list(analysis),
             **({mech.presentation.supports_key: _supports_list(analysis)}
                if analysis.supports else {}),
+            **({"gears": _gears_list(analysis)} if analysis.reactions.teeth else {}),
             **({} if flywheel is None else {"flywheel": flywheel.as_dict()}),
             "units": {
                 "force": "N",
@@ -147,6 +148,13 @@ def _supports_list(analysis: CycleAnalysis) -> list[dict[str, Any]]:
              **reaction_extremes(s.force),
              "orders": [{"order": q, **w.as_dict()} for q, w in analysis.support_orders(s)]}
             for s in analysis.supports]
+
+
+def _gears_list(analysis: CycleAnalysis) -> list[dict[str, Any]]:
+    """Each gear pair's tooth force on its driven gear: RMS and extremes (N)."""
+    return [{"name": name, "rms": float(np.sqrt(np.mean(np.abs(force) ** 2))),
+             **reaction_extremes(force)}
+            for name, force in analysis.reactions.teeth.items()]
 
 
 def _reactions_dict(analysis: CycleAnalysis) -> dict[str, dict[str, float]]:
@@ -204,6 +212,11 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None,
     )
     if analysis.supports:
         lines += ["", supports_text(analysis, sc)]
+    if analysis.reactions.teeth:
+        rows = [[name, sc.fmt(float(np.sqrt(np.mean(np.abs(f) ** 2))), "N"),
+                 sc.fmt(float(np.max(np.abs(f), initial=0.0)), "N")]
+                for name, f in analysis.reactions.teeth.items()]
+        lines += ["", table(rows, ["gear pair: tooth load (N)", "|F| RMS", "|F| max"])]
     if analysis.reactions.slider_normal:
         rows = [[link, sc.fmt(s.slider_normal[link].max, "N"),
                  sc.fmt(s.slider_couple[link].max, "N·m")]

@@ -207,6 +207,8 @@ SECTIONS: tuple[Section, ...] = (
             "Every point at the reference pose (the table below).", (LINKAGE,)),
         Key("sliders", "table", "none",
             "Prismatic pairs (`[[mechanism.sliders]]`, below).", (LINKAGE,)),
+        Key("gears", "table", "none",
+            "Gear pairs (`[[mechanism.gears]]`, below).", (LINKAGE,)),
     )),
     Section("mechanism.lengths", "The lengths, m, each between 1e-50 and 1e50 m (a slider-crank's "
             "offset is signed, and may be 0).", (
@@ -265,6 +267,22 @@ SECTIONS: tuple[Section, ...] = (
                 Key("direction", "—", "required",
                     "The line's direction `[dx, dy]` at the reference pose (any length but "
                     "zero).", (LINKAGE,), example="[1.0, 0.0]"),
+            ), (LINKAGE,)),
+    Section("mechanism.gears[]", "A pair of spur gears between two links of a general "
+            "linkage, each turned about its first point, a ground pivot: `driven` turns at "
+            "`ratio` times `driver`. Their pitch circles touch on the line of the pivots; the "
+            "teeth push along the common tangent there (the separating force of a pressure "
+            "angle left out), and `analyze` gives that tooth load.", (
+                Key("name", "—", "required", "The pair's name, as outputs call its tooth load.",
+                    (LINKAGE,), example='"mesh"'),
+                Key("driver", "—", "required",
+                    "An input, or a link driven by a gear named before.", (LINKAGE,),
+                    example='"crank"'),
+                Key("driven", "—", "required", "The link the gear turns (not an input).",
+                    (LINKAGE,), example='"wheel"'),
+                Key("ratio", "—", "required",
+                    "Its speed over the driver's: negative for two gears in mesh, above 1 for a "
+                    "pinion in a ring gear; not 0 nor 1.", (LINKAGE,), example="-1.0"),
             ), (LINKAGE,)),
     Section("links", "The moving links by name. A four-bar's and a slider-crank's names are "
             "fixed; a general linkage names its own.", (

@@ -15,7 +15,7 @@ from typing import Any
 from ... import tomltext as toml
 from ... import validate as v
 from ...errors import SpecError
-from ...model import GROUND, Body, Linkage, Slider, Spring
+from ...model import GROUND, Body, Gear, Linkage, Slider, Spring
 from ...model import MechanismModel as Model
 from ...spec import schema
 from ...spec.links import link_lines, links_lines, read_link, read_links
@@ -79,6 +79,23 @@ def read(root: Table, mech: Table) -> Linkage:
         fields["direction"] = sub.vector2("direction", default=(1.0, 0.0))
         sub.finish()
         sliders.append(fields)
+    gears = []
+    for sub in mech.tables("gears"):
+        sub.expect(schema.known("mechanism.gears[]", schema.LINKAGE))
+        names: dict[str, str] = {}
+        for attr in ("name", "driver", "driven", "ratio"):
+            if not sub.has(attr):
+                raise sub._missing(attr)
+        for attr in ("name", "driver", "driven"):
+            value = sub.raw(attr)
+            if not isinstance(value, str) or not value:
+                raise SpecError("must be a name", key=sub.key(attr), value=value)
+            names[attr] = value
+        gears.append(Gear(**names, ratio=sub.value("ratio", 0.0)))
+        sub.finish()
+    if len({g.name for g in gears}) != len(gears):
+        raise SpecError("names a gear pair twice", key=mech.key("gears"),
+                        value=[g.name for g in gears])
     mech.finish()
     links_table = root.table("links")
     assert links_table is not None
@@ -111,7 +128,8 @@ def read(root: Table, mech: Table) -> Linkage:
                                   free_length=sub.raw("free_length")))
         sub.finish()
     return Linkage(points=tuple(points.items()), bodies=tuple(bodies), inputs=inputs,
-                   sliders=tuple(Slider(**f) for f in sliders), springs=tuple(springs))
+                   sliders=tuple(Slider(**f) for f in sliders), springs=tuple(springs),
+                   gears=tuple(gears))
 
 
 def _frame(name: str, link_points: tuple[str, ...], positions: dict[str, complex],
@@ -148,6 +166,10 @@ def lines(model: Model) -> list[str]:
         out += ["", "[[mechanism.sliders]]", f"link = {toml.string(s.link)}",
                 f"guide = {toml.string(s.guide)}", f"point = {toml.string(s.point)}",
                 f"direction = [{toml.number(s.direction[0])}, {toml.number(s.direction[1])}]"]
+    for g in mech.gears:
+        out += ["", "[[mechanism.gears]]", f"name = {toml.string(g.name)}",
+                f"driver = {toml.string(g.driver)}", f"driven = {toml.string(g.driven)}",
+                f"ratio = {toml.number(g.ratio)}"]
     for body in mech.bodies:
         names = ", ".join(map(toml.string, body.points))
         out += ["", f"[links.{toml.key(body.name)}]", f"points = [{names}]"]
