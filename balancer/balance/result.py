@@ -91,7 +91,8 @@ class RotorMasses:
     radius
         The counterweights' radius, m (``None``: not given), for their masses.
     replaced
-        The planes whose labelled counterweights the new ones replace, m.
+        The places (crankshaft, plane z in m) whose labelled counterweights the new ones
+        replace.
     unbalance_before, unbalance_after
         ``√Σ (mr·ω²)²`` over the chosen planes' counterweights and the new shafts' eccentrics
         of the original (its replaced counterweights) and of the balanced design, N.
@@ -102,7 +103,7 @@ class RotorMasses:
     counterweights: tuple[PlacedMass, ...]
     shafts: tuple[ShaftDesign, ...]
     radius: float | None
-    replaced: tuple[float, ...]
+    replaced: tuple[tuple[int, float], ...]
     unbalance_before: float
     unbalance_after: float
     bearing_loads: tuple[float, ...]
@@ -129,8 +130,11 @@ class RotorMasses:
     def as_dict(self) -> dict[str, object]:
         """``crankshaft_counterweights`` and ``balance_shafts`` as ``optimize --json`` gives."""
         cws = []
+        several = any(c.crankshaft != 1 for c in self.counterweights)
         for c in self.counterweights:
             item: dict[str, object] = {"z": c.z, "mr": c.mr, "phase_deg": c.phase_deg}
+            if several:  # (an engine of geared crankshafts: which one carries it)
+                item["crankshaft"] = c.crankshaft
             mass = self.mass(c)
             if mass is not None:
                 item["mass"] = mass

@@ -65,7 +65,9 @@ class Site:
     bearing
         A kept mass's rotor's bearing, the frame's point its force acts at (the crankshaft's
         masses: the main bearings' ``O``; a balance shaft's: its own); ``None`` for a chosen
-        site (on the crankshaft where :attr:`shaft` is ``None``, else on its new shaft).
+        site (on a crankshaft where :attr:`shaft` is ``None``, else on its new shaft).
+    crankshaft
+        A chosen counterweight's crankshaft (1 the first; an engine's geared ones 2 and on).
     """
 
     shaft: int | None
@@ -75,6 +77,7 @@ class Site:
     max_mr: float
     kept: complex | None = None
     bearing: str | None = None
+    crankshaft: int = 1
 
     @property
     def free(self) -> bool:
@@ -92,12 +95,14 @@ class Site:
         ``frame_points``: the linkage's ground points, where the crankshaft's masses bear (a
         balance shaft's bearing is a point of its own, even where it turns with the crank).
         """
-        return self.shaft is None or (self.bearing is not None and self.bearing in frame_points)
+        return ((self.shaft is None and self.crankshaft == 1)
+                or (self.bearing is not None and self.bearing in frame_points))
 
     @property
     def where(self) -> str:
         """The site in words, as a violation names it."""
-        where = "crankshaft" if self.shaft is None else f"shaft {(self.shaft or 0) + 1}"
+        where = (("crankshaft" if self.crankshaft == 1 else f"crankshaft {self.crankshaft}")
+                 if self.shaft is None else f"shaft {(self.shaft or 0) + 1}")
         return f"{where} at z = {self.z:g} m"
 
 
@@ -114,7 +119,8 @@ class Sites:
     problem
         The spec's side.
     replaced
-        The crankshaft planes whose labelled counterweights the chosen ones replace, m.
+        The places (crankshaft, plane z in m) whose labelled counterweights the chosen ones
+        replace.
     speed
         The crank's speed, rad/s (the unbalance's ``ω``).
     """
@@ -122,7 +128,7 @@ class Sites:
     sites: tuple[Site, ...]
     start: int
     problem: RotorBalanceProblem
-    replaced: tuple[float, ...]
+    replaced: tuple[tuple[int, float], ...]
     speed: float
 
     @property
@@ -158,7 +164,7 @@ class Sites:
         per_shaft: list[list[PlacedMass]] = [[] for _ in self.problem.shafts]
         for i in self.chosen:
             s = self.sites[i]
-            placed = _placed(s.z, self.vector(x, i), s.max_mr)
+            placed = _placed(s.z, self.vector(x, i), s.max_mr, s.crankshaft)
             (cws if s.shaft is None else per_shaft[s.shaft]).append(placed)
         shafts = tuple(ShaftDesign(ratio=f.ratio, at=f.at, eccentrics=tuple(e))
                        for f, e in zip(self.problem.shafts, per_shaft, strict=True))
@@ -222,13 +228,14 @@ class Sites:
         return tuple(out)
 
 
-def _placed(z: float, vector: complex, bound: float) -> PlacedMass:
+def _placed(z: float, vector: complex, bound: float, crankshaft: int = 1) -> PlacedMass:
     """A mass·radius vector as its size and angle (none below :data:`ABSENT` of its bound)."""
     mr = abs(vector)
     if mr <= ABSENT * bound:
-        return PlacedMass(z=z, mr=0.0, phase_deg=0.0)
+        return PlacedMass(z=z, mr=0.0, phase_deg=0.0, crankshaft=crankshaft)
     return PlacedMass(z=z, mr=min(mr, bound),
-                      phase_deg=math.degrees(math.atan2(vector.imag, vector.real)) % 360.0)
+                      phase_deg=math.degrees(math.atan2(vector.imag, vector.real)) % 360.0,
+                      crankshaft=crankshaft)
 
 
 def sites_of(design: Design, start: int) -> tuple[Sites, NDArray[np.float64]]:
@@ -248,11 +255,18 @@ def sites_of(design: Design, start: int) -> tuple[Sites, NDArray[np.float64]]:
                         "operating speed", key="operation.speed")
     model = cast("RotorBalanced", design.mechanism)
     cws = problem.counterweights
-    replaced: tuple[float, ...] = () if cws is None else cws.planes
     # A crank-web sector's room bounds each plane's mass·radius (balancer.parts.sizing).
     room = math.inf if cws is None or cws.part is None else most_mr(cws.part)
-    sites = [Site(None, 1, 0j, z, min(mr, room)) for z, mr in zip(
-        replaced, () if cws is None else cws.max_mr, strict=True)]
+    sites: list[Site] = []
+    if cws is not None:
+        for k in cws.crankshafts:
+            if k not in model.shafts:
+                raise SpecError(f"names no crankshaft: there are {len(model.shafts)}",
+                                key="balance.counterweights.crankshafts",
+                                value=list(cws.crankshafts))
+            sites += [Site(None, model.shaft_ratio(k), model.shaft_axis(k), z, min(mr, room),
+                           crankshaft=k) for z, mr in zip(cws.planes, cws.max_mr, strict=True)]
+    replaced = tuple((s.crankshaft, s.z) for s in sites)
     for j, shaft in enumerate(problem.shafts):
         sites += [Site(j, shaft.ratio, complex(*shaft.at), z, mr)
                   for z, mr in zip(shaft.planes, shaft.max_mr, strict=True)]
@@ -261,8 +275,8 @@ def sites_of(design: Design, start: int) -> tuple[Sites, NDArray[np.float64]]:
                         "([balance.counterweights]) or a shaft ([[balance.shafts]])",
                         key="balance")
     original = np.zeros(2 * len(sites))
-    for c in model.counterweights_in(replaced):
-        i = next(i for i, s in enumerate(sites) if s.shaft is None and s.z == c.z)
+    for k, c in model.counterweights_in(replaced):
+        i = next(i for i, s in enumerate(sites) if (s.crankshaft, s.z) == (k, c.z))
         original[2 * i: 2 * i + 2] += c.mr * np.array([math.cos(math.radians(c.phase_deg)),
                                                        math.sin(math.radians(c.phase_deg))])
     base = model.with_rotor_masses((), (), replaced)

@@ -342,12 +342,16 @@ class CounterweightPlanes:
         :class:`~balancer.model.parts.Sector`, about the crank's axis), or ``None``. The room
         bounds each plane's mass·radius (:func:`balancer.parts.sizing.most_mr`) and
         ``optimize`` sizes each plane's sector (:mod:`balancer.parts.planes`).
+    crankshafts
+        The crankshafts that carry them (1 the first; an engine's geared ones 2 and on): in
+        each of these planes on each.
     """
 
     planes: tuple[float, ...]
     max_mr: tuple[float, ...]
     radius: float | None = None
     part: Sector | None = None
+    crankshafts: tuple[int, ...] = (1,)
 
     def __post_init__(self) -> None:
         v.store(self, "planes", _planes(self.planes))
@@ -358,6 +362,13 @@ class CounterweightPlanes:
             raise SpecError('an engine\'s crankshaft counterweights are crank-web sectors: '
                             'must be "sector"', key="part.shape",
                             value=getattr(self.part, "shape", self.part))
+        shafts = self.crankshafts
+        if (isinstance(shafts, str) or not isinstance(shafts, tuple | list) or not shafts
+                or any(isinstance(k, bool) or not isinstance(k, int) or k < 1 for k in shafts)
+                or len(set(shafts)) != len(shafts)):
+            raise SpecError("must be crankshafts' numbers, each once (1 the first)",
+                            key="crankshafts", value=shafts)
+        v.store(self, "crankshafts", tuple(shafts))
 
 
 @dataclass(frozen=True)
@@ -462,11 +473,14 @@ class PlacedMass:
         Mass times radius, kg·m (at least 0).
     phase_deg
         Its angle at θ1 = 0 from +x towards +y, degrees.
+    crankshaft
+        A counterweight's crankshaft: 1 the first, 2 and on an engine's geared ones.
     """
 
     z: float
     mr: float
     phase_deg: float
+    crankshaft: int = 1
 
 
 @dataclass(frozen=True)
@@ -488,13 +502,24 @@ class RotorBalanced(Protocol):
     def counterweight_planes(self) -> tuple[float, ...]:
         """The planes counterweights go in where the spec names none, m."""
 
-    def counterweights_in(self, planes: Sequence[float]) -> tuple[PlacedMassLike, ...]:
-        """The counterweights that balancing replaces in ``planes``."""
+    @property
+    def shafts(self) -> tuple[int, ...]:
+        """The crankshafts' numbers, 1 the first."""
+
+    def shaft_ratio(self, shaft: int) -> int:
+        """A crankshaft's speed over the first's."""
+
+    def shaft_axis(self, shaft: int) -> complex:
+        """A crankshaft's axis, ``x + i·y``, m."""
+
+    def counterweights_in(self, places: Sequence[tuple[int, float]]
+                          ) -> tuple[tuple[int, PlacedMassLike], ...]:
+        """The counterweights that balancing replaces at ``places`` (crankshaft, plane)."""
 
     def with_rotor_masses(self, counterweights: Sequence[PlacedMass],
                           shafts: Sequence[ShaftDesign],
-                          replacing: Sequence[float]) -> MechanismModel:
-        """The model with the counterweights in ``replacing`` replaced and the shafts added."""
+                          replacing: Sequence[tuple[int, float]]) -> MechanismModel:
+        """The model with the counterweights at ``replacing`` replaced and the shafts added."""
 
 
 class PlacedMassLike(Protocol):

@@ -238,7 +238,8 @@ def rotor_masses_text(masses: RotorMasses, speed: float, before: CycleAnalysis |
     rows = []
     for c in masses.counterweights:
         mass = masses.mass(c)
-        rows.append(["crankshaft", f"{1e3 * c.z:.6g}", f"{c.mr:.6g}",
+        rows.append(["crankshaft" if c.crankshaft == 1 else f"crankshaft {c.crankshaft}",
+                     f"{1e3 * c.z:.6g}", f"{c.mr:.6g}",
                      f"{c.phase_deg:.6g}" if c.mr > 0 else "—",
                      "" if mass is None else f"{mass:.6g}"])
     for j, s in enumerate(masses.shafts, start=1):

@@ -29,7 +29,7 @@ from .entries import (  # (the mechanism types are the schema's names too)
     Key,
     Section,
 )
-from .schema_engines import ENGINE_BALANCE, ENGINE_BALANCE_SECTIONS
+from .schema_engines import CRANKSHAFT_KEYS, ENGINE_BALANCE, ENGINE_BALANCE_SECTIONS
 from .schema_motions import MOTION_SECTIONS, PLAN_SECTIONS
 
 _CLOSED = (FOUR_BAR, SLIDER_CRANK)
@@ -139,6 +139,9 @@ SECTIONS: tuple[Section, ...] = (
         Key("balance_shafts", "table", "none",
             "An engine's balance shafts, geared to the crank (`[[balance_shafts]]`, below).",
             (ENGINE,)),
+        Key("crankshafts", "table", "none",
+            "An engine's further crankshafts, geared to the first (`[[crankshafts]]`, below).",
+            (ENGINE,)),
         Key("gas", "table", "none",
             "An engine's gas pressure over the working cycle (`[gas]`, below).", (ENGINE,)),
         Key("operation", "table", "none",
@@ -243,6 +246,10 @@ SECTIONS: tuple[Section, ...] = (
                 *(Key(k.name, k.unit, "`[mechanism.lengths]`'s",
                       f"{k.meaning[:-1]} — this cylinder's, where it differs.", (ENGINE,),
                       k.example) for k in _CYLINDER_LENGTHS),
+                Key("crankshaft", "—", "1",
+                    "The crankshaft its pin is on: 1 the first (`[links.crankshaft]`), 2 and on "
+                    "those of `[[crankshafts]]` (its pin at ratio·θ1 + phase from that shaft's "
+                    "axis, its axis through it).", (ENGINE,), example="2"),
             ), (ENGINE,)),
     Section("mechanism.points", "A general linkage's points at the reference pose, which fixes "
             "the assembly branch: every other pose is reached from it continuously as the crank "
@@ -385,6 +392,9 @@ SECTIONS: tuple[Section, ...] = (
             ), (ENGINE,)),
     Section("balance_shafts[].eccentrics[]", "A mass·radius on a balance shaft.", _ECCENTRIC,
             (ENGINE,)),
+    Section("crankshafts[]", "A further crankshaft of an engine, geared to the first (twin-"
+            "crank, U and opposed-piston engines): the cylinders that name it have their pins "
+            "on it; `analyze` gives the gear pair's tooth load.", CRANKSHAFT_KEYS, (ENGINE,)),
     Section("gas", "An engine's gas pressure: cylinder 1's absolute pressure over its working "
             "cycle from its firing top dead centre, a periodic cubic spline through the points; "
             "every cylinder follows it from its own firing (`mechanism.firing_order`). The gas "
@@ -646,6 +656,9 @@ _ENGINE_ORIGINAL: dict[str, tuple[Key, ...]] = {
         Key("balance_shafts", "table", "none",
             "The original balance shafts (`[[original.balance_shafts]]`, as "
             "`[[balance_shafts]]`); none where absent.", (ENGINE,)),
+        Key("crankshafts", "table", "none",
+            "The original geared crankshafts (`[[original.crankshafts]]`, as "
+            "`[[crankshafts]]`); the design's where absent.", (ENGINE,)),
     ),
     "original.<link>": (
         *(replace(k, mechanisms=(ENGINE,)) for k in _link_keys("`{ s, sigma }` or `{ e, f }`",
@@ -671,6 +684,13 @@ SECTIONS = tuple(
             next(s for s in SECTIONS if s.pattern == "balance_shafts[]").keys, (ENGINE,)),
     Section("original.balance_shafts[].eccentrics[]", "A mass·radius on an original balance "
             "shaft.", _ECCENTRIC, (ENGINE,)),
+    Section("crankshafts[].masses[]", "A mass·radius a geared crankshaft carries.",
+            next(s for s in SECTIONS if s.pattern == "links.<link>.masses[]").keys, (ENGINE,)),
+    Section("original.crankshafts[]", "An original geared crankshaft (as `[[crankshafts]]`).",
+            CRANKSHAFT_KEYS, (ENGINE,)),
+    Section("original.crankshafts[].masses[]", "A mass·radius an original geared crankshaft "
+            "carried.", next(s for s in SECTIONS if s.pattern == "links.<link>.masses[]").keys,
+            (ENGINE,)),
 ) + ENGINE_BALANCE_SECTIONS
 
 _BY_PATTERN = {s.pattern: s for s in SECTIONS}
@@ -682,7 +702,7 @@ def pattern(path: str) -> str:
     """The pattern of a table's dotted path (``links.crank.com`` → ``links.<link>.com``)."""
     parts = [_INDEX.sub("[]", part) for part in path.split(".")] if path else []
     if len(parts) >= 2 and parts[0] in ("links", "original", "balance"):
-        kept = {"links": ("ground",), "original": ("balance_shafts[]",),
+        kept = {"links": ("ground",), "original": ("balance_shafts[]", "crankshafts[]"),
                 "balance": ("objective", "counterweights", "shafts", "shafts[]", "motions")}.get(
             parts[0], ())
         if parts[1] not in kept:

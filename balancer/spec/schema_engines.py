@@ -69,6 +69,10 @@ ENGINE_BALANCE_SECTIONS: tuple[Section, ...] = (
                     "`optimize` sizes it, and its room caps `max_mr` at what it holds.",
                     (ENGINE,), example='{ shape = "sector", inner_radius = 0.02, '
                     'outer_radius = 0.075, angle_deg = 160.0, thickness = 0.018 }'),
+                Key("crankshafts", "—", "every crankshaft",
+                    "The crankshafts that carry them, by number (1 the first, 2 and on those "
+                    "of `[[crankshafts]]`): a counterweight in each plane on each.", (ENGINE,),
+                    example="[1, 2]"),
             ), (ENGINE,)),
     Section("balance.counterweights.part", "The crank-web sector of each plane's "
             "counterweight, about the crank's axis, centred on its plane: its angle solved "
@@ -103,4 +107,23 @@ ENGINE_BALANCE_SECTIONS: tuple[Section, ...] = (
                     "The largest mass·radius of each eccentric: one number, or one per plane; "
                     "positive.", (ENGINE,), example="0.006"),
             ), (ENGINE,)),
+)
+
+#: An engine's geared crankshafts (``[[crankshafts]]``): twin-crank, U and opposed-piston
+#: engines.
+CRANKSHAFT_KEYS = (
+    Key("at", "m", "required",
+        "Its axis in the x–y plane `[x, y]`, parallel to the first crankshaft's and away from "
+        "it; the gear pair's pitch circles touch midway.", (ENGINE,), example="[0.16, 0.0]"),
+    Key("ratio", "—", "-1",
+        "Its speed over the first crankshaft's: -1, two gears in mesh turning opposite ways "
+        "(the same way needs an idler, not modelled).", (ENGINE,), example="-1"),
+    Key("inertia", "kg·m²", "0", "About its axis, its masses included; at least 0.", (ENGINE,),
+        example="0.012"),
+    Key("mass", "kg", "0", "Its mass, for its weight under gravity; at least 0.", (ENGINE,),
+        example="6.0"),
+    Key("masses", "table", "none",
+        "Every mass·radius it carries (pins, webs, counterweights), as `[links.crankshaft] "
+        "masses`: their angles at θ1 = 0.", (ENGINE,),
+        example="[{ mr = 0.015, phase_deg = 180.0, z = 0.0 }]"),
 )

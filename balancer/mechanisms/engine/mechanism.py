@@ -25,11 +25,11 @@ from ...linkage.kinematics import Motion
 from ...linkage.loads import Reactions, SupportLoad
 from ...linkage.rotors import Rotor, link_inertia
 from ...linkage.structure import Structure
-from ...model import Body, Linkage, Slider
+from ...model import Body, Gear, Linkage, Slider
 from ..base import DrawnMass, Mechanism, piston_block
 from ..presentation import Presentation
 from .bearings import lever_shares, main_bearing_loads, main_bearing_regressors
-from .model import COUNTERWEIGHT, Engine
+from .model import COUNTERWEIGHT, Engine, crankshaft_name
 
 #: The main bearings' point (the crankshaft's axis at the origin).
 MAIN_BEARINGS = "O"
@@ -45,44 +45,77 @@ def piston_pin(k: int) -> str:
     return f"pistonpin{k}"
 
 
+def shaft_pivot(k: int) -> str:
+    """The frame's point where crankshaft ``k`` turns: ``O`` (the main bearings), ``O2``…."""
+    return MAIN_BEARINGS if k == 1 else f"{MAIN_BEARINGS}{k}"
+
+
+def gear_name(k: int) -> str:
+    """The gear pair that turns crankshaft ``k`` (2 and on) from the first: ``gear2``…."""
+    return f"gear{k}"
+
+
+def _marker_radius(model: Engine, k: int) -> float:
+    """The radius of crankshaft ``k``'s frame marker: its first cylinder's crank, m."""
+    on = [c for c in model.cylinders if c.crankshaft == k]
+    return (on or model.cylinders)[0].crank
+
+
 def engine_linkage(model: Engine) -> Linkage:
     """The engine as a general linkage at θ1 = 0.
 
-    The crankshaft's frame has its x-axis along θ1 (a marker point ``X`` on it at the first
-    cylinder's crank radius on +x), so that its angle is θ1; its pins at ``r·e^{i·phase}``; its
-    inertia the crankshaft's with each balance shaft's as the crank feels it (``k²·J``, as a
+    Each crankshaft's frame has its x-axis along its angle (a marker point ``X``, ``X2``, …
+    on it at its first cylinder's crank radius on +x from its axis), so that the first's angle
+    is θ1 and a geared one's ``ratio·θ1``; its pins at ``r·e^{i·phase}`` from its axis; the
+    first's inertia with each balance shaft's as the crank feels it (``k²·J``, as a
     counter-rotor's is carried: :meth:`~balancer.mechanisms.base.Mechanism.rotor_loads`).
-    Each piston pin on its line ``offset·i·u + s·u`` (``u`` the axis) at the root of
-    ``|W − P| = rod`` farther from the crank (the piston on the head's side of its pin).
+    Each geared crankshaft turns about its own pivot ``O2``, … by a gear pair with the first
+    (:class:`~balancer.model.Gear` ``gear2``, …). Each piston pin on its line ``offset·i·u +
+    s·u`` from its crankshaft's axis (``u`` its axis) at the root of ``|W − P| = rod`` farther
+    from the crank (the piston on the head's side of its pin).
     """
-    points: list[tuple[str, tuple[float, float]]] = [
-        (MAIN_BEARINGS, (0.0, 0.0)), ("X", (model.cylinders[0].crank, 0.0))]
-    bodies: list[Body] = [Body(name="ground", points=(MAIN_BEARINGS,))]
-    shaft_points = [MAIN_BEARINGS, "X"]
+    shafts = model.shafts
+    points: list[tuple[str, tuple[float, float]]] = []
+    shaft_points: dict[int, list[str]] = {}
+    for k in shafts:
+        axis = model.shaft_axis(k)
+        marker = "X" if k == 1 else f"X{k}"
+        points += [(shaft_pivot(k), (axis.real, axis.imag)),
+                   (marker, (axis.real + _marker_radius(model, k), axis.imag))]
+        shaft_points[k] = [shaft_pivot(k), marker]
+    bodies: list[Body] = [Body(name="ground", points=tuple(shaft_pivot(k) for k in shafts))]
     rods: list[Body] = []
     pistons: list[Body] = []
     sliders: list[Slider] = []
     links = model.links
-    n = len(model.cylinders)
+    n, first_rod = len(model.cylinders), len(shafts)
     for k, c in enumerate(model.cylinders, start=1):
+        axis = model.shaft_axis(c.crankshaft)
         pin = cmath.rect(c.crank, c.phase)
         u = c.axis
         along = (pin * u.conjugate()).real
         across = (pin * (1j * u).conjugate()).real
         s = along + math.sqrt(c.rod * c.rod - (c.offset - across) ** 2)
-        wrist = c.offset * 1j * u + s * u
+        wrist = axis + c.offset * 1j * u + s * u
+        pin = axis + pin
         points += [(crank_pin(k), (pin.real, pin.imag)), (piston_pin(k), (wrist.real, wrist.imag))]
-        shaft_points.append(crank_pin(k))
-        rods.append(Body(name=f"rod{k}", points=(crank_pin(k), piston_pin(k)), props=links[k]))
-        pistons.append(Body(name=f"piston{k}", points=(piston_pin(k),), props=links[n + k]))
+        shaft_points[c.crankshaft].append(crank_pin(k))
+        rods.append(Body(name=f"rod{k}", points=(crank_pin(k), piston_pin(k)),
+                         props=links[first_rod + k - 1]))
+        pistons.append(Body(name=f"piston{k}", points=(piston_pin(k),),
+                            props=links[first_rod + n + k - 1]))
         sliders.append(Slider(link=f"piston{k}", guide="ground", point=piston_pin(k),
                               direction=(u.real, u.imag), force=model.gas_force(k)))
     geared = sum(link_inertia(s.inertia, s.ratio) for s in model.balance_shafts)
-    crankshaft = replace(links[0], inertia=links[0].inertia + geared)
-    bodies.append(Body(name="crankshaft", points=tuple(shaft_points), props=crankshaft))
-    return Linkage(points=tuple(points), bodies=(*bodies, *rods, *pistons),
-                   inputs=("crankshaft",),
-                   sliders=tuple(sliders))
+    crankshafts = [Body(name=crankshaft_name(k), points=tuple(shaft_points[k]),
+                        props=(replace(links[0], inertia=links[0].inertia + geared) if k == 1
+                               else links[k - 1]))
+                   for k in shafts]
+    gears = tuple(Gear(name=gear_name(k), driver=crankshaft_name(1),
+                       driven=crankshaft_name(k), ratio=float(model.shaft_ratio(k)))
+                  for k in shafts[1:])
+    return Linkage(points=tuple(points), bodies=(*bodies, *crankshafts, *rods, *pistons),
+                   inputs=("crankshaft",), sliders=tuple(sliders), gears=gears)
 
 
 class EngineMechanism(Mechanism):
@@ -102,16 +135,22 @@ class EngineMechanism(Mechanism):
 
     @cached_property
     def structure(self) -> Structure:
-        exact = {"crankshaft": self.model.cylinders[0].crank}
+        exact = {crankshaft_name(k): _marker_radius(self.model, k) for k in self.model.shafts}
         exact.update({f"rod{k}": c.rod for k, c in enumerate(self.model.cylinders, start=1)})
         return Structure.of(self.linkage, exact)
 
     @cached_property
     def rotors(self) -> tuple[tuple[str, Rotor], ...]:
-        """The crankshaft's masses on the main bearings, then each balance shaft's rotor."""
+        """Each crankshaft's masses on its pivot (the first's on the main bearings), each shaft's.
+
+        A balance shaft's rotor turns on its own bearing ``shaft<j>``.
+        """
         out: list[tuple[str, Rotor]] = []
         if self.model.crankshaft.masses:
             out.append((MAIN_BEARINGS, self.model.crankshaft.rotor))
+        out += [(shaft_pivot(k), g.rotor)
+                for k, g in zip(self.model.shafts[1:], self.model.crankshafts, strict=True)
+                if g.masses]
         out += [(f"shaft{j}", s.rotor)
                 for j, s in enumerate(self.model.balance_shafts, start=1)]
         return tuple(out)
@@ -140,7 +179,9 @@ class EngineMechanism(Mechanism):
     def describe(self) -> str:
         n = len(self.model.cylinders)
         cylinders = "one cylinder" if n == 1 else f"{n} cylinders"
-        return f"{cylinders}, {self.model.strokes}-stroke"
+        shafts = len(self.model.shafts)
+        geared = "" if shafts == 1 else f" on {shafts} crankshafts geared together"
+        return f"{cylinders}{geared}, {self.model.strokes}-stroke"
 
     def _full_turn_rule(self) -> str:
         return " (each rod longer than its crank + |offset|)"
@@ -152,9 +193,11 @@ class EngineMechanism(Mechanism):
 
     def drawn_masses(self) -> tuple[DrawnMass, ...]:
         """The crankshaft's counterweights (its masses labelled so) and every eccentric."""
-        weights = [DrawnMass(axis=0j, ratio=1.0, angle=math.radians(m.phase_deg), mr=m.mr,
-                             what="counterweight")
-                   for m in self.model.crankshaft.masses if m.label == COUNTERWEIGHT]
+        model = self.model
+        weights = [DrawnMass(axis=model.shaft_axis(k), ratio=float(model.shaft_ratio(k)),
+                             angle=math.radians(m.phase_deg), mr=m.mr, what="counterweight")
+                   for k in model.shafts for m in model.shaft_masses(k)
+                   if m.label == COUNTERWEIGHT]
         eccentrics = [DrawnMass(axis=complex(*s.at), ratio=float(s.ratio),
                                 angle=math.radians(m.phase_deg), mr=m.mr, what="eccentric")
                       for s in self.model.balance_shafts for m in s.eccentrics]

@@ -52,6 +52,9 @@ class Cylinder:
         The piston pin's line from the crank's axis, along the axis turned +90°, m (signed).
     bore
         The bore, m, positive (needed with gas; ``None``: not given).
+    crankshaft
+        The crankshaft its pin is on: 1 the first (``[links.crankshaft]``, turning at θ1
+        about the origin), 2 and on the engine's geared ones (:class:`GearedCrankshaft`).
     """
 
     z: float = 0.0
@@ -61,8 +64,13 @@ class Cylinder:
     rod: float
     offset: float = 0.0
     bore: float | None = None
+    crankshaft: int = 1
 
     def __post_init__(self) -> None:
+        if (isinstance(self.crankshaft, bool) or not isinstance(self.crankshaft, int)
+                or self.crankshaft < 1):
+            raise SpecError("must be a crankshaft's number: 1 the first, 2 and on those of "
+                            "[[crankshafts]]", key="crankshaft", value=self.crankshaft)
         for name in ("z", "phase_deg", "bank_deg", "offset"):
             v.store(self, name, v.number(getattr(self, name), name))
         v.store(self, "crank", v.length(self.crank, "crank"))
@@ -99,10 +107,12 @@ class Cylinder:
         """``π·bore²/4``, m² (0 without a bore)."""
         return 0.0 if self.bore is None else math.pi * self.bore * self.bore / 4
 
-    @property
-    def top_dead_centre(self) -> float:
-        """The crank angle θ1 in [0, 2π) where its crank pin points along its axis, rad."""
-        return (self.bank - self.phase) % (2 * math.pi)
+    def top_dead_centre(self, ratio: int = 1) -> float:
+        """The crank angle θ1 in [0, 2π) where its crank pin points along its axis, rad.
+
+        Its crankshaft turning at ``ratio`` (±1) times θ1: its pin at ``ratio·θ1 + phase``.
+        """
+        return ((self.bank - self.phase) / ratio) % (2 * math.pi)
 
 
 #: The shortest crank, a share of its rod: below, the crank's points meet within rounding.
@@ -110,6 +120,11 @@ SHORTEST_CRANK = 1e-6
 
 #: The label of a counterweight that balancing may replace.
 COUNTERWEIGHT = "counterweight"
+
+
+def crankshaft_name(k: int) -> str:
+    """Crankshaft ``k``'s link name: ``crankshaft`` for the first, ``crankshaft2`` and on."""
+    return "crankshaft" if k == 1 else f"crankshaft{k}"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -224,6 +239,58 @@ class BalanceShaft:
         """The shaft as a rotor geared to the crank."""
         return Rotor(ratio=float(self.ratio), inertia=self.inertia, axis=complex(*self.at),
                      eccentrics=tuple(m.eccentric for m in self.eccentrics))
+
+
+@dataclass(frozen=True, kw_only=True)
+class GearedCrankshaft:
+    """A further crankshaft geared to the first: twin-crank, U and opposed-piston engines.
+
+    It turns at ``ratio`` times the first crankshaft's angle about its own axis, parallel to
+    the first; the cylinders that name it (``crankshaft = 2``, …) have their pins on it, at
+    ``ratio·θ1 + phase``. The two are coupled by a pair of spur gears whose pitch circles touch
+    midway between the axes (:class:`balancer.model.Gear`: the tooth load is reported).
+
+    Attributes
+    ----------
+    at
+        Its axis in the x–y plane, m (away from the first's, at the origin).
+    ratio
+        Its speed over the first crankshaft's: -1 (two gears in mesh; a shaft at +1 needs an
+        idler, not modelled).
+    inertia
+        About its axis, kg·m² (its masses' included).
+    mass
+        Its mass, kg, for its weight under gravity (0: not given).
+    masses
+        Every mass·radius it carries (pins, webs, counterweights), at its angles at θ1 = 0.
+    """
+
+    at: tuple[float, float]
+    ratio: int = -1
+    inertia: float = 0.0
+    mass: float = 0.0
+    masses: tuple[Mass, ...] = ()
+
+    def __post_init__(self) -> None:
+        v.store(self, "at", v.vector2(self.at, "at"))
+        if self.at == (0.0, 0.0):
+            raise SpecError("must be away from the first crankshaft's axis (the origin)",
+                            key="at", value=list(self.at))
+        ratio = v.ratio(self.ratio, "ratio")
+        if ratio != -1:
+            raise SpecError("must be -1: two crankshafts geared directly turn opposite ways "
+                            "(one turning the same way needs an idler, not modelled)",
+                            key="ratio", value=self.ratio)
+        v.store(self, "ratio", ratio)
+        v.store(self, "inertia", v.nonnegative(self.inertia, "inertia"))
+        v.store(self, "mass", v.nonnegative(self.mass, "mass"))
+        v.store(self, "masses", _masses(self.masses, "masses"))
+
+    @property
+    def rotor(self) -> Rotor:
+        """Its masses as a rotor at its ratio on its axis (its inertia is its link's)."""
+        return Rotor(ratio=float(self.ratio), inertia=0.0, axis=complex(*self.at),
+                     eccentrics=tuple(m.eccentric for m in self.masses))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -352,7 +419,9 @@ class Engine(MechanismModel):
     main_bearings
         The main bearings' planes along the crankshaft, m, increasing (none: their loads are
         reported summed as ``O``); each throw's loads are shared by the two bearings around it
-        by the lever rule (:mod:`.bearings`).
+        by the lever rule (:mod:`.bearings`). An engine of one crankshaft's.
+    crankshafts
+        Further crankshafts geared to the first (crankshaft 2, 3, …): twin-crank engines.
     """
 
     type: ClassVar[str] = "engine"
@@ -371,6 +440,7 @@ class Engine(MechanismModel):
     firing_order: tuple[int, ...] | None = None
     gas: GasCycle | None = None
     main_bearings: tuple[float, ...] = ()
+    crankshafts: tuple[GearedCrankshaft, ...] = ()
 
     def __post_init__(self) -> None:
         """Check the fields (keys are the spec's, from its root)."""
@@ -393,6 +463,21 @@ class Engine(MechanismModel):
             if not isinstance(s, BalanceShaft):
                 raise SpecError("must be a BalanceShaft", key=v.item("balance_shafts", j), value=s)
         v.store(self, "balance_shafts", shafts)
+        geared = tuple(self.crankshafts)
+        for j, g in enumerate(geared):
+            if not isinstance(g, GearedCrankshaft):
+                raise SpecError("must be a GearedCrankshaft", key=v.item("crankshafts", j),
+                                value=g)
+            if any(g.at == h.at for h in geared[:j]):
+                raise SpecError("is another crankshaft's axis: each turns about its own",
+                                key=f"{v.item('crankshafts', j)}.at", value=list(g.at))
+        v.store(self, "crankshafts", geared)
+        for i, c in enumerate(cylinders):
+            if c.crankshaft > 1 + len(geared):
+                raise SpecError(f"names no crankshaft: there are {1 + len(geared)} (1 the "
+                                "first, 2 and on those of [[crankshafts]])",
+                                key=f"{v.item('mechanism.cylinders', i)}.crankshaft",
+                                value=c.crankshaft)
         strokes = v.number(self.strokes, "mechanism.strokes")
         if strokes not in (2, 4):
             raise SpecError("must be 4 or 2", key="mechanism.strokes", value=self.strokes)
@@ -429,7 +514,31 @@ class Engine(MechanismModel):
                 b <= a for a, b in zip(bearings, bearings[1:], strict=False))):
             raise SpecError("must be two planes or more, increasing along the crankshaft (m)",
                             key="mechanism.main_bearings", value=list(bearings))
+        if bearings and geared:
+            raise SpecError("are an engine of one crankshaft's: the main bearings of geared "
+                            "crankshafts are not modelled (their pivots' loads are reported)",
+                            key="mechanism.main_bearings", value=list(bearings))
         v.store(self, "main_bearings", bearings)
+
+    # -- its crankshafts ---------------------------------------------------------------------
+
+    def shaft_ratio(self, shaft: int) -> int:
+        """Crankshaft ``shaft``'s speed over the first's (1 for the first)."""
+        return 1 if shaft == 1 else self.crankshafts[shaft - 2].ratio
+
+    def shaft_axis(self, shaft: int) -> complex:
+        """Crankshaft ``shaft``'s axis, ``x + i·y``, m (the origin for the first)."""
+        return 0j if shaft == 1 else complex(*self.crankshafts[shaft - 2].at)
+
+    def shaft_masses(self, shaft: int) -> tuple[Mass, ...]:
+        """The masses crankshaft ``shaft`` carries."""
+        return (self.crankshaft.masses if shaft == 1
+                else self.crankshafts[shaft - 2].masses)
+
+    @property
+    def shafts(self) -> tuple[int, ...]:
+        """The crankshafts' numbers, 1 the first."""
+        return tuple(range(1, 2 + len(self.crankshafts)))
 
     # -- the working cycle -------------------------------------------------------------------
 
@@ -456,7 +565,8 @@ class Engine(MechanismModel):
         turn = 2 * math.pi
         previous: float | None = None
         for k in self.firing_order:
-            tdc = self.cylinders[k - 1].top_dead_centre
+            c = self.cylinders[k - 1]
+            tdc = c.top_dead_centre(self.shaft_ratio(c.crankshaft))
             if previous is None:
                 angle = tdc
             else:
@@ -491,24 +601,36 @@ class Engine(MechanismModel):
         if not isinstance(balanced, Engine):  # (a redesign is the same kind of mechanism)
             return None
 
-        def webs(engine: Engine) -> list[float]:
-            return [m.z for m in engine.crankshaft.masses
+        def webs(engine: Engine) -> list[tuple[int, float]]:
+            return [(shaft, m.z) for shaft in engine.shafts for m in engine.shaft_masses(shaft)
                     if m.label == COUNTERWEIGHT and m.mr > 0]
 
         return self.throws(webs(balanced)), balanced.throws(webs(self))
 
-    def throws(self, webs: Sequence[float] = ()) -> tuple[Throw, ...]:
-        """The crank throws and their balance factors (:class:`Throw`), along the crankshaft.
+    def throws(self, webs: Sequence[tuple[int, float]] = ()) -> tuple[Throw, ...]:
+        """The crank throws and their balance factors (:class:`Throw`), along each crankshaft.
 
-        Cylinders share a crank pin where their pins have the same phase and they are next to
-        each other along the crankshaft with no web between them: no plane of a labelled
-        counterweight (nor of ``webs``, m: another design's counterweights, so that two
-        designs' throws are the same) lies between their planes. Each crankshaft mass belongs
-        to the throw nearest its plane (shared evenly between two at the same distance).
+        Cylinders share a crank pin where they are on one crankshaft, their pins have the same
+        phase and they are next to each other along it with no web between them: no plane of a
+        labelled counterweight of that shaft (nor of ``webs``, ``(shaft, z)``: another
+        design's counterweights, so that two designs' throws are the same) lies between their
+        planes. Each of a crankshaft's masses belongs to its throw nearest the mass's plane
+        (shared evenly between two at the same distance). The first crankshaft's throws first.
         """
-        order = sorted(range(len(self.cylinders)), key=lambda i: self.cylinders[i].z)
-        walls = sorted({m.z for m in self.crankshaft.masses
-                        if m.label == COUNTERWEIGHT and m.mr > 0} | set(webs))
+        out: list[Throw] = []
+        for shaft in self.shafts:
+            on = [i for i, c in enumerate(self.cylinders) if c.crankshaft == shaft]
+            if on:
+                walls = [z for k, z in webs if k == shaft]
+                out += self._shaft_throws(on, self.shaft_masses(shaft), walls)
+        return tuple(out)
+
+    def _shaft_throws(self, on: Sequence[int], masses: Sequence[Mass],
+                      webs: Sequence[float]) -> list[Throw]:
+        """:meth:`throws` of one crankshaft: its cylinders' indices ``on``, its masses."""
+        order = sorted(on, key=lambda i: self.cylinders[i].z)
+        walls = sorted({m.z for m in masses if m.label == COUNTERWEIGHT and m.mr > 0}
+                       | set(webs))
         groups: list[list[int]] = []
         for i in order:
             c = self.cylinders[i]
@@ -532,7 +654,7 @@ class Engine(MechanismModel):
         spans = [(min(self.cylinders[i].z for i in m), max(self.cylinders[i].z for i in m))
                  for m in groups]
         length = max(hi for _, hi in spans) - min(lo for lo, _ in spans)
-        for mass in self.crankshaft.masses:
+        for mass in masses:
             gaps = [max(lo - mass.z, mass.z - hi, 0.0) for lo, hi in spans]
             nearest = [g for g, d in enumerate(gaps) if d <= min(gaps) + 1e-12 * length]
             for g in nearest:
@@ -542,33 +664,35 @@ class Engine(MechanismModel):
                     counter[g] -= along
                 else:
                     rotating[g] += along
-        return tuple(Throw(cylinders=tuple(i + 1 for i in members),
-                           phase_deg=self.cylinders[members[0]].phase_deg,
-                           rotating_mr=rotating[g], reciprocating_mr=reciprocating[g],
-                           counterweight_mr=counter[g])
-                     for g, members in enumerate(groups))
+        return [Throw(cylinders=tuple(i + 1 for i in members),
+                      phase_deg=self.cylinders[members[0]].phase_deg,
+                      rotating_mr=rotating[g], reciprocating_mr=reciprocating[g],
+                      counterweight_mr=counter[g])
+                for g, members in enumerate(groups)]
 
     # -- what every mechanism model offers ---------------------------------------------------
 
     @property
     def link_names(self) -> tuple[str, ...]:
         n = len(self.cylinders)
-        return ("crankshaft", *(f"rod{k}" for k in range(1, n + 1)),
-                *(f"piston{k}" for k in range(1, n + 1)))
+        return ("crankshaft", *(crankshaft_name(k) for k in self.shafts[1:]),
+                *(f"rod{k}" for k in range(1, n + 1)), *(f"piston{k}" for k in range(1, n + 1)))
 
     @property
     def links(self) -> tuple[Link, ...]:
-        """The crankshaft (its mass on its axis, its inertia), each rod, each piston."""
-        shaft = ShaftLink(mass=self.crankshaft.mass, inertia=self.crankshaft.inertia, e=0.0,
-                          f=0.0)
+        """Each crankshaft (its mass on its axis, its inertia), each rod, each piston."""
+        first = self.crankshaft
+        shafts = (ShaftLink(mass=first.mass, inertia=first.inertia, e=0.0, f=0.0),
+                  *(ShaftLink(mass=g.mass, inertia=g.inertia, e=0.0, f=0.0)
+                    for g in self.crankshafts))
         rods = tuple(replace(self.rod, z=c.z) for c in self.cylinders)
         pistons = tuple(Link(mass=self.piston, inertia=0.0, e=0.0, f=0.0, z=c.z)
                         for c in self.cylinders)
-        return (shaft, *rods, *pistons)
+        return (*shafts, *rods, *pistons)
 
     @property
     def grounded_links(self) -> tuple[str, ...]:
-        return ("crankshaft",)
+        return ("crankshaft", *(crankshaft_name(k) for k in self.shafts[1:]))
 
     @property
     def sizes(self) -> dict[str, float]:
@@ -586,6 +710,8 @@ class Engine(MechanismModel):
             out[f"{v.item('balance_shafts', j)}.at"] = math.hypot(*s.at)
         for j, z in enumerate(self.main_bearings):
             out[v.item("mechanism.main_bearings", j)] = abs(z)
+        for j, g in enumerate(self.crankshafts):
+            out[f"{v.item('crankshafts', j)}.at"] = math.hypot(*g.at)
         return out
 
     @property
@@ -593,17 +719,24 @@ class Engine(MechanismModel):
         return tuple(("gas", self.gas_force(k)) for k in range(1, len(self.cylinders) + 1))
 
     def with_links(self, links: dict[str, Link]) -> Engine:
-        """A copy with the crankshaft's mass and inertia replaced (``"crankshaft"``).
+        """A copy with crankshafts' masses and inertias replaced (``"crankshaft"``, …).
 
         An engine's rods and pistons are one spec for every cylinder: they are replaced through
         the fields ``rod`` and ``piston`` (``dataclasses.replace``).
         """
-        unknown = set(links) - {"crankshaft"}
+        names = {crankshaft_name(k): k for k in self.shafts}
+        unknown = set(links) - set(names)
         if unknown:
             raise KeyError(sorted(unknown)[0])
-        shaft = links["crankshaft"]
-        return replace(self, crankshaft=replace(self.crankshaft, mass=shaft.mass,
-                                                inertia=shaft.inertia))
+        first = self.crankshaft
+        geared = list(self.crankshafts)
+        for name, link in links.items():
+            k = names[name]
+            if k == 1:
+                first = replace(first, mass=link.mass, inertia=link.inertia)
+            else:
+                geared[k - 2] = replace(geared[k - 2], mass=link.mass, inertia=link.inertia)
+        return replace(self, crankshaft=first, crankshafts=tuple(geared))
 
     def without_loads(self) -> Engine:
         """A copy without gas."""
@@ -616,26 +749,34 @@ class Engine(MechanismModel):
         """The cylinders' planes, each once, in the cylinders' order, m."""
         return tuple(dict.fromkeys(c.z for c in self.cylinders))
 
-    def counterweights_in(self, planes: Sequence[float]) -> tuple[Mass, ...]:
-        """The crankshaft's masses labelled ``"counterweight"`` in ``planes``."""
-        return tuple(m for m in self.crankshaft.masses
-                     if m.label == COUNTERWEIGHT and any(m.z == z for z in planes))
+    def counterweights_in(self, places: Sequence[tuple[int, float]]
+                          ) -> tuple[tuple[int, Mass], ...]:
+        """The masses labelled ``"counterweight"`` at ``places`` (crankshaft, plane z)."""
+        return tuple((k, m) for k in self.shafts for m in self.shaft_masses(k)
+                     if m.label == COUNTERWEIGHT and (k, m.z) in set(places))
 
     def with_rotor_masses(self, counterweights: Sequence[PlacedMass],
-                          shafts: Sequence[ShaftDesign], replacing: Sequence[float]) -> Engine:
+                          shafts: Sequence[ShaftDesign],
+                          replacing: Sequence[tuple[int, float]]) -> Engine:
         """The engine with new counterweights and shafts (DESIGN.md, "Balancing an engine").
 
-        The labelled counterweights in the planes ``replacing`` go; each of ``counterweights``
-        with a mass·radius is added, labelled ``"counterweight"``; each of ``shafts`` is added
-        after the engine's own (no inertia), with its eccentrics that have a mass·radius.
+        The labelled counterweights at ``replacing`` (crankshaft, plane) go; each of
+        ``counterweights`` with a mass·radius is added to its crankshaft, labelled
+        ``"counterweight"``; each of ``shafts`` is added after the engine's own (no inertia),
+        with its eccentrics that have a mass·radius.
         """
         gone = set(self.counterweights_in(replacing))
-        kept = tuple(m for m in self.crankshaft.masses if m not in gone)
-        added = tuple(Mass(mr=c.mr, phase_deg=c.phase_deg, z=c.z, label=COUNTERWEIGHT)
-                      for c in counterweights if c.mr > 0)
+        masses = {k: [m for m in self.shaft_masses(k) if (k, m) not in gone]
+                  for k in self.shafts}
+        for c in counterweights:
+            if c.mr > 0:
+                masses[c.crankshaft].append(Mass(mr=c.mr, phase_deg=c.phase_deg, z=c.z,
+                                                 label=COUNTERWEIGHT))
         new_shafts = tuple(
             BalanceShaft(ratio=s.ratio, at=s.at, eccentrics=tuple(
                 Mass(mr=e.mr, phase_deg=e.phase_deg, z=e.z) for e in s.eccentrics if e.mr > 0))
             for s in shafts)
-        return replace(self, crankshaft=replace(self.crankshaft, masses=kept + added),
-                       balance_shafts=self.balance_shafts + new_shafts)
+        geared = tuple(replace(g, masses=tuple(masses[k]))
+                       for k, g in zip(self.shafts[1:], self.crankshafts, strict=True))
+        return replace(self, crankshaft=replace(self.crankshaft, masses=tuple(masses[1])),
+                       crankshafts=geared, balance_shafts=self.balance_shafts + new_shafts)

@@ -1,7 +1,8 @@
 """An engine's tables of a spec (``type = "engine"``; DESIGN.md, "Engines"): read and written.
 
 ``[mechanism]`` (strokes, firing order, every cylinder's lengths and ``[[mechanism.cylinders]]``),
-``[links.crankshaft]``, ``[links.rod]``, ``[links.piston]``, ``[[balance_shafts]]`` and ``[gas]``.
+``[links.crankshaft]``, ``[links.rod]``, ``[links.piston]``, ``[[crankshafts]]``,
+``[[balance_shafts]]`` and ``[gas]``.
 Angles are in degrees, as the spec writes them: what is written reads back exactly. Reached
 through the registry (:func:`balancer.mechanisms.folder_module`) by the spec
 reader and writer (:mod:`balancer.spec`).
@@ -28,7 +29,7 @@ from ...spec import schema
 from ...spec.links import read_link
 from ...spec.parts import part_text, read_part
 from ...spec.tables import Table
-from .model import BalanceShaft, Crankshaft, Cylinder, Engine, GasCycle, Mass
+from .model import BalanceShaft, Crankshaft, Cylinder, Engine, GasCycle, GearedCrankshaft, Mass
 
 #: The cylinder's lengths, in ``[mechanism.lengths]`` and each ``[[mechanism.cylinders]]``.
 LENGTHS = ("crank", "rod", "offset", "bore")
@@ -67,7 +68,9 @@ def _cylinders(mech: Table) -> tuple[Cylinder, ...]:
                                 key=sub.key(k))
         try:
             cylinder = Cylinder(z=sub.value("z", 0.0), phase_deg=sub.value("phase_deg", 0.0),
-                                bank_deg=sub.value("bank_deg", 0.0), **fields)
+                                bank_deg=sub.value("bank_deg", 0.0),
+                                crankshaft=sub.raw("crankshaft") if sub.has("crankshaft") else 1,
+                                **fields)
         except SpecError as exc:  # named where the value was given: here, or for every cylinder
             name = (exc.key or "").split(".")[-1]
             mine = [k for k in ("offset", "crank") if k in own]
@@ -133,6 +136,22 @@ def _shafts(root: Table) -> tuple[BalanceShaft, ...]:
     return tuple(out)
 
 
+def _geared(root: Table) -> tuple[GearedCrankshaft, ...]:
+    """``[[crankshafts]]``: the crankshafts geared to the first."""
+    out = []
+    for sub in root.tables("crankshafts"):
+        sub.expect(schema.known(sub.path, schema.ENGINE))
+        if not sub.has("at"):
+            raise sub._missing("at")
+        masses = _masses(sub, "masses")  # (each under its own path)
+        with v.under(sub.path):
+            out.append(GearedCrankshaft(at=sub.raw("at"), ratio=sub.value("ratio", -1),
+                                        inertia=sub.value("inertia", 0.0),
+                                        mass=sub.value("mass", 0.0), masses=masses))
+        sub.finish()
+    return tuple(out)
+
+
 def _gas(root: Table) -> GasCycle | None:
     table = root.table("gas", required=False)
     if table is None:
@@ -173,7 +192,7 @@ def read(root: Table, mech: Table) -> Engine:
     return Engine(cylinders=cylinders, crankshaft=crankshaft, rod=rod, piston=piston,
                   balance_shafts=_shafts(root), strokes=strokes,
                   firing_order=None if order is None else tuple(order), gas=_gas(root),
-                  main_bearings=tuple(bearings))
+                  main_bearings=tuple(bearings), crankshafts=_geared(root))
 
 
 def _mass_text(m: Mass) -> str:
@@ -200,6 +219,18 @@ def _links_lines(model: Engine, prefix: str) -> list[str]:
             f"com = {{ e = {toml.number(rod.e)}, f = {toml.number(rod.f)} }}  # m from the big "
             "end",
             "", f"[{prefix}.piston]", f"mass = {toml.number(model.piston)}  # kg"]
+    return out
+
+
+def _geared_lines(model: Engine, key: str) -> list[str]:
+    """Each geared crankshaft as ``[[<key>]]``."""
+    out: list[str] = []
+    for g in model.crankshafts:
+        out += ["", f"[[{key}]]", f"at = [{toml.number(g.at[0])}, {toml.number(g.at[1])}]  # m",
+                f"ratio = {g.ratio}", f"inertia = {toml.number(g.inertia)}  # kg·m²"]
+        if g.mass:
+            out.append(f"mass = {toml.number(g.mass)}  # kg")
+        out += _masses_lines("masses", g.masses)
     return out
 
 
@@ -237,7 +268,10 @@ def lines(model: Model) -> list[str]:
         out += [f"{k} = {toml.number(getattr(c, k))}  # m" for k in LENGTHS
                 if getattr(c, k) is not None
                 and (getattr(c, k) != getattr(first, k) or (k == "bore" and not shared_bore))]
-    out += _links_lines(model, "links") + _shafts_lines(model, "balance_shafts")
+        if c.crankshaft != 1:
+            out.append(f"crankshaft = {c.crankshaft}")
+    out += (_links_lines(model, "links") + _geared_lines(model, "crankshafts")
+            + _shafts_lines(model, "balance_shafts"))
     if model.gas is not None:
         g = model.gas
         out += ["", "[gas]",
@@ -278,10 +312,16 @@ def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
         if not sub.has("max_mr"):
             raise sub._missing("max_mr")
         part = _sector(sub.table("part", required=False))
+        numbers = cast("Engine", engine).shafts
         with v.under(sub.path):
             counterweights = CounterweightPlanes(
                 planes=sub.value("planes", list(cast("Engine", engine).counterweight_planes)),
-                max_mr=sub.raw("max_mr"), radius=sub.value("radius", None), part=part)
+                max_mr=sub.raw("max_mr"), radius=sub.value("radius", None), part=part,
+                crankshafts=sub.raw("crankshafts") if sub.has("crankshafts") else numbers)
+        if part is not None and len(counterweights.crankshafts) > 1:
+            raise SpecError("sizes the first crankshaft's crank webs: with counterweights on "
+                            "several crankshafts, name one (crankshafts = [1])",
+                            key=sub.key("part"))
         sub.finish()
     shafts = []
     for sub in table.tables("shafts"):
@@ -341,6 +381,8 @@ def balance_lines(problem: object) -> list[str]:
             out.append(f"radius = {toml.number(cws.radius)}  # m")
         if cws.part is not None:
             out.append(f"part = {part_text(cws.part)}  # m, °: each plane's crank-web sector")
+        if cws.crankshafts != (1,):
+            out.append(f"crankshafts = [{', '.join(str(k) for k in cws.crankshafts)}]")
     for s in problem.shafts:
         out += ["", "[[balance.shafts]]  # a new shaft, sized by the optimiser",
                 f"ratio = {s.ratio}", f"at = {_numbers(s.at)}  # m",
@@ -359,9 +401,11 @@ def read_original(table: Table, model: Model) -> Model:
     table.expect(schema.known("original", schema.ENGINE))
     crankshaft, rod, piston = _crankshaft(table), _rod(table), _piston(table)
     shafts = _shafts(table)
+    geared = _geared(table) if table.tables("crankshafts") else model.crankshafts
     table.finish()
     piston = v.positive(piston, table.key("piston.mass"))  # (named here, not as [links]')
-    return replace(model, crankshaft=crankshaft, rod=rod, piston=piston, balance_shafts=shafts)
+    return replace(model, crankshaft=crankshaft, rod=rod, piston=piston, balance_shafts=shafts,
+                   crankshafts=geared)
 
 
 def original_lines(model: Model) -> list[str]:
@@ -371,7 +415,8 @@ def original_lines(model: Model) -> list[str]:
     ``[[original.balance_shafts]]``.
     """
     assert isinstance(model, Engine)
-    return _links_lines(model, "original") + _shafts_lines(model, "original.balance_shafts")
+    return (_links_lines(model, "original") + _geared_lines(model, "original.crankshafts")
+            + _shafts_lines(model, "original.balance_shafts"))
 
 
 #: Its ``[balance]``: read and written by this module (:func:`read_balance`,
