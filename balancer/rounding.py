@@ -21,6 +21,21 @@ def figure_text(x: float, width: int = 12) -> str:
     return f"{x:>{width}.6g}"
 
 
+#: A direction within this of 0° (either side), degrees, is 0°: no part is made finer, and the
+#: arithmetic's wrap below 0 would print it as 360° on one machine and 0° on another.
+WRAP_DEG = 1e-6
+
+
+def direction_deg(z: complex) -> float:
+    """The direction of the vector ``z`` from +x towards +y, degrees in [0, 360).
+
+    Within :data:`WRAP_DEG` of 0° (a hair above it, or a hair below it that ``% 360`` turns into
+    360° less a hair): 0°.
+    """
+    angle = math.degrees(math.atan2(z.imag, z.real)) % 360.0
+    return 0.0 if angle < WRAP_DEG or angle > 360.0 - WRAP_DEG else angle
+
+
 #: rpm per rad/s.
 RPM = 30.0 / math.pi
 

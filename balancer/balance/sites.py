@@ -37,6 +37,7 @@ from ..model import Design
 from ..model import MechanismModel as Model
 from ..model.balance import PlacedMass, RotorBalanced, RotorBalanceProblem, ShaftDesign
 from ..parts.sizing import most_mr
+from ..rounding import direction_deg
 
 #: A mass·radius below this share of its bound is none (an interior-point method reaches the
 #: apex of a cone, a mass of nothing, only to its tolerance).
@@ -234,8 +235,7 @@ def _placed(z: float, vector: complex, bound: float, crankshaft: int = 1) -> Pla
     if mr <= ABSENT * bound:
         return PlacedMass(z=z, mr=0.0, phase_deg=0.0, crankshaft=crankshaft)
     return PlacedMass(z=z, mr=min(mr, bound),
-                      phase_deg=math.degrees(math.atan2(vector.imag, vector.real)) % 360.0,
-                      crankshaft=crankshaft)
+                      phase_deg=direction_deg(vector), crankshaft=crankshaft)
 
 
 def sites_of(design: Design, start: int) -> tuple[Sites, NDArray[np.float64]]:

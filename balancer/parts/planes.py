@@ -28,6 +28,7 @@ from ..model import Design
 from ..model import MechanismModel as Model
 from ..model.balance import PlacedMass, RotorBalanced, RotorBalanceProblem
 from ..model.parts import Sector
+from ..rounding import direction_deg
 from .sizing import SizedPart, most_mr, size_web
 
 #: The link the parts are on (the drawing's title, the files' names).
@@ -88,7 +89,7 @@ class PlanePart:
         v = self.made_mr
         if v is None:
             return None
-        return PlacedMass(z=self.z, mr=abs(v), phase_deg=math.degrees(cmath.phase(v)) % 360.0)
+        return PlacedMass(z=self.z, mr=abs(v), phase_deg=direction_deg(v))
 
     @property
     def moves(self) -> complex | None:

@@ -318,9 +318,9 @@ def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
                 planes=sub.value("planes", list(cast("Engine", engine).counterweight_planes)),
                 max_mr=sub.raw("max_mr"), radius=sub.value("radius", None), part=part,
                 crankshafts=sub.raw("crankshafts") if sub.has("crankshafts") else numbers)
-        if part is not None and len(counterweights.crankshafts) > 1:
-            raise SpecError("sizes the first crankshaft's crank webs: with counterweights on "
-                            "several crankshafts, name one (crankshafts = [1])",
+        if part is not None and counterweights.crankshafts != (1,):
+            raise SpecError("sizes the first crankshaft's crank webs: with a part, the "
+                            "counterweights go on it alone (crankshafts = [1])",
                             key=sub.key("part"))
         sub.finish()
     shafts = []

@@ -1,0 +1,227 @@
+"""Geared twin crankshafts (``[[crankshafts]]``) against two engines and a gear by hand.
+
+A twin-crank engine is two engines whose crankshafts a pair of equal spur gears turns opposite
+ways: engine A (the first crankshaft's cylinders and masses, about the origin) at θ1, and
+engine B (the second's, built as an engine of its own about the origin) at ``−θ1`` — the same
+motions, B's moved to its axis ``ā``. What the frame feels is theirs summed: the shaking force
+``F_A + F_B``, the rocking couple ``C_A + C_B``, the shaking moment ``M_A + M_B + ā × F_B``
+(B's about its own axis, carried to the origin). B's motor torque ``T_B`` is now the tooth's:
+the tooth force ``λ·t`` on B at the pitch point ``ā/2`` (``t = i·ā/|ā|``) turns B about its
+axis by ``−(|ā|/2)·λ``, so ``λ = −2·T_B/|ā|``; the first crankshaft's motor drives both,
+``T_A − T_B`` (power: B turns at −ω); the main bearings pass A's reaction less the tooth force,
+B's axis B's reaction plus it. Each engine alone is checked against closed forms in
+``test_engines.py``; here the gear's share is computed by hand.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import cvxpy as cp
+import numpy as np
+import pytest
+
+from balancer.balance.optimizer import optimize
+from balancer.cycle import cycle_analysis
+from balancer.errors import SpecError
+from balancer.mechanisms import mechanism_of
+from balancer.mechanisms.engine.model import (
+    BalanceShaft,
+    Crankshaft,
+    Cylinder,
+    Engine,
+    GearedCrankshaft,
+    Mass,
+)
+from balancer.model import Link
+from balancer.spec import dumps_design, load_design, loads_design
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+#: Two routes through the same core at the same states: rounding of sums of a few dozen terms
+#: each within 64 ε, times the position analysis' condition (< 10 here).
+EXACT = 1e-11
+
+
+def masses(rng: np.random.Generator, count: int) -> tuple[Mass, ...]:
+    return tuple(Mass(mr=float(rng.uniform(0.0, 0.02)), phase_deg=float(rng.uniform(0, 360)),
+                      z=float(rng.uniform(-0.1, 0.1))) for _ in range(count))
+
+
+def twin(rng: np.random.Generator, front: int, rear: int) -> Engine:
+    """A random twin: ``front`` cylinders on the first crankshaft, ``rear`` on a geared one."""
+    cylinders = []
+    for k in range(front + rear):
+        crank = float(rng.uniform(0.03, 0.05))
+        cylinders.append(Cylinder(
+            z=float(rng.uniform(-0.1, 0.1)), phase_deg=float(rng.uniform(0, 360)),
+            bank_deg=float(rng.uniform(0, 360)), crank=crank,
+            rod=float(rng.uniform(3.0, 4.0)) * crank,
+            offset=float(rng.uniform(-0.2, 0.2)) * crank, crankshaft=1 if k < front else 2))
+    rod = Link(mass=float(rng.uniform(0.3, 0.8)), inertia=float(rng.uniform(1e-3, 3e-3)),
+               e=float(rng.uniform(0.02, 0.05)), f=float(rng.uniform(-0.01, 0.01)))
+    at = (float(rng.uniform(0.08, 0.2)) * rng.choice([-1, 1]), float(rng.uniform(-0.1, 0.1)))
+    return Engine(
+        cylinders=tuple(cylinders), rod=rod, piston=float(rng.uniform(0.3, 0.6)),
+        crankshaft=Crankshaft(inertia=0.02, masses=masses(rng, 2)),
+        crankshafts=(GearedCrankshaft(at=at, inertia=0.011, masses=masses(rng, 3)),),
+        balance_shafts=(BalanceShaft(ratio=2, at=(0.0, -0.1), inertia=4e-4,
+                                     eccentrics=masses(rng, 1)),))
+
+
+def halves(engine: Engine) -> tuple[Engine, Engine]:
+    """Engine A (the first crankshaft's cylinders, its masses, the balance shafts) and engine
+    B (the geared crankshaft's cylinders and masses, as an engine about the origin)."""
+    geared = engine.crankshafts[0]
+    a = replace(engine, cylinders=tuple(c for c in engine.cylinders if c.crankshaft == 1),
+                crankshafts=())
+    b = replace(engine, cylinders=tuple(replace(c, crankshaft=1) for c in engine.cylinders
+                                        if c.crankshaft == 2),
+                crankshafts=(), balance_shafts=(),
+                crankshaft=Crankshaft(inertia=geared.inertia, masses=geared.masses))
+    return a, b
+
+
+def column(v) -> np.ndarray:
+    return np.asarray(v.x)[:, 0] + 1j * np.asarray(v.y)[:, 0]
+
+
+@pytest.mark.parametrize(("front", "rear", "seed"), [(1, 1, 1), (2, 1, 2), (2, 3, 3)])
+def test_a_twin_is_two_engines_and_a_gear_by_hand(front: int, rear: int, seed: int) -> None:
+    rng = np.random.default_rng(4400 + seed)
+    engine = twin(rng, front, rear)
+    a, b = halves(engine)
+    theta = rng.uniform(-math.pi, math.pi, 40)
+    omega, alpha = rng.uniform(100, 600, 40), rng.uniform(-5e4, 5e4, 40)
+    both = mechanism_of(engine).crank_forces(theta, omega, alpha)
+    fa = mechanism_of(a).crank_forces(theta, omega, alpha)
+    fb = mechanism_of(b).crank_forces(-theta, -omega, -alpha)
+    at = complex(*engine.crankshafts[0].at)
+    force_b = column(fb.shaking_force)
+    cases = {
+        "shaking force": (column(both.shaking_force), column(fa.shaking_force) + force_b),
+        "rocking couple": (column(both.rocking_couple),
+                           column(fa.rocking_couple) + column(fb.rocking_couple)),
+        "shaking moment": (both.shaking_moment[:, 0],
+                           fa.shaking_moment[:, 0] + fb.shaking_moment[:, 0]
+                           + (np.conj(at) * force_b).imag),
+        "driving torque": (both.driving_torque[:, 0],
+                           fa.driving_torque[:, 0] - fb.driving_torque[:, 0]),
+    }
+    t = 1j * at / abs(at)
+    tooth = -2 * fb.driving_torque[:, 0] / abs(at) * t
+    cases["tooth force"] = (column(both.teeth["gear2"]), tooth)
+    cases["main bearings"] = (column(both.reactions["O"]), column(fa.reactions["O"]) - tooth)
+    cases["second axis"] = (column(both.reactions["O2"]), column(fb.reactions["O"]) + tooth)
+    cases["balance shaft"] = (column(both.reactions["shaft1"]), column(fa.reactions["shaft1"]))
+    for name, (got, want) in cases.items():
+        scale = float(np.max(np.abs(want)))
+        assert scale > 0, name
+        assert np.max(np.abs(got - want)) <= EXACT * scale, name
+
+
+def test_the_square_four_fires_every_180_degrees_at_its_own_top_dead_centres() -> None:
+    """Crankshaft 2 turns at −θ1: a pin at phase φ on it is at top dead centre (upright) where
+    −θ1 + φ = 90°; 1-2-4-3 then fires at 90°, 270°, 450°, 630°."""
+    engine = load_design(EXAMPLES / "square_four.toml").mechanism
+    assert isinstance(engine, Engine)
+    assert np.allclose(np.degrees(engine.firing_angles()), [90.0, 270.0, 630.0, 450.0])
+    for c in engine.cylinders:
+        ratio = engine.shaft_ratio(c.crankshaft)
+        pin = ratio * c.top_dead_centre(ratio) + math.radians(c.phase_deg)
+        assert math.isclose(math.cos(pin - math.radians(c.bank_deg)), 1.0, abs_tol=1e-15)
+
+
+def test_the_square_fours_primary_cancels_between_its_shafts() -> None:
+    """Diagonal pistons move together: the reciprocating primary forces and couples cancel
+    between the two crankshafts; the four secondaries add (the flat-plane four's); only the
+    crankshafts' own rotating masses leave a primary couple, forward on the first and backward
+    on the second, equal."""
+    analysis = cycle_analysis(load_design(EXAMPLES / "square_four.toml").mechanism,
+                              523.5987755982989, 720)
+    scale = float(np.max(np.abs(analysis.reactions.shaking_force)))
+    orders = {o.order: o for o in analysis.orders}
+    first, second = orders[1.0], orders[2.0]
+    assert first.shaking_force.forward <= 1e-12 * scale
+    assert first.shaking_force.backward <= 1e-12 * scale
+    assert first.rocking_couple.forward == pytest.approx(first.rocking_couple.backward,
+                                                         rel=1e-12)
+    assert second.shaking_force.forward == pytest.approx(second.shaking_force.backward,
+                                                         rel=1e-12)
+
+
+def test_a_twin_spec_reads_back_as_written() -> None:
+    design = load_design(EXAMPLES / "square_four.toml")
+    again = loads_design(dumps_design(design))
+    assert again.mechanism == design.mechanism
+    assert again.balance == design.balance
+
+
+@pytest.mark.parametrize(("old", "new", "key"), [
+    ("ratio = -1\n", "ratio = 1\n", "crankshafts[1].ratio"),
+    ("at = [0.09, 0.0]", "at = [0.0, 0.0]", "crankshafts[1].at"),
+    ("crankshaft = 2\n", "crankshaft = 3\n", "mechanism.cylinders[3].crankshaft"),
+    ("firing_order = [1, 2, 4, 3]",
+     "firing_order = [1, 2, 4, 3]\nmain_bearings = [-0.08, 0.0, 0.08]",
+     "mechanism.main_bearings"),
+    ("radius = 0.05 ", "crankshafts = [1, 3]\nradius = 0.05 ",
+     "balance.counterweights.crankshafts"),
+])
+def test_bad_twin_specs_are_refused_by_key(old: str, new: str, key: str) -> None:
+    text = (EXAMPLES / "square_four.toml").read_text()
+    assert old in text
+    with pytest.raises(SpecError) as err:
+        design = loads_design(text.replace(old, new, 1))
+        optimize(design, "convex")
+    assert err.value.key == key
+
+
+def test_both_shafts_counterweights_are_the_independent_programs_optimum() -> None:
+    """The square four's counterweights on both crankshafts: J = CVXPY's optimum of
+    ``‖A·X + b‖²`` over the sites' mass·radius vectors, ``A``'s columns written here (a unit
+    mass·radius at ratio k on axis ā in plane z: ``(kω)²·e^{ikθ1}``, ``i·z·F``, ``ā × F``),
+    ``b`` the two-engine sum's loads; the engine built with the reported masses has that J."""
+    design = load_design(EXAMPLES / "square_four.toml")
+    engine, problem, speed = design.mechanism, design.balance, design.operation.speed
+    result = optimize(design, "convex")
+    theta = result.before.theta1
+    base = cycle_analysis(engine, speed, theta1=theta).reactions  # no counterweights to replace
+    sites = [(engine.shaft_ratio(k), engine.shaft_axis(k), z, bound)
+             for k in problem.counterweights.crankshafts
+             for z, bound in zip(problem.counterweights.planes, problem.counterweights.max_mr,
+                                 strict=True)]
+    n, count = theta.size, 2 * len(sites)
+    force = np.zeros((n, count), complex)
+    for i, (k, _, _, _) in enumerate(sites):
+        turn = (k * speed) ** 2 * np.exp(1j * k * theta)
+        force[:, 2 * i], force[:, 2 * i + 1] = turn, 1j * turn
+    planes = np.repeat([z for _, _, z, _ in sites], 2)
+    axes = np.repeat([a for _, a, _, _ in sites], 2)
+    couple, moment = 1j * planes * force, (np.conj(axes) * force).imag
+    w = problem.objective
+    rows, rhs = [], []
+    for weight, cols, b in ((w.shaking_force, force, base.shaking_force),
+                            (w.rocking_couple, couple, base.rocking_couple)):
+        rows += [math.sqrt(weight / n) * cols.real, math.sqrt(weight / n) * cols.imag]
+        rhs += [math.sqrt(weight / n) * b.real, math.sqrt(weight / n) * b.imag]
+    rows.append(math.sqrt(w.shaking_moment / n) * moment)
+    rhs.append(math.sqrt(w.shaking_moment / n) * base.shaking_moment)
+    a, b = np.vstack(rows), np.concatenate(rhs)
+    x = cp.Variable(count)
+    cons = [cp.norm(x[2 * i : 2 * i + 2]) <= s[3] for i, s in enumerate(sites)]
+    program = cp.Problem(cp.Minimize(cp.sum_squares(a @ x + b)), cons)
+    program.solve(solver=cp.CLARABEL)
+    assert result.optimal
+    assert result.objective == pytest.approx(program.value, rel=1e-6)
+    built = result.linkage
+    assert isinstance(built, Engine)
+    after = cycle_analysis(built, speed, theta1=theta).reactions
+    total = (w.shaking_force * np.mean(np.abs(after.shaking_force) ** 2)
+             + w.rocking_couple * np.mean(np.abs(after.rocking_couple) ** 2)
+             + w.shaking_moment * np.mean(after.shaking_moment ** 2))
+    assert result.objective == pytest.approx(total, rel=1e-9)
+    placed = {(c.crankshaft, c.z): c for c in result.rotor_masses.counterweights}
+    assert {k for k, _ in placed} == {1, 2}
+    on_second = [m for m in built.crankshafts[0].masses if m.label == "counterweight"]
+    assert sorted(m.z for m in on_second) == sorted(z for k, z in placed if k == 2)
