@@ -29,7 +29,7 @@ from .entries import (  # (the mechanism types are the schema's names too)
     Key,
     Section,
 )
-from .schema_engines import CRANKSHAFT_KEYS, ENGINE_BALANCE, ENGINE_BALANCE_SECTIONS
+from .schema_engines import GEARED_CRANKSHAFT, ENGINE_BALANCE, ENGINE_BALANCE_SECTIONS
 from .schema_motions import MOTION_SECTIONS, PLAN_SECTIONS
 
 _CLOSED = (FOUR_BAR, SLIDER_CRANK)
@@ -394,7 +394,7 @@ SECTIONS: tuple[Section, ...] = (
             (ENGINE,)),
     Section("crankshafts[]", "A further crankshaft of an engine, geared to the first (twin-"
             "crank, U and opposed-piston engines): the cylinders that name it have their pins "
-            "on it; `analyze` gives the gear pair's tooth load.", CRANKSHAFT_KEYS, (ENGINE,)),
+            "on it; `analyze` gives the gear pair's tooth load.", GEARED_CRANKSHAFT, (ENGINE,)),
     Section("gas", "An engine's gas pressure: cylinder 1's absolute pressure over its working "
             "cycle from its firing top dead centre, a periodic cubic spline through the points; "
             "every cylinder follows it from its own firing (`mechanism.firing_order`). The gas "
@@ -687,7 +687,7 @@ SECTIONS = tuple(
     Section("crankshafts[].masses[]", "A mass·radius a geared crankshaft carries.",
             next(s for s in SECTIONS if s.pattern == "links.<link>.masses[]").keys, (ENGINE,)),
     Section("original.crankshafts[]", "An original geared crankshaft (as `[[crankshafts]]`).",
-            CRANKSHAFT_KEYS, (ENGINE,)),
+            GEARED_CRANKSHAFT, (ENGINE,)),
     Section("original.crankshafts[].masses[]", "A mass·radius an original geared crankshaft "
             "carried.", next(s for s in SECTIONS if s.pattern == "links.<link>.masses[]").keys,
             (ENGINE,)),

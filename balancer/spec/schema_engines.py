@@ -111,7 +111,7 @@ ENGINE_BALANCE_SECTIONS: tuple[Section, ...] = (
 
 #: An engine's geared crankshafts (``[[crankshafts]]``): twin-crank, U and opposed-piston
 #: engines.
-CRANKSHAFT_KEYS = (
+GEARED_CRANKSHAFT = (
     Key("at", "m", "required",
         "Its axis in the x–y plane `[x, y]`, parallel to the first crankshaft's and away from "
         "it; the gear pair's pitch circles touch midway.", (ENGINE,), example="[0.16, 0.0]"),

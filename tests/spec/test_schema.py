@@ -49,6 +49,11 @@ BASES = {schema.FOUR_BAR: "pb1", schema.SLIDER_CRANK: "engine", schema.LINKAGE: 
 SLIDER = ("links.<link>.gas_force", ("links.<link>", "gas_force"))
 #: Values that depend on the base's names (points, links) or must come whole.
 SPRING = {"points": ["D", "A0"], "stiffness": 100.0, "free_length": 0.3}
+#: A geared crankshaft for the base engine (its cylinders stay on the first), and a wheel the
+#: base linkage's crank turns by a gear pair.
+TWIN = {"at": [0.2, 0.0], "masses": [{"mr": 0.01, "phase_deg": 0.0, "z": 0.0}]}
+WHEEL = {"points": ["W0", "W1"], "mass": 1.0, "inertia": 0.01, "com": {"e": 0.0, "f": 0.0}}
+GEAR = {"name": "mesh", "driver": "crank", "driven": "wheel", "ratio": -1.0}
 #: A motion of the one-input base linkage: its crank's own waypoints.
 MOTION = {"name": "turn", "times": [0.0, 1.0], "path": [[0.0], [0.1]]}
 METHOD = {schema.FOUR_BAR: "complex-masses", schema.SLIDER_CRANK: "complex-masses",
@@ -79,8 +84,9 @@ def original_of(data: dict) -> dict:
     keep = ("mass", "inertia", "com", "masses")
     out = {name: {k: copy.deepcopy(v) for k, v in link.items() if k in keep}
            for name, link in data["links"].items() if name != "ground"}
-    if "balance_shafts" in data:
-        out["balance_shafts"] = copy.deepcopy(data["balance_shafts"])
+    for name in ("balance_shafts", "crankshafts"):
+        if name in data:
+            out[name] = copy.deepcopy(data[name])
     return out
 
 
@@ -113,6 +119,19 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
     """
     data = base(mechanism)
     pattern = section.pattern
+    if mechanism == schema.ENGINE and ("crankshafts" in pattern or name == "crankshafts" or (
+            pattern == "mechanism.cylinders[]" and name == "crankshaft")):
+        data["crankshafts"] = [copy.deepcopy(TWIN)]  # (a twin has no main bearings' planes)
+        data["mechanism"].pop("main_bearings", None)
+        if name == "crankshaft":  # (cylinder 1 moved to it: its firings are its own)
+            data.pop("gas")
+            data["mechanism"].pop("firing_order")
+    if mechanism == schema.LINKAGE and (pattern.startswith("mechanism.gears")
+                                        or (pattern == "mechanism" and name == "gears")):
+        data["mechanism"]["points"] |= {"W0": [0.3, 0.0], "W1": [0.35, 0.0]}
+        data["links"]["ground"]["points"].append("W0")
+        data["links"]["wheel"] = copy.deepcopy(WHEEL)
+        data["mechanism"]["gears"] = [dict(GEAR)]
     if pattern.startswith("original") or (pattern == "" and name == "original"):
         data["original"] = original_of(data)
     if pattern.startswith("springs") or (pattern == "" and name == "springs"):
