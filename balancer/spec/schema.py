@@ -29,7 +29,7 @@ from .entries import (  # (the mechanism types are the schema's names too)
     Key,
     Section,
 )
-from .schema_engines import GEARED_CRANKSHAFT, ENGINE_BALANCE, ENGINE_BALANCE_SECTIONS
+from .schema_engines import ENGINE_BALANCE, ENGINE_BALANCE_SECTIONS, GEARED_CRANKSHAFT
 from .schema_motions import MOTION_SECTIONS, PLAN_SECTIONS
 
 _CLOSED = (FOUR_BAR, SLIDER_CRANK)
