@@ -163,8 +163,13 @@ def search(engine: Engine, speed: float, top: int | None = None) -> Search:
     Raises
     ------
     SpecError
-        For more than :data:`MOST_CYLINDERS` cylinders, or no even-firing crank at all.
+        For more than :data:`MOST_CYLINDERS` cylinders, no even-firing crank at all, or an
+        engine of several crankshafts.
     """
+    if engine.crankshafts:
+        raise SpecError("a search arranges the pins of one crankshaft: an engine with geared "
+                        "crankshafts is not searched (their pins' phases are the spec's)",
+                        key="crankshafts")
     cylinders = engine.cylinders
     n = len(cylinders)
     if n > MOST_CYLINDERS:

@@ -151,3 +151,8 @@ def test_search_balance_sizes_each_cranks_counterweights_as_the_spec_asks(capsys
     assert main(["search", str(EXAMPLES / "v8.toml"), "--balance"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--balance" in err[0]
+
+
+def test_an_engine_of_geared_crankshafts_is_not_searched() -> None:
+    """The search arranges one crankshaft's pins: a twin-crank spec is refused by its key."""
+    assert main(["search", str(EXAMPLES / "square_four.toml")]) == 2
