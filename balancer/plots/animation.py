@@ -31,6 +31,7 @@ from .drawing import (
     drawing_frames,
     drawn_mass_sectors,
     frame,
+    pitch_circles,
     revolution,
     slider_block_outlines,
 )
@@ -160,6 +161,7 @@ def animation_figure(design: Design | Model | Mechanism, *, frames: int = 72,
     fig = Figure(figsize=(6, 4.5), dpi=100, layout="constrained")
     ax = fig.add_subplot()
     rims = [c + r * s for c, r in discs.values() for s in (1, -1, 1j, -1j)]
+    rims += [np.array([c + r * s for s in (1, -1, 1j, -1j)]) for c, r in pitch_circles(linkage)]
     rims += [m.axis + r * np.exp(1j * (angles + a))
              for m, angles, r in sectors for a in np.radians((-SECTOR_HALF_ANGLE, 0.0,
                                                                SECTOR_HALF_ANGLE))]

@@ -89,6 +89,19 @@ def frame(linkage: Model | Mechanism, samples: int = 72, states: InputState | No
     return pivots, guides
 
 
+def pitch_circles(linkage: Model | Mechanism) -> list[tuple[complex, float]]:
+    """Each gear pair's two pitch circles as (centre, radius), m: they touch at its pitch point.
+
+    Centred on the gears' pivots, of the pair's pitch radii (:class:`~balancer.linkage.
+    constraints.Mesh`); none for a mechanism without gears.
+    """
+    out: list[tuple[complex, float]] = []
+    for mesh in mechanism_of(linkage).structure.meshes:
+        rho_a, rho_b = mesh.radii
+        out += [(complex(mesh.oa.complex()), abs(rho_a)), (complex(mesh.ob.complex()), abs(rho_b))]
+    return out
+
+
 def drawing_frames(linkage: Model | Mechanism, states: InputState
                    ) -> tuple[dict[str, NDArray[np.complex128]], dict[str, NDArray[np.complex128]],
                               NDArray[np.complex128]]:

@@ -12,7 +12,7 @@ from ..linkage.inputs import InputState
 from ..mechanisms.base import Mechanism
 from ..model import MechanismModel as Model
 from ..outputs import figure_type, write_with
-from .drawing import frame
+from .drawing import frame, pitch_circles
 
 if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions that draw
     from matplotlib.axes import Axes
@@ -64,12 +64,17 @@ def draw_frame(ax: Axes, linkage: Model | Mechanism,
                ) -> None:
     """The frame: the ground pivots as triangles, the ground guides' travel as thick lines.
 
-    The travel over a revolution, or over the input ``states`` given (a motion's).
+    The travel over a revolution, or over the input ``states`` given (a motion's); each gear
+    pair's pitch circles dashed about their pivots.
     """
     pivots, guides = frame(linkage, states=states)
     ax.plot(pivots.real, pivots.imag, "k^", ms=8, label=label, zorder=5)
     for ends in guides:
         ax.plot(ends.real, ends.imag, "k-", lw=6, alpha=0.25, zorder=1)
+    turn = np.exp(1j * np.linspace(0.0, 2 * np.pi, 121))
+    for centre, radius in pitch_circles(linkage):
+        ring = centre + radius * turn
+        ax.plot(ring.real, ring.imag, "k--", lw=0.8, alpha=0.5, zorder=1)
 
 
 #: How far inside the frame (a fraction of the axes) a point beyond the limits is marked.

@@ -225,3 +225,13 @@ def test_both_shafts_counterweights_are_the_independent_programs_optimum() -> No
     assert {k for k, _ in placed} == {1, 2}
     on_second = [m for m in built.crankshafts[0].masses if m.label == "counterweight"]
     assert sorted(m.z for m in on_second) == sorted(z for k, z in placed if k == 2)
+
+
+def test_the_drawn_pitch_circles_touch_at_the_pitch_point() -> None:
+    """Equal gears 90 mm apart: two circles of 45 mm about the axes, touching midway."""
+    from balancer.plots.drawing import pitch_circles
+    circles = pitch_circles(load_design(EXAMPLES / "square_four.toml").mechanism)
+    assert len(circles) == 2
+    (ca, ra), (cb, rb) = circles
+    assert (ca, cb) == (0j, 0.09 + 0j)
+    assert ra == pytest.approx(0.045, rel=1e-15) and rb == pytest.approx(0.045, rel=1e-15)
