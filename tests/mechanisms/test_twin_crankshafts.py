@@ -36,6 +36,7 @@ from balancer.mechanisms.engine.model import (
     Mass,
 )
 from balancer.model import Link
+from balancer.plots.drawing import pitch_circles
 from balancer.spec import dumps_design, load_design, loads_design
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -229,7 +230,6 @@ def test_both_shafts_counterweights_are_the_independent_programs_optimum() -> No
 
 def test_the_drawn_pitch_circles_touch_at_the_pitch_point() -> None:
     """Equal gears 90 mm apart: two circles of 45 mm about the axes, touching midway."""
-    from balancer.plots.drawing import pitch_circles
     circles = pitch_circles(load_design(EXAMPLES / "square_four.toml").mechanism)
     assert len(circles) == 2
     (ca, ra), (cb, rb) = circles
