@@ -458,6 +458,14 @@ class Group:
         return c
 
     @property
+    def mesh(self) -> Mesh:
+        """A geared group's mesh: its last constraint."""
+        c = self.constraints[-1]
+        if not isinstance(c, Mesh):
+            raise ValueError(f"a {self.kind} group has no mesh")
+        return c
+
+    @property
     def driver(self) -> Driver | SlideDriver:
         """An input group's driver: its last constraint."""
         c = self.constraints[-1]

@@ -40,7 +40,6 @@ from . import numeric
 from .constraints import (
     GROUND_INDEX,
     Group,
-    Mesh,
     Pose,
     Prism,
     group_jacobian,
@@ -109,10 +108,9 @@ def positions(structure: Structure, state: InputState, ops: OpsLike = NUMPY,
             _place(pose, g.links[0], angles[g.driver.index], pivot, local, ops)
             continue
         if g.kind == "geared":  # about its pivot, at its driver's angle times the ratio
-            mesh = g.constraints[1]
-            assert isinstance(mesh, Mesh)
             pivot, local = known_point(pose, g.pivot, g.links[0])
-            _place(pose, g.links[0], mesh.driven_angle(pose.angles[mesh.a]), pivot, local, ops)
+            _place(pose, g.links[0], g.mesh.driven_angle(pose.angles[g.mesh.a]), pivot, local,
+                   ops)
             continue
         if g.kind == "slide":  # on its ground guide, at its input's place along it
             prism = g.constraints[0]
