@@ -19,7 +19,7 @@ import importlib
 import math
 import threading
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
@@ -84,6 +84,9 @@ class RotorLoads:
         (complex ``Mx + i·My``, N·m) they add.
     torque
         What they add to the driving torque, N·m.
+    teeth
+        What they add to gear pairs' tooth forces, complex, N, by pair (a rotor on a geared
+        link whose weights' couple the gear carries).
     """
 
     bearings: dict[str, NDArray[np.complex128]]
@@ -91,6 +94,7 @@ class RotorLoads:
     moment: NDArray[np.float64]
     couple: NDArray[np.complex128]
     torque: NDArray[np.float64]
+    teeth: dict[str, NDArray[np.complex128]] = field(default_factory=dict)
 
 
 def _put(forces: Forces, part: Forces, where: NDArray[np.bool_] | slice) -> None:
@@ -512,6 +516,8 @@ class Mechanism:
 
         for point, f in extra.bearings.items():
             add_vector(forces.reactions[point], f)
+        for name, f in extra.teeth.items():
+            add_vector(forces.teeth[name], f)
         add(forces.driving_torque, extra.torque)
         add_vector(forces.shaking_force, extra.force)
         add(forces.shaking_moment, extra.moment)

@@ -88,16 +88,22 @@ def column(v) -> np.ndarray:
     return np.asarray(v.x)[:, 0] + 1j * np.asarray(v.y)[:, 0]
 
 
-@pytest.mark.parametrize(("front", "rear", "seed"), [(1, 1, 1), (2, 1, 2), (2, 3, 3)])
-def test_a_twin_is_two_engines_and_a_gear_by_hand(front: int, rear: int, seed: int) -> None:
+@pytest.mark.parametrize(("front", "rear", "seed", "gravity"), [
+    (1, 1, 1, (0.0, 0.0)), (2, 1, 2, (0.0, 0.0)), (2, 3, 3, (0.0, 0.0)),
+    (1, 2, 4, (3.0, -9.81))])
+def test_a_twin_is_two_engines_and_a_gear_by_hand(front: int, rear: int, seed: int,
+                                                  gravity: tuple[float, float]) -> None:
+    """Under gravity too: the second crankshaft's masses' weights turn it about its own axis,
+    and its gears carry that couple (engine B's motor takes it, as the tooth does)."""
     rng = np.random.default_rng(4400 + seed)
     engine = twin(rng, front, rear)
     a, b = halves(engine)
     theta = rng.uniform(-math.pi, math.pi, 40)
-    omega, alpha = rng.uniform(100, 600, 40), rng.uniform(-5e4, 5e4, 40)
-    both = mechanism_of(engine).crank_forces(theta, omega, alpha)
-    fa = mechanism_of(a).crank_forces(theta, omega, alpha)
-    fb = mechanism_of(b).crank_forces(-theta, -omega, -alpha)
+    slow = 0.01 if any(gravity) else 1.0  # (weights beside the inertia, not drowned by it)
+    omega, alpha = slow * rng.uniform(100, 600, 40), slow**2 * rng.uniform(-5e4, 5e4, 40)
+    both = mechanism_of(engine).crank_forces(theta, omega, alpha, gravity=gravity)
+    fa = mechanism_of(a).crank_forces(theta, omega, alpha, gravity=gravity)
+    fb = mechanism_of(b).crank_forces(-theta, -omega, -alpha, gravity=gravity)
     at = complex(*engine.crankshafts[0].at)
     force_b = column(fb.shaking_force)
     cases = {

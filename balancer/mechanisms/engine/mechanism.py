@@ -19,14 +19,14 @@ from dataclasses import replace
 from functools import cached_property
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ...linkage.kinematics import Motion
 from ...linkage.loads import Reactions, SupportLoad
 from ...linkage.rotors import Rotor, link_inertia
 from ...linkage.structure import Structure
 from ...model import Body, Gear, Linkage, Slider
-from ..base import DrawnMass, Mechanism, piston_block
+from ..base import DrawnMass, Mechanism, RotorLoads, piston_block
 from ..presentation import Presentation
 from .bearings import lever_shares, main_bearing_loads, main_bearing_regressors
 from .model import COUNTERWEIGHT, Engine, crankshaft_name
@@ -154,6 +154,37 @@ class EngineMechanism(Mechanism):
         out += [(f"shaft{j}", s.rotor)
                 for j, s in enumerate(self.model.balance_shafts, start=1)]
         return tuple(out)
+
+    def rotor_loads(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike,
+                    gravity: tuple[float, float] = (0.0, 0.0), *,
+                    weights_on_crank: bool = False) -> RotorLoads | None:
+        """The rotors' loads (:meth:`Mechanism.rotor_loads`), a geared crankshaft's by its gears.
+
+        A geared crankshaft's masses' weights turn it about its own axis with the couple
+        ``C = ū × ḡ``, which its gear pair takes: the tooth force gains ``−C/ρ_b`` along the
+        tangent (``ρ_b`` its signed pitch radius), its axis's reaction as much and the first
+        crankshaft's as much less (the motor's torque, which the ratio carries, is the same
+        either way).
+        """
+        out = super().rotor_loads(theta1, omega1, alpha1, gravity,
+                                  weights_on_crank=weights_on_crank)
+        if out is None or not any(gravity):
+            return out
+        theta = np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))
+                                      for x in (theta1, omega1, alpha1)))[0]
+        meshes = {m.name: m for m in self.structure.meshes}
+        for k, geared in zip(self.model.shafts[1:], self.model.crankshafts, strict=True):
+            if not geared.masses:
+                continue
+            rotor = geared.rotor
+            couple = np.asarray(rotor.weight_couple(theta, complex(*gravity)), float) / rotor.ratio
+            mesh = meshes[gear_name(k)]
+            tooth = (-couple / mesh.radii[1] * complex(mesh.tangent.complex())).astype(complex)
+            for key, into, sign in ((gear_name(k), out.teeth, 1.0),
+                                    (shaft_pivot(k), out.bearings, 1.0),
+                                    (MAIN_BEARINGS, out.bearings, -1.0)):
+                into[key] = np.asarray(into.get(key, 0.0) + sign * tooth, dtype=complex)
+        return out
 
     def support_loads(self, mo: Motion, reactions: Reactions, *, loads: bool = True,
                       gravity: tuple[float, float] = (0.0, 0.0)) -> tuple[SupportLoad, ...]:
