@@ -259,11 +259,11 @@ def sites_of(design: Design, start: int) -> tuple[Sites, NDArray[np.float64]]:
     room = math.inf if cws is None or cws.part is None else most_mr(cws.part)
     sites: list[Site] = []
     if cws is not None:
-        for k in cws.crankshafts:
+        for k in cws.crankshafts or model.shafts:  # (none named: every crankshaft)
             if k not in model.shafts:
                 raise SpecError(f"names no crankshaft: there are {len(model.shafts)}",
                                 key="balance.counterweights.crankshafts",
-                                value=list(cws.crankshafts))
+                                value=list(cws.crankshafts or ()))
             sites += [Site(None, model.shaft_ratio(k), model.shaft_axis(k), z, min(mr, room),
                            crankshaft=k) for z, mr in zip(cws.planes, cws.max_mr, strict=True)]
     replaced = tuple((s.crankshaft, s.z) for s in sites)

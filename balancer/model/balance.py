@@ -344,14 +344,14 @@ class CounterweightPlanes:
         ``optimize`` sizes each plane's sector (:mod:`balancer.parts.planes`).
     crankshafts
         The crankshafts that carry them (1 the first; an engine's geared ones 2 and on): in
-        each of these planes on each.
+        each of these planes on each; ``None`` (the spec names none): every crankshaft.
     """
 
     planes: tuple[float, ...]
     max_mr: tuple[float, ...]
     radius: float | None = None
     part: Sector | None = None
-    crankshafts: tuple[int, ...] = (1,)
+    crankshafts: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         v.store(self, "planes", _planes(self.planes))
@@ -363,6 +363,8 @@ class CounterweightPlanes:
                             'must be "sector"', key="part.shape",
                             value=getattr(self.part, "shape", self.part))
         shafts = self.crankshafts
+        if shafts is None:
+            return
         if (isinstance(shafts, str) or not isinstance(shafts, tuple | list) or not shafts
                 or any(isinstance(k, bool) or not isinstance(k, int) or k < 1 for k in shafts)
                 or len(set(shafts)) != len(shafts)):

@@ -392,9 +392,12 @@ class Linkage(MechanismModel):
         """Each gear pair between two moving links turned about ground pivots apart.
 
         Its driver an input or a driven gear found before it (their angles run on, unwrapped),
-        its driven link no input and driven once, its ratio neither 0 nor 1.
+        its driven link no input and driven once, its ratio neither 0 nor 1; turned by one crank,
+        each geared link at a whole number of the crank's speed (every motion then repeats each
+        revolution, as a cycle analysis and a balancing sample it).
         """
         driven: set[str] = set()
+        overall = {name: 1.0 for name in self.inputs}
         for i, gear in enumerate(self.gears):
             key = v.item("mechanism.gears", i)
             if not isinstance(gear, Gear):
@@ -426,6 +429,12 @@ class Linkage(MechanismModel):
                                 key=f"{key}.driven", value=gear.driven)
             object.__setattr__(gear, "ratio", ratio)
             driven.add(gear.driven)
+            overall[gear.driven] = speed = overall[gear.driver] * ratio
+            if len(self.inputs) == 1 and abs(speed - round(speed)) > 1e-12 * abs(speed):
+                raise SpecError(f"turns {gear.driven} at {speed:.6g} times the crank's speed: "
+                                "a linkage turned by one crank must repeat every revolution, "
+                                "each geared link at a whole number of the crank's speed",
+                                key=f"{key}.ratio", value=gear.ratio)
         v.store(self, "gears", tuple(self.gears))
 
     @staticmethod

@@ -289,7 +289,8 @@ SECTIONS: tuple[Section, ...] = (
                     (LINKAGE,), example='"wheel"'),
                 Key("ratio", "—", "required",
                     "Its speed over the driver's: negative for two gears in mesh, above 1 for a "
-                    "pinion in a ring gear; not 0 nor 1.", (LINKAGE,), example="-1.0"),
+                    "pinion in a ring gear; not 0 nor 1. Turned by one crank, each geared link "
+                    "at a whole number of the crank's speed.", (LINKAGE,), example="-1.0"),
             ), (LINKAGE,)),
     Section("links", "The moving links by name. A four-bar's and a slider-crank's names are "
             "fixed; a general linkage names its own.", (

@@ -50,7 +50,7 @@ def about_pivot(link: Link, length: float) -> float:
     return link.inertia + link.mass * (link.e**2 + link.f**2)
 
 
-@pytest.mark.parametrize("ratio", [-1.0, -2.0, 2.0, 3.0, -0.5])
+@pytest.mark.parametrize("ratio", [-1.0, -2.0, 2.0, 3.0, -3.0])
 def test_driven_crank_and_tooth_force_by_hand(ratio: float) -> None:
     s = Structure.of(geared(ratio))
     assert [g.kind for g in s.groups] == ["input", "geared"]
@@ -174,3 +174,23 @@ def test_bad_gears_are_refused_by_key(field: str, value: object, key: str) -> No
         Linkage(points=good.points, bodies=good.bodies, inputs=good.inputs,
                 gears=(Gear(**gear),))  # type: ignore[arg-type]
     assert err.value.key == key
+
+
+def test_a_crank_turns_its_geared_links_at_whole_numbers_of_its_speed() -> None:
+    """A cycle analysis samples one revolution: a gear at ½ (a motion of two revolutions) is
+    refused by its key; a chain whose ratios multiply to a whole number is not."""
+    good = geared(-1.0)
+    with pytest.raises(SpecError) as err:
+        Linkage(points=good.points, bodies=good.bodies, inputs=good.inputs,
+                gears=(Gear(name="gear", driver="a", driven="b", ratio=0.5),))
+    assert err.value.key == "mechanism.gears[1].ratio"
+    assert "0.5 times the crank's speed" in str(err.value)
+    third = Body(name="c", points=("R", "Z"), props=DRIVEN)
+    chain = Linkage(points=(*good.points, ("R", (-0.2, 0.1)), ("Z", (-0.15, 0.1))),
+                    bodies=(Body(name="ground", points=("O", "P", "R")), *good.bodies[1:],
+                            third),
+                    inputs=("a",), gears=(Gear(name="ab", driver="a", driven="b", ratio=-2.0),
+                                          Gear(name="bc", driver="b", driven="c", ratio=-0.5)))
+    s = Structure.of(chain)
+    mo = motion(s, InputState.crank(np.array([0.3]), np.array([5.0])))
+    assert mo.rate[2][0] == pytest.approx(5.0, rel=1e-14)

@@ -158,8 +158,12 @@ def test_the_square_fours_primary_cancels_between_its_shafts() -> None:
                                                          rel=1e-12)
 
 
-def test_a_twin_spec_reads_back_as_written() -> None:
-    design = load_design(EXAMPLES / "square_four.toml")
+@pytest.mark.parametrize("shafts", ["", "crankshafts = [1]\n", "crankshafts = [2, 1]\n"])
+def test_a_twin_spec_reads_back_as_written(shafts: str) -> None:
+    """Its crankshafts, and the counterweights' (none named: every crankshaft's, still so)."""
+    text = (EXAMPLES / "square_four.toml").read_text().replace("radius = 0.05 ",
+                                                                 f"{shafts}radius = 0.05 ")
+    design = loads_design(text)
     again = loads_design(dumps_design(design))
     assert again.mechanism == design.mechanism
     assert again.balance == design.balance
@@ -195,7 +199,7 @@ def test_both_shafts_counterweights_are_the_independent_programs_optimum() -> No
     theta = result.before.theta1
     base = cycle_analysis(engine, speed, theta1=theta).reactions  # no counterweights to replace
     sites = [(engine.shaft_ratio(k), engine.shaft_axis(k), z, bound)
-             for k in problem.counterweights.crankshafts
+             for k in problem.counterweights.crankshafts or engine.shafts
              for z, bound in zip(problem.counterweights.planes, problem.counterweights.max_mr,
                                  strict=True)]
     n, count = theta.size, 2 * len(sites)

@@ -312,13 +312,13 @@ def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
         if not sub.has("max_mr"):
             raise sub._missing("max_mr")
         part = _sector(sub.table("part", required=False))
-        numbers = cast("Engine", engine).shafts
+        every = cast("Engine", engine).shafts
         with v.under(sub.path):
             counterweights = CounterweightPlanes(
                 planes=sub.value("planes", list(cast("Engine", engine).counterweight_planes)),
                 max_mr=sub.raw("max_mr"), radius=sub.value("radius", None), part=part,
-                crankshafts=sub.raw("crankshafts") if sub.has("crankshafts") else numbers)
-        if part is not None and counterweights.crankshafts != (1,):
+                crankshafts=sub.raw("crankshafts") if sub.has("crankshafts") else None)
+        if part is not None and (counterweights.crankshafts or every) != (1,):
             raise SpecError("sizes the first crankshaft's crank webs: with a part, the "
                             "counterweights go on it alone (crankshafts = [1])",
                             key=sub.key("part"))
@@ -381,7 +381,7 @@ def balance_lines(problem: object) -> list[str]:
             out.append(f"radius = {toml.number(cws.radius)}  # m")
         if cws.part is not None:
             out.append(f"part = {part_text(cws.part)}  # m, °: each plane's crank-web sector")
-        if cws.crankshafts != (1,):
+        if cws.crankshafts is not None:
             out.append(f"crankshafts = [{', '.join(str(k) for k in cws.crankshafts)}]")
     for s in problem.shafts:
         out += ["", "[[balance.shafts]]  # a new shaft, sized by the optimiser",
