@@ -18,7 +18,8 @@ from typing import Any, TypeGuard
 from . import validate as v
 from .cycle import sample_angles
 from .errors import BalancerError
-from .mechanisms import geometry, mechanism_of
+from .linkage.vectors import V
+from .mechanisms import mechanism_of
 from .mechanisms.base import Mechanism
 from .model import Design
 from .model import MechanismModel as Model
@@ -26,7 +27,7 @@ from .rounding import speed_text
 
 #: Longest length that is plausibly meant, m: no planar linkage this tool balances is longer.
 MAX_LENGTH = 100.0
-#: Fastest plausible tip speed ω·R of a point of the mechanism, m/s: the speed of sound in air.
+#: Fastest plausible speed of a point of the mechanism, m/s: the speed of sound in air.
 MAX_TIP_SPEED = 340.0
 #: Lengths named in a note at most (the rest are counted).
 NAMED = 3
@@ -97,45 +98,46 @@ def length_note(data: dict[str, Any]) -> str | None:
             "as m?)")
 
 
-def tip_radius(mechanism: Model | Mechanism, samples: int = 72) -> float | None:
-    """The largest distance of a point or centre of mass from the crank's pivot, m.
+def tip_speed(mechanism: Model | Mechanism, samples: int = 72) -> float | None:
+    """The largest speed of a point or centre of mass with the crank at 1 rad/s, m/s.
 
-    Over ``samples`` crank angles of a revolution (those where the linkage assembles);
-    ``None`` where its motion cannot be found.
+    Over ``samples`` crank angles of a revolution (those where the linkage assembles): each
+    point of each link and each link's centre of mass, as the motion moves it (a geared
+    link's at its own speed about its own pivot); ``None`` where its motion cannot be found.
     """
     import numpy as np
 
-
     try:
         mech = mechanism_of(mechanism)
-        body = next(b for b in mech.linkage.bodies if b.name == mech.input)
+        s = mech.structure
         with np.errstate(all="ignore"):
             mo = mech.motion(sample_angles(samples), 1.0)
-            points = geometry.points(mech, mo)
-            pivot = points[body.points[0]]
-            where = [np.abs(np.asarray(p, complex) - pivot) for p in points.values()]
-            where += [np.abs(c.complex() + 0 * mo.theta1 - pivot)
-                      for c in geometry.centres_of_mass(mech, mo)]
-            radius = float(np.nanmax(np.concatenate([np.ravel(w) for w in where])))
+            speeds = []
+            for k, body in enumerate(mech.linkage.moving):
+                link = mech.linkage.link(body.name)
+                for local in (*(s.local[(k, p)] for p in body.points), V(link.e, link.f)):
+                    v = mo.point_velocity(k, local)
+                    speeds.append(np.ravel(np.hypot(np.asarray(v.x, float),
+                                                    np.asarray(v.y, float))))
+            fastest = float(np.nanmax(np.concatenate(speeds)))
     except (BalancerError, ValueError, KeyError, StopIteration, FloatingPointError):
         return None
-    return radius if math.isfinite(radius) else None
+    return fastest if math.isfinite(fastest) else None
 
 
 def speed_note(design: Design) -> str | None:
     """A note if a point would move faster than :data:`MAX_TIP_SPEED`, or ``None``.
 
-    The tip speed is ``ω·R``: ω the operating speed ``[operation] speed`` (rad/s), R the
-    :func:`tip_radius` (m). ``None`` too for a design without an operating speed.
+    The tip speed is ``|ω|·v``: ω the operating speed ``[operation] speed`` (rad/s), v the
+    :func:`tip_speed` (m/s at 1 rad/s). ``None`` too for a design without an operating speed.
     """
     if design.operation is None:
         return None
     speed = abs(design.operation.speed)
-    radius = tip_radius(design.mechanism)
-    if radius is None or not speed * radius > MAX_TIP_SPEED:
+    fastest = tip_speed(design.mechanism)
+    if fastest is None or not speed * fastest > MAX_TIP_SPEED:
         return None
-    return (f"operation.speed = {speed_text(design.operation.speed)} moves a point "
-            f"{radius:.4g} m "
-            f"from the crank's pivot at {speed * radius:.4g} m/s, faster than sound "
+    return (f"operation.speed = {speed_text(design.operation.speed)} moves a point at "
+            f"{speed * fastest:.4g} m/s, faster than sound "
             f"({MAX_TIP_SPEED:g} m/s): the speed is in rad/s (rpm written as rad/s?) and "
             "lengths in metres (mm written as m?)")

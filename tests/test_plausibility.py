@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import re
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -13,7 +14,7 @@ from golden.record import NOT_RUN
 
 from balancer import examples
 from balancer.cli import main
-from balancer.plausibility import length_note, speed_note
+from balancer.plausibility import length_note, speed_note, tip_speed
 from balancer.spec import load_design
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -99,3 +100,15 @@ def test_points_centres_of_mass_and_springs_are_lengths_too():
     assert "mechanism.points.D = [350, 0] m (350 m from the origin)" in note
     assert "links.rod.com (120 m from its link's first point)" in note
     assert "springs[1].free_length = 400 m" in note
+
+
+def test_a_point_is_as_fast_as_its_own_motion_moves_it():
+    """A geared crankshaft 1 m from the first turns its pins about its own axis: the square
+    four's at 5000 rpm move at about 20 m/s, not at ω times their distance from the first
+    crankshaft's pivot (543 m/s)."""
+    design = load_design(EXAMPLES / "square_four.toml")
+    far = replace(design.mechanism, crankshafts=(
+        replace(design.mechanism.crankshafts[0], at=(1.0, 0.0)),))
+    fastest = tip_speed(far)
+    assert fastest is not None and 0.037 < fastest < 0.06  # a 37.5 mm crank, its rod's ends
+    assert speed_note(replace(design, mechanism=far)) is None

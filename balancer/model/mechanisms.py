@@ -402,6 +402,11 @@ class Linkage(MechanismModel):
             key = v.item("mechanism.gears", i)
             if not isinstance(gear, Gear):
                 raise SpecError("must be a Gear", key=key, value=gear)
+            if (not isinstance(gear.name, str) or not gear.name
+                    or not all(ch.isalnum() or ch in "_-." for ch in gear.name)):
+                raise SpecError("must be a name of letters, digits, '_', '-' and '.' (the "
+                                "outputs' columns are named by it)", key=f"{key}.name",
+                                value=gear.name)
             for attr in ("driver", "driven"):
                 name = getattr(gear, attr)
                 if name not in names or name == GROUND:

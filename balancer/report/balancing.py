@@ -263,6 +263,12 @@ def rotor_masses_text(masses: RotorMasses, speed: float, before: CycleAnalysis |
         b, a = before.summary.ground["O"].max, after.summary.ground["O"].max
         notes.append(f"the main bearings' net reaction RO (all of them together: the force "
                      f"they pass to the frame): largest {b:.6g} N before, {a:.6g} N after")
+        for k in sorted({c.crankshaft for c in masses.counterweights} - {1}):
+            point = f"O{k}"  # (a geared crankshaft's axis)
+            if point in before.reactions.ground and point in after.reactions.ground:
+                b, a = before.summary.ground[point].max, after.summary.ground[point].max
+                notes.append(f"crankshaft {k}'s bearings' net reaction R{point}: largest "
+                             f"{b:.6g} N before, {a:.6g} N after")
     for j, (s, load) in enumerate(zip(masses.shafts, masses.bearing_loads, strict=True),
                                   start=1):
         # Its eccentrics' centrifugal forces are the scale of the force they leave on its

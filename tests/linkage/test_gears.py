@@ -166,6 +166,8 @@ def test_mesh_jacobian_and_gamma_are_the_residuals_derivatives() -> None:
     ("driver", "b", "mechanism.gears[1].driver"),
     ("driven", "a", "mechanism.gears[1].driven"),
     ("driven", "nowhere", "mechanism.gears[1].driven"),
+    ("name", "a,b", "mechanism.gears[1].name"),
+    ("name", "x\ny", "mechanism.gears[1].name"),
 ])
 def test_bad_gears_are_refused_by_key(field: str, value: object, key: str) -> None:
     good = geared(-1.0)

@@ -16,6 +16,7 @@ B's axis B's reaction plus it. Each engine alone is checked against closed forms
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -245,3 +246,26 @@ def test_the_drawn_pitch_circles_touch_at_the_pitch_point() -> None:
     (ca, ra), (cb, rb) = circles
     assert (ca, cb) == (0j, 0.09 + 0j)
     assert ra == pytest.approx(0.045, rel=1e-15) and rb == pytest.approx(0.045, rel=1e-15)
+
+
+def test_an_original_has_the_designs_geared_crankshafts() -> None:
+    """``optimize --out``'s ``[original]`` writes each geared crankshaft with the masses it had
+    and reads back equal; one missing, one more, or one on another axis is refused by key
+    (the original differs from the design in its masses only)."""
+    design = load_design(EXAMPLES / "square_four.toml")
+    balanced = optimize(design, "convex").balanced_design(design)
+    text = dumps_design(balanced)
+    assert "[[original.crankshafts]]" in text
+    again = loads_design(text)
+    assert again.original == balanced.original
+    assert again.original.crankshafts[0].masses == design.mechanism.crankshafts[0].masses
+    block = "[[original.crankshafts]]" + text.split("[[original.crankshafts]]")[1].split(
+        "\n\n", 1)[0]
+    moved = re.sub(r"at = \[0\.09, 0(\.0)?\]", "at = [0.1, 0.0]", block)
+    for changed, key in ((text.replace(block, ""), "original.crankshafts"),
+                         (text.replace(block, block + "\n\n" + block), "original.crankshafts"),
+                         (text.replace(block, moved), "original.crankshafts[1].at")):
+        assert changed != text
+        with pytest.raises(SpecError) as err:
+            loads_design(changed)
+        assert err.value.key == key

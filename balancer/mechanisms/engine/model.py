@@ -471,6 +471,15 @@ class Engine(MechanismModel):
             if any(g.at == h.at for h in geared[:j]):
                 raise SpecError("is another crankshaft's axis: each turns about its own",
                                 key=f"{v.item('crankshafts', j)}.at", value=list(g.at))
+        size = max(c.rod + c.crank + abs(c.offset) for c in cylinders)
+        for j, g in enumerate(geared):
+            reach = math.hypot(*g.at)  # (the frame's points must stay apart, to rounding)
+            if not v.RELATIVE_LENGTH * size < reach < size / v.RELATIVE_LENGTH:
+                raise SpecError(f"must be apart from the first crankshaft's axis by more than "
+                                f"{v.RELATIVE_LENGTH * size:.3g} m and less than "
+                                f"{size / v.RELATIVE_LENGTH:.3g} m (the engine's size, "
+                                f"{size:.3g} m, over and times {1 / v.RELATIVE_LENGTH:.3g})",
+                                key=f"{v.item('crankshafts', j)}.at", value=list(g.at))
         v.store(self, "crankshafts", geared)
         for i, c in enumerate(cylinders):
             if c.crankshaft > 1 + len(geared):

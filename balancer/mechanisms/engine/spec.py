@@ -401,7 +401,16 @@ def read_original(table: Table, model: Model) -> Model:
     table.expect(schema.known("original", schema.ENGINE))
     crankshaft, rod, piston = _crankshaft(table), _rod(table), _piston(table)
     shafts = _shafts(table)
-    geared = _geared(table) if table.tables("crankshafts") else model.crankshafts
+    geared = _geared(table)
+    if len(geared) != len(model.crankshafts):
+        raise SpecError(f"must be the design's geared crankshafts ({len(model.crankshafts)}), "
+                        "each with the masses it had: [[original.crankshafts]]",
+                        key=table.key("crankshafts"), value=len(geared))
+    for j, (old, new) in enumerate(zip(geared, model.crankshafts, strict=True)):
+        if (old.at, old.ratio) != (new.at, new.ratio):
+            raise SpecError(f"must be the design's axis {list(new.at)} and ratio {new.ratio}: the "
+                            "original differs in its masses only",
+                            key=f"{v.item(table.key('crankshafts'), j)}.at", value=list(old.at))
     table.finish()
     piston = v.positive(piston, table.key("piston.mass"))  # (named here, not as [links]')
     return replace(model, crankshaft=crankshaft, rod=rod, piston=piston, balance_shafts=shafts,
