@@ -101,17 +101,22 @@ def length_note(data: dict[str, Any]) -> str | None:
 def tip_speed(mechanism: Model | Mechanism, samples: int = 72) -> float | None:
     """The largest speed of a point or centre of mass with the crank at 1 rad/s, m/s.
 
-    Over ``samples`` crank angles of a revolution (those where the linkage assembles): each
-    point of each link and each link's centre of mass, as the motion moves it (a geared
-    link's at its own speed about its own pivot); ``None`` where its motion cannot be found.
+    Over ``samples`` crank angles of a revolution, or of the ranges where the linkage
+    assembles less a twentieth of each at either end (where the crank cannot drive it, the
+    links' rates grow without bound): each point of each link and each link's centre of mass,
+    as the motion moves it (a geared link's at its own speed about its own pivot); ``None``
+    where its motion cannot be found.
     """
     import numpy as np
 
     try:
         mech = mechanism_of(mechanism)
         s = mech.structure
+        reach = mech.assembly_range()
+        angles = (sample_angles(samples) if reach.full else np.concatenate(
+            [np.linspace(a + (b - a) / 20, b - (b - a) / 20, samples) for a, b in reach.intervals]))
         with np.errstate(all="ignore"):
-            mo = mech.motion(sample_angles(samples), 1.0)
+            mo = mech.motion(angles, 1.0)
             speeds = []
             for k, body in enumerate(mech.linkage.moving):
                 link = mech.linkage.link(body.name)
@@ -119,7 +124,8 @@ def tip_speed(mechanism: Model | Mechanism, samples: int = 72) -> float | None:
                     v = mo.point_velocity(k, local)
                     speeds.append(np.ravel(np.hypot(np.asarray(v.x, float),
                                                     np.asarray(v.y, float))))
-            fastest = float(np.nanmax(np.concatenate(speeds)))
+            every = np.concatenate(speeds)
+            fastest = float(np.max(every[np.isfinite(every)], initial=0.0))
     except (BalancerError, ValueError, KeyError, StopIteration, FloatingPointError):
         return None
     return fastest if math.isfinite(fastest) else None
