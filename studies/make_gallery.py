@@ -96,7 +96,8 @@ COMMANDS = (
 #: Animations: (gallery name, example spec, frames per revolution).
 ANIMATIONS = (("meijaard2020.gif", "meijaard2020", 48),
               ("single_cylinder.gif", "single_cylinder", 36),
-              ("square_four.gif", "square_four", 36))
+              ("square_four.gif", "square_four", 36),
+              ("opposed_piston.gif", "opposed_piston", 36))
 #: Size budget per gallery file, bytes.
 MAX_BYTES = {".png": 250_000, ".gif": 600_000}
 

@@ -214,3 +214,24 @@ def test_a_design_the_optimum_leaves_free_is_not_compared_but_its_objective_is()
                         ("before.shaking_moment.rms", 214.892 * (1 + 1e-7))):
         moved = _with(doc, path, value)
         assert difference(text, _json(moved), "optimize.json", unique=False) is not None, path
+
+
+def test_a_force_balanced_designs_rounding_is_compared_to_its_scale():
+    """A design force-balanced by its symmetry (the opposed-piston single): its centre of mass's
+    excursion is its positions' rounding (1e-17 m), compared to POSITION_ROUNDING; a run's
+    shaking force is its reactions' rounding, compared to the reactions' scale (its force over
+    its level); a ratio of two such roundings is not compared. A real force is."""
+    analysis = {"centre_of_mass_excursion": 8.32708360701793e-17}
+    text = _json(analysis)
+    assert difference(text, _json(_with(analysis, "centre_of_mass_excursion",
+                                        8.327157583724375e-17)), "analyze.json") is None
+    assert difference(text, _json(_with(analysis, "centre_of_mass_excursion", 2e-12)),
+                      "analyze.json") is not None
+    run = {"max_shaking_force": 2.2e-11, "force_level": 3.3e-15, "rtol": 1e-9, "steps": 64,
+           "revolutions": 4.0}
+    verify = {"driven": run}
+    text = _json(verify)
+    assert difference(text, _json(_with(verify, "driven.max_shaking_force", 2.4e-11)),
+                      "verify.json") is None
+    assert difference(text, _json(_with(verify, "driven.max_shaking_force", 1.0)),
+                      "verify.json") is not None

@@ -116,8 +116,9 @@ GEARED_CRANKSHAFT = (
         "Its axis in the x–y plane `[x, y]`, parallel to the first crankshaft's and away from "
         "it; the gear pair's pitch circles touch midway.", (ENGINE,), example="[0.16, 0.0]"),
     Key("ratio", "—", "-1",
-        "Its speed over the first crankshaft's: -1, two gears in mesh turning opposite ways "
-        "(the same way needs an idler, not modelled).", (ENGINE,), example="-1"),
+        "Its speed over the first crankshaft's: -1, two equal gears in mesh, turning opposite "
+        "ways; 1, through an idler gear midway between the axes, turning the same way (each "
+        "pitch radius a quarter of the axes' distance).", (ENGINE,), example="-1"),
     Key("inertia", "kg·m²", "0", "About its axis, its masses included; at least 0.", (ENGINE,),
         example="0.012"),
     Key("mass", "kg", "0", "Its mass, for its weight under gravity; at least 0.", (ENGINE,),
@@ -126,4 +127,7 @@ GEARED_CRANKSHAFT = (
         "Every mass·radius it carries (pins, webs, counterweights), as `[links.crankshaft] "
         "masses`: their angles at θ1 = 0.", (ENGINE,),
         example="[{ mr = 0.015, phase_deg = 180.0, z = 0.0 }]"),
+    Key("idler_inertia", "kg·m²", "0",
+        "At ratio 1, the idler gear's inertia about its axis (its centre of mass on it); at "
+        "least 0.", (ENGINE,), example="0.0"),
 )

@@ -53,6 +53,9 @@ from dataclasses import dataclass
 from balancer.balance.feasibility import ROUNDING_TOLERANCE
 from balancer.balance.result import GAP_TOLERANCE
 
+#: Where the total centre of mass stands still (a design force-balanced by its symmetry), its
+#: excursion is the rounding of the points' positions: of a machine within metres, m.
+POSITION_ROUNDING = 1e-12
 #: A closed form's or a compiled kernel's figures on another machine's arithmetic (another
 #: SIMD width, another BLAS core, FMA or not): relative to the figure, and to the scale of its
 #: quantity in the output.
@@ -249,6 +252,8 @@ def _optimize_rule(path: str, doc: dict, unique: bool = True) -> Rule:
         run = _runs_tolerance(doc.get("verification") or {})
         if path.endswith("energy_error"):
             return Bound(_runs_tolerance(doc["verification"], turning=False).relative)
+        if path.endswith("force_ratio") and _rounding_force(doc["verification"], path, run):
+            return ANY  # (a ratio of two roundings: the original force-balanced too)
         if re.search(r"_(ratio|level)$", path):  # to the original's (or the reactions'): 1
             return Bound(DESIGN_RELATIVE, DESIGN.loosest(run))
         return DESIGN.loosest(run)
@@ -282,13 +287,33 @@ def fixed_lines(doc: dict | None) -> Callable[[str], str]:
     return lambda text: "\n".join(line for line in text.splitlines() if keep.match(line))
 
 
+def _rounding_force(runs: dict, path: str, run: Tolerance) -> bool:
+    """Whether the run at ``path`` (``….driven.force_ratio``) leaves a shaking force that is
+    rounding of its reactions (its ``force_level``)."""
+    level = (runs.get(path.split(".")[-2]) or {}).get("force_level")
+    return level is not None and abs(float(level)) <= run.relative
+
+
+def _reaction_scale(doc: dict) -> float:
+    """The reactions' scale of a verification, N: each run's shaking force over its level."""
+    runs = [doc] if "force_level" in doc else [v for v in doc.values() if isinstance(v, dict)]
+    return max((float(r["max_shaking_force"]) / float(r["force_level"]) for r in runs
+                if r.get("force_level") and r.get("max_shaking_force") is not None),
+               default=0.0)
+
+
 def _simulation_rule(path: str, doc: dict) -> Rule:
-    """What a figure of ``simulate --json`` or ``verify --json`` is."""
+    """What a figure of ``simulate --json`` or ``verify --json`` is.
+
+    A shaking force is measured against the reactions too (a force-balanced design's is
+    their rounding)."""
     run = _runs_tolerance(doc)
     if re.search(r"energy_error$|formulations_agree_to$|constraint_drift\.", path):  # (relative)
         return Bound(_runs_tolerance(doc, turning=False).relative)
     if re.search(r"force_(ratio|level)$", path):  # rounding where force-balanced
         return Bound(run.relative, run)
+    if path.endswith("max_shaking_force"):
+        return Tolerance(run.relative, run.of_scale, run.relative * _reaction_scale(doc))
     return run
 
 
@@ -311,7 +336,8 @@ def json_rules(verb: str, unique: bool = True) -> Callable[[str, dict], Rule]:
         return lambda path, doc: _optimize_rule(path, doc, unique)
     if verb in ("simulate", "verify"):
         return _simulation_rule
-    return lambda path, doc: EXACT
+    return lambda path, doc: (Tolerance(EXACT_RELATIVE, EXACT_OF_SCALE, POSITION_ROUNDING)
+                              if path == "centre_of_mass_excursion" else EXACT)
 
 
 def text_rule(verb: str, text: str, sibling: dict | None = None,

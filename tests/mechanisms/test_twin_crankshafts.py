@@ -51,8 +51,9 @@ def masses(rng: np.random.Generator, count: int) -> tuple[Mass, ...]:
                       z=float(rng.uniform(-0.1, 0.1))) for _ in range(count))
 
 
-def twin(rng: np.random.Generator, front: int, rear: int) -> Engine:
-    """A random twin: ``front`` cylinders on the first crankshaft, ``rear`` on a geared one."""
+def twin(rng: np.random.Generator, front: int, rear: int, ratio: int = -1) -> Engine:
+    """A random twin: ``front`` cylinders on the first crankshaft, ``rear`` on a geared one
+    (at ``ratio``: +1 through an idler of some inertia)."""
     cylinders = []
     for k in range(front + rear):
         crank = float(rng.uniform(0.03, 0.05))
@@ -67,7 +68,8 @@ def twin(rng: np.random.Generator, front: int, rear: int) -> Engine:
     return Engine(
         cylinders=tuple(cylinders), rod=rod, piston=float(rng.uniform(0.3, 0.6)),
         crankshaft=Crankshaft(inertia=0.02, masses=masses(rng, 2)),
-        crankshafts=(GearedCrankshaft(at=at, inertia=0.011, masses=masses(rng, 3)),),
+        crankshafts=(GearedCrankshaft(at=at, inertia=0.011, masses=masses(rng, 3), ratio=ratio,
+                                      idler_inertia=0.004 if ratio == 1 else 0.0),),
         balance_shafts=(BalanceShaft(ratio=2, at=(0.0, -0.1), inertia=4e-4,
                                      eccentrics=masses(rng, 1)),))
 
@@ -129,6 +131,50 @@ def test_a_twin_is_two_engines_and_a_gear_by_hand(front: int, rear: int, seed: i
         assert np.max(np.abs(got - want)) <= EXACT * scale, name
 
 
+@pytest.mark.parametrize(("seed", "gravity"), [(5, (0.0, 0.0)), (6, (2.0, -9.81))])
+def test_a_twin_turning_one_way_is_two_engines_an_idler_and_its_gears_by_hand(
+        seed: int, gravity: tuple[float, float]) -> None:
+    """At ratio +1 the idler midway (pitch radius r = |ā|/4, inertia J_I, turning at −θ1)
+    meshes with both: B's motor torque is the second pair's tooth force at −r, ``λ_b =
+    −T_B/r``; the idler's own equation about its axis, ``−r·(λ_a + λ_b) = J_I·(−α)``, gives
+    the first pair's; the first crankshaft's bearings pass A's reaction less ``λ_a·t``, the
+    idler's ``(λ_a − λ_b)·t``, B's its own plus ``λ_b·t``; the motor drives A, B and the
+    idler, ``T_A + T_B + J_I·α``; the frame takes the idler's change of momentum, ``J_I·α``
+    on the shaking moment (it turns at −α)."""
+    rng = np.random.default_rng(4400 + seed)
+    engine = twin(rng, 2, 2, ratio=1)
+    a, b = halves(engine)
+    theta = rng.uniform(-math.pi, math.pi, 40)
+    slow = 0.01 if any(gravity) else 1.0
+    omega, alpha = slow * rng.uniform(100, 600, 40), slow**2 * rng.uniform(-5e4, 5e4, 40)
+    both = mechanism_of(engine).crank_forces(theta, omega, alpha, gravity=gravity)
+    fa = mechanism_of(a).crank_forces(theta, omega, alpha, gravity=gravity)
+    fb = mechanism_of(b).crank_forces(theta, omega, alpha, gravity=gravity)
+    at = complex(*engine.crankshafts[0].at)
+    idler = engine.crankshafts[0].idler_inertia
+    r, t = abs(at) / 4, 1j * at / abs(at)
+    lam_b = -fb.driving_torque[:, 0] / r
+    lam_a = -lam_b + idler * alpha / r
+    force_b = column(fb.shaking_force)
+    cases = {
+        "shaking force": (column(both.shaking_force), column(fa.shaking_force) + force_b),
+        "shaking moment": (both.shaking_moment[:, 0],
+                           fa.shaking_moment[:, 0] + fb.shaking_moment[:, 0]
+                           + (np.conj(at) * force_b).imag + idler * alpha),
+        "driving torque": (both.driving_torque[:, 0],
+                           fa.driving_torque[:, 0] + fb.driving_torque[:, 0] + idler * alpha),
+        "second pair": (column(both.teeth["gear2b"]), lam_b * t),
+        "first pair": (column(both.teeth["gear2a"]), lam_a * t),
+        "main bearings": (column(both.reactions["O"]), column(fa.reactions["O"]) - lam_a * t),
+        "idler": (column(both.reactions["I2"]), (lam_a - lam_b) * t),
+        "second axis": (column(both.reactions["O2"]), column(fb.reactions["O"]) + lam_b * t),
+    }
+    for name, (got, want) in cases.items():
+        scale = float(np.max(np.abs(want)))
+        assert scale > 0, name
+        assert np.max(np.abs(got - want)) <= EXACT * scale, name
+
+
 def test_the_square_four_fires_every_180_degrees_at_its_own_top_dead_centres() -> None:
     """Crankshaft 2 turns at −θ1: a pin at phase φ on it is at top dead centre (upright) where
     −θ1 + φ = 90°; 1-2-4-3 then fires at 90°, 270°, 450°, 630°."""
@@ -171,7 +217,8 @@ def test_a_twin_spec_reads_back_as_written(shafts: str) -> None:
 
 
 @pytest.mark.parametrize(("old", "new", "key"), [
-    ("ratio = -1\n", "ratio = 1\n", "crankshafts[1].ratio"),
+    ("ratio = -1\n", "ratio = 2\n", "crankshafts[1].ratio"),
+    ("ratio = -1\n", "ratio = -1\nidler_inertia = 0.001\n", "crankshafts[1].idler_inertia"),
     ("at = [0.09, 0.0]", "at = [0.0, 0.0]", "crankshafts[1].at"),
     ("crankshaft = 2\n", "crankshaft = 3\n", "mechanism.cylinders[3].crankshaft"),
     ("firing_order = [1, 2, 4, 3]",
@@ -269,3 +316,25 @@ def test_an_original_has_the_designs_geared_crankshafts() -> None:
         with pytest.raises(SpecError) as err:
             loads_design(changed)
         assert err.value.key == key
+
+
+def test_the_opposed_piston_single_is_point_or_mirror_symmetric_as_its_gears_turn() -> None:
+    """Turning the same way (through the idler), the opposed-piston single is point-symmetric
+    about the liner's middle c: no shaking force at any sample, a moment. Geared to turn
+    opposite ways, it is mirror-symmetric about the line x = c: no x-force and no moment about
+    c (the moment about the origin is then c × F), the vertical forces added."""
+    text = (EXAMPLES / "opposed_piston.toml").read_text()
+    same = load_design(EXAMPLES / "opposed_piston.toml")
+    speed = same.operation.speed
+    a = cycle_analysis(same.mechanism, speed, 360).reactions
+    scale = float(np.max(np.abs(a.ground["O"])))
+    assert float(np.max(np.abs(a.shaking_force))) <= 1e-12 * scale
+    assert float(np.sqrt(np.mean(a.shaking_moment**2))) > 100.0
+    opposite = loads_design(text.replace("ratio = 1\n", "ratio = -1\n").replace(
+        "idler_inertia = 0.004", "idler_inertia = 0.0"))
+    b = cycle_analysis(opposite.mechanism, speed, 360).reactions
+    c = 0.21  # m: the liner's middle
+    assert float(np.max(np.abs(b.shaking_force.real))) <= 1e-12 * scale
+    assert float(np.max(np.abs(b.shaking_force.imag))) > 1000.0
+    about_c = b.shaking_moment - c * b.shaking_force.imag
+    assert float(np.max(np.abs(about_c))) <= 1e-12 * scale * c

@@ -29,7 +29,7 @@ from ...model import Body, Gear, Linkage, Slider
 from ..base import DrawnMass, Mechanism, RotorLoads, piston_block
 from ..presentation import Presentation
 from .bearings import lever_shares, main_bearing_loads, main_bearing_regressors
-from .model import COUNTERWEIGHT, Engine, crankshaft_name
+from .model import COUNTERWEIGHT, Engine, crankshaft_name, idler_name
 
 #: The main bearings' point (the crankshaft's axis at the origin).
 MAIN_BEARINGS = "O"
@@ -51,8 +51,17 @@ def shaft_pivot(k: int) -> str:
 
 
 def gear_name(k: int) -> str:
-    """The gear pair that turns crankshaft ``k`` (2 and on) from the first: ``gear2``…."""
+    """The gear pair that turns crankshaft ``k`` (2 and on) from the first: ``gear2``….
+
+    Through an idler (at ratio +1), two pairs: ``gear2a`` (the first crankshaft and the
+    idler) and ``gear2b`` (the idler and crankshaft 2).
+    """
     return f"gear{k}"
+
+
+def idler_pivot(k: int) -> str:
+    """The frame's point where the idler of crankshaft ``k`` turns: ``I2``…."""
+    return f"I{k}"
 
 
 def _marker_radius(model: Engine, k: int) -> float:
@@ -88,7 +97,7 @@ def engine_linkage(model: Engine) -> Linkage:
     pistons: list[Body] = []
     sliders: list[Slider] = []
     links = model.links
-    n, first_rod = len(model.cylinders), len(shafts)
+    n, first_rod = len(model.cylinders), len(shafts) + len(model.idled)
     for k, c in enumerate(model.cylinders, start=1):
         axis = model.shaft_axis(c.crankshaft)
         pin = cmath.rect(c.crank, c.phase)
@@ -111,11 +120,27 @@ def engine_linkage(model: Engine) -> Linkage:
                         props=(replace(links[0], inertia=links[0].inertia + geared) if k == 1
                                else links[k - 1]))
                    for k in shafts]
-    gears = tuple(Gear(name=gear_name(k), driver=crankshaft_name(1),
-                       driven=crankshaft_name(k), ratio=float(model.shaft_ratio(k)))
-                  for k in shafts[1:])
-    return Linkage(points=tuple(points), bodies=(*bodies, *crankshafts, *rods, *pistons),
-                   inputs=("crankshaft",), sliders=tuple(sliders), gears=gears)
+    gears: list[Gear] = []
+    idlers: list[Body] = []
+    for k in shafts[1:]:
+        if k not in model.idled:
+            gears.append(Gear(name=gear_name(k), driver=crankshaft_name(1),
+                              driven=crankshaft_name(k), ratio=float(model.shaft_ratio(k))))
+            continue
+        middle = model.shaft_axis(k) / 2  # the idler, its pitch radius and theirs |at|/4
+        tip = middle + abs(model.shaft_axis(k)) / 4
+        points += [(idler_pivot(k), (middle.real, middle.imag)),
+                   (f"Y{k}", (tip.real, tip.imag))]
+        bodies[0] = replace(bodies[0], points=(*bodies[0].points, idler_pivot(k)))
+        idlers.append(Body(name=idler_name(k), points=(idler_pivot(k), f"Y{k}"),
+                           props=links[len(shafts) + model.idled.index(k)]))
+        gears += [Gear(name=f"{gear_name(k)}a", driver=crankshaft_name(1),
+                       driven=idler_name(k), ratio=-1.0),
+                  Gear(name=f"{gear_name(k)}b", driver=idler_name(k),
+                       driven=crankshaft_name(k), ratio=-1.0)]
+    return Linkage(points=tuple(points), bodies=(*bodies, *crankshafts, *idlers, *rods,
+                                                  *pistons),
+                   inputs=("crankshaft",), sliders=tuple(sliders), gears=tuple(gears))
 
 
 class EngineMechanism(Mechanism):
@@ -136,6 +161,7 @@ class EngineMechanism(Mechanism):
     @cached_property
     def structure(self) -> Structure:
         exact = {crankshaft_name(k): _marker_radius(self.model, k) for k in self.model.shafts}
+        exact.update({idler_name(k): abs(self.model.shaft_axis(k)) / 4 for k in self.model.idled})
         exact.update({f"rod{k}": c.rod for k, c in enumerate(self.model.cylinders, start=1)})
         return Structure.of(self.linkage, exact)
 
@@ -178,11 +204,17 @@ class EngineMechanism(Mechanism):
                 continue
             rotor = geared.rotor
             couple = np.asarray(rotor.weight_couple(theta, complex(*gravity)), float) / rotor.ratio
-            mesh = meshes[gear_name(k)]
+            idled = k in self.model.idled
+            mesh = meshes[f"{gear_name(k)}b" if idled else gear_name(k)]
             tooth = (-couple / mesh.radii[1] * complex(mesh.tangent.complex())).astype(complex)
-            for key, into, sign in ((gear_name(k), out.teeth, 1.0),
-                                    (shaft_pivot(k), out.bearings, 1.0),
-                                    (MAIN_BEARINGS, out.bearings, -1.0)):
+            # (through a massless idler its other pair's tooth force is the opposite, and its
+            # bearing takes twice the change: the first crankshaft's then gains it)
+            changes = ([(f"{gear_name(k)}b", out.teeth, 1.0), (f"{gear_name(k)}a", out.teeth, -1.0),
+                        (shaft_pivot(k), out.bearings, 1.0), (idler_pivot(k), out.bearings, -2.0),
+                        (MAIN_BEARINGS, out.bearings, 1.0)] if idled else
+                       [(gear_name(k), out.teeth, 1.0), (shaft_pivot(k), out.bearings, 1.0),
+                        (MAIN_BEARINGS, out.bearings, -1.0)])
+            for key, into, sign in changes:
                 into[key] = np.asarray(into.get(key, 0.0) + sign * tooth, dtype=complex)
         return out
 

@@ -23,6 +23,7 @@ from ...linkage.rotors import Eccentric, Rotor
 from ...model.balance import PlacedMass, ShaftDesign
 from ...model.links import GasForce, Link
 from ...model.mechanisms import MechanismModel
+from .throws import COUNTERWEIGHT, Throw, shaft_throws
 
 #: A four-stroke cycle's crank angle, rad; a two-stroke's is half of it.
 TWO_TURNS = 4 * math.pi
@@ -118,8 +119,9 @@ class Cylinder:
 #: The shortest crank, a share of its rod: below, the crank's points meet within rounding.
 SHORTEST_CRANK = 1e-6
 
-#: The label of a counterweight that balancing may replace.
-COUNTERWEIGHT = "counterweight"
+def idler_name(k: int) -> str:
+    """The idler gear that turns crankshaft ``k`` (at ratio +1) from the first: ``idler2``…."""
+    return f"idler{k}"
 
 
 def crankshaft_name(k: int) -> str:
@@ -247,22 +249,25 @@ class GearedCrankshaft:
 
     It turns at ``ratio`` times the first crankshaft's angle about its own axis, parallel to
     the first; the cylinders that name it (``crankshaft = 2``, …) have their pins on it, at
-    ``ratio·θ1 + phase``. The two are coupled by a pair of spur gears whose pitch circles touch
-    midway between the axes (:class:`balancer.model.Gear`: the tooth load is reported).
+    ``ratio·θ1 + phase``. At ratio −1 the two are coupled by a pair of equal spur gears whose
+    pitch circles touch midway between the axes; at +1 through an idler gear midway between
+    them, the three gears' pitch radii a quarter of the axes' distance
+    (:class:`balancer.model.Gear`: each pair's tooth load is reported).
 
     Attributes
     ----------
     at
         Its axis in the x–y plane, m (away from the first's, at the origin).
     ratio
-        Its speed over the first crankshaft's: -1 (two gears in mesh; a shaft at +1 needs an
-        idler, not modelled).
+        Its speed over the first crankshaft's: -1 (two gears in mesh) or +1 (through an idler).
     inertia
         About its axis, kg·m² (its masses' included).
     mass
         Its mass, kg, for its weight under gravity (0: not given).
     masses
         Every mass·radius it carries (pins, webs, counterweights), at its angles at θ1 = 0.
+    idler_inertia
+        At ratio +1, the idler gear's inertia about its axis, kg·m² (its centre of mass on it).
     """
 
     at: tuple[float, float]
@@ -270,18 +275,23 @@ class GearedCrankshaft:
     inertia: float = 0.0
     mass: float = 0.0
     masses: tuple[Mass, ...] = ()
+    idler_inertia: float = 0.0
 
     def __post_init__(self) -> None:
         v.store(self, "at", v.vector2(self.at, "at"))
         if self.at == (0.0, 0.0):
             raise SpecError("must be away from the first crankshaft's axis (the origin)",
                             key="at", value=list(self.at))
-        ratio = v.ratio(self.ratio, "ratio")
-        if ratio != -1:
-            raise SpecError("must be -1: two crankshafts geared directly turn opposite ways "
-                            "(one turning the same way needs an idler, not modelled)",
-                            key="ratio", value=self.ratio)
-        v.store(self, "ratio", ratio)
+        ratio = v.number(self.ratio, "ratio")
+        if ratio not in (-1, 1):
+            raise SpecError("must be -1 (two gears in mesh: the crankshafts turn opposite ways) "
+                            "or 1 (through an idler gear: the same way)", key="ratio",
+                            value=self.ratio)
+        v.store(self, "ratio", int(ratio))
+        v.store(self, "idler_inertia", v.nonnegative(self.idler_inertia, "idler_inertia"))
+        if self.idler_inertia and self.ratio == -1:
+            raise SpecError("is an idler's: a crankshaft at ratio -1 meshes with the first "
+                            "directly", key="idler_inertia", value=self.idler_inertia)
         v.store(self, "inertia", v.nonnegative(self.inertia, "inertia"))
         v.store(self, "mass", v.nonnegative(self.mass, "mass"))
         v.store(self, "masses", _masses(self.masses, "masses"))
@@ -338,51 +348,6 @@ class GasCycle:
         with v.under("gas"):
             return GasForce(angles=tuple(a for a, _ in pairs),
                             values=tuple(f for _, f in pairs), period=period)
-
-
-@dataclass(frozen=True, kw_only=True)
-class Throw:
-    """One crank throw: the cylinders on one crank pin, and the mass·radius that balances it.
-
-    As engine designers quote a throw's **balance factor**: its counterweights' mass·radius
-    against its rotating mass·radius plus half its reciprocating one (each rod split into two
-    point masses at its pins by its centre of mass: ``m_rod·(1 − e/l)`` rotating at the big
-    end, ``m_rod·e/l`` reciprocating with the piston). 100 % balances the rotating masses and
-    half the reciprocating ones (what a single's "50 %" means); an in-line four with eight
-    counterweights runs about 80 %, with four about 57 %.
-
-    Attributes
-    ----------
-    cylinders
-        Its cylinders, numbered from 1.
-    phase_deg
-        Its crank pin's angle at θ1 = 0, degrees.
-    rotating_mr
-        Its rotating mass·radius along its pin, kg·m: the crankshaft's masses not labelled
-        ``"counterweight"`` nearest to it (pin, webs; each by its component along the pin)
-        and each rod's big-end share ``m_rod·(1 − e/l)·r``.
-    reciprocating_mr
-        ``Σ (m_piston + m_rod·e/l)·r`` over its cylinders, kg·m.
-    counterweight_mr
-        The counterweights nearest to it, each by its component opposite the pin, kg·m.
-    """
-
-    cylinders: tuple[int, ...]
-    phase_deg: float
-    rotating_mr: float
-    reciprocating_mr: float
-    counterweight_mr: float
-
-    @property
-    def factor(self) -> float:
-        """The balance factor, ``counterweight_mr / (rotating_mr + reciprocating_mr/2)``."""
-        return self.counterweight_mr / (self.rotating_mr + self.reciprocating_mr / 2)
-
-    def as_dict(self) -> dict[str, object]:
-        """An entry of ``optimize --json``'s ``balance_factors``."""
-        return {"cylinders": list(self.cylinders), "phase_deg": self.phase_deg,
-                "rotating_mr": self.rotating_mr, "reciprocating_mr": self.reciprocating_mr,
-                "counterweight_mr": self.counterweight_mr, "factor": self.factor}
 
 
 def _masses(items: Sequence[Mass], key: str) -> tuple[Mass, ...]:
@@ -631,53 +596,9 @@ class Engine(MechanismModel):
             on = [i for i, c in enumerate(self.cylinders) if c.crankshaft == shaft]
             if on:
                 walls = [z for k, z in webs if k == shaft]
-                out += self._shaft_throws(on, self.shaft_masses(shaft), walls)
+                out += shaft_throws([self.cylinders[i] for i in on], [i + 1 for i in on],
+                                    self.shaft_masses(shaft), walls, self.rod, self.piston)
         return tuple(out)
-
-    def _shaft_throws(self, on: Sequence[int], masses: Sequence[Mass],
-                      webs: Sequence[float]) -> list[Throw]:
-        """:meth:`throws` of one crankshaft: its cylinders' indices ``on``, its masses."""
-        order = sorted(on, key=lambda i: self.cylinders[i].z)
-        walls = sorted({m.z for m in masses if m.label == COUNTERWEIGHT and m.mr > 0}
-                       | set(webs))
-        groups: list[list[int]] = []
-        for i in order:
-            c = self.cylinders[i]
-            if groups:
-                last = self.cylinders[groups[-1][-1]]
-                turn = (c.phase_deg - last.phase_deg) % 360.0
-                if min(turn, 360.0 - turn) <= 1e-9 and not any(last.z < w < c.z for w in walls):
-                    groups[-1].append(i)
-                    continue
-            groups.append([i])
-        rotating = [0.0] * len(groups)
-        reciprocating = [0.0] * len(groups)
-        counter = [0.0] * len(groups)
-        rod = self.rod
-        for g, members in enumerate(groups):
-            for i in members:
-                c = self.cylinders[i]
-                share = rod.e / c.rod  # of the rod's mass at the small end
-                rotating[g] += rod.mass * (1 - share) * c.crank
-                reciprocating[g] += (self.piston + rod.mass * share) * c.crank
-        spans = [(min(self.cylinders[i].z for i in m), max(self.cylinders[i].z for i in m))
-                 for m in groups]
-        length = max(hi for _, hi in spans) - min(lo for lo, _ in spans)
-        for mass in masses:
-            gaps = [max(lo - mass.z, mass.z - hi, 0.0) for lo, hi in spans]
-            nearest = [g for g, d in enumerate(gaps) if d <= min(gaps) + 1e-12 * length]
-            for g in nearest:
-                pin = self.cylinders[groups[g][0]].phase_deg
-                along = mass.mr * math.cos(math.radians(mass.phase_deg - pin)) / len(nearest)
-                if mass.label == COUNTERWEIGHT:
-                    counter[g] -= along
-                else:
-                    rotating[g] += along
-        return [Throw(cylinders=tuple(i + 1 for i in members),
-                      phase_deg=self.cylinders[members[0]].phase_deg,
-                      rotating_mr=rotating[g], reciprocating_mr=reciprocating[g],
-                      counterweight_mr=counter[g])
-                for g, members in enumerate(groups)]
 
     # -- what every mechanism model offers ---------------------------------------------------
 
@@ -685,7 +606,14 @@ class Engine(MechanismModel):
     def link_names(self) -> tuple[str, ...]:
         n = len(self.cylinders)
         return ("crankshaft", *(crankshaft_name(k) for k in self.shafts[1:]),
+                *(idler_name(k) for k in self.idled),
                 *(f"rod{k}" for k in range(1, n + 1)), *(f"piston{k}" for k in range(1, n + 1)))
+
+    @property
+    def idled(self) -> tuple[int, ...]:
+        """The geared crankshafts turned through an idler (at ratio +1)."""
+        return tuple(k for k, g in zip(self.shafts[1:], self.crankshafts, strict=True)
+                     if g.ratio == 1)
 
     @property
     def links(self) -> tuple[Link, ...]:
@@ -693,7 +621,9 @@ class Engine(MechanismModel):
         first = self.crankshaft
         shafts = (ShaftLink(mass=first.mass, inertia=first.inertia, e=0.0, f=0.0),
                   *(ShaftLink(mass=g.mass, inertia=g.inertia, e=0.0, f=0.0)
-                    for g in self.crankshafts))
+                    for g in self.crankshafts),
+                  *(ShaftLink(mass=0.0, inertia=self.crankshafts[k - 2].idler_inertia, e=0.0,
+                              f=0.0) for k in self.idled))
         rods = tuple(replace(self.rod, z=c.z) for c in self.cylinders)
         pistons = tuple(Link(mass=self.piston, inertia=0.0, e=0.0, f=0.0, z=c.z)
                         for c in self.cylinders)
@@ -734,12 +664,17 @@ class Engine(MechanismModel):
         the fields ``rod`` and ``piston`` (``dataclasses.replace``).
         """
         names = {crankshaft_name(k): k for k in self.shafts}
-        unknown = set(links) - set(names)
+        idlers = {idler_name(k): k for k in self.idled}
+        unknown = set(links) - set(names) - set(idlers)
         if unknown:
             raise KeyError(sorted(unknown)[0])
         first = self.crankshaft
         geared = list(self.crankshafts)
         for name, link in links.items():
+            if name in idlers:
+                k = idlers[name]
+                geared[k - 2] = replace(geared[k - 2], idler_inertia=link.inertia)
+                continue
             k = names[name]
             if k == 1:
                 first = replace(first, mass=link.mass, inertia=link.inertia)

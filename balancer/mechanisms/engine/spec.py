@@ -147,7 +147,8 @@ def _geared(root: Table) -> tuple[GearedCrankshaft, ...]:
         with v.under(sub.path):
             out.append(GearedCrankshaft(at=sub.raw("at"), ratio=sub.value("ratio", -1),
                                         inertia=sub.value("inertia", 0.0),
-                                        mass=sub.value("mass", 0.0), masses=masses))
+                                        mass=sub.value("mass", 0.0), masses=masses,
+                                        idler_inertia=sub.value("idler_inertia", 0.0)))
         sub.finish()
     return tuple(out)
 
@@ -230,6 +231,8 @@ def _geared_lines(model: Engine, key: str) -> list[str]:
                 f"ratio = {g.ratio}", f"inertia = {toml.number(g.inertia)}  # kg·m²"]
         if g.mass:
             out.append(f"mass = {toml.number(g.mass)}  # kg")
+        if g.ratio == 1:
+            out.append(f"idler_inertia = {toml.number(g.idler_inertia)}  # kg·m²")
         out += _masses_lines("masses", g.masses)
     return out
 
