@@ -283,8 +283,8 @@ class BalanceProblem:
                             value=self.force_scope)
         if self.max_speed_fluctuation is not None:
             object.__setattr__(self, "max_speed_fluctuation", v.positive(
-                self.max_speed_fluctuation, "balance.max_speed_fluctuation"))
-        object.__setattr__(self, "flywheel", v.nonnegative(self.flywheel, "balance.flywheel"))
+                self.max_speed_fluctuation, "max_speed_fluctuation"))
+        object.__setattr__(self, "flywheel", v.nonnegative(self.flywheel, "flywheel"))
 
     def weights_of(self, names: Sequence[str]) -> tuple[float, ...]:
         """The weights of the motions called ``names`` (1 where none is given)."""
