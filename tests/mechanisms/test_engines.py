@@ -146,10 +146,12 @@ def momentum_loads(engine: Engine, theta: np.ndarray, speed: float) -> Loads:
     power = np.zeros(theta.size)
     big_f = big_m = 0.0
     for c in engine.cylinders:
-        kin = slider_crank(theta, speed, crank=c.crank, rod=c.rod, offset=c.offset,
+        # (on a geared crankshaft k = ±1 about ā: its own angle k·θ1 at the rate k·ω)
+        k, at = engine.shaft_ratio(c.crankshaft), engine.shaft_axis(c.crankshaft)
+        kin = slider_crank(k * theta, k * speed, crank=c.crank, rod=c.rod, offset=c.offset,
                            phase_deg=c.phase_deg, bank_deg=c.bank_deg, e=rod.e, f=rod.f)
-        for m, pos, vel, acc in ((mp, kin.wrist, kin.wrist_vel, kin.wrist_acc),
-                                 (rod.mass, kin.com, kin.com_vel, kin.com_acc)):
+        for m, pos, vel, acc in ((mp, at + kin.wrist, kin.wrist_vel, kin.wrist_acc),
+                                 (rod.mass, at + kin.com, kin.com_vel, kin.com_acc)):
             force += -m * acc
             couple += 1j * c.z * (-m * acc)
             term = m * cross(pos, acc)
@@ -160,11 +162,15 @@ def momentum_loads(engine: Engine, theta: np.ndarray, speed: float) -> Loads:
         moment -= rod.inertia * kin.spin_acc
         power += rod.inertia * kin.spin * kin.spin_acc
         big_m = max(big_m, float(np.max(np.abs(rod.inertia * kin.spin_acc))))
-    for mass in engine.crankshaft.masses:
-        f = mass.mr * speed**2 * np.exp(1j * (theta + math.radians(mass.phase_deg)))
-        force += f
-        couple += 1j * mass.z * f
-        big_f = max(big_f, mass.mr * speed**2)
+    for shaft in engine.shafts:  # each crankshaft's masses, at its ratio about its axis
+        k, at = engine.shaft_ratio(shaft), engine.shaft_axis(shaft)
+        for mass in engine.shaft_masses(shaft):
+            f = mass.mr * speed**2 * np.exp(1j * (k * theta + math.radians(mass.phase_deg)))
+            force += f
+            couple += 1j * mass.z * f
+            moment += cross(at, f)
+            big_f = max(big_f, mass.mr * speed**2)
+            big_m = max(big_m, abs(at) * mass.mr * speed**2)
     for shaft in engine.balance_shafts:
         k = shaft.ratio
         at = complex(*shaft.at)
@@ -491,10 +497,12 @@ def gas_torque(engine: Engine, theta: np.ndarray, speed: float, firings: dict[in
     total = np.zeros(theta.size)
     for k, fire in firings.items():
         c = engine.cylinders[k - 1]
-        kin = slider_crank(theta, speed, crank=c.crank, rod=c.rod, offset=c.offset,
-                           phase_deg=c.phase_deg, bank_deg=c.bank_deg, e=0.0, f=0.0)
+        ratio = engine.shaft_ratio(c.crankshaft)  # (ds/dθ1 = ratio·ds/dψ on its own crank)
+        kin = slider_crank(ratio * theta, ratio * speed, crank=c.crank, rod=c.rod,
+                           offset=c.offset, phase_deg=c.phase_deg, bank_deg=c.bank_deg,
+                           e=0.0, f=0.0)
         p = spline(np.mod(theta - fire, period))
-        total += (p - engine.gas.crankcase) * (math.pi * c.bore**2 / 4) * kin.ds
+        total += (p - engine.gas.crankcase) * (math.pi * c.bore**2 / 4) * ratio * kin.ds
     return total
 
 
@@ -794,8 +802,9 @@ def firing_angles(engine: Engine) -> dict[int, float]:
     out: dict[int, float] = {}
     previous = None
     for k in engine.firing_order:
-        c = engine.cylinders[k - 1]
-        tdc = math.radians(c.bank_deg - c.phase_deg) % (2 * math.pi)
+        c = engine.cylinders[k - 1]  # (its pin at ratio·θ1 + phase: ratio ±1)
+        ratio = engine.shaft_ratio(c.crankshaft)
+        tdc = math.radians(ratio * (c.bank_deg - c.phase_deg)) % (2 * math.pi)
         if previous is None:
             out[k] = tdc
         else:
