@@ -287,18 +287,27 @@ class ConvexSolver(Repairs, Diagnosis):
         assert bound is not None
         for _ in range(MOST_CUTS):
             solution = solve_program(self._stage1, self.settings)
-            if solution.u is None:
-                return  # (infeasible or failed: the solve says so)
-            x = self.layout.x(solution.u)
-            pair = bound.worst_pair(x)
-            if bound.excess(x) <= CUT_ACCURACY * bound.scale or pair in self._pairs:
-                return
-            self._pairs.append(pair)
-            self._cones, self._relaxed = self._constraints()
-            self._stage1 = self._first_stage()
-            self._stage2 = ConicProgram(self.layout.size, self._cones, objective="nearest",
-                                        equality=self._stage2_equality)
-            self._projections = {}
+            if solution.u is None or not self._add_cut(self.layout.x(solution.u)):
+                return  # (held, or infeasible or failed: the solve says so)
+
+    def _add_cut(self, x: NDArray[np.float64]) -> bool:
+        """Add the speed-fluctuation row of the pair ``x`` breaks most, if it breaks one.
+
+        Whether a row was added (the programs then rebuilt with it).
+        """
+        bound = self.data.fluctuation
+        if bound is None:
+            return False
+        pair = bound.worst_pair(x)
+        if bound.excess(x) <= CUT_ACCURACY * bound.scale or pair in self._pairs:
+            return False
+        self._pairs.append(pair)
+        self._cones, self._relaxed = self._constraints()
+        self._stage1 = self._first_stage()
+        self._stage2 = ConicProgram(self.layout.size, self._cones, objective="nearest",
+                                    equality=self._stage2_equality)
+        self._projections = {}
+        return True
 
     @property
     def constraints(self) -> list[Constraint]:
@@ -586,10 +595,19 @@ class ConvexSolver(Repairs, Diagnosis):
             fixed = [] if self._fb is None else [self._fb[1]]
             probe = x
             if self._tie_free:
-                report2, second = self._run(
-                    self._stage2, "tie-break", target=lay.u(target),
-                    equality_rhs=np.concatenate([*fixed, self._seen @ u1]))
+                held = len(self._pairs)
+                for _ in range(MOST_CUTS):  # (its design may break a pair not yet held)
+                    report2, second = self._run(
+                        self._stage2, "tie-break", target=lay.u(target),
+                        equality_rhs=np.concatenate([*fixed, self._seen @ u1]))
+                    if second.u is None or not self._add_cut(lay.x(second.u)):
+                        break
                 stages.append(report2)
+                if len(self._pairs) > held:  # the certificate's multipliers: of these rows
+                    report, again = self._run(self._stage1, "convex")
+                    if again.u is not None:
+                        first = again
+                        stages.append(report)
             if self._tie_free and second.u is not None:
                 x2, tight2 = self.repair(second.u)
                 objective2 = data.reduced_objective(x2)

@@ -58,7 +58,7 @@ IPOPT_OPTIONS: dict[str, object] = {
 
 #: With a bound on the crank's speed fluctuation, the NLP holds the rows of the pairs of samples
 #: whose inertia is within this share of its swing of its largest and of its least at the start.
-NEAR_EXTREME = 0.1
+NEAR_EXTREME = 0.02
 #: With a bound on the supports' loads (``max_bearing_load``), the NLP started from a design
 #: holds only the samples where that design's load is at least this share of the bound (the
 #: bound's Hessian over every sample is costly to build); its design is kept only if it meets
