@@ -19,6 +19,7 @@ import pytest
 
 from balancer.balance.convex import ConvexSolver, solve_program
 from balancer.balance.optimizer import optimize
+from balancer.balance.pareto import pareto_front
 from balancer.balance.problem import numeric_problem
 from balancer.balance.result import InfeasibleError
 from balancer.errors import SpecError
@@ -132,3 +133,10 @@ def test_the_bound_reads_back_and_bad_ones_are_refused_by_key() -> None:
         with pytest.raises(SpecError) as err:
             loads_design(text)
         assert err.value.key == key
+
+
+def test_a_front_refuses_the_bound_by_its_key() -> None:
+    """pareto's programs do not hold the bound's rows: exit 2, naming it."""
+    with pytest.raises(SpecError) as err:
+        pareto_front(loads_design(bounded(0.3)), "driving-torque", 5)
+    assert err.value.key == "balance.max_speed_fluctuation"
