@@ -382,9 +382,8 @@ def _finish(a_terms: list[NDArray[np.float64]], r_terms: list[NDArray[np.float64
         return None
     finite = np.isfinite(hi)
     # An unbounded entry whose coefficient is not surely ≥ 0 (beyond its rounding) needs a
-    # finite bound: it could lower the bound without end. (One that no term has, rmag = 0 —
-    # an inertia only inactive bounds would hold — adds exactly nothing, anywhere.)
-    if np.any(~finite & (rho <= _EPS * (rmag + np.abs(rho))) & (rmag > 0)):
+    # finite bound: it could lower the bound without end.
+    if np.any(~finite & (rho <= _EPS * (rmag + np.abs(rho)))):
         box = sublevel_box()
         if box is None:
             return None

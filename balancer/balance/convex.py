@@ -115,12 +115,6 @@ Affine: TypeAlias = tuple[NDArray[np.float64], float]
 
 
 
-#: Cutting planes of the speed-fluctuation bound: at most this many rounds, each adding a row
-#: while the optimum breaks the bound by more than CUT_ACCURACY of its scale.
-MOST_CUTS = 30
-CUT_ACCURACY = 1e-9
-
-
 def solve_program(program: ConicProgram, settings: dict[str, Any],
                   **data: NDArray[np.float64]) -> ConicSolution:
     """``program`` by Clarabel with ``settings``, again where it did not solve fully.
@@ -195,10 +189,6 @@ class ConvexSolver(Repairs, Diagnosis):
         n = self.layout.size
         self._scale = data.objective_scale
         lay = self.layout
-        #: The pairs of samples whose speed-fluctuation rows the programs hold (cutting planes:
-        #: :meth:`_cut`), the original's largest and least inertia first.
-        self._pairs: list[tuple[int, int]] = (
-            [] if data.fluctuation is None else [data.fluctuation.worst_pair(data.x0)])
         self._cones, self._relaxed = self._constraints()
         self._fb: tuple[NDArray[np.float64], NDArray[np.float64],
                         NDArray[np.float64]] | None = None
@@ -228,8 +218,13 @@ class ConvexSolver(Repairs, Diagnosis):
         self.compressed = compressed
         self._dual_basis = compressed.basis if k else None
         sv, vt = compressed.singular_values, compressed.vt
-        self._mass_row = mass_row
-        self._stage1 = self._first_stage()
+        if self._norm_form:
+            # In epigraph form, so that the norm's multiplier is the cone's dual.
+            self._stage1 = ConicProgram(n, self._cones, equality=equality, objective="norm",
+                                        P=compressed.P, q=compressed.q)
+        else:  # ‖P·u + q‖² + w_m·Δm, constants dropped
+            self._stage1 = ConicProgram(n, self._cones, equality=equality, objective="squares",
+                                        P=compressed.P[:-1], q=compressed.q[:-1], g=mass_row)
         # finalize's projections by margin, built when first needed
         self._projections: dict[float, ConicProgram] = {}
         # Tie-break. J is strictly convex in y = P·u, so every optimal design has the same y
@@ -256,58 +251,10 @@ class ConvexSolver(Repairs, Diagnosis):
         count = sum(e.shape[0] for e, _ in fixed)  # (fewer rows than variables: free)
         self._tie_free = count < n or (bool(fixed) and np.linalg.matrix_rank(
             np.vstack([e for e, _ in fixed])) < n)
-        self._stage2_equality = ((np.vstack([e for e, _ in fixed]),
-                                  np.concatenate([r for _, r in fixed])) if fixed else None)
-        self._stage2 = ConicProgram(n, self._cones, objective="nearest",
-                                    equality=self._stage2_equality)
-        if data.fluctuation is not None:
-            self._cut()
-
-    def _first_stage(self) -> ConicProgram:
-        """The SOCP over :attr:`_cones`, its objective as :meth:`__init__` chose it.
-
-        ``min ‖P·u + q‖`` (in epigraph form, so that the norm's multiplier is the cone's dual),
-        or ``‖P·u + q‖² + w_m·Δm`` (constants dropped).
-        """
-        n, compressed = self.layout.size, self.compressed
-        equality = None if self._fb is None else self._fb[:2]
-        if self._norm_form:
-            return ConicProgram(n, self._cones, equality=equality, objective="norm",
-                                P=compressed.P, q=compressed.q)
-        return ConicProgram(n, self._cones, equality=equality, objective="squares",
-                            P=compressed.P[:-1], q=compressed.q[:-1], g=self._mass_row)
-
-    def _cut(self) -> None:
-        """Add speed-fluctuation rows until the SOCP's optimum keeps every pair's.
-
-        Cutting planes (:mod:`.fluctuation`): each round the pair of its design's largest and
-        least inertia, while its optimum breaks the bound by more than :data:`CUT_ACCURACY`.
-        """
-        bound = self.data.fluctuation
-        assert bound is not None
-        for _ in range(MOST_CUTS):
-            solution = solve_program(self._stage1, self.settings)
-            if solution.u is None or not self._add_cut(self.layout.x(solution.u)):
-                return  # (held, or infeasible or failed: the solve says so)
-
-    def _add_cut(self, x: NDArray[np.float64]) -> bool:
-        """Add the speed-fluctuation row of the pair ``x`` breaks most, if it breaks one.
-
-        Whether a row was added (the programs then rebuilt with it).
-        """
-        bound = self.data.fluctuation
-        if bound is None:
-            return False
-        pair = bound.worst_pair(x)
-        if bound.excess(x) <= CUT_ACCURACY * bound.scale or pair in self._pairs:
-            return False
-        self._pairs.append(pair)
-        self._cones, self._relaxed = self._constraints()
-        self._stage1 = self._first_stage()
-        self._stage2 = ConicProgram(self.layout.size, self._cones, objective="nearest",
-                                    equality=self._stage2_equality)
-        self._projections = {}
-        return True
+        self._stage2 = ConicProgram(
+            n, self._cones, objective="nearest",
+            equality=(np.vstack([e for e, _ in fixed]), np.concatenate([r for _, r in fixed]))
+            if fixed else None)
 
     @property
     def constraints(self) -> list[Constraint]:
@@ -449,13 +396,6 @@ class ConvexSolver(Repairs, Diagnosis):
                 bound = data.sites.sites[i].max_mr / data.scales[entries.start]
                 norm_at_most([entry(k, data.scales[k]) for k in entries],
                              (np.zeros(lay.size), bound * (1 - margin) if margin < 0.5 else bound))
-        swing = data.fluctuation
-        if swing is not None:  # J_i − J_j − 2δ·J̄ ≤ 2δ·I_f, in units of the bound's scale
-            for pair in self._pairs:
-                coefficients, allowed = swing.row(pair)
-                at_most((lay.T.T @ coefficients / swing.scale,
-                         float(coefficients @ lay.c) / swing.scale),
-                        allowed / swing.scale - margin)
         support, rows = data.support_bound, data.regressors.supports
         if supports and support is not None and rows is not None:  # |load| ≤ bound, each sample
             a, a0 = rows @ lay.T / support, rows @ lay.c / support
@@ -595,19 +535,10 @@ class ConvexSolver(Repairs, Diagnosis):
             fixed = [] if self._fb is None else [self._fb[1]]
             probe = x
             if self._tie_free:
-                held = len(self._pairs)
-                for _ in range(MOST_CUTS):  # (its design may break a pair not yet held)
-                    report2, second = self._run(
-                        self._stage2, "tie-break", target=lay.u(target),
-                        equality_rhs=np.concatenate([*fixed, self._seen @ u1]))
-                    if second.u is None or not self._add_cut(lay.x(second.u)):
-                        break
+                report2, second = self._run(
+                    self._stage2, "tie-break", target=lay.u(target),
+                    equality_rhs=np.concatenate([*fixed, self._seen @ u1]))
                 stages.append(report2)
-                if len(self._pairs) > held:  # the certificate's multipliers: of these rows
-                    report, again = self._run(self._stage1, "convex")
-                    if again.u is not None:
-                        first = again
-                        stages.append(report)
             if self._tie_free and second.u is not None:
                 x2, tight2 = self.repair(second.u)
                 objective2 = data.reduced_objective(x2)

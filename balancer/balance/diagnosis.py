@@ -85,13 +85,6 @@ class Diagnosis:
                     f"{bound:.6g} N: the least largest load is {least:.6g} N "
                     "(balance.max_bearing_load)",
                     needed=(("balance.max_bearing_load", least, bound, "N"),))
-        swing = self.data.fluctuation
-        if swing is not None:
-            return InfeasibleError(
-                f"no design within the other bounds keeps the crank's speed fluctuation at or "
-                f"below {swing.bound:g} with a flywheel of {swing.flywheel:g} kg·m² "
-                "(balance.max_speed_fluctuation): allow more, a larger flywheel "
-                "(balance.flywheel), or the links more inertia")
         return SolverError(f"the convex balancing problem could not be solved ({why}), though "
                            "a design within the bounds meets force balance: numerical trouble")
 

@@ -117,10 +117,6 @@ class Feasibility(ProblemData):
                 words = self.mechanism.presentation.support_words
                 out.append(f"balance.max_bearing_load: a {words} carries {largest:.9g} N, above "
                            f"{bound:.9g}")
-        swing = self.fluctuation
-        if swing is not None and swing.excess(x) > tol * swing.scale:
-            out.append(f"balance.max_speed_fluctuation: the crank's speed fluctuation is "
-                       f"{swing.fluctuation(x):.9g}, above {swing.bound:.9g}")
         residual = self.force_balance_residual(x)
         if residual > max(tol, FORCE_BALANCE_TOLERANCE):
             out.append(f"force balance: residual {residual:.3g} of its terms")

@@ -56,9 +56,6 @@ IPOPT_OPTIONS: dict[str, object] = {
     "ipopt.max_iter": 300,
 }
 
-#: With a bound on the crank's speed fluctuation, the NLP holds the rows of the pairs of samples
-#: whose inertia is within this share of its swing of its largest and of its least at the start.
-NEAR_EXTREME = 0.02
 #: With a bound on the supports' loads (``max_bearing_load``), the NLP started from a design
 #: holds only the samples where that design's load is at least this share of the bound (the
 #: bound's Hessian over every sample is costly to build); its design is kept only if it meets
@@ -223,17 +220,6 @@ class NlpSolver:
             g.append(re * re + im * im)
             lbg += [-math.inf] * rows.shape[0]
             ubg += [1.0] * rows.shape[0]
-        swing = data.fluctuation
-        if swing is not None:  # J_i − J_j − 2δ·J̄ ≤ 2δ·I_f: the pairs near the extremes
-            j = swing.values(data.x0 if start is None else start)
-            top, low = j.max(), j.min()
-            highs = np.flatnonzero(j >= top - NEAR_EXTREME * (top - low))
-            lows = np.flatnonzero(j <= low + NEAR_EXTREME * (top - low))
-            for pair in ((int(h), int(lo)) for h in highs for lo in lows):
-                row, allowed = swing.row(pair)
-                g.append(ca.mtimes(ca.DM(row[None, :] / swing.scale), pi))
-                lbg.append(-math.inf)
-                ubg.append(allowed / swing.scale)
         if data.force_balance is not None:
             a, rhs = data.force_balance
             terms = np.abs(a) @ np.abs(data.scales)  # each condition by its own size

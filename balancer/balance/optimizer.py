@@ -52,7 +52,6 @@ from ..model.motions import MotionSpec, Workspace
 from ..motion_analysis import AlongMotions, along_motions
 from .convex import ConvexSolution, ConvexSolver
 from .feasibility import ROUNDING_TOLERANCE
-from .fluctuation import FluctuationFigures
 from .nlp import NlpSolution, NlpSolver
 from .problem import NumericProblem, numeric_problem
 from .result import (
@@ -253,10 +252,6 @@ class Optimizer:
             gravity=self.gravity,
             weights=data.weights,
             rotor_masses=None if data.sites is None else self._rotor_masses(x),
-            speed_fluctuation=None if data.fluctuation is None else FluctuationFigures(
-                bound=data.fluctuation.bound, flywheel=data.fluctuation.flywheel,
-                before=data.fluctuation.fluctuation(data.x0),
-                after=data.fluctuation.fluctuation(x)),
         )
         return replace(result, message=result.summary(notes))
 

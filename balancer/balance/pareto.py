@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from ..errors import SolverError, SpecError
 from ..force_balance import RESIDUAL_FLOOR, force_balance_residual
 from ..model import Design
-from ..model.balance import BalanceProblem, Objective, RotorBalanceProblem, missing_balance
+from ..model.balance import Objective, RotorBalanceProblem, missing_balance
 from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .convex import (
@@ -181,12 +181,6 @@ def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
     if not 2 <= points <= MAX_POINTS:
         raise SpecError(f"a front has from 2 to {MAX_POINTS} points", key="--points",
                         value=points)
-    if (isinstance(design.balance, BalanceProblem)
-            and design.balance.max_speed_fluctuation is not None):
-        raise SpecError("is a bound of optimize's alone: a front's programs do not hold the "
-                        "speed fluctuation's rows (remove it for pareto)",
-                        key="balance.max_speed_fluctuation",
-                        value=design.balance.max_speed_fluctuation)
     if isinstance(design.balance, RotorBalanceProblem):
         return rotor_front(design, against, points)
     if against == "shaking-force" and design.balance.force_balance:

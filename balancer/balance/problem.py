@@ -114,7 +114,7 @@ class NumericProblem(Feasibility, PhysicalValues, Settling, ObjectiveScale):
             kept.append("_force_balance_sizes")
         for name in kept:  # cached properties that the new problem shares (made once)
             new.__dict__[name] = getattr(self, name)
-        return _moving_the_inertia(new)
+        return new
 
 
 def numeric_problem(design: Design, *, along: bool = False) -> NumericProblem:
@@ -140,11 +140,6 @@ def numeric_problem(design: Design, *, along: bool = False) -> NumericProblem:
     problem = _checked_problem(design.balance)
     mech = mechanism_of(design.mechanism)
     if len(mech.linkage.inputs) > 1 or along:
-        if problem.max_speed_fluctuation is not None:
-            raise SpecError("bounds a crank's speed fluctuation over its revolution at the "
-                            "operating speed: a linkage turned by one crank, balanced over it",
-                            key="balance.max_speed_fluctuation",
-                            value=problem.max_speed_fluctuation)
         check_problem(problem, mech)
         return _along_motions(design, problem, mech)
     if design.operation is None:
@@ -158,10 +153,8 @@ def numeric_problem(design: Design, *, along: bool = False) -> NumericProblem:
     angles = sample_angles(design.operation.samples)
     # (At unit crank acceleration too, for the counter-rotors' settling: in the same pass;
     # its shaking moment alone is used, so its driving torque at rest is not computed.)
-    # (Its driving torque, J(θ), where the crank's speed fluctuation is bounded.)
     reg, unit = cycle_regressors_at(mech, angles, [(speed, 0.0), (0.0, 1.0)],
-                                    torque_at_rest=not abs(speed) > TURNING
-                                    or problem.max_speed_fluctuation is not None)
+                                    torque_at_rest=not abs(speed) > TURNING)
     return _problem(problem, mech, speed, InputState.crank(angles, speed), reg, unit)
 
 
@@ -175,7 +168,7 @@ def _problem(problem: BalanceProblem, mech: Mechanism, speed: float | None,
     """
     links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
     rows, factor, inert = objective_rows(reg, problem.objective, links, mech.layout.size)
-    return _moving_the_inertia(NumericProblem(
+    return NumericProblem(
         problem=problem,
         mechanism=mech,
         speed=speed,
@@ -188,22 +181,7 @@ def _problem(problem: BalanceProblem, mech: Mechanism, speed: float | None,
         force_balance=_force_balance(problem, mech, along),
         inert=inert,
         unit_acceleration=unit,
-    ))
-
-
-def _moving_the_inertia(data: NumericProblem) -> NumericProblem:
-    """``data`` with the entries that move the crank's inertia ``J(θ)`` free, where bounded.
-
-    Where the crank's speed fluctuation is bounded, a link's inertia and a counter-rotor's,
-    which change no shaking at constant speed, enter the bound's rows: they are variables of
-    the programs, not left to settle.
-    """
-    swing = data.fluctuation
-    if swing is None:
-        return data
-    seen = np.any(swing.inertia != 0, axis=0)
-    inert = tuple(bool(i and not seen[k]) for k, i in enumerate(data.inert))
-    return data if inert == data.inert else replace(data, inert=inert)
+    )
 
 
 def _engine_problem(design: Design, problem: RotorBalanceProblem) -> NumericProblem:

@@ -21,8 +21,7 @@ from ..mechanisms.base import Mechanism
 from ..model import MechanismModel as Model
 from ..model.balance import BalanceProblem, Objective, RotorBalanceProblem
 from .bounds import LinkBounds
-from .fluctuation import FluctuationBound
-from .regressors import CycleRegressors, cycle_regressors_at
+from .regressors import CycleRegressors
 from .sites import Sites
 
 #: A counterweight whose mass may be zero (``counterweight = { mass = [0, hi], … }``) and whose
@@ -123,26 +122,6 @@ class ProblemData:
         """The largest load a support (an engine's main bearing) may carry, N, or none."""
         problem = self.problem
         return problem.max_bearing_load if isinstance(problem, RotorBalanceProblem) else None
-
-    @cached_property
-    def fluctuation(self) -> FluctuationBound | None:
-        """The bound on the crank's speed fluctuation (``max_speed_fluctuation``), or none.
-
-        Its ``J(θ)`` rows are the driving torque's at rest under unit crank acceleration (the
-        regressors computed with :attr:`regressors`, where their driving torque is; else here),
-        over the revolution's angles.
-        """
-        problem = self.problem
-        if not isinstance(problem, BalanceProblem) or problem.max_speed_fluctuation is None:
-            return None
-        unit = self.unit_acceleration
-        if unit is None or not np.all(np.isfinite(unit.driving_torque)):
-            angles = np.asarray(self.states.positions[0], dtype=float)
-            (unit,) = cycle_regressors_at(self.mechanism, angles, [(0.0, 1.0)])
-        rows = np.asarray(unit.driving_torque, dtype=float)
-        scale = max(problem.flywheel, float(np.max(np.abs(rows @ self.x0), initial=0.0)), 1e-300)
-        return FluctuationBound(inertia=rows, bound=problem.max_speed_fluctuation,
-                                flywheel=problem.flywheel, scale=scale)
 
     @cached_property
     def preferred(self) -> NDArray[np.float64]:

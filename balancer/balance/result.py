@@ -24,7 +24,6 @@ from ..motion_analysis import AlongMotions, along_motions
 from ..quantities import QUANTITIES, squared_parts
 from ..rounding import Scales
 from .counterweights import Counterweight, added_mass, counterweights
-from .fluctuation import FluctuationFigures
 
 #: Gap to the certified lower bound, relative to the problem's scale (the original design's
 #: RMS; :meth:`balancer.balance.problem.NumericProblem.gap`), within which a design is called
@@ -235,8 +234,6 @@ class BalanceResult:
     gravity: tuple[float, float] = (0.0, 0.0)
     weights: Objective = Objective()
     rotor_masses: RotorMasses | None = None
-    #: The crank's speed fluctuation before and after, where the balancing bounds it.
-    speed_fluctuation: FluctuationFigures | None = None
 
     def __repr__(self) -> str:
         mass = self.added_mass

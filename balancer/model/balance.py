@@ -252,12 +252,6 @@ class BalanceProblem:
     motion_weights
         A linkage with several inputs: each named motion's weight in the objective (one not
         named weighs 1), by name (a dict is accepted).
-    max_speed_fluctuation
-        The largest speed fluctuation the redesign may give the crank at the operating speed,
-        ``(ω_max − ω_min)/ω_mean`` by the turning-moment diagram of its inertia
-        (:mod:`balancer.balance.fluctuation`), or ``None``.
-    flywheel
-        The flywheel on the crank beside the mechanism, kg·m², in that estimate.
     """
 
     force_balance: bool = True
@@ -265,8 +259,6 @@ class BalanceProblem:
     objective: Objective = field(default_factory=Objective)
     links: tuple[tuple[str, LinkFreedom], ...] = ()
     motion_weights: tuple[tuple[str, float], ...] = ()
-    max_speed_fluctuation: float | None = None
-    flywheel: float = 0.0
     #: The figure a balancing of this kind is about, as a sweep's atlas shows it.
     headline: ClassVar[str] = "shaking_moment"
 
@@ -281,10 +273,6 @@ class BalanceProblem:
         if self.force_scope not in FORCE_SCOPES:
             raise SpecError(f"must be one of {', '.join(FORCE_SCOPES)}", key="balance.force",
                             value=self.force_scope)
-        if self.max_speed_fluctuation is not None:
-            object.__setattr__(self, "max_speed_fluctuation", v.positive(
-                self.max_speed_fluctuation, "max_speed_fluctuation"))
-        object.__setattr__(self, "flywheel", v.nonnegative(self.flywheel, "flywheel"))
 
     def weights_of(self, names: Sequence[str]) -> tuple[float, ...]:
         """The weights of the motions called ``names`` (1 where none is given)."""

@@ -71,8 +71,6 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis | AlongMotion
             "counterweights": {name: w.as_dict() for name, w in result.counterweights.items()},
             "added_mass": result.added_mass,
             **({} if result.rotor_masses is None else result.rotor_masses.as_dict()),
-            **({} if result.speed_fluctuation is None
-               else {"speed_fluctuation": result.speed_fluctuation.as_dict()}),
             "objective": result.objective,
             "objective_terms": _objective_terms(result),
             "original_objective": result.original_objective,
@@ -107,9 +105,6 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis | AlongMotion
                           "mr": "kg·m", "phase_deg": "degrees at θ1 = 0", "z, at": "m",
                           "max_bearing_load": "N"}),
                       "sigma": "rad", "disc radius, thickness": "m",
-                      **({} if result.speed_fluctuation is None else {
-                          "speed_fluctuation": "bound, before, after: (ω_max − ω_min)/ω_mean; "
-                                               "flywheel: kg·m²"}),
                       **({} if result.rotor_masses is None else {
                           "rotating_mr, reciprocating_mr, counterweight_mr": "kg·m",
                           "factor": "dimensionless: counterweight_mr / (rotating_mr + "
@@ -385,11 +380,6 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis | AlongMotion
     lines.append(table(rows, ["at the operating speed", "RMS before", "RMS after", "ratio",
                               "max before", "max after", "unit"]))
     lines += [f"warning: {w}" for w in worse_figures(before, after)]
-    f = result.speed_fluctuation
-    if f is not None:
-        lines.append(f"the crank's speed fluctuation (the turning-moment estimate of the "
-                     f"inertia it sees, with a flywheel of {f.flywheel:g} kg·m²): "
-                     f"{f.before:.4g} before, {f.after:.4g} after; at most {f.bound:g}")
     lines.append("")
     lines += _objective_terms_lines(result, sc, "inertial shaking at the operating speed")
     rows = []

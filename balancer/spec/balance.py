@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 from .. import tomltext as toml
-from .. import validate as v
 from ..balance.bounds import check_problem
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
@@ -190,11 +189,6 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
         sub.known = tuple(sub.data)
         weights = {name: sub.nonnegative(name) for name in sub.data}
         sub.finish()
-    fluctuation = table.value("max_speed_fluctuation", None)
-    flywheel = table.value("flywheel", 0.0)
-    if table.has("flywheel") and fluctuation is None:
-        raise SpecError("is the flywheel of the speed fluctuation's bound: give "
-                        "max_speed_fluctuation too", key=table.key("flywheel"), value=flywheel)
     points = tuple(p for p, _ in mech.linkage.points)
     links: dict[str, LinkFreedom] = {}
     for name in names:
@@ -202,11 +196,9 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
         if sub is not None:
             links[name] = _read_link_freedom(sub, points)
     table.finish()
-    with v.under(table.path):
-        problem = BalanceProblem(force_balance=force_balance, force_scope=force_scope,
-                                 objective=objective, links=tuple(links.items()),
-                                 motion_weights=tuple(weights.items()),
-                                 max_speed_fluctuation=fluctuation, flywheel=flywheel)
+    problem = BalanceProblem(force_balance=force_balance, force_scope=force_scope,
+                             objective=objective, links=tuple(links.items()),
+                             motion_weights=tuple(weights.items()))
     check_problem(problem, mech)
     return problem
 
@@ -256,9 +248,6 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
         f"force_balance = {'true' if problem.force_balance else 'false'}",
         *([f"force = {toml.string(problem.force_scope)}  # along the motions only"]
           if problem.force_scope != "every-motion" else []),
-        *([f"max_speed_fluctuation = {toml.number(problem.max_speed_fluctuation)}",
-           f"flywheel = {toml.number(problem.flywheel)}  # kg·m² on the crank"]
-          if problem.max_speed_fluctuation is not None else []),
         "",
         "[balance.objective]  # J = mean(Msh²) + w_tau·mean(tau²) + w_force·mean(|Fsh|²)"
         " + w_mass·Δmass",

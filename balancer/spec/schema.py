@@ -478,15 +478,6 @@ SECTIONS: tuple[Section, ...] = (
                     "A linkage with several inputs: each motion's weight in the objective's "
                     "mean squares (`[balance.motions]`, below).", (LINKAGE,),
                     example="{ turn = 2.0 }"),
-                Key("max_speed_fluctuation", "—", "none",
-                    "The largest speed fluctuation (ω_max − ω_min)/ω_mean the redesign may give "
-                    "the crank at `[operation] speed`: the turning-moment diagram's estimate, "
-                    "(J_max − J_min)/(2·(flywheel + J̄)) of the inertia J(θ) the crank sees "
-                    "(loads left out, as the objective leaves them), a bound the balancing "
-                    "keeps; positive. One crank.", example="0.05"),
-                Key("flywheel", "kg·m²", "0",
-                    "The flywheel on the crank beside the mechanism, in that estimate; at "
-                    "least 0 (needs `max_speed_fluctuation`).", example="0.5"),
             ),
             names=Key("<link>", "table", "—",
                       "A moving link that may change, by its name: its bounds (the table "

@@ -153,8 +153,6 @@ def variant(mechanism: str, section: schema.Section, key: schema.Key | None,
     if mechanism == schema.ENGINE and "balance" not in data and (
             pattern.startswith("balance") or (pattern == "" and name == "balance")):
         data["balance"] = copy.deepcopy(ENGINE_BALANCE)
-    if pattern == "balance" and name == "flywheel" and mechanism != schema.ENGINE:  # (its bound)
-        data["balance"]["max_speed_fluctuation"] = 0.5
     if pattern == "balance.counterweights.part":  # an engine's crank-web sector
         data["balance"]["counterweights"]["part"] = dict(PARTS["sector"])
     if pattern == "links.<link>.gas_force":
