@@ -130,4 +130,13 @@ GEARED_CRANKSHAFT = (
     Key("idler_inertia", "kg·m²", "0",
         "At ratio 1, the idler gear's inertia about its axis (its centre of mass on it); at "
         "least 0.", (ENGINE,), example="0.0"),
+    Key("main_bearings", "m", "none",
+        "Its main bearings' planes, increasing (as `[mechanism] main_bearings` for the first): "
+        "`analyze` then gives each one's load, `B2.1`, `B2.2`, … (analysed; the balancing "
+        "of bearing loads takes an engine of one crankshaft).", (ENGINE,),
+        example="[-0.09, 0.0, 0.09]"),
+    Key("gear_z", "m", "0",
+        "The plane of the gear pair (and idler) that turns it: where the teeth push on it and "
+        "on the first crankshaft, for their main bearings' shares.", (ENGINE,),
+        example="0.0"),
 )

@@ -28,6 +28,7 @@ from balancer.balance.optimizer import optimize
 from balancer.cycle import cycle_analysis
 from balancer.errors import SpecError
 from balancer.mechanisms import mechanism_of
+from balancer.mechanisms.engine.bearings import lever_shares
 from balancer.mechanisms.engine.model import (
     BalanceShaft,
     Crankshaft,
@@ -222,8 +223,10 @@ def test_a_twin_spec_reads_back_as_written(shafts: str) -> None:
     ("at = [0.09, 0.0]", "at = [0.0, 0.0]", "crankshafts[1].at"),
     ("crankshaft = 2\n", "crankshaft = 3\n", "mechanism.cylinders[3].crankshaft"),
     ("firing_order = [1, 2, 4, 3]",
-     "firing_order = [1, 2, 4, 3]\nmain_bearings = [-0.08, 0.0, 0.08]",
-     "mechanism.main_bearings"),
+     "firing_order = [1, 2, 4, 3]\nmain_bearings = [-0.08, 0.0, 0.08]\n[balance]\n"
+     "max_bearing_load = 5000.0\n", "balance.max_bearing_load"),
+    ("firing_order = [1, 2, 4, 3]",
+     "firing_order = [1, 2, 4, 3]\nmain_bearings = [0.08, 0.0]", "mechanism.main_bearings"),
     ("radius = 0.05 ", "crankshafts = [1, 3]\nradius = 0.05 ",
      "balance.counterweights.crankshafts"),
 ])
@@ -338,3 +341,41 @@ def test_the_opposed_piston_single_is_point_or_mirror_symmetric_as_its_gears_tur
     assert float(np.max(np.abs(b.shaking_force.imag))) > 1000.0
     about_c = b.shaking_moment - c * b.shaking_force.imag
     assert float(np.max(np.abs(about_c))) <= 1e-12 * scale * c
+
+
+@pytest.mark.parametrize("ratio", [-1, 1])
+def test_each_crankshafts_main_bearings_share_its_loads_and_its_gears(ratio: int) -> None:
+    """Mains on both crankshafts, the gears at ``gear_z``: each crankshaft's bearings sum to
+    its axis's reaction; and bearing by bearing, a twin's are the two engines' (their own
+    mains) with the tooth force shared by the lever rule at the gears' plane — on the first
+    crankshaft the force on the gear it drives taken away, on the second its own added."""
+    rng = np.random.default_rng(90 + ratio)
+    planes, gear_z = (-0.12, 0.0, 0.12), 0.05
+    base = twin(rng, 2, 2, ratio=ratio)
+    engine = replace(base, main_bearings=planes, crankshafts=(
+        replace(base.crankshafts[0], main_bearings=planes, gear_z=gear_z),))
+    a, b = halves(engine)
+    b = replace(b, main_bearings=planes)
+    speed, gravity = 300.0, (0.0, -9.81)
+    both = cycle_analysis(engine, speed, 72, gravity=gravity)
+    alone_a = cycle_analysis(a, speed, 72, gravity=gravity)
+    theta = both.theta1
+    alone_b = cycle_analysis(b, ratio * speed, theta1=ratio * theta, gravity=gravity)
+    supports = {s.name: s.force for s in both.supports}
+    assert sorted(supports) == ["B1", "B2", "B2.1", "B2.2", "B2.3", "B3"]
+    r = both.reactions.ground
+    scale = float(np.max(np.abs(r["O"])))
+    for names, point in ((("B1", "B2", "B3"), "O"), (("B2.1", "B2.2", "B2.3"), "O2")):
+        total = sum(supports[n] for n in names)
+        assert np.max(np.abs(total - r[point])) <= 1e-12 * scale
+    drives, driven = (("gear2", "gear2") if ratio == -1 else ("gear2a", "gear2b"))
+    pushed, pushing = both.reactions.teeth[drives], both.reactions.teeth[driven]
+    shares = dict(lever_shares(planes, gear_z))
+    for j in range(3):
+        mine_a = {s.name: s.force for s in alone_a.supports}[f"B{j + 1}"]
+        mine_b = {s.name: s.force for s in alone_b.supports}[f"B{j + 1}"]
+        share = shares.get(j, 0.0)
+        np.testing.assert_allclose(supports[f"B{j + 1}"], mine_a - share * pushed,
+                                   atol=1e-11 * scale)
+        np.testing.assert_allclose(supports[f"B2.{j + 1}"], mine_b + share * pushing,
+                                   atol=1e-11 * scale)

@@ -27,7 +27,7 @@ crankshaft's Newton equation): the tests hold the split to it.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Collection, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -59,15 +59,21 @@ def bearing_name(j: int) -> str:
 
 def main_bearing_loads(mech: Mechanism, planes: Sequence[float], ground_point: str,
                        mo: Motion, reactions: Reactions, *, loads: bool = True,
-                       gravity: tuple[float, float] = (0.0, 0.0)
+                       gravity: tuple[float, float] = (0.0, 0.0), shaft: str | None = None,
+                       pistons: Collection[str] | None = None,
+                       teeth: Sequence[tuple[float, NDArray[np.complex128]]] = (),
+                       names: Callable[[int], str] | None = None
                        ) -> dict[str, NDArray[np.complex128]]:
     """Each main bearing's load on the frame at a motion's states, complex ``x + i·y``, N.
 
-    ``mech`` an engine's mechanism (its crankshaft the link ``crankshaft``, cylinder ``k``'s
-    rod and piston ``rod<k>`` and ``piston<k>`` at its plane); ``mo`` its motion and
-    ``reactions`` its frame loads there (their guides' normal forces: a cycle analysis's own,
-    not computed again); ``ground_point`` the crankshaft's rotors' bearing (``O``). ``loads``:
-    the gas forces included (as in ``reactions``).
+    ``mech`` an engine's mechanism (its crankshaft the link ``shaft``, default the input,
+    cylinder ``k``'s rod and piston ``rod<k>`` and ``piston<k>`` at its plane, the pistons on
+    this crankshaft ``pistons``, default every one); ``mo`` its motion and ``reactions`` its
+    frame loads there (their guides' normal forces: a cycle analysis's own, not computed
+    again); ``ground_point`` the crankshaft's rotors' bearing (``O``). ``loads``: the gas
+    forces included (as in ``reactions``). ``teeth``: the gear pairs' forces on this
+    crankshaft, each at its plane (a geared engine's: ``(z, force)``). ``names``: bearing
+    ``j``'s name (default :func:`bearing_name`).
     """
     theta, omega, alpha = (np.reshape(np.asarray(x, dtype=float) * np.ones(mo.count),
                                       mo.count) for x in (mo.theta1, mo.omega1, mo.alpha1))
@@ -88,7 +94,8 @@ def main_bearing_loads(mech: Mechanism, planes: Sequence[float], ground_point: s
     normals = mech.guide_normals()
     sliders = {s.link: s for s in linkage.sliders}
     for name in linkage.link_names:
-        if name in sliders:  # a piston: its chain's force on its crank pin, at its plane
+        if name in sliders and (pistons is None or name in pistons):
+            # a piston: its chain's force on its crank pin, at its plane
             rod = next(b.name for b in linkage.bodies
                        if sliders[name].point in b.points and b.name != name)
             s = sliders[name]
@@ -98,14 +105,18 @@ def main_bearing_loads(mech: Mechanism, planes: Sequence[float], ground_point: s
                 u = complex(*s.direction)
                 pin = pin + np.asarray(s.force.at(theta), float) * (u / abs(u))
             add(linkage.link(rod).z, pin)
-    add(linkage.link(linkage.input).z, carried(linkage.input))
+    own = linkage.input if shaft is None else shaft
+    add(linkage.link(own).z, carried(own))
     for point, rotor in mech.rotors:
         if point != ground_point:
             continue
         for e in rotor.eccentrics:
             single = Rotor(ratio=rotor.ratio, inertia=0.0, axis=rotor.axis, eccentrics=(e,))
             add(e.z, single.loads(theta, omega, alpha, gravity).force)
-    return {bearing_name(j): out[j] for j in range(len(planes))}
+    for z, force in teeth:  # (the gear's push on the shaft is what the shaft passes on)
+        add(z, np.asarray(force, dtype=complex))
+    naming = bearing_name if names is None else names
+    return {naming(j): out[j] for j in range(len(planes))}
 
 
 def main_bearing_regressors(mech: Mechanism, planes: Sequence[float], mo: Motion

@@ -16,7 +16,7 @@ from __future__ import annotations
 import cmath
 import math
 from dataclasses import replace
-from functools import cached_property
+from functools import cached_property, partial
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -57,6 +57,11 @@ def gear_name(k: int) -> str:
     idler) and ``gear2b`` (the idler and crankshaft 2).
     """
     return f"gear{k}"
+
+
+def geared_bearing_name(k: int, j: int) -> str:
+    """Geared crankshaft ``k``'s main bearing ``j`` (from 0): ``B2.1``, ``B2.2``…."""
+    return f"B{k}.{j + 1}"
 
 
 def idler_pivot(k: int) -> str:
@@ -220,14 +225,37 @@ class EngineMechanism(Mechanism):
 
     def support_loads(self, mo: Motion, reactions: Reactions, *, loads: bool = True,
                       gravity: tuple[float, float] = (0.0, 0.0)) -> tuple[SupportLoad, ...]:
-        """Each main bearing's load (:mod:`.bearings`), where the spec places them."""
-        planes = self.model.main_bearings
-        if not planes:
-            return ()
-        found = main_bearing_loads(self, planes, MAIN_BEARINGS, mo, reactions, loads=loads,
-                                   gravity=gravity)
-        return tuple(SupportLoad(name=name, z=z, force=force)
-                     for (name, force), z in zip(found.items(), planes, strict=True))
+        """Each main bearing's load (:mod:`.bearings`), where the spec places them.
+
+        The first crankshaft's ``B1``, ``B2``, …; a geared crankshaft ``k``'s ``B<k>.1``, ….
+        Each crankshaft carries its own cylinders' pins, its weight, its masses and its gear
+        pairs' tooth forces at their plane (``gear_z``): the first, minus each pair's force on
+        the gear it drives; a geared one, its own pair's.
+        """
+        model = self.model
+        out: list[SupportLoad] = []
+        for k in model.shafts:
+            planes = model.shaft_bearings(k)
+            if not planes:
+                continue
+            pistons = {f"piston{i}" for i, c in enumerate(model.cylinders, start=1)
+                       if c.crankshaft == k}
+            teeth: list[tuple[float, NDArray[np.complex128]]] = []
+            for j, g in zip(model.shafts[1:], model.crankshafts, strict=True):
+                idled = j in model.idled
+                if k == 1:  # it drives each geared shaft (or its idler)
+                    name = f"{gear_name(j)}a" if idled else gear_name(j)
+                    teeth.append((g.gear_z, -np.asarray(reactions.teeth[name], complex)))
+                elif k == j:  # it is driven
+                    name = f"{gear_name(j)}b" if idled else gear_name(j)
+                    teeth.append((g.gear_z, np.asarray(reactions.teeth[name], complex)))
+            found = main_bearing_loads(
+                self, planes, shaft_pivot(k), mo, reactions, loads=loads, gravity=gravity,
+                shaft=crankshaft_name(k), pistons=pistons, teeth=teeth,
+                names=None if k == 1 else partial(geared_bearing_name, k))
+            out += [SupportLoad(name=name, z=z, force=force)
+                    for (name, force), z in zip(found.items(), planes, strict=True)]
+        return tuple(out)
 
     def support_regressors(self, mo: Motion) -> tuple[NDArray[np.complex128], ...]:
         """Each main bearing's inertial load over the layout (:mod:`.bearings`)."""

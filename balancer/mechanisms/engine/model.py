@@ -268,6 +268,12 @@ class GearedCrankshaft:
         Every mass·radius it carries (pins, webs, counterweights), at its angles at θ1 = 0.
     idler_inertia
         At ratio +1, the idler gear's inertia about its axis, kg·m² (its centre of mass on it).
+    main_bearings
+        Its main bearings' planes, m, increasing (none: its loads are reported summed at its
+        axis), as the first crankshaft's ``[mechanism] main_bearings``.
+    gear_z
+        The plane of the gear pair (and idler) that turns it, m: where the teeth push on it and
+        on the first crankshaft, for their main bearings' shares.
     """
 
     at: tuple[float, float]
@@ -276,6 +282,8 @@ class GearedCrankshaft:
     mass: float = 0.0
     masses: tuple[Mass, ...] = ()
     idler_inertia: float = 0.0
+    main_bearings: tuple[float, ...] = ()
+    gear_z: float = 0.0
 
     def __post_init__(self) -> None:
         v.store(self, "at", v.vector2(self.at, "at"))
@@ -292,6 +300,8 @@ class GearedCrankshaft:
         if self.idler_inertia and self.ratio == -1:
             raise SpecError("is an idler's: a crankshaft at ratio -1 meshes with the first "
                             "directly", key="idler_inertia", value=self.idler_inertia)
+        v.store(self, "main_bearings", _bearings(self.main_bearings, "main_bearings"))
+        v.store(self, "gear_z", v.number(self.gear_z, "gear_z"))
         v.store(self, "inertia", v.nonnegative(self.inertia, "inertia"))
         v.store(self, "mass", v.nonnegative(self.mass, "mass"))
         v.store(self, "masses", _masses(self.masses, "masses"))
@@ -348,6 +358,17 @@ class GasCycle:
         with v.under("gas"):
             return GasForce(angles=tuple(a for a, _ in pairs),
                             values=tuple(f for _, f in pairs), period=period)
+
+
+def _bearings(planes: object, key: str) -> tuple[float, ...]:
+    """Main bearings' planes: none, or two or more increasing along the crankshaft (m)."""
+    if planes == ():
+        return ()
+    out = v.numbers(planes, key)
+    if len(out) < 2 or any(b <= a for a, b in zip(out, out[1:], strict=False)):
+        raise SpecError("must be two planes or more, increasing along the crankshaft (m)",
+                        key=key, value=list(out))
+    return out
 
 
 def _masses(items: Sequence[Mass], key: str) -> tuple[Mass, ...]:
@@ -482,17 +503,8 @@ class Engine(MechanismModel):
                     f"({180 * self.strokes}°), from 0", key="gas.crank_angle_deg",
                     value=list(angles))
             self.firing_angles()  # (checks that the order fits in the cycle)
-        bearings = (v.numbers(self.main_bearings, "mechanism.main_bearings")
-                    if self.main_bearings != () else ())
-        if bearings and (len(bearings) < 2 or any(
-                b <= a for a, b in zip(bearings, bearings[1:], strict=False))):
-            raise SpecError("must be two planes or more, increasing along the crankshaft (m)",
-                            key="mechanism.main_bearings", value=list(bearings))
-        if bearings and geared:
-            raise SpecError("are an engine of one crankshaft's: the main bearings of geared "
-                            "crankshafts are not modelled (their pivots' loads are reported)",
-                            key="mechanism.main_bearings", value=list(bearings))
-        v.store(self, "main_bearings", bearings)
+        v.store(self, "main_bearings",
+                _bearings(self.main_bearings, "mechanism.main_bearings"))
 
     # -- its crankshafts ---------------------------------------------------------------------
 
@@ -503,6 +515,11 @@ class Engine(MechanismModel):
     def shaft_axis(self, shaft: int) -> complex:
         """Crankshaft ``shaft``'s axis, ``x + i·y``, m (the origin for the first)."""
         return 0j if shaft == 1 else complex(*self.crankshafts[shaft - 2].at)
+
+    def shaft_bearings(self, shaft: int) -> tuple[float, ...]:
+        """Crankshaft ``shaft``'s main bearings' planes, m (none: not placed)."""
+        return (self.main_bearings if shaft == 1
+                else self.crankshafts[shaft - 2].main_bearings)
 
     def shaft_masses(self, shaft: int) -> tuple[Mass, ...]:
         """The masses crankshaft ``shaft`` carries."""

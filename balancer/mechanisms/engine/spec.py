@@ -145,10 +145,16 @@ def _geared(root: Table) -> tuple[GearedCrankshaft, ...]:
             raise sub._missing("at")
         masses = _masses(sub, "masses")  # (each under its own path)
         with v.under(sub.path):
+            bearings = sub.value("main_bearings", ())
+            if not isinstance(bearings, list | tuple):
+                raise SpecError("must be a list of planes (m)", key=sub.key("main_bearings"),
+                                value=bearings)
             out.append(GearedCrankshaft(at=sub.raw("at"), ratio=sub.value("ratio", -1),
                                         inertia=sub.value("inertia", 0.0),
                                         mass=sub.value("mass", 0.0), masses=masses,
-                                        idler_inertia=sub.value("idler_inertia", 0.0)))
+                                        idler_inertia=sub.value("idler_inertia", 0.0),
+                                        main_bearings=tuple(bearings),
+                                        gear_z=sub.value("gear_z", 0.0)))
         sub.finish()
     return tuple(out)
 
@@ -233,6 +239,11 @@ def _geared_lines(model: Engine, key: str) -> list[str]:
             out.append(f"mass = {toml.number(g.mass)}  # kg")
         if g.ratio == 1:
             out.append(f"idler_inertia = {toml.number(g.idler_inertia)}  # kg·m²")
+        if g.main_bearings:
+            out.append(f"main_bearings = [{', '.join(toml.number(z) for z in g.main_bearings)}]"
+                       "  # m")
+        if g.gear_z or g.main_bearings or model.main_bearings:
+            out.append(f"gear_z = {toml.number(g.gear_z)}  # m: its gears' plane")
         out += _masses_lines("masses", g.masses)
     return out
 
@@ -337,11 +348,16 @@ def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
                                        planes=sub.raw("planes"), max_mr=sub.raw("max_mr")))
         sub.finish()
     bound = table.value("max_bearing_load", None)
-    if (bound is not None or objective.main_bearing_load) and not cast(
-            "Engine", engine).main_bearings:
+    if bound is not None or objective.main_bearing_load:
         key = (table.key("max_bearing_load") if bound is not None
                else "balance.objective.main_bearing_load")
-        raise SpecError("needs the main bearings' planes: [mechanism] main_bearings", key=key)
+        if not cast("Engine", engine).main_bearings:
+            raise SpecError("needs the main bearings' planes: [mechanism] main_bearings",
+                            key=key)
+        if cast("Engine", engine).crankshafts:
+            raise SpecError("balances the main bearings of an engine of one crankshaft: its "
+                            "geared crankshafts' bearing loads are analysed, not yet balanced",
+                            key=key)
     table.finish()
     with v.under(table.path):
         return RotorBalanceProblem(objective=objective, counterweights=counterweights,
