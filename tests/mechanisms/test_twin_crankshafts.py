@@ -222,11 +222,12 @@ def test_a_twin_spec_reads_back_as_written(shafts: str) -> None:
     ("ratio = -1\n", "ratio = -1\nidler_inertia = 0.001\n", "crankshafts[1].idler_inertia"),
     ("at = [0.09, 0.0]", "at = [0.0, 0.0]", "crankshafts[1].at"),
     ("crankshaft = 2\n", "crankshaft = 3\n", "mechanism.cylinders[3].crankshaft"),
-    ("firing_order = [1, 2, 4, 3]",
-     "firing_order = [1, 2, 4, 3]\nmain_bearings = [-0.08, 0.0, 0.08]\n[balance]\n"
-     "max_bearing_load = 5000.0\n", "balance.max_bearing_load"),
-    ("firing_order = [1, 2, 4, 3]",
-     "firing_order = [1, 2, 4, 3]\nmain_bearings = [0.08, 0.0]", "mechanism.main_bearings"),
+    ("[balance.objective]", "[balance]\nmax_bearing_load = 5000.0\n\n[balance.objective]",
+     "balance.max_bearing_load"),
+    ("main_bearings = [-0.09, 0.0, 0.09]  # m: the front",
+     "main_bearings = [0.09, 0.0]  # m: the front", "mechanism.main_bearings"),
+    ("main_bearings = [-0.09, 0.0, 0.09]  # m: its own",
+     "main_bearings = [0.09]  # m: its own", "crankshafts[1].main_bearings"),
     ("radius = 0.05 ", "crankshafts = [1, 3]\nradius = 0.05 ",
      "balance.counterweights.crankshafts"),
 ])
