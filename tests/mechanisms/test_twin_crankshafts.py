@@ -228,6 +228,8 @@ def test_a_twin_spec_reads_back_as_written(shafts: str) -> None:
      "main_bearings = [0.09, 0.0]  # m: the front", "mechanism.main_bearings"),
     ("main_bearings = [-0.09, 0.0, 0.09]  # m: its own",
      "main_bearings = [0.09]  # m: its own", "crankshafts[1].main_bearings"),
+    ("main_bearings = [-0.09, 0.0, 0.09]  # m: its own",
+     "main_bearings = 0.1  # m: its own", "crankshafts[1].main_bearings"),
     ("radius = 0.05 ", "crankshafts = [1, 3]\nradius = 0.05 ",
      "balance.counterweights.crankshafts"),
 ])

@@ -144,11 +144,11 @@ def _geared(root: Table) -> tuple[GearedCrankshaft, ...]:
         if not sub.has("at"):
             raise sub._missing("at")
         masses = _masses(sub, "masses")  # (each under its own path)
+        bearings = sub.value("main_bearings", ())
+        if not isinstance(bearings, list | tuple):
+            raise SpecError("must be a list of planes (m)", key=sub.key("main_bearings"),
+                            value=bearings)
         with v.under(sub.path):
-            bearings = sub.value("main_bearings", ())
-            if not isinstance(bearings, list | tuple):
-                raise SpecError("must be a list of planes (m)", key=sub.key("main_bearings"),
-                                value=bearings)
             out.append(GearedCrankshaft(at=sub.raw("at"), ratio=sub.value("ratio", -1),
                                         inertia=sub.value("inertia", 0.0),
                                         mass=sub.value("mass", 0.0), masses=masses,
