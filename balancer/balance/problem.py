@@ -241,7 +241,7 @@ def _support_rows(mech: Mechanism, sites: Sites, angles: NDArray[np.float64], sp
         cols = np.zeros(force.shape, complex)
         for i, site in enumerate(sites.sites):
             if site.on_crank(frame):
-                share = dict(mech.support_shares(site.z)).get(j, 0.0)
+                share = dict(mech.support_shares(site.z, site.at)).get(j, 0.0)
                 cols[:, 2 * i : 2 * i + 2] = share * force[:, 2 * i : 2 * i + 2]
         rows.append(np.hstack([linkage_rows, cols]))
     return np.vstack(rows)

@@ -91,13 +91,12 @@ class Site:
                      eccentrics=(Eccentric(mr=1.0, angle=angle, z=self.z),))
 
     def on_crank(self, frame_points: tuple[str, ...]) -> bool:
-        """Whether it is on the crankshaft, its force on the main bearings.
+        """Whether it is on a crankshaft, its force on that crankshaft's main bearings.
 
         ``frame_points``: the linkage's ground points, where the crankshaft's masses bear (a
         balance shaft's bearing is a point of its own, even where it turns with the crank).
         """
-        return ((self.shaft is None and self.crankshaft == 1)
-                or (self.bearing is not None and self.bearing in frame_points))
+        return self.shaft is None or (self.bearing is not None and self.bearing in frame_points)
 
     @property
     def where(self) -> str:

@@ -698,8 +698,11 @@ class Mechanism:
         """
         return ()
 
-    def support_shares(self, z: float) -> tuple[tuple[int, float], ...]:
-        """How the supports share a load at plane ``z`` on their shaft: ``(support, share)``."""
+    def support_shares(self, z: float, axis: complex = 0j) -> tuple[tuple[int, float], ...]:
+        """How the supports share a load at plane ``z`` on their shaft about ``axis``.
+
+        ``(support, share)`` pairs, the supports in :meth:`support_loads`' order.
+        """
         return ()
 
     def closed_form_force_balance(self) -> NDArray[np.float64] | None:

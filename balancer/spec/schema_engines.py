@@ -132,8 +132,8 @@ GEARED_CRANKSHAFT = (
         "least 0.", (ENGINE,), example="0.0"),
     Key("main_bearings", "m", "none",
         "Its main bearings' planes, increasing (as `[mechanism] main_bearings` for the first): "
-        "`analyze` then gives each one's load, `B2.1`, `B2.2`, … (analysed; the balancing "
-        "of bearing loads takes an engine of one crankshaft).", (ENGINE,),
+        "`analyze` then gives each one's load, `B2.1`, `B2.2`, …, and the balancing's bearing "
+        "terms take them.", (ENGINE,),
         example="[-0.09, 0.0, 0.09]"),
     Key("gear_z", "m", "0",
         "The plane of the gear pair (and idler) that turns it: where the teeth push on it and "

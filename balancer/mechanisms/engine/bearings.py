@@ -119,7 +119,9 @@ def main_bearing_loads(mech: Mechanism, planes: Sequence[float], ground_point: s
     return {naming(j): out[j] for j in range(len(planes))}
 
 
-def main_bearing_regressors(mech: Mechanism, planes: Sequence[float], mo: Motion
+def main_bearing_regressors(mech: Mechanism, planes: Sequence[float], mo: Motion, *,
+                            links: Collection[str] | None = None,
+                            teeth: Sequence[tuple[float, NDArray[np.complex128]]] = ()
                             ) -> list[NDArray[np.complex128]]:
     """Each main bearing's inertial load as a linear map of the design vector, ``(N, P)``.
 
@@ -128,15 +130,23 @@ def main_bearing_regressors(mech: Mechanism, planes: Sequence[float], mo: Motion
     ``m·(ḡ − ā)`` per unit inertial parameter (:func:`~balancer.linkage.dynamics.
     inertial_columns`) at its plane, less each guide's normal force on the frame
     (:meth:`~balancer.mechanisms.base.Mechanism.regressors`) at its cylinder's; columns in the
-    mechanism's :attr:`~balancer.mechanisms.base.Mechanism.layout`.
+    mechanism's :attr:`~balancer.mechanisms.base.Mechanism.layout`. ``links``: those this
+    crankshaft carries (itself, its cylinders' rods and pistons; default every one);
+    ``teeth``: its gear pairs' tooth forces on it, each as such a map at its plane.
     """
     linkage, structure, layout = mech.linkage, mech.structure, mech.layout
     n = mo.count
     out = [np.zeros((n, layout.size), complex) for _ in planes]
     columns = inertial_columns(structure, mo, V(0.0, 0.0))
-    sliders = {s.link: s for s in linkage.sliders}
+    sliders = {s.link: s for s in linkage.sliders
+               if links is None or s.link in links}
     plane = {name: linkage.link(name).z for name in linkage.link_names}
+    for z, force in teeth:
+        for j, share in lever_shares(planes, z):
+            out[j] += share * np.asarray(force, dtype=complex)
     for name, cols in columns.items():
+        if links is not None and name not in links:
+            continue
         for param, (fx, fy, _) in cols:
             force = np.broadcast_to(np.asarray(fx) + 1j * np.asarray(fy), (n,))
             for j, share in lever_shares(planes, plane[name]):

@@ -240,15 +240,8 @@ class EngineMechanism(Mechanism):
                 continue
             pistons = {f"piston{i}" for i, c in enumerate(model.cylinders, start=1)
                        if c.crankshaft == k}
-            teeth: list[tuple[float, NDArray[np.complex128]]] = []
-            for j, g in zip(model.shafts[1:], model.crankshafts, strict=True):
-                idled = j in model.idled
-                if k == 1:  # it drives each geared shaft (or its idler)
-                    name = f"{gear_name(j)}a" if idled else gear_name(j)
-                    teeth.append((g.gear_z, -np.asarray(reactions.teeth[name], complex)))
-                elif k == j:  # it is driven
-                    name = f"{gear_name(j)}b" if idled else gear_name(j)
-                    teeth.append((g.gear_z, np.asarray(reactions.teeth[name], complex)))
+            teeth = [(z, np.asarray(sign * np.asarray(reactions.teeth[name]), dtype=complex))
+                     for z, name, sign in self._gears_on(k)]
             found = main_bearing_loads(
                 self, planes, shaft_pivot(k), mo, reactions, loads=loads, gravity=gravity,
                 shaft=crankshaft_name(k), pistons=pistons, teeth=teeth,
@@ -257,15 +250,63 @@ class EngineMechanism(Mechanism):
                     for (name, force), z in zip(found.items(), planes, strict=True)]
         return tuple(out)
 
-    def support_regressors(self, mo: Motion) -> tuple[NDArray[np.complex128], ...]:
-        """Each main bearing's inertial load over the layout (:mod:`.bearings`)."""
-        planes = self.model.main_bearings
-        return tuple(main_bearing_regressors(self, planes, mo)) if planes else ()
+    def _gears_on(self, k: int) -> list[tuple[float, str, float]]:
+        """The gear pairs whose teeth push on crankshaft ``k``: (plane, pair, sign).
 
-    def support_shares(self, z: float) -> tuple[tuple[int, float], ...]:
-        """The lever rule's shares of a load at ``z`` on the crankshaft (:mod:`.bearings`)."""
-        planes = self.model.main_bearings
-        return lever_shares(planes, z) if planes else ()
+        The first crankshaft drives each geared one's pair (or its idler's first): minus the
+        force on the gear it drives; a geared one is driven by its own (or its idler's
+        second): plus it.
+        """
+        model = self.model
+        out = []
+        for j, g in zip(model.shafts[1:], model.crankshafts, strict=True):
+            idled = j in model.idled
+            if k == 1:
+                out.append((g.gear_z, f"{gear_name(j)}a" if idled else gear_name(j), -1.0))
+            elif k == j:
+                out.append((g.gear_z, f"{gear_name(j)}b" if idled else gear_name(j), 1.0))
+        return out
+
+    def _carried(self, k: int) -> set[str]:
+        """The links crankshaft ``k`` carries: itself, its cylinders' rods and pistons."""
+        on = [i for i, c in enumerate(self.model.cylinders, start=1) if c.crankshaft == k]
+        return {crankshaft_name(k), *(f"rod{i}" for i in on), *(f"piston{i}" for i in on)}
+
+    def support_regressors(self, mo: Motion) -> tuple[NDArray[np.complex128], ...]:
+        """Each main bearing's inertial load over the layout (:mod:`.bearings`).
+
+        Every crankshaft's, in :meth:`support_loads`' order; its gears' tooth forces from the
+        core's regressors.
+        """
+        model = self.model
+        if not any(model.shaft_bearings(k) for k in model.shafts):
+            return ()
+        teeth = self.regressors(mo).teeth if model.crankshafts else {}
+        out: list[NDArray[np.complex128]] = []
+        for k in model.shafts:
+            planes = model.shaft_bearings(k)
+            if planes:
+                maps = [(z, sign * (np.asarray(teeth[name].x) + 1j * np.asarray(teeth[name].y)))
+                        for z, name, sign in self._gears_on(k)]
+                out += main_bearing_regressors(self, planes, mo, links=self._carried(k),
+                                               teeth=maps)
+        return tuple(out)
+
+    def support_shares(self, z: float, axis: complex = 0j) -> tuple[tuple[int, float], ...]:
+        """The lever rule's shares of a load at ``z`` on the crankshaft about ``axis``.
+
+        Its main bearings' indices in :meth:`support_loads`' order (:mod:`.bearings`); none
+        where that crankshaft has none, or no crankshaft turns about ``axis``.
+        """
+        model = self.model
+        first = 0
+        for k in model.shafts:
+            planes = model.shaft_bearings(k)
+            if model.shaft_axis(k) == axis:
+                return tuple((first + j, share) for j, share in lever_shares(planes, z)
+                             ) if planes else ()
+            first += len(planes)
+        return ()
 
     def describe(self) -> str:
         n = len(self.model.cylinders)
