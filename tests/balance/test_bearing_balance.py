@@ -256,3 +256,24 @@ def test_the_front_of_the_bearing_load_against_added_mass(design):
         assert p.value == pytest.approx(mass, rel=1e-9)
     least = [p.least for p in front.points]
     assert all(a >= b * (1 - 1e-7) for a, b in zip(least, least[1:], strict=False))
+
+
+def test_four_counterweights_against_eight(design):
+    """The in-line four's outer webs alone (four of its eight planes: a restriction of its
+    problem) under the same bound: its objective is no lower than the eight webs' certified
+    bound (J4 ≥ J4* ≥ J8* ≥ bound8), the mass·radius added less; each design keeps the
+    bound."""
+    cws = design.balance.counterweights
+    four = tuple(z for z in cws.planes if abs(z) in (0.1635, 0.0185))
+    assert len(four) == 4
+    fewer = replace(design, balance=replace(design.balance, counterweights=replace(
+        cws, planes=four, max_mr=cws.max_mr[:4])))
+    eight, webs4 = optimize(design, "convex"), optimize(fewer, "convex")
+    assert eight.optimal and webs4.optimal
+    assert webs4.objective >= eight.lower_bound
+    assert webs4.rotor_masses.mr_sum < eight.rotor_masses.mr_sum
+    for result in (eight, webs4):
+        after = cycle_analysis(result.linkage, design.operation.speed,
+                               theta1=result.after.theta1, loads=False)
+        largest = max(float(np.max(np.abs(s.force))) for s in after.supports)
+        assert largest <= design.balance.max_bearing_load * (1 + 1e-6)
