@@ -30,6 +30,16 @@ def _rate(rate: list[Num], k: int) -> Num:
     return 0.0 if k == GROUND_INDEX else rate[k]
 
 
+def _sin(x: Num) -> Num:
+    """``sin x`` of a number, an array or a CasADi symbol (which has its own)."""
+    return x.sin() if hasattr(x, "sin") else np.sin(x)
+
+
+def _cos(x: Num) -> Num:
+    """``cos x`` of a number, an array or a CasADi symbol (which has its own)."""
+    return x.cos() if hasattr(x, "cos") else np.cos(x)
+
+
 def _velocity(vel: list[V], k: int) -> V:
     return V(0.0, 0.0) if k == GROUND_INDEX else vel[k]
 
@@ -269,14 +279,14 @@ class Mesh:
         t = self.tangent
         gap = (pose.point(self.a, self.pa) - self.oa) - (pose.point(self.b, self.pb) - self.ob)
         slip = self._slip(pose)
-        sine = np.sin(slip) if not hasattr(slip, "sin") else slip.sin()  # (CasADi's: its own)
+        sine = _sin(slip)
         return [_plus(self.radii[1] * sine, t.dot(gap))]
 
     def jacobian(self, pose: Pose) -> Blocks:
         """:meth:`residual`'s derivative by the links' coordinates."""
         t = self.tangent
         slip = self._slip(pose)
-        cosine = np.cos(slip) if not hasattr(slip, "cos") else slip.cos()
+        cosine = _cos(slip)
         rho_b = self.radii[1]
         ra, rb = pose.rotate(self.a, self.pa), pose.rotate(self.b, self.pb)
         return [(self.a, [[t.x, t.y, rho_b * self.ratio * cosine + ra.cross(t)]]),
@@ -287,7 +297,7 @@ class Mesh:
         """``γ`` (``Φ_q·q̈ = γ``): the velocity terms of the residual's second derivative."""
         t = self.tangent
         slip = self._slip(pose)
-        sine = np.sin(slip) if not hasattr(slip, "sin") else slip.sin()
+        sine = _sin(slip)
         ra, rb = pose.rotate(self.a, self.pa), pose.rotate(self.b, self.pb)
         wa, wb = _rate(rate, self.a), _rate(rate, self.b)
         turn = self.ratio * wa - wb

@@ -32,7 +32,7 @@ from collections.abc import Callable, Collection, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from ...linkage.dynamics import inertial_columns
+from ...linkage.dynamics import Forces, inertial_columns
 from ...linkage.kinematics import Motion
 from ...linkage.loads import Reactions
 from ...linkage.rotors import Rotor
@@ -121,7 +121,8 @@ def main_bearing_loads(mech: Mechanism, planes: Sequence[float], ground_point: s
 
 def main_bearing_regressors(mech: Mechanism, planes: Sequence[float], mo: Motion, *,
                             links: Collection[str] | None = None,
-                            teeth: Sequence[tuple[float, NDArray[np.complex128]]] = ()
+                            teeth: Sequence[tuple[float, NDArray[np.complex128]]] = (),
+                            regressors: Forces | None = None
                             ) -> list[NDArray[np.complex128]]:
     """Each main bearing's inertial load as a linear map of the design vector, ``(N, P)``.
 
@@ -132,7 +133,8 @@ def main_bearing_regressors(mech: Mechanism, planes: Sequence[float], mo: Motion
     (:meth:`~balancer.mechanisms.base.Mechanism.regressors`) at its cylinder's; columns in the
     mechanism's :attr:`~balancer.mechanisms.base.Mechanism.layout`. ``links``: those this
     crankshaft carries (itself, its cylinders' rods and pistons; default every one);
-    ``teeth``: its gear pairs' tooth forces on it, each as such a map at its plane.
+    ``teeth``: its gear pairs' tooth forces on it, each as such a map at its plane;
+    ``regressors``: the mechanism's at ``mo``, where the caller has them (else computed here).
     """
     linkage, structure, layout = mech.linkage, mech.structure, mech.layout
     n = mo.count
@@ -152,8 +154,10 @@ def main_bearing_regressors(mech: Mechanism, planes: Sequence[float], mo: Motion
             for j, share in lever_shares(planes, plane[name]):
                 out[j][:, layout.index(name, param)] += share * force
     if sliders:
-        with np.errstate(all="ignore"):
-            normal = mech.regressors(mo).slider_normal
+        if regressors is None:
+            with np.errstate(all="ignore"):
+                regressors = mech.regressors(mo)
+        normal = regressors.slider_normal
         normals = mech.guide_normals()
         for name in sliders:
             if name not in normal:

@@ -281,7 +281,9 @@ class EngineMechanism(Mechanism):
         model = self.model
         if not any(model.shaft_bearings(k) for k in model.shafts):
             return ()
-        teeth = self.regressors(mo).teeth if model.crankshafts else {}
+        with np.errstate(all="ignore"):  # (once for every crankshaft's bearings)
+            regressors = self.regressors(mo)
+        teeth = regressors.teeth
         out: list[NDArray[np.complex128]] = []
         for k in model.shafts:
             planes = model.shaft_bearings(k)
@@ -289,7 +291,7 @@ class EngineMechanism(Mechanism):
                 maps = [(z, sign * (np.asarray(teeth[name].x) + 1j * np.asarray(teeth[name].y)))
                         for z, name, sign in self._gears_on(k)]
                 out += main_bearing_regressors(self, planes, mo, links=self._carried(k),
-                                               teeth=maps)
+                                               teeth=maps, regressors=regressors)
         return tuple(out)
 
     def support_shares(self, z: float, axis: complex = 0j) -> tuple[tuple[int, float], ...]:
