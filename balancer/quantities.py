@@ -40,7 +40,11 @@ class Quantity:
         As a mean-square term of a balancing's objective: the frame loads it squares and
         averages, each ``(key, part)`` with part ``""`` (a real load), ``"x"`` or ``"y"`` (a
         complex one's components); empty for a term that is no load's mean square (the added
-        mass, the unbalance).
+        mass, the unbalance, a largest load).
+    largest
+        As a term of a balancing's objective that weighs the square of a load's largest
+        magnitude (over the samples and, for the supports, every support): that load's key;
+        ``""`` for every other quantity.
     """
 
     key: str
@@ -51,6 +55,7 @@ class Quantity:
     frame: bool = False
     out_of_plane: bool = False
     squares: tuple[tuple[str, str], ...] = ()
+    largest: str = ""
 
     @property
     def label(self) -> str:
@@ -80,6 +85,7 @@ QUANTITIES: Mapping[str, Quantity] = {q.key: q for q in (
     Quantity("unbalance", "unbalance", "N"),
     Quantity("main_bearing_load", "main-bearing load", "N",
              squares=(("supports", "x"), ("supports", "y"))),
+    Quantity("largest_bearing_load", "largest main-bearing load", "N", largest="supports"),
 )}
 
 #: The quantities a cycle drawing shows, by panel key.

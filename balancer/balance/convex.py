@@ -58,6 +58,7 @@ from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .diagnosis import Diagnosis
 from .feasibility import FORCE_BALANCE_TOLERANCE
+from .largest import LargestLoad, pad
 from .lsq import pinv as pseudo_inverse
 from .problem import NumericProblem
 from .repair import Repairs
@@ -106,6 +107,10 @@ CERTIFY_AGAIN = 1e-8
 #: The tie-break's design replaces the SOCP's if it is feasible and its objective is no worse
 #: by more than this, relative to the problem's scale (:meth:`NumericProblem.within`).
 TIE_ACCEPT = 1e-8
+#: Room given to the largest load's hold in the tie-break (:meth:`ConvexSolver.solve`), in the
+#: problem's scaled units (the objective's scale is one): Clarabel's tolerance, so that the
+#: held program stays feasible; the tie-break's design is kept only within :data:`TIE_ACCEPT`.
+TIE_HOLD = 1e-10
 #: A counterweight whose mass may be zero and that the optimum gives less than this share of
 #: its link's mass is tried at none (:meth:`ConvexSolver._without_small_counterweights`).
 SMALL_COUNTERWEIGHT = 1e-3
@@ -167,6 +172,14 @@ class ConvexSolution:
     stages: tuple[StageReport, ...]
 
 
+def _with_row(p: NDArray[np.float64], q: NDArray[np.float64], at: int
+              ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``‖P·u + q‖`` with the epigraph variable ``τ`` after ``u``, its row ``(0, 1)`` at ``at``."""
+    out = np.insert(np.hstack([p, np.zeros((p.shape[0], 1))]), at, 0.0, axis=0)
+    out[at, -1] = 1.0
+    return out, np.insert(q, at, 0.0)
+
+
 class ConvexSolver(Repairs, Diagnosis):
     """The SOCP of a redesign problem, built once and solved on demand.
 
@@ -208,23 +221,47 @@ class ConvexSolver(Repairs, Diagnosis):
         w_mass = data.weights.added_mass / self._scale / self._scale  # (scale² may underflow)
         mass_row = lay.T[data.mass_entries].sum(axis=0) * w_mass
         mass_offset = (float(lay.c[data.mass_entries].sum()) - data.original_mass) * w_mass
-        self._norm_form = w_mass == 0 and k > 0
-        # The objective as the certificate sees it: the full factor.
-        self._objective = ConvexObjective(P=p_matrix, q=q_vector, norm=self._norm_form,
-                                          g=mass_row, g0=mass_offset)
+        #: The largest support load as a term of the objective (:mod:`.largest`), or ``None``:
+        #: then the first stage's variables are ``(u, τ)``, its objective's factor one row more.
+        self.largest = LargestLoad.of(data, lay, self._scale)
+        self._norm_form = w_mass == 0 and (k > 0 or self.largest is not None)
         compressed = Compressed.of(p_matrix, q_vector)
         #: The objective's factor in the scaled variables, compressed to its rank (its root,
         #: ``‖P·u + q‖``, in units of the problem's scale): what a front's programs minimise.
         self.compressed = compressed
         self._dual_basis = compressed.basis if k else None
         sv, vt = compressed.singular_values, compressed.vt
+        stage_p, stage_q, basis = compressed.P, compressed.q, self._dual_basis
+        width = n
+        if self.largest is not None:  # τ's row before the constant's (which squares drop)
+            width = n + 1
+            p_matrix, q_vector = _with_row(p_matrix, q_vector, k)
+            stage_p, stage_q = _with_row(compressed.P, compressed.q, compressed.P.shape[0] - 1)
+            mass_row = np.append(mass_row, 0.0)
+            rank = compressed.P.shape[0] - 1
+            basis = np.zeros((k + 1, rank + 2))
+            if k:
+                basis[:k, :rank] = compressed.basis[:, :rank]
+                basis[:k, rank + 1] = compressed.basis[:, rank]
+            basis[k, rank] = 1.0
+            self._dual_basis = basis
+        # The objective as the certificate sees it: the full factor.
+        self._objective = ConvexObjective(P=p_matrix, q=q_vector, norm=self._norm_form,
+                                          g=mass_row, g0=mass_offset)
+        #: The first stage's cones: the bounds', and the largest load's epigraph.
+        self._stage_cones = (self._cones if self.largest is None else
+                             [*pad(self._cones, width), *self.largest.cones(width, n)])
+        self._stage_equality = (equality if equality is None or self.largest is None
+                                else (np.hstack([equality[0], np.zeros((equality[0].shape[0],
+                                                                         1))]), equality[1]))
         if self._norm_form:
             # In epigraph form, so that the norm's multiplier is the cone's dual.
-            self._stage1 = ConicProgram(n, self._cones, equality=equality, objective="norm",
-                                        P=compressed.P, q=compressed.q)
+            self._stage1 = ConicProgram(width, self._stage_cones, equality=self._stage_equality,
+                                        objective="norm", P=stage_p, q=stage_q)
         else:  # ‖P·u + q‖² + w_m·Δm, constants dropped
-            self._stage1 = ConicProgram(n, self._cones, equality=equality, objective="squares",
-                                        P=compressed.P[:-1], q=compressed.q[:-1], g=mass_row)
+            self._stage1 = ConicProgram(width, self._stage_cones, equality=self._stage_equality,
+                                        objective="squares", P=stage_p[:-1], q=stage_q[:-1],
+                                        g=mass_row)
         # finalize's projections by margin, built when first needed
         self._projections: dict[float, ConicProgram] = {}
         # Tie-break. J is strictly convex in y = P·u, so every optimal design has the same y
@@ -251,10 +288,13 @@ class ConvexSolver(Repairs, Diagnosis):
         count = sum(e.shape[0] for e, _ in fixed)  # (fewer rows than variables: free)
         self._tie_free = count < n or (bool(fixed) and np.linalg.matrix_rank(
             np.vstack([e for e, _ in fixed])) < n)
-        self._stage2 = ConicProgram(
-            n, self._cones, objective="nearest",
-            equality=(np.vstack([e for e, _ in fixed]), np.concatenate([r for _, r in fixed]))
-            if fixed else None)
+        self._stage2_equality = ((np.vstack([e for e, _ in fixed]),
+                                  np.concatenate([r for _, r in fixed])) if fixed else None)
+        self._stage2 = ConicProgram(n, self._cones, objective="nearest",
+                                    equality=self._stage2_equality)
+        #: The tie-break's hold on the largest load at the first stage's optimum (cones in
+        #: ``u``), set by :meth:`solve`; empty without that term.
+        self._held: list[Constraint] = []
 
     @property
     def constraints(self) -> list[Constraint]:
@@ -495,8 +535,9 @@ class ConvexSolver(Repairs, Diagnosis):
             solver_status=solution.status,
             iterations=solution.iterations,
             time=elapsed,
-            objective=(self.data.reduced_objective(self.layout.x(solution.u))
-                       if solution.u is not None else math.nan),
+            objective=(self.data.reduced_objective(
+                self.layout.x(solution.u[: self.layout.size]))
+                if solution.u is not None else math.nan),
         )
         return report, solution
 
@@ -527,16 +568,23 @@ class ConvexSolver(Repairs, Diagnosis):
         if first.u is None:
             raise self.infeasible(f"Clarabel: {report.solver_status} after "
                                    f"{report.iterations} iterations")
-        u1 = first.u
+        u1 = first.u[: lay.size]  # (without the largest load's τ)
         x, tight = self.repair(u1)
         objective = data.reduced_objective(x)
+        self._held = []
         if tie_break and lay.size:
             target = data.preferred if prefer is None else np.asarray(prefer, float)
             fixed = [] if self._fb is None else [self._fb[1]]
             probe = x
+            stage2 = self._stage2
+            if self.largest is not None:  # every optimum has the same largest load: held
+                tau = max(float(first.u[lay.size]), self.largest.value(u1)) + TIE_HOLD
+                self._held = self.largest.held(tau)
+                stage2 = ConicProgram(lay.size, [*self._cones, *self._held],
+                                      objective="nearest", equality=self._stage2_equality)
             if self._tie_free:
                 report2, second = self._run(
-                    self._stage2, "tie-break", target=lay.u(target),
+                    stage2, "tie-break", target=lay.u(target),
                     equality_rhs=np.concatenate([*fixed, self._seen @ u1]))
                 stages.append(report2)
             if self._tie_free and second.u is not None:
@@ -601,7 +649,7 @@ class ConvexSolver(Repairs, Diagnosis):
         if self._seen.shape[0]:
             equality.append(self._seen)
             rhs.append(self._seen @ u1)
-        program = ConicProgram(lay.size, self._cones, objective="nearest",
+        program = ConicProgram(lay.size, [*self._cones, *self._held], objective="nearest",
                                equality=(np.vstack(equality), np.concatenate(rhs)))
         report, solution = self._run(program, "counterweights off",
                                      target=lay.u(target))
@@ -636,6 +684,10 @@ class ConvexSolver(Repairs, Diagnosis):
                 lower = max(lower, self._lower_bound(again, feasible))
         return lower
 
+    def _point(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The first stage's variables at ``u``: ``u``, and its largest load's ``τ`` if any."""
+        return u if self.largest is None else np.append(u, self.largest.value(u))
+
     def _lower_bound(self, solution: ConicSolution,
                      feasible: NDArray[np.float64] | None) -> float:
         """The certified lower bound on ``J`` from one solution of the SOCP, (N·m)².
@@ -664,12 +716,13 @@ class ConvexSolver(Repairs, Diagnosis):
         """
         upper = None
         if feasible is not None:
-            f = self._objective.value(self.layout.u(feasible))
+            f = self._objective.value(self._point(self.layout.u(feasible)))
             upper = f + abs(f) + 1e-9  # above the optimum, whatever the design's rounding
-        equality = None if self._fb is None else self._fb[:2]
         lo, hi = self.box()
-        bound = lower_bound(self._objective, self._cones, equality, u, multipliers, norm_dual,
-                            lo, hi, upper)
+        if self.largest is not None:  # τ at a minimiser: the largest load, within the box's
+            lo, hi = np.append(lo, 0.0), np.append(hi, self.largest.bound(lo, hi))
+        bound = lower_bound(self._objective, self._stage_cones, self._stage_equality, u,
+                            multipliers, norm_dual, lo, hi, upper)
         scale = self._scale
         if bound is not None and self._norm_form:
             return (max(bound.value, 0.0) * scale) ** 2

@@ -15,7 +15,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..quantities import unit_of, words_of
+from ..quantities import QUANTITIES, unit_of, words_of
 
 #: The second objectives of a front (``pareto --against``).
 Against = Literal["driving-torque", "added-mass", "shaking-force"]
@@ -26,8 +26,10 @@ AGAINST: dict[str, tuple[str, str]] = {
 #: What a front may minimise, and the figures its points report: their words and units.
 FIGURES: dict[str, tuple[str, str]] = {
     "rms": ("weighted RMS shaking √J", "N·m"),
-    **{key: (f"RMS {words_of(key)}", unit_of(key))
-       for key in ("rocking_couple", "shaking_force", "shaking_moment", "main_bearing_load")}}
+    **{key: (words_of(key) if QUANTITIES[key].largest else f"RMS {words_of(key)}",
+             unit_of(key))
+       for key in ("rocking_couple", "shaking_force", "shaking_moment", "main_bearing_load",
+                   "largest_bearing_load")}}
 
 
 @dataclass(frozen=True)

@@ -246,8 +246,11 @@ class NlpSolver:
         self._ubg = np.array(ubg)
         # As many equations (Eq. 58's rows) as variables leave IPOPT nothing to improve on the
         # convex optimum, and CasADi would say on stderr that the NLP is overconstrained.
+        # The largest main-bearing load as an objective (an engine's, whose program is convex
+        # and exact: its convex optimum is global) is not written here: nothing to improve.
         equations = int(np.sum(self._lbg == self._ubg))
-        self._solver = None if equations >= len(symbols) else ca.nlpsol(
+        self._solver = None if (equations >= len(symbols)
+                                or data.weights.largest_bearing_load) else ca.nlpsol(
             "balance", "ipopt", {"x": v, "f": value, "g": ca.vertcat(*g)}, self.options
         )
 
@@ -304,7 +307,9 @@ class NlpSolver:
     def solve(self, x_start: NDArray[np.float64]) -> NlpSolution | None:
         """Run IPOPT from design vector ``x_start`` (normally the convex optimum).
 
-        ``None`` where the problem leaves no freedom beyond its equations (nothing to solve).
+        ``None`` where the problem leaves no freedom beyond its equations (nothing to solve),
+        or its objective weighs the largest main-bearing load (an engine's: the convex program
+        is exact, its optimum global).
         """
         if self._solver is None:
             return None

@@ -28,10 +28,15 @@ BALANCED_SHARE = 1e-3
 class ObjectiveScale(ObjectiveTerms):
     """The scale of a :class:`~.problem.NumericProblem`'s objective, and gaps measured by it."""
 
+    def squares(self, x: NDArray[np.float64]) -> float:
+        """``‖K·x‖² + w_L·L(x)²``: the objective's squares (all but the mass term), (N·m)²."""
+        w = self.weights.largest_bearing_load
+        return self.quadratic(x) + (w * self.largest_support_load(x) ** 2 if w else 0.0)
+
     @cached_property
     def objective_reference(self) -> float:
-        """A positive scale of ``J``: ``‖K·x0‖² + w_m·Σm_original``, (N·m)²."""
-        value = self.quadratic(self.x0) + self.weights.added_mass * self.original_mass
+        """A positive scale of ``J``: ``‖K·x0‖² + w_L·L(x0)² + w_m·Σm_original``, (N·m)²."""
+        value = self.squares(self.x0) + self.weights.added_mass * self.original_mass
         return value if value > 0 else 1.0
 
     @cached_property
@@ -39,22 +44,28 @@ class ObjectiveScale(ObjectiveTerms):
         """The largest RMS a change of the parameters by their own scale makes, N·m.
 
         ``σ_max(R·diag(scales))`` (:attr:`scales`): what the links' inertias can produce, which
-        does not vanish when the original design happens to be balanced.
+        does not vanish when the original design happens to be balanced; with the largest-load
+        term, also ``√w_L`` times the largest row norm of the supports' rows so scaled (what a
+        change by those scales makes of one support's load at one sample).
         """
-        if not self.factor.shape[0]:
-            return 0.0
-        return float(np.linalg.norm(self.factor * self.scales, 2))
+        value = (float(np.linalg.norm(self.factor * self.scales, 2)) if self.factor.shape[0]
+                 else 0.0)
+        w, rows = self.weights.largest_bearing_load, self.regressors.supports
+        if w and rows is not None:
+            largest = float(np.max(np.linalg.norm(rows * self.scales, axis=1), initial=0.0))
+            value = math.hypot(value, math.sqrt(w) * largest)
+        return value
 
     @cached_property
     def objective_scale(self) -> float:
-        """The problem's own scale of ``√J``, N·m: the original design's ``‖K·x0‖``.
+        """The problem's own scale of ``√J``, N·m: the original design's ``√(‖K·x0‖² + w_L·L²)``.
 
         It is the RMS of the original's weighted shaking (its RMS shaking moment for the
         default objective); for a design that is balanced already (below
         :data:`BALANCED_SHARE` of :attr:`inertial_scale`) that share of the inertial scale.
         Solvers scale their objective by it; optimality is judged against it.
         """
-        value = max(math.sqrt(self.quadratic(self.x0)), BALANCED_SHARE * self.inertial_scale)
+        value = max(math.sqrt(self.squares(self.x0)), BALANCED_SHARE * self.inertial_scale)
         return value if value > 0 else 1.0
 
     @property
@@ -83,12 +94,16 @@ class ObjectiveScale(ObjectiveTerms):
         Tiny for most designs; for links of very different masses (whose terms cancel), large
         enough that no claim of optimality finer than it can be made.
         """
-        eps = np.finfo(float).eps
+        eps = float(np.finfo(float).eps)
         blur = ROUNDING_FACTOR * eps * float(np.linalg.norm(np.abs(self.rows) @ np.abs(x)))
+        w, rows = self.weights.largest_bearing_load, self.regressors.supports
+        if w and rows is not None:  # (the largest load: a sum of terms as large as |S_r|·|x|)
+            largest = float(np.max(np.abs(rows) @ np.abs(x), initial=0.0))
+            blur = math.hypot(blur, ROUNDING_FACTOR * eps * math.sqrt(w) * largest)
         s = self.objective_scale
         if self.rms_form:
             return blur / s
-        root = math.sqrt(max(self.quadratic(x), 0.0))
+        root = math.sqrt(max(self.squares(x), 0.0))
         mass = self.weights.added_mass * ROUNDING_FACTOR * eps * self.original_mass
         return (2 * root * blur + blur * blur + mass) / (s * s)
 

@@ -1,10 +1,13 @@
 """The objective's terms: its least-squares rows, their triangular factor, its value.
 
-``J(x) = ‖K·x‖² + w_m·(Σm − Σm_original)``: :func:`objective_rows` stacks the weighted regressor
-rows of each term of ``[balance.objective]`` (shaking moment, driving torque, shaking force,
-rocking couple; an engine's unbalance, ``w_U·Σ (|x_i|·ω²)²`` over its chosen mass·radius sites)
-into ``K`` and factors it; :class:`ObjectiveTerms` evaluates ``J`` from the full
-regressors (:meth:`ObjectiveTerms.objective`) or through the factor
+``J(x) = ‖K·x‖² + w_m·(Σm − Σm_original) + w_L·L(x)²``: :func:`objective_rows` stacks the
+weighted regressor rows of each mean-square term of ``[balance.objective]`` (shaking moment,
+driving torque, shaking force, rocking couple, main-bearing load; an engine's unbalance,
+``w_U·Σ (|x_i|·ω²)²`` over its chosen mass·radius sites) into ``K`` and factors it;
+``L(x) = max_r |S_r·x|`` is the largest main-bearing load over the bearings and samples (the
+rows ``S`` of :attr:`~.regressors.CycleRegressors.supports`; the min–max term, which the convex
+program carries in epigraph form, :mod:`.convex`). :class:`ObjectiveTerms` evaluates ``J`` from
+the full regressors (:meth:`ObjectiveTerms.objective`) or through the factor
 (:meth:`ObjectiveTerms.reduced_objective`).
 """
 
@@ -79,18 +82,33 @@ class ObjectiveTerms(ProblemData):
             total += w.added_mass * (self.total_mass(x) - self.original_mass)
         if w.unbalance and self.sites is not None:
             total += w.unbalance * self.sites.unbalance(x) ** 2
+        if w.largest_bearing_load:
+            total += w.largest_bearing_load * self.largest_support_load(x) ** 2
         return total
+
+    def largest_support_load(self, x: NDArray[np.float64]) -> float:
+        """``L(x)``: the largest support load (an engine's main bearing's) at ``x``, N.
+
+        Over every support and sample (the rows of the regressors' ``supports``); 0 where the
+        problem has none.
+        """
+        rows = self.regressors.supports
+        return 0.0 if rows is None else float(np.max(np.abs(rows @ x), initial=0.0))
 
     def reduced_objective(self, x: NDArray[np.float64]) -> float:
         """``J(x)`` through the factor: ``‖R·x‖² + w_m·(Σm − Σm_original)``, (N·m)².
 
         Equal to :meth:`objective` up to rounding, at a cost independent of the number of
-        sampled angles: what the solvers' inner loops compare.
+        sampled angles (but for the largest-load term's ``w_L·L(x)²``, which needs every
+        sample): what the solvers' inner loops compare.
         """
         r = self.factor @ x
         total = float(r @ r)
-        if self.weights.added_mass:
-            total += self.weights.added_mass * (self.total_mass(x) - self.original_mass)
+        w = self.weights
+        if w.added_mass:
+            total += w.added_mass * (self.total_mass(x) - self.original_mass)
+        if w.largest_bearing_load:
+            total += w.largest_bearing_load * self.largest_support_load(x) ** 2
         return total
 
     @cached_property

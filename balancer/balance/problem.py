@@ -201,7 +201,8 @@ def _engine_problem(design: Design, problem: RotorBalanceProblem) -> NumericProb
     (linkage,) = cycle_regressors_at(mech, angles, [(speed, 0.0)])
     force, moment, couple = site_columns(sites.sites, angles, speed)
     supports = None
-    if problem.objective.main_bearing_load or problem.max_bearing_load is not None:
+    w = problem.objective
+    if w.main_bearing_load or w.largest_bearing_load or problem.max_bearing_load is not None:
         supports = _support_rows(mech, sites, angles, speed, force)
     reg = CycleRegressors(  # no driving torque from a site at constant speed
         shaking_force=np.hstack([linkage.shaking_force, force]),

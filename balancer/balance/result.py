@@ -319,11 +319,15 @@ class BalanceResult:
         """Each mean-square term's RMS in ``analysis`` (inertial: :attr:`before`, :attr:`after`).
 
         Keyed by the term's name (:attr:`Objective.terms`), in its unit; ``added_mass`` gives
-        the mass added to the original, kg.
+        the mass added to the original, kg; a largest load's term (``largest_bearing_load``)
+        its largest magnitude, N.
         """
         values = {t.name: float(np.sqrt(np.mean(sum(
             part**2 for part in squared_parts(t.name, analysis.load)))))
             for t in self.weights.terms if QUANTITIES[t.name].squares}
+        values.update({t.name: float(np.max(np.abs(analysis.load(QUANTITIES[t.name].largest)),
+                                            initial=0.0))
+                       for t in self.weights.terms if QUANTITIES[t.name].largest})
         values["added_mass"] = analysis.linkage.total_mass - self.original.total_mass
         if self.rotor_masses is not None:  # (of the chosen masses, not of the analysis)
             rm = self.rotor_masses
@@ -349,7 +353,8 @@ class BalanceResult:
                          f"{self.in_unit(self.scale):.4g} {unit}")
             # (A figure within rounding of the problem's scale is 0: :class:`Scales`.)
             sc = Scales([(unit, self.in_unit(self.scale))])
-            value = f"RMS {name} {sc.number(self.in_unit(self.rms), unit)} {unit}"
+            what = name if QUANTITIES[term.name].largest else f"RMS {name}"
+            value = f"{what} {sc.number(self.in_unit(self.rms), unit)} {unit}"
             if self.original_objective > 0:
                 ratio = sc.ratio(self.in_unit(self.rms),
                                  self.in_unit(math.sqrt(self.original_objective)), unit)

@@ -17,7 +17,9 @@ so that ``Σ c_i·t_i`` bounds ``Σ |mr_i|`` (or the masses): a second-order con
 by Clarabel, with its certified lower bound (:func:`.certificate.lower_bound`, over the box
 ``|u| ≤ 1``, ``0 ≤ t ≤ 1``, which holds a minimiser: ``t_i = ‖u_i‖`` is feasible whenever any
 ``t`` is). ``ε`` runs on an even grid from nothing added to the least sum among the designs of
-least ``J'`` (the front's two ends).
+least ``J'`` (the front's two ends). Where ``J'`` weighs the largest main-bearing load, its
+epigraph variable ``τ`` (:mod:`.largest`) follows the ``t_i``, with its cones and its row of
+the objective; in the certificate's box ``τ`` lies within what the box's ``u`` can make of it.
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .convex import ACCURACY_FALLBACKS, CERTIFY_AGAIN, ConvexSolver, solve_program
 from .front import Front, FrontPoint, mark_knee
+from .largest import pad
 from .problem import NumericProblem, numeric_problem
 from .sites import Sites
 
@@ -43,7 +46,8 @@ from .sites import Sites
 #: hundred times Clarabel's tolerance, so that the constrained program stays feasible.
 END_ROOM = 1e-8
 #: The quantities ``J'`` may weigh alone, whose RMS the front then shows in its own unit.
-SINGLE = ("rocking_couple", "shaking_force", "shaking_moment", "main_bearing_load")
+SINGLE = ("rocking_couple", "shaking_force", "shaking_moment", "main_bearing_load",
+          "largest_bearing_load")
 
 
 class _RotorFront:
@@ -58,7 +62,9 @@ class _RotorFront:
         chosen = [k for i in self.sites.chosen for k in range(data.size)[self.sites.entries(i)]]
         assert list(solver.layout.primary) == chosen, "the variables are the chosen sites'"
         self.n, self.s = n, s
-        width = n + s
+        largest = solver.largest
+        width = n + s + (largest is not None)
+        self.width = width
         problem = self.sites.problem
         radius = None if problem.counterweights is None else problem.counterweights.radius
         self.per_mr = 1.0 if radius is None else 1.0 / radius
@@ -66,21 +72,25 @@ class _RotorFront:
         self.weights = np.array([self.sites.sites[i].max_mr for i in self.sites.chosen]
                                 ) * self.per_mr
         self.rescale(float(self.weights.sum()))
-        cones = [Constraint("soc", np.hstack([c.M, np.zeros((3, s))]), c.m)
-                 for c in solver.constraints]
+        cones = pad(solver.constraints, width)
         for i in range(s):  # the variables are the chosen sites' scaled entries, in order
             m = np.zeros((3, width))
             m[0, n + i] = 1.0
             m[1, 2 * i] = m[2, 2 * i + 1] = 1.0
             cones.append(Constraint("soc", m, np.zeros(3)))
-        self.cones = cones
         compressed = solver.compressed
-        self.P = np.hstack([compressed.P, np.zeros((compressed.P.shape[0], s))])
+        self.P = np.hstack([compressed.P, np.zeros((compressed.P.shape[0], width - n))])
         self.q = compressed.q
-        self.norm = ConvexObjective(P=self.P, q=self.q, norm=True, g=np.zeros(width), g0=0.0)
-        self.lo = np.r_[-np.ones(n), np.zeros(s)]
+        self.lo = np.r_[-np.ones(n), np.zeros(width - n)]
         self.hi = np.ones(width)
-        self.width = width
+        if largest is not None:  # τ ≥ |a_r·u + a0_r|, and its row ‖(P·u + q, τ)‖
+            cones += largest.cones(width, width - 1)
+            tau_row = np.zeros((1, width))
+            tau_row[0, -1] = 1.0
+            self.P, self.q = np.vstack([self.P, tau_row]), np.append(self.q, 0.0)
+            self.hi[-1] = largest.bound(self.lo[:n], self.hi[:n])
+        self.cones = cones
+        self.norm = ConvexObjective(P=self.P, q=self.q, norm=True, g=np.zeros(width), g0=0.0)
 
     def x(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
         """The design vector (kg·m) of scaled ``u``, each mass·radius within its bound."""
@@ -96,7 +106,9 @@ class _RotorFront:
         out = {name: float(np.sqrt(np.mean(np.abs(getattr(reg, name) @ x) ** 2)))
                for name in ("shaking_force", "rocking_couple", "shaking_moment")}
         if reg.supports is not None:
-            out["main_bearing_load"] = float(np.sqrt(np.mean(np.abs(reg.supports @ x) ** 2)))
+            loads = np.abs(reg.supports @ x)
+            out["main_bearing_load"] = float(np.sqrt(np.mean(loads**2)))
+            out["largest_bearing_load"] = float(np.max(loads, initial=0.0))
         return out
 
     def rescale(self, scale: float) -> None:
@@ -106,7 +118,8 @@ class _RotorFront:
         mass the front uses.
         """
         self.value_scale = scale if scale > 0 else float(self.weights.sum())
-        self.cap_row = np.r_[np.zeros(self.n), self.weights / self.value_scale]
+        self.cap_row = np.r_[np.zeros(self.n), self.weights / self.value_scale,
+                             np.zeros(self.width - self.n - self.s)]
 
     def value(self, x: NDArray[np.float64]) -> float:
         """``Σ |mr_i|`` of ``x``'s chosen sites (kg·m), or the masses at the radius (kg)."""

@@ -76,7 +76,7 @@ OBJECTIVE_KEYS = (
 
 #: The keys of an engine's ``[balance.objective]`` (DESIGN.md, "Balancing an engine").
 ENGINE_OBJECTIVE_KEYS = ("rocking_couple", "shaking_force", "shaking_moment", "unbalance",
-                         "main_bearing_load")
+                         "main_bearing_load", "largest_bearing_load")
 
 
 LINK_KEYS = ("mass", "com_radius", "com_about", "min_gyration", "inertia", "counter_rotor",
@@ -115,6 +115,9 @@ class Objective:
     main_bearing_load
         ``w_B``, m²: of an engine's main-bearing loads' mean-square magnitude, over its bearings
         and the samples (``[mechanism] main_bearings``).
+    largest_bearing_load
+        ``w_L``, m²: of the square of the largest main-bearing load, ``max |R_b(θ)|`` over the
+        bearings and the samples, N (the min–max objective; ``[mechanism] main_bearings``).
     """
 
     shaking_moment: float = 1.0
@@ -126,6 +129,7 @@ class Objective:
     added_mass: float = 0.0
     unbalance: float = 0.0
     main_bearing_load: float = 0.0
+    largest_bearing_load: float = 0.0
 
     @property
     def terms(self) -> tuple[ObjectiveTerm, ...]:
@@ -141,7 +145,8 @@ class Objective:
         weights = [("shaking_moment", self.shaking_moment),
                    ("driving_torque", self.driving_torque), *forces,
                    ("rocking_couple", self.rocking_couple), ("added_mass", self.added_mass),
-                   ("unbalance", self.unbalance), ("main_bearing_load", self.main_bearing_load)]
+                   ("unbalance", self.unbalance), ("main_bearing_load", self.main_bearing_load),
+                   ("largest_bearing_load", self.largest_bearing_load)]
         return tuple(ObjectiveTerm(name, weight, unit_of(name)) for name, weight in weights
                      if weight > 0)
 

@@ -46,6 +46,10 @@ ENGINE_BALANCE: dict[str, tuple[Key, ...]] = {
             "An engine's: w_B, of its main-bearing loads' mean-square magnitude over its "
             "bearings and the cycle (inertial; needs `[mechanism] main_bearings`).", (ENGINE,),
             example="0.01"),
+        Key("largest_bearing_load", "m²", "0",
+            "An engine's: w_L, of the square of its largest main-bearing load over its bearings "
+            "and the cycle (the min–max objective; inertial; needs `[mechanism] "
+            "main_bearings`).", (ENGINE,), example="1.0"),
     ),
 }
 

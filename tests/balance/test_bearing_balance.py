@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
@@ -21,7 +22,7 @@ import pytest
 
 from balancer.balance.optimizer import Optimizer, optimize
 from balancer.balance.problem import numeric_problem
-from balancer.balance.result import InfeasibleError
+from balancer.balance.result import GAP_TOLERANCE, InfeasibleError
 from balancer.cli import main
 from balancer.cycle import cycle_analysis
 from balancer.mechanisms.engine.bearings import lever_shares
@@ -277,3 +278,155 @@ def test_four_counterweights_against_eight(design):
                                theta1=result.after.theta1, loads=False)
         largest = max(float(np.max(np.abs(s.force))) for s in after.supports)
         assert largest <= design.balance.max_bearing_load * (1 + 1e-6)
+
+
+def largest_alone(design, **weights):
+    """The in-line four with the largest main-bearing load weighed (and ``weights``), no bound."""
+    w = replace(design.balance.objective, rocking_couple=0.0, shaking_force=0.0,
+                main_bearing_load=0.0, unbalance=0.0, largest_bearing_load=1.0)
+    return replace(design, balance=replace(design.balance, objective=replace(w, **weights),
+                                           max_bearing_load=None))
+
+
+def built_largest(design, x, data) -> float:
+    """The largest main-bearing load of the engine built with ``x``, by its cycle analysis, N."""
+    built = data.sites.model_of(design.mechanism, x)
+    loads = cycle_analysis(built, design.operation.speed, theta1=data.states.positions[0],
+                           loads=False).supports
+    return max(float(np.max(np.abs(s.force))) for s in loads)
+
+
+def test_the_largest_load_term_is_the_built_engines_largest_bearing_load(design):
+    """``largest_bearing_load``'s J at random counterweights is w_L times the square of the
+    largest load of the built engine's bearings (its cycle analysis, not the regressors)."""
+    spec = largest_alone(design, largest_bearing_load=0.25, shaking_force=0.5)
+    data = numeric_problem(spec)
+    rng = np.random.default_rng(4401)
+    for _ in range(3):
+        x = data.x0.copy()
+        for i in data.sites.chosen:
+            x[data.sites.entries(i)] = rng.uniform(-0.02, 0.02, 2)
+        largest = built_largest(design, x, data)
+        assert data.largest_support_load(x) == pytest.approx(largest, rel=1e-9)
+        built = data.sites.model_of(design.mechanism, x)
+        force = analyze_inertial(built, design.operation.speed, data.states.positions[0])
+        want = 0.25 * largest**2 + 0.5 * float(np.mean(np.abs(force) ** 2))
+        assert data.objective(x) == pytest.approx(want, rel=1e-9)
+        assert data.reduced_objective(x) == pytest.approx(want, rel=1e-9)
+
+
+def least_largest_oracle(design, theta, weights):
+    """CVXPY's epigraph of ``w_L·max|B|² + w_F·mean|F|² + w_U·Σ(mr·ω²)²`` over the bearings'
+    loads by hand (:func:`bearing_map`), in real second-order cones and scaled units (loads in
+    tens of kN, mass·radius by its bound: CVXPY's complex ``abs`` of these loads, unscaled,
+    came back "optimal" 6 % above the optimum). The mass·radius vectors it chooses, kg·m."""
+    problem = design.balance
+    speed = design.operation.speed
+    b0, cols = bearing_map(design, theta)
+    unit, per = 1e4, max(problem.counterweights.max_mr)
+    rows = np.concatenate(list(cols)) * per / unit
+    rows0 = np.concatenate(list(b0)) / unit
+    y, t = cp.Variable(cols.shape[2]), cp.Variable()
+    parts = cp.hstack([cp.reshape(rows.real @ y + rows0.real, (rows0.size, 1), order="C"),
+                       cp.reshape(rows.imag @ y + rows0.imag, (rows0.size, 1), order="C")])
+    cons = [cp.SOC(t * np.ones(rows0.size), parts, axis=1)]
+    cons += [cp.norm(y[2 * i : 2 * i + 2]) <= m / per
+             for i, m in enumerate(problem.counterweights.max_mr)]
+    planes = problem.counterweights.planes
+    engine = design.mechanism
+    base = replace(engine, crankshaft=replace(engine.crankshaft, masses=tuple(
+        m for m in engine.crankshaft.masses
+        if not (m.label == "counterweight" and m.z in planes))))
+    turn = speed**2 * np.exp(1j * theta)
+    fcols = np.column_stack([c for _ in planes for c in (turn, 1j * turn)]) * per / unit
+    f0 = analyze_inertial(base, speed, theta) / unit
+    cost = (weights.largest_bearing_load * cp.square(t)
+            + weights.shaking_force * (cp.sum_squares(fcols.real @ y + f0.real)
+                                       + cp.sum_squares(fcols.imag @ y + f0.imag)) / theta.size
+            + weights.unbalance * (speed**2 * per / unit) ** 2 * cp.sum_squares(y))
+    with warnings.catch_warnings():  # ("almost solved" is enough: its design is evaluated)
+        warnings.simplefilter("ignore", UserWarning)
+        cp.Problem(cp.Minimize(cost), cons).solve(solver=cp.CLARABEL)
+    assert y.value is not None
+    x = np.asarray(y.value) * per
+    for i, m in enumerate(problem.counterweights.max_mr):  # within its bounds exactly
+        x[2 * i : 2 * i + 2] *= min(1.0, m / float(np.linalg.norm(x[2 * i : 2 * i + 2])))
+    return x
+
+
+@pytest.mark.slow
+def test_the_least_largest_load_is_the_independent_programs(design):
+    """The min–max objective against CVXPY's epigraph over the bearings' loads by hand
+    (:func:`least_largest_oracle`): alone (the least largest load, which the bound's diagnosis
+    also names) and with the free force and the unbalance weighed. The oracle's design is no
+    better than the certified bound, ours no worse than the oracle's by more than the certified
+    tolerance; the design's largest load is the built engine's; the NLP backend leaves the
+    convex (exact) optimum as it is."""
+    problem = design.balance
+    for weights in ({}, {"shaking_force": 0.3, "unbalance": 1e-6}):
+        spec = largest_alone(design, **weights)
+        result = optimize(spec, "nlp")
+        assert result.optimal, result.message
+        assert "nlp" not in [s.name for s in result.stages]  # (no IPOPT run: nothing to gain)
+        data = numeric_problem(spec)
+        theta = result.before.theta1
+        oracle = data.x0.copy()
+        for k, i in enumerate(data.sites.chosen):
+            oracle[data.sites.entries(i)] = least_largest_oracle(
+                design, theta, spec.balance.objective)[2 * k : 2 * k + 2]
+        ours, theirs = result.objective, data.objective(oracle)
+        assert theirs >= result.lower_bound * (1 - 1e-12)
+        assert math.sqrt(ours) - math.sqrt(theirs) <= GAP_TOLERANCE * result.scale
+        b0, cols = bearing_map(design, theta)
+        largest = float(np.max(np.abs(b0 + cols @ chosen(result))))
+        assert data.largest_support_load(result.x) == pytest.approx(largest, rel=1e-9)
+        assert built_largest(design, result.x, data) == pytest.approx(largest, rel=1e-9)
+        assert result.term_rms(result.after)["largest_bearing_load"] == pytest.approx(
+            largest, rel=1e-9)
+        if not weights:
+            with pytest.raises(InfeasibleError) as caught:  # the bound's least, by its route
+                optimize(replace(design, balance=replace(problem, max_bearing_load=5000.0)),
+                         "convex")
+            (_, least, _, _), = caught.value.needed
+            assert abs(largest - least) <= GAP_TOLERANCE * result.scale
+
+
+@pytest.mark.slow
+def test_the_front_of_the_largest_bearing_load_against_added_mass(design):
+    """With largest_bearing_load weighed alone, pareto --against added-mass is the front of the
+    largest main-bearing load (N) against the counterweights' mass: each point's figure is the
+    built engine's largest bearing load, above its certified bound, falling as the mass grows,
+    down to the optimiser's least largest load."""
+    from balancer.balance.pareto import pareto_front
+
+    spec = largest_alone(design)
+    front = pareto_front(spec, "added-mass", 3)
+    assert front.minimised == "largest_bearing_load"
+    data = numeric_problem(spec)
+    for p in front.points:
+        largest = built_largest(design, p.x, data)
+        assert p.least == pytest.approx(largest, rel=1e-9)
+        assert p.figures["largest_bearing_load"] == pytest.approx(largest, rel=1e-9)
+        assert p.lower_bound <= p.least * (1 + 1e-9)
+        assert p.least - p.lower_bound <= 1e-6 * p.least
+    least = [p.least for p in front.points]
+    assert all(a >= b * (1 - 1e-7) for a, b in zip(least, least[1:], strict=False))
+    best = optimize(spec, "convex")
+    assert least[-1] == pytest.approx(math.sqrt(best.objective), rel=SOLVERS)
+
+
+def test_the_largest_load_key_is_written_back_and_needs_the_main_bearings(design, tmp_path,
+                                                                          capsys):
+    spec = largest_alone(design, largest_bearing_load=0.5)
+    again = loads_design(dumps_design(spec))
+    assert again.balance.objective == spec.balance.objective
+    assert "largest_bearing_load" not in dumps_design(design)  # (written where weighed)
+    text = (EXAMPLES / "inline_four_mains.toml").read_text()
+    bad = (text.replace("max_bearing_load = 7000.0", "# ")
+           .replace("main_bearing_load = 1.0", "largest_bearing_load = 1.0")
+           .replace("main_bearings = [", "# main_bearings = ["))
+    path = tmp_path / "bad.toml"
+    path.write_text(bad)
+    assert main(["optimize", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "balance.objective.largest_bearing_load" in err and len(err.splitlines()) == 1

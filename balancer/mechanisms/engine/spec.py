@@ -348,9 +348,11 @@ def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
                                        planes=sub.raw("planes"), max_mr=sub.raw("max_mr")))
         sub.finish()
     bound = table.value("max_bearing_load", None)
-    if bound is not None or objective.main_bearing_load:
+    weighted = [name for name in ("main_bearing_load", "largest_bearing_load")
+                if getattr(objective, name)]
+    if bound is not None or weighted:
         key = (table.key("max_bearing_load") if bound is not None
-               else "balance.objective.main_bearing_load")
+               else f"balance.objective.{weighted[0]}")
         model = cast("Engine", engine)
         if not any(model.shaft_bearings(k) for k in model.shafts):
             raise SpecError("needs the main bearings' planes: [mechanism] main_bearings",
@@ -384,7 +386,7 @@ def balance_lines(problem: object) -> list[str]:
     w = problem.objective
     out = ["[balance.objective]  # weights of the mean squares over the cycle",
            *(f"{name} = {toml.number(getattr(w, name))}" for name in ENGINE_OBJECTIVE_KEYS
-             if name != "main_bearing_load" or w.main_bearing_load)]
+             if name not in ("main_bearing_load", "largest_bearing_load") or getattr(w, name))]
     if problem.max_bearing_load is not None:
         out = ["[balance]", f"max_bearing_load = {toml.number(problem.max_bearing_load)}  # N",
                "", *out]
