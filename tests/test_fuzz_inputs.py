@@ -70,6 +70,7 @@ def test_plot_along_a_motion_blames_the_mechanism_not_the_motion(capsys, tmp_pat
 THREE_RRR_FAR = ("[0.08, -0.05, 0.06]", "[1.5, 0.0, 0.0]")
 
 
+@pytest.mark.slow  # (0.6 s each: the full suite's)
 @pytest.mark.parametrize("extra", [[], ["--json"], ["--motion", "shake", "--csv", "out.csv"]])
 def test_inputs_path_where_the_linkage_does_not_assemble(capsys, tmp_path, extra):
     # Found by the campaign (seed 295): the inputs' own path taking a 3-RRR where it does not

@@ -303,6 +303,7 @@ def test_a_link_turning_far_between_samples_keeps_its_turns():
         assert run.energy_error <= 100 * RTOL
 
 
+@pytest.mark.slow  # (0.8 s: the full suite's)
 def test_what_a_fuzz_campaign_found_along_motions(tmp_path, capsys):
     # A [simulation] table on a robot is read (its method among the robot's formulations);
     # a driven run's --duration is refused (it lasts its motion); a motion that moves a
