@@ -6,10 +6,18 @@
 - Each arrangement's figures are the cycle analysis's of the engine built with its phases (the
   order table's whirls, from the inverse dynamics), and its firing order fires evenly by the
   engine's own firing angles.
+- The driving torque's orders are the built engine's (its cycle analysis with its gas), its
+  energy swing the flywheel page's (:class:`balancer.speed_fluctuation.CrankEnergy`: the
+  inverse dynamics at four crank states), even and uneven.
+- With ``step`` (uneven firing): every crank on the grid and every firing order that fits is
+  there (counted by brute force over the orders), each with its firings as the engine places
+  them; the even ones among them keep their figures and the flat-plane four stays first, the
+  even firing's energy swing below every uneven one's of the same crank.
 """
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from dataclasses import replace
@@ -21,7 +29,10 @@ import pytest
 from balancer.arrangements import search
 from balancer.cli import main
 from balancer.cycle import cycle_analysis
+from balancer.errors import SpecError
+from balancer.mechanisms import mechanism_of
 from balancer.spec import load_design
+from balancer.speed_fluctuation import CrankEnergy
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -156,3 +167,112 @@ def test_search_balance_sizes_each_cranks_counterweights_as_the_spec_asks(capsys
 def test_an_engine_of_geared_crankshafts_is_not_searched() -> None:
     """The search arranges one crankshaft's pins: a twin-crank spec is refused by its key."""
     assert main(["search", str(EXAMPLES / "square_four.toml")]) == 2
+
+
+def torque_figures(built, speed: float, samples: int) -> tuple[dict[float, float], float]:
+    """The built engine's driving torque orders up to 12 and its energy swing, by two routes.
+
+    The orders from its cycle analysis (loads included: its gas) over the working cycle; the
+    swing ``ΔE`` from the inverse dynamics at four crank states (the flywheel's
+    :class:`CrankEnergy`: the applied loads' work integrated, the inertia's exactly), on the
+    grid four times finer than the samples as the search evaluates it.
+    """
+    analysis = cycle_analysis(built, speed, samples)
+    cycle = 720 if built.strokes == 4 else 360
+    torque = np.tile(np.asarray(analysis.reactions.driving_torque, float),
+                     cycle // (360 * analysis.revolutions))
+    c = np.fft.rfft(torque) / torque.size
+    orders = {h * 360 / cycle: 2 * abs(c[h]) for h in range(1, 12 * cycle // 360 + 1)}
+    theta = np.arange(torque.size) * math.radians(cycle) / torque.size
+    energy = CrankEnergy.of(mechanism_of(built), theta, math.radians(cycle))
+    j = energy.inertia_on(4)
+    swing = float(np.ptp(energy.work(4) - 0.5 * speed**2 * (j - j[0])))
+    return orders, swing
+
+
+@pytest.mark.parametrize("which", [  # (the fours' gas over 720 samples: the full suite's)
+    pytest.param("four", marks=pytest.mark.slow), pytest.param("four uneven",
+                                                               marks=pytest.mark.slow),
+    "v8", "three uneven"])
+def test_each_arrangements_torque_is_its_engines(which):
+    """Each candidate's torque orders and energy swing are those of the engine built with its
+    crank and firing order (its gas, where the spec has one), and its firing intervals the
+    engine's own firing angles'. Tolerances: the orders to 1e-9 of the torque's scale (the
+    same samples, summed another way); the swing to 1e-8 (the inertial torque integrated as a
+    trigonometric interpolant here, exactly there: their difference is its aliasing)."""
+    name = {"four": "inline_four", "four uneven": "inline_four", "v8": "v8",
+            "three uneven": "inline_three"}[which]
+    design = load_design(EXAMPLES / f"{name}.toml")
+    engine = replace(design.mechanism, crankshaft=replace(design.mechanism.crankshaft,
+                                                          masses=()), balance_shafts=())
+    speed, samples = design.operation.speed, design.operation.samples
+    step = 90.0 if which == "four uneven" else 60.0 if which == "three uneven" else None
+    found = search(engine, speed, top=5, step=step, samples=samples)
+    for a in found.arrangements:
+        built = replace(engine, cylinders=tuple(
+            replace(c, phase_deg=p) for c, p in zip(engine.cylinders, a.phases, strict=True)),
+            firing_order=a.firing_order)
+        firing = [math.degrees(built.firing_angles()[k - 1]) for k in a.firing_order]
+        cycle = 720 if engine.strokes == 4 else 360
+        np.testing.assert_allclose(a.intervals, np.diff([*firing, firing[0] + cycle]),
+                                   atol=1e-9)
+        orders, swing = torque_figures(built, speed, samples)
+        for order, amplitude in a.torque:
+            assert amplitude == pytest.approx(orders[order], abs=1e-9 * found.torque_scale)
+        assert a.energy_swing == pytest.approx(swing, rel=1e-8)
+
+
+def brute_force_orders(engine, phases) -> set[tuple[int, ...]]:
+    """Every firing order, cylinder 1 first, that the engine built with ``phases`` accepts."""
+    cylinders = tuple(replace(c, phase_deg=p)
+                      for c, p in zip(engine.cylinders, phases, strict=True))
+    out = set()
+    for rest in itertools.permutations(range(2, len(cylinders) + 1)):
+        try:  # (an engine with gas checks its firing order when it is made)
+            replace(engine, cylinders=cylinders, firing_order=(1, *rest)).firing_angles()
+        except SpecError:
+            continue
+        out.add((1, *rest))
+    return out
+
+
+def test_the_uneven_search_has_every_crank_on_its_step_and_every_order_that_fits():
+    """An in-line four on a 90° step: 4³ cranks; for each, the firing orders the search gives
+    are exactly those the engine accepts (its firing_angles, over every permutation). The even
+    firings are among them with the even search's figures; the flat-plane four is still first,
+    and no uneven firing of its crank exists (its top dead centres allow none)."""
+    design = load_design(EXAMPLES / "inline_four.toml")
+    engine = replace(design.mechanism, crankshaft=replace(design.mechanism.crankshaft,
+                                                          masses=()), balance_shafts=())
+    speed = design.operation.speed
+    uneven = search(engine, speed, step=90.0, samples=360)
+    even = search(engine, speed, samples=360)
+    by_crank: dict[tuple[float, ...], set[tuple[int, ...]]] = {}
+    for a in uneven.arrangements:
+        by_crank.setdefault(a.phases, set()).add(a.firing_order)
+    for phases, orders in by_crank.items():
+        assert orders == brute_force_orders(engine, phases), phases
+    cranks = {(0.0, *p) for p in itertools.product((0.0, 90.0, 180.0, 270.0), repeat=3)}
+    assert set(by_crank) == {p for p in cranks if brute_force_orders(engine, p)}
+    same = {(a.phases, a.firing_order): a for a in uneven.arrangements}
+    for a in even.arrangements:
+        b = same[(a.phases, a.firing_order)]
+        assert b.free == a.free and b.energy_swing == pytest.approx(a.energy_swing, rel=1e-12)
+    assert {a.phases for a in uneven.arrangements if a.rank == 1} == {(0.0, 180.0, 180.0, 0.0)}
+    assert all(set(a.intervals) == {180.0} for a in uneven.arrangements
+               if a.phases == (0.0, 180.0, 180.0, 0.0))
+    crank = (0.0, 180.0, 90.0, 270.0)  # (a cross-plane crank: even and uneven firings)
+    swings = {len(set(a.intervals)) == 1: a.energy_swing for a in uneven.arrangements
+              if a.phases == crank}
+    assert set(swings) == {False} or swings[True] < swings[False]
+
+
+def test_a_step_that_does_not_divide_the_turn_is_refused(capsys):
+    assert main(["search", str(EXAMPLES / "inline_four.toml"), "--step", "7"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--step" in err[0]
+    assert main(["search", str(EXAMPLES / "inline_four.toml"), "--step", "90", "--json",
+                 "--top", "2"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["step_deg"] == 90.0
+    assert {"firing_intervals_deg", "energy_swing", "torque_orders"} <= set(doc["arrangements"][0])

@@ -11,11 +11,15 @@ from ..mechanisms.engine.model import Engine
 from ..model import Design
 
 
-def search(design: Design, top: int | None = None, *, balance: bool = False) -> Search:
+def search(design: Design, top: int | None = None, *, balance: bool = False,
+           step: float | None = None) -> Search:
     """Every even-firing crank of the design's engine and its firing orders, ranked.
 
-    At the operating speed (``[operation]``), best first (:mod:`balancer.arrangements`);
-    ``top``: the best ``top`` only. ``balance``: each kept arrangement balanced as the spec's
+    At the operating speed (``[operation]``, its samples per revolution for the driving
+    torque), best first (:mod:`balancer.arrangements`); ``top``: the best ``top`` only.
+    ``step``: uneven firing too, every crank whose pins' phases are multiples of ``step``
+    (degrees) from cylinder 1's and every firing order that fits in the working cycle.
+    ``balance``: each kept arrangement balanced as the spec's
     ``[balance]`` asks (its counterweights and shafts, the certified convex optimum of
     :func:`balancer.optimize` on the engine built with that crank and firing order), its
     result in :attr:`~balancer.arrangements.Arrangement.balanced`.
@@ -24,7 +28,8 @@ def search(design: Design, top: int | None = None, *, balance: bool = False) -> 
     ------
     SpecError
         For a design that is not an engine, without ``[operation]``, or whose cylinders have
-        no even-firing crank.
+        no even-firing crank (no crank on ``step`` that fires within the working cycle), or a
+        ``step`` that does not divide 360°.
     """
     engine = design.mechanism
     if not isinstance(engine, Engine):
@@ -36,7 +41,8 @@ def search(design: Design, top: int | None = None, *, balance: bool = False) -> 
     if balance and design.balance is None:
         raise SpecError("balances each crank as [balance] asks: the spec has none",
                         key="--balance")
-    found = search_cranks(engine, design.operation.speed, top)
+    found = search_cranks(engine, design.operation.speed, top, step=step,
+                          samples=design.operation.samples)
     if not balance:
         return found
     from ..balance.optimizer import optimize

@@ -259,8 +259,10 @@ _VERB_TEXTS: dict[str, tuple[str, str]] = {
         "firing order it allows, cylinder 1 first, each judged exactly from its cylinders' "
         "inertial loads at the operating speed: ranked by what crank counterweights cannot "
         "take (the primary force's and couple's backward whirls, the secondary force and "
-        "couple), then by the firings that follow in the same half of the crank. The flat-"
-        "plane four, the in-line six's 1-5-3-6-2-4 and the cross-plane V8 come out on top.",
+        "couple), then by the driving torque's energy swing over the working cycle (what a "
+        "flywheel must hold: it ranks uneven firings, --step), then by the firings that "
+        "follow in the same half of the crank. The flat-plane four, the in-line six's "
+        "1-5-3-6-2-4 and the cross-plane V8 come out on top.",
     ),
     "example": (
         "write a shipped example spec (without NAME: list them)",
@@ -501,6 +503,10 @@ def _search_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--balance", action="store_true",
                    help="balance each of them as the spec's [balance] asks (its certified "
                    "counterweights and shafts) and give the objective left")
+    p.add_argument("--step", type=float, metavar="DEG",
+                   help="uneven firing too: every crank whose pins' phases are multiples of "
+                   "DEG from cylinder 1's (DEG divides 360) and every firing order that fits "
+                   "in the working cycle")
     p.add_argument("--json", action="store_true", help="print a JSON document instead")
 
 

@@ -13,7 +13,7 @@ from .common import load
 def run(args: argparse.Namespace) -> int:
     """Run ``balancer search``; the exit code."""
     design = load(args)
-    found = search(design, top=args.top, balance=args.balance)
+    found = search(design, top=args.top, balance=args.balance, step=args.step)
     print(dumps_json(search_json(found, spec=args.spec)) if args.json
           else search_text(found, design, spec=args.spec))
     return 0
