@@ -52,6 +52,7 @@ from ..model.motions import MotionSpec, Workspace
 from ..motion_analysis import AlongMotions, along_motions
 from .convex import ConvexSolution, ConvexSolver
 from .feasibility import ROUNDING_TOLERANCE
+from .flywheel import sized
 from .nlp import NlpSolution, NlpSolver
 from .problem import NumericProblem, numeric_problem
 from .result import (
@@ -203,6 +204,10 @@ class Optimizer:
                 notes.append(f"IPOPT: {nlp.stage.solver_status}")
         # The design as its physical values, exactly in their bounds (what the spec will say).
         x = data.built(x)
+        sizing = None
+        bound = getattr(data.problem, "max_speed_fluctuation", None)
+        if bound is not None and feasible:  # the flywheel it needs, on the crank (inert)
+            x, sizing = sized(data, x, bound, self.gravity)
         objective = data.objective(x)
         feasible = feasible and not data.violations(x, tol=ROUNDING_TOLERANCE)
         if not feasible and data.force_balance is not None:
@@ -252,6 +257,7 @@ class Optimizer:
             gravity=self.gravity,
             weights=data.weights,
             rotor_masses=None if data.sites is None else self._rotor_masses(x),
+            flywheel=sizing,
         )
         return replace(result, message=result.summary(notes))
 

@@ -149,6 +149,46 @@ class RotorMasses:
 
 
 @dataclass(frozen=True, kw_only=True)
+class FlywheelSizing:
+    """What ``[balance] max_speed_fluctuation`` did (:mod:`.flywheel`): the flywheel it added.
+
+    Attributes
+    ----------
+    bound
+        ``δ``, the largest speed fluctuation allowed.
+    before, balanced, after
+        The speed fluctuation of the original, of the balanced design before its flywheel,
+        and of the balanced design with it (``inf``: it cannot run at the operating speed).
+    added
+        The flywheel put on the crank, kg·m² (0: none needed).
+    crank
+        The crank's name.
+    inertia, counter_rotor
+        Their share of it, kg·m².
+    """
+
+    bound: float
+    before: float
+    balanced: float
+    after: float
+    added: float
+    crank: str
+    inertia: float
+    counter_rotor: float
+
+    def as_dict(self) -> dict[str, object]:
+        """``optimize --json``'s ``speed_fluctuation``."""
+        return {"bound": self.bound, "before": _finite(self.before),
+                "balanced": _finite(self.balanced), "after": _finite(self.after),
+                "flywheel": self.added, "crank": self.crank,
+                "inertia_added": self.inertia, "counter_rotor_added": self.counter_rotor}
+
+
+def _finite(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+@dataclass(frozen=True, kw_only=True)
 class BalanceResult:
     """A balanced design and how it was found (shaped like SciPy's ``OptimizeResult``).
 
@@ -210,6 +250,9 @@ class BalanceResult:
     rotor_masses
         An engine's balancing: the counterweights and shafts it builds (``None`` for a
         linkage's, whose links change).
+    flywheel
+        Under ``[balance] max_speed_fluctuation``: the flywheel put on the crank and the speed
+        fluctuations before and after (:class:`~.flywheel.FlywheelSizing`), else ``None``.
     """
 
     success: bool
@@ -234,6 +277,7 @@ class BalanceResult:
     gravity: tuple[float, float] = (0.0, 0.0)
     weights: Objective = Objective()
     rotor_masses: RotorMasses | None = None
+    flywheel: FlywheelSizing | None = None
 
     def __repr__(self) -> str:
         mass = self.added_mass

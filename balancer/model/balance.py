@@ -257,6 +257,11 @@ class BalanceProblem:
     motion_weights
         A linkage with several inputs: each named motion's weight in the objective (one not
         named weighs 1), by name (a dict is accepted).
+    max_speed_fluctuation
+        A one-input mechanism's: the largest ``(ω_max − ω_min)/ω_mean`` of its crank at the
+        operating speed that the balanced design may have, in ``(0, 2)``; the balancing puts
+        the least flywheel that keeps it on the crank (:mod:`balancer.balance.flywheel`).
+        ``None``: no bound.
     """
 
     force_balance: bool = True
@@ -264,6 +269,7 @@ class BalanceProblem:
     objective: Objective = field(default_factory=Objective)
     links: tuple[tuple[str, LinkFreedom], ...] = ()
     motion_weights: tuple[tuple[str, float], ...] = ()
+    max_speed_fluctuation: float | None = None
     #: The figure a balancing of this kind is about, as a sweep's atlas shows it.
     headline: ClassVar[str] = "shaking_moment"
 
@@ -278,6 +284,12 @@ class BalanceProblem:
         if self.force_scope not in FORCE_SCOPES:
             raise SpecError(f"must be one of {', '.join(FORCE_SCOPES)}", key="balance.force",
                             value=self.force_scope)
+        if self.max_speed_fluctuation is not None:
+            key = "balance.max_speed_fluctuation"
+            delta = v.positive(self.max_speed_fluctuation, key)
+            if not delta < 2:
+                raise SpecError("must be below 2: (ω_max − ω_min)/ω_mean", key=key, value=delta)
+            v.store(self, "max_speed_fluctuation", delta)
 
     def weights_of(self, names: Sequence[str]) -> tuple[float, ...]:
         """The weights of the motions called ``names`` (1 where none is given)."""

@@ -21,7 +21,7 @@ from .motion_runs import motion_verification_text
 from .text import table
 
 if TYPE_CHECKING:  # annotations only (no cycle): the commands that make these load them
-    from ..balance.result import BalanceResult, RotorMasses
+    from ..balance.result import BalanceResult, FlywheelSizing, RotorMasses
     from ..model import Link
     from ..model.mechanisms import ThrowBalance
     from ..verification import Verification
@@ -111,6 +111,8 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis | AlongMotion
                                     "reciprocating_mr/2)"})},
         }
     )
+    if result.flywheel is not None:
+        doc["speed_fluctuation"] = result.flywheel.as_dict()
     factors = result.original.balance_factors(result.linkage)
     if factors is not None:  # an engine's (after the keys every document has)
         doc["balance_factors"] = {"before": [t.as_dict() for t in factors[0]],
@@ -157,6 +159,24 @@ def worse_figures(before: CycleAnalysis | AlongMotions, after: CycleAnalysis | A
             out.append(f"{what} rises {new / old:.3g}× "
                        f"({_fmt(old).strip()} → {_fmt(new).strip()} {unit})")
     return out
+
+
+def flywheel_line(sizing: FlywheelSizing) -> str:
+    """What ``[balance] max_speed_fluctuation`` did: the fluctuations and the flywheel added."""
+    def delta(value: float) -> str:
+        return f"{value:.4g}" if math.isfinite(value) else "∞ (it cannot run at that speed)"
+
+    head = (f"speed fluctuation (ω_max − ω_min)/ω_mean at most {sizing.bound:g} "
+            f"(balance.max_speed_fluctuation): {delta(sizing.before)} original, "
+            f"{delta(sizing.balanced)} balanced")
+    if not sizing.added:
+        return head + " (no flywheel needed)"
+    shares = [f"{value:.6g} on its inertia" if what == "inertia" else
+              f"{value:.6g} on its counter-rotor"
+              for what, value in (("inertia", sizing.inertia),
+                                  ("counter_rotor", sizing.counter_rotor)) if value]
+    return (head + f", {delta(sizing.after)} with a flywheel of {sizing.added:.6g} kg·m² on "
+            f"the {sizing.crank} ({', '.join(shares)})")
 
 
 def _objective_terms(result: BalanceResult) -> dict[str, dict[str, float | str]]:
@@ -382,6 +402,8 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis | AlongMotion
     lines += [f"warning: {w}" for w in worse_figures(before, after)]
     lines.append("")
     lines += _objective_terms_lines(result, sc, "inertial shaking at the operating speed")
+    if result.flywheel is not None:
+        lines += [flywheel_line(result.flywheel), ""]
     rows = []
     for ob, oa in zip(before.orders, after.orders, strict=True):
         if ob.order not in (1.0, 2.0):

@@ -195,10 +195,16 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
         sub = table.table(name, required=False)
         if sub is not None:
             links[name] = _read_link_freedom(sub, points)
+    fluctuation = table.value("max_speed_fluctuation", None)
+    if fluctuation is not None and len(mech.linkage.inputs) > 1:
+        raise SpecError("bounds the crank's speed fluctuation at the operating speed: a "
+                        "linkage with several inputs has no one crank", key=table.key(
+                            "max_speed_fluctuation"), value=fluctuation)
     table.finish()
     problem = BalanceProblem(force_balance=force_balance, force_scope=force_scope,
                              objective=objective, links=tuple(links.items()),
-                             motion_weights=tuple(weights.items()))
+                             motion_weights=tuple(weights.items()),
+                             max_speed_fluctuation=fluctuation)
     check_problem(problem, mech)
     return problem
 
@@ -248,6 +254,9 @@ def balance_lines(problem: BalanceProblem) -> list[str]:
         f"force_balance = {'true' if problem.force_balance else 'false'}",
         *([f"force = {toml.string(problem.force_scope)}  # along the motions only"]
           if problem.force_scope != "every-motion" else []),
+        *([f"max_speed_fluctuation = {toml.number(problem.max_speed_fluctuation)}  # "
+           "(ω_max − ω_min)/ω_mean: the flywheel it needs goes on the crank"]
+          if problem.max_speed_fluctuation is not None else []),
         "",
         "[balance.objective]  # J = mean(Msh²) + w_tau·mean(tau²) + w_force·mean(|Fsh|²)"
         " + w_mass·Δmass",

@@ -478,6 +478,13 @@ SECTIONS: tuple[Section, ...] = (
                     "A linkage with several inputs: each motion's weight in the objective's "
                     "mean squares (`[balance.motions]`, below).", (LINKAGE,),
                     example="{ turn = 2.0 }"),
+                Key("max_speed_fluctuation", "—", "none",
+                    "A one-input linkage's: the largest `(ω_max − ω_min)/ω_mean` of the crank "
+                    "at `[operation] speed` the balanced design may have (0 to 2), by the exact "
+                    "energy balance with its loads; the least flywheel that keeps it goes on "
+                    "the crank (half on its counter-rotor where that may change), within its "
+                    "`inertia` and `counter_rotor` ranges.", (FOUR_BAR, SLIDER_CRANK, LINKAGE),
+                    example="0.02"),
             ),
             names=Key("<link>", "table", "—",
                       "A moving link that may change, by its name: its bounds (the table "

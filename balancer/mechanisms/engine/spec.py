@@ -304,6 +304,11 @@ def read_balance(table: Table, engine: Model) -> RotorBalanceProblem:
         raise SpecError("does not apply to an engine: its balancing chooses counterweights and "
                         "shafts ([balance.counterweights], [[balance.shafts]])",
                         key=table.key("force_balance"), value=table.raw("force_balance"))
+    if table.has("max_speed_fluctuation"):
+        raise SpecError("does not apply to an engine's balancing (its counterweights leave "
+                        "the crankshaft's inertia as it is): [operation] speed_fluctuation "
+                        "gives the flywheel it needs", key=table.key("max_speed_fluctuation"),
+                        value=table.raw("max_speed_fluctuation"))
     table.expect(schema.known("balance", schema.ENGINE))
     defaults = RotorBalanceProblem().objective
     objective = defaults
