@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
@@ -58,7 +58,7 @@ from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .diagnosis import Diagnosis
 from .feasibility import FORCE_BALANCE_TOLERANCE
-from .largest import LargestLoad, pad
+from .largest import ROUNDS, LargestLoad, broken_rows, initial_rows, pad
 from .lsq import pinv as pseudo_inverse
 from .problem import NumericProblem
 from .repair import Repairs
@@ -107,6 +107,10 @@ CERTIFY_AGAIN = 1e-8
 #: The tie-break's design replaces the SOCP's if it is feasible and its objective is no worse
 #: by more than this, relative to the problem's scale (:meth:`NumericProblem.within`).
 TIE_ACCEPT = 1e-8
+#: The bound on the supports' loads as the first stage's working set gives it to Clarabel: this
+#: share tighter (ten times its feasibility tolerance), so that the design keeps the bound
+#: itself to rounding (:meth:`ConvexSolver._stage_program`).
+BOUND_ROOM = 1e-9
 #: Room given to the largest load's hold in the tie-break (:meth:`ConvexSolver.solve`), in the
 #: problem's scaled units (the objective's scale is one): Clarabel's tolerance, so that the
 #: held program stays feasible; the tie-break's design is kept only within :data:`TIE_ACCEPT`.
@@ -248,20 +252,25 @@ class ConvexSolver(Repairs, Diagnosis):
         # The objective as the certificate sees it: the full factor.
         self._objective = ConvexObjective(P=p_matrix, q=q_vector, norm=self._norm_form,
                                           g=mass_row, g0=mass_offset)
-        #: The first stage's cones: the bounds', and the largest load's epigraph.
-        self._stage_cones = (self._cones if self.largest is None else
-                             [*pad(self._cones, width), *self.largest.cones(width, n)])
         self._stage_equality = (equality if equality is None or self.largest is None
                                 else (np.hstack([equality[0], np.zeros((equality[0].shape[0],
                                                                          1))]), equality[1]))
-        if self._norm_form:
-            # In epigraph form, so that the norm's multiplier is the cone's dual.
-            self._stage1 = ConicProgram(width, self._stage_cones, equality=self._stage_equality,
-                                        objective="norm", P=stage_p, q=stage_q)
-        else:  # ‖P·u + q‖² + w_m·Δm, constants dropped
-            self._stage1 = ConicProgram(width, self._stage_cones, equality=self._stage_equality,
-                                        objective="squares", P=stage_p[:-1], q=stage_q[:-1],
-                                        g=mass_row)
+        self._stage_form = (width, stage_p, stage_q, mass_row)
+        # The supports' loads (an engine's main bearings'), bounded or the largest weighed: a
+        # cone per row each, the bound's last among the bounds' (:meth:`_constraints`).
+        supports = data.regressors.supports
+        bounded = data.support_bound is not None and supports is not None
+        self._bound_cones = self._cones[len(self._cones) - supports.shape[0]:] if (
+            bounded and supports is not None) else []
+        self._base_cones = self._cones[: len(self._cones) - len(self._bound_cones)]
+        #: The working set of the supports' rows the first stage carries (:mod:`.largest`),
+        #: or ``None`` (no such rows: every cone).
+        self._rows = (initial_rows(np.abs(supports @ data.x0)) if supports is not None and (
+            bounded or self.largest is not None) else None)
+        #: The first stage's program and its cones (the bounds', the largest load's epigraph
+        #: over the working set), in the order the certificate reads their multipliers.
+        self._stage_cones: list[Constraint] = []
+        self._stage1 = self._stage_program(self._rows)
         # finalize's projections by margin, built when first needed
         self._projections: dict[float, ConicProgram] = {}
         # Tie-break. J is strictly convex in y = P·u, so every optimal design has the same y
@@ -295,6 +304,92 @@ class ConvexSolver(Repairs, Diagnosis):
         #: The tie-break's hold on the largest load at the first stage's optimum (cones in
         #: ``u``), set by :meth:`solve`; empty without that term.
         self._held: list[Constraint] = []
+
+    def _stage_program(self, rows: NDArray[np.intp] | None) -> ConicProgram:
+        """The first stage's program with the supports' ``rows`` (all where ``None``).
+
+        The bounds, the bound on those rows' loads (``max_bearing_load``) and the largest
+        load's epigraph over them (:mod:`.largest`).
+        """
+        width, p, q, g = self._stage_form
+        n = self.layout.size
+
+        def program_cones(room: float) -> list[Constraint]:
+            bound = ([] if rows is None or not self._bound_cones
+                     else [self._bound_cones[r] for r in rows])
+            kept = (self._cones if rows is None else
+                    [*self._base_cones, *(Constraint(c.kind, c.M, np.r_[c.m[0] - room, c.m[1:]])
+                                          for c in bound)])
+            return (kept if self.largest is None else
+                    [*pad(kept, width), *self.largest.cones(width, n, rows)])
+
+        # The certificate reads the program's multipliers against its cones as they are; the
+        # solver is given the bound's a share of Clarabel's tolerance tighter, so that its
+        # design meets the bound itself (finalize would move it off at a cost).
+        self._stage_cones = program_cones(0.0)
+        cones = program_cones(BOUND_ROOM)
+        if self._norm_form:
+            # In epigraph form, so that the norm's multiplier is the cone's dual.
+            return ConicProgram(width, cones, equality=self._stage_equality, objective="norm",
+                                P=p, q=q)
+        # ‖P·u + q‖² + w_m·Δm, constants dropped
+        return ConicProgram(width, cones, equality=self._stage_equality, objective="squares",
+                            P=p[:-1], q=q[:-1], g=g)
+
+    def _first_stage(self) -> tuple[StageReport, ConicSolution]:
+        """The first stage solved: with the supports' working set, until its optimum breaks none.
+
+        Each round's program a relaxation of the whole (:mod:`.largest`); the report's
+        iterations and time those of every round.
+        """
+        report, first = self._run(self._stage1, "convex")
+        supports = self.data.regressors.supports
+        if self._rows is None or supports is None:
+            return report, first
+        n, rows = self.layout.size, self._rows
+        iterations, seconds = report.iterations, report.time
+        for round_ in range(ROUNDS):
+            if first.u is None:
+                break
+            loads = np.abs(supports @ self.layout.x(first.u[:n]))  # N
+            limit = self.row_limit(None if self.largest is None else float(first.u[n]))
+            more = broken_rows(loads, limit, rows, last=round_ == ROUNDS - 1)
+            if more.size == rows.size:
+                break
+            rows = more
+            self._stage1 = self._stage_program(rows)
+            report, first = self._run(self._stage1, "convex")
+            iterations += report.iterations
+            seconds += report.time
+        self._rows = rows  # (a start as good for the next solve)
+        return replace(report, iterations=iterations, time=seconds), first
+
+    def row_limit(self, tau: float | None) -> float:
+        """The largest load a support's row may carry in a program, N.
+
+        The bound (``max_bearing_load``), and the largest load's epigraph variable ``tau``
+        (scaled: ``√w_L·L/s``) where the objective weighs it; ``inf`` without either.
+        """
+        limit = math.inf if self.data.support_bound is None else self.data.support_bound
+        if tau is not None:
+            limit = min(limit, tau * self._scale / math.sqrt(
+                self.data.weights.largest_bearing_load))
+        return limit
+
+    @property
+    def working_rows(self) -> NDArray[np.intp] | None:
+        """The supports' rows a first stage starts from (:mod:`.largest`), or ``None``."""
+        return self._rows
+
+    @property
+    def base_constraints(self) -> list[Constraint]:
+        """:attr:`constraints` but the bound on the supports' loads."""
+        return self._base_cones
+
+    @property
+    def bound_constraints(self) -> list[Constraint]:
+        """The bound on the supports' loads, one cone per row (none without the bound)."""
+        return self._bound_cones
 
     @property
     def constraints(self) -> list[Constraint]:
@@ -563,7 +658,7 @@ class ConvexSolver(Repairs, Diagnosis):
         """
         data, lay = self.data, self.layout
         self.check_consistent()
-        report, first = self._run(self._stage1, "convex")
+        report, first = self._first_stage()
         stages = [report]
         if first.u is None:
             raise self.infeasible(f"Clarabel: {report.solver_status} after "
@@ -579,7 +674,7 @@ class ConvexSolver(Repairs, Diagnosis):
             stage2 = self._stage2
             if self.largest is not None:  # every optimum has the same largest load: held
                 tau = max(float(first.u[lay.size]), self.largest.value(u1)) + TIE_HOLD
-                self._held = self.largest.held(tau)
+                self._held = self.largest.held(tau, self._rows)
                 stage2 = ConicProgram(lay.size, [*self._cones, *self._held],
                                       objective="nearest", equality=self._stage2_equality)
             if self._tie_free:
@@ -720,7 +815,11 @@ class ConvexSolver(Repairs, Diagnosis):
             upper = f + abs(f) + 1e-9  # above the optimum, whatever the design's rounding
         lo, hi = self.box()
         if self.largest is not None:  # τ at a minimiser: the largest load, within the box's
-            lo, hi = np.append(lo, 0.0), np.append(hi, self.largest.bound(lo, hi))
+            # (and, for the norm, no more than the norm itself: at most a feasible design's)
+            reach = self.largest.bound(lo, hi)
+            if upper is not None and self._norm_form:
+                reach = min(reach, upper)
+            lo, hi = np.append(lo, 0.0), np.append(hi, reach)
         bound = lower_bound(self._objective, self._stage_cones, self._stage_equality, u,
                             multipliers, norm_dual, lo, hi, upper)
         scale = self._scale

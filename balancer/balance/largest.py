@@ -12,6 +12,13 @@ problem's scale ``s``) with a second-order cone per row,
 objective's factor: ``‖P·u + q‖² + τ²``, whose least value has ``τ = L``. The term is strictly
 increasing in ``τ``, so every minimiser has the same ``τ``; a tie-break among them holds
 ``|a_r·u + a0_r| ≤ τ̂`` (:meth:`LargestLoad.held`).
+
+The rows are thousands (every bearing at every sample) and nearly parallel: with all of them
+— this term's, or a bound's on the same loads (``max_bearing_load``) — Clarabel stops "almost
+solved", its multipliers too rough for a certificate. So a first stage carries a working set
+of them (:func:`initial_rows`), solved again with the rows its optimum breaks added
+(:func:`broken_rows`) until it breaks none. Each program is a relaxation of the whole one
+(fewer constraints): its certified bound holds for the whole.
 """
 
 from __future__ import annotations
@@ -25,6 +32,17 @@ from numpy.typing import NDArray
 from .certificate import Constraint
 from .problem import NumericProblem
 from .variables import VariableMap
+
+#: Rows a working set starts with or takes at once, at most (the largest loads first).
+BATCH = 64
+#: Rows within this share of the largest load start a working set.
+NEAR = 0.9
+#: A row is broken where its load exceeds its limit by this much of it (and 1e-12 of the
+#: largest load): below the rounding a design is held to
+#: (:data:`~.feasibility.ROUNDING_TOLERANCE`), so that the whole program's bounds hold.
+BROKEN = 1e-12
+#: Working-set rounds at most (each adds rows; all of them in the last resort).
+ROUNDS = 12
 
 
 @dataclass(frozen=True)
@@ -53,23 +71,35 @@ class LargestLoad:
         """``τ`` of ``u``: ``max_r |a_r·u + a0_r|`` (``√w_L·L(x)/s``)."""
         return float(np.max(np.abs(self.a @ u + self.a0), initial=0.0))
 
-    def cones(self, width: int, column: int) -> list[Constraint]:
-        """``|a_r·u + a0_r| ≤ y[column]`` for a program of ``width`` whose first ``n`` are ``u``."""
+    @property
+    def count(self) -> int:
+        """The number of rows (supports × samples)."""
+        return int(self.a.shape[0])
+
+    def cones(self, width: int, column: int, rows: NDArray[np.intp] | None = None
+              ) -> list[Constraint]:
+        """``|a_r·u + a0_r| ≤ y[column]`` for a program of ``width`` whose first ``n`` are ``u``.
+
+        For the rows ``rows`` (all where ``None``).
+        """
         n = self.a.shape[1]
         out = []
-        for r in range(self.a.shape[0]):
+        for r in range(self.count) if rows is None else rows:
             m = np.zeros((3, width))
             m[0, column] = 1.0
             m[1, :n], m[2, :n] = self.a[r].real, self.a[r].imag
             out.append(Constraint("soc", m, np.array([0.0, self.a0[r].real, self.a0[r].imag])))
         return out
 
-    def held(self, tau: float) -> list[Constraint]:
-        """``|a_r·u + a0_r| ≤ tau`` in ``u`` alone (a tie-break's hold on the optimum's ``τ``)."""
+    def held(self, tau: float, rows: NDArray[np.intp] | None = None) -> list[Constraint]:
+        """``|a_r·u + a0_r| ≤ tau`` in ``u`` alone (a tie-break's hold on the optimum's ``τ``).
+
+        For the rows ``rows`` (all where ``None``).
+        """
         zero = np.zeros(self.a.shape[1])
         return [Constraint("soc", np.array([zero, self.a[r].real, self.a[r].imag]),
                            np.array([tau, self.a0[r].real, self.a0[r].imag]))
-                for r in range(self.a.shape[0])]
+                for r in (range(self.count) if rows is None else rows)]
 
     def bound(self, lo: NDArray[np.float64], hi: NDArray[np.float64]) -> float:
         """The largest ``τ`` of any ``u`` in the box ``[lo, hi]`` (∞ where it is unbounded).
@@ -86,6 +116,29 @@ class LargestLoad:
         return float(np.max(np.abs(self.a0) + np.abs(self.a) @ reach, initial=0.0))
 
 
+def initial_rows(loads: NDArray[np.float64]) -> NDArray[np.intp]:
+    """A working set to start from: the rows whose loads are near the largest.
+
+    Those within :data:`NEAR` of it, the :data:`BATCH` largest at most.
+    """
+    near = np.flatnonzero(loads >= NEAR * float(np.max(loads, initial=0.0)))
+    return np.sort(near[np.argsort(-loads[near])][:BATCH]).astype(np.intp)
+
+
+def broken_rows(loads: NDArray[np.float64], limit: float, rows: NDArray[np.intp],
+                last: bool = False) -> NDArray[np.intp]:
+    """The working set ``rows`` with the rows whose ``loads`` break ``limit`` added.
+
+    Broken: above ``limit`` by :data:`BROKEN` of it (and 1e-12 of the largest load). The
+    :data:`BATCH` largest of them (every one where ``last``); ``rows`` as it is where none is.
+    """
+    top = float(np.max(loads, initial=0.0))
+    broken = np.setdiff1d(np.flatnonzero(loads > limit * (1 + BROKEN) + 1e-12 * top), rows)
+    if not last:
+        broken = broken[np.argsort(-loads[broken])][:BATCH]
+    return np.union1d(rows, broken).astype(np.intp)
+
+
 def pad(constraints: list[Constraint], width: int) -> list[Constraint]:
     """Constraints in ``n`` variables as constraints of a program of ``width`` (zeros after)."""
     out = []
@@ -96,4 +149,4 @@ def pad(constraints: list[Constraint], width: int) -> list[Constraint]:
     return out
 
 
-__all__ = ["LargestLoad", "pad"]
+__all__ = ["LargestLoad", "broken_rows", "initial_rows", "pad"]

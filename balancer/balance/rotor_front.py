@@ -38,7 +38,7 @@ from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ConicProgram, ConicSolution
 from .convex import ACCURACY_FALLBACKS, CERTIFY_AGAIN, ConvexSolver, solve_program
 from .front import Front, FrontPoint, mark_knee
-from .largest import pad
+from .largest import ROUNDS, broken_rows, pad
 from .problem import NumericProblem, numeric_problem
 from .sites import Sites
 
@@ -72,7 +72,7 @@ class _RotorFront:
         self.weights = np.array([self.sites.sites[i].max_mr for i in self.sites.chosen]
                                 ) * self.per_mr
         self.rescale(float(self.weights.sum()))
-        cones = pad(solver.constraints, width)
+        cones = pad(solver.base_constraints, width)
         for i in range(s):  # the variables are the chosen sites' scaled entries, in order
             m = np.zeros((3, width))
             m[0, n + i] = 1.0
@@ -83,14 +83,28 @@ class _RotorFront:
         self.q = compressed.q
         self.lo = np.r_[-np.ones(n), np.zeros(width - n)]
         self.hi = np.ones(width)
-        if largest is not None:  # τ ≥ |a_r·u + a0_r|, and its row ‖(P·u + q, τ)‖
-            cones += largest.cones(width, width - 1)
+        if largest is not None:  # its row ‖(P·u + q, τ)‖
             tau_row = np.zeros((1, width))
             tau_row[0, -1] = 1.0
             self.P, self.q = np.vstack([self.P, tau_row]), np.append(self.q, 0.0)
             self.hi[-1] = largest.bound(self.lo[:n], self.hi[:n])
-        self.cones = cones
+        self.base = cones
+        #: Every cone: the bounds', the sites' ``t_i``, and the supports' rows (bounded, or
+        #: ``τ`` above them) all.
+        self.cones = [*cones, *self.row_cones(None)]
+        #: The cones of the last program :meth:`least_objective` solved (its certificate's).
+        self.last_cones = self.cones
         self.norm = ConvexObjective(P=self.P, q=self.q, norm=True, g=np.zeros(width), g0=0.0)
+
+    def row_cones(self, rows: NDArray[np.intp] | None) -> list[Constraint]:
+        """The supports' rows ``rows`` (all where ``None``): the bound's cones, ``τ``'s."""
+        solver, width = self.solver, self.width
+        bound = solver.bound_constraints if rows is None or not solver.bound_constraints else [
+            solver.bound_constraints[r] for r in rows]
+        out = pad(bound, width)
+        if solver.largest is not None:
+            out += solver.largest.cones(width, width - 1, rows)
+        return out
 
     def x(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
         """The design vector (kg·m) of scaled ``u``, each mass·radius within its bound."""
@@ -135,12 +149,27 @@ class _RotorFront:
         """``min ‖P·u + q‖`` within the bounds and ``extra``.
 
         ``settings``: Clarabel's, over the solver's (another solve's, for a tighter bound).
+        With the supports' rows, over a working set of them until the optimum breaks none
+        (:mod:`.largest`); :attr:`last_cones` are the program's.
         """
-        program = ConicProgram(self.width, [*self.cones, *extra], objective="norm", P=self.P,
-                               q=self.q)
-        if settings:
-            return solve_program(program, {**self.solver.settings, **settings})
-        return solve_program(program, self.solver.settings)
+        options = {**self.solver.settings, **(settings or {})}
+        rows = self.solver.working_rows
+        supports = self.data.regressors.supports
+        for round_ in range(ROUNDS + 1):
+            cones = [*self.base, *self.row_cones(rows), *extra]
+            solution = solve_program(ConicProgram(self.width, cones, objective="norm",
+                                                  P=self.P, q=self.q), options)
+            self.last_cones = cones
+            if rows is None or supports is None or solution.u is None:
+                return solution
+            loads = np.abs(supports @ self.x(solution.u))
+            limit = self.solver.row_limit(None if self.solver.largest is None
+                                          else float(solution.u[-1]))
+            more = broken_rows(loads, limit, rows, last=round_ >= ROUNDS - 1)
+            if more.size == rows.size:
+                return solution
+            rows = more
+        return solution
 
     def least_value(self, root: float) -> ConicSolution:
         """``min Σ c_i·t_i`` among the designs with ``‖P·u + q‖ ≤ root``."""
@@ -172,7 +201,7 @@ class _RotorFront:
         y = np.asarray(solution.u, float)
         v = (None if solution.epigraph_dual is None
              else -np.asarray(solution.epigraph_dual[1:]))
-        bound = lower_bound(self.norm, [*self.cones, cap], None, y, list(solution.duals), v,
+        bound = lower_bound(self.norm, self.last_cones, None, y, list(solution.duals), v,
                             self.lo, self.hi, self.norm.value(y))
         return 0.0 if bound is None else max(bound.value, 0.0) * self.data.objective_scale
 

@@ -12,7 +12,7 @@ from ..cycle import CycleAnalysis
 from ..motion_analysis import AlongMotions, load_words
 from ..motion_verification import MotionVerification
 from ..orders import order_name
-from ..quantities import unit_of, words_of
+from ..quantities import QUANTITIES, unit_of, words_of
 from ..rounding import Scales, speed_text
 from ..rounding import figure_text as _fmt
 from .analysis import analysis_figures, force_balance_line, orders_list
@@ -93,9 +93,13 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis | AlongMotion
             "orders": {"before": orders_list(before), "after": orders_list(after)},
             "verification": None if verification is None else verification.as_dict(),
             "out": None if out is None else str(out),
-            "units": {"objective, lower_bound": "(N·m)², the weighted mean squares of the "
+            "units": {"objective, lower_bound": "(N·m)², the weighted mean squares "
+                      + ("(and squared largest loads) " if _largest_terms(result) else "")
+                      + "of the "
                       "inertial shaking (J of [balance.objective])",
-                      "objective_terms": "each term's RMS in its 'unit' (N for a force, N·m "
+                      "objective_terms": "each term's RMS in its 'unit' "
+                      + ("(largest_bearing_load: its largest) " if _largest_terms(result)
+                         else "") + "(N for a force, N·m "
                       "for a moment or torque; added_mass: kg added)",
                       "max_ground_reaction": "N",
                       "gap": "relative to scale (of √J when rms is given, else of J)",
@@ -190,12 +194,22 @@ def _objective_terms_lines(result: BalanceResult, sc: Scales, where: str) -> lis
     """The objective's terms as a table (none with one term: the headline says it)."""
     if result.single_term is not None:
         return []
+    largest = _largest_terms(result)
     rows = [[name.replace("_", " "), f"{t['weight']:.4g}",
              sc.fmt(float(t["before"]), str(t["unit"])),
              sc.fmt(float(t["after"]), str(t["unit"])), str(t["unit"])]
             for name, t in _objective_terms(result).items()]
-    return ["objective J = Σ weight × mean square (added mass: weight × kg added), "
-            f"{where}:", table(rows, ["term", "weight", "RMS before", "RMS after", "unit"]), ""]
+    squares = ("mean square" if not largest else
+               "mean square, or the square of the largest")
+    return [f"objective J = Σ weight × {squares} (added mass: weight × kg added), "
+            f"{where}:", table(rows, ["term", "weight", "RMS before", "RMS after", "unit"])
+            + "".join(f"\n{name.replace('_', ' ')}: its largest, not its RMS"
+                      for name in largest), ""]
+
+
+def _largest_terms(result: BalanceResult) -> tuple[str, ...]:
+    """The objective's terms that weigh a largest load (not a mean square)."""
+    return tuple(t.name for t in result.weights.terms if QUANTITIES[t.name].largest)
 
 
 #: What each kind of counterweight asks of the workshop.
@@ -381,8 +395,8 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis | AlongMotion
         head,
         f"backend {result.backend}: {result.message}",
         f"{result.iterations} solver iterations in {1e3 * result.time:.1f} ms "
-        f"({', '.join(s.name for s in result.stages)}); the objective is the mean-square "
-        "inertial shaking (loads left out)",
+        f"({', '.join(s.name for s in result.stages)}); the objective is the "
+        f"{'' if _largest_terms(result) else 'mean-square '}inertial shaking (loads left out)",
         "",
     ]
     sc = optimization_scales(result, before, after)

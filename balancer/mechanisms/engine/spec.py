@@ -389,7 +389,9 @@ def balance_lines(problem: object) -> list[str]:
     """The problem as TOML lines that :func:`read_balance` reads back equal."""
     assert isinstance(problem, RotorBalanceProblem)
     w = problem.objective
-    out = ["[balance.objective]  # weights of the mean squares over the cycle",
+    out = ["[balance.objective]  # weights of the mean squares over the cycle"
+           + (" (largest_bearing_load: of the largest load's square)"
+              if w.largest_bearing_load else ""),
            *(f"{name} = {toml.number(getattr(w, name))}" for name in ENGINE_OBJECTIVE_KEYS
              if name not in ("main_bearing_load", "largest_bearing_load") or getattr(w, name))]
     if problem.max_bearing_load is not None:
