@@ -49,13 +49,19 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any, TypeAlias
+from typing import Any, TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .certificate import Constraint, ConvexObjective, lower_bound
-from .conic import ConicProgram, ConicSolution
+from .conic import (
+    ACCURACY_FALLBACKS,
+    CLARABEL_SETTINGS,
+    ConicProgram,
+    ConicSolution,
+    solve_program,
+)
 from .diagnosis import Diagnosis
 from .feasibility import FORCE_BALANCE_TOLERANCE
 from .largest import ROUNDS, LargestLoad, broken_rows, initial_rows, pad
@@ -65,40 +71,6 @@ from .repair import Repairs
 from .result import StageReport
 from .variables import Compressed, layout
 
-if TYPE_CHECKING:
-    pass
-
-#: Clarabel's settings for every solve here (tight: the zero optimum of complete balancing
-#: must be reached to ~1e-10 of the original shaking moment).
-CLARABEL_SETTINGS: dict[str, float | int] = {
-    "tol_gap_abs": 1e-10,
-    "tol_gap_rel": 1e-10,
-    "tol_feas": 1e-10,
-    "tol_infeas_abs": 1e-10,
-    "tol_infeas_rel": 1e-10,
-    "tol_ktratio": 1e-8,
-    "max_iter": 200,
-}
-#: Settings Clarabel is run with again, in turn, where it stops for numerical trouble (its
-#: factorisation fails in a thin feasible set, as the redesign campaign found on problems at
-#: the edge of force balance): a stronger static regularisation, then no equilibration.
-NUMERICAL_FALLBACKS: tuple[dict[str, float | bool], ...] = (
-    {"static_regularization_constant": 1e-7},
-    {"equilibrate_enable": False},
-)
-#: Settings tried, in turn, where Clarabel stops "almost solved" (its reduced tolerances met,
-#: not the full ones): shorter steps keep the iterates further inside the cones, where a thin
-#: feasible set (a tie-break whose design has a mass, a centre and an inertia all at their
-#: bounds) loses fewer digits. The first that solves fully is taken. (The Jansen leg's
-#: tie-break: "almost solved" with the default 0.99, its j held 3e-8 to 5e-7 off its mass
-#: bound depending on the machine's arithmetic; at 0.9 solved, the mass on its bound.) The same
-#: settings serve a loose certificate (:data:`CERTIFY_AGAIN`): each lands on another point of
-#: the central path, whose dual residual differs (the Jansen leg's gap of 2.7e-7, or 4e-6 on
-#: another arithmetic, tightened below 1e-8).
-ACCURACY_FALLBACKS: tuple[dict[str, float | bool], ...] = (
-    {"max_step_fraction": 0.9},
-    {"equilibrate_enable": False},
-)
 #: A certified gap (relative to the problem's scale) above this, well inside the certified
 #: tolerance (:data:`~.result.GAP_TOLERANCE`, 1e-6), has the SOCP solved again for a tighter
 #: bound (:meth:`ConvexSolver._certified`): whether a design is proven optimal must not hinge on
@@ -122,28 +94,6 @@ SMALL_COUNTERWEIGHT = 1e-3
 Affine: TypeAlias = tuple[NDArray[np.float64], float]
 
 
-
-
-def solve_program(program: ConicProgram, settings: dict[str, Any],
-                  **data: NDArray[np.float64]) -> ConicSolution:
-    """``program`` by Clarabel with ``settings``, again where it did not solve fully.
-
-    Numerical trouble (a thin feasible set): again with :data:`NUMERICAL_FALLBACKS`; "almost
-    solved": again with :data:`ACCURACY_FALLBACKS`, the first that solves fully taken (else
-    the almost-solved answer stands). Whether a stage solves fully must not hinge on the
-    machine's rounding more than it must.
-    """
-    solution = program.solve(settings, **data)
-    for fallback in NUMERICAL_FALLBACKS:  # numerical trouble (a thin feasible set): again
-        if solution.status != "solver_error":
-            break
-        solution = program.solve({**settings, **fallback}, **data)
-    if solution.status == "optimal_inaccurate":
-        for fallback in ACCURACY_FALLBACKS:
-            again = program.solve({**settings, **fallback}, **data)
-            if again.status == "optimal":
-                return again
-    return solution
 
 
 @dataclass(frozen=True, kw_only=True)

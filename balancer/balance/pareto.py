@@ -33,13 +33,11 @@ from ..force_balance import RESIDUAL_FLOOR, force_balance_residual
 from ..model import Design
 from ..model.balance import Objective, RotorBalanceProblem, missing_balance
 from .certificate import Constraint, ConvexObjective, lower_bound
-from .conic import ConicProgram, ConicSolution
+from .conic import ACCURACY_FALLBACKS, ConicProgram, ConicSolution, solve_program
 from .convex import (
-    ACCURACY_FALLBACKS,
     CERTIFY_AGAIN,
     Compressed,
     ConvexSolver,
-    solve_program,
 )
 from .front import AGAINST, Against, Front, FrontPoint, mark_knee
 from .problem import NumericProblem, numeric_problem

@@ -35,8 +35,8 @@ from ..errors import SolverError, SpecError
 from ..model import Design
 from ..model.balance import RotorBalanceProblem
 from .certificate import Constraint, ConvexObjective, lower_bound
-from .conic import ConicProgram, ConicSolution
-from .convex import ACCURACY_FALLBACKS, CERTIFY_AGAIN, ConvexSolver, solve_program
+from .conic import ACCURACY_FALLBACKS, ConicProgram, ConicSolution, solve_program
+from .convex import CERTIFY_AGAIN, ConvexSolver
 from .front import Front, FrontPoint, mark_knee
 from .largest import ROUNDS, broken_rows, pad
 from .problem import NumericProblem, numeric_problem

@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 from balancer.balance.certificate import Constraint
+from balancer.balance.conic import CLARABEL_SETTINGS as PRODUCT_SETTINGS
 from balancer.balance.conic import ConicProgram, CscMatrix
-from balancer.balance.convex import CLARABEL_SETTINGS as PRODUCT_SETTINGS
 
 #: The product's Clarabel settings at tolerances of 1e-9 (gap, feasibility): at the product's
 #: 1e-10, a random program of this file stalls "almost solved" on some machines' arithmetic
@@ -184,7 +184,7 @@ def test_an_almost_solved_program_is_solved_again_with_shorter_steps():
     ACCURACY_FALLBACKS in turn and takes the first that solves fully, else keeps the first
     answer; numerical trouble first tries NUMERICAL_FALLBACKS. (The Jansen leg's tie-break left
     its j 5e-7 off its mass bound "almost solved" on one machine's arithmetic.)"""
-    from balancer.balance.convex import ACCURACY_FALLBACKS, NUMERICAL_FALLBACKS, solve_program
+    from balancer.balance.conic import ACCURACY_FALLBACKS, NUMERICAL_FALLBACKS, solve_program
 
     class Program:
         def __init__(self, answers):

@@ -20,7 +20,8 @@ import pytest
 from conftest import random_linkage
 
 from balancer import spec
-from balancer.balance.convex import CLARABEL_SETTINGS, TIE_ACCEPT
+from balancer.balance.conic import CLARABEL_SETTINGS
+from balancer.balance.convex import TIE_ACCEPT
 from balancer.balance.optimizer import ConvexSolver, InfeasibleError, Optimizer, Status, optimize
 from balancer.balance.problem import NumericProblem, numeric_problem
 from balancer.balance.result import GAP_TOLERANCE

@@ -405,7 +405,8 @@ def test_the_optimality_claim_is_stated_in_newton_metres_against_the_problems_sc
     # Clarabel's dual residual over the box of the scaled variables (within 100·2e-10 of the
     # scale in the norm's units; the tie-break may add TIE_ACCEPT): a claim of optimality can
     # only err on the safe side.
-    from balancer.balance.convex import CLARABEL_SETTINGS, TIE_ACCEPT
+    from balancer.balance.conic import CLARABEL_SETTINGS
+    from balancer.balance.convex import TIE_ACCEPT
 
     slack = 100 * (CLARABEL_SETTINGS["tol_gap_abs"] + CLARABEL_SETTINGS["tol_feas"])
     assert 0 < result.rms - result.rms_lower_bound <= (slack + TIE_ACCEPT) * result.scale
