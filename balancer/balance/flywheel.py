@@ -10,10 +10,16 @@ does (a counter-rotor turns at the crank's speed). So the balancing's certified 
 the optimum under the bound, and the bound is met by the least flywheel ``I_f``
 (:func:`balancer.speed_fluctuation.flywheel`) on the crank of the balanced design:
 
-- half on the crank's inertia and half on its counter-rotor, where the counter-rotor may change
-  (their difference, which a change of crank speed makes the frame feel — what settling chose,
-  :meth:`~.settling.Settling.settle` — stays as it was);
-- else all on the crank's inertia.
+- half on the crank's inertia and half on its counter-rotor, where both may change (their
+  difference, which a change of crank speed makes the frame feel — what settling chose,
+  :meth:`~.settling.Settling.settle` — stays as it was), what one's range cannot take on the
+  other;
+- a crank that keeps its link and gets a counterweight: on the counter-rotor alone (the
+  counterweight's inertia is its shape's, no flywheel).
+
+The bound holds for the energy balance on the operating samples (a free run of the design swings
+by it to about 1e-7 of it at 360 samples per revolution: the samples' reach of ``J(θ)`` and the
+loads).
 
 Where their ranges (``[balance.<crank>] inertia``, ``counter_rotor``) cannot take it, the
 balancing says so, naming the key and the inertia needed (the other links' inertias are not
@@ -35,6 +41,10 @@ from ..speed_fluctuation import flywheel as least_flywheel
 from .problem import NumericProblem
 from .result import FlywheelSizing, InfeasibleError
 
+#: What the built design's speed fluctuation may exceed the bound by, relative, and still be
+#: taken as keeping it (the energy balance's root finding is to 1e-13; the physical values'
+#: rounding far less than this).
+SAMPLED = 1e-9
 #: Room on the flywheel, relative to all the inertia the crank then sees: the root finder's
 #: tolerance on ``I_f`` is 1e-13 of it; this much more keeps the bound after the design's
 #: rounding.
@@ -60,34 +70,42 @@ def sized(data: NumericProblem, x: NDArray[np.float64], bound: float,
     # (with room on the whole inertia the crank sees, of which δ is nearly inverse)
     added = (needed.inertia + ROOM * (needed.inertia + needed.mechanism_inertia[1])
              if needed.inertia > 0 else 0.0)
-    on_rotor = 0.0
+    # What each may take: the crank's own inertia where it is a link the balancing sizes (a
+    # counterweight's inertia is its shape's, no flywheel), the counter-rotor within its range.
     rotor_range = b.counter_rotor or (rotor, rotor)
-    rotor_free = rotor_range[0] < rotor_range[1] and data.inert[b.rotor_entry]
-    inertia_free = b.inertia[0] < b.inertia[1] and data.inert[b.start + 3]
+    room_rotor = (rotor_range[1] - rotor if rotor_range[0] < rotor_range[1]
+                  and data.inert[b.rotor_entry] else 0.0)
+    room_inertia = (b.inertia[1] - inertia if b.offset is None and b.inertia[0] < b.inertia[1]
+                    and data.inert[b.start + 3] else 0.0)
+    on_rotor = on_inertia = 0.0
     if added > 0:
-        high_inertia, high_rotor = b.inertia[1], rotor_range[1] if rotor_free else rotor
-        if rotor_free and inertia_free:
-            on_rotor = min(added / 2, high_rotor - rotor)
-        elif rotor_free:
-            on_rotor = min(added, high_rotor - rotor)
-        on_inertia = added - on_rotor
-        if not inertia_free and on_inertia > 0 or inertia + on_inertia > high_inertia:
-            reach = (high_inertia if inertia_free else inertia) + (
-                high_rotor if rotor_free else rotor)
-            key = f"{b.key}.inertia" if inertia_free or not rotor_free else (
-                f"{b.key}.counter_rotor")
+        if room_rotor + room_inertia < added:
+            key = f"{b.key}.counter_rotor" if b.counter_rotor is not None and (
+                b.offset is not None or not room_inertia) else f"{b.key}.inertia"
             raise InfeasibleError(
                 f"a speed fluctuation of at most {bound:g} (balance.max_speed_fluctuation) "
-                f"needs a flywheel of {needed.inertia:.6g} kg·m² more on the {crank}: its "
-                f"inertia and counter-rotor {inertia + rotor + needed.inertia:.6g} kg·m² "
-                f"together, beyond the {reach:.6g} that {key} allows; widen it",
-                needed=((key, inertia + rotor + needed.inertia, reach, "kg·m²"),))
+                f"needs a flywheel of {needed.inertia:.6g} kg·m² on the {crank}: more than "
+                f"its inertia and counter-rotor may take ({room_inertia + room_rotor:.6g} "
+                f"kg·m² within their ranges); widen {key}",
+                needed=((key, (rotor if key.endswith("counter_rotor") else inertia) + added
+                         - (room_inertia if key.endswith("counter_rotor") else room_rotor),
+                         rotor_range[1] if key.endswith("counter_rotor") else b.inertia[1],
+                         "kg·m²"),))
+        # half on each where both may take it, what one cannot on the other
+        on_rotor = min(room_rotor, max(added / 2 if room_inertia else added,
+                                       added - room_inertia))
+        on_inertia = added - on_rotor
         physical[crank] = (m, e, f, inertia + on_inertia, rotor + on_rotor)
         x = data.vector_of(physical)
     after = _flywheel(data, data.linkage_of(x), bound, gravity).fluctuation_without
+    if after > bound * (1 + SAMPLED):
+        raise InfeasibleError(
+            f"the flywheel for a speed fluctuation of at most {bound:g} "
+            f"(balance.max_speed_fluctuation) could not be put on the {crank}: it turns with "
+            f"{after:.6g}", needed=(("balance.max_speed_fluctuation", after, bound, ""),))
     return x, FlywheelSizing(bound=bound, before=before, balanced=needed.fluctuation_without,
                              after=after, added=added, crank=crank,
-                             inertia=added - on_rotor, counter_rotor=on_rotor)
+                             inertia=on_inertia, counter_rotor=on_rotor)
 
 
 def _flywheel(data: NumericProblem, model: MechanismModel, bound: float,

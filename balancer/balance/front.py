@@ -95,6 +95,8 @@ class Front:
     value_unit: str | None = None
     original_figures: Mapping[str, float] = field(default_factory=dict)
     masses: bool = False
+    #: What the front leaves out of the spec's ``[balance]``, said with it (text and JSON).
+    notes: tuple[str, ...] = ()
 
     def __repr__(self) -> str:
         ends = (f"{self.points[0].value:.4g}–{self.points[-1].value:.4g} {self.unit}, "
@@ -131,6 +133,7 @@ class Front:
         return {
             "against": self.against,
             **({"minimised": self.minimised} if self.masses else {}),
+            **({"notes": list(self.notes)} if self.notes else {}),
             "points": [{self.minimised: p.least, **{n: p.figures[n] for n in self.figure_names},
                         self.name: p.value, "epsilon": p.epsilon,
                         "lower_bound": p.lower_bound, "knee": p.knee}

@@ -206,7 +206,9 @@ class Optimizer:
         x = data.built(x)
         sizing = None
         bound = getattr(data.problem, "max_speed_fluctuation", None)
-        if bound is not None and feasible:  # the flywheel it needs, on the crank (inert)
+        if bound is not None and feasible and data.speed is not None:
+            # the flywheel it needs, on the crank (inert at the operating speed; a balancing
+            # along motions, as plan --with-masses asks, has no operating speed to keep)
             x, sizing = sized(data, x, bound, self.gravity)
         objective = data.objective(x)
         feasible = feasible and not data.violations(x, tol=ROUNDING_TOLERANCE)

@@ -241,9 +241,13 @@ def pareto_front(design: Design, against: Against, points: int = 11) -> Front:
                               lower_bound=bound, x=x))
     out.sort(key=lambda p: p.value)
     original = (programs.other_value(data.x0), programs.moment_value(data.x0))
+    notes = (() if design.balance.max_speed_fluctuation is None else (
+        "[balance] max_speed_fluctuation: the flywheel it asks for is not put on the points' "
+        "cranks (it changes none of their figures); optimize sizes it",))
     return Front(against=against, points=tuple(mark_knee(out)), original=original,
                  force_balance=design.balance.force_balance,
-                 original_force_balanced=force_balance_residual(data.mechanism) <= RESIDUAL_FLOOR)
+                 original_force_balanced=force_balance_residual(data.mechanism) <= RESIDUAL_FLOOR,
+                 notes=notes)
 
 
 def _certified(programs: _Programs, cap: Constraint, solution: ConicSolution,

@@ -63,6 +63,9 @@ from .parts import Part, Sector
 #: configuration space, or along its motions only.
 FORCE_SCOPES = ("every-motion", "motion")
 
+#: The least ``[balance] max_speed_fluctuation``: finer than the energy balance's root finding
+#: (1e-13 of the flywheel) can tell.
+LEAST_FLUCTUATION = 1e-12
 #: The keys of ``[balance.objective]``, ``[balance.<link>]`` and a counterweight's table.
 OBJECTIVE_KEYS = (
     "shaking_moment",
@@ -287,8 +290,9 @@ class BalanceProblem:
         if self.max_speed_fluctuation is not None:
             key = "balance.max_speed_fluctuation"
             delta = v.positive(self.max_speed_fluctuation, key)
-            if not delta < 2:
-                raise SpecError("must be below 2: (ω_max − ω_min)/ω_mean", key=key, value=delta)
+            if not LEAST_FLUCTUATION <= delta < 2:
+                raise SpecError(f"must be from {LEAST_FLUCTUATION:g} to below 2: "
+                                "(ω_max − ω_min)/ω_mean", key=key, value=delta)
             v.store(self, "max_speed_fluctuation", delta)
 
     def weights_of(self, names: Sequence[str]) -> tuple[float, ...]:

@@ -109,6 +109,9 @@ def optimization_json(result: BalanceResult, before: CycleAnalysis | AlongMotion
                           "mr": "kg·m", "phase_deg": "degrees at θ1 = 0", "z, at": "m",
                           "max_bearing_load": "N"}),
                       "sigma": "rad", "disc radius, thickness": "m",
+                      **({"speed_fluctuation": "(ω_max − ω_min)/ω_mean; flywheel, "
+                          "inertia_added, counter_rotor_added: kg·m²"}
+                         if result.flywheel is not None else {}),
                       **({} if result.rotor_masses is None else {
                           "rotating_mr, reciprocating_mr, counterweight_mr": "kg·m",
                           "factor": "dimensionless: counterweight_mr / (rotating_mr + "

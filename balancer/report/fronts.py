@@ -54,6 +54,7 @@ def front_text(front: Front, spec: str | None = None) -> str:
              table(rows, ["point", f"{name} {front.unit}", f"{front.words} {unit}",
                           *(f"{FIGURES[n][0]} {FIGURES[n][1]}" for n in others),
                           f"certified bound {unit}", ""])]
+    lines += [f"note: {note}" for note in front.notes]
     return "\n".join(lines)
 
 

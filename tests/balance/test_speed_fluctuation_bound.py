@@ -192,3 +192,40 @@ def test_the_key_is_written_back_and_the_written_design_needs_no_more(pb1, tmp_p
 
 def test_the_crank_link_freedom_is_a_dataclass_replace():  # (the helper above relies on it)
     assert replace(LinkFreedom(mass=(1.0, 2.0)), inertia=(0.5, 2.0)).inertia == (0.5, 2.0)
+
+
+def test_regressions_of_the_audit(pb1, tmp_path, capsys):
+    """A counterweight on the crank takes no flywheel (its inertia is its shape's): the flywheel
+    goes on the counter-rotor, or is refused naming it; what the crank's inertia cannot take
+    goes on the counter-rotor; plan --with-masses (a balancing along a motion) leaves the key
+    alone; pareto says its points carry no flywheel; a bound below the root finding's
+    resolution is refused by its key."""
+    design = load_design(EXAMPLES / "pb1_counterweights.toml")
+    problem = replace(design.balance, max_speed_fluctuation=BOUND)
+    with pytest.raises(InfeasibleError) as caught:
+        optimize(replace(design, balance=problem), "convex")
+    (key, needed, given, _), = caught.value.needed
+    assert key == "balance.crank.counter_rotor" and needed > given == 20.0
+    wide = problem.with_link("crank", replace(problem.link("crank"), counter_rotor=(0.0, 1e3)))
+    result = optimize(replace(design, balance=wide), "convex")
+    assert result.flywheel.inertia == 0 and result.flywheel.after <= BOUND
+    assert result.flywheel.counter_rotor == pytest.approx(result.flywheel.added, rel=1e-12)
+    split = optimize(bounded(pb1, inertia=(0.5, 2.0), counter_rotor=(0.0, 1e3)), "convex")
+    assert split.linkage.link("crank").inertia == pytest.approx(2.0, rel=1e-12)
+    assert split.flywheel.after <= BOUND
+    text = (EXAMPLES / "servo_press.toml").read_text().replace(
+        "[balance]\n", "[balance]\nmax_speed_fluctuation = 1.9\n", 1)
+    spec = tmp_path / "press.toml"
+    spec.write_text(text)
+    assert main(["plan", str(spec), "--with-masses", "--json"]) == 0
+    capsys.readouterr()
+    from balancer.balance.pareto import pareto_front
+
+    front = pareto_front(bounded(pb1), "driving-torque", 2)
+    assert front.notes and "max_speed_fluctuation" in front.notes[0]
+    text = (EXAMPLES / "pb1.toml").read_text().replace(
+        "[balance]\n", "[balance]\nmax_speed_fluctuation = 1e-320\n")
+    spec.write_text(text)
+    assert main(["optimize", str(spec)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "balance.max_speed_fluctuation" in err[0]
