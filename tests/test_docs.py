@@ -327,9 +327,13 @@ def test_the_outputs_page_names_the_fronts_and_sweeps_keys(tmp_path, monkeypatch
     engine = str(ROOT / "examples" / "v8_to_balance.toml")
     _, engine_front = run_balancer(f"balancer pareto {engine} --against added-mass --points 2 "
                                    "--json")
+    shaper = str(ROOT / "examples" / "quick_return.toml")  # (its flywheel bound: notes)
+    _, noted = run_balancer(f"balancer pareto {shaper} --against driving-torque --points 2 "
+                            "--json")
     front_doc, sweep_doc = json.loads(front), json.loads(sweep.split("wrote")[0])
     documented = _documented_keys("`pareto --json` and `sweep --json`")
-    assert documented == set(front_doc) | set(sweep_doc) | set(json.loads(engine_front))
+    assert documented == (set(front_doc) | set(sweep_doc) | set(json.loads(engine_front))
+                          | set(json.loads(noted)))
     assert {"shaking_moment", "driving_torque", "epsilon", "lower_bound",
             "knee"} == set(front_doc["points"][0])
 
