@@ -40,6 +40,7 @@ samples. It is the same for every even firing of cylinders of one size; it ranks
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Iterator
@@ -65,6 +66,8 @@ ROUNDING = 1e-9
 MOST_CYLINDERS = 12
 #: Most candidates a search judges.
 MOST_CANDIDATES = 200_000
+#: Cranks judged before the candidates they make project the whole search's count.
+PROJECT_AFTER = 16
 #: The driving torque's orders a search reports, up to this one.
 TORQUE_ORDERS = 12
 #: The energy swing's grid: this many times finer than the samples.
@@ -245,10 +248,20 @@ def search(engine: Engine, speed: float, top: int | None = None, *,
         candidates = [[first_phase]] + [
             sorted({(first_phase + j * grid) % 360 for j in range(int(360 / grid))})
             for _ in throws[1:]]
-    if math.prod(len(c) for c in candidates) > MOST_CANDIDATES:
+    cranks = math.prod(len(c) for c in candidates)
+    if cranks > MOST_CANDIDATES:
         raise SpecError("too many cranks to judge: fewer throws, cylinders sharing pins"
                         + ("" if step is None else ", or a coarser step"),
                         key="mechanism.cylinders" if step is None else "--step")
+    # The torque's samples: every shift of a cylinder's torque (its bank, its pin's phase, its
+    # firing) a whole number of them, so that shifting its harmonics is exact and candidates
+    # alike come out alike (the spec's samples raised to the next multiple of 360°/g, g the
+    # angles' greatest common divisor; as they are where that would take eight times more).
+    g = functools.reduce(_gcd, [Fraction(360), *banks, first_phase,
+                                interval if step is None else _grid(step)])
+    whole = int(360 / g)
+    if whole <= 8 * samples:
+        samples = -(-samples // whole) * whole
     # each cylinder's phasors at phase 0: its rod and piston alone
     bare = Crankshaft(inertia=engine.crankshaft.inertia)
     unit = []
@@ -265,8 +278,8 @@ def search(engine: Engine, speed: float, top: int | None = None, *,
     zs = [c.z for c in cylinders]
     middle = (min(zs) + max(zs)) / 2
     half = [0 if z < middle else 1 for z in zs]
-    out = []
-    for choice in itertools.product(*candidates):
+    out: list[Arrangement] = []
+    for done, choice in enumerate(itertools.product(*candidates), start=1):
         phases = [Fraction(0)] * n
         for t, phase in zip(throws, choice, strict=True):
             for k in t:
@@ -291,14 +304,17 @@ def search(engine: Engine, speed: float, top: int | None = None, *,
                 torque=tuple((torques.order(h), float(2 * abs(spectrum[h])))
                              for h in range(1, torques.highest + 1)),
                 energy_swing=float(swing)))
-        if len(out) > MOST_CANDIDATES:
-            raise SpecError("too many cranks and firing orders to judge: a coarser step",
+        # (refused as soon as the cranks judged so far say the whole would be too many)
+        projected = len(out) * cranks / done if done >= PROJECT_AFTER else len(out)
+        if projected > MOST_CANDIDATES:
+            raise SpecError(f"too many cranks and firing orders to judge (about {projected:.3g}"
+                            f" from the first {done} of {cranks} cranks): a coarser step",
                             key="--step")
     if not out:
         raise SpecError("no crank of these cylinders fires evenly (their banks and the working "
                         "cycle leave none)" if step is None else
                         "no crank on this step fires every cylinder within the working cycle",
-                        key="mechanism.cylinders")
+                        key="mechanism.cylinders" if step is None else "--step")
     length = max(zs) - min(zs) or first.crank
 
     def key(a: Arrangement) -> tuple[object, ...]:
@@ -318,8 +334,17 @@ def search(engine: Engine, speed: float, top: int | None = None, *,
                   step=None if step is None else float(step))
 
 
+def _gcd(a: Fraction, b: Fraction) -> Fraction:
+    """The greatest common divisor of two rational angles (0 with 0: the other)."""
+    d = a.denominator * b.denominator // math.gcd(a.denominator, b.denominator)
+    return Fraction(math.gcd(int(a * d), int(b * d)), d)
+
+
 def _grid(step: float) -> Fraction:
     """An uneven search's step of the pins' phases, degrees: a whole fraction of 360°."""
+    if not math.isfinite(step):
+        raise SpecError("the pins' phases' step must be a number of degrees that divides 360°",
+                        key="--step", value=step)
     grid = Fraction(step).limit_denominator(10**6)
     if not (0 < grid <= 360 and (360 / grid).denominator == 1):
         raise SpecError("the pins' phases' step must divide 360° a whole number of times "

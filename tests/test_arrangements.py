@@ -276,3 +276,23 @@ def test_a_step_that_does_not_divide_the_turn_is_refused(capsys):
     doc = json.loads(capsys.readouterr().out)
     assert doc["step_deg"] == 90.0
     assert {"firing_intervals_deg", "energy_swing", "torque_orders"} <= set(doc["arrangements"][0])
+
+
+def test_regressions_of_the_audit(capsys, tmp_path):
+    """A step of nan or inf is refused by its key; a search too big is refused by its first
+    cranks' count, at once (the V8 on 15°: 24³ cranks); at a number of samples the banks do not
+    divide (the V6's 60° at 100), the torque's samples are raised to a whole multiple, so that
+    mirror images stay tied (1-4-2-6-3-5 and 1-5-3-6-2-4)."""
+    for bad in ("nan", "inf", "360"):
+        assert main(["search", str(EXAMPLES / "v8.toml"), "--step", bad]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "--step" in err[0]
+    assert main(["search", str(EXAMPLES / "v8.toml"), "--step", "15"]) == 2
+    assert "from the first 16 of 13824 cranks" in capsys.readouterr().err  # (not all of them)
+    design = load_design(EXAMPLES / "v6.toml")
+    found = search(design.mechanism, design.operation.speed, step=120.0, samples=100)
+    mirror = {a.firing_order: a for a in found.arrangements
+              if a.firing_order in ((1, 4, 2, 6, 3, 5), (1, 5, 3, 6, 2, 4))
+              and a.phases in ((60.0, 300.0, 300.0, 60.0, 180.0, 180.0),
+                               (60.0, 60.0, 180.0, 300.0, 300.0, 180.0))}
+    assert len({a.rank for a in mirror.values()}) == 1, mirror
