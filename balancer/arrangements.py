@@ -29,9 +29,10 @@ four, the in-line six, the cross-plane V8.
 The driving torque comes from the firing: each cylinder's torque at the operating speed,
 inertial and from its gas (where the spec gives ``[gas]``), is its own at phase 0 firing at its
 own top dead centre, shifted along the working cycle by where its firing falls, ``s = f0 − f``
-(its harmonic ``h`` turned by ``e^{i·h·2π·s/Θ}``: exact where ``s`` is a whole number of
-samples). Each candidate reports the torque's orders up to :data:`TORQUE_ORDERS` (a
-four-stroke's half orders from ½) and ranks by its energy swing ``ΔE`` (the largest less the
+(its harmonic ``h`` turned by ``e^{i·h·2π·s/Θ}``: exact, the samples raised to a multiple
+that every bank and pin phase falls on, so that ``s`` is a whole number of them). Each
+candidate reports the torque's orders up to :data:`TORQUE_ORDERS` (a four-stroke's half orders
+from ½) and ranks by its energy swing ``ΔE`` (the largest less the
 least of ``∫ (T − T̄) dθ`` over the working cycle, the turning-moment diagram's: what a flywheel
 must hold for a given speed fluctuation, :mod:`balancer.speed_fluctuation`), the integral of
 the torque's trigonometric interpolant evaluated :data:`SWING_REFINE` times finer than the
