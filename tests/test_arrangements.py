@@ -278,6 +278,7 @@ def test_a_step_that_does_not_divide_the_turn_is_refused(capsys):
     assert {"firing_intervals_deg", "energy_swing", "torque_orders"} <= set(doc["arrangements"][0])
 
 
+@pytest.mark.slow  # (the full suite's: the fast lane's minute)
 def test_regressions_of_the_audit(capsys, tmp_path):
     """A step of nan or inf is refused by its key; a search too big is refused by its first
     cranks' count, at once (the V8 on 15°: 24³ cranks); at a number of samples the banks do not

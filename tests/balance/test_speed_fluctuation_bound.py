@@ -194,6 +194,7 @@ def test_the_crank_link_freedom_is_a_dataclass_replace():  # (the helper above r
     assert replace(LinkFreedom(mass=(1.0, 2.0)), inertia=(0.5, 2.0)).inertia == (0.5, 2.0)
 
 
+@pytest.mark.slow  # (the full suite's: the fast lane's minute)
 def test_regressions_of_the_audit(pb1, tmp_path, capsys):
     """A counterweight on the crank takes no flywheel (its inertia is its shape's): the flywheel
     goes on the counter-rotor, or is refused naming it; what the crank's inertia cannot take

@@ -62,6 +62,7 @@ def _figures(ax) -> str:
     return ax.get_title().split("\n")[1]
 
 
+@pytest.mark.slow  # (the full suite's: the fast lane's minute)
 def test_the_figure_draws_the_analysis_arrays_and_titles_its_figures(forbal2):
     analysis = analyze_motion(forbal2, "diamond")
     # what `analyze` reports along the motion (the same states, gravity and loads)

@@ -907,6 +907,7 @@ def test_order_zero_of_a_moment_or_torque_is_drawn_as_its_signed_mean():
         a.reactions.shaking_force)), rel=1e-12)
 
 
+@pytest.mark.slow  # (the full suite's: the fast lane's minute)
 def test_order_bars_on_a_log_axis(monkeypatch):
     """``log=True``: each panel with a bar above zero on a logarithmic axis in whole decades,
     every bar shown within them; a negative mean drawn by its magnitude and labelled with its
