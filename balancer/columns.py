@@ -163,7 +163,7 @@ def frame_force_columns(mech: Mechanism, reactions: Reactions) -> tuple[list[str
     for point, values in reactions.ground.items():
         names += [f"R{point}x", f"R{point}y"]
         cols += [values.real, values.imag]
-    normals = mech.guide_normals()
+    normals = mech.linkage.guide_normals()
     for link in normal:
         if link in mech.presentation.guide_force_names:
             point = mech.presentation.guide_force_names[link]
@@ -190,7 +190,7 @@ def slider_columns(mech: Mechanism, theta1: ArrayLike, omega1: ArrayLike, alpha1
     where the crank states do not fix the pose (a crank that does not turn fully, whose free
     motion may change branch at a dead point, or a linkage with change points).
     """
-    sliders = [s for s in mech.linkage.sliders if s.link in mech.ground_sliders]
+    sliders = [s for s in mech.linkage.sliders if s.link in mech.linkage.ground_sliders]
     if not sliders or mech.change_points() or not mech.assembly_range().full:
         return [], []
     with np.errstate(all="ignore"):

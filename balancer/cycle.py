@@ -364,7 +364,7 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     angles = (sample_angles(samples, revolutions) if theta1 is None
               else np.asarray(theta1, dtype=float))
     n = angles.size
-    reactions = Reactions.empty(n, mech.ground_points, mech.ground_sliders,
+    reactions = Reactions.empty(n, mech.ground_points, mech.linkage.ground_sliders,
                                 teeth=tuple(g.name for g in mech.linkage.gears))
 
     compiled = n >= KERNEL_STATES  # a long cycle: its chunks by the compiled program

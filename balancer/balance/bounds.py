@@ -117,8 +117,8 @@ def _check_problem(problem: BalanceProblem, mech: Mechanism) -> None:
                     f"{bounds.com_about} does not reach the {name}'s line (it lies "
                     f"{abs(bounds.com_centre.imag):.6g} m off it)", key=f"{key}.com_on_line",
                     value=True)
-        if freedom.counter_rotor is not None and name not in mech.grounded_links:
-            where = " and the ".join(mech.grounded_links)
+        if freedom.counter_rotor is not None and name not in mech.linkage.grounded_links:
+            where = " and the ".join(mech.linkage.grounded_links)
             raise SpecError(
                 f"a counter-rotor sits on a ground pivot: only the {where} can have one",
                 key=f"{key}.counter_rotor",

@@ -153,7 +153,8 @@ class CrankAngle(LinkageFormulation):
         from firing exactly when it must not. Otherwise the gap itself (the numpy route's
         singular values).
         """
-        least = self.mech.least_gap()
+        self.mech.assembly_range()  # (the least gap over a revolution, found with it)
+        least = self.structure.kinematic.get("least gap")
         if least is not None and least > (10 * DEAD_POINT_THRESHOLD) ** 2:
             return least
 

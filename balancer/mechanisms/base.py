@@ -37,7 +37,7 @@ from ..linkage.loads import Reactions, SupportLoad
 from ..linkage.rotors import Rotor, ground_couple
 from ..linkage.structure import Structure
 from ..linkage.vectors import V
-from ..model import GROUND, Branch, Link, Linkage, MechanismModel
+from ..model import Branch, Link, Linkage, MechanismModel
 from ..model.assembly import AssemblyRange
 from .presentation import Presentation
 
@@ -237,31 +237,9 @@ class Mechanism:
         return (*own, *dict.fromkeys(p for p, _ in self.rotors if p not in own))
 
     @property
-    def ground_sliders(self) -> tuple[str, ...]:
-        """Links that slide on a guide of the frame (their normal force and couple act)."""
-        return tuple(s.link for s in self.linkage.sliders if s.guide == GROUND)
-
-    @property
-    def grounded_links(self) -> tuple[str, ...]:
-        """Links pivoted to the frame (where a counter-rotor can sit)."""
-        return self.linkage.grounded_links
-
-    @property
     def input(self) -> str:
         """The driven link."""
         return self.linkage.input
-
-    def guide_normals(self) -> dict[str, complex]:
-        """Unit normal of each ground guide (its direction turned by +90°), by sliding link.
-
-        The direction in which a positive normal force acts.
-        """
-        out: dict[str, complex] = {}
-        for s in self.linkage.sliders:
-            if s.guide == GROUND:
-                d = complex(*s.direction)
-                out[s.link] = 1j * d / abs(d)
-        return out
 
     @cached_property
     def ground_positions(self) -> dict[str, complex]:
@@ -342,15 +320,6 @@ class Mechanism:
         if "assembly" not in shared:
             shared["assembly"] = assembly_range(self.structure)
         return shared["assembly"]
-
-    def least_gap(self) -> float | None:
-        """The groups' least assembly gap over a revolution, or ``None``.
-
-        Found with the assembly range (sampled, the minima refined); ``None`` where the crank
-        does not turn fully.
-        """
-        self.assembly_range()
-        return self.structure.kinematic.get("least gap")
 
     def change_points(self) -> tuple[float, ...]:
         """Crank angles where the assemblies meet and the smooth motion passes (none in general).
@@ -560,20 +529,6 @@ class Mechanism:
             return couple
         return V.of_array(couple.complex() + np.reshape(geared.couple, (-1, 1)))
 
-    def crank_rocking_couple(self, theta1: ArrayLike, omega1: ArrayLike, alpha1: ArrayLike, *,
-                             loads: bool = True, gravity: tuple[float, float] = (0.0, 0.0)
-                             ) -> NDArray[np.complex128]:
-        """:meth:`rocking_couple` at crank states (arrays ``(N,)``), complex ``Mx + i·My``, N·m.
-
-        The pose is the crank's on the mechanism's branch (:meth:`motion`).
-        """
-        theta1 = np.atleast_1d(np.asarray(theta1, dtype=float))
-        if self.in_one_plane():
-            return np.zeros(theta1.size, complex)
-        with np.errstate(all="ignore"):
-            mo = self.motion(theta1, omega1, alpha1)
-        return self.rocking_couple(mo, loads=loads, gravity=gravity).complex()[:, 0]
-
     def crank_forces(self, theta1: ArrayLike, omega1: ArrayLike = 0.0, alpha1: ArrayLike = 0.0,
                      *, route: Route | None = None, loads: bool = True,
                      gravity: tuple[float, float] = (0.0, 0.0),
@@ -586,9 +541,9 @@ class Mechanism:
         rounding); the states it leaves out, the numpy route computes. ``compiled``: run the
         program compiled where it can be (``None``: at :data:`KERNEL_STATES` states or more;
         a long cycle analysis asks for it for each of its chunks). ``into``: forces at
-        :attr:`ground_points` and :attr:`ground_sliders` whose arrays ``(N, 1)`` (writable,
-        any stride: views of a cycle's columns) receive the figures, and are returned — the
-        compiled program writes there directly.
+        :attr:`ground_points` and the linkage's ``ground_sliders`` whose arrays ``(N, 1)``
+        (writable, any stride: views of a cycle's columns) receive the figures, and are
+        returned — the compiled program writes there directly.
         """
         route = route or self.routes[0]
         states = list(np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))

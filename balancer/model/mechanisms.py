@@ -518,6 +518,23 @@ class Linkage(MechanismModel):
         return tuple(b.name for b in self.moving if ground & set(b.points))
 
     @property
+    def ground_sliders(self) -> tuple[str, ...]:
+        """Links that slide on a guide of the frame (their normal force and couple act)."""
+        return tuple(s.link for s in self.sliders if s.guide == GROUND)
+
+    def guide_normals(self) -> dict[str, complex]:
+        """Unit normal of each ground guide (its direction turned by +90°), by sliding link.
+
+        The direction in which a positive normal force acts.
+        """
+        out: dict[str, complex] = {}
+        for s in self.sliders:
+            if s.guide == GROUND:
+                d = complex(*s.direction)
+                out[s.link] = 1j * d / abs(d)
+        return out
+
+    @property
     def sizes(self) -> dict[str, float]:
         """The geometry's sizes by spec key, m: each point's distance from the origin."""
         return {f"mechanism.points.{p}": math.hypot(*xy) for p, xy in self.points}

@@ -21,6 +21,7 @@ from ..formulations import (
 )
 from ..linkage.loads import Reactions
 from ..mechanisms import mechanism_of
+from ..mechanisms.base import Mechanism
 from ..model import Drive
 from ..model import MechanismModel as Model
 
@@ -205,8 +206,7 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
     shaking_force, moment = f.shaking(ev)
     crank = list(f.link_names).index(f.mechanism.input)
     gravity = (f.gravity.real, f.gravity.imag)
-    rocking = f.mechanism.crank_rocking_couple(theta[crank], omega[crank], alpha[crank],
-                                               gravity=gravity)
+    rocking = _rocking_couple(f.mechanism, theta[crank], omega[crank], alpha[crank], gravity)
     ground: dict[str, NDArray[np.complex128]] = {
         p: np.asarray(v, complex) * np.ones(t.size, complex) for p, v in ev.ground.items()}
     # (The formulations' equations carry the rotors' weights' couple on the crank.)
@@ -301,3 +301,18 @@ def _exchangeable_energy(f: Formulation) -> float:
     for spring in mech.linkage.springs:
         total += spring.stiffness * (length + abs(spring.free_length)) ** 2
     return float(total)
+
+
+def _rocking_couple(mech: Mechanism, theta1: NDArray[np.float64], omega1: NDArray[np.float64],
+                    alpha1: NDArray[np.float64], gravity: tuple[float, float]
+                    ) -> NDArray[np.complex128]:
+    """The rocking couple at the crank's states, complex ``Mx + i·My``, N·m (loads included).
+
+    The pose is the crank's on the mechanism's branch; none for a mechanism in one plane.
+    """
+    theta1 = np.atleast_1d(np.asarray(theta1, dtype=float))
+    if mech.in_one_plane():
+        return np.zeros(theta1.size, complex)
+    with np.errstate(all="ignore"):
+        mo = mech.motion(theta1, omega1, alpha1)
+    return mech.rocking_couple(mo, loads=True, gravity=gravity).complex()[:, 0]

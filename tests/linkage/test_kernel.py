@@ -249,15 +249,15 @@ def test_forces_written_into_a_cycles_columns_are_the_forces_returned(name, comp
     columns = {key: np.full(n, np.nan, complex) for key in
                ("force", "couple", *(f"R{p}" for p in mech.ground_points))}
     reals = {key: np.full(n, np.nan) for key in
-             ("torque", "moment", *(f"N{k}" for k in mech.ground_sliders),
-              *(f"C{k}" for k in mech.ground_sliders))}
+             ("torque", "moment", *(f"N{k}" for k in mech.linkage.ground_sliders),
+              *(f"C{k}" for k in mech.linkage.ground_sliders))}
 
     def vector(a):
         return V(a.real[:, None], a.imag[:, None])
 
     into = Forces(reactions={p: vector(columns[f"R{p}"]) for p in mech.ground_points},
-                  slider_normal={k: reals[f"N{k}"][:, None] for k in mech.ground_sliders},
-                  slider_couple={k: reals[f"C{k}"][:, None] for k in mech.ground_sliders},
+                  slider_normal={k: reals[f"N{k}"][:, None] for k in mech.linkage.ground_sliders},
+                  slider_couple={k: reals[f"C{k}"][:, None] for k in mech.linkage.ground_sliders},
                   input_torques=(reals["torque"][:, None],), shaking_force=vector(columns["force"]),
                   shaking_moment=reals["moment"][:, None], rocking_couple=vector(columns["couple"]))
     written = mech.crank_forces(theta, omega, alpha, compiled=compiled, into=into)

@@ -912,7 +912,7 @@ def test_spec_read_as_written(case):
     """The design vector is (m, m·e, m·f, I_G + m·(e² + f²)) per link, then counter-rotors."""
     mech, links = case.mech, case.spec["links"]
     assert tuple(mech.link_names) == tuple(case.oracle.names)
-    assert set(mech.grounded_links) == set(case.oracle.grounded)
+    assert set(mech.linkage.grounded_links) == set(case.oracle.grounded)
     x = mech.layout.vector(mech.linkage)
     want = _design_vector(mech.layout, {
         k: (links[k]["mass"], links[k]["com"]["e"], links[k]["com"]["f"], links[k]["inertia"],

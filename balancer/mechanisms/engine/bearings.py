@@ -91,7 +91,7 @@ def main_bearing_loads(mech: Mechanism, planes: Sequence[float], ground_point: s
         for j, share in lever_shares(planes, z):
             out[j] = out[j] + share * load
 
-    normals = mech.guide_normals()
+    normals = mech.linkage.guide_normals()
     sliders = {s.link: s for s in linkage.sliders}
     for name in linkage.link_names:
         if name in sliders and (pistons is None or name in pistons):
@@ -158,7 +158,7 @@ def main_bearing_regressors(mech: Mechanism, planes: Sequence[float], mo: Motion
             with np.errstate(all="ignore"):
                 regressors = mech.regressors(mo)
         normal = regressors.slider_normal
-        normals = mech.guide_normals()
+        normals = mech.linkage.guide_normals()
         for name in sliders:
             if name not in normal:
                 continue
