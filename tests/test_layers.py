@@ -227,13 +227,14 @@ def test_every_registered_mechanism_reads_and_writes_its_spec_tables_in_its_fold
         module = importlib.import_module(name)
         for function in ("read", "lines", "read_original", "original_lines"):
             assert callable(getattr(module, function)), f"{kind}: {name}.{function}"
+        from balancer.formulations import own_formulation
         from balancer.mechanisms.formulation import Formulation
 
         for name in cls.own_formulations:  # each imported from the folder when asked for
-            own = cls.own_formulation(name)
+            own = own_formulation(cls, name)
             assert own is not None and issubclass(own, Formulation), f"{kind}: {name}"
             assert own.__module__.startswith(f"{folder}."), f"{kind}: {name}"
-        assert cls.own_formulation("no-such-formulation") is None
+        assert own_formulation(cls, "no-such-formulation") is None
         balance = balance_spec_of(kind)
         assert balance.__name__ == module.BALANCE
         for function in ("read_balance", "balance_lines"):

@@ -34,6 +34,7 @@ outputs) is :mod:`balancer.simulation`.
 
 from __future__ import annotations
 
+import importlib
 from typing import Literal
 
 from ..errors import SpecError
@@ -88,8 +89,23 @@ def formulation_class(name: str, model: Model | Mechanism) -> type[Formulation]:
     if name not in names:
         raise SpecError(f"the {mech.kind} has no such formulation; choose from "
                         f"{', '.join(names)}", key="method", value=name)
-    own: type[Formulation] | None = mech.own_formulation(name)
-    return own or GENERAL[name]
+    return own_formulation(type(mech), name) or GENERAL[name]
+
+
+def own_formulation(kind: type[Mechanism], name: str) -> type[Formulation] | None:
+    """A mechanism class's own formulation ``name`` (its ``own_formulations``), or ``None``.
+
+    Imported from the mechanism's folder when asked for, so that analysing a design loads no
+    formulation.
+    """
+    where = kind.own_formulations.get(name)
+    if where is None:
+        return None
+    module, _, attribute = where.rpartition(".")
+    folder = kind.__module__.rpartition(".")[0]
+    found: type[Formulation] = getattr(importlib.import_module(f"{folder}.{module}"),
+                                       attribute)
+    return found
 
 
 def make(
@@ -130,4 +146,5 @@ __all__ = [
     "least_norm",
     "least_norm_many",
     "make",
+    "own_formulation",
 ]

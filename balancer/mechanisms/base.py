@@ -15,13 +15,12 @@ registry.
 
 from __future__ import annotations
 
-import importlib
 import math
 import threading
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, ClassVar, Literal
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -174,9 +173,9 @@ class Mechanism:
     routes: ClassVar[tuple[Route, ...]] = ("newton-euler", "mass-matrix")
     #: The mechanism's own formulations of the equations of motion by name, the default first:
     #: each a ``"module.Class"`` of its folder (a :class:`~balancer.mechanisms.formulation.
-    #: Formulation`), imported when asked for (:meth:`own_formulation`), so that analysing a
-    #: mechanism does not load its formulations. The general ones (:mod:`balancer.formulations`)
-    #: apply to every mechanism besides.
+    #: Formulation`), imported when asked for (:func:`balancer.formulations.own_formulation`),
+    #: so that analysing a mechanism does not load its formulations. The general ones
+    #: (:mod:`balancer.formulations`) apply to every mechanism besides.
     own_formulations: ClassVar[Mapping[str, str]] = {}
     #: The formulation a check by simulation uses: one the optimiser's route does not share.
     verify_method: ClassVar[str] = "multibody"
@@ -271,20 +270,6 @@ class Mechanism:
         if self.assembly_range().full:
             return (*own, CRANK_ANGLE, MULTIBODY)
         return (*own, MULTIBODY, CRANK_ANGLE)
-
-    @classmethod
-    def own_formulation(cls, name: str) -> Any:
-        """Its own formulation ``name`` (:attr:`own_formulations`): the class, or ``None``.
-
-        (A subclass of :class:`~balancer.mechanisms.formulation.Formulation`, which builds on
-        this module, so that it is not named in the annotation.)
-        """
-        where = cls.own_formulations.get(name)
-        if where is None:
-            return None
-        module, _, attribute = where.rpartition(".")
-        folder = cls.__module__.rpartition(".")[0]
-        return getattr(importlib.import_module(f"{folder}.{module}"), attribute)
 
     def parameters(self) -> NDArray[np.float64]:
         """The design vector of the mechanism's own links (:attr:`layout`)."""
