@@ -328,7 +328,7 @@ def force_balance_residual(mech: Mechanism) -> float:
     of each body's own largest swing (:meth:`~balancer.mechanisms.base.Mechanism.first_moments`).
     """
     if not mech.rotors:
-        return force_balance_conditions(mech).residual(mech.parameters())
+        return force_balance_conditions(mech).residual(mech.layout.vector(mech.linkage))
     theta = 2 * np.pi * np.arange(ROTOR_SAMPLES) / ROTOR_SAMPLES
     with np.errstate(all="ignore"):
         moments = geometry.first_moments(mech, mech.motion(theta))

@@ -57,7 +57,7 @@ def test_a_design_of_the_null_space_keeps_its_centre_of_mass_still(spec):
     null = np.linalg.svd(found.matrix)[2][found.count:].T
     rng = np.random.default_rng(7)
     x = null @ rng.normal(size=null.shape[1])
-    x *= np.max(np.abs(mech.parameters())) / np.max(np.abs(x))
+    x *= np.max(np.abs(mech.layout.vector(mech.linkage))) / np.max(np.abs(x))
     # states over a box three times the one sampled, those that assemble
     reference = np.array([mech.structure.ref_angle[k] for k in mech.structure.inputs])
     q = reference[:, None] + rng.uniform(-0.8, 0.8, (reference.size, 400))
@@ -73,5 +73,5 @@ def test_a_design_of_the_null_space_keeps_its_centre_of_mass_still(spec):
     terms = np.max(np.abs(g[kept] * x))
     assert np.max(np.abs(moment - moment[0])) <= 1e-12 * terms * x.size
     # and the design as it is moves its centre of mass
-    own = g[kept] @ mech.parameters()
+    own = g[kept] @ mech.layout.vector(mech.linkage)
     assert np.max(np.abs(own - own[0])) > 1e-3 * np.max(np.abs(own))

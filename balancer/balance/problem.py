@@ -175,7 +175,7 @@ def _problem(problem: BalanceProblem, mech: Mechanism, speed: float | None,
         states=states,
         regressors=reg,
         links=links,
-        x0=mech.parameters(),
+        x0=mech.layout.vector(mech.linkage),
         rows=rows,
         factor=factor,
         force_balance=_force_balance(problem, mech, along),
@@ -210,7 +210,7 @@ def _engine_problem(design: Design, problem: RotorBalanceProblem) -> NumericProb
         driving_torque=np.hstack([linkage.driving_torque, np.zeros(moment.shape)]),
         rocking_couple=np.hstack([linkage.rocking_couple, couple]), supports=supports)
     links = tuple(resolve_link(mech, name, None) for name in mech.link_names)
-    x0 = np.concatenate([mech.parameters(), site_values])
+    x0 = np.concatenate([mech.layout.vector(mech.linkage), site_values])
     rows, factor, inert = objective_rows(reg, problem.objective, links, x0.size, sites)
     if supports is not None:  # (a rod's inertia moves its guide's force: the bound sees it)
         seen = np.any(supports != 0, axis=0)

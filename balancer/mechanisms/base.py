@@ -271,10 +271,6 @@ class Mechanism:
             return (*own, CRANK_ANGLE, MULTIBODY)
         return (*own, MULTIBODY, CRANK_ANGLE)
 
-    def parameters(self) -> NDArray[np.float64]:
-        """The design vector of the mechanism's own links (:attr:`layout`)."""
-        return self.layout.vector(self.linkage)
-
     def with_links(self, links: dict[str, Link]) -> Mechanism:
         """The same mechanism with some links' mass properties replaced."""
         return type(self)(self.model.with_links(links))

@@ -175,7 +175,8 @@ def test_an_engines_problem_is_the_linkages_with_its_sites_after_the_links(balan
     start = mechanism_of(design.mechanism).layout.size
     count = 2 * len(sites(design.balance))
     assert data.sites is not None and data.sites.start == start
-    np.testing.assert_array_equal(data.x0[:start], mechanism_of(design.mechanism).parameters())
+    mech = mechanism_of(design.mechanism)
+    np.testing.assert_array_equal(data.x0[:start], mech.layout.vector(mech.linkage))
     rng = np.random.default_rng(41)
     bounds = np.repeat([bound for *_, bound in sites(design.balance)], 2)
     for _ in range(5):

@@ -373,7 +373,8 @@ def test_partial_balancing_matches_the_classic_closed_form():
         expected = sc_cond.classic_counterweight(base.mechanism, wx / (wx + wy))
         closed = replace(base.mechanism.crank, e=(expected / crank.mass).real, f=0.0)
         data = numeric_problem(design)
-        x_closed = mechanism_of(base.mechanism.with_link("crank", closed)).parameters()
+        closed_mech = mechanism_of(base.mechanism.with_link("crank", closed))
+        x_closed = closed_mech.layout.vector(closed_mech.linkage)
         j_closed = data.objective(x_closed)
         # The objective is quadratic and flat at the optimum: the solver certifies its design
         # within J − J_low of the optimum (its lower bound), which the closed form's objective
