@@ -231,7 +231,7 @@ def simulation_columns(traj: TrajectoryLike, all_columns: bool = False
     frame_names, frame_cols = frame_force_columns(mech, traj.reactions)
     names += frame_names
     cols += frame_cols
-    crank = list(traj.links).index(mech.input)
+    crank = list(traj.links).index(mech.linkage.input)
     slider_names, slider_cols = slider_columns(mech, traj.theta[crank], traj.omega[crank],
                                                traj.alpha[crank])
     names += slider_names

@@ -62,7 +62,7 @@ def sized(data: NumericProblem, x: NDArray[np.float64], bound: float,
     """
     assert data.speed is not None, "a one-input mechanism at its operating speed"
     physical = dict(data.physical(x))
-    crank = data.mechanism.input
+    crank = data.mechanism.linkage.input
     b = next(link for link in data.links if link.name == crank)
     needed = _flywheel(data, data.linkage_of(x), bound, gravity)
     before = _flywheel(data, data.linkage, bound, gravity).fluctuation_without

@@ -235,11 +235,6 @@ class Mechanism:
         own = self.linkage.ground.points
         return (*own, *dict.fromkeys(p for p, _ in self.rotors if p not in own))
 
-    @property
-    def input(self) -> str:
-        """The driven link."""
-        return self.linkage.input
-
     @cached_property
     def ground_positions(self) -> dict[str, complex]:
         """Place of each ground point, complex ``x + i·y``, m."""

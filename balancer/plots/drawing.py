@@ -48,7 +48,7 @@ def centre_of_mass_path(linkage: Model | Mechanism, traj: TrajectoryLike
     there).
     """
     mech = mechanism_of(linkage)
-    crank = traj.links.index(mech.input)
+    crank = traj.links.index(mech.linkage.input)
     mo = mech.motion(traj.theta[crank], traj.omega[crank], traj.alpha[crank])
     return np.asarray(geometry.total_centre_of_mass(mech, mo), complex)
 

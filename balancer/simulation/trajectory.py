@@ -204,7 +204,7 @@ def trajectory_of(f: Formulation, times: Sequence[float], states: Sequence[NDArr
     scale = max(np.max(np.abs(kin)), np.max(np.abs(work)), _exchangeable_energy(f), 1e-300)
     energy_error = float(np.max(np.abs(kin - kin[0] - work)) / scale)
     shaking_force, moment = f.shaking(ev)
-    crank = list(f.link_names).index(f.mechanism.input)
+    crank = list(f.link_names).index(f.mechanism.linkage.input)
     gravity = (f.gravity.real, f.gravity.imag)
     rocking = _rocking_couple(f.mechanism, theta[crank], omega[crank], alpha[crank], gravity)
     ground: dict[str, NDArray[np.complex128]] = {

@@ -174,7 +174,7 @@ def test_a_driven_six_bar_has_the_cycle_analysis_reactions():
     traj = simulate(design.mechanism, settings, method="multibody", rtol=1e-10, atol=1e-12,
                     outputs=41)
     mech = mechanism_of(design.mechanism)
-    crank = traj.links.index(mech.input)
+    crank = traj.links.index(mech.linkage.input)
     mo = mech.motion(traj.theta[crank], speed, 0.0)
     forces = mech.inverse_dynamics(mo, gravity=(0.0, -9.81))
     force = traj.largest_reaction
