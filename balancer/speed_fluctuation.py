@@ -158,6 +158,17 @@ class CrankEnergy:
         return cls(theta=theta, inertia=inertia, half_slope=half_slope, load=-rest,
                    cycle=cycle)
 
+    @classmethod
+    def over_cycle(cls, mech: Mechanism, samples: int, gravity: tuple[float, float] = (0.0, 0.0)
+                   ) -> CrankEnergy:
+        """:meth:`of` over the mechanism's cycle (its :attr:`~Mechanism.cycle_revolutions`).
+
+        At ``samples`` equally spaced angles per revolution from 0.
+        """
+        revolutions = mech.cycle_revolutions
+        theta = np.arange(samples * revolutions, dtype=float) * (2 * math.pi / samples)
+        return cls.of(mech, theta, 2 * math.pi * revolutions, gravity)
+
     @property
     def mean_load(self) -> float:
         """``Q̄``, N·m."""
@@ -291,6 +302,17 @@ def fluctuation_of(omega: NDArray[np.float64]) -> float:
     return float((np.max(w) - np.min(w)) * np.mean(1.0 / w))
 
 
+def fluctuation_alone(energy: CrankEnergy, speed: float) -> float:
+    """``δ`` of the mechanism with no flywheel at mean ``speed``.
+
+    ``inf`` where it cannot run at that mean speed (it stops within its cycle).
+    """
+    try:
+        return fluctuation_of(speeds(energy, 0.0, speed))
+    except TooSlow:
+        return math.inf
+
+
 def flywheel(energy: CrankEnergy, speed: float, fluctuation: float) -> Flywheel:
     """The least flywheel inertia for speed fluctuation ``fluctuation`` at mean ``speed``.
 
@@ -308,10 +330,7 @@ def flywheel(energy: CrankEnergy, speed: float, fluctuation: float) -> Flywheel:
     def excess(i_f: float) -> float:
         return fluctuation_of(speeds(energy, i_f, speed)) - fluctuation
 
-    try:
-        alone = fluctuation_of(speeds(energy, 0.0, speed))
-    except TooSlow:  # (it stops within its cycle: no fluctuation to speak of)
-        alone = math.inf
+    alone = fluctuation_alone(energy, speed)
     if alone <= fluctuation:
         added = 0.0
     else:

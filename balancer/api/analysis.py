@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from .. import validate as v
-from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses, sample_angles
+from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_analyses
 from ..errors import SpecError
 from ..force_balance import force_balance_residual
 from ..mechanisms import mechanism_of
@@ -93,10 +92,8 @@ def flywheel(design: Design, fluctuation: float | None = None, *,
         fluctuation = op.speed_fluctuation
     mech = mechanism_of(design.mechanism)
     mech.require_full_revolution("sizing a flywheel")
-    revolutions = mech.cycle_revolutions
     g = op.gravity if gravity is None else v.vector2(gravity, "gravity")
-    energy = CrankEnergy.of(mech, sample_angles(op.samples, revolutions),
-                            2 * math.pi * revolutions, g)
+    energy = CrankEnergy.over_cycle(mech, op.samples, g)
     return least_flywheel(energy, op.speed, fluctuation)
 
 

@@ -64,7 +64,7 @@ from .conic import (
 )
 from .diagnosis import Diagnosis
 from .feasibility import FORCE_BALANCE_TOLERANCE
-from .largest import ROUNDS, LargestLoad, broken_rows, initial_rows, pad
+from .largest import LargestLoad, initial_rows, over_working_set, pad
 from .lsq import pinv as pseudo_inverse
 from .problem import NumericProblem
 from .repair import Repairs
@@ -292,27 +292,28 @@ class ConvexSolver(Repairs, Diagnosis):
         Each round's program a relaxation of the whole (:mod:`.largest`); the report's
         iterations and time those of every round.
         """
-        report, first = self._run(self._stage1, "convex")
         supports = self.data.regressors.supports
         if self._rows is None or supports is None:
-            return report, first
-        n, rows = self.layout.size, self._rows
-        iterations, seconds = report.iterations, report.time
-        for round_ in range(ROUNDS):
-            if first.u is None:
-                break
-            loads = np.abs(supports @ self.layout.x(first.u[:n]))  # N
-            limit = self.row_limit(None if self.largest is None else float(first.u[n]))
-            more = broken_rows(loads, limit, rows, last=round_ == ROUNDS - 1)
-            if more.size == rows.size:
-                break
-            rows = more
-            self._stage1 = self._stage_program(rows)
-            report, first = self._run(self._stage1, "convex")
-            iterations += report.iterations
-            seconds += report.time
-        self._rows = rows  # (a start as good for the next solve)
-        return replace(report, iterations=iterations, time=seconds), first
+            return self._run(self._stage1, "convex")
+        n = self.layout.size
+        reports: list[StageReport] = []
+
+        def solve(rows: NDArray[np.intp]) -> ConicSolution:
+            if reports:  # (the first round's program is built already)
+                self._stage1 = self._stage_program(rows)
+            report, solution = self._run(self._stage1, "convex")
+            reports.append(report)
+            return solution
+
+        def limits(solution: ConicSolution) -> tuple[NDArray[np.float64], float]:
+            assert solution.u is not None
+            loads = np.abs(supports @ self.layout.x(solution.u[:n]))  # N
+            return loads, self.row_limit(None if self.largest is None else float(solution.u[n]))
+
+        first, self._rows = over_working_set(self._rows, solve, limits)  # (a start as good
+        # for the next solve)
+        return replace(reports[-1], iterations=sum(r.iterations for r in reports),
+                       time=sum(r.time for r in reports)), first
 
     def row_limit(self, tau: float | None) -> float:
         """The largest load a support's row may carry in a program, N.

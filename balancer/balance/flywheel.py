@@ -28,15 +28,12 @@ traded against the shaking for it).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import NDArray
 
-from ..cycle import sample_angles
 from ..mechanisms import mechanism_of
 from ..model import MechanismModel
-from ..speed_fluctuation import CrankEnergy, Flywheel
+from ..speed_fluctuation import CrankEnergy, fluctuation_alone
 from ..speed_fluctuation import flywheel as least_flywheel
 from .problem import NumericProblem
 from .result import FlywheelSizing, InfeasibleError
@@ -64,8 +61,8 @@ def sized(data: NumericProblem, x: NDArray[np.float64], bound: float,
     physical = dict(data.physical(x))
     crank = data.mechanism.linkage.input
     b = next(link for link in data.links if link.name == crank)
-    needed = _flywheel(data, data.linkage_of(x), bound, gravity)
-    before = _flywheel(data, data.linkage, bound, gravity).fluctuation_without
+    needed = least_flywheel(_energy(data, data.linkage_of(x), gravity), data.speed, bound)
+    before = fluctuation_alone(_energy(data, data.linkage, gravity), data.speed)
     m, e, f, inertia, rotor = physical[crank]
     # (with room on the whole inertia the crank sees, of which δ is nearly inverse)
     added = (needed.inertia + ROOM * (needed.inertia + needed.mechanism_inertia[1])
@@ -97,7 +94,7 @@ def sized(data: NumericProblem, x: NDArray[np.float64], bound: float,
         on_inertia = added - on_rotor
         physical[crank] = (m, e, f, inertia + on_inertia, rotor + on_rotor)
         x = data.vector_of(physical)
-    after = _flywheel(data, data.linkage_of(x), bound, gravity).fluctuation_without
+    after = fluctuation_alone(_energy(data, data.linkage_of(x), gravity), data.speed)
     if after > bound * (1 + SAMPLED):
         raise InfeasibleError(
             f"the flywheel for a speed fluctuation of at most {bound:g} "
@@ -108,16 +105,11 @@ def sized(data: NumericProblem, x: NDArray[np.float64], bound: float,
                              inertia=on_inertia, counter_rotor=on_rotor)
 
 
-def _flywheel(data: NumericProblem, model: MechanismModel, bound: float,
-              gravity: tuple[float, float]) -> Flywheel:
-    """The least flywheel of ``model`` for ``bound`` at the problem's speed and samples."""
-    assert data.speed is not None
+def _energy(data: NumericProblem, model: MechanismModel, gravity: tuple[float, float]
+            ) -> CrankEnergy:
+    """The energy balance's terms of ``model`` over its cycle at the problem's samples."""
     mech = mechanism_of(model)
-    revolutions = mech.cycle_revolutions
-    samples = data.samples // data.mechanism.cycle_revolutions
-    energy = CrankEnergy.of(mech, sample_angles(samples, revolutions),
-                            2 * math.pi * revolutions, gravity)
-    return least_flywheel(energy, data.speed, bound)
+    return CrankEnergy.over_cycle(mech, data.samples // mech.cycle_revolutions, gravity)
 
 
 __all__ = ["sized"]

@@ -24,12 +24,14 @@ of them (:func:`initial_rows`), solved again with the rows its optimum breaks ad
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .certificate import Constraint
+from .conic import ConicSolution
 from .problem import NumericProblem
 from .variables import VariableMap
 
@@ -139,6 +141,29 @@ def broken_rows(loads: NDArray[np.float64], limit: float, rows: NDArray[np.intp]
     return np.union1d(rows, broken).astype(np.intp)
 
 
+def over_working_set(rows: NDArray[np.intp], solve: Callable[[NDArray[np.intp]], ConicSolution],
+                     limits: Callable[[ConicSolution], tuple[NDArray[np.float64], float]]
+                     ) -> tuple[ConicSolution, NDArray[np.intp]]:
+    """A program solved over a working set of the supports' rows until it breaks none.
+
+    ``solve(rows)`` solves the program with ``rows``; ``limits(solution)`` gives the loads of
+    every row at its point and the limit they must keep. Each round adds the rows broken
+    (:func:`broken_rows`; every one in the last of :data:`ROUNDS`). Returns the last solution
+    and its rows.
+    """
+    solution = solve(rows)
+    for round_ in range(ROUNDS):
+        if solution.u is None:
+            break
+        loads, limit = limits(solution)
+        more = broken_rows(loads, limit, rows, last=round_ == ROUNDS - 1)
+        if more.size == rows.size:
+            break
+        rows = more
+        solution = solve(rows)
+    return solution, rows
+
+
 def pad(constraints: list[Constraint], width: int) -> list[Constraint]:
     """Constraints in ``n`` variables as constraints of a program of ``width`` (zeros after)."""
     out = []
@@ -149,4 +174,4 @@ def pad(constraints: list[Constraint], width: int) -> list[Constraint]:
     return out
 
 
-__all__ = ["LargestLoad", "broken_rows", "initial_rows", "pad"]
+__all__ = ["LargestLoad", "broken_rows", "initial_rows", "over_working_set", "pad"]

@@ -38,7 +38,7 @@ from .certificate import Constraint, ConvexObjective, lower_bound
 from .conic import ACCURACY_FALLBACKS, ConicProgram, ConicSolution, solve_program
 from .convex import CERTIFY_AGAIN, ConvexSolver
 from .front import Front, FrontPoint, mark_knee
-from .largest import ROUNDS, broken_rows, pad
+from .largest import over_working_set, pad
 from .problem import NumericProblem, numeric_problem
 from .sites import Sites
 
@@ -153,23 +153,23 @@ class _RotorFront:
         (:mod:`.largest`); :attr:`last_cones` are the program's.
         """
         options = {**self.solver.settings, **(settings or {})}
-        rows = self.solver.working_rows
         supports = self.data.regressors.supports
-        for round_ in range(ROUNDS + 1):
+
+        def solve(rows: NDArray[np.intp] | None) -> ConicSolution:
             cones = [*self.base, *self.row_cones(rows), *extra]
-            solution = solve_program(ConicProgram(self.width, cones, objective="norm",
-                                                  P=self.P, q=self.q), options)
             self.last_cones = cones
-            if rows is None or supports is None or solution.u is None:
-                return solution
-            loads = np.abs(supports @ self.x(solution.u))
-            limit = self.solver.row_limit(None if self.solver.largest is None
-                                          else float(solution.u[-1]))
-            more = broken_rows(loads, limit, rows, last=round_ >= ROUNDS - 1)
-            if more.size == rows.size:
-                return solution
-            rows = more
-        return solution
+            return solve_program(ConicProgram(self.width, cones, objective="norm", P=self.P,
+                                              q=self.q), options)
+
+        def limits(solution: ConicSolution) -> tuple[NDArray[np.float64], float]:
+            assert solution.u is not None and supports is not None
+            return np.abs(supports @ self.x(solution.u)), self.solver.row_limit(
+                None if self.solver.largest is None else float(solution.u[-1]))
+
+        rows = self.solver.working_rows
+        if rows is None or supports is None:
+            return solve(None)
+        return over_working_set(rows, solve, limits)[0]
 
     def least_value(self, root: float) -> ConicSolution:
         """``min Σ c_i·t_i`` among the designs with ``‖P·u + q‖ ≤ root``."""
