@@ -11,6 +11,7 @@ libraries (SciPy's integrators, CVXPY, CasADi, matplotlib) come with the command
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import os
 import sys
@@ -539,10 +540,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     while an error was being reported — ends it with exit code 130 and the one line
     ``balancer: interrupted`` (:mod:`balancer.interrupts`).
     """
+    return _main(argv, whole_process=False)
+
+
+def _main(argv: Sequence[str] | None, *, whole_process: bool) -> int:
+    """:func:`main`, or the process's command (``whole_process``, :func:`entry_point`).
+
+    A process that ends with the command sets aside for good what loading made (:func:`_loaded`).
+    """
     with interrupts.handling():
         try:
             try:
-                code, line = _run(argv)
+                code, line = _run(argv, whole_process=whole_process)
             except KeyboardInterrupt as exc:
                 code, line = 130, _interrupted(exc)
             with interrupts.shielded():  # from here on a SIGINT only counts
@@ -563,22 +572,46 @@ def _interrupted(exc: KeyboardInterrupt | None) -> str:
     return f"balancer: interrupted: {what}" if what else "balancer: interrupted"
 
 
+def _loaded(load: Callable[[], Any], whole_process: bool) -> Any:
+    """What ``load()`` returns; in a whole process, loaded with the collector held off.
+
+    Loading numpy and a verb's layers makes some 10⁵ objects (functions, classes, their
+    dictionaries) that live as long as the process does, none of them garbage. The cyclic
+    garbage collector, left on, goes over the young ones every 700 allocations and over all of
+    them now and then: a seventh of a short command's time (``analyze`` of the paper's
+    four-bar, benchmarks/bench_commands.py). In a process that ends with the command it is
+    held off while they load, and what they made is frozen (:func:`gc.freeze`, as Python's
+    documentation advises for a process that loads, then works): the command's own
+    collections go over its own objects only. Called from a longer process (a notebook, the
+    tests), :func:`main` leaves the collector as it is.
+    """
+    if not whole_process:
+        return load()
+    gc.disable()
+    try:
+        return load()
+    finally:
+        gc.freeze()
+        gc.enable()
+
+
 def _verb_of(argv: Sequence[str]) -> str:
     """The verb a command line asks for: its first word that is no option (``""``: none)."""
     return next((a for a in argv if not a.startswith("-")), "")
 
 
-def _run(argv: Sequence[str] | None) -> tuple[int, str | None]:
+def _run(argv: Sequence[str] | None, *, whole_process: bool) -> tuple[int, str | None]:
     """Parse and run the command: its exit code and the error line to print, if any."""
     parser = build_parser(_verb_of(sys.argv[1:] if argv is None else argv))
     args = None
     try:
         args = parser.parse_args(argv)
         # Each verb's module imports what it needs: only the one asked for is loaded.
-        verb = importlib.import_module(f".{args.verb}", __name__)
         # A user sees results or one line of error: the libraries' warnings (an overflow in an
         # intermediate, a solver's note) are not theirs to read. Results are checked finite
         # before they are written (report.dumps_json, report.csv_text).
+        verb = _loaded(lambda: importlib.import_module(f".{args.verb}", __name__),
+                       whole_process)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             return verb.run(args), None
@@ -632,8 +665,11 @@ def entry_point() -> None:
     # main() handles SIGINT itself; one that comes just before or after it is counted (and
     # decides the exit code), never raised as a traceback.
     with interrupts.handling(), interrupts.shielded():
-        code = main()
+        code = _main(None, whole_process=True)
         if interrupts.closing() and code != 130:
             print(_interrupted(None), file=sys.stderr)
             code = 130
+    # The process ends: Python's last collection at exit would go over every object it made,
+    # none of them garbage worth the time (a tenth of a short command's time).
+    gc.freeze()
     sys.exit(code)

@@ -286,6 +286,36 @@ def test_the_command_runs_openblas_on_one_thread_unless_told(given, used):
     assert out.strip().splitlines()[-1] == f"{used} False"  # set before numpy loads
 
 
+def test_the_command_sets_aside_what_loading_made_and_collects_its_own_garbage():
+    """The process's command freezes what its verb's loading made (balancer.cli._loaded), and
+    runs with the collector on: a command's own cyclic garbage is still collected."""
+    code = ("import gc, sys, json\nsys.argv = ['balancer', 'analyze', " + repr(EXAMPLE) + "]\n"
+            "import balancer.cli.analyze as verb\nseen = {}\nrun = verb.run\n"
+            "def watched(args):\n"
+            "    seen.update(on=gc.isenabled(), frozen=gc.get_freeze_count())\n"
+            "    cycle = []; cycle.append(cycle); del cycle\n"
+            "    seen['collected'] = gc.collect()\n"
+            "    return run(args)\n"
+            "verb.run = watched\nfrom balancer.cli import entry_point\ntry:\n"
+            "    entry_point()\nexcept SystemExit as e:\n    seen['code'] = e.code\n"
+            "print(json.dumps(seen))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    seen = json.loads(out.strip().splitlines()[-1])
+    assert seen["code"] == 0 and seen["on"]
+    assert seen["frozen"] > 10_000  # numpy's and the layers' objects, out of the collector's way
+    assert seen["collected"] >= 1
+
+
+def test_main_leaves_the_collector_as_it_was(capsys):
+    """Called within a longer process, main() neither freezes nor turns off the collector."""
+    import gc
+
+    before = (gc.isenabled(), gc.get_freeze_count())
+    assert main(["analyze", EXAMPLE]) == 0
+    assert (gc.isenabled(), gc.get_freeze_count()) == before
+
+
 def test_version_is_the_installed_packages(capsys):
     from importlib.metadata import version
 
