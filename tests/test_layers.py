@@ -260,3 +260,34 @@ def test_no_module_is_over_800_lines():
     long = {name: n for name, path in modules().items()
             if (n := len(path.read_text(encoding="utf-8").splitlines())) > MODULE_LINES}
     assert not long, f"modules over {MODULE_LINES} lines: {long}"
+
+
+#: The core's joint kinds (:mod:`balancer.linkage.constraints`), which dispatch through their
+#: own methods: no other module asks a joint which kind it is (issue 41).
+JOINT_KINDS = {"Pin", "Prism", "Mesh", "Driver", "SlideDriver"}
+
+
+def _kinds_asked(node: ast.AST) -> set[str]:
+    """The joint kinds an ``isinstance`` call's second argument names (a name, tuple or union)."""
+    if isinstance(node, ast.Name):
+        return {node.id} & JOINT_KINDS
+    if isinstance(node, ast.Attribute):
+        return {node.attr} & JOINT_KINDS
+    if isinstance(node, ast.Tuple):
+        return set().union(*(_kinds_asked(e) for e in node.elts))
+    if isinstance(node, ast.BinOp):
+        return _kinds_asked(node.left) | _kinds_asked(node.right)
+    return set()
+
+
+def test_no_module_but_the_joints_own_asks_a_joint_its_kind():
+    asked = {}
+    for name, path in modules().items():
+        if name == "linkage.constraints":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                    and node.func.id == "isinstance" and len(node.args) == 2
+                    and (kinds := _kinds_asked(node.args[1]))):
+                asked.setdefault(name, set()).update(kinds)
+    assert not asked, f"isinstance on joint kinds outside linkage.constraints: {asked}"

@@ -10,6 +10,7 @@ Assur group (:class:`Group`) of them.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import ClassVar, TypeAlias
 
@@ -358,6 +359,14 @@ class _InputDriver:
         """The motor's torque (an actuator's force) on its input: minus its multiplier."""
         frame.torques[self.index] = -multipliers[0]
 
+    def own_group(self, pins: Sequence[Pin], pivot: str) -> Group | None:
+        """The group that places its link from the ground (``None``: it cannot).
+
+        A crank's: the link's pin to the ground at its first point ``pivot``, and itself; a
+        slide's: its prism and itself.
+        """
+        raise NotImplementedError
+
 
 @dataclass(frozen=True)
 class Driver(_InputDriver):
@@ -388,6 +397,11 @@ class Driver(_InputDriver):
               state: InputState | None = None) -> list[Num]:
         """``γ``: the input's prescribed acceleration (rad/s²; none given: zero)."""
         return [0.0 if state is None else state.accelerations[self.index]]
+
+    def own_group(self, pins: Sequence[Pin], pivot: str) -> Group | None:
+        """The input link about its pin to the ground at ``pivot`` (``None``: no such pin)."""
+        found = [c for c in pins if c.a == self.link and c.b == GROUND_INDEX and c.point == pivot]
+        return Group((self.link,), (found[0], self), "input") if found else None
 
 
 @dataclass(frozen=True)
@@ -429,6 +443,10 @@ class SlideDriver(_InputDriver):
         w = _rate(rate, self.link)
         spin = self.prism.dg.dot(ps) * (w * w)
         return [spin if state is None else state.accelerations[self.index] + spin]
+
+    def own_group(self, pins: Sequence[Pin], pivot: str) -> Group | None:
+        """The slider along its ground guide: its prism and itself place it."""
+        return Group((self.link,), (self.prism, self), "slide")
 
 
 Constraint = Pin | Prism | Mesh | Driver | SlideDriver
@@ -482,6 +500,41 @@ class Group:
         if not isinstance(c, Driver | SlideDriver):
             raise ValueError(f"a {self.kind} group has no driver")
         return c
+
+    @property
+    def slide(self) -> Prism:
+        """A slide group's prism (its first constraint): the guide its input runs along."""
+        c = self.constraints[0]
+        if not isinstance(c, Prism):
+            raise ValueError(f"a {self.kind} group has no slide")
+        return c
+
+    def rrr(self) -> tuple[Pin, Pin, Pin]:
+        """An RRR dyad's pins: on the first link's known side, between them, on the second's."""
+        j1, j2, j3 = self._three()
+        if not (isinstance(j1, Pin) and isinstance(j2, Pin) and isinstance(j3, Pin)):
+            raise ValueError(f"a {self.kind} group is no RRR dyad")
+        return j1, j2, j3
+
+    def rrp(self) -> tuple[Pin, Pin, Prism]:
+        """An RRP (PRR) dyad's joints: pin, pin, and the prism of its second link."""
+        j1, j2, j3 = self._three()
+        if not (isinstance(j1, Pin) and isinstance(j2, Pin) and isinstance(j3, Prism)):
+            raise ValueError(f"a {self.kind} group is no RRP dyad")
+        return j1, j2, j3
+
+    def rpr(self) -> tuple[Pin, Prism, Pin]:
+        """An RPR dyad's joints: a pin, the prism between its links, a pin."""
+        j1, j2, j3 = self._three()
+        if not (isinstance(j1, Pin) and isinstance(j2, Prism) and isinstance(j3, Pin)):
+            raise ValueError(f"a {self.kind} group is no RPR dyad")
+        return j1, j2, j3
+
+    def _three(self) -> tuple[Constraint, Constraint, Constraint]:
+        if len(self.constraints) != 3:
+            raise ValueError(f"a {self.kind} group is no dyad")
+        j1, j2, j3 = self.constraints
+        return j1, j2, j3
 
 
 def unit(x: float, y: float) -> complex:

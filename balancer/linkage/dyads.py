@@ -13,7 +13,7 @@ from typing import TypeAlias, overload
 import numpy as np
 from numpy.typing import NDArray
 
-from .constraints import GROUND_INDEX, Group, Pin, Pose, Prism
+from .constraints import GROUND_INDEX, Group, Pin, Pose
 from .vectors import NUMPY, Num, OpsLike, V
 
 #: A link's frame: its angle (rad), and its cosine and sine (``None``: from the angle).
@@ -70,8 +70,7 @@ class Dyads:
 
     @staticmethod
     def rrr(ops: OpsLike, pose: Pose, g: Group, sign: Num | None = None) -> float | Solution:
-        (a, b), (j1, j2, j3) = g.links, g.constraints
-        assert isinstance(j1, Pin) and isinstance(j2, Pin) and isinstance(j3, Pin)  # RRR
+        (a, b), (j1, j2, j3) = g.links, g.rrr()
         p1, pa1 = known_point(pose, j1, a)
         p3, pb3 = known_point(pose, j3, b)
         pa2, pb2 = _local(j2, a), _local(j2, b)
@@ -94,8 +93,7 @@ class Dyads:
     @staticmethod
     def _rrp_line(ops: OpsLike, pose: Pose, g: Group) -> tuple[V, V, Num, Num, Num]:
         """The line ``Q + t·d̄`` that ``P2`` runs on, and ``b``'s angle, cosine and sine."""
-        b, (_, j2, j3) = g.links[1], g.constraints
-        assert isinstance(j2, Pin) and isinstance(j3, Prism)  # RRP
+        b, (_, j2, j3) = g.links[1], g.rrp()
         other = j3.g if j3.s == b else j3.s
         theta_k = 0.0 if other == GROUND_INDEX else pose.angles[other]
         theta_b = theta_k + j3.delta if j3.s == b else theta_k - j3.delta
@@ -119,8 +117,7 @@ class Dyads:
     @classmethod
     def rrp(cls, ops: OpsLike, pose: Pose, g: Group, sign: Num | None = None
             ) -> float | Solution:
-        (a, b), (j1, j2, _) = g.links, g.constraints
-        assert isinstance(j1, Pin) and isinstance(j2, Pin)  # RRP
+        (a, b), (j1, j2, _) = g.links, g.rrp()
         p1, pa1 = known_point(pose, j1, a)
         pa2, pb2 = _local(j2, a), _local(j2, b)
         ra2 = (pa2 - pa1).norm2()
@@ -147,8 +144,7 @@ class Dyads:
 
     @staticmethod
     def rpr(ops: OpsLike, pose: Pose, g: Group, sign: Num | None = None) -> float | Solution:
-        (a, b), (j1, j2, j3) = g.links, g.constraints
-        assert isinstance(j1, Pin) and isinstance(j2, Prism) and isinstance(j3, Pin)  # RPR
+        (a, b), (j1, j2, j3) = g.links, g.rpr()
         pivots = {a: known_point(pose, j1, a), b: known_point(pose, j3, b)}
         s_link, g_link = j2.s, j2.g
         p_s, ps_piv = pivots[s_link]

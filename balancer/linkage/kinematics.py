@@ -41,7 +41,6 @@ from .constraints import (
     GROUND_INDEX,
     Group,
     Pose,
-    Prism,
     group_jacobian,
 )
 from .dyads import Dyads, Frame, known_point
@@ -113,8 +112,7 @@ def positions(structure: Structure, state: InputState, ops: OpsLike = NUMPY,
                    ops)
             continue
         if g.kind == "slide":  # on its ground guide, at its input's place along it
-            prism = g.constraints[0]
-            assert isinstance(prism, Prism)
+            prism = g.slide
             along = prism.pg + prism.dg * angles[g.driver.index]
             _place(pose, g.links[0], prism.delta + 0.0 * angles[g.driver.index], along,
                    prism.ps, ops)

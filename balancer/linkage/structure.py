@@ -132,15 +132,6 @@ class Structure:
         return self.drivers[0].link
 
     @property
-    def driver(self) -> Driver:
-        """A one-input linkage's driver (about its pivot); ``ValueError`` for several."""
-        if len(self.drivers) != 1:
-            raise ValueError(f"the linkage has {len(self.drivers)} inputs, not one")
-        driver = self.drivers[0]
-        assert isinstance(driver, Driver)  # (a slide is never the only input: _driver)
-        return driver
-
-    @property
     def constraints(self) -> tuple[Pin | Prism | Mesh, ...]:
         """All constraints but the drivers (``3·n − m`` rows for ``m`` inputs)."""
         return (*self.pins, *self.prisms, *self.meshes)
@@ -352,18 +343,13 @@ class Structure:
         groups = []
         several = len(self.drivers) > 1
         for driver in self.drivers:
-            k = driver.link
-            if isinstance(driver, SlideDriver):  # (its prism and itself place it)
-                groups.append(Group((k,), (driver.prism, driver), "slide"))
-                continue
-            pivot = [c for c in self.pins if c.a == k and c.b == GROUND_INDEX
-                     and c.point == self.linkage.moving[k].points[0]]
-            if not pivot:
+            own = driver.own_group(self.pins, self.linkage.moving[driver.link].points[0])
+            if own is None:
                 raise SpecError(
                     "the input must be pinned to the ground at its first point",
                     key="mechanism.inputs" if several else "mechanism.input",
                     value=list(self.linkage.inputs) if several else self.linkage.inputs[0])
-            groups.append(Group((k,), (pivot[0], driver), "input"))
+            groups.append(own)
         unknown = set(range(self.size)) - known
         q_ref = self.reference_coordinates()
         while unknown:
