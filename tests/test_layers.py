@@ -8,6 +8,7 @@ package's public names: every type a user meets is a name of ``balancer``, loade
 from __future__ import annotations
 
 import ast
+import functools
 import re
 import subprocess
 import sys
@@ -77,6 +78,12 @@ def layer(name: str) -> int:
     return found
 
 
+@functools.cache
+def nodes(path: Path) -> tuple[ast.AST, ...]:
+    """Every node of a module's syntax tree (parsed once for all the tests here)."""
+    return tuple(ast.walk(ast.parse(path.read_text(encoding="utf-8"))))
+
+
 def imports(name: str, path: Path, known: dict[str, Path]) -> set[str]:
     """The package's modules that module ``name`` imports, anywhere in its source."""
     is_package = path.name == "__init__.py"
@@ -84,7 +91,7 @@ def imports(name: str, path: Path, known: dict[str, Path]) -> set[str]:
     if not is_package:
         base = base[:-1]
     out = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    for node in nodes(path):
         if isinstance(node, ast.Import):
             targets = [a.name for a in node.names if a.name.startswith("balancer.")]
             out |= {t.removeprefix("balancer.") for t in targets}
@@ -285,7 +292,7 @@ def test_no_module_but_the_joints_own_asks_a_joint_its_kind():
     for name, path in modules().items():
         if name == "linkage.constraints":
             continue
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in nodes(path):
             if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
                     and node.func.id == "isinstance" and len(node.args) == 2
                     and (kinds := _kinds_asked(node.args[1]))):
