@@ -31,7 +31,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("linkage", "orders", "parts.shapes", "parts.sizing"),
     # The mechanism interface (and its wording for the layers that print), and what every
     # mechanism's formulations share.
-    ("mechanisms.base", "mechanisms.presentation", "mechanisms.geometry",
+    ("mechanisms.base", "mechanisms.presentation", "mechanisms.drawing", "mechanisms.geometry",
      "mechanisms.formulation", "mechanisms.chains"),
     # Each mechanism in its own folder; the general formulations (any mechanism).
     ("mechanisms.fourbar", "mechanisms.slidercrank", "mechanisms.general",

@@ -95,7 +95,7 @@ def test_the_load_is_minus_the_slope_of_the_weights_potential():
         return -sum(link.mass * (g[0] * np.ravel(c.x)[0] + g[1] * np.ravel(c.y)[0])
                     for link, c in zip(mech.links, centres, strict=True))
 
-    scale = max(link.mass for link in mech.links) * 9.81 * mech.crank_reach()
+    scale = max(link.mass for link in mech.links) * 9.81 * mech.drawing().reach
     for i in range(0, energy.theta.size, 5):
         t = float(energy.theta[i])
         want = -(potential(t + STEP) - potential(t - STEP)) / (2 * STEP)

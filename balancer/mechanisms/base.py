@@ -38,6 +38,8 @@ from ..linkage.structure import Structure
 from ..linkage.vectors import V
 from ..model import Branch, Link, Linkage, MechanismModel
 from ..model.assembly import AssemblyRange
+from . import drawing
+from .drawing import Drawing
 from .presentation import Presentation
 
 if TYPE_CHECKING:
@@ -113,48 +115,6 @@ class Limit:
     mask: NDArray[np.bool_]
     offsets: tuple[float, ...]
     weights: tuple[float, ...]
-
-
-@dataclass(frozen=True)
-class DrawnMass:
-    """A mass·radius on a shaft geared to the crank, as a drawing shows it.
-
-    Attributes
-    ----------
-    axis
-        The shaft's axis in the x–y plane, complex, m.
-    ratio
-        The shaft's speed over the crank's (its angle is ``ratio·θ1 + angle``).
-    angle
-        The mass' direction from the axis at θ1 = 0, rad.
-    mr
-        Its mass times its centre's distance from the axis, kg·m.
-    what
-        ``"counterweight"`` (on the crankshaft) or ``"eccentric"`` (on a balance shaft).
-    """
-
-    axis: complex
-    ratio: float
-    angle: float
-    mr: float
-    what: str
-
-
-#: A sliding block's size in a drawing where the mechanism gives none: its length along its
-#: slider and its width across, as fractions of the crank's reach (:meth:`Mechanism.slider_blocks`).
-BLOCK_SIZE = (0.6, 0.35)
-#: A piston's length along its cylinder over its bore, in a drawing.
-PISTON_LENGTH = 0.7
-
-
-def piston_block(crank: float, bore: float | None) -> tuple[float, float]:
-    """A piston's ``(length, width)`` in a drawing, m.
-
-    Its bore across (without one, the stroke ``2·crank``: a square engine), and
-    :data:`PISTON_LENGTH` of it along its axis; ``crank`` and ``bore`` in m.
-    """
-    width = bore if bore is not None else 2.0 * crank
-    return PISTON_LENGTH * width, width
 
 
 class Mechanism:
@@ -647,37 +607,10 @@ class Mechanism:
 
     # -- what a drawing shows ------------------------------------------------------------------
 
-    def crank_reach(self) -> float:
-        """The input link's reach: its farthest point from its first (its pivot), m.
+    def drawing(self) -> Drawing:
+        """What a drawing shows besides the links (:class:`~balancer.mechanisms.drawing.Drawing`).
 
-        With several inputs, the largest of theirs.
+        A general linkage's: each one-point sliding link a block, no shafts' masses; a piston
+        engine's its pistons, counterweights and balance shafts' eccentrics.
         """
-        places = dict(self.linkage.points)
-        reach = 0.0
-        for name in self.linkage.inputs:
-            first, *others = next(b.points for b in self.linkage.bodies if b.name == name)
-            pivot = complex(*places[first])
-            reach = max([reach, *(abs(complex(*places[p]) - pivot) for p in others)])
-        return reach
-
-    def slider_blocks(self) -> dict[str, tuple[float, float]]:
-        """What a drawing shows of each sliding link that is one point: a block, m.
-
-        Per link, ``(length, width)`` of a rectangle centred on its point, its length along
-        its frame's x-axis (its slider's direction) and its width across: :data:`BLOCK_SIZE`
-        of the crank's reach (:meth:`crank_reach`). A piston engine's are its pistons.
-        """
-        r = self.crank_reach()
-        one_point = {b.name for b in self.linkage.bodies if len(b.points) == 1}
-        return {s.link: (BLOCK_SIZE[0] * r, BLOCK_SIZE[1] * r)
-                for s in self.linkage.sliders if s.link in one_point}
-
-    def drawn_masses(self) -> tuple[DrawnMass, ...]:
-        """The counterweights and eccentrics a drawing shows on shafts geared to the crank.
-
-        None in general (a link's counterweight is part of the link, a counter-rotor a disc
-        on its axis); an engine's crankshaft counterweights and balance shafts' eccentrics.
-        """
-        return ()
-
-
+        return drawing.of_linkage(self.linkage)

@@ -17,7 +17,8 @@ from ..cycle import sample_angles
 from ..linkage.inputs import InputState
 from ..linkage.vectors import V
 from ..mechanisms import geometry, mechanism_of
-from ..mechanisms.base import DrawnMass, Mechanism
+from ..mechanisms.base import Mechanism
+from ..mechanisms.drawing import DrawnMass
 from ..model import GROUND
 from ..model import MechanismModel as Model
 
@@ -151,14 +152,14 @@ def slider_block_outlines(linkage: Model | Mechanism, states: InputState
                           ) -> dict[str, NDArray[np.complex128]]:
     """Each sliding block's outline at the input ``states``: per link ``(frames, 5)``, m.
 
-    The rectangle of :meth:`~balancer.mechanisms.base.Mechanism.slider_blocks` (an engine's
-    pistons, sized by their bore), centred on the link's point and along its slider, its four
-    corners and the first again (complex), carried by the link.
+    The rectangle of the mechanism's :class:`~balancer.mechanisms.drawing.Drawing` (an
+    engine's pistons, sized by their bore), centred on the link's point and along its
+    slider, its four corners and the first again (complex), carried by the link.
     """
     mech = mechanism_of(linkage)
     mo = mech.motion_at(states)
     out: dict[str, NDArray[np.complex128]] = {}
-    for name, (length, width) in mech.slider_blocks().items():
+    for name, (length, width) in mech.drawing().blocks.items():
         k = mech.link_names.index(name)
         corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5), (-0.5, -0.5)]
         out[name] = np.column_stack([
@@ -171,18 +172,17 @@ def drawn_mass_sectors(linkage: Model | Mechanism, states: InputState
                        ) -> list[tuple[DrawnMass, NDArray[np.float64], float]]:
     """The shafts' counterweights and eccentrics as sectors at the crank's ``states``.
 
-    Per mass (:meth:`~balancer.mechanisms.base.Mechanism.drawn_masses`, a one-input
-    mechanism's): the mass, its direction from its axis at the crank angles ``(frames,)``
-    (rad, ``ratio·θ1 + angle``), and the radius of the sector that shows it (m): sectors of
-    one thickness and angle, so their radius goes as the cube root of their mass·radius, the
+    Per mass (the :class:`~balancer.mechanisms.drawing.Drawing`'s, a one-input mechanism's):
+    the mass, its direction from its axis at the crank angles ``(frames,)`` (rad,
+    ``ratio·θ1 + angle``), and the radius of the sector that shows it (m): sectors of one
+    thickness and angle, so their radius goes as the cube root of their mass·radius, the
     largest reaching the crank's reach.
     """
-    mech = mechanism_of(linkage)
-    masses = mech.drawn_masses()
+    drawn = mechanism_of(linkage).drawing()
+    masses, reach = drawn.masses, drawn.reach
     if not masses:
         return []
     largest = max((m.mr for m in masses), default=0.0)
     theta1 = np.asarray(states.positions[0], dtype=float)
-    reach = mech.crank_reach()
     return [(m, m.ratio * theta1 + m.angle, reach * float(np.cbrt(m.mr / largest)))
             for m in masses if m.mr > 0]

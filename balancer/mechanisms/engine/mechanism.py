@@ -26,7 +26,8 @@ from ...linkage.loads import Reactions, SupportLoad
 from ...linkage.rotors import Rotor, link_inertia
 from ...linkage.structure import Structure
 from ...model import Body, Gear, Linkage, Slider
-from ..base import DrawnMass, Mechanism, RotorLoads, piston_block
+from ..base import Mechanism, RotorLoads
+from ..drawing import Drawing, DrawnMass, piston_block
 from ..presentation import Presentation
 from .bearings import lever_shares, main_bearing_loads, main_bearing_regressors
 from .model import COUNTERWEIGHT, Engine, crankshaft_name, idler_name
@@ -320,14 +321,15 @@ class EngineMechanism(Mechanism):
     def _full_turn_rule(self) -> str:
         return " (each rod longer than its crank + |offset|)"
 
-    def slider_blocks(self) -> dict[str, tuple[float, float]]:
-        """Each piston by its cylinder's bore (without one, its stroke)."""
-        return {f"piston{k}": piston_block(c.crank, c.bore)
-                for k, c in enumerate(self.model.cylinders, start=1)}
+    def drawing(self) -> Drawing:
+        """The pistons, the crankshaft's counterweights and the balance shafts' eccentrics.
 
-    def drawn_masses(self) -> tuple[DrawnMass, ...]:
-        """The crankshaft's counterweights (its masses labelled so) and every eccentric."""
+        Each piston by its cylinder's bore (without one, its stroke); the counterweights are
+        the crankshaft's masses labelled so.
+        """
         model = self.model
+        blocks = {f"piston{k}": piston_block(c.crank, c.bore)
+                  for k, c in enumerate(model.cylinders, start=1)}
         weights = [DrawnMass(axis=model.shaft_axis(k), ratio=float(model.shaft_ratio(k)),
                              angle=math.radians(m.phase_deg), mr=m.mr, what="counterweight")
                    for k in model.shafts for m in model.shaft_masses(k)
@@ -335,7 +337,7 @@ class EngineMechanism(Mechanism):
         eccentrics = [DrawnMass(axis=complex(*s.at), ratio=float(s.ratio),
                                 angle=math.radians(m.phase_deg), mr=m.mr, what="eccentric")
                       for s in self.model.balance_shafts for m in s.eccentrics]
-        return (*weights, *eccentrics)
+        return replace(super().drawing(), blocks=blocks, masses=(*weights, *eccentrics))
 
 
 #: The class the registry builds for this folder (:data:`balancer.mechanisms.FOLDERS`).

@@ -9,6 +9,7 @@ of its inverse dynamics is the slider-crank's own (:mod:`balancer.mechanisms.sli
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from functools import cached_property
 
 import numpy as np
@@ -19,7 +20,8 @@ from ...linkage.kinematics import Motion
 from ...linkage.structure import Structure
 from ...model import Body, Branch, Linkage, Slider
 from ...model.assembly import AssemblyRange
-from ..base import Mechanism, Route, piston_block
+from ..base import Mechanism, Route
+from ..drawing import Drawing, piston_block
 from ..presentation import Presentation
 from . import kinematics as closed
 from .conditions import force_balance_matrix
@@ -85,9 +87,10 @@ class SliderCrankMechanism(Mechanism):
     def branch(self) -> Branch:
         return self.model.branch
 
-    def slider_blocks(self) -> dict[str, tuple[float, float]]:
+    def drawing(self) -> Drawing:
         """The slider drawn as a piston (a slider-crank is mostly an engine's cylinder)."""
-        return {"slider": piston_block(self.model.lengths[0], None)}
+        return replace(super().drawing(),
+                       blocks={"slider": piston_block(self.model.lengths[0], None)})
 
     def assembly_range(self) -> AssemblyRange:
         return closed.assembly_range(self.model.lengths)
