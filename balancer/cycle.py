@@ -231,10 +231,13 @@ class CycleAnalysis:
         """The loads at the supports that share a ground point's reaction, at the samples.
 
         An engine's main bearings where its spec places them
-        (:meth:`~balancer.mechanisms.base.Mechanism.support_loads`); none in general.
+        (:attr:`~balancer.mechanisms.base.Mechanism.supports`); none in general.
         """
-        return self.mechanism.support_loads(self.motion, self.reactions, loads=self.loads,
-                                            gravity=self.gravity)
+        supports = self.mechanism.supports
+        if supports is None:
+            return ()
+        return supports.loads(self.motion, self.reactions, loads=self.loads,
+                              gravity=self.gravity)
 
     def support_orders(self, support: SupportLoad) -> list[tuple[float, Whirl]]:
         """A support's load by order of the crank speed (as :attr:`orders`' shaking force)."""

@@ -225,24 +225,25 @@ def _support_rows(mech: Mechanism, sites: Sites, angles: NDArray[np.float64], sp
                   force: NDArray[np.complex128]) -> NDArray[np.complex128]:
     """The supports' (an engine's main bearings') loads over the design vector, ``(S·N, P)``.
 
-    The linkage's entries by the mechanism's regressors
-    (:meth:`~balancer.mechanisms.base.Mechanism.support_regressors`); each mass·radius on the
+    The linkage's entries by the supports' regressors
+    (:meth:`~balancer.mechanisms.base.Supports.regressors`); each mass·radius on the
     crankshaft (:meth:`.sites.Site.on_crank`) its centrifugal force ``force``'s columns shared
-    by :meth:`~balancer.mechanisms.base.Mechanism.support_shares`; a shaft's, coaxial or not,
-    on its own bearings.
+    by :meth:`~balancer.mechanisms.base.Supports.shares`; a shaft's, coaxial or not, on its
+    own bearings.
     """
-    with np.errstate(all="ignore"):
-        per = mech.support_regressors(mech.motion(angles, speed, 0.0))
-    if not per:
+    supports = mech.supports
+    if supports is None:
         raise SpecError("needs the main bearings' planes: [mechanism] main_bearings",
                         key="balance")
+    with np.errstate(all="ignore"):
+        per = supports.regressors(mech.motion(angles, speed, 0.0))
     rows = []
     frame = mech.linkage.ground.points
     for j, linkage_rows in enumerate(per):
         cols = np.zeros(force.shape, complex)
         for i, site in enumerate(sites.sites):
             if site.on_crank(frame):
-                share = dict(mech.support_shares(site.z, site.at)).get(j, 0.0)
+                share = dict(supports.shares(site.z, site.at)).get(j, 0.0)
                 cols[:, 2 * i : 2 * i + 2] = share * force[:, 2 * i : 2 * i + 2]
         rows.append(np.hstack([linkage_rows, cols]))
     return np.vstack(rows)

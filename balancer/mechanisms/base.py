@@ -20,7 +20,7 @@ import threading
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import TYPE_CHECKING, ClassVar, Literal
+from typing import TYPE_CHECKING, ClassVar, Literal, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -115,6 +115,37 @@ class Limit:
     mask: NDArray[np.bool_]
     offsets: tuple[float, ...]
     weights: tuple[float, ...]
+
+
+class Supports(Protocol):
+    """Supports that share a ground point's reaction: what a mechanism with them gives.
+
+    An engine's main bearings (:meth:`Mechanism.supports`), in one order throughout.
+    """
+
+    def loads(self, mo: Motion, reactions: Reactions, *, loads: bool = True,
+              gravity: tuple[float, float] = (0.0, 0.0)) -> tuple[SupportLoad, ...]:
+        """Each support's load at a motion's states.
+
+        From the motion ``mo`` and the frame loads ``reactions`` computed there (with the
+        applied ``loads`` and ``gravity`` they were computed with).
+        """
+        ...
+
+    def regressors(self, mo: Motion) -> tuple[NDArray[np.complex128], ...]:
+        """:meth:`loads` (inertial) as linear maps of the design vector, ``(N, P)`` each.
+
+        Over the mechanism's layout; the rotors' masses are left out (a balancing's
+        mass·radius sites, shared among the supports by :meth:`shares`).
+        """
+        ...
+
+    def shares(self, z: float, axis: complex = 0j) -> tuple[tuple[int, float], ...]:
+        """How the supports share a load at plane ``z`` on their shaft about ``axis``.
+
+        ``(support, share)`` pairs; none where no shaft with supports turns about ``axis``.
+        """
+        ...
 
 
 class Mechanism:
@@ -570,31 +601,14 @@ class Mechanism:
         return dynamics.shaking_regressors(self.structure, mo, gravity,
                                            torque_at_rest=torque_at_rest)
 
-    def support_loads(self, mo: Motion, reactions: Reactions, *, loads: bool = True,
-                      gravity: tuple[float, float] = (0.0, 0.0)) -> tuple[SupportLoad, ...]:
-        """The loads at supports that share a ground point's reaction, at a motion's states.
+    @property
+    def supports(self) -> Supports | None:
+        """Supports that share ground points' reactions, or ``None`` (in general).
 
-        From the motion ``mo`` and the frame loads ``reactions`` computed there (with the
-        applied ``loads`` and ``gravity`` they were computed with). None in general; an
-        engine's main bearings where its spec places them (each carries its share of the
+        An engine's main bearings where its spec places them (each carries its share of the
         crankshaft's loads by the lever rule).
         """
-        return ()
-
-    def support_regressors(self, mo: Motion) -> tuple[NDArray[np.complex128], ...]:
-        """:meth:`support_loads` (inertial) as linear maps of the design vector, ``(N, P)`` each.
-
-        Over :attr:`layout`; the rotors' masses are left out (a balancing's mass·radius sites,
-        shared among the supports by :meth:`support_shares`).
-        """
-        return ()
-
-    def support_shares(self, z: float, axis: complex = 0j) -> tuple[tuple[int, float], ...]:
-        """How the supports share a load at plane ``z`` on their shaft about ``axis``.
-
-        ``(support, share)`` pairs, the supports in :meth:`support_loads`' order.
-        """
-        return ()
+        return None
 
     def closed_form_force_balance(self) -> NDArray[np.float64] | None:
         """Shaking-force balance in closed form, ``A`` with ``A·π = 0`` over :attr:`layout`.

@@ -39,7 +39,7 @@ class Presentation:
         (``R{name}x``, ``R{name}y``) rather than by its normal force ``N_{link}``.
     support_words, supports_key
         What a report calls the supports that share a ground point's reaction
-        (:meth:`~balancer.mechanisms.base.Mechanism.support_loads`), and their JSON key.
+        (:attr:`~balancer.mechanisms.base.Mechanism.supports`), and their JSON key.
     """
 
     force_balance_source: str = "the conditions found from the linkage"

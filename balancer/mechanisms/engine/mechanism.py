@@ -224,92 +224,11 @@ class EngineMechanism(Mechanism):
                 into[key] = np.asarray(into.get(key, 0.0) + sign * tooth, dtype=complex)
         return out
 
-    def support_loads(self, mo: Motion, reactions: Reactions, *, loads: bool = True,
-                      gravity: tuple[float, float] = (0.0, 0.0)) -> tuple[SupportLoad, ...]:
-        """Each main bearing's load (:mod:`.bearings`), where the spec places them.
-
-        The first crankshaft's ``B1``, ``B2``, …; a geared crankshaft ``k``'s ``B<k>.1``, ….
-        Each crankshaft carries its own cylinders' pins, its weight, its masses and its gear
-        pairs' tooth forces at their plane (``gear_z``): the first, minus each pair's force on
-        the gear it drives; a geared one, its own pair's.
-        """
+    @cached_property
+    def supports(self) -> MainBearings | None:
+        """The main bearings where the spec places them (:class:`MainBearings`), else ``None``."""
         model = self.model
-        out: list[SupportLoad] = []
-        for k in model.shafts:
-            planes = model.shaft_bearings(k)
-            if not planes:
-                continue
-            pistons = {f"piston{i}" for i, c in enumerate(model.cylinders, start=1)
-                       if c.crankshaft == k}
-            teeth = [(z, np.asarray(sign * np.asarray(reactions.teeth[name]), dtype=complex))
-                     for z, name, sign in self._gears_on(k)]
-            found = main_bearing_loads(
-                self, planes, shaft_pivot(k), mo, reactions, loads=loads, gravity=gravity,
-                shaft=crankshaft_name(k), pistons=pistons, teeth=teeth,
-                names=None if k == 1 else partial(geared_bearing_name, k))
-            out += [SupportLoad(name=name, z=z, force=force)
-                    for (name, force), z in zip(found.items(), planes, strict=True)]
-        return tuple(out)
-
-    def _gears_on(self, k: int) -> list[tuple[float, str, float]]:
-        """The gear pairs whose teeth push on crankshaft ``k``: (plane, pair, sign).
-
-        The first crankshaft drives each geared one's pair (or its idler's first): minus the
-        force on the gear it drives; a geared one is driven by its own (or its idler's
-        second): plus it.
-        """
-        model = self.model
-        out = []
-        for j, g in zip(model.shafts[1:], model.crankshafts, strict=True):
-            idled = j in model.idled
-            if k == 1:
-                out.append((g.gear_z, f"{gear_name(j)}a" if idled else gear_name(j), -1.0))
-            elif k == j:
-                out.append((g.gear_z, f"{gear_name(j)}b" if idled else gear_name(j), 1.0))
-        return out
-
-    def _carried(self, k: int) -> set[str]:
-        """The links crankshaft ``k`` carries: itself, its cylinders' rods and pistons."""
-        on = [i for i, c in enumerate(self.model.cylinders, start=1) if c.crankshaft == k]
-        return {crankshaft_name(k), *(f"rod{i}" for i in on), *(f"piston{i}" for i in on)}
-
-    def support_regressors(self, mo: Motion) -> tuple[NDArray[np.complex128], ...]:
-        """Each main bearing's inertial load over the layout (:mod:`.bearings`).
-
-        Every crankshaft's, in :meth:`support_loads`' order; its gears' tooth forces from the
-        core's regressors.
-        """
-        model = self.model
-        if not any(model.shaft_bearings(k) for k in model.shafts):
-            return ()
-        with np.errstate(all="ignore"):  # (once for every crankshaft's bearings)
-            regressors = self.regressors(mo)
-        teeth = regressors.teeth
-        out: list[NDArray[np.complex128]] = []
-        for k in model.shafts:
-            planes = model.shaft_bearings(k)
-            if planes:
-                maps = [(z, sign * (np.asarray(teeth[name].x) + 1j * np.asarray(teeth[name].y)))
-                        for z, name, sign in self._gears_on(k)]
-                out += main_bearing_regressors(self, planes, mo, links=self._carried(k),
-                                               teeth=maps, regressors=regressors)
-        return tuple(out)
-
-    def support_shares(self, z: float, axis: complex = 0j) -> tuple[tuple[int, float], ...]:
-        """The lever rule's shares of a load at ``z`` on the crankshaft about ``axis``.
-
-        Its main bearings' indices in :meth:`support_loads`' order (:mod:`.bearings`); none
-        where that crankshaft has none, or no crankshaft turns about ``axis``.
-        """
-        model = self.model
-        first = 0
-        for k in model.shafts:
-            planes = model.shaft_bearings(k)
-            if model.shaft_axis(k) == axis:
-                return tuple((first + j, share) for j, share in lever_shares(planes, z)
-                             ) if planes else ()
-            first += len(planes)
-        return ()
+        return MainBearings(self) if any(model.shaft_bearings(k) for k in model.shafts) else None
 
     def describe(self) -> str:
         n = len(self.model.cylinders)
@@ -338,6 +257,105 @@ class EngineMechanism(Mechanism):
                                 angle=math.radians(m.phase_deg), mr=m.mr, what="eccentric")
                       for s in self.model.balance_shafts for m in s.eccentrics]
         return replace(super().drawing(), blocks=blocks, masses=(*weights, *eccentrics))
+
+
+class MainBearings:
+    """An engine's main bearings (:class:`~balancer.mechanisms.base.Supports`).
+
+    Each crankshaft's bearings share its loads by the lever rule (:mod:`.bearings`). The
+    first crankshaft's ``B1``, ``B2``, …; a geared crankshaft ``k``'s ``B<k>.1``, …, in that
+    order throughout.
+    """
+
+    def __init__(self, engine: EngineMechanism) -> None:
+        self.engine = engine
+
+    def loads(self, mo: Motion, reactions: Reactions, *, loads: bool = True,
+              gravity: tuple[float, float] = (0.0, 0.0)) -> tuple[SupportLoad, ...]:
+        """Each main bearing's load (:mod:`.bearings`), where the spec places them.
+
+        The first crankshaft's ``B1``, ``B2``, …; a geared crankshaft ``k``'s ``B<k>.1``, ….
+        Each crankshaft carries its own cylinders' pins, its weight, its masses and its gear
+        pairs' tooth forces at their plane (``gear_z``): the first, minus each pair's force on
+        the gear it drives; a geared one, its own pair's.
+        """
+        model = self.engine.model
+        out: list[SupportLoad] = []
+        for k in model.shafts:
+            planes = model.shaft_bearings(k)
+            if not planes:
+                continue
+            pistons = {f"piston{i}" for i, c in enumerate(model.cylinders, start=1)
+                       if c.crankshaft == k}
+            teeth = [(z, np.asarray(sign * np.asarray(reactions.teeth[name]), dtype=complex))
+                     for z, name, sign in self._gears_on(k)]
+            found = main_bearing_loads(
+                self.engine, planes, shaft_pivot(k), mo, reactions, loads=loads, gravity=gravity,
+                shaft=crankshaft_name(k), pistons=pistons, teeth=teeth,
+                names=None if k == 1 else partial(geared_bearing_name, k))
+            out += [SupportLoad(name=name, z=z, force=force)
+                    for (name, force), z in zip(found.items(), planes, strict=True)]
+        return tuple(out)
+
+    def _gears_on(self, k: int) -> list[tuple[float, str, float]]:
+        """The gear pairs whose teeth push on crankshaft ``k``: (plane, pair, sign).
+
+        The first crankshaft drives each geared one's pair (or its idler's first): minus the
+        force on the gear it drives; a geared one is driven by its own (or its idler's
+        second): plus it.
+        """
+        model = self.engine.model
+        out = []
+        for j, g in zip(model.shafts[1:], model.crankshafts, strict=True):
+            idled = j in model.idled
+            if k == 1:
+                out.append((g.gear_z, f"{gear_name(j)}a" if idled else gear_name(j), -1.0))
+            elif k == j:
+                out.append((g.gear_z, f"{gear_name(j)}b" if idled else gear_name(j), 1.0))
+        return out
+
+    def _carried(self, k: int) -> set[str]:
+        """The links crankshaft ``k`` carries: itself, its cylinders' rods and pistons."""
+        on = [i for i, c in enumerate(self.engine.model.cylinders, start=1) if c.crankshaft == k]
+        return {crankshaft_name(k), *(f"rod{i}" for i in on), *(f"piston{i}" for i in on)}
+
+    def regressors(self, mo: Motion) -> tuple[NDArray[np.complex128], ...]:
+        """Each main bearing's inertial load over the layout (:mod:`.bearings`).
+
+        Every crankshaft's, in :meth:`loads`' order; its gears' tooth forces from the
+        core's regressors.
+        """
+        model = self.engine.model
+        if not any(model.shaft_bearings(k) for k in model.shafts):
+            return ()
+        with np.errstate(all="ignore"):  # (once for every crankshaft's bearings)
+            regressors = self.engine.regressors(mo)
+        teeth = regressors.teeth
+        out: list[NDArray[np.complex128]] = []
+        for k in model.shafts:
+            planes = model.shaft_bearings(k)
+            if planes:
+                maps = [(z, sign * (np.asarray(teeth[name].x) + 1j * np.asarray(teeth[name].y)))
+                        for z, name, sign in self._gears_on(k)]
+                out += main_bearing_regressors(self.engine, planes, mo, links=self._carried(k),
+                                               teeth=maps, regressors=regressors)
+        return tuple(out)
+
+    def shares(self, z: float, axis: complex = 0j) -> tuple[tuple[int, float], ...]:
+        """The lever rule's shares of a load at ``z`` on the crankshaft about ``axis``.
+
+        Its main bearings' indices in :meth:`loads`' order (:mod:`.bearings`); none
+        where that crankshaft has none, or no crankshaft turns about ``axis``.
+        """
+        model = self.engine.model
+        first = 0
+        for k in model.shafts:
+            planes = model.shaft_bearings(k)
+            if model.shaft_axis(k) == axis:
+                return tuple((first + j, share) for j, share in lever_shares(planes, z)
+                             ) if planes else ()
+            first += len(planes)
+        return ()
 
 
 #: The class the registry builds for this folder (:data:`balancer.mechanisms.FOLDERS`).
