@@ -198,7 +198,7 @@ def slider_columns(mech: Mechanism, theta1: ArrayLike, omega1: ArrayLike, alpha1
     names: list[str] = []
     cols: Columns = []
     for s in sliders:
-        k = mech.link_names.index(s.link)
+        k = mech.linkage.link_names.index(s.link)
         local = mech.structure.local[(k, s.point)]
         d = complex(*s.direction) / math.hypot(*s.direction)
         for prefix, vector in (("x", mo.point(k, local)), ("v", mo.point_velocity(k, local)),

@@ -34,7 +34,7 @@ from .linkage.dynamics import Forces
 from .linkage.kinematics import Motion
 from .linkage.loads import Reactions, SupportLoad
 from .mechanisms import geometry, mechanism_of
-from .mechanisms.base import KERNEL_STATES, Mechanism, Route
+from .mechanisms.base import KERNEL_STATES, Mechanism, Route, frame_points, require_full_revolution
 from .model import MechanismModel as Model
 from .orders import Order, Whirl, order_bins, order_table, whirls
 from .quantities import FRAME_LOADS
@@ -362,12 +362,12 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     if route not in mech.routes:
         raise SpecError(f"the {mech.kind} has no such route; choose from "
                         f"{', '.join(mech.routes)}", key="route", value=route)
-    mech.require_full_revolution("a cycle analysis")
+    require_full_revolution(mech, "a cycle analysis")
     revolutions = mech.cycle_revolutions if theta1 is None else 1
     angles = (sample_angles(samples, revolutions) if theta1 is None
               else np.asarray(theta1, dtype=float))
     n = angles.size
-    reactions = Reactions.empty(n, mech.ground_points, mech.linkage.ground_sliders,
+    reactions = Reactions.empty(n, frame_points(mech), mech.linkage.ground_sliders,
                                 teeth=tuple(g.name for g in mech.linkage.gears))
 
     compiled = n >= KERNEL_STATES  # a long cycle: its chunks by the compiled program

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from .errors import SpecError
 from .linkage.vectors import V
-from .mechanisms.base import Mechanism
+from .mechanisms.base import Mechanism, require_full_revolution
 
 #: Samples per revolution of each plane's load: its orders are exact far above the picture's.
 SAMPLES = 720
@@ -108,7 +108,7 @@ def phasors(mech: Mechanism, speed: float, orders: tuple[int, ...] = (1, 2),
         if not (isinstance(n, int) and 1 <= n < samples // 2):
             raise SpecError(f"must be whole numbers from 1 to {samples // 2 - 1}",
                             key="--phasor-orders", value=list(orders))
-    mech.require_full_revolution("a phasor picture")
+    require_full_revolution(mech, "a phasor picture")
     theta = 2 * math.pi * np.arange(samples) / samples
     with np.errstate(all="ignore"):
         mo = mech.motion(theta, speed, 0.0)
@@ -120,7 +120,7 @@ def phasors(mech: Mechanism, speed: float, orders: tuple[int, ...] = (1, 2),
         by_plane[key] = ([*names, what], total + load)
 
     structure = mech.structure
-    for name, link in zip(mech.link_names, mech.links, strict=True):
+    for name, link in zip(mech.linkage.link_names, mech.linkage.links, strict=True):
         if link.mass == 0:
             continue
         a = mo.point_acceleration(structure.index(name), V(link.e, link.f)).complex()

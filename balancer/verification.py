@@ -27,6 +27,7 @@ import numpy as np
 
 from .errors import LockupError, SpecError
 from .mechanisms import mechanism_of
+from .mechanisms.base import require_full_revolution
 from .model import Design, SimulationSettings
 from .model import MechanismModel as Model
 from .simulation import MAX_OUTPUTS, Trajectory, check, simulate
@@ -390,7 +391,7 @@ def _plan(design: Design, method: str | None, duration: float | None, rtol: floa
     else:
         resolution = 2 * math.pi / PER_REVOLUTION
     start = settings.theta1
-    mech.require_full_revolution("a driven check")
+    require_full_revolution(mech, "a driven check")
     driven_settings = _resolved(replace(settings, drive="constant-speed", omega1=speed,
                                         theta1=start), speed, resolution)
     free_settings = _resolved(replace(settings, drive="free"), FREE_MARGIN * settings.omega1,

@@ -49,7 +49,7 @@ def design() -> Design:
 
 def _momenta(mech, mo) -> np.ndarray:
     px, py, lz = (np.zeros(mo.count) for _ in range(3))
-    for k, link in enumerate(mech.links):
+    for k, link in enumerate(mech.linkage.links):
         r, v = mo.point(k, V(link.e, link.f)), mo.point_velocity(k, V(link.e, link.f))
         px += link.mass * v.x
         py += link.mass * v.y
@@ -82,7 +82,7 @@ def test_gravity_adds_the_weight_to_the_shaking_force(design):
     g = (0.3, -9.81)
     plain = motion_analysis(mech, design.motions[0])
     heavy = motion_analysis(mech, design.motions[0], gravity=g)
-    total = sum(link.mass for link in mech.links)
+    total = sum(link.mass for link in mech.linkage.links)
     weight = total * complex(*g)
     gap = heavy.reactions.shaking_force - plain.reactions.shaking_force
     assert np.max(np.abs(gap - weight)) <= 1e-12 * abs(weight)

@@ -50,16 +50,16 @@ def kinetic_inertia(mech, theta: float) -> float:
     def places(t: float) -> tuple[np.ndarray, np.ndarray]:
         mo = mech.motion(np.array([t]))
         centres = np.array([complex(np.ravel(mo.point(k, V(link.e, link.f)).complex())[0])
-                            for k, link in enumerate(mech.links)])
+                            for k, link in enumerate(mech.linkage.links)])
         angles = np.array([float(np.asarray(mo.pose.angles[k]).ravel()[0])
-                           for k in range(len(mech.links))])
+                           for k in range(len(mech.linkage.links))])
         return centres, angles
 
     (c1, a1), (c0, a0) = places(theta + STEP), places(theta - STEP)
     v = (c1 - c0) / (2 * STEP)
     w = (a1 - a0) / (2 * STEP)
     total = 0.0
-    for link, vk, wk in zip(mech.links, v, w, strict=True):
+    for link, vk, wk in zip(mech.linkage.links, v, w, strict=True):
         total += link.mass * abs(vk) ** 2 + (link.inertia + link.counter_rotor) * wk**2
     return total
 
@@ -91,11 +91,11 @@ def test_the_load_is_minus_the_slope_of_the_weights_potential():
 
     def potential(t: float) -> float:
         mo = mech.motion(np.array([t]))
-        centres = (mo.point(k, V(link.e, link.f)) for k, link in enumerate(mech.links))
+        centres = (mo.point(k, V(link.e, link.f)) for k, link in enumerate(mech.linkage.links))
         return -sum(link.mass * (g[0] * np.ravel(c.x)[0] + g[1] * np.ravel(c.y)[0])
-                    for link, c in zip(mech.links, centres, strict=True))
+                    for link, c in zip(mech.linkage.links, centres, strict=True))
 
-    scale = max(link.mass for link in mech.links) * 9.81 * mech.drawing().reach
+    scale = max(link.mass for link in mech.linkage.links) * 9.81 * mech.drawing().reach
     for i in range(0, energy.theta.size, 5):
         t = float(energy.theta[i])
         want = -(potential(t + STEP) - potential(t - STEP)) / (2 * STEP)

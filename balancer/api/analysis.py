@@ -10,7 +10,7 @@ from ..cycle import DRAWING_TOLERANCE, CycleAnalysis, cycle_analysis, drawn_anal
 from ..errors import SpecError
 from ..force_balance import force_balance_residual
 from ..mechanisms import mechanism_of
-from ..mechanisms.base import Mechanism, Route
+from ..mechanisms.base import Mechanism, Route, require_full_revolution
 from ..model import Design, check_scales
 
 if TYPE_CHECKING:  # (the loads along motions: imported when a spec asks for them)
@@ -91,7 +91,7 @@ def flywheel(design: Design, fluctuation: float | None = None, *,
                             key="operation.speed_fluctuation")
         fluctuation = op.speed_fluctuation
     mech = mechanism_of(design.mechanism)
-    mech.require_full_revolution("sizing a flywheel")
+    require_full_revolution(mech, "sizing a flywheel")
     g = op.gravity if gravity is None else v.vector2(gravity, "gravity")
     energy = CrankEnergy.over_cycle(mech, op.samples, g)
     return least_flywheel(energy, op.speed, fluctuation)

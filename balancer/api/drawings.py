@@ -12,6 +12,7 @@ import numpy as np
 
 from .. import validate as v
 from ..mechanisms import geometry
+from ..mechanisms.base import frame_positions
 from ..model import GROUND
 from ..motion_analysis import MotionAnalysis
 from ..plots.along import MotionDrawing
@@ -60,7 +61,7 @@ def motion_drawing(analysis: MotionAnalysis, *, poses: int = 5) -> MotionDrawing
         links = {name: p[:-1] for name, p in links.items()}
     point = analysis.motion.point
     return MotionDrawing(t=np.asarray(analysis.t[index], float), links=links,
-                         ground=dict(mech.ground_positions),
+                         ground=dict(frame_positions(mech)),
                          centre_of_mass=analysis.centre_of_mass,
                          point=point,
                          path=None if point is None else np.asarray(points[point], complex))

@@ -8,6 +8,7 @@ from typing import Literal
 from .. import validate as v
 from ..formulations import Method
 from ..mechanisms import mechanism_of
+from ..mechanisms.base import require_one_input
 from ..model import Design, Drive
 from ..motion_verification import (
     FREE_SECONDS,
@@ -33,7 +34,7 @@ def simulate(design: Design, *, method: Method | None = None, drive: Drive | Non
     ``progress(done, total)`` in simulated seconds. See
     :func:`balancer.simulation.simulate_design`.
     """
-    mechanism_of(design.mechanism).require_one_input("a simulation (simulate_motion drives "
+    require_one_input(mechanism_of(design.mechanism), "a simulation (simulate_motion drives "
                                                       "every input along a motion)")
     return simulate_design(design, method=method, drive=drive, duration=duration, rtol=rtol,
                            atol=atol, outputs=outputs, progress=progress)

@@ -86,7 +86,7 @@ def _check_problem(problem: BalanceProblem, mech: Mechanism) -> None:
             raise SpecError(f"the {mech.kind} has no moving link {name} (its moving links are "
                             f"{', '.join(bodies)})", key=f"balance.{name}")
     free = False
-    for name in mech.link_names:
+    for name in mech.linkage.link_names:
         freedom = problem.link(name)
         if freedom is None:
             continue

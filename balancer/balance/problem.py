@@ -43,6 +43,7 @@ from ..linkage.dynamics import TURNING
 from ..linkage.inputs import InputState
 from ..linkage.vectors import V
 from ..mechanisms import Mechanism, mechanism_of
+from ..mechanisms.base import require_full_revolution
 from ..model import Design
 from ..model.balance import BalanceProblem, RotorBalanceProblem
 from ..motion_analysis import motion_weights, stacked_torques
@@ -87,7 +88,8 @@ class NumericProblem(Feasibility, PhysicalValues, Settling, ObjectiveScale):
         problem = _checked_problem(problem)
         mech = self.mechanism
         check_problem(problem, mech)
-        links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
+        links = tuple(resolve_link(mech, name, problem.link(name))
+                      for name in mech.linkage.link_names)
         same_objective = problem.objective == self.problem.objective
         if same_objective:
             rows, factor, inert = self.rows, self.factor, self.inert
@@ -148,7 +150,7 @@ def numeric_problem(design: Design, *, along: bool = False) -> NumericProblem:
             key="operation.speed",
         )
     check_problem(problem, mech)
-    mech.require_full_revolution("balancing")
+    require_full_revolution(mech, "balancing")
     speed = design.operation.speed
     angles = sample_angles(design.operation.samples)
     # (At unit crank acceleration too, for the counter-rotors' settling: in the same pass;
@@ -166,7 +168,7 @@ def _problem(problem: BalanceProblem, mech: Mechanism, speed: float | None,
     The links' bounds, the objective's rows and the force balance are the same whatever the
     samples are: a revolution at ``speed``, or motions (``speed`` ``None``).
     """
-    links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.link_names)
+    links = tuple(resolve_link(mech, name, problem.link(name)) for name in mech.linkage.link_names)
     rows, factor, inert = objective_rows(reg, problem.objective, links, mech.layout.size)
     return NumericProblem(
         problem=problem,
@@ -209,7 +211,7 @@ def _engine_problem(design: Design, problem: RotorBalanceProblem) -> NumericProb
         shaking_moment=np.hstack([linkage.shaking_moment, moment]),
         driving_torque=np.hstack([linkage.driving_torque, np.zeros(moment.shape)]),
         rocking_couple=np.hstack([linkage.rocking_couple, couple]), supports=supports)
-    links = tuple(resolve_link(mech, name, None) for name in mech.link_names)
+    links = tuple(resolve_link(mech, name, None) for name in mech.linkage.link_names)
     x0 = np.concatenate([mech.layout.vector(mech.linkage), site_values])
     rows, factor, inert = objective_rows(reg, problem.objective, links, x0.size, sites)
     if supports is not None:  # (a rod's inertia moves its guide's force: the bound sees it)

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..linkage.dynamics import shaking_regressors
 from ..mechanisms.base import Mechanism
 
 
@@ -62,9 +63,8 @@ def cycle_regressors_at(mech: Mechanism, angles: NDArray[np.float64],
     def evaluate(theta: NDArray[np.float64]) -> tuple[NDArray[Any], ...]:
         m = theta.size
         with np.errstate(all="ignore"):
-            f = mech.shaking_regressors(mech.motion(np.tile(theta, count),
-                                                    np.repeat(omegas, m), np.repeat(alphas, m)),
-                                        torque_at_rest=torque_at_rest)
+            mo = mech.motion(np.tile(theta, count), np.repeat(omegas, m), np.repeat(alphas, m))
+            f = shaking_regressors(mech.structure, mo, torque_at_rest=torque_at_rest)
         return (f.shaking_force.complex(), np.asarray(f.shaking_moment),
                 np.asarray(f.driving_torque), f.rocking_couple.complex())
 

@@ -12,6 +12,7 @@ from ..api.analysis import analyze_motion, phasors, several_inputs
 from ..api.drawings import motion_drawing
 from ..errors import OutputError, SpecError
 from ..mechanisms import mechanism_of
+from ..mechanisms.base import require_full_revolution, require_one_input
 from ..model import Design
 from ..outputs import animation_type, figure_type
 from ..plots import (
@@ -55,12 +56,12 @@ def run(args: argparse.Namespace) -> int:
     design = load(args)
     if args.motion is not None or several_inputs(design):
         if phasor is not None:
-            mechanism_of(design.mechanism).require_one_input("a phasor picture")
+            require_one_input(mechanism_of(design.mechanism), "a phasor picture")
             raise SpecError("phasors are of one crank revolution, not of a motion",
                             key="--phasors", value=str(phasor))
         return _along_motion(args, design, cycle, orders, animation)
 
-    mechanism_of(design.mechanism).require_full_revolution(
+    require_full_revolution(mechanism_of(design.mechanism),
         "an animation of one revolution" if animation is not None else "a cycle plot")
     figures = []
     if cycle is not None:
@@ -91,7 +92,7 @@ def _along_motion(args: argparse.Namespace, design: Design, cycle: Path | None,
     are of one crank revolution: refused here (exit code 2).
     """
     if orders is not None:
-        mechanism_of(design.mechanism).require_one_input("an order table")  # (its words)
+        require_one_input(mechanism_of(design.mechanism), "an order table")  # (its words)
         raise SpecError("an order table is of one crank revolution, not of a motion: --motion "
                         "draws its loads with --cycle PATH and the mechanism with --animate "
                         "PATH", key="--orders", value=str(orders))

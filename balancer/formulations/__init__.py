@@ -38,7 +38,7 @@ import importlib
 from typing import Literal
 
 from ..errors import SpecError
-from ..mechanisms import mechanism_of
+from ..mechanisms import base, mechanism_of
 from ..mechanisms.base import Mechanism
 from ..mechanisms.formulation import (
     DEAD_POINT_THRESHOLD,
@@ -65,10 +65,10 @@ GENERAL: dict[str, type[Formulation]] = {"multibody": Multibody, "crank-angle": 
 def formulation_names(model: Model | Mechanism) -> tuple[str, ...]:
     """The formulations that apply to a mechanism, the default first.
 
-    The mechanism's own (:attr:`balancer.mechanisms.base.Mechanism.formulation_names`), and the
-    general ones every linkage has.
+    The mechanism's own (:attr:`balancer.mechanisms.base.Mechanism.own_formulations`), and the
+    general ones every linkage has (:func:`balancer.mechanisms.base.formulation_names`).
     """
-    return mechanism_of(model).formulation_names
+    return base.formulation_names(mechanism_of(model))
 
 
 def default_method(model: Model | Mechanism) -> str:
@@ -85,7 +85,7 @@ def formulation_class(name: str, model: Model | Mechanism) -> type[Formulation]:
         If the mechanism has no such formulation (naming those it has).
     """
     mech = mechanism_of(model)
-    names = mech.formulation_names
+    names = base.formulation_names(mech)
     if name not in names:
         raise SpecError(f"the {mech.kind} has no such formulation; choose from "
                         f"{', '.join(names)}", key="method", value=name)

@@ -181,7 +181,7 @@ class LinkageFormulation(Formulation):
         self.mech = mechanism
         self.structure = self.mech.structure
         self.n = self.structure.size
-        self.links = self.mech.links
+        self.links = self.mech.linkage.links
 
     def change_points(self) -> tuple[float, ...]:
         """The mechanism's change points: the driver names them if the motion stalls there."""
@@ -219,7 +219,7 @@ def configuration_work(mech: Mechanism, gravity: tuple[float, float], pose: Pose
     theta = np.asarray(angles, dtype=float)
     count = theta.shape[1]
     work = np.zeros(count)
-    for k, link in enumerate(mech.links):
+    for k, link in enumerate(mech.linkage.links):
         com = pose.point(k, V(link.e, link.f))
         work += (g * link.mass + V(*link.force)).dot(com - V(com.x[0], com.y[0]))
         work += link.moment * (theta[k] - theta[k, 0])

@@ -199,16 +199,6 @@ class Mechanism:
         return Layout.of(self.structure)
 
     @property
-    def link_names(self) -> tuple[str, ...]:
-        """Names of the moving links, in order."""
-        return self.linkage.link_names
-
-    @property
-    def links(self) -> tuple[Link, ...]:
-        """Mass properties of the moving links."""
-        return self.linkage.links
-
-    @property
     def rotors(self) -> tuple[tuple[str, Rotor], ...]:
         """Rotors geared to the input besides the links' counter-rotors (none in general).
 
@@ -221,41 +211,12 @@ class Mechanism:
         return ()
 
     @property
-    def ground_points(self) -> tuple[str, ...]:
-        """Points of the frame (where reactions act): the linkage's, and rotors' bearings."""
-        own = self.linkage.ground.points
-        return (*own, *dict.fromkeys(p for p, _ in self.rotors if p not in own))
-
-    @cached_property
-    def ground_positions(self) -> dict[str, complex]:
-        """Place of each ground point, complex ``x + i·y``, m."""
-        places = {p: complex(*xy) for p, xy in self.linkage.points}
-        places.update({p: rotor.axis for p, rotor in self.rotors if p not in places})
-        return {p: places[p] for p in self.ground_points}
-
-    @property
     def start_angle(self) -> float:
         """Crank angle at which a simulation starts when the spec gives none, rad.
 
         The reference pose's.
         """
         return float(self.structure.ref_angle[self.structure.input])
-
-    @property
-    def formulation_names(self) -> tuple[str, ...]:
-        """Every formulation of the equations of motion that applies, the default first.
-
-        The mechanism's own, then the general ones, which apply to any linkage: the multibody
-        formulation (:mod:`balancer.formulations.multibody`) and the crank-angle one
-        (:mod:`balancer.formulations.crank_angle`), the latter first where the crank turns fully
-        (no dead point of the crank to stop it).
-        """
-        own = tuple(self.own_formulations)
-        if len(self.linkage.inputs) > 1:  # (driven along motions, or free: no crank)
-            return (MULTIBODY, INPUT_COORDINATES)
-        if self.assembly_range().full:
-            return (*own, CRANK_ANGLE, MULTIBODY)
-        return (*own, MULTIBODY, CRANK_ANGLE)
 
     def with_links(self, links: dict[str, Link]) -> Mechanism:
         """The same mechanism with some links' mass properties replaced."""
@@ -295,42 +256,6 @@ class Mechanism:
         formulation in absolute coordinates cannot tell the branches apart.
         """
         return ()
-
-    def require_one_input(self, purpose: str) -> None:
-        """Nothing, if one input drives the mechanism (a crank).
-
-        Raises
-        ------
-        SpecError
-            Otherwise (exit code 2): ``purpose`` (e.g. "a simulation") turns a crank; a
-            linkage with several inputs is analysed along its motions.
-        """
-        inputs = self.linkage.inputs
-        if len(inputs) > 1:
-            raise SpecError(
-                f"{purpose} turns one crank, and this linkage has {len(inputs)} inputs; "
-                "along its motions ([[motion]]) `balancer analyze` gives its loads, `plot "
-                "--cycle` and `--animate` draw them, `simulate` and `verify` run them, and "
-                "`optimize`, `pareto` and `sweep` balance it", key="mechanism.inputs",
-                value=list(inputs))
-
-    def require_full_revolution(self, purpose: str) -> AssemblyRange:
-        """The assembly range, if the crank turns a full revolution.
-
-        Raises
-        ------
-        AssemblyError
-            Otherwise (exit code 2): ``purpose`` (e.g. "a cycle analysis") needs a crank that
-            turns.
-        """
-        self.require_one_input(purpose)
-        rng = self.assembly_range()
-        if not rng.full:
-            raise AssemblyError(
-                f"{purpose} needs a crank that turns a full revolution{self._full_turn_rule()}, "
-                f"but this {self.kind} assembles only for θ1 in {rng.describe()}",
-                key=self.geometry_key)
-        return rng
 
     def _full_turn_rule(self) -> str:
         return ""
@@ -433,7 +358,7 @@ class Mechanism:
         if not in_place:
             n = np.shape(extra.torque)[0]
             zero = V(np.zeros((n, 1)), np.zeros((n, 1)))
-            reactions = {p: forces.reactions.get(p, zero) for p in self.ground_points}
+            reactions = {p: forces.reactions.get(p, zero) for p in frame_points(self)}
             forces = Forces(reactions=reactions, slider_normal=forces.slider_normal,
                             slider_couple=forces.slider_couple,
                             input_torques=forces.input_torques,
@@ -474,7 +399,7 @@ class Mechanism:
 
     def in_one_plane(self) -> bool:
         """Whether every link and rotor's mass moves in the crank's plane (no rocking couple)."""
-        return not (any(link.z for link in self.links)
+        return not (any(link.z for link in self.linkage.links)
                     or any(e.z for _, r in self.rotors for e in r.eccentrics))
 
     def rocking_couple(self, mo: Motion, *, loads: bool = True,
@@ -508,7 +433,7 @@ class Mechanism:
         rounding); the states it leaves out, the numpy route computes. ``compiled``: run the
         program compiled where it can be (``None``: at :data:`KERNEL_STATES` states or more;
         a long cycle analysis asks for it for each of its chunks). ``into``: forces at
-        :attr:`ground_points` and the linkage's ``ground_sliders`` whose arrays ``(N, 1)``
+        :func:`frame_points` and the linkage's ``ground_sliders`` whose arrays ``(N, 1)``
         (writable, any stride: views of a cycle's columns) receive the figures, and are
         returned — the compiled program writes there directly.
         """
@@ -591,16 +516,6 @@ class Mechanism:
         forces, _ = dynamics.regressors(self.structure, mo, gravity)
         return forces
 
-    def shaking_regressors(self, mo: Motion, gravity: tuple[float, float] = (0.0, 0.0), *,
-                           torque_at_rest: bool = True) -> dynamics.Shaking:
-        """:meth:`regressors`' shaking force and moment, driving torque and rocking couple.
-
-        From momentum and power (:func:`~balancer.linkage.dynamics.shaking_regressors`;
-        ``torque_at_rest`` as there).
-        """
-        return dynamics.shaking_regressors(self.structure, mo, gravity,
-                                           torque_at_rest=torque_at_rest)
-
     @property
     def supports(self) -> Supports | None:
         """Supports that share ground points' reactions, or ``None`` (in general).
@@ -628,3 +543,75 @@ class Mechanism:
         engine's its pistons, counterweights and balance shafts' eccentrics.
         """
         return drawing.of_linkage(self.linkage)
+
+
+# -- what the package derives from any mechanism ---------------------------------------------
+
+
+def frame_points(mech: Mechanism) -> tuple[str, ...]:
+    """Points of the frame (where reactions act): the linkage's, and rotors' bearings."""
+    own = mech.linkage.ground.points
+    return (*own, *dict.fromkeys(p for p, _ in mech.rotors if p not in own))
+
+
+def frame_positions(mech: Mechanism) -> dict[str, complex]:
+    """Place of each of :func:`frame_points`, complex ``x + i·y``, m."""
+    places = {p: complex(*xy) for p, xy in mech.linkage.points}
+    places.update({p: rotor.axis for p, rotor in mech.rotors if p not in places})
+    return {p: places[p] for p in frame_points(mech)}
+
+
+def formulation_names(mech: Mechanism) -> tuple[str, ...]:
+    """Every formulation of the equations of motion that applies, the default first.
+
+    The mechanism's own (:attr:`Mechanism.own_formulations`), then the general ones, which
+    apply to any linkage: the multibody formulation (:mod:`balancer.formulations.multibody`)
+    and the crank-angle one (:mod:`balancer.formulations.crank_angle`), the latter first where
+    the crank turns fully (no dead point of the crank to stop it).
+    """
+    own = tuple(mech.own_formulations)
+    if len(mech.linkage.inputs) > 1:  # (driven along motions, or free: no crank)
+        return (MULTIBODY, INPUT_COORDINATES)
+    if mech.assembly_range().full:
+        return (*own, CRANK_ANGLE, MULTIBODY)
+    return (*own, MULTIBODY, CRANK_ANGLE)
+
+
+def require_one_input(mech: Mechanism, purpose: str) -> None:
+    """Nothing, if one input drives the mechanism (a crank).
+
+    Raises
+    ------
+    SpecError
+        Otherwise (exit code 2): ``purpose`` (e.g. "a simulation") turns a crank; a linkage
+        with several inputs is analysed along its motions.
+    """
+    inputs = mech.linkage.inputs
+    if len(inputs) > 1:
+        raise SpecError(
+            f"{purpose} turns one crank, and this linkage has {len(inputs)} inputs; "
+            "along its motions ([[motion]]) `balancer analyze` gives its loads, `plot "
+            "--cycle` and `--animate` draw them, `simulate` and `verify` run them, and "
+            "`optimize`, `pareto` and `sweep` balance it", key="mechanism.inputs",
+            value=list(inputs))
+
+
+def require_full_revolution(mech: Mechanism, purpose: str) -> AssemblyRange:
+    """The mechanism's assembly range, if its crank turns a full revolution.
+
+    Raises
+    ------
+    SpecError
+        With several inputs (:func:`require_one_input`).
+    AssemblyError
+        Otherwise (exit code 2): ``purpose`` (e.g. "a cycle analysis") needs a crank that
+        turns.
+    """
+    require_one_input(mech, purpose)
+    rng = mech.assembly_range()
+    if not rng.full:
+        raise AssemblyError(
+            f"{purpose} needs a crank that turns a full revolution{mech._full_turn_rule()}, "
+            f"but this {mech.kind} assembles only for θ1 in {rng.describe()}",
+            key=mech.geometry_key)
+    return rng

@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from ..linkage import rotors
 from ..model.assembly import AssemblyRange
-from .base import Mechanism
+from .base import Mechanism, frame_positions
 
 if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are built
     import casadi as ca
@@ -344,12 +344,12 @@ class Formulation(ABC):
             return ev.shaking_force, ev.shaking_moment
         force: Any = 0.0
         moment = -np.asarray(ev.driving_torque, float)
-        positions = self.mechanism.ground_positions
+        positions = frame_positions(self.mechanism)
         for point, value in ev.ground.items():
             value = np.asarray(value, complex)
             force = force + value
             moment = moment + (np.conj(positions[point]) * value).imag
-        for k, link in enumerate(self.mechanism.links):
+        for k, link in enumerate(self.mechanism.linkage.links):
             if link.counter_rotor:
                 moment = moment + rotors.ground_couple(link.counter_rotor,
                                                         np.asarray(ev.alpha)[k])
@@ -358,7 +358,7 @@ class Formulation(ABC):
     @property
     def link_names(self) -> tuple[str, ...]:
         """Names of the moving links, in the order of ``theta``, ``omega``, ``alpha``."""
-        return self.mechanism.link_names
+        return self.mechanism.linkage.link_names
 
     def theta1_of(self, t: float, y: NDArray[np.float64]) -> float:
         """Crank angle at a state, rad."""

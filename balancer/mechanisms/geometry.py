@@ -22,7 +22,7 @@ from .base import Mechanism
 
 def centres_of_mass(mech: Mechanism, mo: Motion) -> list[V]:
     """Each moving link's centre of mass at the motion's states, m."""
-    return [mo.point(k, V(link.e, link.f)) for k, link in enumerate(mech.links)]
+    return [mo.point(k, V(link.e, link.f)) for k, link in enumerate(mech.linkage.links)]
 
 
 def first_moments(mech: Mechanism, mo: Motion) -> list[NDArray[np.complex128]]:
@@ -31,7 +31,7 @@ def first_moments(mech: Mechanism, mo: Motion) -> list[NDArray[np.complex128]]:
     Complex ``x + i·y``; the shaking force is minus the second time derivative of their sum.
     """
     links = [c.complex() * link.mass
-             for c, link in zip(centres_of_mass(mech, mo), mech.links, strict=True)]
+             for c, link in zip(centres_of_mass(mech, mo), mech.linkage.links, strict=True)]
     return [*links, *(rotor.first_moment(mo.theta1) for _, rotor in mech.rotors)]
 
 

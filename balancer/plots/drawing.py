@@ -17,7 +17,7 @@ from ..cycle import sample_angles
 from ..linkage.inputs import InputState
 from ..linkage.vectors import V
 from ..mechanisms import geometry, mechanism_of
-from ..mechanisms.base import Mechanism
+from ..mechanisms.base import Mechanism, frame_positions
 from ..mechanisms.drawing import DrawnMass
 from ..model import GROUND
 from ..model import MechanismModel as Model
@@ -69,7 +69,7 @@ def frame(linkage: Model | Mechanism, samples: int = 72, states: InputState | No
     motion's).
     """
     mech = mechanism_of(linkage)
-    pivots = np.array(list(mech.ground_positions.values()), complex)
+    pivots = np.array(list(frame_positions(mech).values()), complex)
     if states is None:
         rng = mech.assembly_range()
         angles = sample_angles(samples) if rng.full else np.linspace(*rng.intervals[0],
@@ -122,7 +122,8 @@ def drawing_frames(linkage: Model | Mechanism, states: InputState
         ring = [*names, names[0]] if len(names) > 2 else list(names)
         links[name] = np.column_stack([points[p] for p in ring])
     coms = {name: np.asarray(c.complex() + 0 * mo.state.positions[0], complex)
-            for name, c in zip(mech.link_names, geometry.centres_of_mass(mech, mo), strict=True)}
+            for name, c in zip(mech.linkage.link_names, geometry.centres_of_mass(mech, mo),
+                               strict=True)}
     return links, coms, np.asarray(geometry.total_centre_of_mass(mech, mo), complex)
 
 
@@ -139,7 +140,7 @@ def counterweight_paths(linkage: Model | Mechanism,
     mech = mechanism_of(linkage)
     mo = mech.motion_at(states)
     out: dict[str, tuple[NDArray[np.complex128], float]] = {}
-    for k, name in enumerate(mech.link_names):
+    for k, name in enumerate(mech.linkage.link_names):
         w = counterweights.get(name)
         if w is None or w.kind != "add":
             continue
@@ -160,7 +161,7 @@ def slider_block_outlines(linkage: Model | Mechanism, states: InputState
     mo = mech.motion_at(states)
     out: dict[str, NDArray[np.complex128]] = {}
     for name, (length, width) in mech.drawing().blocks.items():
-        k = mech.link_names.index(name)
+        k = mech.linkage.link_names.index(name)
         corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5), (-0.5, -0.5)]
         out[name] = np.column_stack([
             mo.point(k, V(u * length, v * width)).complex() + 0 * mo.state.positions[0]

@@ -168,7 +168,7 @@ def _core_energies(mech: Mechanism, mo: Motion, t: NDArray[np.float64],
     :func:`~balancer.formulations.compiled.configuration_work`).
     """
     kinetic: NDArray[np.float64] = np.zeros(mo.count)
-    for k, link in enumerate(mech.links):
+    for k, link in enumerate(mech.linkage.links):
         _, me, mf, j = link.inertial_parameters
         c, s = mo.pose.cos[k], mo.pose.sin[k]
         first_x, first_y = me * c - mf * s, me * s + mf * c
@@ -193,7 +193,7 @@ def _energy_floor(mech: Mechanism, duration: float) -> float:
     ``M`` its moving mass, ``L`` its size, ``T`` the run's duration: what a motion across the
     linkage in that time would exchange, to rounding.
     """
-    mass = sum(link.mass for link in mech.links)
+    mass = sum(link.mass for link in mech.linkage.links)
     size = mech.structure.length_scale()
     return max(1e3 * float(np.finfo(float).eps) * mass * size**2 / duration**2, 1e-300)
 

@@ -295,7 +295,7 @@ def _exchangeable_energy(f: Formulation) -> float:
     length = mech.structure.length_scale()
     g = abs(f.gravity)
     total = sum((link.mass * g + math.hypot(*link.force)) * length
-                + 2 * math.pi * abs(link.moment) for link in mech.links)
+                + 2 * math.pi * abs(link.moment) for link in mech.linkage.links)
     for _, gas in mech.model.gas_forces:
         total += max(abs(x) for x in gas.values) * length
     for spring in mech.linkage.springs:

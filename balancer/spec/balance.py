@@ -146,7 +146,7 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
         Naming the key and value at fault (see :func:`check_problem`).
     """
     mech = mechanism_of(mechanism)
-    names = mech.link_names
+    names = mech.linkage.link_names
     for name, value in table.data.items():  # a table for a link the mechanism does not have
         if isinstance(value, dict) and name not in ("objective", "motions", *names):
             raise SpecError(f"names no moving link of the {mech.kind}{hint(name, names)} (its "

@@ -47,6 +47,7 @@ from typing import TYPE_CHECKING, Any
 from .. import validate as v
 from ..errors import SpecError
 from ..mechanisms import mechanism_of
+from ..mechanisms.base import formulation_names
 from ..model import Design, Operation, SimulationSettings
 from ..model import MechanismModel as Model
 from . import schema
@@ -84,7 +85,7 @@ def _read_simulation(root: Table, mechanism: Model) -> SimulationSettings:
     defaults = SimulationSettings()
     if table is None:
         return defaults
-    method = table.string("method", choices=mechanism_of(mechanism).formulation_names,
+    method = table.string("method", choices=formulation_names(mechanism_of(mechanism)),
                           default="") or None
     names = ("duration", "theta1", "omega1", "gravity", "drive", "rtol", "atol", "outputs")
     with v.under("simulation"):

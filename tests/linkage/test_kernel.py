@@ -25,6 +25,7 @@ from balancer.cycle import cycle_analysis
 from balancer.linkage.kernel import CACHE_ENV, SWITCH_ENV, Kernel, compile_kernel
 from balancer.linkage.program import Tape
 from balancer.mechanisms import mechanism_of
+from balancer.mechanisms.base import frame_points
 from balancer.spec import load_design
 
 #: The whole module is of the full suite, not of the fast lane (`pytest -m "not slow"`).
@@ -247,7 +248,7 @@ def test_forces_written_into_a_cycles_columns_are_the_forces_returned(name, comp
     returned = mech.crank_forces(theta, omega, alpha, compiled=compiled)
     n = theta.size
     columns = {key: np.full(n, np.nan, complex) for key in
-               ("force", "couple", *(f"R{p}" for p in mech.ground_points))}
+               ("force", "couple", *(f"R{p}" for p in frame_points(mech)))}
     reals = {key: np.full(n, np.nan) for key in
              ("torque", "moment", *(f"N{k}" for k in mech.linkage.ground_sliders),
               *(f"C{k}" for k in mech.linkage.ground_sliders))}
@@ -255,7 +256,7 @@ def test_forces_written_into_a_cycles_columns_are_the_forces_returned(name, comp
     def vector(a):
         return V(a.real[:, None], a.imag[:, None])
 
-    into = Forces(reactions={p: vector(columns[f"R{p}"]) for p in mech.ground_points},
+    into = Forces(reactions={p: vector(columns[f"R{p}"]) for p in frame_points(mech)},
                   slider_normal={k: reals[f"N{k}"][:, None] for k in mech.linkage.ground_sliders},
                   slider_couple={k: reals[f"C{k}"][:, None] for k in mech.linkage.ground_sliders},
                   input_torques=(reals["torque"][:, None],), shaking_force=vector(columns["force"]),

@@ -879,7 +879,7 @@ def test_states_are_regular_and_the_crank_turns(case, solved):
     pose) places every link at every state; the oracle's matrices are well conditioned."""
     if case.several:
         mo = case.motion()
-        for k in range(len(case.mech.link_names)):
+        for k in range(len(case.mech.linkage.link_names)):
             for x in (mo.pose.angles[k], mo.pose.origins[k].x, mo.pose.origins[k].y):
                 assert np.all(np.isfinite(x))
     else:
@@ -911,7 +911,7 @@ def test_oracle_is_consistent_with_the_momentum_theorems(case, solved):
 def test_spec_read_as_written(case):
     """The design vector is (m, m·e, m·f, I_G + m·(e² + f²)) per link, then counter-rotors."""
     mech, links = case.mech, case.spec["links"]
-    assert tuple(mech.link_names) == tuple(case.oracle.names)
+    assert tuple(mech.linkage.link_names) == tuple(case.oracle.names)
     assert set(mech.linkage.grounded_links) == set(case.oracle.grounded)
     x = mech.layout.vector(mech.linkage)
     want = _design_vector(mech.layout, {
@@ -938,7 +938,7 @@ def test_kinematics(case, solved):
         return float(np.broadcast_to(np.asarray(x, dtype=float), (STATES,))[i])
 
     errs = Errors()
-    for k, name in enumerate(case.mech.link_names):
+    for k, name in enumerate(case.mech.linkage.link_names):
         j = o.names.index(name)
         for i, s in enumerate(solved):
             rates = np.abs(s["qd"][2::3])

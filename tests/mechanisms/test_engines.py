@@ -960,7 +960,7 @@ def test_an_engine_with_eccentrics_moves_under_gravity_as_its_weights_say(shaft,
     slope, error = derivative_with_error(potential, theta0, h=1e-3)
     mo = mech.motion(np.array([theta0]), 1.0, 0.0)
     inertia = 0.0
-    for k, link in enumerate(mech.links):
+    for k, link in enumerate(mech.linkage.links):
         v = mo.point_velocity(k, V(link.e, link.f))
         w = float(np.asarray(mo.rate[k]).ravel()[0])
         inertia += (link.mass * float(np.asarray(v.norm2()).ravel()[0]) + link.inertia * w * w

@@ -346,8 +346,8 @@ def test_an_animation_runs_along_the_motion(forbal2_file):
     for a, b in zip(states.positions, want.positions, strict=True):
         np.testing.assert_array_equal(a, b)
     _, coms, total = drawing_frames(design.mechanism, states)
-    masses = np.array([link.mass for link in mech.links])
-    weighed = sum(m * coms[name] for m, name in zip(masses, mech.link_names, strict=True))
+    masses = np.array([link.mass for link in mech.linkage.links])
+    weighed = sum(m * coms[name] for m, name in zip(masses, mech.linkage.link_names, strict=True))
     np.testing.assert_allclose(total, weighed / masses.sum(), rtol=0, atol=1e-15)
     from balancer.plots import animation_figure
 

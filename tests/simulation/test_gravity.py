@@ -61,9 +61,9 @@ def _general_com(analysis):
     """Total centre of mass (complex, m) and mass from the analysis' link frames."""
     mech = analysis.mechanism
     pose = analysis.motion.pose
-    total = sum(link.mass for link in mech.links)
+    total = sum(link.mass for link in mech.linkage.links)
     com = 0.0
-    for k, link in enumerate(mech.links):
+    for k, link in enumerate(mech.linkage.links):
         origin = pose.origins[k].x + 1j * pose.origins[k].y
         com = com + link.mass * (origin + np.exp(1j * pose.angles[k]) * complex(link.e, link.f))
     return com / total, total
@@ -129,7 +129,7 @@ def test_gravity_adds_the_weights_at_speed_slider_crank_and_linkage(name):
     com, total = _general_com(with_g)
     force, moment = _weight_terms(com, total, G)
     mech = with_g.mechanism
-    reach = mech.structure.length_scale() * len(mech.links)
+    reach = mech.structure.length_scale() * len(mech.linkage.links)
     # The difference of two evaluations, each within rounding of its terms; the position
     # analysis' condition on these well-conditioned revolutions is of order 10.
     tol = 10 * ROUNDING * _scale(without, with_g)

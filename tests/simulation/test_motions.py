@@ -235,7 +235,7 @@ def _momentum_rate(mech, state):
     """``Σ m_k·a_ck`` from the core's kinematics: each centre of mass's acceleration, N."""
     mo = mech.motion_at(state)
     total = 0.0
-    for k, link in enumerate(mech.links):
+    for k, link in enumerate(mech.linkage.links):
         c, s_ = np.asarray(mo.pose.cos[k]), np.asarray(mo.pose.sin[k])
         rx, ry = link.e * c - link.f * s_, link.e * s_ + link.f * c
         w, al = np.asarray(mo.rate[k]), np.asarray(mo.accel[k])
