@@ -34,7 +34,14 @@ from .linkage.dynamics import Forces
 from .linkage.kinematics import Motion
 from .linkage.loads import Reactions, SupportLoad
 from .mechanisms import geometry, mechanism_of
-from .mechanisms.base import KERNEL_STATES, Mechanism, Route, frame_points, require_full_revolution
+from .mechanisms.base import (
+    KERNEL_STATES,
+    Mechanism,
+    Route,
+    frame_points,
+    in_one_plane,
+    require_full_revolution,
+)
 from .model import MechanismModel as Model
 from .orders import Order, Whirl, order_bins, order_table, whirls
 from .quantities import FRAME_LOADS
@@ -204,8 +211,8 @@ class CycleAnalysis:
         s = self.summary
         cycle = (f" over a cycle of 720° ({self.samples} in all)" if self.revolutions == 2
                  else "")
-        return (f"CycleAnalysis({self.mechanism.kind}, {self.samples_per_revolution} angles per "
-                f"revolution{cycle} at {speed_text(self.speed)}: RMS shaking force "
+        return (f"CycleAnalysis({self.mechanism.model.type}, {self.samples_per_revolution} "
+                f"angles per revolution{cycle} at {speed_text(self.speed)}: RMS shaking force "
                 f"{s.shaking_force.rms:.4g} N, "
                 f"shaking moment {s.shaking_moment.rms:.4g} N·m, driving torque "
                 f"{s.driving_torque.rms:.4g} N·m)")
@@ -360,10 +367,10 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     mech = model if isinstance(model, Mechanism) else mechanism_of(model)
     route = route or mech.routes[0]
     if route not in mech.routes:
-        raise SpecError(f"the {mech.kind} has no such route; choose from "
+        raise SpecError(f"the {mech.model.type} has no such route; choose from "
                         f"{', '.join(mech.routes)}", key="route", value=route)
     require_full_revolution(mech, "a cycle analysis")
-    revolutions = mech.cycle_revolutions if theta1 is None else 1
+    revolutions = mech.model.cycle_revolutions if theta1 is None else 1
     angles = (sample_angles(samples, revolutions) if theta1 is None
               else np.asarray(theta1, dtype=float))
     n = angles.size
@@ -464,7 +471,7 @@ def panel_keys(*analyses: CycleAnalysis | None) -> tuple[str, ...]:
     torque on its mounts) where every one of them reports it.
     """
     given = [a for a in analyses if a is not None]
-    planes = any(not a.mechanism.in_one_plane() for a in given)
+    planes = any(not in_one_plane(a.mechanism) for a in given)
     mounts = bool(given) and all(a.mount_torque is not None for a in given)
     return ("force", *(("couple",) if planes else ()), "moment", "torque",
             *(("mount",) if mounts else ()))

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from .errors import SpecError
 from .linkage.vectors import V
-from .mechanisms.base import Mechanism, require_full_revolution
+from .mechanisms.base import Mechanism, in_one_plane, require_full_revolution
 
 #: Samples per revolution of each plane's load: its orders are exact far above the picture's.
 SAMPLES = 720
@@ -142,7 +142,7 @@ def phasors(mech: Mechanism, speed: float, orders: tuple[int, ...] = (1, 2),
             coefficients[n] = (forward, backward)
         planes.append(PlanePhasors(z=z, what=tuple(names), force=coefficients))
     return Phasors(speed=speed, orders=tuple(orders), planes=tuple(planes),
-                   in_one_plane=mech.in_one_plane())
+                   in_one_plane=in_one_plane(mech))
 
 
 __all__ = ["PlanePhasors", "Phasors", "phasors"]

@@ -165,7 +165,7 @@ class CrankEnergy:
 
         At ``samples`` equally spaced angles per revolution from 0.
         """
-        revolutions = mech.cycle_revolutions
+        revolutions = mech.model.cycle_revolutions
         theta = np.arange(samples * revolutions, dtype=float) * (2 * math.pi / samples)
         return cls.of(mech, theta, 2 * math.pi * revolutions, gravity)
 

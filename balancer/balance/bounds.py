@@ -83,8 +83,8 @@ def _check_problem(problem: BalanceProblem, mech: Mechanism) -> None:
     bodies = {b.name: b for b in mech.linkage.moving}
     for name in problem.listed:
         if name not in bodies:
-            raise SpecError(f"the {mech.kind} has no moving link {name} (its moving links are "
-                            f"{', '.join(bodies)})", key=f"balance.{name}")
+            raise SpecError(f"the {mech.model.type} has no moving link {name} (its moving "
+                            f"links are {', '.join(bodies)})", key=f"balance.{name}")
     free = False
     for name in mech.linkage.link_names:
         freedom = problem.link(name)

@@ -109,7 +109,7 @@ def _energy(data: NumericProblem, model: MechanismModel, gravity: tuple[float, f
             ) -> CrankEnergy:
     """The energy balance's terms of ``model`` over its cycle at the problem's samples."""
     mech = mechanism_of(model)
-    return CrankEnergy.over_cycle(mech, data.samples // mech.cycle_revolutions, gravity)
+    return CrankEnergy.over_cycle(mech, data.samples // mech.model.cycle_revolutions, gravity)
 
 
 __all__ = ["sized"]

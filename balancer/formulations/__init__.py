@@ -87,7 +87,7 @@ def formulation_class(name: str, model: Model | Mechanism) -> type[Formulation]:
     mech = mechanism_of(model)
     names = base.formulation_names(mech)
     if name not in names:
-        raise SpecError(f"the {mech.kind} has no such formulation; choose from "
+        raise SpecError(f"the {mech.model.type} has no such formulation; choose from "
                         f"{', '.join(names)}", key="method", value=name)
     return own_formulation(type(mech), name) or GENERAL[name]
 

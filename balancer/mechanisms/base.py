@@ -15,7 +15,6 @@ registry.
 
 from __future__ import annotations
 
-import math
 import threading
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
@@ -174,11 +173,6 @@ class Mechanism:
     geometry_key: ClassVar[str] = "mechanism.points"
     def __init__(self, model: MechanismModel) -> None:
         self.model = model
-
-    @property
-    def kind(self) -> str:
-        """The spec's ``mechanism.type`` (the model's)."""
-        return self.model.type
 
     # -- identity -----------------------------------------------------------------------------
 
@@ -385,23 +379,6 @@ class Mechanism:
         add_vector(forces.rocking_couple, extra.couple)
         return forces
 
-    @property
-    def cycle_revolutions(self) -> int:
-        """Crank revolutions of the mechanism's cycle: 2 where a load repeats every two.
-
-        A slider force given as a table of period 4π (a four-stroke engine's gas force); else
-        1 (the motion and every other load repeat every revolution).
-        """
-        for _, gas in self.model.gas_forces:
-            if not gas.is_zero and math.isclose(gas.period, 4 * math.pi, rel_tol=1e-12):
-                return 2
-        return 1
-
-    def in_one_plane(self) -> bool:
-        """Whether every link and rotor's mass moves in the crank's plane (no rocking couple)."""
-        return not (any(link.z for link in self.linkage.links)
-                    or any(e.z for _, r in self.rotors for e in r.eccentrics))
-
     def rocking_couple(self, mo: Motion, *, loads: bool = True,
                        gravity: tuple[float, float] = (0.0, 0.0)) -> V:
         """The rocking couple on the frame (:func:`balancer.linkage.dynamics.rocking_couple`).
@@ -409,7 +386,7 @@ class Mechanism:
         Arrays ``(N, 1)``, N·m: what a closed-form route, which works in the plane, adds to its
         forces; zeros for a mechanism in one plane.
         """
-        if self.in_one_plane():
+        if in_one_plane(self):
             zero = np.zeros((mo.count, 1))
             return V(zero, zero.copy())
         couple = dynamics.rocking_couple_of(self.structure, mo, self.linkage, gravity=gravity,
@@ -447,13 +424,13 @@ class Mechanism:
             if program is not None and program.kernel is not None:
                 return self._program_forces(program, states, loads, gravity, compiled=True,
                                             into=into)
-        forces = self.uncompiled_forces(states, route=route, loads=loads, gravity=gravity)
+        forces = self._uncompiled_forces(states, route=route, loads=loads, gravity=gravity)
         if into is None:
             return forces
         _put(into, forces.matching(into), slice(None))
         return into
 
-    def uncompiled_forces(self, states: list[NDArray[np.float64]], *, route: Route,
+    def _uncompiled_forces(self, states: list[NDArray[np.float64]], *, route: Route,
                           loads: bool, gravity: tuple[float, float]) -> Forces:
         """:meth:`crank_forces` without a compiled kernel, at states ``(θ1, ω1, α1)``.
 
@@ -548,6 +525,12 @@ class Mechanism:
 # -- what the package derives from any mechanism ---------------------------------------------
 
 
+def in_one_plane(mech: Mechanism) -> bool:
+    """Whether every link and rotor's mass moves in the crank's plane (no rocking couple)."""
+    return not (any(link.z for link in mech.linkage.links)
+                or any(e.z for _, r in mech.rotors for e in r.eccentrics))
+
+
 def frame_points(mech: Mechanism) -> tuple[str, ...]:
     """Points of the frame (where reactions act): the linkage's, and rotors' bearings."""
     own = mech.linkage.ground.points
@@ -612,6 +595,6 @@ def require_full_revolution(mech: Mechanism, purpose: str) -> AssemblyRange:
     if not rng.full:
         raise AssemblyError(
             f"{purpose} needs a crank that turns a full revolution{mech._full_turn_rule()}, "
-            f"but this {mech.kind} assembles only for θ1 in {rng.describe()}",
+            f"but this {mech.model.type} assembles only for θ1 in {rng.describe()}",
             key=mech.geometry_key)
     return rng

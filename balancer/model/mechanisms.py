@@ -87,6 +87,18 @@ class MechanismModel(ABC):
         return ()
 
     @property
+    def cycle_revolutions(self) -> int:
+        """Crank revolutions of the mechanism's cycle: 2 where a load repeats every two.
+
+        A slider force given as a table of period 4π (a four-stroke engine's gas force); else
+        1 (the motion and every other load repeat every revolution).
+        """
+        for _, gas in self.gas_forces:
+            if not gas.is_zero and math.isclose(gas.period, 4 * math.pi, rel_tol=1e-12):
+                return 2
+        return 1
+
+    @property
     def total_mass(self) -> float:
         """Mass of the moving links, kg."""
         return math.fsum(link.mass for link in self.links)

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..cycle import ROUNDING_SPAN
+from ..mechanisms.base import in_one_plane
 from ..motion_analysis import MotionAnalysis, load_words
 from ..quantities import QUANTITIES
 from ..report.along import law_words
@@ -88,7 +89,7 @@ def loads_over_time(analysis: MotionAnalysis) -> dict[str, tuple[str, str]]:
     q = QUANTITIES
     out = {key: (q[key].axis or q[key].words, q[key].unit)
            for key in ("shaking_force", "shaking_moment")}
-    if not analysis.mechanism.in_one_plane():
+    if not in_one_plane(analysis.mechanism):
         out["rocking_couple"] = (q["rocking_couple"].words, q["rocking_couple"].unit)
     for name in analysis.inputs:  # (a slide's actuator: a force, N)
         out[f"torque_{name}"] = load_words(analysis.mechanism, f"torque_{name}")

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..linkage.loads import Reactions
+from ..mechanisms.base import in_one_plane
 from ..model.motions import REVOLUTION, MotionSpec
 from ..motion_analysis import AlongMotions, MotionAnalysis, load_words
 from ..rounding import Scales
@@ -41,10 +42,10 @@ def motions_text(along: AlongMotions, spec: str | None = None) -> str:
     mech = first.mechanism
     gravity = first.gravity
     lines = [head,
-             f"{mech.kind} ({mech.describe()}), driven at {', '.join(first.inputs)}"
+             f"{mech.model.type} ({mech.describe()}), driven at {', '.join(first.inputs)}"
              + (f"; gravity ({gravity[0]:g}, {gravity[1]:g}) m/s² included"
                 if any(gravity) else "; gravity not included")]
-    planar = mech.in_one_plane()
+    planar = in_one_plane(mech)
     size = mech.structure.length_scale()
     sc = _scales(along)
     for analysis in analyses:
@@ -135,7 +136,7 @@ def motions_json(along: AlongMotions, spec: str | None = None) -> dict[str, Any]
     first = along.motions[0]
     w = along.workspace
     out: dict[str, Any] = {
-        "spec": spec, "mechanism": first.mechanism.kind, "inputs": list(first.inputs),
+        "spec": spec, "mechanism": first.mechanism.model.type, "inputs": list(first.inputs),
         "gravity": list(first.gravity), "force_balanced": along.force_balanced,
         "force_balance_residual": {"relative": along.force_balance_residual},
         "workspace": None if w is None else {

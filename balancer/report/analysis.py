@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..cycle import CycleAnalysis
+from ..mechanisms.base import in_one_plane
 from ..orders import order_name
 from ..quantities import FRAME_LOADS
 from ..rounding import Scales, speed_text
@@ -72,7 +73,7 @@ def orders_text(analysis: CycleAnalysis, scales: Scales | None = None) -> str:
     ``scales``: the report's (:class:`Scales`; default the analysis' own figures).
     """
     sc = scales if scales is not None else Scales(analysis_figures(analysis))
-    planes = not analysis.mechanism.in_one_plane()
+    planes = not in_one_plane(analysis.mechanism)
     rows = []
     for o in analysis.orders:
         f = o.shaking_force
@@ -104,7 +105,7 @@ def analysis_json(analysis: CycleAnalysis, spec: str | None = None,
         doc["spec"] = spec
     doc.update(
         {
-            "mechanism": mech.kind,
+            "mechanism": mech.model.type,
             "class": mech.describe(),
             **({"branch": mech.branch} if mech.branch is not None else {}),
             "speed": analysis.speed,
@@ -179,14 +180,14 @@ def analysis_text(analysis: CycleAnalysis, spec: str | None = None,
     mech = analysis.mechanism
     s = analysis.summary
     sc = Scales(analysis_figures(analysis))
-    planar = mech.in_one_plane()
+    planar = in_one_plane(mech)
     head = f"balancer analyze — {spec}" if spec else "balancer analyze"
     per_cycle = (f" over a cycle of 720° ({analysis.samples} in all)"
                  if analysis.revolutions == 2 else "")
     lines = [
         head,
-        f"{mech.kind} ({mech.describe()}), {analysis.samples_per_revolution} crank angles per "
-        f"revolution{per_cycle} at {speed_text(analysis.speed)}, {analysis.route} route"
+        f"{mech.model.type} ({mech.describe()}), {analysis.samples_per_revolution} crank angles "
+        f"per revolution{per_cycle} at {speed_text(analysis.speed)}, {analysis.route} route"
         + (f"; gravity ({analysis.gravity[0]:g}, {analysis.gravity[1]:g}) m/s² included"
            if any(analysis.gravity) else "; gravity not included")
         + ("" if analysis.loads else "; loads left out"),

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..balance.counterweights import UNCHANGED, Counterweight, link_scales
 from ..cycle import CycleAnalysis
+from ..mechanisms.base import in_one_plane
 from ..motion_analysis import AlongMotions, load_words
 from ..motion_verification import MotionVerification
 from ..orders import order_name
@@ -404,7 +405,7 @@ def optimization_text(result: BalanceResult, before: CycleAnalysis | AlongMotion
     ]
     sc = optimization_scales(result, before, after)
     rows = []
-    planes = () if after.mechanism.in_one_plane() else ("rocking_couple",)
+    planes = () if in_one_plane(after.mechanism) else ("rocking_couple",)
     for name in ("shaking_force", "shaking_moment", "driving_torque", *planes):
         b, a = getattr(before.summary, name), getattr(after.summary, name)
         unit = unit_of(name)
@@ -473,7 +474,7 @@ def _along_motions_text(result: BalanceResult, before: AlongMotions, after: Alon
     for b_motion, a_motion in zip(before.motions, after.motions, strict=True):
         b_loads, a_loads = b_motion.loads(), a_motion.loads()
         for key, b in b_loads.items():
-            if key == "rocking_couple" and after.mechanism.in_one_plane():
+            if key == "rocking_couple" and in_one_plane(after.mechanism):
                 continue
             a = a_loads[key]
             words, unit = load_words(after.mechanism, key)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from ..mechanisms.base import in_one_plane
 from ..motion_analysis import load_words
 from ..rounding import Scales
 from .along import reactions_lines
@@ -38,7 +39,7 @@ def motion_run_text(run: MotionRun, spec: str | None = None) -> str:
 
     sc.add((words(k)[1], f.max) for k, f in loads.items())
     sc.add([("N", run.largest_reaction)])
-    planar = mech.in_one_plane()
+    planar = in_one_plane(mech)
     rows = [[words(k)[0], sc.fmt(f.rms, words(k)[1]), sc.fmt(f.max, words(k)[1]),
              words(k)[1]] for k, f in loads.items()
             if not (k == "rocking_couple" and planar)

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..mechanisms.base import in_one_plane
 from ..motion_analysis import load_words
 from ..rounding import Scales
 from .text import table
@@ -57,7 +58,7 @@ def plan_text(plan: Plan, spec: str | None = None) -> str:
     mech = plan.before.mechanism
     sc = Scales()
     sc.add((load_words(mech, k)[1], f.max) for k, f in (*before.items(), *after.items()))
-    planar = mech.in_one_plane()
+    planar = in_one_plane(mech)
     rows = []
     for key, old in before.items():
         if key == "rocking_couple" and planar:
@@ -167,7 +168,7 @@ def codesign_text(result: CoDesign, spec: str | None = None) -> str:
              f"objective: {_objective_words(plan)}", ""]
     mech = plan.before.mechanism
     keys = [k for k in plan.before.loads()
-            if not (k == "rocking_couple" and mech.in_one_plane())]
+            if not (k == "rocking_couple" and in_one_plane(mech))]
     sc = Scales()
     loads = {lever: a.loads() for lever, a in result.analyses.items()}
     sc.add((load_words(mech, k)[1], f.rms) for one in loads.values() for k, f in one.items())

@@ -21,7 +21,7 @@ from ..formulations import (
 )
 from ..linkage.loads import Reactions
 from ..mechanisms import mechanism_of
-from ..mechanisms.base import Mechanism
+from ..mechanisms.base import Mechanism, in_one_plane
 from ..model import Drive
 from ..model import MechanismModel as Model
 
@@ -311,7 +311,7 @@ def _rocking_couple(mech: Mechanism, theta1: NDArray[np.float64], omega1: NDArra
     The pose is the crank's on the mechanism's branch; none for a mechanism in one plane.
     """
     theta1 = np.atleast_1d(np.asarray(theta1, dtype=float))
-    if mech.in_one_plane():
+    if in_one_plane(mech):
         return np.zeros(theta1.size, complex)
     with np.errstate(all="ignore"):
         mo = mech.motion(theta1, omega1, alpha1)

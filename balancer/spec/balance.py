@@ -149,8 +149,8 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
     names = mech.linkage.link_names
     for name, value in table.data.items():  # a table for a link the mechanism does not have
         if isinstance(value, dict) and name not in ("objective", "motions", *names):
-            raise SpecError(f"names no moving link of the {mech.kind}{hint(name, names)} (its "
-                            f"moving links are {', '.join(names)}; the frame stays as it is)",
+            raise SpecError(f"names no moving link of the {mech.model.type}{hint(name, names)} "
+                            f"(its moving links are {', '.join(names)}; the frame stays as it is)",
                             key=table.key(name))
     _check_keys(table, (*schema.known("balance"), *names))
     force_balance = True
@@ -172,8 +172,8 @@ def read_balance(table: Table, mechanism: Model | Mechanism) -> BalanceProblem:
     objective = Objective()
     sub = table.table("objective", required=False)
     if sub is not None:
-        _check_keys(sub, schema.known("balance.objective", mech.kind),
-                    elsewhere=schema.known("balance.objective"), kind=mech.kind)
+        _check_keys(sub, schema.known("balance.objective", mech.model.type),
+                    elsewhere=schema.known("balance.objective"), kind=mech.model.type)
         weights_of = {name: sub.nonnegative(name, default=getattr(objective, name))
                       for name in OBJECTIVE_KEYS}
         if sub.has("torque"):  # (DESIGN.md's name of the inputs' torques' term)

@@ -47,7 +47,7 @@ DEFAULT_SPEC = Path(__file__).resolve().parents[2] / "examples" / "pb1.toml"
 
 def de_problem(data):
     """Bounds, a vectorised objective and the design map for differential evolution."""
-    if data.mechanism.kind != "four-bar":
+    if data.mechanism.model.type != "four-bar":
         raise SystemExit("this anchor eliminates force balance with Eq. 57: four-bars only")
     l1, l2, l3, _ = data.linkage.lengths
     crank, coupler, rocker = data.links

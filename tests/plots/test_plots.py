@@ -18,6 +18,7 @@ from balancer import api, cycle, outputs, plots
 from balancer.api import analyze
 from balancer.cli import main
 from balancer.mechanisms import geometry, mechanism_of
+from balancer.mechanisms.base import in_one_plane
 from balancer.plots import drawing, style
 from balancer.rounding import speed_text
 from balancer.spec import load_design
@@ -789,8 +790,8 @@ def flat_single():
                      if 'label = "counterweight"' not in line) + TWO_PLANES
     design = balancer.loads_design(text)
     balanced = balancer.optimize(design).balanced_design(design)
-    assert mechanism_of(design.mechanism).in_one_plane()
-    assert not mechanism_of(balanced.mechanism).in_one_plane()
+    assert in_one_plane(mechanism_of(design.mechanism))
+    assert not in_one_plane(mechanism_of(balanced.mechanism))
     return design, balanced
 
 

@@ -24,7 +24,7 @@ from ...linkage.structure import Structure
 from ...linkage.vectors import V
 from ...model import Body, Branch, Linkage
 from ...model.assembly import AssemblyRange
-from ..base import Limit, Mechanism, Route
+from ..base import Limit, Mechanism, Route, in_one_plane
 from ..presentation import Presentation
 from . import kinematics as fourbar
 from .assembly import assembly_range, classify
@@ -189,7 +189,7 @@ class FourBarMechanism(Mechanism):
         """
         return self._closed_form_forces(fourbar_motion(self.model, mo), route, loads, gravity)
 
-    def uncompiled_forces(self, states: list[NDArray[np.float64]], *, route: Route,
+    def _uncompiled_forces(self, states: list[NDArray[np.float64]], *, route: Route,
                           loads: bool, gravity: tuple[float, float]) -> Forces:
         """The crank forces from the closed-form motion alone (Eq. 2–10, 12–28, 45–54).
 
@@ -208,7 +208,7 @@ class FourBarMechanism(Mechanism):
     def _rocking_couple(self, mo: fourbar.FourBarMotion, loads: bool,
                         gravity: tuple[float, float]) -> V:
         """The rocking couple at the closed-form motion (the general core's, from its motion)."""
-        if self.in_one_plane():
+        if in_one_plane(self):
             zero = np.zeros((mo.size, 1))
             return V(zero, zero.copy())
         return self.rocking_couple(general_motion(mo), loads=loads, gravity=gravity)
