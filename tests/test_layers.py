@@ -298,3 +298,17 @@ def test_no_module_but_the_joints_own_asks_a_joint_its_kind():
                     and (kinds := _kinds_asked(node.args[1]))):
                 asked.setdefault(name, set()).update(kinds)
     assert not asked, f"isinstance on joint kinds outside linkage.constraints: {asked}"
+
+
+def test_the_mechanism_interface_is_what_the_architecture_page_lists():
+    """docs/architecture.md lists every public member of the mechanism interface, and no more."""
+    from balancer.mechanisms.base import Mechanism
+
+    page = (PACKAGE.parent / "docs" / "architecture.md").read_text(encoding="utf-8")
+    listed = page.split("<!-- interface:", 1)[1].split("<!-- /interface -->", 1)[0]
+    names = set(re.findall(r"`(\w+)`", listed.split("-->", 1)[1]))
+    members = {n for n in vars(Mechanism) if not n.startswith("_")}
+    assert names == members, (f"not on the page: {sorted(members - names)}; "
+                              f"not on the class: {sorted(names - members)}")
+    count = re.search(r"`Mechanism` class \(`mechanisms/base.py`\), (\d+)\s+members", page)
+    assert count is not None and int(count.group(1)) == len(members)
