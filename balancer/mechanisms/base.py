@@ -1,16 +1,19 @@
 """The one mechanism interface that everything downstream uses.
 
 A :class:`Mechanism` wraps a model (:class:`~balancer.FourBar`,
-:class:`~balancer.SliderCrank` or :class:`~balancer.model.Linkage`) and tells the rest of
-the package what it needs: the links and the ground points, the named layout of the design
-vector, the range of crank angles where it assembles, the motion at arrays of crank angles, the
-forces on the ground and the driving torque (and the same as linear maps of the design vector),
-the path of the total centre of mass, the formulations of its equations of motion, what to
-draw. The general linkage implements it with the general core (:mod:`balancer.linkage`); the
-four-bar and the slider-crank build their general linkage and add the seeds' closed forms where
-those are the seeds' own route or do what the general core does not (the four-bar's change
-points). Code downstream never asks which mechanism it has; :func:`mechanism_of` is the one
-registry.
+:class:`~balancer.SliderCrank`, :class:`~balancer.Engine` or :class:`~balancer.model.Linkage`)
+and tells the rest of the package what it needs: its general linkage and that linkage's
+equations, the named layout of the design vector, the range of crank angles where it
+assembles, the motion at input states, the forces on the ground and the driving torque (and
+the same as linear maps of the design vector), its supports, the formulations of its equations
+of motion, and for the layers that print its wording and what a drawing shows. The general
+linkage implements it with the general core (:mod:`balancer.linkage`); the four-bar, the
+slider-crank and the engine build their general linkage and add closed forms where those are
+the seeds' own route or do what the general core does not (the four-bar's change points).
+What the package derives from any mechanism is the functions at the end of this module (the
+frame's points, whether it moves in one plane, its formulations' names, the refusals of a
+purpose it cannot serve). Code downstream never asks which mechanism it has;
+:func:`~balancer.mechanisms.mechanism_of` is the one registry.
 """
 
 from __future__ import annotations
