@@ -312,3 +312,15 @@ def test_the_mechanism_interface_is_what_the_architecture_page_lists():
                               f"not on the class: {sorted(names - members)}")
     count = re.search(r"`Mechanism` class \(`mechanisms/base.py`\), (\d+)\s+members", page)
     assert count is not None and int(count.group(1)) == len(members)
+
+
+def test_no_two_public_classes_share_a_name():
+    """A class name says which class it is, across the package (issue 41)."""
+    where: dict[str, list[str]] = {}
+    for name, path in modules().items():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in tree.body:
+            if isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+                where.setdefault(node.name, []).append(name)
+    shared = {cls: mods for cls, mods in where.items() if len(mods) > 1}
+    assert not shared, f"public classes of one name in several modules: {shared}"
