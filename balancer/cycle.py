@@ -36,6 +36,7 @@ from .linkage.loads import Reactions, SupportLoad
 from .mechanisms import geometry, mechanism_of
 from .mechanisms.base import (
     KERNEL_STATES,
+    ROUTES,
     Mechanism,
     Route,
     frame_points,
@@ -349,7 +350,7 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     samples
         Number of equally spaced angles per revolution from θ1 = 0.
     route
-        Inverse-dynamics route (the mechanism's :attr:`~Mechanism.routes`; default its first).
+        Inverse-dynamics route (one of :data:`~balancer.mechanisms.base.ROUTES`; default the first).
     loads
         Include applied loads (forces, moments, a slider's gas force).
     gravity
@@ -365,10 +366,10 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
         For an unknown route.
     """
     mech = model if isinstance(model, Mechanism) else mechanism_of(model)
-    route = route or mech.routes[0]
-    if route not in mech.routes:
+    route = route or ROUTES[0]
+    if route not in ROUTES:
         raise SpecError(f"the {mech.model.type} has no such route; choose from "
-                        f"{', '.join(mech.routes)}", key="route", value=route)
+                        f"{', '.join(ROUTES)}", key="route", value=route)
     require_full_revolution(mech, "a cycle analysis")
     revolutions = mech.model.cycle_revolutions if theta1 is None else 1
     angles = (sample_angles(samples, revolutions) if theta1 is None

@@ -50,6 +50,8 @@ if TYPE_CHECKING:
 #: The inverse-dynamics routes of every mechanism (``analyze --route``): the links' equations
 #: group by group, or all at once with the mass matrices and the constraints' multipliers.
 Route = Literal["newton-euler", "mass-matrix"]
+#: The routes, the default first.
+ROUTES: tuple[Route, ...] = ("newton-euler", "mass-matrix")
 #: The formulations of the equations of motion that apply to every linkage: in absolute
 #: coordinates with the constraints' multipliers, and in the crank angle.
 MULTIBODY = "multibody"
@@ -162,8 +164,6 @@ class Mechanism:
     #: How the layers that print name its figures (wording, columns, outputs); the core never
     #: reads it.
     presentation: ClassVar[Presentation] = Presentation()
-    #: Inverse-dynamics routes (``analyze --route``), the default first.
-    routes: ClassVar[tuple[Route, ...]] = ("newton-euler", "mass-matrix")
     #: The mechanism's own formulations of the equations of motion by name, the default first:
     #: each a ``"module.Class"`` of its folder (a :class:`~balancer.mechanisms.formulation.
     #: Formulation`), imported when asked for (:func:`balancer.formulations.own_formulation`),
@@ -289,11 +289,11 @@ class Mechanism:
                          gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
         """Forces on the ground and driving torque of the mechanism's own design (one column).
 
-        ``route`` is one of :attr:`routes`: ``"newton-euler"`` the links' equations group by
+        ``route`` is one of :data:`ROUTES`: ``"newton-euler"`` the links' equations group by
         group (:func:`balancer.linkage.dynamics.kinetostatics`), ``"mass-matrix"`` all at once
         with the links' mass matrices and the constraints' multipliers.
         """
-        route = route or self.routes[0]
+        route = route or ROUTES[0]
         general = _GENERAL_ROUTES[route]
         forces = dynamics.inverse_dynamics(self.structure, mo, self.linkage, gravity=gravity,
                                            loads=loads, route=general)
@@ -417,7 +417,7 @@ class Mechanism:
         (writable, any stride: views of a cycle's columns) receive the figures, and are
         returned — the compiled program writes there directly.
         """
-        route = route or self.routes[0]
+        route = route or ROUTES[0]
         states = list(np.broadcast_arrays(*(np.atleast_1d(np.asarray(x, dtype=float))
                                             for x in (theta1, omega1, alpha1))))
         if compiled is None:

@@ -53,6 +53,7 @@ from balancer.linkage import dynamics, kinematics
 from balancer.linkage.inputs import InputState
 from balancer.linkage.structure import Structure
 from balancer.mechanisms import mechanism_of
+from balancer.mechanisms.base import ROUTES
 from balancer.spec import load_design
 
 #: The whole module is of the full suite, not of the fast lane (`pytest -m "not slow"`): each
@@ -1015,7 +1016,7 @@ def _compare(case, forces, states, column=None):
 @pytest.mark.parametrize("route", ["newton-euler", "mass-matrix"])
 def test_inverse_dynamics(case, solved, route):
     """Loads, springs, gravity and counter-rotors on: every force on the ground, the torque."""
-    assert route in case.mech.routes
+    assert route in ROUTES
     forces = case.mech.inverse_dynamics(case.motion(), route=route, gravity=case.gravity)
     _compare(case, forces, solved)
 

@@ -24,7 +24,7 @@ from ...linkage.structure import Structure
 from ...linkage.vectors import V
 from ...model import Body, Branch, Linkage
 from ...model.assembly import AssemblyRange
-from ..base import Limit, Mechanism, Route, in_one_plane
+from ..base import ROUTES, Limit, Mechanism, Route, in_one_plane
 from ..presentation import Presentation
 from . import kinematics as fourbar
 from .assembly import assembly_range, classify
@@ -201,7 +201,7 @@ class FourBarMechanism(Mechanism):
 
     def _closed_form_forces(self, mo: fourbar.FourBarMotion, route: Route | None, loads: bool,
                             gravity: tuple[float, float]) -> Forces:
-        route_fn = mass_matrix if (route or self.routes[0]) == "mass-matrix" else newton_euler
+        route_fn = mass_matrix if (route or ROUTES[0]) == "mass-matrix" else newton_euler
         r = route_fn(self.model, mo, gravity=gravity, loads=loads)
         return r.forces(rocking_couple=self._rocking_couple(mo, loads, gravity))
 

@@ -20,7 +20,7 @@ from ...linkage.kinematics import Motion
 from ...linkage.structure import Structure
 from ...model import Body, Branch, Linkage, Slider
 from ...model.assembly import AssemblyRange
-from ..base import Mechanism, Route
+from ..base import ROUTES, Mechanism, Route
 from ..drawing import Drawing, piston_block
 from ..presentation import Presentation
 from . import kinematics as closed
@@ -106,7 +106,7 @@ class SliderCrankMechanism(Mechanism):
 
     def inverse_dynamics(self, mo: Motion, *, route: Route | None = None, loads: bool = True,
                          gravity: tuple[float, float] = (0.0, 0.0)) -> Forces:
-        if (route or self.routes[0]) != "mass-matrix":
+        if (route or ROUTES[0]) != "mass-matrix":
             return super().inverse_dynamics(mo, route=route, loads=loads, gravity=gravity)
         smo = closed.motion_of(self.model, mo.theta1, mo.omega1, mo.alpha1)
         r = mass_matrix(self.model, smo, gravity=gravity, loads=loads)
