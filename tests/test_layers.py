@@ -324,3 +324,18 @@ def test_no_two_public_classes_share_a_name():
                 where.setdefault(node.name, []).append(name)
     shared = {cls: mods for cls, mods in where.items() if len(mods) > 1}
     assert not shared, f"public classes of one name in several modules: {shared}"
+
+
+def test_the_members_no_mechanism_gives_are_those_the_page_calls_computed():
+    """The architecture page's seven computed members are those no registered mechanism
+    overrides; every other member is one some mechanism gives."""
+    from balancer.mechanisms import FOLDERS, mechanism_class
+    from balancer.mechanisms.base import Mechanism
+
+    page = (PACKAGE.parent / "docs" / "architecture.md").read_text(encoding="utf-8")
+    listed = page.split("<!-- services -->", 1)[1].split("<!-- /services -->", 1)[0]
+    computed = set(re.findall(r"`(\w+)`", listed))
+    classes = [mechanism_class(kind) for kind in FOLDERS]
+    given = {n for cls in classes for n in vars(cls) if not n.startswith("_")}
+    members = {n for n in vars(Mechanism) if not n.startswith("_")}
+    assert computed == members - given
