@@ -339,7 +339,7 @@ def cycle_analysis(model: Model | Mechanism, speed: float, samples: int = 360, *
     """Analyse one cycle at constant ``speed`` (rad/s), ``samples`` angles per revolution.
 
     The cycle is one revolution, or two where the loads repeat every two
-    (:attr:`Mechanism.cycle_revolutions`: a four-stroke engine's gas force).
+    (:attr:`~balancer.model.MechanismModel.cycle_revolutions`: a four-stroke engine's gas force).
 
     Parameters
     ----------

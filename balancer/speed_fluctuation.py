@@ -161,9 +161,10 @@ class CrankEnergy:
     @classmethod
     def over_cycle(cls, mech: Mechanism, samples: int, gravity: tuple[float, float] = (0.0, 0.0)
                    ) -> CrankEnergy:
-        """:meth:`of` over the mechanism's cycle (its :attr:`~Mechanism.cycle_revolutions`).
+        """:meth:`of` over the mechanism's cycle.
 
-        At ``samples`` equally spaced angles per revolution from 0.
+        Its model's :attr:`~balancer.model.MechanismModel.cycle_revolutions`, at ``samples``
+        equally spaced angles per revolution from 0.
         """
         revolutions = mech.model.cycle_revolutions
         theta = np.arange(samples * revolutions, dtype=float) * (2 * math.pi / samples)

@@ -141,10 +141,10 @@ def design_of(base: Design, x: np.ndarray) -> Design:
     (:attr:`balancer.BalanceResult.x`); none here (the problem frees none).
     """
     mech = base.mechanism
-    if np.any(x[4 * len(mech.linkage.link_names):] != 0):
+    if np.any(x[4 * len(mech.link_names):] != 0):
         raise ValueError("the design has counter-rotors, which this rebuild leaves out")
     links = {}
-    for k, name in enumerate(mech.linkage.link_names):
+    for k, name in enumerate(mech.link_names):
         m, me, mf, j = x[4 * k: 4 * k + 4]
         links[name] = replace(mech.link(name), mass=float(m), e=float(me / m),
                               f=float(mf / m), inertia=float(j - (me**2 + mf**2) / m))

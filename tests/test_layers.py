@@ -287,17 +287,40 @@ def _kinds_asked(node: ast.AST) -> set[str]:
     return set()
 
 
+def _kind_questions(node: ast.AST) -> set[str]:
+    """The joint kinds a node asks about: ``isinstance``/``issubclass`` of them, ``type(x) is``
+    (or ``==``) one of them, or a ``case`` pattern of their class."""
+    if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+            and node.func.id in ("isinstance", "issubclass") and len(node.args) == 2):
+        return _kinds_asked(node.args[1])
+    if (isinstance(node, ast.Compare) and isinstance(node.left, ast.Call)
+            and isinstance(node.left.func, ast.Name) and node.left.func.id == "type"):
+        return set().union(*(_kinds_asked(c) for c in node.comparators))
+    if isinstance(node, ast.MatchClass):
+        return _kinds_asked(node.cls)
+    return set()
+
+
 def test_no_module_but_the_joints_own_asks_a_joint_its_kind():
-    asked = {}
+    asked: dict[str, set[str]] = {}
     for name, path in modules().items():
         if name == "linkage.constraints":
             continue
         for node in nodes(path):
-            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
-                    and node.func.id == "isinstance" and len(node.args) == 2
-                    and (kinds := _kinds_asked(node.args[1]))):
+            if kinds := _kind_questions(node):
                 asked.setdefault(name, set()).update(kinds)
-    assert not asked, f"isinstance on joint kinds outside linkage.constraints: {asked}"
+    assert not asked, f"joint kinds asked outside linkage.constraints: {asked}"
+
+
+def test_the_joint_kind_check_sees_each_way_of_asking():
+    """The check above catches each form (a check that could not fail would hold nothing)."""
+    forms = ["isinstance(j, Pin)", "isinstance(j, (Prism, Mesh))", "isinstance(j, Pin | Driver)",
+             "issubclass(type(j), SlideDriver)", "type(j) is Prism", "type(j) == Mesh",
+             "match j:\n    case Pin():\n        pass"]
+    for form in forms:
+        found = set().union(*(_kind_questions(n) for n in ast.walk(ast.parse(form))))
+        assert found, form
+    assert not set().union(*(_kind_questions(n) for n in ast.walk(ast.parse("isinstance(j, V)"))))
 
 
 def test_the_mechanism_interface_is_what_the_architecture_page_lists():

@@ -58,7 +58,7 @@ Method = Literal["opened-loop", "complex-masses", "mass-matrix", "lie-group", "m
                  "crank-angle"]
 #: The formulations every linkage has, by name; each mechanism adds its own
 #: (:attr:`~balancer.mechanisms.base.Mechanism.own_formulations`; the names a mechanism offers,
-#: in its order, are its ``formulation_names``).
+#: in its order, are :func:`balancer.mechanisms.base.formulation_names`).
 GENERAL: dict[str, type[Formulation]] = {"multibody": Multibody, "crank-angle": CrankAngle}
 
 

@@ -124,7 +124,7 @@ class Limit:
 class Supports(Protocol):
     """Supports that share a ground point's reaction: what a mechanism with them gives.
 
-    An engine's main bearings (:meth:`Mechanism.supports`), in one order throughout.
+    An engine's main bearings (:attr:`Mechanism.supports`), in one order throughout.
     """
 
     def loads(self, mo: Motion, reactions: Reactions, *, loads: bool = True,

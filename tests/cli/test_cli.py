@@ -287,22 +287,35 @@ def test_the_command_runs_openblas_on_one_thread_unless_told(given, used):
 
 
 def test_the_command_sets_aside_what_loading_made_and_collects_its_own_garbage():
-    """The process's command freezes what its verb's loading made (balancer.cli._loaded), and
-    runs with the collector on: a command's own cyclic garbage is still collected."""
-    code = ("import gc, sys, json\nsys.argv = ['balancer', 'analyze', " + repr(EXAMPLE) + "]\n"
-            "import balancer.cli.analyze as verb\nseen = {}\nrun = verb.run\n"
-            "def watched(args):\n"
-            "    seen.update(on=gc.isenabled(), frozen=gc.get_freeze_count())\n"
-            "    cycle = []; cycle.append(cycle); del cycle\n"
-            "    seen['collected'] = gc.collect()\n"
-            "    return run(args)\n"
-            "verb.run = watched\nfrom balancer.cli import entry_point\ntry:\n"
+    """The process's command loads its verb with the collector off, freezes what the loading
+    made (balancer.cli._loaded), and runs with the collector on: a command's own cyclic garbage
+    is still collected."""
+    code = ("import gc, importlib, json, sys\n"
+            "sys.argv = ['balancer', 'analyze', " + repr(EXAMPLE) + "]\n"
+            "seen = {'loaded before': 'balancer.cli.analyze' in sys.modules}\n"
+            "real = importlib.import_module\n"
+            "def spy(name, package=None):\n"
+            "    if name != '.analyze':\n"
+            "        return real(name, package)\n"
+            "    seen['loading on'] = gc.isenabled()\n"
+            "    verb = real(name, package)\n"
+            "    run = verb.run\n"
+            "    def watched(args):\n"
+            "        seen.update(on=gc.isenabled(), frozen=gc.get_freeze_count())\n"
+            "        cycle = []; cycle.append(cycle); del cycle\n"
+            "        seen['collected'] = gc.collect()\n"
+            "        return run(args)\n"
+            "    verb.run = watched\n"
+            "    return verb\n"
+            "importlib.import_module = spy\n"
+            "from balancer.cli import entry_point\ntry:\n"
             "    entry_point()\nexcept SystemExit as e:\n    seen['code'] = e.code\n"
             "print(json.dumps(seen))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout
     seen = json.loads(out.strip().splitlines()[-1])
-    assert seen["code"] == 0 and seen["on"]
+    assert seen["code"] == 0 and not seen["loaded before"]
+    assert seen["loading on"] is False and seen["on"] is True
     assert seen["frozen"] > 10_000  # numpy's and the layers' objects, out of the collector's way
     assert seen["collected"] >= 1
 

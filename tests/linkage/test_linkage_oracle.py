@@ -1013,10 +1013,9 @@ def _compare(case, forces, states, column=None):
     errs.check()
 
 
-@pytest.mark.parametrize("route", ["newton-euler", "mass-matrix"])
+@pytest.mark.parametrize("route", ROUTES)
 def test_inverse_dynamics(case, solved, route):
     """Loads, springs, gravity and counter-rotors on: every force on the ground, the torque."""
-    assert route in ROUTES
     forces = case.mech.inverse_dynamics(case.motion(), route=route, gravity=case.gravity)
     _compare(case, forces, solved)
 
