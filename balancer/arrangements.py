@@ -408,7 +408,7 @@ def _uneven_orders(tdc: list[Fraction], cycle: int) -> Iterator[tuple[int, ...]]
     yield from place(first)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class _Torques:
     """Each cylinder's driving torque at phase 0, as harmonics of the working cycle.
 

@@ -147,7 +147,7 @@ class CycleSummary:
         return {key: figure.as_dict() for key, figure in figures if figure is not None}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CycleAnalysis:
     """One crank revolution at constant speed: what the mechanism does to its frame.
 

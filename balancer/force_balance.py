@@ -50,7 +50,7 @@ MIN_SAMPLES = 64
 SPREAD = 0.3
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ForceBalance:
     """The force-balance conditions ``A·π = 0`` of a mechanism.
 

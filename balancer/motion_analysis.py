@@ -46,7 +46,7 @@ class Load:
         return cls(rms=float(np.sqrt(np.mean(size**2))), max=float(np.max(size)))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class MotionAnalysis:
     """The frame's loads along one motion.
 

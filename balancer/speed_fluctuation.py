@@ -107,7 +107,7 @@ class Flywheel:
                 "speed_min": self.speeds[0], "speed_max": self.speeds[1]}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CrankEnergy:
     """``J``, ``½·J'`` and ``Q`` over a cycle's crank angles (see the module docstring).
 

@@ -362,3 +362,29 @@ def test_the_members_no_mechanism_gives_are_those_the_page_calls_computed():
     given = {n for cls in classes for n in vars(cls) if not n.startswith("_")}
     members = {n for n in vars(Mechanism) if not n.startswith("_")}
     assert computed == members - given
+
+
+def _dataclass_keywords(node: ast.ClassDef) -> dict[str, object] | None:
+    """A class's ``@dataclass(...)`` keywords (``{}`` bare), or ``None`` if it is none."""
+    for d in node.decorator_list:
+        if isinstance(d, ast.Name) and d.id == "dataclass":
+            return {}
+        if isinstance(d, ast.Call) and isinstance(d.func, ast.Name) and d.func.id == "dataclass":
+            return {k.arg: ast.literal_eval(k.value) for k in d.keywords if k.arg}
+    return None
+
+
+def test_records_of_arrays_compare_by_identity():
+    """A dataclass with an array field is ``eq=False``: arrays' equality has no one truth value
+    (``==`` of two such records raised), and on Python 3.11 each ``__eq__`` and ``__hash__`` is
+    compiled at import, a command's start-up."""
+    compared = []
+    for name, path in modules().items():
+        for node in nodes(path):
+            if not isinstance(node, ast.ClassDef) or (keys := _dataclass_keywords(node)) is None:
+                continue
+            arrays = [n.target.id for n in node.body if isinstance(n, ast.AnnAssign)
+                      and isinstance(n.target, ast.Name) and "NDArray" in ast.unparse(n.annotation)]
+            if arrays and keys.get("eq", True):
+                compared.append(f"{name}.{node.name}")
+    assert not compared, f"records of arrays with value equality: {compared}"

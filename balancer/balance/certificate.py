@@ -60,7 +60,7 @@ ACTIVE_MULTIPLIER = 1e-7
 ACTIVE_SLACK = 1e-4
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Constraint:
     """A cone constraint ``M·u + m ∈ K``.
 
@@ -101,7 +101,7 @@ class Constraint:
         return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ConvexObjective:
     """``f(u) = ‖P·u + q‖`` (``norm``), else ``‖P·u + q‖² + g·u + g0``."""
 

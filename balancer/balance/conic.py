@@ -72,7 +72,7 @@ def _settings(settings: dict[str, Any]) -> Any:
     return options
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CscMatrix:
     """A dense matrix's nonzeros in compressed sparse columns, as Clarabel reads a matrix.
 
@@ -100,7 +100,7 @@ class CscMatrix:
                    data=dense[rows, cols])
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ConicSolution:
     """What one solve returned.
 

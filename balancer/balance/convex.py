@@ -96,7 +96,7 @@ Affine: TypeAlias = tuple[NDArray[np.float64], float]
 
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False)
 class ConvexSolution:
     """The convex optimum (after the tie-break) and its lower bound.
 

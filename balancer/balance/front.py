@@ -32,7 +32,7 @@ FIGURES: dict[str, tuple[str, str]] = {
                    "largest_bearing_load")}}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FrontPoint:
     """One point of a front: a design and its two objectives.
 

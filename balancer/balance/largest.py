@@ -47,7 +47,7 @@ BROKEN = 1e-12
 ROUNDS = 12
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class LargestLoad:
     """The largest-load term in a convex program's scaled variables (module docstring).
 

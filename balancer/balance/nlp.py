@@ -66,7 +66,7 @@ _CONVERGED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 _INFEASIBLE = ("Infeasible_Problem_Detected", "Restoration_Failed")
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False)
 class NlpSolution:
     """IPOPT's answer.
 

@@ -32,7 +32,7 @@ from .sites import Sites
 ABSENT = 1e-9
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False)
 class ProblemData:
     """The redesign problem in numbers, built once by :func:`~.problem.numeric_problem`.
 

@@ -20,7 +20,7 @@ from ..linkage.dynamics import shaking_regressors
 from ..mechanisms.base import Mechanism
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CycleRegressors:
     """The inertial shaking over a revolution as linear maps of the design vector.
 

@@ -188,7 +188,7 @@ def _finite(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False)
 class BalanceResult:
     """A balanced design and how it was found (shaped like SciPy's ``OptimizeResult``).
 

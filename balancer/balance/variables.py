@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 from .problem import NumericProblem
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class VariableMap:
     """The design vector as an affine map of the free variables: ``x = c + T·u``.
 
@@ -109,7 +109,7 @@ def layout(data: NumericProblem) -> VariableMap:
     return VariableMap(c=c, T=rows[:, : len(primary)].copy(), primary=tuple(primary))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Compressed:
     """An objective's factor ``‖P·u + q‖`` compressed to its numerical rank, for the solver.
 

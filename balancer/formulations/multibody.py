@@ -55,7 +55,7 @@ if TYPE_CHECKING:  # annotations only: CasADi is imported where symbols are buil
     import casadi as ca
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class StateDynamics:
     """The multibody formulation's solve at many states, and what it exerts on the frame.
 

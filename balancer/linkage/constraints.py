@@ -45,7 +45,7 @@ def _velocity(vel: list[V], k: int) -> V:
     return V(0.0, 0.0) if k == GROUND_INDEX else vel[k]
 
 
-@dataclass
+@dataclass(eq=False)
 class FrameTally:
     """What the joints put on the frame, collected joint by joint (:meth:`Pin.tally`, …).
 

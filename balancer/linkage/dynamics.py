@@ -103,7 +103,7 @@ class Layout:
         return x
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Forces:
     """Inverse dynamics at arrays of crank states, for ``C`` columns (designs or parameters).
 
@@ -510,7 +510,7 @@ def regressors(structure: Structure, mo: Motion, gravity: tuple[float, float] = 
 TURNING = 1e-100
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Shaking:
     """What the frame feels from a linkage as linear maps of the design vector.
 

@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from .vectors import Num
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class InputState:
     """Positions, rates and accelerations of every input at ``N`` states.
 

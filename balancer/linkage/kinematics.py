@@ -153,7 +153,7 @@ def numeric_start(structure: Structure, g: Group, theta1: NDArray[np.float64]
     return numeric.start(structure, g, theta1, positions)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Motion:
     """Frames of every moving link and their rates at arrays of input states.
 

@@ -21,7 +21,7 @@ from .dynamics import Forces
 from .vectors import V
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SupportLoad:
     """The load on the frame at one of the supports that share a ground point's reaction.
 
@@ -43,7 +43,7 @@ class SupportLoad:
     force: NDArray[np.complex128]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Reactions:
     """What the mechanism exerts on its frame at each sample (arrays of shape ``(N,)``).
 

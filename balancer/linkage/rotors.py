@@ -86,7 +86,7 @@ def dynamic_link(link: Link) -> Link:
     )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FrameLoads:
     """What a rotor puts on the frame and takes from its link at crank states (arrays).
 

@@ -76,7 +76,7 @@ _GENERAL_ROUTES: dict[Route, Literal["groups", "global"]] = {
 _PROGRAM_LOCK = threading.Lock()
 
 
-@dataclass
+@dataclass(eq=False)
 class RotorLoads:
     """What a mechanism's rotors add to the frame's loads at crank states (arrays ``(N,)``).
 
@@ -108,7 +108,7 @@ def _put(forces: Forces, part: Forces, where: NDArray[np.bool_] | slice) -> None
         mine[where] = theirs
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Limit:
     """Samples of a revolution that are exactly at a singular pose of the smooth motion.
 

@@ -68,7 +68,7 @@ def least_norm_many(jac: NDArray[np.float64], res: NDArray[np.float64]) -> NDArr
     return np.einsum("kri,kr->ki", jac, x)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class DrivenRates:
     """A driven crank's prescribed motion at many times (:meth:`Formulation.driven_rates`).
 
@@ -89,7 +89,7 @@ class DrivenRates:
     transmission: NDArray[np.float64]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Evaluation:
     """What a formulation says about one state (or, from ``evaluate_batch``, about many).
 

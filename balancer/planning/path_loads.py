@@ -34,7 +34,7 @@ from ..motion_analysis import frame_reactions
 FORM_TOLERANCE = 1e-9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class PathLoads:
     """The frame loads along a path at arguments ``tau``, as ``A·τ̈ + B·τ̇² + C``.
 

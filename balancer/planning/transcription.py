@@ -52,7 +52,7 @@ EARLY = 1e-8
 LEAST_RATE2 = 1e-10
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Problem:
     """A time-law problem on a mesh (module docstring).
 
@@ -141,7 +141,7 @@ class Problem:
                      + np.sum(self.weights * self.offsets**2))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Transcribed:
     """A solved transcription.
 
@@ -192,7 +192,7 @@ def solve(problem: Problem, start: NDArray[np.float64]) -> Transcribed:
     return replace(held, certified=reached) if reached else held
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class _Compiled:
     """A problem's NLP, built once: IPOPT's solver and the bounds of its unknowns and rows.
 

@@ -29,7 +29,7 @@ if TYPE_CHECKING:  # annotations only: matplotlib is imported by the functions t
     from matplotlib.figure import Figure
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False)
 class MotionDrawing:
     """What the figure of a motion draws of its mechanism: positions, complex ``x + i·y``, m.
 

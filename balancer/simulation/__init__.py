@@ -103,7 +103,7 @@ def _lock_time(f: Formulation, theta1: float, speed: float, duration: float) -> 
     return None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class _Setup:
     """A simulation's checked settings and formulation, before any integration."""
 

@@ -65,7 +65,7 @@ Method = Literal["multibody", "input-coordinates"]
 Drive = Literal["motion", "free"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class MotionRun:
     """A simulated motion of a linkage with several inputs.
 

@@ -78,7 +78,7 @@ MAX_REFINED = 20
 EXTRA_REFINED = 10_000
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Cumulative:
     """The result of :func:`cumulative`.
 

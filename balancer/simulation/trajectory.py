@@ -26,7 +26,7 @@ from ..model import Drive
 from ..model import MechanismModel as Model
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Trajectory:
     """A simulated motion at equally spaced output times.
 

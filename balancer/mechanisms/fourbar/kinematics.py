@@ -36,7 +36,7 @@ def _sign(branch: str) -> float:
     raise ValueError(f"branch must be '+' or '-', got {branch!r}")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Position:
     """Configuration of a four-bar at an array of crank angles (Eq. 2–4).
 
@@ -195,7 +195,7 @@ def transfer_functions(pos: Position) -> tuple[NDArray[np.float64], NDArray[np.f
     return big2, big3
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FourBarMotion:
     """Positions, angular velocities and accelerations of a four-bar at arrays of states.
 

@@ -57,7 +57,7 @@ class LinkVectors(Protocol):
 # Principal vectors
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class OpenedLoopVectors:
     """Principal vectors of the opened loop (Eq. 12) and the derived vectors (Eq. 13), m.
 
@@ -89,7 +89,7 @@ def opened_loop_vectors(linkage: FourBar, pos: Position) -> OpenedLoopVectors:
     return OpenedLoopVectors(a12=a12, a21=a21, a23=a23, a32=a32, a14p=a14p, a34p=a34p)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FrameVectors:
     """Principal vectors of the system about the frame (Eq. 30) and derived vectors (Eq. 31), m.
 

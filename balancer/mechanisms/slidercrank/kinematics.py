@@ -66,7 +66,7 @@ def _sign(branch: str | ArrayLike) -> float | NDArray[np.float64]:
     return np.asarray(branch, dtype=float)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SliderMotion:
     """Positions, rates and accelerations of a slider-crank at arrays of crank states.
 
