@@ -8,10 +8,11 @@ four-stroke, 360° later) — and every firing order each allows, cylinder 1 fir
 its phase (the crank's angle is a convention); the others take the phases that put their first
 cylinder's top dead centre on a firing, ``bank − s − j·Θ/n`` (``s`` cylinder 1's). With a
 ``step`` the firing may be uneven: every throw's phase a multiple of ``step`` from throw 1's,
-and every firing order that fits in the working cycle by the engine's own rule
-(:meth:`~.mechanisms.engine.model.Engine.firing_angles`: cylinder 1 at its first top dead
-centre at or after θ1 = 0, each next one at its own next top dead centre after the previous
-firing), the even ones among them.
+and every firing that fits in the working cycle by the engine's own rule
+(:meth:`~.mechanisms.engine.model.Engine.firing_angles`: the order's first cylinder at its first
+top dead centre at or after θ1 = 0, each next one at its own next top dead centre after the
+previous firing), each by one order that fires it — cylinder 1 first where one does — the even
+ones among them.
 
 Each candidate is judged by what it leaves free, from its cylinders' inertial loads alone (rods
 and pistons, not the crankshaft's own masses, which the designer sizes after): a cylinder with
@@ -84,7 +85,9 @@ class Arrangement:
     phases
         Each cylinder's crank pin phase, degrees in [0, 360), cylinder 1 first.
     firing_order
-        The cylinders in the order they fire, cylinder 1 first.
+        The cylinders in the order they fire, as the spec's ``firing_order`` takes it:
+        cylinder 1 first, but for an uneven firing that only an order from another cylinder
+        fires (:func:`search` with a ``step``).
     free
         What crank counterweights cannot take, N and N·m: ``force_1_backward``,
         ``couple_1_backward``, ``force_2``, ``couple_2`` (both whirls' magnitudes summed).
@@ -94,7 +97,7 @@ class Arrangement:
         Firings that follow one another in the same half of the crank (cyclically).
     intervals
         The crank angles from each firing to the next, in the firing order, degrees (the
-        last to cylinder 1's next firing; all ``Θ/n`` where the firing is even).
+        last to the first's next firing; all ``Θ/n`` where the firing is even).
     torque
         The driving torque's orders at the operating speed, inertial and from the gas: each
         ``(order, amplitude)`` up to :data:`TORQUE_ORDERS`, N·m.
@@ -378,26 +381,42 @@ def _next_after(tdc: Fraction, previous: Fraction) -> Fraction:
 
 
 def _uneven_orders(tdc: list[Fraction], cycle: int) -> Iterator[tuple[int, ...]]:
-    """Each firing order, cylinder 1 first, whose firings fit in the working cycle ``cycle``.
+    """Each firing that fits in the working cycle ``cycle``, by one firing order that fires it.
 
-    By the rule of :func:`_firings` (each cylinder at its next top dead centre after the
-    previous firing), all of them within ``cycle`` of cylinder 1's.
+    By the rule of :func:`_firings` (the first at its first top dead centre, each next one at its
+    next top dead centre after the previous firing, all within ``cycle`` of the first), from
+    every cylinder first: an order from another cylinder can fire a pattern no order from
+    cylinder 1 fires (a cylinder at the later of its two top dead centres while the earlier one
+    follows the previous firing too). Orders that fire the cylinders the same angles apart (the
+    same pattern, shifted) are one engine: the first found is kept, cylinder 1 first where one
+    order from it fires the pattern.
     """
+    seen: set[tuple[Fraction, ...]] = set()
+    for first in range(1, len(tdc) + 1):
+        for order in _orders_from(tdc, cycle, first):
+            firing = _firings(tdc, order)
+            pattern = tuple((f - firing[0]) % cycle for f in firing)
+            if pattern not in seen:
+                seen.add(pattern)
+                yield order
+
+
+def _orders_from(tdc: list[Fraction], cycle: int, first: int) -> Iterator[tuple[int, ...]]:
+    """Each firing order, cylinder ``first`` first, whose firings fit in the working cycle."""
     n = len(tdc)
-    first = tdc[0]
-    order = [1]
-    used = [False] * n
-    used[0] = True
+    start = tdc[first - 1]
+    order = [first]
+    used = [k == first - 1 for k in range(n)]
 
     def place(previous: Fraction) -> Iterator[tuple[int, ...]]:
         if len(order) == n:
             yield tuple(order)
             return
-        for k in range(1, n):
+        for k in range(n):
             if used[k]:
                 continue
             angle = _next_after(tdc[k], previous)
-            if angle - first >= cycle:
+            if angle - start >= cycle:
                 continue
             used[k] = True
             order.append(k + 1)
@@ -405,7 +424,7 @@ def _uneven_orders(tdc: list[Fraction], cycle: int) -> Iterator[tuple[int, ...]]
             order.pop()
             used[k] = False
 
-    yield from place(first)
+    yield from place(start)
 
 
 @dataclass(frozen=True, eq=False)

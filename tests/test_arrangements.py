@@ -9,10 +9,11 @@
 - The driving torque's orders are the built engine's (its cycle analysis with its gas), its
   energy swing the flywheel page's (:class:`balancer.speed_fluctuation.CrankEnergy`: the
   inverse dynamics at four crank states), even and uneven.
-- With ``step`` (uneven firing): every crank on the grid and every firing order that fits is
-  there (counted by brute force over the orders), each with its firings as the engine places
-  them; the even ones among them keep their figures and the flat-plane four stays first, the
-  even firing's energy swing below every uneven one's of the same crank.
+- With ``step`` (uneven firing): every crank on the grid and every firing that fits is there
+  once (counted by brute force over every order, from any cylinder), by an order the engine
+  fires it with, cylinder 1 first wherever one such order is; the even ones among them keep
+  their figures and the flat-plane four stays first, the even firing's energy swing below
+  every uneven one's of the same crank.
 """
 
 from __future__ import annotations
@@ -222,17 +223,25 @@ def test_each_arrangements_torque_is_its_engines(which):
         assert a.energy_swing == pytest.approx(swing, rel=1e-8)
 
 
-def brute_force_orders(engine, phases) -> set[tuple[int, ...]]:
-    """Every firing order, cylinder 1 first, that the engine built with ``phases`` accepts."""
+def pattern(firing: list[float], cycle: float) -> tuple[float, ...]:
+    """Firing angles less cylinder 1's, modulo the working cycle, degrees (to 1e-6°)."""
+    return tuple(round((f - firing[0]) % cycle, 6) % cycle for f in firing)
+
+
+def brute_force_firings(engine, phases) -> dict[tuple[float, ...], set[tuple[int, ...]]]:
+    """Every firing the engine built with ``phases`` accepts, by its pattern (cylinder 1 at 0),
+    each with the orders, from any cylinder, that fire it (its firing_angles, every
+    permutation)."""
     cylinders = tuple(replace(c, phase_deg=p)
                       for c, p in zip(engine.cylinders, phases, strict=True))
-    out = set()
-    for rest in itertools.permutations(range(2, len(cylinders) + 1)):
+    cycle = 720.0 if engine.strokes == 4 else 360.0
+    out: dict[tuple[float, ...], set[tuple[int, ...]]] = {}
+    for order in itertools.permutations(range(1, len(cylinders) + 1)):
         try:  # (an engine with gas checks its firing order when it is made)
-            replace(engine, cylinders=cylinders, firing_order=(1, *rest)).firing_angles()
+            angles = replace(engine, cylinders=cylinders, firing_order=order).firing_angles()
         except SpecError:
             continue
-        out.add((1, *rest))
+        out.setdefault(pattern([math.degrees(a) for a in angles], cycle), set()).add(order)
     return out
 
 
@@ -247,13 +256,27 @@ def test_the_uneven_search_has_every_crank_on_its_step_and_every_order_that_fits
     speed = design.operation.speed
     uneven = search(engine, speed, step=90.0, samples=360)
     even = search(engine, speed, samples=360)
-    by_crank: dict[tuple[float, ...], set[tuple[int, ...]]] = {}
+    by_crank: dict[tuple[float, ...], list[tuple[int, ...]]] = {}
     for a in uneven.arrangements:
-        by_crank.setdefault(a.phases, set()).add(a.firing_order)
-    for phases, orders in by_crank.items():
-        assert orders == brute_force_orders(engine, phases), phases
+        by_crank.setdefault(a.phases, []).append(a.firing_order)
     cranks = {(0.0, *p) for p in itertools.product((0.0, 90.0, 180.0, 270.0), repeat=3)}
-    assert set(by_crank) == {p for p in cranks if brute_force_orders(engine, p)}
+    firings = {p: brute_force_firings(engine, p) for p in cranks}
+    assert set(by_crank) == {p for p in cranks if firings[p]}
+    from_others = 0
+    for phases, orders in by_crank.items():
+        found = {}
+        for order in orders:  # each the engine's own: its pattern, once
+            angles = replace(engine, cylinders=tuple(
+                replace(c, phase_deg=p) for c, p in zip(engine.cylinders, phases, strict=True)),
+                firing_order=order).firing_angles()
+            key = pattern([math.degrees(a) for a in angles], 720.0)
+            assert key not in found and order in firings[phases][key], (phases, order)
+            found[key] = order
+        assert set(found) == set(firings[phases]), phases  # every firing that fits, once
+        for key, order in found.items():  # cylinder 1 first wherever an order from it fires it
+            assert (order[0] == 1) == any(o[0] == 1 for o in firings[phases][key])
+            from_others += order[0] != 1
+    assert from_others  # (firings that only an order from another cylinder fires: 90° has some)
     same = {(a.phases, a.firing_order): a for a in uneven.arrangements}
     for a in even.arrangements:
         b = same[(a.phases, a.firing_order)]
