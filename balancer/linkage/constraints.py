@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import ClassVar, TypeAlias
+from typing import ClassVar, TypeAlias, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -511,30 +511,21 @@ class Group:
 
     def rrr(self) -> tuple[Pin, Pin, Pin]:
         """An RRR dyad's pins: on the first link's known side, between them, on the second's."""
-        j1, j2, j3 = self._three()
-        if not (isinstance(j1, Pin) and isinstance(j2, Pin) and isinstance(j3, Pin)):
-            raise ValueError(f"a {self.kind} group is no RRR dyad")
-        return j1, j2, j3
+        return cast(tuple[Pin, Pin, Pin], self._dyad("RRR"))
 
     def rrp(self) -> tuple[Pin, Pin, Prism]:
         """An RRP (PRR) dyad's joints: pin, pin, and the prism of its second link."""
-        j1, j2, j3 = self._three()
-        if not (isinstance(j1, Pin) and isinstance(j2, Pin) and isinstance(j3, Prism)):
-            raise ValueError(f"a {self.kind} group is no RRP dyad")
-        return j1, j2, j3
+        return cast(tuple[Pin, Pin, Prism], self._dyad("RRP"))
 
     def rpr(self) -> tuple[Pin, Prism, Pin]:
         """An RPR dyad's joints: a pin, the prism between its links, a pin."""
-        j1, j2, j3 = self._three()
-        if not (isinstance(j1, Pin) and isinstance(j2, Prism) and isinstance(j3, Pin)):
-            raise ValueError(f"a {self.kind} group is no RPR dyad")
-        return j1, j2, j3
+        return cast(tuple[Pin, Prism, Pin], self._dyad("RPR"))
 
-    def _three(self) -> tuple[Constraint, Constraint, Constraint]:
-        if len(self.constraints) != 3:
-            raise ValueError(f"a {self.kind} group is no dyad")
-        j1, j2, j3 = self.constraints
-        return j1, j2, j3
+    def _dyad(self, letters: str) -> tuple[Constraint, ...]:
+        """Its three joints, if their letters (each kind's own) are ``letters``."""
+        if "".join(c.letter for c in self.constraints) != letters:
+            raise ValueError(f"a {self.kind} group is no {letters} dyad")
+        return self.constraints
 
 
 def unit(x: float, y: float) -> complex:
