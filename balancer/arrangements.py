@@ -289,12 +289,14 @@ def search(engine: Engine, speed: float, top: int | None = None, *,
             for k in t:
                 phases[k] = phase
         tdc = [(banks[k] - phases[k]) % 360 for k in range(n)]
-        orders = list(_firing_orders(tdc, start, interval, cycle) if step is None
-                      else _uneven_orders(tdc, cycle))
-        if not orders:
+        fired = ([(order, _firings(tdc, order))
+                  for order in _firing_orders(tdc, start, interval, cycle)] if step is None
+                 else list(_uneven_orders(tdc, cycle)))
+        if not fired:
             continue
         free, taken = _judge(unit, [float(p) for p in phases], zs)
-        firings = [_firings(tdc, order) for order in orders]
+        orders = [order for order, _ in fired]
+        firings = [firing for _, firing in fired]
         spectra = torques.of(firings)
         swings = torques.swings(spectra)
         for order, firing, spectrum, swing in zip(orders, firings, spectra, swings,
@@ -380,16 +382,17 @@ def _next_after(tdc: Fraction, previous: Fraction) -> Fraction:
     return angle
 
 
-def _uneven_orders(tdc: list[Fraction], cycle: int) -> Iterator[tuple[int, ...]]:
-    """Each firing that fits in the working cycle ``cycle``, by one firing order that fires it.
+def _uneven_orders(tdc: list[Fraction], cycle: int
+                   ) -> Iterator[tuple[tuple[int, ...], list[Fraction]]]:
+    """Each firing that fits in the working cycle ``cycle``: an order, and its angles.
 
-    By the rule of :func:`_firings` (the first at its first top dead centre, each next one at its
-    next top dead centre after the previous firing, all within ``cycle`` of the first), from
-    every cylinder first: an order from another cylinder can fire a pattern no order from
-    cylinder 1 fires (a cylinder at the later of its two top dead centres while the earlier one
-    follows the previous firing too). Orders that fire the cylinders the same angles apart (the
-    same pattern, shifted) are one engine: the first found is kept, cylinder 1 first where one
-    order from it fires the pattern.
+    The firing angles by cylinder as :func:`_firings` gives them. By its rule (the first at its
+    first top dead centre, each next one at its next top dead centre after the previous
+    firing, all within ``cycle`` of the first), from every cylinder first: an order from
+    another cylinder can fire a pattern no order from cylinder 1 fires (a cylinder at the later
+    of its two top dead centres while the earlier one follows the previous firing too). Orders
+    that fire the cylinders the same angles apart (the same pattern, shifted) are one engine:
+    the first found is kept, cylinder 1 first where one order from it fires the pattern.
     """
     seen: set[tuple[Fraction, ...]] = set()
     for first in range(1, len(tdc) + 1):
@@ -398,7 +401,7 @@ def _uneven_orders(tdc: list[Fraction], cycle: int) -> Iterator[tuple[int, ...]]
             pattern = tuple((f - firing[0]) % cycle for f in firing)
             if pattern not in seen:
                 seen.add(pattern)
-                yield order
+                yield order, firing
 
 
 def _orders_from(tdc: list[Fraction], cycle: int, first: int) -> Iterator[tuple[int, ...]]:

@@ -326,8 +326,6 @@ class MainBearings:
         core's regressors.
         """
         model = self.engine.model
-        if not any(model.shaft_bearings(k) for k in model.shafts):
-            return ()
         with np.errstate(all="ignore"):  # (once for every crankshaft's bearings)
             regressors = self.engine.regressors(mo)
         teeth = regressors.teeth
